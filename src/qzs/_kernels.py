@@ -1,0 +1,514 @@
+"""Numba kernels of the isolator simulator: one force law, one stepper.
+
+Arrays and floats in, a status code out; no validation and no Python objects
+(scipy ``_ivp/rk.py`` style). The same :func:`run_chunk` serves a single run, a
+batch and a cluster worker.
+
+Inside the kernels the parameters, the excitation scalars and the state are
+tuples of floats, not arrays: that keeps the hot path free of reference counting
+and lets LLVM hold everything in registers. The packed arrays (pvlib ``spa``
+style) are converted once per call of :func:`run_chunk`.
+
+ODE state (``S_*``): relative position z [m], relative velocity v [m/s], the
+charge amplifier's low-pass state [m/s], the PI integral [m*s], then the energy
+ledger [J] integrated with the motion: work by the base, friction dissipation,
+motor work, stop dissipation. The persistent state array also holds the
+zero-order-hold controller outputs (``A_*``). Integer flags (``I_*``): mode
+(slipping, stuck to the base, resting on a plastic stop), slip direction, step
+counter, contact flag and counters.
+
+Stick-slip follows MODEL.md (and Modelica's ``MassWithStopAndFriction``): a
+slipping payload is located at the zero crossing of v inside the step, then it
+sticks if friction can hold it (``|F_hold| <= Fs``) or else reverses; a stuck
+payload breaks away, located inside the step too, when ``|F_hold|`` exceeds Fs.
+"""
+import numpy as np
+from numba import njit
+
+from qzs.excitation import advance_phase, base_motion, base_motion_near, excitation_tuple
+
+# Packed parameters.
+(P_MASS, P_GRAVITY, P_SPRING_A, P_SPRING_B, P_FS, P_FC, P_CBC, P_CV, P_Z_LOW, P_Z_HIGH,
+ P_STOP_K, P_STOP_C, P_PLASTIC, P_FMAX, P_ZREF, P_KP, P_KI, P_KD, P_HP_OMEGA,
+ P_CONTROL_STEPS, P_DT) = range(21)
+N_PARAMS = 21
+
+# ODE state, then the held controller outputs of a sampled controller.
+S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
+N_ODE = 8
+A_F_PI, A_F_DAMP, A_F_MOTOR = range(N_ODE, N_ODE + 3)
+N_STATE = N_ODE + 3
+
+# Integer flags.
+I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)
+N_FLAGS = 6
+MODE_SLIP, MODE_STICK, MODE_WALL_LOW, MODE_WALL_HIGH = 0, 1, 2, 3
+
+# Force breakdown returned by the right-hand side.
+(F_Y, F_YD, F_YDD, F_SPRING, F_FRICTION, F_STOP, F_STOP_ELASTIC, F_MOTOR, F_PI, F_DAMP,
+ F_V_MEASURED, F_HOLD, F_XDD) = range(13)
+N_FORCES = 13
+
+# Output channels.
+(C_TIME, C_BASE_Y, C_BASE_YD, C_BASE_YDD, C_X, C_XD, C_XDD, C_Z, C_V, C_F_SPRING,
+ C_F_FRICTION, C_F_STOP, C_F_MOTOR, C_F_PI, C_F_DAMP, C_V_MEASURED, C_W_BASE, C_D_FRICTION,
+ C_W_MOTOR, C_D_STOP, C_E_KINETIC, C_E_SPRING, C_E_GRAVITY, C_E_STOP) = range(24)
+N_CHANNELS = 24
+O_LOCKED, O_CONTACT = 0, 1
+
+SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
+STATUS_OK, STATUS_DIVERGED = 0, 1
+
+# No 'nnan'/'ninf' fast-math: the divergence check needs isfinite.
+_JIT = dict(cache=True, fastmath={"nsz", "contract", "arcp"}, error_model="numpy")
+
+
+@njit(**_JIT)
+def params_tuple(p):
+    """The packed parameter array as a tuple."""
+    return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
+            p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20])
+
+
+@njit(**_JIT, inline="always")
+def _tanh(u):
+    """tanh through one exp (half the cost of libm's; error below 3e-16)."""
+    r = 1.0 - 2.0 / (np.exp(2.0 * abs(u)) + 1.0)
+    return r if u >= 0.0 else -r
+
+
+@njit(**_JIT, inline="always")
+def controller_output(P, z, v_measured, integral):
+    """PI + damping command: ``(F_pi, F_damp, F_motor, integral_rate)`` (MODEL.md)."""
+    error = P[P_ZREF] - z
+    f_pi = P[P_KP] * error + P[P_KI] * integral
+    f_damp = -P[P_KD] * v_measured
+    command = f_pi + f_damp
+    f_max = P[P_FMAX]
+    rate = error
+    if command > f_max:
+        command = f_max
+        if error * P[P_KI] > 0.0:
+            rate = 0.0  # anti-windup: do not integrate further into saturation
+    elif command < -f_max:
+        command = -f_max
+        if error * P[P_KI] < 0.0:
+            rate = 0.0
+    return f_pi, f_damp, command, rate
+
+
+@njit(**_JIT, inline="always")
+def rhs(y, yd, ydd, s, mode, direction, held, P):
+    """Right-hand side at base motion ``(y, yd, ydd)``: ``(derivatives, forces)``.
+
+    ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g`` (MODEL.md);
+    while held (stuck, or resting on a plastic stop) ``v = 0`` and ``xdd = ydd``.
+    """
+    m = P[P_MASS]
+    z = s[S_Z]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    xd = yd + v
+    f_spring = -P[P_SPRING_A] * _tanh(P[P_SPRING_B] * z)
+
+    f_stop = 0.0
+    f_elastic = 0.0
+    if P[P_PLASTIC] == 0.0:
+        if z < P[P_Z_LOW]:
+            f_elastic = P[P_STOP_K] * (P[P_Z_LOW] - z)
+            f_stop = max(f_elastic - P[P_STOP_C] * v, 0.0)  # a stop pushes, never pulls
+        elif z > P[P_Z_HIGH]:
+            f_elastic = -P[P_STOP_K] * (z - P[P_Z_HIGH])
+            f_stop = min(f_elastic - P[P_STOP_C] * v, 0.0)
+
+    v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
+    if P[P_CONTROL_STEPS] > 0.0:
+        f_pi, f_damp, f_motor = held
+        integral_rate = 0.0
+    else:
+        f_pi, f_damp, f_motor, integral_rate = controller_output(P, z, v_measured, s[S_INT])
+
+    f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
+    f_hold = m * ydd - f_applied
+    if mode == MODE_SLIP:
+        sign = direction if v == 0.0 else (1.0 if v > 0.0 else -1.0)
+        level = P[P_FC] + (P[P_FS] - P[P_FC]) * np.exp(-P[P_CBC] * abs(v))
+        f_friction = -level * sign - P[P_CV] * v
+        xdd = (f_applied + f_friction) / m
+    else:
+        f_friction = f_hold
+        if mode == MODE_WALL_LOW:  # the stop takes the upward part, friction the rest
+            f_wall = max(f_hold, 0.0)
+            f_friction = f_hold - f_wall
+            f_stop += f_wall
+        elif mode == MODE_WALL_HIGH:
+            f_wall = min(f_hold, 0.0)
+            f_friction = f_hold - f_wall
+            f_stop += f_wall
+        xdd = ydd
+
+    deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
+             (f_spring + f_friction + f_stop + f_motor) * yd, -f_friction * v, f_motor * v,
+             -(f_stop - f_elastic) * v)
+    force = (y, yd, ydd, f_spring, f_friction, f_stop, f_elastic, f_motor, f_pi, f_damp,
+             v_measured, f_hold, xdd)
+    return deriv, force
+
+
+@njit(**_JIT)
+def rhs_at(t, s, mode, direction, held, P, E, table):
+    """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
+    y, yd, ydd = base_motion(t, E, table)
+    return rhs(y, yd, ydd, s, mode, direction, held, P)
+
+
+@njit(**_JIT, inline="always")
+def _axpy(s, a, k):
+    return (s[0] + a * k[0], s[1] + a * k[1], s[2] + a * k[2], s[3] + a * k[3],
+            s[4] + a * k[4], s[5] + a * k[5], s[6] + a * k[6], s[7] + a * k[7])
+
+
+@njit(**_JIT, inline="always")
+def _combine(s, h, b1, k1, b2, k2, b3, k3, b4, k4):
+    return (s[0] + h * (b1 * k1[0] + b2 * k2[0] + b3 * k3[0] + b4 * k4[0]),
+            s[1] + h * (b1 * k1[1] + b2 * k2[1] + b3 * k3[1] + b4 * k4[1]),
+            s[2] + h * (b1 * k1[2] + b2 * k2[2] + b3 * k3[2] + b4 * k4[2]),
+            s[3] + h * (b1 * k1[3] + b2 * k2[3] + b3 * k3[3] + b4 * k4[3]),
+            s[4] + h * (b1 * k1[4] + b2 * k2[4] + b3 * k3[4] + b4 * k4[4]),
+            s[5] + h * (b1 * k1[5] + b2 * k2[5] + b3 * k3[5] + b4 * k4[5]),
+            s[6] + h * (b1 * k1[6] + b2 * k2[6] + b3 * k3[6] + b4 * k4[6]),
+            s[7] + h * (b1 * k1[7] + b2 * k2[7] + b3 * k3[7] + b4 * k4[7]))
+
+
+@njit(**_JIT, inline="always")
+def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
+    """One explicit Runge-Kutta step of length ``h`` [s] from state tuple ``s``.
+
+    Euler (order 1), Bogacki-Shampine ode3 without its error stage (order 3,
+    Simulink's fixed-step ode3), classic RK4 (order 4). ``phase, sin0, cos0``
+    are the excitation's phase and its sine and cosine at a nearby time (see
+    :func:`qzs.excitation.base_motion_near`).
+    """
+    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+    k1 = rhs(y, yd, ydd, s, mode, direction, held, P)[0]
+    if solver == SOLVER_EULER:
+        return _axpy(s, h, k1)
+    if solver == SOLVER_ODE3:
+        y, yd, ydd = base_motion_near(t + 0.5 * h, phase, sin0, cos0, E, table)
+        k2 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k1), mode, direction, held, P)[0]
+        y, yd, ydd = base_motion_near(t + 0.75 * h, phase, sin0, cos0, E, table)
+        k3 = rhs(y, yd, ydd, _axpy(s, 0.75 * h, k2), mode, direction, held, P)[0]
+        return _combine(s, h, 2.0 / 9.0, k1, 1.0 / 3.0, k2, 4.0 / 9.0, k3, 0.0, k3)
+    y, yd, ydd = base_motion_near(t + 0.5 * h, phase, sin0, cos0, E, table)
+    k2 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k1), mode, direction, held, P)[0]
+    k3 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k2), mode, direction, held, P)[0]
+    y, yd, ydd = base_motion_near(t + h, phase, sin0, cos0, E, table)
+    k4 = rhs(y, yd, ydd, _axpy(s, h, k3), mode, direction, held, P)[0]
+    return _combine(s, h, 1.0 / 6.0, k1, 1.0 / 3.0, k2, 1.0 / 3.0, k3, 1.0 / 6.0, k4)
+
+
+@njit(**_JIT)
+def energies(y, yd, s, mode, P):
+    """Kinetic, spring, gravity and stop-elastic energy [J] of the payload."""
+    z = s[S_Z]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    m = P[P_MASS]
+    u = abs(P[P_SPRING_B] * z)
+    pen = 0.0
+    if P[P_PLASTIC] == 0.0:
+        pen = max(P[P_Z_LOW] - z, 0.0) + max(z - P[P_Z_HIGH], 0.0)
+    return (0.5 * m * (yd + v) ** 2,
+            P[P_SPRING_A] / P[P_SPRING_B] * (u + np.log1p(np.exp(-2.0 * u)) - np.log(2.0)),
+            m * P[P_GRAVITY] * (y + z),
+            0.5 * P[P_STOP_K] * pen * pen)
+
+
+@njit(**_JIT)
+def _mechanical_energy(t, s, mode, P, E, table):
+    y, yd, ydd = base_motion(t, E, table)
+    e = energies(y, yd, s, mode, P)
+    return e[0] + e[1] + e[2] + e[3]
+
+
+@njit(**_JIT)
+def _with(s, index, value):
+    """Copy of state tuple ``s`` with entry ``index`` replaced by ``value``."""
+    return (value if index == 0 else s[0], value if index == 1 else s[1],
+            value if index == 2 else s[2], value if index == 3 else s[3],
+            value if index == 4 else s[4], value if index == 5 else s[5],
+            value if index == 6 else s[6], value if index == 7 else s[7])
+
+
+@njit(**_JIT)
+def _hold_margin(mode, f_hold, fs):
+    """How far the holding force is inside what friction (and a plastic stop) can give [N]."""
+    if mode == MODE_STICK:
+        return fs - abs(f_hold)
+    if mode == MODE_WALL_LOW:
+        return f_hold + fs
+    return fs - f_hold
+
+
+@njit(**_JIT)
+def _release_direction(mode, f_hold):
+    if mode == MODE_STICK:
+        return -1 if f_hold > 0.0 else 1
+    return 1 if mode == MODE_WALL_LOW else -1
+
+
+@njit(**_JIT)
+def _settle(t, s, direction, held, P, E, table):
+    """At a zero crossing of v: stick if friction can hold the payload, else reverse.
+
+    Returns ``(state, mode, direction)``. The velocity is set to exactly 0; the
+    tiny kinetic-energy change of that snap is booked to friction dissipation so
+    that the energy ledger stays closed.
+    """
+    before = _mechanical_energy(t, s, MODE_SLIP, P, E, table)
+    s = _with(s, S_V, 0.0)
+    f_hold = rhs_at(t, s, MODE_STICK, 0.0, held, P, E, table)[1][F_HOLD]
+    mode = MODE_SLIP
+    if abs(f_hold) <= P[P_FS]:
+        mode = MODE_STICK
+    else:
+        direction = -1 if f_hold > 0.0 else 1
+    snap = before - _mechanical_energy(t, s, mode, P, E, table)
+    return _with(s, S_D_FRICTION, s[S_D_FRICTION] + snap), mode, direction
+
+
+@njit(**_JIT)
+def _hit_wall(t, s, mode, low, P, E, table):
+    """Perfectly plastic impact: z put on the stop, v absorbed, energy booked to the stop."""
+    before = _mechanical_energy(t, s, mode, P, E, table)
+    s = _with(_with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH]), S_V, 0.0)
+    mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
+    loss = before - _mechanical_energy(t, s, mode, P, E, table)
+    return _with(s, S_D_STOP, s[S_D_STOP] + loss), mode
+
+
+@njit(**_JIT)
+def _event(s, s1, mode, direction, margin, margin1, P):
+    """Kind (0: none) and step fraction of the first transition between ``s`` and ``s1``."""
+    theta = 2.0
+    event = 0
+    if mode == MODE_SLIP:
+        v0 = direction * s[S_V]
+        v1 = direction * s1[S_V]
+        if v1 < 0.0 or (v1 == 0.0 and v0 > 0.0):  # v reached zero: stick or reverse
+            theta = v0 / (v0 - v1) if v0 > v1 else 0.0
+            event = 1
+        if P[P_PLASTIC] != 0.0:  # reached a plastic stop
+            if s1[S_Z] < P[P_Z_LOW]:
+                fraction = (s[S_Z] - P[P_Z_LOW]) / (s[S_Z] - s1[S_Z])
+                if fraction < theta:
+                    theta, event = fraction, 2
+            elif s1[S_Z] > P[P_Z_HIGH]:
+                fraction = (P[P_Z_HIGH] - s[S_Z]) / (s1[S_Z] - s[S_Z])
+                if fraction < theta:
+                    theta, event = fraction, 3
+    elif margin1 < 0.0:  # friction (and stop) can no longer hold the payload
+        theta = margin / (margin - margin1) if margin > margin1 else 0.0
+        event = 4
+    return event, min(max(theta, 0.0), 1.0)
+
+
+@njit(**_JIT)
+def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0):
+    """Advance one grid step, locating at most one mode transition inside it.
+
+    ``margin`` is the holding margin at ``t`` if known (NaN if not); ``phase,
+    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``. Returns
+    ``(state, mode, direction, margin, sticks, impacts)``: the holding margin
+    at the end (NaN while slipping), the counts of new stick events and of
+    plastic impacts in the step.
+    """
+    sticks = 0
+    impacts = 0
+    if mode == MODE_SLIP:
+        if direction * s[S_V] < 0.0:  # a crossing the in-step location missed
+            s, mode, direction = _settle(t, s, direction, held, P, E, table)
+            sticks += mode == MODE_STICK
+    if mode != MODE_SLIP:
+        if margin != margin:  # NaN: not known yet
+            y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+            margin = _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD],
+                                  P[P_FS])
+        if margin < 0.0:
+            y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+            direction = _release_direction(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD])
+            mode = MODE_SLIP
+
+    # One call site of the (inlined) Runge-Kutta step: pass 0 tries the whole
+    # step; with an event inside it, pass 1 integrates up to the event and pass 2
+    # the rest of the step in the new mode.
+    start = t
+    length = h
+    s_start = s
+    margin1 = np.nan
+    for stage in range(3):
+        s1 = rk_step(solver, start, length, s_start, mode, float(direction), held, P, E, table,
+                     phase, sin0, cos0)
+        if mode != MODE_SLIP:
+            y, yd, ydd = base_motion_near(start + length, phase, sin0, cos0, E, table)
+            margin1 = _hold_margin(mode, rhs(y, yd, ydd, s1, mode, 0.0, held, P)[1][F_HOLD],
+                                   P[P_FS])
+        if stage == 0:
+            event, theta = _event(s, s1, mode, direction, margin, margin1, P)
+            if event == 0:
+                return s1, mode, direction, margin1, sticks, impacts
+            length = theta * h
+            if length > 0.0:
+                continue
+            s1 = s
+        if stage <= 1:
+            start = t + length
+            if event == 1:
+                s1, mode, direction = _settle(start, s1, direction, held, P, E, table)
+                sticks += mode == MODE_STICK
+            elif event == 2 or event == 3:
+                s1, mode = _hit_wall(start, s1, mode, event == 2, P, E, table)
+                impacts += 1
+            else:
+                f_hold = rhs_at(start, s1, mode, 0.0, held, P, E, table)[1][F_HOLD]
+                direction = _release_direction(mode, f_hold)
+                mode = MODE_SLIP
+            length = h - length
+            s_start = s1
+            if length > 0.0:
+                continue
+        break
+    if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:
+        if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
+            s1, mode = _hit_wall(t + h, s1, mode, s1[S_Z] < P[P_Z_LOW], P, E, table)
+            impacts += 1
+    if mode == MODE_SLIP:
+        margin1 = np.nan
+    return s1, mode, direction, margin1, sticks, impacts
+
+
+@njit(**_JIT)
+def sample_controller(t, s, mode, P, E, table):
+    """Sampled controller: read z and the measured velocity; returns ``(held, state)``."""
+    y, yd, ydd = base_motion(t, E, table)
+    xd = yd + (s[S_V] if mode == MODE_SLIP else 0.0)
+    v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
+    f_pi, f_damp, f_motor, rate = controller_output(P, s[S_Z], v_measured, s[S_INT])
+    s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
+    return (f_pi, f_damp, f_motor), s
+
+
+@njit(**_JIT)
+def record(t, s, mode, direction, held, P, E, table, row, row_flags, phase, sin0, cos0):
+    """Write one output sample (channels ``C_*``) of the state at time ``t``.
+
+    ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
+    """
+    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+    force = rhs(y, yd, ydd, s, mode, float(direction), held, P)[1]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    row[C_TIME] = t
+    row[C_BASE_Y] = force[F_Y]
+    row[C_BASE_YD] = force[F_YD]
+    row[C_BASE_YDD] = force[F_YDD]
+    row[C_X] = force[F_Y] + s[S_Z]
+    row[C_XD] = force[F_YD] + v
+    row[C_XDD] = force[F_XDD]
+    row[C_Z] = s[S_Z]
+    row[C_V] = v
+    row[C_F_SPRING] = force[F_SPRING]
+    row[C_F_FRICTION] = force[F_FRICTION]
+    row[C_F_STOP] = force[F_STOP]
+    row[C_F_MOTOR] = force[F_MOTOR]
+    row[C_F_PI] = force[F_PI]
+    row[C_F_DAMP] = force[F_DAMP]
+    row[C_V_MEASURED] = force[F_V_MEASURED]
+    row[C_W_BASE] = s[S_W_BASE]
+    row[C_D_FRICTION] = s[S_D_FRICTION]
+    row[C_W_MOTOR] = s[S_W_MOTOR]
+    row[C_D_STOP] = s[S_D_STOP]
+    row[C_E_KINETIC], row[C_E_SPRING], row[C_E_GRAVITY], row[C_E_STOP] = energies(
+        force[F_Y], force[F_YD], s, mode, P)
+    row_flags[O_LOCKED] = mode != MODE_SLIP
+    row_flags[O_CONTACT] = _in_contact(s, mode, P)
+
+
+@njit(**_JIT)
+def _in_contact(s, mode, P):
+    return mode >= MODE_WALL_LOW or s[S_Z] < P[P_Z_LOW] or s[S_Z] > P[P_Z_HIGH]
+
+
+@njit(**_JIT)
+def evaluate(t, state, flags, p, ex, table, row, row_flags):
+    """Record the persistent state (arrays, as :func:`run_chunk` keeps it) at ``t``."""
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
+    E = excitation_tuple(ex)
+    phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, True)
+    record(t, s, flags[I_MODE], flags[I_DIRECTION], held, params_tuple(p), E, table, row,
+           row_flags, phase, sin0, cos0)
+
+
+@njit(**_JIT)
+def hold_force(t, state, p, ex, table):
+    """Force friction must supply to keep the payload stuck at ``state`` [N], and the forces."""
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
+    return rhs_at(t, s, MODE_STICK, 0.0, held, params_tuple(p), excitation_tuple(ex), table)[1]
+
+
+@njit(**_JIT)
+def run_chunk(solver, n_steps, decimation, state, flags, p, ex, table, out, out_flags, row0):
+    """Advance ``n_steps`` grid steps, writing every ``decimation``-th state to ``out``.
+
+    ``state`` and ``flags`` carry the run between calls. Returns ``(status,
+    rows_written)``; ``status`` is ``STATUS_DIVERGED`` when the state becomes
+    non-finite or leaves a bound of 100 strokes or 1e4 m/s, and ``state`` then
+    holds the last finite state, ``flags[I_STEP]`` its step.
+    """
+    P = params_tuple(p)
+    E = excitation_tuple(ex)
+    h = P[P_DT]
+    control_steps = int(P[P_CONTROL_STEPS])
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
+    mode = flags[I_MODE]
+    direction = flags[I_DIRECTION]
+    contact = flags[I_CONTACT]
+    step = flags[I_STEP]
+    bound = 100.0 * (P[P_Z_HIGH] - P[P_Z_LOW]) + abs(P[P_Z_LOW]) + abs(P[P_Z_HIGH])
+    status = STATUS_OK
+    row = row0
+    margin = np.nan
+    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
+    for _ in range(n_steps):
+        t = step * h
+        if control_steps > 0 and step % control_steps == 0:
+            held, s = sample_controller(t, s, mode, P, E, table)
+            margin = np.nan
+        s1, mode1, direction1, margin1, sticks, impacts = grid_step(
+            solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0)
+        if not (np.isfinite(s1[S_Z]) and np.isfinite(s1[S_V]) and np.isfinite(s1[S_HP])
+                and np.isfinite(s1[S_INT]) and abs(s1[S_Z]) <= bound and abs(s1[S_V]) <= 1e4):
+            status = STATUS_DIVERGED
+            break
+        s, mode, direction, margin = s1, mode1, direction1, margin1
+        step += 1
+        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
+        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
+        flags[I_N_STICKS] += sticks
+        flags[I_N_CONTACTS] += impacts
+        now = _in_contact(s, mode, P)
+        if now and contact == 0 and P[P_PLASTIC] == 0.0:
+            flags[I_N_CONTACTS] += 1
+        contact = 1 if now else 0
+        if step % decimation == 0:
+            record(step * h, s, mode, direction, held, P, E, table, out[row], out_flags[row],
+                   phase, sin0, cos0)
+            row += 1
+    for i in range(N_ODE):
+        state[i] = s[i]
+    state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR] = held
+    flags[I_MODE] = mode
+    flags[I_DIRECTION] = direction
+    flags[I_CONTACT] = contact
+    flags[I_STEP] = step
+    return status, row - row0

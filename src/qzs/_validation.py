@@ -1,0 +1,75 @@
+"""Small argument checks shared by the parameter classes and public functions.
+
+Messages follow scipy's style: name the argument, the value received and the fix.
+"""
+import math
+
+from qzs.errors import ParameterError
+
+
+def as_float(name, value, error=ParameterError):
+    """Return ``value`` as a finite float or raise ``error`` naming ``name``."""
+    if isinstance(value, bool):
+        raise error(f"`{name}` must be a number, got the boolean {value!r}.")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise error(f"`{name}` must be a number, got {value!r}.") from None
+    if not math.isfinite(number):
+        raise error(f"`{name}` must be finite, got {number!r}.")
+    return number
+
+
+def positive(name, value, error=ParameterError):
+    """Return ``value`` as a float that must be finite and > 0."""
+    number = as_float(name, value, error)
+    if number <= 0.0:
+        raise error(f"`{name}` must be positive, got {number!r}.")
+    return number
+
+
+def non_negative(name, value, error=ParameterError):
+    """Return ``value`` as a float that must be finite and >= 0."""
+    number = as_float(name, value, error)
+    if number < 0.0:
+        raise error(f"`{name}` must be non-negative, got {number!r}.")
+    return number
+
+
+def choice(name, value, options, error=ParameterError):
+    """Return ``value`` if it is one of ``options``."""
+    if value not in options:
+        listed = ", ".join(repr(o) for o in options)
+        raise error(f"`{name}` must be one of {listed}; got {value!r}.")
+    return value
+
+
+def validate_fields(instance, rules):
+    """Validate and normalise the fields of a frozen dataclass in ``__post_init__``.
+
+    Parameters
+    ----------
+    instance : dataclass instance
+        The frozen instance being initialised.
+    rules : dict
+        Field name -> checker ``f(name, value) -> value``. A value of ``None`` is
+        passed through untouched when the checker is wrapped with :func:`optional`.
+    """
+    for name, rule in rules.items():
+        object.__setattr__(instance, name, rule(name, getattr(instance, name)))
+
+
+def optional(rule):
+    """Wrap a checker so that ``None`` passes through unchanged."""
+
+    def check(name, value):
+        return None if value is None else rule(name, value)
+
+    return check
+
+
+def parameter(default, unit, doc):
+    """A dataclass field with its default, its unit and a one-line description."""
+    from dataclasses import field
+
+    return field(default=default, metadata={"unit": unit, "doc": doc})

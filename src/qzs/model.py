@@ -1,0 +1,194 @@
+"""The isolator plant: parameters and force laws (MODEL.md, paper eqs. 1-3).
+
+Coordinates (MODEL.md): ``y`` base position, ``x`` payload position, ``z = x - y``
+relative position (encoder), ``v = xd - yd`` relative (slip) velocity; upward positive.
+
+    m * xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m * g
+"""
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from qzs._validation import as_float, choice, non_negative, optional, parameter, positive, validate_fields
+from qzs.errors import ParameterError
+
+__all__ = [
+    "IsolatorParameters",
+    "InitialState",
+    "STOP_MODELS",
+    "spring_force",
+    "spring_stiffness",
+    "spring_energy",
+    "friction_force",
+    "passive_natural_frequency",
+]
+
+#: Hard-stop contact models: a stiff spring-damper, or a perfectly plastic stop.
+STOP_MODELS = ("compliant", "plastic")
+
+
+@dataclass(frozen=True, kw_only=True)
+class IsolatorParameters:
+    """Physical parameters of the single-axis isolator (MODEL.md, Table 1).
+
+    Parameters
+    ----------
+    mass : float
+        Moving mass of the payload and all moving parts, m [kg]. Default 6.4.
+    gravity : float
+        Gravitational acceleration, g [m/s^2]; 0 for a horizontal or bench-top set-up.
+    spring_force : float
+        MagSpring constant-force amplitude, a [N] (eq. 2, ``F = -a*tanh(b*z)``).
+    spring_shape : float
+        MagSpring transition coefficient, b [1/m]. A tiny value makes the spring
+        linear with stiffness ``a*b`` over the stroke.
+    stiction_force : float
+        Breakaway (static) friction force, Fs [N]; must be >= ``coulomb_force``.
+    coulomb_force : float
+        Coulomb (kinetic) friction force, Fc [N].
+    stribeck_decay : float
+        Decay rate from stiction to Coulomb friction, Cbc [s/m].
+    viscous_damping : float
+        Viscous friction coefficient, Cv [N*s/m].
+    stroke_half : float
+        Half the guide's stroke: the stops are at ``stop_center +- stroke_half`` [m].
+    stop_center : float or None
+        Centre of the stroke in relative position z [m]; ``None`` (default) centres
+        the stops on the controller's position setpoint.
+    stop_stiffness : float
+        Contact stiffness of the compliant hard stop [N/m].
+    stop_damping : float
+        Contact damping of the compliant hard stop [N*s/m].
+    stop_model : {"compliant", "plastic"}
+        Compliant spring-damper contact, or a perfectly plastic stop that absorbs
+        the relative velocity on impact and holds the payload at the limit.
+    motor_force_max : float
+        Motor force saturation [N] (LinMot PS01-23x80: 44 N).
+    """
+
+    mass: float = parameter(6.4, "kg", "moving mass m")
+    gravity: float = parameter(9.81, "m/s^2", "gravitational acceleration g")
+    spring_force: float = parameter(60.84, "N", "MagSpring force amplitude a")
+    spring_shape: float = parameter(78.10, "1/m", "MagSpring shape coefficient b")
+    stiction_force: float = parameter(10.0, "N", "stiction (breakaway) force Fs")
+    coulomb_force: float = parameter(1.0, "N", "Coulomb friction force Fc")
+    stribeck_decay: float = parameter(100.0, "s/m", "Stribeck decay coefficient Cbc")
+    viscous_damping: float = parameter(100.0, "N*s/m", "viscous friction coefficient Cv")
+    stroke_half: float = parameter(0.080, "m", "half stroke of the linear guide")
+    stop_center: float | None = parameter(None, "m", "centre of the stops in z (None: the setpoint)")
+    stop_stiffness: float = parameter(1e6, "N/m", "hard-stop contact stiffness")
+    stop_damping: float = parameter(1e3, "N*s/m", "hard-stop contact damping")
+    stop_model: str = parameter("compliant", "-", "hard-stop model: compliant or plastic")
+    motor_force_max: float = parameter(44.0, "N", "motor force saturation")
+
+    def __post_init__(self):
+        validate_fields(self, {
+            "mass": positive,
+            "gravity": non_negative,
+            "spring_force": non_negative,
+            "spring_shape": positive,
+            "stiction_force": non_negative,
+            "coulomb_force": non_negative,
+            "stribeck_decay": non_negative,
+            "viscous_damping": non_negative,
+            "stroke_half": positive,
+            "stop_center": optional(as_float),
+            "stop_stiffness": positive,
+            "stop_damping": non_negative,
+            "stop_model": lambda n, v: choice(n, v, STOP_MODELS),
+            "motor_force_max": non_negative,
+        })
+        if self.coulomb_force > self.stiction_force:
+            raise ParameterError(
+                f"`stiction_force` ({self.stiction_force!r} N) must be >= `coulomb_force` "
+                f"({self.coulomb_force!r} N): the breakaway force cannot be below the sliding "
+                "friction. Set both equal for friction without a Stribeck peak, or both 0 "
+                "for a frictionless guide."
+            )
+
+    @property
+    def weight_deficit(self):
+        """``m*g - a`` [N]: how much of the weight the spring's plateau cannot carry."""
+        return self.mass * self.gravity - self.spring_force
+
+    def to_dict(self):
+        """Return the parameters as a plain ``dict`` (``None`` values omitted)."""
+        return {k: v for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True, kw_only=True)
+class InitialState:
+    """Initial state of a run.
+
+    Parameters
+    ----------
+    relative_position : float or None
+        z(0) [m]; ``None`` (default) starts at the position setpoint.
+    relative_velocity : float
+        v(0) [m/s]; default 0 (moving with the base).
+    locked : bool or None
+        Start stuck to the base (True) or slipping (False); ``None`` (default)
+        decides from the forces: stuck if friction can hold the payload.
+    pi_integral : float or None
+        Initial value of the PI integral of the position error [m*s]; ``None``
+        (default) preloads it so that the motor holds the payload at rest
+        (bumpless start); it stays 0 when ``pi_ki`` is 0.
+    """
+
+    relative_position: float | None = None
+    relative_velocity: float = 0.0
+    locked: bool | None = None
+    pi_integral: float | None = None
+
+    def __post_init__(self):
+        validate_fields(self, {
+            "relative_position": optional(as_float),
+            "relative_velocity": as_float,
+            "pi_integral": optional(as_float),
+        })
+        if self.locked is not None and not isinstance(self.locked, (bool, np.bool_)):
+            raise ParameterError(f"`locked` must be True, False or None, got {self.locked!r}.")
+        if self.locked and self.relative_velocity != 0.0:
+            raise ParameterError(
+                "`relative_velocity` must be 0 when `locked` is True (a stuck payload moves "
+                f"with the base), got {self.relative_velocity!r} m/s."
+            )
+
+
+def spring_force(relative_position, params):
+    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2)."""
+    z = np.asarray(relative_position, dtype=float)
+    return -params.spring_force * np.tanh(params.spring_shape * z)
+
+
+def spring_stiffness(relative_position, params):
+    """Tangent stiffness ``a*b/cosh(b*z)^2`` [N/m] of the MagSpring at ``z`` [m]."""
+    z = np.asarray(relative_position, dtype=float)
+    return params.spring_force * params.spring_shape / np.cosh(params.spring_shape * z) ** 2
+
+
+def spring_energy(relative_position, params):
+    """Potential energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0."""
+    u = np.abs(params.spring_shape * np.asarray(relative_position, dtype=float))
+    return params.spring_force / params.spring_shape * (u + np.log1p(np.exp(-2 * u)) - np.log(2))
+
+
+def friction_force(relative_velocity, params):
+    """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, MODEL.md signs).
+
+    ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign(v) - Cv*v``: it always opposes slip.
+    At ``v = 0`` it returns 0; the stuck state is handled by the simulator.
+    """
+    v = np.asarray(relative_velocity, dtype=float)
+    p = params
+    level = p.coulomb_force + (p.stiction_force - p.coulomb_force) * np.exp(-p.stribeck_decay * np.abs(v))
+    return -level * np.sign(v) - p.viscous_damping * v
+
+
+def passive_natural_frequency(params, relative_position):
+    """Natural frequency [Hz] of the payload on the MagSpring alone, linearised at ``z`` [m].
+
+    ``sqrt(k/m)/(2*pi)`` with ``k`` the tangent stiffness; about 0.08 Hz at the
+    default operating point ``z = -0.060 m`` (paper, Section 3.1).
+    """
+    return float(np.sqrt(spring_stiffness(relative_position, params) / params.mass) / (2 * np.pi))
