@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/qzs simulate --out results/demo.nc
+	$(BIN)/qzs paper --out results/paper
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

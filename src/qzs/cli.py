@@ -4,6 +4,8 @@
                  [--amplitude M] [--f0 HZ] [--f1 HZ] [--frequency HZ] [--duration S]
                  [--dt S] [--sample-rate HZ] [--solver ode3|rk4|euler] [--out FILE.nc|FILE.csv]
     qzs params [--toml FILE]
+    qzs study FILE.toml [--quick] [--out DIR] [--workers N]
+    qzs paper [--quick] [--out DIR] [--workers N]
 """
 import argparse
 import sys
@@ -45,6 +47,21 @@ def _build_parser():
     sim.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
                      help=f"figure of the run (default {DEFAULT_PLOT}; 'none' to skip)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    for name, text in (("paper", "run every study of the paper, write figures, metrics and "
+                                 "report.html"),
+                       ("study", "run one study definition (a shipped name or a TOML file)")):
+        cmd = sub.add_parser(name, help=text, description=text)
+        if name == "study":
+            cmd.add_argument("definition", metavar="FILE.toml",
+                             help="study file, or a shipped study name (e.g. stiction)")
+        cmd.add_argument("--quick", action="store_true",
+                         help="shorter runs (fewer, shorter Welch segments)")
+        cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
+                         help=f"output folder (default results/{name})")
+        cmd.add_argument("--workers", type=int, metavar="N",
+                         help="worker processes (default: all cores)")
+        cmd.add_argument("--quiet", action="store_true", help="no progress bar")
 
     params = sub.add_parser("params", help="print the default parameters with units")
     params.add_argument("--toml", metavar="FILE", help="write them as a config file instead")
@@ -152,12 +169,38 @@ def _params(args):
     return 0
 
 
+def _studies(args):
+    import time
+
+    from qzs.report import write_paper_outputs
+    from qzs.studies import load_study, run_studies, shipped_studies
+
+    if args.command == "paper":
+        studies = [load_study(p) for p in shipped_studies()]
+    else:
+        studies = [load_study(args.definition)]
+    if args.workers is not None and args.workers < 1:
+        raise SystemExit(f"qzs: error: --workers must be >= 1, got {args.workers}")
+    start = time.perf_counter()
+    results = run_studies(studies, quick=args.quick, workers=args.workers,
+                          progress=not args.quiet)
+    wall = time.perf_counter() - start
+    verdicts = write_paper_outputs(results, args.out, quick=args.quick, wall_seconds=wall)
+    for result in results:
+        print(f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s")
+    print(f"{'total':<12}    wall {wall:7.1f} s")
+    for verdict in verdicts:
+        print(f"  [{verdict.label}] {verdict.statement}\n      {verdict.evidence}")
+    print(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv and figures")
+    return 0
+
+
 def main(argv=None):
     """Entry point of the ``qzs`` command; returns the process exit code."""
     from qzs.errors import DataError, ParameterError, SimulationError
 
     args = _build_parser().parse_args(argv)
-    handlers = {"simulate": _simulate, "params": _params}
+    handlers = {"simulate": _simulate, "params": _params, "paper": _studies, "study": _studies}
     try:
         return handlers[args.command](args)
     except (ParameterError, DataError, SimulationError) as error:

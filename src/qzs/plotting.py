@@ -1,7 +1,8 @@
 """Figures and text summaries of simulation results (matplotlib, Agg-safe)."""
 import numpy as np
 
-__all__ = ["plot_simulation", "plot_energy", "summary_text", "envelope"]
+__all__ = ["plot_simulation", "plot_energy", "plot_transmissibility", "plot_spring_fit",
+           "summary_text", "envelope"]
 
 _MAX_POINTS = 4000  # per trace: long runs are drawn as a min/max envelope
 
@@ -125,14 +126,17 @@ def _title(result):
             f"{result.run['solver']} dt = {result.run['dt']:g} s")
 
 
-def _save(fig, path):
-    from qzs.io import atomic_path
-
+def _save(fig, path, also_svg=False):
+    """Write ``fig`` atomically (format from the suffix); a .png also as .svg if asked."""
     from pathlib import Path
+
+    from qzs.io import atomic_path
 
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=130)
+    if also_svg and path.suffix.lower() == ".png":
+        _save(fig, path.with_suffix(".svg"))
 
 
 def summary_text(result):
@@ -170,3 +174,74 @@ def summary_text(result):
                  f"({residual / scale:.2g} of the base work)")
     lines.append(f"  time span        {t[0]:g} .. {t[-1]:g} s")
     return "\n".join(lines)
+
+
+def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear", title="",
+                          path=None, untrusted_below=None, estimator="sqrt(S_payload/S_base)"):
+    """Transmissibility curves in dB against frequency, as the paper draws them.
+
+    Parameters
+    ----------
+    curves : sequence of dict
+        Each with ``label``, ``frequency`` [Hz], ``magnitude`` (amplitude ratio) and
+        optionally ``linear`` (the linearised model's magnitude on the same
+        frequencies, drawn dashed in the same colour) and ``style`` (matplotlib kwargs).
+    frequency_range : (float, float)
+        Axis limits [Hz].
+    scale : {"linear", "log"}
+        Frequency axis scale.
+    untrusted_below : float, optional
+        Shade the band below this frequency [Hz] as not trustworthy (high-pass).
+    path : str or Path, optional
+        Written as given and, for a .png, also as .svg beside it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = _figure(1, height=4.2)
+    ax = axes[0]
+    for i, curve in enumerate(curves):
+        f = np.asarray(curve["frequency"])
+        keep = (f >= frequency_range[0]) & (f <= frequency_range[1]) & (f > 0)
+        style = {"color": f"C{i}", "lw": 1.0, **curve.get("style", {})}
+        ax.plot(f[keep], 20 * np.log10(np.maximum(curve["magnitude"][keep], 1e-12)),
+                label=curve["label"], **style)
+        if curve.get("linear") is not None:
+            ax.plot(f[keep], 20 * np.log10(np.maximum(curve["linear"][keep], 1e-12)),
+                    color=style["color"], lw=0.8, ls="--")
+    if any(c.get("linear") is not None for c in curves):
+        ax.plot([], [], color="0.4", ls="--", lw=0.8, label="linearised model")
+    if untrusted_below:
+        ax.axvspan(frequency_range[0], untrusted_below, color="0.85", zorder=0,
+                   label=f"untrustworthy (< {untrusted_below:g} Hz, high-pass)")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xscale(scale)
+    low = frequency_range[0] if scale == "linear" else max(frequency_range[0], 0.01)
+    ax.set_xlim(low, frequency_range[1])
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"transmissibility {estimator} [dB]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title(title)
+    if path is not None:
+        _save(fig, path, also_svg=True)
+    return fig
+
+
+def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=None, title=""):
+    """MagSpring force against displacement with its tanh fit (paper Fig. 5)."""
+    fig, axes = _figure(1, height=3.8)
+    ax = axes[0]
+    z = np.linspace(np.min(displacement), np.max(displacement), 400)
+    ax.plot(np.asarray(displacement) * 1e3, force, "o", ms=3.5, label="measured (synthetic)")
+    ax.plot(z * 1e3, -spring_force * np.tanh(spring_shape * z), "-",
+            label=f"fit: a = {spring_force:.2f} N, b = {spring_shape:.2f} 1/m")
+    ax.set_xlabel("relative position z [mm]")
+    ax.set_ylabel("spring force [N]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title(title)
+    if path is not None:
+        _save(fig, path, also_svg=True)
+    return fig
