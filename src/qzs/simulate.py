@@ -224,16 +224,16 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None, 
             f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
-    decimation = _steps_per(sample_rate, dt, "sample_rate")
-    control_steps = 0
-    if controller.controller_rate > 0:
-        control_steps = _steps_per(controller.controller_rate, dt, "controller_rate")
     limit = largest_stable_step(isolator, controller, solver)
     if dt > limit:
         raise StabilityError(
             f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
             f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
             f"stable step is {limit:.3g} s. Reduce `dt`, or soften `stop_stiffness`.")
+    decimation = _steps_per(sample_rate, dt, "sample_rate")
+    control_steps = 0
+    if controller.controller_rate > 0:
+        control_steps = _steps_per(controller.controller_rate, dt, "controller_rate")
 
     p = _pack_parameters(isolator, controller, dt, control_steps)
     packed = excitation.pack()

@@ -1,0 +1,112 @@
+"""The `qzs` command: it only parses, calls the API and reports."""
+import numpy as np
+import pytest
+
+from qzs.cli import main
+from qzs.io import read_result, save_config
+
+
+def test_params_lists_every_parameter_with_units(capsys):
+    assert main(["params"]) == 0
+    out = capsys.readouterr().out
+    for name, unit in (("mass", "kg"), ("stiction_force", "N"), ("pi_ki", "N/(m*s)"),
+                       ("velocity_highpass", "Hz"), ("stop_center", "m")):
+        line = next(line for line in out.splitlines() if f" {name} " in f" {line} ")
+        assert unit in line
+
+
+def test_params_toml_round_trips(tmp_path):
+    path = tmp_path / "p.toml"
+    assert main(["params", "--toml", str(path), "--set", "mass=7"]) == 0
+    from qzs.io import load_config
+
+    assert load_config(path)["isolator"].mass == 7.0
+
+
+def test_simulate_writes_outputs_and_summary(tmp_path, capsys):
+    out, plot = tmp_path / "run.csv", tmp_path / "run.png"
+    code = main(["simulate", "--excitation", "sine", "--frequency", "3", "--amplitude", "0.004",
+                 "--duration", "2", "--sample-rate", "200", "--set", "pi_kp=20",
+                 "--out", str(out), "--plot", str(plot), "--quiet"])
+    assert code == 0
+    text = capsys.readouterr().out
+    for key in ("operating point", "stroke used", "stop contacts", "locked", "M steps/s",
+                "PI integral must carry"):
+        assert key in text
+    data = read_result(out)
+    assert data.attrs["controller.pi_kp"] == 20.0
+    assert data.sizes["time"] == 401
+    assert plot.stat().st_size > 10_000 and plot.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_simulate_config_and_set_override(tmp_path):
+    config = save_config(tmp_path / "c.toml", excitation={"kind": "sine", "frequency": 2.0,
+                                                          "amplitude": 0.002},
+                         simulation={"duration": 1.0, "sample_rate": 100.0})
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--config", str(config), "--set", "viscous_damping=50",
+                 "--out", str(out), "--plot", "none", "--quiet"]) == 0
+    data = read_result(out)
+    assert data.attrs["isolator.viscous_damping"] == 50.0
+    assert data.attrs["excitation.frequency"] == 2.0
+    assert np.isclose(float(data.time[-1]), 1.0)
+
+
+def test_simulate_file_excitation(tmp_path):
+    t = np.linspace(0, 1, 1001)
+    record = tmp_path / "base.csv"
+    record.write_text("time,displacement\n" + "\n".join(
+        f"{a},{0.003 * np.sin(2 * np.pi * 2 * a)}" for a in t))
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--excitation", "file", "--record", str(record), "--out", str(out),
+                 "--plot", "none", "--quiet"]) == 0
+    data = read_result(out)
+    np.testing.assert_allclose(data.base_displacement.values[::100],
+                               0.003 * np.sin(2 * np.pi * 2 * data.time.values[::100]),
+                               atol=1e-6)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["simulate", "--set", "mass=-2"], "`mass` must be positive, got -2.0"),
+    (["simulate", "--set", "masss=2"], "unknown parameter 'masss'"),
+    (["simulate", "--dt", "0.5", "--duration", "10", "--excitation", "sine"],
+     "largest stable step"),
+    (["simulate", "--excitation", "file", "--record", "/nonexistent.csv"],
+     "displacement record not found"),
+])
+def test_errors_are_one_clear_line(capsys, argv, message):
+    assert main(argv + ["--plot", "none", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error:") and message in err
+    assert "Traceback" not in err
+
+
+def test_study_runs_a_user_file(tmp_path, capsys):
+    study = tmp_path / "mine.toml"
+    study.write_text("""
+[study]
+name = "mine"
+title = "Two stictions"
+kind = "transmissibility"
+claims = []
+[[study.view]]
+figure = "mine"
+frequency_range = [0.0, 10.0]
+[analysis]
+quick_fft_length = 2048
+quick_n_averages = 4
+band = [0.0, 10.0]
+[excitation]
+f1 = 10.0
+[[case]]
+label = "a"
+stiction_force = 2.0
+[[case]]
+label = "b"
+stiction_force = 8.0
+""")
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--quick", "--out", str(out), "--workers", "1",
+                 "--quiet"]) == 0
+    assert (out / "mine.png").exists() and (out / "mine.svg").exists()
+    assert (out / "metrics.csv").read_text().count("\nmine,") == 2
