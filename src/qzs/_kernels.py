@@ -71,9 +71,27 @@ def params_tuple(p):
 
 
 @njit(**_JIT, inline="always")
+def _exp(x):
+    """exp for ``x <= 40``, in plain arithmetic so that loops over cases vectorise.
+
+    ``exp(x) = exp(x/256)**256``: a degree-10 Taylor polynomial on ``|x/256| <= 0.16``
+    (truncation below 5e-17) squared 8 times; relative error below 5e-14.
+    Returns 0 for ``x < -40`` (below 5e-18) and is not meant for ``x > 40``.
+    """
+    y = max(x, -40.0) * (1.0 / 256.0)
+    p = 1.0 + y * (1.0 + y * (1.0 / 2.0 + y * (1.0 / 6.0 + y * (1.0 / 24.0 + y * (
+        1.0 / 120.0 + y * (1.0 / 720.0 + y * (1.0 / 5040.0 + y * (1.0 / 40320.0 + y * (
+            1.0 / 362880.0 + y * (1.0 / 3628800.0))))))))))
+    for _ in range(8):
+        p *= p
+    return p if x >= -40.0 else 0.0
+
+
+@njit(**_JIT, inline="always")
 def _tanh(u):
-    """tanh through one exp (half the cost of libm's; error below 3e-16)."""
-    r = 1.0 - 2.0 / (np.exp(2.0 * abs(u)) + 1.0)
+    """tanh from one :func:`_exp` (exactly +-1 beyond |u| = 20; error below 1e-13)."""
+    a = min(abs(u), 20.0)
+    r = 1.0 - 2.0 / (_exp(2.0 * a) + 1.0)
     return r if u >= 0.0 else -r
 
 
@@ -130,8 +148,8 @@ def rhs(y, yd, ydd, s, mode, direction, held, P):
     f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
     f_hold = m * ydd - f_applied
     if mode == MODE_SLIP:
-        sign = direction if v == 0.0 else (1.0 if v > 0.0 else -1.0)
-        level = P[P_FC] + (P[P_FS] - P[P_FC]) * np.exp(-P[P_CBC] * abs(v))
+        sign = direction  # continued analytically past v = 0 so the crossing is smooth
+        level = P[P_FC] + (P[P_FS] - P[P_FC]) * _exp(-P[P_CBC] * abs(v))
         f_friction = -level * sign - P[P_CV] * v
         xdd = (f_applied + f_friction) / m
     else:
@@ -256,38 +274,72 @@ def _release_direction(mode, f_hold):
 
 
 @njit(**_JIT)
+def _book_impulse(t, s, ledger, E, table, P):
+    """Set v to exactly 0 and book the impulse that does it (closes the energy ledger).
+
+    Stopping a slip velocity ``v`` takes an impulse ``-m*v`` between payload and base.
+    It does work ``-m*v*yd`` through the base and dissipates ``m*v**2/2`` in the
+    element that supplies it (``ledger``: friction or stop); both are exact.
+    """
+    y, yd, ydd = base_motion(t, E, table)
+    m = P[P_MASS]
+    v = s[S_V]
+    s = _with(s, S_V, 0.0)
+    s = _with(s, S_W_BASE, s[S_W_BASE] - m * v * yd)
+    return _with(s, ledger, s[ledger] + 0.5 * m * v * v)
+
+
+@njit(**_JIT)
 def _settle(t, s, direction, held, P, E, table):
     """At a zero crossing of v: stick if friction can hold the payload, else reverse.
 
-    Returns ``(state, mode, direction)``. The velocity is set to exactly 0; the
-    tiny kinetic-energy change of that snap is booked to friction dissipation so
-    that the energy ledger stays closed.
+    Returns ``(state, mode, direction)``. v is set to exactly 0 either way; the
+    crossing is located to round-off, so the impulse booked for it is negligible.
     """
-    before = _mechanical_energy(t, s, MODE_SLIP, P, E, table)
-    s = _with(s, S_V, 0.0)
+    s = _book_impulse(t, s, S_D_FRICTION, E, table, P)
     f_hold = rhs_at(t, s, MODE_STICK, 0.0, held, P, E, table)[1][F_HOLD]
-    mode = MODE_SLIP
     if abs(f_hold) <= P[P_FS]:
-        mode = MODE_STICK
-    else:
-        direction = -1 if f_hold > 0.0 else 1
-    snap = before - _mechanical_energy(t, s, mode, P, E, table)
-    return _with(s, S_D_FRICTION, s[S_D_FRICTION] + snap), mode, direction
+        return s, MODE_STICK, direction
+    return s, MODE_SLIP, -1 if f_hold > 0.0 else 1
 
 
 @njit(**_JIT)
-def _hit_wall(t, s, mode, low, P, E, table):
-    """Perfectly plastic impact: z put on the stop, v absorbed, energy booked to the stop."""
-    before = _mechanical_energy(t, s, mode, P, E, table)
-    s = _with(_with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH]), S_V, 0.0)
+def _hit_wall(t, s, low, held, P, E, table):
+    """Perfectly plastic impact: v absorbed by the stop's impulse, z put on the stop.
+
+    The payload then rests on the stop if friction and the stop can hold it,
+    else it leaves at once (v = 0, slipping away from the stop). Returns
+    ``(state, mode, direction)``.
+    """
+    s = _book_impulse(t, s, S_D_STOP, E, table, P)
+    before = _mechanical_energy(t, s, MODE_SLIP, P, E, table)
+    s = _with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH])
+    # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
+    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, MODE_SLIP, P, E,
+                                                                    table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
-    loss = before - _mechanical_energy(t, s, mode, P, E, table)
-    return _with(s, S_D_STOP, s[S_D_STOP] + loss), mode
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    if _hold_margin(mode, f_hold, P[P_FS]) < 0.0:
+        return s, MODE_SLIP, _release_direction(mode, f_hold)
+    return s, mode, 0
 
 
 @njit(**_JIT)
-def _event(s, s1, mode, direction, margin, margin1, P):
-    """Kind (0: none) and step fraction of the first transition between ``s`` and ``s1``."""
+def _event_value(event, t, s, mode, direction, held, P, E, table):
+    """The function whose sign change defines ``event`` (positive before it)."""
+    if event == 1:
+        return direction * s[S_V]
+    if event == 2:
+        return s[S_Z] - P[P_Z_LOW]
+    if event == 3:
+        return P[P_Z_HIGH] - s[S_Z]
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    return _hold_margin(mode, f_hold, P[P_FS])
+
+
+@njit(**_JIT)
+def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
+    """Kind (0: none) and time fraction (secant) of the first transition in a step."""
     theta = 2.0
     event = 0
     if mode == MODE_SLIP:
@@ -312,76 +364,107 @@ def _event(s, s1, mode, direction, margin, margin1, P):
 
 
 @njit(**_JIT)
+def _rk(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
+    """Not-inlined :func:`rk_step`, for the event path (keeps the compiled code small)."""
+    return rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0)
+
+
+@njit(**_JIT)
+def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table, phase,
+            sin0, cos0):
+    """Refine an event inside ``[t, t + h]`` by regula falsi (Illinois) on its function.
+
+    Returns ``(time from t, state there)``; the event function is then zero to
+    round-off (at most 6 refinements, each one Runge-Kutta step).
+    """
+    lo, hi = 0.0, h
+    g_lo, g_hi = g0, g1
+    if g0 <= 0.0:
+        return 0.0, s
+    at = h * g0 / (g0 - g1)
+    state = s1
+    side = 0
+    for _ in range(6):
+        state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table, phase, sin0,
+                    cos0)
+        g = _event_value(event, t + at, state, mode, direction, held, P, E, table)
+        if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
+            break
+        if g > 0.0:
+            lo, g_lo = at, g
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+        else:
+            hi, g_hi = at, g
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        at = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+    return at, state
+
+
+@njit(**_JIT)
 def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0):
-    """Advance one grid step, locating at most one mode transition inside it.
+    """Advance one grid step, locating and handling at most one transition inside it.
 
     ``margin`` is the holding margin at ``t`` if known (NaN if not); ``phase,
     sin0, cos0`` the excitation's phase and its sine and cosine at ``t``. Returns
-    ``(state, mode, direction, margin, sticks, impacts)``: the holding margin
-    at the end (NaN while slipping), the counts of new stick events and of
-    plastic impacts in the step.
+    ``(state, mode, direction, margin, sticks, impacts)``: the holding margin at
+    the end (NaN while slipping), the counts of new stick events and of plastic
+    impacts in the step.
     """
     sticks = 0
     impacts = 0
-    if mode == MODE_SLIP:
-        if direction * s[S_V] < 0.0:  # a crossing the in-step location missed
-            s, mode, direction = _settle(t, s, direction, held, P, E, table)
-            sticks += mode == MODE_STICK
+    if mode == MODE_SLIP and direction * s[S_V] < 0.0:  # a crossing missed earlier
+        s, mode, direction = _settle(t, s, direction, held, P, E, table)
+        sticks += mode == MODE_STICK
+        margin = np.nan
     if mode != MODE_SLIP:
         if margin != margin:  # NaN: not known yet
-            y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-            margin = _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD],
-                                  P[P_FS])
+            margin = _event_value(4, t, s, mode, direction, held, P, E, table)
         if margin < 0.0:
-            y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-            direction = _release_direction(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD])
+            f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+            direction = _release_direction(mode, f_hold)
             mode = MODE_SLIP
 
-    # One call site of the (inlined) Runge-Kutta step: pass 0 tries the whole
-    # step; with an event inside it, pass 1 integrates up to the event and pass 2
-    # the rest of the step in the new mode.
-    start = t
-    length = h
-    s_start = s
+    s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, E, table, phase, sin0, cos0)
     margin1 = np.nan
-    for stage in range(3):
-        s1 = rk_step(solver, start, length, s_start, mode, float(direction), held, P, E, table,
-                     phase, sin0, cos0)
-        if mode != MODE_SLIP:
-            y, yd, ydd = base_motion_near(start + length, phase, sin0, cos0, E, table)
-            margin1 = _hold_margin(mode, rhs(y, yd, ydd, s1, mode, 0.0, held, P)[1][F_HOLD],
-                                   P[P_FS])
-        if stage == 0:
-            event, theta = _event(s, s1, mode, direction, margin, margin1, P)
-            if event == 0:
-                return s1, mode, direction, margin1, sticks, impacts
-            length = theta * h
-            if length > 0.0:
-                continue
-            s1 = s
-        if stage <= 1:
-            start = t + length
-            if event == 1:
-                s1, mode, direction = _settle(start, s1, direction, held, P, E, table)
-                sticks += mode == MODE_STICK
-            elif event == 2 or event == 3:
-                s1, mode = _hit_wall(start, s1, mode, event == 2, P, E, table)
-                impacts += 1
-            else:
-                f_hold = rhs_at(start, s1, mode, 0.0, held, P, E, table)[1][F_HOLD]
-                direction = _release_direction(mode, f_hold)
-                mode = MODE_SLIP
-            length = h - length
-            s_start = s1
-            if length > 0.0:
-                continue
-        break
-    if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:
+    if mode != MODE_SLIP:
+        margin1 = _event_value(4, t + h, s1, mode, direction, held, P, E, table)
+    event, theta = _first_event(t, h, s, s1, mode, direction, margin, margin1, P)
+    if event == 0:
+        return s1, mode, direction, margin1, sticks, impacts
+
+    g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, E, table)
+    g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
+                                                 E, table)
+    at, s_event = _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E,
+                          table, phase, sin0, cos0)
+    t_event = t + at
+    if event == 1:
+        s_event, mode, direction = _settle(t_event, s_event, direction, held, P, E, table)
+        sticks += mode == MODE_STICK
+    elif event == 2 or event == 3:
+        s_event, mode, direction = _hit_wall(t_event, s_event, event == 2, held, P, E, table)
+        impacts += 1
+    else:
+        f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, E, table)[1][F_HOLD]
+        direction = _release_direction(mode, f_hold)
+        mode = MODE_SLIP
+    rest = h - at
+    s1 = s_event
+    if rest > 0.0:
+        s1 = _rk(solver, t_event, rest, s_event, mode, float(direction), held, P, E, table,
+                 phase, sin0, cos0)
+    if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
         if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
-            s1, mode = _hit_wall(t + h, s1, mode, s1[S_Z] < P[P_Z_LOW], P, E, table)
+            s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, E,
+                                            table)
             impacts += 1
-    if mode == MODE_SLIP:
-        margin1 = np.nan
+    margin1 = np.nan
+    if mode != MODE_SLIP:
+        margin1 = _event_value(4, t + h, s1, mode, direction, held, P, E, table)
     return s1, mode, direction, margin1, sticks, impacts
 
 

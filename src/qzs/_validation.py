@@ -4,12 +4,14 @@ Messages follow scipy's style: name the argument, the value received and the fix
 """
 import math
 
+import numpy as np
+
 from qzs.errors import ParameterError
 
 
 def as_float(name, value, error=ParameterError):
     """Return ``value`` as a finite float or raise ``error`` naming ``name``."""
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         raise error(f"`{name}` must be a number, got the boolean {value!r}.")
     try:
         number = float(value)

@@ -341,8 +341,8 @@ class DisplacementRecord(_Tabulated):
         if np.any(steps <= 0):
             i = int(np.argmax(steps <= 0))
             raise ExcitationError(
-                f"`time` must be strictly increasing; sample {i + 1} ({time[i + 1]!r} s) does "
-                f"not follow sample {i} ({time[i]!r} s). Sort the record and drop duplicates.")
+                f"`time` must be strictly increasing; sample {i + 1} ({float(time[i + 1])!r} s) does "
+                f"not follow sample {i} ({float(time[i])!r} s). Sort the record and drop duplicates.")
         object.__setattr__(self, "time", time - time[0])
         object.__setattr__(self, "displacement", disp)
 
