@@ -6,6 +6,7 @@
     qzs params [--toml FILE]
     qzs study FILE.toml [--quick] [--out DIR] [--workers N]
     qzs paper [--quick] [--out DIR] [--workers N]
+    qzs experiment LOG --map MAP.toml [--out DIR]
 """
 import argparse
 import sys
@@ -62,6 +63,10 @@ def _build_parser():
         cmd.add_argument("--workers", type=int, metavar="N",
                          help="worker processes (default: all cores)")
         cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    from qzs import experiment
+
+    experiment.add_parser(sub)
 
     params = sub.add_parser("params", help="print the default parameters with units")
     params.add_argument("--toml", metavar="FILE", help="write them as a config file instead")
@@ -200,7 +205,10 @@ def main(argv=None):
     from qzs.errors import DataError, ParameterError, SimulationError
 
     args = _build_parser().parse_args(argv)
-    handlers = {"simulate": _simulate, "params": _params, "paper": _studies, "study": _studies}
+    from qzs import experiment
+
+    handlers = {"simulate": _simulate, "params": _params, "paper": _studies, "study": _studies,
+                "experiment": experiment.run}
     try:
         return handlers[args.command](args)
     except (ParameterError, DataError, SimulationError) as error:
