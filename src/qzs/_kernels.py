@@ -538,7 +538,7 @@ def hold_force(t, state, p, ex, table):
     return rhs_at(t, s, MODE_STICK, 0.0, held, params_tuple(p), excitation_tuple(ex), table)[1]
 
 
-@njit(**_JIT)
+@njit(**_JIT, nogil=True)
 def run_chunk(solver, n_steps, decimation, state, flags, p, ex, table, out, out_flags, row0):
     """Advance ``n_steps`` grid steps, writing every ``decimation``-th state to ``out``.
 
@@ -595,3 +595,22 @@ def run_chunk(solver, n_steps, decimation, state, flags, p, ex, table, out, out_
     flags[I_CONTACT] = contact
     flags[I_STEP] = step
     return status, row - row0
+
+
+@njit(cache=True, nogil=True, fastmath={"nsz", "contract", "arcp"}, error_model="numpy")
+def run_batch_chunk(solver, n_steps, decimation, states, flags, params, ex, table, out,
+                    out_flags, row0, status, first, last, rows):
+    """:func:`run_chunk` for cases ``first..last-1`` of a batch (releases the GIL).
+
+    Row ``c`` of ``states``, ``flags``, ``params``, ``out`` and ``out_flags`` is
+    case ``c``; the excitation is shared. Each case runs the very same
+    :func:`run_chunk` as a single run, so its numbers are identical; threads run
+    disjoint ranges of cases in parallel. A case whose ``status`` is not
+    ``STATUS_OK`` is skipped (it failed earlier); ``rows[c]`` gets the rows written.
+    """
+    for c in range(first, last):
+        if status[c] == STATUS_OK:
+            code, written = run_chunk(solver, n_steps, decimation, states[c], flags[c],
+                                      params[c], ex, table, out[c], out_flags[c], row0)
+            status[c] = code
+            rows[c] = written

@@ -5,6 +5,7 @@
 >>> result.summary()  # doctest: +SKIP
 """
 import time as _time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from qzs.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine, ba
 from qzs.model import InitialState, IsolatorParameters
 from qzs.results import SimulationResult
 
-__all__ = ["simulate", "largest_stable_step", "SOLVERS"]
+__all__ = ["simulate", "prepare_run", "largest_stable_step", "SOLVERS"]
 
 #: Fixed-step integrators and their orders of accuracy.
 SOLVERS = {"euler": (K.SOLVER_EULER, 1), "ode3": (K.SOLVER_ODE3, 3), "rk4": (K.SOLVER_RK4, 4)}
@@ -158,6 +159,77 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     return s, flags
 
 
+@dataclass
+class PreparedRun:
+    """Everything the kernels need for one run, validated (see :func:`prepare_run`)."""
+
+    excitation: object
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    params: np.ndarray
+    packed: tuple
+    state: np.ndarray
+    flags: np.ndarray
+    duration: float
+    decimation: int
+    solver_code: int
+    dt: float
+    sample_rate: float
+
+
+def prepare_run(excitation=None, isolator=None, controller=None, *, duration=None, dt=1e-4,
+                sample_rate=1000.0, solver="ode3", initial_state=None):
+    """Validate a run's inputs and pack them for the kernels (shared by single and batch runs).
+
+    Parameters and exceptions as in :func:`simulate`.
+
+    Returns
+    -------
+    PreparedRun
+    """
+    excitation = Chirp() if excitation is None else excitation
+    isolator = IsolatorParameters() if isolator is None else isolator
+    controller = ControllerParameters() if controller is None else controller
+    initial_state = InitialState() if initial_state is None else initial_state
+    for name, value, kinds in (("excitation", excitation, _EXCITATIONS),
+                               ("isolator", isolator, (IsolatorParameters,)),
+                               ("controller", controller, (ControllerParameters,)),
+                               ("initial_state", initial_state, (InitialState,))):
+        if not isinstance(value, kinds):
+            names = " or ".join(k.__name__ for k in kinds)
+            raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
+    solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
+    dt = positive("dt", dt)
+    sample_rate = positive("sample_rate", sample_rate)
+    if duration is None:
+        if excitation.duration is None:
+            raise ParameterError("`duration` is required for a sine excitation, got None.")
+        duration = excitation.duration
+    duration = positive("duration", duration)
+    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
+        raise ParameterError(
+            f"`duration` ({duration!r} s) exceeds the excitation's length "
+            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    if dt > duration:
+        raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
+    limit = largest_stable_step(isolator, controller, solver)
+    if dt > limit:
+        raise StabilityError(
+            f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
+            f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
+            f"stable step is {limit:.3g} s. Reduce `dt`, or soften `stop_stiffness`.")
+    decimation = _steps_per(sample_rate, dt, "sample_rate")
+    control_steps = 0
+    if controller.controller_rate > 0:
+        control_steps = _steps_per(controller.controller_rate, dt, "controller_rate")
+
+    p = _pack_parameters(isolator, controller, dt, control_steps)
+    packed = excitation.pack()
+    s, flags = _initial_state(initial_state, isolator, controller, p, excitation, packed)
+    return PreparedRun(excitation, isolator, controller, p, packed, s, flags, duration,
+                       decimation, solver_code, dt, sample_rate)
+
+
 def simulate(excitation=None, isolator=None, controller=None, *, duration=None, dt=1e-4,
              sample_rate=1000.0, solver="ode3", initial_state=None, progress=False,
              interruptible=False):
@@ -199,45 +271,12 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None, 
     SimulationError
         The state diverged or became non-finite (the message names time and state).
     """
-    excitation = Chirp() if excitation is None else excitation
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
-    initial_state = InitialState() if initial_state is None else initial_state
-    for name, value, kinds in (("excitation", excitation, _EXCITATIONS),
-                               ("isolator", isolator, (IsolatorParameters,)),
-                               ("controller", controller, (ControllerParameters,)),
-                               ("initial_state", initial_state, (InitialState,))):
-        if not isinstance(value, kinds):
-            names = " or ".join(k.__name__ for k in kinds)
-            raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
-    solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
-    dt = positive("dt", dt)
-    sample_rate = positive("sample_rate", sample_rate)
-    if duration is None:
-        if excitation.duration is None:
-            raise ParameterError("`duration` is required for a sine excitation, got None.")
-        duration = excitation.duration
-    duration = positive("duration", duration)
-    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
-        raise ParameterError(
-            f"`duration` ({duration!r} s) exceeds the excitation's length "
-            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
-    if dt > duration:
-        raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
-    limit = largest_stable_step(isolator, controller, solver)
-    if dt > limit:
-        raise StabilityError(
-            f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
-            f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
-            f"stable step is {limit:.3g} s. Reduce `dt`, or soften `stop_stiffness`.")
-    decimation = _steps_per(sample_rate, dt, "sample_rate")
-    control_steps = 0
-    if controller.controller_rate > 0:
-        control_steps = _steps_per(controller.controller_rate, dt, "controller_rate")
-
-    p = _pack_parameters(isolator, controller, dt, control_steps)
-    packed = excitation.pack()
-    s, flags = _initial_state(initial_state, isolator, controller, p, excitation, packed)
+    run = prepare_run(excitation, isolator, controller, duration=duration, dt=dt,
+                      sample_rate=sample_rate, solver=solver, initial_state=initial_state)
+    excitation, isolator, controller = run.excitation, run.isolator, run.controller
+    p, packed, s, flags = run.params, run.packed, run.state, run.flags
+    duration, decimation, solver_code = run.duration, run.decimation, run.solver_code
+    dt, sample_rate = run.dt, run.sample_rate
     n_steps = int(round(duration / dt))
     n_out = n_steps // decimation + 1
     out = np.empty((n_out, K.N_CHANNELS))

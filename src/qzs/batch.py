@@ -1,0 +1,219 @@
+"""Many parameter sets through the same kernel at once: the engine of sweeps.
+
+Each case is validated and packed exactly as :func:`qzs.simulate` does it, and
+:func:`qzs._kernels.run_batch_chunk` advances all cases by the same step,
+in parallel over cores, calling the single-run kernel for each: per case the
+numbers are identical to ``simulate``'s. Output is reduced while integrating:
+only the requested channels are kept, and per-case statistics (stroke, stop
+contacts, RMS motor force, time locked) are accumulated chunk by chunk.
+"""
+import os
+import time as _time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs import _kernels as K
+from qzs.errors import ParameterError
+from qzs.results import CHANNELS
+from qzs.simulate import prepare_run
+
+__all__ = ["BatchResult", "simulate_batch", "STATS"]
+
+#: Per-case statistics: name -> (unit, description).
+STATS = {
+    "stop_contacts": ("1", "number of hard-stop contacts"),
+    "z_min": ("m", "lowest relative position"),
+    "z_max": ("m", "highest relative position"),
+    "peak_stroke": ("m", "largest |z - stop_center|"),
+    "motor_force_rms": ("N", "RMS motor force"),
+    "locked_fraction": ("1", "fraction of samples locked"),
+    "stick_events": ("1", "number of stick events"),
+    "steps": ("1", "integration steps done"),
+}
+_ROWS_PER_CHUNK = 4_000_000  # output rows held at once, over all cases (~770 MB)
+
+
+@dataclass
+class BatchResult:
+    """Outputs of :func:`simulate_batch`.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n_samples,)
+        Sample times [s].
+    channels : dict of str to ndarray, shape (n_cases, n_samples)
+        The requested channels (names and units of :data:`qzs.results.CHANNELS`).
+    stats : dict of str to ndarray, shape (n_cases,)
+        Per-case statistics, see :data:`STATS`.
+    status : ndarray of int8, shape (n_cases,)
+        0 for a completed case, 1 for a failed one.
+    messages : list of str
+        '' or the failure message (time and state) of each case.
+    elapsed : float
+        Wall time of the integration [s].
+    """
+
+    time: np.ndarray
+    channels: dict
+    stats: dict
+    status: np.ndarray
+    messages: list
+    elapsed: float = 0.0
+    cases: list = field(default_factory=list)
+
+    @property
+    def steps_per_second(self):
+        """Simulated steps per second over all cases [steps/s]."""
+        return float(self.stats["steps"].sum()) / max(self.elapsed, 1e-12)
+
+
+def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rate=1000.0,
+                   solver="ode3", channels=("base_acceleration", "payload_acceleration"),
+                   workers=None, progress=False):
+    """Simulate many parameter sets under one excitation, in parallel.
+
+    Parameters
+    ----------
+    cases : sequence of (IsolatorParameters, ControllerParameters)
+        The parameter sets; each starts from the default initial state.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
+        Shared base motion; default the paper's chirp.
+    duration, dt, sample_rate, solver
+        As in :func:`qzs.simulate` [s], [s], [Hz].
+    channels : sequence of str
+        Time series to keep (names of :data:`qzs.results.CHANNELS`); may be empty.
+    workers : int, optional
+        Threads, each running a share of the cases in the kernel (which releases
+        the GIL); default all cores.
+    progress : bool
+        Show a progress bar over simulated time.
+
+    Returns
+    -------
+    BatchResult
+
+    Raises
+    ------
+    ParameterError
+        An invalid argument, or a case that is invalid (the message names its index).
+    """
+    cases = list(cases)
+    if not cases:
+        raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
+    unknown = [c for c in channels if c not in CHANNELS]
+    if unknown:
+        raise ParameterError(f"unknown channel(s) {unknown}; channels are {list(CHANNELS)}.")
+    prepared = []
+    for index, pair in enumerate(cases):
+        try:
+            isolator, controller = pair
+            prepared.append(prepare_run(excitation, isolator, controller, duration=duration,
+                                        dt=dt, sample_rate=sample_rate, solver=solver))
+        except (TypeError, ValueError) as error:
+            raise type(error)(f"case {index}: {error}") if isinstance(error, ParameterError) \
+                else ParameterError(f"case {index}: {error}") from None
+    first = prepared[0]
+    n = len(prepared)
+    n_steps = int(round(first.duration / first.dt))
+    decimation = first.decimation
+    n_out = n_steps // decimation + 1
+    states = np.stack([r.state for r in prepared])
+    flags = np.stack([r.flags for r in prepared])
+    params = np.stack([r.params for r in prepared])
+    ex, table = first.packed
+    columns = [CHANNELS[c][0] for c in channels]
+    kept = {c: np.empty((n, n_out)) for c in channels}
+    status = np.zeros(n, dtype=np.int64)
+
+    rows_per_chunk = max(1, _ROWS_PER_CHUNK // n)
+    chunk_steps = max(decimation, (rows_per_chunk * decimation) // decimation * decimation)
+    out = np.empty((n, min(n_out, chunk_steps // decimation + 1), K.N_CHANNELS))
+    out_flags = np.zeros((n, out.shape[1], 2), dtype=np.bool_)
+    for c in range(n):
+        K.evaluate(0.0, states[c], flags[c], params[c], ex, table, out[c, 0], out_flags[c, 0])
+    z_min = np.full(n, np.inf)
+    z_max = np.full(n, -np.inf)
+    peak = np.zeros(n)
+    force_squares = np.zeros(n)
+    locked = np.zeros(n)
+    counted = np.zeros(n)
+    centers = 0.5 * (params[:, K.P_Z_LOW] + params[:, K.P_Z_HIGH])
+    failed_at = np.full(n, -1, dtype=np.int64)
+
+    def absorb(rows, start_row, first_row):
+        nonlocal z_min, z_max, peak
+        block = out[:, first_row:first_row + rows]
+        for name, col in zip(channels, columns):
+            kept[name][:, start_row:start_row + rows] = block[:, :, col]
+        z = block[:, :, K.C_Z]
+        z_min = np.minimum(z_min, z.min(axis=1))
+        z_max = np.maximum(z_max, z.max(axis=1))
+        peak = np.maximum(peak, np.abs(z - centers[:, None]).max(axis=1))
+        force_squares[:] += (block[:, :, K.C_F_MOTOR] ** 2).sum(axis=1)
+        locked[:] += out_flags[:, first_row:first_row + rows, K.O_LOCKED].sum(axis=1)
+        counted[:] += rows
+
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
+    workers = min(workers or os.cpu_count() or 1, n)
+    bounds = np.linspace(0, n, workers + 1).astype(int)
+    written = np.zeros(n, dtype=np.int64)
+    pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=n_steps, unit="step", unit_scale=True, desc=f"{n} cases",
+               disable=not progress, leave=False)
+    start = _time.perf_counter()
+    try:
+        absorb(1, 0, 0)
+        done, row = 0, 1
+        while done < n_steps:
+            steps = min(chunk_steps, n_steps - done)
+            before = status.copy()
+            args = (first.solver_code, steps, decimation, states, flags, params, ex, table,
+                    out, out_flags, 0, status)
+            if pool is None:
+                K.run_batch_chunk(*args, 0, n, written)
+            else:
+                list(pool.map(lambda i: K.run_batch_chunk(*args, bounds[i], bounds[i + 1],
+                                                           written), range(workers)))
+            newly = (before == K.STATUS_OK) & (status != K.STATUS_OK)
+            failed_at[newly] = flags[newly, K.I_STEP]
+            rows = steps // decimation
+            if np.any(written[status == K.STATUS_OK] != rows):  # pragma: no cover
+                raise RuntimeError("batch kernel wrote an unexpected number of rows")
+            for c in np.flatnonzero(status != K.STATUS_OK):  # keep the part that finished
+                out[c, written[c]:rows] = np.nan
+            absorb(rows, row, 0)
+            row += rows
+            done += steps
+            bar.update(steps)
+    finally:
+        bar.close()
+        if pool is not None:
+            pool.shutdown()
+    elapsed = _time.perf_counter() - start
+
+    messages = []
+    for c in range(n):
+        if status[c] == K.STATUS_OK:
+            messages.append("")
+        else:
+            t = failed_at[c] * first.dt
+            messages.append(
+                f"the simulation diverged at t = {t:.6g} s (last finite state: relative "
+                f"position z = {states[c, K.S_Z]:.6g} m, relative velocity v = "
+                f"{states[c, K.S_V]:.6g} m/s)")
+    stats = {
+        "stop_contacts": flags[:, K.I_N_CONTACTS].astype(float),
+        "z_min": z_min, "z_max": z_max, "peak_stroke": peak,
+        "motor_force_rms": np.sqrt(force_squares / np.maximum(counted, 1)),
+        "locked_fraction": locked / np.maximum(counted, 1),
+        "stick_events": flags[:, K.I_N_STICKS].astype(float),
+        "steps": flags[:, K.I_STEP].astype(float),
+    }
+    time = np.arange(n_out) * (decimation * first.dt)
+    return BatchResult(time, kept, stats, (status != K.STATUS_OK).astype(np.int8), messages,
+                       elapsed, cases)
