@@ -1,0 +1,77 @@
+"""Batch engine: the same numbers as single runs, failures recorded, stats consistent."""
+import numpy as np
+import pytest
+from helpers import linear_controller, linear_isolator
+
+import qzs
+from qzs.batch import STATS, simulate_batch
+
+EXCITATION = qzs.Chirp(duration=12.0, f1=8.0)
+CASES = [(qzs.IsolatorParameters(stiction_force=fs), qzs.ControllerParameters(pi_kp=kp, pi_ki=ki))
+         for fs in (2.0, 10.0) for kp, ki in ((5.0, 2.0), (50.0, 20.0))]
+
+
+@pytest.fixture(scope="module")
+def batch():
+    return simulate_batch(CASES + [(qzs.IsolatorParameters(), qzs.ControllerParameters(
+        pi_kp=0.0, pi_ki=0.0))], EXCITATION, sample_rate=500.0,
+        channels=("payload_acceleration", "relative_position", "motor_force"), workers=2)
+
+
+def test_batch_equals_single_runs_exactly(batch):
+    for index, (isolator, controller) in enumerate(CASES):
+        single = qzs.simulate(EXCITATION, isolator, controller, sample_rate=500.0)
+        for name in ("payload_acceleration", "relative_position", "motor_force"):
+            assert np.array_equal(batch.channels[name][index], single[name]), (index, name)
+        assert batch.stats["stop_contacts"][index] == single.run["stop_contacts"]
+        assert batch.stats["stick_events"][index] == single.run["stick_events"]
+        assert batch.stats["z_min"][index] == single.relative_position.min()
+        assert batch.stats["locked_fraction"][index] == pytest.approx(single.locked.mean())
+        rms = np.sqrt(np.mean(single.motor_force ** 2))
+        assert batch.stats["motor_force_rms"][index] == pytest.approx(rms, rel=1e-12)
+    np.testing.assert_allclose(batch.time, single.time, rtol=0, atol=1e-12)
+
+
+def test_stats_are_consistent(batch):
+    assert set(batch.stats) == set(STATS)
+    z = batch.channels["relative_position"]
+    center = qzs.ControllerParameters().position_setpoint
+    np.testing.assert_allclose(batch.stats["peak_stroke"], np.abs(z - center).max(axis=1))
+    assert np.all(batch.stats["steps"] == 120_000)
+    assert batch.stats["stop_contacts"][-1] == 0 or batch.stats["z_min"][-1] < -0.13
+    assert batch.steps_per_second > 0
+
+
+def test_one_thread_equals_many():
+    one = simulate_batch(CASES[:3], EXCITATION, sample_rate=250.0, channels=("relative_position",),
+                         workers=1)
+    two = simulate_batch(CASES[:3], EXCITATION, sample_rate=250.0, channels=("relative_position",),
+                         workers=2)
+    assert np.array_equal(one.channels["relative_position"], two.channels["relative_position"])
+
+
+def test_a_failing_case_is_recorded_and_the_others_go_on():
+    plant = linear_isolator(stiffness=1e-9, damping=100.0, stroke_half=1.0, motor_force_max=1e12)
+    unstable = linear_controller(pi_kp=1e6, controller_rate=100.0)
+    result = simulate_batch([CASES[0], (plant, unstable), CASES[1]],
+                            qzs.Sine(amplitude=0.01, frequency=1.0), duration=5.0,
+                            sample_rate=100.0, channels=("relative_position",))
+    assert list(result.status) == [0, 1, 0]
+    assert result.messages[0] == result.messages[2] == ""
+    assert "diverged at t = " in result.messages[1]
+    assert np.all(np.isfinite(result.channels["relative_position"][[0, 2]]))
+    assert result.stats["steps"][1] < result.stats["steps"][0]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(channels=("payload_jerk",)), r"unknown channel\(s\) \['payload_jerk'\]"),
+    (dict(cases=[]), "at least one"),
+    (dict(cases=[(qzs.IsolatorParameters(), "not a controller")]), "case 0: `controller` must be"),
+    (dict(dt=0.5), "case 0: .*largest stable step"),
+    (dict(workers=0), "`workers` must be a positive integer"),
+])
+def test_bad_arguments(kwargs, match):
+    arguments = dict(cases=CASES[:1], excitation=EXCITATION, sample_rate=2.0)
+    arguments.update(kwargs)
+    with pytest.raises(qzs.ParameterError, match=match):
+        simulate_batch(**arguments)
