@@ -338,6 +338,13 @@ def _event_value(event, t, s, mode, direction, held, P, E, table):
 
 
 @njit(**_JIT)
+def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
+    """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
+    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+    return _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
+
+
+@njit(**_JIT)
 def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     """Kind (0: none) and time fraction (secant) of the first transition in a step."""
     theta = 2.0
@@ -422,7 +429,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
         margin = np.nan
     if mode != MODE_SLIP:
         if margin != margin:  # NaN: not known yet
-            margin = _event_value(4, t, s, mode, direction, held, P, E, table)
+            margin = _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0)
         if margin < 0.0:
             f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
             direction = _release_direction(mode, f_hold)
@@ -431,7 +438,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, E, table, phase, sin0, cos0)
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _event_value(4, t + h, s1, mode, direction, held, P, E, table)
+        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
     event, theta = _first_event(t, h, s, s1, mode, direction, margin, margin1, P)
     if event == 0:
         return s1, mode, direction, margin1, sticks, impacts
@@ -464,7 +471,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
             impacts += 1
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _event_value(4, t + h, s1, mode, direction, held, P, E, table)
+        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
     return s1, mode, direction, margin1, sticks, impacts
 
 

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy.interpolate import CubicSpline
 
 from qzs._validation import as_float, choice, non_negative, positive, validate_fields
 from qzs.errors import ExcitationError
@@ -284,6 +283,8 @@ class RandomExcitation(_Tabulated):
         return self.f_high
 
     def _spline(self):
+        from scipy.interpolate import CubicSpline
+
         rate = 20.0 * self.f_high
         n = int(np.ceil(self.duration * rate)) + 1
         n_fft = n if n % 2 == 0 else n + 1
@@ -357,6 +358,8 @@ class DisplacementRecord(_Tabulated):
         return 0.5 / float(np.median(np.diff(self.time)))
 
     def _spline(self):
+        from scipy.interpolate import CubicSpline
+
         steps = np.diff(self.time)
         uniform = np.ptp(steps) <= 1e-9 * steps.mean()
         return CubicSpline(self.time, self.displacement), (steps.mean() if uniform else 0.0)

@@ -142,8 +142,10 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     if initial.pi_integral is not None:
         s[K.S_INT] = initial.pi_integral
     elif controller.pi_ki > 0:  # preload: the motor carries what the spring and stops do not
-        needed = np.clip(force[K.F_HOLD], -isolator.motor_force_max, isolator.motor_force_max)
-        s[K.S_INT] = (needed - force[K.F_PI] - force[K.F_DAMP]) / controller.pi_ki
+        without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
+        needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
+        f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], 0.0)[:2]
+        s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
     held = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], s[K.S_INT])
     s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
     force = K.hold_force(0.0, s, p, *packed_excitation)
