@@ -263,7 +263,7 @@ GOOD = np.random.default_rng(2).standard_normal(256)
     ({"n_averages": 0}, ParameterError, r"`n_averages` must be an integer >= 1, got 0"),
     ({"highpass_corner": -1.0}, ParameterError, r"`highpass_corner`.*got -1.0"),
     ({"payload": GOOD[:-1]}, DataError, r"`base` and `payload` must have the same length, got 256 and 255"),
-    ({"base": np.where(np.arange(256) % 50 == 0, np.nan, GOOD)}, DataError, r"`base` contains 6 non-finite"),
+    ({"base": np.where(np.arange(256) % 50 == 0, np.nan, GOOD)}, DataError, r"`base` has 6 non-finite"),
     ({"payload": GOOD.reshape(16, 16)}, DataError, r"`payload` must be a 1-D.*\(16, 16\)"),
     ({"fft_length": 512}, DataError, r"needs at least 512 samples \(5.12 s at 100 Hz\), got 256"),
     ({"fft_length": 64, "n_averages": 8}, DataError, r"n_averages=8 .*needs at least 288 samples \(2.88 s"),

@@ -75,3 +75,30 @@ def parameter(default, unit, doc):
     from dataclasses import field
 
     return field(default=default, metadata={"unit": unit, "doc": doc})
+
+
+def finite_series(name, values, error, fix="interpolate or trim them first"):
+    """``values`` as a 1-D float array with no NaN or inf, or ``error`` naming the count."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim != 1:
+        raise error(f"`{name}` must be a 1-D series, got shape {array.shape}.")
+    bad = int(np.count_nonzero(~np.isfinite(array)))
+    if bad:
+        raise error(f"`{name}` has {bad} non-finite (NaN or inf) samples out of {array.size}; "
+                    f"{fix}.")
+    return array
+
+
+def read_toml(path, what, error=ParameterError):
+    """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad."""
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        with open(path, "rb") as handle:
+            return tomllib.load(handle)
+    except FileNotFoundError:
+        raise error(f"{what} not found: {str(path)!r}.") from None
+    except tomllib.TOMLDecodeError as err:
+        raise error(f"{what} {str(path)!r} is not valid TOML: {err}.") from None

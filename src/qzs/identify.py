@@ -20,6 +20,7 @@ from types import MappingProxyType
 import numpy as np
 from scipy import optimize, stats
 
+from qzs._validation import finite_series
 from qzs.errors import DataError, ParameterError
 
 __all__ = ["SpringFit", "fit_spring", "FrictionFit", "fit_friction", "plot_friction_fit",
@@ -168,14 +169,8 @@ def _student(confidence, dof):
 
 
 def _series(name, values):
-    array = np.asarray(values, dtype=float)
-    if array.ndim != 1:
-        raise DataError(f"`{name}` must be 1-D, got shape {array.shape}.")
-    bad = np.count_nonzero(~np.isfinite(array))
-    if bad:
-        raise DataError(f"`{name}` has {bad} non-finite (NaN or inf) samples of {array.size}; "
-                        "clean or interpolate them first (qzs.readers can, nan = 'interpolate').")
-    return array
+    return finite_series(name, values, DataError,
+                         "clean or interpolate them first (qzs.readers can, nan = 'interpolate')")
 
 
 # ---------------------------------------------------------------- friction

@@ -8,11 +8,11 @@ import dataclasses
 import math
 import os
 import tempfile
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
+from qzs._validation import read_toml
 from qzs.control import ControllerParameters
 from qzs.errors import DataError, ParameterError
 from qzs.model import IsolatorParameters
@@ -180,13 +180,7 @@ def load_config(path):
         ``simulation`` (plain dicts).
     """
     path = Path(path)
-    try:
-        with open(path, "rb") as handle:
-            document = tomllib.load(handle)
-    except FileNotFoundError:
-        raise ParameterError(f"config file not found: {str(path)!r}.") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ParameterError(f"{str(path)!r} is not valid TOML: {error}.") from None
+    document = read_toml(path, "config file")
     allowed = {"isolator", "controller", "excitation", "simulation"}
     unknown = set(document) - allowed
     if unknown:

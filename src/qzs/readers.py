@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import io
 import re
-import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +52,7 @@ from typing import Mapping
 
 import numpy as np
 
+from qzs._validation import read_toml
 from qzs.errors import DataError, ParameterError
 
 __all__ = ["Recording", "ChannelMap", "ChannelSpec", "DataWarning", "ROLES", "UNITS",
@@ -197,14 +197,7 @@ def load_channel_map(source):
     if isinstance(source, ChannelMap):
         return source
     if isinstance(source, (str, Path)):
-        try:
-            with open(source, "rb") as handle:
-                document = tomllib.load(handle)
-        except FileNotFoundError:
-            raise ParameterError(f"channel map not found: {str(source)!r}.") from None
-        except tomllib.TOMLDecodeError as error:
-            raise ParameterError(f"channel map {str(source)!r} is not valid TOML: "
-                                 f"{error}.") from None
+        document = read_toml(source, "channel map")
     elif isinstance(source, Mapping):
         document = dict(source)
     else:

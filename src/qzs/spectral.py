@@ -15,6 +15,7 @@ from typing import Mapping
 import numpy as np
 from scipy import signal
 
+from qzs._validation import finite_series
 from qzs.errors import DataError, ParameterError
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
@@ -52,14 +53,8 @@ def _noverlap(fft_length, overlap):
 
 
 def _signal(name, values):
-    array = np.asarray(values, dtype=float)
-    if array.ndim != 1:
-        raise DataError(f"`{name}` must be a 1-D time series, got shape {array.shape}.")
-    bad = np.count_nonzero(~np.isfinite(array))
-    if bad:
-        raise DataError(f"`{name}` contains {bad} non-finite (NaN or inf) samples out of "
-                        f"{array.size}; interpolate or trim them before estimating spectra.")
-    return array
+    return finite_series(name, values, DataError,
+                         "interpolate or trim them before estimating spectra")
 
 
 # ---------------------------------------------------------------- run sizing

@@ -19,7 +19,6 @@ Kinds:
 """
 import dataclasses
 import os
-import tomllib
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from importlib import resources
@@ -27,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs._validation import read_toml
 from qzs.errors import ParameterError
 
 __all__ = ["Study", "StudyResult", "CaseResult", "load_study", "shipped_studies", "run_studies",
@@ -106,10 +106,7 @@ def load_study(path):
         else:
             raise ParameterError(f"study file not found: {str(path)!r}; shipped studies are "
                                  f"{sorted(names)}.")
-    try:
-        document = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as error:
-        raise ParameterError(f"{str(path)!r} is not valid TOML: {error}.") from None
+    document = read_toml(path, "study file")
     allowed = {"study", "defaults", "case", "excitation", "analysis", "simulation", "spring",
                "processing"}
     unknown = set(document) - allowed
