@@ -7,6 +7,8 @@
     qzs study FILE.toml [--quick] [--out DIR] [--workers N]
     qzs paper [--quick] [--out DIR] [--workers N]
     qzs experiment LOG --map MAP.toml [--out DIR]
+    qzs sweep FILE.toml [--resume] [--workers N | --scheduler ADDRESS]
+    qzs sweep-plot STORE [--metric NAME] [--x PARAM] [--y PARAM]
 """
 import argparse
 import sys
@@ -64,9 +66,10 @@ def _build_parser():
                          help="worker processes (default: all cores)")
         cmd.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    from qzs import experiment
+    from qzs import experiment, sweep
 
     experiment.add_parser(sub)
+    sweep.add_parsers(sub)
 
     params = sub.add_parser("params", help="print the default parameters with units")
     params.add_argument("--toml", metavar="FILE", help="write them as a config file instead")
@@ -205,10 +208,11 @@ def main(argv=None):
     from qzs.errors import DataError, ParameterError, SimulationError
 
     args = _build_parser().parse_args(argv)
-    from qzs import experiment
+    from qzs import experiment, sweep
 
     handlers = {"simulate": _simulate, "params": _params, "paper": _studies, "study": _studies,
-                "experiment": experiment.run}
+                "experiment": experiment.run, "sweep": sweep.run_sweep_command,
+                "sweep-plot": sweep.run_sweep_plot_command}
     try:
         return handlers[args.command](args)
     except (ParameterError, DataError, SimulationError) as error:

@@ -1,0 +1,223 @@
+"""Sweep definitions: validation messages, grids, random and Latin-hypercube sampling.
+
+No simulation runs here (see test_sweep_run.py).
+"""
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from qzs import ParameterError
+from qzs.sweep_definition import (
+    DISTRIBUTIONS,
+    METHODS,
+    draw_samples,
+    load_sweep,
+    plan_text,
+    sample_cases,
+    shipped_sweeps,
+)
+
+QUICK = {"fft_length": 1024, "n_averages": 4}
+
+
+def definition(**tables):
+    document = {"sweep": {"name": "t"}, "analysis": dict(QUICK)}
+    for key, value in tables.items():
+        document[key] = {**document.get(key, {}), **value}
+    return document
+
+
+def raises(document, *patterns):
+    with pytest.raises(ParameterError) as info:
+        load_sweep(document)
+    message = str(info.value)
+    for pattern in patterns:
+        assert pattern in message, message
+    assert isinstance(info.value, ValueError)
+    return message
+
+
+# ---------------------------------------------------------------- malformed files
+def test_unknown_parameter_lists_the_valid_names():
+    message = raises(definition(grid={"pi_kpp": [1.0, 2.0]}), "unknown parameter 'pi_kpp'",
+                     "pi_kp", "stiction_force", "excitation.amplitude", "excitation.f1")
+    assert "excitation.frequency" not in message  # a chirp has no `frequency`
+
+
+def test_unknown_fixed_parameter_and_unknown_table_and_key():
+    raises(definition(parameters={"stiffness": 1.0}), "unknown key(s) ['stiffness']",
+           "[parameters]", "stiction_force")
+    raises({**definition(grid={"pi_kp": [1.0]}), "grids": {}}, "unknown key(s) ['grids']")
+    raises(definition(grid={"pi_kp": [1.0]}, analysis={"fft": 8}), "[analysis]",
+           "fft_length")
+    raises(definition(grid={"pi_kp": [1.0]}, outputs={"stats": ["peak"]}),
+           "unknown stats ['peak']", "peak_stroke")
+
+
+@pytest.mark.parametrize("spec", [[], {"start": 1.0, "stop": 2.0, "num": 0},
+                                  {"start": 2.0, "stop": 1.0, "step": 0.5}])
+def test_empty_range_is_an_error(spec):
+    raises(definition(grid={"pi_kp": spec}), "empty range for 'pi_kp'")
+
+
+def test_malformed_range():
+    raises(definition(grid={"pi_kp": {"start": 1.0, "stop": 2.0}}), "one of `num` or `step`")
+    raises(definition(grid={"pi_kp": {"start": 0.0, "stop": 2.0, "num": 3, "scale": "log"}}),
+           "log range", "`start` > 0")
+    raises(definition(grid={"pi_kp": 3.0}), "list of values or a table")
+
+
+def test_bad_distribution_names_the_allowed_ones_and_their_keys():
+    sample = {"sweep": {"name": "t", "method": "lhs", "samples": 8}}
+    message = raises({**definition(distributions={"mass": {"distribution": "gamma", "a": 2}}),
+                      **sample}, "unknown distribution 'gamma'", "uniform", "normal",
+                     "lognormal", "loguniform")
+    assert "median" in message and "std" in message
+    raises({**definition(distributions={"mass": {"distribution": "normal", "mean": 6.4}}),
+            **sample}, "takes keys ['mean', 'std']", "missing ['std']")
+    raises({**definition(distributions={"mass": {"distribution": "uniform", "low": 7.0,
+                                                 "high": 6.0}}), **sample}, "`low` < `high`")
+    raises({**definition(distributions={"mass": {"distribution": "lognormal", "median": 6.4,
+                                                 "sigma": -1.0}}), **sample},
+           "`mass.sigma` must be positive")
+    raises({**definition(distributions={"mass": 6.4}), **sample}, "`distribution` key")
+
+
+def test_bad_sampling_method_and_method_mismatches():
+    raises(definition(sweep={"method": "sobol"}, grid={"pi_kp": [1.0]}), "`method` must be one",
+           *[repr(m) for m in METHODS])
+    raises(definition(distributions={"mass": {"distribution": "uniform", "low": 6.0,
+                                              "high": 7.0}}), "[distributions] needs")
+    raises(definition(sweep={"method": "random"}, grid={"pi_kp": [1.0]}),
+           "needs a [distributions] table")
+    raises(definition(sweep={"method": "lhs"},
+                      distributions={"mass": {"distribution": "uniform", "low": 6.0,
+                                              "high": 7.0}}), "`samples` must be an integer")
+    raises(definition(), "nothing varies")
+
+
+def test_fixed_and_varied_conflicts_and_invalid_fixed_values():
+    raises(definition(parameters={"pi_kp": 5.0}, grid={"pi_kp": [1.0]}), "both fixed and varied")
+    raises(definition(parameters={"mass": -1.0}, grid={"pi_kp": [1.0]}), "mass")
+    raises(definition(excitation={"kind": "square"}, grid={"pi_kp": [1.0]}), "`kind` must be")
+    raises(definition(excitation={"frequency": 2.0}, grid={"pi_kp": [1.0]}), "[excitation]")
+
+
+def test_analysis_and_simulation_checks():
+    raises(definition(grid={"pi_kp": [1.0]}, analysis={"sample_rate": 3000.0}),
+           "`sample_rate` (3000.0 Hz) must divide")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"solver": "rk45"}), "`solver`")
+    raises(definition(grid={"pi_kp": [1.0]}, analysis={"duration": 10.0}),
+           "either `n_averages` or `duration`")
+    raises(definition(grid={"pi_kp": [1.0]}, outputs={"bands": {"low": [0.01, 0.02]}}),
+           "holds no frequency bin")
+
+
+def test_missing_file_lists_the_shipped_sweeps(tmp_path):
+    with pytest.raises(ParameterError, match="shipped sweeps are .*pi_vs_stiction"):
+        load_sweep(tmp_path / "nope.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[sweep\n")
+    with pytest.raises(ParameterError, match="not valid TOML"):
+        load_sweep(bad)
+    wrong = tmp_path / "wrong.toml"
+    wrong.write_text("[grid]\npi_kpp = [1.0]\n")
+    with pytest.raises(ParameterError, match=r"wrong\.toml.*unknown parameter 'pi_kpp'"):
+        load_sweep(wrong)
+
+
+def test_the_shipped_example_loads():
+    assert [p.stem for p in shipped_sweeps()] == ["pi_vs_stiction"]
+    sweep = load_sweep("pi_vs_stiction")
+    assert sweep.n_cases == 9 * 4 * 5
+    assert sweep.analysis["duration"] == pytest.approx(131.072)
+    assert "180 cases" in plan_text(sweep)
+
+
+# ---------------------------------------------------------------- grids
+def test_grid_is_the_full_product_in_order_with_excitation_axes_slowest():
+    sweep = load_sweep(definition(grid={
+        "pi_kp": [1.0, 2.0, 3.0], "stiction_force": {"start": 5.0, "stop": 15.0, "num": 3},
+        "excitation.amplitude": [0.005, 0.010], "pi_ki": {"start": 1.0, "stop": 100.0,
+                                                          "num": 3, "scale": "log"}}))
+    cases = sample_cases(sweep)
+    assert sweep.n_cases == 3 * 3 * 2 * 3 == cases["pi_kp"].size
+    assert list(cases) == ["excitation.amplitude", "pi_kp", "stiction_force", "pi_ki"]
+    np.testing.assert_allclose(cases["pi_ki"][:3], [1.0, 10.0, 100.0])
+    np.testing.assert_array_equal(cases["excitation.amplitude"][:27], 0.005)
+    points = set(zip(*(cases[k].tolist() for k in cases)))
+    assert len(points) == sweep.n_cases
+
+
+def test_step_range_includes_its_end():
+    sweep = load_sweep(definition(grid={"pi_kp": {"start": 0.0, "stop": 1.0, "step": 0.25}}))
+    np.testing.assert_allclose(sample_cases(sweep)["pi_kp"], [0, 0.25, 0.5, 0.75, 1.0])
+
+
+def test_string_values_on_a_grid():
+    sweep = load_sweep(definition(grid={"stop_model": ["compliant", "plastic"]}))
+    assert sample_cases(sweep)["stop_model"].tolist() == ["compliant", "plastic"]
+
+
+# ---------------------------------------------------------------- sampling
+UNIFORM = {"x": ("uniform", {"low": 2.0, "high": 6.0})}
+
+
+@pytest.mark.parametrize("n", [7, 50])
+def test_latin_hypercube_puts_one_sample_in_each_stratum(n):
+    two = {**UNIFORM, "y": ("loguniform", {"low": 1.0, "high": 100.0})}
+    draws = draw_samples(two, n, "lhs", seed=3)
+    x_strata = np.floor((draws["x"] - 2.0) / 4.0 * n).astype(int)
+    y_strata = np.floor(np.log10(draws["y"]) / 2.0 * n).astype(int)
+    for strata in (x_strata, y_strata):
+        np.testing.assert_array_equal(np.sort(strata), np.arange(n))
+
+
+def test_random_sampling_is_not_stratified_but_in_range():
+    draws = draw_samples(UNIFORM, 200, "random", seed=3)["x"]
+    assert 2.0 <= draws.min() and draws.max() <= 6.0
+    assert np.unique(np.floor((draws - 2.0) / 4.0 * 200)).size < 200
+
+
+@pytest.mark.parametrize("method", ["random", "lhs"])
+def test_seeds_reproduce_and_differ(method):
+    a = draw_samples(UNIFORM, 20, method, seed=1)["x"]
+    np.testing.assert_array_equal(a, draw_samples(UNIFORM, 20, method, seed=1)["x"])
+    assert not np.allclose(a, draw_samples(UNIFORM, 20, method, seed=2)["x"])
+
+
+@pytest.mark.parametrize("method", ["random", "lhs"])
+def test_distribution_moments(method):
+    spec = {"u": ("uniform", {"low": 5.0, "high": 15.0}),
+            "n": ("normal", {"mean": 100.0, "std": 10.0}),
+            "l": ("lognormal", {"median": 6.4, "sigma": 0.1}),
+            "t": ("normal", {"mean": 0.0, "std": 1.0, "low": -1.0, "high": 2.0}),
+            "g": ("loguniform", {"low": 1.0, "high": 1000.0})}
+    d = draw_samples(spec, 4000, method, seed=11)
+    tolerance = 0.05  # relative, loose enough for 4000 independent draws
+    assert d["u"].mean() == pytest.approx(10.0, rel=tolerance / 5)
+    assert d["u"].std() == pytest.approx(10.0 / math.sqrt(12), rel=tolerance)
+    assert d["n"].mean() == pytest.approx(100.0, rel=tolerance / 5)
+    assert d["n"].std() == pytest.approx(10.0, rel=tolerance)
+    assert np.median(d["l"]) == pytest.approx(6.4, rel=tolerance / 5)
+    assert np.log(d["l"]).std() == pytest.approx(0.1, rel=tolerance)
+    assert -1.0 <= d["t"].min() and d["t"].max() <= 2.0
+    assert d["t"].mean() == pytest.approx(stats.truncnorm(-1.0, 2.0).mean(), abs=0.03)
+    assert np.log10(d["g"]).mean() == pytest.approx(1.5, rel=tolerance)
+    assert set(DISTRIBUTIONS) == {"uniform", "normal", "lognormal", "loguniform"}
+
+
+def test_samples_are_crossed_with_the_grid_as_common_random_numbers():
+    sweep = load_sweep(definition(
+        sweep={"method": "lhs", "samples": 5, "seed": 4}, grid={"pi_kp": [1.0, 2.0, 3.0]},
+        distributions={"stiction_force": {"distribution": "uniform", "low": 5.0,
+                                          "high": 15.0}}))
+    cases = sample_cases(sweep)
+    assert sweep.n_cases == 15
+    np.testing.assert_array_equal(cases["pi_kp"], np.repeat([1.0, 2.0, 3.0], 5))
+    np.testing.assert_array_equal(cases["sample"], np.tile(np.arange(5), 3))
+    stiction = cases["stiction_force"].reshape(3, 5)
+    np.testing.assert_array_equal(stiction[0], stiction[2])
+    assert sweep.hash == load_sweep(dict(sweep.document)).hash

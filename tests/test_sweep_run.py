@@ -1,0 +1,257 @@
+"""Running sweeps: batched results equal single runs, failures are recorded, interrupted
+sweeps resume to the same Dataset, a Dask cluster gives the same Dataset, the command line.
+
+Runs are short chirps (9 s, 0-10 Hz) analysed with a 2048-point FFT.
+"""
+import argparse
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import qzs
+from qzs import ParameterError
+from qzs import sweep_backends
+from qzs.spectral import transmissibility, transmissibility_metrics
+from qzs.sweep import add_parsers, load_sweep, run_sweep, run_sweep_command
+from qzs.sweep_store import FAILED, INVALID, OK
+
+ANALYSIS = {"fft_length": 2048, "n_averages": 8, "band": [0.0, 10.0],
+            "at_frequencies": [2.0, 4.0]}
+
+
+def document(batch_size=2, **outputs):
+    return {"sweep": {"name": "small", "batch_size": batch_size},
+            "grid": {"pi_kp": [5.0, 200.0], "stiction_force": [5.0, 15.0]},
+            "parameters": {"pi_ki": 2.0},
+            "excitation": {"f1": 10.0},
+            "analysis": dict(ANALYSIS),
+            "outputs": {"bands": {"low": [1.0, 3.0]}, **outputs}}
+
+
+#: A weightless, frictionless linear plant whose P loop, sampled at 100 Hz with a gain of
+#: 1e6 N/m, is violently unstable (tests/test_simulate.py's divergence test).
+DIVERGING = {
+    "sweep": {"name": "diverging", "batch_size": 4},
+    "parameters": {"gravity": 0.0, "stiction_force": 0.0, "coulomb_force": 0.0,
+                   "spring_shape": 1e-3, "spring_force": 1e-6, "viscous_damping": 100.0,
+                   "stop_center": 0.0, "stroke_half": 1.0, "motor_force_max": 1e12,
+                   "position_setpoint": 0.0, "pi_ki": 0.0, "velocity_highpass": 0.0,
+                   "controller_rate": 100.0},
+    # 1e6 diverges, -1 is invalid, 1e12 is too stiff for dt (refused by the stability check)
+    "grid": {"pi_kp": [10.0, 1e6, -1.0, 1e12, 20.0]},
+    "excitation": {"f1": 10.0},
+    "analysis": dict(ANALYSIS),
+}
+
+
+def load(path):
+    return xr.open_zarr(path, consolidated=False).load()
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The small sweep run once in-process, keeping two time series."""
+    store = tmp_path_factory.mktemp("sweep") / "reference.zarr"
+    definition = load_sweep(document(time_series=["relative_position",
+                                                  "payload_acceleration"]))
+    return definition, run_sweep(definition, store, progress=False).load(), store
+
+
+def test_batched_results_equal_single_runs(reference):
+    definition, data, _ = reference
+    assert data.sizes["case"] == 4 and bool(data["done"].all())
+    assert (data["status"].values == OK).all()
+    for case in range(4):
+        kp = float(data["pi_kp"][case])
+        stiction = float(data["stiction_force"][case])
+        run = qzs.simulate(qzs.Chirp(f1=10.0, duration=definition.analysis["duration"]),
+                           qzs.IsolatorParameters(stiction_force=stiction),
+                           qzs.ControllerParameters(pi_kp=kp, pi_ki=2.0))
+        row = data.isel(case=case)
+        np.testing.assert_array_equal(row["relative_position"].values, run.relative_position)
+        np.testing.assert_array_equal(row["payload_acceleration"].values,
+                                      run.payload_acceleration)
+        assert row["stop_contacts"] == run.run["stop_contacts"]
+        assert row["stick_events"] == run.run["stick_events"]
+        center = run.controller.position_setpoint
+        assert float(row["peak_stroke"]) == pytest.approx(  # stop centre: (low + high) / 2
+            np.abs(run.relative_position - center).max(), rel=1e-12)
+        assert float(row["motor_force_rms"]) == pytest.approx(
+            np.sqrt(np.mean(run.motor_force ** 2)), rel=1e-12)
+        estimate = transmissibility(run.base_acceleration, run.payload_acceleration, 1000.0,
+                                    fft_length=2048)
+        keep = (estimate.frequency > 0) & (estimate.frequency <= 10.0)
+        np.testing.assert_array_equal(data["frequency"].values, estimate.frequency[keep])
+        np.testing.assert_array_equal(row["transmissibility"].values, estimate.magnitude[keep])
+        metrics = transmissibility_metrics(estimate.frequency[keep], estimate.magnitude[keep],
+                                           at_frequencies=[2.0, 4.0]).to_dict()
+        for name in ("resonance_frequency", "isolation_onset", "transmissibility_at_2_hz"):
+            np.testing.assert_equal(float(row[name]), metrics[name])
+        band = (estimate.frequency >= 1.0) & (estimate.frequency <= 3.0)
+        assert float(row["mean_transmissibility_low"]) == estimate.magnitude[band].mean()
+        assert int(row["n_averages"]) == 8
+
+
+def test_store_layout_units_and_attributes(reference):
+    definition, data, _ = reference
+    assert set(data.dims) == {"case", "frequency", "time"}
+    assert data["pi_kp"].attrs["units"] == "N/m" and data["pi_kp"].dims == ("case",)
+    assert data["peak_stroke"].attrs["units"] == "m"
+    assert "sqrt(S_payload / S_base)" in data["transmissibility"].attrs["long_name"]
+    assert data.attrs["sweep_hash"] == definition.hash
+    assert data["message"].values.tolist() == [""] * 4
+
+
+def test_time_series_are_off_by_default(tmp_path):
+    data = run_sweep(document(batch_size=4), tmp_path / "s.zarr", progress=False)
+    assert "time" not in data.dims and "relative_position" not in data
+    ok = data.where(data["status"] == OK, drop=True)  # lazily opened, still selectable
+    assert ok.sizes["case"] == 4 and ok["message"].dtype == object
+
+
+def test_failing_cases_are_recorded_and_the_sweep_goes_on(tmp_path):
+    data = run_sweep(DIVERGING, tmp_path / "d.zarr", progress=False).load()
+    status = data["status"].values.tolist()
+    assert status == [OK, FAILED, INVALID, INVALID, OK]
+    messages = data["message"].values
+    assert "diverged at t = " in messages[1] and "relative position z =" in messages[1]
+    assert "pi_kp" in messages[2] and "non-negative" in messages[2]
+    assert "largest stable step" in messages[3]
+    assert np.isnan(data["transmissibility"].values[1:4]).all()
+    assert np.isfinite(data["transmissibility"].values[[0, 4]]).all()
+    assert bool(data["done"].all())
+
+
+def _count_cases(monkeypatch, interrupt_at=None):
+    """Patch the batch call: count the cases it runs, and raise Ctrl-C at call `interrupt_at`."""
+    calls = []
+    original = sweep_backends.simulate_batch
+
+    def patched(cases, *args, **kwargs):
+        calls.append(len(cases))
+        if interrupt_at is not None and len(calls) == interrupt_at:
+            raise KeyboardInterrupt
+        return original(cases, *args, **kwargs)
+
+    monkeypatch.setattr(sweep_backends, "simulate_batch", patched)
+    return calls
+
+
+def test_resume_after_an_interrupt_gives_the_same_dataset(reference, tmp_path, monkeypatch):
+    definition, expected, _ = reference
+    store = tmp_path / "resumed.zarr"
+    calls = _count_cases(monkeypatch, interrupt_at=2)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(definition, store, progress=False)
+    partial = load(store)
+    assert partial["done"].values.tolist() == [True, True, False, False]
+    with pytest.raises(ParameterError, match="exists; pass `resume`"):
+        run_sweep(definition, store, progress=False)
+    calls.clear()
+    monkeypatch.setattr(sweep_backends, "simulate_batch", sweep_backends.simulate_batch)
+    calls = _count_cases(monkeypatch)
+    resumed = run_sweep(definition, store, resume=True, progress=False).load()
+    assert sum(calls) == 2  # only the batch that was not stored
+    xr.testing.assert_identical(resumed, expected)
+
+
+def test_a_batch_killed_before_its_done_flags_is_recomputed(reference, tmp_path, monkeypatch):
+    definition, expected, store = reference
+    import shutil
+
+    copy = tmp_path / "killed.zarr"
+    shutil.copytree(store, copy)
+    # a process killed after writing batch 0's data but before its done flags:
+    xr.Dataset({"done": ("case", np.zeros(2, bool)),
+                "peak_stroke": ("case", np.full(2, -1.0))}).to_zarr(
+        copy, region={"case": slice(0, 2)}, mode="r+", consolidated=False)
+    calls = _count_cases(monkeypatch)
+    resumed = run_sweep(definition, copy, resume=True, progress=False).load()
+    assert sum(calls) == 2
+    xr.testing.assert_identical(resumed, expected)
+    assert run_sweep(definition, copy, resume=True, progress=False) is not None
+    assert sum(calls) == 2  # nothing left to run
+
+
+def test_resume_refuses_a_different_definition(reference, tmp_path):
+    _, _, store = reference
+    changed = document(time_series=["relative_position", "payload_acceleration"])
+    changed["grid"]["pi_kp"] = [5.0, 100.0]
+    with pytest.raises(ParameterError, match="different sweep definition"):
+        run_sweep(changed, store, resume=True, progress=False)
+
+
+def test_overwrite_replaces_a_store(tmp_path):
+    store = tmp_path / "o.zarr"
+    run_sweep(DIVERGING, store, progress=False)
+    data = run_sweep(document(batch_size=4), store, overwrite=True, progress=False)
+    assert data.attrs["sweep_name"] == "small"
+
+
+@pytest.fixture(scope="module")
+def dask_cluster():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None,
+                                  processes=True) as cluster:
+        with distributed.Client(cluster) as client:
+            yield cluster, client
+
+
+def test_dask_cluster_run_equals_the_local_run(reference, dask_cluster, tmp_path):
+    definition, expected, _ = reference
+    cluster, client = dask_cluster
+    data = run_sweep(definition, tmp_path / "dask.zarr", scheduler=client, progress=False)
+    xr.testing.assert_identical(data.load(), expected)
+    failing = run_sweep(DIVERGING, tmp_path / "dask-fail.zarr",
+                        scheduler=cluster.scheduler_address, progress=False).load()
+    local = run_sweep(DIVERGING, tmp_path / "local-fail.zarr", progress=False).load()
+    xr.testing.assert_identical(failing, local)
+
+
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # the fixture's scheduler
+def test_workers_start_a_local_cluster(tmp_path):
+    pytest.importorskip("distributed")
+    data = run_sweep(DIVERGING, tmp_path / "own.zarr", workers=1, progress=False).load()
+    local = run_sweep(DIVERGING, tmp_path / "local.zarr", progress=False).load()
+    xr.testing.assert_identical(data, local)
+
+
+# ---------------------------------------------------------------- command line
+def parse(*argv):
+    parser = argparse.ArgumentParser(prog="qzs")
+    add_parsers(parser.add_subparsers(dest="command", required=True))
+    return parser.parse_args(argv)
+
+
+@pytest.fixture
+def sweep_file(tmp_path):
+    import tomli_w
+
+    path = tmp_path / "small.toml"
+    path.write_text(tomli_w.dumps(document(batch_size=4)))
+    return path
+
+
+def test_command_runs_prints_and_refuses_reuse(sweep_file, tmp_path, capsys):
+    store = tmp_path / "cli.zarr"
+    assert run_sweep_command(parse("sweep", str(sweep_file), "--dry-run")) == 0
+    assert "4 cases (grid), 1 batches of 4" in capsys.readouterr().out
+    assert run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store),
+                                   "--quiet")) == 0
+    out = capsys.readouterr().out
+    assert "4 of 4 cases stored" in out and "ok 4, invalid 0, failed 0" in out
+    with pytest.raises(ParameterError, match="exists"):
+        run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store)))
+    with pytest.raises(ParameterError, match="--workers"):
+        run_sweep_command(parse("sweep", str(sweep_file), "--workers", "0"))
+
+
+def test_command_interrupt_exits_130_with_the_resume_hint(sweep_file, tmp_path, capsys,
+                                                          monkeypatch):
+    _count_cases(monkeypatch, interrupt_at=1)
+    store = tmp_path / "int.zarr"
+    assert run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store),
+                                   "--quiet")) == 130
+    err = capsys.readouterr().err
+    assert "0 of 4 cases are stored" in err and "--resume" in err
