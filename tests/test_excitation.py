@@ -176,7 +176,7 @@ def test_record_of_a_sine_drives_the_simulator_like_the_sine():
     (lambda: RandomExcitation(seed=True), r"`seed` must be an integer, got True"),
     (lambda: DisplacementRecord(time=[0, 1, 2], displacement=[0, 1, 2]), "at least 4 samples, got 3"),
     (lambda: DisplacementRecord(time=[0, 1, 1, 2], displacement=[0, 0, 0, 0]),
-     r"`time` must be strictly increasing; sample 2 \("),
+     r"`time` must be strictly increasing, but it is duplicated at sample 2 \("),
     (lambda: DisplacementRecord(time=[0, 2, 1, 3], displacement=[0, 0, 0, 0]), "strictly increasing"),
     (lambda: DisplacementRecord(time=[0, 1, 2, 3], displacement=[0, np.nan, 0, 0]),
      "`displacement` has 1 non-finite samples"),
@@ -193,7 +193,7 @@ def test_bad_excitation_is_rejected_with_a_clear_message(factory, match):
 def test_non_monotonic_time_message_shows_plain_numbers():
     with pytest.raises(ExcitationError) as info:
         DisplacementRecord(time=np.array([0.0, 1.0, 1.0, 2.0]), displacement=np.zeros(4))
-    assert "sample 2 (1.0 s) does not follow sample 1 (1.0 s)" in str(info.value)
+    assert "at sample 2 (t = 1.0 s after t = 1.0 s; 1 such steps)" in str(info.value)
     assert "np.float64" not in str(info.value)
 
 

@@ -102,3 +102,17 @@ def read_toml(path, what, error=ParameterError):
         raise error(f"{what} not found: {str(path)!r}.") from None
     except tomllib.TOMLDecodeError as err:
         raise error(f"{what} {str(path)!r} is not valid TOML: {err}.") from None
+
+
+def strictly_increasing(name, time, error, fix="sort it and drop duplicates first", where=""):
+    """Raise ``error`` if ``time`` is not strictly increasing (says where, how, how often).
+
+    ``where`` prefixes the message (e.g. the file the time base came from).
+    """
+    steps = np.diff(time)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0))
+        what = "duplicated" if steps[i] == 0 else "decreasing"
+        raise error(f"{where}`{name}` must be strictly increasing, but it is {what} at sample {i + 1} "
+                    f"(t = {float(time[i + 1])!r} s after t = {float(time[i])!r} s; "
+                    f"{int(np.count_nonzero(steps <= 0))} such steps); {fix}.")

@@ -17,7 +17,7 @@ import numpy as np
 from qzs import _kernels as K
 from qzs.errors import ParameterError
 from qzs.results import CHANNELS
-from qzs.simulate import prepare_run
+from qzs.simulate import divergence_message, prepare_run
 
 __all__ = ["BatchResult", "simulate_batch", "STATS"]
 
@@ -196,16 +196,8 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rat
             pool.shutdown()
     elapsed = _time.perf_counter() - start
 
-    messages = []
-    for c in range(n):
-        if status[c] == K.STATUS_OK:
-            messages.append("")
-        else:
-            t = failed_at[c] * first.dt
-            messages.append(
-                f"the simulation diverged at t = {t:.6g} s (last finite state: relative "
-                f"position z = {states[c, K.S_Z]:.6g} m, relative velocity v = "
-                f"{states[c, K.S_V]:.6g} m/s)")
+    messages = ["" if status[c] == K.STATUS_OK else
+                divergence_message(states[c], failed_at[c], first.dt) for c in range(n)]
     stats = {
         "stop_contacts": flags[:, K.I_N_CONTACTS].astype(float),
         "z_min": z_min, "z_max": z_max, "peak_stroke": peak,

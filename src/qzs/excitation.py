@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from qzs._validation import as_float, choice, non_negative, positive, validate_fields
+from qzs._validation import (as_float, choice, non_negative, positive, strictly_increasing,
+                             validate_fields)
 from qzs.errors import ExcitationError
 
 __all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "base_motion_series"]
@@ -338,12 +339,8 @@ class DisplacementRecord(_Tabulated):
             if bad:
                 raise ExcitationError(f"`{name}` has {bad} non-finite samples (NaN or inf); "
                                       "remove or interpolate them first.")
-        steps = np.diff(time)
-        if np.any(steps <= 0):
-            i = int(np.argmax(steps <= 0))
-            raise ExcitationError(
-                f"`time` must be strictly increasing; sample {i + 1} ({float(time[i + 1])!r} s) does "
-                f"not follow sample {i} ({float(time[i])!r} s). Sort the record and drop duplicates.")
+        strictly_increasing("time", time, ExcitationError,
+                            "sort the record and drop duplicates first")
         object.__setattr__(self, "time", time - time[0])
         object.__setattr__(self, "displacement", disp)
 

@@ -52,7 +52,7 @@ from typing import Mapping
 
 import numpy as np
 
-from qzs._validation import read_toml
+from qzs._validation import read_toml, strictly_increasing
 from qzs.errors import DataError, ParameterError
 
 __all__ = ["Recording", "ChannelMap", "ChannelSpec", "DataWarning", "ROLES", "UNITS",
@@ -662,14 +662,8 @@ def _check_time(time, role, source):
     if bad:
         raise DataError(f"{source}: the time of {role} has {bad} non-finite values; "
                         "a time base cannot be repaired, fix the log.")
-    steps = np.diff(time)
-    if np.any(steps <= 0):
-        i = int(np.argmax(steps <= 0))
-        what = "duplicated" if steps[i] == 0 else "decreasing"
-        raise DataError(f"{source}: time must be strictly increasing, but it is {what} at "
-                        f"sample {i + 1} (t = {time[i + 1]!r} s after t = {time[i]!r} s; "
-                        f"{np.count_nonzero(steps <= 0)} such steps); sort the log and drop "
-                        "duplicates first.")
+    strictly_increasing("time", time, DataError, "sort the log and drop duplicates first",
+                        where=f"{source}: ")
 
 
 def _fill_nan(values, role, policy, source):

@@ -325,9 +325,13 @@ def _progress_bar(total, enabled):
     return tqdm(total=total, unit="step", unit_scale=True, desc="simulating", leave=False)
 
 
+def divergence_message(state, step, dt):
+    """What a diverged run reports: the time [s] of the failing step and the last finite state."""
+    return (f"the simulation diverged at t = {step * dt:.6g} s (last finite state: relative "
+            f"position z = {state[K.S_Z]:.6g} m, relative velocity v = {state[K.S_V]:.6g} m/s, "
+            f"PI integral {state[K.S_INT]:.6g} m*s); check the gains and parameters, or reduce "
+            "`dt`.")
+
+
 def _raise_diverged(s, flags, p):
-    t = flags[K.I_STEP] * p[K.P_DT]
-    raise SimulationError(
-        f"the simulation diverged at t = {t:.6g} s (last finite state: relative position "
-        f"z = {s[K.S_Z]:.6g} m, relative velocity v = {s[K.S_V]:.6g} m/s, PI integral "
-        f"{s[K.S_INT]:.6g} m*s); check the gains and parameters, or reduce `dt`.")
+    raise SimulationError(divergence_message(s, flags[K.I_STEP], p[K.P_DT]))

@@ -303,9 +303,10 @@ def run_studies(studies, *, quick=False, workers=None, progress=True):
 
     from tqdm.auto import tqdm
 
-    tasks = [(i, j, task) for i, study in enumerate(studies)
-             for j, task in enumerate(_tasks(study, quick))]
-    results = [[None] * len(_tasks(s, quick)) for s in studies]
+    per_study = [_tasks(study, quick) for study in studies]
+    tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
+             for j, task in enumerate(study_tasks)]
+    results = [[None] * len(study_tasks) for study_tasks in per_study]
     workers = workers or os.cpu_count() or 1
     bar = tqdm(total=len(tasks), unit="case", desc="studies", disable=not progress)
     start = time.perf_counter()
