@@ -321,10 +321,9 @@ def plot_experiment(result, *, path=None, title=None):
     -------
     matplotlib.figure.Figure
     """
-    from qzs.identify import _subplots
-    from qzs.plotting import _save
+    from qzs.plotting import new_figure, save_figure
 
-    fig, (top, bottom) = _subplots(2, height=2.6)
+    fig, (top, bottom) = new_figure(2, height=2.6, sharex=False)
     bottom.sharex(top)
     f, measured, coherence = result._in_band(result.measured)
     top.plot(f, 20 * np.log10(np.maximum(measured, 1e-12)), color="C0", lw=1.0,
@@ -349,7 +348,7 @@ def plot_experiment(result, *, path=None, title=None):
     bottom.set_xlabel("frequency [Hz]")
     top.set_title(title if title is not None else Path(result.recording.source.split(" (")[0]).name)
     if path is not None:
-        _save(fig, path, also_svg=True)
+        save_figure(fig, path, also_svg=True)
     return fig
 
 

@@ -442,20 +442,6 @@ def fit_friction(time, displacement, force, *, spring=None, mass=None,
                        friction=measured - values["offset"], residual=full_residual, used=used)
 
 
-def _subplots(rows, height):
-    """A figure of ``rows`` independent axes (Agg when there is no display)."""
-    import matplotlib
-
-    from qzs.plotting import _has_display
-
-    if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf") and not _has_display():
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(rows, 1, figsize=(9, height * rows + 0.8), constrained_layout=True)
-    return fig, np.atleast_1d(axes)
-
-
 def plot_friction_fit(fit, *, path=None, title=""):
     """Friction force against velocity with the fitted law, and the residuals against time.
 
@@ -470,9 +456,9 @@ def plot_friction_fit(fit, *, path=None, title=""):
     -------
     matplotlib.figure.Figure
     """
-    from qzs.plotting import _save
+    from qzs.plotting import new_figure, save_figure
 
-    fig, axes = _subplots(2, height=3.0)
+    fig, axes = new_figure(2, height=3.0, sharex=False)
     top, bottom = axes
     v, used = fit.velocity, fit.used
     top.plot(v[~used] * 1e3, fit.friction[~used], ".", ms=2, color="0.7",
@@ -495,7 +481,7 @@ def plot_friction_fit(fit, *, path=None, title=""):
         ax.grid(True, alpha=0.3)
     top.set_title(title)
     if path is not None:
-        _save(fig, path, also_svg=True)
+        save_figure(fig, path, also_svg=True)
     return fig
 
 

@@ -2,7 +2,7 @@
 import numpy as np
 
 __all__ = ["plot_simulation", "plot_energy", "plot_transmissibility", "plot_spring_fit",
-           "summary_text", "envelope"]
+           "summary_text", "envelope", "new_figure", "save_figure"]
 
 _MAX_POINTS = 4000  # per trace: long runs are drawn as a min/max envelope
 
@@ -32,14 +32,15 @@ def envelope(time, values, max_points=_MAX_POINTS):
     return t_out, v_out
 
 
-def _figure(rows, height=2.1):
+def new_figure(rows, height=2.1, sharex=True):
+    """A figure of ``rows`` stacked axes, 9 in wide (Agg when there is no display)."""
     import matplotlib
 
     if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf") and not _has_display():
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(9, height * rows + 0.8),
+    fig, axes = plt.subplots(rows, 1, sharex=sharex, figsize=(9, height * rows + 0.8),
                              constrained_layout=True)
     return fig, np.atleast_1d(axes)
 
@@ -64,7 +65,7 @@ def plot_simulation(result, path=None, title=None):
     -------
     matplotlib.figure.Figure
     """
-    fig, axes = _figure(4)
+    fig, axes = new_figure(4)
     t = result.time
 
     def trace(ax, name, scale=1.0, **style):
@@ -97,13 +98,13 @@ def plot_simulation(result, path=None, title=None):
         ax.grid(True, alpha=0.3)
     fig.suptitle(title or _title(result))
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig
 
 
 def plot_energy(result, path=None):
     """Energy ledger of a run [J]: work in, dissipation, stored energy and the residual."""
-    fig, axes = _figure(2, height=2.6)
+    fig, axes = new_figure(2, height=2.6)
     t = result.time
     for name in ("base_work", "motor_work", "friction_dissipation", "stop_dissipation"):
         axes[0].plot(*envelope(t, result[name]), lw=0.8, label=name.replace("_", " "))
@@ -116,7 +117,7 @@ def plot_energy(result, path=None):
         ax.grid(True, alpha=0.3)
     fig.suptitle("Energy ledger: dE = W_base + W_motor - D_friction - D_stop")
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig
 
 
@@ -126,7 +127,7 @@ def _title(result):
             f"{result.run['solver']} dt = {result.run['dt']:g} s")
 
 
-def _save(fig, path, also_svg=False):
+def save_figure(fig, path, also_svg=False):
     """Write ``fig`` atomically (format from the suffix); a .png also as .svg if asked."""
     from pathlib import Path
 
@@ -136,7 +137,7 @@ def _save(fig, path, also_svg=False):
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=130)
     if also_svg and path.suffix.lower() == ".png":
-        _save(fig, path.with_suffix(".svg"))
+        save_figure(fig, path.with_suffix(".svg"))
 
 
 def summary_text(result):
@@ -199,7 +200,7 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
     -------
     matplotlib.figure.Figure
     """
-    fig, axes = _figure(1, height=4.2)
+    fig, axes = new_figure(1, height=4.2)
     ax = axes[0]
     for i, curve in enumerate(curves):
         f = np.asarray(curve["frequency"])
@@ -225,13 +226,13 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
     ax.legend(fontsize="small")
     ax.set_title(title)
     if path is not None:
-        _save(fig, path, also_svg=True)
+        save_figure(fig, path, also_svg=True)
     return fig
 
 
 def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=None, title=""):
     """MagSpring force against displacement with its tanh fit (paper Fig. 5)."""
-    fig, axes = _figure(1, height=3.8)
+    fig, axes = new_figure(1, height=3.8)
     ax = axes[0]
     z = np.linspace(np.min(displacement), np.max(displacement), 400)
     ax.plot(np.asarray(displacement) * 1e3, force, "o", ms=3.5, label="measured (synthetic)")
@@ -243,5 +244,5 @@ def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=Non
     ax.legend(fontsize="small")
     ax.set_title(title)
     if path is not None:
-        _save(fig, path, also_svg=True)
+        save_figure(fig, path, also_svg=True)
     return fig

@@ -11,22 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import ParameterError
+from qzs.plotting import new_figure, save_figure
 
 __all__ = ["plot_metric", "plot_transmissibility_band", "add_plot_parser", "run_plot",
            "REDUCTIONS"]
 
 REDUCTIONS = ("median", "mean", "min", "max")
 _Y_LABEL = "transmissibility, amplitude ratio sqrt(S_payload/S_base) [-]"
-
-
-def _pyplot():
-    import matplotlib
-
-    if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf"):
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _usable(dataset):
@@ -105,8 +96,7 @@ def plot_metric(dataset, metric, x, y=None, *, reduce="median", path=None):
     if y is not None:
         frame["y"] = dataset[y].values[ok]
     grid = _grid_names(dataset)
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 5.0), constrained_layout=True)
+    fig, (ax,) = new_figure(1, height=4.2)
     if y is None:
         _line(ax, frame, x in grid, reduce)
         ax.set_ylabel(_label(dataset, metric))
@@ -136,7 +126,7 @@ def plot_metric(dataset, metric, x, y=None, *, reduce="median", path=None):
     ax.set_title(_title(dataset, left_out))
     ax.grid(True, alpha=0.3)
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig
 
 
@@ -207,8 +197,7 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
             raise ParameterError(f"{by!r} has {len(distinct)} levels among the cases; "
                                  "the band plot takes at most 8 (choose a grid parameter).")
         levels = [(v, ok & (values == v)) for v in sorted(distinct)]
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8.0, 5.0), constrained_layout=True)
+    fig, (ax,) = new_figure(1, height=4.2)
     for k, (value, mask) in enumerate(levels):
         chosen = curves[mask]
         if chosen.shape[0] == 0:
@@ -230,7 +219,7 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     if path is not None:
-        _save(fig, path)
+        save_figure(fig, path)
     return fig
 
 
@@ -239,12 +228,6 @@ def _title(dataset, left_out):
     if left_out:
         title += f"\n({left_out} case(s) not run or failed, not shown)"
     return title
-
-
-def _save(fig, path):
-    from qzs.plotting import _save as save
-
-    save(fig, path)
 
 
 # ---------------------------------------------------------------- command line
