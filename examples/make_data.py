@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 import qzs
-from qzs.experiment import _highpass
+from qzs.spectral import highpass
 from qzs.readers import write_dspace_mat
 
 SEED = 20240605
@@ -27,7 +27,7 @@ def experiment_log(folder, rng):
     time = run.time
     signals = {}
     for name, channel in (("shaker_vel", "base_velocity"), ("payload_vel", "payload_velocity")):
-        measured = _highpass(run[channel], HIGHPASS, RATE) * 1e3
+        measured = highpass(run[channel], HIGHPASS, RATE) * 1e3
         signals[name] = measured + rng.normal(0.0, VELOCITY_NOISE, time.size)
     table = np.column_stack([time, signals["shaker_vel"], signals["payload_vel"]])
     header = ("# synthetic experiment log made by examples/make_data.py (qzs model + noise)\n"

@@ -12,7 +12,8 @@ import pytest
 
 import qzs
 from qzs.errors import DataError, ParameterError
-from qzs.experiment import _highpass, add_parser, infer_chirp, process_experiment, run
+from qzs.experiment import add_parser, infer_chirp, process_experiment, run
+from qzs.spectral import highpass
 from qzs.readers import DataWarning, Recording, read_recording
 from qzs.spectral import transmissibility
 
@@ -71,7 +72,7 @@ def synthetic_log(kind="velocity", duration=60.0, rate=200.0, noise=1e-4, seed=0
     chirp = qzs.Chirp(amplitude=0.010, f0=0.0, f1=15.0, duration=duration)
     sim = qzs.simulate(chirp, dt=1e-4, sample_rate=rate)
     rng = np.random.default_rng(seed)
-    channels = {f"{part}_{kind}": _highpass(sim[f"{part}_{kind}"], 1.0, rate)
+    channels = {f"{part}_{kind}": highpass(sim[f"{part}_{kind}"], 1.0, rate)
                 + rng.normal(0, noise, len(sim)) for part in ("base", "payload")}
     unit = "m/s" if kind == "velocity" else "m/s^2"
     recording = Recording(time=sim.time, channels=channels, units=dict.fromkeys(channels, unit),

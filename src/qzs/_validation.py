@@ -22,6 +22,14 @@ def as_float(name, value, error=ParameterError):
     return number
 
 
+def integer(name, value, minimum, error=ParameterError):
+    """Return ``value`` as an int that must be an integer (not a bool) >= ``minimum``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
+            or value < minimum:
+        raise error(f"`{name}` must be an integer >= {minimum}, got {value!r}.")
+    return int(value)
+
+
 def positive(name, value, error=ParameterError):
     """Return ``value`` as a float that must be finite and > 0."""
     number = as_float(name, value, error)

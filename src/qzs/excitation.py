@@ -180,6 +180,13 @@ class Chirp:
         """Highest frequency in the signal [Hz]."""
         return max(self.f0, self.f1)
 
+    def frequency_at(self, time):
+        """Instantaneous frequency [Hz] at ``time`` [s] (held at ``f1`` after the sweep)."""
+        fraction = np.clip(np.asarray(time, dtype=float) / self.duration, 0.0, 1.0)
+        if self.method == "linear":
+            return self.f0 + (self.f1 - self.f0) * fraction
+        return self.f0 * (self.f1 / self.f0) ** fraction
+
     def pack(self):
         """Kernel form: ``(scalars, table)``."""
         kind = KIND_CHIRP_LINEAR if self.method == "linear" else KIND_CHIRP_LOG

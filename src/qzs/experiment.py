@@ -30,6 +30,7 @@ import numpy as np
 
 from qzs.errors import DataError, ParameterError
 from qzs.readers import DataWarning, Recording
+from qzs.spectral import highpass
 
 __all__ = ["ExperimentResult", "process_experiment", "infer_chirp", "plot_experiment",
            "add_parser", "run", "main"]
@@ -45,16 +46,6 @@ def _signal_kind(recording):
     raise DataError(f"{recording.source}: an experiment needs base_velocity and "
                     "payload_velocity, or base_acceleration and payload_acceleration; the "
                     f"recording has {sorted(recording.channels)}. Name them in the channel map.")
-
-
-def _highpass(values, corner, sample_rate):
-    """First-order high-pass ``s/(s + 2*pi*corner)`` (bilinear), as a charge amplifier's."""
-    from scipy import signal
-
-    if not corner:
-        return np.asarray(values, dtype=float)
-    b, a = signal.bilinear([1.0, 0.0], [1.0, 2 * np.pi * corner], fs=sample_rate)
-    return signal.lfilter(b, a, values)
 
 
 def infer_chirp(recording, *, highpass_corner=1.0):
@@ -352,14 +343,6 @@ def plot_experiment(result, *, path=None, title=None):
     return fig
 
 
-def _chirp_frequency(chirp, time):
-    """Instantaneous frequency [Hz] of ``chirp`` at ``time`` [s] (the band it has swept)."""
-    fraction = min(time / chirp.duration, 1.0)
-    if chirp.method == "linear":
-        return chirp.f0 + (chirp.f1 - chirp.f0) * fraction
-    return chirp.f0 * (chirp.f1 / chirp.f0) ** fraction
-
-
 def _averages(n_samples, fft_length, n_averages, notes):
     """``n_averages`` if the log holds them, else None (all that fit) with a warning."""
     from qzs.spectral import welch_average_count
@@ -441,7 +424,7 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=32768, n_av
     # Welch uses the log's start; the last segment's second half sees the top of the sweep
     # only through the window's taper: analyse up to the sweep's frequency at its centre.
     used = required_samples(fft_length, measured.n_averages) - fft_length // 2
-    band = (0.0, min(_chirp_frequency(excitation, used / rate), rate / 2))
+    band = (0.0, min(float(excitation.frequency_at(used / rate)), rate / 2))
     untrusted = 1.5 * corner
 
     def metrics(estimate):
@@ -475,7 +458,7 @@ def _simulate_like(recording, kind, excitation, isolator, controller, corner, we
     began = _time.perf_counter()
     run = simulate(chirp, isolator, controller, duration=duration, dt=1.0 / (rate * steps),
                    sample_rate=rate)
-    base, payload = (_highpass(run[name][:n], corner, rate) for name in SIGNAL_PAIRS[kind])
+    base, payload = (highpass(run[name][:n], corner, rate) for name in SIGNAL_PAIRS[kind])
     return transmissibility(base, payload, rate, **welch), _time.perf_counter() - began
 
 

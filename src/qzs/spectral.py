@@ -15,10 +15,10 @@ from typing import Mapping
 import numpy as np
 from scipy import signal
 
-from qzs._validation import finite_series
+from qzs._validation import finite_series, integer
 from qzs.errors import DataError, ParameterError
 
-__all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
+__all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "highpass",
            "required_duration", "required_samples", "transmissibility",
            "transmissibility_metrics", "welch_average_count"]
 
@@ -28,12 +28,6 @@ _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
 
 
 # ---------------------------------------------------------------- validation
-def _integer(name, value, minimum):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise ParameterError(f"`{name}` must be an integer >= {minimum}, got {value!r}.")
-    return int(value)
-
-
 def _positive(name, value, allow_none=False):
     if value is None and allow_none:
         return None
@@ -57,6 +51,22 @@ def _signal(name, values):
                          "interpolate or trim them before estimating spectra")
 
 
+def highpass(values, corner, sample_rate):
+    """First-order high-pass ``s/(s + 2*pi*corner)`` (bilinear), as a charge amplifier's.
+
+    Parameters
+    ----------
+    values : array_like
+        Signal sampled at ``sample_rate`` [Hz].
+    corner : float
+        Corner frequency [Hz]; 0 or None returns the signal unchanged.
+    """
+    if not corner:
+        return np.asarray(values, dtype=float)
+    b, a = signal.bilinear([1.0, 0.0], [1.0, 2 * np.pi * corner], fs=sample_rate)
+    return signal.lfilter(b, a, values)
+
+
 # ---------------------------------------------------------------- run sizing
 def welch_average_count(n_samples, fft_length, overlap=0.5):
     """Number of segments scipy.signal.welch averages over `n_samples` [samples].
@@ -64,16 +74,16 @@ def welch_average_count(n_samples, fft_length, overlap=0.5):
     Segments are `fft_length` [samples] long and share the fraction `overlap` in [0, 1);
     the count is ``(n_samples - noverlap) // step``, 0 if the record is shorter than one segment.
     """
-    n_samples = _integer("n_samples", n_samples, 0)
-    fft_length = _integer("fft_length", fft_length, 8)
+    n_samples = integer("n_samples", n_samples, 0)
+    fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     return 0 if n_samples < fft_length else (n_samples - noverlap) // (fft_length - noverlap)
 
 
 def required_samples(fft_length, n_averages, overlap=0.5):
     """Shortest record giving `n_averages` Welch segments: ``fft_length + (n_averages - 1) * step``."""
-    fft_length = _integer("fft_length", fft_length, 8)
-    n_averages = _integer("n_averages", n_averages, 1)
+    fft_length = integer("fft_length", fft_length, 8)
+    n_averages = integer("n_averages", n_averages, 1)
     return fft_length + (n_averages - 1) * (fft_length - _noverlap(fft_length, overlap))
 
 
@@ -189,7 +199,7 @@ def transmissibility(base, payload, sample_rate, *, fft_length=32768, overlap=0.
         Signals not 1-D, of different lengths, non-finite, or too short.
     """
     sample_rate = _positive("sample_rate", sample_rate)
-    fft_length = _integer("fft_length", fft_length, 8)
+    fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     highpass_corner = _positive("highpass_corner", highpass_corner, allow_none=True)
     if estimator not in ESTIMATORS:
@@ -253,7 +263,7 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=32768, window="han
         RMS amplitude per bin [u].
     """
     sample_rate = _positive("sample_rate", sample_rate)
-    fft_length = _integer("fft_length", fft_length, 8)
+    fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     values = _signal("signal_values", signal_values)
     if values.size < fft_length:

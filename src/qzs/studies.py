@@ -226,25 +226,17 @@ def _transmissibility_case(task):
 
 def _locked_below(run, chirp, frequency):
     """Fraction of the time the payload is locked while the chirp is below ``frequency`` [Hz]."""
-    t = run.time / chirp.duration
-    if chirp.method == "linear":
-        instantaneous = chirp.f0 + (chirp.f1 - chirp.f0) * t
-    else:
-        instantaneous = chirp.f0 * (chirp.f1 / chirp.f0) ** t
-    below = instantaneous < frequency
+    below = chirp.frequency_at(run.time) < frequency
     return float(run.locked[below].mean()) if below.any() else float("nan")
 
 
 def _experiment_processing(run, rate, welch, options, band):
     """Velocities through the charge amplifier's high-pass, as the experiment measured them."""
-    from scipy import signal
-
-    from qzs.spectral import transmissibility
+    from qzs.spectral import highpass, transmissibility
 
     corner = float(options.get("highpass", 1.0))
-    b, a = signal.bilinear([1.0, 0.0], [1.0, 2 * np.pi * corner], fs=rate)
-    base_velocity = signal.lfilter(b, a, run.base_velocity)
-    payload_velocity = signal.lfilter(b, a, run.payload_velocity)
+    base_velocity = highpass(run.base_velocity, corner, rate)
+    payload_velocity = highpass(run.payload_velocity, corner, rate)
     estimate = transmissibility(base_velocity, payload_velocity, rate, highpass_corner=corner,
                                 **welch)
     keep = (estimate.frequency > band[0]) & (estimate.frequency <= band[1])

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs._validation import read_toml
+from qzs._validation import integer, read_toml
 from qzs.errors import ParameterError
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "shipped_sweeps",
@@ -185,12 +185,6 @@ def _keys(table, name, allowed):
     return table
 
 
-def _integer(name, value, minimum):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise ParameterError(f"`{name}` must be an integer >= {minimum}, got {value!r}.")
-    return int(value)
-
-
 def _number(name, value, *, positive=False):
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
         raise ParameterError(f"`{name}` must be a finite number, got {value!r}.")
@@ -227,8 +221,8 @@ def _definition(document, where, stem):
                              f"Latin hypercube), got {method!r}.")
     seed = head.get("seed")
     if seed is not None:
-        seed = _integer("seed", seed, 0)
-    batch_size = _integer("batch_size", head.get("batch_size", 32), 1)
+        seed = integer("seed", seed, 0)
+    batch_size = integer("batch_size", head.get("batch_size", 32), 1)
 
     excitation = dict(_keys(document.get("excitation", {}), "excitation",
                             ("kind",) + tuple({k for v in EXCITATION_PARAMETERS.values()
@@ -279,7 +273,7 @@ def _definition(document, where, stem):
         if not distributions:
             raise ParameterError(f"method {method!r} needs a [distributions] table of the "
                                  "parameters to sample.")
-        samples = _integer("samples", head.get("samples", 0), 1)
+        samples = integer("samples", head.get("samples", 0), 1)
     if not grid and not distributions:
         raise ParameterError("nothing varies: add a [grid] or a [distributions] table.")
 
@@ -395,7 +389,7 @@ def _analysis(table, dt):
     if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
         raise ParameterError(f"`sample_rate` ({rate!r} Hz) must divide the integration rate "
                              f"1/dt = {1 / dt:g} Hz into a whole number of steps.")
-    fft_length = analysis["fft_length"] = _integer("fft_length", analysis["fft_length"], 8)
+    fft_length = analysis["fft_length"] = integer("fft_length", analysis["fft_length"], 8)
     overlap = analysis["overlap"] = _number("overlap", analysis["overlap"])
     if "duration" in given:
         analysis["duration"] = _number("duration", given["duration"], positive=True)
@@ -405,7 +399,7 @@ def _analysis(table, dt):
             raise ParameterError(f"`duration` ({analysis['duration']!r} s) is shorter than "
                                  f"one FFT segment ({fft_length / rate:g} s).")
     else:
-        analysis["n_averages"] = _integer("n_averages", analysis["n_averages"], 1)
+        analysis["n_averages"] = integer("n_averages", analysis["n_averages"], 1)
         analysis["duration"] = required_duration(fft_length, analysis["n_averages"], rate,
                                                  overlap)
     band = analysis["band"]
