@@ -124,3 +124,17 @@ def strictly_increasing(name, time, error, fix="sort it and drop duplicates firs
         raise error(f"{where}`{name}` must be strictly increasing, but it is {what} at sample {i + 1} "
                     f"(t = {float(time[i + 1])!r} s after t = {float(time[i])!r} s; "
                     f"{int(np.count_nonzero(steps <= 0))} such steps); {fix}.")
+
+
+def known_keys(table, allowed, where, prefix=""):
+    """Return ``table`` if it is a dict whose keys are all in ``allowed``, else raise.
+
+    ``where`` names the table in the message (e.g. ``[analysis]``); ``prefix`` the file.
+    """
+    if not isinstance(table, dict):
+        raise ParameterError(f"{prefix}{where} must be a table, got {table!r}.")
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        raise ParameterError(f"{prefix}unknown key(s) {unknown} in {where}; allowed are "
+                             f"{sorted(allowed)}.")
+    return table

@@ -94,8 +94,7 @@ def fit_spring(displacement, force, *, convention="model", confidence=0.95):
     """
     if convention not in CONVENTIONS:
         raise ParameterError(f"`convention` must be one of {CONVENTIONS}, got {convention!r}.")
-    if not 0 < confidence < 1:
-        raise ParameterError(f"`confidence` must be in (0, 1), got {confidence!r}.")
+    _student(confidence, 1)  # validates `confidence` before the work
     z = np.asarray(displacement, dtype=float).ravel()
     f = np.asarray(force, dtype=float).ravel()
     if z.shape != f.shape:
@@ -121,9 +120,8 @@ def fit_spring(displacement, force, *, convention="model", confidence=0.95):
         raise RuntimeError(f"the tanh fit did not converge ({error}); check the data's "
                            "sign convention and that it spans the transition region.") from None
     residual = f - model(z, *params)
-    dof = max(z.size - 2, 1)
-    t = stats.t.ppf(0.5 + confidence / 2, dof)
-    errors = np.sqrt(np.clip(np.diag(covariance), 0, np.inf)) * t
+    errors = np.sqrt(np.clip(np.diag(covariance), 0, np.inf)) * _student(confidence,
+                                                                         max(z.size - 2, 1))
     scale = 1.4826 * np.median(np.abs(residual - np.median(residual)))
     outliers = tuple(int(i) for i in np.flatnonzero(np.abs(residual) > 4 * max(scale, 1e-300)))
     a, b = params

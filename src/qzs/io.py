@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs._validation import read_toml
+from qzs._validation import known_keys, read_toml
 from qzs.control import ControllerParameters
 from qzs.errors import DataError, ParameterError
 from qzs.model import IsolatorParameters
@@ -204,10 +204,7 @@ def load_config(path):
     isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
                                              settings)
     for section, keys in (("excitation", EXCITATION_KEYS), ("simulation", SIMULATION_KEYS)):
-        unknown = set(document.get(section, {})) - set(keys)
-        if unknown:
-            raise ParameterError(f"{str(path)!r}: unknown key(s) {sorted(unknown)} in "
-                                 f"[{section}]; allowed are {list(keys)}.")
+        known_keys(document.get(section, {}), keys, f"[{section}]", f"{str(path)!r}: ")
     return {"isolator": isolator, "controller": controller,
             "excitation": dict(document.get("excitation", {})),
             "simulation": dict(document.get("simulation", {}))}

@@ -52,7 +52,7 @@ from typing import Mapping
 
 import numpy as np
 
-from qzs._validation import read_toml, strictly_increasing
+from qzs._validation import known_keys, read_toml, strictly_increasing
 from qzs.errors import DataError, ParameterError
 
 __all__ = ["Recording", "ChannelMap", "ChannelSpec", "DataWarning", "ROLES", "UNITS",
@@ -180,10 +180,7 @@ class ChannelMap:
 
 
 def _check_keys(table, allowed, where):
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        raise ParameterError(f"channel map: unknown key(s) {unknown} in {where}; "
-                             f"allowed are {sorted(allowed)}.")
+    known_keys(table, allowed, where, "channel map: ")
 
 
 def load_channel_map(source):

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs._validation import read_toml
+from qzs._validation import known_keys, read_toml
 from qzs.errors import ParameterError
 
 __all__ = ["Study", "StudyResult", "CaseResult", "load_study", "shipped_studies", "run_studies",
@@ -132,10 +132,8 @@ def load_study(path):
             raise ParameterError(f"{str(path)!r}, case {i + 1}: {error}") from None
     for table, keys in (("excitation", EXCITATION_DEFAULTS), ("analysis", ANALYSIS_DEFAULTS),
                         ("simulation", SIMULATION_DEFAULTS)):
-        extra = set(document.get(table, {})) - set(keys) - {"duration"}
-        if extra:
-            raise ParameterError(f"{str(path)!r}: unknown key(s) {sorted(extra)} in [{table}]; "
-                                 f"allowed are {sorted(keys)}.")
+        known_keys(document.get(table, {}), {*keys, "duration"}, f"[{table}]",
+                   f"{str(path)!r}: ")
     views = tuple(head.get("view", ()))
     options = {**document.get("spring", {}), **document.get("processing", {})}
     return Study(name=head["name"], title=head.get("title", head["name"]), kind=kind,

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs._validation import integer, read_toml
+from qzs._validation import integer, known_keys, read_toml
 from qzs.errors import ParameterError
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "shipped_sweeps",
@@ -176,13 +176,7 @@ def load_sweep(source):
 
 
 def _keys(table, name, allowed):
-    if not isinstance(table, dict):
-        raise ParameterError(f"[{name}] must be a table, got {table!r}.")
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        raise ParameterError(f"unknown key(s) {unknown} in [{name}]; allowed are "
-                             f"{sorted(allowed)}.")
-    return table
+    return known_keys(table, allowed, f"[{name}]")
 
 
 def _number(name, value, *, positive=False):
