@@ -133,6 +133,11 @@ def _series(times, ex, table, out):
 _NO_TABLE = np.zeros((5, 2))
 
 
+def _excitation_rule(rule):
+    """A :mod:`qzs._validation` checker that raises :class:`ExcitationError`."""
+    return lambda name, value: rule(name, value, ExcitationError)
+
+
 def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=0.0):
     ex = np.zeros(N_EXCITATION)
     ex[[E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING]] = (
@@ -164,10 +169,10 @@ class Chirp:
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": lambda n, v: non_negative(n, v, ExcitationError),
-            "f0": lambda n, v: non_negative(n, v, ExcitationError),
-            "f1": lambda n, v: non_negative(n, v, ExcitationError),
-            "duration": lambda n, v: positive(n, v, ExcitationError),
+            "amplitude": _excitation_rule(non_negative),
+            "f0": _excitation_rule(non_negative),
+            "f1": _excitation_rule(non_negative),
+            "duration": _excitation_rule(positive),
             "method": lambda n, v: choice(n, v, ("linear", "logarithmic"), ExcitationError),
         })
         if self.method == "logarithmic" and (self.f0 <= 0 or self.f1 <= 0):
@@ -214,9 +219,9 @@ class Sine:
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": lambda n, v: non_negative(n, v, ExcitationError),
-            "frequency": lambda n, v: non_negative(n, v, ExcitationError),
-            "phase": lambda n, v: as_float(n, v, ExcitationError),
+            "amplitude": _excitation_rule(non_negative),
+            "frequency": _excitation_rule(non_negative),
+            "phase": _excitation_rule(as_float),
         })
 
     @property
@@ -273,10 +278,10 @@ class RandomExcitation(_Tabulated):
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": lambda n, v: non_negative(n, v, ExcitationError),
-            "f_low": lambda n, v: non_negative(n, v, ExcitationError),
-            "f_high": lambda n, v: positive(n, v, ExcitationError),
-            "duration": lambda n, v: positive(n, v, ExcitationError),
+            "amplitude": _excitation_rule(non_negative),
+            "f_low": _excitation_rule(non_negative),
+            "f_high": _excitation_rule(positive),
+            "duration": _excitation_rule(positive),
         })
         if self.f_low >= self.f_high:
             raise ExcitationError(
