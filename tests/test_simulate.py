@@ -9,6 +9,7 @@ from helpers import SHORT_CHIRP, linear_controller, linear_isolator
 
 import qzs
 from qzs import _kernels as kernels
+from qzs import _lanes
 from qzs import (
     SOLVERS,
     ControllerParameters,
@@ -252,7 +253,7 @@ def test_interrupt_returns_a_partial_result_only_when_interruptible(monkeypatch)
     def interrupted(*args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(kernels, "run_chunk", interrupted)
+    monkeypatch.setattr(_lanes, "run_single", interrupted)
     r = simulate(SHORT_CHIRP, duration=1.0, interruptible=True)
     assert not r.completed and len(r) == 1 and r.run["steps"] == 0
     with pytest.raises(KeyboardInterrupt):

@@ -209,6 +209,41 @@ def test_dask_cluster_run_equals_the_local_run(reference, dask_cluster, tmp_path
     xr.testing.assert_identical(failing, local)
 
 
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # an in-process worker's
+def test_failed_dask_tasks_are_retried(reference, tmp_path, monkeypatch):
+    """A task that raises (a lost worker, a full disk) runs again; the Dataset is unchanged."""
+    distributed = pytest.importorskip("distributed")
+    definition, expected, _ = reference
+    calls = []
+    run_group = sweep_backends._run_group
+
+    def flaky(*args, **kwargs):  # every other call fails, so each task fails once
+        calls.append(None)
+        if len(calls) % 2:
+            raise OSError("transient failure (injected by the test)")
+        return run_group(*args, **kwargs)
+
+    # an in-process cluster: its worker threads see the patched module
+    monkeypatch.setattr(sweep_backends, "_run_group", flaky)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            data = run_sweep(definition, tmp_path / "retried.zarr", scheduler=client,
+                             progress=False).load()
+    xr.testing.assert_identical(data, expected)
+    assert len(calls) == 2 * definition.n_cases // definition.batch_size
+
+
+def test_cases_with_their_own_excitation_run_side_by_side(tmp_path):
+    """Per-case excitations make one group per case: run in parallel, the same Dataset."""
+    sweep = document(batch_size=4)
+    sweep["grid"] = {"pi_kp": [5.0, 200.0], "excitation.amplitude": [0.005, 0.010]}
+    parallel = run_sweep(sweep, tmp_path / "parallel.zarr", threads=2, progress=False).load()
+    serial = run_sweep(sweep, tmp_path / "serial.zarr", threads=1, progress=False).load()
+    xr.testing.assert_identical(parallel, serial)
+    assert np.all(parallel["status"].values == OK)
+
+
 @pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # the fixture's scheduler
 def test_workers_start_a_local_cluster(tmp_path):
     pytest.importorskip("distributed")

@@ -1,13 +1,13 @@
 """Numba kernels of the isolator simulator: one force law, one stepper.
 
 Arrays and floats in, a status code out; no validation and no Python objects
-(scipy ``_ivp/rk.py`` style). The same :func:`run_chunk` serves a single run, a
-batch and a cluster worker.
+(scipy ``_ivp/rk.py`` style). The driver in :mod:`qzs._lanes` advances one case
+or many with these, for a single run, a batch and a cluster worker alike.
 
 Inside the kernels the parameters, the excitation scalars and the state are
 tuples of floats, not arrays: that keeps the hot path free of reference counting
 and lets LLVM hold everything in registers. The packed arrays (pvlib ``spa``
-style) are converted once per call of :func:`run_chunk`.
+style) are converted once per call of the driver, :func:`qzs._lanes.run_lanes`.
 
 ODE state (``S_*``): relative position z [m], relative velocity v [m/s], the
 charge amplifier's low-pass state [m/s], the PI integral [m*s], then the energy
@@ -22,8 +22,12 @@ slipping payload is located at the zero crossing of v inside the step, then it
 sticks if friction can hold it (``|F_hold| <= Fs``) or else reverses; a stuck
 payload breaks away, located inside the step too, when ``|F_hold|`` exceeds Fs.
 """
+import math
+
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic, overload
 
 from qzs.excitation import advance_phase, base_motion, base_motion_near, excitation_tuple
 
@@ -59,8 +63,10 @@ O_LOCKED, O_CONTACT = 0, 1
 SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
 STATUS_OK, STATUS_DIVERGED = 0, 1
 
-# No 'nnan'/'ninf' fast-math: the divergence check needs isfinite.
-_JIT = dict(cache=True, fastmath={"nsz", "contract", "arcp"}, error_model="numpy")
+# No fast-math at all: without contraction (FMA) or reassociation a lane of a
+# vectorised loop computes the very same bits as scalar code, so a case gives the
+# same numbers alone and in a batch; the divergence check needs isfinite too.
+_JIT = dict(cache=True, error_model="numpy")
 
 
 @njit(**_JIT)
@@ -70,10 +76,70 @@ def params_tuple(p):
             p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20])
 
 
+def _pow2(k):
+    """``2.0**k`` for an integer ``-1022 <= k <= 1023`` (Python fallback of the intrinsic)."""
+    return math.ldexp(1.0, int(k))
+
+
+@intrinsic
+def _pow2_bits(typingctx, k):
+    """``2.0**k`` built from its exponent bits: one shift, vectorisable."""
+    def codegen(context, builder, signature, args):
+        i64 = ir.IntType(64)
+        bits = builder.shl(builder.add(args[0], ir.Constant(i64, 1023)), ir.Constant(i64, 52))
+        return builder.bitcast(bits, ir.DoubleType())
+    return types.float64(types.int64), codegen
+
+
+@overload(_pow2, jit_options=dict(cache=True))
+def _pow2_jit(k):
+    return lambda k: _pow2_bits(k)
+
+
+def fma(a, b, c):
+    """``a * b + c`` rounded once (Python fallback of the intrinsic: rounded twice)."""
+    return a * b + c
+
+
+@intrinsic
+def _fma_instruction(typingctx, a, b, c):
+    """Fused multiply-add: the same single rounding in scalar and vector code."""
+    def codegen(context, builder, signature, args):
+        double = ir.DoubleType()
+        function = builder.module.declare_intrinsic(
+            "llvm.fma", [double], ir.FunctionType(double, [double, double, double]))
+        return builder.call(function, args)
+    return types.float64(types.float64, types.float64, types.float64), codegen
+
+
+@overload(fma, jit_options=dict(cache=True))
+def _fma_jit(a, b, c):
+    return lambda a, b, c: _fma_instruction(float(a), float(b), float(c))
+
+
 @njit(**_JIT, inline="always")
 def _exp(x):
-    """exp (libm), the one place to swap in another implementation."""
-    return np.exp(x)
+    """exp in plain arithmetic (no libm call), so that loops over cases vectorise.
+
+    Cody-Waite reduction ``x = k*ln2 + r``, ``|r| <= ln2/2``, a degree-13 Taylor
+    polynomial (truncation below 1e-17, Estrin's scheme) and ``2**k`` from the exponent bits;
+    within 2 ulp of libm. ``x`` is clamped to [-700, 700]: ``exp(-700)`` ~ 1e-304
+    stands in for 0. The same operations in every lane and in scalar code give
+    the same bits, which keeps batched runs identical to single runs.
+    """
+    x = min(max(x, -700.0), 700.0)
+    k = np.floor(fma(x, 1.4426950408889634, 0.5))
+    r = fma(k, -1.90821492927058770002e-10, fma(k, -6.93147180369123816490e-01, x))
+    # Estrin's scheme: the same polynomial as Horner's, in a quarter of the latency
+    r2 = r * r
+    r4 = r2 * r2
+    low = fma(fma(fma(r, 1.0 / 5040.0, 1.0 / 720.0), r2, fma(r, 1.0 / 120.0, 1.0 / 24.0)), r4,
+              fma(fma(r, 1.0 / 6.0, 0.5), r2, 1.0 + r))
+    high = fma(fma(r, 1.0 / 6227020800.0, 1.0 / 479001600.0), r4,
+               fma(fma(r, 1.0 / 39916800.0, 1.0 / 3628800.0), r2,
+                   fma(r, 1.0 / 362880.0, 1.0 / 40320.0)))
+    p = fma(high, r4 * r4, low)
+    return p * _pow2(np.int64(k))
 
 
 @njit(**_JIT, inline="always")
@@ -140,7 +206,7 @@ def rhs(y, yd, ydd, s, mode, direction, held, P):
         sign = direction  # continued analytically past v = 0 so the crossing is smooth
         level = P[P_FC] + (P[P_FS] - P[P_FC]) * _exp(-P[P_CBC] * abs(v))
         f_friction = -level * sign - P[P_CV] * v
-        xdd = (f_applied + f_friction) / m
+        xdd = (f_applied + f_friction) * (1.0 / m)  # one division per step, off the critical path
     else:
         f_friction = f_hold
         if mode == MODE_WALL_LOW:  # the stop takes the upward part, friction the rest
@@ -170,47 +236,91 @@ def rhs_at(t, s, mode, direction, held, P, E, table):
 
 @njit(**_JIT, inline="always")
 def _axpy(s, a, k):
-    return (s[0] + a * k[0], s[1] + a * k[1], s[2] + a * k[2], s[3] + a * k[3],
-            s[4] + a * k[4], s[5] + a * k[5], s[6] + a * k[6], s[7] + a * k[7])
+    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`)."""
+    return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]), fma(a, k[3], s[3]),
+            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]))
 
 
 @njit(**_JIT, inline="always")
-def _combine(s, h, b1, k1, b2, k2, b3, k3, b4, k4):
-    return (s[0] + h * (b1 * k1[0] + b2 * k2[0] + b3 * k3[0] + b4 * k4[0]),
-            s[1] + h * (b1 * k1[1] + b2 * k2[1] + b3 * k3[1] + b4 * k4[1]),
-            s[2] + h * (b1 * k1[2] + b2 * k2[2] + b3 * k3[2] + b4 * k4[2]),
-            s[3] + h * (b1 * k1[3] + b2 * k2[3] + b3 * k3[3] + b4 * k4[3]),
-            s[4] + h * (b1 * k1[4] + b2 * k2[4] + b3 * k3[4] + b4 * k4[4]),
-            s[5] + h * (b1 * k1[5] + b2 * k2[5] + b3 * k3[5] + b4 * k4[5]),
-            s[6] + h * (b1 * k1[6] + b2 * k2[6] + b3 * k3[6] + b4 * k4[6]),
-            s[7] + h * (b1 * k1[7] + b2 * k2[7] + b3 * k3[7] + b4 * k4[7]))
+def n_stages(solver):
+    """Number of right-hand-side evaluations per step of ``solver``."""
+    if solver == SOLVER_EULER:
+        return 1
+    return 3 if solver == SOLVER_ODE3 else 4
+
+
+@njit(**_JIT, inline="always")
+def tableau(solver, h, stage):
+    """Butcher tableau row of ``stage`` for a step ``h`` [s]: ``(offset, a, weight)``.
+
+    All three solvers have a diagonal tableau: stage ``j`` is evaluated at
+    ``t + offset`` from ``s + a * k[j - 1]``, and the step is ``s + sum(weight * k)``.
+    Euler (order 1), Bogacki-Shampine ode3 without its error stage (order 3,
+    Simulink's fixed-step ode3), classic RK4 (order 4).
+    """
+    if solver == SOLVER_EULER:
+        return 0.0, 0.0, h
+    if solver == SOLVER_ODE3:
+        if stage == 0:
+            return 0.0, 0.0, h * (2.0 / 9.0)
+        if stage == 1:
+            return 0.5 * h, 0.5 * h, h * (1.0 / 3.0)
+        return 0.75 * h, 0.75 * h, h * (4.0 / 9.0)
+    if stage == 0:
+        return 0.0, 0.0, h * (1.0 / 6.0)
+    if stage == 3:
+        return h, h, h * (1.0 / 6.0)
+    return 0.5 * h, 0.5 * h, h * (1.0 / 3.0)
+
+
+@njit(**_JIT, inline="always")
+def rk_from_bases(solver, h, s, mode, direction, held, P, bases):
+    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
+
+    ``bases`` holds the base motion ``(y, yd, ydd)`` at each stage's time. The
+    weighted sum is accumulated stage by stage, in the same order as the
+    batched stages of :mod:`qzs._lanes`, so both give the same bits.
+    """
+    b0, b1, b2, b3 = bases
+    k = rhs(b0[0], b0[1], b0[2], s, mode, direction, held, P)[0]
+    result = _axpy(s, tableau(solver, h, 0)[2], k)
+    if solver == SOLVER_EULER:
+        return result
+    _, a, weight = tableau(solver, h, 1)
+    k = rhs(b1[0], b1[1], b1[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    result = _axpy(result, weight, k)
+    _, a, weight = tableau(solver, h, 2)
+    k = rhs(b2[0], b2[1], b2[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    result = _axpy(result, weight, k)
+    if solver == SOLVER_ODE3:
+        return result
+    _, a, weight = tableau(solver, h, 3)
+    k = rhs(b3[0], b3[1], b3[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    return _axpy(result, weight, k)
+
+
+@njit(**_JIT, inline="always")
+def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
+    """Base motion at the stage times of a step from ``t`` (unused stages repeat the first)."""
+    b0 = base_motion_near(t, phase, sin0, cos0, E, table)
+    b1 = b2 = b3 = b0
+    if solver != SOLVER_EULER:
+        b1 = base_motion_near(t + tableau(solver, h, 1)[0], phase, sin0, cos0, E, table)
+        b2 = base_motion_near(t + tableau(solver, h, 2)[0], phase, sin0, cos0, E, table)
+        if solver == SOLVER_RK4:
+            b3 = base_motion_near(t + h, phase, sin0, cos0, E, table)
+    return b0, b1, b2, b3
 
 
 @njit(**_JIT, inline="always")
 def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
-    """One explicit Runge-Kutta step of length ``h`` [s] from state tuple ``s``.
+    """:func:`rk_from_bases` evaluating the base motion itself.
 
-    Euler (order 1), Bogacki-Shampine ode3 without its error stage (order 3,
-    Simulink's fixed-step ode3), classic RK4 (order 4). ``phase, sin0, cos0``
-    are the excitation's phase and its sine and cosine at a nearby time (see
-    :func:`qzs.excitation.base_motion_near`).
+    ``phase, sin0, cos0`` are the excitation's phase and its sine and cosine at a
+    nearby time (see :func:`qzs.excitation.base_motion_near`).
     """
-    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    k1 = rhs(y, yd, ydd, s, mode, direction, held, P)[0]
-    if solver == SOLVER_EULER:
-        return _axpy(s, h, k1)
-    if solver == SOLVER_ODE3:
-        y, yd, ydd = base_motion_near(t + 0.5 * h, phase, sin0, cos0, E, table)
-        k2 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k1), mode, direction, held, P)[0]
-        y, yd, ydd = base_motion_near(t + 0.75 * h, phase, sin0, cos0, E, table)
-        k3 = rhs(y, yd, ydd, _axpy(s, 0.75 * h, k2), mode, direction, held, P)[0]
-        return _combine(s, h, 2.0 / 9.0, k1, 1.0 / 3.0, k2, 4.0 / 9.0, k3, 0.0, k3)
-    y, yd, ydd = base_motion_near(t + 0.5 * h, phase, sin0, cos0, E, table)
-    k2 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k1), mode, direction, held, P)[0]
-    k3 = rhs(y, yd, ydd, _axpy(s, 0.5 * h, k2), mode, direction, held, P)[0]
-    y, yd, ydd = base_motion_near(t + h, phase, sin0, cos0, E, table)
-    k4 = rhs(y, yd, ydd, _axpy(s, h, k3), mode, direction, held, P)[0]
-    return _combine(s, h, 1.0 / 6.0, k1, 1.0 / 3.0, k2, 1.0 / 3.0, k3, 1.0 / 6.0, k4)
+    bases = stage_bases(solver, t, h, E, table, phase, sin0, cos0)
+    return rk_from_bases(solver, h, s, mode, direction, held, P, bases)
 
 
 @njit(**_JIT)
@@ -245,7 +355,7 @@ def _with(s, index, value):
             value if index == 6 else s[6], value if index == 7 else s[7])
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _hold_margin(mode, f_hold, fs):
     """How far the holding force is inside what friction (and a plastic stop) can give [N]."""
     if mode == MODE_STICK:
@@ -255,7 +365,7 @@ def _hold_margin(mode, f_hold, fs):
     return fs - f_hold
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _release_direction(mode, f_hold):
     if mode == MODE_STICK:
         return -1 if f_hold > 0.0 else 1
@@ -333,7 +443,7 @@ def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
     return _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     """Kind (0: none) and time fraction (secant) of the first transition in a step."""
     theta = 2.0
@@ -400,7 +510,7 @@ def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, tab
     return at, state
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0):
     """Advance one grid step, locating and handling at most one transition inside it.
 
@@ -510,14 +620,14 @@ def record(t, s, mode, direction, held, P, E, table, row, row_flags, phase, sin0
     row_flags[O_CONTACT] = _in_contact(s, mode, P)
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _in_contact(s, mode, P):
     return mode >= MODE_WALL_LOW or s[S_Z] < P[P_Z_LOW] or s[S_Z] > P[P_Z_HIGH]
 
 
 @njit(**_JIT)
 def evaluate(t, state, flags, p, ex, table, row, row_flags):
-    """Record the persistent state (arrays, as :func:`run_chunk` keeps it) at ``t``."""
+    """Record the persistent state (arrays, as the driver keeps it) at ``t``."""
     s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
     held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
     E = excitation_tuple(ex)
@@ -532,81 +642,3 @@ def hold_force(t, state, p, ex, table):
     s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
     held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
     return rhs_at(t, s, MODE_STICK, 0.0, held, params_tuple(p), excitation_tuple(ex), table)[1]
-
-
-@njit(**_JIT, nogil=True)
-def run_chunk(solver, n_steps, decimation, state, flags, p, ex, table, out, out_flags, row0):
-    """Advance ``n_steps`` grid steps, writing every ``decimation``-th state to ``out``.
-
-    ``state`` and ``flags`` carry the run between calls. Returns ``(status,
-    rows_written)``; ``status`` is ``STATUS_DIVERGED`` when the state becomes
-    non-finite or leaves a bound of 100 strokes or 1e4 m/s, and ``state`` then
-    holds the last finite state, ``flags[I_STEP]`` its step.
-    """
-    P = params_tuple(p)
-    E = excitation_tuple(ex)
-    h = P[P_DT]
-    control_steps = int(P[P_CONTROL_STEPS])
-    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
-    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
-    mode = flags[I_MODE]
-    direction = flags[I_DIRECTION]
-    contact = flags[I_CONTACT]
-    step = flags[I_STEP]
-    bound = 100.0 * (P[P_Z_HIGH] - P[P_Z_LOW]) + abs(P[P_Z_LOW]) + abs(P[P_Z_HIGH])
-    status = STATUS_OK
-    row = row0
-    margin = np.nan
-    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
-    for _ in range(n_steps):
-        t = step * h
-        if control_steps > 0 and step % control_steps == 0:
-            held, s = sample_controller(t, s, mode, P, E, table)
-            margin = np.nan
-        s1, mode1, direction1, margin1, sticks, impacts = grid_step(
-            solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0)
-        if not (np.isfinite(s1[S_Z]) and np.isfinite(s1[S_V]) and np.isfinite(s1[S_HP])
-                and np.isfinite(s1[S_INT]) and abs(s1[S_Z]) <= bound and abs(s1[S_V]) <= 1e4):
-            status = STATUS_DIVERGED
-            break
-        s, mode, direction, margin = s1, mode1, direction1, margin1
-        step += 1
-        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
-        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
-        flags[I_N_STICKS] += sticks
-        flags[I_N_CONTACTS] += impacts
-        now = _in_contact(s, mode, P)
-        if now and contact == 0 and P[P_PLASTIC] == 0.0:
-            flags[I_N_CONTACTS] += 1
-        contact = 1 if now else 0
-        if step % decimation == 0:
-            record(step * h, s, mode, direction, held, P, E, table, out[row], out_flags[row],
-                   phase, sin0, cos0)
-            row += 1
-    for i in range(N_ODE):
-        state[i] = s[i]
-    state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR] = held
-    flags[I_MODE] = mode
-    flags[I_DIRECTION] = direction
-    flags[I_CONTACT] = contact
-    flags[I_STEP] = step
-    return status, row - row0
-
-
-@njit(cache=True, nogil=True, fastmath={"nsz", "contract", "arcp"}, error_model="numpy")
-def run_batch_chunk(solver, n_steps, decimation, states, flags, params, ex, table, out,
-                    out_flags, row0, status, first, last, rows):
-    """:func:`run_chunk` for cases ``first..last-1`` of a batch (releases the GIL).
-
-    Row ``c`` of ``states``, ``flags``, ``params``, ``out`` and ``out_flags`` is
-    case ``c``; the excitation is shared. Each case runs the very same
-    :func:`run_chunk` as a single run, so its numbers are identical; threads run
-    disjoint ranges of cases in parallel. A case whose ``status`` is not
-    ``STATUS_OK`` is skipped (it failed earlier); ``rows[c]`` gets the rows written.
-    """
-    for c in range(first, last):
-        if status[c] == STATUS_OK:
-            code, written = run_chunk(solver, n_steps, decimation, states[c], flags[c],
-                                      params[c], ex, table, out[c], out_flags[c], row0)
-            status[c] = code
-            rows[c] = written

@@ -1,9 +1,9 @@
 """Many parameter sets through the same kernel at once: the engine of sweeps.
 
 Each case is validated and packed exactly as :func:`qzs.simulate` does it, and
-:func:`qzs._kernels.run_batch_chunk` advances all cases by the same step,
-in parallel over cores, calling the single-run kernel for each: per case the
-numbers are identical to ``simulate``'s. Output is reduced while integrating:
+:func:`qzs._lanes.run_lanes` advances all cases by the same step, several cases
+per vector instruction, with a share of the cases on each core: per case the
+numbers are identical to ``simulate``'s, which runs the same kernel with one case. Output is reduced while integrating:
 only the requested channels are kept, and per-case statistics (stroke, stop
 contacts, RMS motor force, time locked) are accumulated chunk by chunk.
 """
@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs import _kernels as K
+from qzs import _lanes
 from qzs.errors import ParameterError
 from qzs.results import CHANNELS
 from qzs.simulate import divergence_message, prepare_run
@@ -67,6 +68,25 @@ class BatchResult:
     def steps_per_second(self):
         """Simulated steps per second over all cases [steps/s]."""
         return float(self.stats["steps"].sum()) / max(self.elapsed, 1e-12)
+
+
+def _advance(solver, done, steps, decimation, states, flags, params, ex, table, out, out_flags,
+             status, written, first, last):
+    """Advance cases ``first..last-1`` by ``steps`` steps (one thread's share)."""
+    if last - first == 1:  # the one-case kernel: the same numbers, without lane bookkeeping
+        if status[first] == K.STATUS_OK:
+            status[first], written[first] = _lanes.run_single(
+                solver, steps, decimation, states[first], flags[first], params[first], ex, table,
+                out[first], out_flags[first], 0)
+        return
+    for a in range(first, last, _lanes.MAX_LANES):
+        b = min(a + _lanes.MAX_LANES, last)
+        code = _lanes.run_lanes(solver, done, steps, decimation, states[a:b], flags[a:b],
+                                params[a:b], ex, table, out[a:b], out_flags[a:b], 0,
+                                status[a:b], written[a:b])
+        if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long
+            raise RuntimeError(f"the batch kernel refused {b - a} cases (at most "
+                               f"{_lanes.MAX_LANES} per call)")
 
 
 def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rate=1000.0,
@@ -172,13 +192,14 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rat
         while done < n_steps:
             steps = min(chunk_steps, n_steps - done)
             before = status.copy()
-            args = (first.solver_code, steps, decimation, states, flags, params, ex, table,
-                    out, out_flags, 0, status)
+            def advance(a, b):
+                _advance(first.solver_code, done, steps, decimation, states, flags, params, ex,
+                         table, out, out_flags, status, written, a, b)
+
             if pool is None:
-                K.run_batch_chunk(*args, 0, n, written)
+                advance(0, n)
             else:
-                list(pool.map(lambda i: K.run_batch_chunk(*args, bounds[i], bounds[i + 1],
-                                                           written), range(workers)))
+                list(pool.map(lambda i: advance(bounds[i], bounds[i + 1]), range(workers)))
             newly = (before == K.STATUS_OK) & (status != K.STATUS_OK)
             failed_at[newly] = flags[newly, K.I_STEP]
             rows = steps // decimation

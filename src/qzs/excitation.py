@@ -23,7 +23,7 @@ KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
 E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING = range(7)
 N_EXCITATION = 7
 _TWO_PI = 2.0 * np.pi
-_JIT = dict(cache=True, fastmath={"nsz", "contract", "arcp"}, error_model="numpy")
+_JIT = dict(cache=True, error_model="numpy")  # no fast-math: see qzs._kernels
 
 
 @njit(**_JIT)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs import _kernels as K
+from qzs import _lanes
 from qzs._validation import as_float, choice, positive
 from qzs.control import ControllerParameters
 from qzs.errors import ParameterError, SimulationError, StabilityError
@@ -41,6 +42,19 @@ def _stiff_modes(isolator, controller):
     return np.asarray(eigenvalues, dtype=complex)
 
 
+def _stability_test(isolator, controller, solver):
+    """``stable(h)``: does a step ``h`` [s] keep every stiff mode's growth below 0.1 %/s?"""
+    choice("solver", solver, tuple(SOLVERS))
+    coefficients = np.array(_STABILITY_POLYNOMIALS[solver][::-1])
+    eigenvalues = _stiff_modes(isolator, controller)
+
+    def stable(h):
+        growth = np.log(np.abs(np.polyval(coefficients, h * eigenvalues)))
+        return bool(np.all(growth <= 1e-3 * h))
+
+    return stable
+
+
 def largest_stable_step(isolator=None, controller=None, solver="ode3"):
     """Largest time step [s] for which the explicit integrator stays stable.
 
@@ -62,14 +76,7 @@ def largest_stable_step(isolator=None, controller=None, solver="ode3"):
     """
     isolator = isolator or IsolatorParameters()
     controller = controller or ControllerParameters()
-    choice("solver", solver, tuple(SOLVERS))
-    coefficients = np.array(_STABILITY_POLYNOMIALS[solver][::-1])
-    eigenvalues = _stiff_modes(isolator, controller)
-
-    def stable(h):
-        growth = np.log(np.abs(np.polyval(coefficients, h * eigenvalues)))
-        return bool(np.all(growth <= 1e-3 * h))
-
+    stable = _stability_test(isolator, controller, solver)
     low, high = 0.0, 1.0
     while stable(high) and high < 1e3:
         low, high = high, high * 2
@@ -214,8 +221,8 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
             f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
-    limit = largest_stable_step(isolator, controller, solver)
-    if dt > limit:
+    if not _stability_test(isolator, controller, solver)(dt):
+        limit = largest_stable_step(isolator, controller, solver)  # only for the message
         raise StabilityError(
             f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
             f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
@@ -292,8 +299,8 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None, 
     try:
         while done < n_steps:
             n = min(chunk, n_steps - done)
-            status, written = K.run_chunk(solver_code, n, decimation, s, flags, p, *packed,
-                                          out, out_flags, rows)
+            status, written = _lanes.run_single(solver_code, n, decimation, s, flags, p, *packed,
+                                                out, out_flags, rows)
             rows += written
             if status != K.STATUS_OK:
                 _raise_diverged(s, flags, p)

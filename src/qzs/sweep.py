@@ -84,7 +84,9 @@ def run_sweep(definition, store=None, *, resume=False, overwrite=False, schedule
     workers : int, optional
         Start a local Dask cluster of this many single-threaded worker processes.
         Without `scheduler` and `workers` the batches run in this process, each in
-        parallel over `threads` (numba) threads.
+        parallel over `threads` threads (cases sharing an excitation in one batch
+        call, several cases per vector instruction; cases with an excitation of
+        their own side by side).
     threads : int, optional
         Threads per batch; default all cores locally, 1 on a Dask cluster.
     progress : bool

@@ -3,13 +3,17 @@
 :func:`run_batch` is the task every backend runs, unchanged (stumpy style: the
 same kernel in-process and on a cluster): it builds the cases of one batch,
 groups them by excitation, runs each group through
-:func:`qzs.batch.simulate_batch` and reduces every case to the outputs the sweep
-keeps. A case with invalid parameters, a diverged simulation or a failed
+:func:`qzs.batch.simulate_batch` (the groups side by side, one per core, when
+the cases have excitations of their own) and reduces every case to the outputs
+the sweep keeps. A case with invalid parameters, a diverged simulation or a failed
 analysis is recorded with its status and message; the others go on.
 """
+import os
 import re
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import nullcontext
 
 import numpy as np
 
@@ -20,7 +24,7 @@ from qzs.sweep_store import ANALYSIS_FAILED, FAILED, INVALID, OK, schema
 __all__ = ["run_batch", "build_excitation", "execute", "case_settings"]
 
 _CASE_ERROR = re.compile(r"^case (\d+): (.*)$", re.S)
-_LOCK = threading.Lock()  # one numba-parallel batch at a time per process
+_LOCK = threading.Lock()  # one multi-threaded batch at a time per process
 
 
 def build_excitation(kind, values, analysis):
@@ -87,7 +91,8 @@ def run_batch(definition, start, settings, n_time, threads=None):
     n_time : int
         Samples kept per time series (0: none).
     threads : int, optional
-        Numba threads for :func:`~qzs.batch.simulate_batch`; default all cores.
+        Cores to use: the threads of :func:`~qzs.batch.simulate_batch`, or the
+        groups run side by side when cases have their own excitation; default all.
 
     Returns
     -------
@@ -117,15 +122,25 @@ def run_batch(definition, start, settings, n_time, threads=None):
             continue
         key = tuple(sorted(excitation.items()))
         groups.setdefault(key, (built, []))[1].append((i, isolator, controller))
-    steps = 0
-    for (excitation, duration), members in groups.values():
-        steps += _run_group(definition, excitation, duration, members, arrays, n_time, threads)
+    groups = list(groups.values())
+    cores = threads or os.cpu_count() or 1
+    if len(groups) > 1 and cores > 1:  # cases with their own excitations: a group per core
+        with _LOCK, ThreadPoolExecutor(min(cores, len(groups))) as pool:
+            steps = sum(pool.map(lambda group: _run_group(
+                definition, *group[0], group[1], arrays, n_time, 1, lock=nullcontext()), groups))
+    else:
+        steps = sum(_run_group(definition, excitation, duration, members, arrays, n_time,
+                               threads) for (excitation, duration), members in groups)
     return {"start": start, "arrays": arrays, "steps": steps,
             "elapsed": time.perf_counter() - began}
 
 
-def _run_group(definition, excitation, duration, members, arrays, n_time, threads):
-    """Run cases sharing one excitation; cases the batch call rejects are recorded invalid."""
+def _run_group(definition, excitation, duration, members, arrays, n_time, threads, lock=_LOCK):
+    """Run cases sharing one excitation; cases the batch call rejects are recorded invalid.
+
+    ``lock`` is held around the batch call (by default the process-wide one: one
+    multi-threaded batch at a time).
+    """
     out = definition.outputs
     spectral = bool(out["transmissibility"] or out["coherence"] or out["metrics"]
                     or out["bands"])
@@ -135,7 +150,7 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
     sim = definition.simulation
     while members:
         try:
-            with _LOCK:
+            with lock:
                 result = simulate_batch(
                     [(iso, ctl) for _, iso, ctl in members], excitation, duration=duration,
                     dt=sim["dt"], sample_rate=definition.analysis["sample_rate"],
