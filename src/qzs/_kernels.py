@@ -63,9 +63,10 @@ O_LOCKED, O_CONTACT = 0, 1
 SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
 STATUS_OK, STATUS_DIVERGED = 0, 1
 
-# No fast-math at all: without contraction (FMA) or reassociation a lane of a
+# No fast-math at all: without implicit contraction or reassociation a lane of a
 # vectorised loop computes the very same bits as scalar code, so a case gives the
-# same numbers alone and in a batch; the divergence check needs isfinite too.
+# same numbers alone and in a batch (the fused multiply-adds worth having are
+# explicit, :func:`fma`); the divergence check needs isfinite too.
 _JIT = dict(cache=True, error_model="numpy")
 
 
