@@ -3,9 +3,10 @@
 Each case is validated and packed exactly as :func:`qzs.simulate` does it, and
 :func:`qzs._lanes.run_lanes` advances all cases by the same step, several cases
 per vector instruction, with a share of the cases on each core: per case the
-numbers are identical to ``simulate``'s, which runs the same kernel with one case. Output is reduced while integrating:
-only the requested channels are kept, and per-case statistics (stroke, stop
-contacts, RMS motor force, time locked) are accumulated chunk by chunk.
+numbers are identical to ``simulate``'s (see :mod:`qzs._lanes`). Output is
+reduced while integrating: only the requested channels are kept, and per-case
+statistics (stroke, stop contacts, RMS motor force, time locked) are
+accumulated chunk by chunk.
 """
 import os
 import time as _time
@@ -185,6 +186,10 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rat
 
     bar = tqdm(total=n_steps, unit="step", unit_scale=True, desc=f"{n} cases",
                disable=not progress, leave=False)
+    def advance(a, b):  # cases a..b-1 by `steps` steps from step `done` (read at call time)
+        _advance(first.solver_code, done, steps, decimation, states, flags, params, ex, table,
+                 out, out_flags, status, written, a, b)
+
     start = _time.perf_counter()
     try:
         absorb(1, 0, 0)
@@ -192,10 +197,6 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=1e-4, sample_rat
         while done < n_steps:
             steps = min(chunk_steps, n_steps - done)
             before = status.copy()
-            def advance(a, b):
-                _advance(first.solver_code, done, steps, decimation, states, flags, params, ex,
-                         table, out, out_flags, status, written, a, b)
-
             if pool is None:
                 advance(0, n)
             else:
