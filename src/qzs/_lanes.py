@@ -176,7 +176,7 @@ def _vector_pass(solver, n, t, h, L, T, PP, bases, b_end):
 @njit(**_JIT, nogil=True)
 def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, table, out,
               out_flags, row0, status, rows):
-    """Advance every case ``n_steps`` grid steps from step ``step0``; record every ``decimation``-th.
+    """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
 
     Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
     (``K.N_PARAMS``), ``out`` and ``out_flags`` (rows from ``row0``) is case ``c``;
