@@ -307,9 +307,11 @@ def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
     b1 = b2 = b3 = b0
     if solver != SOLVER_EULER:
         b1 = base_motion_near(t + tableau(solver, h, 1)[0], phase, sin0, cos0, E, table)
-        b2 = base_motion_near(t + tableau(solver, h, 2)[0], phase, sin0, cos0, E, table)
-        if solver == SOLVER_RK4:
-            b3 = base_motion_near(t + h, phase, sin0, cos0, E, table)
+        b2 = b1  # RK4's second and third stages share a time
+        if solver == SOLVER_ODE3:
+            b2 = base_motion_near(t + tableau(solver, h, 2)[0], phase, sin0, cos0, E, table)
+        else:
+            b3 = base_motion_near(t + tableau(solver, h, 3)[0], phase, sin0, cos0, E, table)
     return b0, b1, b2, b3
 
 
