@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import qzs
-from qzs.batch import simulate_batch
+from qzs.engine.batch import simulate_batch
 
 TARGET_PER_CORE = 10e6
 TARGET_SPEEDUP = 1.8

@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 
 from qzs.identify import fit_friction, fit_spring  # noqa: E402
 from qzs.model import IsolatorParameters  # noqa: E402
-from qzs.plotting import plot_spring_fit  # noqa: E402
+from qzs.viz import plot_spring_fit  # noqa: E402
 
 
 def main(argv=None):

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 
 import qzs
-from qzs.spectral import highpass
-from qzs.readers import write_dspace_mat
+from qzs.analysis.spectral import highpass
+from qzs.iotools.readers import write_dspace_mat
 
 SEED = 20240605
 RATE = 500.0  # [Hz] sample rate of the experiment log

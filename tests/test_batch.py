@@ -4,7 +4,7 @@ import pytest
 from helpers import linear_controller, linear_isolator
 
 import qzs
-from qzs.batch import STATS, simulate_batch
+from qzs.engine.batch import STATS, simulate_batch
 
 EXCITATION = qzs.Chirp(duration=12.0, f1=8.0)
 CASES = [(qzs.IsolatorParameters(stiction_force=fs), qzs.ControllerParameters(pi_kp=kp, pi_ki=ki))

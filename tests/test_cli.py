@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from qzs.cli import main
-from qzs.io import read_result, save_config
+from qzs.iotools import read_result, save_config
 
 
 def test_params_lists_every_parameter_with_units(capsys):
@@ -18,7 +18,7 @@ def test_params_lists_every_parameter_with_units(capsys):
 def test_params_toml_round_trips(tmp_path):
     path = tmp_path / "p.toml"
     assert main(["params", "--toml", str(path), "--set", "mass=7"]) == 0
-    from qzs.io import load_config
+    from qzs.iotools import load_config
 
     assert load_config(path)["isolator"].mass == 7.0
 

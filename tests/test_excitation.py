@@ -5,7 +5,7 @@ from helpers import linear_controller, linear_isolator
 from scipy import signal
 
 from qzs import Chirp, DisplacementRecord, ExcitationError, ParameterError, RandomExcitation, Sine, simulate
-from qzs.excitation import base_motion_series
+from qzs.engine import base_motion_series
 
 
 def _record(nonuniform=False):

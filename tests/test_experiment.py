@@ -12,10 +12,12 @@ import pytest
 
 import qzs
 from qzs.errors import DataError, ParameterError
-from qzs.experiment import add_parser, infer_chirp, process_experiment, run
-from qzs.spectral import highpass
-from qzs.readers import DataWarning, Recording, read_recording
-from qzs.spectral import transmissibility
+from qzs.cli.experiment import add_parser, run
+from qzs.workflows.experiment import infer_chirp, process_experiment
+from qzs.analysis.spectral import highpass
+from qzs.errors import DataWarning
+from qzs.iotools.readers import Recording, read_recording
+from qzs.analysis.spectral import transmissibility
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "examples" / "data"
@@ -123,7 +125,7 @@ def test_bad_input():
         source="noise")
     with pytest.raises(DataError, match="not a rising linear chirp"):
         process_experiment(noise, fft_length=1024, n_averages=None)
-    with pytest.raises(ParameterError, match="must be a qzs.readers.Recording"):
+    with pytest.raises(ParameterError, match="must be a qzs.iotools.readers.Recording"):
         process_experiment({"time": [0, 1]})
 
 
@@ -156,29 +158,16 @@ def _readme_commands():
     return [line.split("#")[0].strip() for line in block.splitlines() if line.split("#")[0].strip()]
 
 
-def _cli_has_experiment(capsys):
-    from qzs.cli import main
-
-    try:
-        main(["experiment", "--help"])
-    except SystemExit as stop:
-        capsys.readouterr()
-        return stop.code == 0
-    return True
-
-
 def _run_in_process(words, capsys):
     """Run a README command line in this process (the imports are paid once)."""
     import runpy
 
-    from qzs import experiment
+    from qzs.cli import main
 
     if words[:2] == ["qzs", "experiment"]:
-        from qzs.cli import main
-
-        return main(words[1:]) if _cli_has_experiment(capsys) else experiment.main(words[2:])
-    if words[:3] == ["python", "-m", "qzs.experiment"]:
-        return experiment.main(words[3:])
+        return main(words[1:])
+    if words[:3] == ["python", "-m", "qzs"]:
+        return main(words[3:])
     assert words[0] == "python" and words[1].endswith(".py"), words
     saved = sys.argv
     sys.argv = words[1:]
@@ -215,8 +204,8 @@ def test_every_readme_command_works(tmp_path, capsys, monkeypatch):
 
 
 def test_module_entry_point_runs():
-    """``python -m qzs.experiment`` starts, parses and reports a bad map as an error."""
-    done = subprocess.run([sys.executable, "-m", "qzs.experiment", str(DATA / "experiment.csv"),
+    """``python -m qzs experiment`` starts, parses and reports a bad map as an error."""
+    done = subprocess.run([sys.executable, "-m", "qzs", "experiment", str(DATA / "experiment.csv"),
                            "--map", str(DATA / "missing.toml")], capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 2 and "channel map not found" in done.stderr

@@ -6,7 +6,9 @@ import pytest
 
 import qzs
 from qzs.errors import DataError, ParameterError
-from qzs.identify import FitError, fit_friction, plot_friction_fit
+from qzs.errors import FitError
+from qzs.identify import fit_friction
+from qzs.viz.identify import plot_friction_fit
 
 TRUTH = qzs.IsolatorParameters()
 NAMES = ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping")

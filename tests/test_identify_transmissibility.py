@@ -4,8 +4,9 @@ import pytest
 
 import qzs
 from qzs.errors import DataError, ParameterError
-from qzs.identify import FitError, fit_transmissibility
-from qzs.spectral import transmissibility
+from qzs.errors import FitError
+from qzs.identify import fit_transmissibility
+from qzs.analysis.spectral import transmissibility
 
 CHIRP = qzs.Chirp(amplitude=0.010, f0=0.0, f1=20.0, duration=60.0)
 RATE = 100.0

@@ -4,14 +4,14 @@ import pytest
 
 import qzs
 from qzs.errors import DataError, ParameterError
-from qzs.io import (
+from qzs.iotools import (
     atomic_path,
     load_config,
     read_displacement_csv,
     read_result,
     save_config,
-    update_parameters,
 )
+from qzs.model.registry import update_parameters
 
 
 @pytest.fixture(scope="module")

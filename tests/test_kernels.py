@@ -2,19 +2,19 @@
 import numpy as np
 from numba import njit
 
-from qzs import _kernels as K
+from qzs.engine import arithmetic as K
 
 
 @njit(cache=True)
 def _exp_all(x, out):
     for i in range(x.size):
-        out[i] = K._exp(x[i])
+        out[i] = K.exp(x[i])
 
 
 @njit(cache=True)
 def _tanh_all(x, out):
     for i in range(x.size):
-        out[i] = K._tanh(x[i])
+        out[i] = K.tanh(x[i])
 
 
 @njit(cache=True)

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 import qzs
-from qzs import _lanes
-from qzs.batch import simulate_batch
+from qzs.engine import lanes as _lanes
+from qzs.engine.batch import simulate_batch
 
 # A shaking hard enough for stick-slip, stop impacts (plastic and compliant) and no-PI
 # payloads sinking to the lower stop; a third of the controllers sampled at 1 kHz.

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import qzs
-from qzs.linear import linearize
+from qzs.analysis.linear import linearize
 
 
 def closed_form(frequency, m, k, c, kp, ki, kd, f_hp):

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from qzs.errors import DataError, ParameterError
-from qzs.readers import (DataWarning, Recording, load_channel_map, read_recording,
+from qzs.iotools.readers import (DataWarning, Recording, load_channel_map, read_recording,
                          write_dspace_mat)
 
 RATE = 200.0

@@ -8,8 +8,8 @@ import scipy.linalg
 from helpers import SHORT_CHIRP, linear_controller, linear_isolator
 
 import qzs
-from qzs import _kernels as kernels
-from qzs import _lanes
+from qzs.engine import kernels as kernels
+from qzs.engine import lanes as _lanes
 from qzs import (
     SOLVERS,
     ControllerParameters,
@@ -22,7 +22,7 @@ from qzs import (
     largest_stable_step,
     simulate,
 )
-from qzs.results import CHANNELS, FLAGS
+from qzs.engine.results import CHANNELS, FLAGS
 
 
 # ------------------------------------------------------------------ bad input
@@ -206,7 +206,7 @@ def test_kinematic_channels_are_consistent(short_run):
     np.testing.assert_allclose(r.payload_displacement, r.base_displacement + r.relative_position, rtol=0,
                                atol=1e-16)
     np.testing.assert_allclose(r.payload_velocity, r.base_velocity + r.relative_velocity, rtol=0, atol=1e-16)
-    y, yd, ydd = qzs.excitation.base_motion_series(SHORT_CHIRP, r.time)
+    y, yd, ydd = qzs.engine.base_motion_series(SHORT_CHIRP, r.time)
     np.testing.assert_allclose(r.base_displacement, y, rtol=0, atol=1e-15)
     np.testing.assert_allclose(r.base_acceleration, ydd, rtol=0, atol=1e-12)
 

@@ -6,7 +6,7 @@ import pytest
 from scipy import optimize, signal
 
 from qzs.errors import DataError, ParameterError
-from qzs.spectral import (
+from qzs.analysis.spectral import (
     amplitude_spectrum,
     required_duration,
     required_samples,

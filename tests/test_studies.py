@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from qzs.errors import ParameterError
-from qzs.report import CLAIMS, decide_claims, write_paper_outputs
-from qzs.studies import load_study, run_studies, shipped_studies
+from qzs.workflows.report import CLAIMS, decide_claims, write_paper_outputs
+from qzs.workflows.studies import load_study, run_studies, shipped_studies
 
 
 def test_every_shipped_study_loads_and_names_known_claims():

@@ -9,7 +9,7 @@ import pytest
 from scipy import stats
 
 from qzs import ParameterError
-from qzs.sweep_definition import (
+from qzs.workflows.sweeps.definition import (
     DISTRIBUTIONS,
     METHODS,
     draw_samples,

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from qzs import ParameterError
-from qzs.sweep import add_parsers, run_sweep, run_sweep_plot_command
-from qzs.sweep_plots import plot_metric, plot_transmissibility_band, scalar_outputs
+from qzs.cli.sweep import add_parsers, run_plot_command as run_sweep_plot_command
+from qzs.workflows.sweeps import run_sweep
+from qzs.viz.sweeps import plot_metric, plot_transmissibility_band, scalar_outputs
 
 matplotlib.use("Agg")
 
@@ -40,7 +41,7 @@ def _axes_data(figure):
 
 
 def test_line_and_heat_map_of_a_grid(grid_store, tmp_path):
-    from qzs.sweep import open_sweep
+    from qzs.workflows.sweeps import open_sweep
 
     data = open_sweep(grid_store)
     assert {"peak_stroke", "mean_transmissibility_low", "resonance_peak"} <= set(
@@ -60,7 +61,7 @@ def test_line_and_heat_map_of_a_grid(grid_store, tmp_path):
 
 
 def test_monte_carlo_band_and_scatter(monte_carlo_store, tmp_path):
-    from qzs.sweep import open_sweep
+    from qzs.workflows.sweeps import open_sweep
 
     data = open_sweep(monte_carlo_store)
     figure = plot_transmissibility_band(data, path=tmp_path / "band.png")
@@ -73,7 +74,7 @@ def test_monte_carlo_band_and_scatter(monte_carlo_store, tmp_path):
 
 
 def test_plot_errors_name_the_choices(grid_store):
-    from qzs.sweep import open_sweep
+    from qzs.workflows.sweeps import open_sweep
 
     data = open_sweep(grid_store)
     with pytest.raises(ParameterError, match="unknown metric 'peak'.*peak_stroke"):

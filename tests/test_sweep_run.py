@@ -11,10 +11,11 @@ import xarray as xr
 
 import qzs
 from qzs import ParameterError
-from qzs import sweep_backends
-from qzs.spectral import transmissibility, transmissibility_metrics
-from qzs.sweep import add_parsers, load_sweep, run_sweep, run_sweep_command
-from qzs.sweep_store import FAILED, INVALID, OK
+from qzs.workflows.sweeps import backends as sweep_backends
+from qzs.analysis.spectral import transmissibility, transmissibility_metrics
+from qzs.cli.sweep import add_parsers, run_sweep_command
+from qzs.workflows.sweeps import load_sweep, run_sweep
+from qzs.workflows.sweeps.store import FAILED, INVALID, OK
 
 ANALYSIS = {"fft_length": 2048, "n_averages": 8, "band": [0.0, 10.0],
             "at_frequencies": [2.0, 4.0]}

@@ -1,35 +1,44 @@
 """qzs: simulation and analysis of semi-active quasi-zero-stiffness vibration isolators.
 
 The isolator of Leav et al. (constant-force MagSpring + linear motor, stick-slip
-friction, guide hard stops, PI position loop and active damping), simulated
-exactly as ``MODEL.md`` specifies, and the tools to judge it by transmissibility.
+friction, guide hard stops, PI position loop and active damping), simulated as
+docs/model.md describes, and the tools to judge it by transmissibility.
+
+This module is the flat public API. The subpackages are the architecture, each
+importing only from those listed before it:
+
+``model``      parameters, force laws (numpy), excitations, the parameter registry
+``analysis``   spectral estimation and metrics, linearisation, run statistics
+``engine``     numba kernels, single and lockstep drivers, simulate, batch, results
+``iotools``    result and config files, rig-log readers
+``identify``   spring, friction and transmissibility fits
+``viz``        every figure
+``workflows``  the paper's studies and report, experiment pipeline, sweeps
+``cli``        the ``qzs`` command
 """
-from importlib.metadata import PackageNotFoundError, version as _version
+from qzs._version import __version__
+from qzs.engine.results import SimulationResult
+from qzs.engine.simulate import simulate
+from qzs.engine.stability import SOLVERS, largest_stable_step
+from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
+                        MissingDependencyError, ParameterError, SimulationError, StabilityError)
+from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
+                       IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
+                       friction_force, passive_natural_frequency, spring_force, spring_stiffness)
 
-try:
-    __version__ = _version("qzs")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0+unknown"
-
-from qzs.control import ControllerParameters, closed_loop_natural_frequency  # noqa: E402
-from qzs.errors import (  # noqa: E402
-    DataError,
-    ExcitationError,
-    ParameterError,
-    SimulationError,
-    StabilityError,
-)
-from qzs.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine  # noqa: E402
-from qzs.model import (  # noqa: E402
-    InitialState,
-    IsolatorParameters,
-    friction_force,
-    passive_natural_frequency,
-    spring_force,
-    spring_stiffness,
-)
-from qzs.results import SimulationResult  # noqa: E402
-from qzs.simulate import SOLVERS, largest_stable_step, simulate  # noqa: E402
+# Loaded on first use, so that ``import qzs`` stays lean (PEP 562).
+_LAZY = {
+    "simulate_batch": "qzs.engine.batch", "BatchResult": "qzs.engine.batch",
+    "transmissibility": "qzs.analysis.spectral",
+    "TransmissibilityEstimate": "qzs.analysis.spectral",
+    "transmissibility_metrics": "qzs.analysis.spectral",
+    "linearize": "qzs.analysis.linear",
+    "fit_spring": "qzs.identify", "fit_friction": "qzs.identify",
+    "fit_transmissibility": "qzs.identify",
+    "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
+    "load_config": "qzs.iotools", "read_result": "qzs.iotools",
+    "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
+}
 
 __all__ = [
     "__version__",
@@ -38,5 +47,21 @@ __all__ = [
     "simulate", "largest_stable_step", "SOLVERS", "SimulationResult",
     "spring_force", "spring_stiffness", "friction_force",
     "passive_natural_frequency", "closed_loop_natural_frequency",
-    "ParameterError", "ExcitationError", "StabilityError", "SimulationError", "DataError",
+    "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
+    "DataError", "FitError", "MissingDependencyError", "DataWarning", "FitWarning",
+    *_LAZY,
 ]
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'qzs' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -2,7 +2,9 @@
 
 Messages follow scipy's style: name the argument, the value received and the fix.
 """
+import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -78,11 +80,13 @@ def optional(rule):
     return check
 
 
-def parameter(default, unit, doc):
-    """A dataclass field with its default, its unit and a one-line description."""
-    from dataclasses import field
+def parameter(default=dataclasses.MISSING, unit="", doc=""):
+    """A dataclass field with its default (none: required), its unit and a one-line description.
 
-    return field(default=default, metadata={"unit": unit, "doc": doc})
+    The unit and description are what the parameter registry
+    (:mod:`qzs.model.registry`) reports for the field.
+    """
+    return dataclasses.field(default=default, metadata={"unit": unit, "doc": doc})
 
 
 def finite_series(name, values, error, fix="interpolate or trim them first"):
@@ -100,7 +104,6 @@ def finite_series(name, values, error, fix="interpolate or trim them first"):
 def read_toml(path, what, error=ParameterError):
     """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad."""
     import tomllib
-    from pathlib import Path
 
     path = Path(path)
     try:

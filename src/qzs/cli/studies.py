@@ -1,0 +1,42 @@
+"""``qzs paper`` and ``qzs study``: the paper's studies, their figures, metrics and report."""
+from pathlib import Path
+
+from qzs.errors import ParameterError
+
+__all__ = ["add_parsers", "run"]
+
+
+def add_parsers(subparsers):
+    """Add ``paper`` and ``study`` to an ``argparse`` sub-parser collection."""
+    for name, text in (("paper", "run every study of the paper, write figures, metrics and "
+                                 "report.html"),
+                       ("study", "run one study definition (a shipped name or a TOML file)")):
+        cmd = subparsers.add_parser(name, help=text, description=text)
+        if name == "study":
+            cmd.add_argument("definition", metavar="FILE.toml",
+                             help="study file, or a shipped study name (e.g. stiction)")
+        cmd.add_argument("--quick", action="store_true",
+                         help="shorter runs (fewer, shorter Welch segments)")
+        cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
+                         help=f"output folder (default results/{name})")
+        cmd.add_argument("--workers", type=int, metavar="N",
+                         help="worker processes (default: all cores)")
+        cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args):
+    """Run ``qzs paper`` or ``qzs study`` from parsed arguments; returns the exit code."""
+    from qzs.workflows.report import run_paper
+
+    if args.workers is not None and args.workers < 1:
+        raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
+    definitions = None if args.command == "paper" else [args.definition]
+    results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
+                                        workers=args.workers, progress=not args.quiet)
+    for result in results:
+        print(f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s")
+    print(f"{'total':<12}    wall {wall:7.1f} s")
+    for verdict in verdicts:
+        print(f"  [{verdict.label}] {verdict.statement}\n      {verdict.evidence}")
+    print(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv and figures")
+    return 0

@@ -1,0 +1,89 @@
+"""``qzs sweep`` and ``qzs sweep-plot``: parameter sweeps into a Zarr store, and their figures."""
+import sys
+from pathlib import Path
+
+from qzs.errors import ParameterError
+
+__all__ = ["add_parsers", "run_sweep_command", "run_plot_command"]
+
+REDUCTIONS = ("median", "mean", "min", "max")
+
+
+def add_parsers(subparsers):
+    """Add ``sweep`` and ``sweep-plot`` to an ``argparse`` sub-parser collection."""
+    cmd = subparsers.add_parser(
+        "sweep", help="run a parameter sweep or Monte Carlo study into a Zarr store",
+        description="Run every case of a sweep file (grid, random or Latin-hypercube "
+                    "sampling) and store per-case metrics, statistics and transmissibility "
+                    "in a Zarr store, batch by batch; Ctrl-C and --resume continue it.")
+    cmd.add_argument("definition", metavar="FILE.toml",
+                     help="sweep file, or a shipped sweep name (e.g. pi_vs_stiction)")
+    cmd.add_argument("--out", metavar="STORE.zarr", help="store (default NAME.zarr)")
+    cmd.add_argument("--resume", action="store_true",
+                     help="continue an interrupted sweep in --out (same sweep file)")
+    cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")
+    where = cmd.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run on an existing Dask cluster (e.g. tcp://host:8786)")
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="start a local Dask cluster of N worker processes")
+    cmd.add_argument("--threads", type=int, metavar="N",
+                     help="threads per batch (default: all cores locally, 1 on Dask)")
+    cmd.add_argument("--dry-run", action="store_true",
+                     help="print the cases and the work, run nothing")
+    cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    plot = subparsers.add_parser(
+        "sweep-plot", help="figures of a sweep store",
+        description="Plot a per-case output against one parameter (--metric NAME --x: line) "
+                    "or two (--x and --y: heat map), or the transmissibility band (median and "
+                    "5/95 percentiles; the default, one band per level of --x if given).")
+    plot.add_argument("store", metavar="STORE.zarr", help="sweep store written by `qzs sweep`")
+    plot.add_argument("--x", metavar="PARAM", help="parameter on the horizontal axis")
+    plot.add_argument("--y", metavar="PARAM", help="parameter on the vertical axis (heat map)")
+    plot.add_argument("--metric", metavar="NAME",
+                      help="per-case output (e.g. peak_stroke), or 'transmissibility' (the "
+                           "default without --y: the band, one per --x level)")
+    plot.add_argument("--reduce", choices=REDUCTIONS, default="median",
+                      help="combine the cases at one grid point (default median; max = worst)")
+    plot.add_argument("--out", metavar="FILE", help="figure file (default sweep-<...>.png)")
+    return cmd
+
+
+def run_sweep_command(args):
+    """Run ``qzs sweep`` from parsed arguments; returns the exit code (130 if interrupted)."""
+    from qzs.workflows.sweeps import load_sweep, open_sweep, plan_text, stored_count
+    from qzs.workflows.sweeps.backends import execute
+    from qzs.workflows.sweeps.store import summary_text
+
+    definition = load_sweep(args.definition)
+    store = Path(args.out) if args.out else Path(f"{definition.name}.zarr")
+    for option in ("workers", "threads"):
+        value = getattr(args, option)
+        if value is not None and value < 1:
+            raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
+    if args.dry_run:
+        print(plan_text(definition))
+        return 0
+    try:
+        report = execute(definition, store, resume=args.resume, overwrite=args.overwrite,
+                         scheduler=args.scheduler, workers=args.workers, threads=args.threads,
+                         progress=not args.quiet)
+    except KeyboardInterrupt:
+        print(f"qzs: interrupted; {stored_count(store)} of {definition.n_cases} cases are "
+              f"stored in {store}. Continue with: qzs sweep {args.definition} --out {store} "
+              "--resume", file=sys.stderr)
+        return 130
+    print(summary_text(open_sweep(store), report))
+    print(f"  wrote            {store}")
+    return 0
+
+
+def run_plot_command(args):
+    """Run ``qzs sweep-plot`` from parsed arguments; returns the exit code."""
+    from qzs.workflows.sweeps import plot_sweep
+
+    out = plot_sweep(args.store, metric=args.metric, x=args.x, y=args.y, reduce=args.reduce,
+                     out=args.out)
+    print(f"wrote {out}")
+    return 0

@@ -1,0 +1,24 @@
+"""The defaults of runs and analyses, in one place (python-control ``config.defaults`` style).
+
+Model parameters carry their defaults in their own fields (:mod:`qzs.model.registry`
+lists them with units); this module holds the settings of a run and of the spectral
+analysis that several layers share: :func:`qzs.simulate`, the paper's studies, sweeps,
+identification and the command line all read them here.
+"""
+from types import MappingProxyType
+
+__all__ = ["SIMULATION", "ANALYSIS", "REPORTED_FREQUENCIES"]
+
+#: Integration settings: the paper's (Section 3): Simulink's ode3 at dt = 1e-4 s [s],
+#: output at 1 kHz [Hz].
+SIMULATION = MappingProxyType({"dt": 1e-4, "solver": "ode3", "sample_rate": 1000.0})
+
+#: Spectral analysis: the paper's Welch settings (32768-point Hann segments, 122
+#: averages at 1 kHz, half overlap) [samples, -, Hz], the quick variant used by
+#: ``--quick`` and sweeps, and the band [Hz] the studies keep.
+ANALYSIS = MappingProxyType({
+    "sample_rate": 1000.0, "fft_length": 32768, "n_averages": 122, "overlap": 0.5,
+    "quick_fft_length": 16384, "quick_n_averages": 30, "band": (0.0, 20.0)})
+
+#: Frequencies [Hz] at which reports and sweeps quote the transmissibility.
+REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)

@@ -1,0 +1,97 @@
+"""Arithmetic of the kernels: an own ``exp`` and ``tanh``, explicit fused multiply-adds.
+
+No fast-math at all (:data:`JIT`): without implicit contraction or reassociation a
+lane of a vectorised loop computes the very same bits as scalar code, so a case
+gives the same numbers alone and in a batch (docs/model.md §9). The fused
+multiply-adds worth having are explicit (:func:`fma`), and ``exp`` is written in
+plain arithmetic so that loops over cases vectorise; the divergence check needs
+``isfinite`` too, which fast-math would drop.
+"""
+import math
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic, overload
+
+__all__ = ["JIT", "fma", "exp", "tanh"]
+
+#: Options of every kernel: cached on disk, numpy's error model, no fast-math.
+JIT = dict(cache=True, error_model="numpy")
+_JIT = JIT
+
+
+def _pow2(k):
+    """``2.0**k`` for an integer ``-1022 <= k <= 1023`` (Python fallback of the intrinsic)."""
+    return math.ldexp(1.0, int(k))
+
+
+@intrinsic
+def _pow2_bits(typingctx, k):
+    """``2.0**k`` built from its exponent bits: one shift, vectorisable."""
+    def codegen(context, builder, signature, args):
+        i64 = ir.IntType(64)
+        bits = builder.shl(builder.add(args[0], ir.Constant(i64, 1023)), ir.Constant(i64, 52))
+        return builder.bitcast(bits, ir.DoubleType())
+    return types.float64(types.int64), codegen
+
+
+@overload(_pow2, jit_options=dict(cache=True))
+def _pow2_jit(k):
+    return lambda k: _pow2_bits(k)
+
+
+def fma(a, b, c):
+    """``a * b + c`` rounded once (Python fallback of the intrinsic: rounded twice)."""
+    return a * b + c
+
+
+@intrinsic
+def _fma_instruction(typingctx, a, b, c):
+    """Fused multiply-add: the same single rounding in scalar and vector code."""
+    def codegen(context, builder, signature, args):
+        double = ir.DoubleType()
+        function = builder.module.declare_intrinsic(
+            "llvm.fma", [double], ir.FunctionType(double, [double, double, double]))
+        return builder.call(function, args)
+    return types.float64(types.float64, types.float64, types.float64), codegen
+
+
+@overload(fma, jit_options=dict(cache=True))
+def _fma_jit(a, b, c):
+    return lambda a, b, c: _fma_instruction(float(a), float(b), float(c))
+
+
+@njit(**_JIT, inline="always")
+def exp(x):
+    """exp in plain arithmetic (no libm call), so that loops over cases vectorise.
+
+    Cody-Waite reduction ``x = k*ln2 + r``, ``|r| <= ln2/2``, a degree-13 Taylor
+    polynomial (truncation below 1e-17, Estrin's scheme) and ``2**k`` from the exponent bits;
+    within 2 ulp of libm. ``x`` is clamped to [-700, 700]: ``exp(-700)`` ~ 1e-304
+    stands in for 0. The same operations in every lane and in scalar code give
+    the same bits, which keeps batched runs identical to single runs.
+    """
+    x = min(max(x, -700.0), 700.0)
+    k = np.floor(fma(x, 1.4426950408889634, 0.5))
+    r = fma(k, -1.90821492927058770002e-10, fma(k, -6.93147180369123816490e-01, x))
+    # Estrin's scheme: the same polynomial as Horner's, in a quarter of the latency
+    r2 = r * r
+    r4 = r2 * r2
+    low = fma(fma(fma(r, 1.0 / 5040.0, 1.0 / 720.0), r2, fma(r, 1.0 / 120.0, 1.0 / 24.0)), r4,
+              fma(fma(r, 1.0 / 6.0, 0.5), r2, 1.0 + r))
+    high = fma(fma(r, 1.0 / 6227020800.0, 1.0 / 479001600.0), r4,
+               fma(fma(r, 1.0 / 39916800.0, 1.0 / 3628800.0), r2,
+                   fma(r, 1.0 / 362880.0, 1.0 / 40320.0)))
+    p = fma(high, r4 * r4, low)
+    return p * _pow2(np.int64(k))
+
+
+@njit(**_JIT, inline="always")
+def tanh(u):
+    """tanh from one :func:`exp` (exactly +-1 beyond |u| = 20; error below 3e-16)."""
+    a = min(abs(u), 20.0)
+    r = 1.0 - 2.0 / (exp(2.0 * a) + 1.0)
+    return r if u >= 0.0 else -r
+
+

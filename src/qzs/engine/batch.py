@@ -1,0 +1,216 @@
+"""Many parameter sets through the same kernel at once: the engine of sweeps.
+
+Each case is validated and packed exactly as :func:`qzs.simulate` does it, and
+:func:`qzs.engine.lanes.run_lanes` advances all cases by the same step, several cases
+per vector instruction, with a share of the cases on each core: per case the
+numbers are identical to ``simulate``'s (see :mod:`qzs.engine.lanes`). Output is
+reduced while integrating: only the requested channels are kept, and per-case
+statistics (stroke, stop contacts, RMS motor force, time locked) are
+accumulated chunk by chunk.
+"""
+import os
+import time as _time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs import defaults
+from qzs.analysis.statistics import STATISTICS, RunStatistics
+from qzs.engine import kernels as K
+from qzs.engine import lanes as _lanes
+from qzs.engine.prepare import divergence_message, prepare_run
+from qzs.engine.results import CHANNELS
+from qzs.errors import CaseError, ParameterError
+
+__all__ = ["BatchResult", "simulate_batch", "STATS"]
+
+#: Per-case statistics: name -> (unit, description).
+STATS = {
+    "stop_contacts": ("1", "number of hard-stop contacts"),
+    **STATISTICS,
+    "stick_events": ("1", "number of stick events"),
+    "steps": ("1", "integration steps done"),
+}
+_ROWS_PER_CHUNK = 4_000_000  # output rows held at once, over all cases (~770 MB)
+
+
+@dataclass
+class BatchResult:
+    """Outputs of :func:`simulate_batch`.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n_samples,)
+        Sample times [s].
+    channels : dict of str to ndarray, shape (n_cases, n_samples)
+        The requested channels (names and units of :data:`qzs.engine.results.CHANNELS`).
+    stats : dict of str to ndarray, shape (n_cases,)
+        Per-case statistics, see :data:`STATS`.
+    status : ndarray of int8, shape (n_cases,)
+        0 for a completed case, 1 for a failed one.
+    messages : list of str
+        '' or the failure message (time and state) of each case.
+    elapsed : float
+        Wall time of the integration [s].
+    """
+
+    time: np.ndarray
+    channels: dict
+    stats: dict
+    status: np.ndarray
+    messages: list
+    elapsed: float = 0.0
+    cases: list = field(default_factory=list)
+
+    @property
+    def steps_per_second(self):
+        """Simulated steps per second over all cases [steps/s]."""
+        return float(self.stats["steps"].sum()) / max(self.elapsed, 1e-12)
+
+
+def _advance(solver, done, steps, decimation, states, flags, params, ex, table, out, out_flags,
+             status, written, first, last):
+    """Advance cases ``first..last-1`` by ``steps`` steps (one thread's share)."""
+    if last - first == 1:  # the one-case kernel: the same numbers, without lane bookkeeping
+        if status[first] == K.STATUS_OK:
+            status[first], written[first] = _lanes.run_single(
+                solver, steps, decimation, states[first], flags[first], params[first], ex, table,
+                out[first], out_flags[first], 0)
+        return
+    for a in range(first, last, _lanes.MAX_LANES):
+        b = min(a + _lanes.MAX_LANES, last)
+        code = _lanes.run_lanes(solver, done, steps, decimation, states[a:b], flags[a:b],
+                                params[a:b], ex, table, out[a:b], out_flags[a:b], 0,
+                                status[a:b], written[a:b])
+        if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long
+            raise RuntimeError(f"the batch kernel refused {b - a} cases (at most "
+                               f"{_lanes.MAX_LANES} per call)")
+
+
+def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULATION["dt"],
+                   sample_rate=defaults.SIMULATION["sample_rate"],
+                   solver=defaults.SIMULATION["solver"],
+                   channels=("base_acceleration", "payload_acceleration"),
+                   workers=None, progress=False):
+    """Simulate many parameter sets under one excitation, in parallel.
+
+    Parameters
+    ----------
+    cases : sequence of (IsolatorParameters, ControllerParameters)
+        The parameter sets; each starts from the default initial state.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
+        Shared base motion; default the paper's chirp.
+    duration, dt, sample_rate, solver
+        As in :func:`qzs.simulate` [s], [s], [Hz].
+    channels : sequence of str
+        Time series to keep (names of :data:`qzs.engine.results.CHANNELS`); may be empty.
+    workers : int, optional
+        Threads, each running a share of the cases in the kernel (which releases
+        the GIL); default all cores.
+    progress : bool
+        Show a progress bar over simulated time.
+
+    Returns
+    -------
+    BatchResult
+
+    Raises
+    ------
+    ParameterError
+        An invalid argument, or a case that is invalid (the message names its index).
+    """
+    cases = list(cases)
+    if not cases:
+        raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
+    unknown = [c for c in channels if c not in CHANNELS]
+    if unknown:
+        raise ParameterError(f"unknown channel(s) {unknown}; channels are {list(CHANNELS)}.")
+    prepared = []
+    for index, pair in enumerate(cases):
+        try:
+            isolator, controller = pair
+            prepared.append(prepare_run(excitation, isolator, controller, duration=duration,
+                                        dt=dt, sample_rate=sample_rate, solver=solver))
+        except (TypeError, ValueError) as error:
+            raise CaseError(index, error) from error
+    first = prepared[0]
+    n = len(prepared)
+    n_steps = int(round(first.duration / first.dt))
+    decimation = first.decimation
+    n_out = n_steps // decimation + 1
+    states = np.stack([r.state for r in prepared])
+    flags = np.stack([r.flags for r in prepared])
+    params = np.stack([r.params for r in prepared])
+    ex, table = first.packed
+    columns = [CHANNELS[c][0] for c in channels]
+    kept = {c: np.empty((n, n_out)) for c in channels}
+    status = np.zeros(n, dtype=np.int64)
+
+    rows_per_chunk = max(1, _ROWS_PER_CHUNK // n)
+    chunk_steps = max(decimation, (rows_per_chunk * decimation) // decimation * decimation)
+    out = np.empty((n, min(n_out, chunk_steps // decimation + 1), K.N_CHANNELS))
+    out_flags = np.zeros((n, out.shape[1], 2), dtype=np.bool_)
+    for c in range(n):
+        K.evaluate(0.0, states[c], flags[c], params[c], ex, table, out[c, 0], out_flags[c, 0])
+    statistics = RunStatistics(0.5 * (params[:, K.P_Z_LOW] + params[:, K.P_Z_HIGH]))
+    failed_at = np.full(n, -1, dtype=np.int64)
+
+    def absorb(rows, start_row, first_row):
+        block = out[:, first_row:first_row + rows]
+        for name, col in zip(channels, columns):
+            kept[name][:, start_row:start_row + rows] = block[:, :, col]
+        statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
+                       out_flags[:, first_row:first_row + rows, K.O_LOCKED])
+
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
+    workers = min(workers or os.cpu_count() or 1, n)
+    bounds = np.linspace(0, n, workers + 1).astype(int)
+    written = np.zeros(n, dtype=np.int64)
+    pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=n_steps, unit="step", unit_scale=True, desc=f"{n} cases",
+               disable=not progress, leave=False)
+    def advance(a, b):  # cases a..b-1 by `steps` steps from step `done` (read at call time)
+        _advance(first.solver_code, done, steps, decimation, states, flags, params, ex, table,
+                 out, out_flags, status, written, a, b)
+
+    start = _time.perf_counter()
+    try:
+        absorb(1, 0, 0)
+        done, row = 0, 1
+        while done < n_steps:
+            steps = min(chunk_steps, n_steps - done)
+            before = status.copy()
+            if pool is None:
+                advance(0, n)
+            else:
+                list(pool.map(lambda i: advance(bounds[i], bounds[i + 1]), range(workers)))
+            newly = (before == K.STATUS_OK) & (status != K.STATUS_OK)
+            failed_at[newly] = flags[newly, K.I_STEP]
+            rows = steps // decimation
+            if np.any(written[status == K.STATUS_OK] != rows):  # pragma: no cover
+                raise RuntimeError("batch kernel wrote an unexpected number of rows")
+            for c in np.flatnonzero(status != K.STATUS_OK):  # keep the part that finished
+                out[c, written[c]:rows] = np.nan
+            absorb(rows, row, 0)
+            row += rows
+            done += steps
+            bar.update(steps)
+    finally:
+        bar.close()
+        if pool is not None:
+            pool.shutdown()
+    elapsed = _time.perf_counter() - start
+
+    messages = ["" if status[c] == K.STATUS_OK else
+                divergence_message(states[c], failed_at[c], first.dt) for c in range(n)]
+    stats = {"stop_contacts": flags[:, K.I_N_CONTACTS].astype(float), **statistics.result(),
+             "stick_events": flags[:, K.I_N_STICKS].astype(float),
+             "steps": flags[:, K.I_STEP].astype(float)}
+    stats = {name: stats[name] for name in STATS}
+    time = np.arange(n_out) * (decimation * first.dt)
+    return BatchResult(time, kept, stats, (status != K.STATUS_OK).astype(np.int8), messages,
+                       elapsed, cases)

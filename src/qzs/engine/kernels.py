@@ -1,0 +1,546 @@
+"""Numba kernels of the isolator simulator: one force law, one stepper.
+
+Arrays and floats in, a status code out; no validation and no Python objects
+(scipy ``_ivp/rk.py`` style). The driver in :mod:`qzs.engine.lanes` advances one case
+or many with these, for a single run, a batch and a cluster worker alike.
+
+Inside the kernels the parameters, the excitation scalars and the state are
+tuples of floats, not arrays: that keeps the hot path free of reference counting
+and lets LLVM hold everything in registers. The packed arrays (pvlib ``spa``
+style) are converted once per call of the driver, :func:`qzs.engine.lanes.run_lanes`.
+
+ODE state (``S_*``): relative position z [m], relative velocity v [m/s], the
+charge amplifier's low-pass state [m/s], the PI integral [m*s], then the energy
+ledger [J] integrated with the motion: work by the base, friction dissipation,
+motor work, stop dissipation. The persistent state array also holds the
+zero-order-hold controller outputs (``A_*``). Integer flags (``I_*``): mode
+(slipping, stuck to the base, resting on a plastic stop), slip direction, step
+counter, contact flag and counters.
+
+Stick-slip follows docs/model.md (and Modelica's ``MassWithStopAndFriction``): a
+slipping payload is located at the zero crossing of v inside the step, then it
+sticks if friction can hold it (``|F_hold| <= Fs``) or else reverses; a stuck
+payload breaks away, located inside the step too, when ``|F_hold|`` exceeds Fs.
+"""
+import numpy as np
+from numba import njit
+
+from qzs.engine.arithmetic import JIT as _JIT
+from qzs.engine.arithmetic import fma
+from qzs.engine.base_motion import advance_phase, base_motion, base_motion_near, excitation_tuple
+from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
+                             spring_energy_law, spring_law)
+
+# Packed parameters.
+(P_MASS, P_GRAVITY, P_SPRING_A, P_SPRING_B, P_FS, P_FC, P_CBC, P_CV, P_Z_LOW, P_Z_HIGH,
+ P_STOP_K, P_STOP_C, P_PLASTIC, P_FMAX, P_ZREF, P_KP, P_KI, P_KD, P_HP_OMEGA,
+ P_CONTROL_STEPS, P_DT) = range(21)
+N_PARAMS = 21
+
+# ODE state, then the held controller outputs of a sampled controller.
+S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
+N_ODE = 8
+A_F_PI, A_F_DAMP, A_F_MOTOR = range(N_ODE, N_ODE + 3)
+N_STATE = N_ODE + 3
+
+# Integer flags.
+I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)
+N_FLAGS = 6
+MODE_SLIP, MODE_STICK, MODE_WALL_LOW, MODE_WALL_HIGH = 0, 1, 2, 3
+
+# Force breakdown returned by the right-hand side.
+(F_Y, F_YD, F_YDD, F_SPRING, F_FRICTION, F_STOP, F_STOP_ELASTIC, F_MOTOR, F_PI, F_DAMP,
+ F_V_MEASURED, F_HOLD, F_XDD) = range(13)
+N_FORCES = 13
+
+# Output channels.
+(C_TIME, C_BASE_Y, C_BASE_YD, C_BASE_YDD, C_X, C_XD, C_XDD, C_Z, C_V, C_F_SPRING,
+ C_F_FRICTION, C_F_STOP, C_F_MOTOR, C_F_PI, C_F_DAMP, C_V_MEASURED, C_W_BASE, C_D_FRICTION,
+ C_W_MOTOR, C_D_STOP, C_E_KINETIC, C_E_SPRING, C_E_GRAVITY, C_E_STOP) = range(24)
+N_CHANNELS = 24
+O_LOCKED, O_CONTACT = 0, 1
+
+SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
+STATUS_OK, STATUS_DIVERGED = 0, 1
+
+@njit(**_JIT)
+def params_tuple(p):
+    """The packed parameter array as a tuple."""
+    return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
+            p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20])
+
+
+@njit(**_JIT, inline="always")
+def controller_output(P, z, v_measured, integral):
+    """:func:`qzs.engine.laws.controller_law` with the packed parameters ``P``."""
+    return controller_law(P[P_ZREF], P[P_KP], P[P_KI], P[P_KD], P[P_FMAX], z, v_measured,
+                          integral)
+
+
+@njit(**_JIT, inline="always")
+def rhs(y, yd, ydd, s, mode, direction, held, P):
+    """Right-hand side at base motion ``(y, yd, ydd)``: ``(derivatives, forces)``.
+
+    ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g`` (docs/model.md);
+    while held (stuck, or resting on a plastic stop) ``v = 0`` and ``xdd = ydd``.
+    """
+    m = P[P_MASS]
+    z = s[S_Z]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    xd = yd + v
+    f_spring = spring_law(P[P_SPRING_A], P[P_SPRING_B], z)
+
+    f_stop = 0.0
+    f_elastic = 0.0
+    if P[P_PLASTIC] == 0.0:
+        f_stop, f_elastic = compliant_stop_law(z, v, P[P_Z_LOW], P[P_Z_HIGH], P[P_STOP_K],
+                                               P[P_STOP_C])
+
+    v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
+    if P[P_CONTROL_STEPS] > 0.0:
+        f_pi, f_damp, f_motor = held
+        integral_rate = 0.0
+    else:
+        f_pi, f_damp, f_motor, integral_rate = controller_output(P, z, v_measured, s[S_INT])
+
+    f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
+    f_hold = m * ydd - f_applied
+    if mode == MODE_SLIP:
+        f_friction = sliding_friction_law(v, direction, P[P_FS], P[P_FC], P[P_CBC], P[P_CV])
+        xdd = (f_applied + f_friction) * (1.0 / m)  # one division per step, off the critical path
+    else:
+        f_friction = f_hold
+        if mode == MODE_WALL_LOW:  # the stop takes the upward part, friction the rest
+            f_wall = max(f_hold, 0.0)
+            f_friction = f_hold - f_wall
+            f_stop += f_wall
+        elif mode == MODE_WALL_HIGH:
+            f_wall = min(f_hold, 0.0)
+            f_friction = f_hold - f_wall
+            f_stop += f_wall
+        xdd = ydd
+
+    deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
+             (f_spring + f_friction + f_stop + f_motor) * yd, -f_friction * v, f_motor * v,
+             -(f_stop - f_elastic) * v)
+    force = (y, yd, ydd, f_spring, f_friction, f_stop, f_elastic, f_motor, f_pi, f_damp,
+             v_measured, f_hold, xdd)
+    return deriv, force
+
+
+@njit(**_JIT)
+def rhs_at(t, s, mode, direction, held, P, E, table):
+    """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
+    y, yd, ydd = base_motion(t, E, table)
+    return rhs(y, yd, ydd, s, mode, direction, held, P)
+
+
+@njit(**_JIT, inline="always")
+def _axpy(s, a, k):
+    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`)."""
+    return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]), fma(a, k[3], s[3]),
+            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]))
+
+
+@njit(**_JIT, inline="always")
+def n_stages(solver):
+    """Number of right-hand-side evaluations per step of ``solver``."""
+    if solver == SOLVER_EULER:
+        return 1
+    return 3 if solver == SOLVER_ODE3 else 4
+
+
+@njit(**_JIT, inline="always")
+def tableau(solver, h, stage):
+    """Butcher tableau row of ``stage`` for a step ``h`` [s]: ``(offset, a, weight)``.
+
+    All three solvers have a diagonal tableau: stage ``j`` is evaluated at
+    ``t + offset`` from ``s + a * k[j - 1]``, and the step is ``s + sum(weight * k)``.
+    Euler (order 1), Bogacki-Shampine ode3 without its error stage (order 3,
+    Simulink's fixed-step ode3), classic RK4 (order 4).
+    """
+    if solver == SOLVER_EULER:
+        return 0.0, 0.0, h
+    if solver == SOLVER_ODE3:
+        if stage == 0:
+            return 0.0, 0.0, h * (2.0 / 9.0)
+        if stage == 1:
+            return 0.5 * h, 0.5 * h, h * (1.0 / 3.0)
+        return 0.75 * h, 0.75 * h, h * (4.0 / 9.0)
+    if stage == 0:
+        return 0.0, 0.0, h * (1.0 / 6.0)
+    if stage == 3:
+        return h, h, h * (1.0 / 6.0)
+    return 0.5 * h, 0.5 * h, h * (1.0 / 3.0)
+
+
+@njit(**_JIT, inline="always")
+def rk_from_bases(solver, h, s, mode, direction, held, P, bases):
+    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
+
+    ``bases`` holds the base motion ``(y, yd, ydd)`` at each stage's time. The
+    weighted sum is accumulated stage by stage, in the same order as the
+    batched stages of :mod:`qzs.engine.lanes`, so both give the same bits.
+    """
+    b0, b1, b2, b3 = bases
+    k = rhs(b0[0], b0[1], b0[2], s, mode, direction, held, P)[0]
+    result = _axpy(s, tableau(solver, h, 0)[2], k)
+    if solver == SOLVER_EULER:
+        return result
+    _, a, weight = tableau(solver, h, 1)
+    k = rhs(b1[0], b1[1], b1[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    result = _axpy(result, weight, k)
+    _, a, weight = tableau(solver, h, 2)
+    k = rhs(b2[0], b2[1], b2[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    result = _axpy(result, weight, k)
+    if solver == SOLVER_ODE3:
+        return result
+    _, a, weight = tableau(solver, h, 3)
+    k = rhs(b3[0], b3[1], b3[2], _axpy(s, a, k), mode, direction, held, P)[0]
+    return _axpy(result, weight, k)
+
+
+@njit(**_JIT, inline="always")
+def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
+    """Base motion at the stage times of a step from ``t`` (unused stages repeat the first)."""
+    b0 = base_motion_near(t, phase, sin0, cos0, E, table)
+    b1 = b2 = b3 = b0
+    if solver != SOLVER_EULER:
+        b1 = base_motion_near(t + tableau(solver, h, 1)[0], phase, sin0, cos0, E, table)
+        b2 = b1  # RK4's second and third stages share a time
+        if solver == SOLVER_ODE3:
+            b2 = base_motion_near(t + tableau(solver, h, 2)[0], phase, sin0, cos0, E, table)
+        else:
+            b3 = base_motion_near(t + tableau(solver, h, 3)[0], phase, sin0, cos0, E, table)
+    return b0, b1, b2, b3
+
+
+@njit(**_JIT, inline="always")
+def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
+    """:func:`rk_from_bases` evaluating the base motion itself.
+
+    ``phase, sin0, cos0`` are the excitation's phase and its sine and cosine at a
+    nearby time (see :func:`qzs.engine.base_motion.base_motion_near`).
+    """
+    bases = stage_bases(solver, t, h, E, table, phase, sin0, cos0)
+    return rk_from_bases(solver, h, s, mode, direction, held, P, bases)
+
+
+@njit(**_JIT)
+def energies(y, yd, s, mode, P):
+    """Kinetic, spring, gravity and stop-elastic energy [J] of the payload."""
+    z = s[S_Z]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    m = P[P_MASS]
+    pen = 0.0
+    if P[P_PLASTIC] == 0.0:
+        pen = max(P[P_Z_LOW] - z, 0.0) + max(z - P[P_Z_HIGH], 0.0)
+    return (0.5 * m * (yd + v) ** 2,
+            spring_energy_law(P[P_SPRING_A], P[P_SPRING_B], z),
+            m * P[P_GRAVITY] * (y + z),
+            0.5 * P[P_STOP_K] * pen * pen)
+
+
+@njit(**_JIT)
+def _mechanical_energy(t, s, mode, P, E, table):
+    y, yd, ydd = base_motion(t, E, table)
+    e = energies(y, yd, s, mode, P)
+    return e[0] + e[1] + e[2] + e[3]
+
+
+@njit(**_JIT)
+def _with(s, index, value):
+    """Copy of state tuple ``s`` with entry ``index`` replaced by ``value``."""
+    return (value if index == 0 else s[0], value if index == 1 else s[1],
+            value if index == 2 else s[2], value if index == 3 else s[3],
+            value if index == 4 else s[4], value if index == 5 else s[5],
+            value if index == 6 else s[6], value if index == 7 else s[7])
+
+
+@njit(**_JIT, inline="always")
+def _hold_margin(mode, f_hold, fs):
+    """How far the holding force is inside what friction (and a plastic stop) can give [N]."""
+    if mode == MODE_STICK:
+        return fs - abs(f_hold)
+    if mode == MODE_WALL_LOW:
+        return f_hold + fs
+    return fs - f_hold
+
+
+@njit(**_JIT, inline="always")
+def _release_direction(mode, f_hold):
+    if mode == MODE_STICK:
+        return -1 if f_hold > 0.0 else 1
+    return 1 if mode == MODE_WALL_LOW else -1
+
+
+@njit(**_JIT)
+def _book_impulse(t, s, ledger, E, table, P):
+    """Set v to exactly 0 and book the impulse that does it (closes the energy ledger).
+
+    Stopping a slip velocity ``v`` takes an impulse ``-m*v`` between payload and base.
+    It does work ``-m*v*yd`` through the base and dissipates ``m*v**2/2`` in the
+    element that supplies it (``ledger``: friction or stop); both are exact.
+    """
+    y, yd, ydd = base_motion(t, E, table)
+    m = P[P_MASS]
+    v = s[S_V]
+    s = _with(s, S_V, 0.0)
+    s = _with(s, S_W_BASE, s[S_W_BASE] - m * v * yd)
+    return _with(s, ledger, s[ledger] + 0.5 * m * v * v)
+
+
+@njit(**_JIT)
+def _settle(t, s, direction, held, P, E, table):
+    """At a zero crossing of v: stick if friction can hold the payload, else reverse.
+
+    Returns ``(state, mode, direction)``. v is set to exactly 0 either way; the
+    crossing is located to round-off, so the impulse booked for it is negligible.
+    """
+    s = _book_impulse(t, s, S_D_FRICTION, E, table, P)
+    f_hold = rhs_at(t, s, MODE_STICK, 0.0, held, P, E, table)[1][F_HOLD]
+    if abs(f_hold) <= P[P_FS]:
+        return s, MODE_STICK, direction
+    return s, MODE_SLIP, -1 if f_hold > 0.0 else 1
+
+
+@njit(**_JIT)
+def _hit_wall(t, s, low, held, P, E, table):
+    """Perfectly plastic impact: v absorbed by the stop's impulse, z put on the stop.
+
+    The payload then rests on the stop if friction and the stop can hold it,
+    else it leaves at once (v = 0, slipping away from the stop). Returns
+    ``(state, mode, direction)``.
+    """
+    s = _book_impulse(t, s, S_D_STOP, E, table, P)
+    before = _mechanical_energy(t, s, MODE_SLIP, P, E, table)
+    s = _with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH])
+    # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
+    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, MODE_SLIP, P, E,
+                                                                    table))
+    mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    if _hold_margin(mode, f_hold, P[P_FS]) < 0.0:
+        return s, MODE_SLIP, _release_direction(mode, f_hold)
+    return s, mode, 0
+
+
+@njit(**_JIT)
+def _event_value(event, t, s, mode, direction, held, P, E, table):
+    """The function whose sign change defines ``event`` (positive before it)."""
+    if event == 1:
+        return direction * s[S_V]
+    if event == 2:
+        return s[S_Z] - P[P_Z_LOW]
+    if event == 3:
+        return P[P_Z_HIGH] - s[S_Z]
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    return _hold_margin(mode, f_hold, P[P_FS])
+
+
+@njit(**_JIT)
+def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
+    """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
+    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+    return _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
+
+
+@njit(**_JIT, inline="always")
+def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
+    """Kind (0: none) and time fraction (secant) of the first transition in a step."""
+    theta = 2.0
+    event = 0
+    if mode == MODE_SLIP:
+        v0 = direction * s[S_V]
+        v1 = direction * s1[S_V]
+        if v1 < 0.0 or (v1 == 0.0 and v0 > 0.0):  # v reached zero: stick or reverse
+            theta = v0 / (v0 - v1) if v0 > v1 else 0.0
+            event = 1
+        if P[P_PLASTIC] != 0.0:  # reached a plastic stop
+            if s1[S_Z] < P[P_Z_LOW]:
+                fraction = (s[S_Z] - P[P_Z_LOW]) / (s[S_Z] - s1[S_Z])
+                if fraction < theta:
+                    theta, event = fraction, 2
+            elif s1[S_Z] > P[P_Z_HIGH]:
+                fraction = (P[P_Z_HIGH] - s[S_Z]) / (s1[S_Z] - s[S_Z])
+                if fraction < theta:
+                    theta, event = fraction, 3
+    elif margin1 < 0.0:  # friction (and stop) can no longer hold the payload
+        theta = margin / (margin - margin1) if margin > margin1 else 0.0
+        event = 4
+    return event, min(max(theta, 0.0), 1.0)
+
+
+@njit(**_JIT)
+def _rk(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
+    """Not-inlined :func:`rk_step`, for the event path (keeps the compiled code small)."""
+    return rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0)
+
+
+@njit(**_JIT)
+def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table, phase,
+            sin0, cos0):
+    """Refine an event inside ``[t, t + h]`` by regula falsi (Illinois) on its function.
+
+    Returns ``(time from t, state there)``; the event function is then zero to
+    round-off (at most 6 refinements, each one Runge-Kutta step).
+    """
+    lo, hi = 0.0, h
+    g_lo, g_hi = g0, g1
+    if g0 <= 0.0:
+        return 0.0, s
+    at = h * g0 / (g0 - g1)
+    state = s1
+    side = 0
+    for _ in range(6):
+        state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table, phase, sin0,
+                    cos0)
+        g = _event_value(event, t + at, state, mode, direction, held, P, E, table)
+        if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
+            break
+        if g > 0.0:
+            lo, g_lo = at, g
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+        else:
+            hi, g_hi = at, g
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        at = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+    return at, state
+
+
+@njit(**_JIT)
+def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0):
+    """Advance one grid step, locating and handling at most one transition inside it.
+
+    ``margin`` is the holding margin at ``t`` if known (NaN if not); ``phase,
+    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``. Returns
+    ``(state, mode, direction, margin, sticks, impacts)``: the holding margin at
+    the end (NaN while slipping), the counts of new stick events and of plastic
+    impacts in the step.
+    """
+    sticks = 0
+    impacts = 0
+    if mode == MODE_SLIP and direction * s[S_V] < 0.0:  # a crossing missed earlier
+        s, mode, direction = _settle(t, s, direction, held, P, E, table)
+        sticks += mode == MODE_STICK
+        margin = np.nan
+    if mode != MODE_SLIP:
+        if margin != margin:  # NaN: not known yet
+            margin = _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0)
+        if margin < 0.0:
+            f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+            direction = _release_direction(mode, f_hold)
+            mode = MODE_SLIP
+
+    s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, E, table, phase, sin0, cos0)
+    margin1 = np.nan
+    if mode != MODE_SLIP:
+        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
+    event, theta = _first_event(t, h, s, s1, mode, direction, margin, margin1, P)
+    if event == 0:
+        return s1, mode, direction, margin1, sticks, impacts
+
+    g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, E, table)
+    g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
+                                                 E, table)
+    at, s_event = _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E,
+                          table, phase, sin0, cos0)
+    t_event = t + at
+    if event == 1:
+        s_event, mode, direction = _settle(t_event, s_event, direction, held, P, E, table)
+        sticks += mode == MODE_STICK
+    elif event == 2 or event == 3:
+        s_event, mode, direction = _hit_wall(t_event, s_event, event == 2, held, P, E, table)
+        impacts += 1
+    else:
+        f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, E, table)[1][F_HOLD]
+        direction = _release_direction(mode, f_hold)
+        mode = MODE_SLIP
+    rest = h - at
+    s1 = s_event
+    if rest > 0.0:
+        s1 = _rk(solver, t_event, rest, s_event, mode, float(direction), held, P, E, table,
+                 phase, sin0, cos0)
+    if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
+        if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
+            s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, E,
+                                            table)
+            impacts += 1
+    margin1 = np.nan
+    if mode != MODE_SLIP:
+        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
+    return s1, mode, direction, margin1, sticks, impacts
+
+
+@njit(**_JIT)
+def sample_controller(t, s, mode, P, E, table):
+    """Sampled controller: read z and the measured velocity; returns ``(held, state)``."""
+    y, yd, ydd = base_motion(t, E, table)
+    xd = yd + (s[S_V] if mode == MODE_SLIP else 0.0)
+    v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
+    f_pi, f_damp, f_motor, rate = controller_output(P, s[S_Z], v_measured, s[S_INT])
+    s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
+    return (f_pi, f_damp, f_motor), s
+
+
+@njit(**_JIT)
+def record(t, s, mode, direction, held, P, E, table, row, row_flags, phase, sin0, cos0):
+    """Write one output sample (channels ``C_*``) of the state at time ``t``.
+
+    ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
+    """
+    y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
+    force = rhs(y, yd, ydd, s, mode, float(direction), held, P)[1]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    row[C_TIME] = t
+    row[C_BASE_Y] = force[F_Y]
+    row[C_BASE_YD] = force[F_YD]
+    row[C_BASE_YDD] = force[F_YDD]
+    row[C_X] = force[F_Y] + s[S_Z]
+    row[C_XD] = force[F_YD] + v
+    row[C_XDD] = force[F_XDD]
+    row[C_Z] = s[S_Z]
+    row[C_V] = v
+    row[C_F_SPRING] = force[F_SPRING]
+    row[C_F_FRICTION] = force[F_FRICTION]
+    row[C_F_STOP] = force[F_STOP]
+    row[C_F_MOTOR] = force[F_MOTOR]
+    row[C_F_PI] = force[F_PI]
+    row[C_F_DAMP] = force[F_DAMP]
+    row[C_V_MEASURED] = force[F_V_MEASURED]
+    row[C_W_BASE] = s[S_W_BASE]
+    row[C_D_FRICTION] = s[S_D_FRICTION]
+    row[C_W_MOTOR] = s[S_W_MOTOR]
+    row[C_D_STOP] = s[S_D_STOP]
+    row[C_E_KINETIC], row[C_E_SPRING], row[C_E_GRAVITY], row[C_E_STOP] = energies(
+        force[F_Y], force[F_YD], s, mode, P)
+    row_flags[O_LOCKED] = mode != MODE_SLIP
+    row_flags[O_CONTACT] = _in_contact(s, mode, P)
+
+
+@njit(**_JIT, inline="always")
+def _in_contact(s, mode, P):
+    return mode >= MODE_WALL_LOW or s[S_Z] < P[P_Z_LOW] or s[S_Z] > P[P_Z_HIGH]
+
+
+@njit(**_JIT)
+def evaluate(t, state, flags, p, ex, table, row, row_flags):
+    """Record the persistent state (arrays, as the driver keeps it) at ``t``."""
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
+    E = excitation_tuple(ex)
+    phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, True)
+    record(t, s, flags[I_MODE], flags[I_DIRECTION], held, params_tuple(p), E, table, row,
+           row_flags, phase, sin0, cos0)
+
+
+@njit(**_JIT)
+def hold_force(t, state, p, ex, table):
+    """Force friction must supply to keep the payload stuck at ``state`` [N], and the forces."""
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
+    return rhs_at(t, s, MODE_STICK, 0.0, held, params_tuple(p), excitation_tuple(ex), table)[1]

@@ -1,0 +1,335 @@
+"""The driver kernels: advance one case, or a batch of cases in lockstep.
+
+Every case of a batch takes the same grid step at the same time, so the base
+motion at the Runge-Kutta stages is computed once per step for all of them. The
+cases are held structure-of-arrays (one row per quantity, one column, a *lane*,
+per case) and each step is two passes over the lanes:
+
+1. the Runge-Kutta step of every lane, stage by stage, in short loops that LLVM
+   vectorises (several lanes per instruction). A lane is flagged, and left as
+   it was, when it needs more: a transition inside the step (stick, slip,
+   impact), a holding margin not known yet, or a non-finite state;
+2. for the flagged lanes only, the full event-locating step of
+   :func:`qzs.engine.kernels.grid_step`.
+
+No fast-math is used (see :mod:`qzs.engine.kernels`): a lane computes the same bits
+in a vector register as in scalar code, and pass 1 takes the same operations in
+the same order as :func:`qzs.engine.kernels.grid_step` does for an ordinary step. So
+:func:`run_single`, the one-case driver that steps with ``grid_step`` alone,
+and :func:`run_lanes` give identical numbers, whatever the other lanes are.
+"""
+import numpy as np
+from numba import njit
+
+from qzs.engine import kernels as K
+from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
+
+# Rows of the lane-state array: the persistent state (``K.S_*`` and ``K.A_*``) first.
+(R_MODE, R_DIRECTION, R_MARGIN, R_CONTACT, R_CONTACTS, R_STICKS,
+ R_FAILED) = range(K.N_STATE, K.N_STATE + 7)
+N_ROWS = K.N_STATE + 7
+# Rows of the per-step scratch array: the running weighted sum, the stage input, the flag.
+T_SUM, T_INPUT, T_FLAGGED = 0, K.N_ODE, K.N_ODE + 4
+N_SCRATCH = K.N_ODE + 5
+#: Most lanes per call. Lane arrays are flat, row ``i`` of lane ``c`` at ``i * W + c``
+#: with the row stride ``W`` a compile-time constant: LLVM then sees that the rows of
+#: an array cannot overlap and vectorises the lane loops with two overlap checks. ``W``
+#: is not a power of two so that a lane's rows fall in different cache sets.
+MAX_LANES = 1024
+W = MAX_LANES + 8
+STATUS_TOO_MANY_LANES = -1
+
+_JIT = K._JIT
+# grid_step inlined into the one-case driver, where it is the hot path
+_grid_step_inline = njit(**_JIT, inline="always")(getattr(K.grid_step, "py_func", K.grid_step))
+
+
+@njit(**_JIT, inline="always")
+def _params(PP, c):
+    return (PP[c], PP[W + c], PP[2 * W + c], PP[3 * W + c], PP[4 * W + c], PP[5 * W + c],
+            PP[6 * W + c], PP[7 * W + c], PP[8 * W + c], PP[9 * W + c], PP[10 * W + c],
+            PP[11 * W + c], PP[12 * W + c], PP[13 * W + c], PP[14 * W + c], PP[15 * W + c],
+            PP[16 * W + c], PP[17 * W + c], PP[18 * W + c], PP[19 * W + c], PP[20 * W + c])
+
+
+@njit(**_JIT, inline="always")
+def _state(L, c):
+    return (L[c], L[W + c], L[2 * W + c], L[3 * W + c], L[4 * W + c], L[5 * W + c],
+            L[6 * W + c], L[7 * W + c])
+
+
+@njit(**_JIT, inline="always")
+def _held(L, c):
+    return L[K.A_F_PI * W + c], L[K.A_F_DAMP * W + c], L[K.A_F_MOTOR * W + c]
+
+
+@njit(**_JIT, inline="always")
+def _finite(s, P):
+    """The divergence test: finite, within 100 strokes of the stops and below 1e4 m/s."""
+    bound = 100.0 * (P[K.P_Z_HIGH] - P[K.P_Z_LOW]) + abs(P[K.P_Z_LOW]) + abs(P[K.P_Z_HIGH])
+    return (np.isfinite(s[K.S_Z]) and np.isfinite(s[K.S_V]) and np.isfinite(s[K.S_HP])
+            and np.isfinite(s[K.S_INT]) and abs(s[K.S_Z]) <= bound and abs(s[K.S_V]) <= 1e4)
+
+
+@njit(**_JIT, inline="always")
+def _store(L, c, s, margin, contact, P):
+    """Put the end-of-step state of lane ``c``; counts a new compliant-stop contact."""
+    (L[c], L[W + c], L[2 * W + c], L[3 * W + c], L[4 * W + c], L[5 * W + c], L[6 * W + c],
+     L[7 * W + c]) = s
+    L[R_MARGIN * W + c] = margin
+    new_contact = contact and L[R_CONTACT * W + c] == 0.0 and P[K.P_PLASTIC] == 0.0
+    L[R_CONTACT * W + c] = 1.0 if contact else 0.0
+    L[R_CONTACTS * W + c] += 1.0 if new_contact else 0.0
+
+
+@njit(**_JIT, inline="always")
+def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
+    """One Runge-Kutta stage of every lane: ``k`` at the stage input, added to the sum.
+
+    The stage input and the running sum are read from ``source`` (rows from
+    ``at_input`` and ``at_sum``): the state itself for the first stage, the
+    scratch array ``T`` after. Then the next stage's input ``s + a_next * k`` goes
+    to ``T``. The right-hand side reads the motion states only (z, v, filter,
+    integral); the ledger rates just add up.
+    """
+    for c in range(n):
+        x = (source[at_input * W + c], source[(at_input + 1) * W + c],
+             source[(at_input + 2) * W + c], source[(at_input + 3) * W + c], 0.0, 0.0, 0.0, 0.0)
+        k = K.rhs(base[0], base[1], base[2], x, int(L[R_MODE * W + c]),
+                  L[R_DIRECTION * W + c], _held(L, c), _params(PP, c))[0]
+        T[T_SUM * W + c] = K.fma(weight, k[0], source[at_sum * W + c])
+        T[(T_SUM + 1) * W + c] = K.fma(weight, k[1], source[(at_sum + 1) * W + c])
+        T[(T_SUM + 2) * W + c] = K.fma(weight, k[2], source[(at_sum + 2) * W + c])
+        T[(T_SUM + 3) * W + c] = K.fma(weight, k[3], source[(at_sum + 3) * W + c])
+        T[(T_SUM + 4) * W + c] = K.fma(weight, k[4], source[(at_sum + 4) * W + c])
+        T[(T_SUM + 5) * W + c] = K.fma(weight, k[5], source[(at_sum + 5) * W + c])
+        T[(T_SUM + 6) * W + c] = K.fma(weight, k[6], source[(at_sum + 6) * W + c])
+        T[(T_SUM + 7) * W + c] = K.fma(weight, k[7], source[(at_sum + 7) * W + c])
+        T[T_INPUT * W + c] = K.fma(a_next, k[0], L[c])
+        T[(T_INPUT + 1) * W + c] = K.fma(a_next, k[1], L[W + c])
+        T[(T_INPUT + 2) * W + c] = K.fma(a_next, k[2], L[2 * W + c])
+        T[(T_INPUT + 3) * W + c] = K.fma(a_next, k[3], L[3 * W + c])
+
+
+@njit(**_JIT)
+def _first_stage_pass(n, a_next, weight, base, L, T, PP):
+    """:func:`_stage_lanes` from the state."""
+    _stage_lanes(n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_pass(n, a_next, weight, base, L, T, PP):
+    """:func:`_stage_lanes` from the previous stage."""
+    _stage_lanes(n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_pass(n, t, h, b_end, L, T, PP):
+    """End the step of every lane: store it, or flag the lane for pass 2 (returns how many).
+
+    What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
+    nothing happens in it. A flagged lane keeps its state at ``t``.
+    """
+    flagged_lanes = 0
+    for c in range(n):
+        s = _state(L, c)
+        s1 = (T[T_SUM * W + c], T[(T_SUM + 1) * W + c], T[(T_SUM + 2) * W + c],
+              T[(T_SUM + 3) * W + c], T[(T_SUM + 4) * W + c], T[(T_SUM + 5) * W + c],
+              T[(T_SUM + 6) * W + c], T[(T_SUM + 7) * W + c])
+        P = _params(PP, c)
+        mode = int(L[R_MODE * W + c])
+        direction = L[R_DIRECTION * W + c]
+        margin = L[R_MARGIN * W + c]
+        margin1 = np.nan
+        if mode != K.MODE_SLIP:
+            force = K.rhs(b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c), P)[1]
+            margin1 = K._hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
+        ready = direction * s[K.S_V] >= 0.0 if mode == K.MODE_SLIP else margin >= 0.0
+        event = K._first_event(t, h, s, s1, mode, direction, margin, margin1, P)[0]
+        flagged = not ready or event != 0 or not _finite(s1, P) or L[R_FAILED * W + c] != 0.0
+        T[T_FLAGGED * W + c] = 1.0 if flagged else 0.0
+        flagged_lanes += flagged
+        if not flagged:
+            _store(L, c, s1, margin1, K._in_contact(s1, mode, P), P)
+    return flagged_lanes
+
+
+@njit(**_JIT)
+def _vector_pass(solver, n, t, h, L, T, PP, bases, b_end):
+    """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
+
+    Stage by stage (``K.tableau``, in the order of ``K.rk_from_bases``) with the
+    intermediate values in ``T``: each loop is short, its iterations independent,
+    and LLVM vectorises it.
+    """
+    stages = K.n_stages(solver)
+    for stage in range(stages):
+        weight = K.tableau(solver, h, stage)[2]
+        a_next = K.tableau(solver, h, stage + 1)[1] if stage + 1 < stages else 0.0
+        if stage == 0:
+            _first_stage_pass(n, a_next, weight, bases[stage], L, T, PP)
+        else:
+            _stage_pass(n, a_next, weight, bases[stage], L, T, PP)
+    return _finish_pass(n, t, h, b_end, L, T, PP)
+
+
+@njit(**_JIT, nogil=True)
+def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, table, out,
+              out_flags, row0, status, rows):
+    """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
+
+    Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
+    (``K.N_PARAMS``), ``out`` and ``out_flags`` (rows from ``row0``) is case ``c``;
+    the excitation ``ex, table`` is shared. ``states`` and ``flags`` carry the
+    cases between calls. A case whose ``status`` is not ``K.STATUS_OK`` is left
+    alone; one that diverges (non-finite, beyond 100 strokes or 1e4 m/s) gets
+    ``K.STATUS_DIVERGED``, keeps its last finite state and, in ``flags[c,
+    K.I_STEP]``, that state's step. ``rows[c]`` gets the rows case ``c`` wrote.
+    At most ``MAX_LANES`` cases per call: returns ``K.STATUS_OK``, or
+    ``STATUS_TOO_MANY_LANES`` (and does nothing) for more.
+    """
+    n = states.shape[0]
+    if n > MAX_LANES:
+        return STATUS_TOO_MANY_LANES
+    E = excitation_tuple(ex)
+    PP = np.zeros(K.N_PARAMS * W)
+    L = np.zeros(N_ROWS * W)
+    T = np.zeros(N_SCRATCH * W)
+    failed_step = np.full(n, -1, dtype=np.int64)
+    sampled = False
+    for c in range(n):
+        for i in range(K.N_PARAMS):
+            PP[i * W + c] = params[c, i]
+        for i in range(K.N_STATE):
+            L[i * W + c] = states[c, i]
+        L[R_MODE * W + c] = flags[c, K.I_MODE]
+        L[R_DIRECTION * W + c] = flags[c, K.I_DIRECTION]
+        L[R_MARGIN * W + c] = np.nan  # holding margins are worked out again
+        L[R_CONTACT * W + c] = flags[c, K.I_CONTACT]
+        L[R_CONTACTS * W + c] = flags[c, K.I_N_CONTACTS]
+        L[R_STICKS * W + c] = flags[c, K.I_N_STICKS]
+        L[R_FAILED * W + c] = 0.0 if status[c] == K.STATUS_OK else 1.0
+        rows[c] = 0
+        sampled = sampled or params[c, K.P_CONTROL_STEPS] > 0.0
+    h = params[0, K.P_DT] if n > 0 else 0.0
+    step = step0
+    row = row0
+    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
+    for _ in range(n_steps):
+        t = step * h
+        if sampled:
+            for c in range(n):
+                control_steps = int(PP[K.P_CONTROL_STEPS * W + c])
+                if control_steps > 0 and step % control_steps == 0 and L[R_FAILED * W + c] == 0.0:
+                    held, s = K.sample_controller(t, _state(L, c), int(L[R_MODE * W + c]),
+                                                  _params(PP, c), E, table)
+                    L[K.A_F_PI * W + c], L[K.A_F_DAMP * W + c], L[K.A_F_MOTOR * W + c] = held
+                    L[K.S_INT * W + c] = s[K.S_INT]
+                    L[R_MARGIN * W + c] = np.nan
+        bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
+        b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
+        if _vector_pass(solver, n, t, h, L, T, PP, bases, b_end) > 0:
+            for c in range(n):  # pass 2: the flagged lanes
+                if T[T_FLAGGED * W + c] == 0.0 or L[R_FAILED * W + c] != 0.0:
+                    continue
+                P = _params(PP, c)
+                s1, mode, direction, margin, sticks, impacts = K.grid_step(
+                    solver, t, h, _state(L, c), int(L[R_MODE * W + c]),
+                    int(L[R_DIRECTION * W + c]), _held(L, c), P, E, table,
+                    L[R_MARGIN * W + c], phase, sin0, cos0)
+                if not _finite(s1, P):
+                    L[R_FAILED * W + c] = 1.0
+                    failed_step[c] = step
+                    rows[c] = row - row0
+                    continue
+                L[R_MODE * W + c] = mode
+                L[R_DIRECTION * W + c] = direction
+                L[R_CONTACTS * W + c] += impacts
+                L[R_STICKS * W + c] += sticks
+                _store(L, c, s1, margin, K._in_contact(s1, mode, P), P)
+        step += 1
+        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
+        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
+        if step % decimation == 0:
+            for c in range(n):
+                if L[R_FAILED * W + c] == 0.0:
+                    K.record(step * h, _state(L, c), int(L[R_MODE * W + c]),
+                             int(L[R_DIRECTION * W + c]), _held(L, c), _params(PP, c), E,
+                             table, out[c, row], out_flags[c, row], phase, sin0, cos0)
+            row += 1
+
+    for c in range(n):
+        if status[c] != K.STATUS_OK:
+            continue
+        for i in range(K.N_STATE):
+            states[c, i] = L[i * W + c]
+        flags[c, K.I_MODE] = int(L[R_MODE * W + c])
+        flags[c, K.I_DIRECTION] = int(L[R_DIRECTION * W + c])
+        flags[c, K.I_CONTACT] = int(L[R_CONTACT * W + c])
+        flags[c, K.I_N_CONTACTS] = int(L[R_CONTACTS * W + c])
+        flags[c, K.I_N_STICKS] = int(L[R_STICKS * W + c])
+        if failed_step[c] >= 0:
+            status[c] = K.STATUS_DIVERGED
+            flags[c, K.I_STEP] = failed_step[c]
+        else:
+            flags[c, K.I_STEP] = step
+            rows[c] = row - row0
+    return K.STATUS_OK
+
+
+@njit(**_JIT, nogil=True)
+def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out_flags, row0):
+    """One case: :func:`run_lanes` with a single lane, without the lanes' bookkeeping.
+
+    Every step is :func:`qzs.engine.kernels.grid_step`, which takes the very same
+    operations as a lane's step in :func:`run_lanes` (pass 1 for an ordinary
+    step, pass 2 for one with a transition), so the numbers are identical.
+    Returns ``(status, rows_written)``; on divergence ``state`` holds the last
+    finite state and ``flags[K.I_STEP]`` its step.
+    """
+    P = K.params_tuple(p)
+    E = excitation_tuple(ex)
+    h = P[K.P_DT]
+    control_steps = int(P[K.P_CONTROL_STEPS])
+    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+    held = (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR])
+    mode = flags[K.I_MODE]
+    direction = flags[K.I_DIRECTION]
+    contact = flags[K.I_CONTACT]
+    step = flags[K.I_STEP]
+    status = K.STATUS_OK
+    row = row0
+    margin = np.nan
+    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
+    for _ in range(n_steps):
+        t = step * h
+        if control_steps > 0 and step % control_steps == 0:
+            held, s = K.sample_controller(t, s, mode, P, E, table)
+            margin = np.nan
+        s1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
+            solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0)
+        if not _finite(s1, P):
+            status = K.STATUS_DIVERGED
+            break
+        s, mode, direction, margin = s1, mode1, direction1, margin1
+        step += 1
+        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
+        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
+        flags[K.I_N_STICKS] += sticks
+        flags[K.I_N_CONTACTS] += impacts
+        now = K._in_contact(s, mode, P)
+        if now and contact == 0 and P[K.P_PLASTIC] == 0.0:
+            flags[K.I_N_CONTACTS] += 1
+        contact = 1 if now else 0
+        if step % decimation == 0:
+            K.record(step * h, s, mode, direction, held, P, E, table, out[row], out_flags[row],
+                     phase, sin0, cos0)
+            row += 1
+    for i in range(K.N_ODE):
+        state[i] = s[i]
+    state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR] = held
+    flags[K.I_MODE] = mode
+    flags[K.I_DIRECTION] = direction
+    flags[K.I_CONTACT] = contact
+    flags[K.I_STEP] = step
+    return status, row - row0

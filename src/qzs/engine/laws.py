@@ -1,0 +1,84 @@
+"""The force laws of one leg, written once as numba functions (docs/model.md §3 and §5).
+
+Every driver calls these: the single run and the lockstep batch through
+:func:`qzs.engine.kernels.rhs`, and any later multi-leg model leg by leg. Scalars in,
+scalars out, inlined where they are called, so that the compiled arithmetic is the
+same wherever they are used. The numpy versions in :mod:`qzs.model.isolator` (for
+plots and fits) are tested equal to these.
+"""
+import numpy as np
+from numba import njit
+
+from qzs.engine.arithmetic import JIT, exp, tanh
+
+__all__ = ["spring_law", "spring_energy_law", "sliding_friction_law", "compliant_stop_law",
+           "controller_law"]
+
+
+@njit(**JIT, inline="always")
+def spring_law(a, b, z):
+    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2)."""
+    return -a * tanh(b * z)
+
+
+@njit(**JIT, inline="always")
+def spring_energy_law(a, b, z):
+    """Energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0."""
+    u = abs(b * z)
+    return a / b * (u + np.log1p(np.exp(-2.0 * u)) - np.log(2.0))
+
+
+@njit(**JIT, inline="always")
+def sliding_friction_law(v, sign, fs, fc, cbc, cv):
+    """Friction [N] while slipping at ``v`` [m/s] in direction ``sign`` (+-1) (eq. 3).
+
+    ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign - Cv*v``: it opposes the slip. ``sign``
+    is the slip direction, continued analytically past ``v = 0`` so that the
+    zero crossing the stepper locates is smooth.
+    """
+    level = fc + (fs - fc) * exp(-cbc * abs(v))
+    return -level * sign - cv * v
+
+
+@njit(**JIT, inline="always")
+def compliant_stop_law(z, v, z_low, z_high, stiffness, damping):
+    """Compliant hard stop: ``(force, elastic force)`` [N] at ``z`` [m], ``v`` [m/s].
+
+    A spring-damper ``k*pen + c*pen_rate`` beyond either stop that only pushes: the
+    damper never pulls the payload back into the wall. The elastic part alone
+    stores energy (``stiffness*pen**2/2``); the rest is dissipated.
+    """
+    f_stop = 0.0
+    f_elastic = 0.0
+    if z < z_low:
+        f_elastic = stiffness * (z_low - z)
+        f_stop = max(f_elastic - damping * v, 0.0)  # a stop pushes, never pulls
+    elif z > z_high:
+        f_elastic = -stiffness * (z - z_high)
+        f_stop = min(f_elastic - damping * v, 0.0)
+    return f_stop, f_elastic
+
+
+@njit(**JIT, inline="always")
+def controller_law(z_ref, kp, ki, kd, f_max, z, v_measured, integral):
+    """PI + damping command: ``(F_pi, F_damp, F_motor, integral_rate)`` (docs/model.md §5).
+
+    ``F_pi = Kp*e + Ki*integral`` with ``e = z_ref - z`` [m], ``F_damp = -Kd*v_measured``,
+    ``F_motor`` their sum clipped to ``+-f_max`` [N]; the integral's rate is ``e``,
+    or 0 while the motor saturates and ``e`` pushes further into saturation
+    (anti-windup by conditional integration).
+    """
+    error = z_ref - z
+    f_pi = kp * error + ki * integral
+    f_damp = -kd * v_measured
+    command = f_pi + f_damp
+    rate = error
+    if command > f_max:
+        command = f_max
+        if error * ki > 0.0:
+            rate = 0.0  # anti-windup: do not integrate further into saturation
+    elif command < -f_max:
+        command = -f_max
+        if error * ki < 0.0:
+            rate = 0.0
+    return f_pi, f_damp, command, rate

@@ -1,0 +1,195 @@
+"""Validation and packing of a run's inputs for the kernels, shared by single and batch runs."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from qzs import defaults
+from qzs._validation import choice, positive
+from qzs.engine import kernels as K
+from qzs.engine.base_motion import base_motion_series
+from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
+from qzs.errors import ParameterError, StabilityError
+from qzs.model.controller import ControllerParameters
+from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
+from qzs.model.isolator import InitialState, IsolatorParameters
+
+__all__ = ["PreparedRun", "prepare_run", "steps_per_sample", "divergence_message"]
+
+_EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
+
+
+def _pack_parameters(isolator, controller, dt, control_steps):
+    center = controller.position_setpoint if isolator.stop_center is None else isolator.stop_center
+    p = np.zeros(K.N_PARAMS)
+    p[K.P_MASS] = isolator.mass
+    p[K.P_GRAVITY] = isolator.gravity
+    p[K.P_SPRING_A] = isolator.spring_force
+    p[K.P_SPRING_B] = isolator.spring_shape
+    p[K.P_FS] = isolator.stiction_force
+    p[K.P_FC] = isolator.coulomb_force
+    p[K.P_CBC] = isolator.stribeck_decay
+    p[K.P_CV] = isolator.viscous_damping
+    p[K.P_Z_LOW] = center - isolator.stroke_half
+    p[K.P_Z_HIGH] = center + isolator.stroke_half
+    p[K.P_STOP_K] = isolator.stop_stiffness
+    p[K.P_STOP_C] = isolator.stop_damping
+    p[K.P_PLASTIC] = 1.0 if isolator.stop_model == "plastic" else 0.0
+    p[K.P_FMAX] = isolator.motor_force_max
+    p[K.P_ZREF] = controller.position_setpoint
+    p[K.P_KP] = controller.pi_kp
+    p[K.P_KI] = controller.pi_ki
+    p[K.P_KD] = controller.damping_gain
+    p[K.P_HP_OMEGA] = 2 * np.pi * controller.velocity_highpass
+    p[K.P_CONTROL_STEPS] = control_steps
+    p[K.P_DT] = dt
+    return p
+
+
+def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
+    """Grid steps per period of ``rate`` [-]: the one place this arithmetic is done.
+
+    Parameters
+    ----------
+    rate : float
+        Sample or controller rate [Hz].
+    dt : float
+        Integration step [s].
+    name : str
+        Argument name for the message.
+    rounding : {"exact", "up", "down"}
+        ``exact``: ``1/(rate*dt)`` must be a whole number (else :class:`ParameterError`
+        with a rate that works); ``up``: the fewest steps whose length is at most
+        ``dt``; ``down``: the most steps of at least ``dt`` (at least 1).
+
+    Returns
+    -------
+    int
+    """
+    ratio = 1.0 / (rate * dt)
+    if rounding == "up":
+        return max(1, int(np.ceil(ratio - 1e-9)))
+    if rounding == "down":
+        return max(1, int(np.floor(ratio + 1e-9)))
+    steps = int(round(ratio))
+    if steps < 1 or abs(ratio - steps) > 1e-6 * ratio:
+        hint = 1.0 / (max(steps, 1) * dt)
+        raise ParameterError(
+            f"`{name}` ({rate!r} Hz) must divide the integration rate 1/dt = {1 / dt:g} Hz into "
+            f"a whole number of steps; got {ratio:g} steps. Use e.g. {name}={hint:g}.")
+    return steps
+
+
+def _initial_state(initial, isolator, controller, p, excitation, packed_excitation):
+    """State vector and flags at t = 0 (at rest at the setpoint by default)."""
+    s = np.zeros(K.N_STATE)
+    flags = np.zeros(K.N_FLAGS, dtype=np.int64)
+    z0 = controller.position_setpoint if initial.relative_position is None else initial.relative_position
+    if not p[K.P_Z_LOW] <= z0 <= p[K.P_Z_HIGH]:
+        raise ParameterError(
+            f"the initial `relative_position` ({z0!r} m) must lie between the stops "
+            f"[{p[K.P_Z_LOW]:g}, {p[K.P_Z_HIGH]:g}] m; move it or the stops (`stop_center`).")
+    s[K.S_Z] = z0
+    s[K.S_V] = initial.relative_velocity
+    yd0 = base_motion_series(excitation, [0.0])[1][0]
+    s[K.S_HP] = yd0 + initial.relative_velocity  # the amplifier's high-pass has settled
+    force = K.hold_force(0.0, s, p, *packed_excitation)
+    if initial.pi_integral is not None:
+        s[K.S_INT] = initial.pi_integral
+    elif controller.pi_ki > 0:  # preload: the motor carries what the spring and stops do not
+        without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
+        needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
+        f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], 0.0)[:2]
+        s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
+    held = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], s[K.S_INT])
+    s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
+    force = K.hold_force(0.0, s, p, *packed_excitation)
+    f_hold = force[K.F_HOLD]
+    locked = initial.locked
+    if locked is None:
+        locked = initial.relative_velocity == 0.0 and abs(f_hold) <= isolator.stiction_force
+    flags[K.I_MODE] = K.MODE_STICK if locked else K.MODE_SLIP
+    if initial.relative_velocity != 0.0:
+        flags[K.I_DIRECTION] = 1 if initial.relative_velocity > 0 else -1
+    else:
+        flags[K.I_DIRECTION] = -1 if f_hold > 0 else 1
+    return s, flags
+
+
+@dataclass
+class PreparedRun:
+    """Everything the kernels need for one run, validated (see :func:`prepare_run`)."""
+
+    excitation: object
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    params: np.ndarray
+    packed: tuple
+    state: np.ndarray
+    flags: np.ndarray
+    duration: float
+    decimation: int
+    solver_code: int
+    dt: float
+    sample_rate: float
+
+
+def prepare_run(excitation=None, isolator=None, controller=None, *, duration=None,
+                dt=defaults.SIMULATION["dt"], sample_rate=defaults.SIMULATION["sample_rate"],
+                solver=defaults.SIMULATION["solver"], initial_state=None):
+    """Validate a run's inputs and pack them for the kernels (shared by single and batch runs).
+
+    Parameters and exceptions as in :func:`simulate`.
+
+    Returns
+    -------
+    PreparedRun
+    """
+    excitation = Chirp() if excitation is None else excitation
+    isolator = IsolatorParameters() if isolator is None else isolator
+    controller = ControllerParameters() if controller is None else controller
+    initial_state = InitialState() if initial_state is None else initial_state
+    for name, value, kinds in (("excitation", excitation, _EXCITATIONS),
+                               ("isolator", isolator, (IsolatorParameters,)),
+                               ("controller", controller, (ControllerParameters,)),
+                               ("initial_state", initial_state, (InitialState,))):
+        if not isinstance(value, kinds):
+            names = " or ".join(k.__name__ for k in kinds)
+            raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
+    solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
+    dt = positive("dt", dt)
+    sample_rate = positive("sample_rate", sample_rate)
+    if duration is None:
+        if excitation.duration is None:
+            raise ParameterError("`duration` is required for a sine excitation, got None.")
+        duration = excitation.duration
+    duration = positive("duration", duration)
+    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
+        raise ParameterError(
+            f"`duration` ({duration!r} s) exceeds the excitation's length "
+            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    if dt > duration:
+        raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
+    if not stability_test(isolator, controller, solver)(dt):
+        limit = largest_stable_step(isolator, controller, solver)  # only for the message
+        raise StabilityError(
+            f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
+            f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
+            f"stable step is {limit:.3g} s. Reduce `dt`, or soften `stop_stiffness`.")
+    decimation = steps_per_sample(sample_rate, dt, "sample_rate")
+    control_steps = 0
+    if controller.controller_rate > 0:
+        control_steps = steps_per_sample(controller.controller_rate, dt, "controller_rate")
+
+    p = _pack_parameters(isolator, controller, dt, control_steps)
+    packed = excitation.pack()
+    s, flags = _initial_state(initial_state, isolator, controller, p, excitation, packed)
+    return PreparedRun(excitation, isolator, controller, p, packed, s, flags, duration,
+                       decimation, solver_code, dt, sample_rate)
+
+
+def divergence_message(state, step, dt):
+    """What a diverged run reports: the time [s] of the failing step and the last finite state."""
+    return (f"the simulation diverged at t = {step * dt:.6g} s (last finite state: relative "
+            f"position z = {state[K.S_Z]:.6g} m, relative velocity v = {state[K.S_V]:.6g} m/s, "
+            f"PI integral {state[K.S_INT]:.6g} m*s); check the gains and parameters, or reduce "
+            "`dt`.")

@@ -1,0 +1,81 @@
+"""Linear stability of the explicit integrators: is a step small enough? (docs/model.md §7)."""
+import numpy as np
+
+from qzs._validation import choice
+from qzs.engine import kernels as K
+from qzs.model.controller import ControllerParameters
+from qzs.model.isolator import IsolatorParameters
+
+__all__ = ["SOLVERS", "largest_stable_step", "stability_test"]
+
+#: Fixed-step integrators: name -> (kernel code, order of accuracy).
+SOLVERS = {"euler": (K.SOLVER_EULER, 1), "ode3": (K.SOLVER_ODE3, 3), "rk4": (K.SOLVER_RK4, 4)}
+_STABILITY_POLYNOMIALS = {  # |R(h*lambda)| <= 1 is linear stability (Taylor coefficients)
+    "euler": [1, 1], "ode3": [1, 1, 1 / 2, 1 / 6], "rk4": [1, 1, 1 / 2, 1 / 6, 1 / 24]}
+
+
+def _stiff_modes(isolator, controller):
+    """Eigenvalues [1/s] of the fastest linear modes: free, and pressed on a compliant stop."""
+    m = isolator.mass
+    stiffness = isolator.spring_force * isolator.spring_shape + controller.pi_kp
+    damping = isolator.viscous_damping + controller.damping_gain
+    cases = [(stiffness, damping)]
+    if isolator.stop_model == "compliant":
+        cases.append((stiffness + isolator.stop_stiffness, damping + isolator.stop_damping))
+    eigenvalues = [-2 * np.pi * controller.velocity_highpass]
+    for k, c in cases:
+        eigenvalues.extend(np.roots([m, c, k]))
+    return np.asarray(eigenvalues, dtype=complex)
+
+
+def stability_test(isolator, controller, solver):
+    """``stable(h)``: does a step ``h`` [s] keep every stiff mode's growth below 0.1 %/s?"""
+    choice("solver", solver, tuple(SOLVERS))
+    coefficients = np.array(_STABILITY_POLYNOMIALS[solver][::-1])
+    eigenvalues = _stiff_modes(isolator, controller)
+
+    def stable(h):
+        growth = np.log(np.abs(np.polyval(coefficients, h * eigenvalues)))
+        return bool(np.all(growth <= 1e-3 * h))
+
+    return stable
+
+
+def largest_stable_step(isolator=None, controller=None, solver="ode3"):
+    """Largest time step [s] for which the explicit integrator stays stable.
+
+    Linear stability of the stiffest modes (the payload on its spring, PI gain
+    and dampers, and pressed against a compliant hard stop): the step ``h``
+    must keep the solver's amplification ``|R(h*lambda)|`` from growing faster
+    than 0.1 % per second for every eigenvalue ``lambda``.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+    controller : ControllerParameters, optional
+    solver : {"ode3", "rk4", "euler"}
+
+    Returns
+    -------
+    float
+        The largest stable step [s].
+    """
+    isolator = isolator or IsolatorParameters()
+    controller = controller or ControllerParameters()
+    stable = stability_test(isolator, controller, solver)
+    low, high = 0.0, 1.0
+    while stable(high) and high < 1e3:
+        low, high = high, high * 2
+    if stable(high):
+        return float(high)
+    for _ in range(200):  # bisection on a log scale to relative precision ~1e-6
+        mid = np.sqrt(low * high) if low > 0 else high / 2
+        if stable(mid):
+            low = mid
+        else:
+            high = mid
+        if low > 0 and high / low < 1 + 1e-6:
+            break
+    return float(low)
+
+

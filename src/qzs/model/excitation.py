@@ -1,0 +1,398 @@
+"""Base excitations: displacement y(t) with consistent velocity and acceleration.
+
+Every excitation packs into the same kernel form (pvlib ``loc_args`` style): an
+integer kind, a float array of scalars and, for tabulated signals, a piecewise
+cubic (breakpoints and coefficients, scipy ``PPoly`` layout). The engine's kernel
+(:func:`qzs.engine.base_motion.base_motion`) evaluates ``(y, yd, ydd)`` at any
+time from that form, so integrator stages between grid points see the exact same
+signal as the output samples (docs/model.md §6).
+
+:func:`build_excitation` is the one factory that turns a kind name and options
+(as configs, the command line and sweeps spell them) into an excitation object.
+"""
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from qzs._validation import (as_float, choice, non_negative, parameter, positive,
+                             strictly_increasing, validate_fields)
+from qzs.errors import DataError, ExcitationError
+
+__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
+           "EXCITATION_OPTIONS", "build_excitation", "read_displacement_csv"]
+
+KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
+# Indices into the packed scalars; a table is a (5, n) array: breakpoints in row 0
+# (one more than the pieces), the cubic's coefficients (highest power first) in rows 1-4.
+E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING = range(7)
+N_EXCITATION = 7
+
+_NO_TABLE = np.zeros((5, 2))
+
+
+def _excitation_rule(rule):
+    """A :mod:`qzs._validation` checker that raises :class:`ExcitationError`."""
+    return lambda name, value: rule(name, value, ExcitationError)
+
+
+def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=0.0):
+    ex = np.zeros(N_EXCITATION)
+    ex[[E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING]] = (
+        kind, amplitude, f0, f1, duration, phase, spacing)
+    return ex
+
+
+@dataclass(frozen=True, kw_only=True)
+class Chirp:
+    """Constant-displacement-amplitude swept sine (the paper's: 10 mm, 0 -> 20 Hz).
+
+    Parameters
+    ----------
+    amplitude : float
+        Displacement amplitude [m]; default 0.010.
+    f0, f1 : float
+        Start and end frequency [Hz]; default 0 and 20.
+    duration : float
+        Sweep time [s]; default 2000 (enough for 122 Welch averages of 32768 at 1 kHz).
+    method : {"linear", "logarithmic"}
+        Instantaneous frequency linear or exponential in time (``f0 > 0`` for the latter).
+    """
+
+    amplitude: float = parameter(0.010, "m", "chirp displacement amplitude")
+    f0: float = parameter(0.0, "Hz", "chirp start frequency")
+    f1: float = parameter(20.0, "Hz", "chirp end frequency")
+    duration: float = parameter(2000.0, "s", "sweep time")
+    method: str = parameter("linear", "-", "sweep law: linear or logarithmic")
+
+    def __post_init__(self):
+        validate_fields(self, {
+            "amplitude": _excitation_rule(non_negative),
+            "f0": _excitation_rule(non_negative),
+            "f1": _excitation_rule(non_negative),
+            "duration": _excitation_rule(positive),
+            "method": lambda n, v: choice(n, v, ("linear", "logarithmic"), ExcitationError),
+        })
+        if self.method == "logarithmic" and (self.f0 <= 0 or self.f1 <= 0):
+            raise ExcitationError(
+                f"a logarithmic chirp needs `f0` > 0 and `f1` > 0, got f0={self.f0!r} Hz, "
+                f"f1={self.f1!r} Hz; start at e.g. 0.1 Hz or use method='linear'.")
+
+    @property
+    def max_frequency(self):
+        """Highest frequency in the signal [Hz]."""
+        return max(self.f0, self.f1)
+
+    def frequency_at(self, time):
+        """Instantaneous frequency [Hz] at ``time`` [s] (held at ``f1`` after the sweep)."""
+        fraction = np.clip(np.asarray(time, dtype=float) / self.duration, 0.0, 1.0)
+        if self.method == "linear":
+            return self.f0 + (self.f1 - self.f0) * fraction
+        return self.f0 * (self.f1 / self.f0) ** fraction
+
+    def pack(self):
+        """Kernel form: ``(scalars, table)``."""
+        kind = KIND_CHIRP_LINEAR if self.method == "linear" else KIND_CHIRP_LOG
+        return _pack(kind, self.amplitude, self.f0, self.f1, self.duration), _NO_TABLE
+
+
+@dataclass(frozen=True, kw_only=True)
+class Sine:
+    """Harmonic base displacement ``amplitude*sin(2*pi*frequency*t + phase)``.
+
+    Parameters
+    ----------
+    amplitude : float
+        Displacement amplitude [m].
+    frequency : float
+        Frequency [Hz].
+    phase : float
+        Phase at t = 0 [rad].
+    """
+
+    amplitude: float = parameter(0.010, "m", "sine displacement amplitude")
+    frequency: float = parameter(1.0, "Hz", "sine frequency")
+    phase: float = parameter(0.0, "rad", "phase at t = 0")
+    duration = None  # unbounded: the run's duration is chosen by the caller
+
+    def __post_init__(self):
+        validate_fields(self, {
+            "amplitude": _excitation_rule(non_negative),
+            "frequency": _excitation_rule(non_negative),
+            "phase": _excitation_rule(as_float),
+        })
+
+    @property
+    def max_frequency(self):
+        """Highest frequency in the signal [Hz]."""
+        return self.frequency
+
+    def pack(self):
+        """Kernel form: ``(scalars, table)``."""
+        return _pack(KIND_SINE, self.amplitude, self.frequency, phase=self.phase), _NO_TABLE
+
+
+class _Tabulated:
+    """An excitation held as a C2 cubic spline of displacement (consistent derivatives)."""
+
+    def _spline(self):  # pragma: no cover - defined by subclasses
+        raise NotImplementedError
+
+    def pack(self):
+        """Kernel form: ``(scalars, table)`` of the cubic spline."""
+        spline, spacing = self._spline()
+        table = np.zeros((5, spline.x.size))
+        table[0] = spline.x
+        table[1:, :-1] = spline.c
+        return _pack(KIND_TABLE, duration=self.duration, spacing=spacing), table
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class RandomExcitation(_Tabulated):
+    """Band-limited random base displacement, reproducible from its seed.
+
+    A flat displacement spectrum between ``f_low`` and ``f_high`` with random
+    phases (a periodic multisine, period ``duration``), scaled to the RMS
+    ``amplitude``, tabulated at 20 points per period of ``f_high`` and held as a
+    C2 cubic spline so that velocity and acceleration are consistent.
+
+    Parameters
+    ----------
+    amplitude : float
+        RMS displacement [m].
+    f_low, f_high : float
+        Band edges [Hz], ``0 <= f_low < f_high``.
+    duration : float
+        Length of the record [s].
+    seed : int
+        Seed of ``numpy.random.default_rng``: the same seed gives the same signal.
+    """
+
+    amplitude: float = parameter(0.001, "m", "RMS displacement")
+    f_low: float = parameter(0.5, "Hz", "lower band edge")
+    f_high: float = parameter(20.0, "Hz", "upper band edge")
+    duration: float = parameter(100.0, "s", "record length")
+    seed: int = parameter(0, "1", "random seed")
+
+    def __post_init__(self):
+        validate_fields(self, {
+            "amplitude": _excitation_rule(non_negative),
+            "f_low": _excitation_rule(non_negative),
+            "f_high": _excitation_rule(positive),
+            "duration": _excitation_rule(positive),
+        })
+        if self.f_low >= self.f_high:
+            raise ExcitationError(
+                f"`f_low` must be below `f_high`, got f_low={self.f_low!r} Hz, "
+                f"f_high={self.f_high!r} Hz.")
+        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool):
+            raise ExcitationError(f"`seed` must be an integer, got {self.seed!r}.")
+
+    @property
+    def max_frequency(self):
+        """Highest frequency in the signal [Hz]."""
+        return self.f_high
+
+    def _spline(self):
+        from scipy.interpolate import CubicSpline
+
+        rate = 20.0 * self.f_high
+        n = int(np.ceil(self.duration * rate)) + 1
+        n_fft = n if n % 2 == 0 else n + 1
+        spacing = self.duration / (n - 1)
+        freqs = np.fft.rfftfreq(n_fft, d=spacing)
+        band = (freqs >= self.f_low) & (freqs <= self.f_high) & (freqs > 0)
+        if not band.any():
+            raise ExcitationError(
+                f"no frequency line of a {self.duration!r} s record falls in "
+                f"[{self.f_low!r}, {self.f_high!r}] Hz; lengthen `duration` or widen the band.")
+        rng = np.random.default_rng(self.seed)
+        spectrum = np.zeros(freqs.size, complex)
+        spectrum[band] = np.exp(1j * rng.uniform(0, 2 * np.pi, band.sum()))
+        signal = np.fft.irfft(spectrum, n_fft)[:n]
+        rms = np.sqrt(np.mean(signal ** 2))
+        signal *= self.amplitude / rms if rms > 0 else 0.0
+        time = np.arange(n) * spacing
+        return CubicSpline(time, signal, bc_type="not-a-knot"), spacing
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class DisplacementRecord(_Tabulated):
+    """A user-given base displacement record, interpolated by a C2 cubic spline.
+
+    Velocity and acceleration are the spline's derivatives, so all three are
+    consistent. Measured records should be low-pass filtered first: the spline
+    passes through every sample, noise included.
+
+    Parameters
+    ----------
+    time : array_like
+        Sample times [s], strictly increasing, at least 4 samples.
+    displacement : array_like
+        Base displacement [m] at those times.
+    """
+
+    time: np.ndarray = parameter(unit="s", doc="sample times")
+    displacement: np.ndarray = parameter(unit="m", doc="base displacement")
+
+    def __post_init__(self):
+        time = np.asarray(self.time, dtype=float)
+        disp = np.asarray(self.displacement, dtype=float)
+        if time.ndim != 1 or disp.shape != time.shape:
+            raise ExcitationError(
+                "`time` and `displacement` must be 1-D arrays of the same length, got shapes "
+                f"{time.shape} and {disp.shape}.")
+        if time.size < 4:
+            raise ExcitationError(f"a displacement record needs at least 4 samples, got {time.size}.")
+        for name, values in (("time", time), ("displacement", disp)):
+            bad = np.count_nonzero(~np.isfinite(values))
+            if bad:
+                raise ExcitationError(f"`{name}` has {bad} non-finite samples (NaN or inf); "
+                                      "remove or interpolate them first.")
+        strictly_increasing("time", time, ExcitationError,
+                            "sort the record and drop duplicates first")
+        object.__setattr__(self, "time", time - time[0])
+        object.__setattr__(self, "displacement", disp)
+
+    @property
+    def duration(self):
+        """Length of the record [s]."""
+        return float(self.time[-1])
+
+    @property
+    def max_frequency(self):
+        """Nyquist frequency of the record [Hz] (an upper bound of its content)."""
+        return 0.5 / float(np.median(np.diff(self.time)))
+
+    def _spline(self):
+        from scipy.interpolate import CubicSpline
+
+        steps = np.diff(self.time)
+        uniform = np.ptp(steps) <= 1e-9 * steps.mean()
+        return CubicSpline(self.time, self.displacement), (steps.mean() if uniform else 0.0)
+
+    @classmethod
+    def from_file(cls, path, *, time_column="time", displacement_column="displacement"):
+        """Read a record from a CSV file with a header (see :func:`read_displacement_csv`).
+
+        Parameters
+        ----------
+        path : str or Path
+            The CSV file.
+        time_column, displacement_column : str
+            Names of the columns holding time [s] and displacement [m].
+        """
+        time, displacement = read_displacement_csv(path, time_column, displacement_column)
+        return cls(time=time, displacement=displacement)
+
+
+#: Excitation kinds by the names configs, the command line and sweeps use.
+EXCITATION_KINDS = {"chirp": Chirp, "sine": Sine, "random": RandomExcitation,
+                    "file": DisplacementRecord}
+#: Options of each kind, as configs, the command line and sweeps spell them.
+EXCITATION_OPTIONS = {
+    "chirp": ("amplitude", "f0", "f1", "duration", "method"),
+    "sine": ("amplitude", "frequency", "phase"),
+    "random": ("amplitude", "f0", "f1", "duration", "seed"),
+    "file": ("record",),
+}
+# Option name -> field name where they differ (a random band is f0..f1 in files).
+_FIELD_NAMES = {"random": {"f0": "f_low", "f1": "f_high"}}
+
+
+def option_field(kind, option):
+    """The field of ``kind``'s class that the option ``option`` sets (its name, usually)."""
+    return _FIELD_NAMES.get(kind, {}).get(option, option)
+
+
+def build_excitation(kind, options=None):
+    """The excitation of kind ``kind`` built from ``options`` (the one factory).
+
+    Parameters
+    ----------
+    kind : {"chirp", "sine", "random", "file"}
+        Excitation kind.
+    options : dict, optional
+        Option name -> value, names as in :data:`EXCITATION_OPTIONS`: ``amplitude`` [m]
+        (RMS for random), ``f0``/``f1`` [Hz] (chirp start/end, random band),
+        ``frequency`` [Hz] and ``phase`` [rad] (sine), ``duration`` [s], ``method``
+        (chirp), ``seed`` (random), ``record`` (file: a CSV path). Missing options
+        take the class defaults.
+
+    Returns
+    -------
+    Chirp, Sine, RandomExcitation or DisplacementRecord
+
+    Raises
+    ------
+    ExcitationError
+        Unknown kind, an option the kind does not take, or an invalid value.
+    """
+    if kind not in EXCITATION_KINDS:
+        raise ExcitationError(f"excitation `kind` must be one of {tuple(EXCITATION_KINDS)}, "
+                              f"got {kind!r}.")
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(EXCITATION_OPTIONS[kind]))
+    if unknown:
+        raise ExcitationError(f"a {kind} excitation takes no option(s) {unknown}; its options "
+                              f"are {list(EXCITATION_OPTIONS[kind])}.")
+    if kind == "file":
+        if "record" not in options:
+            raise ExcitationError("a `file` excitation needs `record`, the path of a CSV file "
+                                  "with columns time [s] and displacement [m].")
+        return DisplacementRecord.from_file(options["record"])
+    if kind == "random" and "seed" in options:
+        seed = options["seed"]
+        if isinstance(seed, float) and seed.is_integer():
+            options["seed"] = int(seed)
+    cls = EXCITATION_KINDS[kind]
+    return cls(**{option_field(kind, name): value for name, value in options.items()})
+
+
+def read_displacement_csv(path, time_column="time", displacement_column="displacement"):
+    """Read ``time`` [s] and ``displacement`` [m] columns from a CSV file with a header.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file: a header line of column names, then rows of numbers; lines
+        starting with ``#`` are comments.
+    time_column, displacement_column : str
+        Names of the columns holding time [s] and displacement [m].
+
+    Returns
+    -------
+    time, displacement : ndarray
+        The two columns [s], [m].
+
+    Raises
+    ------
+    DataError
+        Missing file or columns (the message lists the columns found), non-numeric
+        or non-finite samples.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise DataError(f"displacement record not found: {str(path)!r}.")
+    with open(path, encoding="utf-8") as handle:
+        lines = [line for line in handle if line.strip() and not line.startswith("#")]
+    if not lines:
+        raise DataError(f"{str(path)!r} is empty.")
+    names = [n.strip() for n in lines[0].split(",")]
+    missing = [c for c in (time_column, displacement_column) if c not in names]
+    if missing:
+        raise DataError(f"{str(path)!r} has no column(s) {missing}; columns found: {names}.")
+    try:
+        data = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+    except ValueError as error:
+        raise DataError(f"{str(path)!r}: non-numeric value ({error}).") from None
+    if data.shape[0] == 0 or data.shape[1] != len(names):
+        raise DataError(f"{str(path)!r}: expected rows of {len(names)} numbers, got shape "
+                        f"{data.shape}.")
+    time = data[:, names.index(time_column)]
+    displacement = data[:, names.index(displacement_column)]
+    bad = int(np.count_nonzero(~np.isfinite(time)) + np.count_nonzero(~np.isfinite(displacement)))
+    if bad:
+        raise DataError(f"{str(path)!r}: {bad} non-finite samples (NaN or inf) in "
+                        f"{time_column!r}/{displacement_column!r}; clean the record first.")
+    return time, displacement

@@ -1,0 +1,209 @@
+"""The parameter registry: every model and excitation parameter's name, unit, doc and default.
+
+One source, read by everything that names parameters: the command line's ``--set``
+and ``qzs params``, TOML configs, sweeps, identification, and the metadata of saved
+results. The parameters themselves are the fields of the frozen dataclasses
+(:class:`~qzs.model.isolator.IsolatorParameters`,
+:class:`~qzs.model.controller.ControllerParameters` and the excitations), each
+declared with its default, unit and one-line description; this module only reads
+them.
+"""
+import dataclasses
+import math
+from dataclasses import dataclass
+from types import MappingProxyType
+
+from qzs.errors import ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_field
+from qzs.model.isolator import IsolatorParameters
+
+__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "parameter_info", "unit_of",
+           "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
+           "format_value"]
+
+#: Sections of the model parameters: config table name -> dataclass.
+SECTIONS = MappingProxyType({"isolator": IsolatorParameters,
+                             "controller": ControllerParameters})
+
+
+@dataclass(frozen=True, kw_only=True)
+class ParameterInfo:
+    """What the registry knows of one parameter.
+
+    Attributes
+    ----------
+    name : str
+        The parameter's name (``stiction_force``, ``excitation.f0``).
+    section : str
+        ``isolator``, ``controller`` or ``excitation.<kind>``.
+    unit : str
+        SI unit (``N``, ``m``, ``Hz``; ``-`` for a choice, ``1`` for a count).
+    doc : str
+        One-line description.
+    default : object
+        Default value (``None`` where that has a meaning, e.g. ``stop_center``).
+    numeric : bool
+        True for a float parameter that takes any number in its range (fits vary these).
+    """
+
+    name: str
+    section: str
+    unit: str
+    doc: str
+    default: object
+    numeric: bool
+
+
+def _info(section, field, name=None):
+    default = None if field.default is dataclasses.MISSING else field.default
+    return ParameterInfo(name=name or field.name, section=section,
+                         unit=field.metadata.get("unit", ""), doc=field.metadata.get("doc", ""),
+                         default=default, numeric=field.type in (float, "float"))
+
+
+#: Model parameters: name -> :class:`ParameterInfo`, isolator first, then controller.
+PARAMETERS = MappingProxyType({
+    f.name: _info(section, f) for section, cls in SECTIONS.items()
+    for f in dataclasses.fields(cls)})
+
+
+def _excitation_info(kind, option):
+    if option == "duration" and kind == "sine":  # a sine runs as long as the run
+        return ParameterInfo(name="excitation.duration", section=f"excitation.{kind}",
+                             unit="s", doc="run duration", default=None, numeric=True)
+    if option == "record":
+        return ParameterInfo(name="excitation.record", section=f"excitation.{kind}", unit="",
+                             doc="CSV file of time [s] and displacement [m]", default=None,
+                             numeric=False)
+    fields = {f.name: f for f in dataclasses.fields(EXCITATION_KINDS[kind])}
+    return _info(f"excitation.{kind}", fields[option_field(kind, option)],
+                 name=f"excitation.{option}")
+
+
+def parameter_info(name, kind=None):
+    """The :class:`ParameterInfo` of a model parameter or of ``excitation.<option>``.
+
+    Parameters
+    ----------
+    name : str
+        A model parameter (``pi_kp``) or an excitation option (``excitation.f0``).
+    kind : str, optional
+        Excitation kind for ``excitation.<option>`` (default: the first kind that
+        has the option).
+
+    Raises
+    ------
+    ParameterError
+        Unknown name; the message lists the valid ones.
+    """
+    if name in PARAMETERS:
+        return PARAMETERS[name]
+    if name.startswith("excitation."):
+        option = name.split(".", 1)[1]
+        kinds = [kind] if kind is not None else list(EXCITATION_OPTIONS)
+        for k in kinds:
+            if option in EXCITATION_OPTIONS.get(k, ()) or (option == "duration" and k == "sine"):
+                return _excitation_info(k, option)
+    valid = sorted(PARAMETERS) + sorted({f"excitation.{o}" for v in EXCITATION_OPTIONS.values()
+                                         for o in v})
+    raise ParameterError(f"unknown parameter {name!r}; valid names are: {', '.join(valid)}.")
+
+
+def unit_of(name, kind=None):
+    """SI unit [string] of a model parameter or of ``excitation.<option>`` (see :func:`parameter_info`).
+
+    Parameters
+    ----------
+    name : str
+        Parameter name.
+    kind : str, optional
+        Excitation kind, for excitation options.
+    """
+    return parameter_info(name, kind).unit
+
+
+def numeric_parameters():
+    """Names of the float model parameters (those a fit or a sweep may vary continuously)."""
+    return tuple(name for name, info in PARAMETERS.items() if info.numeric)
+
+
+def update_parameters(isolator, controller, settings):
+    """Return ``(isolator, controller)`` with the named parameters replaced.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters to start from.
+    controller : ControllerParameters
+        Controller parameters to start from.
+    settings : dict
+        Parameter names (``mass``, ``pi_kp``, ...; see :data:`PARAMETERS`) to values in
+        their SI units; string values are parsed (:func:`parse_value`, ``none`` for
+        an optional value).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name (the message lists the valid ones) or an invalid value.
+    """
+    changes = {section: {} for section in SECTIONS}
+    for name, value in settings.items():
+        if name not in PARAMETERS:
+            raise ParameterError(f"unknown parameter {name!r}; valid names are: "
+                                 f"{', '.join(sorted(PARAMETERS))}.")
+        changes[PARAMETERS[name].section][name] = (parse_value(value) if isinstance(value, str)
+                                                   else value)
+    return (dataclasses.replace(isolator, **changes["isolator"]),
+            dataclasses.replace(controller, **changes["controller"]))
+
+
+def parameter_table(isolator=None, controller=None):
+    """Rows ``(section, name, value, unit, description)`` of every model parameter.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Values to show; defaults if omitted.
+    controller : ControllerParameters, optional
+        Values to show; defaults if omitted.
+    """
+    objects = {"isolator": isolator or IsolatorParameters(),
+               "controller": controller or ControllerParameters()}
+    return [(info.section, name, getattr(objects[info.section], name), info.unit, info.doc)
+            for name, info in PARAMETERS.items()]
+
+
+def parse_value(text):
+    """Parse a ``--set`` or header value: number, none, true/false, else the string.
+
+    Parameters
+    ----------
+    text : str
+        The value as typed (``5``, ``1e-3``, ``none``, ``plastic``).
+    """
+    lowered = text.strip().lower()
+    if lowered in ("none", "null"):
+        return None
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        number = float(text)
+    except ValueError:
+        return text.strip()
+    return int(number) if number.is_integer() and "." not in text and "e" not in lowered else number
+
+
+def format_value(value):
+    """Human-readable parameter value: ``none``, ``%g`` for floats, else ``str``.
+
+    Parameters
+    ----------
+    value : object
+        A parameter value.
+    """
+    if value is None:
+        return "none"
+    if isinstance(value, float) and math.isfinite(value):
+        return f"{value:g}"
+    return str(value)

@@ -1,0 +1,17 @@
+"""Every figure qzs draws (matplotlib, Agg when there is no display).
+
+``figures``           the figure factory, the atomic writer, long-trace envelopes
+``simulation``        a run's time series and energy ledger
+``transmissibility``  transmissibility curves as the paper draws them
+``identify``          spring, friction and transmissibility fits
+``experiment``        a measured log beside its simulation
+``sweeps``            sweep stores: metrics against parameters, transmissibility bands
+"""
+from qzs.viz.figures import envelope, new_figure, save_figure
+from qzs.viz.identify import plot_friction_fit, plot_spring_fit, plot_transmissibility_fit
+from qzs.viz.simulation import plot_energy, plot_simulation
+from qzs.viz.transmissibility import plot_transmissibility
+
+__all__ = ["envelope", "new_figure", "save_figure", "plot_simulation", "plot_energy",
+           "plot_transmissibility", "plot_spring_fit", "plot_friction_fit",
+           "plot_transmissibility_fit"]

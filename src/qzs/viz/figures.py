@@ -1,0 +1,65 @@
+"""What every figure shares: a figure factory, an atomic writer, an envelope for long traces."""
+import numpy as np
+
+__all__ = ["envelope", "new_figure", "save_figure"]
+
+_MAX_POINTS = 4000  # per trace: long runs are drawn as a min/max envelope
+
+
+def envelope(time, values, max_points=_MAX_POINTS):
+    """Min/max envelope of a long trace, for plotting without aliasing.
+
+    Returns ``(time, values)`` unchanged when short, else two points (min and
+    max) per bin for ``max_points // 2`` bins.
+    """
+    time = np.asarray(time)
+    values = np.asarray(values, dtype=float)
+    n = values.size
+    if n <= max_points:
+        return time, values
+    bins = max_points // 2
+    width = n // bins
+    used = bins * width
+    blocks = values[:used].reshape(bins, width)
+    t = time[:used].reshape(bins, width)
+    low, high = blocks.argmin(axis=1), blocks.argmax(axis=1)
+    first = np.minimum(low, high)
+    second = np.maximum(low, high)
+    rows = np.arange(bins)
+    t_out = np.column_stack([t[rows, first], t[rows, second]]).ravel()
+    v_out = np.column_stack([blocks[rows, first], blocks[rows, second]]).ravel()
+    return t_out, v_out
+
+
+def new_figure(rows, height=2.1, sharex=True):
+    """A figure of ``rows`` stacked axes, 9 in wide (Agg when there is no display)."""
+    import matplotlib
+
+    if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf") and not _has_display():
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(rows, 1, sharex=sharex, figsize=(9, height * rows + 0.8),
+                             constrained_layout=True)
+    return fig, np.atleast_1d(axes)
+
+
+def _has_display():
+    import os
+
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def save_figure(fig, path, also_svg=False):
+    """Write ``fig`` atomically (format from the suffix); a .png also as .svg if asked."""
+    from pathlib import Path
+
+    from qzs.iotools.files import atomic_path
+
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=130)
+    if also_svg and path.suffix.lower() == ".png":
+        save_figure(fig, path.with_suffix(".svg"))
+
+

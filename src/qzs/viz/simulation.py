@@ -1,0 +1,75 @@
+"""Figures of one run: time series and the energy ledger."""
+from qzs.analysis.summary import run_title
+from qzs.viz.figures import envelope, new_figure, save_figure
+
+__all__ = ["plot_simulation", "plot_energy"]
+
+
+def plot_simulation(result, path=None, title=None):
+    """Time series of a run: motion, relative position with the stops, forces, accelerations.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    path : str or Path, optional
+        If given, the figure is also written there (format from the suffix).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = new_figure(4)
+    t = result.time
+
+    def trace(ax, name, scale=1.0, **style):
+        tt, vv = envelope(t, result[name] * scale)
+        ax.plot(tt, vv, lw=0.7, **style)
+
+    trace(axes[0], "base_displacement", 1e3, label="base y")
+    trace(axes[0], "payload_displacement", 1e3, label="payload x")
+    axes[0].set_ylabel("displacement [mm]")
+
+    trace(axes[1], "relative_position", 1e3, color="C2", label="z = x - y")
+    run = result.run
+    for z_stop in (run["stop_low"], run["stop_high"]):
+        axes[1].axhline(z_stop * 1e3, color="k", lw=1.0, ls="--")
+    axes[1].axhline(result.controller.position_setpoint * 1e3, color="C3", lw=0.8, ls=":",
+                    label="setpoint")
+    axes[1].set_ylabel("relative position [mm]")
+
+    for name, label in (("spring_force", "spring"), ("friction_force", "friction"),
+                        ("motor_force", "motor"), ("stop_force", "stop")):
+        trace(axes[2], name, label=label)
+    axes[2].set_ylabel("force [N]")
+
+    trace(axes[3], "base_acceleration", label="base")
+    trace(axes[3], "payload_acceleration", label="payload")
+    axes[3].set_ylabel("acceleration [m/s$^2$]")
+    axes[3].set_xlabel("time [s]")
+    for ax in axes:
+        ax.legend(loc="upper right", fontsize="small", ncols=4)
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(title or run_title(result))
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_energy(result, path=None):
+    """Energy ledger of a run [J]: work in, dissipation, stored energy and the residual."""
+    fig, axes = new_figure(2, height=2.6)
+    t = result.time
+    for name in ("base_work", "motor_work", "friction_dissipation", "stop_dissipation"):
+        axes[0].plot(*envelope(t, result[name]), lw=0.8, label=name.replace("_", " "))
+    axes[0].set_ylabel("energy [J]")
+    axes[1].plot(*envelope(t, result.energy_residual()), lw=0.8, color="k")
+    axes[1].set_ylabel("ledger residual [J]")
+    axes[1].set_xlabel("time [s]")
+    axes[0].legend(fontsize="small")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    fig.suptitle("Energy ledger: dE = W_base + W_motor - D_friction - D_stop")
+    if path is not None:
+        save_figure(fig, path)
+    return fig

@@ -1,0 +1,7 @@
+"""Workflows built on the layers below: the paper's studies and report, experiment logs, sweeps.
+
+``studies``     the paper's studies as TOML definitions (``study_files/``), run in parallel
+``report``      ``qzs paper``: figures, metrics, claims decided from the data
+``experiment``  a measured log beside its simulation
+``sweeps``      parameter sweeps and Monte Carlo runs into Zarr stores, locally or on Dask
+"""

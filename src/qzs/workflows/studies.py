@@ -1,0 +1,305 @@
+"""The paper's numerical studies as declarative TOML definitions, and their runner.
+
+A study file has a ``[study]`` table (name, title, kind, claims, views), optional
+``[defaults]`` parameter overrides shared by its cases, ``[[case]]`` tables (a
+``label`` and parameter overrides (names of ``qzs params``)), and optional ``[excitation]``,
+``[analysis]`` and ``[simulation]`` tables. The shipped files live in
+``qzs/workflows/study_files/*.toml``: copy one, edit it, run it with ``qzs study FILE.toml``.
+
+Kinds:
+
+``transmissibility``
+    Each case: a constant-amplitude chirp sized for the wanted Welch averages,
+    simulated, reduced to its transmissibility curve and metrics.
+``processing``
+    As above, and also processed like the experiment: velocities through the
+    charge amplifier's high-pass, the experiment's averages.
+``spring_characteristic``
+    The MagSpring's static characteristic and its tanh fit (no simulation).
+"""
+import dataclasses
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs._validation import known_keys, read_toml
+from qzs.analysis.linear import linearize
+from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
+                                   transmissibility_metrics)
+from qzs.analysis.statistics import run_statistics
+from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
+from qzs.engine.simulate import simulate
+from qzs.errors import ParameterError
+from qzs.identify.spring import fit_spring
+from qzs.iotools.shipped import resolve_shipped, shipped_files
+from qzs.model.controller import ControllerParameters
+from qzs.model.excitation import EXCITATION_OPTIONS, Chirp
+from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.model.registry import update_parameters
+
+__all__ = ["Study", "StudyResult", "CaseResult", "load_study", "shipped_studies", "run_studies",
+           "run_study"]
+
+KINDS = ("transmissibility", "processing", "spring_characteristic")
+#: Folder of the shipped study files, inside the package.
+SHIPPED = "workflows/study_files"
+# Keys of the optional tables (the sample rate is the analysis's).
+_TABLE_KEYS = {"excitation": EXCITATION_OPTIONS["chirp"], "analysis": (*ANALYSIS, "duration"),
+               "simulation": ("dt", "solver")}
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study definition (see the module docstring for the TOML layout)."""
+
+    name: str
+    title: str
+    kind: str
+    cases: tuple
+    claims: tuple = ()
+    views: tuple = ()
+    defaults: dict = field(default_factory=dict)
+    excitation: dict = field(default_factory=dict)
+    analysis: dict = field(default_factory=dict)
+    simulation: dict = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+    source: str = ""
+
+
+@dataclass
+class CaseResult:
+    """What one case of a study produced (small: safe to send between processes)."""
+
+    label: str
+    settings: dict
+    frequency: np.ndarray = None
+    magnitude: np.ndarray = None
+    coherence: np.ndarray = None
+    metrics: dict = field(default_factory=dict)
+    stats: dict = field(default_factory=dict)
+    linear: dict = field(default_factory=dict)
+    extra: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+
+@dataclass
+class StudyResult:
+    """The cases of one study, in definition order, and the wall time spent on them."""
+
+    study: Study
+    cases: list
+    quick: bool
+    seconds: float = 0.0
+
+
+def shipped_studies():
+    """Paths of the study definitions shipped with qzs, in the paper's order."""
+    return shipped_files(SHIPPED)
+
+
+def load_study(path):
+    """Read and validate a study definition (a path, or the name of a shipped study)."""
+    path = resolve_shipped(path, SHIPPED, "study", "studies")
+    document = read_toml(path, "study file")
+    allowed = {"study", "defaults", "case", "excitation", "analysis", "simulation", "spring",
+               "processing"}
+    unknown = set(document) - allowed
+    if unknown:
+        raise ParameterError(f"{str(path)!r}: unknown table(s) {sorted(unknown)}; allowed are "
+                             f"{sorted(allowed)}.")
+    head = document.get("study")
+    if not isinstance(head, dict) or "name" not in head or "kind" not in head:
+        raise ParameterError(f"{str(path)!r} needs a [study] table with `name` and `kind`.")
+    kind = head["kind"]
+    if kind not in KINDS:
+        raise ParameterError(f"{str(path)!r}: `kind` must be one of {KINDS}, got {kind!r}.")
+    cases = tuple(document.get("case", ()))
+    if kind != "spring_characteristic" and not cases:
+        raise ParameterError(f"{str(path)!r} defines no [[case]]; add at least one.")
+    defaults = dict(document.get("defaults", {}))
+    for i, case in enumerate(cases):
+        settings = {k: v for k, v in case.items() if k != "label"}
+        try:  # validate every case now, not in a worker later
+            update_parameters(IsolatorParameters(), ControllerParameters(),
+                              {**defaults, **settings})
+        except ParameterError as error:
+            raise ParameterError(f"{str(path)!r}, case {i + 1}: {error}") from None
+    for table, keys in _TABLE_KEYS.items():
+        known_keys(document.get(table, {}), keys, f"[{table}]", f"{str(path)!r}: ")
+    views = tuple(head.get("view", ()))
+    options = {**document.get("spring", {}), **document.get("processing", {})}
+    return Study(name=head["name"], title=head.get("title", head["name"]), kind=kind,
+                 cases=cases, claims=tuple(head.get("claims", ())), views=views,
+                 defaults=defaults, excitation=dict(document.get("excitation", {})),
+                 analysis=dict(document.get("analysis", {})),
+                 simulation=dict(document.get("simulation", {})), options=options,
+                 source=str(path))
+
+
+def _tasks(study, quick):
+    """One picklable task per case: everything a worker needs to run it."""
+    analysis = {**ANALYSIS, **study.analysis}
+    if quick:
+        analysis["fft_length"] = analysis["quick_fft_length"]
+        analysis["n_averages"] = min(analysis["n_averages"], analysis["quick_n_averages"])
+    if study.kind == "processing":
+        analysis["n_averages"] = int(study.options.get("n_averages", analysis["n_averages"]))
+        if quick:
+            analysis["n_averages"] = min(analysis["n_averages"], analysis["quick_n_averages"])
+    if study.kind == "spring_characteristic":
+        return [dict(kind=study.kind, label="MagSpring", settings={}, options=study.options)]
+    return [dict(kind=study.kind, label=case.get("label", f"case {i + 1}"),
+                 settings={**study.defaults, **{k: v for k, v in case.items() if k != "label"}},
+                 excitation=dict(study.excitation), analysis=analysis,
+                 simulation={"dt": SIMULATION["dt"], "solver": SIMULATION["solver"],
+                             **study.simulation}, options=study.options)
+            for i, case in enumerate(study.cases)]
+
+
+def run_case(task):
+    """Run one case (a task from :func:`_tasks`); top-level so process pools can call it."""
+    start = time.perf_counter()
+    if task["kind"] == "spring_characteristic":
+        result = _spring_case(task)
+    else:
+        result = _transmissibility_case(task)
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _transmissibility_case(task):
+    analysis = task["analysis"]
+    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
+                                             task["settings"])
+    rate = analysis["sample_rate"]
+    duration = task["excitation"].get("duration") or required_duration(
+        analysis["fft_length"], analysis["n_averages"], rate, analysis["overlap"])
+    excitation = Chirp(**{k: v for k, v in task["excitation"].items() if k != "duration"},
+                       duration=duration)
+    run = simulate(excitation, isolator, controller, sample_rate=rate, **task["simulation"])
+    welch = dict(fft_length=analysis["fft_length"], overlap=analysis["overlap"])
+    estimate = transmissibility(run.base_acceleration, run.payload_acceleration, rate, **welch)
+    low, high = analysis["band"]
+    keep = band_mask(estimate.frequency, low, high)
+    frequency = estimate.frequency[keep]
+    magnitude = estimate.magnitude[keep]
+    result = CaseResult(task["label"], task["settings"], frequency, magnitude,
+                        estimate.coherence[keep])
+    result.metrics = _metrics(frequency, magnitude)
+    z = run.relative_position
+    statistics = run_statistics(z, run.motor_force, run.locked,
+                                0.5 * (run.run["stop_low"] + run.run["stop_high"]))
+    result.stats = dict(stop_contacts=run.run["stop_contacts"], z_min=statistics["z_min"],
+                        z_max=statistics["z_max"], z_final=float(z[-1]),
+                        locked_fraction=statistics["locked_fraction"],
+                        motor_force_rms=statistics["motor_force_rms"],
+                        duration=float(duration), steps=run.run["steps"],
+                        n_averages=estimate.n_averages, fft_length=estimate.fft_length,
+                        steps_per_second=run.steps_per_second,
+                        locked_fraction_below_half_hz=_locked_below(run, excitation, 0.5))
+    model = linearize(isolator, controller)
+    result.linear = dict(undamped_natural_frequency=model.undamped_natural_frequency,
+                         natural_frequency=model.natural_frequency,
+                         damping_ratio=model.damping_ratio,
+                         magnitude=model.transmissibility(frequency))
+    if task["kind"] == "processing":
+        result.extra = _experiment_processing(run, rate, welch, task["options"], (low, high))
+    return result
+
+
+def _locked_below(run, chirp, frequency):
+    """Fraction of the time the payload is locked while the chirp is below ``frequency`` [Hz]."""
+    below = chirp.frequency_at(run.time) < frequency
+    return float(run.locked[below].mean()) if below.any() else float("nan")
+
+
+def _experiment_processing(run, rate, welch, options, band):
+    """Velocities through the charge amplifier's high-pass, as the experiment measured them."""
+    corner = float(options.get("highpass", 1.0))
+    base_velocity = highpass(run.base_velocity, corner, rate)
+    payload_velocity = highpass(run.payload_velocity, corner, rate)
+    estimate = transmissibility(base_velocity, payload_velocity, rate, highpass_corner=corner,
+                                **welch)
+    keep = band_mask(estimate.frequency, *band)
+    metrics = _metrics(estimate.frequency[keep], estimate.magnitude[keep], corner)
+    return dict(frequency=estimate.frequency[keep], magnitude=estimate.magnitude[keep],
+                metrics=metrics, highpass=corner, n_averages=estimate.n_averages)
+
+
+def _metrics(frequency, magnitude, highpass=None):
+    metrics = transmissibility_metrics(frequency, magnitude, at_frequencies=REPORTED_FREQUENCIES,
+                                       highpass_corner=highpass)
+    return metrics.to_dict()
+
+
+def _spring_case(task):
+    options = task["options"]
+    truth = IsolatorParameters()
+    rng = np.random.default_rng(int(options.get("seed", 5)))
+    z = np.linspace(options.get("displacement_min", -0.1), options.get("displacement_max", 0.1),
+                    int(options.get("points", 41)))
+    force = spring_force(z, truth)
+    measured = force + rng.normal(0.0, float(options.get("noise", 0.01)) * truth.spring_force,
+                                  z.size)
+    fit = fit_spring(z, measured)
+    result = CaseResult("MagSpring", {})
+    result.extra = dict(displacement=z, force=measured, fit=dataclasses.asdict(fit),
+                        true_force_amplitude=truth.spring_force,
+                        true_shape=truth.spring_shape)
+    result.metrics = {"spring_force": fit.spring_force, "spring_shape": fit.spring_shape}
+    return result
+
+
+def run_studies(studies, *, quick=False, workers=None, progress=True):
+    """Run several studies, all their cases in parallel over processes.
+
+    Parameters
+    ----------
+    studies : sequence of Study
+    quick : bool
+        Shorter runs (fewer, shorter Welch segments) for a fast look.
+    workers : int, optional
+        Worker processes; default the machine's core count. 1 runs in-process.
+    progress : bool
+        Show a progress bar over cases.
+
+    Returns
+    -------
+    list of StudyResult
+    """
+    from tqdm.auto import tqdm
+
+    per_study = [_tasks(study, quick) for study in studies]
+    tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
+             for j, task in enumerate(study_tasks)]
+    results = [[None] * len(study_tasks) for study_tasks in per_study]
+    workers = workers or os.cpu_count() or 1
+    bar = tqdm(total=len(tasks), unit="case", desc="studies", disable=not progress)
+    start = time.perf_counter()
+    try:
+        if workers == 1:
+            for i, j, task in tasks:
+                results[i][j] = run_case(task)
+                bar.update()
+        else:
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futures = {pool.submit(run_case, task): (i, j) for i, j, task in tasks}
+                for future in as_completed(futures):
+                    i, j = futures[future]
+                    results[i][j] = future.result()
+                    bar.update()
+    finally:
+        bar.close()
+    elapsed = time.perf_counter() - start
+    return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed)
+            for study, cases in zip(studies, results)]
+
+
+def run_study(study, **options):
+    """Run one study (a :class:`Study`, a path or a shipped name); see :func:`run_studies`."""
+    if not isinstance(study, Study):
+        study = load_study(study)
+    return run_studies([study], **options)[0]

@@ -1,0 +1,161 @@
+"""Parameter sweeps and Monte Carlo runs: thousands of isolator simulations from one TOML file.
+
+A sweep file names what varies and what to keep::
+
+    [sweep]
+    name = "gains"
+    method = "grid"          # "grid" (default), "random" or "lhs" (Latin hypercube)
+    samples = 64             # random/lhs: draws, crossed with every [grid] point
+    seed = 1                 # random/lhs: the same seed gives the same cases
+    batch_size = 32          # cases per batch: one task, one Zarr chunk
+
+    [parameters]             # parameter names (qzs params) held fixed for every case
+    damping_gain = 0.0
+
+    [excitation]             # kind (chirp, sine, random) and fixed values
+    kind = "chirp"
+    amplitude = 0.010
+
+    [grid]                   # full factorial: a list, or a range table
+    pi_kp = [5.0, 20.0, 50.0]
+    stiction_force = { start = 5.0, stop = 15.0, num = 5 }    # scale = "log" optional
+    "excitation.f1" = [10.0, 20.0]
+
+    [distributions]          # random/lhs only
+    viscous_damping = { distribution = "normal", mean = 100.0, std = 10.0 }
+
+    [simulation]             # dt [s], solver
+    [analysis]               # sample_rate [Hz], fft_length, n_averages or duration [s],
+                             # overlap, band [Hz], at_frequencies [Hz]
+    [outputs]                # stats, metrics, transmissibility, coherence, time_series,
+                             # bands = { low = [0.2, 1.0] }  (mean T in a band [Hz])
+
+Cases are the product of the grid points (excitation parameters vary slowest,
+so that batches share one excitation) and the samples (the same draws at every
+grid point: common random numbers). :func:`run_sweep` runs them batch by batch
+through :func:`qzs.engine.batch.simulate_batch`, locally or on a Dask cluster, and
+writes each finished batch to a Zarr store (:mod:`qzs.workflows.sweeps.store`) that an
+interrupted run resumes. Shipped examples: ``qzs/workflows/sweep_files/*.toml``; the
+guide is ``docs/sweeps.md``.
+
+Modules: :mod:`~qzs.workflows.sweeps.definition` (files, grids, sampling),
+:mod:`~qzs.workflows.sweeps.backends` (the batch task, local and Dask backends),
+:mod:`~qzs.workflows.sweeps.store` (the Zarr store); figures in :mod:`qzs.viz.sweeps`.
+"""
+from pathlib import Path
+
+from qzs.errors import ParameterError
+from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, METHODS,
+                                             SweepDefinition, draw_samples, load_sweep,
+                                             plan_text, sample_cases, shipped_sweeps)
+
+__all__ = ["run_sweep", "open_sweep", "plot_sweep", "stored_count", "load_sweep",
+           "sample_cases", "draw_samples", "shipped_sweeps", "plan_text", "SweepDefinition",
+           "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS"]
+
+
+# ---------------------------------------------------------------- running
+def run_sweep(definition, store=None, *, resume=False, overwrite=False, scheduler=None,
+              workers=None, threads=None, progress=True):
+    """Run a sweep and write every finished batch to a Zarr store.
+
+    Parameters
+    ----------
+    definition : SweepDefinition, str, Path or dict
+        The sweep, a TOML file, the name of a shipped sweep, or a parsed document.
+    store : str or Path, optional
+        The Zarr store (a directory); default ``<name>.zarr`` in the working directory.
+    resume : bool
+        Continue an interrupted sweep in ``store``: batches already stored are kept,
+        the others are run. The store must have been written by the same definition.
+    overwrite : bool
+        Replace an existing ``store``.
+    scheduler : str or distributed.Client, optional
+        Run on this Dask cluster (scheduler address or client).
+    workers : int, optional
+        Start a local Dask cluster of this many single-threaded worker processes.
+        Without `scheduler` and `workers` the batches run in this process, each in
+        parallel over `threads` threads (cases sharing an excitation in one batch
+        call, several cases per vector instruction; cases with an excitation of
+        their own side by side).
+    threads : int, optional
+        Threads per batch; default all cores locally, 1 on a Dask cluster.
+    progress : bool
+        Show a progress bar (cases done, failures, time left).
+
+    Returns
+    -------
+    xarray.Dataset
+        The store, opened lazily (:func:`open_sweep`).
+
+    Raises
+    ------
+    ParameterError
+        Invalid definition, an existing store without `resume`/`overwrite`, or a
+        store written by a different definition.
+    KeyboardInterrupt
+        On Ctrl-C, after the batches that finished have been stored.
+    """
+    from qzs.workflows.sweeps.backends import execute
+
+    if not isinstance(definition, SweepDefinition):
+        definition = load_sweep(definition)
+    store = Path(store) if store is not None else Path(f"{definition.name}.zarr")
+    execute(definition, store, resume=resume, overwrite=overwrite, scheduler=scheduler,
+            workers=workers, threads=threads, progress=progress)
+    return open_sweep(store)
+
+
+def open_sweep(store):
+    """Open a sweep store as an ``xarray.Dataset`` (lazy; ``.load()`` to read it all)."""
+    from qzs.workflows.sweeps.store import open_store
+
+    return open_store(store)
+
+
+def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None):
+    """Draw a sweep store's figure, choosing what the arguments leave open; returns the path.
+
+    Parameters
+    ----------
+    store : str or Path
+        The Zarr store.
+    metric : str, optional
+        A per-case output (e.g. ``peak_stroke``) or ``transmissibility`` (the band);
+        default the band without ``y`` if the store keeps it, else ``peak_stroke``.
+    x, y : str, optional
+        Parameters on the horizontal and vertical axis (``y``: a heat map).
+    reduce : {"median", "mean", "min", "max"}
+        How cases at one grid point combine.
+    out : str or Path, optional
+        Figure file; default ``<sweep>-<metric>-<x>[-<y>].png``.
+    """
+    from qzs.viz.sweeps import (plot_metric, plot_transmissibility_band, scalar_outputs,
+                                varied_parameters)
+
+    dataset = open_sweep(store)
+    name = dataset.attrs.get("sweep_name", Path(store).stem)
+    if metric is None:
+        scalars = scalar_outputs(dataset)
+        metric = ("transmissibility" if y is None and "transmissibility" in dataset
+                  else "peak_stroke" if "peak_stroke" in scalars else scalars[0])
+    if metric == "transmissibility":
+        if y is not None:
+            raise ParameterError("the transmissibility band takes --x (one band per level), "
+                                 "not --y; choose a --metric for a heat map.")
+        out = out or f"{name}-transmissibility{'-' + x if x else ''}.png"
+        plot_transmissibility_band(dataset, by=x, path=out)
+    else:
+        x = x or varied_parameters(dataset)[0]
+        parts = [name, metric, x] + ([y] if y else [])
+        out = out or "-".join(parts) + ".png"
+        plot_metric(dataset, metric, x, y, reduce=reduce, path=out)
+    return out
+
+
+def stored_count(store):
+    """Cases already stored in ``store`` [-] (0 if there is no store yet)."""
+    try:
+        return int(open_sweep(store)["done"].sum())
+    except Exception:  # noqa: BLE001 - the store may not exist yet
+        return 0

@@ -1,0 +1,306 @@
+"""Running a sweep: one batch task, its reduction, and the local and Dask backends.
+
+:func:`run_batch` is the task every backend runs, unchanged (stumpy style: the
+same kernel in-process and on a cluster): it builds the cases of one batch,
+groups them by excitation, runs each group through
+:func:`qzs.engine.batch.simulate_batch` (the groups side by side, one per core, when
+the cases have excitations of their own) and reduces every case to the outputs
+the sweep keeps. A case with invalid parameters, a diverged simulation or a failed
+analysis is recorded with its status and message; the others go on.
+"""
+import os
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import nullcontext
+
+import numpy as np
+
+from qzs._optional import require
+from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
+from qzs.engine.batch import simulate_batch
+from qzs.engine.prepare import steps_per_sample
+from qzs.errors import CaseError, DataError, ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.isolator import IsolatorParameters
+from qzs.model.registry import update_parameters
+from qzs.workflows.sweeps.definition import case_excitation, sample_cases
+from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, FAILED, INVALID, OK, open_store,
+                                        prepare_store, schema, write_batch)
+
+__all__ = ["run_batch", "execute", "case_settings"]
+
+_LOCK = threading.Lock()  # one multi-threaded batch at a time per process
+
+
+def case_settings(definition, columns):
+    """One dict of plain Python values per case: the varied parameters."""
+    names = list(definition.varied)
+    rows = zip(*(np.asarray(columns[n]).tolist() for n in names)) if names else []
+    return [dict(zip(names, row)) for row in rows]
+
+
+def case_duration(definition, settings):
+    """Simulated time [s] of a case."""
+    if "excitation.duration" in settings:
+        return float(settings["excitation.duration"])
+    return float(definition.excitation.get("duration", definition.analysis["duration"]))
+
+
+def _empty(definition, n, n_time):
+    arrays = {}
+    for name, (dims, dtype, fill, _) in schema(definition, n_time).items():
+        shape = tuple(n if d == "case" else (definition.frequency.size if d == "frequency"
+                                             else n_time) for d in dims)
+        arrays[name] = np.full(shape, fill, dtype=object if name == "message" else dtype)
+    return arrays
+
+
+def run_batch(definition, start, settings, n_time, threads=None):
+    """Simulate and reduce one batch of cases (the task of every backend).
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+    start : int
+        Index of the batch's first case.
+    settings : list of dict
+        The varied parameters of each case (:func:`case_settings`).
+    n_time : int
+        Samples kept per time series (0: none).
+    threads : int, optional
+        Cores to use: the threads of :func:`~qzs.engine.batch.simulate_batch`, or the
+        groups run side by side when cases have their own excitation; default all.
+
+    Returns
+    -------
+    dict
+        ``start``, ``arrays`` (one per store variable, first axis the cases),
+        ``steps`` and ``elapsed`` [s].
+    """
+    began = time.perf_counter()
+    arrays = _empty(definition, len(settings), n_time)
+    groups = {}
+    for i, case in enumerate(settings):
+        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
+        excitation = {**definition.excitation,
+                      **{k.split(".", 1)[1]: v for k, v in case.items()
+                         if k.startswith("excitation.")}}
+        try:
+            isolator, controller = update_parameters(
+                IsolatorParameters(), ControllerParameters(), {**definition.parameters, **model})
+            built = case_excitation(definition.excitation_kind, excitation,
+                                     definition.analysis)
+        except (ParameterError, TypeError) as error:
+            arrays["status"][i], arrays["message"][i] = INVALID, str(error)
+            continue
+        key = tuple(sorted(excitation.items()))
+        groups.setdefault(key, (built, []))[1].append((i, isolator, controller))
+    groups = list(groups.values())
+    cores = threads or os.cpu_count() or 1
+    if len(groups) > 1 and cores > 1:  # cases with their own excitations: a group per core
+        with _LOCK, ThreadPoolExecutor(min(cores, len(groups))) as pool:
+            steps = sum(pool.map(lambda group: _run_group(
+                definition, *group[0], group[1], arrays, n_time, 1, lock=nullcontext()), groups))
+    else:
+        steps = sum(_run_group(definition, excitation, duration, members, arrays, n_time,
+                               threads) for (excitation, duration), members in groups)
+    return {"start": start, "arrays": arrays, "steps": steps,
+            "elapsed": time.perf_counter() - began}
+
+
+def _run_group(definition, excitation, duration, members, arrays, n_time, threads, lock=_LOCK):
+    """Run cases sharing one excitation; cases the batch call rejects are recorded invalid.
+
+    ``lock`` is held around the batch call (by default the process-wide one: one
+    multi-threaded batch at a time).
+    """
+    out = definition.outputs
+    spectral = bool(out["transmissibility"] or out["coherence"] or out["metrics"]
+                    or out["bands"])
+    channels = (["base_acceleration", "payload_acceleration"] if spectral else []) + [
+        c for c in out["time_series"] if not spectral or c not in (
+            "base_acceleration", "payload_acceleration")]
+    sim = definition.simulation
+    while members:
+        try:
+            with lock:
+                result = simulate_batch(
+                    [(iso, ctl) for _, iso, ctl in members], excitation, duration=duration,
+                    dt=sim["dt"], sample_rate=definition.analysis["sample_rate"],
+                    solver=sim["solver"], channels=tuple(channels), workers=threads)
+        except CaseError as error:
+            i = members.pop(error.index)[0]
+            arrays["status"][i], arrays["message"][i] = INVALID, error.reason
+            continue
+        break
+    else:
+        return 0
+    for j, (i, _, _) in enumerate(members):
+        for name in out["stats"]:
+            arrays[name][i] = result.stats[name][j]
+        for name in out["time_series"]:
+            series = result.channels[name][j][:n_time]
+            arrays[name][i, :series.size] = series
+        if result.status[j]:
+            arrays["status"][i], arrays["message"][i] = FAILED, result.messages[j]
+            continue
+        arrays["status"][i] = OK
+        if spectral:
+            try:
+                _reduce(definition, result.channels["base_acceleration"][j],
+                        result.channels["payload_acceleration"][j], arrays, i)
+            except (DataError, ParameterError) as error:
+                arrays["status"][i] = ANALYSIS_FAILED
+                arrays["message"][i] = f"transmissibility analysis failed: {error}"
+    return int(np.nansum(result.stats["steps"]))
+
+
+def _reduce(definition, base, payload, arrays, i):
+    """Transmissibility curve, metrics in the band and band means of one case."""
+    a, out = definition.analysis, definition.outputs
+    estimate = transmissibility(base, payload, a["sample_rate"], fft_length=a["fft_length"],
+                                overlap=a["overlap"])
+    f, magnitude = estimate.frequency, estimate.magnitude
+    low, high = a["band"]
+    keep = band_mask(f, low, high)
+    arrays["n_averages"][i] = estimate.n_averages
+    if out["transmissibility"]:
+        arrays["transmissibility"][i] = magnitude[keep]
+    if out["coherence"]:
+        arrays["coherence"][i] = estimate.coherence[keep]
+    for label, (lo, hi) in out["bands"].items():
+        arrays[f"mean_transmissibility_{label}"][i] = magnitude[band_mask(f, lo, hi)].mean()
+    if out["metrics"]:
+        metrics = transmissibility_metrics(f[keep], magnitude[keep],
+                                           at_frequencies=a["at_frequencies"]).to_dict()
+        for name in out["metrics"]:
+            arrays[name][i] = metrics[name]
+
+
+# ---------------------------------------------------------------- backends
+def _local(definition, batches, settings, n_time, threads):
+    for start, stop in batches:
+        yield run_batch(definition, start, settings[start:stop], n_time, threads)
+
+
+def _dask(client, definition, batches, settings, n_time, threads):
+    """Submit batches to a Dask cluster (at most two per worker thread in flight)."""
+    as_completed = require("distributed", "running a sweep on a Dask cluster").as_completed
+
+    pending = iter(batches)
+    window = max(2, 2 * sum(client.nthreads().values()))
+    futures = as_completed()
+    submitted = []
+
+    def submit(batch):
+        start, stop = batch
+        submitted.append(client.submit(run_batch, definition, start, settings[start:stop], n_time,
+                                  threads, retries=2, pure=False))
+        futures.add(submitted[-1])
+
+    for batch in [b for _, b in zip(range(window), pending)]:
+        submit(batch)
+    try:
+        for future in futures:
+            result = future.result()
+            future.release()
+            following = next(pending, None)
+            if following is not None:
+                submit(following)
+            yield result
+    finally:
+        futures.clear()
+        client.cancel(submitted)
+
+
+def _client(scheduler, workers):
+    """A Dask client (and whether to close it): given, by address, or on a new LocalCluster."""
+    distributed = require("distributed", "running a sweep on a Dask cluster")
+    Client, LocalCluster = distributed.Client, distributed.LocalCluster
+
+    if isinstance(scheduler, Client):
+        return scheduler, None
+    if scheduler is not None:
+        return Client(scheduler), None
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None,
+                           processes=True)
+    return Client(cluster), cluster
+
+
+def execute(definition, store, *, resume=False, overwrite=False, scheduler=None, workers=None,
+            threads=None, progress=True):
+    """Run the batches of `definition` not yet in `store`, storing each as it finishes.
+
+    See :func:`qzs.workflows.sweeps.run_sweep` for the parameters.
+
+    Returns
+    -------
+    dict
+        ``cases`` run now, ``failed`` among them, ``steps`` and ``wall`` [s].
+    """
+    from tqdm.auto import tqdm
+
+    columns = sample_cases(definition)
+    settings = case_settings(definition, columns)
+    n_time = 0
+    if definition.outputs["time_series"]:
+        longest = max(case_duration(definition, s) for s in settings)
+        decimation = steps_per_sample(definition.analysis["sample_rate"],
+                                      definition.simulation["dt"])
+        n_time = int(round(longest / definition.simulation["dt"])) // decimation + 1
+    client = cluster = None
+    report = {"cases": 0, "failed": 0, "steps": 0, "wall": 0.0}
+    began = time.perf_counter()
+    bar = results = None
+    try:
+        if scheduler is not None or workers is not None:  # before the store: fail early
+            client, cluster = _client(scheduler, workers)
+        done = prepare_store(store, definition, columns, n_time, resume=resume,
+                             overwrite=overwrite)
+        size = definition.batch_size
+        batches = [(a, min(a + size, definition.n_cases))
+                   for a in range(0, definition.n_cases, size) if not done[a:a + size].all()]
+        if client is not None:
+            results = _dask(client, definition, batches, settings, n_time,
+                            1 if threads is None else threads)
+        else:
+            results = _local(definition, batches, settings, n_time, threads)
+        failed = _stored_failures(store) if done.any() else 0
+        bar = tqdm(total=definition.n_cases, initial=int(done.sum()), unit="case",
+                   desc=definition.name, disable=not progress, dynamic_ncols=True,
+                   postfix={"failed": failed})
+        for result in results:
+            write_batch(store, definition, result["start"], result["arrays"], n_time)
+            n = len(result["arrays"]["status"])
+            new_failures = int(np.count_nonzero(result["arrays"]["status"] > OK))
+            report["cases"] += n
+            report["failed"] += new_failures
+            report["steps"] += result["steps"]
+            failed += new_failures
+            bar.update(n)
+            bar.set_postfix(failed=failed, refresh=False)
+    finally:
+        if bar is not None:
+            bar.close()
+        if results is not None:
+            results.close()
+        if client is not None and not _is_client(scheduler):
+            client.close()
+        if cluster is not None:
+            cluster.close()
+        report["wall"] = time.perf_counter() - began
+    return report
+
+
+def _stored_failures(store):
+    dataset = open_store(store)
+    return int(np.count_nonzero(dataset["done"].values & (dataset["status"].values > OK)))
+
+
+def _is_client(obj):
+    try:
+        from distributed import Client
+    except ImportError:  # without Dask nothing is a client
+        return False
+    return isinstance(obj, Client)

@@ -1,0 +1,251 @@
+"""The Zarr store of a sweep: layout, creation, batch writes, resume checks.
+
+Layout (an ``xarray.Dataset``): dimension ``case`` (chunked by the sweep's
+``batch_size``), ``frequency`` if a spectral curve is kept, ``time`` if time series
+are kept. The varied parameters are coordinates on ``case``. Every case has
+``done`` (bool), ``status`` (:data:`STATUS`) and ``message`` ('' or why it failed).
+
+Writes are atomic per batch: the template (metadata only) is written to a
+temporary directory and renamed into place; a batch covers whole chunks, each
+chunk file is replaced atomically by zarr, and the batch's ``done`` flags are
+written last. A process killed mid-batch leaves that batch not done, and
+``--resume`` recomputes exactly the batches that are not done.
+"""
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from qzs._optional import require
+from qzs._version import __version__
+from qzs.engine.batch import STATS
+from qzs.engine.results import CHANNELS
+from qzs.errors import ParameterError
+from qzs.model.registry import unit_of
+
+__all__ = ["STATUS", "PENDING", "OK", "INVALID", "FAILED", "ANALYSIS_FAILED", "schema",
+           "prepare_store", "write_batch", "open_store", "summary_text"]
+
+#: Case status codes stored in ``status``.
+STATUS = {0: "pending", 1: "ok", 2: "invalid", 3: "failed", 4: "analysis_failed"}
+PENDING, OK, INVALID, FAILED, ANALYSIS_FAILED = range(5)
+_STATUS_DOC = ("0 pending (not run), 1 ok, 2 invalid parameters, 3 simulation failed "
+               "(diverged), 4 analysis failed")
+_METRIC_UNITS = {"resonance_frequency": "Hz", "resonance_peak": "1", "isolation_onset": "Hz",
+                 "minus_3db_frequency": "Hz", "rolloff_db_per_decade": "dB/decade"}
+_STRING = (np.dtypes.StringDType() if hasattr(np.dtypes, "StringDType")  # numpy >= 2
+           else np.dtype(object))
+_ZARR = dict(consolidated=False)
+
+
+def schema(definition, n_time):
+    """Variables of the store: name -> (dims, dtype, fill, attrs).
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+    n_time : int
+        Samples kept per time series (0 if none are kept).
+    """
+    out = definition.outputs
+    rate = definition.analysis["sample_rate"]
+    variables = {
+        "status": (("case",), np.int8, PENDING, {"long_name": "case status",
+                                                 "flag_values": list(STATUS),
+                                                 "flag_meanings": " ".join(STATUS.values()),
+                                                 "description": _STATUS_DOC}),
+        "message": (("case",), _STRING, "", {"long_name": "failure message ('' if ok)"}),
+    }
+    for name in out["stats"]:
+        unit, doc = STATS[name]
+        variables[name] = (("case",), np.float64, np.nan, {"units": unit, "long_name": doc})
+    spectral = out["transmissibility"] or out["coherence"] or out["metrics"] or out["bands"]
+    if spectral:
+        variables["n_averages"] = (("case",), np.int32, 0,
+                                   {"long_name": "Welch segments averaged"})
+    for name in out["metrics"]:
+        unit = _METRIC_UNITS.get(name, "1")
+        variables[name] = (("case",), np.float64, np.nan,
+                           {"units": unit, "long_name": name.replace("_", " ")})
+    for label, (low, high) in out["bands"].items():
+        variables[f"mean_transmissibility_{label}"] = (
+            ("case",), np.float64, np.nan,
+            {"units": "1", "band": [low, high],
+             "long_name": f"mean transmissibility {low:g}-{high:g} Hz, amplitude ratio "
+                          "sqrt(S_payload/S_base)"})
+    if out["transmissibility"]:
+        variables["transmissibility"] = (("case", "frequency"), np.float64, np.nan,
+                                         {"units": "1", "long_name": "transmissibility, "
+                                          "amplitude ratio sqrt(S_payload / S_base)"})
+    if out["coherence"]:
+        variables["coherence"] = (("case", "frequency"), np.float64, np.nan,
+                                  {"units": "1", "long_name": "magnitude-squared coherence"})
+    for name in out["time_series"]:
+        _, unit, doc = CHANNELS[name]
+        variables[name] = (("case", "time"), np.float64, np.nan,
+                           {"units": unit, "long_name": doc, "sample_rate": rate})
+    return variables
+
+
+def _coords(definition, columns, n_time):
+    coords = {"case": ("case", np.arange(definition.n_cases))}
+    for name, values in columns.items():
+        values = np.asarray(values)
+        if values.dtype.kind in "UO":
+            values = values.astype(_STRING)
+        units = unit_of(name, definition.excitation_kind) if name != "sample" else "1"
+        coords[name] = ("case", values, {"units": units, "long_name": f"varied: {name}"}
+                        if name != "sample" else {"long_name": "index of the random draw"})
+    if definition.outputs["transmissibility"] or definition.outputs["coherence"]:
+        coords["frequency"] = ("frequency", definition.frequency, {"units": "Hz"})
+    if n_time:
+        rate = definition.analysis["sample_rate"]
+        coords["time"] = ("time", np.arange(n_time) / rate, {"units": "s"})
+    return coords
+
+
+def _attrs(definition):
+    a, s = definition.analysis, definition.simulation
+    return {"sweep_name": definition.name, "sweep_title": definition.title,
+            "sweep_method": definition.method, "sweep_hash": definition.hash,
+            "sweep_definition": json.dumps(definition.document, sort_keys=True, default=str),
+            "sweep_source": definition.source, "batch_size": definition.batch_size,
+            "excitation_kind": definition.excitation_kind, "dt": s["dt"], "solver": s["solver"],
+            "sample_rate": a["sample_rate"], "fft_length": a["fft_length"],
+            "n_averages": a["n_averages"], "overlap": a["overlap"], "band": a["band"],
+            "duration": a["duration"], "qzs_version": __version__}
+
+
+def _create(path, definition, columns, n_time):
+    """Write the template (metadata only) beside `path`, then rename it into place."""
+    require("zarr", "writing a sweep store")
+    da = require("dask.array", "writing a sweep store")
+    import xarray as xr
+
+    chunk = definition.batch_size
+    sizes = {"case": definition.n_cases, "frequency": definition.frequency.size,
+             "time": n_time}
+    data = {}
+    for name, (dims, dtype, fill, attrs) in schema(definition, n_time).items():
+        shape = tuple(sizes[d] for d in dims)
+        chunks = tuple(chunk if d == "case" else sizes[d] for d in dims)
+        data[name] = (dims, da.full(shape, fill, dtype=dtype, chunks=chunks), attrs)
+    data["done"] = (("case",), da.zeros(definition.n_cases, dtype=bool, chunks=chunk),
+                    {"long_name": "case finished and stored"})
+    dataset = xr.Dataset(data, coords=_coords(definition, columns, n_time),
+                         attrs=_attrs(definition))
+    tmp = path.with_name(f".{path.name}.creating-{os.getpid()}")
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        dataset.to_zarr(tmp, mode="w-", compute=False, zarr_format=3, **_ZARR)
+        os.rename(tmp, path)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def prepare_store(path, definition, columns, n_time, *, resume=False, overwrite=False):
+    """Create the store, or open it to resume; returns the ``done`` flags (n_cases,).
+
+    Raises
+    ------
+    ParameterError
+        `path` exists and neither `resume` nor `overwrite` is set, or it was written
+        by a different sweep definition (its hash differs).
+    """
+    path = Path(path)
+    if path.exists() and overwrite and not resume:
+        shutil.rmtree(path)
+    if not path.exists():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _create(path, definition, columns, n_time)
+        return np.zeros(definition.n_cases, dtype=bool)
+    if not resume:
+        raise ParameterError(f"the store {str(path)!r} exists; pass `resume` (--resume) to "
+                             "continue it, `overwrite` (--overwrite) to replace it, or choose "
+                             "another store.")
+    try:
+        dataset = open_store(path)
+    except Exception as error:  # noqa: BLE001 - anything that is not a readable store
+        raise ParameterError(f"{str(path)!r} is not a readable sweep store ({error}); "
+                             "remove it or choose another store.") from None
+    stored = dataset.attrs.get("sweep_hash")
+    if stored != definition.hash:
+        raise ParameterError(
+            f"cannot resume {str(path)!r}: it was written by a different sweep definition "
+            f"(stored hash {str(stored)[:12]}, this definition {definition.hash[:12]}). "
+            "Resume with the same sweep file, or use --overwrite or another --out.")
+    if dataset.sizes.get("case") != definition.n_cases or dataset.sizes.get("time", 0) != n_time:
+        raise ParameterError(f"cannot resume {str(path)!r}: its shape does not match the "
+                             "definition; use --overwrite or another --out.")
+    return dataset["done"].values.astype(bool)
+
+
+def write_batch(path, definition, start, arrays, n_time):
+    """Store one finished batch (cases ``start:start + n``), its ``done`` flags last.
+
+    Parameters
+    ----------
+    arrays : dict of str to ndarray
+        Every variable of :func:`schema`, first axis the batch's cases.
+    """
+    import xarray as xr
+
+    variables = schema(definition, n_time)
+    n = len(arrays["status"])
+    region = {"case": slice(start, start + n)}
+    data = {name: (dims, np.asarray(arrays[name]).astype(dtype, copy=False))
+            for name, (dims, dtype, _, _) in variables.items()}
+    xr.Dataset(data).to_zarr(path, region=region, mode="r+", **_ZARR)
+    xr.Dataset({"done": ("case", np.ones(n, dtype=bool))}).to_zarr(
+        path, region=region, mode="r+", **_ZARR)
+
+
+def open_store(path):
+    """Open a sweep store lazily as an ``xarray.Dataset`` (strings as Python objects)."""
+    import xarray as xr
+
+    path = Path(path)
+    if not path.exists():
+        raise ParameterError(f"no sweep store at {str(path)!r}.")
+    dataset = xr.open_zarr(path, chunks=None, **_ZARR)  # lazy, without dask
+    strings = [n for n, v in dataset.variables.items() if v.dtype == _STRING]
+    return dataset.assign({n: dataset[n].astype(object) for n in strings if n in
+                           dataset.data_vars}).assign_coords(
+        {n: dataset[n].astype(object) for n in strings if n in dataset.coords})
+
+
+def summary_text(dataset, report=None):
+    """A few lines: cases by status, the commonest failures, this run's throughput.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        An opened store.
+    report : dict, optional
+        What :func:`qzs.sweep_backends.execute` returned (cases, steps, wall [s]).
+    """
+    status = dataset["status"].values
+    done = dataset["done"].values
+    lines = [f"sweep {dataset.attrs.get('sweep_name', '?')!r}: {int(done.sum())} of "
+             f"{done.size} cases stored"]
+    counts = {STATUS[k]: int(np.count_nonzero(status[done] == k)) for k in STATUS if k}
+    lines.append("  " + ", ".join(f"{name} {n}" for name, n in counts.items()))
+    failed = done & (status > OK)
+    if failed.any():
+        messages = dataset["message"].values[failed]
+        kinds, first = {}, {}
+        for index, message in zip(np.flatnonzero(failed), messages):
+            key = str(message).split(" at t = ")[0][:80]
+            kinds[key] = kinds.get(key, 0) + 1
+            first.setdefault(key, (index, str(message)))
+        for key, count in sorted(kinds.items(), key=lambda kv: -kv[1])[:3]:
+            index, message = first[key]
+            lines.append(f"  {count} x (e.g. case {index}): {message[:160]}")
+    if report and report["cases"]:
+        wall = max(report["wall"], 1e-9)
+        lines.append(f"  this run: {report['cases']} cases in {wall:.1f} s wall, "
+                     f"{report['steps']:.3g} steps, {report['steps'] / wall:.3g} steps/s")
+    return "\n".join(lines)
