@@ -207,7 +207,7 @@ def make_rhs(params):
 
     State ``s = [z, v, hp, integral]``: relative position [m], relative velocity [m/s],
     the charge amplifier's high-pass state [m/s], the PI integral [m*s]. Written from
-    MODEL.md, independently of qzs' kernels; the constants are closure variables (fast
+    docs/model.md, independently of qzs' kernels; the constants are closure variables (fast
     local look-ups in Python, compile-time constants for numba). No stick-slip locking.
     """
     (amp, f0, rate, m, g, a, b, fs, fc, cbc, cv, z_low, z_high, k_stop, c_stop, f_max,

@@ -98,7 +98,7 @@ def test_passive_natural_frequency_is_highest_at_the_spring_centre():
 
 
 def test_paper_values_leave_a_weight_deficit_that_validation_accepts():
-    """MODEL.md 'Gravity': m*g = 62.78 N exceeds the spring plateau of 60.84 N."""
+    """docs/model.md §5 (gravity): m*g = 62.78 N exceeds the spring plateau of 60.84 N."""
     assert DEFAULT.weight_deficit == pytest.approx(6.4 * 9.81 - 60.84, rel=1e-12)
     assert DEFAULT.weight_deficit > 0
     assert IsolatorParameters(gravity=0.0).weight_deficit < 0

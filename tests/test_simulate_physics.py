@@ -303,7 +303,7 @@ def sine_3hz_runs():
 
 
 def test_passive_isolator_sinks_to_the_lower_stop(sine_3hz_runs):
-    """MODEL.md 'Gravity': m*g exceeds the spring plateau; once stiction breaks it drifts down."""
+    """docs/model.md §5 (gravity): m*g exceeds the spring plateau; once stiction breaks it drifts down."""
     passive, _ = sine_3hz_runs
     low = passive.run["stop_low"]
     assert low == pytest.approx(-0.060 - 0.080)

@@ -56,7 +56,18 @@ class LinearModel:
     poles: np.ndarray
 
     def transmissibility(self, frequency):
-        """``|X/Y|`` at ``frequency`` [Hz] (amplitude ratio)."""
+        """``|X/Y|`` at ``frequency`` [Hz] (amplitude ratio).
+
+        Parameters
+        ----------
+        frequency : float or array_like
+            Frequency [Hz].
+
+        Returns
+        -------
+        float or ndarray
+            Amplitude ratio ``|X/Y|`` [-], of the shape of ``frequency``.
+        """
         response = self.transfer_function(2j * np.pi * np.asarray(frequency, dtype=float))
         return np.abs(response)
 
@@ -67,7 +78,9 @@ def linearize(isolator=None, controller=None, relative_position=None):
     Parameters
     ----------
     isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
     relative_position : float, optional
         Operating point z [m]; default the position setpoint.
 
@@ -103,5 +116,20 @@ def linearize(isolator=None, controller=None, relative_position=None):
 
 
 def linear_transmissibility(frequency, isolator=None, controller=None):
-    """Closed-form ``|X/Y|`` [-] of the linearised isolator at ``frequency`` [Hz]."""
+    """Closed-form ``|X/Y|`` [-] of the linearised isolator at ``frequency`` [Hz].
+
+    Parameters
+    ----------
+    frequency : float or array_like
+        Frequency [Hz].
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+
+    Returns
+    -------
+    float or ndarray
+        Amplitude ratio ``|X/Y|`` [-] at the setpoint (see :func:`linearize`).
+    """
     return linearize(isolator, controller).transmissibility(frequency)

@@ -62,6 +62,13 @@ def highpass(values, corner, sample_rate):
         Signal sampled at ``sample_rate`` [Hz].
     corner : float
         Corner frequency [Hz]; 0 or None returns the signal unchanged.
+    sample_rate : float
+        Sample rate of ``values`` [Hz].
+
+    Returns
+    -------
+    ndarray
+        The filtered signal, in the unit of ``values``.
     """
     if not corner:
         return np.asarray(values, dtype=float)
@@ -97,6 +104,20 @@ def welch_average_count(n_samples, fft_length, overlap=0.5):
 
     Segments are `fft_length` [samples] long and share the fraction `overlap` in [0, 1);
     the count is ``(n_samples - noverlap) // step``, 0 if the record is shorter than one segment.
+
+    Parameters
+    ----------
+    n_samples : int
+        Length of the record [samples], >= 0.
+    fft_length : int
+        Segment length [samples], >= 8.
+    overlap : float
+        Fraction of a segment shared with the next [-], in [0, 1).
+
+    Returns
+    -------
+    int
+        Number of segments averaged.
     """
     n_samples = integer("n_samples", n_samples, 0)
     fft_length = integer("fft_length", fft_length, 8)
@@ -105,7 +126,22 @@ def welch_average_count(n_samples, fft_length, overlap=0.5):
 
 
 def required_samples(fft_length, n_averages, overlap=0.5):
-    """Shortest record giving `n_averages` Welch segments: ``fft_length + (n_averages - 1) * step``."""
+    """Shortest record giving `n_averages` Welch segments: ``fft_length + (n_averages - 1) * step``.
+
+    Parameters
+    ----------
+    fft_length : int
+        Segment length [samples], >= 8.
+    n_averages : int
+        Number of segments wanted, >= 1.
+    overlap : float
+        Fraction of a segment shared with the next [-], in [0, 1).
+
+    Returns
+    -------
+    int
+        Record length [samples].
+    """
     fft_length = integer("fft_length", fft_length, 8)
     n_averages = integer("n_averages", n_averages, 1)
     return fft_length + (n_averages - 1) * (fft_length - _noverlap(fft_length, overlap))
@@ -115,6 +151,22 @@ def required_duration(fft_length, n_averages, sample_rate, overlap=0.5):
     """Shortest record duration [s] giving `n_averages` segments at `sample_rate` [Hz].
 
     The paper's 32768-point FFT with 122 averages at 1 kHz needs 2015.232 s.
+
+    Parameters
+    ----------
+    fft_length : int
+        Segment length [samples], >= 8.
+    n_averages : int
+        Number of segments wanted, >= 1.
+    sample_rate : float
+        Sample rate [Hz].
+    overlap : float
+        Fraction of a segment shared with the next [-], in [0, 1).
+
+    Returns
+    -------
+    float
+        Record duration [s]: :func:`required_samples` divided by ``sample_rate``.
     """
     return required_samples(fft_length, n_averages, overlap) / _positive("sample_rate", sample_rate)
 
@@ -278,8 +330,14 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
     ----------
     signal_values : array_like, shape (n,)
         Time series (any unit ``u``), sampled at `sample_rate` [Hz].
-    fft_length, window, overlap
-        Segment length [samples], window and overlap fraction, as in :func:`transmissibility`.
+    sample_rate : float
+        Sample rate [Hz].
+    fft_length : int
+        Segment and FFT length [samples], >= 8, as in :func:`transmissibility`.
+    window : str, tuple or array_like
+        Window, as in :func:`transmissibility`.
+    overlap : float
+        Segment overlap fraction [-] in [0, 1), as in :func:`transmissibility`.
 
     Returns
     -------
@@ -305,8 +363,24 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
 class TransmissibilityMetrics:
     """Scalar metrics of a transmissibility curve; frequencies in [Hz], ratios [-].
 
-    ``at`` maps each requested frequency [Hz] to the interpolated transmissibility [-];
-    ``rolloff_db_per_decade`` is in [dB/decade]. NaN marks a metric the curve does not define.
+    NaN marks a metric the curve does not define (see :func:`transmissibility_metrics`).
+
+    Attributes
+    ----------
+    resonance_frequency : float
+        Frequency of the maximum over the trusted band [Hz].
+    resonance_peak : float
+        Transmissibility at that maximum, an amplitude ratio [-].
+    isolation_onset : float
+        Frequency above which the transmissibility stays below 1 [Hz].
+    minus_3db_frequency : float
+        First frequency above resonance where the curve falls to ``peak / sqrt(2)`` [Hz].
+    at : Mapping[float, float]
+        Each requested frequency [Hz] -> the interpolated transmissibility [-].
+    rolloff_db_per_decade : float
+        Least-squares slope of ``20 log10 T`` against ``log10 f`` [dB/decade].
+    untrusted_below : float
+        Frequency below which the curve is untrusted [Hz]; 0 if all of it is trusted.
     """
 
     resonance_frequency: float

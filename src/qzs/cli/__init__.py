@@ -30,7 +30,9 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
 def build_parser():
     """The ``qzs`` argument parser with every subcommand."""
     parser = argparse.ArgumentParser(
-        prog="qzs", description="Semi-active quasi-zero-stiffness isolator toolkit.")
+        prog="qzs", description="Semi-active quasi-zero-stiffness isolator toolkit.",
+        epilog="The model, its signs, defaults and every modelling decision: docs/model.md "
+               "(in the qzs repository). Parameter names and units: `qzs params`.")
     parser.add_argument("--version", action="version", version=f"qzs {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     simulate.add_parser(sub)
@@ -42,7 +44,18 @@ def build_parser():
 
 
 def main(argv=None):
-    """Entry point of the ``qzs`` command; returns the process exit code."""
+    """Entry point of the ``qzs`` command; returns the process exit code.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``qzs``; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        0 on success, 2 for bad input, 130 when interrupted.
+    """
     args = build_parser().parse_args(argv)
     return run_handler(HANDLERS[args.command], args)
 

@@ -4,7 +4,18 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(subparsers):
-    """Add ``experiment`` to an ``argparse`` sub-parser collection; returns the parser."""
+    """Add ``experiment`` to an ``argparse`` sub-parser collection; returns the parser.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``experiment`` parser.
+    """
     parser = subparsers.add_parser(
         "experiment", help="process an experiment log: transmissibility beside the simulation",
         description="Read a test-rig log with a channel map, estimate the transmissibility, "
@@ -28,7 +39,18 @@ def add_parser(subparsers):
 
 
 def run(args):
-    """Run ``qzs experiment`` from parsed arguments; returns the exit code."""
+    """Run ``qzs experiment`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs experiment`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
     from qzs.workflows.experiment import run_experiment
 
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,

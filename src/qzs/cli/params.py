@@ -7,7 +7,18 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(subparsers):
-    """Add ``params`` to an ``argparse`` sub-parser collection."""
+    """Add ``params`` to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``params`` parser.
+    """
     params = subparsers.add_parser("params", help="print the default parameters with units")
     params.add_argument("--toml", metavar="FILE", help="write them as a config file instead")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")
@@ -16,7 +27,18 @@ def add_parser(subparsers):
 
 
 def run(args):
-    """Run ``qzs params`` from parsed arguments; returns the exit code."""
+    """Run ``qzs params`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs params`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
     config = parameters(args)
     if args.toml:
         path = save_config(args.toml, config["isolator"], config["controller"])

@@ -12,7 +12,18 @@ _OPTIONS = ("amplitude", "f0", "f1", "frequency", "method", "seed", "duration", 
 
 
 def add_parser(subparsers):
-    """Add ``simulate`` to an ``argparse`` sub-parser collection."""
+    """Add ``simulate`` to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``simulate`` parser.
+    """
     sim = subparsers.add_parser(
         "simulate", help="simulate the isolator under a base excitation",
         description="Simulate the isolator. With no options: the paper's default case "
@@ -57,7 +68,18 @@ def _excitation(args, table):
 
 
 def run(args):
-    """Run ``qzs simulate`` from parsed arguments; returns the exit code (130 if interrupted)."""
+    """Run ``qzs simulate`` from parsed arguments; returns the exit code (130 if interrupted).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs simulate`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code: 0, or 130 if Ctrl-C ended the run early.
+    """
     from qzs.engine.simulate import simulate
 
     config = parameters(args)

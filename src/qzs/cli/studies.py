@@ -7,7 +7,13 @@ __all__ = ["add_parsers", "run"]
 
 
 def add_parsers(subparsers):
-    """Add ``paper`` and ``study`` to an ``argparse`` sub-parser collection."""
+    """Add ``paper`` and ``study`` to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+    """
     for name, text in (("paper", "run every study of the paper, write figures, metrics and "
                                  "report.html"),
                        ("study", "run one study definition (a shipped name or a TOML file)")):
@@ -25,7 +31,18 @@ def add_parsers(subparsers):
 
 
 def run(args):
-    """Run ``qzs paper`` or ``qzs study`` from parsed arguments; returns the exit code."""
+    """Run ``qzs paper`` or ``qzs study`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs paper`` or ``qzs study`` arguments (``args.command`` tells which).
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
     from qzs.workflows.report import run_paper
 
     if args.workers is not None and args.workers < 1:

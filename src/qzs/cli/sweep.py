@@ -10,7 +10,18 @@ REDUCTIONS = ("median", "mean", "min", "max")
 
 
 def add_parsers(subparsers):
-    """Add ``sweep`` and ``sweep-plot`` to an ``argparse`` sub-parser collection."""
+    """Add ``sweep`` and ``sweep-plot`` to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``sweep`` parser.
+    """
     cmd = subparsers.add_parser(
         "sweep", help="run a parameter sweep or Monte Carlo study into a Zarr store",
         description="Run every case of a sweep file (grid, random or Latin-hypercube "
@@ -51,7 +62,18 @@ def add_parsers(subparsers):
 
 
 def run_sweep_command(args):
-    """Run ``qzs sweep`` from parsed arguments; returns the exit code (130 if interrupted)."""
+    """Run ``qzs sweep`` from parsed arguments; returns the exit code (130 if interrupted).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs sweep`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code: 0, or 130 if Ctrl-C interrupted the sweep (its stored cases stay).
+    """
     from qzs.workflows.sweeps import load_sweep, open_sweep, plan_text, stored_count
     from qzs.workflows.sweeps.backends import execute
     from qzs.workflows.sweeps.store import summary_text
@@ -80,7 +102,18 @@ def run_sweep_command(args):
 
 
 def run_plot_command(args):
-    """Run ``qzs sweep-plot`` from parsed arguments; returns the exit code."""
+    """Run ``qzs sweep-plot`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs sweep-plot`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
     from qzs.workflows.sweeps import plot_sweep
 
     out = plot_sweep(args.store, metric=args.metric, x=args.x, y=args.y, reduce=args.reduce,

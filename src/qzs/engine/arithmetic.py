@@ -42,7 +42,19 @@ def _pow2_jit(k):
 
 
 def fma(a, b, c):
-    """``a * b + c`` rounded once (Python fallback of the intrinsic: rounded twice)."""
+    """``a * b + c`` rounded once (Python fallback of the intrinsic: rounded twice).
+
+    Parameters
+    ----------
+    a, b : float
+        The factors.
+    c : float
+        The addend.
+
+    Returns
+    -------
+    float
+    """
     return a * b + c
 
 
@@ -71,6 +83,15 @@ def exp(x):
     within 2 ulp of libm. ``x`` is clamped to [-700, 700]: ``exp(-700)`` ~ 1e-304
     stands in for 0. The same operations in every lane and in scalar code give
     the same bits, which keeps batched runs identical to single runs.
+
+    Parameters
+    ----------
+    x : float
+        The exponent.
+
+    Returns
+    -------
+    float
     """
     x = min(max(x, -700.0), 700.0)
     k = np.floor(fma(x, 1.4426950408889634, 0.5))
@@ -89,7 +110,17 @@ def exp(x):
 
 @njit(**_JIT, inline="always")
 def tanh(u):
-    """tanh from one :func:`exp` (exactly +-1 beyond |u| = 20; error below 3e-16)."""
+    """tanh from one :func:`exp` (exactly +-1 beyond |u| = 20; error below 3e-16).
+
+    Parameters
+    ----------
+    u : float
+        The argument.
+
+    Returns
+    -------
+    float
+    """
     a = min(abs(u), 20.0)
     r = 1.0 - 2.0 / (exp(2.0 * a) + 1.0)
     return r if u >= 0.0 else -r

@@ -19,7 +19,18 @@ _TWO_PI = 2.0 * np.pi
 
 @njit(**_JIT)
 def excitation_tuple(ex):
-    """The packed scalars as a tuple (cheaper than an array inside the kernels)."""
+    """The packed scalars as a tuple (cheaper than an array inside the kernels).
+
+    Parameters
+    ----------
+    ex : ndarray, shape (7,)
+        The packed scalars of an excitation (the first item of its ``pack()``).
+
+    Returns
+    -------
+    tuple of float
+        The same seven values (``E`` of the other kernels).
+    """
     return (ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6])
 
 
@@ -69,7 +80,22 @@ def _harmonic(amplitude, s, c, omega, omega_dot):
 
 @njit(**_JIT)
 def base_motion(t, E, table):
-    """Base displacement [m], velocity [m/s] and acceleration [m/s^2] at time ``t`` [s]."""
+    """Base displacement [m], velocity [m/s] and acceleration [m/s^2] at time ``t`` [s].
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    E : tuple of float
+        The excitation's packed scalars (:func:`excitation_tuple`).
+    table : ndarray, shape (5, n)
+        The tabulated signal's piecewise cubic (unused by the harmonic kinds).
+
+    Returns
+    -------
+    y, yd, ydd : float
+        Base displacement [m], velocity [m/s] and acceleration [m/s^2].
+    """
     if int(E[E_KIND]) == KIND_TABLE:
         return _table(t, E[E_SPACING], table)
     phase, omega, omega_dot = _phase(t, E)
@@ -94,7 +120,26 @@ def _rotate(phase, phase0, sin0, cos0):
 
 @njit(**_JIT, inline="always")
 def base_motion_near(t, phase0, sin0, cos0, E, table):
-    """:func:`base_motion` at ``t``, given the phase and its sine/cosine at a nearby time."""
+    """:func:`base_motion` at ``t``, given the phase and its sine/cosine at a nearby time.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    phase0 : float
+        Phase at the nearby time [rad] (from :func:`advance_phase`).
+    sin0, cos0 : float
+        Its sine and cosine.
+    E : tuple of float
+        The excitation's packed scalars (:func:`excitation_tuple`).
+    table : ndarray, shape (5, n)
+        The tabulated signal's piecewise cubic (unused by the harmonic kinds).
+
+    Returns
+    -------
+    y, yd, ydd : float
+        Base displacement [m], velocity [m/s] and acceleration [m/s^2].
+    """
     if int(E[E_KIND]) == KIND_TABLE:
         return _table(t, E[E_SPACING], table)
     phase, omega, omega_dot = _phase(t, E)
@@ -104,7 +149,26 @@ def base_motion_near(t, phase0, sin0, cos0, E, table):
 
 @njit(**_JIT)
 def advance_phase(t, phase0, sin0, cos0, E, exact):
-    """Phase [rad] and its sine and cosine at ``t``, rotated from a nearby time or ``exact``."""
+    """Phase [rad] and its sine and cosine at ``t``, rotated from a nearby time or ``exact``.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    phase0 : float
+        Phase at the nearby time [rad].
+    sin0, cos0 : float
+        Its sine and cosine.
+    E : tuple of float
+        The excitation's packed scalars (:func:`excitation_tuple`).
+    exact : bool
+        Compute the sine and cosine directly instead of rotating them from ``phase0``.
+
+    Returns
+    -------
+    phase, sine, cosine : float
+        Phase [rad] at ``t`` and its sine and cosine; ``(0, 0, 1)`` for a tabulated signal.
+    """
     if int(E[E_KIND]) == KIND_TABLE:
         return 0.0, 0.0, 1.0
     phase = _phase(t, E)[0]

@@ -53,6 +53,8 @@ class BatchResult:
         '' or the failure message (time and state) of each case.
     elapsed : float
         Wall time of the integration [s].
+    cases : list of (IsolatorParameters, ControllerParameters)
+        The parameter sets simulated, in the order of the rows.
     """
 
     time: np.ndarray
@@ -101,8 +103,14 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
         The parameter sets; each starts from the default initial state.
     excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
         Shared base motion; default the paper's chirp.
-    duration, dt, sample_rate, solver
-        As in :func:`qzs.simulate` [s], [s], [Hz].
+    duration : float, optional
+        Simulated time [s]; default the excitation's length, as in :func:`qzs.simulate`.
+    dt : float
+        Integration step [s], as in :func:`qzs.simulate`.
+    sample_rate : float
+        Output sample rate [Hz], as in :func:`qzs.simulate`.
+    solver : {"ode3", "rk4", "euler"}
+        Integrator, as in :func:`qzs.simulate`.
     channels : sequence of str
         Time series to keep (names of :data:`qzs.engine.results.CHANNELS`); may be empty.
     workers : int, optional

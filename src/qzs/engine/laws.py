@@ -17,13 +17,43 @@ __all__ = ["spring_law", "spring_energy_law", "sliding_friction_law", "compliant
 
 @njit(**JIT, inline="always")
 def spring_law(a, b, z):
-    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2)."""
+    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2).
+
+    Parameters
+    ----------
+    a : float
+        MagSpring force amplitude [N] (``spring_force``).
+    b : float
+        MagSpring shape coefficient [1/m] (``spring_shape``).
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Spring force [N].
+    """
     return -a * tanh(b * z)
 
 
 @njit(**JIT, inline="always")
 def spring_energy_law(a, b, z):
-    """Energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0."""
+    """Energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0.
+
+    Parameters
+    ----------
+    a : float
+        MagSpring force amplitude [N] (``spring_force``).
+    b : float
+        MagSpring shape coefficient [1/m] (``spring_shape``), non-zero.
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Stored energy [J].
+    """
     u = abs(b * z)
     return a / b * (u + np.log1p(np.exp(-2.0 * u)) - np.log(2.0))
 
@@ -35,6 +65,26 @@ def sliding_friction_law(v, sign, fs, fc, cbc, cv):
     ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign - Cv*v``: it opposes the slip. ``sign``
     is the slip direction, continued analytically past ``v = 0`` so that the
     zero crossing the stepper locates is smooth.
+
+    Parameters
+    ----------
+    v : float
+        Relative (slip) velocity [m/s].
+    sign : float
+        Slip direction, +1 or -1.
+    fs : float
+        Stiction force Fs [N].
+    fc : float
+        Coulomb force Fc [N].
+    cbc : float
+        Stribeck decay coefficient Cbc [s/m].
+    cv : float
+        Viscous friction coefficient Cv [N*s/m].
+
+    Returns
+    -------
+    float
+        Friction force on the payload [N].
     """
     level = fc + (fs - fc) * exp(-cbc * abs(v))
     return -level * sign - cv * v
@@ -47,6 +97,24 @@ def compliant_stop_law(z, v, z_low, z_high, stiffness, damping):
     A spring-damper ``k*pen + c*pen_rate`` beyond either stop that only pushes: the
     damper never pulls the payload back into the wall. The elastic part alone
     stores energy (``stiffness*pen**2/2``); the rest is dissipated.
+
+    Parameters
+    ----------
+    z : float
+        Relative position [m].
+    v : float
+        Relative velocity [m/s].
+    z_low, z_high : float
+        Positions of the lower and upper stop [m].
+    stiffness : float
+        Contact stiffness [N/m].
+    damping : float
+        Contact damping [N*s/m].
+
+    Returns
+    -------
+    force, elastic_force : float
+        Stop force on the payload and its elastic part [N]; both 0 between the stops.
     """
     f_stop = 0.0
     f_elastic = 0.0
@@ -67,6 +135,32 @@ def controller_law(z_ref, kp, ki, kd, f_max, z, v_measured, integral):
     ``F_motor`` their sum clipped to ``+-f_max`` [N]; the integral's rate is ``e``,
     or 0 while the motor saturates and ``e`` pushes further into saturation
     (anti-windup by conditional integration).
+
+    Parameters
+    ----------
+    z_ref : float
+        Position setpoint [m].
+    kp : float
+        Proportional gain [N/m].
+    ki : float
+        Integral gain [N/(m*s)].
+    kd : float
+        Active damping gain [N*s/m].
+    f_max : float
+        Motor force saturation [N].
+    z : float
+        Relative position [m].
+    v_measured : float
+        Measured (high-passed) velocity [m/s].
+    integral : float
+        Integral of the position error [m*s].
+
+    Returns
+    -------
+    F_pi, F_damp, F_motor : float
+        PI force, damping force and saturated motor command [N].
+    integral_rate : float
+        Rate of the integral [m].
     """
     error = z_ref - z
     f_pi = kp * error + ki * integral

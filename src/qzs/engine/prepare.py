@@ -117,7 +117,35 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
 
 @dataclass
 class PreparedRun:
-    """Everything the kernels need for one run, validated (see :func:`prepare_run`)."""
+    """Everything the kernels need for one run, validated (see :func:`prepare_run`).
+
+    Attributes
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The base excitation.
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        PI and damping loops.
+    params : ndarray, shape (N_PARAMS,)
+        The packed parameters of the kernels (:mod:`qzs.engine.kernels` ``P_*``).
+    packed : tuple
+        The excitation's kernel form ``(scalars, table)`` (its ``pack()``).
+    state : ndarray, shape (N_STATE,)
+        State at t = 0 (``S_*``, then the held controller outputs).
+    flags : ndarray of int64, shape (N_FLAGS,)
+        Integer flags at t = 0 (``I_*``: stick/slip mode, direction, counters).
+    duration : float
+        Simulated time [s].
+    decimation : int
+        Integration steps per output sample.
+    solver_code : int
+        The integrator's kernel code (:data:`qzs.engine.stability.SOLVERS`).
+    dt : float
+        Integration step [s].
+    sample_rate : float
+        Output sample rate [Hz].
+    """
 
     excitation: object
     isolator: IsolatorParameters
@@ -138,7 +166,26 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
                 solver=defaults.SIMULATION["solver"], initial_state=None):
     """Validate a run's inputs and pack them for the kernels (shared by single and batch runs).
 
-    Parameters and exceptions as in :func:`simulate`.
+    Exceptions as in :func:`qzs.simulate`.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
+        Base motion; default the paper's chirp.
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    duration : float, optional
+        Simulated time [s]; default the excitation's length (required for a sine).
+    dt : float
+        Integration step [s].
+    sample_rate : float
+        Output sample rate [Hz]; ``1/dt`` must be a whole multiple of it.
+    solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator.
+    initial_state : InitialState, optional
+        Default: at rest at the setpoint, stuck if friction can hold the payload.
 
     Returns
     -------
@@ -188,7 +235,22 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
 
 
 def divergence_message(state, step, dt):
-    """What a diverged run reports: the time [s] of the failing step and the last finite state."""
+    """What a diverged run reports: the time [s] of the failing step and the last finite state.
+
+    Parameters
+    ----------
+    state : ndarray, shape (N_STATE,)
+        The last finite state.
+    step : int
+        Index of the failing step.
+    dt : float
+        Integration step [s].
+
+    Returns
+    -------
+    str
+        The message of the :class:`~qzs.errors.SimulationError`.
+    """
     return (f"the simulation diverged at t = {step * dt:.6g} s (last finite state: relative "
             f"position z = {state[K.S_Z]:.6g} m, relative velocity v = {state[K.S_V]:.6g} m/s, "
             f"PI integral {state[K.S_INT]:.6g} m*s); check the gains and parameters, or reduce "

@@ -4,6 +4,10 @@
 :mod:`qzs.iotools`, ``.summary()`` calls :mod:`qzs.analysis.summary`, and
 ``.to_xarray()`` only repackages.
 """
+import dataclasses
+
+import numpy as np
+
 from qzs.engine import kernels as K
 
 __all__ = ["SimulationResult", "CHANNELS", "FLAGS"]
@@ -49,10 +53,21 @@ class SimulationResult:
     Channels are attributes (``result.payload_acceleration``) and items
     (``result["locked"]``); see :data:`CHANNELS` and :data:`FLAGS`.
 
+    Parameters
+    ----------
+    data : ndarray, shape (n_samples, N_CHANNELS)
+        The output samples, one column per channel of :data:`CHANNELS` (in their units).
+    flags : ndarray of bool, shape (n_samples, 2)
+        The boolean outputs, one column per flag of :data:`FLAGS`.
+
     Attributes
     ----------
-    isolator, controller, excitation
-        The inputs of the run.
+    isolator : IsolatorParameters
+        Plant parameters of the run.
+    controller : ControllerParameters
+        PI and damping loops of the run.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base excitation of the run.
     run : dict
         Solver, ``dt`` [s], ``sample_rate`` [Hz], ``steps``, ``elapsed`` [s],
         ``completed``, ``stop_contacts``, ``stick_events``, stop positions [m].
@@ -114,11 +129,12 @@ class SimulationResult:
         meta.update({f"isolator.{k}": v for k, v in self.isolator.to_dict().items()})
         meta.update({f"controller.{k}": v for k, v in self.controller.to_dict().items()})
         meta["excitation"] = type(self.excitation).__name__
-        for name in ("amplitude", "f0", "f1", "frequency", "phase", "f_low", "f_high",
-                     "duration", "method", "seed"):
-            value = getattr(self.excitation, name, None)
-            if value is not None:
-                meta[f"excitation.{name}"] = value
+        for field in dataclasses.fields(self.excitation):  # scalars; a record's arrays are data
+            value = getattr(self.excitation, field.name)
+            if value is not None and not isinstance(value, np.ndarray):
+                meta[f"excitation.{field.name}"] = value
+        if self.excitation.duration is not None:
+            meta.setdefault("excitation.duration", self.excitation.duration)
         meta.update({f"run.{k}": v for k, v in self.run.items()})
         return {k: (int(v) if isinstance(v, bool) else v) for k, v in meta.items()}
 
@@ -149,7 +165,18 @@ class SimulationResult:
         return plot_simulation(self, **kwargs)
 
     def save(self, path):
-        """Write the run atomically to NetCDF (``.nc``) or CSV (``.csv``), with metadata."""
+        """Write the run atomically to NetCDF (``.nc``) or CSV (``.csv``), with metadata.
+
+        Parameters
+        ----------
+        path : str or Path
+            Target file; its suffix (``.nc`` or ``.csv``) chooses the format.
+
+        Returns
+        -------
+        Path
+            The path written (see :func:`qzs.iotools.files.save_result`).
+        """
         from qzs.iotools.files import save_result
 
         return save_result(self, path)

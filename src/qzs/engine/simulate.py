@@ -31,7 +31,7 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; MODEL.md defaults if omitted.
+        PI and damping loops; defaults of docs/model.md §11 if omitted.
     duration : float, optional
         Simulated time [s]; default the excitation's length (required for a sine).
     dt : float

@@ -29,7 +29,22 @@ def _stiff_modes(isolator, controller):
 
 
 def stability_test(isolator, controller, solver):
-    """``stable(h)``: does a step ``h`` [s] keep every stiff mode's growth below 0.1 %/s?"""
+    """``stable(h)``: does a step ``h`` [s] keep every stiff mode's growth below 0.1 %/s?
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        PI and damping loops.
+    solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator.
+
+    Returns
+    -------
+    callable
+        ``stable(h) -> bool`` for a step ``h`` [s].
+    """
     choice("solver", solver, tuple(SOLVERS))
     coefficients = np.array(_STABILITY_POLYNOMIALS[solver][::-1])
     eigenvalues = _stiff_modes(isolator, controller)
@@ -52,8 +67,11 @@ def largest_stable_step(isolator=None, controller=None, solver="ode3"):
     Parameters
     ----------
     isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
     solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator; default ode3.
 
     Returns
     -------

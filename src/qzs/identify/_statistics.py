@@ -41,4 +41,4 @@ def student_quantile(confidence, dof):
 
 def finite_samples(name, values):
     return finite_series(name, values, DataError,
-                         "clean or interpolate them first (qzs.readers can, nan = 'interpolate')")
+                         "clean or interpolate them first (qzs.iotools.readers can, nan = 'interpolate')")

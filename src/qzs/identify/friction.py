@@ -6,6 +6,7 @@ from types import MappingProxyType
 import numpy as np
 from scipy import optimize
 
+from qzs._validation import strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
@@ -69,17 +70,52 @@ class FrictionFit:
     used: np.ndarray
 
     def friction_force(self, velocity):
-        """Fitted sliding friction on the payload [N] at ``velocity`` [m/s] (MODEL.md sign)."""
+        """Fitted sliding friction on the payload [N] at ``velocity`` [m/s] (docs/model.md §3 sign).
+
+        Parameters
+        ----------
+        velocity : float or array_like
+            Relative (slip) velocity [m/s].
+
+        Returns
+        -------
+        float or ndarray
+            Friction force on the payload [N] (eq. 3 with the fitted parameters).
+        """
 
         return friction_force(velocity, self.to_isolator())
 
     def to_isolator(self, isolator=None):
-        """``isolator`` (default Table 1) with the fitted friction parameters."""
+        """``isolator`` (default Table 1) with the fitted friction parameters.
+
+        Parameters
+        ----------
+        isolator : IsolatorParameters, optional
+            The other parameters; Table 1 defaults if omitted.
+
+        Returns
+        -------
+        IsolatorParameters
+            A copy with ``stiction_force``, ``coulomb_force``, ``stribeck_decay`` and
+            ``viscous_damping`` replaced (the ``offset`` is not a model parameter).
+        """
         return dataclasses.replace(isolator or IsolatorParameters(),
                                    **{n: getattr(self, n) for n in FRICTION_PARAMETERS[:4]})
 
     def plot(self, path=None, title=""):
-        """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`)."""
+        """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there (a .png also as .svg).
+        title : str
+            Figure title.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from qzs.viz.identify import plot_friction_fit
 
         return plot_friction_fit(self, path=path, title=title)
@@ -89,16 +125,13 @@ def _smoothed_derivatives(time, displacement, window, polyorder, tolerance):
     """Savitzky-Golay velocity and acceleration on a uniform time base."""
     from scipy.signal import savgol_filter
 
+    strictly_increasing("time", time, DataError, "sort the data and drop duplicates")
     steps = np.diff(time)
-    if np.any(steps <= 0):
-        i = int(np.argmax(steps <= 0))
-        raise DataError(f"`time` must be strictly increasing; sample {i + 1} ({time[i + 1]!r} s) "
-                        f"follows {time[i]!r} s. Sort the data and drop duplicates.")
     step = float(np.median(steps))
     jitter = float(np.max(np.abs(steps - step))) / step
     if jitter > tolerance:
         raise DataError(f"`time` is not uniformly sampled (relative jitter {jitter:.3g} > "
-                        f"{tolerance:g}); resample it first (qzs.readers: resample = true).")
+                        f"{tolerance:g}); resample it first (qzs.iotools.readers: resample = true).")
     samples = max(int(round(window / step)) | 1, polyorder + 2 | 1)
     if samples > time.size:
         raise DataError(f"the smoothing window ({samples} samples = {samples * step:g} s) is "
@@ -132,7 +165,7 @@ def fit_friction(time, displacement, force, *, spring=None, mass=None,
     """Fit the friction law (eq. 3) to a dynamic test: imposed displacement, measured force.
 
     The test machine drives the carriage through ``z(t)`` and measures the force it
-    applies, ``F``. By Newton's law on the carriage (MODEL.md signs; gravity and the
+    applies, ``F``. By Newton's law on the carriage (docs/model.md §1 signs; gravity and the
     load cell's zero go into ``offset``)::
 
         F = m*a - F_spring(z) - F_friction(v) + offset

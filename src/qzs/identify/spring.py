@@ -19,7 +19,7 @@ class SpringFit:
     Attributes
     ----------
     spring_force, spring_shape : float
-        ``a`` [N] and ``b`` [1/m] in the model's convention (MODEL.md: ``F = -a*tanh(b*z)``,
+        ``a`` [N] and ``b`` [1/m] in the model's convention (docs/model.md §3: ``F = -a*tanh(b*z)``,
         z upward, a > 0 for a restoring spring).
     spring_force_interval, spring_shape_interval : tuple of float
         Confidence intervals at ``confidence``.
@@ -27,7 +27,7 @@ class SpringFit:
         Confidence level of the intervals.
     convention : str
         Displacement convention of the input data: ``"model"`` (z = x - y, the spring
-        pushes up when compressed, as MODEL.md) or ``"test_machine"`` (displacement
+        pushes up when compressed, as docs/model.md §1) or ``"test_machine"`` (displacement
         measured the other way round, as the paper's Fig. 5, where the fit reads a < 0).
     residual_rms : float
         RMS of the force residuals [N].

@@ -27,7 +27,7 @@ class TransmissibilityFit:
     Attributes
     ----------
     parameters : Mapping[str, float]
-        Fitted values of the free parameters (MODEL.md names and units).
+        Fitted values of the free parameters (registry names and SI units, docs/model.md §11).
     intervals : Mapping[str, tuple]
         Name -> (low, high) confidence interval (fitted in log space, so asymmetric).
     confidence : float
@@ -60,7 +60,19 @@ class TransmissibilityFit:
     elapsed: float
 
     def plot(self, path=None, title=""):
-        """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`)."""
+        """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there (a .png also as .svg).
+        title : str
+            Figure title.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from qzs.viz.identify import plot_transmissibility_fit
 
         return plot_transmissibility_fit(self, path=path, title=title)
@@ -118,7 +130,7 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
 
     Each evaluation simulates the isolator under a chirp covering the band
     (:func:`qzs.simulate`), estimates its transmissibility from base and payload
-    acceleration (:func:`qzs.spectral.transmissibility`, PSD ratio) and interpolates it
+    acceleration (:func:`qzs.analysis.spectral.transmissibility`, PSD ratio) and interpolates it
     onto the measured frequencies; ``scipy.optimize.least_squares`` minimises the
     differences of the natural logs of the two amplitude ratios over the parameters'
     logs (all free parameters must be positive). The rest stay as given.
@@ -147,7 +159,7 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
     frequency, magnitude : array_like, shape (n,)
         Measured curve: frequencies [Hz] and amplitude ratio [-].
     free : sequence of str
-        Parameters to fit, by their MODEL.md names (IsolatorParameters or
+        Parameters to fit, by their registry names (IsolatorParameters or
         ControllerParameters fields).
     isolator, controller : IsolatorParameters, ControllerParameters, optional
         Values of everything else, and the start of the free ones (Table 1 defaults).

@@ -23,6 +23,16 @@ def atomic_path(path):
     """Yield a temporary path beside ``path``; rename it onto ``path`` on success.
 
     On any error the temporary file is removed and ``path`` is left untouched.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write; its folder is created if missing.
+
+    Yields
+    ------
+    Path
+        The temporary file to write instead.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -45,11 +55,28 @@ def _umask():
 
 
 def save_result(result, path):
-    """Write a :class:`~qzs.results.SimulationResult` to NetCDF (``.nc``) or CSV (``.csv``).
+    """Write a :class:`~qzs.engine.results.SimulationResult` to NetCDF (``.nc``) or CSV (``.csv``).
 
     Both carry every parameter, the excitation, the run settings and the qzs
     version as metadata (NetCDF global attributes; CSV ``# key = value`` header
-    lines). Returns the path written.
+    lines).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    path : str or Path
+        Target file, ending in ``.nc`` or ``.csv``.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    ParameterError
+        Any other suffix.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -77,7 +104,23 @@ def save_result(result, path):
 
 
 def read_result(path):
-    """Read a saved result (``.nc`` or ``.csv``) back as an ``xarray.Dataset``."""
+    """Read a saved result (``.nc`` or ``.csv``) back as an ``xarray.Dataset``.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file written by :func:`save_result` (any suffix other than ``.nc`` is read as CSV).
+
+    Returns
+    -------
+    xarray.Dataset
+        The channels on coordinate ``time`` [s], units and metadata in attributes.
+
+    Raises
+    ------
+    DataError
+        Missing file, or a CSV without a header line or with mismatched columns.
+    """
     import xarray as xr
 
     path = Path(path)

@@ -154,7 +154,19 @@ class Recording:
 # ---------------------------------------------------------------- the channel map
 @dataclass(frozen=True)
 class ChannelSpec:
-    """One role of a channel map: which signal, its unit, its scale (see module doc)."""
+    """One role of a channel map: which signal, its unit, its scale (see module doc).
+
+    Attributes
+    ----------
+    role : str
+        The channel's role, a key of :data:`ROLES`.
+    source : str
+        The signal's name in the file (or, in a MAT file, ``Y(k)`` or ``Y[k]/name``).
+    unit : str
+        The unit of ``raw * scale``, a key of :data:`UNITS`; converted to SI on reading.
+    scale : float
+        Factor applied to the raw samples before the unit conversion (a sensitivity).
+    """
 
     role: str
     source: str
@@ -164,7 +176,28 @@ class ChannelSpec:
 
 @dataclass(frozen=True)
 class ChannelMap:
-    """A parsed channel map (see the module doc for the TOML layout)."""
+    """A parsed channel map (see the module doc for the TOML layout).
+
+    Attributes
+    ----------
+    channels : Mapping[str, ChannelSpec]
+        Role -> its channel.
+    time_source : str or None
+        Signal holding the time base; None for the format's default (CSV column
+        ``time``, NetCDF the signal's dimension, MAT ``X(1).Data``).
+    time_unit : {"s", "ms"}
+        Unit of the time base.
+    resample : bool
+        Put a non-uniform time base on a uniform grid.
+    tolerance : float
+        Allowed relative jitter of the sample interval [-], in (0, 1).
+    nan : {"raise", "interpolate"}
+        What NaN samples do: raise :class:`DataError`, or get filled with a warning.
+    variable : str or None
+        MAT files: the top-level struct to read; None if the file holds one.
+    experiment : Mapping[str, object]
+        The ``[experiment]`` table, read by ``qzs experiment`` (chirp and analysis).
+    """
 
     channels: Mapping[str, ChannelSpec]
     time_source: str | None = None
@@ -182,6 +215,15 @@ def _check_keys(table, allowed, where):
 
 def load_channel_map(source):
     """Parse a channel map from a TOML file, a TOML-like ``dict``, or pass a ChannelMap.
+
+    Parameters
+    ----------
+    source : str, Path, dict or ChannelMap
+        A TOML file, its content as a dict, or a ChannelMap (returned as is).
+
+    Returns
+    -------
+    ChannelMap
 
     Raises
     ------
@@ -507,6 +549,7 @@ def write_dspace_mat(path, time, signals, *, version="5", variable="qzs_log", un
     Parameters
     ----------
     path : str or Path
+        The file to write.
     time : array_like, shape (n,)
         Time vector [s], stored as ``X(1).Data``.
     signals : dict

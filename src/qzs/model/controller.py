@@ -28,7 +28,7 @@ class ControllerParameters:
     ----------
     position_setpoint : float
         Encoder position setpoint z_ref [m]; default -0.060 m, the middle of the
-        MagSpring's constant-force region (MODEL.md, operating point).
+        MagSpring's constant-force region (docs/model.md §1, operating point).
     pi_kp : float
         Proportional gain Kp [N/m]; Kp = 50 N/m moves the resonance to about 0.45 Hz.
     pi_ki : float
@@ -71,7 +71,7 @@ def closed_loop_natural_frequency(isolator=None, controller=None, relative_posit
     ``sqrt((k_spring(z) + Kp)/m) / (2*pi)`` with ``k_spring`` the MagSpring's
     tangent stiffness at ``relative_position`` (default: the setpoint). The
     integral and damping terms shift it only slightly; the full linearised
-    model is in :mod:`qzs.spectral`'s linear analysis.
+    model is :func:`qzs.analysis.linear.linearize`.
 
     Parameters
     ----------

@@ -84,7 +84,18 @@ class Chirp:
         return max(self.f0, self.f1)
 
     def frequency_at(self, time):
-        """Instantaneous frequency [Hz] at ``time`` [s] (held at ``f1`` after the sweep)."""
+        """Instantaneous frequency [Hz] at ``time`` [s] (held at ``f1`` after the sweep).
+
+        Parameters
+        ----------
+        time : float or array_like
+            Time since the start of the sweep [s] (held at ``f0`` before it).
+
+        Returns
+        -------
+        float or ndarray
+            Instantaneous frequency [Hz].
+        """
         fraction = np.clip(np.asarray(time, dtype=float) / self.duration, 0.0, 1.0)
         if self.method == "linear":
             return self.f0 + (self.f1 - self.f0) * fraction

@@ -1,6 +1,6 @@
-"""The isolator plant: parameters and force laws (MODEL.md, paper eqs. 1-3).
+"""The isolator plant: parameters and force laws (docs/model.md §2-3, paper eqs. 1-3).
 
-Coordinates (MODEL.md): ``y`` base position, ``x`` payload position, ``z = x - y``
+Coordinates (docs/model.md §1): ``y`` base position, ``x`` payload position, ``z = x - y``
 relative position (encoder), ``v = xd - yd`` relative (slip) velocity; upward positive.
 
     m * xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m * g
@@ -29,7 +29,7 @@ STOP_MODELS = ("compliant", "plastic")
 
 @dataclass(frozen=True, kw_only=True)
 class IsolatorParameters:
-    """Physical parameters of the single-axis isolator (MODEL.md, Table 1).
+    """Physical parameters of the single-axis isolator (docs/model.md §11, paper Table 1).
 
     Parameters
     ----------
@@ -60,8 +60,8 @@ class IsolatorParameters:
     stop_damping : float
         Contact damping of the compliant hard stop [N*s/m].
     stop_model : {"compliant", "plastic"}
-        Compliant spring-damper contact, or a perfectly plastic stop that absorbs
-        the relative velocity on impact and holds the payload at the limit.
+        Hard-stop model [-]: compliant spring-damper contact, or a perfectly plastic
+        stop that absorbs the relative velocity on impact and holds the payload at the limit.
     motor_force_max : float
         Motor force saturation [N] (LinMot PS01-23x80: 44 N).
     """
@@ -156,28 +156,80 @@ class InitialState:
 
 
 def spring_force(relative_position, params):
-    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2)."""
+    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2).
+
+    Parameters
+    ----------
+    relative_position : float or array_like
+        Relative position z [m].
+    params : IsolatorParameters
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+
+    Returns
+    -------
+    float or ndarray
+        Spring force on the payload [N].
+    """
     z = np.asarray(relative_position, dtype=float)
     return -params.spring_force * np.tanh(params.spring_shape * z)
 
 
 def spring_stiffness(relative_position, params):
-    """Tangent stiffness ``a*b/cosh(b*z)^2`` [N/m] of the MagSpring at ``z`` [m]."""
+    """Tangent stiffness ``a*b/cosh(b*z)^2`` [N/m] of the MagSpring at ``z`` [m].
+
+    Parameters
+    ----------
+    relative_position : float or array_like
+        Relative position z [m].
+    params : IsolatorParameters
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+
+    Returns
+    -------
+    float or ndarray
+        Tangent stiffness [N/m].
+    """
     z = np.asarray(relative_position, dtype=float)
     return params.spring_force * params.spring_shape / np.cosh(params.spring_shape * z) ** 2
 
 
 def spring_energy(relative_position, params):
-    """Potential energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0."""
+    """Potential energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0.
+
+    Parameters
+    ----------
+    relative_position : float or array_like
+        Relative position z [m].
+    params : IsolatorParameters
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+
+    Returns
+    -------
+    float or ndarray
+        Stored energy [J].
+    """
     u = np.abs(params.spring_shape * np.asarray(relative_position, dtype=float))
     return params.spring_force / params.spring_shape * (u + np.log1p(np.exp(-2 * u)) - np.log(2))
 
 
 def friction_force(relative_velocity, params):
-    """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, MODEL.md signs).
+    """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, signs of docs/model.md §3).
 
     ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign(v) - Cv*v``: it always opposes slip.
     At ``v = 0`` it returns 0; the stuck state is handled by the simulator.
+
+    Parameters
+    ----------
+    relative_velocity : float or array_like
+        Relative (slip) velocity v [m/s].
+    params : IsolatorParameters
+        Supplies the friction parameters (``stiction_force``, ``coulomb_force``,
+        ``stribeck_decay``, ``viscous_damping``).
+
+    Returns
+    -------
+    float or ndarray
+        Friction force on the payload [N].
     """
     v = np.asarray(relative_velocity, dtype=float)
     p = params
@@ -190,5 +242,17 @@ def passive_natural_frequency(params, relative_position):
 
     ``sqrt(k/m)/(2*pi)`` with ``k`` the tangent stiffness; about 0.08 Hz at the
     default operating point ``z = -0.060 m`` (paper, Section 3.1).
+
+    Parameters
+    ----------
+    params : IsolatorParameters
+        Supplies the MagSpring and the ``mass``.
+    relative_position : float
+        Operating point z [m].
+
+    Returns
+    -------
+    float
+        Natural frequency [Hz].
     """
     return float(np.sqrt(spring_stiffness(relative_position, params) / params.mass) / (2 * np.pi))

@@ -11,6 +11,20 @@ def envelope(time, values, max_points=_MAX_POINTS):
 
     Returns ``(time, values)`` unchanged when short, else two points (min and
     max) per bin for ``max_points // 2`` bins.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Sample times [s].
+    values : array_like, shape (n,)
+        The trace (any unit).
+    max_points : int
+        Most points to return.
+
+    Returns
+    -------
+    time, values : ndarray
+        The envelope's times [s] and values, in time order within each bin.
     """
     time = np.asarray(time)
     values = np.asarray(values, dtype=float)
@@ -32,7 +46,23 @@ def envelope(time, values, max_points=_MAX_POINTS):
 
 
 def new_figure(rows, height=2.1, sharex=True):
-    """A figure of ``rows`` stacked axes, 9 in wide (Agg when there is no display)."""
+    """A figure of ``rows`` stacked axes, 9 in wide (Agg when there is no display).
+
+    Parameters
+    ----------
+    rows : int
+        Number of axes, stacked vertically.
+    height : float
+        Height of each axes [in] (the figure adds 0.8 in).
+    sharex : bool
+        Share the horizontal axis.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of matplotlib.axes.Axes
+        The ``rows`` axes, top first.
+    """
     import matplotlib
 
     if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf") and not _has_display():
@@ -51,7 +81,17 @@ def _has_display():
 
 
 def save_figure(fig, path, also_svg=False):
-    """Write ``fig`` atomically (format from the suffix); a .png also as .svg if asked."""
+    """Write ``fig`` atomically (format from the suffix); a .png also as .svg if asked.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or Path
+        Target file; its suffix chooses the format (none: PNG).
+    also_svg : bool
+        For a .png, write the same figure beside it as .svg too.
+    """
     from pathlib import Path
 
     from qzs.iotools.files import atomic_path

@@ -8,7 +8,27 @@ __all__ = ["plot_spring_fit", "plot_friction_fit", "plot_transmissibility_fit"]
 
 
 def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=None, title=""):
-    """MagSpring force against displacement with its tanh fit (paper Fig. 5)."""
+    """MagSpring force against displacement with its tanh fit (paper Fig. 5).
+
+    Parameters
+    ----------
+    displacement : array_like
+        Spring displacement z [m] of the measured points.
+    force : array_like
+        Measured spring force [N].
+    spring_force : float
+        Fitted force amplitude a [N].
+    spring_shape : float
+        Fitted shape coefficient b [1/m].
+    path : str or Path, optional
+        Write the figure there (a .png also as .svg).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = new_figure(1, height=3.8)
     ax = axes[0]
     z = np.linspace(np.min(displacement), np.max(displacement), 400)
@@ -31,9 +51,11 @@ def plot_friction_fit(fit, *, path=None, title=""):
     Parameters
     ----------
     fit : FrictionFit
+        The fit (:func:`qzs.identify.fit_friction`).
     path : str or Path, optional
         Write the figure there (a .png also as .svg).
     title : str
+        Figure title.
 
     Returns
     -------

@@ -11,9 +11,12 @@ def plot_simulation(result, path=None, title=None):
     Parameters
     ----------
     result : SimulationResult
+        The run.
     path : str or Path, optional
         If given, the figure is also written there (format from the suffix).
     title : str, optional
+        Figure title; default :func:`qzs.analysis.summary.run_title` (excitation,
+        duration, solver and step).
 
     Returns
     -------
@@ -57,7 +60,19 @@ def plot_simulation(result, path=None, title=None):
 
 
 def plot_energy(result, path=None):
-    """Energy ledger of a run [J]: work in, dissipation, stored energy and the residual."""
+    """Energy ledger of a run [J]: work in, dissipation, stored energy and the residual.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    path : str or Path, optional
+        If given, the figure is also written there (format from the suffix).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = new_figure(2, height=2.6)
     t = result.time
     for name in ("base_work", "motor_work", "friction_dissipation", "stop_dissipation"):

@@ -35,7 +35,17 @@ def _grid_names(dataset):
 
 
 def varied_parameters(dataset):
-    """Names of the varied parameters stored on ``case`` (excluding ``sample``)."""
+    """Names of the varied parameters stored on ``case`` (excluding ``sample``).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        An opened sweep store (:func:`qzs.workflows.sweeps.open_sweep`).
+
+    Returns
+    -------
+    list of str
+    """
     return [name for name, coord in dataset.coords.items()
             if coord.dims == ("case",) and name not in ("case", "sample")]
 
@@ -57,7 +67,18 @@ def _reduce(values, how):
 
 
 def scalar_outputs(dataset):
-    """Per-case numeric outputs that :func:`plot_metric` can draw."""
+    """Per-case numeric outputs that :func:`plot_metric` can draw.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        An opened sweep store (:func:`qzs.workflows.sweeps.open_sweep`).
+
+    Returns
+    -------
+    list of str
+        Names of the float variables on dimension ``case``, sorted.
+    """
     return sorted(name for name, v in dataset.data_vars.items()
                   if v.dims == ("case",) and v.dtype.kind == "f")
 
@@ -68,7 +89,7 @@ def plot_metric(dataset, metric, x, y=None, *, reduce="median", path=None):
     Parameters
     ----------
     dataset : xarray.Dataset
-        An opened sweep store (:func:`qzs.sweep.open_sweep`).
+        An opened sweep store (:func:`qzs.workflows.sweeps.open_sweep`).
     metric : str
         A per-case output, e.g. ``"peak_stroke"`` [m] or ``"mean_transmissibility_low"``.
     x, y : str
@@ -177,6 +198,7 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
     path : str or Path, optional
         Write the figure there.
     frequency_scale : {"log", "linear"}
+        Frequency axis scale.
 
     Returns
     -------

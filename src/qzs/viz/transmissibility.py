@@ -20,10 +20,14 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
         Axis limits [Hz].
     scale : {"linear", "log"}
         Frequency axis scale.
-    untrusted_below : float, optional
-        Shade the band below this frequency [Hz] as not trustworthy (high-pass).
+    title : str
+        Figure title.
     path : str or Path, optional
         Written as given and, for a .png, also as .svg beside it.
+    untrusted_below : float, optional
+        Shade the band below this frequency [Hz] as not trustworthy (high-pass).
+    estimator : str
+        How the magnitude was estimated, for the axis label (default the PSD ratio).
 
     Returns
     -------

@@ -121,6 +121,7 @@ class ExperimentResult:
     Attributes
     ----------
     recording : Recording
+        The log processed.
     signal : {"velocity", "acceleration"}
         Which base/payload pair was used.
     measured, simulated : TransmissibilityEstimate
@@ -138,7 +139,8 @@ class ExperimentResult:
     excitation : Chirp
         The chirp simulated (``excitation_inferred`` tells whether it was inferred).
     excitation_inferred : bool
-    isolator, controller
+        True if the chirp was inferred from the log (:func:`infer_chirp`), False if given.
+    isolator, controller : IsolatorParameters, ControllerParameters
         Parameters of the simulation.
     notes : tuple of str
         Warnings raised while processing.
@@ -178,7 +180,19 @@ class ExperimentResult:
         return float(np.median(np.abs(20 * np.log10(measured[trusted] / simulated[trusted]))))
 
     def plot(self, path=None, title=None):
-        """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`)."""
+        """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there (a .png also as .svg).
+        title : str, optional
+            Figure title; default the log's file name.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from qzs.viz.experiment import plot_experiment
 
         return plot_experiment(self, path=path, title=title)
@@ -229,6 +243,11 @@ class ExperimentResult:
 
     def write_report(self, folder):
         """Write ``transmissibility.png`` (+ .svg), ``transmissibility.csv`` and ``report.md``.
+
+        Parameters
+        ----------
+        folder : str or Path
+            Output folder, created if missing.
 
         Returns
         -------

@@ -2,7 +2,7 @@
 
 Writes to an output folder: one figure per paper figure (PNG and SVG),
 ``metrics.json`` and ``metrics.csv`` (per study and case), and ``report.html``,
-which puts each figure beside the paper's claim (MODEL.md, "What the paper
+which puts each figure beside the paper's claim (docs/model.md §13, "What the paper
 reports") and says, from the numbers, whether the claim is reproduced.
 """
 import csv
@@ -27,7 +27,19 @@ __all__ = ["CLAIMS", "Verdict", "decide_claims", "write_paper_outputs", "run_pap
 
 @dataclass(frozen=True)
 class Verdict:
-    """Whether a claim is reproduced (True/False, None if partly), with the numbers."""
+    """Whether a claim is reproduced (True/False, None if partly), with the numbers.
+
+    Attributes
+    ----------
+    claim : str
+        The claim's id, a key of :data:`CLAIMS`.
+    statement : str
+        What the paper states.
+    reproduced : bool or None
+        True if reproduced, False if not, None if partly.
+    evidence : str
+        The numbers the decision rests on.
+    """
 
     claim: str
     statement: str
@@ -36,6 +48,7 @@ class Verdict:
 
     @property
     def label(self):
+        """``"reproduced"``, ``"not reproduced"`` or ``"partly reproduced"``."""
         return {True: "reproduced", False: "not reproduced", None: "partly reproduced"}[
             self.reproduced]
 
@@ -158,7 +171,7 @@ def _experiment_shape(results):
                 f"(paper: rolls off); T(12 Hz) = {t12:.3f} (paper: 0.3, accepted 0.2-0.4)")
 
 
-#: claim id -> (MODEL.md statement, studies it needs, decision function)
+#: claim id -> (the paper's statement (docs/model.md §13), studies it needs, decision function)
 CLAIMS = {
     "resonance_masked": ("Passive resonance about 0.08 Hz, masked by stiction.",
                          ("stiction",), _resonance_masked),
@@ -181,7 +194,18 @@ CLAIMS = {
 
 
 def decide_claims(study_results):
-    """Decide every claim whose studies were run; returns a list of :class:`Verdict`."""
+    """Decide every claim whose studies were run; returns a list of :class:`Verdict`.
+
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies run; a claim is decided only if every study it needs is among them.
+
+    Returns
+    -------
+    list of Verdict
+        In the order of :data:`CLAIMS`.
+    """
     by_name = {r.study.name: r for r in study_results}
     verdicts = []
     for claim, (statement, needs, decide) in CLAIMS.items():
@@ -262,7 +286,21 @@ def _json_ready(value):
 def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None):
     """Write figures, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
 
-    Returns the list of :class:`Verdict`.
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies run.
+    folder : str or Path
+        Output folder, created if missing.
+    quick : bool
+        Whether the runs were the quick ones (recorded in the metrics and the report).
+    wall_seconds : float, optional
+        Wall time of the runs [s], recorded in the metrics and the report.
+
+    Returns
+    -------
+    list of Verdict
+        As :func:`decide_claims` gives them.
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

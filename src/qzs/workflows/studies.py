@@ -53,7 +53,37 @@ _TABLE_KEYS = {"excitation": EXCITATION_OPTIONS["chirp"], "analysis": (*ANALYSIS
 
 @dataclass(frozen=True)
 class Study:
-    """A study definition (see the module docstring for the TOML layout)."""
+    """A study definition (see the module docstring for the TOML layout).
+
+    Attributes
+    ----------
+    name : str
+        Short name (``[study] name``), used to find its results and claims.
+    title : str
+        Title of its figures; default the name.
+    kind : {"transmissibility", "processing", "spring_characteristic"}
+        What each case computes (see the module docstring).
+    cases : tuple of dict
+        The ``[[case]]`` tables: a ``label`` and parameter overrides.
+    claims : tuple of str
+        Ids of the paper's claims it bears on (keys of
+        :data:`qzs.workflows.report.CLAIMS`).
+    views : tuple of dict
+        Figures to draw: ``figure`` (file stem), ``frequency_range`` [Hz] and
+        optionally ``frequency_scale``.
+    defaults : dict
+        Parameter overrides shared by every case (``[defaults]``).
+    excitation : dict
+        Options of the chirp (``[excitation]``).
+    analysis : dict
+        Overrides of :data:`qzs.defaults.ANALYSIS`, and ``duration`` (``[analysis]``).
+    simulation : dict
+        ``dt`` and ``solver`` (``[simulation]``).
+    options : dict
+        The ``[spring]`` and ``[processing]`` tables, merged.
+    source : str
+        The file it was read from.
+    """
 
     name: str
     title: str
@@ -71,7 +101,35 @@ class Study:
 
 @dataclass
 class CaseResult:
-    """What one case of a study produced (small: safe to send between processes)."""
+    """What one case of a study produced (small: safe to send between processes).
+
+    Attributes
+    ----------
+    label : str
+        The case's label.
+    settings : dict
+        Its parameter overrides (registry names -> values), defaults included.
+    frequency : ndarray
+        Frequencies of the transmissibility curve over the analysed band [Hz].
+    magnitude : ndarray
+        Transmissibility, amplitude ratio [-], at ``frequency``.
+    coherence : ndarray
+        Magnitude-squared coherence [-] at ``frequency``.
+    metrics : dict
+        Metrics of the curve (:meth:`TransmissibilityMetrics.to_dict
+        <qzs.analysis.spectral.TransmissibilityMetrics.to_dict>`); for the spring
+        study, the fitted ``spring_force`` and ``spring_shape``.
+    stats : dict
+        Run statistics (stop contacts, stroke, time locked, Welch settings, speed).
+    linear : dict
+        The linearised model: natural frequencies [Hz], damping ratio [-] and its
+        ``magnitude`` at ``frequency``.
+    extra : dict
+        What the kind adds: the experiment-style curve (``processing``), or the
+        spring's data and fit (``spring_characteristic``).
+    seconds : float
+        Time spent on the case [s].
+    """
 
     label: str
     settings: dict
@@ -87,7 +145,19 @@ class CaseResult:
 
 @dataclass
 class StudyResult:
-    """The cases of one study, in definition order, and the wall time spent on them."""
+    """The cases of one study, in definition order, and the wall time spent on them.
+
+    Attributes
+    ----------
+    study : Study
+        The definition run.
+    cases : list of CaseResult
+        Its cases, in definition order.
+    quick : bool
+        Whether the runs were the quick ones.
+    seconds : float
+        Time spent on its cases [s], summed over them (they may run in parallel).
+    """
 
     study: Study
     cases: list
@@ -101,7 +171,22 @@ def shipped_studies():
 
 
 def load_study(path):
-    """Read and validate a study definition (a path, or the name of a shipped study)."""
+    """Read and validate a study definition (a path, or the name of a shipped study).
+
+    Parameters
+    ----------
+    path : str or Path
+        A study file, or the name of a shipped one (e.g. ``"stiction"``).
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    ParameterError
+        Missing file, unknown table or key, bad kind, no case, or an invalid parameter.
+    """
     path = resolve_shipped(path, SHIPPED, "study", "studies")
     document = read_toml(path, "study file")
     allowed = {"study", "defaults", "case", "excitation", "analysis", "simulation", "spring",
@@ -259,6 +344,7 @@ def run_studies(studies, *, quick=False, workers=None, progress=True):
     Parameters
     ----------
     studies : sequence of Study
+        The definitions (:func:`load_study`).
     quick : bool
         Shorter runs (fewer, shorter Welch segments) for a fast look.
     workers : int, optional
@@ -299,7 +385,19 @@ def run_studies(studies, *, quick=False, workers=None, progress=True):
 
 
 def run_study(study, **options):
-    """Run one study (a :class:`Study`, a path or a shipped name); see :func:`run_studies`."""
+    """Run one study (a :class:`Study`, a path or a shipped name); see :func:`run_studies`.
+
+    Parameters
+    ----------
+    study : Study, str or Path
+        The definition, a study file or the name of a shipped study.
+    **options
+        ``quick``, ``workers`` and ``progress``, as for :func:`run_studies`.
+
+    Returns
+    -------
+    StudyResult
+    """
     if not isinstance(study, Study):
         study = load_study(study)
     return run_studies([study], **options)[0]

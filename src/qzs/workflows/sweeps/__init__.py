@@ -107,7 +107,22 @@ def run_sweep(definition, store=None, *, resume=False, overwrite=False, schedule
 
 
 def open_sweep(store):
-    """Open a sweep store as an ``xarray.Dataset`` (lazy; ``.load()`` to read it all)."""
+    """Open a sweep store as an ``xarray.Dataset`` (lazy; ``.load()`` to read it all).
+
+    Parameters
+    ----------
+    store : str or Path
+        The Zarr store (a directory) written by :func:`run_sweep`.
+
+    Returns
+    -------
+    xarray.Dataset
+
+    Raises
+    ------
+    ParameterError
+        There is no store at ``store``.
+    """
     from qzs.workflows.sweeps.store import open_store
 
     return open_store(store)
@@ -154,7 +169,17 @@ def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None)
 
 
 def stored_count(store):
-    """Cases already stored in ``store`` [-] (0 if there is no store yet)."""
+    """Cases already stored in ``store`` [-] (0 if there is no store yet).
+
+    Parameters
+    ----------
+    store : str or Path
+        The Zarr store (a directory).
+
+    Returns
+    -------
+    int
+    """
     try:
         return int(open_sweep(store)["done"].sum())
     except Exception:  # noqa: BLE001 - the store may not exist yet

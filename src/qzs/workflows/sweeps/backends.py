@@ -34,7 +34,21 @@ _LOCK = threading.Lock()  # one multi-threaded batch at a time per process
 
 
 def case_settings(definition, columns):
-    """One dict of plain Python values per case: the varied parameters."""
+    """One dict of plain Python values per case: the varied parameters.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    columns : dict of str to ndarray
+        One array per varied parameter over the cases
+        (:func:`~qzs.workflows.sweeps.definition.sample_cases`).
+
+    Returns
+    -------
+    list of dict
+        Per case, varied parameter name -> value (no ``sample`` index).
+    """
     names = list(definition.varied)
     rows = zip(*(np.asarray(columns[n]).tolist() for n in names)) if names else []
     return [dict(zip(names, row)) for row in rows]
@@ -62,6 +76,7 @@ def run_batch(definition, start, settings, n_time, threads=None):
     Parameters
     ----------
     definition : SweepDefinition
+        The sweep.
     start : int
         Index of the batch's first case.
     settings : list of dict
@@ -232,7 +247,26 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
             threads=None, progress=True):
     """Run the batches of `definition` not yet in `store`, storing each as it finishes.
 
-    See :func:`qzs.workflows.sweeps.run_sweep` for the parameters.
+    The engine of :func:`qzs.workflows.sweeps.run_sweep`, which says more.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    store : str or Path
+        The Zarr store (a directory).
+    resume : bool
+        Keep the batches already in ``store`` and run the others.
+    overwrite : bool
+        Replace an existing ``store``.
+    scheduler : str or distributed.Client, optional
+        Run on this Dask cluster (scheduler address or client).
+    workers : int, optional
+        Start a local Dask cluster of this many single-threaded worker processes.
+    threads : int, optional
+        Threads per batch; default all cores locally, 1 on a Dask cluster.
+    progress : bool
+        Show a progress bar.
 
     Returns
     -------

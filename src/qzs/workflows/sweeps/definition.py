@@ -1,6 +1,6 @@
 """Sweep definitions: reading and validating a sweep file, grids and sampling.
 
-The TOML layout is described in :mod:`qzs.sweep`. :func:`load_sweep` turns a file
+The TOML layout is described in :mod:`qzs.workflows.sweeps`. :func:`load_sweep` turns a file
 (or a parsed document) into a frozen :class:`SweepDefinition`, with every mistake
 reported the scipy way (what, the value, the fix); :func:`sample_cases` lists the
 varied parameters of every case: grid points times random or Latin-hypercube
@@ -65,20 +65,24 @@ def _analysis_defaults():
 
 @dataclass(frozen=True)
 class SweepDefinition:
-    """A validated sweep (the TOML layout is described in :mod:`qzs.sweep`).
+    """A validated sweep (the TOML layout is described in :mod:`qzs.workflows.sweeps`).
 
     Attributes
     ----------
     name, title : str
+        Short name (the default store is ``<name>.zarr``) and title.
     method : {"grid", "random", "lhs"}
+        How the cases are drawn: full factorial only, or random or Latin-hypercube samples.
     samples : int
         Draws per grid point (1 for a pure grid).
     seed : int or None
+        Seed of the draws; the same seed gives the same cases.
     batch_size : int
         Cases per batch [cases].
     parameters : dict
-        Fixed MODEL.md parameters.
+        Fixed model parameters (registry names).
     excitation_kind : str
+        Kind of the excitation (``chirp``, ``sine``, ``random``).
     excitation : dict
         Fixed excitation values (without the ``excitation.`` prefix).
     grid : dict
@@ -90,6 +94,7 @@ class SweepDefinition:
     document : dict
         The parsed TOML file; its hash identifies the sweep in a store.
     source : str
+        The file it was read from.
     """
 
     name: str
@@ -508,6 +513,11 @@ def sample_cases(definition):
     Grid points (the last [grid] axis fastest, excitation axes slowest) times the
     samples (fastest): each grid point sees the same draws.
 
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+
     Returns
     -------
     dict of str to ndarray, shape (n_cases,)
@@ -527,7 +537,18 @@ def sample_cases(definition):
 
 
 def plan_text(definition):
-    """What a sweep will run: cases, batches, varied parameters and simulated steps."""
+    """What a sweep will run: cases, batches, varied parameters and simulated steps.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+
+    Returns
+    -------
+    str
+        A few lines of text (``qzs sweep --dry-run``).
+    """
     a, s = definition.analysis, definition.simulation
     columns = sample_cases(definition)
     lines = [f"sweep {definition.name!r}: {definition.title}",

@@ -46,6 +46,7 @@ def schema(definition, n_time):
     Parameters
     ----------
     definition : SweepDefinition
+        The sweep.
     n_time : int
         Samples kept per time series (0 if none are kept).
     """
@@ -149,6 +150,27 @@ def _create(path, definition, columns, n_time):
 def prepare_store(path, definition, columns, n_time, *, resume=False, overwrite=False):
     """Create the store, or open it to resume; returns the ``done`` flags (n_cases,).
 
+    Parameters
+    ----------
+    path : str or Path
+        The Zarr store (a directory).
+    definition : SweepDefinition
+        The sweep.
+    columns : dict of str to ndarray
+        The varied parameters of every case (:func:`~qzs.workflows.sweeps.sample_cases`),
+        stored as coordinates of a new store.
+    n_time : int
+        Samples kept per time series (0 if none are kept).
+    resume : bool
+        Open an existing store written by the same definition, keeping its cases.
+    overwrite : bool
+        Replace an existing store (unless ``resume``).
+
+    Returns
+    -------
+    ndarray of bool, shape (n_cases,)
+        Which cases are already stored (all False for a new store).
+
     Raises
     ------
     ParameterError
@@ -188,8 +210,16 @@ def write_batch(path, definition, start, arrays, n_time):
 
     Parameters
     ----------
+    path : str or Path
+        The Zarr store, created by :func:`prepare_store`.
+    definition : SweepDefinition
+        The sweep.
+    start : int
+        Index of the batch's first case.
     arrays : dict of str to ndarray
         Every variable of :func:`schema`, first axis the batch's cases.
+    n_time : int
+        Samples kept per time series (0 if none are kept).
     """
     import xarray as xr
 
@@ -204,7 +234,22 @@ def write_batch(path, definition, start, arrays, n_time):
 
 
 def open_store(path):
-    """Open a sweep store lazily as an ``xarray.Dataset`` (strings as Python objects)."""
+    """Open a sweep store lazily as an ``xarray.Dataset`` (strings as Python objects).
+
+    Parameters
+    ----------
+    path : str or Path
+        The Zarr store (a directory).
+
+    Returns
+    -------
+    xarray.Dataset
+
+    Raises
+    ------
+    ParameterError
+        There is no store at ``path``.
+    """
     import xarray as xr
 
     path = Path(path)
@@ -225,7 +270,7 @@ def summary_text(dataset, report=None):
     dataset : xarray.Dataset
         An opened store.
     report : dict, optional
-        What :func:`qzs.sweep_backends.execute` returned (cases, steps, wall [s]).
+        What :func:`qzs.workflows.sweeps.backends.execute` returned (cases, steps, wall [s]).
     """
     status = dataset["status"].values
     done = dataset["done"].values
