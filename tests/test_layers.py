@@ -18,7 +18,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 LAYERS = ("base", "model", "analysis", "engine", "iotools", "identify", "viz", "workflows",
           "cli")
 #: Top-level modules that are the base layer.
-BASE = {"errors", "_validation", "_version", "_optional", "defaults"}
+BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults"}
 #: The facade (``qzs/__init__.py``, ``qzs/__main__.py``) may import anything; no module imports it.
 FACADE = {"qzs", "qzs.__main__"}
 #: Methods that may delegate to a higher layer (result objects: ``.plot()``, ``.save()``).
@@ -72,7 +72,16 @@ def imports(source, module, is_package=False):
                             found.append((target, child.lineno, function, in_class))
                 visit(child, function, in_class)
 
-    visit(ast.parse(source), None, False)
+    tree = ast.parse(source)
+    visit(tree, None, False)
+    # a lazily exported name is an import too: the modules of a dict of qzs module names
+    # (``lazy_exports(__name__, {"name": "qzs.x.y"})``) must keep the same rules
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for value in node.values:
+                if (isinstance(value, ast.Constant) and isinstance(value.value, str)
+                        and value.value.split(".")[0] == "qzs" and _is_module(value.value)):
+                    found.append((value.value, value.lineno, None, False))
     return found
 
 
@@ -157,6 +166,8 @@ def test_no_import_cycles_between_modules():
     ("from qzs.model.isolator import spring_force\n", False),
     ("class R:\n    def plot(self):\n        from qzs.viz import plot_simulation\n", False),
     ("class R:\n    def other(self):\n        from qzs.viz import plot_simulation\n", True),
+    ("_EXPORTS = {'plot': 'qzs.viz.simulation'}\n", True),               # a lazy export
+    ("_EXPORTS = {'simulate': 'qzs.engine.simulate'}\n", False),
 ])
 def test_the_checker_sees_an_upward_import(source, upward):
     """The check itself: an engine module that imports upward is reported, else not."""

@@ -16,6 +16,7 @@ importing only from those listed before it:
 ``workflows``  the paper's studies and report, experiment pipeline, sweeps
 ``cli``        the ``qzs`` command
 """
+from qzs._lazy import lazy_exports
 from qzs._version import __version__
 from qzs.engine.results import SimulationResult
 from qzs.engine.simulate import simulate
@@ -52,16 +53,4 @@ __all__ = [
     *_LAZY,
 ]
 
-
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'qzs' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)

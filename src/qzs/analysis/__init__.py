@@ -5,21 +5,14 @@
 ``statistics``  run statistics (stroke, time locked, motor effort)
 ``summary``     the one-screen text summary of a run
 """
-from qzs.analysis.spectral import (TransmissibilityEstimate, TransmissibilityMetrics,
-                                   amplitude_spectrum, band_mask, highpass, required_duration,
-                                   required_samples, transmissibility, transmissibility_metrics,
-                                   welch_average_count)
-from qzs.analysis.statistics import STATISTICS, RunStatistics, run_statistics
+from qzs._lazy import lazy_exports
 
-__all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
-           "band_mask", "highpass", "required_duration", "required_samples", "transmissibility",
-           "transmissibility_metrics", "welch_average_count", "STATISTICS", "RunStatistics",
-           "run_statistics", "linearize"]
-
-
-def __getattr__(name):  # python-control is imported only when the linear model is asked for
-    if name == "linearize":
-        from qzs.analysis.linear import linearize
-
-        return linearize
-    raise AttributeError(f"module 'qzs.analysis' has no attribute {name!r}")
+_SPECTRAL = ("TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
+             "band_mask", "highpass", "required_duration", "required_samples",
+             "transmissibility", "transmissibility_metrics", "welch_average_count")
+_EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
+            **{name: "qzs.analysis.statistics"
+               for name in ("STATISTICS", "RunStatistics", "run_statistics")},
+            "linearize": "qzs.analysis.linear"}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)  # scipy.signal, python-control on use

@@ -11,13 +11,15 @@
 ``batch``        :func:`simulate_batch`, many parameter sets at once
 ``results``      :class:`SimulationResult`
 """
-from qzs.engine.base_motion import base_motion_series
-from qzs.engine.batch import BatchResult, simulate_batch
-from qzs.engine.prepare import prepare_run, steps_per_sample
-from qzs.engine.results import CHANNELS, FLAGS, SimulationResult
-from qzs.engine.simulate import simulate
-from qzs.engine.stability import SOLVERS, largest_stable_step
+from qzs._lazy import lazy_exports
 
-__all__ = ["simulate", "simulate_batch", "BatchResult", "SimulationResult", "CHANNELS", "FLAGS",
-           "SOLVERS", "largest_stable_step", "prepare_run", "steps_per_sample",
-           "base_motion_series"]
+_EXPORTS = {
+    "simulate": "qzs.engine.simulate", "simulate_batch": "qzs.engine.batch",
+    "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.results",
+    "CHANNELS": "qzs.engine.results", "FLAGS": "qzs.engine.results",
+    "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
+    "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
+    "base_motion_series": "qzs.engine.base_motion",
+}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
