@@ -3,10 +3,9 @@ import sys
 from pathlib import Path
 
 from qzs.errors import ParameterError
+from qzs.viz.sweeps import REDUCTIONS
 
 __all__ = ["add_parsers", "run_sweep_command", "run_plot_command"]
-
-REDUCTIONS = ("median", "mean", "min", "max")
 
 
 def add_parsers(subparsers):

@@ -126,7 +126,9 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     Raises
     ------
     ParameterError
-        An invalid argument, or a case that is invalid (the message names its index).
+        An invalid argument.
+    CaseError
+        A case that is invalid; its ``index`` attribute says which, ``reason`` why.
     """
     cases = list(cases)
     if not cases:

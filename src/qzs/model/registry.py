@@ -18,7 +18,8 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_field
 from qzs.model.isolator import IsolatorParameters
 
-__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "parameter_info", "unit_of",
+__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "EXCITATION_PARAMETERS", "parameter_info",
+           "unit_of",
            "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
            "format_value"]
 
@@ -68,17 +69,24 @@ PARAMETERS = MappingProxyType({
     for f in dataclasses.fields(cls)})
 
 
+#: Excitation parameters by kind: the factory's options, and the run's duration where the
+#: kind has no duration of its own (a sine runs as long as the run).
+EXCITATION_PARAMETERS = MappingProxyType({
+    kind: (*options, *(() if "duration" in options else ("duration",)))
+    for kind, options in EXCITATION_OPTIONS.items()})
+# What an option that is no field of its class means: (unit, description).
+_RUN_OPTIONS = {"duration": ("s", "run duration"),
+                "record": ("", "CSV file of time [s] and displacement [m]")}
+
+
 def _excitation_info(kind, option):
-    if option == "duration" and kind == "sine":  # a sine runs as long as the run
-        return ParameterInfo(name="excitation.duration", section=f"excitation.{kind}",
-                             unit="s", doc="run duration", default=None, numeric=True)
-    if option == "record":
-        return ParameterInfo(name="excitation.record", section=f"excitation.{kind}", unit="",
-                             doc="CSV file of time [s] and displacement [m]", default=None,
-                             numeric=False)
     fields = {f.name: f for f in dataclasses.fields(EXCITATION_KINDS[kind])}
-    return _info(f"excitation.{kind}", fields[option_field(kind, option)],
-                 name=f"excitation.{option}")
+    field = fields.get(option_field(kind, option))
+    if field is not None:
+        return _info(f"excitation.{kind}", field, name=f"excitation.{option}")
+    unit, doc = _RUN_OPTIONS[option]
+    return ParameterInfo(name=f"excitation.{option}", section=f"excitation.{kind}", unit=unit,
+                         doc=doc, default=None, numeric=option == "duration")
 
 
 def parameter_info(name, kind=None):
@@ -101,12 +109,12 @@ def parameter_info(name, kind=None):
         return PARAMETERS[name]
     if name.startswith("excitation."):
         option = name.split(".", 1)[1]
-        kinds = [kind] if kind is not None else list(EXCITATION_OPTIONS)
+        kinds = [kind] if kind is not None else list(EXCITATION_PARAMETERS)
         for k in kinds:
-            if option in EXCITATION_OPTIONS.get(k, ()) or (option == "duration" and k == "sine"):
+            if option in EXCITATION_PARAMETERS.get(k, ()):
                 return _excitation_info(k, option)
-    valid = sorted(PARAMETERS) + sorted({f"excitation.{o}" for v in EXCITATION_OPTIONS.values()
-                                         for o in v})
+    valid = sorted(PARAMETERS) + sorted({f"excitation.{o}"
+                                         for v in EXCITATION_PARAMETERS.values() for o in v})
     raise ParameterError(f"unknown parameter {name!r}; valid names are: {', '.join(valid)}.")
 
 

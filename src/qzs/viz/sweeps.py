@@ -6,7 +6,6 @@ reduced to one value, with their spread shaded); sampled parameters as continuou
 (scatter, with a binned median).
 """
 import json
-from pathlib import Path
 
 import numpy as np
 

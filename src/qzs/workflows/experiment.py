@@ -30,6 +30,7 @@ import numpy as np
 
 from qzs.analysis.spectral import (band_mask, highpass, required_samples, transmissibility,
                                    transmissibility_metrics, welch_average_count)
+from qzs.defaults import ANALYSIS
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
 from qzs.errors import DataError, DataWarning, ParameterError
@@ -40,6 +41,8 @@ from qzs.model.excitation import Chirp
 
 __all__ = ["ExperimentResult", "process_experiment", "infer_chirp", "run_experiment"]
 
+#: Welch averages of the paper's experiment (Section 4).
+EXPERIMENT_AVERAGES = 29
 SIGNAL_PAIRS = {"velocity": ("base_velocity", "payload_velocity"),
                 "acceleration": ("base_acceleration", "payload_acceleration")}
 
@@ -339,7 +342,8 @@ def _averages(n_samples, fft_length, n_averages, notes):
     return available
 
 
-def process_experiment(recording, *, highpass_corner=1.0, fft_length=32768, n_averages=29,
+def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["fft_length"],
+                       n_averages=EXPERIMENT_AVERAGES,
                        isolator=None, controller=None, simulate_match=True, excitation=None,
                        dt=1e-4):
     """Transmissibility of an experiment log, its metrics, and the matching simulation.
@@ -482,8 +486,8 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
         excitation = Chirp(**{**values, **given}, duration=recording.duration)
     result = process_experiment(
         recording, highpass_corner=corner,
-        fft_length=fft_length or settings.get("fft_length", 32768),
-        n_averages=n_averages or settings.get("n_averages", 29),
+        fft_length=fft_length or settings.get("fft_length", ANALYSIS["fft_length"]),
+        n_averages=n_averages or settings.get("n_averages", EXPERIMENT_AVERAGES),
         isolator=isolator, controller=controller, simulate_match=simulate_match,
         excitation=excitation)
     return result, result.write_report(out)

@@ -23,8 +23,9 @@ from qzs.engine.stability import SOLVERS
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
-from qzs.model.excitation import EXCITATION_OPTIONS, build_excitation
+from qzs.model.excitation import build_excitation
 from qzs.model.isolator import IsolatorParameters
+from qzs.model import registry
 from qzs.model.registry import PARAMETERS, update_parameters
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "shipped_sweeps",
@@ -38,11 +39,10 @@ DISTRIBUTIONS = {
     "lognormal": (("median", "sigma"), ()),        # sigma: standard deviation of ln(value)
     "loguniform": (("low", "high"), ()),
 }
-#: Excitation kinds and their parameters (``excitation.<name>`` in [grid]/[distributions]):
-#: the factory's options, and the run's ``duration`` for a sine.
-EXCITATION_PARAMETERS = {
-    kind: (*options, *(() if "duration" in options else ("duration",)))
-    for kind, options in EXCITATION_OPTIONS.items() if kind != "file"}
+#: Excitation kinds a sweep can use and their parameters (``excitation.<name>`` in
+#: [grid]/[distributions]); a recorded base motion has nothing to vary.
+EXCITATION_PARAMETERS = {kind: parameters for kind, parameters
+                         in registry.EXCITATION_PARAMETERS.items() if kind != "file"}
 TABLES = ("sweep", "parameters", "excitation", "grid", "distributions", "simulation",
           "analysis", "outputs")
 SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batch_size")
