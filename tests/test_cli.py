@@ -59,7 +59,7 @@ def test_simulate_file_excitation(tmp_path):
         f"{a},{0.003 * np.sin(2 * np.pi * 2 * a)}" for a in t))
     out = tmp_path / "r.nc"
     assert main(["simulate", "--excitation", "file", "--record", str(record), "--out", str(out),
-                 "--plot", "none", "--quiet"]) == 0
+                 "--fade-in", "0", "--plot", "none", "--quiet"]) == 0
     data = read_result(out)
     np.testing.assert_allclose(data.base_displacement.values[::100],
                                0.003 * np.sin(2 * np.pi * 2 * data.time.values[::100]),

@@ -137,6 +137,51 @@ def test_units_scale_and_time_unit(tmp_path):
     assert recording.units["base_acceleration"] == "m/s^2"
 
 
+#: Every unit a channel map accepts, with its SI unit and factor written out here by hand
+#: (1 g is the standard gravity 9.80665 m/s^2 by definition), not copied from the table.
+EXPECTED_UNITS = {
+    "m": ("m", 1.0), "mm": ("m", 0.001), "um": ("m", 0.000001), "µm": ("m", 0.000001),
+    "m/s": ("m/s", 1.0), "mm/s": ("m/s", 0.001), "um/s": ("m/s", 0.000001),
+    "m/s^2": ("m/s^2", 1.0), "m/s2": ("m/s^2", 1.0), "mm/s^2": ("m/s^2", 0.001),
+    "mm/s2": ("m/s^2", 0.001), "g": ("m/s^2", 9.80665),
+    "N": ("N", 1.0), "kN": ("N", 1000.0), "V": ("V", 1.0),
+}
+#: A role for each SI unit.
+ROLE_OF = {"m": "relative_position", "m/s": "base_velocity", "m/s^2": "base_acceleration",
+           "N": "force", "V": "motor_command"}
+
+
+def test_every_unit_of_the_table_is_tested():
+    from qzs.iotools.readers import UNITS
+
+    assert set(UNITS) == set(EXPECTED_UNITS)  # a new unit needs its expectation here
+
+
+@pytest.mark.parametrize("unit", sorted(EXPECTED_UNITS))
+@pytest.mark.parametrize("scale", [1.0, -2.0])
+def test_each_unit_converts_to_si(tmp_path, unit, scale):
+    si_unit, factor = EXPECTED_UNITS[unit]
+    role = ROLE_OF[si_unit]
+    raw = np.array([2.5, -1.25, 0.0, 4.0])
+    path = tmp_path / "log.csv"
+    path.write_text("time,signal\n" + "".join(f"{k * 0.01!r},{v!r}\n"
+                                               for k, v in enumerate(raw.tolist())))
+    recording = read_recording(path, {"channels": {role: {"source": "signal", "unit": unit,
+                                                          "scale": scale}}})
+    np.testing.assert_allclose(recording[role], raw * scale * factor, rtol=1e-15, atol=0)
+    assert recording.units[role] == si_unit
+
+
+@pytest.mark.parametrize("unit, step", [("s", 0.01), ("ms", 0.00001)])
+def test_each_time_unit_converts_to_seconds(tmp_path, unit, step):
+    path = tmp_path / "log.csv"
+    path.write_text("t,x\n" + "".join(f"{k * 0.01!r},1.0\n" for k in range(5)))
+    recording = read_recording(path, {"time": {"source": "t", "unit": unit},
+                                      "channels": {"force": {"source": "x", "unit": "N"}}})
+    np.testing.assert_allclose(recording.time, np.arange(5) * step, rtol=1e-12)
+    assert recording.sample_rate == pytest.approx(1.0 / step)
+
+
 def test_non_uniform_time_is_an_error_or_resampled(tmp_path):
     time = TIME.copy()
     time[100:] += 0.5 / RATE  # one long interval

@@ -268,11 +268,11 @@ from qzs import InitialState, IsolatorParameters, ControllerParameters, Sine, si
 
 def runs():
     passive = ControllerParameters(pi_kp=0.0, pi_ki=0.0)
-    yield simulate(Sine(amplitude=0.01, frequency=2.5), duration=0.6, dt=1e-4, sample_rate=1e4)
-    yield simulate(Sine(amplitude=0.01, frequency=4.0), IsolatorParameters(stop_model="plastic"), passive,
+    yield simulate(Sine(amplitude=0.01, frequency=2.5, fade_in=0.0), duration=0.6, dt=1e-4, sample_rate=1e4)
+    yield simulate(Sine(amplitude=0.01, frequency=4.0, fade_in=0.0), IsolatorParameters(stop_model="plastic"), passive,
                    duration=0.3, dt=1e-4, sample_rate=1e4,
                    initial_state=InitialState(relative_position=-0.139, relative_velocity=-0.3))
-    yield simulate(Sine(amplitude=0.01, frequency=4.0), IsolatorParameters(), passive, duration=0.3,
+    yield simulate(Sine(amplitude=0.01, frequency=4.0, fade_in=0.0), IsolatorParameters(), passive, duration=0.3,
                    dt=1e-4, sample_rate=1e4, initial_state=InitialState(relative_position=-0.139,
                                                                         relative_velocity=-0.3))
 

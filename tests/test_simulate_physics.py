@@ -70,7 +70,7 @@ def test_frictionless_linear_limit_matches_closed_form_transmissibility(case, fr
     settle = np.ceil(1.5 * np.log(1e9) / slowest / period) * period
     cycles = max(2, int(np.ceil(2 * frequency)))
     amplitude = 0.010
-    r = simulate(Sine(amplitude=amplitude, frequency=frequency), linear_isolator(STIFFNESS, DAMPING, MASS),
+    r = simulate(Sine(amplitude=amplitude, frequency=frequency, fade_in=0.0), linear_isolator(STIFFNESS, DAMPING, MASS),
                  controller, duration=settle + cycles * period, dt=1e-4, sample_rate=1000.0)
     assert r.run["stop_contacts"] == 0
     steady = r.time >= settle - 1e-9
@@ -116,10 +116,10 @@ SMOOTH = Case(IsolatorParameters(gravity=0.0, stiction_force=0.0, coulomb_force=
                                  stop_model="plastic"),
               ControllerParameters(position_setpoint=0.0, pi_kp=50.0, pi_ki=20.0, damping_gain=5.0,
                                    velocity_highpass=1.0),
-              Sine(amplitude=0.001, frequency=10.0), InitialState(relative_velocity=3.0), 0.25)
+              Sine(amplitude=0.001, frequency=10.0, fade_in=0.0), InitialState(relative_velocity=3.0), 0.25)
 # The same frictionless plant with a slower, larger base motion: the slip velocity now changes
 # sign twice in the 1 s. The equations are just as smooth (no friction: Fs = Fc = 0).
-OSCILLATING = SMOOTH._replace(excitation=Sine(amplitude=0.010, frequency=2.0),
+OSCILLATING = SMOOTH._replace(excitation=Sine(amplitude=0.010, frequency=2.0, fade_in=0.0),
                               initial=InitialState(relative_velocity=0.3), end=1.0)
 STEPS = {"euler": range(10, 17), "ode3": range(10, 15), "rk4": range(8, 12)}
 ORDERS = {"euler": 1, "ode3": 3, "rk4": 4}
@@ -236,7 +236,7 @@ def test_breakaway_happens_when_the_holding_force_reaches_stiction():
     m, fs = DEFAULT_PLANT.mass, DEFAULT_PLANT.stiction_force
     assert m * amplitude * w**2 > fs
     breakaway = np.arcsin(fs / (m * amplitude * w**2)) / w
-    r = simulate(Sine(amplitude=amplitude, frequency=frequency), duration=0.1, dt=dt, sample_rate=1 / dt)
+    r = simulate(Sine(amplitude=amplitude, frequency=frequency, fade_in=0.0), duration=0.1, dt=dt, sample_rate=1 / dt)
     first_slip = np.argmin(r.locked)
     assert r.time[first_slip - 1] <= breakaway < r.time[first_slip]
     np.testing.assert_allclose(r.friction_force[:first_slip],
@@ -297,7 +297,7 @@ def test_plastic_stop_is_never_passed(plastic_sine_run):
 # ====================================================================== 6. gravity: passive sinks
 @pytest.fixture(scope="module")
 def sine_3hz_runs():
-    excitation = Sine(amplitude=0.010, frequency=3.0)
+    excitation = Sine(amplitude=0.010, frequency=3.0, fade_in=0.0)
     return (simulate(excitation, controller=PASSIVE, duration=10.0, sample_rate=1000.0),
             simulate(excitation, duration=10.0, sample_rate=1000.0))
 
@@ -333,7 +333,7 @@ def test_locked_samples_hold_within_stiction(default_chirp_run, passive_chirp_ru
 
 def test_plastic_impact_with_the_base_pulling_away_releases_at_once():
     low = -0.140
-    r = simulate(Sine(amplitude=0.010, frequency=10.0, phase=np.pi / 2),  # ydd(0) = -39.5 m/s^2
+    r = simulate(Sine(amplitude=0.010, frequency=10.0, phase=np.pi / 2, fade_in=0.0),  # ydd(0) = -39.5 m/s^2
                  IsolatorParameters(stop_model="plastic"), PASSIVE, duration=0.002, dt=1e-4, sample_rate=1e4,
                  initial_state=InitialState(relative_position=low + 1e-4, relative_velocity=-0.5))
     assert r.run["stop_contacts"] == 1
@@ -355,7 +355,7 @@ def test_no_chatter_and_plausible_stick_events(default_chirp_run):
 
 def test_payload_sticks_at_every_velocity_reversal_of_a_slow_sine():
     """2 Hz, 10 mm: friction breaks each half cycle and holds the payload at each reversal."""
-    r = simulate(Sine(amplitude=0.010, frequency=2.0), duration=10.0, dt=1e-4, sample_rate=1e4)
+    r = simulate(Sine(amplitude=0.010, frequency=2.0, fade_in=0.0), duration=10.0, dt=1e-4, sample_rate=1e4)
     cycles = 20
     sticks = r.run["stick_events"]
     assert 2 * cycles - 2 <= sticks <= 2 * cycles
@@ -366,14 +366,14 @@ def test_payload_sticks_at_every_velocity_reversal_of_a_slow_sine():
 
 def test_a_single_stick_is_counted_once():
     """Started slipping at zero velocity where friction can hold: it sticks once and stays."""
-    r = simulate(Sine(amplitude=0.001, frequency=1.0), duration=0.01, dt=1e-4, sample_rate=1e4,
+    r = simulate(Sine(amplitude=0.001, frequency=1.0, fade_in=0.0), duration=0.01, dt=1e-4, sample_rate=1e4,
                  initial_state=InitialState(locked=False))
     assert r.locked[1:].all()
     assert r.run["stick_events"] == 1
 
 
 def test_frictionless_start_stuck_or_slipping_is_the_same_motion():
-    excitation = Sine(amplitude=0.010, frequency=1.0)
+    excitation = Sine(amplitude=0.010, frequency=1.0, fade_in=0.0)
     plant, controller = linear_isolator(), linear_controller(pi_kp=100.0)
     stuck = simulate(excitation, plant, controller, duration=1.0, sample_rate=1000.0)
     slipping = simulate(excitation, plant, controller, duration=1.0, sample_rate=1000.0,

@@ -1,5 +1,6 @@
 """Study definitions, the runner, and the paper report decided from data."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -89,15 +90,156 @@ def test_claims_follow_the_numbers(quick_paper):
     results, verdicts, _ = quick_paper
     by_claim = {v.claim: v for v in verdicts}
     assert by_claim["no_pi_stops"].reproduced is True
+    assert by_claim["viscous_high_frequency"].reproduced is True
     tampered = copy.deepcopy(results)
     for r in tampered:
         if r.study.name == "no_pi":
             r.cases[0].stats["stop_contacts"] = 0
-        if r.study.name == "viscous":
-            r.cases.reverse()
+        if r.study.name == "viscous":  # swap the curves of the least and most damped cases
+            first, last = r.cases[0], r.cases[-1]
+            first.magnitude, last.magnitude = last.magnitude, first.magnitude
+            first.trusted, last.trusted = last.trusted, first.trusted
     flipped = {v.claim: v for v in decide_claims(tampered)}
     assert flipped["no_pi_stops"].reproduced is False
     assert flipped["viscous_high_frequency"].reproduced is False
+    # reordering the cases of a file changes nothing: trends follow the swept parameter
+    reordered = copy.deepcopy(results)
+    for r in reordered:
+        r.cases.reverse()
+    assert [v.label for v in decide_claims(reordered)] == [v.label for v in verdicts]
+
+
+def test_resonance_masked_from_the_simulated_runs(quick_paper):
+    """The payload is locked while the chirp is below 0.5 Hz (not above): masked."""
+    results, verdicts, _ = quick_paper
+    by_claim = {v.claim: v for v in verdicts}
+    assert by_claim["resonance_masked"].label == "reproduced", by_claim["resonance_masked"]
+    stiction = next(r for r in results if r.study.name == "stiction")
+    for case in stiction.cases:
+        assert case.stats["locked_fraction_below_half_hz"] >= 0.9
+        assert case.stats["locked_fraction_below_half_hz"] > 2 * case.stats["locked_fraction"]
+
+
+def test_no_metric_comes_from_an_untrusted_bin(quick_paper):
+    """Every case of every study: metrics from trusted bins only, or NaN with a reason."""
+    from test_trust import assert_metrics_from_trusted
+
+    from qzs.analysis.spectral import transmissibility_metrics
+    from qzs.defaults import REPORTED_FREQUENCIES
+
+    results, _, _ = quick_paper
+    checked = 0
+    for result in results:
+        if result.study.kind == "spring_characteristic":
+            continue
+        for case in result.cases:
+            curves = [(case.frequency, case.magnitude, case.trusted, case.coherence,
+                       case.metrics, case.reasons, None)]
+            if result.study.kind == "processing":
+                x = case.extra
+                curves.append((x["frequency"], x["magnitude"], x["trusted"], x["coherence"],
+                               x["metrics"], x["reasons"], x["highpass"]))
+            for f, t, trusted, coherence, metrics, reasons, corner in curves:
+                assert trusted.dtype == bool and trusted.shape == f.shape
+                assert np.all(coherence[trusted] >= 0.9)
+                if np.isfinite(metrics["resonance_frequency"]):  # never the 0.061 Hz artefact
+                    i = int(np.flatnonzero(f == metrics["resonance_frequency"])[0])
+                    assert trusted[i] and coherence[i] >= 0.9
+                    assert metrics["resonance_frequency"] > metrics["trusted_from"]
+
+                def recompute(values, f=f, trusted=trusted, corner=corner):
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        return transmissibility_metrics(
+                            f, values, trusted=trusted, highpass_corner=corner,
+                            at_frequencies=REPORTED_FREQUENCIES).to_dict()
+
+                assert_metrics_from_trusted(f, t, trusted, metrics, reasons, recompute)
+                checked += 1
+    assert checked == 19
+
+
+def test_outputs_say_why_a_metric_is_undefined(quick_paper):
+    import csv
+
+    results, _, folder = quick_paper
+    rows = list(csv.DictReader((folder / "metrics.csv").open()))
+    cases = [row for row in rows if row["study"] != "spring"]
+    assert "resonance_frequency_reason" in rows[0]
+    for row in cases:
+        for name in ("resonance_frequency", "isolation_onset", "transmissibility_at_1_hz"):
+            assert row[name] != "nan"
+            assert (row[name] == "") == bool(row.get(f"{name}_reason")), (row["case"], name)
+    document = json.loads((folder / "metrics.json").read_text())
+    for study in document["studies"].values():
+        for row in study["cases"]:
+            for name, value in row.items():
+                if value is None and f"{name}_reason" in row:
+                    assert row[f"{name}_reason"]
+    stiction = document["studies"]["stiction"]
+    assert stiction["settings"]["solver"] == "ode3"
+    assert stiction["settings"]["fft_length"] == 8192
+    assert stiction["settings"]["window"] == "hann"
+
+
+def test_report_states_settings_links_figures_and_hides_artefacts(quick_paper):
+    import re
+
+    _, _, folder = quick_paper
+    text = (folder / "report.html").read_text()
+    for setting in ("solver", "time step [s]", "chirp duration [s]", "FFT length [samples]",
+                    "averages", "window", "sample rate [Hz]", "stiction_force [N]",
+                    "pi_kp [N/m]"):
+        assert setting in text, setting
+    assert "figure img{width:100%" in text
+    for name in ("fig07_stiction", "fig13_processing"):
+        assert f"<a href='{name}.png'>PNG</a>" in text and f"<a href='{name}.svg'>SVG</a>" in text
+    # the report's metric tables: a dash with a footnote, or a value above the trusted start
+    tables = [t for t in re.findall(r"<table>.*?</table>", text, flags=re.S) if "peak of T at" in t]
+    assert len(tables) == 6
+    for table in tables:
+        for row in re.findall(r"<tr>(.*?)</tr>", table, flags=re.S)[1:]:
+            cells = re.findall(r"<td>(.*?)</td>", row)
+            trusted_from, resonance = float(cells[1]), cells[2]
+            assert resonance.startswith("&mdash;<sup>") or float(resonance) > trusted_from
+        dashes = {int(n) for n in re.findall(r"&mdash;<sup>(\d+)</sup>", table)}
+        if dashes:
+            notes = re.match(r"\s*<ol class='notes'>(.*?)</ol>",
+                             text[text.index(table) + len(table):], flags=re.S)
+            assert len(re.findall("<li>", notes.group(1))) == max(dashes)
+
+
+def test_study_cli_prints_json(tmp_path, capsys):
+    """``qzs study FILE --json``: claims, per-case metrics with NaN as null beside a reason."""
+    from qzs.cli import main
+
+    path = tmp_path / "tiny.toml"
+    path.write_text("[study]\nname = 'tiny'\nkind = 'transmissibility'\n"
+                    "claims = ['no_pi_stops', 'stiction_low_frequency']\n"
+                    "[[study.view]]\nfigure = 'tiny'\nfrequency_range = [0.0, 20.0]\n"
+                    "[analysis]\nquick_fft_length = 2048\nquick_n_averages = 6\n"
+                    "[[case]]\nlabel = 'no PI'\npi_kp = 0.0\npi_ki = 0.0\n"
+                    "[[case]]\nlabel = 'PI'\npi_kp = 5.0\npi_ki = 2.0\n")
+    out = tmp_path / "out"
+    code = main(["study", str(path), "--quick", "--out", str(out), "--workers", "1", "--quiet",
+                 "--json"])
+    assert code == 0
+    record = json.loads(capsys.readouterr().out)
+    verdicts = {c["claim"]: c for c in record["claims"]}
+    assert verdicts["stiction_low_frequency"]["verdict"] == "not decidable"
+    assert verdicts["no_pi_stops"]["study"] == "tiny" and verdicts["no_pi_stops"]["evidence"]
+    cases = record["studies"]["tiny"]["cases"]
+    assert [c["case"] for c in cases] == ["no PI", "PI"]
+    for entry in cases:
+        for name, value in entry.items():
+            if value is None and name in ("resonance_frequency", "isolation_onset"):
+                assert entry[f"{name}_reason"]
+    outputs = record["outputs"]
+    assert outputs["report"] == str(out / "report.html")
+    assert str(out / "tiny.png") in outputs["figures"] and str(out / "tiny.svg") in outputs["figures"]
+    for path in (outputs["report"], outputs["metrics_json"], outputs["metrics_csv"],
+                 *outputs["figures"]):
+        assert (tmp_path / path).exists() or __import__("pathlib").Path(path).exists()
 
 
 def test_study_physics_is_sensible(quick_paper):

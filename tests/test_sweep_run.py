@@ -104,6 +104,41 @@ def test_store_layout_units_and_attributes(reference):
     assert data["message"].values.tolist() == [""] * 4
 
 
+def test_store_has_consolidated_metadata_and_integer_counts(reference):
+    import zarr
+
+    _, data, store = reference
+    group = zarr.open_group(store, mode="r", use_consolidated=True)  # raises without it
+    assert group.metadata.consolidated_metadata is not None
+    assert "done" in group.metadata.consolidated_metadata.metadata
+    for name in ("stop_contacts", "stick_events", "steps", "n_averages"):
+        assert data[name].dtype.kind == "i", name
+        assert (data[name].values >= 0).all(), name
+
+
+def test_counts_of_cases_without_a_run_are_minus_one(tmp_path):
+    data = run_sweep(DIVERGING, tmp_path / "d.zarr", progress=False).load()
+    invalid = data["status"].values == INVALID
+    assert invalid.any() and data["stop_contacts"].dtype.kind == "i"
+    assert (data["stop_contacts"].values[invalid] == -1).all()
+    assert (data["steps"].values[~invalid] > 0).all()
+
+
+def test_a_store_without_consolidated_metadata_still_opens(reference, tmp_path):
+    import warnings
+
+    from qzs.workflows.sweeps import open_sweep
+
+    _, expected, store = reference
+    plain = tmp_path / "plain.zarr"
+    xr.open_zarr(store, consolidated=True).to_zarr(plain, consolidated=False,
+                                                   zarr_format=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "failed to open consolidated" warning
+        data = open_sweep(plain).load()
+    xr.testing.assert_identical(data, expected)
+
+
 def test_time_series_are_off_by_default(tmp_path):
     data = run_sweep(document(batch_size=4), tmp_path / "s.zarr", progress=False)
     assert "time" not in data.dims and "relative_position" not in data
@@ -124,15 +159,24 @@ def test_failing_cases_are_recorded_and_the_sweep_goes_on(tmp_path):
     assert bool(data["done"].all())
 
 
-def _count_cases(monkeypatch, interrupt_at=None):
-    """Patch the batch call: count the cases it runs, and raise Ctrl-C at call `interrupt_at`."""
+class SimulatedInterrupt(Exception):
+    """The test's stand-in for Ctrl-C: an ordinary exception, so it cannot abort the session."""
+
+
+def _count_cases(monkeypatch, interrupt_at=None, exception=SimulatedInterrupt):
+    """Patch the batch call: count the cases it runs; raise ``exception`` at call `interrupt_at`.
+
+    The original is taken from the module now (not from an earlier patch) and the patch is
+    undone by ``monkeypatch`` (pass ``monkeypatch.context()`` to undo it sooner). The
+    interruption fires once, so a later run through the same patch cannot raise it.
+    """
     calls = []
     original = sweep_backends.simulate_batch
 
     def patched(cases, *args, **kwargs):
         calls.append(len(cases))
         if interrupt_at is not None and len(calls) == interrupt_at:
-            raise KeyboardInterrupt
+            raise exception("interrupted by the test")
         return original(cases, *args, **kwargs)
 
     monkeypatch.setattr(sweep_backends, "simulate_batch", patched)
@@ -142,18 +186,20 @@ def _count_cases(monkeypatch, interrupt_at=None):
 def test_resume_after_an_interrupt_gives_the_same_dataset(reference, tmp_path, monkeypatch):
     definition, expected, _ = reference
     store = tmp_path / "resumed.zarr"
-    calls = _count_cases(monkeypatch, interrupt_at=2)
-    with pytest.raises(KeyboardInterrupt):
-        run_sweep(definition, store, progress=False)
+    unpatched = sweep_backends.simulate_batch
+    with monkeypatch.context() as patch:
+        calls = _count_cases(patch, interrupt_at=2)
+        with pytest.raises(SimulatedInterrupt):
+            run_sweep(definition, store, progress=False)
+        assert calls == [2, 2]
+    assert sweep_backends.simulate_batch is unpatched  # the interrupting patch is gone
     partial = load(store)
     assert partial["done"].values.tolist() == [True, True, False, False]
     with pytest.raises(ParameterError, match="exists; pass `resume`"):
         run_sweep(definition, store, progress=False)
-    calls.clear()
-    monkeypatch.setattr(sweep_backends, "simulate_batch", sweep_backends.simulate_batch)
     calls = _count_cases(monkeypatch)
     resumed = run_sweep(definition, store, resume=True, progress=False).load()
-    assert sum(calls) == 2  # only the batch that was not stored
+    assert calls == [2]  # only the batch that was not stored
     xr.testing.assert_identical(resumed, expected)
 
 
@@ -285,9 +331,32 @@ def test_command_runs_prints_and_refuses_reuse(sweep_file, tmp_path, capsys):
 
 def test_command_interrupt_exits_130_with_the_resume_hint(sweep_file, tmp_path, capsys,
                                                           monkeypatch):
-    _count_cases(monkeypatch, interrupt_at=1)
+    _count_cases(monkeypatch, interrupt_at=1, exception=KeyboardInterrupt)  # a real Ctrl-C
     store = tmp_path / "int.zarr"
-    assert run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store),
-                                   "--quiet")) == 130
+    try:
+        code = run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store),
+                                       "--quiet"))
+    except KeyboardInterrupt:  # must not escape: it would end the whole pytest session
+        pytest.fail("Ctrl-C escaped `qzs sweep` instead of ending it with exit code 130")
+    assert code == 130
     err = capsys.readouterr().err
     assert "0 of 4 cases are stored" in err and "--resume" in err
+
+
+def test_command_sigterm_exits_143_with_the_resume_hint(sweep_file, tmp_path, capsys,
+                                                        monkeypatch):
+    from qzs.errors import Terminated
+
+    _count_cases(monkeypatch, interrupt_at=1, exception=lambda message: Terminated(15))
+    store = tmp_path / "term.zarr"
+    try:
+        code = run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store),
+                                       "--quiet"))
+    except Terminated:
+        pytest.fail("SIGTERM's exception escaped `qzs sweep` instead of ending it with 143")
+    assert code == 143
+    err = capsys.readouterr().err
+    assert "terminated; 0 of 4 cases are stored" in err and "--resume" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "term.zarr"]
+    assert run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store), "--resume",
+                                   "--quiet")) == 0

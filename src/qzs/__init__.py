@@ -22,7 +22,8 @@ from qzs.engine.results import SimulationResult
 from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
-                        MissingDependencyError, ParameterError, SimulationError, StabilityError)
+                        MissingDependencyError, OutputPathError, ParameterError,
+                        ResultTooLargeError, SimulationError, StabilityError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
                        IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
@@ -39,6 +40,7 @@ _LAZY = {
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
     "load_config": "qzs.iotools", "read_result": "qzs.iotools",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
+    "simulate_to_file": "qzs.workflows.run",
 }
 
 __all__ = [
@@ -49,7 +51,8 @@ __all__ = [
     "spring_force", "spring_stiffness", "friction_force",
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
-    "DataError", "FitError", "MissingDependencyError", "DataWarning", "FitWarning",
+    "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
+    "DataWarning", "FitWarning",
     *_LAZY,
 ]
 

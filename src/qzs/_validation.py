@@ -102,7 +102,11 @@ def finite_series(name, values, error, fix="interpolate or trim them first"):
 
 
 def read_toml(path, what, error=ParameterError):
-    """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad."""
+    """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad.
+
+    A missing file, a folder, a file that is not UTF-8 text (a binary file given by
+    mistake) and invalid TOML each get a message naming the file and the fix.
+    """
     import tomllib
 
     path = Path(path)
@@ -111,6 +115,13 @@ def read_toml(path, what, error=ParameterError):
             return tomllib.load(handle)
     except FileNotFoundError:
         raise error(f"{what} not found: {str(path)!r}.") from None
+    except IsADirectoryError:
+        raise error(f"{what} {str(path)!r} is a folder; pass the TOML file.") from None
+    except UnicodeDecodeError as err:
+        raise error(
+            f"{what} {str(path)!r} is not UTF-8 text (byte {err.object[err.start]:#04x} at "
+            f"position {err.start}), so it is not a TOML file; was a binary file (a log, a "
+            "figure, a result) given by mistake? Pass the TOML file.") from None
     except tomllib.TOMLDecodeError as err:
         raise error(f"{what} {str(path)!r} is not valid TOML: {err}.") from None
 

@@ -8,6 +8,7 @@ message is for people, never for parsing.
 
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
+           "OutputPathError", "ResultTooLargeError", "WriteError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -43,12 +44,90 @@ class CaseError(ParameterError):
         return type(self), (self.index, self.reason)
 
 
+class OutputPathError(ParameterError):
+    """An output path cannot be written (extension, folder, permissions, free space).
+
+    Raised by :func:`qzs.iotools.paths.check_output_path` before any long work starts.
+
+    Attributes
+    ----------
+    argument : str
+        The option or parameter that named the path (``"--out"``, ``"out"``).
+    value : str
+        The path as given.
+    reason : str
+        What is wrong and the fix.
+    """
+
+    def __init__(self, argument, value, reason):
+        self.argument, self.value, self.reason = str(argument), str(value), str(reason)
+        super().__init__(f"{self.argument} {self.value!r} {self.reason}.")
+
+    def __reduce__(self):
+        return type(self), (self.argument, self.value, self.reason)
+
+
+class ResultTooLargeError(ParameterError):
+    """A run's result would not fit in memory; raised before the run starts.
+
+    Attributes
+    ----------
+    needed : int
+        Memory the result would take [bytes].
+    available : int
+        Memory available now [bytes].
+    duration : float
+        The run's simulated time [s].
+    sample_rate : float
+        The run's output rate [Hz].
+    """
+
+    def __init__(self, needed, available, duration, sample_rate):
+        self.needed, self.available = int(needed), int(available)
+        self.duration, self.sample_rate = float(duration), float(sample_rate)
+        gib = 1024 ** 3
+        super().__init__(
+            f"a {self.duration:g} s run at {self.sample_rate:g} Hz keeps "
+            f"{self.needed / gib:.2f} GiB of samples, more than half the {self.available / gib:.2f} "
+            "GiB of memory available; stream it to a file instead (`--out FILE.nc` on the "
+            "command line, `qzs.simulate_to_file` in Python), or lower the "
+            "`sample_rate` or the `duration`.")
+
+    def __reduce__(self):
+        return type(self), (self.needed, self.available, self.duration, self.sample_rate)
+
+
 class SimulationError(RuntimeError):
     """A simulation diverged or produced non-finite values (names the time and state)."""
 
 
 class DataError(ValueError):
     """An input data file or signal is malformed (missing channel, bad time base, NaN)."""
+
+
+class WriteError(DataError):
+    """A file could not be written (disk full, permissions, read-only file system).
+
+    Nothing is left behind: the temporary file is removed and the target untouched.
+
+    Attributes
+    ----------
+    path : Path
+        The file being written.
+    reason : str
+        What went wrong (``"the disk is full"``, ``"permission denied"``, ...).
+    message : str, optional
+        The message for people; default ``cannot write <path>: <reason>.``
+    """
+
+    def __init__(self, path, reason, message=None):
+        from pathlib import Path
+
+        self.path, self.reason = Path(path), str(reason)
+        super().__init__(message or f"cannot write {str(self.path)!r}: {self.reason}.")
+
+    def __reduce__(self):
+        return type(self), (self.path, self.reason, str(self))
 
 
 class FitError(RuntimeError):
@@ -76,6 +155,33 @@ class MissingDependencyError(ImportError):
 
     def __reduce__(self):
         return type(self), (self.package, self.extra, self.feature)
+
+
+class Terminated(BaseException):
+    """The process received a termination signal (SIGTERM) and unwinds to exit.
+
+    A ``BaseException``, like ``KeyboardInterrupt``, so that ``except Exception``
+    does not swallow it while ``finally`` blocks and context managers still run
+    (atomic writers remove their temporary files). :func:`qzs.cli.main` raises it
+    from its SIGTERM handler and exits with :attr:`exit_code`.
+
+    Attributes
+    ----------
+    signum : int
+        The signal's number (15 for SIGTERM).
+    """
+
+    def __init__(self, signum=15):
+        self.signum = int(signum)
+        super().__init__(f"terminated by signal {self.signum}")
+
+    @property
+    def exit_code(self):
+        """The shell's convention for a death by signal: 128 + the signal's number [-]."""
+        return 128 + self.signum
+
+    def __reduce__(self):
+        return type(self), (self.signum,)
 
 
 class DataWarning(UserWarning):

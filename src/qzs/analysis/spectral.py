@@ -1,14 +1,22 @@
 """Transmissibility estimation and metrics for a base-excited isolator.
 
 Pure numpy/scipy.signal: Welch spectra of base and payload acceleration, their ratio
-(the paper's 'transmissibility', Section 4), and scalar metrics read off the curve.
+(the paper's 'transmissibility', Section 4), which of its bins can be trusted, and
+scalar metrics read off the trusted bins only (docs/model.md §10).
 Segments follow scipy's rule: ``step = fft_length - round(overlap * fft_length)`` and
 ``n_averages = (n_samples - noverlap) // step``.
+
+A bin is *trusted* when it is above 0 Hz, its magnitude-squared coherence is at least
+``ANALYSIS["coherence_min"]``, it holds at least ``ANALYSIS["base_share_min"]`` of the
+base's own power (DC excluded), and it lies at or above ``ANALYSIS["highpass_factor"]``
+times a measurement high-pass corner. Every metric comes from trusted bins, or is NaN
+with the reason in :attr:`TransmissibilityMetrics.reasons`.
 """
 from __future__ import annotations
 
 import numbers
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
 
@@ -17,12 +25,12 @@ from scipy import signal
 
 from qzs._validation import finite_series, integer
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
-from qzs.errors import DataError, ParameterError
+from qzs.errors import DataError, DataWarning, ParameterError
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
-           "highpass",
-           "required_duration", "required_samples", "transmissibility",
-           "transmissibility_metrics", "welch_average_count"]
+           "highpass", "required_duration", "required_samples", "transmissibility",
+           "transmissibility_at", "transmissibility_metrics", "trusted_bins",
+           "welch_average_count"]
 
 ESTIMATORS = ("psd_ratio", "h1", "h2")
 _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
@@ -76,7 +84,7 @@ def highpass(values, corner, sample_rate):
     return signal.lfilter(b, a, values)
 
 
-def band_mask(frequency, low, high):
+def band_mask(frequency, low, high, trusted=None):
     """Bins of ``frequency`` in the closed band ``[low, high]`` [Hz], never the DC bin.
 
     The one rule every band in qzs follows (curves kept, band means, fits, figures):
@@ -89,13 +97,81 @@ def band_mask(frequency, low, high):
         Bin frequencies [Hz].
     low, high : float
         Band edges [Hz].
+    trusted : array_like of bool, optional
+        Keep only these bins too (:attr:`TransmissibilityEstimate.trusted`); a band
+        left with no trusted bin raises a :class:`~qzs.errors.DataWarning`.
 
     Returns
     -------
     ndarray of bool
     """
     f = np.asarray(frequency, dtype=float)
-    return (f > 0) & (f >= low) & (f <= high)
+    mask = (f > 0) & (f >= low) & (f <= high)
+    if trusted is not None:
+        trusted = np.asarray(trusted, dtype=bool)
+        if trusted.shape != f.shape:
+            raise ParameterError(f"`trusted` must have the shape of `frequency` {f.shape}, "
+                                 f"got {trusted.shape}.")
+        mask &= trusted
+        if not mask.any():
+            warnings.warn(f"no trusted bin in the band [{low:g}, {high:g}] Hz: a mean, maximum "
+                          "or fit over it is undefined (NaN)", DataWarning, stacklevel=2)
+    return mask
+
+
+def trusted_bins(frequency, coherence, base_share, *, coherence_min=ANALYSIS["coherence_min"],
+                 base_share_min=ANALYSIS["base_share_min"], highpass_corner=None,
+                 highpass_factor=ANALYSIS["highpass_factor"], magnitude=None):
+    """The bins of a transmissibility estimate that can be trusted (docs/model.md §10).
+
+    A bin is trusted when all hold: it is above 0 Hz; its magnitude-squared coherence
+    is at least ``coherence_min`` (the payload's power there is explained by the base's;
+    the PSD ratio then exceeds the coherent response ``|H1|`` by at most
+    ``1/sqrt(coherence_min)``); it holds at least ``base_share_min`` of the base's power
+    (the base excited it at all); it lies at or above ``highpass_factor * highpass_corner``;
+    and its magnitude, if given, is finite.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (n,)
+        Bin frequencies [Hz].
+    coherence : array_like, shape (n,)
+        Magnitude-squared coherence of base and payload [-], 0..1.
+    base_share : array_like, shape (n,)
+        Each bin's share of the base's power, DC excluded [-].
+    coherence_min : float
+        Least coherence of a trusted bin [-], in (0, 1].
+    base_share_min : float
+        Least share of the base's power of a trusted bin [-], >= 0.
+    highpass_corner : float, optional
+        High-pass corner of the measurement chain [Hz]; bins below
+        ``highpass_factor * highpass_corner`` are untrusted.
+    highpass_factor : float
+        Multiple of the corner below which bins are untrusted [-].
+    magnitude : array_like, shape (n,), optional
+        The transmissibility [-]; non-finite bins are untrusted.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+    """
+    f = np.asarray(frequency, dtype=float)
+    if isinstance(coherence_min, bool) or not isinstance(coherence_min, numbers.Real) \
+            or not 0 < coherence_min <= 1:
+        raise ParameterError(f"`coherence_min` must be in (0, 1], got {coherence_min!r}.")
+    if isinstance(base_share_min, bool) or not isinstance(base_share_min, numbers.Real) \
+            or not 0 <= base_share_min < 1:
+        raise ParameterError(f"`base_share_min` must be in [0, 1), got {base_share_min!r}.")
+    corner = _positive("highpass_corner", highpass_corner, allow_none=True)
+    factor = _positive("highpass_factor", highpass_factor)
+    with np.errstate(invalid="ignore"):
+        mask = ((f > 0) & (np.asarray(coherence, dtype=float) >= coherence_min)
+                & (np.asarray(base_share, dtype=float) >= base_share_min))
+    if corner is not None:
+        mask &= f >= factor * corner
+    if magnitude is not None:
+        mask &= np.isfinite(np.asarray(magnitude, dtype=float))
+    return mask
 
 
 # ---------------------------------------------------------------- run sizing
@@ -186,6 +262,13 @@ class TransmissibilityEstimate:
         Phase of payload relative to base [rad]; NaN for ``psd_ratio``.
     coherence : ndarray, shape (n,)
         Magnitude-squared coherence [-], 0..1.
+    base_share : ndarray, shape (n,)
+        Each bin's share of the base's power [-], ``S_base / sum(S_base)`` over the bins
+        above 0 Hz (0 at DC).
+    trusted : ndarray of bool, shape (n,)
+        The bins metrics may use (:func:`trusted_bins`): never DC, coherence at least
+        ``coherence_min``, base share at least ``base_share_min``, at or above
+        ``highpass_factor * highpass_corner``, finite magnitude.
     estimator : str
         ``"psd_ratio"``, ``"h1"`` or ``"h2"``.
     fft_length, n_averages : int
@@ -194,17 +277,31 @@ class TransmissibilityEstimate:
         Sample rate [Hz].
     highpass_corner : float or None
         Corner of a high-pass filter in the measurement chain [Hz], if any.
+    coherence_min, base_share_min : float
+        The thresholds ``trusted`` was drawn with [-].
+    highpass_factor : float
+        Multiple of ``highpass_corner`` below which bins are untrusted [-].
     """
 
     frequency: np.ndarray
     magnitude: np.ndarray
     phase: np.ndarray
     coherence: np.ndarray
+    base_share: np.ndarray
+    trusted: np.ndarray
     estimator: str
     fft_length: int
     n_averages: int
     sample_rate: float
     highpass_corner: float | None = None
+    coherence_min: float = ANALYSIS["coherence_min"]
+    base_share_min: float = ANALYSIS["base_share_min"]
+    highpass_factor: float = ANALYSIS["highpass_factor"]
+
+    @property
+    def untrusted_below(self):
+        """Upper edge of the high-pass's untrusted band [Hz]: ``highpass_factor * highpass_corner``, or 0."""
+        return 0.0 if self.highpass_corner is None else self.highpass_factor * self.highpass_corner
 
     def magnitude_db(self):
         """Magnitude in decibels, ``20 * log10(magnitude)`` [dB] (-inf where it is 0)."""
@@ -212,8 +309,21 @@ class TransmissibilityEstimate:
             return 20.0 * np.log10(self.magnitude)
 
     def metrics(self, **options):
-        """Scalar metrics of this curve; keywords go to :func:`transmissibility_metrics`."""
+        """Scalar metrics of this curve's trusted bins (:func:`transmissibility_metrics`).
+
+        Parameters
+        ----------
+        **options
+            Keywords of :func:`transmissibility_metrics`; ``trusted``,
+            ``highpass_corner`` and ``untrusted_factor`` default to this estimate's.
+
+        Returns
+        -------
+        TransmissibilityMetrics
+        """
+        options.setdefault("trusted", self.trusted)
         options.setdefault("highpass_corner", self.highpass_corner)
+        options.setdefault("untrusted_factor", self.highpass_factor)
         return transmissibility_metrics(self.frequency, self.magnitude, **options)
 
     def to_xarray(self):
@@ -222,22 +332,32 @@ class TransmissibilityEstimate:
 
         name = _MAGNITUDE_NAMES[self.estimator]
         attrs = {"estimator": self.estimator, "fft_length": self.fft_length,
-                 "n_averages": self.n_averages, "sample_rate": self.sample_rate}
+                 "n_averages": self.n_averages, "sample_rate": self.sample_rate,
+                 "coherence_min": self.coherence_min, "base_share_min": self.base_share_min,
+                 "highpass_factor": self.highpass_factor}
         if self.highpass_corner is not None:
             attrs["highpass_corner"] = self.highpass_corner
         variables = {"magnitude": (self.magnitude, "1", f"transmissibility, {name}"),
                      "phase": (self.phase, "rad", "phase of payload relative to base"),
-                     "coherence": (self.coherence, "1", "magnitude-squared coherence")}
-        return xr.Dataset({key: ("frequency", values, {"units": units, "long_name": long_name})
-                           for key, (values, units, long_name) in variables.items()},
-                          coords={"frequency": ("frequency", self.frequency,
-                                                {"units": "Hz", "long_name": "frequency"})},
-                          attrs=attrs)
+                     "coherence": (self.coherence, "1", "magnitude-squared coherence"),
+                     "base_share": (self.base_share, "1", "share of the base's power"),
+                     "trusted": (self.trusted.astype("i1"), "1",
+                                 "1 where the bin is trusted (docs/model.md section 10)")}
+        dataset = xr.Dataset({key: ("frequency", values, {"units": units, "long_name": long_name})
+                              for key, (values, units, long_name) in variables.items()},
+                              coords={"frequency": ("frequency", self.frequency,
+                                                    {"units": "Hz", "long_name": "frequency"})},
+                              attrs=attrs)
+        dataset["trusted"].attrs.update(flag_values=np.array([0, 1], dtype="i1"),
+                                        flag_meanings="untrusted trusted")
+        return dataset
 
 
 def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_length"],
                      overlap=ANALYSIS["overlap"], window="hann",
-                     n_averages=None, estimator="psd_ratio", detrend="constant", highpass_corner=None):
+                     n_averages=None, estimator="psd_ratio", detrend="constant", highpass_corner=None,
+                     coherence_min=ANALYSIS["coherence_min"], base_share_min=ANALYSIS["base_share_min"],
+                     highpass_factor=ANALYSIS["highpass_factor"]):
     """Estimate the transmissibility from base to payload acceleration by Welch averaging.
 
     Parameters
@@ -262,11 +382,20 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
     detrend : str, callable or False
         Per-segment detrending, as in ``scipy.signal.welch``.
     highpass_corner : float, optional
-        High-pass corner of the measurement chain [Hz], recorded for the metrics.
+        High-pass corner of the measurement chain [Hz]: bins below
+        ``highpass_factor * highpass_corner`` are untrusted.
+    coherence_min : float
+        Least magnitude-squared coherence of a trusted bin [-] (:func:`trusted_bins`).
+    base_share_min : float
+        Least share of the base's power of a trusted bin [-] (:func:`trusted_bins`).
+    highpass_factor : float
+        Multiple of ``highpass_corner`` below which bins are untrusted [-].
 
     Returns
     -------
     TransmissibilityEstimate
+        With ``trusted``, the bins metrics may use, and the ``coherence`` and
+        ``base_share`` arrays that define it.
 
     Raises
     ------
@@ -299,24 +428,35 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
     kw = dict(fs=sample_rate, window=window, nperseg=fft_length, noverlap=noverlap, detrend=detrend)
     with np.errstate(divide="ignore", invalid="ignore"):
         frequency, coherence = signal.coherence(base, payload, **kw)
+        s_bb = signal.welch(base, **kw)[1]
         if estimator == "psd_ratio":
-            s_bb, s_pp = signal.welch(base, **kw)[1], signal.welch(payload, **kw)[1]
+            s_pp = signal.welch(payload, **kw)[1]
             magnitude = np.sqrt(np.divide(s_pp, s_bb, out=np.full_like(s_pp, np.nan), where=s_bb > 0))
             phase = np.full_like(magnitude, np.nan)
         else:
             if estimator == "h1":
-                numerator, denominator = signal.csd(base, payload, **kw)[1], signal.welch(base, **kw)[1]
+                numerator, denominator = signal.csd(base, payload, **kw)[1], s_bb
             else:
                 numerator, denominator = signal.welch(payload, **kw)[1], signal.csd(payload, base, **kw)[1]
             response = np.divide(numerator, denominator, out=np.full(frequency.shape, np.nan, complex),
                                  where=np.abs(denominator) > 0)
             magnitude, phase = np.abs(response), np.angle(response)
-    arrays = [np.asarray(a, dtype=float) for a in (frequency, magnitude, phase, np.clip(coherence, 0, 1))]
+        total = float(np.sum(s_bb[frequency > 0]))
+        base_share = np.where(frequency > 0, s_bb / total if total > 0 else 0.0, 0.0)
+        coherence = np.nan_to_num(np.clip(coherence, 0, 1), nan=0.0)
+    trusted = trusted_bins(frequency, coherence, base_share, coherence_min=coherence_min,
+                           base_share_min=base_share_min, highpass_corner=highpass_corner,
+                           highpass_factor=highpass_factor, magnitude=magnitude)
+    arrays = [np.asarray(a, dtype=float) for a in (frequency, magnitude, phase, coherence, base_share)]
+    arrays.append(trusted)
     for array in arrays:
         array.setflags(write=False)
     return TransmissibilityEstimate(*arrays, estimator=estimator, fft_length=fft_length,
                                     n_averages=welch_average_count(base.size, fft_length, overlap),
-                                    sample_rate=sample_rate, highpass_corner=highpass_corner)
+                                    sample_rate=sample_rate, highpass_corner=highpass_corner,
+                                    coherence_min=float(coherence_min),
+                                    base_share_min=float(base_share_min),
+                                    highpass_factor=float(highpass_factor))
 
 
 def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_length"], window="hann",
@@ -359,18 +499,27 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
 
 
 # ---------------------------------------------------------------- metrics
+#: The scalar metrics, in the order of :meth:`TransmissibilityMetrics.to_dict`.
+METRIC_NAMES = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
+                "rolloff_db_per_decade", "untrusted_below")
+
+
+def _spot_key(frequency):
+    return f"transmissibility_at_{frequency:g}_hz"
+
+
 @dataclass(frozen=True)
 class TransmissibilityMetrics:
-    """Scalar metrics of a transmissibility curve; frequencies in [Hz], ratios [-].
+    """Scalar metrics of a transmissibility curve's trusted bins; frequencies [Hz], ratios [-].
 
-    NaN marks a metric the curve does not define (see :func:`transmissibility_metrics`).
+    NaN marks a metric the trusted bins do not define; ``reasons`` says why.
 
     Attributes
     ----------
     resonance_frequency : float
-        Frequency of the maximum over the trusted band [Hz].
+        Frequency of the resonance peak over the trusted bins [Hz].
     resonance_peak : float
-        Transmissibility at that maximum, an amplitude ratio [-].
+        Transmissibility at that peak, an amplitude ratio [-].
     isolation_onset : float
         Frequency above which the transmissibility stays below 1 [Hz].
     minus_3db_frequency : float
@@ -380,7 +529,12 @@ class TransmissibilityMetrics:
     rolloff_db_per_decade : float
         Least-squares slope of ``20 log10 T`` against ``log10 f`` [dB/decade].
     untrusted_below : float
-        Frequency below which the curve is untrusted [Hz]; 0 if all of it is trusted.
+        Frequency below which a measurement high-pass makes the curve untrusted [Hz];
+        0 without one.
+    reasons : Mapping[str, str]
+        For each metric that is NaN (keys of :meth:`to_dict`), why it is undefined.
+    trusted_range : (float, float)
+        Lowest and highest trusted bin [Hz, Hz]; NaN, NaN if no bin is trusted.
     """
 
     resonance_frequency: float
@@ -390,14 +544,28 @@ class TransmissibilityMetrics:
     at: Mapping[float, float]
     rolloff_db_per_decade: float
     untrusted_below: float
+    reasons: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    trusted_range: tuple = (float("nan"), float("nan"))
 
     def to_dict(self):
-        """Flat dict; ``at`` becomes keys ``transmissibility_at_<f>_hz``."""
-        names = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
-                 "rolloff_db_per_decade", "untrusted_below")
-        out = {name: getattr(self, name) for name in names}
-        out.update({f"transmissibility_at_{f:g}_hz": value for f, value in self.at.items()})
+        """Flat dict of the values; ``at`` becomes keys ``transmissibility_at_<f>_hz``."""
+        out = {name: getattr(self, name) for name in METRIC_NAMES}
+        out.update({_spot_key(f): value for f, value in self.at.items()})
         return out
+
+    def reason(self, name):
+        """Why metric ``name`` (a key of :meth:`to_dict`) is NaN; ``""`` if it is defined.
+
+        Parameters
+        ----------
+        name : str
+            A key of :meth:`to_dict`.
+
+        Returns
+        -------
+        str
+        """
+        return self.reasons.get(name, "")
 
 
 def _crossing(frequency, magnitude, j, level):
@@ -406,12 +574,23 @@ def _crossing(frequency, magnitude, j, level):
     return float(frequency[j] + fraction * (frequency[j + 1] - frequency[j]))
 
 
-def _curve(frequency, magnitude):
-    """Validated (frequency, magnitude) without the DC bin."""
+def _curve(frequency, magnitude, trusted=None):
+    """Validated (frequency, magnitude, trusted) without the DC bin.
+
+    Without ``trusted`` every bin above 0 Hz is trusted and must be finite; with it,
+    non-finite bins are allowed and untrusted.
+    """
     f, t = np.asarray(frequency, dtype=float), np.asarray(magnitude, dtype=float)
     if f.ndim != 1 or f.shape != t.shape:
         raise ParameterError(f"`frequency` and `magnitude` must be 1-D of the same shape, "
                              f"got {f.shape} and {t.shape}.")
+    if trusted is None:
+        ok = np.ones(f.shape, dtype=bool)
+    else:
+        ok = np.asarray(trusted)
+        if ok.shape != f.shape or ok.dtype != bool:
+            raise ParameterError(f"`trusted` must be a boolean array of the shape of `frequency` "
+                                 f"{f.shape}, got {ok.dtype} {ok.shape}.")
     if not np.all(np.isfinite(f)) or np.any(f < 0):
         raise ParameterError(f"`frequency` must be finite and non-negative [Hz], "
                              f"got {np.count_nonzero(~(f >= 0))} values that are not.")
@@ -419,95 +598,248 @@ def _curve(frequency, magnitude):
         k = int(np.flatnonzero(np.diff(f) <= 0)[0])
         raise ParameterError(f"`frequency` must be strictly increasing, got frequency[{k + 1}]={f[k + 1]:g} "
                              f"after frequency[{k}]={f[k]:g}; sort the curve first.")
-    f, t = f[f > 0], t[f > 0]
+    above = f > 0
+    f, t, ok = f[above], t[above], ok[above]
     if f.size < 2:
         raise ParameterError(f"the curve needs at least 2 points above 0 Hz, got {f.size}.")
-    bad = np.count_nonzero(~np.isfinite(t))
-    if bad:
-        raise ParameterError(f"`magnitude` has {bad} non-finite values above 0 Hz; drop those bins first.")
-    if np.any(t < 0):
-        raise ParameterError(f"`magnitude` must be non-negative (an amplitude ratio), got minimum {t.min():g}.")
-    return f, t
+    finite = np.isfinite(t)
+    if trusted is None and not finite.all():
+        raise ParameterError(f"`magnitude` has {np.count_nonzero(~finite)} non-finite values above "
+                             "0 Hz; drop those bins first, or pass `trusted` without them.")
+    if np.any(t[finite] < 0):
+        raise ParameterError(f"`magnitude` must be non-negative (an amplitude ratio), got minimum "
+                             f"{t[finite].min():g}.")
+    return f, t, ok & finite
 
 
-def transmissibility_metrics(frequency, magnitude, *, at_frequencies=REPORTED_FREQUENCIES,
-                             highpass_corner=None, untrusted_factor=1.5, rolloff_band=None):
-    """Resonance, isolation band, roll-off and spot values of a transmissibility curve.
+def _spot(f, t, ok, at, untrusted_below=0.0):
+    """Transmissibility at ``at`` [Hz] between two adjacent trusted bins: (value, reason)."""
+    nan = float("nan")
+    if not f[0] <= at <= f[-1]:
+        return nan, f"{at:g} Hz lies outside the curve ({f[0]:g} to {f[-1]:g} Hz)"
+    k = int(np.searchsorted(f, at))
+    used = (k,) if f[k] == at else (k - 1, k)
+    if not all(ok[i] for i in used):
+        why = (f"below {untrusted_below:g} Hz, the high-pass limit" if f[used[0]] < untrusted_below
+               else "low coherence or no base power")
+        return nan, f"{at:g} Hz lies in untrusted bins ({', '.join(f'{f[i]:.4g}' for i in used)} Hz: {why})"
+    return float(np.interp(at, f[list(used)], t[list(used)])), ""
 
-    The DC bin (frequency 0) is dropped before anything else. Crossings are linearly
-    interpolated between bins.
+
+def transmissibility_at(frequency, magnitude, at_frequencies, *, trusted=None):
+    """Transmissibility at ``at_frequencies``, linearly interpolated between trusted bins.
+
+    A value comes only from two adjacent trusted bins (or one trusted bin at exactly
+    that frequency); elsewhere it is NaN.
 
     Parameters
     ----------
     frequency : array_like, shape (n,)
         Strictly increasing, non-negative frequencies [Hz].
     magnitude : array_like, shape (n,)
-        Transmissibility as amplitude ratio [-], finite and non-negative.
+        Transmissibility as amplitude ratio [-].
+    at_frequencies : float or sequence of float
+        Where to read the curve [Hz].
+    trusted : array_like of bool, shape (n,), optional
+        The bins that may be used (:attr:`TransmissibilityEstimate.trusted`); default all
+        above 0 Hz.
+
+    Returns
+    -------
+    ndarray
+        One value [-] per frequency of ``at_frequencies``, NaN where undefined.
+    """
+    f, t, ok = _curve(frequency, magnitude, trusted)
+    spots = np.atleast_1d(np.asarray(at_frequencies, dtype=float))
+    return np.array([_spot(f, t, ok, float(at))[0] for at in spots])
+
+
+def _describe(f, ok):
+    idx = np.flatnonzero(ok)
+    return f"{f[idx[0]]:.3g} to {f[idx[-1]]:.3g} Hz" if idx.size else "none"
+
+
+def _resonance(f, t, ok, peak_min):
+    """(index or None, reason) of the resonance peak over the trusted bins."""
+    idx = np.flatnonzero(ok)
+    i = int(idx[np.argmax(t[idx])])
+    problems = []
+    if i == 0:
+        problems.append("is the curve's lowest bin")
+    elif not ok[i - 1]:
+        problems.append(f"borders untrusted bins below it ({f[i - 1]:.3g} Hz), where a peak "
+                        "cannot be seen")
+    if i == f.size - 1:
+        problems.append("is the curve's highest bin")
+    elif not ok[i + 1]:
+        problems.append(f"borders untrusted bins above it ({f[i + 1]:.3g} Hz), where a peak "
+                        "cannot be seen")
+    if t[i] <= peak_min:
+        problems.append(f"is not above {peak_min:.3g} (+{20 * np.log10(peak_min):.2g} dB), which "
+                        "a payload moving with the base (T = 1: locked by stiction, or "
+                        "overdamped) can show at the least trusted coherence")
+    if problems:
+        return None, (f"no resonance peak in the trusted bins: their maximum, T = {t[i]:.3g} at "
+                      f"{f[i]:.3g} Hz, " + "; it ".join(problems))
+    return i, ""
+
+
+def _onset(f, t, ok):
+    """(isolation onset [Hz], reason)."""
+    nan = float("nan")
+    idx = np.flatnonzero(ok)
+    above_one = idx[t[idx] >= 1.0]
+    if above_one.size == 0:
+        if idx[0] == 0:
+            return float(f[0]), ""
+        return nan, (f"T < 1 over every trusted bin ({_describe(f, ok)}): the onset lies at or "
+                     f"below {f[idx[0]]:.3g} Hz, where the curve is untrusted")
+    j = int(above_one[-1])
+    if j == idx[-1]:
+        if j == f.size - 1:
+            return nan, f"T >= 1 at the top of the curve ({f[j]:.3g} Hz): no isolation"
+        return nan, (f"T >= 1 at the highest trusted bin ({f[j]:.3g} Hz); above it the curve is "
+                     "untrusted")
+    if not ok[j + 1]:
+        return nan, (f"T falls below 1 after {f[j]:.3g} Hz, across untrusted bins up to "
+                     f"{f[idx[np.searchsorted(idx, j) + 1]]:.3g} Hz")
+    return _crossing(f, t, j, 1.0), ""
+
+
+def _minus_3db(f, t, ok, i):
+    """(-3 dB frequency [Hz], reason) above the resonance at index ``i``."""
+    level = t[i] / np.sqrt(2.0)
+    for k in range(i + 1, f.size):
+        if not ok[k]:
+            return float("nan"), (f"T has not fallen to peak/sqrt(2) = {level:.3g} before the "
+                                  f"untrusted bin at {f[k]:.3g} Hz")
+        if t[k] <= level:
+            return _crossing(f, t, k - 1, level), ""
+    return float("nan"), f"T stays above peak/sqrt(2) = {level:.3g} up to the top of the curve"
+
+
+def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequencies=REPORTED_FREQUENCIES,
+                             highpass_corner=None, untrusted_factor=ANALYSIS["highpass_factor"],
+                             rolloff_band=None, peak_min=None):
+    """Resonance, isolation band, roll-off and spot values of a transmissibility curve.
+
+    Every metric comes from trusted bins only: the DC bin is never used, nor bins
+    outside ``trusted``, nor bins below ``untrusted_factor * highpass_corner``. A metric
+    the trusted bins do not define is NaN, with the reason in
+    :attr:`TransmissibilityMetrics.reasons`. Crossings are linearly interpolated
+    between adjacent trusted bins, never across an untrusted one.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (n,)
+        Strictly increasing, non-negative frequencies [Hz].
+    magnitude : array_like, shape (n,)
+        Transmissibility as amplitude ratio [-], non-negative; finite where trusted.
+    trusted : array_like of bool, shape (n,), optional
+        The bins that may be used (:attr:`TransmissibilityEstimate.trusted`); default
+        every bin above 0 Hz (an exact curve).
     at_frequencies : sequence of float
-        Frequencies [Hz] at which to report the transmissibility (NaN outside the curve).
+        Frequencies [Hz] at which to report the transmissibility (:func:`transmissibility_at`).
     highpass_corner : float, optional
-        High-pass corner of the measurement chain [Hz]; results below
-        ``untrusted_factor * highpass_corner`` are untrusted (the paper: 1 Hz -> ~1.5 Hz).
+        High-pass corner of the measurement chain [Hz]; bins below
+        ``untrusted_factor * highpass_corner`` are untrusted (the paper: 1 Hz -> 1.5 Hz).
     untrusted_factor : float
-        Multiple of the corner below which the curve is untrusted.
+        Multiple of the corner below which the curve is untrusted [-].
     rolloff_band : (float, float), optional
         Band [Hz] for the roll-off fit; default from twice the isolation onset to the top.
+    peak_min : float, optional
+        Least transmissibility of a resonance peak [-]; default
+        ``1/sqrt(ANALYSIS["coherence_min"])`` (1.054, +0.46 dB): at the least trusted
+        coherence the PSD ratio of a payload moving with the base (T = 1) can reach it.
 
     Returns
     -------
     TransmissibilityMetrics
-        ``resonance_frequency``/``resonance_peak``: maximum over the trusted band;
-        ``isolation_onset``: frequency above which T < 1 up to the top of the curve
-        (the first frequency if T < 1 everywhere, NaN if T >= 1 at the top);
+        ``resonance_frequency``/``resonance_peak``: the maximum over the trusted bins, if
+        it is a peak (both neighbours trusted and lower) above ``peak_min``;
+        ``isolation_onset``: frequency above which T < 1 over the trusted bins (the
+        first frequency if T < 1 everywhere and the first bin is trusted);
         ``minus_3db_frequency``: first frequency above resonance where T = peak / sqrt(2);
-        ``rolloff_db_per_decade``: least-squares slope of 20 log10 T against log10 f;
+        ``rolloff_db_per_decade``: least-squares slope of 20 log10 T against log10 f over
+        the trusted bins of the roll-off band (at least 3);
         ``untrusted_below``: ``untrusted_factor * highpass_corner``, or 0.
 
     Raises
     ------
     ParameterError
         Invalid curve or option.
+
+    Warns
+    -----
+    DataWarning
+        No bin of the curve is trusted: every metric is NaN.
     """
-    f, t = _curve(frequency, magnitude)
+    f, t, ok = _curve(frequency, magnitude, trusted)
     corner = _positive("highpass_corner", highpass_corner, allow_none=True)
     factor = _positive("untrusted_factor", untrusted_factor)
+    peak_min = (1.0 / np.sqrt(ANALYSIS["coherence_min"]) if peak_min is None
+                else _positive("peak_min", peak_min))
     untrusted_below = 0.0 if corner is None else factor * corner
+    ok = ok & (f >= untrusted_below)
     spots = np.atleast_1d(np.asarray(at_frequencies, dtype=float))
     if spots.ndim != 1 or not np.all(np.isfinite(spots)):
         raise ParameterError(f"`at_frequencies` must be a 1-D sequence of finite frequencies [Hz], "
                              f"got {at_frequencies!r}.")
-
-    nan = float("nan")
-    resonance_frequency = resonance_peak = minus_3db = nan
-    trusted = np.flatnonzero(f >= untrusted_below)
-    if trusted.size:
-        i = int(trusted[np.argmax(t[trusted])])
-        resonance_frequency, resonance_peak = float(f[i]), float(t[i])
-        below = np.flatnonzero(t[i:] <= resonance_peak / np.sqrt(2.0))
-        if resonance_peak > 0 and below.size:
-            minus_3db = _crossing(f, t, i + int(below[0]) - 1, resonance_peak / np.sqrt(2.0))
-    above_one = np.flatnonzero(t >= 1.0)
-    if above_one.size == 0:
-        onset = float(f[0])
-    elif above_one[-1] == f.size - 1:
-        onset = nan
-    else:
-        onset = _crossing(f, t, int(above_one[-1]), 1.0)
-
-    if rolloff_band is None:
-        low, high = 2.0 * onset, f[-1]
-    else:
+    edges = None
+    if rolloff_band is not None:
         edges = np.asarray(rolloff_band, dtype=float)
         if edges.shape != (2,) or not np.all(np.isfinite(edges)) or not 0 < edges[0] < edges[1]:
             raise ParameterError(f"`rolloff_band` must be (low, high) with 0 < low < high [Hz], "
                                  f"got {rolloff_band!r}.")
-        low, high = edges
-    band = band_mask(f, low, high) & (t > 0)
-    rolloff = nan
-    if np.count_nonzero(band) >= 3:
-        rolloff = float(np.polyfit(np.log10(f[band]), 20.0 * np.log10(t[band]), 1)[0])
-    at = {float(fa): float(np.interp(fa, f, t, left=nan, right=nan)) for fa in spots}
-    return TransmissibilityMetrics(resonance_frequency=resonance_frequency, resonance_peak=resonance_peak,
-                                   isolation_onset=onset, minus_3db_frequency=minus_3db,
-                                   at=MappingProxyType(at), rolloff_db_per_decade=rolloff,
-                                   untrusted_below=untrusted_below)
+
+    nan = float("nan")
+    values = dict.fromkeys(("resonance_frequency", "resonance_peak", "isolation_onset",
+                            "minus_3db_frequency", "rolloff_db_per_decade"), nan)
+    reasons = {}
+    at = {}
+    if not ok.any():
+        reason = (f"no trusted bin in the curve ({f[0]:.3g} to {f[-1]:.3g} Hz): coherence too low, "
+                  "base not excited" + (f" or below {untrusted_below:g} Hz (high-pass)"
+                                        if untrusted_below else ""))
+        warnings.warn(f"transmissibility metrics: {reason}; every metric is NaN", DataWarning,
+                      stacklevel=2)
+        reasons = dict.fromkeys(values, reason)
+        at = {float(fa): nan for fa in spots}
+        reasons.update({_spot_key(fa): reason for fa in at})
+        return TransmissibilityMetrics(**values, at=MappingProxyType(at), untrusted_below=untrusted_below,
+                                       reasons=MappingProxyType(reasons))
+
+    i, reason = _resonance(f, t, ok, peak_min)
+    if i is None:
+        reasons["resonance_frequency"] = reasons["resonance_peak"] = reason
+        reasons["minus_3db_frequency"] = "no resonance peak to fall from (see resonance_frequency)"
+    else:
+        values["resonance_frequency"], values["resonance_peak"] = float(f[i]), float(t[i])
+        values["minus_3db_frequency"], reason = _minus_3db(f, t, ok, i)
+        if reason:
+            reasons["minus_3db_frequency"] = reason
+    values["isolation_onset"], reason = _onset(f, t, ok)
+    if reason:
+        reasons["isolation_onset"] = reason
+
+    if edges is None and not np.isfinite(values["isolation_onset"]):
+        reasons["rolloff_db_per_decade"] = ("its band starts at twice the isolation onset, which is "
+                                            "undefined (see isolation_onset)")
+    else:
+        low, high = (2.0 * values["isolation_onset"], f[-1]) if edges is None else edges
+        band = band_mask(f, low, high) & ok & (t > 0)
+        if np.count_nonzero(band) >= 3:
+            values["rolloff_db_per_decade"] = float(
+                np.polyfit(np.log10(f[band]), 20.0 * np.log10(t[band]), 1)[0])
+        else:
+            reasons["rolloff_db_per_decade"] = (f"{np.count_nonzero(band)} trusted bin(s) in the "
+                                                f"roll-off band [{low:.3g}, {high:.3g}] Hz; a fit "
+                                                "needs 3")
+    for fa in spots:
+        at[float(fa)], reason = _spot(f, t, ok, float(fa), untrusted_below)
+        if reason:
+            reasons[_spot_key(float(fa))] = reason
+    idx = np.flatnonzero(ok)
+    return TransmissibilityMetrics(**values, at=MappingProxyType(at), untrusted_below=untrusted_below,
+                                   reasons=MappingProxyType(reasons),
+                                   trusted_range=(float(f[idx[0]]), float(f[idx[-1]])))

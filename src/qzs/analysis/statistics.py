@@ -6,7 +6,8 @@ summary.
 """
 import numpy as np
 
-__all__ = ["RunStatistics", "run_statistics", "STATISTICS"]
+__all__ = ["RunStatistics", "run_statistics", "STATISTICS", "SummaryStatistics",
+           "SUMMARY_STATISTICS"]
 
 #: Statistics of a run: name -> (unit, description).
 STATISTICS = {
@@ -85,3 +86,98 @@ def run_statistics(relative_position, motor_force, locked, stop_center):
                    np.asarray(motor_force, dtype=float)[None, :],
                    np.asarray(locked, dtype=bool)[None, :])
     return {name: float(value[0]) for name, value in statistics.result().items()}
+
+
+class SummaryStatistics:
+    """What a run's summary reports, accumulated exactly over consecutive blocks of samples.
+
+    A run that streams its samples to a file keeps only a preview in memory; its
+    summary still comes from every sample, block by block, as they are written.
+    The stroke, locked share and motor RMS come from :class:`RunStatistics` (one
+    implementation for single runs, batches and studies).
+
+    Parameters
+    ----------
+    stop_center : float
+        Centre of the stroke [m].
+    motor_force_max : float
+        The motor's force limit [N]: a sample saturates when the loops ask for it or more
+        (the conditional-integration anti-windup holds the integral at the limit).
+    """
+
+    def __init__(self, stop_center, motor_force_max):
+        self.run = RunStatistics([stop_center])
+        self.force_limit = float(motor_force_max)
+        self.count = 0
+        self.z_sum = 0.0
+        self.z_last = np.nan
+        self.contact = 0
+        self.saturated = 0
+        self.motor_peak = 0.0
+        self.energy_start = None
+        self.residual_max = 0.0
+        self.base_work_max = 0.0
+        self.time_first = np.nan
+        self.time_last = np.nan
+
+    def add(self, block):
+        """Absorb one block of consecutive samples.
+
+        Parameters
+        ----------
+        block : mapping of str to ndarray, each shape (n_samples,)
+            ``time`` [s], ``relative_position`` [m], ``motor_force`` [N], ``pi_force`` [N],
+            ``damping_force`` [N], ``locked`` and ``stop_contact`` (bool),
+            ``mechanical_energy`` [J] (kinetic + spring + gravity + stop),
+            ``base_work``, ``motor_work``, ``friction_dissipation`` and
+            ``stop_dissipation`` [J].
+        """
+        z = np.asarray(block["relative_position"], dtype=float)
+        if z.size == 0:
+            return
+        motor = np.asarray(block["motor_force"], dtype=float)
+        self.run.add(z[None, :], motor[None, :], np.asarray(block["locked"], bool)[None, :])
+        if self.count == 0:
+            self.time_first = float(block["time"][0])
+            self.energy_start = float(block["mechanical_energy"][0])
+        self.count += z.size
+        self.z_sum += float(z.sum())
+        self.z_last = float(z[-1])
+        self.time_last = float(block["time"][-1])
+        self.contact += int(np.count_nonzero(block["stop_contact"]))
+        asked = np.abs(np.asarray(block["pi_force"]) + np.asarray(block["damping_force"]))
+        self.saturated += int(np.count_nonzero(asked >= self.force_limit * (1.0 - 1e-9)))
+        self.motor_peak = max(self.motor_peak, float(np.abs(motor).max()))
+        net = (block["base_work"] + block["motor_work"] - block["friction_dissipation"]
+               - block["stop_dissipation"])
+        residual = block["mechanical_energy"] - self.energy_start - net
+        self.residual_max = max(self.residual_max, float(np.abs(residual).max()))
+        self.base_work_max = max(self.base_work_max, float(np.abs(block["base_work"]).max()))
+
+    def result(self):
+        """The statistics so far (see :data:`SUMMARY_STATISTICS`) as floats and ints."""
+        run = {name: float(value[0]) for name, value in self.run.result().items()}
+        counted = max(self.count, 1)
+        return {**run, "samples": self.count, "z_mean": self.z_sum / counted,
+                "z_final": self.z_last, "contact_fraction": self.contact / counted,
+                "saturated_fraction": self.saturated / counted, "motor_force_peak": self.motor_peak,
+                "energy_residual_max": self.residual_max, "base_work_max": self.base_work_max,
+                "time_first": self.time_first, "time_last": self.time_last}
+
+
+#: What :meth:`SummaryStatistics.result` holds beyond :data:`STATISTICS`: name -> (unit,
+#: description).
+SUMMARY_STATISTICS = {
+    **STATISTICS,
+    "samples": ("1", "samples summarised"),
+    "z_mean": ("m", "mean relative position"),
+    "z_final": ("m", "last relative position"),
+    "contact_fraction": ("1", "fraction of samples in contact with a stop"),
+    "saturated_fraction": ("1", "fraction of samples where the loops ask for the motor's "
+                                "limit or more"),
+    "motor_force_peak": ("N", "largest |motor force|"),
+    "energy_residual_max": ("J", "largest |energy-ledger residual|"),
+    "base_work_max": ("J", "largest |work done by the base|"),
+    "time_first": ("s", "time of the first sample"),
+    "time_last": ("s", "time of the last sample"),
+}

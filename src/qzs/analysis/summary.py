@@ -1,9 +1,14 @@
-"""The one-screen text summary of a run: what a careful engineer would check first."""
-import numpy as np
+"""The summary of a run: what a careful engineer would check first, as text or as a record.
 
-from qzs.analysis.statistics import run_statistics
+The numbers come from :attr:`SimulationResult.statistics` (every sample, also of a
+run streamed to a file); the warnings from :func:`run_warnings`.
+"""
+__all__ = ["summary_text", "summary_record", "run_title", "run_warnings", "WARNING_LIMITS"]
 
-__all__ = ["summary_text", "run_title"]
+#: Where the summary starts to warn: the output rate per excitation frequency [-], the
+#: integration steps per period [-], the energy-ledger residual per unit of base work [-].
+WARNING_LIMITS = {"samples_per_period": 5.0, "steps_per_period": 20.0,
+                  "energy_residual_share": 1e-4}
 
 
 def run_title(result):
@@ -19,8 +24,125 @@ def run_title(result):
             f"{result.run['solver']} dt = {result.run['dt']:g} s")
 
 
+def run_warnings(result):
+    """What in a run deserves a second look, each as ``(code, message)``.
+
+    Codes: ``interrupted``; ``motor_saturated`` (the loops asked for the motor's limit
+    or more); ``setpoint_outside_constant_force`` (the setpoint is not where the
+    spring's force is flat, so the isolator is not quasi-zero-stiffness there);
+    ``output_rate_low`` (the excitation reaches above a fifth of the output rate);
+    ``few_steps_per_period`` (fewer than 20 integration steps per period of the
+    excitation's highest frequency); ``energy_residual`` (the energy ledger does not
+    balance to 1e-4 of the base work).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+
+    Returns
+    -------
+    list of tuple of str
+    """
+    iso, ctrl, run = result.isolator, result.controller, result.run
+    stats = result.statistics
+    warnings = []
+    if not result.completed:
+        warnings.append(("interrupted", f"the run was interrupted at t = "
+                                        f"{stats['time_last']:g} s of {run['duration']:g} s"))
+    if stats["saturated_fraction"] > 0:
+        warnings.append((
+            "motor_saturated",
+            f"the motor saturates {100 * stats['saturated_fraction']:.2f} % of the time (the "
+            f"loops ask for motor_force_max = {iso.motor_force_max:g} N or more): the loops "
+            "have no authority left there; lower the gains or the excitation, or check the "
+            "load"))
+    edge = iso.constant_force_edge
+    if ctrl.position_setpoint > edge:
+        from qzs.model.isolator import spring_force, spring_stiffness
+
+        force = -float(spring_force(ctrl.position_setpoint, iso))
+        stiffness = float(spring_stiffness(ctrl.position_setpoint, iso))
+        warnings.append((
+            "setpoint_outside_constant_force",
+            f"the setpoint z_ref = {1e3 * ctrl.position_setpoint:.1f} mm lies outside the "
+            f"spring's constant-force region (z < {1e3 * edge:.1f} mm): the spring gives "
+            f"{force:.2f} N of its {iso.spring_force:g} N plateau with a stiffness of "
+            f"{stiffness:.0f} N/m, so the isolator is not quasi-zero-stiffness there; move "
+            "position_setpoint below the edge"))
+    top = _highest_frequency(result)
+    if top > 0:
+        per_sample = run["sample_rate"] / top
+        if per_sample < WARNING_LIMITS["samples_per_period"]:
+            warnings.append((
+                "output_rate_low",
+                f"the excitation reaches {top:g} Hz, above a fifth of the output rate "
+                f"({run['sample_rate']:g} Hz; {per_sample:.1f} samples per period): the "
+                "output under-resolves it; raise sample_rate"))
+        per_step = 1.0 / (top * run["dt"])
+        if per_step < WARNING_LIMITS["steps_per_period"]:
+            warnings.append((
+                "few_steps_per_period",
+                f"only {per_step:.1f} integration steps per period at {top:g} Hz (dt = "
+                f"{run['dt']:g} s); the fixed-step integrator is inaccurate there, reduce dt "
+                f"below {1.0 / (WARNING_LIMITS['steps_per_period'] * top):.3g} s"))
+    share = _residual_share(stats)
+    if share > WARNING_LIMITS["energy_residual_share"]:
+        warnings.append((
+            "energy_residual",
+            f"the energy ledger is off by {stats['energy_residual_max']:.3g} J "
+            f"({share:.2g} of the base work): the integration error is large; reduce dt"))
+    return warnings
+
+
+def _highest_frequency(result):
+    """Highest frequency [Hz] the excitation reaches within the run."""
+    exc = result.excitation
+    if hasattr(exc, "frequency_at"):
+        return float(max(exc.frequency_at(0.0), exc.frequency_at(result.run["duration"])))
+    return float(exc.max_frequency)
+
+
+def _residual_share(stats):
+    return stats["energy_residual_max"] / max(stats["base_work_max"], 1e-300)
+
+
+def _coverage(result):
+    """For a chirp the run cuts short: the band it covers, as a line; else ''."""
+    exc = result.excitation
+    duration = result.run["duration"]
+    if not hasattr(exc, "frequency_at") or duration >= exc.duration * (1 - 1e-12):
+        return ""
+    reached = float(exc.frequency_at(duration))
+    return (f"  excitation       the first {duration:g} s of a {exc.duration:g} s chirp: "
+            f"{exc.f0:g} -> {reached:.3g} Hz of {exc.f0:g} -> {exc.f1:g} Hz")
+
+
+def summary_record(result):
+    """The summary as data: run settings, statistics (SI units) and warnings.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+
+    Returns
+    -------
+    dict
+        ``excitation`` (kind), ``run`` (settings and counts, ``steps_per_second`` [1/s]
+        of integration only), ``statistics`` (:data:`~qzs.analysis.statistics.SUMMARY_STATISTICS`
+        names: [m], [N], [J], [s], shares in [-]), ``warnings`` (list of ``{"code",
+        "message"}``).
+    """
+    run = dict(result.run)
+    run["steps_per_second"] = result.steps_per_second
+    return {"excitation": type(result.excitation).__name__, "run": run,
+            "statistics": dict(result.statistics),
+            "warnings": [{"code": c, "message": m} for c, m in run_warnings(result)]}
+
+
 def summary_text(result):
-    """One-screen summary: operating point, stroke used, contacts, time locked, speed.
+    """One-screen summary: operating point, stroke used, contacts, time locked, speed, warnings.
 
     Parameters
     ----------
@@ -28,26 +150,32 @@ def summary_text(result):
         The run.
     """
     iso, ctrl, run = result.isolator, result.controller, result.run
-    z = result.relative_position
-    t = result.time
+    stats = result.statistics
     low, high = run["stop_low"], run["stop_high"]
-    statistics = run_statistics(z, result.motor_force, result.locked, 0.5 * (low + high))
-    used = (statistics["z_max"] - statistics["z_min"]) / (high - low)
+    used = (stats["z_max"] - stats["z_min"]) / (high - low)
+    samples = run.get("samples", stats["samples"])
+    kept = ("" if run.get("preview_every", 1) == 1 else
+            f" (every {run['preview_every']}th kept in memory)")
     lines = [
         f"qzs simulation  {run_title(result)}{'' if result.completed else '  [INTERRUPTED]'}",
         f"  steps            {run['steps']:,} in {run['elapsed']:.2f} s "
-        f"({result.steps_per_second / 1e6:.2f} M steps/s), {len(result):,} samples at "
-        f"{run['sample_rate']:g} Hz",
+        f"({result.steps_per_second / 1e6:.2f} M steps/s, compilation excluded), "
+        f"{samples:,} samples at {run['sample_rate']:g} Hz{kept}",
+    ]
+    coverage = _coverage(result)
+    if coverage:
+        lines.append(coverage)
+    lines += [
         f"  operating point  setpoint z_ref = {ctrl.position_setpoint * 1e3:.1f} mm; "
-        f"mean z = {z.mean() * 1e3:.2f} mm; final z = {z[-1] * 1e3:.2f} mm",
-        f"  stroke used      z in [{statistics['z_min'] * 1e3:.2f}, {statistics['z_max'] * 1e3:.2f}] mm = "
+        f"mean z = {stats['z_mean'] * 1e3:.2f} mm; final z = {stats['z_final'] * 1e3:.2f} mm",
+        f"  stroke used      z in [{stats['z_min'] * 1e3:.2f}, {stats['z_max'] * 1e3:.2f}] mm = "
         f"{100 * used:.1f} % of the stops' [{low * 1e3:.0f}, {high * 1e3:.0f}] mm",
         f"  stop contacts    {run['stop_contacts']} "
-        f"({100 * result.stop_contact.mean():.2f} % of the time in contact)",
-        f"  locked           {100 * statistics['locked_fraction']:.1f} % of the time; "
+        f"({100 * stats['contact_fraction']:.2f} % of the time in contact)",
+        f"  locked           {100 * stats['locked_fraction']:.1f} % of the time; "
         f"{run['stick_events']} stick events",
-        f"  motor force      RMS {statistics['motor_force_rms']:.2f} N, "
-        f"peak {np.abs(result.motor_force).max():.2f} N (limit {iso.motor_force_max:g} N)",
+        f"  motor force      RMS {stats['motor_force_rms']:.2f} N, "
+        f"peak {stats['motor_force_peak']:.2f} N (limit {iso.motor_force_max:g} N)",
     ]
     deficit = iso.weight_deficit
     if deficit > 0:
@@ -55,9 +183,9 @@ def summary_text(result):
             f"  note             m*g = {iso.mass * iso.gravity:.2f} N exceeds the spring's "
             f"{iso.spring_force:.2f} N plateau: the PI integral must carry {deficit:.2f} N"
             + ("" if ctrl.pi_ki > 0 else " (pi_ki = 0: nothing does; the payload sinks)"))
-    residual = np.abs(result.energy_residual()).max()
-    scale = max(np.abs(result.base_work).max(), 1e-300)
-    lines.append(f"  energy ledger    max residual {residual:.3g} J "
-                 f"({residual / scale:.2g} of the base work)")
-    lines.append(f"  time span        {t[0]:g} .. {t[-1]:g} s")
+    lines.append(f"  energy ledger    max residual {stats['energy_residual_max']:.3g} J "
+                 f"({_residual_share(stats):.2g} of the base work)")
+    lines.append(f"  time span        {stats['time_first']:g} .. {stats['time_last']:g} s")
+    lines += [f"  WARNING          {message}" for code, message in run_warnings(result)
+              if code != "interrupted"]
     return "\n".join(lines)

@@ -10,15 +10,22 @@
     qzs sweep FILE.toml [--resume] [--workers N | --scheduler ADDRESS]
     qzs sweep-plot STORE [--metric NAME] [--x PARAM] [--y PARAM]
 
-Every subcommand hands its parsed arguments to a function of the layers below;
-bad input ends with one line on stderr and exit code 2, Ctrl-C with 130.
+Every subcommand hands its parsed arguments to a function of the layers below.
+Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
+1 a failed run, 2 bad input or usage (one line on stderr, never a traceback), 130 Ctrl-C,
+141 the output pipe was closed by its reader (``qzs params | head -1`` ends quietly),
+143 SIGTERM (converted into :class:`qzs.errors.Terminated`, so that cleanup runs and no
+temporary file stays behind).
 """
 import argparse
+import os
+import signal
 import sys
 
 from qzs._version import __version__
 from qzs.cli import experiment, params, simulate, studies, sweep
-from qzs.cli.common import run_handler
+from qzs.cli.common import EPILOG, run_handler
+from qzs.errors import Terminated
 
 __all__ = ["main", "build_parser"]
 
@@ -32,7 +39,7 @@ def build_parser():
     parser = argparse.ArgumentParser(
         prog="qzs", description="Semi-active quasi-zero-stiffness isolator toolkit.",
         epilog="The model, its signs, defaults and every modelling decision: docs/model.md "
-               "(in the qzs repository). Parameter names and units: `qzs params`.")
+               "(in the qzs repository). Parameter names and units: `qzs params`. " + EPILOG)
     parser.add_argument("--version", action="version", version=f"qzs {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     simulate.add_parser(sub)
@@ -40,11 +47,19 @@ def build_parser():
     experiment.add_parser(sub)
     sweep.add_parsers(sub)
     params.add_parser(sub)
+    for command in sub.choices.values():  # every subcommand's help ends with the exit codes
+        if EPILOG not in (command.epilog or ""):
+            command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG
     return parser
 
 
 def main(argv=None):
     """Entry point of the ``qzs`` command; returns the process exit code.
+
+    While it runs, SIGTERM raises :class:`qzs.errors.Terminated` in the main thread
+    (so ``finally`` blocks and atomic writers clean up) and the previous handler is
+    restored afterwards. A reader that closes the output pipe early ends the command
+    quietly: the rest of stdout goes to ``os.devnull`` and the exit code is 141.
 
     Parameters
     ----------
@@ -54,10 +69,74 @@ def main(argv=None):
     Returns
     -------
     int
-        0 on success, 2 for bad input, 130 when interrupted.
+        0 success, 1 a failed run, 2 bad input or usage, 130 interrupted (Ctrl-C),
+        141 output pipe closed, 143 terminated (SIGTERM); see
+        :data:`qzs.cli.common.EXIT_CODES`.
     """
-    args = build_parser().parse_args(argv)
-    return run_handler(HANDLERS[args.command], args)
+    previous = _catch_sigterm()
+    try:
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as exit_:  # --help, --version, usage errors (2)
+            _flush_stdout()
+            return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None
+                                                                   else 2)
+        code = run_handler(HANDLERS[args.command], args)
+        _flush_stdout()  # a closed pipe shows here, not as "Exception ignored" at exit
+        return code
+    except BrokenPipeError:
+        _silence_stdout()
+        return 141
+    except Terminated as error:  # outside a handler: while parsing or flushing
+        return error.exit_code
+    except KeyboardInterrupt:
+        return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _flush_stdout():
+    if sys.stdout is not None:
+        sys.stdout.flush()
+
+
+def _silence_stdout():
+    """Point stdout at os.devnull, so that the interpreter's last flush cannot fail."""
+    try:
+        fileno = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file (captured, closed)
+        fileno = None
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    if fileno is not None:
+        os.dup2(devnull, fileno)
+        os.close(devnull)
+    else:
+        sys.stdout = os.fdopen(devnull, "w")
+
+
+def _catch_sigterm():
+    """Make SIGTERM raise :class:`Terminated` in this process; returns the old handler.
+
+    Only the main thread can set a handler (None is returned elsewhere). The first
+    SIGTERM raises; a second one, while the cleanup runs, ends the process at once (the
+    default action). Child processes forked later (worker pools) inherit the handler;
+    there it restores the default action and re-sends the signal, so that a pool can
+    still stop its workers.
+    """
+    pid = os.getpid()
+
+    def handler(signum, frame):
+        signal.signal(signum, signal.SIG_DFL)
+        if os.getpid() != pid:
+            os.kill(os.getpid(), signum)
+            return
+        raise Terminated(signum)
+
+    try:
+        return signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread
+        return None
 
 
 if __name__ == "__main__":  # pragma: no cover

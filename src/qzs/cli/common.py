@@ -1,13 +1,42 @@
-"""What every subcommand shares: ``--set`` pairs, parameter loading, the error contract."""
-import sys
+"""What every subcommand shares: ``--set`` pairs, parameter loading, ``--json``, the exit codes.
 
-from qzs.errors import DataError, MissingDependencyError, ParameterError, SimulationError
+Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
+
+- 0: success.
+- 1: the run started and failed (:class:`~qzs.errors.SimulationError`,
+  :class:`~qzs.errors.FitError`, an I/O error while writing such as a full disk
+  (:class:`~qzs.errors.WriteError`), out of memory).
+- 2: bad input or usage (:class:`~qzs.errors.ParameterError` and its subclasses, such as
+  :class:`~qzs.errors.CaseError` for an invalid case of a batch, found before the batch
+  runs; :class:`~qzs.errors.DataError`, :class:`~qzs.errors.MissingDependencyError`;
+  argparse's usage errors are 2 as well).
+- 130: interrupted by Ctrl-C (SIGINT).
+- 141: the reader of the output went away (a closed pipe, ``qzs params | head -1``):
+  the command stops quietly, as a program killed by SIGPIPE would (128 + 13).
+- 143: terminated by SIGTERM (128 + 15), after the cleanup ran (no temporary file stays).
+"""
+import dataclasses
+import json
+import math
+import sys
+from pathlib import Path
+
+from qzs.errors import (DataError, FitError, MissingDependencyError, ParameterError,
+                        SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
-__all__ = ["settings", "parameters", "add_set_option", "run_handler"]
+__all__ = ["settings", "parameters", "add_set_option", "add_json_option", "emit", "jsonable",
+           "integer_at_least", "run_handler", "EXIT_CODES", "EPILOG"]
+
+#: Exit code -> meaning, for every subcommand.
+EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
+              130: "interrupted (Ctrl-C)", 141: "output pipe closed by its reader",
+              143: "terminated (SIGTERM), after cleanup"}
+#: The exit codes as a help epilog.
+EPILOG = "exit codes: " + ", ".join(f"{code} {text}" for code, text in EXIT_CODES.items()) + "."
 
 
 def add_set_option(parser):
@@ -20,6 +49,113 @@ def add_set_option(parser):
     """
     parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
                         help="override a parameter by its name (see `qzs params`; repeatable)")
+
+
+def add_json_option(parser):
+    """Add ``--json`` to ``parser``: print the summary as one JSON object instead of text.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser; its handler then prints through :func:`emit`.
+    """
+    parser.add_argument("--json", action="store_true",
+                        help="print the summary as one JSON object (NaN and inf as null) "
+                             "instead of text")
+
+
+def emit(args, text, record):
+    """Print ``text``, or with ``--json`` the ``record`` as one line of strict JSON.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``args.json`` (absent: False) chooses the output.
+    text : str
+        The human-readable summary.
+    record : dict
+        The same summary as data; made JSON-safe by :func:`jsonable` (NaN and inf become
+        null, numpy scalars and arrays become numbers and lists).
+    """
+    if getattr(args, "json", False):
+        print(json.dumps(jsonable(record), allow_nan=False))
+    else:
+        print(text)
+
+
+def jsonable(value):
+    """``value`` as plain JSON types: NaN and inf -> None, numpy -> Python, Path -> str.
+
+    Dicts (keys as strings), lists, tuples and sets are converted item by item; a
+    dataclass, or an object with ``to_dict()``, through its fields; anything else
+    unknown becomes its ``str``.
+
+    Parameters
+    ----------
+    value : object
+        What to convert.
+
+    Returns
+    -------
+    object
+        None, bool, int, float (finite), str, list or dict.
+    """
+    import numpy as np
+
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, np.generic):
+        value = value.item()
+        if isinstance(value, (bool, str, bytes)) or value is None:
+            return value.decode() if isinstance(value, bytes) else value
+    if isinstance(value, int):
+        return int(value)
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, complex):
+        return [jsonable(value.real), jsonable(value.imag)]
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, dict) or hasattr(value, "items") and callable(value.items):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set, frozenset)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if callable(getattr(value, "to_dict", None)):
+        return jsonable(value.to_dict())
+    return str(value)
+
+
+def integer_at_least(minimum):
+    """An argparse ``type``: an integer >= ``minimum``, else a usage error (exit code 2).
+
+    Parameters
+    ----------
+    minimum : int
+        The smallest value allowed.
+
+    Returns
+    -------
+    callable
+        ``text -> int``, raising ``argparse.ArgumentTypeError`` with the value and the bound.
+    """
+    import argparse
+
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, "
+                                             f"got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, got {value}")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
 
 
 def settings(pairs):
@@ -73,7 +209,10 @@ def parameters(args):
 
 
 def run_handler(handler, args):
-    """Run a subcommand's handler; bad input is one line on stderr and exit code 2.
+    """Run a subcommand's handler and map its outcome to the exit code (:data:`EXIT_CODES`).
+
+    Every error ends as one line ``qzs: error: ...`` on stderr, never a traceback;
+    which exit code follows from the error's class, never from its message.
 
     Parameters
     ----------
@@ -85,14 +224,35 @@ def run_handler(handler, args):
     Returns
     -------
     int
-        The handler's exit code; 2 after a :class:`ParameterError`, :class:`DataError`,
-        :class:`SimulationError` or :class:`MissingDependencyError`; 130 after Ctrl-C.
+        The handler's exit code; 1 after a failed run (:class:`SimulationError`,
+        :class:`FitError`, :class:`WriteError`, an ``OSError`` or ``MemoryError``); 2 after
+        bad input (:class:`ParameterError` and subclasses such as :class:`CaseError`,
+        :class:`DataError`, :class:`MissingDependencyError`); 130 after Ctrl-C; 143 after SIGTERM
+        (:class:`~qzs.errors.Terminated`, raised by :func:`qzs.cli.main`'s handler).
+        ``BrokenPipeError`` is left to :func:`qzs.cli.main` (141).
     """
     try:
         return handler(args)
-    except (ParameterError, DataError, SimulationError, MissingDependencyError) as error:
-        print(f"qzs: error: {error}", file=sys.stderr)
-        return 2
+    except (SimulationError, FitError, WriteError) as error:  # WriteError before DataError
+        return _fail(error, 1)
+    except (ParameterError, DataError, MissingDependencyError) as error:
+        return _fail(error, 2)
     except KeyboardInterrupt:
         print("qzs: interrupted", file=sys.stderr)
         return 130
+    except Terminated as error:
+        print(f"qzs: terminated by signal {error.signum}", file=sys.stderr)
+        return error.exit_code
+    except BrokenPipeError:
+        raise
+    except OSError as error:  # writing: disk full, permission denied, ...
+        where = f" {str(error.filename)!r}" if error.filename else ""
+        return _fail(f"cannot access{where}: {error.strerror or error}", 1)
+    except MemoryError as error:
+        return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; choose a "
+                     "shorter run, a lower --sample-rate, or write with --out", 1)
+
+
+def _fail(error, code):
+    print(f"qzs: error: {error}", file=sys.stderr)
+    return code

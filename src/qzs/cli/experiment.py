@@ -1,4 +1,6 @@
 """``qzs experiment``: an experiment log beside the matching simulation."""
+from qzs.cli.common import EPILOG, add_json_option, emit, integer_at_least
+from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parser", "run"]
 
@@ -19,7 +21,9 @@ def add_parser(subparsers):
     parser = subparsers.add_parser(
         "experiment", help="process an experiment log: transmissibility beside the simulation",
         description="Read a test-rig log with a channel map, estimate the transmissibility, "
-                    "simulate the same chirp, and write a figure, a table and report.md.")
+                    "simulate the same chirp, and write a figure, a table and report.md.",
+        epilog="A log whose time base is not uniform needs --resample (or resample = true in "
+               "the map's [options]). " + EPILOG)
     parser.add_argument("log", metavar="LOG", help="log file (.csv, .mat, .mf4, .nc)")
     parser.add_argument("--map", required=True, metavar="MAP.toml",
                         help="channel map (see qzs.iotools.readers)")
@@ -27,14 +31,17 @@ def add_parser(subparsers):
                         help="output folder (default qzs-experiment)")
     parser.add_argument("--no-simulation", action="store_true",
                         help="do not simulate the matching run")
-    parser.add_argument("--fft-length", type=int, metavar="N",
-                        help="Welch segment length [samples] (default 32768)")
-    parser.add_argument("--averages", type=int, metavar="N",
-                        help="Welch averages (default 29; fewer if the log is short)")
+    parser.add_argument("--fft-length", type=integer_at_least(8), metavar="N",
+                        help="Welch segment length [samples], >= 8 (default the map's "
+                             "[experiment] fft_length, else 32768)")
+    parser.add_argument("--averages", type=integer_at_least(1), metavar="N",
+                        help="Welch averages, >= 1 (default the map's [experiment] "
+                             "n_averages, else 29; fewer if the log is short)")
     parser.add_argument("--config", metavar="PARAMS.toml",
                         help="model parameters for the simulation (see `qzs params --toml`)")
     parser.add_argument("--resample", action="store_true",
                         help="resample a non-uniform time base onto a uniform grid")
+    add_json_option(parser)
     return parser
 
 
@@ -51,12 +58,15 @@ def run(args):
     int
         The exit code, 0.
     """
-    from qzs.workflows.experiment import run_experiment
+    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
+    from qzs.workflows.experiment import run_experiment  # scipy and the engine: after the check
 
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,
                                    n_averages=args.averages, config=args.config,
                                    resample=args.resample,
                                    simulate_match=not args.no_simulation)
-    print(result.summary())
-    print(f"wrote {paths['report']}, {paths['figure'].name} (+ .svg) and {paths['table'].name}")
+    text = (f"{result.summary()}\nwrote {paths['report']}, {paths['figure'].name} (+ .svg) "
+            f"and {paths['table'].name}")
+    emit(args, text, {**result.to_record(),
+                      "files": {name: str(path) for name, path in paths.items()}})
     return 0

@@ -1,6 +1,10 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from qzs.cli.common import add_set_option, parameters
+from pathlib import Path
+
+from qzs.cli.common import EPILOG, add_set_option, parameters
+from qzs.errors import OutputPathError
 from qzs.iotools.config import save_config
+from qzs.iotools.paths import check_output_path
 from qzs.model.registry import format_value, parameter_table
 
 __all__ = ["add_parser", "run"]
@@ -19,8 +23,14 @@ def add_parser(subparsers):
     argparse.ArgumentParser
         The ``params`` parser.
     """
-    params = subparsers.add_parser("params", help="print the default parameters with units")
-    params.add_argument("--toml", metavar="FILE", help="write them as a config file instead")
+    params = subparsers.add_parser(
+        "params", help="print the default parameters with units",
+        description="Print every parameter with its value (the defaults, or --config's, with "
+                    "--set applied), unit and description; or write them as a config file.",
+        epilog="--toml never replaces an existing file unless --force is given. " + EPILOG)
+    params.add_argument("--toml", metavar="FILE.toml", help="write them as a config file instead")
+    params.add_argument("--force", action="store_true",
+                        help="let --toml replace an existing file")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")
     add_set_option(params)
     return params
@@ -38,7 +48,19 @@ def run(args):
     -------
     int
         The exit code, 0.
+
+    Raises
+    ------
+    OutputPathError
+        ``--toml`` names an existing file without ``--force``, or a path that cannot be
+        written (checked before anything is written).
     """
+    if args.toml:
+        check_output_path(args.toml, argument="--toml", suffixes=(".toml",),
+                          estimated_bytes=64 * 1024)
+        if Path(args.toml).exists() and not getattr(args, "force", False):
+            raise OutputPathError("--toml", args.toml, "exists; pass --force to replace it, "
+                                  "or choose another name")
     config = parameters(args)
     if args.toml:
         path = save_config(args.toml, config["isolator"], config["controller"])

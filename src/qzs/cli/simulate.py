@@ -1,14 +1,24 @@
-"""``qzs simulate``: one run, its summary, its figure and optionally its time series."""
-import sys
+"""``qzs simulate``: one run, its summary, its figure and optionally its time series.
 
-from qzs.cli.common import add_set_option, parameters
+``--duration`` is the simulated time, as ``duration`` is in :func:`qzs.simulate`; the
+excitation's own length (a chirp's sweep time, a random record's length) is
+``--excitation-duration``. An option the chosen excitation does not use is an error.
+"""
+from qzs.analysis.summary import summary_record
+from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
+from qzs.errors import ParameterError
+from qzs.iotools.paths import check_output_path
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, build_excitation
 
 __all__ = ["add_parser", "run"]
 
 DEFAULT_PLOT = "qzs-simulation.png"
-# Options read from the command line into the excitation (those the kind takes).
-_OPTIONS = ("amplitude", "f0", "f1", "frequency", "method", "seed", "duration", "record")
+#: Formats ``--plot`` writes (matplotlib chooses by the extension).
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+#: Command-line flag -> the excitation option it sets (names of ``EXCITATION_OPTIONS``).
+_FLAGS = {"--amplitude": "amplitude", "--f0": "f0", "--f1": "f1", "--frequency": "frequency",
+          "--phase": "phase", "--method": "method", "--seed": "seed", "--record": "record",
+          "--excitation-duration": "duration", "--fade-in": "fade_in"}
 
 
 def add_parser(subparsers):
@@ -27,7 +37,12 @@ def add_parser(subparsers):
     sim = subparsers.add_parser(
         "simulate", help="simulate the isolator under a base excitation",
         description="Simulate the isolator. With no options: the paper's default case "
-                    "(10 mm chirp, 0-20 Hz, 2000 s, ode3, dt = 1e-4 s), summary and plot.")
+                    "(10 mm chirp, 0-20 Hz, 2000 s, ode3, dt = 1e-4 s), summary and plot. "
+                    "--duration is the simulated time (default: the whole excitation); "
+                    "the excitation's own length is --excitation-duration, so "
+                    "`--duration 60` simulates the first 60 s of the 2000 s chirp, as "
+                    "qzs.simulate(Chirp(), duration=60) does.",
+        epilog=EPILOG)
     sim.add_argument("--config", metavar="FILE.toml",
                      help="run configuration (see `qzs params --toml`)")
     add_set_option(sim)
@@ -38,33 +53,54 @@ def add_parser(subparsers):
     sim.add_argument("--f0", type=float, metavar="HZ", help="chirp start / random band low [Hz]")
     sim.add_argument("--f1", type=float, metavar="HZ", help="chirp end / random band high [Hz]")
     sim.add_argument("--frequency", type=float, metavar="HZ", help="sine frequency [Hz]")
+    sim.add_argument("--phase", type=float, metavar="RAD", help="sine phase at t = 0 [rad]")
     sim.add_argument("--method", choices=("linear", "logarithmic"), help="chirp sweep law")
-    sim.add_argument("--seed", type=int, help="random excitation seed")
+    sim.add_argument("--seed", type=int, help="random excitation seed (>= 0)")
     sim.add_argument("--record", metavar="FILE.csv",
                      help="displacement record for --excitation file (columns time, displacement)")
-    sim.add_argument("--duration", type=float, metavar="S", help="simulated time [s]")
+    sim.add_argument("--excitation-duration", type=float, metavar="S",
+                     help="the excitation's length [s]: chirp sweep time (default 2000), "
+                          "random record length (default 100)")
+    sim.add_argument("--fade-in", type=float, metavar="S",
+                     help="smooth fade-in of the excitation [s] (default 2 for sine, random "
+                          "and file, 0 for chirp; 0 starts at full amplitude)")
+    sim.add_argument("--duration", type=float, metavar="S",
+                     help="simulated time [s] (default the excitation's length; 10 for a sine)")
     sim.add_argument("--dt", type=float, metavar="S", help="integration step [s] (default 1e-4)")
     sim.add_argument("--sample-rate", type=float, metavar="HZ",
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                      help="integrator (default ode3)")
-    sim.add_argument("--out", metavar="FILE", help="write the time series (.nc or .csv)")
+    sim.add_argument("--out", metavar="FILE",
+                     help="stream the time series to FILE (.nc or .csv) while simulating")
     sim.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
-                     help=f"figure of the run (default {DEFAULT_PLOT}; 'none' to skip)")
+                     help=f"figure of the run (.png, .svg or .pdf; default {DEFAULT_PLOT}; "
+                          "'none' to skip)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_option(sim)
     return sim
 
 
-def _excitation(args, table):
+def _excitation(args, table, source):
+    """The excitation: the config's ``[excitation]`` table, then the command line's flags."""
     options = dict(table)
-    kind = args.excitation or options.pop("kind", "chirp")
+    kind = args.excitation or options.get("kind", "chirp")
     options.pop("kind", None)
-    for key in _OPTIONS:
-        value = getattr(args, key)
+    origin = {name: f"`{name}` in the [excitation] table of {source}" for name in options}
+    for flag, name in _FLAGS.items():
+        value = getattr(args, flag[2:].replace("-", "_"))
         if value is not None:
-            options[key] = value
-    return build_excitation(kind, {k: v for k, v in options.items()
-                                   if k in EXCITATION_OPTIONS[kind]})
+            options[name] = value
+            origin[name] = f"`{flag}`"
+    unused = [origin[name] for name in options if name not in EXCITATION_OPTIONS[kind]]
+    if unused:
+        usable = [f"--{'excitation-duration' if o == 'duration' else o.replace('_', '-')}"
+                  for o in EXCITATION_OPTIONS[kind]]
+        raise ParameterError(
+            f"{', '.join(unused)} is not used by a {kind} excitation (it takes "
+            f"{', '.join(usable)}); drop it or choose the excitation that uses it "
+            "(--excitation).")
+    return build_excitation(kind, options)
 
 
 def run(args):
@@ -80,27 +116,37 @@ def run(args):
     int
         The exit code: 0, or 130 if Ctrl-C ended the run early.
     """
+    import sys
+
     from qzs.engine.simulate import simulate
+    from qzs.workflows.run import simulate_to_file
 
     config = parameters(args)
-    excitation = _excitation(args, config["excitation"])
+    excitation = _excitation(args, config["excitation"], args.config)
     settings = dict(config["simulation"])
     for key in ("dt", "sample_rate", "solver", "duration"):
         value = getattr(args, key)
         if value is not None:
             settings[key] = value
-    if "duration" not in settings and config["excitation"].get("duration") is not None:
-        settings["duration"] = config["excitation"]["duration"]
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
-    result = simulate(excitation, config["isolator"], config["controller"], **settings,
-                      progress=not args.quiet, interruptible=True)
-    print(result.summary())
+    plot = None if args.plot.lower() == "none" else args.plot
+    if plot is not None:
+        check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+    common = dict(progress=not args.quiet and not args.json, interruptible=True)
     if args.out:
-        path = result.save(args.out)
-        print(f"  wrote            {path}")
-    if args.plot and args.plot.lower() != "none":
-        result.plot(path=args.plot)
-        print(f"  wrote            {args.plot}")
+        result = simulate_to_file(args.out, excitation, config["isolator"],
+                                  config["controller"], **settings, **common, argument="--out")
+    else:
+        result = simulate(excitation, config["isolator"], config["controller"], **settings,
+                          **common)
+    files = {}
+    if args.out:
+        files["out"] = args.out
+    if plot is not None:
+        result.plot(path=plot)
+        files["plot"] = plot
+    text = result.summary() + "".join(f"\n  wrote            {p}" for p in files.values())
+    emit(args, text, {**summary_record(result), "files": files})
     return 0 if result.completed else 130

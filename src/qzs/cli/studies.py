@@ -1,6 +1,7 @@
 """``qzs paper`` and ``qzs study``: the paper's studies, their figures, metrics and report."""
 from pathlib import Path
 
+from qzs.cli.common import add_json_option, emit
 from qzs.errors import ParameterError
 
 __all__ = ["add_parsers", "run"]
@@ -28,6 +29,7 @@ def add_parsers(subparsers):
         cmd.add_argument("--workers", type=int, metavar="N",
                          help="worker processes (default: all cores)")
         cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+        add_json_option(cmd)
 
 
 def run(args):
@@ -43,17 +45,19 @@ def run(args):
     int
         The exit code, 0.
     """
-    from qzs.workflows.report import run_paper
+    from qzs.workflows.report import paper_summary, run_paper
 
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
                                         workers=args.workers, progress=not args.quiet)
-    for result in results:
-        print(f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s")
-    print(f"{'total':<12}    wall {wall:7.1f} s")
-    for verdict in verdicts:
-        print(f"  [{verdict.label}] {verdict.statement}\n      {verdict.evidence}")
-    print(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv and figures")
+    lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"
+             for result in results]
+    lines.append(f"{'total':<12}    wall {wall:7.1f} s")
+    lines.extend(f"  [{verdict.label}] {verdict.statement} ({verdict.study})\n"
+                 f"      {verdict.evidence}" for verdict in verdicts)
+    lines.append(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv and figures")
+    emit(args, "\n".join(lines),
+         paper_summary(results, verdicts, args.out, quick=args.quick, wall_seconds=wall))
     return 0

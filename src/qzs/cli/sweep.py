@@ -2,8 +2,10 @@
 import sys
 from pathlib import Path
 
-from qzs.errors import ParameterError
-from qzs.viz.sweeps import REDUCTIONS
+from qzs.cli.common import EPILOG
+from qzs.errors import ParameterError, Terminated
+from qzs.iotools.paths import check_output_path
+from qzs.viz.sweeps import FIGURE_BYTES, REDUCTIONS, figure_suffixes
 
 __all__ = ["add_parsers", "run_sweep_command", "run_plot_command"]
 
@@ -25,7 +27,11 @@ def add_parsers(subparsers):
         "sweep", help="run a parameter sweep or Monte Carlo study into a Zarr store",
         description="Run every case of a sweep file (grid, random or Latin-hypercube "
                     "sampling) and store per-case metrics, statistics and transmissibility "
-                    "in a Zarr store, batch by batch; Ctrl-C and --resume continue it.")
+                    "in a Zarr store, batch by batch; Ctrl-C and --resume continue it.",
+        epilog="The store is checked before any case runs: its folder must be writable and "
+               "hold its uncompressed size, and an existing store needs --resume or "
+               "--overwrite. Ctrl-C (130) and SIGTERM (143) keep the batches already stored. "
+               + EPILOG)
     cmd.add_argument("definition", metavar="FILE.toml",
                      help="sweep file, or a shipped sweep name (e.g. pi_vs_stiction)")
     cmd.add_argument("--out", metavar="STORE.zarr", help="store (default NAME.zarr)")
@@ -47,7 +53,9 @@ def add_parsers(subparsers):
         "sweep-plot", help="figures of a sweep store",
         description="Plot a per-case output against one parameter (--metric NAME --x: line) "
                     "or two (--x and --y: heat map), or the transmissibility band (median and "
-                    "5/95 percentiles; the default, one band per level of --x if given).")
+                    "5/95 percentiles; the default, one band per level of --x if given).",
+        epilog="The figure's format follows the extension of --out (.png, .svg, .pdf, ...), "
+               "checked before the store is read. " + EPILOG)
     plot.add_argument("store", metavar="STORE.zarr", help="sweep store written by `qzs sweep`")
     plot.add_argument("--x", metavar="PARAM", help="parameter on the horizontal axis")
     plot.add_argument("--y", metavar="PARAM", help="parameter on the vertical axis (heat map)")
@@ -56,7 +64,8 @@ def add_parsers(subparsers):
                            "default without --y: the band, one per --x level)")
     plot.add_argument("--reduce", choices=REDUCTIONS, default="median",
                       help="combine the cases at one grid point (default median; max = worst)")
-    plot.add_argument("--out", metavar="FILE", help="figure file (default sweep-<...>.png)")
+    plot.add_argument("--out", metavar="FILE",
+                      help="figure file, format from its extension (default <sweep>-<...>.png)")
     return cmd
 
 
@@ -71,10 +80,11 @@ def run_sweep_command(args):
     Returns
     -------
     int
-        The exit code: 0, or 130 if Ctrl-C interrupted the sweep (its stored cases stay).
+        The exit code: 0, or 130 if Ctrl-C interrupted the sweep, 143 if SIGTERM ended it
+        (its stored cases stay either way).
     """
     from qzs.workflows.sweeps import load_sweep, open_sweep, plan_text, stored_count
-    from qzs.workflows.sweeps.backends import execute
+    from qzs.workflows.sweeps.backends import check_store_path, execute
     from qzs.workflows.sweeps.store import summary_text
 
     definition = load_sweep(args.definition)
@@ -86,15 +96,19 @@ def run_sweep_command(args):
     if args.dry_run:
         print(plan_text(definition))
         return 0
+    check_store_path(definition, store, argument="--out", resume=args.resume,
+                     overwrite=args.overwrite)
     try:
         report = execute(definition, store, resume=args.resume, overwrite=args.overwrite,
                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
                          progress=not args.quiet)
-    except KeyboardInterrupt:
-        print(f"qzs: interrupted; {stored_count(store)} of {definition.n_cases} cases are "
+    except (KeyboardInterrupt, Terminated) as stop:
+        what, code = (("interrupted", 130) if isinstance(stop, KeyboardInterrupt)
+                      else ("terminated", stop.exit_code))
+        print(f"qzs: {what}; {stored_count(store)} of {definition.n_cases} cases are "
               f"stored in {store}. Continue with: qzs sweep {args.definition} --out {store} "
               "--resume", file=sys.stderr)
-        return 130
+        return code
     print(summary_text(open_sweep(store), report))
     print(f"  wrote            {store}")
     return 0
@@ -115,6 +129,9 @@ def run_plot_command(args):
     """
     from qzs.workflows.sweeps import plot_sweep
 
+    if args.out is not None:
+        check_output_path(args.out, argument="--out", suffixes=figure_suffixes(),
+                          estimated_bytes=FIGURE_BYTES)
     out = plot_sweep(args.store, metric=args.metric, x=args.x, y=args.y, reduce=args.reduce,
                      out=args.out)
     print(f"wrote {out}")

@@ -8,8 +8,9 @@ import numpy as np
 from numba import njit
 
 from qzs.engine.arithmetic import JIT as _JIT
-from qzs.model.excitation import (E_AMPLITUDE, E_DURATION, E_F0, E_F1, E_KIND, E_PHASE,
-                                  E_SPACING, KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_TABLE)
+from qzs.model.excitation import (E_AMPLITUDE, E_DURATION, E_F0, E_F1, E_FADE, E_KIND,
+                                  E_PHASE, E_SPACING, KIND_CHIRP_LINEAR, KIND_CHIRP_LOG,
+                                  KIND_TABLE)
 
 __all__ = ["base_motion", "base_motion_near", "advance_phase", "excitation_tuple",
            "base_motion_series"]
@@ -23,15 +24,15 @@ def excitation_tuple(ex):
 
     Parameters
     ----------
-    ex : ndarray, shape (7,)
+    ex : ndarray, shape (8,)
         The packed scalars of an excitation (the first item of its ``pack()``).
 
     Returns
     -------
     tuple of float
-        The same seven values (``E`` of the other kernels).
+        The same eight values (``E`` of the other kernels).
     """
-    return (ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6])
+    return (ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6], ex[7])
 
 
 @njit(**_JIT, inline="always")
@@ -74,6 +75,25 @@ def _table(t, spacing, table):
 
 
 @njit(**_JIT, inline="always")
+def _fade(t, fade, y, yd, ydd):
+    """The motion times the fade-in window ``w(s) = s - sin(2*pi*s)/(2*pi)``, ``s = t/fade``.
+
+    The window's slope ``(1 - cos(2*pi*s))/fade`` is a raised cosine, so ``w``, ``w'`` and
+    ``w''`` are continuous at both ends: the faded motion has no step in displacement,
+    velocity or acceleration. Product rule: ``(w*y)' = w'*y + w*y'`` and ``(w*y)'' =
+    w''*y + 2*w'*y' + w*y''`` keep the three consistent (docs/model.md §6).
+    """
+    if t >= fade or fade <= 0.0:
+        return y, yd, ydd
+    if t <= 0.0:
+        t = 0.0
+    k = 2.0 * np.pi / fade
+    s, c = np.sin(k * t), np.cos(k * t)
+    w, w1, w2 = t / fade - s / (2.0 * np.pi), (1.0 - c) / fade, k * s / fade
+    return w * y, w1 * y + w * yd, w2 * y + 2.0 * w1 * yd + w * ydd
+
+
+@njit(**_JIT, inline="always")
 def _harmonic(amplitude, s, c, omega, omega_dot):
     return amplitude * s, amplitude * c * omega, amplitude * (c * omega_dot - s * omega * omega)
 
@@ -97,9 +117,11 @@ def base_motion(t, E, table):
         Base displacement [m], velocity [m/s] and acceleration [m/s^2].
     """
     if int(E[E_KIND]) == KIND_TABLE:
-        return _table(t, E[E_SPACING], table)
-    phase, omega, omega_dot = _phase(t, E)
-    return _harmonic(E[E_AMPLITUDE], np.sin(phase), np.cos(phase), omega, omega_dot)
+        y, yd, ydd = _table(t, E[E_SPACING], table)
+    else:
+        phase, omega, omega_dot = _phase(t, E)
+        y, yd, ydd = _harmonic(E[E_AMPLITUDE], np.sin(phase), np.cos(phase), omega, omega_dot)
+    return _fade(t, E[E_FADE], y, yd, ydd)
 
 
 @njit(**_JIT, inline="always")
@@ -141,10 +163,12 @@ def base_motion_near(t, phase0, sin0, cos0, E, table):
         Base displacement [m], velocity [m/s] and acceleration [m/s^2].
     """
     if int(E[E_KIND]) == KIND_TABLE:
-        return _table(t, E[E_SPACING], table)
-    phase, omega, omega_dot = _phase(t, E)
-    s, c = _rotate(phase, phase0, sin0, cos0)
-    return _harmonic(E[E_AMPLITUDE], s, c, omega, omega_dot)
+        y, yd, ydd = _table(t, E[E_SPACING], table)
+    else:
+        phase, omega, omega_dot = _phase(t, E)
+        s, c = _rotate(phase, phase0, sin0, cos0)
+        y, yd, ydd = _harmonic(E[E_AMPLITUDE], s, c, omega, omega_dot)
+    return _fade(t, E[E_FADE], y, yd, ydd)
 
 
 @njit(**_JIT)

@@ -16,6 +16,8 @@ from qzs.model.isolator import InitialState, IsolatorParameters
 __all__ = ["PreparedRun", "prepare_run", "steps_per_sample", "divergence_message"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
+# A base at rest, for the static load of the PI preload.
+_AT_REST = Sine(amplitude=0.0, fade_in=0.0).pack()
 
 
 def _pack_parameters(isolator, controller, dt, control_steps):
@@ -92,15 +94,19 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     s[K.S_V] = initial.relative_velocity
     yd0 = base_motion_series(excitation, [0.0])[1][0]
     s[K.S_HP] = yd0 + initial.relative_velocity  # the amplifier's high-pass has settled
-    force = K.hold_force(0.0, s, p, *packed_excitation)
+    measured = K.hold_force(0.0, s, p, *packed_excitation)[K.F_V_MEASURED]
     if initial.pi_integral is not None:
         s[K.S_INT] = initial.pi_integral
-    elif controller.pi_ki > 0:  # preload: the motor carries what the spring and stops do not
+    elif controller.pi_ki > 0:
+        # Preload: the motor carries the static load the spring and stops do not, nothing
+        # more. Evaluated with the base at rest: the base's acceleration at t = 0 is no load
+        # the integrator should hold (docs/model.md §11).
+        force = K.hold_force(0.0, s, p, *_AT_REST)
         without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
         needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
-        f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], 0.0)[:2]
+        f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, measured, 0.0)[:2]
         s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
-    held = K.controller_output(K.params_tuple(p), z0, force[K.F_V_MEASURED], s[K.S_INT])
+    held = K.controller_output(K.params_tuple(p), z0, measured, s[K.S_INT])
     s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
     force = K.hold_force(0.0, s, p, *packed_excitation)
     f_hold = force[K.F_HOLD]

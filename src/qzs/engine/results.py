@@ -5,12 +5,19 @@
 ``.to_xarray()`` only repackages.
 """
 import dataclasses
+import datetime
+import os
+import shlex
+import sys
 
 import numpy as np
 
 from qzs.engine import kernels as K
+from qzs.model.registry import unit_of
 
-__all__ = ["SimulationResult", "CHANNELS", "FLAGS"]
+__all__ = ["SimulationResult", "CHANNELS", "FLAGS", "FLAG_MEANINGS", "RUN_UNITS", "CONVENTIONS",
+           "NONE_VALUE", "variable_attributes", "parameter_metadata", "run_metadata",
+           "history_line", "file_attributes"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -45,6 +52,196 @@ FLAGS = {
     "locked": (K.O_LOCKED, "payload held at zero slip (stuck by friction or on a plastic stop)"),
     "stop_contact": (K.O_CONTACT, "payload in contact with a hard stop"),
 }
+#: CF ``flag_meanings`` of the flags: the words for the values 0 and 1.
+FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
+#: Units of the entries of :attr:`SimulationResult.run` ("1" for counts and 0/1 booleans,
+#: "-" for a choice).
+RUN_UNITS = {"solver": "-", "dt": "s", "sample_rate": "Hz", "duration": "s", "steps": "1",
+             "elapsed": "s", "completed": "1", "stop_contacts": "1", "stick_events": "1",
+             "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1"}
+#: The metadata conventions result files follow (docs/model.md §7).
+CONVENTIONS = "CF-1.10"
+#: How a parameter whose value is ``None`` is stored (NetCDF has no null); the keys stored
+#: so are listed in the global attribute ``none_parameters``.
+NONE_VALUE = "none"
+_TIME_ATTRS = {"units": "s", "standard_name": "time", "axis": "T",
+               "long_name": "time since the start of the run",
+               "comment": "relative run time without a calendar date: units 's' instead of "
+                          "'s since <date>' (docs/model.md §7)"}
+
+
+def variable_attributes():
+    """CF attributes of every variable of a result, ``time`` first, then channels and flags.
+
+    Every variable has ``units`` and ``long_name``; ``time`` also ``standard_name`` and
+    ``axis``; the flags (stored as int8 0/1) ``flag_values`` and ``flag_meanings``.
+
+    Returns
+    -------
+    dict of str to dict
+        Variable name -> attributes.
+    """
+    attrs = {"time": dict(_TIME_ATTRS)}
+    attrs.update({name: {"units": unit, "long_name": doc}
+                  for name, (_, unit, doc) in CHANNELS.items() if name != "time"})
+    attrs.update({name: {"units": "1", "long_name": doc,
+                         "flag_values": np.array([0, 1], dtype=np.int8),
+                         "flag_meanings": FLAG_MEANINGS[name]}
+                  for name, (_, doc) in FLAGS.items()})
+    return attrs
+
+
+def _plain(value):
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def parameter_metadata(isolator, controller, excitation):
+    """Every parameter of a run with its unit: ``{key: (value, unit)}``.
+
+    Keys are ``isolator.<name>``, ``controller.<name>``, ``excitation`` (the class
+    name, no unit) and ``excitation.<field>``; units come from the parameter
+    registry and the excitation's field metadata. ``None`` values are kept,
+    booleans become 0/1; a displacement record's arrays are data, not metadata.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        Controller parameters.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base excitation.
+
+    Returns
+    -------
+    dict of str to (object, str)
+    """
+    meta = {}
+    for section, params in (("isolator", isolator), ("controller", controller)):
+        for field in dataclasses.fields(params):
+            meta[f"{section}.{field.name}"] = (_plain(getattr(params, field.name)),
+                                               unit_of(field.name))
+    meta["excitation"] = (type(excitation).__name__, "")
+    for field in dataclasses.fields(excitation):
+        value = getattr(excitation, field.name)
+        if not isinstance(value, np.ndarray):
+            meta[f"excitation.{field.name}"] = (_plain(value), field.metadata.get("unit", ""))
+    if "excitation.duration" not in meta and getattr(excitation, "duration", None) is not None:
+        meta["excitation.duration"] = (float(excitation.duration), "s")
+    return meta
+
+
+def run_metadata(run):
+    """The run's settings and outcome with units: ``{"run.<key>": (value, unit)}``.
+
+    Parameters
+    ----------
+    run : dict
+        :attr:`SimulationResult.run`; counts stay integers, booleans become 0/1.
+
+    Returns
+    -------
+    dict of str to (object, str)
+    """
+    return {f"run.{k}": (_plain(v), RUN_UNITS.get(k, "")) for k, v in run.items()}
+
+
+def _now():
+    return datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
+
+
+def history_line(excitation, run):
+    """One CF ``history`` line: ISO time, qzs version, command and what was run.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base excitation of the run.
+    run : dict
+        :attr:`SimulationResult.run`.
+
+    Returns
+    -------
+    str
+    """
+    from qzs._version import __version__
+
+    program = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    if program == "qzs" or sys.argv[0].endswith(os.path.join("qzs", "__main__.py")):
+        command = shlex.join(["qzs", *sys.argv[1:]])
+    else:
+        command = "qzs.simulate (Python)"
+    state = "" if run.get("completed", True) else ", interrupted"
+    return (f"{_now()} qzs {__version__}: {command}; {type(excitation).__name__} base "
+            f"excitation, solver {run.get('solver')}, dt {run.get('dt')} s, "
+            f"{run.get('steps')} steps{state}")
+
+
+def _storable(meta):
+    """NetCDF global attributes from ``{key: (value, unit)}``: values, ``<key>_units``,
+    ``None`` as :data:`NONE_VALUE` listed in ``none_parameters``."""
+    attrs, none = {}, []
+    for key, (value, unit) in meta.items():
+        if value is None:
+            value = NONE_VALUE
+            none.append(key)
+        attrs[key] = value
+        if unit:
+            attrs[f"{key}_units"] = unit
+    return attrs, none
+
+
+def file_attributes(isolator, controller, excitation, run, history=None):
+    """The global attributes of a result file (CF-1.10 and every parameter with its unit).
+
+    Split in two: ``(head, tail)``, the part known before the run (conventions,
+    title, source, parameters) and the part known after it (``run.*``, ``history``).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        Controller parameters.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base excitation.
+    run : dict or None
+        :attr:`SimulationResult.run`; None for the head only (``tail`` is then empty).
+    history : str, optional
+        The ``history`` line; default :func:`history_line`.
+
+    Returns
+    -------
+    (dict, dict)
+    """
+    from qzs._version import __version__
+
+    params, none = _storable(parameter_metadata(isolator, controller, excitation))
+    head = {"Conventions": CONVENTIONS,
+            "title": f"qzs simulation of the semi-active QZS isolator under a "
+                     f"{type(excitation).__name__} base excitation",
+            "source": f"qzs {__version__}: fixed-step simulation of the semi-active "
+                      "quasi-zero-stiffness isolator (model: docs/model.md)",
+            "references": "Leav, Eriksson, Cazzolato, Robertson, Ding: A novel semi-active "
+                          "quasi-zero stiffness vibration isolation system using a "
+                          "constant-force magnetic spring and an electromagnetic linear motor",
+            "comment": "parameters are global attributes '<section>.<name>' in SI units, "
+                       "each with its unit in '<section>.<name>_units'",
+            "qzs_version": __version__}
+    head.update(params)
+    if none:
+        head["none_parameters"] = " ".join(none)
+    if run is None:
+        return head, {}
+    tail, _ = _storable(run_metadata(run))
+    tail["history"] = history if history is not None else history_line(excitation, run)
+    return head, tail
 
 
 class SimulationResult:
@@ -59,6 +256,9 @@ class SimulationResult:
         The output samples, one column per channel of :data:`CHANNELS` (in their units).
     flags : ndarray of bool, shape (n_samples, 2)
         The boolean outputs, one column per flag of :data:`FLAGS`.
+    statistics : dict, optional
+        The summary's statistics of every sample, when ``data`` is only a preview of a run
+        streamed to a file (see :attr:`statistics`); computed from ``data`` if omitted.
 
     Attributes
     ----------
@@ -69,17 +269,37 @@ class SimulationResult:
     excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
         Base excitation of the run.
     run : dict
-        Solver, ``dt`` [s], ``sample_rate`` [Hz], ``steps``, ``elapsed`` [s],
-        ``completed``, ``stop_contacts``, ``stick_events``, stop positions [m].
+        Solver, ``dt`` [s], ``sample_rate`` [Hz], ``steps``, ``elapsed`` [s] (integration
+        only: compiling the kernels is not counted), ``completed``, ``stop_contacts``,
+        ``stick_events``, stop positions [m], ``samples`` (output samples of the run) and
+        ``preview_every`` (1, or k if the result keeps every k-th of a streamed run).
     """
 
-    def __init__(self, data, flags, *, isolator, controller, excitation, run):
+    def __init__(self, data, flags, *, isolator, controller, excitation, run, statistics=None):
         self._data = data
         self._flags = flags
         self.isolator = isolator
         self.controller = controller
         self.excitation = excitation
         self.run = run
+        self._statistics = statistics
+
+    @property
+    def statistics(self):
+        """What the summary reports, from every sample of the run (also of a streamed one).
+
+        A dict, see :data:`qzs.analysis.statistics.SUMMARY_STATISTICS` for names and units.
+        """
+        if self._statistics is None:  # a result built from arrays: summarise them
+            from qzs.analysis.statistics import SummaryStatistics
+
+            center = 0.5 * (self.run["stop_low"] + self.run["stop_high"])
+            statistics = SummaryStatistics(center, self.isolator.motor_force_max)
+            block = {name: self[name] for name in (*CHANNELS, *FLAGS)}
+            block["mechanical_energy"] = self.mechanical_energy()
+            statistics.add(block)
+            self._statistics = statistics.result()
+        return self._statistics
 
     def __getitem__(self, name):
         if name in CHANNELS:
@@ -122,35 +342,38 @@ class SimulationResult:
         return energy - energy[0] - net
 
     def metadata(self):
-        """Flat ``dict`` of every parameter, the excitation, the run settings and the version."""
+        """Flat ``dict`` of every parameter, the excitation, the run settings and the version.
+
+        ``None`` values are kept, booleans are 0/1; the units are in
+        :func:`parameter_metadata` and :func:`run_metadata`.
+        """
         from qzs._version import __version__
 
         meta = {"qzs_version": __version__}
-        meta.update({f"isolator.{k}": v for k, v in self.isolator.to_dict().items()})
-        meta.update({f"controller.{k}": v for k, v in self.controller.to_dict().items()})
-        meta["excitation"] = type(self.excitation).__name__
-        for field in dataclasses.fields(self.excitation):  # scalars; a record's arrays are data
-            value = getattr(self.excitation, field.name)
-            if value is not None and not isinstance(value, np.ndarray):
-                meta[f"excitation.{field.name}"] = value
-        if self.excitation.duration is not None:
-            meta.setdefault("excitation.duration", self.excitation.duration)
-        meta.update({f"run.{k}": v for k, v in self.run.items()})
-        return {k: (int(v) if isinstance(v, bool) else v) for k, v in meta.items()}
+        meta.update({k: v for k, (v, _) in parameter_metadata(
+            self.isolator, self.controller, self.excitation).items()})
+        meta.update({k: v for k, (v, _) in run_metadata(self.run).items()})
+        return meta
 
     def to_xarray(self):
-        """The run as an ``xarray.Dataset`` on dimension ``time`` with units and metadata."""
+        """The run as an ``xarray.Dataset`` on dimension ``time``, with CF-1.10 metadata.
+
+        The same variables and attributes as a saved NetCDF file (see
+        :func:`variable_attributes` and docs/model.md §7), except that the flags stay
+        boolean and ``None`` parameters are ``"none"`` (listed in ``none_parameters``).
+        """
         import xarray as xr
 
-        time = self["time"]
+        attributes = variable_attributes()
         variables = {
-            name: ("time", self._data[:, col], {"units": unit, "long_name": doc})
-            for name, (col, unit, doc) in CHANNELS.items() if name != "time"}
+            name: ("time", self._data[:, col], attributes[name])
+            for name, (col, _, _) in CHANNELS.items() if name != "time"}
         variables.update({
-            name: ("time", self._flags[:, col], {"long_name": doc})
-            for name, (col, doc) in FLAGS.items()})
-        return xr.Dataset(variables, coords={"time": ("time", time, {"units": "s"})},
-                          attrs=self.metadata())
+            name: ("time", self._flags[:, col], attributes[name])
+            for name, (col, _) in FLAGS.items()})
+        head, tail = file_attributes(self.isolator, self.controller, self.excitation, self.run)
+        return xr.Dataset(variables, coords={"time": ("time", self["time"], attributes["time"])},
+                          attrs={**head, **tail})
 
     def summary(self):
         """One-screen text summary of the run."""

@@ -9,19 +9,31 @@ import time as _time
 import numpy as np
 
 from qzs import defaults
+from qzs.analysis.statistics import SummaryStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.results import SimulationResult
-from qzs.errors import SimulationError
+from qzs.engine.results import CHANNELS, FLAGS, SimulationResult
+from qzs.errors import ResultTooLargeError, SimulationError
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "result_bytes"]
+
+#: Bytes one output sample takes in memory: every channel as float64, the flags as bool.
+BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
+#: Samples a streamed run keeps in memory for its plot: every k-th, at most this many.
+PREVIEW_SAMPLES = 200_000
+#: Integration steps per chunk at most: the unit of progress, streaming and Ctrl-C.
+CHUNK_STEPS = 2_000_000
+#: Output samples per chunk at most: the buffer of a streamed run (12 MB).
+CHUNK_SAMPLES = 65_536
+#: Share of the available memory a result may take before a run without a sink is refused.
+MEMORY_SHARE = 0.5
 
 
 def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
              dt=defaults.SIMULATION["dt"], sample_rate=defaults.SIMULATION["sample_rate"],
              solver=defaults.SIMULATION["solver"], initial_state=None, progress=False,
-             interruptible=False):
+             interruptible=False, sink=None):
     """Simulate the isolator under a base excitation with a fixed-step integrator.
 
     Parameters
@@ -48,6 +60,15 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     interruptible : bool
         If True, Ctrl-C ends the run early and returns what was simulated
         (``result.completed`` is False) instead of raising ``KeyboardInterrupt``.
+    sink : callable, optional
+        ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
+        (``data`` of shape (n, N_CHANNELS) in the columns of
+        :data:`~qzs.engine.results.CHANNELS`, ``flags`` of shape (n, 2); both are reused
+        buffers: consume or copy them). The result then keeps only a preview (every
+        k-th sample, at most :data:`PREVIEW_SAMPLES`; ``result.run["preview_every"]``),
+        so memory stays bounded however long the run
+        (:class:`qzs.iotools.files.ResultWriter` is such a sink). The summary's
+        statistics always come from every sample.
 
     Returns
     -------
@@ -56,7 +77,8 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     Raises
     ------
     ParameterError
-        Invalid argument; ``StabilityError`` if ``dt`` exceeds the largest stable step.
+        Invalid argument; ``StabilityError`` if ``dt`` exceeds the largest stable step;
+        ``ResultTooLargeError`` if, without a ``sink``, the result would not fit in memory.
     SimulationError
         The state diverged or became non-finite (the message names time and state).
     """
@@ -68,40 +90,121 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     dt, sample_rate = run.dt, run.sample_rate
     n_steps = int(round(duration / dt))
     n_out = n_steps // decimation + 1
-    out = np.empty((n_out, K.N_CHANNELS))
-    out_flags = np.zeros((n_out, 2), dtype=np.bool_)
+    chunk = decimation * max(1, min(CHUNK_STEPS // decimation, CHUNK_SAMPLES))
+    if sink is None:
+        _check_memory(n_out, duration, sample_rate)
+        every = 1
+        out = np.empty((n_out, K.N_CHANNELS))
+        out_flags = np.zeros((n_out, 2), dtype=np.bool_)
+    else:
+        every = max(1, -(-n_out // PREVIEW_SAMPLES))
+        out = np.empty((chunk // decimation + 1, K.N_CHANNELS))
+        out_flags = np.zeros((out.shape[0], 2), dtype=np.bool_)
+        preview, preview_flags = [], []
     K.evaluate(0.0, s, flags, p, *packed, out[0], out_flags[0])
+    statistics = SummaryStatistics(0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]), isolator.motor_force_max)
 
-    rows, done, completed = 1, 0, True
-    chunk = max(decimation, int(2e6 // decimation) * decimation)
+    def absorb(first, rows, total):
+        """Rows ``first:first+rows`` of the buffer are new; ``total`` were written before."""
+        block, block_flags = out[first:first + rows], out_flags[first:first + rows]
+        statistics.add(_named(block, block_flags))
+        if sink is not None:
+            sink(block, block_flags)
+            keep = np.flatnonzero((total + np.arange(rows)) % every == 0)
+            preview.append(block[keep].copy())
+            preview_flags.append(block_flags[keep].copy())
+
+    absorb(0, 1, 0)
+    rows, done, completed, start = 1, 0, True, None
     bar = _progress_bar(n_steps, progress)
-    start = _time.perf_counter()
     try:
+        # a zero-step call compiles (or loads) the kernel: the clock counts integration only
+        _lanes.run_single(solver_code, 0, decimation, s, flags, p, *packed, out, out_flags, 1)
+        start = _time.perf_counter()
         while done < n_steps:
             n = min(chunk, n_steps - done)
-            status, written = _lanes.run_single(solver_code, n, decimation, s, flags, p, *packed,
-                                                out, out_flags, rows)
-            rows += written
+            row0 = rows if sink is None else 0
+            try:
+                status = _lanes.run_single(solver_code, n, decimation, s, flags, p, *packed,
+                                           out, out_flags, row0)[0]
+            finally:  # Ctrl-C lands after the kernel returns: keep the rows it wrote
+                written = int(flags[K.I_STEP]) // decimation - done // decimation
+                absorb(row0, written, rows)
+                rows += written
+                done = int(flags[K.I_STEP])
             if status != K.STATUS_OK:
                 _raise_diverged(s, flags, p)
-            done += n
             if bar is not None:
                 bar.update(n)
     except KeyboardInterrupt:
         if not interruptible:
             raise
         completed = False
-        done = int(flags[K.I_STEP])
     finally:
         if bar is not None:
             bar.close()
-    elapsed = _time.perf_counter() - start
+    elapsed = 0.0 if start is None else _time.perf_counter() - start
     run = dict(solver=solver, dt=dt, sample_rate=sample_rate, duration=duration,
                steps=int(flags[K.I_STEP]), elapsed=elapsed, completed=completed,
                stop_contacts=int(flags[K.I_N_CONTACTS]), stick_events=int(flags[K.I_N_STICKS]),
-               stop_low=float(p[K.P_Z_LOW]), stop_high=float(p[K.P_Z_HIGH]))
-    return SimulationResult(out[:rows], out_flags[:rows], isolator=isolator,
-                            controller=controller, excitation=excitation, run=run)
+               stop_low=float(p[K.P_Z_LOW]), stop_high=float(p[K.P_Z_HIGH]), samples=rows,
+               preview_every=every)
+    if sink is None:
+        data, data_flags = out[:rows], out_flags[:rows]
+    else:
+        data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
+    return SimulationResult(data, data_flags, isolator=isolator, controller=controller,
+                            excitation=excitation, run=run, statistics=statistics.result())
+
+
+def result_bytes(duration, sample_rate):
+    """Memory [bytes] a run's result takes: every channel and flag at every output sample.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time [s].
+    sample_rate : float
+        Output sample rate [Hz].
+
+    Returns
+    -------
+    int
+    """
+    return int((int(round(duration * sample_rate)) + 1) * BYTES_PER_SAMPLE)
+
+
+def _available_memory():
+    """Memory the system can give without swapping [bytes] (None where unknown)."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        import os
+
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _check_memory(n_out, duration, sample_rate):
+    needed = n_out * BYTES_PER_SAMPLE
+    available = _available_memory()
+    if available is not None and needed > MEMORY_SHARE * available:
+        raise ResultTooLargeError(needed, available, duration, sample_rate)
+
+
+def _named(data, flags):
+    """A block of output rows as the named arrays :class:`SummaryStatistics` takes."""
+    block = {name: data[:, column] for name, (column, _, _) in CHANNELS.items()}
+    block.update({name: flags[:, column] for name, (column, _) in FLAGS.items()})
+    block["mechanical_energy"] = (block["kinetic_energy"] + block["spring_energy"]
+                                  + block["gravity_energy"] + block["stop_energy"])
+    return block
 
 
 def _progress_bar(total, enabled):

@@ -34,9 +34,20 @@ def fit_covariance(jacobian, residual, n_parameters):
 
 
 def student_quantile(confidence, dof):
+    """Two-sided Student-t quantile: ``t.ppf((1 + confidence) / 2, dof)``.
+
+    The half-width of a ``confidence`` interval is this times the standard error
+    (1.96 for 95 % and many degrees of freedom, not the one-sided 1.645).
+    """
     if not 0 < confidence < 1:
         raise ParameterError(f"`confidence` must be in (0, 1), got {confidence!r}.")
     return float(stats.t.ppf(0.5 + confidence / 2, dof))
+
+
+def profile_threshold(confidence, dof):
+    """Rise of the residual sum of squares, in units of the residual variance, that bounds
+    a profile-likelihood interval of one parameter: ``F(1, dof)`` quantile, ``t^2``."""
+    return student_quantile(confidence, dof) ** 2
 
 
 def finite_samples(name, values):

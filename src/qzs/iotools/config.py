@@ -9,7 +9,8 @@ from qzs.model.excitation import EXCITATION_OPTIONS
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, update_parameters
 
-__all__ = ["load_config", "save_config", "EXCITATION_KEYS", "SIMULATION_KEYS"]
+__all__ = ["load_config", "save_config", "EXCITATION_KEYS",
+           "SIMULATION_KEYS"]
 
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
 EXCITATION_KEYS = ("kind", *dict.fromkeys(o for v in EXCITATION_OPTIONS.values() for o in v))
@@ -35,6 +36,11 @@ def load_config(path):
     dict
         ``isolator`` and ``controller`` (parameter objects), ``excitation`` and
         ``simulation`` (plain dicts).
+
+    Raises
+    ------
+    ParameterError
+        A missing, binary or malformed file, an unknown table or key, a bad value.
     """
     path = Path(path)
     document = read_toml(path, "config file")

@@ -76,6 +76,10 @@ FORMATS = {".csv": "csv", ".txt": "csv", ".mat": "mat", ".mf4": "mf4", ".mdf": "
 NAN_POLICIES = ("raise", "interpolate")
 EXPERIMENT_KEYS = ("highpass_corner", "amplitude", "f0", "f1", "method", "fft_length",
                    "n_averages")
+#: How to put a log on a uniform time base, in every interface that reads logs.
+_RESAMPLE_FIX = ("resample it onto a uniform grid: set resample = true in the channel map's "
+                 "[options], or pass --resample to `qzs experiment` (resample=True to "
+                 "read_recording)")
 _INDEXED = re.compile(r"^\s*([XY])\[(\d+)\]\s*(?:/(.*))?$")
 
 
@@ -327,6 +331,11 @@ def read_recording(path, channel_map, *, resample=None, format=None):
     spec = load_channel_map(channel_map)
     if not path.exists():
         raise DataError(f"log file not found: {str(path)!r}.")
+    if path.is_dir():
+        raise DataError(f"log file {str(path)!r} is a folder; pass the log file.")
+    if path.stat().st_size == 0:
+        raise DataError(f"log file {str(path)!r} is empty (0 bytes); the export or copy "
+                        "did not finish: export the log again.")
     if format is None:
         format = FORMATS.get(path.suffix.lower())
         if format is None:
@@ -498,19 +507,26 @@ def _vector(value, what, path):
 
 def _load_mat5(path):
     from scipy.io import loadmat
+    from scipy.io.matlab import MatReadError
 
     try:
         return loadmat(path, simplify_cells=True)
-    except (ValueError, TypeError, OSError) as error:
-        raise DataError(f"{str(path)!r} is not a readable MAT file: {error}") from None
+    except (MatReadError, ValueError, TypeError, OSError, EOFError, NotImplementedError,
+            UnicodeDecodeError) as error:
+        raise DataError(f"{str(path)!r} is not a readable MAT file ({error}); export it "
+                        "again from ControlDesk as MAT (v5, v7 or v7.3).") from None
 
 
 def _load_mat73(path):
     import h5py
 
-    with h5py.File(path, "r") as handle:
-        return {name: _h5_value(handle, handle[name]) for name in handle
-                if not name.startswith("#")}
+    try:
+        with h5py.File(path, "r") as handle:
+            return {name: _h5_value(handle, handle[name]) for name in handle
+                    if not name.startswith("#")}
+    except (OSError, KeyError, ValueError, TypeError) as error:  # h5py's errors are these
+        raise DataError(f"{str(path)!r} is not a readable MAT file (v7.3, HDF5: {error}); "
+                        "export it again from ControlDesk.") from None
 
 
 def _h5_class(obj):
@@ -664,7 +680,7 @@ def _assemble(signals, spec, resample, source):
     if not shared and not resample:
         sizes = {role: t.size for role, (t, _) in checked.items()}
         raise DataError(f"{source}: the channels have different time bases ({sizes} samples); "
-                        "set resample = true in the map's [options] or pass resample=True.")
+                        f"{_RESAMPLE_FIX}.")
     time = times[0]
     steps = np.diff(time)
     step = float(np.median(steps))
@@ -675,8 +691,8 @@ def _assemble(signals, spec, resample, source):
     elif not resample:
         raise DataError(f"{source}: the time base is not uniform: sample intervals range from "
                         f"{steps.min():.6g} to {steps.max():.6g} s (relative jitter {jitter:.3g} > "
-                        f"tolerance {spec.tolerance:g}); set resample = true in the map's "
-                        "[options], pass resample=True, or raise `tolerance`.")
+                        f"tolerance {spec.tolerance:g}); {_RESAMPLE_FIX}, or raise the map's "
+                        "[options] tolerance.")
     else:  # linear interpolation onto the finest median interval over the common span
         step = min(float(np.median(np.diff(t))) for t in times)
         start, end = max(t[0] for t in times), min(t[-1] for t in times)

@@ -20,13 +20,17 @@ from qzs._validation import (as_float, choice, non_negative, parameter, positive
 from qzs.errors import DataError, ExcitationError
 
 __all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
-           "EXCITATION_OPTIONS", "build_excitation", "read_displacement_csv"]
+           "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv"]
 
 KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
 # Indices into the packed scalars; a table is a (5, n) array: breakpoints in row 0
 # (one more than the pieces), the cubic's coefficients (highest power first) in rows 1-4.
-E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING = range(7)
-N_EXCITATION = 7
+E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING, E_FADE = range(8)
+N_EXCITATION = 8
+#: Default fade-in [s] of the excitations that start at full amplitude (sine, random,
+#: record): a smooth ramp (its slope a raised cosine) of a few of the closed loop's
+#: time constants (docs/model.md §6). A chirp from 0 Hz starts gently and needs none.
+DEFAULT_FADE_IN = 2.0
 
 _NO_TABLE = np.zeros((5, 2))
 
@@ -36,11 +40,35 @@ def _excitation_rule(rule):
     return lambda name, value: rule(name, value, ExcitationError)
 
 
-def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=0.0):
+def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=0.0,
+          fade=0.0):
     ex = np.zeros(N_EXCITATION)
-    ex[[E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING]] = (
-        kind, amplitude, f0, f1, duration, phase, spacing)
+    ex[[E_KIND, E_AMPLITUDE, E_F0, E_F1, E_DURATION, E_PHASE, E_SPACING, E_FADE]] = (
+        kind, amplitude, f0, f1, duration, phase, spacing, fade)
     return ex
+
+
+def _fade_rule(name, value):
+    return non_negative(name, value, ExcitationError)
+
+
+def _resolve_fade(excitation):
+    """``fade_in=None`` (the default) becomes :data:`DEFAULT_FADE_IN`, or a quarter of the
+    excitation's length if that is shorter; then the value is checked."""
+    duration = excitation.duration
+    if excitation.fade_in is None:
+        fade = DEFAULT_FADE_IN if duration is None else min(DEFAULT_FADE_IN, 0.25 * duration)
+        object.__setattr__(excitation, "fade_in", fade)
+    object.__setattr__(excitation, "fade_in", _fade_rule("fade_in", excitation.fade_in))
+    if duration is not None and excitation.fade_in > duration:
+        raise ExcitationError(
+            f"`fade_in` ({excitation.fade_in!r} s) must not exceed the excitation's length "
+            f"({duration!r} s); shorten it, or set fade_in=0 to start at full amplitude.")
+
+
+_FADE_DOC = ("fade-in [s]: smooth ramp (slope a raised cosine) of the amplitude from 0 at "
+             "t = 0 to full at t = fade_in; 0 starts at full amplitude; default 2 s (a "
+             "quarter of the excitation if shorter; none for a chirp)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -57,6 +85,9 @@ class Chirp:
         Sweep time [s]; default 2000 (enough for 122 Welch averages of 32768 at 1 kHz).
     method : {"linear", "logarithmic"}
         Instantaneous frequency linear or exponential in time (``f0 > 0`` for the latter).
+    fade_in : float
+        Smooth ramp (slope a raised cosine) of the amplitude over the first ``fade_in`` [s];
+        default 0 (a chirp from 0 Hz starts gently; give one for ``f0 > 0``).
     """
 
     amplitude: float = parameter(0.010, "m", "chirp displacement amplitude")
@@ -64,6 +95,7 @@ class Chirp:
     f1: float = parameter(20.0, "Hz", "chirp end frequency")
     duration: float = parameter(2000.0, "s", "sweep time")
     method: str = parameter("linear", "-", "sweep law: linear or logarithmic")
+    fade_in: float = parameter(0.0, "s", _FADE_DOC)
 
     def __post_init__(self):
         validate_fields(self, {
@@ -73,6 +105,7 @@ class Chirp:
             "duration": _excitation_rule(positive),
             "method": lambda n, v: choice(n, v, ("linear", "logarithmic"), ExcitationError),
         })
+        _resolve_fade(self)
         if self.method == "logarithmic" and (self.f0 <= 0 or self.f1 <= 0):
             raise ExcitationError(
                 f"a logarithmic chirp needs `f0` > 0 and `f1` > 0, got f0={self.f0!r} Hz, "
@@ -104,7 +137,8 @@ class Chirp:
     def pack(self):
         """Kernel form: ``(scalars, table)``."""
         kind = KIND_CHIRP_LINEAR if self.method == "linear" else KIND_CHIRP_LOG
-        return _pack(kind, self.amplitude, self.f0, self.f1, self.duration), _NO_TABLE
+        return (_pack(kind, self.amplitude, self.f0, self.f1, self.duration, fade=self.fade_in),
+                _NO_TABLE)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,11 +153,16 @@ class Sine:
         Frequency [Hz].
     phase : float
         Phase at t = 0 [rad].
+    fade_in : float
+        Smooth ramp (slope a raised cosine) of the amplitude over the first ``fade_in`` [s];
+        default (None) 2 s (:data:`DEFAULT_FADE_IN`); 0 starts at full amplitude, which
+        kicks the payload off its setpoint (docs/model.md §6).
     """
 
     amplitude: float = parameter(0.010, "m", "sine displacement amplitude")
     frequency: float = parameter(1.0, "Hz", "sine frequency")
     phase: float = parameter(0.0, "rad", "phase at t = 0")
+    fade_in: float = parameter(None, "s", _FADE_DOC)
     duration = None  # unbounded: the run's duration is chosen by the caller
 
     def __post_init__(self):
@@ -132,6 +171,7 @@ class Sine:
             "frequency": _excitation_rule(non_negative),
             "phase": _excitation_rule(as_float),
         })
+        _resolve_fade(self)
 
     @property
     def max_frequency(self):
@@ -140,7 +180,8 @@ class Sine:
 
     def pack(self):
         """Kernel form: ``(scalars, table)``."""
-        return _pack(KIND_SINE, self.amplitude, self.frequency, phase=self.phase), _NO_TABLE
+        return (_pack(KIND_SINE, self.amplitude, self.frequency, phase=self.phase,
+                      fade=self.fade_in), _NO_TABLE)
 
 
 class _Tabulated:
@@ -155,7 +196,7 @@ class _Tabulated:
         table = np.zeros((5, spline.x.size))
         table[0] = spline.x
         table[1:, :-1] = spline.c
-        return _pack(KIND_TABLE, duration=self.duration, spacing=spacing), table
+        return _pack(KIND_TABLE, duration=self.duration, spacing=spacing, fade=self.fade_in), table
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)
@@ -176,7 +217,11 @@ class RandomExcitation(_Tabulated):
     duration : float
         Length of the record [s].
     seed : int
-        Seed of ``numpy.random.default_rng``: the same seed gives the same signal.
+        Seed of ``numpy.random.default_rng`` (>= 0): the same seed gives the same signal.
+    fade_in : float
+        Smooth ramp (slope a raised cosine) of the amplitude over the first ``fade_in`` [s];
+        default (None) 2 s (:data:`DEFAULT_FADE_IN`), or a quarter of ``duration`` if
+        that is shorter; 0 starts at full amplitude.
     """
 
     amplitude: float = parameter(0.001, "m", "RMS displacement")
@@ -184,6 +229,7 @@ class RandomExcitation(_Tabulated):
     f_high: float = parameter(20.0, "Hz", "upper band edge")
     duration: float = parameter(100.0, "s", "record length")
     seed: int = parameter(0, "1", "random seed")
+    fade_in: float = parameter(None, "s", _FADE_DOC)
 
     def __post_init__(self):
         validate_fields(self, {
@@ -196,8 +242,11 @@ class RandomExcitation(_Tabulated):
             raise ExcitationError(
                 f"`f_low` must be below `f_high`, got f_low={self.f_low!r} Hz, "
                 f"f_high={self.f_high!r} Hz.")
-        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool):
-            raise ExcitationError(f"`seed` must be an integer, got {self.seed!r}.")
+        if (not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool)
+                or self.seed < 0):
+            raise ExcitationError(f"`seed` must be a non-negative integer (numpy's generators "
+                                  f"take 0 .. 2**128-1), got {self.seed!r}.")
+        _resolve_fade(self)
 
     @property
     def max_frequency(self):
@@ -241,10 +290,15 @@ class DisplacementRecord(_Tabulated):
         Sample times [s], strictly increasing, at least 4 samples.
     displacement : array_like
         Base displacement [m] at those times.
+    fade_in : float
+        Smooth ramp (slope a raised cosine) of the amplitude over the first ``fade_in`` [s];
+        default (None) 2 s (:data:`DEFAULT_FADE_IN`), or a quarter of the record if that
+        is shorter; 0 replays the record as it is.
     """
 
     time: np.ndarray = parameter(unit="s", doc="sample times")
     displacement: np.ndarray = parameter(unit="m", doc="base displacement")
+    fade_in: float = parameter(None, "s", _FADE_DOC)
 
     def __post_init__(self):
         time = np.asarray(self.time, dtype=float)
@@ -264,6 +318,7 @@ class DisplacementRecord(_Tabulated):
                             "sort the record and drop duplicates first")
         object.__setattr__(self, "time", time - time[0])
         object.__setattr__(self, "displacement", disp)
+        _resolve_fade(self)
 
     @property
     def duration(self):
@@ -283,7 +338,8 @@ class DisplacementRecord(_Tabulated):
         return CubicSpline(self.time, self.displacement), (steps.mean() if uniform else 0.0)
 
     @classmethod
-    def from_file(cls, path, *, time_column="time", displacement_column="displacement"):
+    def from_file(cls, path, *, time_column="time", displacement_column="displacement",
+                  fade_in=None):
         """Read a record from a CSV file with a header (see :func:`read_displacement_csv`).
 
         Parameters
@@ -292,9 +348,12 @@ class DisplacementRecord(_Tabulated):
             The CSV file.
         time_column, displacement_column : str
             Names of the columns holding time [s] and displacement [m].
+        fade_in : float
+            Smooth ramp (slope a raised cosine) of the amplitude [s]; 0 for none; default
+            (None) as :class:`DisplacementRecord`'s.
         """
         time, displacement = read_displacement_csv(path, time_column, displacement_column)
-        return cls(time=time, displacement=displacement)
+        return cls(time=time, displacement=displacement, fade_in=fade_in)
 
 
 #: Excitation kinds by the names configs, the command line and sweeps use.
@@ -302,10 +361,10 @@ EXCITATION_KINDS = {"chirp": Chirp, "sine": Sine, "random": RandomExcitation,
                     "file": DisplacementRecord}
 #: Options of each kind, as configs, the command line and sweeps spell them.
 EXCITATION_OPTIONS = {
-    "chirp": ("amplitude", "f0", "f1", "duration", "method"),
-    "sine": ("amplitude", "frequency", "phase"),
-    "random": ("amplitude", "f0", "f1", "duration", "seed"),
-    "file": ("record",),
+    "chirp": ("amplitude", "f0", "f1", "duration", "method", "fade_in"),
+    "sine": ("amplitude", "frequency", "phase", "fade_in"),
+    "random": ("amplitude", "f0", "f1", "duration", "seed", "fade_in"),
+    "file": ("record", "fade_in"),
 }
 # Option name -> field name where they differ (a random band is f0..f1 in files).
 _FIELD_NAMES = {"random": {"f0": "f_low", "f1": "f_high"}}
@@ -327,8 +386,8 @@ def build_excitation(kind, options=None):
         Option name -> value, names as in :data:`EXCITATION_OPTIONS`: ``amplitude`` [m]
         (RMS for random), ``f0``/``f1`` [Hz] (chirp start/end, random band),
         ``frequency`` [Hz] and ``phase`` [rad] (sine), ``duration`` [s], ``method``
-        (chirp), ``seed`` (random), ``record`` (file: a CSV path). Missing options
-        take the class defaults.
+        (chirp), ``seed`` (random), ``record`` (file: a CSV path), ``fade_in`` [s]
+        (every kind). Missing options take the class defaults.
 
     Returns
     -------
@@ -351,7 +410,8 @@ def build_excitation(kind, options=None):
         if "record" not in options:
             raise ExcitationError("a `file` excitation needs `record`, the path of a CSV file "
                                   "with columns time [s] and displacement [m].")
-        return DisplacementRecord.from_file(options["record"])
+        return DisplacementRecord.from_file(
+            options["record"], **({"fade_in": options["fade_in"]} if "fade_in" in options else {}))
     if kind == "random" and "seed" in options:
         seed = options["seed"]
         if isinstance(seed, float) and seed.is_integer():

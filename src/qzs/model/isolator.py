@@ -25,6 +25,9 @@ __all__ = [
 
 #: Hard-stop contact models: a stiff spring-damper, or a perfectly plastic stop.
 STOP_MODELS = ("compliant", "plastic")
+#: Share of the plateau force ``a`` the spring may fall short of inside its constant-force
+#: region [-] (docs/model.md §3).
+CONSTANT_FORCE_TOLERANCE = 0.01
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -110,6 +113,12 @@ class IsolatorParameters:
     def weight_deficit(self):
         """``m*g - a`` [N]: how much of the weight the spring's plateau cannot carry."""
         return self.mass * self.gravity - self.spring_force
+
+    @property
+    def constant_force_edge(self):
+        """Edge of the spring's constant-force region [m]: ``z`` below it is compressed so far
+        that ``|F_spring| >= 0.99 a`` (docs/model.md §3); ``-atanh(0.99)/b``."""
+        return -float(np.arctanh(1.0 - CONSTANT_FORCE_TOLERANCE)) / self.spring_shape
 
     def to_dict(self):
         """Return the parameters as a plain ``dict`` (``None`` values omitted)."""

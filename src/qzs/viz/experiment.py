@@ -5,12 +5,20 @@ import numpy as np
 
 from qzs.analysis.spectral import band_mask
 from qzs.viz.figures import new_figure, save_figure
+from qzs.viz.transmissibility import COINCIDE_DB, coinciding
 
 __all__ = ["plot_experiment"]
 
 
+def _db(values):
+    return 20 * np.log10(np.maximum(np.asarray(values, dtype=float), 1e-12))
+
+
 def plot_experiment(result, *, path=None, title=None):
     """Measured and simulated transmissibility [dB] and the coherence, flagged band shaded.
+
+    Trusted bins (docs/model.md §10) are drawn solid and set the vertical range;
+    untrusted bins are drawn faint.
 
     Parameters
     ----------
@@ -25,22 +33,49 @@ def plot_experiment(result, *, path=None, title=None):
     -------
     matplotlib.figure.Figure
     """
-    fig, (top, bottom) = new_figure(2, height=2.6, sharex=False)
+    fig, (top, bottom) = new_figure(2, height=2.6, sharex=False, width=10.0,
+                                    height_ratios=(3, 1.4))
     bottom.sharex(top)
-    f, measured, coherence = result._in_band(result.measured)
-    top.plot(f, 20 * np.log10(np.maximum(measured, 1e-12)), color="C0", lw=1.0,
-             label=f"experiment ({result.measured.n_averages} averages)")
+    limits = []
+    simulated_label = "simulation (same chirp and processing)"
     if result.simulated is not None:
-        g = result.simulated.frequency
-        keep = band_mask(g, 0.0, result.band[1])
-        top.plot(g[keep], 20 * np.log10(np.maximum(result.simulated.magnitude[keep], 1e-12)),
-                 color="C3", lw=1.0, ls="--", label="simulation (same chirp and processing)")
-    bottom.plot(f, coherence, color="C0", lw=0.8)
+        curves = [dict(label=name, frequency=e.frequency, magnitude=e.magnitude,
+                       trusted=getattr(e, "trusted", None))
+                  for name, e in (("experiment", result.measured), ("simulation", result.simulated))]
+        groups, _ = coinciding(curves, frequency_range=(0.0, result.band[1]))
+        if len(groups) == 1:
+            simulated_label += f", on top of the experiment (within {COINCIDE_DB:g} dB)"
+    for estimate, color, ls, label, band in (
+            (result.measured, "C0", "-", f"experiment ({result.measured.n_averages} averages)",
+             (0.0, result.band[1])),
+            (result.simulated, "C3", "--", simulated_label,
+             (0.0, result.band[1]))):
+        if estimate is None:
+            continue
+        f = estimate.frequency
+        keep = band_mask(f, *band)
+        trusted = getattr(estimate, "trusted", None)
+        trusted = keep if trusted is None else keep & trusted
+        db = _db(estimate.magnitude)
+        top.plot(f[keep], db[keep], color=color, lw=0.8, ls=ls, alpha=0.25)
+        top.plot(f[keep], np.where(trusted, db, np.nan)[keep], color=color, lw=1.1, ls=ls,
+                 label=label)
+        limits.extend(db[trusted][np.isfinite(db[trusted])])
+        if estimate is result.measured:
+            bottom.plot(f[keep], estimate.coherence[keep], color=color, lw=0.8)
+    top.plot([], [], color="0.45", lw=1.0, alpha=0.45, label="faint: untrusted bins")
     for ax in (top, bottom):
         if result.untrusted_below > 0:
-            ax.axvspan(0, result.untrusted_below, color="0.85", zorder=0,
+            ax.axvspan(0, result.untrusted_below, color="0.88", zorder=0,
                        label=f"not trustworthy (< {result.untrusted_below:g} Hz, high-pass)")
         ax.grid(True, alpha=0.3)
+    if limits:
+        low, high = min(min(limits), 0.0), max(max(limits), 0.0)
+        pad = max(1.0, 0.06 * (high - low))
+        top.set_ylim(low - pad, high + pad)
+    coherence_min = getattr(result.measured, "coherence_min", None)
+    if coherence_min is not None:
+        bottom.axhline(coherence_min, color="k", lw=0.8, ls=":")
     top.axhline(0.0, color="k", lw=0.6)
     top.set_xlim(0, result.band[1])
     top.set_ylabel("transmissibility [dB]\nsqrt(S_payload/S_base)")

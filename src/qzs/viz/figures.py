@@ -45,17 +45,22 @@ def envelope(time, values, max_points=_MAX_POINTS):
     return t_out, v_out
 
 
-def new_figure(rows, height=2.1, sharex=True):
-    """A figure of ``rows`` stacked axes, 9 in wide (Agg when there is no display).
+def new_figure(rows, height=2.1, sharex=True, width=9.0, height_ratios=None):
+    """A figure of ``rows`` stacked axes (Agg when there is no display).
 
     Parameters
     ----------
     rows : int
         Number of axes, stacked vertically.
     height : float
-        Height of each axes [in] (the figure adds 0.8 in).
+        Height of each axes [in] (the figure adds 0.8 in); with ``height_ratios``, the
+        mean height.
     sharex : bool
         Share the horizontal axis.
+    width : float
+        Figure width [in].
+    height_ratios : sequence of float, optional
+        Relative heights of the axes, top first; default all equal.
 
     Returns
     -------
@@ -69,8 +74,9 @@ def new_figure(rows, height=2.1, sharex=True):
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(rows, 1, sharex=sharex, figsize=(9, height * rows + 0.8),
-                             constrained_layout=True)
+    extra = {} if height_ratios is None else {"gridspec_kw": {"height_ratios": height_ratios}}
+    fig, axes = plt.subplots(rows, 1, sharex=sharex, figsize=(width, height * rows + 0.8),
+                             constrained_layout=True, **extra)
     return fig, np.atleast_1d(axes)
 
 

@@ -50,10 +50,16 @@ def plot_simulation(result, path=None, title=None):
     trace(axes[3], "payload_acceleration", label="payload")
     axes[3].set_ylabel("acceleration [m/s$^2$]")
     axes[3].set_xlabel("time [s]")
+    fade = getattr(result.excitation, "fade_in", 0.0)
     for ax in axes:
+        if fade > 0:
+            ax.axvspan(0.0, min(fade, t[-1]), color="0.85", lw=0, zorder=0,
+                       label=f"fade-in {fade:g} s" if ax is axes[0] else None)
         ax.legend(loc="upper right", fontsize="small", ncols=4)
         ax.grid(True, alpha=0.3)
-    fig.suptitle(title or run_title(result))
+    every = result.run.get("preview_every", 1)
+    subtitle = "" if every == 1 else f" (every {every}th of {result.run['samples']:,} samples)"
+    fig.suptitle((title or run_title(result)) + subtitle)
     if path is not None:
         save_figure(fig, path)
     return fig

@@ -13,10 +13,25 @@ from qzs.errors import ParameterError
 from qzs.viz.figures import new_figure, save_figure
 
 __all__ = ["plot_metric", "plot_transmissibility_band", "scalar_outputs", "varied_parameters",
-           "REDUCTIONS"]
+           "figure_suffixes", "REDUCTIONS", "FIGURE_BYTES"]
 
 REDUCTIONS = ("median", "mean", "min", "max")
+#: What one figure file takes at most [bytes] (generous), for the free-space check.
+FIGURE_BYTES = 20 * 1024 ** 2
 _Y_LABEL = "transmissibility, amplitude ratio sqrt(S_payload/S_base) [-]"
+
+
+def figure_suffixes():
+    """File extensions matplotlib can write a figure to (``.png``, ``.svg``, ``.pdf``...).
+
+    Returns
+    -------
+    tuple of str
+        Sorted, each with its leading dot.
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return tuple(sorted("." + name for name in FigureCanvasBase.get_supported_filetypes()))
 
 
 def _usable(dataset):
@@ -76,10 +91,12 @@ def scalar_outputs(dataset):
     Returns
     -------
     list of str
-        Names of the float variables on dimension ``case``, sorted.
+        Names of the numeric variables on dimension ``case`` (floats and integer counts;
+        not the ``status`` flags), sorted.
     """
     return sorted(name for name, v in dataset.data_vars.items()
-                  if v.dims == ("case",) and v.dtype.kind == "f")
+                  if v.dims == ("case",) and v.dtype.kind in "fiu"
+                  and "flag_values" not in v.attrs)
 
 
 def plot_metric(dataset, metric, x, y=None, *, reduce="median", path=None):

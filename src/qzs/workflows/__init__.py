@@ -1,5 +1,6 @@
 """Workflows built on the layers below: the paper's studies and report, experiment logs, sweeps.
 
+``run``         one run streamed to a file as it is simulated (bounded memory)
 ``studies``     the paper's studies as TOML definitions (``study_files/``), run in parallel
 ``report``      ``qzs paper``: figures, metrics, claims decided from the data
 ``experiment``  a measured log beside its simulation

@@ -33,9 +33,11 @@ from qzs.analysis.spectral import (band_mask, highpass, required_samples, transm
 from qzs.defaults import ANALYSIS
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
+from qzs._validation import integer
 from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
+from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.model.excitation import Chirp
 
@@ -43,6 +45,10 @@ __all__ = ["ExperimentResult", "process_experiment", "infer_chirp", "run_experim
 
 #: Welch averages of the paper's experiment (Section 4).
 EXPERIMENT_AVERAGES = 29
+#: Shortest Welch segment [samples] (:func:`qzs.analysis.spectral.transmissibility`).
+MIN_FFT_LENGTH = 8
+#: What the report writes at most [bytes]: two figures, a table, the Markdown (generous).
+REPORT_BYTES = 20 * 1024 ** 2
 SIGNAL_PAIRS = {"velocity": ("base_velocity", "payload_velocity"),
                 "acceleration": ("base_acceleration", "payload_acceleration")}
 
@@ -244,6 +250,35 @@ class ExperimentResult:
         lines.extend(f"  note           {note}" for note in self.notes)
         return "\n".join(lines)
 
+    def to_record(self):
+        """The summary as data (plain types; NaN where a metric is undefined), for ``--json``.
+
+        Returns
+        -------
+        dict
+            ``log`` (source, samples, sample_rate [Hz], duration [s], signal), ``chirp``
+            (amplitude [m], f0 and f1 [Hz], duration [s], inferred), ``welch`` (fft_length
+            [samples], n_averages, window), ``band`` [Hz], ``highpass_corner`` and
+            ``untrusted_below`` [Hz], ``metrics`` and ``simulated_metrics`` (None without
+            simulation), ``discrepancy_db`` [dB], ``simulation_seconds`` [s] and ``notes``.
+        """
+        rec, chirp = self.recording, self.excitation
+        return {
+            "log": {"source": rec.source, "samples": int(rec.time.size),
+                    "sample_rate": rec.sample_rate, "duration": rec.duration,
+                    "signal": self.signal},
+            "chirp": {"amplitude": chirp.amplitude, "f0": chirp.f0, "f1": chirp.f1,
+                      "duration": chirp.duration, "inferred": self.excitation_inferred},
+            "welch": {"fft_length": int(self.measured.fft_length),
+                      "n_averages": int(self.measured.n_averages), "window": "hann"},
+            "band": [float(b) for b in self.band],
+            "highpass_corner": self.highpass_corner, "untrusted_below": self.untrusted_below,
+            "metrics": self.metrics.to_dict(),
+            "simulated_metrics": (self.simulated_metrics.to_dict()
+                                  if self.simulated_metrics is not None else None),
+            "discrepancy_db": self.discrepancy_db(),
+            "simulation_seconds": self.simulation_seconds, "notes": list(self.notes)}
+
     def write_report(self, folder):
         """Write ``transmissibility.png`` (+ .svg), ``transmissibility.csv`` and ``report.md``.
 
@@ -375,6 +410,8 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
 
     Raises
     ------
+    ParameterError
+        ``fft_length`` below 8 or ``n_averages`` below 1 (or not integers).
     DataError
         Missing channels, a log shorter than one FFT segment, a base signal that is not a
         chirp (when it must be inferred).
@@ -385,6 +422,9 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
     corner = float(highpass_corner or 0.0)
     if corner < 0:
         raise ParameterError(f"`highpass_corner` must be >= 0 [Hz], got {highpass_corner!r}.")
+    fft_length = _welch_setting("fft_length", fft_length, MIN_FFT_LENGTH)
+    if n_averages is not None:
+        n_averages = _welch_setting("n_averages", n_averages, 1)
     kind = _signal_kind(recording)
     notes = []
     averages = _averages(recording.time.size, fft_length, n_averages, notes)
@@ -420,6 +460,20 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
                             isolator, controller, tuple(notes), seconds)
 
 
+_FIXES = {"fft_length": "a power of two such as 8192 (--fft-length)",
+          "n_averages": "a count such as 29 (--averages), or leave it out for all that fit"}
+
+
+def _welch_setting(name, value, minimum, where=None):
+    """``value`` as an int >= ``minimum``, or a ParameterError naming it and the fix."""
+    try:
+        return integer(name, value, minimum)
+    except ParameterError:
+        label = f"`{name}`" if where is None else where
+        raise ParameterError(f"{label} must be an integer >= {minimum}, got {value!r}; "
+                             f"use {_FIXES[name]}.") from None
+
+
 def _simulate_like(recording, kind, excitation, isolator, controller, corner, welch, dt):
     """Simulate ``excitation`` at the log's rate and length; estimate like the log."""
     rate = recording.sample_rate
@@ -451,7 +505,8 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
     channel_map : str or Path
         The channel map (TOML, see :mod:`qzs.iotools.readers`).
     out : str or Path
-        Output folder.
+        Output folder, created if missing; checked (writable, free space) before the log
+        is read.
     fft_length : int, optional
         Welch segment length [samples]; default the map's, else 32768.
     n_averages : int, optional
@@ -468,10 +523,28 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
     result : ExperimentResult
     paths : dict
         ``figure``, ``table``, ``report`` -> Path.
+
+    Raises
+    ------
+    ParameterError
+        ``out`` cannot be written (checked first, :func:`qzs.iotools.paths.check_output_path`),
+        ``fft_length`` below 8 or ``n_averages`` below 1 (the arguments or the map's).
+    DataError
+        The log cannot be read or processed (see :func:`qzs.iotools.readers.read_recording`).
     """
+    check_output_path(out, argument="out", suffixes=None, directory=True,
+                      estimated_bytes=REPORT_BYTES)
     channel_map = load_channel_map(channel_map)
-    recording = read_recording(log, channel_map, resample=True if resample else None)
     settings = dict(channel_map.experiment)
+    welch = {}
+    for name, value, minimum in (("fft_length", fft_length, MIN_FFT_LENGTH),
+                                 ("n_averages", n_averages, 1)):
+        if value is not None:
+            welch[name] = _welch_setting(name, value, minimum)
+        elif name in settings:
+            welch[name] = _welch_setting(name, settings[name], minimum,
+                                         where=f"the channel map's [experiment] {name}")
+    recording = read_recording(log, channel_map, resample=True if resample else None)
     isolator = controller = None
     if config:
         loaded = load_config(config)
@@ -486,8 +559,8 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
         excitation = Chirp(**{**values, **given}, duration=recording.duration)
     result = process_experiment(
         recording, highpass_corner=corner,
-        fft_length=fft_length or settings.get("fft_length", ANALYSIS["fft_length"]),
-        n_averages=n_averages or settings.get("n_averages", EXPERIMENT_AVERAGES),
+        fft_length=welch.get("fft_length", ANALYSIS["fft_length"]),
+        n_averages=welch.get("n_averages", EXPERIMENT_AVERAGES),
         isolator=isolator, controller=controller, simulate_match=simulate_match,
         excitation=excitation)
     return result, result.write_report(out)

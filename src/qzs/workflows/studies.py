@@ -16,12 +16,17 @@ Kinds:
     charge amplifier's high-pass, the experiment's averages.
 ``spring_characteristic``
     The MagSpring's static characteristic and its tanh fit (no simulation).
+
+``[study] claims`` names, by id, the paper's claims the study's cases decide (the keys of
+:data:`CLAIMS`; docs/model.md §13); an unknown id is an error. Each curve keeps which of
+its bins are trusted (docs/model.md §10), and every metric comes from those bins only.
 """
 import dataclasses
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
@@ -40,12 +45,29 @@ from qzs.model.excitation import EXCITATION_OPTIONS, Chirp
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import update_parameters
 
-__all__ = ["Study", "StudyResult", "CaseResult", "load_study", "shipped_studies", "run_studies",
-           "run_study"]
+__all__ = ["CLAIMS", "Study", "StudyResult", "CaseResult", "load_study", "shipped_studies",
+           "run_studies", "run_study"]
 
 KINDS = ("transmissibility", "processing", "spring_characteristic")
 #: Folder of the shipped study files, inside the package.
 SHIPPED = "workflows/study_files"
+#: The paper's claims a study may name in ``[study] claims``, by id: what the paper states
+#: (docs/model.md §13). :data:`qzs.workflows.report.CLAIMS` decides each from the cases of
+#: the studies that name it.
+CLAIMS = MappingProxyType({
+    "resonance_masked": "Passive resonance about 0.08 Hz, masked by stiction.",
+    "pi_resonance_range": "PI moves the resonance within 0.08-0.45 Hz.",
+    "stiction_low_frequency": "More stiction: higher transmissibility at low frequency, "
+                              "narrower isolation band.",
+    "viscous_high_frequency": "Above about 3 Hz the viscous friction governs: more Cv, "
+                              "higher transmissibility.",
+    "pi_low_frequency": "High PI gains spoil low-frequency isolation; gains should be just "
+                        "high enough to hold z.",
+    "no_pi_stops": "Without the PI loop the payload drifts to the hard stops (Section 4.1).",
+    "damping_small_effect": "Active damping did not help much.",
+    "experiment_shape": "Experiment: resonance peaks below 3.5 Hz, roll-off from 4 Hz, "
+                        "transmissibility 0.3 at 12 Hz.",
+})
 # Keys of the optional tables (the sample rate is the analysis's).
 _TABLE_KEYS = {"excitation": EXCITATION_OPTIONS["chirp"], "analysis": (*ANALYSIS, "duration"),
                "simulation": ("dt", "solver")}
@@ -66,8 +88,7 @@ class Study:
     cases : tuple of dict
         The ``[[case]]`` tables: a ``label`` and parameter overrides.
     claims : tuple of str
-        Ids of the paper's claims it bears on (keys of
-        :data:`qzs.workflows.report.CLAIMS`).
+        Ids of the paper's claims its cases decide (keys of :data:`CLAIMS`).
     views : tuple of dict
         Figures to draw: ``figure`` (file stem), ``frequency_range`` [Hz] and
         optionally ``frequency_scale``.
@@ -115,18 +136,29 @@ class CaseResult:
         Transmissibility, amplitude ratio [-], at ``frequency``.
     coherence : ndarray
         Magnitude-squared coherence [-] at ``frequency``.
+    trusted : ndarray of bool
+        The bins of ``frequency`` metrics may use
+        (:attr:`TransmissibilityEstimate.trusted <qzs.analysis.spectral.TransmissibilityEstimate>`).
     metrics : dict
-        Metrics of the curve (:meth:`TransmissibilityMetrics.to_dict
-        <qzs.analysis.spectral.TransmissibilityMetrics.to_dict>`); for the spring
-        study, the fitted ``spring_force`` and ``spring_shape``.
+        Metrics of the trusted bins (:meth:`TransmissibilityMetrics.to_dict
+        <qzs.analysis.spectral.TransmissibilityMetrics.to_dict>`), NaN where undefined; for
+        the spring study, the fitted ``spring_force`` and ``spring_shape``.
+    reasons : dict
+        For each NaN metric, why it is undefined.
     stats : dict
         Run statistics (stop contacts, stroke, time locked, Welch settings, speed).
+    run : dict
+        How the case was run and analysed: ``solver``, ``dt`` [s], ``sample_rate`` [Hz],
+        the chirp's ``chirp_amplitude`` [m], ``chirp_f0``, ``chirp_f1`` [Hz] and
+        ``chirp_duration`` [s], ``window``, ``fft_length`` [samples], ``n_averages``,
+        ``overlap`` [-], ``coherence_min`` and ``base_share_min`` [-].
     linear : dict
         The linearised model: natural frequencies [Hz], damping ratio [-] and its
         ``magnitude`` at ``frequency``.
     extra : dict
-        What the kind adds: the experiment-style curve (``processing``), or the
-        spring's data and fit (``spring_characteristic``).
+        What the kind adds: the experiment-style curve with its coherence, trusted
+        bins, metrics and reasons (``processing``), or the spring's data and fit
+        (``spring_characteristic``).
     seconds : float
         Time spent on the case [s].
     """
@@ -136,8 +168,11 @@ class CaseResult:
     frequency: np.ndarray = None
     magnitude: np.ndarray = None
     coherence: np.ndarray = None
+    trusted: np.ndarray = None
     metrics: dict = field(default_factory=dict)
+    reasons: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
+    run: dict = field(default_factory=dict)
     linear: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
     seconds: float = 0.0
@@ -185,7 +220,8 @@ def load_study(path):
     Raises
     ------
     ParameterError
-        Missing file, unknown table or key, bad kind, no case, or an invalid parameter.
+        Missing file, unknown table or key, bad kind, no case, an invalid parameter, or
+        an unknown claim id.
     """
     path = resolve_shipped(path, SHIPPED, "study", "studies")
     document = read_toml(path, "study file")
@@ -214,10 +250,18 @@ def load_study(path):
             raise ParameterError(f"{str(path)!r}, case {i + 1}: {error}") from None
     for table, keys in _TABLE_KEYS.items():
         known_keys(document.get(table, {}), keys, f"[{table}]", f"{str(path)!r}: ")
+    claims = head.get("claims", [])
+    if not isinstance(claims, list) or not all(isinstance(c, str) for c in claims):
+        raise ParameterError(f"{str(path)!r}: [study] `claims` must be a list of claim ids, "
+                             f"got {claims!r}; known ids are {sorted(CLAIMS)}.")
+    for claim in claims:
+        if claim not in CLAIMS:
+            raise ParameterError(f"{str(path)!r}: unknown claim id {claim!r} in [study] claims; "
+                                 f"known ids are {sorted(CLAIMS)}.")
     views = tuple(head.get("view", ()))
     options = {**document.get("spring", {}), **document.get("processing", {})}
     return Study(name=head["name"], title=head.get("title", head["name"]), kind=kind,
-                 cases=cases, claims=tuple(head.get("claims", ())), views=views,
+                 cases=cases, claims=tuple(claims), views=views,
                  defaults=defaults, excitation=dict(document.get("excitation", {})),
                  analysis=dict(document.get("analysis", {})),
                  simulation=dict(document.get("simulation", {})), options=options,
@@ -265,15 +309,26 @@ def _transmissibility_case(task):
     excitation = Chirp(**{k: v for k, v in task["excitation"].items() if k != "duration"},
                        duration=duration)
     run = simulate(excitation, isolator, controller, sample_rate=rate, **task["simulation"])
-    welch = dict(fft_length=analysis["fft_length"], overlap=analysis["overlap"])
+    welch = dict(fft_length=analysis["fft_length"], overlap=analysis["overlap"],
+                 coherence_min=analysis["coherence_min"],
+                 base_share_min=analysis["base_share_min"],
+                 highpass_factor=analysis["highpass_factor"])
     estimate = transmissibility(run.base_acceleration, run.payload_acceleration, rate, **welch)
     low, high = analysis["band"]
     keep = band_mask(estimate.frequency, low, high)
     frequency = estimate.frequency[keep]
     magnitude = estimate.magnitude[keep]
     result = CaseResult(task["label"], task["settings"], frequency, magnitude,
-                        estimate.coherence[keep])
-    result.metrics = _metrics(frequency, magnitude)
+                        estimate.coherence[keep], estimate.trusted[keep])
+    result.metrics, result.reasons = _metrics(estimate, keep)
+    result.run = dict(solver=task["simulation"]["solver"], dt=float(task["simulation"]["dt"]),
+                      sample_rate=float(rate), chirp_amplitude=excitation.amplitude,
+                      chirp_f0=excitation.f0, chirp_f1=excitation.f1,
+                      chirp_duration=float(duration), window="hann",
+                      fft_length=estimate.fft_length, n_averages=estimate.n_averages,
+                      overlap=float(analysis["overlap"]),
+                      coherence_min=estimate.coherence_min,
+                      base_share_min=estimate.base_share_min)
     z = run.relative_position
     statistics = run_statistics(z, run.motor_force, run.locked,
                                 0.5 * (run.run["stop_low"] + run.run["stop_high"]))
@@ -309,15 +364,23 @@ def _experiment_processing(run, rate, welch, options, band):
     estimate = transmissibility(base_velocity, payload_velocity, rate, highpass_corner=corner,
                                 **welch)
     keep = band_mask(estimate.frequency, *band)
-    metrics = _metrics(estimate.frequency[keep], estimate.magnitude[keep], corner)
+    metrics, reasons = _metrics(estimate, keep)
     return dict(frequency=estimate.frequency[keep], magnitude=estimate.magnitude[keep],
-                metrics=metrics, highpass=corner, n_averages=estimate.n_averages)
+                coherence=estimate.coherence[keep], trusted=estimate.trusted[keep],
+                metrics=metrics, reasons=reasons, highpass=corner,
+                untrusted_below=estimate.untrusted_below, n_averages=estimate.n_averages)
 
 
-def _metrics(frequency, magnitude, highpass=None):
-    metrics = transmissibility_metrics(frequency, magnitude, at_frequencies=REPORTED_FREQUENCIES,
-                                       highpass_corner=highpass)
-    return metrics.to_dict()
+def _metrics(estimate, keep):
+    """Metrics of the estimate's trusted bins within ``keep``: (values, reasons) dicts."""
+    metrics = transmissibility_metrics(estimate.frequency[keep], estimate.magnitude[keep],
+                                       trusted=estimate.trusted[keep],
+                                       at_frequencies=REPORTED_FREQUENCIES,
+                                       highpass_corner=estimate.highpass_corner,
+                                       untrusted_factor=estimate.highpass_factor)
+    values = metrics.to_dict()
+    values["trusted_from"], values["trusted_to"] = metrics.trusted_range
+    return values, dict(metrics.reasons)
 
 
 def _spring_case(task):

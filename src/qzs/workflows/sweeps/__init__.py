@@ -91,8 +91,10 @@ def run_sweep(definition, store=None, *, resume=False, overwrite=False, schedule
     Raises
     ------
     ParameterError
-        Invalid definition, an existing store without `resume`/`overwrite`, or a
-        store written by a different definition.
+        Invalid definition, an existing store without `resume`/`overwrite`, a store
+        written by a different definition, or a store that cannot be written (a
+        read-only folder, less free space than its uncompressed size), all checked
+        before any case runs.
     KeyboardInterrupt
         On Ctrl-C, after the batches that finished have been stored.
     """
@@ -121,7 +123,7 @@ def open_sweep(store):
     Raises
     ------
     ParameterError
-        There is no store at ``store``.
+        There is no store at ``store``, or it is not a sweep store.
     """
     from qzs.workflows.sweeps.store import open_store
 
@@ -143,11 +145,27 @@ def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None)
     reduce : {"median", "mean", "min", "max"}
         How cases at one grid point combine.
     out : str or Path, optional
-        Figure file; default ``<sweep>-<metric>-<x>[-<y>].png``.
-    """
-    from qzs.viz.sweeps import (plot_metric, plot_transmissibility_band, scalar_outputs,
-                                varied_parameters)
+        Figure file; its extension chooses the format (:func:`qzs.viz.sweeps.figure_suffixes`);
+        default ``<sweep>-<metric>-<x>[-<y>].png``.
 
+    Returns
+    -------
+    str or Path
+        The figure file written.
+
+    Raises
+    ------
+    ParameterError
+        ``out`` cannot be written (checked before the store is read), ``store`` is not a
+        sweep store, an unknown metric or parameter.
+    """
+    from qzs.iotools.paths import check_output_path
+    from qzs.viz.sweeps import (FIGURE_BYTES, figure_suffixes, plot_metric,
+                                plot_transmissibility_band, scalar_outputs, varied_parameters)
+
+    if out is not None:
+        check_output_path(out, argument="out", suffixes=figure_suffixes(),
+                          estimated_bytes=FIGURE_BYTES)
     dataset = open_sweep(store)
     name = dataset.attrs.get("sweep_name", Path(store).stem)
     if metric is None:

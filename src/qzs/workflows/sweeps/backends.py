@@ -13,6 +13,7 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import nullcontext
+from pathlib import Path
 
 import numpy as np
 
@@ -20,15 +21,17 @@ from qzs._optional import require
 from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
 from qzs.engine.batch import simulate_batch
 from qzs.engine.prepare import steps_per_sample
-from qzs.errors import CaseError, DataError, ParameterError
+from qzs.errors import CaseError, DataError, OutputPathError, ParameterError
+from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 from qzs.workflows.sweeps.definition import case_excitation, sample_cases
-from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, FAILED, INVALID, OK, open_store,
-                                        prepare_store, schema, write_batch)
+from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID, OK,
+                                        estimated_bytes, open_store, prepare_store, schema,
+                                        write_batch)
 
-__all__ = ["run_batch", "execute", "case_settings"]
+__all__ = ["run_batch", "execute", "case_settings", "check_store_path"]
 
 _LOCK = threading.Lock()  # one multi-threaded batch at a time per process
 
@@ -62,10 +65,13 @@ def case_duration(definition, settings):
 
 
 def _empty(definition, n, n_time):
+    """The batch's arrays, filled; counts as floats (NaN) until write_batch stores them."""
     arrays = {}
     for name, (dims, dtype, fill, _) in schema(definition, n_time).items():
         shape = tuple(n if d == "case" else (definition.frequency.size if d == "frequency"
                                              else n_time) for d in dims)
+        if name in COUNTS:
+            dtype, fill = np.float64, np.nan
         arrays[name] = np.full(shape, fill, dtype=object if name == "message" else dtype)
     return arrays
 
@@ -277,12 +283,9 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
 
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
-    n_time = 0
-    if definition.outputs["time_series"]:
-        longest = max(case_duration(definition, s) for s in settings)
-        decimation = steps_per_sample(definition.analysis["sample_rate"],
-                                      definition.simulation["dt"])
-        n_time = int(round(longest / definition.simulation["dt"])) // decimation + 1
+    n_time = _n_time(definition, settings)
+    _check_store(definition, store, n_time, argument="store", resume=resume,
+                 overwrite=overwrite)
     client = cluster = None
     report = {"cases": 0, "failed": 0, "steps": 0, "wall": 0.0}
     began = time.perf_counter()
@@ -325,6 +328,53 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
             cluster.close()
         report["wall"] = time.perf_counter() - began
     return report
+
+
+def _n_time(definition, settings):
+    """Samples kept per time series (0 if none are kept)."""
+    if not definition.outputs["time_series"]:
+        return 0
+    longest = max(case_duration(definition, s) for s in settings)
+    decimation = steps_per_sample(definition.analysis["sample_rate"],
+                                  definition.simulation["dt"])
+    return int(round(longest / definition.simulation["dt"])) // decimation + 1
+
+
+def check_store_path(definition, store, *, argument="store", resume=False, overwrite=False):
+    """Check a sweep's store before any case runs: writable, room for it, not in the way.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    store : str or Path
+        The Zarr store (a directory) to write.
+    argument : str
+        How the caller names the store, for the message (``"--out"``, ``"store"``).
+    resume : bool
+        The store will be continued: it may exist, and its size is not checked again.
+    overwrite : bool
+        The store will be replaced if it exists.
+
+    Raises
+    ------
+    OutputPathError
+        The folder cannot be written, the file system has less free space than the
+        store's uncompressed size, or the store exists without ``resume``/``overwrite``.
+    """
+    settings = case_settings(definition, sample_cases(definition))
+    _check_store(definition, store, _n_time(definition, settings), argument=argument,
+                 resume=resume, overwrite=overwrite)
+
+
+def _check_store(definition, store, n_time, *, argument, resume, overwrite):
+    size = None if resume else estimated_bytes(definition, n_time)
+    check_output_path(store, argument=argument, suffixes=None, directory=True,
+                      estimated_bytes=size)
+    if Path(store).exists() and not resume and not overwrite:
+        raise OutputPathError(argument, store, "exists; pass `resume` (--resume) to continue "
+                              "it, `overwrite` (--overwrite) to replace it, or choose another "
+                              "store")
 
 
 def _stored_failures(store):

@@ -4,6 +4,12 @@ Layout (an ``xarray.Dataset``): dimension ``case`` (chunked by the sweep's
 ``batch_size``), ``frequency`` if a spectral curve is kept, ``time`` if time series
 are kept. The varied parameters are coordinates on ``case``. Every case has
 ``done`` (bool), ``status`` (:data:`STATUS`) and ``message`` ('' or why it failed).
+Counts (:data:`COUNTS`, ``n_averages``) are integers; a count of a case that has
+none (not run, or invalid) is :data:`COUNT_FILL` (-1), never NaN.
+
+The store has consolidated metadata (``zarr.consolidate_metadata``: one read opens
+it); :func:`open_store` uses it where it exists and falls back to reading every
+array's metadata for stores written without it.
 
 Writes are atomic per batch: the template (metadata only) is written to a
 temporary directory and renamed into place; a batch covers whole chunks, each
@@ -14,6 +20,8 @@ written last. A process killed mid-batch leaves that batch not done, and
 import json
 import os
 import shutil
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -25,8 +33,9 @@ from qzs.engine.results import CHANNELS
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
 
-__all__ = ["STATUS", "PENDING", "OK", "INVALID", "FAILED", "ANALYSIS_FAILED", "schema",
-           "prepare_store", "write_batch", "open_store", "summary_text"]
+__all__ = ["STATUS", "PENDING", "OK", "INVALID", "FAILED", "ANALYSIS_FAILED", "COUNTS",
+           "COUNT_FILL", "schema", "prepare_store", "write_batch", "open_store",
+           "estimated_bytes", "summary_text"]
 
 #: Case status codes stored in ``status``.
 STATUS = {0: "pending", 1: "ok", 2: "invalid", 3: "failed", 4: "analysis_failed"}
@@ -37,7 +46,19 @@ _METRIC_UNITS = {"resonance_frequency": "Hz", "resonance_peak": "1", "isolation_
                  "minus_3db_frequency": "Hz", "rolloff_db_per_decade": "dB/decade"}
 _STRING = (np.dtypes.StringDType() if hasattr(np.dtypes, "StringDType")  # numpy >= 2
            else np.dtype(object))
-_ZARR = dict(consolidated=False)
+#: Per-case statistics that count something: stored as integers.
+COUNTS = ("stop_contacts", "stick_events", "steps")
+#: The stored count of a case that has none (not run, invalid parameters).
+COUNT_FILL = -1
+_REGION = dict(consolidated=False)  # batch writes change no metadata: keep the consolidated one
+
+
+@contextmanager
+def _v3_consolidated():
+    """Consolidated metadata in Zarr format 3 is zarr-python's extension: it says so."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Consolidated metadata is currently not part")
+        yield
 
 
 def schema(definition, n_time):
@@ -61,7 +82,13 @@ def schema(definition, n_time):
     }
     for name in out["stats"]:
         unit, doc = STATS[name]
-        variables[name] = (("case",), np.float64, np.nan, {"units": unit, "long_name": doc})
+        if name in COUNTS:
+            variables[name] = (("case",), np.int64, COUNT_FILL,
+                               {"units": unit, "long_name": doc, "valid_min": 0,
+                                "comment": f"{COUNT_FILL} where the case has no count "
+                                           "(not run or invalid, see status)"})
+        else:
+            variables[name] = (("case",), np.float64, np.nan, {"units": unit, "long_name": doc})
     spectral = out["transmissibility"] or out["coherence"] or out["metrics"] or out["bands"]
     if spectral:
         variables["n_averages"] = (("case",), np.int32, 0,
@@ -140,7 +167,8 @@ def _create(path, definition, columns, n_time):
     tmp = path.with_name(f".{path.name}.creating-{os.getpid()}")
     shutil.rmtree(tmp, ignore_errors=True)
     try:
-        dataset.to_zarr(tmp, mode="w-", compute=False, zarr_format=3, **_ZARR)
+        with _v3_consolidated():
+            dataset.to_zarr(tmp, mode="w-", compute=False, zarr_format=3, consolidated=True)
         os.rename(tmp, path)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -226,11 +254,42 @@ def write_batch(path, definition, start, arrays, n_time):
     variables = schema(definition, n_time)
     n = len(arrays["status"])
     region = {"case": slice(start, start + n)}
-    data = {name: (dims, np.asarray(arrays[name]).astype(dtype, copy=False))
-            for name, (dims, dtype, _, _) in variables.items()}
-    xr.Dataset(data).to_zarr(path, region=region, mode="r+", **_ZARR)
+    data = {name: (dims, _stored(arrays[name], dtype, fill))
+            for name, (dims, dtype, fill, _) in variables.items()}
+    xr.Dataset(data).to_zarr(path, region=region, mode="r+", **_REGION)
     xr.Dataset({"done": ("case", np.ones(n, dtype=bool))}).to_zarr(
-        path, region=region, mode="r+", **_ZARR)
+        path, region=region, mode="r+", **_REGION)
+
+
+def _stored(values, dtype, fill):
+    """``values`` in the store's dtype: a float count's NaN becomes ``fill``, not garbage."""
+    values = np.asarray(values)
+    if np.dtype(dtype).kind in "iu" and values.dtype.kind == "f":
+        values = np.rint(np.where(np.isfinite(values), values, fill))
+    return values.astype(dtype, copy=False)
+
+
+def estimated_bytes(definition, n_time):
+    """Uncompressed size of a sweep store [bytes]: an upper bound for the free-space check.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    n_time : int
+        Samples kept per time series (0 if none are kept).
+
+    Returns
+    -------
+    int
+    """
+    sizes = {"case": definition.n_cases, "frequency": definition.frequency.size,
+             "time": n_time}
+    total = definition.n_cases * (1 + 64)  # done flags, coordinates
+    for dims, dtype, _, _ in schema(definition, n_time).values():
+        itemsize = 64 if dtype is _STRING else np.dtype(dtype).itemsize
+        total += itemsize * int(np.prod([sizes[d] for d in dims]))
+    return total
 
 
 def open_store(path):
@@ -248,18 +307,42 @@ def open_store(path):
     Raises
     ------
     ParameterError
-        There is no store at ``path``.
+        There is no store at ``path``, or what is there is not a sweep store (a file, a
+        folder that is no Zarr store, a Zarr store that ``qzs sweep`` did not write).
     """
-    import xarray as xr
-
     path = Path(path)
     if not path.exists():
-        raise ParameterError(f"no sweep store at {str(path)!r}.")
-    dataset = xr.open_zarr(path, chunks=None, **_ZARR)  # lazy, without dask
+        raise ParameterError(f"no sweep store at {str(path)!r}; give the folder that "
+                             "`qzs sweep` wrote (its --out, default <name>.zarr).")
+    if not path.is_dir():
+        raise ParameterError(f"{str(path)!r} is a file, not a sweep store (a Zarr folder "
+                             "written by `qzs sweep`); give the store's folder.")
+    dataset = _open_zarr(path)
+    missing = sorted({"done", "status"} - set(dataset.variables)) + (
+        [] if "sweep_hash" in dataset.attrs else ["attribute sweep_hash"])
+    if missing:
+        raise ParameterError(f"{str(path)!r} is a Zarr store but not a sweep store: it has "
+                             f"no {', '.join(missing)}; give a store written by `qzs sweep`.")
     strings = [n for n, v in dataset.variables.items() if v.dtype == _STRING]
     return dataset.assign({n: dataset[n].astype(object) for n in strings if n in
                            dataset.data_vars}).assign_coords(
         {n: dataset[n].astype(object) for n in strings if n in dataset.coords})
+
+
+def _open_zarr(path):
+    """Open lazily, without dask: consolidated metadata where it exists, else per array."""
+    import xarray as xr
+
+    try:
+        with _v3_consolidated():
+            return xr.open_zarr(path, chunks=None, consolidated=True)
+    except Exception:  # noqa: BLE001 - no consolidated metadata (older stores), or no store
+        pass
+    try:
+        return xr.open_zarr(path, chunks=None, consolidated=False)
+    except Exception as error:  # noqa: BLE001 - zarr's errors for "not a store" vary
+        raise ParameterError(f"{str(path)!r} is not a sweep store (no readable Zarr group: "
+                             f"{error}); give a store written by `qzs sweep`.") from None
 
 
 def summary_text(dataset, report=None):

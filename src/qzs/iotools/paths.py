@@ -1,0 +1,135 @@
+"""Output paths checked before any long work starts: extension, folder, permissions, space.
+
+:func:`check_output_path` answers in well under a second and writes nothing: a run that
+would fail at its end (an unknown extension, a folder that cannot be made, a read-only
+folder, a full disk) fails before it starts instead.
+
+A missing parent folder is fine when it can be created (the atomic writer,
+:func:`qzs.iotools.files.atomic_path`, creates it when it writes): its nearest existing
+ancestor must be a writable directory. A file standing where a folder must go, or a
+read-only folder, is an error.
+"""
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from qzs.errors import OutputPathError
+
+__all__ = ["check_output_path", "format_bytes"]
+
+
+def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False):
+    """Check that ``path`` can be written, before the work that produces it starts.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (or, with ``directory``, the folder) to be written.
+    argument : str
+        How the caller names it, for the message and the error's ``argument``
+        (``"--out"`` on the command line, ``"out"`` in the API).
+    suffixes : iterable of str or None
+        Allowed extensions, with or without the leading dot, compared case-insensitively
+        (``(".nc", ".csv")``); None accepts any name.
+    estimated_bytes : int or float, optional
+        Expected size of what will be written [bytes]; an error if the file system has
+        less free space.
+    directory : bool
+        ``path`` is a folder to write files into (it may exist, as a directory).
+
+    Returns
+    -------
+    Path
+        ``path`` as a Path.
+
+    Raises
+    ------
+    OutputPathError
+        (a :class:`~qzs.errors.ParameterError`; attributes ``argument``, ``value`` and
+        ``reason``) for an unknown extension, a directory where a file must go (or the
+        reverse), a parent that is a file, a folder that is not writable, or too little
+        free space.
+    """
+    path = Path(path)
+    value = str(path)
+
+    def fail(reason):
+        raise OutputPathError(argument, value, reason)
+
+    if suffixes is not None:
+        allowed = tuple(dict.fromkeys("." + s.lower().lstrip(".") for s in suffixes))
+        if path.suffix.lower() not in allowed:
+            shown = " or ".join(allowed)
+            got = f"extension {path.suffix!r}" if path.suffix else "no extension"
+            fail(f"has {got}; it must end in {shown} (the format is chosen by the "
+                 "extension)")
+    if path.exists():
+        if directory and not path.is_dir():
+            fail("is a file, not a folder; choose a folder name")
+        if not directory and path.is_dir():
+            fail("is a folder; give a file name")
+    existing = _nearest_existing(path if directory else path.parent)
+    if not existing.is_dir():
+        fail(f"cannot be created: {str(existing)!r} is a file, not a folder")
+    target = path if directory and path.is_dir() else existing
+    if not _writable(target):
+        folder = Path(os.path.abspath(path if directory else path.parent))
+        if target == folder:
+            fail(f"cannot be written: the folder {str(target)!r} is read-only; choose a "
+                 "writable folder")
+        whose = "the" if directory else "its"
+        fail(f"cannot be written: {whose} folder {str(folder)!r} does not exist and cannot be "
+             f"created in the read-only folder {str(target)!r}; choose a writable folder")
+    if estimated_bytes is not None:
+        free = shutil.disk_usage(target).free
+        if estimated_bytes > free:
+            fail(f"needs about {format_bytes(estimated_bytes)} but only {format_bytes(free)} "
+                 f"are free on the file system of {str(target)!r}; free some space or "
+                 "choose another folder")
+    return path
+
+
+def _nearest_existing(folder):
+    """``folder`` or its nearest ancestor that exists (the folder itself may be missing)."""
+    folder = Path(os.path.abspath(folder))
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    return folder
+
+
+def _writable(folder):
+    """Can a file be created in ``folder``? Asked of the file system, leaving nothing.
+
+    ``os.access`` answers from the permission bits, which root ignores; a probe file
+    (an unnamed O_TMPFILE where the file system has it, else one removed at once)
+    answers for read-only mounts and ACLs too.
+    """
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return False
+    try:
+        with tempfile.TemporaryFile(dir=folder, prefix=".qzs-probe-"):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def format_bytes(count):
+    """A byte count for people: ``1.5 GiB``.
+
+    Parameters
+    ----------
+    count : int or float
+        Bytes [B].
+
+    Returns
+    -------
+    str
+    """
+    value = float(count)
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if abs(value) < 1024 or unit == "TiB":
+            return f"{value:.0f} {unit}" if unit == "B" else f"{value:.1f} {unit}"
+        value /= 1024
+    return f"{value:.1f} TiB"  # pragma: no cover

@@ -1,0 +1,181 @@
+"""Inputs that used to end in a traceback or a wrong message: each is one clear error.
+
+Every case names the argument (or file), the value and the fix, raises a
+ParameterError or DataError from the API, and ends the command with exit code 2 and
+one ``qzs: error:`` line on stderr.
+"""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from qzs.cli import main
+from qzs.errors import DataError, ParameterError
+from qzs.iotools.config import load_config
+from qzs.iotools.readers import load_channel_map, read_recording
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "examples" / "data"
+BINARY = bytes(range(256)) * 4  # not UTF-8: byte 0x80 cannot start a character
+MAP = {"channels": {"base_velocity": {"source": "shaker_vel", "unit": "mm/s"},
+                    "payload_velocity": {"source": "payload_vel", "unit": "mm/s"}}}
+MAP_TOML = ('[channels.base_velocity]\nsource = "shaker_vel"\nunit = "mm/s"\n'
+            '[channels.payload_velocity]\nsource = "payload_vel"\nunit = "mm/s"\n')
+
+
+def one_error_line(capsys, *needles):
+    """stderr is one ``qzs: error:`` line (no traceback) holding every needle."""
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error:"), err
+    assert "Traceback" not in err and err.count("\n") == 1, err
+    for needle in needles:
+        assert needle in err, (needle, err)
+    return err
+
+
+# ---------------------------------------------------------------- a binary file as TOML
+@pytest.fixture
+def binary(tmp_path):
+    path = tmp_path / "image.toml"
+    path.write_bytes(BINARY)
+    return path
+
+
+def test_binary_config_is_a_parameter_error(binary):
+    with pytest.raises(ParameterError, match=r"config file '.*image.toml' is not UTF-8 text"):
+        load_config(binary)
+
+
+@pytest.mark.parametrize("argv", [["params", "--config"], ["simulate", "--plot", "none",
+                                                           "--config"], ["study"]])
+def test_binary_config_on_the_command_line(binary, capsys, argv):
+    assert main([*argv, str(binary)]) == 2
+    one_error_line(capsys, str(binary), "not UTF-8 text")
+
+
+def test_binary_channel_map_and_sweep_file(binary):
+    from qzs.workflows.sweeps import load_sweep
+
+    with pytest.raises(ParameterError, match="channel map '.*' is not UTF-8 text"):
+        load_channel_map(binary)
+    with pytest.raises(ParameterError, match="sweep file '.*' is not UTF-8 text"):
+        load_sweep(binary)
+
+
+def test_a_folder_given_as_toml(tmp_path):
+    with pytest.raises(ParameterError, match="config file '.*' is a folder; pass the TOML file"):
+        load_config(tmp_path)
+
+
+# ---------------------------------------------------------------- empty and broken logs
+@pytest.mark.parametrize("content, match", [
+    (b"", "is empty"),
+    (b"not a MAT file at all, just some text" * 10, "not a readable MAT file"),
+    (b"\x89HDF\r\n\x1a\n" + b"\x00" * 64, "not a readable MAT file"),  # a truncated v7.3
+], ids=["empty", "text", "truncated-hdf5"])
+def test_empty_or_broken_mat_log(tmp_path, content, match):
+    path = tmp_path / "log.mat"
+    path.write_bytes(content)
+    with pytest.raises(DataError, match=match) as error:
+        read_recording(path, MAP)
+    assert str(path) in str(error.value)
+
+
+@pytest.mark.parametrize("suffix", [".mat", ".csv", ".nc"])
+def test_empty_log_on_the_command_line(tmp_path, capsys, suffix):
+    log = tmp_path / f"log{suffix}"
+    log.write_bytes(b"")
+    (tmp_path / "map.toml").write_text(MAP_TOML)
+    assert main(["experiment", str(log), "--map", str(tmp_path / "map.toml"),
+                 "--no-simulation", "--out", str(tmp_path / "out")]) == 2
+    one_error_line(capsys, str(log))
+    assert not (tmp_path / "out").exists()
+
+
+# ---------------------------------------------------------------- time base: the CLI option
+def _non_uniform_log(tmp_path):
+    rate = 200.0
+    time = np.arange(4000) / rate
+    time[1000:] += 0.5 / rate
+    path = tmp_path / "log.csv"
+    lines = ["time,shaker_vel,payload_vel"] + [
+        f"{t!r},{50 * np.sin(2 * np.pi * (0.5 + t) * t):.9g},{20 * np.cos(2 * np.pi * t):.9g}"
+        for t in time.tolist()]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_non_uniform_time_base_names_the_command_line_option(tmp_path, capsys):
+    log = _non_uniform_log(tmp_path)
+    with pytest.raises(DataError, match="--resample"):
+        read_recording(log, MAP)
+    (tmp_path / "map.toml").write_text(MAP_TOML)
+    assert main(["experiment", str(log), "--map", str(tmp_path / "map.toml"),
+                 "--no-simulation", "--out", str(tmp_path / "out")]) == 2
+    one_error_line(capsys, "not uniform", "--resample")
+
+
+# ---------------------------------------------------------------- Welch settings of experiment
+@pytest.mark.parametrize("option, value", [("--fft-length", "0"), ("--averages", "0"),
+                                           ("--fft-length", "-4"), ("--averages", "-1")])
+def test_experiment_refuses_zero_fft_length_and_averages(tmp_path, capsys, option, value):
+    code = main(["experiment", str(DATA / "experiment.csv"), "--map",
+                 str(DATA / "experiment_map.toml"), "--no-simulation",
+                 "--out", str(tmp_path / "out"), option, value])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert option in err and value in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("keyword, value, name", [("fft_length", 0, "fft_length"),
+                                                  ("n_averages", 0, "n_averages"),
+                                                  ("fft_length", 2.5, "fft_length")])
+def test_run_experiment_refuses_zero_settings(tmp_path, keyword, value, name):
+    from qzs.workflows.experiment import run_experiment
+
+    with pytest.raises(ParameterError, match=f"`{name}`.*got {value}"):
+        run_experiment(DATA / "experiment.csv", DATA / "experiment_map.toml",
+                       out=tmp_path / "out", simulate_match=False, **{keyword: value})
+    assert not (tmp_path / "out").exists()
+
+
+def test_map_experiment_table_with_zero_averages(tmp_path):
+    from qzs.workflows.experiment import run_experiment
+
+    text = (DATA / "experiment_map.toml").read_text()
+    (tmp_path / "map.toml").write_text(text + "\n[experiment]\nn_averages = 0\n"
+                                       if "[experiment]" not in text else
+                                       text.replace("[experiment]",
+                                                    "[experiment]\nn_averages = 0", 1))
+    with pytest.raises(ParameterError, match=r"\[experiment\] n_averages.*got 0"):
+        run_experiment(DATA / "experiment.csv", tmp_path / "map.toml", out=tmp_path / "out",
+                       simulate_match=False)
+
+
+# ---------------------------------------------------------------- sweep-plot on a non-store
+@pytest.mark.parametrize("make", ["file", "folder", "missing", "zarr-without-sweep"])
+def test_sweep_plot_on_something_that_is_not_a_sweep_store(tmp_path, capsys, make):
+    target = tmp_path / "thing.zarr"
+    if make == "file":
+        target.write_text("time,x\n0,1\n")
+    elif make == "folder":
+        target.mkdir()
+        (target / "notes.txt").write_text("hello")
+    elif make == "zarr-without-sweep":
+        import xarray as xr
+
+        xr.Dataset({"a": ("x", np.arange(3.0))}).to_zarr(target, consolidated=False)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(["sweep-plot", str(target), "--out", str(tmp_path / "f.png")]) == 2
+    one_error_line(capsys, str(target), "sweep store")
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
+    log = _non_uniform_log(tmp_path)
+    (tmp_path / "map.toml").write_text(MAP_TOML)
+    assert main(["experiment", str(log), "--map", str(tmp_path / "map.toml"), "--resample",
+                 "--no-simulation", "--fft-length", "512", "--averages", "4",
+                 "--out", str(tmp_path / "out"), "--json"]) == 0
+    assert (tmp_path / "out" / "report.md").exists()

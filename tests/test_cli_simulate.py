@@ -1,0 +1,201 @@
+"""`qzs simulate`: --duration as in the API, unused options refused, --json, summary warnings."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from qzs import Chirp, ControllerParameters, IsolatorParameters, RandomExcitation, Sine, simulate
+from qzs.analysis.summary import run_warnings
+from qzs.cli import main
+from qzs.iotools import read_result, save_config
+
+
+@pytest.mark.parametrize("flags, excitation", [
+    ([], Chirp()),
+    (["--excitation-duration", "60"], Chirp(duration=60.0)),
+    (["--excitation", "random", "--seed", "3"], RandomExcitation(seed=3)),
+])
+def test_cli_and_api_give_the_same_base_motion_for_the_same_duration(tmp_path, flags, excitation):
+    """`--duration 5` is 5 s of simulated time, as `simulate(..., duration=5)`: the same base
+    motion sample for sample (the chirp is not squeezed into the 5 s)."""
+    out = tmp_path / "run.nc"
+    assert main(["simulate", *flags, "--duration", "5", "--sample-rate", "100", "--out", str(out),
+                 "--plot", "none", "--quiet"]) == 0
+    api = simulate(excitation, duration=5.0, sample_rate=100.0)
+    data = read_result(out)
+    np.testing.assert_array_equal(data["base_displacement"].values, api.base_displacement)
+    np.testing.assert_array_equal(data["relative_position"].values, api.relative_position)
+
+
+def test_a_cut_chirp_says_which_band_it_covered(capsys):
+    assert main(["simulate", "--duration", "30", "--sample-rate", "100", "--plot", "none",
+                 "--quiet"]) == 0
+    assert "the first 30 s of a 2000 s chirp: 0 -> 0.3 Hz of 0 -> 20 Hz" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["--frequency", "3"], "`--frequency`"),
+    (["--record", "base.csv"], "`--record`"),
+    (["--excitation", "sine", "--seed", "4"], "`--seed`"),
+    (["--excitation", "sine", "--excitation-duration", "20"], "`--excitation-duration`"),
+    (["--excitation", "sine", "--f0", "1"], "`--f0`"),
+    (["--excitation", "random", "--method", "logarithmic"], "`--method`"),
+])
+def test_an_option_the_excitation_does_not_use_is_an_error(tmp_path, capsys, argv, flag):
+    plot = tmp_path / "never.png"
+    assert main(["simulate", *argv, "--duration", "1", "--plot", str(plot), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert flag in err and "is not used by a" in err
+    assert not plot.exists()
+
+
+def test_a_config_option_of_another_kind_is_named_with_its_file(tmp_path, capsys):
+    config = save_config(tmp_path / "c.toml", excitation={"kind": "sine", "frequency": 2.0})
+    assert main(["simulate", "--config", str(config), "--excitation", "chirp", "--duration", "1",
+                 "--plot", "none", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "`frequency` in the [excitation] table of" in err and "c.toml" in err
+
+
+def test_json_summary_is_strict_json_with_the_statistics(capsys):
+    assert main(["simulate", "--excitation", "sine", "--frequency", "300", "--amplitude", "1e-4",
+                 "--duration", "3", "--plot", "none", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["excitation"] == "Sine"
+    assert record["run"]["steps"] == 30000 and record["run"]["completed"] is True
+    assert record["statistics"]["samples"] == 3001
+    assert [w["code"] for w in record["warnings"]] == ["output_rate_low"]
+
+
+# ------------------------------------------------------------------ the summary's warnings
+def _codes(result):
+    return [code for code, _ in run_warnings(result)]
+
+
+SINE = Sine(amplitude=0.002, frequency=3.0)
+
+
+def test_a_plain_run_has_no_warning():
+    result = simulate(SINE, duration=3.0, sample_rate=200.0)
+    assert _codes(result) == []
+    assert "WARNING" not in result.summary()
+
+
+def test_saturation_is_warned_with_its_share():
+    """A 1 N motor cannot carry the 1.94 N the spring leaves: it saturates all the time."""
+    result = simulate(SINE, IsolatorParameters(motor_force_max=1.0), duration=3.0,
+                      sample_rate=200.0)
+    assert _codes(result) == ["motor_saturated"]
+    assert result.statistics["saturated_fraction"] == 1.0
+    assert "the motor saturates 100.00 % of the time" in result.summary()
+
+
+def test_setpoint_outside_the_constant_force_region_is_warned():
+    edge = IsolatorParameters().constant_force_edge
+    assert -0.034 < edge < -0.033  # atanh(0.99)/78.1 m
+    inside = simulate(SINE, controller=ControllerParameters(position_setpoint=edge - 1e-4),
+                      duration=2.0, sample_rate=200.0)
+    outside = simulate(SINE, controller=ControllerParameters(position_setpoint=edge + 1e-3),
+                       duration=2.0, sample_rate=200.0)
+    assert "setpoint_outside_constant_force" not in _codes(inside)
+    assert "setpoint_outside_constant_force" in _codes(outside)
+
+
+def test_fast_excitation_for_the_output_rate_and_the_step_is_warned():
+    fast = Sine(amplitude=1e-5, frequency=210.0)
+    at_200 = simulate(fast, duration=1.0, sample_rate=1000.0)  # 4.8 samples per period
+    assert _codes(at_200) == ["output_rate_low"]
+    at_ok = simulate(Sine(amplitude=1e-5, frequency=190.0), duration=1.0, sample_rate=1000.0)
+    assert _codes(at_ok) == []
+    coarse = simulate(Sine(amplitude=1e-4, frequency=55.0), duration=1.0, dt=1e-3,
+                      sample_rate=1000.0, solver="rk4")  # 18 steps per period
+    assert "few_steps_per_period" in _codes(coarse)
+
+
+def test_a_large_energy_residual_is_warned():
+    """Euler at 1 ms on a 5 Hz, 5 mm sine: the ledger drifts far beyond 1e-4 of the base work."""
+    loose = simulate(Sine(amplitude=0.005, frequency=5.0), duration=3.0, dt=1e-3,
+                     sample_rate=1000.0, solver="euler")
+    tight = simulate(Sine(amplitude=0.005, frequency=5.0), duration=3.0, dt=1e-4,
+                     sample_rate=1000.0)
+    assert "energy_residual" in _codes(loose)
+    assert "energy_residual" not in _codes(tight)
+
+
+# ------------------------------------------------------------------ outputs: checked, never half-written
+_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
+
+
+@pytest.mark.parametrize("option, name", [
+    ("--out", "run.xyz"), ("--plot", "figure.xyz"), ("--out", "ro"), ("--out", "file/run.nc"),
+    ("--plot", "file/deeper/figure.png"),
+    ("--out", "/sys/run.nc"), ("--plot", "/sys/qzs/figure.png"),  # read-only even for root
+    pytest.param("--out", "ro/run.nc", marks=pytest.mark.skipif(_ROOT, reason="root writes anyway")),
+    pytest.param("--plot", "ro/figure.png",
+                 marks=pytest.mark.skipif(_ROOT, reason="root writes anyway")),
+])
+def test_a_bad_output_path_fails_at_once_and_leaves_nothing(tmp_path, capsys, option, name):
+    import time
+
+    (tmp_path / "file").write_text("a file where a folder must go")
+    read_only = tmp_path / "ro"
+    read_only.mkdir()
+    read_only.chmod(0o555)
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    start = time.perf_counter()
+    try:  # the default 2000 s chirp: a check after the run would take minutes
+        plot = [] if option == "--plot" else ["--plot", str(tmp_path / "plot.png")]
+        code = main(["simulate", option, str(tmp_path / name), *plot, "--quiet"])
+    finally:
+        read_only.chmod(0o755)
+    assert code == 2
+    assert time.perf_counter() - start < 5.0
+    assert f"{option} " in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before
+    assert not any(p.name.startswith(".") for p in tmp_path.iterdir())
+
+
+def test_ctrl_c_writes_what_was_simulated(tmp_path, monkeypatch):
+    """An interrupted streamed run keeps its samples, says so (run.completed = 0), exit 130."""
+    from qzs.engine import lanes, simulate as simulate_module
+
+    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)
+    real, calls = lanes.run_single, []
+
+    def interrupted(*args):
+        calls.append(args[1])
+        result = real(*args)
+        if len(calls) == 4:  # the warm-up call, then three chunks of 100 samples
+            raise KeyboardInterrupt
+        return result
+
+    monkeypatch.setattr(lanes, "run_single", interrupted)
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--excitation", "sine", "--duration", "10", "--out", str(out),
+                 "--plot", "none", "--quiet"]) == 130
+    data = read_result(out)
+    assert data.attrs["run.completed"] == 0
+    assert data.sizes["time"] == 301  # t = 0 and three chunks of 100 samples
+    np.testing.assert_allclose(data.time.values[-1], 0.3)
+
+
+def test_sigterm_leaves_no_file_behind(tmp_path):
+    """SIGTERM during a streamed run: exit 143, no result and no hidden temporary file."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "run.nc"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "qzs", "simulate", "--out", str(out), "--plot", "none",
+         "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not any(tmp_path.iterdir()) and time.monotonic() < deadline:  # the writer started
+        time.sleep(0.05)
+    time.sleep(0.5)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 143, err
+    assert list(tmp_path.iterdir()) == []

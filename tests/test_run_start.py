@@ -1,0 +1,107 @@
+"""The start of a run: the PI preload carries the static load only; excitations fade in.
+
+Issue 10: the preload used to include ``m*ydd(0)``, so a random base motion that starts
+with an acceleration dropped the payload onto the lower stop; a sine at full amplitude
+kicked the payload 36 mm off its setpoint.
+"""
+import numpy as np
+import pytest
+
+from qzs import ControllerParameters, IsolatorParameters, Sine, simulate
+from qzs.engine.base_motion import base_motion_series
+from qzs.engine.prepare import prepare_run
+from qzs.engine import kernels as K
+from qzs.errors import ExcitationError
+from qzs.model.excitation import (DEFAULT_FADE_IN, Chirp, DisplacementRecord, RandomExcitation,
+                                  build_excitation)
+
+RANDOM = dict(amplitude=0.002, f_low=0.5, f_high=20.0, seed=7, duration=60.0)
+
+
+def test_preload_carries_the_static_load_only():
+    """The integral at t = 0 does not depend on the base's acceleration at t = 0."""
+    at_rest = prepare_run(Sine(amplitude=0.0), duration=1.0)
+    # y = A cos(w t): the base starts at full acceleration -A w^2 = -39.5 m/s^2
+    shaken = prepare_run(Sine(amplitude=0.001, frequency=100.0, phase=np.pi / 2, fade_in=0.0),
+                         duration=1.0)
+    assert base_motion_series(shaken.excitation, [0.0])[2][0] < -39.0
+    assert shaken.state[K.S_INT] == at_rest.state[K.S_INT]
+    # and it is the static load: the motor then supplies m*g - a*tanh(-b*z_ref)
+    iso, ctrl = IsolatorParameters(), ControllerParameters()
+    static = iso.mass * iso.gravity - iso.spring_force * np.tanh(-iso.spring_shape
+                                                                 * ctrl.position_setpoint)
+    assert shaken.state[K.A_F_MOTOR] == pytest.approx(static, rel=1e-12)
+
+
+def test_random_run_from_the_issue_touches_no_stop():
+    """`qzs simulate --excitation random --f0 0.5 --f1 20 --amplitude 0.002 --seed 7`: with the
+    static preload (and even without a fade-in) the payload stays far from the stops."""
+    result = simulate(RandomExcitation(**RANDOM, fade_in=0.0), duration=60.0, sample_rate=200.0)
+    assert result.run["stop_contacts"] == 0
+    assert abs(result.motor_force[0]) < 5.0  # was -22.6 N
+    z = result.relative_position - result.controller.position_setpoint
+    assert np.abs(z).max() < 0.02  # the stops are 80 mm away
+
+
+def test_faded_in_sine_stays_near_the_setpoint():
+    """A 1 mm, 100 Hz sine: faded in, the payload stays within 2 mm of the setpoint; started
+    at full amplitude it is kicked tens of millimetres off (the reason for the default)."""
+    faded = simulate(Sine(amplitude=0.001, frequency=100.0), duration=6.0, sample_rate=1000.0)
+    kicked = simulate(Sine(amplitude=0.001, frequency=100.0, fade_in=0.0), duration=6.0,
+                      sample_rate=1000.0)
+    setpoint = faded.controller.position_setpoint
+    assert faded.excitation.fade_in == DEFAULT_FADE_IN > 0
+    assert np.abs(faded.relative_position - setpoint).max() < 0.002
+    assert np.abs(kicked.relative_position - setpoint).max() > 0.010
+
+
+@pytest.mark.parametrize("excitation", [
+    Sine(amplitude=0.002, frequency=3.0, phase=0.7, fade_in=1.5),
+    RandomExcitation(amplitude=0.001, duration=10.0, fade_in=1.5),
+    Chirp(amplitude=0.002, f0=2.0, f1=5.0, duration=10.0, fade_in=1.5),
+])
+def test_fade_in_is_a_raised_cosine_with_consistent_derivatives(excitation):
+    """y = w*y_raw with w(s) = s - sin(2 pi s)/(2 pi), s = t/T (a ramp whose slope is a raised
+    cosine): zero motion at t = 0, the raw signal after T, and velocity and acceleration the
+    exact, continuous derivatives (central differences agree everywhere, the ends included)."""
+    raw = type(excitation)(**{**_fields(excitation), "fade_in": 0.0})
+    t = np.linspace(0.0, 3.0, 30001)
+    y, yd, ydd = base_motion_series(excitation, t)
+    y0, yd0, ydd0 = base_motion_series(raw, t)
+    s = t / 1.5
+    w = np.where(s < 1.0, s - np.sin(2 * np.pi * s) / (2 * np.pi), 1.0)
+    np.testing.assert_allclose(y, w * y0, atol=1e-15)
+    assert y[0] == 0.0 and yd[0] == 0.0 and ydd[0] == 0.0
+    after = t >= 1.5
+    np.testing.assert_array_equal(y[after], y0[after])
+    np.testing.assert_array_equal(ydd[after], ydd0[after])
+    h = t[1] - t[0]
+    inner = slice(1, -1)
+    scale_v, scale_a = np.abs(yd).max(), np.abs(ydd).max()
+    np.testing.assert_allclose((y[2:] - y[:-2]) / (2 * h), yd[inner], atol=1e-4 * scale_v)
+    np.testing.assert_allclose((yd[2:] - yd[:-2]) / (2 * h), ydd[inner], atol=2e-3 * scale_a)
+
+
+def _fields(excitation):
+    import dataclasses
+
+    return {f.name: getattr(excitation, f.name) for f in dataclasses.fields(excitation)}
+
+
+def test_fade_in_defaults_and_switch():
+    assert Chirp().fade_in == 0.0  # a chirp from 0 Hz starts gently
+    for kind in ("sine", "random"):
+        assert build_excitation(kind).fade_in == DEFAULT_FADE_IN
+        assert build_excitation(kind, {"fade_in": 0}).fade_in == 0.0
+    record = DisplacementRecord(time=np.arange(10.0), displacement=np.zeros(10))
+    assert record.fade_in == DEFAULT_FADE_IN
+    with pytest.raises(ExcitationError, match="`fade_in` must be"):
+        Sine(fade_in=-1.0)
+    with pytest.raises(ExcitationError, match=r"`fade_in` \(20.0 s\) must not exceed"):
+        RandomExcitation(duration=10.0, fade_in=20.0)
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True])
+def test_bad_seed_is_named(seed):
+    with pytest.raises(ExcitationError, match="`seed` must be a non-negative integer"):
+        RandomExcitation(seed=seed)
