@@ -172,6 +172,7 @@ def test_sweep_plot_on_something_that_is_not_a_sweep_store(tmp_path, capsys, mak
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
+@pytest.mark.filterwarnings("ignore:transmissibility metrics. no trusted bin:qzs.errors.DataWarning")  # a 20 s log
 def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
     log = _non_uniform_log(tmp_path)
     (tmp_path / "map.toml").write_text(MAP_TOML)

@@ -224,3 +224,37 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     fit = namespace["fit"]  # the example log's Table 1 value is recovered
     assert fit.parameters["viscous_damping"] == pytest.approx(100.0, rel=0.03)
     assert (tmp_path / "results" / "experiment-python" / "report.md").exists()
+
+
+def test_experiment_metrics_come_from_trusted_bins_only(example):
+    """The metrics read the estimate's trusted bins only: an estimate that distrusts a mid
+    band full of garbage (a 1e6 spike) gives the metrics of the clean curve without it, and
+    every metric of the example passes the trusted-bin check (docs/model.md §10)."""
+    import dataclasses
+
+    from test_trust import assert_metrics_from_trusted
+
+    from qzs.analysis.spectral import band_mask, transmissibility_metrics
+    from qzs.workflows.experiment import experiment_metrics
+
+    measured = example.measured
+    keep = band_mask(measured.frequency, 0.0, example.band[1])
+    f = measured.frequency[keep]
+    assert measured.trusted[keep][(f >= 1.5)].all()  # the example trusts all above 1.5 Hz
+    hole = (measured.frequency > 4.0) & (measured.frequency < 6.0)
+    spiked = dataclasses.replace(measured, trusted=measured.trusted & ~hole,
+                                 magnitude=np.where(hole, 1e6, measured.magnitude))
+    clean = dataclasses.replace(measured, trusted=measured.trusted & ~hole)
+    with_hole = experiment_metrics(spiked, example.band, 1.0).to_dict()
+    assert with_hole == pytest.approx(experiment_metrics(clean, example.band, 1.0).to_dict(),
+                                      nan_ok=True)
+    assert not with_hole["resonance_peak"] > 2.0
+    trusted = spiked.trusted[keep] & (f >= example.untrusted_below)
+
+    def recompute(values):
+        return transmissibility_metrics(f, values, trusted=spiked.trusted[keep],
+                                        highpass_corner=1.0).to_dict()
+
+    metrics = experiment_metrics(spiked, example.band, 1.0)
+    assert_metrics_from_trusted(f, spiked.magnitude[keep], trusted, metrics.to_dict(),
+                                metrics.reasons, recompute=recompute)

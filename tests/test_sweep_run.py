@@ -12,7 +12,7 @@ import xarray as xr
 import qzs
 from qzs import ParameterError
 from qzs.workflows.sweeps import backends as sweep_backends
-from qzs.analysis.spectral import transmissibility, transmissibility_metrics
+from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
 from qzs.cli.sweep import add_parsers, run_sweep_command
 from qzs.workflows.sweeps import load_sweep, run_sweep
 from qzs.workflows.sweeps.store import FAILED, INVALID, OK
@@ -27,7 +27,7 @@ def document(batch_size=2, **outputs):
             "parameters": {"pi_ki": 2.0},
             "excitation": {"f1": 10.0},
             "analysis": dict(ANALYSIS),
-            "outputs": {"bands": {"low": [1.0, 3.0]}, **outputs}}
+            "outputs": {"bands": {"low": [1.0, 3.0], "all": [0.0, 10.0]}, **outputs}}
 
 
 #: A weightless, frictionless linear plant whose P loop, sampled at 100 Hz with a gain of
@@ -86,11 +86,16 @@ def test_batched_results_equal_single_runs(reference):
         np.testing.assert_array_equal(data["frequency"].values, estimate.frequency[keep])
         np.testing.assert_array_equal(row["transmissibility"].values, estimate.magnitude[keep])
         metrics = transmissibility_metrics(estimate.frequency[keep], estimate.magnitude[keep],
+                                           trusted=estimate.trusted[keep],
                                            at_frequencies=[2.0, 4.0]).to_dict()
         for name in ("resonance_frequency", "isolation_onset", "transmissibility_at_2_hz"):
             np.testing.assert_equal(float(row[name]), metrics[name])
-        band = (estimate.frequency >= 1.0) & (estimate.frequency <= 3.0)
+        # band means and metrics from the estimate's trusted bins only (docs/model.md §10)
+        band = (estimate.frequency >= 1.0) & (estimate.frequency <= 3.0) & estimate.trusted
+        assert band.any() and not estimate.trusted[keep].all()
         assert float(row["mean_transmissibility_low"]) == estimate.magnitude[band].mean()
+        whole = band_mask(estimate.frequency, 0.0, 10.0) & estimate.trusted  # some untrusted
+        assert float(row["mean_transmissibility_all"]) == estimate.magnitude[whole].mean()
         assert int(row["n_averages"]) == 8
 
 

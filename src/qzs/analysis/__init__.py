@@ -9,10 +9,12 @@ from qzs._lazy import lazy_exports
 
 _SPECTRAL = ("TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
              "band_mask", "highpass", "required_duration", "required_samples",
-             "transmissibility", "transmissibility_metrics", "welch_average_count")
+             "transmissibility", "transmissibility_at", "transmissibility_metrics",
+             "trusted_bins", "welch_average_count")
 _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
             **{name: "qzs.analysis.statistics"
-               for name in ("STATISTICS", "RunStatistics", "run_statistics")},
+               for name in ("STATISTICS", "RunStatistics", "run_statistics",
+                            "SUMMARY_STATISTICS", "SummaryStatistics")},
             "linearize": "qzs.analysis.linear"}
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)  # scipy.signal, python-control on use

@@ -41,7 +41,8 @@ from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.model.excitation import Chirp
 
-__all__ = ["ExperimentResult", "process_experiment", "infer_chirp", "run_experiment"]
+__all__ = ["ExperimentResult", "process_experiment", "experiment_metrics", "infer_chirp",
+           "run_experiment"]
 
 #: Welch averages of the paper's experiment (Section 4).
 EXPERIMENT_AVERAGES = 29
@@ -174,16 +175,25 @@ class ExperimentResult:
     simulation_seconds: float
 
     def _in_band(self, estimate):
-        keep = (estimate.frequency > 0) & (estimate.frequency <= self.band[1])
-        return estimate.frequency[keep], estimate.magnitude[keep], estimate.coherence[keep]
+        """Frequency [Hz], magnitude [-], coherence [-] and trust of the bins in the band.
+
+        A bin is trusted where the estimate trusts it (docs/model.md §10) and it lies at or
+        above :attr:`untrusted_below`.
+        """
+        keep = band_mask(estimate.frequency, 0.0, self.band[1])
+        f = estimate.frequency[keep]
+        trusted = estimate.trusted[keep] & (f >= self.untrusted_below)
+        return f, estimate.magnitude[keep], estimate.coherence[keep], trusted
 
     def discrepancy_db(self):
         """Median ``|20 log10(measured/simulated)|`` [dB] over the trusted band (NaN if none)."""
         if self.simulated is None:
             return float("nan")
-        f, measured, _ = self._in_band(self.measured)
+        f, measured, _, trusted = self._in_band(self.measured)
         simulated = np.interp(f, self.simulated.frequency, self.simulated.magnitude)
-        trusted = (f >= self.untrusted_below) & (measured > 0) & (simulated > 0)
+        simulated_trusted = np.interp(f, self.simulated.frequency,
+                                      self.simulated.trusted.astype(float)) == 1.0
+        trusted &= simulated_trusted & (measured > 0) & (simulated > 0)
         if not trusted.any():
             return float("nan")
         return float(np.median(np.abs(20 * np.log10(measured[trusted] / simulated[trusted]))))
@@ -210,12 +220,16 @@ class ExperimentResult:
         """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag."""
         import xarray as xr
 
-        f, measured, coherence = self._in_band(self.measured)
+        f, measured, coherence, trusted = self._in_band(self.measured)
         variables = {"experiment": ("frequency", measured, {"units": "1", "long_name":
                                     "measured transmissibility sqrt(S_payload/S_base)"}),
                      "coherence": ("frequency", coherence, {"units": "1"}),
-                     "trusted": ("frequency", (f >= self.untrusted_below).astype("i1"),
-                                 {"long_name": f"1 at or above {self.untrusted_below:g} Hz"})}
+                     "trusted": ("frequency", trusted.astype("i1"),
+                                 {"units": "1", "flag_values": [0, 1],
+                                  "flag_meanings": "untrusted trusted",
+                                  "long_name": "1 where the measured estimate is trusted "
+                                               "(coherence, base power, at or above "
+                                               f"{self.untrusted_below:g} Hz)"})}
         if self.simulated is not None:
             variables["simulation"] = ("frequency", np.interp(f, self.simulated.frequency,
                                                               self.simulated.magnitude),
@@ -444,20 +458,39 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
     band = (0.0, min(float(excitation.frequency_at(used / rate)), rate / 2))
     untrusted = 1.5 * corner
 
-    def metrics(estimate):
-        keep = band_mask(estimate.frequency, 0.0, band[1])
-        return transmissibility_metrics(estimate.frequency[keep], estimate.magnitude[keep],
-                                        highpass_corner=corner or None)
-
     simulated = simulated_metrics = None
     seconds = 0.0
     if simulate_match:
         simulated, seconds = _simulate_like(recording, kind, excitation, isolator, controller,
                                             corner, welch, dt)
-        simulated_metrics = metrics(simulated)
-    return ExperimentResult(recording, kind, measured, simulated, metrics(measured),
+        simulated_metrics = experiment_metrics(simulated, band, corner)
+    return ExperimentResult(recording, kind, measured, simulated,
+                            experiment_metrics(measured, band, corner),
                             simulated_metrics, band, corner, untrusted, excitation, inferred,
                             isolator, controller, tuple(notes), seconds)
+
+
+def experiment_metrics(estimate, band, highpass_corner):
+    """Metrics of an experiment's (or its simulation's) estimate from its trusted bins only.
+
+    Parameters
+    ----------
+    estimate : TransmissibilityEstimate
+        The measured or simulated transmissibility.
+    band : (float, float)
+        Analysed band [Hz]; bins above ``band[1]`` are left out.
+    highpass_corner : float
+        High-pass corner of the measurement chain [Hz] (0 for none): bins below 1.5 times it
+        are left out too (docs/model.md §10).
+
+    Returns
+    -------
+    TransmissibilityMetrics
+    """
+    keep = band_mask(estimate.frequency, 0.0, band[1])
+    return transmissibility_metrics(estimate.frequency[keep], estimate.magnitude[keep],
+                                    trusted=estimate.trusted[keep],
+                                    highpass_corner=highpass_corner or None)
 
 
 _FIXES = {"fft_length": "a power of two such as 8192 (--fft-length)",

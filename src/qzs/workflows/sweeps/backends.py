@@ -190,10 +190,13 @@ def _reduce(definition, base, payload, arrays, i):
         arrays["transmissibility"][i] = magnitude[keep]
     if out["coherence"]:
         arrays["coherence"][i] = estimate.coherence[keep]
-    for label, (lo, hi) in out["bands"].items():
-        arrays[f"mean_transmissibility_{label}"][i] = magnitude[band_mask(f, lo, hi)].mean()
+    for label, (lo, hi) in out["bands"].items():  # trusted bins only; NaN if none
+        inside = band_mask(f, lo, hi, trusted=estimate.trusted)
+        arrays[f"mean_transmissibility_{label}"][i] = (magnitude[inside].mean() if inside.any()
+                                                       else np.nan)
     if out["metrics"]:
         metrics = transmissibility_metrics(f[keep], magnitude[keep],
+                                           trusted=estimate.trusted[keep],
                                            at_frequencies=a["at_frequencies"]).to_dict()
         for name in out["metrics"]:
             arrays[name][i] = metrics[name]
