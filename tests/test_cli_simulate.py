@@ -199,3 +199,12 @@ def test_sigterm_leaves_no_file_behind(tmp_path):
     _, err = process.communicate(timeout=120)
     assert process.returncode == 143, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unknown_excitation_kind_in_a_config_is_named(tmp_path, capsys):
+    """Was answered with "--excitation file needs --record"."""
+    config = tmp_path / "c.toml"
+    config.write_text('[excitation]\nkind = "square"\n')
+    assert main(["simulate", "--config", str(config), "--plot", "none", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "excitation `kind` must be one of ('chirp', 'sine', 'random', 'file'), got 'square'" in err

@@ -82,7 +82,8 @@ class Chirp:
     f0, f1 : float
         Start and end frequency [Hz]; default 0 and 20.
     duration : float
-        Sweep time [s]; default 2000 (enough for 122 Welch averages of 32768 at 1 kHz).
+        Sweep time [s]; default 2000, the paper's (121 half-overlapping Welch segments of 32768
+        samples at 1 kHz; the paper's 122 need 2015.2 s, which the studies run).
     method : {"linear", "logarithmic"}
         Instantaneous frequency linear or exponential in time (``f0 > 0`` for the latter).
     fade_in : float
