@@ -34,9 +34,24 @@ def test_streamed_statistics_equal_those_of_the_whole_run(monkeypatch):
     flags = np.concatenate([b[1] for b in blocks])
     np.testing.assert_array_equal(data, whole._data)
     np.testing.assert_array_equal(flags, whole._flags)
-    assert streamed.run["preview_every"] == 5  # ceil(1001 / 250)
-    np.testing.assert_array_equal(streamed.time, whole.time[::5])
+    assert streamed.run["preview_every"] == 9  # ceil(1001 / 125): two rows per group
     assert streamed.run["samples"] == len(whole) == 1001
+    # the preview is the envelope: each group's min and max of every channel, flags all/any
+    z = whole.relative_position
+    groups = [slice(i, min(i + 9, 1001)) for i in range(0, 1001, 9)]
+    preview_z = streamed.relative_position
+    assert preview_z.min() == z.min() and preview_z.max() == z.max()
+    lows, highs = preview_z[0::2], preview_z[1::2]
+    chunk_groups = len(lows)  # a group a chunk boundary splits is split in two
+    assert 112 <= chunk_groups <= 112 + 7
+    for name in ("payload_acceleration", "motor_force", "time"):
+        assert streamed[name].min() == whole[name].min()
+        assert streamed[name].max() == whole[name].max()
+    assert streamed.time[0] == 0.0 and streamed.time[-1] == whole.time[-1]
+    assert np.all(np.diff(streamed.time) >= 0)
+    np.testing.assert_array_equal(lows[0], min(z[groups[0]]))
+    np.testing.assert_array_equal(highs[0], max(z[groups[0]]))
+    assert streamed.locked.any() == whole.locked.any()
     for name, value in whole.statistics.items():
         assert streamed.statistics[name] == pytest.approx(value, rel=1e-12, abs=1e-15), name
     # the statistics are those of every sample, not of the preview
@@ -52,7 +67,7 @@ def test_simulate_to_file_writes_every_sample(tmp_path, monkeypatch):
     whole = simulate(EXCITATION, duration=1.0, sample_rate=500.0)
     assert data.sizes["time"] == len(whole) == 501
     np.testing.assert_array_equal(data["relative_position"].values, whole.relative_position)
-    assert len(result) < 501
+    assert len(result) < 501 and result.run["preview_every"] > 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
 
 

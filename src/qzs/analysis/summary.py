@@ -155,7 +155,7 @@ def summary_text(result):
     used = (stats["z_max"] - stats["z_min"]) / (high - low)
     samples = run.get("samples", stats["samples"])
     kept = ("" if run.get("preview_every", 1) == 1 else
-            f" (every {run['preview_every']}th kept in memory)")
+            f" (in memory: their min/max per {run['preview_every']} samples)")
     lines = [
         f"qzs simulation  {run_title(result)}{'' if result.completed else '  [INTERRUPTED]'}",
         f"  steps            {run['steps']:,} in {run['elapsed']:.2f} s "

@@ -272,7 +272,8 @@ class SimulationResult:
         Solver, ``dt`` [s], ``sample_rate`` [Hz], ``steps``, ``elapsed`` [s] (integration
         only: compiling the kernels is not counted), ``completed``, ``stop_contacts``,
         ``stick_events``, stop positions [m], ``samples`` (output samples of the run) and
-        ``preview_every`` (1, or k if the result keeps every k-th of a streamed run).
+        ``preview_every`` (1, or k if the result of a streamed run keeps the min/max
+        envelope of groups of k samples, for figures).
     """
 
     def __init__(self, data, flags, *, isolator, controller, excitation, run, statistics=None):

@@ -20,7 +20,8 @@ __all__ = ["simulate", "result_bytes"]
 
 #: Bytes one output sample takes in memory: every channel as float64, the flags as bool.
 BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
-#: Samples a streamed run keeps in memory for its plot: every k-th, at most this many.
+#: Rows a streamed run keeps in memory for its plot: all samples up to this many, else the
+#: min/max envelope of groups of k samples in at most this many rows.
 PREVIEW_SAMPLES = 200_000
 #: Integration steps per chunk at most: the unit of progress, streaming and Ctrl-C.
 CHUNK_STEPS = 2_000_000
@@ -64,9 +65,11 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
         (``data`` of shape (n, N_CHANNELS) in the columns of
         :data:`~qzs.engine.results.CHANNELS`, ``flags`` of shape (n, 2); both are reused
-        buffers: consume or copy them). The result then keeps only a preview (every
-        k-th sample, at most :data:`PREVIEW_SAMPLES`; ``result.run["preview_every"]``),
-        so memory stays bounded however long the run
+        buffers: consume or copy them). The result then keeps every sample if there are
+        at most :data:`PREVIEW_SAMPLES`, else a preview for figures: per group of k
+        consecutive samples (``result.run["preview_every"]``) one row of each channel's
+        minimum and one of its maximum (the flags' all and any), so memory stays bounded
+        however long the run and a plot shows the true envelope, never an aliased pick
         (:class:`qzs.iotools.files.ResultWriter` is such a sink). The summary's
         statistics always come from every sample.
 
@@ -97,7 +100,7 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         out = np.empty((n_out, K.N_CHANNELS))
         out_flags = np.zeros((n_out, 2), dtype=np.bool_)
     else:
-        every = max(1, -(-n_out // PREVIEW_SAMPLES))
+        every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // (PREVIEW_SAMPLES // 2))
         out = np.empty((chunk // decimation + 1, K.N_CHANNELS))
         out_flags = np.zeros((out.shape[0], 2), dtype=np.bool_)
         preview, preview_flags = [], []
@@ -110,9 +113,13 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         statistics.add(_named(block, block_flags))
         if sink is not None:
             sink(block, block_flags)
-            keep = np.flatnonzero((total + np.arange(rows)) % every == 0)
-            preview.append(block[keep].copy())
-            preview_flags.append(block_flags[keep].copy())
+            if every == 1:
+                preview.append(block.copy())
+                preview_flags.append(block_flags.copy())
+            elif rows:
+                low, high = _envelope_rows(block, block_flags, total, every)
+                preview.append(low)
+                preview_flags.append(high)
 
     absorb(0, 1, 0)
     rows, done, completed, start = 1, 0, True, None
@@ -155,6 +162,22 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
     return SimulationResult(data, data_flags, isolator=isolator, controller=controller,
                             excitation=excitation, run=run, statistics=statistics.result())
+
+
+def _envelope_rows(data, flags, first, every):
+    """A block's min/max envelope: per group of ``every`` samples (counted from the run's
+    start, sample ``first`` being the block's first), a row of each channel's minimum (at
+    the group's first time) and one of its maximum (at its last time); the flags are
+    all/any. Returns ``(rows, flags)``, two rows per group, in time order."""
+    group = (first + np.arange(data.shape[0])) // every
+    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    rows = np.empty((2 * starts.size, data.shape[1]))
+    rows[0::2] = np.minimum.reduceat(data, starts, axis=0)
+    rows[1::2] = np.maximum.reduceat(data, starts, axis=0)
+    marks = np.empty((2 * starts.size, flags.shape[1]), dtype=np.bool_)
+    marks[0::2] = np.logical_and.reduceat(flags, starts, axis=0)
+    marks[1::2] = np.logical_or.reduceat(flags, starts, axis=0)
+    return rows, marks
 
 
 def result_bytes(duration, sample_rate):

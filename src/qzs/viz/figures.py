@@ -32,10 +32,11 @@ def envelope(time, values, max_points=_MAX_POINTS):
     if n <= max_points:
         return time, values
     bins = max_points // 2
-    width = n // bins
-    used = bins * width
-    blocks = values[:used].reshape(bins, width)
-    t = time[:used].reshape(bins, width)
+    width = -(-n // bins)  # every sample in a bin: the last one is padded with the last sample
+    bins = -(-n // width)
+    pad = bins * width - n
+    blocks = np.concatenate([values, np.repeat(values[-1], pad)]).reshape(bins, width)
+    t = np.concatenate([time, np.repeat(time[-1], pad)]).reshape(bins, width)
     low, high = blocks.argmin(axis=1), blocks.argmax(axis=1)
     first = np.minimum(low, high)
     second = np.maximum(low, high)

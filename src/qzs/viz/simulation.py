@@ -58,7 +58,8 @@ def plot_simulation(result, path=None, title=None):
         ax.legend(loc="upper right", fontsize="small", ncols=4)
         ax.grid(True, alpha=0.3)
     every = result.run.get("preview_every", 1)
-    subtitle = "" if every == 1 else f" (every {every}th of {result.run['samples']:,} samples)"
+    subtitle = ("" if every == 1 else
+                f" (envelope: min/max per {every} of {result.run['samples']:,} samples)")
     fig.suptitle((title or run_title(result)) + subtitle)
     if path is not None:
         save_figure(fig, path)
