@@ -160,13 +160,13 @@ def test_ctrl_c_writes_what_was_simulated(tmp_path, monkeypatch):
     """An interrupted streamed run keeps its samples, says so (run.completed = 0), exit 130."""
     from qzs.engine import lanes, simulate as simulate_module
 
-    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)
+    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)  # cut to 128: lcm(10, 256) steps
     real, calls = lanes.run_single, []
 
     def interrupted(*args):
         calls.append(args[1])
         result = real(*args)
-        if len(calls) == 4:  # the warm-up call, then three chunks of 100 samples
+        if len(calls) == 4:  # the warm-up call, then three chunks of 128 samples
             raise KeyboardInterrupt
         return result
 
@@ -176,8 +176,8 @@ def test_ctrl_c_writes_what_was_simulated(tmp_path, monkeypatch):
                  "--plot", "none", "--quiet"]) == 130
     data = read_result(out)
     assert data.attrs["run.completed"] == 0
-    assert data.sizes["time"] == 301  # t = 0 and three chunks of 100 samples
-    np.testing.assert_allclose(data.time.values[-1], 0.3)
+    assert data.sizes["time"] == 1 + 3 * 128  # t = 0 and three chunks
+    np.testing.assert_allclose(data.time.values[-1], 0.384)
 
 
 def test_sigterm_leaves_no_file_behind(tmp_path):

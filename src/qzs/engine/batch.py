@@ -19,7 +19,7 @@ from qzs import defaults
 from qzs.analysis.statistics import STATISTICS, RunStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
-from qzs.engine.prepare import divergence_message, prepare_run
+from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
 from qzs.engine.results import CHANNELS
 from qzs.errors import CaseError, ParameterError
 
@@ -217,8 +217,8 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     status = np.zeros(n, dtype=np.int64)
 
     rows_per_chunk = max(1, _ROWS_PER_CHUNK // n)
-    chunk_steps = max(decimation, (rows_per_chunk * decimation) // decimation * decimation)
-    out = np.empty((n, min(n_out, chunk_steps // decimation + 1), K.N_CHANNELS))
+    chunk = chunk_steps(decimation, n_steps, rows_per_chunk)
+    out = np.empty((n, min(n_out, chunk // decimation + 1), K.N_CHANNELS))
     out_flags = np.zeros((n, out.shape[1], 2), dtype=np.bool_)
     for c in range(n):
         K.evaluate(0.0, states[c], flags[c], params[c], ex, table, out[c, 0], out_flags[c, 0])
@@ -256,7 +256,7 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
         absorb(1, 0, 0)
         done, row = 0, 1
         while done < n_steps:
-            steps = min(chunk_steps, n_steps - done)
+            steps = min(chunk, n_steps - done)
             before = status.copy()
             if pool is None:
                 advance(0, n)

@@ -41,7 +41,13 @@ N_PARAMS = 21
 S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
 N_ODE = 8
 A_F_PI, A_F_DAMP, A_F_MOTOR = range(N_ODE, N_ODE + 3)
-N_STATE = N_ODE + 3
+# The holding margin of the last step (NaN: work it out again), carried across kernel calls so
+# that where a run is cut into chunks changes nothing (docs/model.md §9).
+A_MARGIN = N_ODE + 3
+N_STATE = N_ODE + 4
+#: The excitation's sine and cosine are computed exactly every this many steps and rotated in
+#: between; kernel calls start on multiples of it, so chunking changes no bit (docs/model.md §9).
+PHASE_PERIOD = 256
 
 # Integer flags.
 I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)

@@ -25,9 +25,10 @@ from qzs.engine import kernels as K
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
 
 # Rows of the lane-state array: the persistent state (``K.S_*`` and ``K.A_*``) first.
-(R_MODE, R_DIRECTION, R_MARGIN, R_CONTACT, R_CONTACTS, R_STICKS,
- R_FAILED) = range(K.N_STATE, K.N_STATE + 7)
-N_ROWS = K.N_STATE + 7
+R_MARGIN = K.A_MARGIN  # the holding margin is part of the persistent state
+(R_MODE, R_DIRECTION, R_CONTACT, R_CONTACTS, R_STICKS,
+ R_FAILED) = range(K.N_STATE, K.N_STATE + 6)
+N_ROWS = K.N_STATE + 6
 # Rows of the per-step scratch array: the running weighted sum, the stage input, the flag.
 T_SUM, T_INPUT, T_FLAGGED = 0, K.N_ODE, K.N_ODE + 4
 N_SCRATCH = K.N_ODE + 5
@@ -204,7 +205,6 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
             L[i * W + c] = states[c, i]
         L[R_MODE * W + c] = flags[c, K.I_MODE]
         L[R_DIRECTION * W + c] = flags[c, K.I_DIRECTION]
-        L[R_MARGIN * W + c] = np.nan  # holding margins are worked out again
         L[R_CONTACT * W + c] = flags[c, K.I_CONTACT]
         L[R_CONTACTS * W + c] = flags[c, K.I_N_CONTACTS]
         L[R_STICKS * W + c] = flags[c, K.I_N_STICKS]
@@ -248,8 +248,9 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                 L[R_STICKS * W + c] += sticks
                 _store(L, c, s1, margin, K._in_contact(s1, mode, P), P)
         step += 1
-        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
-        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
+        # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
+        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
+                                          step % K.PHASE_PERIOD == 0)
         if step % decimation == 0:
             for c in range(n):
                 if L[R_FAILED * W + c] == 0.0:
@@ -299,7 +300,7 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
     step = flags[K.I_STEP]
     status = K.STATUS_OK
     row = row0
-    margin = np.nan
+    margin = state[K.A_MARGIN]
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
     for _ in range(n_steps):
         t = step * h
@@ -313,8 +314,9 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
             break
         s, mode, direction, margin = s1, mode1, direction1, margin1
         step += 1
-        # rotate the excitation's sine/cosine to the next step; exact every 256 steps
-        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E, step % 256 == 0)
+        # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
+        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
+                                          step % K.PHASE_PERIOD == 0)
         flags[K.I_N_STICKS] += sticks
         flags[K.I_N_CONTACTS] += impacts
         now = K._in_contact(s, mode, P)
@@ -328,6 +330,7 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
     for i in range(K.N_ODE):
         state[i] = s[i]
     state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR] = held
+    state[K.A_MARGIN] = margin
     flags[K.I_MODE] = mode
     flags[K.I_DIRECTION] = direction
     flags[K.I_CONTACT] = contact

@@ -13,7 +13,7 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.isolator import InitialState, IsolatorParameters
 
-__all__ = ["PreparedRun", "prepare_run", "steps_per_sample", "divergence_message"]
+__all__ = ["PreparedRun", "prepare_run", "steps_per_sample", "chunk_steps", "divergence_message"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 # A base at rest, for the static load of the PI preload.
@@ -81,9 +81,38 @@ def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
     return steps
 
 
+def chunk_steps(decimation, max_steps, max_samples):
+    """Integration steps per kernel call [-]: the one rule for every driver.
+
+    A whole number of output samples and of :data:`~qzs.engine.kernels.PHASE_PERIOD` (the
+    excitation's sine and cosine are exact on those steps), so that cutting a run into
+    calls changes no bit: a single run and a batch give the same numbers whatever their
+    chunks (docs/model.md §9).
+
+    Parameters
+    ----------
+    decimation : int
+        Integration steps per output sample [-].
+    max_steps : int
+        Most steps per call [-] (progress and Ctrl-C granularity).
+    max_samples : int
+        Most output samples per call [-] (the buffer).
+
+    Returns
+    -------
+    int
+        A multiple of ``lcm(decimation, PHASE_PERIOD)``, at least one, within both bounds
+        where one multiple fits.
+    """
+    unit = int(np.lcm(int(decimation), K.PHASE_PERIOD))
+    steps = min(int(max_steps), int(max_samples) * int(decimation))
+    return unit * max(1, steps // unit)
+
+
 def _initial_state(initial, isolator, controller, p, excitation, packed_excitation):
     """State vector and flags at t = 0 (at rest at the setpoint by default)."""
     s = np.zeros(K.N_STATE)
+    s[K.A_MARGIN] = np.nan  # not known yet: the first step works it out
     flags = np.zeros(K.N_FLAGS, dtype=np.int64)
     z0 = controller.position_setpoint if initial.relative_position is None else initial.relative_position
     if not p[K.P_Z_LOW] <= z0 <= p[K.P_Z_HIGH]:

@@ -12,7 +12,7 @@ from qzs import defaults
 from qzs.analysis.statistics import SummaryStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
-from qzs.engine.prepare import divergence_message, prepare_run
+from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
 from qzs.engine.results import CHANNELS, FLAGS, SimulationResult
 from qzs.errors import ResultTooLargeError, SimulationError
 
@@ -93,7 +93,7 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     dt, sample_rate = run.dt, run.sample_rate
     n_steps = int(round(duration / dt))
     n_out = n_steps // decimation + 1
-    chunk = decimation * max(1, min(CHUNK_STEPS // decimation, CHUNK_SAMPLES))
+    chunk = chunk_steps(decimation, CHUNK_STEPS, CHUNK_SAMPLES)
     if sink is None:
         _check_memory(n_out, duration, sample_rate)
         every = 1
