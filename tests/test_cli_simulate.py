@@ -208,3 +208,16 @@ def test_an_unknown_excitation_kind_in_a_config_is_named(tmp_path, capsys):
     assert main(["simulate", "--config", str(config), "--plot", "none", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "excitation `kind` must be one of ('chirp', 'sine', 'random', 'file'), got 'square'" in err
+
+
+def test_tolerance_chooses_the_step_the_run_uses(capsys):
+    """`--tolerance DB` runs with the step qzs.engine.accuracy.choose_step finds."""
+    from qzs.engine.accuracy import choose_step
+
+    assert main(["simulate", "--excitation-duration", "100", "--duration", "20",
+                 "--tolerance", "0.05", "--sample-rate", "500", "--plot", "none", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    expected = choose_step(Chirp(duration=100.0), tolerance_db=0.05, sample_rate=500.0)
+    assert record["step"]["dt"] == record["run"]["dt"] == expected.dt
+    assert record["step"]["error_db"] <= 0.05
+    assert main(["simulate", "--tolerance", "0.1", "--dt", "1e-3"]) == 2

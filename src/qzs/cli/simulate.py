@@ -66,7 +66,12 @@ def add_parser(subparsers):
                           "and file, 0 for chirp; 0 starts at full amplitude)")
     sim.add_argument("--duration", type=float, metavar="S",
                      help="simulated time [s] (default the excitation's length; 10 for a sine)")
-    sim.add_argument("--dt", type=float, metavar="S", help="integration step [s] (default 1e-4)")
+    step = sim.add_mutually_exclusive_group()
+    step.add_argument("--dt", type=float, metavar="S", help="integration step [s] (default 1e-4)")
+    step.add_argument("--tolerance", type=float, metavar="DB",
+                      help="choose the largest step whose transmissibility stays within DB "
+                           "[dB] of a finer one, on a short probe of the excitation "
+                           "(docs/model.md §7), instead of --dt")
     sim.add_argument("--sample-rate", type=float, metavar="HZ",
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
@@ -131,6 +136,16 @@ def run(args):
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
+    notes = ""
+    if args.tolerance is not None:
+        from qzs.engine.accuracy import choose_step
+
+        choice = choose_step(excitation, config["isolator"], config["controller"],
+                             tolerance_db=args.tolerance,
+                             **{k: settings[k] for k in ("solver", "sample_rate") if k in settings},
+                             progress=not args.quiet and not args.json)
+        settings["dt"] = choice.dt
+        notes = "\n  step             " + choice.summary().replace("\n", "\n                   ")
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
@@ -147,6 +162,12 @@ def run(args):
     if plot is not None:
         result.plot(path=plot)
         files["plot"] = plot
-    text = result.summary() + "".join(f"\n  wrote            {p}" for p in files.values())
-    emit(args, text, {**summary_record(result), "files": files})
+    text = (result.summary() + notes
+            + "".join(f"\n  wrote            {p}" for p in files.values()))
+    record = {**summary_record(result), "files": files}
+    if args.tolerance is not None:
+        record["step"] = {"dt": choice.dt, "error_db": choice.error,
+                          "tolerance_db": choice.tolerance, "reference_dt": choice.reference_dt,
+                          "notes": list(choice.notes)}
+    emit(args, text, record)
     return 0 if result.completed else 130

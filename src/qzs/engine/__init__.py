@@ -10,6 +10,7 @@
 ``simulate``     :func:`simulate`, the validated single run
 ``batch``        :func:`simulate_batch`, many parameter sets at once
 ``results``      :class:`SimulationResult`
+``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
 """
 from qzs._lazy import lazy_exports
 
@@ -20,6 +21,7 @@ _EXPORTS = {
     "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",
+    "choose_step": "qzs.engine.accuracy", "StepChoice": "qzs.engine.accuracy",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

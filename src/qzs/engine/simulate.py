@@ -5,6 +5,7 @@
 >>> result.summary()  # doctest: +SKIP
 """
 import time as _time
+from concurrent.futures import ThreadPoolExecutor, wait
 
 import numpy as np
 
@@ -107,9 +108,14 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
     K.evaluate(0.0, s, flags, p, *packed, out[0], out_flags[0])
     statistics = SummaryStatistics(0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]), isolator.motor_force_max)
 
-    def absorb(first, rows, total):
-        """Rows ``first:first+rows`` of the buffer are new; ``total`` were written before."""
-        block, block_flags = out[first:first + rows], out_flags[first:first + rows]
+    buffers = [(out, out_flags)]
+    if sink is not None:  # two buffers: the kernel fills one while the other is written
+        buffers.append((np.empty_like(out), np.zeros_like(out_flags)))
+
+    def absorb(buffer, first, rows, total):
+        """Rows ``first:first+rows`` of a buffer are new; ``total`` were written before."""
+        data, marks = buffers[buffer]
+        block, block_flags = data[first:first + rows], marks[first:first + rows]
         statistics.add(_named(block, block_flags))
         if sink is not None:
             sink(block, block_flags)
@@ -121,33 +127,57 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
                 preview.append(low)
                 preview_flags.append(high)
 
-    absorb(0, 1, 0)
-    rows, done, completed, start = 1, 0, True, None
+    def integrate(n, row0, buffer):
+        data, marks = buffers[buffer]
+        return _lanes.run_single(solver_code, n, decimation, s, flags, p, *packed, data, marks,
+                                 row0)[0]
+
+    absorb(0, 0, 1, 0)
+    rows, done, completed, start, interrupted = 1, 0, True, None, False
     bar = _progress_bar(n_steps, progress)
+    # The kernel holds no GIL: it integrates the next chunk in a thread while this one writes
+    # the last (statistics, sink, preview), so writing costs no integration time.
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="qzs-kernel")
+
+    def launch(chunk_index, done, rows):
+        n = min(chunk, n_steps - done)
+        buffer = chunk_index % len(buffers)
+        row0 = rows if sink is None else 0
+        return pool.submit(integrate, n, row0, buffer), n, row0, buffer
+
     try:
         # a zero-step call compiles (or loads) the kernel: the clock counts integration only
-        _lanes.run_single(solver_code, 0, decimation, s, flags, p, *packed, out, out_flags, 1)
+        pool.submit(integrate, 0, 1, 0).result()
         start = _time.perf_counter()
-        while done < n_steps:
-            n = min(chunk, n_steps - done)
-            row0 = rows if sink is None else 0
+        pending = launch(0, done, rows) if done < n_steps else None
+        index = 0
+        while pending is not None:
+            future, n, row0, buffer = pending
+            status, stopped = _collect(future)
+            interrupted = interrupted or stopped
+            written = int(flags[K.I_STEP]) // decimation - done // decimation
+            done = int(flags[K.I_STEP])
+            index += 1
+            pending = None
+            if status == K.STATUS_OK and not interrupted and done < n_steps:
+                pending = launch(index, done, rows + written)
             try:
-                status = _lanes.run_single(solver_code, n, decimation, s, flags, p, *packed,
-                                           out, out_flags, row0)[0]
-            finally:  # Ctrl-C lands after the kernel returns: keep the rows it wrote
-                written = int(flags[K.I_STEP]) // decimation - done // decimation
-                absorb(row0, written, rows)
-                rows += written
-                done = int(flags[K.I_STEP])
+                absorb(buffer, row0, written, rows)
+            except KeyboardInterrupt:  # the next chunk is under way: keep it, then stop
+                interrupted = True
+            rows += written
             if status != K.STATUS_OK:
                 _raise_diverged(s, flags, p)
             if bar is not None:
                 bar.update(n)
+        if interrupted:
+            raise KeyboardInterrupt
     except KeyboardInterrupt:
         if not interruptible:
             raise
         completed = False
     finally:
+        pool.shutdown(wait=True)
         if bar is not None:
             bar.close()
     elapsed = 0.0 if start is None else _time.perf_counter() - start
@@ -162,6 +192,26 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
     return SimulationResult(data, data_flags, isolator=isolator, controller=controller,
                             excitation=excitation, run=run, statistics=statistics.result())
+
+
+def _collect(future):
+    """The kernel's status once it has ended, and whether Ctrl-C came meanwhile.
+
+    The kernel cannot be stopped (it holds no GIL and checks no signal): after Ctrl-C it
+    is waited for, so that the rows it wrote are kept; a KeyboardInterrupt raised in its
+    own thread leaves its rows written as well.
+    """
+    stopped = False
+    while True:
+        try:
+            wait([future])
+            break
+        except KeyboardInterrupt:
+            stopped = True
+    error = future.exception()
+    if isinstance(error, KeyboardInterrupt):
+        return K.STATUS_OK, True
+    return future.result(), stopped
 
 
 def _envelope_rows(data, flags, first, every):

@@ -1,0 +1,172 @@
+"""The accuracy-driven step (qzs.engine.accuracy, docs/model.md §7 "Accuracy-driven step")."""
+import math
+
+import numpy as np
+import pytest
+
+import qzs.engine.simulate as simulate_module
+from helpers import linear_controller, linear_isolator
+from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine, simulate
+from qzs.engine import StepChoice, choose_step
+from qzs.engine.accuracy import probe_excitation, step_error
+from qzs.engine.prepare import steps_per_sample
+from qzs.engine.stability import largest_stable_step, stability_test
+from qzs.errors import ParameterError
+
+CHIRP = Chirp(duration=20.0)
+PROBE = 20.0  # s: short probes keep the tests quick
+
+
+def _check_against_fine(choice, measure, factor=64, isolator=None, controller=None):
+    """The chosen step's actual error on the probe, against a step ``factor`` times finer."""
+    run = dict(isolator=isolator, controller=controller, duration=choice.probe_duration,
+               sample_rate=choice.sample_rate, solver=choice.solver)
+    coarse = simulate(choice.probe, dt=choice.dt, **run)
+    fine = simulate(choice.probe, dt=choice.dt / factor, **run)
+    return step_error(coarse, fine, measure, band=choice.band)
+
+
+@pytest.mark.parametrize("tolerance", [1e-3, 1e-4])
+def test_chosen_step_meets_a_db_tolerance_against_a_much_finer_reference(tolerance):
+    choice = choose_step(CHIRP, tolerance_db=tolerance, band=(1.0, 20.0), probe_duration=PROBE)
+    assert isinstance(choice, StepChoice)
+    assert choice.measure == "transmissibility_db" and 2 * choice.error <= tolerance
+    actual = _check_against_fine(choice, "transmissibility_db")
+    assert actual <= tolerance
+    # the estimate is an estimate, not a wild bound: within a factor 3 of the actual error
+    assert actual / 3 <= choice.error <= 3 * actual
+    assert choice.reference_dt == pytest.approx(choice.dt / 4)
+
+
+def test_chosen_step_meets_a_state_tolerance_and_halves_when_needed():
+    choice = choose_step(CHIRP, tolerance_state=1e-6, probe_duration=PROBE, safety=1.0)
+    assert choice.dt < 1.0 / choice.sample_rate  # the tolerance forced halvings
+    actual = _check_against_fine(choice, "state_m")
+    assert actual <= 1e-6
+    # the coarser step tried before it really missed the tolerance (the search is not idle)
+    assert choice.history[-2][2] > 1e-6
+    # a safety factor asks more of the estimate: never a larger step
+    assert choose_step(CHIRP, tolerance_state=1e-6, probe_duration=PROBE).dt <= choice.dt
+
+
+def test_a_tighter_tolerance_never_gives_a_larger_step():
+    steps = [choose_step(CHIRP, tolerance_state=tol, probe_duration=PROBE).dt
+             for tol in (1e-4, 1e-5, 1e-6, 1e-7)]
+    assert all(later <= earlier for earlier, later in zip(steps, steps[1:]))
+    assert steps[-1] < steps[0]
+    db = [choose_step(CHIRP, tolerance_db=tol, probe_duration=PROBE).dt
+          for tol in (1e-2, 1e-4, 2e-5)]
+    assert all(later <= earlier for earlier, later in zip(db, db[1:]))
+
+
+@pytest.mark.parametrize("sample_rate, controller_rate", [(100.0, 0.0), (1000.0, 300.0),
+                                                          (50.0, 0.0)])
+def test_the_step_respects_stability_and_divides_the_output_period(sample_rate, controller_rate):
+    controller = ControllerParameters(controller_rate=controller_rate)
+    choice = choose_step(CHIRP, controller=controller, tolerance_db=0.5,
+                         sample_rate=sample_rate, probe_duration=PROBE)
+    limit = largest_stable_step(IsolatorParameters(), controller, "ode3")
+    assert choice.stability_limit == pytest.approx(limit)
+    assert choice.dt <= limit
+    assert stability_test(IsolatorParameters(), controller, "ode3")(choice.dt)
+    assert steps_per_sample(sample_rate, choice.dt) == choice.steps_per_sample
+    if controller_rate:
+        steps_per_sample(controller_rate, choice.dt, "controller_rate")  # raises if not whole
+    # stability-bound cases start at the largest stable multiple of the output period
+    if 1.0 / sample_rate > limit:
+        k = steps_per_sample(sample_rate, choice.history[0][0])
+        assert 1.0 / (sample_rate * (k - 1)) > limit
+        assert any("stability bounds" in note for note in choice.notes)
+
+
+def test_stiff_stops_lower_the_step():
+    stiff = IsolatorParameters(stop_stiffness=1e8)
+    limit = largest_stable_step(stiff, None, "ode3")
+    assert limit < 1e-3
+    choice = choose_step(CHIRP, stiff, tolerance_db=0.5, probe_duration=PROBE)
+    assert choice.dt <= limit
+    steps_per_sample(1000.0, choice.dt)
+
+
+def _refuse_to_simulate(*args, **kwargs):
+    raise AssertionError("choose_step simulated before validating its arguments")
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(), "exactly one"),
+    (dict(tolerance_db=0.1, tolerance_state=1e-6), "exactly one"),
+    (dict(tolerance_db=0.0), "positive"),
+    (dict(tolerance_db=-0.1), "positive"),
+    (dict(tolerance_state=math.nan), "positive"),
+    (dict(tolerance_db=True), "positive"),
+    (dict(tolerance_db=0.1, band=(1.0, 30.0)), "outside the excitation"),
+    (dict(tolerance_db=0.1, band=(5.0, 1.0)), "low <= high"),
+    (dict(tolerance_db=0.1, band=(1.0, 20.0), sample_rate=30.0), "Nyquist"),
+    (dict(tolerance_db=0.1, band="wide"), "two frequencies"),
+    (dict(tolerance_db=0.1, solver="rk45"), "solver"),
+    (dict(tolerance_db=0.1, sample_rate=-1.0), "sample_rate"),
+    (dict(tolerance_db=0.1, probe_duration=0.0), "probe_duration"),
+    (dict(tolerance_db=0.1, fft_length=10 ** 9), "fft_length"),
+    (dict(tolerance_db=0.1, max_halvings=1), "max_halvings"),
+    (dict(tolerance_db=0.1, safety=0.5), "safety"),
+])
+def test_bad_arguments_raise_before_any_simulation(monkeypatch, kwargs, match):
+    monkeypatch.setattr(simulate_module, "simulate", _refuse_to_simulate)
+    with pytest.raises(ParameterError, match=match):
+        choose_step(CHIRP, **kwargs)
+
+
+def test_bad_models_and_excitations_are_refused(monkeypatch):
+    monkeypatch.setattr(simulate_module, "simulate", _refuse_to_simulate)
+    with pytest.raises(ParameterError, match="excitation"):
+        choose_step("chirp", tolerance_db=0.1)
+    with pytest.raises(ParameterError, match="isolator"):
+        choose_step(CHIRP, ControllerParameters(), tolerance_db=0.1)
+    with pytest.raises(ParameterError, match="band"):  # a sine's band is its frequency
+        choose_step(Sine(frequency=3.0), tolerance_db=0.1, band=(1.0, 20.0))
+
+
+def test_an_unreachable_tolerance_is_an_error_not_a_silent_step():
+    with pytest.raises(ParameterError, match="meets the tolerance"):
+        choose_step(CHIRP, tolerance_state=1e-15, probe_duration=5.0, max_halvings=3)
+
+
+@pytest.mark.parametrize("solver, order", [("euler", 1), ("ode3", 3), ("rk4", 4)])
+def test_linear_error_scales_with_the_schemes_order(solver, order):
+    # frictionless, linear spring, smooth sine started at full amplitude (a fade-in's
+    # raised-cosine slope is not smooth enough for rk4: it caps the observed order at 3)
+    excitation = Sine(frequency=2.0, amplitude=0.01, fade_in=0.0)
+    tolerance = {"euler": 5e-6, "ode3": 1e-10, "rk4": 1e-11}[solver]
+    isolator, controller = linear_isolator(), linear_controller(pi_kp=50.0)
+    choice = choose_step(excitation, isolator, controller, tolerance_state=tolerance,
+                         solver=solver, sample_rate=100.0, probe_duration=10.0, safety=1.0)
+    differences = [d for _, d, _ in choice.history]
+    assert len(differences) >= 2
+    ratios = [a / b for a, b in zip(differences, differences[1:])]
+    assert ratios == pytest.approx([2.0 ** order] * len(ratios), rel=0.1)
+    # the Richardson estimate is the true error: a run 16 times finer is off by 16**-order
+    actual = _check_against_fine(choice, "state_m", 16, isolator, controller)
+    assert choice.error == pytest.approx(actual / (1 - 16.0 ** -order), rel=0.05)
+    assert not any("observed order" in note for note in choice.notes)
+
+
+def test_the_probe_of_a_chirp_covers_the_band_and_is_short():
+    probe, duration = probe_excitation(Chirp(), (1.0, 20.0))
+    assert duration == 60.0 and probe.duration == 60.0
+    assert probe.f0 == 0.0 and probe.f1 == pytest.approx(22.0)  # past the band's top
+    probe, _ = probe_excitation(Chirp(f0=0.0, f1=20.0), (10.0, 15.0), 30.0)
+    assert probe.f0 == pytest.approx(8.0) and probe.f1 == pytest.approx(16.5)
+    assert probe.fade_in > 0
+    falling, _ = probe_excitation(Chirp(f0=20.0, f1=0.0), (1.0, 20.0), 30.0)
+    assert falling.f0 == pytest.approx(22.0) and falling.f1 == 0.0
+    sine = Sine(frequency=4.0)
+    assert probe_excitation(sine, (4.0, 4.0))[0] is sine
+
+
+def test_summary_names_the_step_and_the_binding_limit():
+    choice = choose_step(CHIRP, tolerance_db=0.1, probe_duration=PROBE, progress=False)
+    text = choice.summary()
+    assert "dt = 0.001 s" in text and "dB" in text and "output rate bounds" in text
+    with pytest.raises(AttributeError):
+        choice.dt = 1.0  # frozen
+    assert np.isfinite(choice.error)
