@@ -378,14 +378,27 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
 
 
 @njit(**_JIT)
-def _rk(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
-    """Not-inlined :func:`rk_step`, for the event path (keeps the compiled code small)."""
-    return rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0)
+def _rk(solver, t, h, s, mode, direction, held, P, E, table):
+    """The Runge-Kutta step of :func:`rk_step` for the event path, stage by stage.
+
+    The same tableau and fused updates, in the same order; each stage calls the
+    non-inlined :func:`rhs_at`, which evaluates the base motion exactly (libm sine)
+    rather than rotating it from a nearby phase. Single runs and batches both take this
+    path for the part of a step around an event, so they stay identical; compiling
+    :func:`rk_step`'s inlined stages a second time here took about 70 s of a cold start
+    (docs/model.md §9).
+    """
+    result, k = s, s
+    for stage in range(n_stages(solver)):
+        offset, a, weight = tableau(solver, h, stage)
+        k = rhs_at(t + offset, s if stage == 0 else _axpy(s, a, k), mode, direction, held, P,
+                   E, table)[0]
+        result = _axpy(result, weight, k)
+    return result
 
 
 @njit(**_JIT)
-def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table, phase,
-            sin0, cos0):
+def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table):
     """Refine an event inside ``[t, t + h]`` by regula falsi (Illinois) on its function.
 
     Returns ``(time from t, state there)``; the event function is then zero to
@@ -399,8 +412,7 @@ def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, tab
     state = s1
     side = 0
     for _ in range(6):
-        state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table, phase, sin0,
-                    cos0)
+        state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table)
         g = _event_value(event, t + at, state, mode, direction, held, P, E, table)
         if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
             break
@@ -454,7 +466,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
                                                  E, table)
     at, s_event = _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E,
-                          table, phase, sin0, cos0)
+                          table)
     t_event = t + at
     if event == 1:
         s_event, mode, direction = _settle(t_event, s_event, direction, held, P, E, table)
@@ -469,8 +481,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     rest = h - at
     s1 = s_event
     if rest > 0.0:
-        s1 = _rk(solver, t_event, rest, s_event, mode, float(direction), held, P, E, table,
-                 phase, sin0, cos0)
+        s1 = _rk(solver, t_event, rest, s_event, mode, float(direction), held, P, E, table)
     if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
         if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
             s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, E,
