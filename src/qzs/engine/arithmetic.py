@@ -8,6 +8,7 @@ plain arithmetic so that loops over cases vectorise; the divergence check needs
 ``isfinite`` too, which fast-math would drop.
 """
 import math
+import os
 
 import numpy as np
 from llvmlite import ir
@@ -126,3 +127,55 @@ def tanh(u):
     return r if u >= 0.0 else -r
 
 
+
+
+# ---------------------------------------------------------------- stale kernel caches
+#: The modules whose compiled kernels numba caches, and the source files they are built from
+#: (the excitation's packed-layout constants are compiled in as globals).
+_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes")
+_KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "model/excitation.py")
+#: The fingerprint of those sources, kept beside numba's cache files.
+_STAMP = "qzs-kernel-sources.sha256"
+
+
+@njit(**JIT)
+def _cache_probe():  # pragma: no cover - only its cache location is used
+    return 0
+
+
+def _drop_stale_kernel_caches():
+    """Delete qzs's cached kernels when any kernel source changed since they were compiled.
+
+    numba checks a cached function against its own file only: after an edit of
+    ``base_motion.py`` a cached ``kernels.py`` kernel that inlined the old code would be
+    loaded unchanged (editable installs; a fresh install rewrites every file). The
+    sources' fingerprint is kept beside the cache; when it differs, the cached kernels
+    of :data:`_KERNEL_MODULES` are removed before any is loaded, and numba compiles them
+    again. Best effort: a cache folder that cannot be read or written is left alone.
+    """
+    import hashlib
+    from pathlib import Path
+
+    try:
+        folder = Path(_cache_probe._cache._cache_path)
+        root = Path(__file__).resolve().parents[1]
+        digest = hashlib.sha256()
+        for name in _KERNEL_SOURCES:
+            digest.update((root / name).read_bytes())
+        stamp = folder / _STAMP
+        fingerprint = digest.hexdigest()
+        if stamp.exists() and stamp.read_text(encoding="ascii").strip() == fingerprint:
+            return False
+        for path in folder.glob("*.nb[ic]"):
+            if path.name.split(".", 1)[0] in _KERNEL_MODULES:
+                path.unlink(missing_ok=True)
+        folder.mkdir(parents=True, exist_ok=True)
+        partial = folder / f".{_STAMP}.{os.getpid()}"
+        partial.write_text(fingerprint + "\n", encoding="ascii")
+        os.replace(partial, stamp)
+        return True
+    except (OSError, AttributeError):  # no cache folder, read-only install, other numba
+        return False
+
+
+_drop_stale_kernel_caches()
