@@ -11,6 +11,7 @@ import time
 import numpy as np
 import pytest
 
+import qzs
 from qzs import Chirp, Sine, simulate
 from qzs.engine import simulate as simulate_module
 from qzs.errors import ResultTooLargeError
@@ -105,3 +106,33 @@ def test_peak_memory_of_a_streamed_run_does_not_grow_with_its_duration(tmp_path)
         peaks[duration] = json.loads(out.stdout.strip().splitlines()[-1])
     kept = simulate_module.result_bytes(2000.0, 1000.0) - simulate_module.result_bytes(400.0, 1000.0)
     assert peaks[2000.0] - peaks[400.0] < 0.25 * kept, peaks
+
+
+def test_ctrl_c_while_a_chunk_is_written_keeps_every_chunk_whole(tmp_path, monkeypatch):
+    """SIGINT arriving inside the sink (the main thread writing a chunk) stops the run after
+    the chunk under way: the file holds whole chunks, in order, and says it is incomplete."""
+    import signal
+
+    from qzs.iotools import ResultWriter
+
+    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)  # cut to 128 samples
+    path = tmp_path / "run.nc"
+    calls = []
+    with ResultWriter(path, isolator=qzs.IsolatorParameters(),
+                      controller=qzs.ControllerParameters(), excitation=EXCITATION) as writer:
+        def sink(data, flags):
+            calls.append(len(data))
+            if len(calls) == 3:
+                signal.raise_signal(signal.SIGINT)  # Ctrl-C in the middle of writing
+            writer.append(data, flags)
+
+        result = simulate(EXCITATION, duration=10.0, sample_rate=1000.0, sink=sink,
+                          interruptible=True)
+        writer.finish(result.run)
+    assert not result.completed
+    assert calls == [1, 128, 128, 128]  # t = 0, the chunk being written, the one under way
+    data = read_result(path)
+    assert data.sizes["time"] == result.run["samples"] == 1 + 3 * 128
+    np.testing.assert_allclose(np.diff(data.time.values), 1e-3, rtol=1e-9)
+    assert data.attrs["run.completed"] == 0
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

@@ -4,6 +4,8 @@
 >>> result = simulate(Chirp(duration=20.0, f1=5.0), dt=1e-4, sample_rate=500.0)
 >>> result.summary()  # doctest: +SKIP
 """
+import signal
+import threading
 import time as _time
 from concurrent.futures import ThreadPoolExecutor, wait
 
@@ -145,7 +147,10 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         row0 = rows if sink is None else 0
         return pool.submit(integrate, n, row0, buffer), n, row0, buffer
 
+    deferred = _DeferredInterrupt() if interruptible else None
     try:
+        if deferred is not None:  # Ctrl-C stops the run between chunks: rows stay whole
+            deferred.install()
         # a zero-step call compiles (or loads) the kernel: the clock counts integration only
         pool.submit(integrate, 0, 1, 0).result()
         start = _time.perf_counter()
@@ -154,17 +159,14 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         while pending is not None:
             future, n, row0, buffer = pending
             status, stopped = _collect(future)
-            interrupted = interrupted or stopped
+            interrupted = interrupted or stopped or (deferred is not None and deferred.requested)
             written = int(flags[K.I_STEP]) // decimation - done // decimation
             done = int(flags[K.I_STEP])
             index += 1
             pending = None
             if status == K.STATUS_OK and not interrupted and done < n_steps:
                 pending = launch(index, done, rows + written)
-            try:
-                absorb(buffer, row0, written, rows)
-            except KeyboardInterrupt:  # the next chunk is under way: keep it, then stop
-                interrupted = True
+            absorb(buffer, row0, written, rows)
             rows += written
             if status != K.STATUS_OK:
                 _raise_diverged(s, flags, p)
@@ -177,6 +179,8 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
             raise
         completed = False
     finally:
+        if deferred is not None:
+            deferred.restore()
         pool.shutdown(wait=True)
         if bar is not None:
             bar.close()
@@ -192,6 +196,34 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
     return SimulationResult(data, data_flags, isolator=isolator, controller=controller,
                             excitation=excitation, run=run, statistics=statistics.result())
+
+
+class _DeferredInterrupt:
+    """While an interruptible run goes on, Ctrl-C asks it to stop after the chunk under way.
+
+    A KeyboardInterrupt raised in the middle of writing a chunk would leave the chunk
+    half-written (its statistics counted, its rows not in the file); the handler only
+    sets :attr:`requested`, which the run checks between chunks. Installed only in the
+    main thread (where Python runs signal handlers), restored afterwards.
+    """
+
+    def __init__(self):
+        self.requested = False
+        self._previous = None
+
+    def _handler(self, signum, frame):
+        self.requested = True
+
+    def install(self):
+        """Take over SIGINT (main thread only)."""
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handler)
+
+    def restore(self):
+        """Give SIGINT back to the handler it had."""
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+            self._previous = None
 
 
 def _collect(future):
