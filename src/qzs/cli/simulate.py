@@ -63,7 +63,8 @@ def add_parser(subparsers):
                           "random record length (default 100)")
     sim.add_argument("--fade-in", type=float, metavar="S",
                      help="smooth fade-in of the excitation [s] (default 2 for sine, random "
-                          "and file, 0 for chirp; 0 starts at full amplitude)")
+                          "and file, a quarter of a shorter one; 0 for chirp; 0 starts at "
+                          "full amplitude)")
     sim.add_argument("--duration", type=float, metavar="S",
                      help="simulated time [s] (default the excitation's length; 10 for a sine)")
     step = sim.add_mutually_exclusive_group()
