@@ -19,9 +19,7 @@ import numpy as np
 from qzs import defaults
 from qzs._validation import choice as _choice
 from qzs.errors import ParameterError
-from qzs.model.controller import ControllerParameters
-from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
-from qzs.model.isolator import IsolatorParameters
+from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error"]
 
@@ -355,22 +353,12 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
+    from qzs.engine.prepare import run_inputs
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 
     measure, tolerance = _tolerance(tolerance_db, tolerance_state)
-    excitation = Chirp() if excitation is None else excitation
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
-    if not isinstance(excitation, (Chirp, Sine, RandomExcitation, DisplacementRecord)):
-        raise ParameterError("`excitation` must be a Chirp, Sine, RandomExcitation or "
-                             f"DisplacementRecord, got {type(excitation).__name__}.")
-    if not isinstance(isolator, IsolatorParameters):
-        raise ParameterError(f"`isolator` must be an IsolatorParameters, got "
-                             f"{type(isolator).__name__}.")
-    if not isinstance(controller, ControllerParameters):
-        raise ParameterError(f"`controller` must be a ControllerParameters, got "
-                             f"{type(controller).__name__}.")
+    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
     _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
     if (isinstance(sample_rate, bool) or not isinstance(sample_rate, (int, float, np.number))
             or not np.isfinite(sample_rate) or sample_rate <= 0):

@@ -13,7 +13,8 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.isolator import InitialState, IsolatorParameters
 
-__all__ = ["PreparedRun", "prepare_run", "steps_per_sample", "chunk_steps", "divergence_message"]
+__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample", "chunk_steps",
+           "divergence_message"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 # A base at rest, for the static load of the PI preload.
@@ -79,6 +80,45 @@ def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
             f"`{name}` ({rate!r} Hz) must divide the integration rate 1/dt = {1 / dt:g} Hz into "
             f"a whole number of steps; got {ratio:g} steps. Use e.g. {name}={hint:g}.")
     return steps
+
+
+def run_inputs(excitation=None, isolator=None, controller=None):
+    """A run's excitation, isolator and controller, the defaults put in for None.
+
+    The one place these defaults are chosen: the paper's chirp, Table 1's isolator and
+    the default loops (docs/model.md §11).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
+        Base motion; default :class:`~qzs.model.excitation.Chirp`.
+    isolator : IsolatorParameters, optional
+        Plant parameters; default Table 1.
+    controller : ControllerParameters, optional
+        PI and damping loops; default the defaults.
+
+    Returns
+    -------
+    excitation, isolator, controller
+
+    Raises
+    ------
+    ParameterError
+        An argument of another type.
+    """
+    inputs = (Chirp() if excitation is None else excitation,
+              IsolatorParameters() if isolator is None else isolator,
+              ControllerParameters() if controller is None else controller)
+    for name, value, kinds in zip(("excitation", "isolator", "controller"), inputs,
+                                  (_EXCITATIONS, (IsolatorParameters,), (ControllerParameters,))):
+        _check_type(name, value, kinds)
+    return inputs
+
+
+def _check_type(name, value, kinds):
+    if not isinstance(value, kinds):
+        names = " or ".join(k.__name__ for k in kinds)
+        raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
 
 
 def chunk_steps(decimation, max_steps, max_samples):
@@ -226,17 +266,9 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
     -------
     PreparedRun
     """
-    excitation = Chirp() if excitation is None else excitation
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
+    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
     initial_state = InitialState() if initial_state is None else initial_state
-    for name, value, kinds in (("excitation", excitation, _EXCITATIONS),
-                               ("isolator", isolator, (IsolatorParameters,)),
-                               ("controller", controller, (ControllerParameters,)),
-                               ("initial_state", initial_state, (InitialState,))):
-        if not isinstance(value, kinds):
-            names = " or ".join(k.__name__ for k in kinds)
-            raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
+    _check_type("initial_state", initial_state, (InitialState,))
     solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
     dt = positive("dt", dt)
     sample_rate = positive("sample_rate", sample_rate)

@@ -17,7 +17,7 @@ from qzs.model.registry import unit_of
 
 __all__ = ["SimulationResult", "CHANNELS", "FLAGS", "FLAG_MEANINGS", "RUN_UNITS", "CONVENTIONS",
            "NONE_VALUE", "variable_attributes", "parameter_metadata", "run_metadata",
-           "history_line", "file_attributes"]
+           "history_line", "file_attributes", "named_block"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -244,6 +244,28 @@ def file_attributes(isolator, controller, excitation, run, history=None):
     return head, tail
 
 
+def named_block(data, flags):
+    """Output rows as the named arrays :class:`~qzs.analysis.statistics.SummaryStatistics` takes.
+
+    Parameters
+    ----------
+    data : ndarray, shape (n, N_CHANNELS)
+        Output rows, one column per channel of :data:`CHANNELS`.
+    flags : ndarray of bool, shape (n, 2)
+        The flags of :data:`FLAGS`.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Every channel and flag by name (views), plus ``mechanical_energy`` [J].
+    """
+    block = {name: data[:, column] for name, (column, _, _) in CHANNELS.items()}
+    block.update({name: flags[:, column] for name, (column, _) in FLAGS.items()})
+    block["mechanical_energy"] = (block["kinetic_energy"] + block["spring_energy"]
+                                  + block["gravity_energy"] + block["stop_energy"])
+    return block
+
+
 class SimulationResult:
     """Time series and metadata of one simulation.
 
@@ -296,9 +318,7 @@ class SimulationResult:
 
             center = 0.5 * (self.run["stop_low"] + self.run["stop_high"])
             statistics = SummaryStatistics(center, self.isolator.motor_force_max)
-            block = {name: self[name] for name in (*CHANNELS, *FLAGS)}
-            block["mechanical_energy"] = self.mechanical_energy()
-            statistics.add(block)
+            statistics.add(named_block(self._data, self._flags))
             self._statistics = statistics.result()
         return self._statistics
 

@@ -16,7 +16,7 @@ from qzs.analysis.statistics import SummaryStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
-from qzs.engine.results import CHANNELS, FLAGS, SimulationResult
+from qzs.engine.results import SimulationResult, named_block
 from qzs.errors import ResultTooLargeError, SimulationError
 
 __all__ = ["simulate", "result_bytes"]
@@ -118,7 +118,7 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         """Rows ``first:first+rows`` of a buffer are new; ``total`` were written before."""
         data, marks = buffers[buffer]
         block, block_flags = data[first:first + rows], marks[first:first + rows]
-        statistics.add(_named(block, block_flags))
+        statistics.add(named_block(block, block_flags))
         if sink is not None:
             sink(block, block_flags)
             if every == 1:
@@ -301,15 +301,6 @@ def _check_memory(n_out, duration, sample_rate):
     available = _available_memory()
     if available is not None and needed > MEMORY_SHARE * available:
         raise ResultTooLargeError(needed, available, duration, sample_rate)
-
-
-def _named(data, flags):
-    """A block of output rows as the named arrays :class:`SummaryStatistics` takes."""
-    block = {name: data[:, column] for name, (column, _, _) in CHANNELS.items()}
-    block.update({name: flags[:, column] for name, (column, _) in FLAGS.items()})
-    block["mechanical_energy"] = (block["kinetic_energy"] + block["spring_energy"]
-                                  + block["gravity_energy"] + block["stop_energy"])
-    return block
 
 
 def _progress_bar(total, enabled):

@@ -7,12 +7,10 @@
 from pathlib import Path
 
 from qzs import defaults
+from qzs.engine.prepare import run_inputs
 from qzs.engine.simulate import simulate
 from qzs.iotools.files import ResultWriter, estimated_size
 from qzs.iotools.paths import check_output_path
-from qzs.model.controller import ControllerParameters
-from qzs.model.excitation import Chirp
-from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["simulate_to_file", "RESULT_SUFFIXES"]
 
@@ -71,9 +69,7 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
     OutputPathError
         The path cannot be written (extension, folder, permissions, free space).
     """
-    excitation = Chirp() if excitation is None else excitation
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
+    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
     length = duration if duration is not None else excitation.duration
     size = None
     known = Path(path).suffix.lower() in RESULT_SUFFIXES  # else check_output_path names them
