@@ -252,3 +252,56 @@ def test_study_physics_is_sensible(quick_paper):
         keep = (case.frequency > 6) & (case.frequency < 18)
         ratio = case.magnitude[keep] / case.linear["magnitude"][keep]
         assert np.all(np.abs(ratio - 1) < 0.1)
+
+
+def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
+    """Cases sharing a chirp go through the batch kernel together; every curve, metric and
+    statistic equals the one-case path's exactly (a processing case joins the same batch and
+    brings the velocities)."""
+    import dataclasses
+
+    stiction = load_study("stiction")
+    processing = load_study("processing")
+    analysis = {"quick_fft_length": 2048, "quick_n_averages": 6}
+    studies = [dataclasses.replace(stiction, analysis={**stiction.analysis, **analysis},
+                                   cases=stiction.cases[::2]),
+               dataclasses.replace(processing, analysis={**processing.analysis, **analysis},
+                                   options={**processing.options, "n_averages": 6})]
+    import qzs.engine.batch
+
+    batches = []
+    original = qzs.engine.batch.simulate_batch
+
+    def counted(cases, *args, **kwargs):
+        batches.append(len(cases))
+        return original(cases, *args, **kwargs)
+
+    monkeypatch.setattr(qzs.engine.batch, "simulate_batch", counted)
+    lockstep = run_studies(studies, quick=True, workers=2, progress=False)
+    assert batches == [3]  # two stiction cases and the processing case: one batch
+    single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False)
+    assert batches == [3]
+
+    def same(a, b):
+        if isinstance(a, np.ndarray):
+            return np.array_equal(a, b, equal_nan=True)
+        if isinstance(a, float) and np.isnan(a):
+            return isinstance(b, float) and np.isnan(b)
+        return a == b
+
+    compared = 0
+    for study_a, study_b in zip(lockstep, single):
+        for a, b in zip(study_a.cases, study_b.cases):
+            for field in ("frequency", "magnitude", "coherence", "trusted"):
+                assert same(getattr(a, field), getattr(b, field)), (a.label, field)
+            for name in a.metrics:
+                assert same(a.metrics[name], b.metrics[name]), (a.label, name)
+                compared += 1
+            for name in a.stats:
+                if name != "steps_per_second":
+                    assert same(a.stats[name], b.stats[name]), (a.label, name)
+            for name in ("metrics", "magnitude"):
+                if a.extra:
+                    assert same(str(a.extra[name]), str(b.extra[name])), (a.label, name)
+    assert compared > 20
+    assert lockstep[1].cases[0].extra["magnitude"].size > 0

@@ -106,8 +106,12 @@ def test_fixed_and_varied_conflicts_and_invalid_fixed_values():
 
 
 def test_analysis_and_simulation_checks():
-    raises(definition(grid={"pi_kp": [1.0]}, analysis={"sample_rate": 3000.0}),
-           "`sample_rate` (3000.0 Hz) must divide")
+    raises(definition(grid={"pi_kp": [1.0]}, analysis={"sample_rate": 3000.0},
+                      simulation={"dt": 1e-4}), "`sample_rate` (3000.0 Hz) must divide")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"dt": 1e-4, "tolerance_db": 0.1}),
+           "either `dt`", "`tolerance_db`")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"tolerance_db": -1.0}),
+           "`tolerance_db`")
     raises(definition(grid={"pi_kp": [1.0]}, simulation={"solver": "rk45"}), "`solver`")
     raises(definition(grid={"pi_kp": [1.0]}, analysis={"duration": 10.0}),
            "either `n_averages` or `duration`")
@@ -221,3 +225,29 @@ def test_samples_are_crossed_with_the_grid_as_common_random_numbers():
     stiction = cases["stiction_force"].reshape(3, 5)
     np.testing.assert_array_equal(stiction[0], stiction[2])
     assert sweep.hash == load_sweep(dict(sweep.document)).hash
+
+
+def test_without_dt_the_step_is_chosen_for_the_tolerance_before_any_case_runs():
+    """No `dt`: the sweep's step is the smallest of the steps choose_step picks on the first,
+    middle and last cases; deterministic; a fixed `dt` is kept as given."""
+    from qzs.engine.accuracy import choose_step
+    from qzs.workflows.sweeps.backends import build_case, case_settings, choose_sweep_step
+
+    document = definition(grid={"stiction_force": [2.0, 15.0]},
+                          analysis={"fft_length": 2048, "n_averages": 6},
+                          simulation={"tolerance_db": 0.05})
+    sweep = load_sweep(document)
+    assert sweep.simulation["dt"] is None and "chosen at run time" in plan_text(sweep)
+    settings = case_settings(sweep, sample_cases(sweep))
+    chosen, choices = choose_sweep_step(sweep, settings)
+    assert [i for i, _ in choices] == [0, 1]
+    isolator, controller, (excitation, _), _ = build_case(sweep, settings[1])
+    direct = choose_step(excitation, isolator, controller, tolerance_db=0.05)
+    assert chosen.simulation["dt"] == min(c.dt for _, c in choices) <= direct.dt
+    from qzs.engine.accuracy import SAFETY
+
+    assert all(c.error * SAFETY <= 0.05 for _, c in choices)
+    assert "0.05 dB" in chosen.simulation["step_note"]
+    assert choose_sweep_step(sweep, settings)[0].simulation["dt"] == chosen.simulation["dt"]
+    fixed = load_sweep(definition(grid={"stiction_force": [2.0]}, simulation={"dt": 2e-4}))
+    assert choose_sweep_step(fixed, case_settings(fixed, sample_cases(fixed)))[0] is fixed

@@ -68,7 +68,8 @@ def test_batched_results_equal_single_runs(reference):
         stiction = float(data["stiction_force"][case])
         run = qzs.simulate(qzs.Chirp(f1=10.0, duration=definition.analysis["duration"]),
                            qzs.IsolatorParameters(stiction_force=stiction),
-                           qzs.ControllerParameters(pi_kp=kp, pi_ki=2.0))
+                           qzs.ControllerParameters(pi_kp=kp, pi_ki=2.0),
+                           dt=float(data.attrs["dt"]))  # the step chosen for the sweep
         row = data.isel(case=case)
         np.testing.assert_array_equal(row["relative_position"].values, run.relative_position)
         np.testing.assert_array_equal(row["payload_acceleration"].values,

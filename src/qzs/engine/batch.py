@@ -20,7 +20,7 @@ from qzs.analysis.statistics import STATISTICS, RunStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
-from qzs.engine.results import CHANNELS
+from qzs.engine.results import CHANNELS, FLAGS
 from qzs.errors import CaseError, ParameterError
 
 __all__ = ["BatchResult", "simulate_batch", "STATS"]
@@ -44,7 +44,8 @@ class BatchResult:
     time : ndarray, shape (n_samples,)
         Sample times [s].
     channels : dict of str to ndarray, shape (n_cases, n_samples)
-        The requested channels (names and units of :data:`qzs.engine.results.CHANNELS`).
+        The requested channels (names and units of :data:`qzs.engine.results.CHANNELS`;
+        the flags of :data:`qzs.engine.results.FLAGS` as boolean arrays).
     stats : dict of str to ndarray, shape (n_cases,)
         Per-case statistics, see :data:`STATS`.
     status : ndarray of int8, shape (n_cases,)
@@ -55,6 +56,8 @@ class BatchResult:
         Wall time of the integration [s].
     cases : list of (IsolatorParameters, ControllerParameters)
         The parameter sets simulated, in the order of the rows.
+    stop_limits : ndarray, shape (n_cases, 2)
+        Each case's lower and upper hard stop in relative position z [m].
     """
 
     time: np.ndarray
@@ -64,6 +67,7 @@ class BatchResult:
     messages: list
     elapsed: float = 0.0
     cases: list = field(default_factory=list)
+    stop_limits: np.ndarray = None
 
     @property
     def steps_per_second(self):
@@ -91,7 +95,9 @@ class BatchResult:
 
         attributes = variable_attributes()
         n = len(self.status)
-        variables = {name: (("case", "time"), values, attributes[name])
+        variables = {name: (("case", "time"),
+                            values.astype(np.int8) if values.dtype == bool else values,
+                            attributes[name])
                      for name, values in self.channels.items()}
         for name, values in self.stats.items():
             unit, doc = STATS[name]
@@ -171,7 +177,9 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     solver : {"ode3", "rk4", "euler"}
         Integrator, as in :func:`qzs.simulate`.
     channels : sequence of str
-        Time series to keep (names of :data:`qzs.engine.results.CHANNELS`); may be empty.
+        Time series to keep: names of :data:`qzs.engine.results.CHANNELS`, or of the
+        boolean flags :data:`qzs.engine.results.FLAGS` (``"locked"``, ``"stop_contact"``);
+        may be empty.
     workers : int, optional
         Threads, each running a share of the cases in the kernel (which releases
         the GIL); default all cores.
@@ -192,9 +200,13 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     cases = list(cases)
     if not cases:
         raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
-    unknown = [c for c in channels if c not in CHANNELS]
+    if isinstance(channels, str):
+        raise ParameterError(f"`channels` must be a sequence of channel names, got the string "
+                             f"{channels!r}; write ({channels!r},).")
+    unknown = [c for c in channels if c not in CHANNELS and c not in FLAGS]
     if unknown:
-        raise ParameterError(f"unknown channel(s) {unknown}; channels are {list(CHANNELS)}.")
+        raise ParameterError(f"unknown channel(s) {unknown}; channels are "
+                             f"{[*CHANNELS, *FLAGS]}.")
     prepared = []
     for index, pair in enumerate(cases):
         try:
@@ -212,8 +224,12 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     flags = np.stack([r.flags for r in prepared])
     params = np.stack([r.params for r in prepared])
     ex, table = first.packed
-    columns = [CHANNELS[c][0] for c in channels]
-    kept = {c: np.empty((n, n_out)) for c in channels}
+    values = [c for c in channels if c in CHANNELS]
+    columns = [CHANNELS[c][0] for c in values]
+    flag_names = [c for c in channels if c in FLAGS]
+    flag_columns = [FLAGS[c][0] for c in flag_names]
+    kept = {c: (np.empty((n, n_out)) if c in CHANNELS else np.zeros((n, n_out), dtype=bool))
+            for c in channels}
     status = np.zeros(n, dtype=np.int64)
 
     rows_per_chunk = max(1, _ROWS_PER_CHUNK // n)
@@ -227,8 +243,11 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
 
     def absorb(rows, start_row, first_row):
         block = out[:, first_row:first_row + rows]
-        for name, col in zip(channels, columns):
+        for name, col in zip(values, columns):
             kept[name][:, start_row:start_row + rows] = block[:, :, col]
+        for name, col in zip(flag_names, flag_columns):
+            kept[name][:, start_row:start_row + rows] = out_flags[:, first_row:first_row + rows,
+                                                                  col]
         statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
                        out_flags[:, first_row:first_row + rows, K.O_LOCKED])
 
@@ -269,6 +288,7 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
                 raise RuntimeError("batch kernel wrote an unexpected number of rows")
             for c in np.flatnonzero(status != K.STATUS_OK):  # keep the part that finished
                 out[c, written[c]:rows] = np.nan
+                out_flags[c, written[c]:rows] = False
             absorb(rows, row, 0)
             row += rows
             done += steps
@@ -287,4 +307,4 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     stats = {name: stats[name] for name in STATS}
     time = np.arange(n_out) * (decimation * first.dt)
     return BatchResult(time, kept, stats, (status != K.STATUS_OK).astype(np.int8), messages,
-                       elapsed, cases)
+                       elapsed, cases, params[:, [K.P_Z_LOW, K.P_Z_HIGH]].copy())

@@ -299,7 +299,8 @@ def run_case(task):
     return result
 
 
-def _transmissibility_case(task):
+def _case_inputs(task):
+    """``(isolator, controller, excitation, sample rate [Hz])`` of a simulated case."""
     analysis = task["analysis"]
     isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
                                              task["settings"])
@@ -308,7 +309,19 @@ def _transmissibility_case(task):
         analysis["fft_length"], analysis["n_averages"], rate, analysis["overlap"])
     excitation = Chirp(**{k: v for k, v in task["excitation"].items() if k != "duration"},
                        duration=duration)
+    return isolator, controller, excitation, rate
+
+
+def _transmissibility_case(task):
+    isolator, controller, excitation, rate = _case_inputs(task)
     run = simulate(excitation, isolator, controller, sample_rate=rate, **task["simulation"])
+    return _analyse_case(task, run, isolator, controller, excitation, rate)
+
+
+def _analyse_case(task, run, isolator, controller, excitation, rate):
+    """A case's curve, metrics and statistics from its run (a single or a lockstep run)."""
+    analysis = task["analysis"]
+    duration = excitation.duration
     welch = dict(fft_length=analysis["fft_length"], overlap=analysis["overlap"],
                  coherence_min=analysis["coherence_min"],
                  base_share_min=analysis["base_share_min"],
@@ -348,6 +361,94 @@ def _transmissibility_case(task):
     if task["kind"] == "processing":
         result.extra = _experiment_processing(run, rate, welch, task["options"], (low, high))
     return result
+
+
+#: What a lockstep case keeps of its run: the series :func:`_analyse_case` reads.
+_LOCKSTEP_CHANNELS = ("time", "base_acceleration", "payload_acceleration", "relative_position",
+                      "motor_force", "locked")
+#: And, for a ``processing`` case, the velocities the experiment measured.
+_PROCESSING_CHANNELS = ("base_velocity", "payload_velocity")
+
+
+@dataclass(frozen=True)
+class _LockstepRun:
+    """One case of a lockstep batch, with the parts of a SimulationResult the analysis reads."""
+
+    time: np.ndarray
+    base_acceleration: np.ndarray
+    payload_acceleration: np.ndarray
+    relative_position: np.ndarray
+    motor_force: np.ndarray
+    locked: np.ndarray
+    base_velocity: np.ndarray
+    payload_velocity: np.ndarray
+    run: dict
+    steps_per_second: float
+
+
+def _lockstep_key(task):
+    """Cases with equal keys share every step of their runs: same chirp, rate, step, solver."""
+    _, _, excitation, rate = _case_inputs(task)
+    return excitation, float(rate), float(task["simulation"]["dt"]), task["simulation"]["solver"]
+
+
+def _run_lockstep(tasks, workers, progress):
+    """Simulate cases that share their excitation and step through the lockstep batch kernel.
+
+    The batch kernel gives every case the numbers :func:`qzs.simulate` gives it, to
+    the last bit (:mod:`qzs.engine.lanes`), so the curves and metrics are those of
+    the one-case path. The cases' analyses run in ``workers`` threads.
+
+    Parameters
+    ----------
+    tasks : list of dict
+        Tasks of :func:`_tasks` with equal :func:`_lockstep_key`.
+    workers : int
+        Threads for the kernel and the analyses.
+    progress : bool
+        Show the batch's progress bar over simulated time.
+
+    Returns
+    -------
+    list of CaseResult
+        In the order of ``tasks``.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from qzs.engine.batch import simulate_batch
+    from qzs.errors import SimulationError
+
+    inputs = [_case_inputs(task) for task in tasks]
+    _, _, excitation, rate = inputs[0]
+    simulation = tasks[0]["simulation"]
+    channels = _LOCKSTEP_CHANNELS
+    if any(task["kind"] == "processing" for task in tasks):
+        channels += _PROCESSING_CHANNELS
+    batch = simulate_batch([(isolator, controller) for isolator, controller, _, _ in inputs],
+                           excitation, dt=simulation["dt"], solver=simulation["solver"],
+                           sample_rate=rate, channels=channels, workers=workers,
+                           progress=progress)
+    for task, message in zip(tasks, batch.messages):
+        if message:
+            raise SimulationError(f"{task['label']}: {message}")
+    share = batch.elapsed / len(tasks)
+
+    def analyse(c):
+        start = time.perf_counter()
+        isolator, controller, _, _ = inputs[c]
+        series = {name: batch.channels[name][c] if name in batch.channels else None
+                  for name in (*_LOCKSTEP_CHANNELS, *_PROCESSING_CHANNELS)}
+        run = _LockstepRun(**series, steps_per_second=batch.steps_per_second,
+                           run=dict(stop_low=float(batch.stop_limits[c, 0]),
+                                    stop_high=float(batch.stop_limits[c, 1]),
+                                    stop_contacts=int(batch.stats["stop_contacts"][c]),
+                                    steps=int(batch.stats["steps"][c])))
+        result = _analyse_case(tasks[c], run, isolator, controller, excitation, rate)
+        result.seconds = share + time.perf_counter() - start
+        return result
+
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(analyse, range(len(tasks))))
 
 
 def _locked_below(run, chirp, frequency):
@@ -401,8 +502,13 @@ def _spring_case(task):
     return result
 
 
-def run_studies(studies, *, quick=False, workers=None, progress=True):
-    """Run several studies, all their cases in parallel over processes.
+def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True):
+    """Run several studies, all their cases in parallel.
+
+    Cases that share their chirp, sample rate, step and solver (the paper's
+    transmissibility studies all do) go through the lockstep batch kernel together,
+    which gives each the numbers of its own :func:`qzs.simulate` run, to the last
+    bit; the others run one per process, alongside.
 
     Parameters
     ----------
@@ -411,9 +517,13 @@ def run_studies(studies, *, quick=False, workers=None, progress=True):
     quick : bool
         Shorter runs (fewer, shorter Welch segments) for a fast look.
     workers : int, optional
-        Worker processes; default the machine's core count. 1 runs in-process.
+        Cores to use (threads of the batch kernel, worker processes of the other
+        cases); default the machine's core count. 1 runs everything in-process.
     progress : bool
-        Show a progress bar over cases.
+        Show a progress bar over cases (and one over simulated time for a batch).
+    lockstep : bool
+        Share steps between cases through the batch kernel; False runs every case
+        through the one-case driver, one per process (the same numbers, slower).
 
     Returns
     -------
@@ -425,23 +535,43 @@ def run_studies(studies, *, quick=False, workers=None, progress=True):
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
              for j, task in enumerate(study_tasks)]
     results = [[None] * len(study_tasks) for study_tasks in per_study]
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
     workers = workers or os.cpu_count() or 1
+    groups, single = {}, []
+    for entry in tasks:
+        if lockstep and entry[2]["kind"] in ("transmissibility", "processing"):
+            groups.setdefault(_lockstep_key(entry[2]), []).append(entry)
+        else:
+            single.append(entry)
+    for key in [key for key, members in groups.items() if len(members) == 1]:
+        single += groups.pop(key)
     bar = tqdm(total=len(tasks), unit="case", desc="studies", disable=not progress)
     start = time.perf_counter()
+    pool = None
     try:
-        if workers == 1:
-            for i, j, task in tasks:
+        futures = {}
+        if single and workers > 1:  # alongside the batches; a batch's analysis overlaps them
+            pool = ProcessPoolExecutor(max_workers=min(workers, len(single)))
+            futures = {pool.submit(run_case, task): (i, j) for i, j, task in single}
+        elif single:
+            for i, j, task in single:
                 results[i][j] = run_case(task)
                 bar.update()
-        else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = {pool.submit(run_case, task): (i, j) for i, j, task in tasks}
-                for future in as_completed(futures):
-                    i, j = futures[future]
-                    results[i][j] = future.result()
-                    bar.update()
+        for members in groups.values():
+            cases = _run_lockstep([task for _, _, task in members], workers,
+                                  progress)
+            for (i, j, _), case in zip(members, cases):
+                results[i][j] = case
+            bar.update(len(members))
+        for future in as_completed(futures):
+            i, j = futures[future]
+            results[i][j] = future.result()
+            bar.update()
     finally:
         bar.close()
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
     elapsed = time.perf_counter() - start
     return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed)
             for study, cases in zip(studies, results)]

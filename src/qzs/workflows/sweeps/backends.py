@@ -31,7 +31,8 @@ from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID
                                         estimated_bytes, open_store, prepare_store, schema,
                                         write_batch)
 
-__all__ = ["run_batch", "execute", "case_settings", "check_store_path"]
+__all__ = ["run_batch", "execute", "case_settings", "check_store_path", "build_case",
+           "choose_sweep_step"]
 
 _LOCK = threading.Lock()  # one multi-threaded batch at a time per process
 
@@ -76,6 +77,108 @@ def _empty(definition, n, n_time):
     return arrays
 
 
+def build_case(definition, case):
+    """A case's parameters and excitation.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    case : dict
+        The case's varied parameters (an entry of :func:`case_settings`).
+
+    Returns
+    -------
+    isolator : IsolatorParameters
+    controller : ControllerParameters
+    excitation : tuple
+        ``(excitation, duration [s])`` of
+        :func:`~qzs.workflows.sweeps.definition.case_excitation`.
+    key : tuple
+        Equal for cases that share their excitation.
+
+    Raises
+    ------
+    ParameterError
+        Invalid parameter values.
+    """
+    model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
+    excitation = {**definition.excitation,
+                  **{k.split(".", 1)[1]: v for k, v in case.items()
+                     if k.startswith("excitation.")}}
+    isolator, controller = update_parameters(
+        IsolatorParameters(), ControllerParameters(), {**definition.parameters, **model})
+    built = case_excitation(definition.excitation_kind, excitation, definition.analysis)
+    return isolator, controller, built, tuple(sorted(excitation.items()))
+
+
+#: Cases of a sweep the accuracy-driven step is chosen on: the first, the middle and the
+#: last (for a grid, its two extreme corners and its centre).
+STEP_CASES = 3
+
+
+def choose_sweep_step(definition, settings, *, progress=False):
+    """Fix a sweep's step: the largest meeting its ``tolerance_db`` on every case probed.
+
+    A sweep whose file gives no ``dt`` is integrated at the step
+    :func:`qzs.engine.accuracy.choose_step` picks for ``[simulation] tolerance_db``
+    (default :data:`qzs.defaults.ACCURACY`), probed on :data:`STEP_CASES` cases spread
+    over the sweep; the smallest of their steps serves every case (all cases of a batch
+    share their steps). Choosing is deterministic, so a resumed sweep gets the same step.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    settings : list of dict
+        The varied parameters of each case (:func:`case_settings`).
+    progress : bool
+        Show the probes' progress.
+
+    Returns
+    -------
+    definition : SweepDefinition
+        With ``simulation["dt"]`` set (the same object if the file gave ``dt``).
+    choices : tuple of (int, StepChoice)
+        The probed cases' indices and their choices (empty if the file gave ``dt``).
+
+    Raises
+    ------
+    ParameterError
+        No probed case is valid, or no step meets the tolerance.
+    """
+    import dataclasses
+
+    from qzs.engine.accuracy import choose_step
+
+    simulation = definition.simulation
+    if simulation["dt"] is not None:
+        return definition, ()
+    picks = sorted({int(i) for i in np.linspace(0, len(settings) - 1, STEP_CASES).round()})
+    choices, reasons = [], []
+    for i in picks:
+        try:
+            isolator, controller, (excitation, _), _ = build_case(definition, settings[i])
+        except (ParameterError, TypeError) as error:
+            reasons.append(f"case {i}: {error}")
+            continue
+        choices.append((i, choose_step(excitation, isolator, controller,
+                                       tolerance_db=simulation["tolerance_db"],
+                                       solver=simulation["solver"],
+                                       sample_rate=definition.analysis["sample_rate"],
+                                       progress=progress)))
+    if not choices:
+        raise ParameterError("no step could be chosen for `tolerance_db`: the cases probed "
+                             f"are invalid ({'; '.join(reasons)}); fix them or give `dt`.")
+    dt = min(choice.dt for _, choice in choices)
+    note = (f"dt = {dt:g} s chosen for the transmissibility within "
+            f"{simulation['tolerance_db']:g} dB on cases "
+            + ", ".join(f"{i} (dt {c.dt:g} s, estimated error {c.error:.2g} dB)"
+                        for i, c in choices))
+    simulation = {**simulation, "dt": dt, "step_note": note}
+    return dataclasses.replace(definition, simulation=simulation), tuple(choices)
+
+
 def run_batch(definition, start, settings, n_time, threads=None):
     """Simulate and reduce one batch of cases (the task of every backend).
 
@@ -103,19 +206,11 @@ def run_batch(definition, start, settings, n_time, threads=None):
     arrays = _empty(definition, len(settings), n_time)
     groups = {}
     for i, case in enumerate(settings):
-        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
-        excitation = {**definition.excitation,
-                      **{k.split(".", 1)[1]: v for k, v in case.items()
-                         if k.startswith("excitation.")}}
         try:
-            isolator, controller = update_parameters(
-                IsolatorParameters(), ControllerParameters(), {**definition.parameters, **model})
-            built = case_excitation(definition.excitation_kind, excitation,
-                                     definition.analysis)
+            isolator, controller, built, key = build_case(definition, case)
         except (ParameterError, TypeError) as error:
             arrays["status"][i], arrays["message"][i] = INVALID, str(error)
             continue
-        key = tuple(sorted(excitation.items()))
         groups.setdefault(key, (built, []))[1].append((i, isolator, controller))
     groups = list(groups.values())
     cores = threads or os.cpu_count() or 1
@@ -286,6 +381,7 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
 
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
+    definition, _ = choose_sweep_step(definition, settings)
     n_time = _n_time(definition, settings)
     _check_store(definition, store, n_time, argument="store", resume=resume,
                  overwrite=overwrite)
@@ -334,13 +430,18 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
 
 
 def _n_time(definition, settings):
-    """Samples kept per time series (0 if none are kept)."""
+    """Samples kept per time series (0 if none are kept).
+
+    Before the step is chosen (``dt`` None), counted at the output period: the same
+    count, give or take the last sample of a duration that is not a whole number of
+    periods (enough for the size check made before any case runs).
+    """
     if not definition.outputs["time_series"]:
         return 0
     longest = max(case_duration(definition, s) for s in settings)
-    decimation = steps_per_sample(definition.analysis["sample_rate"],
-                                  definition.simulation["dt"])
-    return int(round(longest / definition.simulation["dt"])) // decimation + 1
+    dt = definition.simulation["dt"] or 1.0 / definition.analysis["sample_rate"]
+    decimation = steps_per_sample(definition.analysis["sample_rate"], dt)
+    return int(round(longest / dt)) // decimation + 1
 
 
 def check_store_path(definition, store, *, argument="store", resume=False, overwrite=False):

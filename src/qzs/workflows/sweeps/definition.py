@@ -16,7 +16,7 @@ import numpy as np
 
 from qzs._validation import integer, known_keys, read_toml
 from qzs.analysis.spectral import required_duration, welch_average_count
-from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
+from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
 from qzs.engine.results import CHANNELS
 from qzs.engine.stability import SOLVERS
@@ -46,7 +46,10 @@ EXCITATION_PARAMETERS = {kind: parameters for kind, parameters
 TABLES = ("sweep", "parameters", "excitation", "grid", "distributions", "simulation",
           "analysis", "outputs")
 SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batch_size")
-SIMULATION_DEFAULTS = {"dt": SIMULATION["dt"], "solver": SIMULATION["solver"]}
+#: ``dt`` None: the step is chosen for ``tolerance_db`` before the sweep runs
+#: (:func:`qzs.workflows.sweeps.backends.choose_sweep_step`); a ``dt`` in the file fixes it.
+SIMULATION_DEFAULTS = {"dt": None, "solver": SIMULATION["solver"],
+                       "tolerance_db": ACCURACY["tolerance_db"]}
 #: Folder of the shipped sweep files, inside the package.
 SHIPPED = "workflows/sweep_files"
 OUTPUT_KEYS = ("stats", "metrics", "transmissibility", "coherence", "time_series", "bands")
@@ -265,7 +268,16 @@ def _definition(document, where, stem):
     if simulation["solver"] not in SOLVERS:
         raise ParameterError(f"`solver` must be one of {tuple(SOLVERS)}, got "
                              f"{simulation['solver']!r}.")
-    simulation["dt"] = _number("dt", simulation["dt"], positive=True)
+    given = document.get("simulation", {})
+    if "dt" in given and "tolerance_db" in given:
+        raise ParameterError("give either `dt` (a fixed step [s]) or `tolerance_db` (the "
+                             "accuracy the step is chosen for [dB]) in [simulation], not both.")
+    if "dt" in given:
+        simulation["dt"] = _number("dt", simulation["dt"], positive=True)
+        simulation["tolerance_db"] = None
+    else:
+        simulation["tolerance_db"] = _number("tolerance_db", simulation["tolerance_db"],
+                                             positive=True)
     analysis = _analysis(document.get("analysis", {}), simulation["dt"])
     top = excitation.get("f1")
     if (kind != "sine" and "band" not in document.get("analysis", {})
@@ -384,7 +396,7 @@ def _analysis(table, dt):
         raise ParameterError("give either `n_averages` or `duration` in [analysis], not both.")
     rate = analysis["sample_rate"] = _number("sample_rate", analysis["sample_rate"],
                                              positive=True)
-    ratio = 1.0 / (rate * dt)
+    ratio = 1.0 / (rate * dt) if dt is not None else 1.0  # a chosen step divides it
     if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
         raise ParameterError(f"`sample_rate` ({rate!r} Hz) must divide the integration rate "
                              f"1/dt = {1 / dt:g} Hz into a whole number of steps.")
@@ -556,7 +568,7 @@ def plan_text(definition):
              f"{-(-definition.n_cases // definition.batch_size)} batches of "
              f"{definition.batch_size}",
              f"  {definition.excitation_kind} excitation, {a['duration']:g} s per case, "
-             f"dt = {s['dt']:g} s ({s['solver']}), {a['sample_rate']:g} Hz output, "
+             f"{_step_text(s)} ({s['solver']}), {a['sample_rate']:g} Hz output, "
              f"{a['fft_length']}-point FFT x {a['n_averages']} averages"]
     for name in definition.varied:
         values = columns[name]
@@ -565,6 +577,17 @@ def plan_text(definition):
                          f"({np.unique(values).size} distinct)")
         else:
             lines.append(f"  {name:<24} {sorted(set(values.tolist()))}")
-    steps = definition.n_cases * a["duration"] / s["dt"]
-    lines.append(f"  about {steps:.3g} integration steps in all")
+    if s["dt"] is not None:
+        steps = definition.n_cases * a["duration"] / s["dt"]
+        lines.append(f"  about {steps:.3g} integration steps in all")
     return "\n".join(lines)
+
+
+def _step_text(simulation):
+    if simulation["dt"] is not None:
+        text = f"dt = {simulation['dt']:g} s"
+        if simulation.get("tolerance_db") is not None:
+            text += f" (chosen for {simulation['tolerance_db']:g} dB)"
+        return text
+    return (f"dt chosen at run time for the transmissibility within "
+            f"{simulation['tolerance_db']:g} dB")

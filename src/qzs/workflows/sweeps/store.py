@@ -141,6 +141,8 @@ def _attrs(definition):
             "sweep_definition": json.dumps(definition.document, sort_keys=True, default=str),
             "sweep_source": definition.source, "batch_size": definition.batch_size,
             "excitation_kind": definition.excitation_kind, "dt": s["dt"], "solver": s["solver"],
+            "tolerance_db": s.get("tolerance_db"),
+            "dt_note": s.get("step_note", "dt fixed by the sweep file"),
             "sample_rate": a["sample_rate"], "fft_length": a["fft_length"],
             "n_averages": a["n_averages"], "overlap": a["overlap"], "band": a["band"],
             "duration": a["duration"], "qzs_version": __version__}
@@ -361,6 +363,8 @@ def summary_text(dataset, report=None):
              f"{done.size} cases stored"]
     counts = {STATUS[k]: int(np.count_nonzero(status[done] == k)) for k in STATUS if k}
     lines.append("  " + ", ".join(f"{name} {n}" for name, n in counts.items()))
+    if "dt_note" in dataset.attrs:
+        lines.append(f"  {dataset.attrs['dt_note']}")
     failed = done & (status > OK)
     if failed.any():
         messages = dataset["message"].values[failed]
