@@ -251,3 +251,20 @@ def test_without_dt_the_step_is_chosen_for_the_tolerance_before_any_case_runs():
     assert choose_sweep_step(sweep, settings)[0].simulation["dt"] == chosen.simulation["dt"]
     fixed = load_sweep(definition(grid={"stiction_force": [2.0]}, simulation={"dt": 2e-4}))
     assert choose_sweep_step(fixed, case_settings(fixed, sample_cases(fixed)))[0] is fixed
+
+
+def test_a_case_no_step_can_settle_is_named_and_the_others_set_the_step():
+    """Without the PI loop the payload falls onto the stop and every refinement redraws its
+    bounces: no step meets the tolerance there. The sweep warns, names the case in its note,
+    and takes the step of the cases that converge."""
+    from qzs import DataWarning
+    from qzs.workflows.sweeps.backends import case_settings, choose_sweep_step
+
+    sweep = load_sweep(definition(grid={"pi_kp": [0.0, 50.0]}, parameters={"pi_ki": 0.0},
+                                  analysis={"fft_length": 2048, "n_averages": 6}))
+    settings = case_settings(sweep, sample_cases(sweep))
+    with pytest.warns(DataWarning, match="case 0: no step"):
+        chosen, choices = choose_sweep_step(sweep, settings)
+    assert [i for i, _ in choices] == [1]
+    assert chosen.simulation["dt"] == choices[0][1].dt
+    assert "case 0: no step" in chosen.simulation["step_note"]

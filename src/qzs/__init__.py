@@ -23,7 +23,8 @@ from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
                         MissingDependencyError, OutputPathError, ParameterError,
-                        ResultTooLargeError, SimulationError, StabilityError)
+                        ResultTooLargeError, SimulationError, StabilityError,
+                        ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
                        IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
@@ -52,6 +53,7 @@ __all__ = [
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
+    "ToleranceNotMetError",
     "DataWarning", "FitWarning",
     *_LAZY,
 ]

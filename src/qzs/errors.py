@@ -8,7 +8,8 @@ message is for people, never for parsing.
 
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
-           "OutputPathError", "ResultTooLargeError", "WriteError", "Terminated",
+           "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
+           "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -42,6 +43,41 @@ class CaseError(ParameterError):
 
     def __reduce__(self):  # picklable with its attributes (Dask, process pools)
         return type(self), (self.index, self.reason)
+
+
+class ToleranceNotMetError(ParameterError):
+    """No step tried meets an accuracy tolerance (:func:`qzs.engine.accuracy.choose_step`).
+
+    The response then depends on the step at every step tried: stop contacts or a
+    stick-slip pattern that each refinement redraws.
+
+    Attributes
+    ----------
+    tolerance : float
+        The tolerance asked for, in ``unit``.
+    unit : str
+        ``"dB"`` (transmissibility) or ``"m"`` (state).
+    smallest_step : float
+        The finest step tried [s].
+    smallest_error : float
+        The smallest error estimated over the steps tried, in ``unit`` (inf: none).
+    """
+
+    def __init__(self, tolerance, unit, smallest_step, smallest_error, safety):
+        self.tolerance = float(tolerance)
+        self.unit = str(unit)
+        self.smallest_step = float(smallest_step)
+        self.smallest_error = float(smallest_error)
+        self.safety = float(safety)
+        super().__init__(
+            f"no step down to {self.smallest_step:.3g} s meets the tolerance "
+            f"{self.tolerance:g} {self.unit} with safety {self.safety:g} on the probe (smallest "
+            f"estimated error {self.smallest_error:.3g} {self.unit}); loosen the tolerance or "
+            "raise `max_halvings`.")
+
+    def __reduce__(self):
+        return type(self), (self.tolerance, self.unit, self.smallest_step, self.smallest_error,
+                            self.safety)
 
 
 class OutputPathError(ParameterError):

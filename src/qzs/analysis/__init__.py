@@ -2,6 +2,7 @@
 
 ``spectral``    transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
 ``linear``      the linearised closed loop at the operating point (python-control)
+``hexapod_linear``  the six-leg platform of isolator legs linearised at its home pose
 ``statistics``  run statistics (stroke, time locked, motor effort)
 ``summary``     the one-screen text summary of a run
 """
@@ -15,6 +16,9 @@ _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
             **{name: "qzs.analysis.statistics"
                for name in ("STATISTICS", "RunStatistics", "run_statistics",
                             "SUMMARY_STATISTICS", "SummaryStatistics")},
-            "linearize": "qzs.analysis.linear"}
+            "linearize": "qzs.analysis.linear",
+            **{name: "qzs.analysis.hexapod_linear"
+               for name in ("HexapodLinearModel", "hexapod_linearize", "geometric_stiffness",
+                            "off_diagonal_coupling")}}
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)  # scipy.signal, python-control on use

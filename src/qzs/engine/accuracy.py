@@ -18,7 +18,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs._validation import choice as _choice
-from qzs.errors import ParameterError
+from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error"]
@@ -448,11 +448,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         if bar is not None:
             bar.close()
     if chosen is None:
-        raise ParameterError(
-            f"no step down to {dt0 / 2 ** (max_halvings - 1):.3g} s meets the tolerance "
-            f"{tolerance:g} {_MEASURES[measure]} with safety {safety:g} on the probe "
-            f"(smallest estimated error "
-            f"{min(h[2] for h in history):.3g}); loosen the tolerance or raise `max_halvings`.")
+        raise ToleranceNotMetError(tolerance, _MEASURES[measure], dt0 / 2 ** (max_halvings - 1),
+                                   min(h[2] for h in history), safety)
     j = chosen
     if differences[j] > 0 and differences[j + 1] > 0:
         observed = math.log2(differences[j] / differences[j + 1])

@@ -7,6 +7,12 @@ The equations, signs and defaults are described in docs/model.md.
 from qzs.model.controller import ControllerParameters, closed_loop_natural_frequency
 from qzs.model.excitation import (EXCITATION_KINDS, EXCITATION_OPTIONS, Chirp, DisplacementRecord,
                                   RandomExcitation, Sine, build_excitation)
+from qzs.model.hexapod import (LEG_COUNT, HexapodGeometry, PlatformParameters, StrokeCheck,
+                               angular_velocity_matrix, base_jacobian, cubic_geometry,
+                               forward_kinematics, inverse_kinematics, jacobian, leg_positions,
+                               leg_unit_vectors, leg_vectors, mass_matrix, radial_geometry,
+                               rotation_angles, rotation_matrix, static_leg_forces, stroke_check,
+                               weight_wrench)
 from qzs.model.isolator import (STOP_MODELS, InitialState, IsolatorParameters, friction_force,
                                 passive_natural_frequency, spring_energy, spring_force,
                                 spring_stiffness)
@@ -18,4 +24,9 @@ __all__ = ["IsolatorParameters", "ControllerParameters", "InitialState", "STOP_M
            "EXCITATION_OPTIONS", "build_excitation", "spring_force", "spring_stiffness",
            "spring_energy", "friction_force", "passive_natural_frequency",
            "closed_loop_natural_frequency", "PARAMETERS", "ParameterInfo", "parameter_info",
-           "unit_of", "update_parameters"]
+           "unit_of", "update_parameters",
+           "HexapodGeometry", "PlatformParameters", "StrokeCheck", "LEG_COUNT", "cubic_geometry",
+           "radial_geometry", "rotation_matrix", "rotation_angles", "angular_velocity_matrix",
+           "leg_vectors", "leg_unit_vectors", "inverse_kinematics", "forward_kinematics",
+           "jacobian", "base_jacobian", "stroke_check", "leg_positions", "mass_matrix",
+           "weight_wrench", "static_leg_forces"]

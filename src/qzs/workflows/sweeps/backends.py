@@ -11,6 +11,7 @@ analysis is recorded with its status and message; the others go on.
 import os
 import threading
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import nullcontext
 from pathlib import Path
@@ -21,7 +22,9 @@ from qzs._optional import require
 from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
 from qzs.engine.batch import simulate_batch
 from qzs.engine.prepare import steps_per_sample
-from qzs.errors import CaseError, DataError, OutputPathError, ParameterError
+from qzs.defaults import SIMULATION
+from qzs.errors import (CaseError, DataError, DataWarning, OutputPathError, ParameterError,
+                        ToleranceNotMetError)
 from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -145,7 +148,14 @@ def choose_sweep_step(definition, settings, *, progress=False):
     Raises
     ------
     ParameterError
-        No probed case is valid, or no step meets the tolerance.
+        No probed case is valid.
+
+    Warns
+    -----
+    DataWarning
+        A probed case for which no step meets the tolerance (its response depends on
+        the step): the step comes from the others (the paper's dt = 1e-4 s if none), and
+        the note says so.
     """
     import dataclasses
 
@@ -155,26 +165,40 @@ def choose_sweep_step(definition, settings, *, progress=False):
     if simulation["dt"] is not None:
         return definition, ()
     picks = sorted({int(i) for i in np.linspace(0, len(settings) - 1, STEP_CASES).round()})
-    choices, reasons = [], []
+    choices, reasons, unmet = [], [], []
+    tolerance = simulation["tolerance_db"]
     for i in picks:
         try:
             isolator, controller, (excitation, _), _ = build_case(definition, settings[i])
         except (ParameterError, TypeError) as error:
             reasons.append(f"case {i}: {error}")
             continue
-        choices.append((i, choose_step(excitation, isolator, controller,
-                                       tolerance_db=simulation["tolerance_db"],
-                                       solver=simulation["solver"],
-                                       sample_rate=definition.analysis["sample_rate"],
-                                       progress=progress)))
-    if not choices:
+        try:
+            choices.append((i, choose_step(excitation, isolator, controller,
+                                           tolerance_db=tolerance, solver=simulation["solver"],
+                                           sample_rate=definition.analysis["sample_rate"],
+                                           progress=progress)))
+        except ToleranceNotMetError as error:
+            unmet.append((i, error))
+    if not choices and not unmet:
         raise ParameterError("no step could be chosen for `tolerance_db`: the cases probed "
                              f"are invalid ({'; '.join(reasons)}); fix them or give `dt`.")
-    dt = min(choice.dt for _, choice in choices)
-    note = (f"dt = {dt:g} s chosen for the transmissibility within "
-            f"{simulation['tolerance_db']:g} dB on cases "
-            + ", ".join(f"{i} (dt {c.dt:g} s, estimated error {c.error:.2g} dB)"
-                        for i, c in choices))
+    if choices:
+        dt = min(choice.dt for _, choice in choices)
+        note = (f"dt = {dt:g} s chosen for the transmissibility within {tolerance:g} dB on "
+                "cases " + ", ".join(f"{i} (dt {c.dt:g} s, estimated error {c.error:.2g} dB)"
+                                     for i, c in choices))
+    else:
+        dt = SIMULATION["dt"]
+        note = f"dt = {dt:g} s, the paper's step: no case probed meets {tolerance:g} dB"
+    if unmet:
+        note += ("; " + ", ".join(f"case {i}" for i, _ in unmet) + ": no step down to "
+                 f"{unmet[0][1].smallest_step:.3g} s meets {tolerance:g} dB (best estimate "
+                 + ", ".join(f"{e.smallest_error:.2g} dB" for _, e in unmet)
+                 + "): the response of such cases depends on the step (stop contacts or a "
+                 "stick-slip pattern each refinement redraws) and their curves carry that "
+                 "uncertainty")
+        warnings.warn(note, DataWarning, stacklevel=2)
     simulation = {**simulation, "dt": dt, "step_note": note}
     return dataclasses.replace(definition, simulation=simulation), tuple(choices)
 
