@@ -427,17 +427,19 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
         base, payload = base[:needed], payload[:needed]
     kw = dict(fs=sample_rate, window=window, nperseg=fft_length, noverlap=noverlap, detrend=detrend)
     with np.errstate(divide="ignore", invalid="ignore"):
-        frequency, coherence = signal.coherence(base, payload, **kw)
-        s_bb = signal.welch(base, **kw)[1]
+        # each spectrum once; the coherence is scipy.signal.coherence's own formula on them
+        frequency, s_bb = signal.welch(base, **kw)
+        s_pp = signal.welch(payload, **kw)[1]
+        s_bp = signal.csd(base, payload, **kw)[1]
+        coherence = np.abs(s_bp) ** 2 / s_bb / s_pp
         if estimator == "psd_ratio":
-            s_pp = signal.welch(payload, **kw)[1]
             magnitude = np.sqrt(np.divide(s_pp, s_bb, out=np.full_like(s_pp, np.nan), where=s_bb > 0))
             phase = np.full_like(magnitude, np.nan)
         else:
             if estimator == "h1":
-                numerator, denominator = signal.csd(base, payload, **kw)[1], s_bb
+                numerator, denominator = s_bp, s_bb
             else:
-                numerator, denominator = signal.welch(payload, **kw)[1], signal.csd(payload, base, **kw)[1]
+                numerator, denominator = s_pp, signal.csd(payload, base, **kw)[1]
             response = np.divide(numerator, denominator, out=np.full(frequency.shape, np.nan, complex),
                                  where=np.abs(denominator) > 0)
             magnitude, phase = np.abs(response), np.angle(response)
