@@ -61,6 +61,8 @@ class ToleranceNotMetError(ParameterError):
         The finest step tried [s].
     smallest_error : float
         The smallest error estimated over the steps tried, in ``unit`` (inf: none).
+    safety : float
+        The factor [-] the estimate had to stay below the tolerance by.
     """
 
     def __init__(self, tolerance, unit, smallest_step, smallest_error, safety):
