@@ -181,55 +181,38 @@ def tableau(solver, h, stage):
 
 
 @njit(**_JIT, inline="always")
-def rk_from_bases(solver, h, s, mode, direction, held, P, bases):
-    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
-
-    ``bases`` holds the base motion ``(y, yd, ydd)`` at each stage's time. The
-    weighted sum is accumulated stage by stage, in the same order as the
-    batched stages of :mod:`qzs.engine.lanes`, so both give the same bits.
-    """
-    b0, b1, b2, b3 = bases
-    k = rhs(b0[0], b0[1], b0[2], s, mode, direction, held, P)[0]
-    result = _axpy(s, tableau(solver, h, 0)[2], k)
-    if solver == SOLVER_EULER:
-        return result
-    _, a, weight = tableau(solver, h, 1)
-    k = rhs(b1[0], b1[1], b1[2], _axpy(s, a, k), mode, direction, held, P)[0]
-    result = _axpy(result, weight, k)
-    _, a, weight = tableau(solver, h, 2)
-    k = rhs(b2[0], b2[1], b2[2], _axpy(s, a, k), mode, direction, held, P)[0]
-    result = _axpy(result, weight, k)
-    if solver == SOLVER_ODE3:
-        return result
-    _, a, weight = tableau(solver, h, 3)
-    k = rhs(b3[0], b3[1], b3[2], _axpy(s, a, k), mode, direction, held, P)[0]
-    return _axpy(result, weight, k)
-
-
-@njit(**_JIT, inline="always")
 def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
     """Base motion at the stage times of a step from ``t`` (unused stages repeat the first)."""
     b0 = base_motion_near(t, phase, sin0, cos0, E, table)
     b1 = b2 = b3 = b0
     if solver != SOLVER_EULER:
         b1 = base_motion_near(t + tableau(solver, h, 1)[0], phase, sin0, cos0, E, table)
-        b2 = b1  # RK4's second and third stages share a time
-        if solver == SOLVER_ODE3:
-            b2 = base_motion_near(t + tableau(solver, h, 2)[0], phase, sin0, cos0, E, table)
-        else:
-            b3 = base_motion_near(t + tableau(solver, h, 3)[0], phase, sin0, cos0, E, table)
+        last = 2 if solver == SOLVER_ODE3 else 3  # RK4's second and third stages share a time
+        b_last = base_motion_near(t + tableau(solver, h, last)[0], phase, sin0, cos0, E, table)
+        b2 = b_last if solver == SOLVER_ODE3 else b1
+        b3 = b_last if solver != SOLVER_ODE3 else b0
     return b0, b1, b2, b3
 
 
 @njit(**_JIT, inline="always")
 def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
-    """:func:`rk_from_bases` evaluating the base motion itself.
+    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
 
     ``phase, sin0, cos0`` are the excitation's phase and its sine and cosine at a
-    nearby time (see :func:`qzs.engine.base_motion.base_motion_near`).
+    nearby time (see :func:`qzs.engine.base_motion.base_motion_near`). The stages run
+    in a loop with one inlined base motion and one inlined right-hand side (a copy per
+    stage cost numba's inliner about 20 s of a cold start, docs/model.md §9); the
+    weighted sum is accumulated stage by stage, in the same order as the batched
+    stages of :mod:`qzs.engine.lanes` (whose base motion at each stage time,
+    :func:`stage_bases`, is the same call), so both give the same bits.
     """
-    bases = stage_bases(solver, t, h, E, table, phase, sin0, cos0)
-    return rk_from_bases(solver, h, s, mode, direction, held, P, bases)
+    result, k = s, s
+    for stage in range(n_stages(solver)):
+        offset, a, weight = tableau(solver, h, stage)
+        y, yd, ydd = base_motion_near(t + offset, phase, sin0, cos0, E, table)
+        k = rhs(y, yd, ydd, s if stage == 0 else _axpy(s, a, k), mode, direction, held, P)[0]
+        result = _axpy(result, weight, k)
+    return result
 
 
 @njit(**_JIT)

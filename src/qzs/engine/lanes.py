@@ -159,7 +159,7 @@ def _finish_pass(n, t, h, b_end, L, T, PP):
 def _vector_pass(solver, n, t, h, L, T, PP, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
 
-    Stage by stage (``K.tableau``, in the order of ``K.rk_from_bases``) with the
+    Stage by stage (``K.tableau``, in the order of ``K.rk_step``) with the
     intermediate values in ``T``: each loop is short, its iterations independent,
     and LLVM vectorises it.
     """
