@@ -491,8 +491,9 @@ def _modes(stiffness, mass):
         if value < -threshold:
             shape = ", ".join(f"{_AXES[i]} {modes[i, k]:+.3g}" for i in range(6)
                               if abs(modes[i, k]) >= 0.1 * np.max(np.abs(modes[:, k])))
-            notes.append(f"mode {k} is statically unstable: omega^2 = {value:.4g} rad^2/s^2 < 0 "
-                         f"(negative stiffness along {shape}); its natural frequency is NaN")
+            notes.append(f"mode {k + 1} (of 6, lowest omega^2 first) is statically unstable: "
+                         f"omega^2 = {value:.4g} rad^2/s^2 < 0 (negative stiffness along "
+                         f"{shape}); its natural frequency is NaN")
         else:
             frequencies[k] = np.sqrt(max(value, 0.0)) / (2 * np.pi)
     return eigenvalues, modes, frequencies, tuple(notes)

@@ -23,7 +23,7 @@ import signal
 import sys
 
 from qzs._version import __version__
-from qzs.cli import experiment, params, simulate, studies, sweep
+from qzs.cli import experiment, hexapod, params, simulate, studies, sweep
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -31,7 +31,8 @@ __all__ = ["main", "build_parser"]
 
 HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run,
             "study": studies.run, "experiment": experiment.run,
-            "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command}
+            "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
+            "hexapod": hexapod.run}
 
 
 def build_parser():
@@ -47,6 +48,7 @@ def build_parser():
     experiment.add_parser(sub)
     sweep.add_parsers(sub)
     params.add_parser(sub)
+    hexapod.add_parser(sub)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes
         if EPILOG not in (command.epilog or ""):
             command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG

@@ -1,0 +1,128 @@
+"""``qzs hexapod``: the six-axis platform of six isolator legs (docs/hexapod.md)."""
+from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
+from qzs.errors import ParameterError
+
+__all__ = ["add_parser", "run", "run_linear"]
+
+#: ``--frame`` choices and the name the analysis takes.
+FRAMES = {"center-of-mass": "center_of_mass", "origin": "origin", "cube-center": "cube_center"}
+
+
+def _add_setup_options(parser):
+    parser.add_argument("--config", metavar="FILE.toml",
+                        help="hexapod file: [geometry], [platform], [leg], [controller] "
+                             "(see qzs.workflows.hexapod)")
+    parser.add_argument("--cubic", action="store_true",
+                        help="a cubic configuration without a file (with --cube-edge)")
+    parser.add_argument("--cube-edge", metavar="M", type=float,
+                        help="edge of the cube [m] (with --cubic; default 0.15)")
+    parser.add_argument("--cube-center-height", metavar="M", type=float,
+                        help="height of the cube's centre above the base [m] (with --cubic; "
+                             "default: the legs' lower ends on the base plane, edge/(2*sqrt(3)))")
+    add_set_option(parser)
+
+
+def add_parser(subparsers):
+    """Add ``hexapod`` and its subcommands to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``hexapod`` parser.
+    """
+    hexapod = subparsers.add_parser(
+        "hexapod", help="six isolator legs in a Stewart platform",
+        description="The six-axis platform of the paper's future work: six semi-active QZS "
+                    "legs between a base and a rigid top (docs/hexapod.md).")
+    sub = hexapod.add_subparsers(dest="hexapod_command", required=True)
+    linear = sub.add_parser(
+        "linear", help="stiffness matrix and modes at the operating point",
+        description="Linearise the platform about its home pose (every leg slipping, motors "
+                    "unsaturated) and print the 6x6 stiffness matrix and the modes. Without "
+                    "--config or --cubic: the cubic configuration of edge 0.15 m carrying "
+                    "the payload its six MagSprings hold.")
+    _add_setup_options(linear)
+    linear.add_argument("--leg-stiffness", metavar="N_PER_M", type=float,
+                        help="replace every leg's axial stiffness [N/m] (a purely linear "
+                             "analysis: spring tangent + Kp otherwise)")
+    linear.add_argument("--frame", choices=tuple(FRAMES), default="center-of-mass",
+                        help="where the matrices are expressed (default: the payload's centre "
+                             "of mass; cube-center: a cubic geometry's cube centre)")
+    linear.add_argument("--no-preload", action="store_true",
+                        help="leave out the geometric stiffness of the static leg forces")
+    add_json_option(linear)
+    linear.set_defaults(handler=run_linear)
+    for command in sub.choices.values():
+        command.epilog = EPILOG
+    return hexapod
+
+
+def run(args):
+    """Run the ``qzs hexapod`` subcommand the arguments name; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments (``args.handler`` is the subcommand's).
+
+    Returns
+    -------
+    int
+        The subcommand's exit code.
+    """
+    return args.handler(args)
+
+
+def _setup(args):
+    """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`)."""
+    from qzs.model.hexapod import cubic_geometry
+    from qzs.workflows.hexapod import default_cube_center_height, hexapod_setup, load_hexapod
+
+    overrides = settings(args.set)
+    cube_options = args.cube_edge is not None or args.cube_center_height is not None
+    if args.config and (args.cubic or cube_options):
+        raise ParameterError("give either --config or --cubic (with --cube-edge), not both.")
+    if cube_options and not args.cubic:
+        raise ParameterError("--cube-edge and --cube-center-height describe a cubic "
+                             "configuration: add --cubic.")
+    if args.config:
+        return load_hexapod(args.config, overrides)
+    if args.cubic:
+        edge = 0.15 if args.cube_edge is None else args.cube_edge
+        if not edge > 0:
+            raise ParameterError(f"--cube-edge must be a positive length [m], got {edge!r}.")
+        height = (default_cube_center_height(edge) if args.cube_center_height is None
+                  else args.cube_center_height)
+        geometry = cubic_geometry(cube_edge=edge, cube_center_height=height)
+        return hexapod_setup(geometry=geometry, settings=overrides, kind="cubic")
+    return hexapod_setup(settings=overrides)
+
+
+def run_linear(args):
+    """Run ``qzs hexapod linear`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    from qzs.workflows.hexapod import linear_record, linear_text
+
+    if args.leg_stiffness is not None and not args.leg_stiffness > 0:
+        raise ParameterError(f"--leg-stiffness must be a positive stiffness [N/m], got "
+                             f"{args.leg_stiffness!r}.")
+    setup = _setup(args)
+    model, record = linear_record(setup, leg_stiffness=args.leg_stiffness,
+                                  frame=FRAMES[args.frame], include_preload=not args.no_preload)
+    emit(args, linear_text(setup, model, record), record)
+    return 0

@@ -1,0 +1,421 @@
+"""Six-axis platform set-ups: TOML files, defaults, and the reports behind ``qzs hexapod``.
+
+A hexapod file (``qzs hexapod linear --config FILE.toml``)::
+
+    [geometry]                # kind = "cubic" | "radial" | "joints"
+    kind = "cubic"
+    cube_edge = 0.15          # [m]
+    cube_center_height = 0.0433   # [m]; default: the legs' lower ends on the base plane
+    stroke_half = 0.080       # [m] each leg's guide: stops at z_ref +- stroke_half
+
+    [platform]                # optional; default: the mass the six MagSprings hold at the
+    mass = 21.48              # operating point [kg], a uniform disc through the top joints
+    principal_inertia = [0.2, 0.2, 0.4]   # [kg*m^2] (or inertia = 3x3), about the centre of mass
+    center_of_mass = [0.0, 0.0, 0.0]      # [m], top frame
+    gravity = 9.81            # [m/s^2]
+
+    [leg]                     # each leg: isolator parameters by registry name (qzs params)
+    stiction_force = 10.0
+    [controller]              # each leg's PI and damping loop (qzs params)
+    pi_kp = 50.0
+
+``radial`` takes ``base_radius``, ``top_radius``, ``height`` [m] and ``base_angle``,
+``top_angle`` [deg]; ``joints`` takes ``base_joints`` and ``top_joints`` (6 x 3) and
+``home_position`` (3) [m]. The model is described in docs/hexapod.md.
+"""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs._validation import read_toml
+from qzs.errors import ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.hexapod import (LEG_COUNT, PlatformParameters, cubic_geometry, leg_unit_vectors,
+                               radial_geometry, HexapodGeometry)
+from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.model.registry import PARAMETERS, update_parameters
+
+__all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
+           "supported_mass", "default_platform", "default_cube_center_height",
+           "linear_record", "linear_text"]
+
+#: How a ``[geometry]`` table describes the platform: its keys per kind (required, optional).
+GEOMETRY_KINDS = {
+    "cubic": (("cube_edge",), ("cube_center_height", "base_radius", "top_radius",
+                                "stroke_half")),
+    "radial": (("base_radius", "top_radius", "base_angle", "top_angle", "height"),
+               ("stroke_half",)),
+    "joints": (("base_joints", "top_joints", "home_position"), ("stroke_half",)),
+}
+#: The six axes of a pose, a twist or a base motion, in order.
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+#: Units of the stiffness matrix's blocks (translation rows/columns first).
+STIFFNESS_UNITS = (("N/m", "N/rad"), ("N", "N*m/rad"))
+_FRAME_WORDS = {"center_of_mass": "payload's centre of mass", "origin": "top frame origin",
+                "cube_center": "cube's centre"}
+_PLATFORM_KEYS = ("mass", "inertia", "principal_inertia", "center_of_mass", "gravity")
+
+
+@dataclass(frozen=True, kw_only=True)
+class HexapodSetup:
+    """A six-legged platform ready to analyse or simulate.
+
+    Attributes
+    ----------
+    geometry : HexapodGeometry
+        Joints and home pose.
+    platform : PlatformParameters
+        The rigid top with its payload.
+    isolator : IsolatorParameters
+        Each leg's plant (its ``mass`` and ``gravity`` are not used: the platform's are).
+    controller : ControllerParameters
+        Each leg's PI and damping loop.
+    kind : str
+        How the geometry was described (``cubic``, ``radial``, ``joints``).
+    excitation : dict
+        ``[excitation.<axis>]`` tables, axis name -> options (for a simulation).
+    simulation : dict
+        ``[simulation]`` options (for a simulation).
+    source : str
+        The file it was read from ('' if built from arguments).
+    """
+
+    geometry: HexapodGeometry
+    platform: PlatformParameters
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    kind: str = "joints"
+    excitation: dict = field(default_factory=dict)
+    simulation: dict = field(default_factory=dict)
+    source: str = ""
+
+
+def default_cube_center_height(cube_edge):
+    """Height [m] of the cube's centre that puts the legs' lower ends on the base plane.
+
+    The six legs of the cubic configuration run along six edges of a cube standing on a
+    vertex, between its three lower and three upper side vertices, which lie
+    ``a/(2*sqrt(3))`` below and above its centre.
+
+    Parameters
+    ----------
+    cube_edge : float
+        Edge of the cube [m].
+
+    Returns
+    -------
+    float
+        ``cube_edge / (2 * sqrt(3))`` [m].
+    """
+    return float(cube_edge) / (2.0 * math.sqrt(3.0))
+
+
+def supported_mass(geometry, isolator=None, controller=None, *, gravity=9.81):
+    """The mass [kg] the legs' MagSprings hold at the operating point, by themselves.
+
+    Each spring pushes with ``spring_force(z_ref)`` along its leg at the home pose;
+    the vertical part of their sum, divided by ``gravity``, is the payload they carry
+    without help from the PI loop (the paper's single leg: 60.84 N, 6.20 kg at 9.81).
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        The platform.
+    isolator : IsolatorParameters, optional
+        Each leg's plant; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        Each leg's loop (its setpoint is the operating point); defaults if omitted.
+    gravity : float
+        Gravitational acceleration [m/s^2], > 0.
+
+    Returns
+    -------
+    float
+        Mass [kg].
+    """
+    isolator = isolator or IsolatorParameters()
+    controller = controller or ControllerParameters()
+    if not gravity > 0:
+        raise ParameterError(f"`gravity` must be positive to carry a mass, got {gravity!r} m/s^2.")
+    force = float(spring_force(controller.position_setpoint, isolator))  # > 0: pushes it away
+    vertical = float(np.sum(leg_unit_vectors(geometry)[:, 2])) * force
+    if not vertical > 0:
+        raise ParameterError(f"the legs' springs push the platform down ({vertical:g} N) at "
+                             "the operating point: they hold no payload; give [platform] mass.")
+    return vertical / gravity
+
+
+def default_platform(geometry, isolator=None, controller=None, *, gravity=9.81):
+    """A platform the legs' springs hold at the operating point: a disc through the top joints.
+
+    Mass :func:`supported_mass`; centre of mass at the top frame origin; the inertia of
+    a uniform thin disc whose radius is the top joints' mean distance from the top
+    frame's z axis (``m r^2/4`` about x and y, ``m r^2/2`` about z).
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        The platform.
+    isolator : IsolatorParameters, optional
+        Each leg's plant.
+    controller : ControllerParameters, optional
+        Each leg's loop.
+    gravity : float
+        Gravitational acceleration [m/s^2].
+
+    Returns
+    -------
+    PlatformParameters
+    """
+    mass = supported_mass(geometry, isolator, controller, gravity=gravity)
+    radius = float(np.mean(np.hypot(geometry.top_joints[:, 0], geometry.top_joints[:, 1])))
+    inertia = mass * radius ** 2 * np.diag([0.25, 0.25, 0.5])
+    return PlatformParameters(mass=mass, inertia=inertia, gravity=gravity)
+
+
+def _geometry(table, where):
+    table = dict(table)
+    kind = table.pop("kind", None)
+    if kind not in GEOMETRY_KINDS:
+        raise ParameterError(f"{where}[geometry] `kind` must be one of {sorted(GEOMETRY_KINDS)}, "
+                             f"got {kind!r}.")
+    required, optional = GEOMETRY_KINDS[kind]
+    missing = [k for k in required if k not in table]
+    unknown = sorted(set(table) - set(required) - set(optional))
+    if missing or unknown:
+        raise ParameterError(f"{where}[geometry] of kind {kind!r} needs {list(required)} and "
+                             f"may have {list(optional)}; "
+                             + (f"missing {missing}" if missing else f"unknown {unknown}") + ".")
+    if kind == "cubic":
+        table.setdefault("cube_center_height", default_cube_center_height(table["cube_edge"]))
+        return cubic_geometry(**table), kind
+    if kind == "radial":
+        for name in ("base_angle", "top_angle"):
+            table[name] = math.radians(float(table[name]))
+        return radial_geometry(**table), kind
+    return HexapodGeometry(**table), kind
+
+
+def _platform(table, geometry, isolator, controller, where):
+    unknown = sorted(set(table) - set(_PLATFORM_KEYS))
+    if unknown:
+        raise ParameterError(f"{where}[platform]: unknown key(s) {unknown}; allowed are "
+                             f"{list(_PLATFORM_KEYS)}.")
+    if "inertia" in table and "principal_inertia" in table:
+        raise ParameterError(f"{where}[platform]: give `inertia` (3 x 3) or `principal_inertia` "
+                             "(3), not both.")
+    gravity = table.get("gravity", 9.81)
+    default = default_platform(geometry, isolator, controller, gravity=gravity) if (
+        "mass" not in table or not ("inertia" in table or "principal_inertia" in table)) else None
+    mass = table.get("mass", default.mass if default else None)
+    if "principal_inertia" in table:
+        values = np.asarray(table["principal_inertia"], dtype=float)
+        if values.shape != (3,):
+            raise ParameterError(f"{where}[platform] `principal_inertia` must be 3 moments "
+                                 f"[kg*m^2], got {table['principal_inertia']!r}.")
+        inertia = np.diag(values)
+    elif "inertia" in table:
+        inertia = table["inertia"]
+    else:
+        inertia = default.inertia * (float(mass) / default.mass)
+    return PlatformParameters(mass=mass, inertia=inertia,
+                              center_of_mass=table.get("center_of_mass", (0.0, 0.0, 0.0)),
+                              gravity=gravity)
+
+
+def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=None,
+                  settings=None, kind="joints"):
+    """A :class:`HexapodSetup` from objects, with registry overrides applied to every leg.
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry, optional
+        Default: the cubic configuration of edge 0.15 m with its lower ends on the base
+        plane (:func:`default_cube_center_height`).
+    platform : PlatformParameters, optional
+        Default: :func:`default_platform` (after ``settings``).
+    isolator : IsolatorParameters, optional
+        Each leg's plant; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        Each leg's loop; defaults if omitted.
+    settings : dict, optional
+        ``name -> value`` overrides by registry name (``qzs params``; ``--set``).
+    kind : str
+        How ``geometry`` was described, for reports.
+
+    Returns
+    -------
+    HexapodSetup
+    """
+    if geometry is None:
+        geometry, kind = cubic_geometry(cube_edge=0.15, cube_center_height=(
+            default_cube_center_height(0.15))), "cubic"
+    if not isinstance(geometry, HexapodGeometry):
+        raise ParameterError(f"`geometry` must be a HexapodGeometry, got "
+                             f"{type(geometry).__name__}.")
+    isolator, controller = update_parameters(isolator or IsolatorParameters(),
+                                             controller or ControllerParameters(),
+                                             settings or {})
+    if platform is None:
+        platform = default_platform(geometry, isolator, controller)
+    if not isinstance(platform, PlatformParameters):
+        raise ParameterError(f"`platform` must be a PlatformParameters, got "
+                             f"{type(platform).__name__}.")
+    return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
+                        controller=controller, kind=kind)
+
+
+def load_hexapod(path, settings=None):
+    """Read a hexapod TOML file (the layout of this module's docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    settings : dict, optional
+        Registry overrides applied to every leg after the file (``--set``).
+
+    Returns
+    -------
+    HexapodSetup
+
+    Raises
+    ------
+    ParameterError
+        A missing or malformed file, an unknown table or key, a bad value.
+    """
+    document = read_toml(path, "hexapod file")
+    where = f"{str(path)!r}: "
+    allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation"}
+    unknown = sorted(set(document) - allowed)
+    if unknown:
+        raise ParameterError(f"{where}unknown table(s) {unknown}; allowed are {sorted(allowed)}.")
+    if "geometry" not in document:
+        raise ParameterError(f"{where}a [geometry] table is needed (kind = 'cubic', 'radial' "
+                             "or 'joints').")
+    for section, expected in (("leg", "isolator"), ("controller", "controller")):
+        for name in document.get(section, {}):
+            if name not in PARAMETERS or PARAMETERS[name].section != expected:
+                article = "an" if expected == "isolator" else "a"
+                raise ParameterError(f"{where}[{section}] `{name}` is not {article} {expected} "
+                                     "parameter; see `qzs params`.")
+    isolator, controller = update_parameters(
+        IsolatorParameters(), ControllerParameters(),
+        {**document.get("leg", {}), **document.get("controller", {}), **(settings or {})})
+    geometry, kind = _geometry(document["geometry"], where)
+    platform = _platform(document.get("platform", {}), geometry, isolator, controller, where)
+    excitation = document.get("excitation", {})
+    wrong = sorted(set(excitation) - set(AXES))
+    if wrong:
+        raise ParameterError(f"{where}[excitation.<axis>] axes must be among {list(AXES)}, got "
+                             f"{wrong}.")
+    return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
+                        controller=controller, kind=kind, excitation=dict(excitation),
+                        simulation=dict(document.get("simulation", {})), source=str(path))
+
+
+def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_preload=True):
+    """The linear analysis of a set-up as data (``qzs hexapod linear --json``).
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        The platform.
+    leg_stiffness : float, optional
+        Replace every leg's axial stiffness [N/m] (a purely linear analysis).
+    frame : {"center_of_mass", "origin", "cube_center"} or array_like
+        Where the matrices are expressed: the payload's centre of mass, the top frame
+        origin, the cube's centre (a cubic geometry only: its top frame origin), or a
+        point in the top frame [m].
+    include_preload : bool
+        Include the geometric stiffness of the static leg forces.
+
+    Returns
+    -------
+    model : HexapodLinearModel
+    record : dict
+        ``stiffness_matrix`` (6x6, SI: N/m, N/rad, N, N*m/rad), ``damping_matrix``,
+        ``mass_matrix``, ``natural_frequencies`` [Hz] (None where a direction is
+        statically unstable, with ``notes``), ``mode_shapes``, ``stable``, ``frame``,
+        ``static_leg_forces`` [N], ``units``.
+    """
+    from qzs.analysis.hexapod_linear import hexapod_linearize
+
+    requested = frame
+    if isinstance(frame, str) and frame == "cube_center":
+        if setup.kind != "cubic":
+            raise ParameterError(f"`frame` 'cube_center' needs a cubic geometry, got a "
+                                 f"{setup.kind!r} one; use 'center_of_mass', 'origin' or a point.")
+        frame = "origin"
+    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller,
+                              leg_stiffness=leg_stiffness, frame=frame,
+                              include_preload=include_preload)
+    record = {
+        "frame": requested if isinstance(requested, str) else np.asarray(frame, dtype=float),
+        "axes": list(AXES),
+        "stiffness_matrix": model.stiffness_matrix,
+        "damping_matrix": model.damping_matrix,
+        "mass_matrix": model.mass_matrix,
+        "natural_frequencies": model.natural_frequencies,
+        "mode_shapes": model.mode_shapes,
+        "stable": bool(model.stable),
+        "static_leg_forces": model.leg_forces,
+        "include_preload": bool(include_preload),
+        "leg_stiffness": leg_stiffness,
+        "platform_mass": setup.platform.mass,
+        "notes": list(model.notes),
+        "units": {"stiffness_matrix": "N/m | N/rad (rows x,y,z) ; N | N*m/rad (rows rx,ry,rz)",
+                  "damping_matrix": "N*s/m | N*s/rad ; N*s | N*m*s/rad",
+                  "mass_matrix": "kg | kg*m ; kg*m | kg*m^2",
+                  "natural_frequencies": "Hz", "static_leg_forces": "N",
+                  "leg_stiffness": "N/m", "platform_mass": "kg"},
+    }
+    return model, record
+
+
+def linear_text(setup, model, record):
+    """The linear analysis as text for people (``qzs hexapod linear``).
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        The platform.
+    model : HexapodLinearModel
+        Its linearisation.
+    record : dict
+        :func:`linear_record`'s record.
+
+    Returns
+    -------
+    str
+    """
+    frame = record["frame"]
+    lines = [f"qzs hexapod: {setup.kind} geometry, platform {setup.platform.mass:.4g} kg, "
+             f"matrices at the "
+             f"{_FRAME_WORDS.get(frame, frame) if isinstance(frame, str) else list(frame)}"
+             + ("" if record["include_preload"] else ", without the preload stiffness")]
+    if record["leg_stiffness"] is not None:
+        lines.append(f"  every leg's axial stiffness set to {record['leg_stiffness']:g} N/m")
+    forces = np.asarray(record["static_leg_forces"])
+    lines.append("  static leg forces [N]  " + "  ".join(f"{f:8.3f}" for f in forces))
+    lines.append("stiffness matrix  (rows/columns x y z [m], rx ry rz [rad]; "
+                 "N/m, N/rad | N, N*m/rad)")
+    header = "        " + "".join(f"{a:>12}" for a in AXES)
+    lines.append(header)
+    for axis, row in zip(AXES, np.asarray(record["stiffness_matrix"])):
+        lines.append(f"  {axis:<6}" + "".join(f"{v:12.4g}" for v in row))
+    lines.append("modes  (undamped, springs + Kp + preload; shapes at the frame point)")
+    shapes = np.asarray(record["mode_shapes"])
+    for j, frequency in enumerate(np.asarray(record["natural_frequencies"], dtype=float)):
+        shape = shapes[:, j]
+        main = AXES[int(np.argmax(np.abs(shape)))]
+        shown = "unstable" if not np.isfinite(frequency) else f"{frequency:9.4g} Hz"
+        lines.append(f"  mode {j + 1}  {shown:>12}   mostly {main:<3} "
+                     + " ".join(f"{v:8.3g}" for v in shape))
+    for note in record["notes"]:
+        lines.append(f"  note: {note}")
+    if not record["stable"]:
+        lines.append("  the platform is statically unstable in the directions without a "
+                     "frequency: raise pi_kp (see docs/hexapod.md §6)")
+    return "\n".join(lines)

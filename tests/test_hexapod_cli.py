@@ -1,0 +1,121 @@
+"""``qzs hexapod linear`` and the hexapod files: closed forms through the command line."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from qzs.cli import main
+from qzs.errors import ParameterError
+from qzs.model.hexapod import leg_unit_vectors
+from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.workflows.hexapod import (default_cube_center_height, hexapod_setup, load_hexapod,
+                                   supported_mass)
+
+
+def run_json(capsys, *argv):
+    code = main(["hexapod", "linear", *argv, "--json"])
+    assert code == 0
+    return json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("edge", [0.1, 0.25])
+def test_cubic_stiffness_at_the_cube_centre_is_the_published_diagonal(capsys, edge):
+    """k * diag(2, 2, 2, a^2/2, a^2/2, 2 a^2) for every leg of axial stiffness k."""
+    k = 1234.0
+    record = run_json(capsys, "--cubic", "--cube-edge", str(edge), "--leg-stiffness", str(k),
+                      "--no-preload", "--frame", "cube-center")
+    expected = k * np.diag([2, 2, 2, edge ** 2 / 2, edge ** 2 / 2, 2 * edge ** 2])
+    np.testing.assert_allclose(record["stiffness_matrix"], expected, rtol=1e-12,
+                               atol=1e-9 * k)
+    assert record["frame"] == "cube_center"
+    m = record["platform_mass"]
+    # translations: 2k on mass m
+    assert record["natural_frequencies"][0] == pytest.approx(
+        math.sqrt(2 * k / m) / (2 * math.pi), rel=1e-9)
+
+
+def test_off_the_centre_translations_and_rotations_couple(capsys):
+    edge, k = 0.2, 1000.0
+    centre = run_json(capsys, "--cubic", "--cube-edge", str(edge), "--leg-stiffness", str(k),
+                      "--no-preload", "--frame", "cube-center")
+    setup = hexapod_setup()
+    raised = run_json(capsys, "--cubic", "--cube-edge", str(edge), "--leg-stiffness", str(k),
+                      "--no-preload", "--frame", "origin", "--set", "pi_kp=50")
+    assert np.allclose(np.asarray(centre["stiffness_matrix"])[:3, 3:], 0.0, atol=1e-9 * k)
+    assert setup.kind == "cubic" and np.allclose(raised["stiffness_matrix"],
+                                                 centre["stiffness_matrix"])
+
+
+def test_the_default_payload_is_what_the_springs_hold():
+    """Six springs at the setpoint push with f along their legs: m g = f * sum(u_z)."""
+    setup = hexapod_setup()
+    f = float(spring_force(setup.controller.position_setpoint, IsolatorParameters()))
+    uz = leg_unit_vectors(setup.geometry)[:, 2]
+    assert setup.platform.mass * 9.81 == pytest.approx(f * uz.sum(), rel=1e-12)
+    assert uz == pytest.approx(np.full(6, 1 / math.sqrt(3)))  # cubic legs: 54.7 deg off vertical
+    assert supported_mass(setup.geometry, gravity=9.81) == pytest.approx(setup.platform.mass)
+
+
+def test_set_stiffens_every_leg(capsys):
+    """pi_kp adds Kp to each leg's axial stiffness: 2 Kp in each translation of the cube."""
+    base = run_json(capsys, "--cubic", "--frame", "cube-center", "--no-preload")
+    stiffer = run_json(capsys, "--cubic", "--frame", "cube-center", "--no-preload",
+                       "--set", "pi_kp=550")
+    difference = np.diag(stiffer["stiffness_matrix"]) - np.diag(base["stiffness_matrix"])
+    assert difference[:3] == pytest.approx([1000.0] * 3, rel=1e-9)
+
+
+def test_paper_legs_are_statically_unstable_under_their_own_preload(capsys):
+    """Compressed legs on spherical joints: negative stiffness -4 f/a in each translation
+    of the cube, far above the legs' 2 (k_spring + Kp): unstable directions get no frequency."""
+    record = run_json(capsys)
+    assert record["stable"] is False
+    assert any(f is None for f in record["natural_frequencies"])
+    assert any("statically unstable" in note for note in record["notes"])
+    text_code = main(["hexapod", "linear"])
+    assert text_code == 0
+
+
+def test_hexapod_file(tmp_path, capsys):
+    path = tmp_path / "radial.toml"
+    path.write_text("[geometry]\nkind = 'radial'\nbase_radius = 0.2\ntop_radius = 0.12\n"
+                    "base_angle = 20.0\ntop_angle = 30.0\nheight = 0.25\n"
+                    "[platform]\nmass = 10.0\nprincipal_inertia = [0.1, 0.1, 0.15]\n"
+                    "[leg]\nviscous_damping = 50.0\n[controller]\npi_kp = 3000.0\n")
+    setup = load_hexapod(path)
+    assert setup.kind == "radial" and setup.platform.mass == 10.0
+    assert setup.isolator.viscous_damping == 50.0 and setup.controller.pi_kp == 3000.0
+    record = run_json(capsys, "--config", str(path), "--no-preload")
+    assert np.allclose(record["stiffness_matrix"], np.asarray(record["stiffness_matrix"]).T)
+    assert record["stable"] is True
+    assert main(["hexapod", "linear", "--config", str(path), "--frame", "cube-center"]) == 2
+    assert "needs a cubic geometry" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text, match", [
+    ("[geometry]\nkind = 'square'\n", "`kind` must be one of"),
+    ("[geometry]\nkind = 'cubic'\n", "missing \\['cube_edge'\\]"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\nwidth = 2\n", "unknown \\['width'\\]"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[leg]\npi_kp = 3.0\n",
+     "`pi_kp` is not an isolator parameter"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[platform]\nmass = 3.0\n"
+     "inertia = [[1,0,0],[0,1,0],[0,0,1]]\nprincipal_inertia = [1, 1, 1]\n", "not both"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[excitation.w]\nkind = 'sine'\n",
+     "axes must be among"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[wheels]\n", "unknown table"),
+])
+def test_bad_hexapod_files_name_what_is_wrong(tmp_path, text, match):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ParameterError, match=match):
+        load_hexapod(path)
+
+
+def test_bad_options_are_usage_errors(capsys):
+    assert main(["hexapod", "linear", "--cube-edge", "0.1"]) == 2
+    assert "add --cubic" in capsys.readouterr().err
+    assert main(["hexapod", "linear", "--cubic", "--cube-edge", "-1"]) == 2
+    assert "--cube-edge must be a positive" in capsys.readouterr().err
+    assert main(["hexapod", "linear", "--leg-stiffness", "0"]) == 2
+    assert default_cube_center_height(0.3) == pytest.approx(0.3 / (2 * math.sqrt(3)))
