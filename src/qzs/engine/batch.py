@@ -265,10 +265,13 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
         _advance(first.solver_code, done, steps, decimation, states, flags, params, ex, table,
                  out, out_flags, status, written, a, b)
 
-    # zero-step calls compile (or load) the kernels first: the clock counts integration only
+    # zero-step calls compile (or load) the kernels first, only those the shares will use (a
+    # fresh worker compiles nothing it does not run): the clock counts integration only
     done, steps = 0, 0
-    advance(0, min(n, 1))
-    if n > 1:
+    sizes = {int(b - a) for a, b in zip(bounds[:-1], bounds[1:]) if b > a}
+    if 1 in sizes:
+        advance(0, 1)
+    if any(size > 1 for size in sizes):
         advance(0, min(n, _lanes.MAX_LANES))
     start = _time.perf_counter()
     try:
