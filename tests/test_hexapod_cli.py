@@ -119,3 +119,26 @@ def test_bad_options_are_usage_errors(capsys):
     assert "--cube-edge must be a positive" in capsys.readouterr().err
     assert main(["hexapod", "linear", "--leg-stiffness", "0"]) == 2
     assert default_cube_center_height(0.3) == pytest.approx(0.3 / (2 * math.sqrt(3)))
+
+
+def test_linear_plot_is_written_and_draws_the_model(tmp_path, capsys):
+    """--plot writes the 6x6 grid; the diagonal panels carry the model's own curve."""
+    import matplotlib.pyplot as plt
+
+    from qzs.analysis.hexapod_linear import hexapod_linearize
+    from qzs.viz.hexapod_matrix import plot_transmissibility_matrix
+
+    out = tmp_path / "grid.png"
+    assert main(["hexapod", "linear", "--set", "pi_kp=2500", "--plot", str(out)]) == 0
+    assert out.stat().st_size > 10_000 and not list(tmp_path.glob("*.tmp*"))
+    setup = hexapod_setup(settings={"pi_kp": 2500.0})
+    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller)
+    frequency = np.geomspace(0.1, 10, 50)
+    figure = plot_transmissibility_matrix(frequency, linear=model)
+    line = figure.axes[2 * 6 + 2].get_lines()[0]  # platform z per base z
+    expected = 20 * np.log10(np.abs(model.transmissibility(frequency)[:, 2, 2]))
+    np.testing.assert_allclose(line.get_ydata(), expected)
+    plt.close(figure)
+    with pytest.raises(ParameterError, match="shape"):
+        plot_transmissibility_matrix(frequency, simulated=np.ones((3, 6, 6)))
+    assert main(["hexapod", "linear", "--plot", str(tmp_path / "grid.txt")]) == 2

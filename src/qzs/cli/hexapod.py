@@ -55,6 +55,8 @@ def add_parser(subparsers):
                              "of mass; cube-center: a cubic geometry's cube centre)")
     linear.add_argument("--no-preload", action="store_true",
                         help="leave out the geometric stiffness of the static leg forces")
+    linear.add_argument("--plot", metavar="FILE.png",
+                        help="draw the 6x6 transmissibility of the linear model (0.05-50 Hz)")
     add_json_option(linear)
     linear.set_defaults(handler=run_linear)
     for command in sub.choices.values():
@@ -121,8 +123,18 @@ def run_linear(args):
     if args.leg_stiffness is not None and not args.leg_stiffness > 0:
         raise ParameterError(f"--leg-stiffness must be a positive stiffness [N/m], got "
                              f"{args.leg_stiffness!r}.")
+    if args.plot:
+        from qzs.iotools.paths import check_output_path
+
+        check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
     setup = _setup(args)
     model, record = linear_record(setup, leg_stiffness=args.leg_stiffness,
                                   frame=FRAMES[args.frame], include_preload=not args.no_preload)
-    emit(args, linear_text(setup, model, record), record)
+    text = linear_text(setup, model, record)
+    if args.plot:
+        from qzs.workflows.hexapod import plot_linear_transmissibility
+
+        record["plot"] = str(plot_linear_transmissibility(setup, model, args.plot))
+        text += f"\n  wrote {args.plot}"
+    emit(args, text, record)
     return 0

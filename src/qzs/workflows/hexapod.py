@@ -38,7 +38,7 @@ from qzs.model.registry import PARAMETERS, update_parameters
 
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
-           "linear_record", "linear_text"]
+           "linear_record", "linear_text", "plot_linear_transmissibility"]
 
 #: How a ``[geometry]`` table describes the platform: its keys per kind (required, optional).
 GEOMETRY_KINDS = {
@@ -419,3 +419,40 @@ def linear_text(setup, model, record):
         lines.append("  the platform is statically unstable in the directions without a "
                      "frequency: raise pi_kp (see docs/hexapod.md §6)")
     return "\n".join(lines)
+
+
+def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50.0), points=400):
+    """Write the linear model's 6x6 transmissibility grid (:mod:`qzs.viz.hexapod_matrix`).
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        The platform (for the title).
+    model : HexapodLinearModel
+        Its linearisation.
+    out : str or Path
+        The figure file (.png, .svg or .pdf), written atomically.
+    frequency_range : (float, float)
+        Band drawn [Hz], log-spaced.
+    points : int
+        Frequencies drawn.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    from pathlib import Path
+
+    import matplotlib.pyplot as plt
+
+    from qzs.viz.hexapod_matrix import plot_transmissibility_matrix
+
+    frequency = np.geomspace(*frequency_range, points)
+    stability = "" if model.stable else " (linearly UNSTABLE: see the notes)"
+    figure = plot_transmissibility_matrix(
+        frequency, linear=model, out=out,
+        title=f"Linear transmissibility of the {setup.kind} hexapod, platform "
+              f"{setup.platform.mass:.3g} kg{stability}")
+    plt.close(figure)
+    return Path(out)

@@ -1,0 +1,126 @@
+"""The six-axis platform's 6x6 transmissibility as a grid of magnitude plots.
+
+Row ``i``, column ``j``: the platform's motion along axis ``i`` per base motion along axis
+``j`` (x, y, z [m]; rx, ry, rz [rad]), in dB of its unit (1, m/rad or rad/m). The linear
+model is drawn dashed; a simulated estimate solid on its trusted bins only (docs/model.md
+§10), faint elsewhere.
+"""
+import numpy as np
+
+from qzs.viz.figures import save_figure
+
+__all__ = ["plot_transmissibility_matrix", "AXES"]
+
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+_FLOOR = 1e-12
+
+
+def _unit(i, j):
+    row, column = ("m" if i < 3 else "rad"), ("m" if j < 3 else "rad")
+    return "1" if row == column else f"{row}/{column}"
+
+
+def _db(values):
+    return 20 * np.log10(np.maximum(np.abs(np.asarray(values)), _FLOOR))
+
+
+def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trusted=None,
+                                 frequency_range=None, floor_db=-80.0, title=None, out=None):
+    """Draw the 6x6 transmissibility matrix; optionally write it.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (n,)
+        Frequencies [Hz] of ``simulated`` (and of ``linear`` if it is an array).
+    linear : HexapodLinearModel or array_like, shape (n, 6, 6), optional
+        The linear model (its ``transmissibility`` evaluated at ``frequency``), or its
+        complex or magnitude values; drawn dashed.
+    simulated : array_like, shape (n, 6, 6), optional
+        Simulated magnitudes (NaN where a base axis was not excited); drawn solid.
+    trusted : array_like of bool, shape (n, 6, 6), optional
+        Which simulated bins are trusted; default all finite ones.
+    frequency_range : (float, float), optional
+        Horizontal range [Hz]; default the positive frequencies given.
+    floor_db : float
+        Lowest level drawn [dB]: entries that stay below it (the uncoupled ones of a
+        symmetric platform) show as empty panels marked "< floor".
+    title : str, optional
+        Figure title.
+    out : str or Path, optional
+        Write the figure there (atomically; format from the suffix).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from qzs.viz.figures import new_figure  # noqa: F401  (sets a headless backend if needed)
+    import matplotlib.pyplot as plt
+
+    from qzs.errors import ParameterError
+
+    frequency = np.asarray(frequency, dtype=float)
+    if frequency.ndim != 1 or frequency.size < 2:
+        raise ParameterError(f"`frequency` must be a 1-d array of at least 2 frequencies [Hz], "
+                             f"got shape {frequency.shape}.")
+    if linear is not None and hasattr(linear, "transmissibility"):
+        linear = linear.transmissibility(np.where(frequency > 0, frequency, np.nan))
+    curves = {}
+    for name, values in (("linear", linear), ("simulated", simulated)):
+        if values is None:
+            continue
+        values = np.asarray(values)
+        if values.shape != (frequency.size, 6, 6):
+            raise ParameterError(f"`{name}` must have shape ({frequency.size}, 6, 6), got "
+                                 f"{values.shape}.")
+        curves[name] = _db(values)
+    if not curves:
+        raise ParameterError("give `linear`, `simulated` or both.")
+    if trusted is None and simulated is not None:
+        trusted = np.isfinite(np.asarray(simulated, dtype=float))
+    positive = frequency > 0
+    low, high = frequency_range or (frequency[positive].min(), frequency[positive].max())
+
+    fig, axes = plt.subplots(6, 6, sharex=True, figsize=(15, 12.5), constrained_layout=True)
+    top = max(float(np.nanmax(c[positive])) for c in curves.values())
+    top = 10 * np.ceil(top / 10 + 0.05)
+    for i in range(6):
+        for j in range(6):
+            ax = axes[i, j]
+            drawn = False
+            if "simulated" in curves:
+                level = curves["simulated"][:, i, j]
+                good = positive & np.asarray(trusted)[:, i, j] & np.isfinite(level)
+                ax.plot(frequency[positive], np.where(positive, level, np.nan)[positive],
+                        color="C0", lw=0.6, alpha=0.25)
+                ax.plot(frequency, np.where(good, level, np.nan), color="C0", lw=1.0,
+                        label="simulated (trusted bins)")
+                drawn |= bool(np.any(good & (level > floor_db)))
+            if "linear" in curves:
+                level = curves["linear"][:, i, j]
+                ax.plot(frequency[positive], level[positive], color="k", ls="--", lw=0.9,
+                        label="linear model")
+                drawn |= bool(np.any(level[positive] > floor_db))
+            if not drawn:
+                ax.text(0.5, 0.5, f"< {floor_db:g} dB", transform=ax.transAxes, ha="center",
+                        va="center", color="0.5", fontsize=8)
+            ax.set_xscale("log")
+            ax.set_xlim(low, high)
+            ax.set_ylim(floor_db, top)
+            ax.grid(True, which="both", lw=0.3, alpha=0.5)
+            ax.tick_params(labelsize=7)
+            if i == 0:
+                ax.set_title(f"base {AXES[j]}", fontsize=9)
+            if j == 0:
+                ax.set_ylabel(f"platform {AXES[i]}\n|T| [dB]", fontsize=8)
+            if i == 5:
+                ax.set_xlabel("frequency [Hz]", fontsize=8)
+            ax.text(0.97, 0.95, f"[{_unit(i, j)}]", transform=ax.transAxes, ha="right",
+                    va="top", fontsize=6.5, color="0.35")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="upper right", fontsize=8, ncol=2)
+    fig.suptitle(title or "Platform motion per base motion: transmissibility matrix "
+                          "(amplitude ratio, dB of its unit)", fontsize=11)
+    if out is not None:
+        save_figure(fig, out)
+    return fig
