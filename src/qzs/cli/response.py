@@ -1,0 +1,211 @@
+"""``qzs response``: the steady-state frequency response by stepped-sine simulation.
+
+It parses and delegates to :func:`qzs.workflows.response.steady_state_response`
+(docs/response.md); ``--json`` prints the list of points, one record each.
+"""
+from qzs.cli.common import add_set_option, emit, integer_at_least, parameters
+from qzs.errors import ParameterError
+from qzs.iotools.paths import check_output_path
+
+__all__ = ["add_parser", "run", "parse_frequencies", "DEFAULT_RANGE"]
+
+DEFAULT_PLOT = "qzs-response.png"
+#: Formats ``--plot`` writes (matplotlib chooses by the extension).
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+#: Default frequencies: 40 from 0.5 to 20 Hz (the paper's band above the locked region).
+DEFAULT_RANGE = (0.5, 20.0, 40)
+
+
+def add_parser(subparsers):
+    """Add ``response`` to an ``argparse`` sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``response`` parser.
+    """
+    parser = subparsers.add_parser(
+        "response", help="steady-state frequency response (stepped sine, harmonic balance)",
+        description="Simulate each frequency until the response is periodic, sweeping up and "
+                    "down (each frequency starts from the last one's state), and report the "
+                    "fundamental transmissibility (payload over base acceleration), the "
+                    "harmonics, the relative amplitude, the locked share of the period and the "
+                    "stop contacts; the harmonic balance of the smooth model is drawn over it "
+                    "(docs/response.md). Without options: 40 log-spaced frequencies from 0.5 to "
+                    "20 Hz, 10 mm, both sweeps, the step chosen for 0.01 dB.")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--frequencies", metavar="F1,F2,...",
+                       help="the frequencies [Hz], comma-separated")
+    where.add_argument("--range", metavar="F0,F1,N",
+                       help="N frequencies from F0 to F1 [Hz] (default 0.5,20,40)")
+    parser.add_argument("--spacing", choices=("log", "linear"), default="log",
+                        help="spacing of a --range (default log)")
+    parser.add_argument("--amplitude", type=float, metavar="M",
+                        help="base displacement amplitude [m] (default the config's, else 0.010)")
+    parser.add_argument("--config", metavar="FILE.toml",
+                        help="run configuration (see `qzs params --toml`)")
+    add_set_option(parser)
+    parser.add_argument("--direction", choices=("up", "down", "both"), default="both",
+                        help="sweeps: up, down or both (default; in parallel)")
+    step = parser.add_mutually_exclusive_group()
+    step.add_argument("--dt", type=float, metavar="S",
+                      help="largest integration step [s] (each frequency uses the largest step "
+                           "at most this with whole samples per period)")
+    step.add_argument("--tolerance", type=float, metavar="DB",
+                      help="choose the step for this accuracy [dB] on a chirp over the band "
+                           "(default 0.01; docs/model.md §7)")
+    parser.add_argument("--solver", choices=("ode3", "rk4", "euler"),
+                        help="integrator (default ode3)")
+    parser.add_argument("--periodic-tolerance", type=float, metavar="X",
+                        help="periodicity tolerance: scaled state change per period "
+                             "(default 1e-6)")
+    parser.add_argument("--max-periods", type=integer_at_least(8), metavar="N",
+                        help="periods at most per frequency before it is reported not "
+                             "periodic (default 100000, a safety; --max-time usually ends it)")
+    parser.add_argument("--max-time", type=float, metavar="S",
+                        help="simulated time at most per frequency [s] (default 30 of the "
+                             "linearised loop's slowest time constants, within 60-3600 s; "
+                             "115 s for the paper's loop)")
+    parser.add_argument("--harmonics", type=integer_at_least(2), metavar="N",
+                        help="highest harmonic reported (default 5)")
+    parser.add_argument("--no-harmonic-balance", action="store_true",
+                        help="skip the harmonic balance of the smooth model")
+    parser.add_argument("--friction-velocity", type=float, metavar="M_PER_S",
+                        help="regularisation velocity of the harmonic balance's friction "
+                             "[m/s] (default 0.001)")
+    parser.add_argument("--compare-chirp", action="store_true",
+                        help="also simulate the paper's chirp (0.01 Hz/s) and draw its Welch "
+                             "estimate beside the steady state")
+    parser.add_argument("--workers", type=integer_at_least(1), metavar="N",
+                        help="processes (default: the sweeps and extra tasks, at most the cores)")
+    parser.add_argument("--out", metavar="FILE",
+                        help="write the response to FILE (.nc, .csv or .json)")
+    parser.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
+                        help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--json", action="store_true",
+                        help="print the points as a JSON list of records (frequency [Hz], "
+                             "transmissibility [-], direction, ...; NaN as null) instead of "
+                             "the table; notes go to stderr")
+    return parser
+
+
+def parse_frequencies(frequencies=None, frequency_range=None, spacing="log"):
+    """The frequencies of ``--frequencies`` or ``--range`` (default :data:`DEFAULT_RANGE`).
+
+    Parameters
+    ----------
+    frequencies : str, optional
+        ``"F1,F2,..."`` [Hz].
+    frequency_range : str, optional
+        ``"F0,F1,N"``: N frequencies from F0 to F1 [Hz].
+    spacing : {"log", "linear"}
+        Spacing of a range.
+
+    Returns
+    -------
+    list of float
+        The frequencies [Hz], unchecked (the workflow checks them).
+
+    Raises
+    ------
+    ParameterError
+        Text that is not numbers, or a range that is not ``F0,F1,N`` with ``N >= 1``.
+    """
+    import numpy as np
+
+    if frequencies is not None:
+        try:
+            return [float(item) for item in frequencies.split(",") if item.strip()]
+        except ValueError:
+            raise ParameterError(f"--frequencies must be numbers in Hz separated by commas, "
+                                 f"got {frequencies!r}; e.g. --frequencies 1,2,5.") from None
+    if frequency_range is None:
+        low, high, count = DEFAULT_RANGE
+    else:
+        parts = frequency_range.split(",")
+        try:
+            low, high, count = float(parts[0]), float(parts[1]), int(parts[2])
+            if len(parts) != 3 or count < 1:
+                raise ValueError
+        except (ValueError, IndexError):
+            raise ParameterError(
+                f"--range must be F0,F1,N (two frequencies in Hz and a count >= 1), got "
+                f"{frequency_range!r}; e.g. --range 0.5,20,40.") from None
+        if not (np.isfinite(low) and np.isfinite(high) and 0 < low <= high):
+            raise ParameterError(f"--range needs 0 < F0 <= F1 (finite, Hz), got "
+                                 f"{frequency_range!r}; e.g. --range 0.5,20,40.")
+    if count == 1:
+        return [low]
+    grid = np.geomspace(low, high, count) if spacing == "log" else np.linspace(low, high, count)
+    return [float(f) for f in grid]
+
+
+def run(args):
+    """Run ``qzs response`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs response`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code, 0 (points that did not settle are NaN with their reason).
+    """
+    import sys
+
+    from qzs.workflows.response import RESPONSE_SUFFIXES, steady_state_response
+
+    frequencies = parse_frequencies(args.frequencies, args.range, args.spacing)
+    config = parameters(args)
+    simulation = dict(config["simulation"])
+    amplitude = args.amplitude
+    if amplitude is None:
+        amplitude = config["excitation"].get("amplitude", 0.010)
+    plot = None if args.plot.lower() == "none" else args.plot
+    if plot is not None:
+        check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+    if args.out:
+        check_output_path(args.out, argument="--out", suffixes=RESPONSE_SUFFIXES)
+    options = {}
+    if args.dt is not None:
+        options["dt"] = args.dt
+    elif args.tolerance is not None:
+        options["tolerance_db"] = args.tolerance
+    elif "dt" in simulation:
+        options["dt"] = simulation["dt"]
+    if args.solver or "solver" in simulation:
+        options["solver"] = args.solver or simulation["solver"]
+    for flag, name in (("periodic_tolerance", "periodic_tolerance"),
+                       ("max_periods", "max_periods"), ("max_time", "max_time"),
+                       ("harmonics", "harmonics"),
+                       ("friction_velocity", "friction_velocity"), ("workers", "workers")):
+        value = getattr(args, flag)
+        if value is not None:
+            options[name] = value
+    response = steady_state_response(
+        frequencies, amplitude, config["isolator"], config["controller"],
+        direction=args.direction, harmonic_balance=not args.no_harmonic_balance,
+        compare_chirp=args.compare_chirp, progress=not args.quiet and not args.json, **options)
+    files = {}
+    if args.out:
+        response.save(args.out)
+        files["out"] = args.out
+    if plot is not None:
+        import matplotlib.pyplot as plt
+
+        plt.close(response.plot(path=plot))
+        files["plot"] = plot
+    text = response.summary() + "".join(f"\n  wrote            {p}" for p in files.values())
+    if args.json:
+        for note in response.notes:
+            print(f"qzs: note: {note}", file=sys.stderr)
+    emit(args, text, response.to_records())
+    return 0

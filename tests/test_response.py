@@ -1,0 +1,377 @@
+"""The stepped-sine steady state (qzs.workflows.response) against closed forms no one here wrote.
+
+* Den Hartog (1931): the exact steady state of a linear oscillator with Coulomb (and viscous)
+  friction under a harmonic force, here the base's inertial force on the relative motion;
+* the ideal zero-stiffness isolator with Coulomb friction under base motion: held while the
+  stiction exceeds the base's inertial force, sliding without stops below a friction ratio
+  c* = 1/sqrt(1 + pi^2/4), with fundamental transmissibility 4c/pi (docs/response.md §6);
+* the linearised closed loop (python-control) for a frictionless guide;
+* sub-harmonic responses of an impact oscillator, confirmed on one uncut simulation.
+
+Then the contract: bad input refused before any work, NaN with a reason, files written whole,
+the command line, the figure, parallel runs equal to serial ones.
+"""
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import root
+
+import qzs
+from qzs import ControllerParameters, IsolatorParameters, ParameterError, Sine
+from qzs.workflows.response import (SAMPLES_PER_PERIOD, steady_state_response, steps_for)
+
+MASS = 6.4
+PASSIVE = ControllerParameters(pi_kp=0.0, pi_ki=0.0, position_setpoint=0.0)
+
+
+def run(frequencies, amplitude, isolator, controller, **options):
+    options = {"direction": "up", "dt": 1e-3, "harmonic_balance": False, "workers": 1,
+               **options}
+    return steady_state_response(frequencies, amplitude, isolator, controller, **options)
+
+
+# ---------------------------------------------------------------- Den Hartog (1931)
+def den_hartog_amplitude(force_ratio, beta, static):
+    """Den Hartog's closed form: the peak amplitude of ``m z'' + k z + F sgn(z') =
+    P cos(w t)`` moving without stops (J. P. Den Hartog, Forced vibrations with combined
+    Coulomb and viscous friction, Trans. ASME 53, APM-53-9, 107-115, 1931):
+    ``X = (P/k) sqrt(V^2 - (F/P)^2 U^2)``,
+    ``V = 1/(1 - beta^2)``, ``U = sin(pi/beta) / (beta (1 + cos(pi/beta)))``."""
+    v = 1.0 / (1.0 - beta ** 2)
+    u = math.sin(math.pi / beta) / (beta * (1.0 + math.cos(math.pi / beta)))
+    return static * math.sqrt(v ** 2 - force_ratio ** 2 * u ** 2)
+
+
+def exact_coulomb_oscillator(m, k, c, friction, force, omega):
+    """Den Hartog's construction, solved here: the symmetric steady state of
+    ``m z'' + c z' + k z + F sgn(z') = P cos(w t + phi)`` without stops.
+
+    Over the half period ``0 <= t <= pi/w`` the mass moves up from ``-X`` to ``+X``
+    (``z' > 0``), so the equation is linear there: the free solution of the damped
+    oscillator plus the forced one, shifted by ``-F/k``. The four conditions ``z(0) = -X``,
+    ``z'(0) = 0``, ``z(pi/w) = X``, ``z'(pi/w) = 0`` fix ``C1, C2, X, phi``; the other half is
+    the mirror image. Returns ``(X, |Z_1|)``: the peak and the fundamental amplitude.
+    """
+    wn = math.sqrt(k / m)
+    zeta = c / (2 * math.sqrt(k * m))
+    wd, decay = wn * math.sqrt(1 - zeta ** 2), zeta * wn
+    receptance = 1.0 / (k - m * omega ** 2 + 1j * c * omega)
+    half = math.pi / omega
+
+    def motion(c1, c2, phi, t):
+        e = np.exp(-decay * t)
+        free = e * (c1 * np.cos(wd * t) + c2 * np.sin(wd * t))
+        free_rate = e * ((-decay * c1 + wd * c2) * np.cos(wd * t)
+                         - (decay * c2 + wd * c1) * np.sin(wd * t))
+        forced = force * receptance * np.exp(1j * (omega * t + phi))
+        return -friction / k + free + forced.real, free_rate + (1j * omega * forced).real
+
+    def conditions(u):
+        c1, c2, x, phi = u
+        z0, v0 = motion(c1, c2, phi, 0.0)
+        z1, v1 = motion(c1, c2, phi, half)
+        return [z0 + x, v0, z1 - x, v1]
+
+    guess = abs(force * receptance)
+    for phi in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+        solution = root(conditions, [0.0, 0.0, guess, phi], tol=1e-14)
+        if not solution.success or solution.x[2] <= 0:
+            continue
+        c1, c2, x, phi = solution.x
+        inside = np.linspace(0, half, 4001)[1:-1]
+        z, v = motion(c1, c2, phi, inside)
+        if np.all(v > 0):  # moving without stops: the construction holds
+            break
+    else:
+        raise AssertionError("no motion without stops for this case")
+    n = 8192
+    t = np.arange(n) * 2 * half / n
+    first = t < half
+    z = np.where(first, motion(c1, c2, phi, np.where(first, t, 0.0))[0],
+                 -motion(c1, c2, phi, np.where(first, 0.0, t - half))[0])
+    # turning point: the spring and the force must overcome friction, or the mass would stick
+    assert abs(-k * x + force * math.cos(math.pi + phi)) > friction
+    return x, abs(2.0 / n * np.sum(z * np.exp(-1j * omega * t)))
+
+
+@pytest.mark.parametrize("beta, force_ratio, viscous", [
+    (0.6, 0.3, 0.0), (1.6, 0.3, 0.0), (2.5, 0.5, 0.0), (1.6, 0.3, 5.0)])
+def test_den_hartog_coulomb_oscillator(beta, force_ratio, viscous):
+    """A linear spring (tanh with a tiny shape: bz ~ 1e-5), Coulomb friction F (Fs = Fc) and
+    viscous friction, no controller, no gravity: the relative motion is Den Hartog's
+    oscillator forced by ``-m y''`` = ``m A w^2 cos(w t)``."""
+    natural, amplitude, shape = 2.0, 0.005, 1e-3
+    k = MASS * (2 * math.pi * natural) ** 2
+    frequency = beta * natural
+    omega = 2 * math.pi * frequency
+    force = MASS * amplitude * omega ** 2
+    friction = force_ratio * force
+    peak, fundamental = exact_coulomb_oscillator(MASS, k, viscous, friction, force, omega)
+    if viscous == 0.0:  # the construction reproduces the printed closed form
+        assert peak == pytest.approx(den_hartog_amplitude(force_ratio, beta, force / k),
+                                     rel=1e-9)
+    isolator = IsolatorParameters(mass=MASS, gravity=0.0, spring_force=k / shape,
+                                  spring_shape=shape, stiction_force=friction,
+                                  coulomb_force=friction, viscous_damping=viscous,
+                                  stroke_half=1.0)
+    point = run([frequency], amplitude, isolator, PASSIVE).points[0]
+    assert point.converged and point.period_multiple == 1, point.reason
+    assert point.relative_amplitude == pytest.approx(fundamental, rel=1e-5)
+    # the sampled peak: 256 samples a period miss the crest by at most 1 - cos(pi/256)
+    assert point.relative_peak == pytest.approx(peak, rel=2e-4)
+    assert point.locked_fraction == 0.0 and point.stop_contacts == 0.0
+
+
+# ---------------------------------------------------------------- zero stiffness + Coulomb
+CRITICAL_RATIO = 1.0 / math.sqrt(1.0 + math.pi ** 2 / 4.0)  # docs/response.md §6
+
+
+def zero_stiffness(ratio, amplitude, frequency):
+    friction = ratio * MASS * amplitude * (2 * math.pi * frequency) ** 2
+    return IsolatorParameters(mass=MASS, gravity=0.0, spring_force=0.0,
+                              stiction_force=friction, coulomb_force=friction,
+                              viscous_damping=0.0, stroke_half=1.0)
+
+
+@pytest.mark.parametrize("ratio", [0.2, 0.5, 0.53])
+def test_zero_stiffness_isolator_slides_with_four_c_over_pi(ratio):
+    """Below c* the payload slides all the time: its acceleration is a square wave of
+    height F/m, whose fundamental is 4F/(pi m), i.e. T = 4c/pi; odd harmonics 4c/(k pi)."""
+    amplitude, frequency = 0.005, 3.0
+    point = run([frequency], amplitude, zero_stiffness(ratio, amplitude, frequency),
+                PASSIVE).points[0]
+    assert point.converged, point.reason
+    assert point.transmissibility == pytest.approx(4 * ratio / math.pi, rel=1e-5)
+    assert point.harmonics[1] == pytest.approx(4 * ratio / (3 * math.pi), rel=1e-4)
+    assert point.harmonics[3] == pytest.approx(4 * ratio / (5 * math.pi), rel=1e-3)
+    assert point.harmonics[0] < 1e-6 and point.harmonics[2] < 1e-6  # no even harmonics
+    assert point.locked_fraction == 0.0
+
+
+def test_zero_stiffness_isolator_sticks_above_the_critical_ratio():
+    """Just above c* the payload sticks at each reversal (the stick rule |F_hold| <= Fs
+    decides it) and the square-wave result no longer holds; at c >= 1 it never slips."""
+    amplitude, frequency = 0.005, 3.0
+    above = run([frequency], amplitude, zero_stiffness(1.02 * CRITICAL_RATIO, amplitude,
+                                                       frequency), PASSIVE).points[0]
+    below = run([frequency], amplitude, zero_stiffness(0.98 * CRITICAL_RATIO, amplitude,
+                                                       frequency), PASSIVE).points[0]
+    assert below.locked_fraction == 0.0
+    assert above.locked_fraction > 0.0
+    assert abs(above.transmissibility / (4 * 1.02 * CRITICAL_RATIO / math.pi) - 1) > 1e-5
+    held = run([frequency], amplitude, zero_stiffness(1.2, amplitude, frequency),
+               PASSIVE).points[0]
+    assert held.locked_fraction == 1.0
+    assert held.transmissibility == pytest.approx(1.0, abs=1e-12)
+
+
+# ---------------------------------------------------------------- linear closed loop
+def test_frictionless_steady_state_is_the_linear_closed_loop():
+    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    controller = ControllerParameters(damping_gain=30.0)
+    frequencies = [0.3, 1.0, 3.0, 10.0]
+    response = run(frequencies, 0.001, isolator, controller)
+    model = qzs.linearize(isolator, controller)
+    expected = model.transfer_function(2j * np.pi * np.array(frequencies))
+    up = response.branch("up")
+    assert np.all(up["converged"] == 1)
+    np.testing.assert_allclose(up["transmissibility"], np.abs(expected), rtol=1e-4)
+    np.testing.assert_allclose(up["phase"], np.angle(expected), atol=1e-4)
+    # and the record's linear value is the same model's
+    records = response.to_records()
+    np.testing.assert_allclose([r["linear_transmissibility"] for r in records],
+                               np.abs(expected), rtol=1e-12)
+
+
+# ---------------------------------------------------------------- sub-harmonics
+def impact_oscillator():
+    k, shape = MASS * (2 * math.pi * 2.0) ** 2, 1e-3
+    return IsolatorParameters(mass=MASS, gravity=0.0, spring_force=k / shape,
+                              spring_shape=shape, stiction_force=0.0, coulomb_force=0.0,
+                              viscous_damping=2.0, stroke_half=0.003, stop_stiffness=2e4,
+                              stop_damping=500.0)
+
+
+@pytest.mark.parametrize("frequency, multiple", [(2.2, 2), (3.2, 3)])
+def test_subharmonic_responses_are_found_and_confirmed_by_one_uncut_run(frequency, multiple):
+    """A payload bouncing between close compliant stops settles on period-2 and period-3
+    orbits. An uncut qzs.simulate of the same sine repeats every ``multiple`` periods and
+    not sooner, and gives the very same transmissibility: cutting a run into periods
+    (whole multiples of the kernels' 256-step exact-sine period) changes no bit."""
+    amplitude, isolator = 0.005, impact_oscillator()
+    point = run([frequency], amplitude, isolator, PASSIVE).points[0]
+    assert point.converged and point.period_multiple == multiple
+    assert point.subharmonic > 1e-3 and point.stop_contacts > 0
+    period = 1.0 / frequency
+    steps = steps_for(frequency, 1e-3)
+    fade = math.ceil(2.0 * frequency) / frequency
+    result = qzs.simulate(Sine(amplitude=amplitude, frequency=frequency, phase=math.pi / 2,
+                               fade_in=fade), isolator, PASSIVE,
+                          duration=point.periods * period, dt=period / steps,
+                          sample_rate=frequency * SAMPLES_PER_PERIOD)
+    z = result.relative_position[::SAMPLES_PER_PERIOD][-4:]
+    assert abs(z[-1] - z[-1 - multiple]) < 1e-8 * amplitude * 1e3
+    assert all(abs(z[-1] - z[-1 - j]) > 1e-6 for j in range(1, multiple))
+    x = result.to_xarray()
+    n = multiple * SAMPLES_PER_PERIOD
+    # the last whole periods, their closing sample (phase 0 again) moved to the front
+    payload, base = (np.roll(x[name].values[-n:], 1)
+                     for name in ("payload_displacement", "base_displacement"))
+    kernel = np.exp(-2j * np.pi * multiple * np.arange(n) / n)
+    ratio = np.sum(payload * kernel) / np.sum(base * kernel)
+    assert abs(ratio) == pytest.approx(point.transmissibility, rel=1e-14)
+
+
+# ---------------------------------------------------------------- honesty and contract
+def test_a_response_that_does_not_settle_is_nan_with_its_reason():
+    # the default isolator coming down into the locked band hunts: the PI integral ramps
+    # while stiction holds the payload off the setpoint, on a cycle much longer than the
+    # excitation's period
+    response = steady_state_response([1.0, 2.5], direction="down", dt=1e-3,
+                                     harmonic_balance=False, workers=1, max_time=300.0)
+    points = {p.frequency: p for p in response.points}
+    assert points[2.5].converged
+    held = points[1.0]
+    assert not held.converged and held.period_multiple == 0
+    assert math.isnan(held.transmissibility) and math.isnan(held.locked_fraction)
+    assert "not periodic after 300 periods" in held.reason and "PI integral" in held.reason
+    assert any("NaN" in note for note in response.notes)
+
+
+@pytest.mark.parametrize("arguments, options, name", [
+    (([-1.0, 2.0],), {}, "frequencies"),
+    (([float("nan")],), {}, "frequencies"),
+    (([],), {}, "frequencies"),
+    (([2.0], 0.0), {}, "amplitude"),
+    (([2.0],), {"direction": "sideways"}, "direction"),
+    (([2.0],), {"dt": 1e-3, "tolerance_db": 0.01}, "dt"),
+    (([2.0],), {"dt": 0.05}, "dt"),
+    (([60.0],), {"dt": 1e-3}, "frequencies"),
+    (([2.0],), {"harmonics": 100}, "harmonics"),
+    (([2.0],), {"periodic_tolerance": 0.5}, "periodic_tolerance"),
+    (([2.0],), {"max_periods": 2}, "max_periods"),
+    (([2.0],), {"workers": 0}, "workers"),
+])
+def test_bad_input_is_refused_before_any_work(arguments, options, name):
+    with pytest.raises(ParameterError, match=name):
+        steady_state_response(*arguments, harmonic_balance=False, **options)
+
+
+def test_a_sampled_controller_is_refused():
+    with pytest.raises(ParameterError, match="controller_rate"):
+        steady_state_response([2.0], controller=ControllerParameters(controller_rate=1000.0),
+                              dt=1e-3)
+
+
+def test_parallel_sweeps_equal_serial_ones():
+    options = dict(direction="both", dt=1e-3, harmonic_balance=False)
+    frequencies = [2.0, 3.0, 5.0]
+    serial = steady_state_response(frequencies, workers=1, **options)
+    parallel = steady_state_response(frequencies, workers=2, **options)
+    strip = [{k: v for k, v in p.to_dict().items() if k != "seconds"} for p in serial.points]
+    assert strip == [{k: v for k, v in p.to_dict().items() if k != "seconds"}
+                     for p in parallel.points]
+    # every sweep starts from rest, later frequencies from the previous state
+    assert [p.start for p in serial.points] == ["rest", "continued", "continued"] * 2
+
+
+def test_the_step_is_chosen_for_accuracy_by_default():
+    response = steady_state_response([3.0, 6.0], direction="up", harmonic_balance=False,
+                                     workers=1)
+    assert response.step is not None and response.dt == response.step.dt
+    assert any("chosen for 0.01 dB" in note for note in response.notes)
+    for p in response.points:
+        assert p.dt <= response.dt and round(1 / (p.frequency * p.dt)) % SAMPLES_PER_PERIOD == 0
+
+
+@pytest.fixture(scope="module")
+def small_response():
+    return steady_state_response([2.0, 4.0, 8.0], direction="both", dt=1e-3, workers=1)
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".csv", ".json"])
+def test_save_writes_whole_files(small_response, tmp_path, suffix):
+    path = small_response.save(tmp_path / f"response{suffix}")
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
+    if suffix == ".nc":
+        import xarray as xr
+
+        data = xr.load_dataset(path, engine="h5netcdf")
+        np.testing.assert_allclose(data["transmissibility"].sel(direction="up").values,
+                                   small_response.branch("up")["transmissibility"])
+        assert data["frequency"].attrs["units"] == "Hz"
+        assert data.attrs["isolator.stiction_force_units"] == "N"
+    elif suffix == ".json":
+        record = json.loads(path.read_text())
+        assert {"frequency", "transmissibility"} <= set(record["points"][0])
+    else:
+        text = path.read_text()
+        assert "# amplitude = 0.01 [m]" in text and "direction,frequency,transmissibility" in text
+        assert len([line for line in text.splitlines() if line.startswith(("up", "down"))]) == 6
+
+
+def test_save_refuses_an_unknown_format(small_response, tmp_path):
+    with pytest.raises(ParameterError, match="extension"):
+        small_response.save(tmp_path / "response.xlsx")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_xarray_and_summary(small_response):
+    data = small_response.to_xarray()
+    assert data["transmissibility"].dims == ("direction", "frequency")
+    assert data["harmonics"].sizes["harmonic"] == 4
+    assert "balance_transmissibility" in data
+    text = small_response.summary()
+    assert "steady-state response" in text and "8.000" in text
+
+
+def test_figure_has_units_on_every_axis(small_response, tmp_path):
+    import matplotlib.pyplot as plt
+
+    fig = small_response.plot(path=tmp_path / "response.png")
+    assert (tmp_path / "response.png").stat().st_size > 10_000
+    labels = [ax.get_ylabel() for ax in fig.axes] + [fig.axes[-1].get_xlabel()]
+    assert all("[" in label and "]" in label for label in labels), labels
+    assert "[Hz]" in labels[-1]
+    plt.close(fig)
+
+
+def test_command_line_prints_a_list_of_records(tmp_path, capsys):
+    from qzs.cli import main
+
+    out = tmp_path / "r.csv"
+    code = main(["response", "--frequencies", "3,6", "--direction", "up", "--dt", "1e-3",
+                 "--no-harmonic-balance", "--plot", "none", "--out", str(out), "--json",
+                 "--quiet"])
+    assert code == 0
+    records = json.loads(capsys.readouterr().out)
+    assert isinstance(records, list) and [r["frequency"] for r in records] == [3.0, 6.0]
+    assert all(0 < r["transmissibility"] < 1 for r in records)
+    assert out.exists()
+
+
+@pytest.mark.parametrize("argv, text", [
+    (["response", "--range", "1,2"], "--range"),
+    (["response", "--frequencies", "1,x"], "--frequencies"),
+    (["response", "--frequencies", "-1", "--dt", "1e-3"], "frequencies"),
+    (["response", "--out", "r.xlsx"], "--out"),
+])
+def test_command_line_bad_input_is_exit_code_2(argv, text, capsys):
+    from qzs.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error:") and text in err and err.count("\n") == 1
+
+
+def test_chirp_and_steady_state_agree_where_the_payload_slides():
+    """The paper's default case: above the break-away the payload slides all period long
+    and the slow chirp's Welch ratio reads the steady state within 0.1 dB
+    (docs/response.md §7)."""
+    response = steady_state_response([5.0, 10.0], direction="up", dt=1e-3,
+                                     harmonic_balance=False, compare_chirp=True, workers=1)
+    chirp = response.chirp_at()
+    steady = response.branch("up")["transmissibility"]
+    assert np.all(np.abs(20 * np.log10(chirp / steady)) < 0.1)
