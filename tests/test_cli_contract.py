@@ -87,7 +87,8 @@ def test_an_os_error_names_its_file(capsys):
 ARGV = {"simulate": ["simulate"], "params": ["params"], "paper": ["paper"],
         "study": ["study", "x.toml"], "experiment": ["experiment", "log.csv", "--map", "m.toml"],
         "sweep": ["sweep", "s.toml"], "sweep-plot": ["sweep-plot", "s.zarr"],
-        "hexapod": ["hexapod", "linear"]}
+        "hexapod": ["hexapod", "linear"], "response": ["response"],
+        "design": ["design"]}
 
 
 def test_every_subcommand_has_the_same_exit_codes(monkeypatch, capsys):

@@ -142,3 +142,23 @@ def test_linear_plot_is_written_and_draws_the_model(tmp_path, capsys):
     with pytest.raises(ParameterError, match="shape"):
         plot_transmissibility_matrix(frequency, simulated=np.ones((3, 6, 6)))
     assert main(["hexapod", "linear", "--plot", str(tmp_path / "grid.txt")]) == 2
+
+
+def test_hexapod_simulate_command(tmp_path, capsys):
+    """The shipped platform under an x sine: a summary per leg, a CF file with a dof
+    dimension, a figure; options that need an axis say so."""
+    import xarray as xr
+
+    out, figure = tmp_path / "run.nc", tmp_path / "run.png"
+    assert main(["hexapod", "simulate", "--axis", "x", "--excitation", "sine", "--frequency",
+                 "4", "--amplitude", "0.003", "--duration", "2", "--out", str(out), "--plot",
+                 str(figure), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "stroke used" in text and "Energy ledger residual" in text
+    with xr.open_dataset(out, engine="h5netcdf") as data:
+        assert data.sizes["dof"] == 6 and data.sizes["leg"] == 6
+        assert data.sizes["time"] == 2001
+    assert figure.stat().st_size > 10_000
+    assert main(["hexapod", "simulate", "--amplitude", "0.01"]) == 2
+    assert "add --axis" in capsys.readouterr().err
+    assert main(["hexapod", "simulate", "--out", str(tmp_path / "x.csv")]) == 2

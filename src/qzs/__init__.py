@@ -42,6 +42,10 @@ _LAZY = {
     "load_config": "qzs.iotools", "read_result": "qzs.iotools",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
+    "simulate_hexapod": "qzs.engine.hexapod", "HexapodResult": "qzs.engine.hexapod",
+    "steady_state_response": "qzs.workflows.response",
+    "SteadyStateResponse": "qzs.workflows.response",
+    "design_controller": "qzs.workflows.design", "DesignResult": "qzs.workflows.design",
 }
 
 __all__ = [

@@ -3,6 +3,8 @@
 ``spectral``    transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
 ``linear``      the linearised closed loop at the operating point (python-control)
 ``hexapod_linear``  the six-leg platform of isolator legs linearised at its home pose
+``control_design``  static design, Routh-Hurwitz, sampled-loop margins, hunting (describing functions)
+``harmonic_balance``  periodic responses of the smooth model: AFT, continuation, Hill stability
 ``statistics``  run statistics (stroke, time locked, motor effort)
 ``summary``     the one-screen text summary of a run
 """
@@ -17,6 +19,13 @@ _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
                for name in ("STATISTICS", "RunStatistics", "run_statistics",
                             "SUMMARY_STATISTICS", "SummaryStatistics")},
             "linearize": "qzs.analysis.linear",
+            **{name: "qzs.analysis.control_design"
+               for name in ("static_design", "routh_hurwitz", "loop_margins",
+                            "required_controller_rate", "predict_hunting")},
+            **{name: "qzs.analysis.harmonic_balance"
+               for name in ("SmoothModel", "HarmonicBalanceSolution", "FrequencyResponseCurve",
+                            "periodic_response", "frequency_response_curve",
+                            "floquet_exponents", "smooth_right_hand_side")},
             **{name: "qzs.analysis.hexapod_linear"
                for name in ("HexapodLinearModel", "hexapod_linearize", "geometric_stiffness",
                             "off_diagonal_coupling")}}

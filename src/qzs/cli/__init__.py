@@ -9,6 +9,8 @@
     qzs experiment LOG --map MAP.toml [--out DIR]
     qzs sweep FILE.toml [--resume] [--workers N | --scheduler ADDRESS]
     qzs sweep-plot STORE [--metric NAME] [--x PARAM] [--y PARAM]
+    qzs response [--frequencies F1,F2,... | --range F0,F1,N] [--direction up|down|both] [--json]
+    qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
 
 Every subcommand hands its parsed arguments to a function of the layers below.
 Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
@@ -23,7 +25,7 @@ import signal
 import sys
 
 from qzs._version import __version__
-from qzs.cli import experiment, hexapod, params, simulate, studies, sweep
+from qzs.cli import design, experiment, hexapod, params, response, simulate, studies, sweep
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -32,7 +34,8 @@ __all__ = ["main", "build_parser"]
 HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run,
             "study": studies.run, "experiment": experiment.run,
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
-            "hexapod": hexapod.run}
+            "hexapod": hexapod.run, "response": response.run,
+            "design": design.run}
 
 
 def build_parser():
@@ -49,6 +52,8 @@ def build_parser():
     sweep.add_parsers(sub)
     params.add_parser(sub)
     hexapod.add_parser(sub)
+    design.add_parser(sub)
+    response.add_parser(sub)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes
         if EPILOG not in (command.epilog or ""):
             command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG

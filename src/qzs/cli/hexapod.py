@@ -2,7 +2,7 @@
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
 from qzs.errors import ParameterError
 
-__all__ = ["add_parser", "run", "run_linear"]
+__all__ = ["add_parser", "run", "run_linear", "run_simulate"]
 
 #: ``--frame`` choices and the name the analysis takes.
 FRAMES = {"center-of-mass": "center_of_mass", "origin": "origin", "cube-center": "cube_center"}
@@ -59,6 +59,35 @@ def add_parser(subparsers):
                         help="draw the 6x6 transmissibility of the linear model (0.05-50 Hz)")
     add_json_option(linear)
     linear.set_defaults(handler=run_linear)
+    simulate = sub.add_parser(
+        "simulate", help="simulate the platform: stick-slip on every leg",
+        description="Simulate the six-leg platform (exact stick-slip on every leg, stops, "
+                    "per-leg PI and damping, docs/hexapod.md §9) under the base motion of the "
+                    "file's [excitation.<axis>] tables or of --axis/--excitation, and print a "
+                    "summary per leg: stroke used, stop contacts, time locked, motor RMS. "
+                    "Without --config or --cubic: the shipped paper_legs_cubic file.")
+    _add_setup_options(simulate)
+    simulate.add_argument("--axis", choices=("x", "y", "z", "rx", "ry", "rz"),
+                          help="the base axis --excitation drives (replaces the file's table "
+                               "for that axis); rotations in [rad]")
+    simulate.add_argument("--excitation", choices=("chirp", "sine", "random"),
+                          help="base motion along --axis (default chirp)")
+    simulate.add_argument("--amplitude", type=float, metavar="M",
+                          help="amplitude [m] (or [rad] for a rotation axis)")
+    simulate.add_argument("--f0", type=float, metavar="HZ", help="chirp start / random band low [Hz]")
+    simulate.add_argument("--f1", type=float, metavar="HZ", help="chirp end / random band high [Hz]")
+    simulate.add_argument("--frequency", type=float, metavar="HZ", help="sine frequency [Hz]")
+    simulate.add_argument("--excitation-duration", type=float, metavar="S",
+                          help="length of the chirp or random excitation [s]")
+    simulate.add_argument("--duration", type=float, metavar="S", help="simulated time [s]")
+    simulate.add_argument("--dt", type=float, metavar="S", help="integration step [s]")
+    simulate.add_argument("--sample-rate", type=float, metavar="HZ", help="output rate [Hz]")
+    simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"))
+    simulate.add_argument("--out", metavar="FILE.nc", help="write the run as NetCDF (CF-1.10)")
+    simulate.add_argument("--plot", metavar="FILE.png", help="draw the run")
+    simulate.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_option(simulate)
+    simulate.set_defaults(handler=run_simulate)
     for command in sub.choices.values():
         command.epilog = EPILOG
     return hexapod
@@ -80,7 +109,7 @@ def run(args):
     return args.handler(args)
 
 
-def _setup(args):
+def _setup(args, default_file=False):
     """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`)."""
     from qzs.model.hexapod import cubic_geometry
     from qzs.workflows.hexapod import default_cube_center_height, hexapod_setup, load_hexapod
@@ -94,6 +123,10 @@ def _setup(args):
                              "configuration: add --cubic.")
     if args.config:
         return load_hexapod(args.config, overrides)
+    if default_file:
+        from qzs.workflows.hexapod import SHIPPED_DEFAULT
+
+        return load_hexapod(SHIPPED_DEFAULT, overrides)
     if args.cubic:
         edge = 0.15 if args.cube_edge is None else args.cube_edge
         if not edge > 0:
@@ -136,5 +169,63 @@ def run_linear(args):
 
         record["plot"] = str(plot_linear_transmissibility(setup, model, args.plot))
         text += f"\n  wrote {args.plot}"
+    emit(args, text, record)
+    return 0
+
+
+_EXCITATION_OPTIONS = ("amplitude", "f0", "f1", "frequency")
+
+
+def run_simulate(args):
+    """Run ``qzs hexapod simulate`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    from qzs.iotools.files import atomic_path
+    from qzs.iotools.paths import check_output_path
+    from qzs.workflows.hexapod import simulate_setup
+
+    given = [name for name in (*_EXCITATION_OPTIONS, "excitation", "excitation_duration")
+             if getattr(args, name) is not None]
+    if given and args.axis is None:
+        raise ParameterError(f"--{given[0].replace('_', '-')} describes the base motion of "
+                             "one axis: add --axis (x, y, z, rx, ry or rz).")
+    if args.out:
+        check_output_path(args.out, argument="--out", suffixes=(".nc",))
+    if args.plot:
+        check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
+    setup = _setup(args, default_file=True)
+    excitation = None
+    if args.axis is not None:
+        options = {"kind": args.excitation or "chirp"}
+        options.update({name: getattr(args, name) for name in _EXCITATION_OPTIONS
+                        if getattr(args, name) is not None})
+        if args.excitation_duration is not None:
+            options["duration"] = args.excitation_duration
+        excitation = {args.axis: options}
+    result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
+                            sample_rate=args.sample_rate, solver=args.solver,
+                            progress=not args.quiet and not args.json)
+    text = result.summary()
+    record = {"summary": text, "run": result.run, "source": setup.source}
+    if args.out:
+        with atomic_path(args.out) as tmp:
+            result.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+        text += f"\n  wrote            {args.out}"
+        record["out"] = args.out
+    if args.plot:
+        import matplotlib.pyplot as plt
+
+        plt.close(result.plot(path=args.plot))
+        text += f"\n  wrote            {args.plot}"
+        record["plot"] = args.plot
     emit(args, text, record)
     return 0

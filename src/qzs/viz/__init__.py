@@ -6,12 +6,15 @@
 ``identify``          spring, friction and transmissibility fits
 ``experiment``        a measured log beside its simulation
 ``sweeps``            sweep stores: metrics against parameters, transmissibility bands
+``design``            a controller design's figures (``qzs design``)
+``hexapod``           a hexapod run: platform pose, leg strokes, motor forces
 """
 from qzs.viz.figures import envelope, new_figure, save_figure
+from qzs.viz.hexapod import plot_hexapod
 from qzs.viz.identify import plot_friction_fit, plot_spring_fit, plot_transmissibility_fit
 from qzs.viz.simulation import plot_energy, plot_simulation
 from qzs.viz.transmissibility import plot_transmissibility
 
 __all__ = ["envelope", "new_figure", "save_figure", "plot_simulation", "plot_energy",
            "plot_transmissibility", "plot_spring_fit", "plot_friction_fit",
-           "plot_transmissibility_fit"]
+           "plot_transmissibility_fit", "plot_hexapod"]

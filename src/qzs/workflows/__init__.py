@@ -5,4 +5,7 @@
 ``report``      ``qzs paper``: figures, metrics, claims decided from the data
 ``experiment``  a measured log beside its simulation
 ``sweeps``      parameter sweeps and Monte Carlo runs into Zarr stores, locally or on Dask
+``design``      ``qzs design``: PI and damping gains searched by simulation, with the evidence
+``response``    steady-state frequency response: stepped-sine sweeps up and down, beside the
+                harmonic balance and the paper's chirp estimate
 """

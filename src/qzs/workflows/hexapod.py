@@ -30,6 +30,7 @@ import numpy as np
 
 from qzs._validation import read_toml
 from qzs.errors import ParameterError
+from qzs.iotools.shipped import resolve_shipped
 from qzs.model.controller import ControllerParameters
 from qzs.model.hexapod import (LEG_COUNT, PlatformParameters, cubic_geometry, leg_unit_vectors,
                                radial_geometry, HexapodGeometry)
@@ -38,7 +39,15 @@ from qzs.model.registry import PARAMETERS, update_parameters
 
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
-           "linear_record", "linear_text", "plot_linear_transmissibility"]
+           "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
+           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS"]
+
+#: Folder of the shipped hexapod files, inside the package.
+SHIPPED = "workflows/hexapod_files"
+#: The shipped file ``qzs hexapod`` uses without --config or --cubic.
+SHIPPED_DEFAULT = "paper_legs_cubic"
+#: Keys of a hexapod file's ``[simulation]`` table.
+SIMULATION_KEYS = ("dt", "sample_rate", "solver", "duration")
 
 #: How a ``[geometry]`` table describes the platform: its keys per kind (required, optional).
 GEOMETRY_KINDS = {
@@ -272,7 +281,7 @@ def load_hexapod(path, settings=None):
     Parameters
     ----------
     path : str or Path
-        The file.
+        The file, or the name of a shipped one (``paper_legs_cubic``).
     settings : dict, optional
         Registry overrides applied to every leg after the file (``--set``).
 
@@ -285,6 +294,7 @@ def load_hexapod(path, settings=None):
     ParameterError
         A missing or malformed file, an unknown table or key, a bad value.
     """
+    path = resolve_shipped(path, SHIPPED, "hexapod", "hexapod files")
     document = read_toml(path, "hexapod file")
     where = f"{str(path)!r}: "
     allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation"}
@@ -310,9 +320,18 @@ def load_hexapod(path, settings=None):
     if wrong:
         raise ParameterError(f"{where}[excitation.<axis>] axes must be among {list(AXES)}, got "
                              f"{wrong}.")
+    simulation = dict(document.get("simulation", {}))
+    wrong = sorted(set(simulation) - set(SIMULATION_KEYS))
+    if wrong:
+        raise ParameterError(f"{where}[simulation]: unknown key(s) {wrong}; allowed are "
+                             f"{list(SIMULATION_KEYS)}.")
+    for axis, options in excitation.items():
+        if not isinstance(options, dict) or "kind" not in options:
+            raise ParameterError(f"{where}[excitation.{axis}] needs a `kind` (chirp, sine, "
+                                 "random or file) and its options.")
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
                         controller=controller, kind=kind, excitation=dict(excitation),
-                        simulation=dict(document.get("simulation", {})), source=str(path))
+                        simulation=simulation, source=str(path))
 
 
 def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_preload=True):
@@ -456,3 +475,60 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
               f"{setup.platform.mass:.3g} kg{stability}")
     plt.close(figure)
     return Path(out)
+
+
+def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rate=None,
+                   solver=None, progress=False):
+    """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        The platform (:func:`load_hexapod`, :func:`hexapod_setup`).
+    excitation : dict, optional
+        Axis name -> options (``kind`` and the options of
+        :func:`qzs.model.build_excitation`) replacing the file's tables for those axes.
+    duration : float, optional
+        Simulated time [s]; default the file's, else the shortest excitation's length.
+    dt : float, optional
+        Integration step [s]; default the file's, else 1e-4.
+    sample_rate : float, optional
+        Output rate [Hz]; default the file's, else 1000.
+    solver : {"ode3", "rk4", "euler"}, optional
+        Integrator; default the file's, else ode3.
+    progress : bool
+        Show a progress bar over simulated time.
+
+    Returns
+    -------
+    HexapodResult
+
+    Raises
+    ------
+    ParameterError
+        No excitation on any axis, an invalid one, or invalid run settings (before any
+        integration).
+    """
+    from qzs.defaults import SIMULATION
+    from qzs.engine.hexapod import simulate_hexapod
+    from qzs.model.excitation import build_excitation
+
+    tables = {**setup.excitation, **(excitation or {})}
+    if not tables:
+        raise ParameterError("no base motion: give an [excitation.<axis>] table (e.g. "
+                             "[excitation.z] kind = 'chirp') or --axis with --excitation.")
+    built = {}
+    for axis, options in tables.items():
+        options = dict(options)
+        kind = options.pop("kind", None)
+        built[axis] = build_excitation(kind, options)
+    run = {**setup.simulation}
+    for name, value in (("duration", duration), ("dt", dt), ("sample_rate", sample_rate),
+                        ("solver", solver)):
+        if value is not None:
+            run[name] = value
+    return simulate_hexapod(setup.geometry, setup.platform, setup.isolator, setup.controller,
+                            excitation=built, duration=run.get("duration"),
+                            dt=run.get("dt", SIMULATION["dt"]),
+                            sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
+                            solver=run.get("solver", SIMULATION["solver"]), progress=progress)
