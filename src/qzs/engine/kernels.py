@@ -354,6 +354,15 @@ def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
 
 
 @njit(**_JIT, inline="always")
+def _crossed_zero(v0, v1, P):
+    """Did the slip velocity reach zero in the step (``v0``, ``v1``: ``d*v`` at its ends)?
+
+    Only the exact model tracks it; the regularised one (``P_VREG > 0``) slips through.
+    """
+    return P[P_VREG] == 0.0 and (v1 < 0.0 or (v1 == 0.0 and v0 > 0.0))
+
+
+@njit(**_JIT, inline="always")
 def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     """Kind (0: none) and time fraction (secant) of the first transition in a step."""
     theta = 2.0
@@ -361,8 +370,7 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     if mode == MODE_SLIP:
         v0 = direction * s[S_V]
         v1 = direction * s1[S_V]
-        # v reached zero: stick or reverse (not an event of the regularised model)
-        if P[P_VREG] == 0.0 and (v1 < 0.0 or (v1 == 0.0 and v0 > 0.0)):
+        if _crossed_zero(v0, v1, P):  # v reached zero: stick or reverse
             theta = v0 / (v0 - v1) if v0 > v1 else 0.0
             event = 1
         if P[P_PLASTIC] != 0.0:  # reached a plastic stop
@@ -378,6 +386,19 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
         theta = margin / (margin - margin1) if margin > margin1 else 0.0
         event = 4
     return event, min(max(theta, 0.0), 1.0)
+
+
+@njit(**_JIT, inline="always")
+def _any_event(s, s1, mode, direction, margin1, P):
+    """Whether a step may hold a transition, without locating it (no division).
+
+    False only when :func:`_first_event` finds none: a lane pass keeps such a step and
+    hands every other one to :func:`grid_step`, which decides (docs/model.md §9).
+    """
+    if mode == MODE_SLIP:
+        return (_crossed_zero(direction * s[S_V], direction * s1[S_V], P)
+                or (P[P_PLASTIC] != 0.0 and (s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH])))
+    return margin1 < 0.0
 
 
 @njit(**_JIT)

@@ -39,6 +39,13 @@ N_SCRATCH = K.N_ODE + 5
 MAX_LANES = 1024
 W = MAX_LANES + 8
 STATUS_TOO_MANY_LANES = -1
+#: What the lanes of a call have in common (``_batch_kind``): all exact stick-slip
+#: (``P_VREG = 0``), all regularised (``P_VREG > 0``, compliant stops, slipping), or a mix.
+#: Each pass is compiled once per kind with the kind a constant, so LLVM drops what the
+#: kind lacks: the friction's ``tanh`` of the exact model, the held modes of the
+#: regularised one. The values are the lanes' own either way: the same bits.
+KIND_EXACT, KIND_SMOOTH, KIND_MIXED = 0, 1, 2
+assert K.P_PLASTIC == 12 and K.P_VREG == 21 and K.N_PARAMS == 22  # as in _params
 
 _JIT = K._JIT
 # grid_step inlined into the one-case driver, where it is the hot path
@@ -57,12 +64,21 @@ def _at(row, c):
 
 
 @njit(**_JIT, inline="always")
-def _params(PP, c):
+def _params(PP, c, kind=KIND_MIXED):
+    """The parameter tuple of lane ``c`` (``K.P_*``), with the constants of ``kind``."""
+    plastic = 0.0 if kind == KIND_SMOOTH else PP[_at(K.P_PLASTIC, c)]
+    v_reg = 0.0 if kind == KIND_EXACT else PP[_at(K.P_VREG, c)]
     return (PP[_at(0, c)], PP[_at(1, c)], PP[_at(2, c)], PP[_at(3, c)], PP[_at(4, c)],
             PP[_at(5, c)], PP[_at(6, c)], PP[_at(7, c)], PP[_at(8, c)], PP[_at(9, c)],
-            PP[_at(10, c)], PP[_at(11, c)], PP[_at(12, c)], PP[_at(13, c)], PP[_at(14, c)],
+            PP[_at(10, c)], PP[_at(11, c)], plastic, PP[_at(13, c)], PP[_at(14, c)],
             PP[_at(15, c)], PP[_at(16, c)], PP[_at(17, c)], PP[_at(18, c)], PP[_at(19, c)],
-            PP[_at(20, c)], PP[_at(21, c)])
+            PP[_at(20, c)], v_reg)
+
+
+@njit(**_JIT, inline="always")
+def _mode(L, c, kind):
+    """Stick-slip mode of lane ``c``: always slipping in a regularised batch."""
+    return K.MODE_SLIP if kind == KIND_SMOOTH else int(L[_at(R_MODE, c)])
 
 
 @njit(**_JIT, inline="always")
@@ -96,7 +112,7 @@ def _store(L, c, s, margin, contact, P):
 
 
 @njit(**_JIT, inline="always")
-def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
+def _stage_lanes(kind, n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
     """One Runge-Kutta stage of every lane: ``k`` at the stage input, added to the sum.
 
     The stage input and the running sum are read from ``source`` (rows from
@@ -108,8 +124,8 @@ def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
     for c in range(n):
         x = (source[_at(at_input, c)], source[_at(at_input + 1, c)],
              source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0)
-        k = K.rhs(base[0], base[1], base[2], x, int(L[_at(R_MODE, c)]),
-                  L[_at(R_DIRECTION, c)], _held(L, c), _params(PP, c))[0]
+        k = K.rhs(base[0], base[1], base[2], x, _mode(L, c, kind), L[_at(R_DIRECTION, c)],
+                  _held(L, c), _params(PP, c, kind))[0]
         T[_at(T_SUM, c)] = K.fma(weight, k[0], source[_at(at_sum, c)])
         T[_at(T_SUM + 1, c)] = K.fma(weight, k[1], source[_at(at_sum + 1, c)])
         T[_at(T_SUM + 2, c)] = K.fma(weight, k[2], source[_at(at_sum + 2, c)])
@@ -124,20 +140,8 @@ def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
         T[_at(T_INPUT + 3, c)] = K.fma(a_next, k[3], L[_at(3, c)])
 
 
-@njit(**_JIT)
-def _first_stage_pass(n, a_next, weight, base, L, T, PP):
-    """:func:`_stage_lanes` from the state."""
-    _stage_lanes(n, a_next, weight, base, L, T, PP, L, 0, 0)
-
-
-@njit(**_JIT)
-def _stage_pass(n, a_next, weight, base, L, T, PP):
-    """:func:`_stage_lanes` from the previous stage."""
-    _stage_lanes(n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
-
-
-@njit(**_JIT)
-def _finish_pass(n, t, h, b_end, L, T, PP):
+@njit(**_JIT, inline="always")
+def _finish_lanes(kind, n, b_end, L, T, PP):
     """End the step of every lane: store it, or flag the lane for pass 2 (returns how many).
 
     What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
@@ -149,8 +153,8 @@ def _finish_pass(n, t, h, b_end, L, T, PP):
         s1 = (T[_at(T_SUM, c)], T[_at(T_SUM + 1, c)], T[_at(T_SUM + 2, c)],
               T[_at(T_SUM + 3, c)], T[_at(T_SUM + 4, c)], T[_at(T_SUM + 5, c)],
               T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)])
-        P = _params(PP, c)
-        mode = int(L[_at(R_MODE, c)])
+        P = _params(PP, c, kind)
+        mode = _mode(L, c, kind)
         direction = L[_at(R_DIRECTION, c)]
         margin = L[_at(R_MARGIN, c)]
         margin1 = np.nan
@@ -161,8 +165,8 @@ def _finish_pass(n, t, h, b_end, L, T, PP):
             ready = P[K.P_VREG] > 0.0 or direction * s[K.S_V] >= 0.0
         else:
             ready = margin >= 0.0
-        event = K._first_event(t, h, s, s1, mode, direction, margin, margin1, P)[0]
-        flagged = not ready or event != 0 or not _finite(s1, P) or L[_at(R_FAILED, c)] != 0.0
+        flagged = (not ready or K._any_event(s, s1, mode, direction, margin1, P)
+                   or not _finite(s1, P) or L[_at(R_FAILED, c)] != 0.0)
         T[_at(T_FLAGGED, c)] = 1.0 if flagged else 0.0
         flagged_lanes += flagged
         if not flagged:
@@ -170,23 +174,103 @@ def _finish_pass(n, t, h, b_end, L, T, PP):
     return flagged_lanes
 
 
+# Each loop of pass 1 compiled once per kind, each its own function: a function holding
+# all three loops took LLVM ten times as long to compile.
 @njit(**_JIT)
-def _vector_pass(solver, n, t, h, L, T, PP, bases, b_end):
+def _first_stage_exact(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_exact(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_exact(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_EXACT, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _first_stage_smooth(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_smooth(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_smooth(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_SMOOTH, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _first_stage_mixed(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_mixed(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_mixed(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_MIXED, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
 
     Stage by stage (``K.tableau``, in the order of ``K.rk_from_bases``) with the
     intermediate values in ``T``: each loop is short, its iterations independent,
-    and LLVM vectorises it.
+    and LLVM vectorises it. The loops compiled for ``kind`` (see :data:`KIND_EXACT`).
     """
     stages = K.n_stages(solver)
     for stage in range(stages):
         weight = K.tableau(solver, h, stage)[2]
         a_next = K.tableau(solver, h, stage + 1)[1] if stage + 1 < stages else 0.0
-        if stage == 0:
-            _first_stage_pass(n, a_next, weight, bases[stage], L, T, PP)
+        base = bases[stage]
+        if kind == KIND_EXACT:
+            if stage == 0:
+                _first_stage_exact(n, a_next, weight, base, L, T, PP)
+            else:
+                _stage_exact(n, a_next, weight, base, L, T, PP)
+        elif kind == KIND_SMOOTH:
+            if stage == 0:
+                _first_stage_smooth(n, a_next, weight, base, L, T, PP)
+            else:
+                _stage_smooth(n, a_next, weight, base, L, T, PP)
+        elif stage == 0:
+            _first_stage_mixed(n, a_next, weight, base, L, T, PP)
         else:
-            _stage_pass(n, a_next, weight, bases[stage], L, T, PP)
-    return _finish_pass(n, t, h, b_end, L, T, PP)
+            _stage_mixed(n, a_next, weight, base, L, T, PP)
+    if kind == KIND_EXACT:
+        return _finish_exact(n, b_end, L, T, PP)
+    if kind == KIND_SMOOTH:
+        return _finish_smooth(n, b_end, L, T, PP)
+    return _finish_mixed(n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _batch_kind(n, PP, L):
+    """:data:`KIND_EXACT`, :data:`KIND_SMOOTH` or :data:`KIND_MIXED` for lanes ``0..n-1``.
+
+    Regularised lanes count as such only with compliant stops and slipping, as the
+    model has them (docs/model.md §3), so that the constants of the kind are theirs.
+    """
+    exact = smooth = 0
+    for c in range(n):
+        if PP[_at(K.P_VREG, c)] == 0.0:
+            exact += 1
+        elif PP[_at(K.P_PLASTIC, c)] == 0.0 and L[_at(R_MODE, c)] == K.MODE_SLIP:
+            smooth += 1
+    if exact == n:
+        return KIND_EXACT
+    return KIND_SMOOTH if smooth == n else KIND_MIXED
 
 
 @njit(**_JIT, nogil=True)
@@ -227,6 +311,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         rows[c] = 0
         sampled = sampled or params[c, K.P_CONTROL_STEPS] > 0.0
     h = params[0, K.P_DT] if n > 0 else 0.0
+    kind = _batch_kind(n, PP, L)
     step = step0
     row = row0
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
@@ -243,7 +328,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                     L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
-        if _vector_pass(solver, n, t, h, L, T, PP, bases, b_end) > 0:
+        if _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end) > 0:
             for c in range(n):  # pass 2: the flagged lanes
                 if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
