@@ -1,8 +1,10 @@
 """The lockstep driver: every lane gives the one-case driver's numbers, bit for bit."""
 import numpy as np
 import pytest
+from numba import njit
 
 import qzs
+from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.batch import simulate_batch
 
@@ -64,3 +66,40 @@ def test_batches_larger_than_one_call_are_split(monkeypatch):
     assert np.array_equal(split.channels["relative_position"],
                           whole.channels["relative_position"])
     assert np.array_equal(split.stats["stick_events"], whole.stats["stick_events"])
+
+
+@njit(error_model="numpy")  # as the kernels (x/0 is inf); not cached: it inlines kernel code
+def _events(cases):
+    """``_any_event`` and ``_first_event``'s kind for rows of (z0, v0, z1, v1, mode,
+    direction, margin, margin1, plastic, v_reg)."""
+    out = np.empty((cases.shape[0], 2), dtype=np.int64)
+    for i in range(cases.shape[0]):
+        z0, v0, z1, v1, mode, direction, margin, margin1, plastic, v_reg = cases[i]
+        P = (6.4, 9.81, 60.84, 78.1, 10.0, 1.0, 100.0, 100.0, -0.1, 0.1, 1e6, 1e3, plastic,
+             44.0, -0.06, 50.0, 20.0, 0.0, 6.28, 0.0, 1e-4, v_reg)
+        s = (z0, v0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        s1 = (z1, v1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        out[i, 0] = K._any_event(s, s1, int(mode), direction, margin1, P)
+        out[i, 1] = K._first_event(0.0, 1e-4, s, s1, int(mode), direction, margin, margin1,
+                                   P)[0]
+    return out
+
+
+def test_the_lane_pass_keeps_a_step_only_when_grid_step_finds_no_transition():
+    """Pass 1 tests a step with ``_any_event`` (no division) and hands the rest to pass 2:
+    wherever it keeps a step, ``grid_step``'s ``_first_event`` must find none."""
+    rng = np.random.default_rng(5)
+    n = 20000
+    pick = lambda values: rng.choice(np.asarray(values, dtype=float), n)  # noqa: E731
+    cases = np.column_stack([
+        pick([-0.2, -0.1, -0.05, 0.0, 0.1, 0.2]), pick([-1.0, -1e-9, 0.0, 1e-9, 1.0]),
+        pick([-0.2, -0.1, -0.05, 0.0, 0.1, 0.2]), pick([-1.0, -1e-9, 0.0, 1e-9, 1.0]),
+        pick([K.MODE_SLIP, K.MODE_SLIP, K.MODE_STICK, K.MODE_WALL_LOW, K.MODE_WALL_HIGH]),
+        pick([-1.0, 1.0]), pick([-1.0, 0.0, 1.0, np.nan]), pick([-1.0, 0.0, 1.0, np.nan]),
+        pick([0.0, 1.0]), pick([0.0, 0.0, 1e-3])])
+    out = _events(cases)
+    assert np.all(out[out[:, 0] == 0, 1] == 0)          # kept: no transition in it
+    assert np.count_nonzero(out[:, 1] != 0) > 1000      # (there are transitions to find)
+    # the regularised model has no zero-crossing events
+    smooth = (cases[:, 9] > 0) & (cases[:, 8] == 0) & (cases[:, 4] == K.MODE_SLIP)
+    assert np.all(out[smooth] == 0)

@@ -36,12 +36,12 @@ def test_sliding_friction_law_equals_the_numpy_law_and_opposes_the_slip():
     v = np.concatenate([-np.logspace(-9, 1, 300), np.logspace(-9, 1, 300)])
     numba = _vectorised(lambda vv: laws.sliding_friction_law(
         vv, np.sign(vv), P.stiction_force, P.coulomb_force, P.stribeck_decay,
-        P.viscous_damping), v)
+        P.viscous_damping, 0.0), v)
     np.testing.assert_allclose(numba, friction_force(v, P), rtol=2e-15, atol=1e-14)
     assert np.all(numba * v < 0)
     # the breakaway force is Fs, and far from it Coulomb plus viscous
-    assert laws.sliding_friction_law(0.0, 1.0, 12.0, 2.5, 40.0, 80.0) == -12.0
-    assert laws.sliding_friction_law(1.0, 1.0, 12.0, 2.5, 40.0, 80.0) == pytest.approx(
+    assert laws.sliding_friction_law(0.0, 1.0, 12.0, 2.5, 40.0, 80.0, 0.0) == -12.0
+    assert laws.sliding_friction_law(1.0, 1.0, 12.0, 2.5, 40.0, 80.0, 0.0) == pytest.approx(
         -(2.5 + 9.5 * np.exp(-40.0) + 80.0), rel=1e-15)
 
 

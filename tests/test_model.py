@@ -106,7 +106,8 @@ def test_paper_values_leave_a_weight_deficit_that_validation_accepts():
 
 # ------------------------------------------------------------------ parameters
 TABLE_1 = dict(mass=6.4, gravity=9.81, spring_force=60.84, spring_shape=78.10, stiction_force=10.0,
-               coulomb_force=1.0, stribeck_decay=100.0, viscous_damping=100.0, stroke_half=0.080,
+               coulomb_force=1.0, stribeck_decay=100.0, viscous_damping=100.0,
+               friction_regularisation=0.0, stroke_half=0.080,
                stop_center=None, stop_stiffness=1e6, stop_damping=1e3, stop_model="compliant",
                motor_force_max=44.0)
 
@@ -143,6 +144,8 @@ def test_parameters_are_frozen_keyword_only_and_round_trip_through_dict():
     ("stroke_half", [0.08], r"must be a number, got \[0.08\]"),
     ("stop_center", float("nan"), "must be finite, got nan"),
     ("stop_model", "elastic", "must be one of 'compliant', 'plastic'; got 'elastic'"),
+    ("friction_regularisation", -1e-3, "must be non-negative, got -0.001"),
+    ("friction_regularisation", float("inf"), "must be finite, got inf"),
 ])
 def test_invalid_parameter_is_named_with_its_value(name, value, match):
     with pytest.raises(ParameterError, match=match) as info:

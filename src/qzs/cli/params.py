@@ -66,11 +66,12 @@ def run(args):
         path = save_config(args.toml, config["isolator"], config["controller"])
         print(f"wrote {path}")
         return 0
-    print(f"{'section':<11}{'name':<20}{'value':>12}  {'unit':<9}description")
-    for section, name, value, unit, doc in parameter_table(config["isolator"],
-                                                           config["controller"]):
+    rows = parameter_table(config["isolator"], config["controller"])
+    width = max(20, 1 + max(len(row[1]) for row in rows))
+    print(f"{'section':<11}{'name':<{width}}{'value':>12}  {'unit':<9}description")
+    for section, name, value, unit, doc in rows:
         shown = format_value(value)
         if name == "stop_center" and value is None:
             shown = "setpoint"
-        print(f"{section:<11}{name:<20}{shown:>12}  {unit:<9}{doc}")
+        print(f"{section:<11}{name:<{width}}{shown:>12}  {unit:<9}{doc}")
     return 0

@@ -31,11 +31,12 @@ from qzs.engine.base_motion import advance_phase, base_motion, base_motion_near,
 from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
                              spring_energy_law, spring_law)
 
-# Packed parameters.
+# Packed parameters. P_VREG > 0 selects the regularised friction model: no stick-slip events,
+# the mode stays slipping (docs/model.md §3).
 (P_MASS, P_GRAVITY, P_SPRING_A, P_SPRING_B, P_FS, P_FC, P_CBC, P_CV, P_Z_LOW, P_Z_HIGH,
  P_STOP_K, P_STOP_C, P_PLASTIC, P_FMAX, P_ZREF, P_KP, P_KI, P_KD, P_HP_OMEGA,
- P_CONTROL_STEPS, P_DT) = range(21)
-N_PARAMS = 21
+ P_CONTROL_STEPS, P_DT, P_VREG) = range(22)
+N_PARAMS = 22
 
 # ODE state, then the held controller outputs of a sampled controller.
 S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
@@ -73,7 +74,7 @@ STATUS_OK, STATUS_DIVERGED = 0, 1
 def params_tuple(p):
     """The packed parameter array as a tuple."""
     return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
-            p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20])
+            p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20], p[21])
 
 
 @njit(**_JIT, inline="always")
@@ -112,7 +113,8 @@ def rhs(y, yd, ydd, s, mode, direction, held, P):
     f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
     f_hold = m * ydd - f_applied
     if mode == MODE_SLIP:
-        f_friction = sliding_friction_law(v, direction, P[P_FS], P[P_FC], P[P_CBC], P[P_CV])
+        f_friction = sliding_friction_law(v, direction, P[P_FS], P[P_FC], P[P_CBC], P[P_CV],
+                                          P[P_VREG])
         xdd = (f_applied + f_friction) * (1.0 / m)  # one division per step, off the critical path
     else:
         f_friction = f_hold
@@ -335,6 +337,15 @@ def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
 
 
 @njit(**_JIT, inline="always")
+def _crossed_zero(v0, v1, P):
+    """Did the slip velocity reach zero in the step (``v0``, ``v1``: ``d*v`` at its ends)?
+
+    Only the exact model tracks it; the regularised one (``P_VREG > 0``) slips through.
+    """
+    return P[P_VREG] == 0.0 and (v1 < 0.0 or (v1 == 0.0 and v0 > 0.0))
+
+
+@njit(**_JIT, inline="always")
 def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     """Kind (0: none) and time fraction (secant) of the first transition in a step."""
     theta = 2.0
@@ -342,7 +353,7 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
     if mode == MODE_SLIP:
         v0 = direction * s[S_V]
         v1 = direction * s1[S_V]
-        if v1 < 0.0 or (v1 == 0.0 and v0 > 0.0):  # v reached zero: stick or reverse
+        if _crossed_zero(v0, v1, P):  # v reached zero: stick or reverse
             theta = v0 / (v0 - v1) if v0 > v1 else 0.0
             event = 1
         if P[P_PLASTIC] != 0.0:  # reached a plastic stop
@@ -358,6 +369,19 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
         theta = margin / (margin - margin1) if margin > margin1 else 0.0
         event = 4
     return event, min(max(theta, 0.0), 1.0)
+
+
+@njit(**_JIT, inline="always")
+def _any_event(s, s1, mode, direction, margin1, P):
+    """Whether a step may hold a transition, without locating it (no division).
+
+    False only when :func:`_first_event` finds none: a lane pass keeps such a step and
+    hands every other one to :func:`grid_step`, which decides (docs/model.md §9).
+    """
+    if mode == MODE_SLIP:
+        return (_crossed_zero(direction * s[S_V], direction * s1[S_V], P)
+                or (P[P_PLASTIC] != 0.0 and (s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH])))
+    return margin1 < 0.0
 
 
 @njit(**_JIT)
@@ -425,7 +449,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     """
     sticks = 0
     impacts = 0
-    if mode == MODE_SLIP and direction * s[S_V] < 0.0:  # a crossing missed earlier
+    if mode == MODE_SLIP and P[P_VREG] == 0.0 and direction * s[S_V] < 0.0:  # missed earlier
         s, mode, direction = _settle(t, s, direction, held, P, E, table)
         sticks += mode == MODE_STICK
         margin = np.nan

@@ -39,6 +39,13 @@ N_SCRATCH = K.N_ODE + 5
 MAX_LANES = 1024
 W = MAX_LANES + 8
 STATUS_TOO_MANY_LANES = -1
+#: What the lanes of a call have in common (``_batch_kind``): all exact stick-slip
+#: (``P_VREG = 0``), all regularised (``P_VREG > 0``, compliant stops, slipping), or a mix.
+#: Each pass is compiled once per kind with the kind a constant, so LLVM drops what the
+#: kind lacks: the friction's ``tanh`` of the exact model, the held modes of the
+#: regularised one. The values are the lanes' own either way: the same bits.
+KIND_EXACT, KIND_SMOOTH, KIND_MIXED = 0, 1, 2
+assert K.P_PLASTIC == 12 and K.P_VREG == 21 and K.N_PARAMS == 22  # as in _params
 
 _JIT = K._JIT
 # grid_step inlined into the one-case driver, where it is the hot path
@@ -46,22 +53,43 @@ _grid_step_inline = njit(**_JIT, inline="always")(getattr(K.grid_step, "py_func"
 
 
 @njit(**_JIT, inline="always")
-def _params(PP, c):
-    return (PP[c], PP[W + c], PP[2 * W + c], PP[3 * W + c], PP[4 * W + c], PP[5 * W + c],
-            PP[6 * W + c], PP[7 * W + c], PP[8 * W + c], PP[9 * W + c], PP[10 * W + c],
-            PP[11 * W + c], PP[12 * W + c], PP[13 * W + c], PP[14 * W + c], PP[15 * W + c],
-            PP[16 * W + c], PP[17 * W + c], PP[18 * W + c], PP[19 * W + c], PP[20 * W + c])
+def _at(row, c):
+    """Index of row ``row``, lane ``c`` in a lane array (see :data:`W`), unsigned.
+
+    numba adds a negative-index wraparound to a signed index; LLVM folds it away in small
+    lane loops, but not in the stage loops once the regularised friction's third ``exp``
+    made them larger, and it then stopped vectorising them. An unsigned index has none.
+    """
+    return np.uint64(row * W + c)
+
+
+@njit(**_JIT, inline="always")
+def _params(PP, c, kind=KIND_MIXED):
+    """The parameter tuple of lane ``c`` (``K.P_*``), with the constants of ``kind``."""
+    plastic = 0.0 if kind == KIND_SMOOTH else PP[_at(K.P_PLASTIC, c)]
+    v_reg = 0.0 if kind == KIND_EXACT else PP[_at(K.P_VREG, c)]
+    return (PP[_at(0, c)], PP[_at(1, c)], PP[_at(2, c)], PP[_at(3, c)], PP[_at(4, c)],
+            PP[_at(5, c)], PP[_at(6, c)], PP[_at(7, c)], PP[_at(8, c)], PP[_at(9, c)],
+            PP[_at(10, c)], PP[_at(11, c)], plastic, PP[_at(13, c)], PP[_at(14, c)],
+            PP[_at(15, c)], PP[_at(16, c)], PP[_at(17, c)], PP[_at(18, c)], PP[_at(19, c)],
+            PP[_at(20, c)], v_reg)
+
+
+@njit(**_JIT, inline="always")
+def _mode(L, c, kind):
+    """Stick-slip mode of lane ``c``: always slipping in a regularised batch."""
+    return K.MODE_SLIP if kind == KIND_SMOOTH else int(L[_at(R_MODE, c)])
 
 
 @njit(**_JIT, inline="always")
 def _state(L, c):
-    return (L[c], L[W + c], L[2 * W + c], L[3 * W + c], L[4 * W + c], L[5 * W + c],
-            L[6 * W + c], L[7 * W + c])
+    return (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)],
+            L[_at(5, c)], L[_at(6, c)], L[_at(7, c)])
 
 
 @njit(**_JIT, inline="always")
 def _held(L, c):
-    return L[K.A_F_PI * W + c], L[K.A_F_DAMP * W + c], L[K.A_F_MOTOR * W + c]
+    return L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)]
 
 
 @njit(**_JIT, inline="always")
@@ -75,16 +103,16 @@ def _finite(s, P):
 @njit(**_JIT, inline="always")
 def _store(L, c, s, margin, contact, P):
     """Put the end-of-step state of lane ``c``; counts a new compliant-stop contact."""
-    (L[c], L[W + c], L[2 * W + c], L[3 * W + c], L[4 * W + c], L[5 * W + c], L[6 * W + c],
-     L[7 * W + c]) = s
-    L[R_MARGIN * W + c] = margin
-    new_contact = contact and L[R_CONTACT * W + c] == 0.0 and P[K.P_PLASTIC] == 0.0
-    L[R_CONTACT * W + c] = 1.0 if contact else 0.0
-    L[R_CONTACTS * W + c] += 1.0 if new_contact else 0.0
+    (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)], L[_at(5, c)],
+     L[_at(6, c)], L[_at(7, c)]) = s
+    L[_at(R_MARGIN, c)] = margin
+    new_contact = contact and L[_at(R_CONTACT, c)] == 0.0 and P[K.P_PLASTIC] == 0.0
+    L[_at(R_CONTACT, c)] = 1.0 if contact else 0.0
+    L[_at(R_CONTACTS, c)] += 1.0 if new_contact else 0.0
 
 
 @njit(**_JIT, inline="always")
-def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
+def _stage_lanes(kind, n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
     """One Runge-Kutta stage of every lane: ``k`` at the stage input, added to the sum.
 
     The stage input and the running sum are read from ``source`` (rows from
@@ -94,38 +122,26 @@ def _stage_lanes(n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
     integral); the ledger rates just add up.
     """
     for c in range(n):
-        x = (source[at_input * W + c], source[(at_input + 1) * W + c],
-             source[(at_input + 2) * W + c], source[(at_input + 3) * W + c], 0.0, 0.0, 0.0, 0.0)
-        k = K.rhs(base[0], base[1], base[2], x, int(L[R_MODE * W + c]),
-                  L[R_DIRECTION * W + c], _held(L, c), _params(PP, c))[0]
-        T[T_SUM * W + c] = K.fma(weight, k[0], source[at_sum * W + c])
-        T[(T_SUM + 1) * W + c] = K.fma(weight, k[1], source[(at_sum + 1) * W + c])
-        T[(T_SUM + 2) * W + c] = K.fma(weight, k[2], source[(at_sum + 2) * W + c])
-        T[(T_SUM + 3) * W + c] = K.fma(weight, k[3], source[(at_sum + 3) * W + c])
-        T[(T_SUM + 4) * W + c] = K.fma(weight, k[4], source[(at_sum + 4) * W + c])
-        T[(T_SUM + 5) * W + c] = K.fma(weight, k[5], source[(at_sum + 5) * W + c])
-        T[(T_SUM + 6) * W + c] = K.fma(weight, k[6], source[(at_sum + 6) * W + c])
-        T[(T_SUM + 7) * W + c] = K.fma(weight, k[7], source[(at_sum + 7) * W + c])
-        T[T_INPUT * W + c] = K.fma(a_next, k[0], L[c])
-        T[(T_INPUT + 1) * W + c] = K.fma(a_next, k[1], L[W + c])
-        T[(T_INPUT + 2) * W + c] = K.fma(a_next, k[2], L[2 * W + c])
-        T[(T_INPUT + 3) * W + c] = K.fma(a_next, k[3], L[3 * W + c])
+        x = (source[_at(at_input, c)], source[_at(at_input + 1, c)],
+             source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0)
+        k = K.rhs(base[0], base[1], base[2], x, _mode(L, c, kind), L[_at(R_DIRECTION, c)],
+                  _held(L, c), _params(PP, c, kind))[0]
+        T[_at(T_SUM, c)] = K.fma(weight, k[0], source[_at(at_sum, c)])
+        T[_at(T_SUM + 1, c)] = K.fma(weight, k[1], source[_at(at_sum + 1, c)])
+        T[_at(T_SUM + 2, c)] = K.fma(weight, k[2], source[_at(at_sum + 2, c)])
+        T[_at(T_SUM + 3, c)] = K.fma(weight, k[3], source[_at(at_sum + 3, c)])
+        T[_at(T_SUM + 4, c)] = K.fma(weight, k[4], source[_at(at_sum + 4, c)])
+        T[_at(T_SUM + 5, c)] = K.fma(weight, k[5], source[_at(at_sum + 5, c)])
+        T[_at(T_SUM + 6, c)] = K.fma(weight, k[6], source[_at(at_sum + 6, c)])
+        T[_at(T_SUM + 7, c)] = K.fma(weight, k[7], source[_at(at_sum + 7, c)])
+        T[_at(T_INPUT, c)] = K.fma(a_next, k[0], L[_at(0, c)])
+        T[_at(T_INPUT + 1, c)] = K.fma(a_next, k[1], L[_at(1, c)])
+        T[_at(T_INPUT + 2, c)] = K.fma(a_next, k[2], L[_at(2, c)])
+        T[_at(T_INPUT + 3, c)] = K.fma(a_next, k[3], L[_at(3, c)])
 
 
-@njit(**_JIT)
-def _first_stage_pass(n, a_next, weight, base, L, T, PP):
-    """:func:`_stage_lanes` from the state."""
-    _stage_lanes(n, a_next, weight, base, L, T, PP, L, 0, 0)
-
-
-@njit(**_JIT)
-def _stage_pass(n, a_next, weight, base, L, T, PP):
-    """:func:`_stage_lanes` from the previous stage."""
-    _stage_lanes(n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
-
-
-@njit(**_JIT)
-def _finish_pass(n, t, h, b_end, L, T, PP):
+@njit(**_JIT, inline="always")
+def _finish_lanes(kind, n, b_end, L, T, PP):
     """End the step of every lane: store it, or flag the lane for pass 2 (returns how many).
 
     What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
@@ -134,44 +150,127 @@ def _finish_pass(n, t, h, b_end, L, T, PP):
     flagged_lanes = 0
     for c in range(n):
         s = _state(L, c)
-        s1 = (T[T_SUM * W + c], T[(T_SUM + 1) * W + c], T[(T_SUM + 2) * W + c],
-              T[(T_SUM + 3) * W + c], T[(T_SUM + 4) * W + c], T[(T_SUM + 5) * W + c],
-              T[(T_SUM + 6) * W + c], T[(T_SUM + 7) * W + c])
-        P = _params(PP, c)
-        mode = int(L[R_MODE * W + c])
-        direction = L[R_DIRECTION * W + c]
-        margin = L[R_MARGIN * W + c]
+        s1 = (T[_at(T_SUM, c)], T[_at(T_SUM + 1, c)], T[_at(T_SUM + 2, c)],
+              T[_at(T_SUM + 3, c)], T[_at(T_SUM + 4, c)], T[_at(T_SUM + 5, c)],
+              T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)])
+        P = _params(PP, c, kind)
+        mode = _mode(L, c, kind)
+        direction = L[_at(R_DIRECTION, c)]
+        margin = L[_at(R_MARGIN, c)]
         margin1 = np.nan
         if mode != K.MODE_SLIP:
             force = K.rhs(b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c), P)[1]
             margin1 = K._hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
-        ready = direction * s[K.S_V] >= 0.0 if mode == K.MODE_SLIP else margin >= 0.0
-        event = K._first_event(t, h, s, s1, mode, direction, margin, margin1, P)[0]
-        flagged = not ready or event != 0 or not _finite(s1, P) or L[R_FAILED * W + c] != 0.0
-        T[T_FLAGGED * W + c] = 1.0 if flagged else 0.0
+        if mode == K.MODE_SLIP:  # no zero crossing missed (none is tracked when regularised)
+            ready = P[K.P_VREG] > 0.0 or direction * s[K.S_V] >= 0.0
+        else:
+            ready = margin >= 0.0
+        flagged = (not ready or K._any_event(s, s1, mode, direction, margin1, P)
+                   or not _finite(s1, P) or L[_at(R_FAILED, c)] != 0.0)
+        T[_at(T_FLAGGED, c)] = 1.0 if flagged else 0.0
         flagged_lanes += flagged
         if not flagged:
             _store(L, c, s1, margin1, K._in_contact(s1, mode, P), P)
     return flagged_lanes
 
 
+# Each loop of pass 1 compiled once per kind, each its own function: a function holding
+# all three loops took LLVM ten times as long to compile.
 @njit(**_JIT)
-def _vector_pass(solver, n, t, h, L, T, PP, bases, b_end):
+def _first_stage_exact(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_exact(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_exact(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_EXACT, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _first_stage_smooth(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_smooth(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_smooth(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_SMOOTH, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _first_stage_mixed(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, L, 0, 0)
+
+
+@njit(**_JIT)
+def _stage_mixed(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+
+
+@njit(**_JIT)
+def _finish_mixed(n, b_end, L, T, PP):
+    return _finish_lanes(KIND_MIXED, n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
 
     Stage by stage (``K.tableau``, in the order of ``K.rk_step``) with the
     intermediate values in ``T``: each loop is short, its iterations independent,
-    and LLVM vectorises it.
+    and LLVM vectorises it. The loops compiled for ``kind`` (see :data:`KIND_EXACT`).
     """
     stages = K.n_stages(solver)
     for stage in range(stages):
         weight = K.tableau(solver, h, stage)[2]
         a_next = K.tableau(solver, h, stage + 1)[1] if stage + 1 < stages else 0.0
-        if stage == 0:
-            _first_stage_pass(n, a_next, weight, bases[stage], L, T, PP)
+        base = bases[stage]
+        if kind == KIND_EXACT:
+            if stage == 0:
+                _first_stage_exact(n, a_next, weight, base, L, T, PP)
+            else:
+                _stage_exact(n, a_next, weight, base, L, T, PP)
+        elif kind == KIND_SMOOTH:
+            if stage == 0:
+                _first_stage_smooth(n, a_next, weight, base, L, T, PP)
+            else:
+                _stage_smooth(n, a_next, weight, base, L, T, PP)
+        elif stage == 0:
+            _first_stage_mixed(n, a_next, weight, base, L, T, PP)
         else:
-            _stage_pass(n, a_next, weight, bases[stage], L, T, PP)
-    return _finish_pass(n, t, h, b_end, L, T, PP)
+            _stage_mixed(n, a_next, weight, base, L, T, PP)
+    if kind == KIND_EXACT:
+        return _finish_exact(n, b_end, L, T, PP)
+    if kind == KIND_SMOOTH:
+        return _finish_smooth(n, b_end, L, T, PP)
+    return _finish_mixed(n, b_end, L, T, PP)
+
+
+@njit(**_JIT)
+def _batch_kind(n, PP, L):
+    """:data:`KIND_EXACT`, :data:`KIND_SMOOTH` or :data:`KIND_MIXED` for lanes ``0..n-1``.
+
+    Regularised lanes count as such only with compliant stops and slipping, as the
+    model has them (docs/model.md §3), so that the constants of the kind are theirs.
+    """
+    exact = smooth = 0
+    for c in range(n):
+        if PP[_at(K.P_VREG, c)] == 0.0:
+            exact += 1
+        elif PP[_at(K.P_PLASTIC, c)] == 0.0 and L[_at(R_MODE, c)] == K.MODE_SLIP:
+            smooth += 1
+    if exact == n:
+        return KIND_EXACT
+    return KIND_SMOOTH if smooth == n else KIND_MIXED
 
 
 @njit(**_JIT, nogil=True)
@@ -200,18 +299,19 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
     sampled = False
     for c in range(n):
         for i in range(K.N_PARAMS):
-            PP[i * W + c] = params[c, i]
+            PP[_at(i, c)] = params[c, i]
         for i in range(K.N_STATE):
-            L[i * W + c] = states[c, i]
-        L[R_MODE * W + c] = flags[c, K.I_MODE]
-        L[R_DIRECTION * W + c] = flags[c, K.I_DIRECTION]
-        L[R_CONTACT * W + c] = flags[c, K.I_CONTACT]
-        L[R_CONTACTS * W + c] = flags[c, K.I_N_CONTACTS]
-        L[R_STICKS * W + c] = flags[c, K.I_N_STICKS]
-        L[R_FAILED * W + c] = 0.0 if status[c] == K.STATUS_OK else 1.0
+            L[_at(i, c)] = states[c, i]
+        L[_at(R_MODE, c)] = flags[c, K.I_MODE]
+        L[_at(R_DIRECTION, c)] = flags[c, K.I_DIRECTION]
+        L[_at(R_CONTACT, c)] = flags[c, K.I_CONTACT]
+        L[_at(R_CONTACTS, c)] = flags[c, K.I_N_CONTACTS]
+        L[_at(R_STICKS, c)] = flags[c, K.I_N_STICKS]
+        L[_at(R_FAILED, c)] = 0.0 if status[c] == K.STATUS_OK else 1.0
         rows[c] = 0
         sampled = sampled or params[c, K.P_CONTROL_STEPS] > 0.0
     h = params[0, K.P_DT] if n > 0 else 0.0
+    kind = _batch_kind(n, PP, L)
     step = step0
     row = row0
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
@@ -219,33 +319,33 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         t = step * h
         if sampled:
             for c in range(n):
-                control_steps = int(PP[K.P_CONTROL_STEPS * W + c])
-                if control_steps > 0 and step % control_steps == 0 and L[R_FAILED * W + c] == 0.0:
-                    held, s = K.sample_controller(t, _state(L, c), int(L[R_MODE * W + c]),
+                control_steps = int(PP[_at(K.P_CONTROL_STEPS, c)])
+                if control_steps > 0 and step % control_steps == 0 and L[_at(R_FAILED, c)] == 0.0:
+                    held, s = K.sample_controller(t, _state(L, c), int(L[_at(R_MODE, c)]),
                                                   _params(PP, c), E, table)
-                    L[K.A_F_PI * W + c], L[K.A_F_DAMP * W + c], L[K.A_F_MOTOR * W + c] = held
-                    L[K.S_INT * W + c] = s[K.S_INT]
-                    L[R_MARGIN * W + c] = np.nan
+                    L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)] = held
+                    L[_at(K.S_INT, c)] = s[K.S_INT]
+                    L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
-        if _vector_pass(solver, n, t, h, L, T, PP, bases, b_end) > 0:
+        if _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end) > 0:
             for c in range(n):  # pass 2: the flagged lanes
-                if T[T_FLAGGED * W + c] == 0.0 or L[R_FAILED * W + c] != 0.0:
+                if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
                 P = _params(PP, c)
                 s1, mode, direction, margin, sticks, impacts = K.grid_step(
-                    solver, t, h, _state(L, c), int(L[R_MODE * W + c]),
-                    int(L[R_DIRECTION * W + c]), _held(L, c), P, E, table,
-                    L[R_MARGIN * W + c], phase, sin0, cos0)
+                    solver, t, h, _state(L, c), int(L[_at(R_MODE, c)]),
+                    int(L[_at(R_DIRECTION, c)]), _held(L, c), P, E, table,
+                    L[_at(R_MARGIN, c)], phase, sin0, cos0)
                 if not _finite(s1, P):
-                    L[R_FAILED * W + c] = 1.0
+                    L[_at(R_FAILED, c)] = 1.0
                     failed_step[c] = step
                     rows[c] = row - row0
                     continue
-                L[R_MODE * W + c] = mode
-                L[R_DIRECTION * W + c] = direction
-                L[R_CONTACTS * W + c] += impacts
-                L[R_STICKS * W + c] += sticks
+                L[_at(R_MODE, c)] = mode
+                L[_at(R_DIRECTION, c)] = direction
+                L[_at(R_CONTACTS, c)] += impacts
+                L[_at(R_STICKS, c)] += sticks
                 _store(L, c, s1, margin, K._in_contact(s1, mode, P), P)
         step += 1
         # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
@@ -253,9 +353,9 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                                           step % K.PHASE_PERIOD == 0)
         if step % decimation == 0:
             for c in range(n):
-                if L[R_FAILED * W + c] == 0.0:
-                    K.record(step * h, _state(L, c), int(L[R_MODE * W + c]),
-                             int(L[R_DIRECTION * W + c]), _held(L, c), _params(PP, c), E,
+                if L[_at(R_FAILED, c)] == 0.0:
+                    K.record(step * h, _state(L, c), int(L[_at(R_MODE, c)]),
+                             int(L[_at(R_DIRECTION, c)]), _held(L, c), _params(PP, c), E,
                              table, out[c, row], out_flags[c, row], phase, sin0, cos0)
             row += 1
 
@@ -263,12 +363,12 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         if status[c] != K.STATUS_OK:
             continue
         for i in range(K.N_STATE):
-            states[c, i] = L[i * W + c]
-        flags[c, K.I_MODE] = int(L[R_MODE * W + c])
-        flags[c, K.I_DIRECTION] = int(L[R_DIRECTION * W + c])
-        flags[c, K.I_CONTACT] = int(L[R_CONTACT * W + c])
-        flags[c, K.I_N_CONTACTS] = int(L[R_CONTACTS * W + c])
-        flags[c, K.I_N_STICKS] = int(L[R_STICKS * W + c])
+            states[c, i] = L[_at(i, c)]
+        flags[c, K.I_MODE] = int(L[_at(R_MODE, c)])
+        flags[c, K.I_DIRECTION] = int(L[_at(R_DIRECTION, c)])
+        flags[c, K.I_CONTACT] = int(L[_at(R_CONTACT, c)])
+        flags[c, K.I_N_CONTACTS] = int(L[_at(R_CONTACTS, c)])
+        flags[c, K.I_N_STICKS] = int(L[_at(R_STICKS, c)])
         if failed_step[c] >= 0:
             status[c] = K.STATUS_DIVERGED
             flags[c, K.I_STEP] = failed_step[c]

@@ -59,19 +59,21 @@ def spring_energy_law(a, b, z):
 
 
 @njit(**JIT, inline="always")
-def sliding_friction_law(v, sign, fs, fc, cbc, cv):
+def sliding_friction_law(v, sign, fs, fc, cbc, cv, v_reg):
     """Friction [N] while slipping at ``v`` [m/s] in direction ``sign`` (+-1) (eq. 3).
 
     ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign - Cv*v``: it opposes the slip. ``sign``
     is the slip direction, continued analytically past ``v = 0`` so that the
-    zero crossing the stepper locates is smooth.
+    zero crossing the stepper locates is smooth. With a regularisation velocity
+    ``v_reg > 0``, ``tanh(v/v_reg)`` takes the place of ``sign`` (the regularised
+    model, docs/model.md §3): smooth through ``v = 0``, no stick-slip.
 
     Parameters
     ----------
     v : float
         Relative (slip) velocity [m/s].
     sign : float
-        Slip direction, +1 or -1.
+        Slip direction, +1 or -1 (unused when ``v_reg > 0``).
     fs : float
         Stiction force Fs [N].
     fc : float
@@ -80,6 +82,8 @@ def sliding_friction_law(v, sign, fs, fc, cbc, cv):
         Stribeck decay coefficient Cbc [s/m].
     cv : float
         Viscous friction coefficient Cv [N*s/m].
+    v_reg : float
+        Regularisation velocity [m/s]; 0 for the exact model.
 
     Returns
     -------
@@ -87,6 +91,8 @@ def sliding_friction_law(v, sign, fs, fc, cbc, cv):
         Friction force on the payload [N].
     """
     level = fc + (fs - fc) * exp(-cbc * abs(v))
+    if v_reg > 0.0:
+        sign = tanh(v / v_reg)
     return -level * sign - cv * v
 
 

@@ -45,6 +45,7 @@ def _pack_parameters(isolator, controller, dt, control_steps):
     p[K.P_HP_OMEGA] = 2 * np.pi * controller.velocity_highpass
     p[K.P_CONTROL_STEPS] = control_steps
     p[K.P_DT] = dt
+    p[K.P_VREG] = isolator.friction_regularisation
     return p
 
 
@@ -180,8 +181,16 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     force = K.hold_force(0.0, s, p, *packed_excitation)
     f_hold = force[K.F_HOLD]
     locked = initial.locked
+    regularised = isolator.friction_regularisation > 0.0
+    if locked and regularised:
+        raise ParameterError(
+            "`locked` must not be True with `friction_regularisation` > 0 "
+            f"({isolator.friction_regularisation!r} m/s): the regularised friction model never "
+            "locks the payload. Leave `locked` as None or False, or set "
+            "`friction_regularisation=0` (exact stick-slip).")
     if locked is None:
-        locked = initial.relative_velocity == 0.0 and abs(f_hold) <= isolator.stiction_force
+        locked = (not regularised and initial.relative_velocity == 0.0
+                  and abs(f_hold) <= isolator.stiction_force)
     flags[K.I_MODE] = K.MODE_STICK if locked else K.MODE_SLIP
     if initial.relative_velocity != 0.0:
         flags[K.I_DIRECTION] = 1 if initial.relative_velocity > 0 else -1
@@ -285,10 +294,14 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
     if not stability_test(isolator, controller, solver)(dt):
         limit = largest_stable_step(isolator, controller, solver)  # only for the message
+        mode, remedy = "the hard-stop contact or the spring/PI/damping loop", "`stop_stiffness`"
+        if isolator.friction_regularisation > 0:
+            mode += ", with the regularised friction's slope Fs/v_reg at v = 0"
+            remedy += " or raise `friction_regularisation`"
         raise StabilityError(
             f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
-            f"(stiffest mode: the hard-stop contact or the spring/PI/damping loop); the largest "
-            f"stable step is {limit:.3g} s. Reduce `dt`, or soften `stop_stiffness`.")
+            f"(stiffest mode: {mode}); the largest stable step is {limit:.3g} s. Reduce `dt`, "
+            f"or soften {remedy}.")
     decimation = steps_per_sample(sample_rate, dt, "sample_rate")
     control_steps = 0
     if controller.controller_rate > 0:

@@ -15,10 +15,15 @@ _STABILITY_POLYNOMIALS = {  # |R(h*lambda)| <= 1 is linear stability (Taylor coe
 
 
 def _stiff_modes(isolator, controller):
-    """Eigenvalues [1/s] of the fastest linear modes: free, and pressed on a compliant stop."""
+    """Eigenvalues [1/s] of the fastest linear modes: free, and pressed on a compliant stop.
+
+    Regularised friction adds its slope at ``v = 0``, ``Fs/v_reg`` [N*s/m], to the damping.
+    """
     m = isolator.mass
     stiffness = isolator.spring_force * isolator.spring_shape + controller.pi_kp
     damping = isolator.viscous_damping + controller.damping_gain
+    if isolator.friction_regularisation > 0.0:
+        damping += isolator.stiction_force / isolator.friction_regularisation
     cases = [(stiffness, damping)]
     if isolator.stop_model == "compliant":
         cases.append((stiffness + isolator.stop_stiffness, damping + isolator.stop_damping))

@@ -53,6 +53,13 @@ class IsolatorParameters:
         Decay rate from stiction to Coulomb friction, Cbc [s/m].
     viscous_damping : float
         Viscous friction coefficient, Cv [N*s/m].
+    friction_regularisation : float
+        Regularisation velocity of the friction law, v_reg [m/s]; 0 (default) is the
+        exact stick-slip model. A positive value replaces it, for comparisons with
+        solvers that cannot handle stick-slip events, by the smooth law
+        ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*tanh(v/v_reg) - Cv*v``: the payload never
+        locks (no stick events) and slips at a small speed where the exact model
+        sticks. Needs the compliant stops (docs/model.md §3).
     stroke_half : float
         Half the guide's stroke: the stops are at ``stop_center +- stroke_half`` [m].
     stop_center : float or None
@@ -77,6 +84,8 @@ class IsolatorParameters:
     coulomb_force: float = parameter(1.0, "N", "Coulomb friction force Fc")
     stribeck_decay: float = parameter(100.0, "s/m", "Stribeck decay coefficient Cbc")
     viscous_damping: float = parameter(100.0, "N*s/m", "viscous friction coefficient Cv")
+    friction_regularisation: float = parameter(
+        0.0, "m/s", "friction regularisation velocity v_reg (0: exact stick-slip)")
     stroke_half: float = parameter(0.080, "m", "half stroke of the linear guide")
     stop_center: float | None = parameter(None, "m", "centre of the stops in z (None: the setpoint)")
     stop_stiffness: float = parameter(1e6, "N/m", "hard-stop contact stiffness")
@@ -94,6 +103,7 @@ class IsolatorParameters:
             "coulomb_force": non_negative,
             "stribeck_decay": non_negative,
             "viscous_damping": non_negative,
+            "friction_regularisation": non_negative,
             "stroke_half": positive,
             "stop_center": optional(as_float),
             "stop_stiffness": positive,
@@ -107,6 +117,13 @@ class IsolatorParameters:
                 f"({self.coulomb_force!r} N): the breakaway force cannot be below the sliding "
                 "friction. Set both equal for friction without a Stribeck peak, or both 0 "
                 "for a frictionless guide."
+            )
+        if self.friction_regularisation > 0.0 and self.stop_model == "plastic":
+            raise ParameterError(
+                f"`friction_regularisation` ({self.friction_regularisation!r} m/s) needs "
+                "`stop_model='compliant'`: a plastic stop holds the payload at rest, which "
+                "the regularised friction model has no state for. Use the compliant stops, "
+                "or `friction_regularisation=0` (exact stick-slip)."
             )
 
     @property
@@ -225,7 +242,9 @@ def friction_force(relative_velocity, params):
     """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, signs of docs/model.md §3).
 
     ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign(v) - Cv*v``: it always opposes slip.
-    At ``v = 0`` it returns 0; the stuck state is handled by the simulator.
+    At ``v = 0`` it returns 0; the stuck state is handled by the simulator. With
+    ``friction_regularisation`` v_reg > 0, ``tanh(v/v_reg)`` takes the place of
+    ``sign(v)`` (the regularised model, docs/model.md §3).
 
     Parameters
     ----------
@@ -243,7 +262,11 @@ def friction_force(relative_velocity, params):
     v = np.asarray(relative_velocity, dtype=float)
     p = params
     level = p.coulomb_force + (p.stiction_force - p.coulomb_force) * np.exp(-p.stribeck_decay * np.abs(v))
-    return -level * np.sign(v) - p.viscous_damping * v
+    if p.friction_regularisation > 0.0:
+        direction = np.tanh(v / p.friction_regularisation)
+    else:
+        direction = np.sign(v)
+    return -level * direction - p.viscous_damping * v
 
 
 def passive_natural_frequency(params, relative_position):
