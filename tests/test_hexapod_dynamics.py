@@ -318,3 +318,15 @@ def test_a_recorded_base_motion_replays_through_its_spline(cubic):
     assert result["time"][-1] == pytest.approx(1.0)
     assert np.max(np.abs(result["platform_pose"][:, 1] - result["base_pose"][:, 1])) < 1e-15
     assert np.max(np.abs(result["base_pose"][:, 1])) == pytest.approx(0.002, rel=1e-2)
+
+
+def test_regularised_friction_is_refused_by_the_hexapod():
+    import qzs
+    from qzs.workflows.hexapod import hexapod_setup
+
+    setup = hexapod_setup(settings={"pi_kp": 2000.0, "pi_ki": 800.0})
+    with pytest.raises(qzs.ParameterError, match="friction_regularisation"):
+        qzs.simulate_hexapod(setup.geometry, setup.platform,
+                             qzs.IsolatorParameters(friction_regularisation=1e-3),
+                             setup.controller, excitation={"z": qzs.Sine(frequency=2.0)},
+                             duration=0.1)

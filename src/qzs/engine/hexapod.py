@@ -599,7 +599,7 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
             V[V_ZREF + i], V[V_KP + i], V[V_KI + i], V[V_KD + i], V[V_FMAX + i], z, v_measured,
             V[V_INT + i])
         f_friction = sliding_friction_law(v, V[V_DIR + i], V[V_FS + i], V[V_FC + i],
-                                          V[V_CBC + i], V[V_CV + i])
+                                          V[V_CBC + i], V[V_CV + i], 0.0)  # exact model
         f_friction = f_friction if slipping else 0.0
         V[V_Z + i] = z
         V[V_V + i] = v
@@ -1221,6 +1221,10 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
             raise ParameterError(
                 f"leg {leg + 1}: `stop_model` {iso.stop_model!r} is not supported by the hexapod "
                 "(its stops are compliant contacts only); use stop_model='compliant'.")
+        if getattr(iso, "friction_regularisation", 0.0) != 0.0:
+            raise ParameterError(
+                f"leg {leg + 1}: `friction_regularisation` ({iso.friction_regularisation!r} m/s) "
+                "must be 0: the hexapod integrates the exact stick-slip model only.")
         if con.controller_rate != 0:
             raise ParameterError(
                 f"leg {leg + 1}: `controller_rate` ({con.controller_rate!r} Hz) must be 0: the "
