@@ -132,7 +132,7 @@ def tanh(u):
 # ---------------------------------------------------------------- stale kernel caches
 #: The modules whose compiled kernels numba caches, and the source files they are built from
 #: (the excitation's packed-layout constants are compiled in as globals).
-_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes")
+_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes", "hexapod")
 _KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "model/excitation.py")
 #: The fingerprint of those sources, kept beside numba's cache files.
 _STAMP = "qzs-kernel-sources.sha256"

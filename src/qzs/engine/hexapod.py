@@ -47,11 +47,8 @@ continues; at most ``MAX_EVENTS`` per step.
 Legs that act alike switch together (``SIMULTANEOUS``), so a symmetric platform stays
 symmetric to rounding.
 """
-import hashlib
-import os
 import time as _time
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -1078,42 +1075,8 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
     return status, row - row0
 
 
-# ---------------------------------------------------------------- stale caches of these kernels
-#: Sources these kernels compile in (inlined laws, arithmetic, base motion, the tableau,
-#: the packed-excitation constants); numba checks a cached kernel against its own file only.
-_SOURCES = ("engine/arithmetic.py", "engine/laws.py", "engine/base_motion.py",
-            "engine/kernels.py", "model/excitation.py")
-_STAMP = "qzs-hexapod-kernel-sources.sha256"
-
-
-def _drop_stale_caches():
-    """Delete this module's cached kernels when a source they inline changed (best effort).
-
-    The same rule as :func:`qzs.engine.arithmetic._drop_stale_kernel_caches`, for this
-    module's own cache files (``hexapod.*.nbi``/``.nbc``), with its own fingerprint.
-    """
-    try:
-        folder = Path(_finite._cache._cache_path)
-        root = Path(__file__).resolve().parents[1]
-        digest = hashlib.sha256()
-        for name in _SOURCES:
-            digest.update((root / name).read_bytes())
-        fingerprint = digest.hexdigest()
-        stamp = folder / _STAMP
-        if stamp.exists() and stamp.read_text(encoding="ascii").strip() == fingerprint:
-            return False
-        for path in folder.glob("hexapod.*.nb[ic]"):
-            path.unlink(missing_ok=True)
-        folder.mkdir(parents=True, exist_ok=True)
-        partial = folder / f".{_STAMP}.{os.getpid()}"
-        partial.write_text(fingerprint + "\n", encoding="ascii")
-        os.replace(partial, stamp)
-        return True
-    except (OSError, AttributeError):  # no cache folder, read-only install, other numba
-        return False
-
-
-_drop_stale_caches()
+# Stale cached kernels of this module are dropped with the others (qzs.engine.arithmetic:
+# "hexapod" is one of its _KERNEL_MODULES).
 
 
 # ---------------------------------------------------------------- validation and packing
