@@ -51,38 +51,9 @@ COLD = ("import time; t = time.perf_counter(); import numpy as np; "
         "print(i - t, time.perf_counter() - i)")
 
 
-def _load():
-    try:
-        return " ".join(f"{x:.2f}" for x in os.getloadavg())
-    except OSError:
-        return "n/a"
-
-
-def _cpu_times():
-    with open("/proc/stat") as handle:
-        values = [int(x) for x in handle.readline().split()[1:]]
-    idle = values[3] + values[4]  # idle + iowait
-    return sum(values) - idle, sum(values)
-
-
-def busy_cpus(interval=0.5):
-    """CPUs' worth of work done on the machine over ``interval`` s (None if unknown)."""
-    try:
-        busy0, total0 = _cpu_times()
-        time.sleep(interval)
-        busy1, total1 = _cpu_times()
-    except (OSError, ValueError, IndexError):
-        return None
-    return (busy1 - busy0) / max(total1 - total0, 1) * (os.cpu_count() or 1)
-
-
-def wait_for_idle(max_wait, threshold=0.3):
-    """Wait up to ``max_wait`` s for other work to stop; returns the last busy level."""
-    deadline = time.monotonic() + max_wait
-    while True:
-        busy = busy_cpus()
-        if busy is None or busy <= threshold or time.monotonic() >= deadline:
-            return busy
+# the shared-machine helpers of bench_simulate.py (the load, waiting for idle CPUs)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_simulate import _load, wait_for_idle  # noqa: E402
 
 
 def main():
