@@ -1434,7 +1434,7 @@ figure{margin:1em 0}figure img{width:100%;height:auto;border:1px solid #eee}
 figcaption{font-size:.9em;color:#444}table{border-collapse:collapse;font-size:.85em;margin:.5em 0}
 td,th{border:1px solid #ddd;padding:.2em .5em;text-align:right}th{background:#eee}
 td:first-child,th:first-child{text-align:left}.answer{padding:.6em 1em;border-left:6px solid
-#2a8a2a;background:#f7f7f7}.warn{border-color:#c0392b}"""
+#2a8a2a;background:#f7f7f7}.warn{border-color:#c0392b}pre{white-space:pre-wrap;font-size:.85em}"""
 
 
 def _table(headers, rows):
