@@ -17,7 +17,8 @@ Targets (issue 11), each row: the qzs figure, its baseline, the ratio, the targe
    worker costing only its own tasks;
 5. the accuracy-driven step (``qzs.engine.accuracy``): its gain at equal accuracy over the
    paper's dt = 1e-4 s on the default chirp;
-6. the lane kernel against JAX (needs jax; it is never installed by this script).
+6. the lane kernel against JAX on the same (regularised) model, 1024 cases, one and two cores
+   (``bench_jax.py``; needs jax, the ``bench`` extra, never installed by this script).
 
 The C baseline is ``benchmarks/c_reference/isolator.c``, compiled here with gcc (flags in
 ``c_reference/reference.py``) into a cache folder outside the repository and run in this
@@ -459,12 +460,19 @@ def target_jax(table, args):
         table.add(6, "lane kernel vs JAX (vmap + lax.scan), 1024 cases", "-", "-", "-",
                   f">= {TARGET_JAX:g}x", "not measured: jax not installed")
         return
-    if not (HERE / "bench_jax.py").exists():
-        table.add(6, "lane kernel vs JAX", "-", "-", "-", f">= {TARGET_JAX:g}x",
-                  "not measured: no JAX baseline in benchmarks/ yet")
-        return
-    table.add(6, "lane kernel vs JAX: see benchmarks/bench_jax.py", "-", "-", "-",
-              f">= {TARGET_JAX:g}x", "not wired in")
+    import bench_jax
+
+    options = argparse.Namespace(cases=bench_jax.N_CASES, steps=20_000 if args.quick else 100_000,
+                                 repeats=args.repeats, idle_wait=args.idle_wait, extra=False,
+                                 cold=False)
+    results = bench_jax.measure(options)
+    for key in ("jax1", "jax2", "reg1", "reg2", "exact1", "exact2"):
+        table.note_runs([dict(seconds=r["seconds"], busy=r["busy"]) for r in results[key]["runs"]])
+    for what, value, baseline, ratio, goal, verdict in bench_jax.verdicts(results):
+        info = verdict == "info"
+        timed = goal.startswith(">=")  # a speed: indicative only with --quick
+        verdict = verdict + ("*" if args.quick and timed and not info else "")
+        table.add("6i" if info else 6, what, value, baseline, ratio, goal, verdict)
 
 
 # --------------------------------------------------------------------------- main
