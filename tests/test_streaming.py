@@ -136,3 +136,36 @@ def test_ctrl_c_while_a_chunk_is_written_keeps_every_chunk_whole(tmp_path, monke
     np.testing.assert_allclose(np.diff(data.time.values), 1e-3, rtol=1e-9)
     assert data.attrs["run.completed"] == 0
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_sigterm_during_an_interruptible_run_is_raised_between_chunks(monkeypatch):
+    """Where SIGTERM is turned into Terminated (the CLI), an interruptible run defers it to the
+    next chunk boundary and raises it there, in the run's own code: raised at an arbitrary
+    point it may land in a weakref callback, where Python only prints it and goes on (the
+    run then finished and wrote its file). With the default action nothing is taken over."""
+    import os
+    import signal
+
+    import qzs
+    from qzs.errors import Terminated
+
+    def raising(signum, frame):  # what the CLI installs
+        raise Terminated(signum)
+
+    previous = signal.signal(signal.SIGTERM, raising)
+    sent = []
+
+    def sink(block, flags):
+        if len(block) > 1 and not sent:  # a chunk of the run (the first call is row 0)
+            sent.append("signal")
+            os.kill(os.getpid(), signal.SIGTERM)
+            sent.append("chunk written whole")  # not cut off inside the sink
+
+    try:
+        with pytest.raises(Terminated):
+            qzs.simulate(qzs.Chirp(duration=60.0), interruptible=True, sink=sink)
+        assert sent == ["signal", "chunk written whole"]
+        assert signal.getsignal(signal.SIGTERM) is raising  # given back
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert signal.getsignal(signal.SIGTERM) is previous

@@ -17,7 +17,7 @@ from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
 from qzs.engine.results import SimulationResult, named_block
-from qzs.errors import ResultTooLargeError, SimulationError
+from qzs.errors import ResultTooLargeError, SimulationError, Terminated
 
 __all__ = ["simulate", "result_bytes"]
 
@@ -172,6 +172,8 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
                 _raise_diverged(s, flags, p)
             if bar is not None:
                 bar.update(n)
+        if deferred is not None and deferred.terminated:
+            raise Terminated(deferred.terminated)
         if interrupted:
             raise KeyboardInterrupt
     except KeyboardInterrupt:
@@ -203,27 +205,37 @@ class _DeferredInterrupt:
 
     A KeyboardInterrupt raised in the middle of writing a chunk would leave the chunk
     half-written (its statistics counted, its rows not in the file); the handler only
-    sets :attr:`requested`, which the run checks between chunks. Installed only in the
-    main thread (where Python runs signal handlers), restored afterwards.
+    sets :attr:`requested`, which the run checks between chunks. Where SIGTERM has a
+    Python handler (the command line turns it into :class:`~qzs.errors.Terminated`), it
+    is deferred the same way and :attr:`terminated` holds its number, for the run to
+    raise between chunks: raised at an arbitrary point it could land in a weakref
+    callback, where Python prints it and carries on. Installed only in the main thread
+    (where Python runs signal handlers), restored afterwards.
     """
 
     def __init__(self):
         self.requested = False
-        self._previous = None
+        self.terminated = 0
+        self._previous = {}
 
     def _handler(self, signum, frame):
         self.requested = True
+        if signum == signal.SIGTERM:
+            self.terminated = signum
 
     def install(self):
-        """Take over SIGINT (main thread only)."""
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self._handler)
+        """Take over SIGINT, and SIGTERM where it has a Python handler (main thread only)."""
+        if threading.current_thread() is not threading.main_thread():
+            return
+        self._previous[signal.SIGINT] = signal.signal(signal.SIGINT, self._handler)
+        if callable(signal.getsignal(signal.SIGTERM)):
+            self._previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, self._handler)
 
     def restore(self):
-        """Give SIGINT back to the handler it had."""
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
-            self._previous = None
+        """Give the signals back to the handlers they had."""
+        for signum, previous in self._previous.items():
+            signal.signal(signum, previous)
+        self._previous = {}
 
 
 def _collect(future):
