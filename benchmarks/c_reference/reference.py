@@ -90,6 +90,9 @@ def prepare(excitation=None, isolator=None, controller=None, **kwargs):
     run = prepare_run(excitation, isolator, controller, **kwargs)
     if run.solver_code != 1:
         raise ValueError("the C reference integrates ode3 only")
+    if run.isolator.friction_regularisation > 0:
+        raise ValueError("the C reference has the exact model's friction law only "
+                         "(friction_regularisation = 0)")
     return run
 
 
