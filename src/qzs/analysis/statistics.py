@@ -39,8 +39,10 @@ class RunStatistics:
         self.locked = np.zeros(n)
         self.counted = np.zeros(n)
 
-    def add(self, relative_position, motor_force, locked):
-        """Absorb one block of samples of every case.
+    def add(self, relative_position, motor_force, locked, cases=slice(None)):
+        """Absorb one block of samples of every case, or of the cases ``cases``.
+
+        Blocks of disjoint ``cases`` may be added from different threads at once.
 
         Parameters
         ----------
@@ -50,14 +52,17 @@ class RunStatistics:
             Motor force [N].
         locked : ndarray of bool, shape (n_cases, n_samples)
             Whether the payload is held at zero slip.
+        cases : slice
+            The cases the rows are (default all).
         """
         z = relative_position
-        self.z_min = np.minimum(self.z_min, z.min(axis=1))
-        self.z_max = np.maximum(self.z_max, z.max(axis=1))
-        self.peak = np.maximum(self.peak, np.abs(z - self.centers[:, None]).max(axis=1))
-        self.force_squares += (motor_force ** 2).sum(axis=1)
-        self.locked += locked.sum(axis=1)
-        self.counted += z.shape[1]
+        self.z_min[cases] = np.minimum(self.z_min[cases], z.min(axis=1))
+        self.z_max[cases] = np.maximum(self.z_max[cases], z.max(axis=1))
+        self.peak[cases] = np.maximum(self.peak[cases],
+                                      np.abs(z - self.centers[cases, None]).max(axis=1))
+        self.force_squares[cases] += (motor_force ** 2).sum(axis=1)
+        self.locked[cases] += locked.sum(axis=1)
+        self.counted[cases] += z.shape[1]
 
     def result(self):
         """The statistics so far: name (see :data:`STATISTICS`) -> array of shape (n_cases,)."""

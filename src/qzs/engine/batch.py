@@ -241,15 +241,18 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     statistics = RunStatistics(0.5 * (params[:, K.P_Z_LOW] + params[:, K.P_Z_HIGH]))
     failed_at = np.full(n, -1, dtype=np.int64)
 
-    def absorb(rows, start_row, first_row):
-        block = out[:, first_row:first_row + rows]
+    def absorb(rows, start_row, first_row, a=0, b=n):
+        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics."""
+        cases = slice(a, b)
+        block = out[cases, first_row:first_row + rows]
         for name, col in zip(values, columns):
-            kept[name][:, start_row:start_row + rows] = block[:, :, col]
+            kept[name][cases, start_row:start_row + rows] = block[:, :, col]
         for name, col in zip(flag_names, flag_columns):
-            kept[name][:, start_row:start_row + rows] = out_flags[:, first_row:first_row + rows,
-                                                                  col]
+            kept[name][cases, start_row:start_row + rows] = out_flags[cases,
+                                                                      first_row:first_row + rows,
+                                                                      col]
         statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
-                       out_flags[:, first_row:first_row + rows, K.O_LOCKED])
+                       out_flags[cases, first_row:first_row + rows, K.O_LOCKED], cases)
 
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
@@ -264,6 +267,19 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
     def advance(a, b):  # cases a..b-1 by `steps` steps from step `done` (read at call time)
         _advance(first.solver_code, done, steps, decimation, states, flags, params, ex, table,
                  out, out_flags, status, written, a, b)
+
+    def chunk_of(a, b):
+        """One thread's share of a chunk: advance cases a..b-1, then absorb their rows
+        (in the thread too, so that the statistics do not wait for the slowest share)."""
+        advance(a, b)
+        rows = steps // decimation
+        ok = status[a:b] == K.STATUS_OK
+        if np.any(written[a:b][ok] != rows):  # pragma: no cover
+            raise RuntimeError("batch kernel wrote an unexpected number of rows")
+        for c in a + np.flatnonzero(~ok):  # keep the part that finished
+            out[c, written[c]:rows] = np.nan
+            out_flags[c, written[c]:rows] = False
+        absorb(rows, row, 0, a, b)
 
     # zero-step calls compile (or load) the kernels first, only those the shares will use (a
     # fresh worker compiles nothing it does not run): the clock counts integration only
@@ -281,19 +297,12 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
             steps = min(chunk, n_steps - done)
             before = status.copy()
             if pool is None:
-                advance(0, n)
+                chunk_of(0, n)
             else:
-                list(pool.map(lambda i: advance(bounds[i], bounds[i + 1]), range(workers)))
+                list(pool.map(lambda i: chunk_of(bounds[i], bounds[i + 1]), range(workers)))
             newly = (before == K.STATUS_OK) & (status != K.STATUS_OK)
             failed_at[newly] = flags[newly, K.I_STEP]
-            rows = steps // decimation
-            if np.any(written[status == K.STATUS_OK] != rows):  # pragma: no cover
-                raise RuntimeError("batch kernel wrote an unexpected number of rows")
-            for c in np.flatnonzero(status != K.STATUS_OK):  # keep the part that finished
-                out[c, written[c]:rows] = np.nan
-                out_flags[c, written[c]:rows] = False
-            absorb(rows, row, 0)
-            row += rows
+            row += steps // decimation
             done += steps
             bar.update(steps)
     finally:
