@@ -19,7 +19,9 @@ the same order as :func:`qzs.engine.kernels.grid_step` does for an ordinary step
 and :func:`run_lanes` give identical numbers, whatever the other lanes are.
 """
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 from qzs.engine import kernels as K
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
@@ -39,46 +41,49 @@ N_SCRATCH = K.N_ODE + 5
 MAX_LANES = 1024
 W = MAX_LANES + 8
 STATUS_TOO_MANY_LANES = -1
-#: What the lanes of a call have in common (``_batch_kind``): all exact stick-slip
-#: (``P_VREG = 0``), all regularised (``P_VREG > 0``, compliant stops, slipping), or a mix.
-#: Each pass is compiled once per kind with the kind a constant, so LLVM drops what the
-#: kind lacks: the friction's ``tanh`` of the exact model, the held modes of the
-#: regularised one. The values are the lanes' own either way: the same bits.
-KIND_EXACT, KIND_SMOOTH, KIND_MIXED = 0, 1, 2
-assert K.P_PLASTIC == 12 and K.P_VREG == 21 and K.N_PARAMS == 22  # as in _params
+#: Pass 1 is compiled in variants, each with a value a call can fix as a constant, so
+#: that LLVM drops the code it makes unreachable (the same bits either way):
+#: ``exact``, every lane of the call has the exact stick-slip friction (``P_VREG = 0``,
+#: fixed for the call): the stages skip the regularised friction's ``tanh``, a third
+#: ``exp`` per stage; ``slipping``, no lane is locked (stuck or resting) at this step (the
+#: modes change in pass 2 only): the end of the step skips the holding margin.
+assert K.P_VREG == K.N_PARAMS - 1  # the last entry of _params
 
 _JIT = K._JIT
 # grid_step inlined into the one-case driver, where it is the hot path
 _grid_step_inline = njit(**_JIT, inline="always")(getattr(K.grid_step, "py_func", K.grid_step))
 
 
-@njit(**_JIT, inline="always")
-def _at(row, c):
-    """Index of row ``row``, lane ``c`` in a lane array (see :data:`W`), unsigned.
+@intrinsic
+def _at(typingctx, row, c):
+    """Index ``row * W + c`` of row ``row``, lane ``c`` in a lane array, unsigned.
 
-    numba adds a negative-index wraparound to a signed index; LLVM folds it away in small
-    lane loops, but not in the stage loops once the regularised friction's third ``exp``
-    made them larger, and it then stopped vectorising them. An unsigned index has none.
+    numba adds a negative-index wraparound to a signed index; LLVM folds it away in
+    small lane loops, but not in the stage loops once the regularised friction's third
+    ``exp`` made them larger, and it then stopped vectorising them. An unsigned index
+    has none. An intrinsic (two instructions in place) rather than an inlined function:
+    numba's inlining of its hundred uses cost 10 s of compiling.
     """
-    return np.uint64(row * W + c)
+    if not (isinstance(row, types.Integer) and isinstance(c, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        i64 = ir.IntType(64)
+        row_, c_ = (context.cast(builder, value, kind, types.int64)
+                    for value, kind in zip(args, signature.args))
+        return builder.add(builder.mul(row_, ir.Constant(i64, W)), c_)
+    return types.uint64(row, c), codegen
 
 
 @njit(**_JIT, inline="always")
-def _params(PP, c, kind=KIND_MIXED):
-    """The parameter tuple of lane ``c`` (``K.P_*``), with the constants of ``kind``."""
-    plastic = 0.0 if kind == KIND_SMOOTH else PP[_at(K.P_PLASTIC, c)]
-    v_reg = 0.0 if kind == KIND_EXACT else PP[_at(K.P_VREG, c)]
+def _params(PP, c, exact=False):
+    """The parameter tuple of lane ``c`` (``K.P_*``); ``P_VREG`` the constant 0 if ``exact``."""
+    v_reg = 0.0 if exact else PP[_at(K.P_VREG, c)]
     return (PP[_at(0, c)], PP[_at(1, c)], PP[_at(2, c)], PP[_at(3, c)], PP[_at(4, c)],
             PP[_at(5, c)], PP[_at(6, c)], PP[_at(7, c)], PP[_at(8, c)], PP[_at(9, c)],
-            PP[_at(10, c)], PP[_at(11, c)], plastic, PP[_at(13, c)], PP[_at(14, c)],
+            PP[_at(10, c)], PP[_at(11, c)], PP[_at(12, c)], PP[_at(13, c)], PP[_at(14, c)],
             PP[_at(15, c)], PP[_at(16, c)], PP[_at(17, c)], PP[_at(18, c)], PP[_at(19, c)],
             PP[_at(20, c)], v_reg)
-
-
-@njit(**_JIT, inline="always")
-def _mode(L, c, kind):
-    """Stick-slip mode of lane ``c``: always slipping in a regularised batch."""
-    return K.MODE_SLIP if kind == KIND_SMOOTH else int(L[_at(R_MODE, c)])
 
 
 @njit(**_JIT, inline="always")
@@ -112,7 +117,7 @@ def _store(L, c, s, margin, contact, P):
 
 
 @njit(**_JIT, inline="always")
-def _stage_lanes(kind, n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
+def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
     """One Runge-Kutta stage of every lane: ``k`` at the stage input, added to the sum.
 
     The stage input and the running sum are read from ``source`` (rows from
@@ -124,8 +129,8 @@ def _stage_lanes(kind, n, a_next, weight, base, L, T, PP, source, at_input, at_s
     for c in range(n):
         x = (source[_at(at_input, c)], source[_at(at_input + 1, c)],
              source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0)
-        k = K.rhs(base[0], base[1], base[2], x, _mode(L, c, kind), L[_at(R_DIRECTION, c)],
-                  _held(L, c), _params(PP, c, kind))[0]
+        k = K.rhs(base[0], base[1], base[2], x, int(L[_at(R_MODE, c)]),
+                  L[_at(R_DIRECTION, c)], _held(L, c), _params(PP, c, exact))[0]
         T[_at(T_SUM, c)] = K.fma(weight, k[0], source[_at(at_sum, c)])
         T[_at(T_SUM + 1, c)] = K.fma(weight, k[1], source[_at(at_sum + 1, c)])
         T[_at(T_SUM + 2, c)] = K.fma(weight, k[2], source[_at(at_sum + 2, c)])
@@ -141,11 +146,12 @@ def _stage_lanes(kind, n, a_next, weight, base, L, T, PP, source, at_input, at_s
 
 
 @njit(**_JIT, inline="always")
-def _finish_lanes(kind, n, b_end, L, T, PP):
+def _finish_lanes(slipping, n, b_end, L, T, PP):
     """End the step of every lane: store it, or flag the lane for pass 2 (returns how many).
 
     What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
-    nothing happens in it. A flagged lane keeps its state at ``t``.
+    nothing happens in it. A flagged lane keeps its state at ``t``. ``slipping``: no
+    lane is held, so none needs its holding margin.
     """
     flagged_lanes = 0
     for c in range(n):
@@ -153,8 +159,8 @@ def _finish_lanes(kind, n, b_end, L, T, PP):
         s1 = (T[_at(T_SUM, c)], T[_at(T_SUM + 1, c)], T[_at(T_SUM + 2, c)],
               T[_at(T_SUM + 3, c)], T[_at(T_SUM + 4, c)], T[_at(T_SUM + 5, c)],
               T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)])
-        P = _params(PP, c, kind)
-        mode = _mode(L, c, kind)
+        P = _params(PP, c)
+        mode = K.MODE_SLIP if slipping else int(L[_at(R_MODE, c)])
         direction = L[_at(R_DIRECTION, c)]
         margin = L[_at(R_MARGIN, c)]
         margin1 = np.nan
@@ -174,103 +180,63 @@ def _finish_lanes(kind, n, b_end, L, T, PP):
     return flagged_lanes
 
 
-# Each loop of pass 1 compiled once per kind, each its own function: a function holding
-# all three loops took LLVM ten times as long to compile.
+# Each loop of pass 1 is a function of its own per variant: one function holding all three
+# loops took LLVM ten times as long to compile.
 @njit(**_JIT)
 def _first_stage_exact(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, L, 0, 0)
+    _stage_lanes(True, n, a_next, weight, base, L, T, PP, L, 0, 0)
 
 
 @njit(**_JIT)
 def _stage_exact(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_EXACT, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+    _stage_lanes(True, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
 
 
 @njit(**_JIT)
-def _finish_exact(n, b_end, L, T, PP):
-    return _finish_lanes(KIND_EXACT, n, b_end, L, T, PP)
+def _first_stage_any(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(False, n, a_next, weight, base, L, T, PP, L, 0, 0)
 
 
 @njit(**_JIT)
-def _first_stage_smooth(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, L, 0, 0)
+def _stage_any(n, a_next, weight, base, L, T, PP):
+    _stage_lanes(False, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
 
 
 @njit(**_JIT)
-def _stage_smooth(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_SMOOTH, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+def _finish_slipping(n, b_end, L, T, PP):
+    return _finish_lanes(True, n, b_end, L, T, PP)
 
 
 @njit(**_JIT)
-def _finish_smooth(n, b_end, L, T, PP):
-    return _finish_lanes(KIND_SMOOTH, n, b_end, L, T, PP)
+def _finish_any(n, b_end, L, T, PP):
+    return _finish_lanes(False, n, b_end, L, T, PP)
 
 
 @njit(**_JIT)
-def _first_stage_mixed(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, L, 0, 0)
-
-
-@njit(**_JIT)
-def _stage_mixed(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(KIND_MIXED, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
-
-
-@njit(**_JIT)
-def _finish_mixed(n, b_end, L, T, PP):
-    return _finish_lanes(KIND_MIXED, n, b_end, L, T, PP)
-
-
-@njit(**_JIT)
-def _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end):
+def _vector_pass(exact, slipping, solver, n, h, L, T, PP, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
 
     Stage by stage (``K.tableau``, in the order of ``K.rk_step``) with the
     intermediate values in ``T``: each loop is short, its iterations independent,
-    and LLVM vectorises it. The loops compiled for ``kind`` (see :data:`KIND_EXACT`).
+    and LLVM vectorises it. ``exact`` and ``slipping`` pick the variants (see above).
     """
     stages = K.n_stages(solver)
     for stage in range(stages):
         weight = K.tableau(solver, h, stage)[2]
         a_next = K.tableau(solver, h, stage + 1)[1] if stage + 1 < stages else 0.0
         base = bases[stage]
-        if kind == KIND_EXACT:
-            if stage == 0:
+        if stage == 0:
+            if exact:
                 _first_stage_exact(n, a_next, weight, base, L, T, PP)
             else:
-                _stage_exact(n, a_next, weight, base, L, T, PP)
-        elif kind == KIND_SMOOTH:
-            if stage == 0:
-                _first_stage_smooth(n, a_next, weight, base, L, T, PP)
-            else:
-                _stage_smooth(n, a_next, weight, base, L, T, PP)
-        elif stage == 0:
-            _first_stage_mixed(n, a_next, weight, base, L, T, PP)
+                _first_stage_any(n, a_next, weight, base, L, T, PP)
+        elif exact:
+            _stage_exact(n, a_next, weight, base, L, T, PP)
         else:
-            _stage_mixed(n, a_next, weight, base, L, T, PP)
-    if kind == KIND_EXACT:
-        return _finish_exact(n, b_end, L, T, PP)
-    if kind == KIND_SMOOTH:
-        return _finish_smooth(n, b_end, L, T, PP)
-    return _finish_mixed(n, b_end, L, T, PP)
-
-
-@njit(**_JIT)
-def _batch_kind(n, PP, L):
-    """:data:`KIND_EXACT`, :data:`KIND_SMOOTH` or :data:`KIND_MIXED` for lanes ``0..n-1``.
-
-    Regularised lanes count as such only with compliant stops and slipping, as the
-    model has them (docs/model.md §3), so that the constants of the kind are theirs.
-    """
-    exact = smooth = 0
-    for c in range(n):
-        if PP[_at(K.P_VREG, c)] == 0.0:
-            exact += 1
-        elif PP[_at(K.P_PLASTIC, c)] == 0.0 and L[_at(R_MODE, c)] == K.MODE_SLIP:
-            smooth += 1
-    if exact == n:
-        return KIND_EXACT
-    return KIND_SMOOTH if smooth == n else KIND_MIXED
+            _stage_any(n, a_next, weight, base, L, T, PP)
+    if slipping:
+        return _finish_slipping(n, b_end, L, T, PP)
+    return _finish_any(n, b_end, L, T, PP)
 
 
 @njit(**_JIT, nogil=True)
@@ -311,7 +277,11 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         rows[c] = 0
         sampled = sampled or params[c, K.P_CONTROL_STEPS] > 0.0
     h = params[0, K.P_DT] if n > 0 else 0.0
-    kind = _batch_kind(n, PP, L)
+    exact = True  # every lane of the exact model (fixed for the call)
+    locked = 0  # lanes stuck or resting on a plastic stop (their mode changes in pass 2 only)
+    for c in range(n):
+        exact = exact and PP[_at(K.P_VREG, c)] == 0.0
+        locked += int(L[_at(R_MODE, c)] != K.MODE_SLIP)
     step = step0
     row = row0
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
@@ -328,7 +298,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                     L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
-        if _vector_pass(kind, solver, n, h, L, T, PP, bases, b_end) > 0:
+        if _vector_pass(exact, locked == 0, solver, n, h, L, T, PP, bases, b_end) > 0:
             for c in range(n):  # pass 2: the flagged lanes
                 if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
@@ -342,6 +312,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                     failed_step[c] = step
                     rows[c] = row - row0
                     continue
+                locked += int(mode != K.MODE_SLIP) - int(L[_at(R_MODE, c)] != K.MODE_SLIP)
                 L[_at(R_MODE, c)] = mode
                 L[_at(R_DIRECTION, c)] = direction
                 L[_at(R_CONTACTS, c)] += impacts
