@@ -104,6 +104,11 @@ def test_hexapod_file(tmp_path, capsys):
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[excitation.w]\nkind = 'sine'\n",
      "axes must be among"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[wheels]\n", "unknown table"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\ngain = 3\n",
+     "\\[cartesian\\]: unknown key"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\nposition_gain = [1, 2]\n",
+     "position_gain"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\npoint = 'centre'\n", "point"),
 ])
 def test_bad_hexapod_files_name_what_is_wrong(tmp_path, text, match):
     path = tmp_path / "bad.toml"
@@ -162,3 +167,27 @@ def test_hexapod_simulate_command(tmp_path, capsys):
     assert main(["hexapod", "simulate", "--amplitude", "0.01"]) == 2
     assert "add --axis" in capsys.readouterr().err
     assert main(["hexapod", "simulate", "--out", str(tmp_path / "x.csv")]) == 2
+
+
+def test_cartesian_table_and_sampled_controller_from_a_file(tmp_path, capsys):
+    """``[cartesian]``: gains left out are the legs' loops' stiffness on each axis; at the
+    cube's centre of a cubic platform that is the per-leg linear model exactly, and the
+    simulation says which control it ran; ``controller_rate`` makes the loops sampled."""
+    text = ("[geometry]\nkind = 'cubic'\ncube_edge = 0.15\n"
+            "[controller]\npi_kp = 2000.0\npi_ki = 800.0\ncontroller_rate = 1000.0\n"
+            "[excitation.z]\nkind = 'sine'\namplitude = 0.001\nfrequency = 2.0\n")
+    per_leg, centralised = tmp_path / "legs.toml", tmp_path / "axes.toml"
+    per_leg.write_text(text)
+    centralised.write_text(text + "[cartesian]\npoint = 'origin'\nposition_gain = "
+                           "[4000.0, 4000.0, 8000.0, 22.5, 22.5, 90.0]\n")
+    setup = load_hexapod(centralised)
+    assert setup.cartesian.point == "origin"
+    assert setup.cartesian.position_gain[2] == 8000.0
+    assert np.allclose(setup.cartesian.integral_gain[:3], 2 * 800.0)  # 2 legs' worth per axis
+    one = run_json(capsys, "--config", str(per_leg), "--frame", "cube-center")
+    two = run_json(capsys, "--config", str(centralised), "--frame", "cube-center")
+    stiffness = np.asarray(two["stiffness_matrix"]) - np.asarray(one["stiffness_matrix"])
+    assert np.allclose(stiffness, np.diag([0, 0, 4000.0, 0, 0, 0]), atol=1e-6)
+    assert main(["hexapod", "simulate", "--config", str(centralised), "--duration", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert "centralised" in out and "sampled at 1000 Hz" in out

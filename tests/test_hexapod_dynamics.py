@@ -21,8 +21,8 @@ from qzs import (Chirp, ControllerParameters, DisplacementRecord, IsolatorParame
                  ParameterError, Sine, StabilityError, simulate)
 from qzs.analysis.hexapod_linear import hexapod_linearize
 from qzs.engine.hexapod import AXES, HEXAPOD_CHANNELS, HexapodResult, simulate_hexapod
-from qzs.model.hexapod import (HexapodGeometry, PlatformParameters, cubic_geometry,
-                               static_leg_forces)
+from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
+                               cubic_geometry, jacobian, static_leg_forces)
 
 STABLE = ControllerParameters(pi_kp=2000.0, pi_ki=800.0)
 #: Every leg carries about the single axis's load: 22.17 kg on six cubic legs (62.8 N each).
@@ -249,6 +249,170 @@ def test_six_vertical_legs_are_six_single_axes(excitation, duration, isolator):
     assert np.max(np.abs(result["platform_pose"][:, [0, 1, 3, 4, 5]])) < 1e-12
 
 
+@pytest.mark.parametrize("rate, excitation, duration, isolator", [
+    (1000.0, Chirp(duration=20.0), 8.0, IsolatorParameters()),
+    (250.0, Sine(amplitude=0.01, frequency=4.0), 6.0,
+     IsolatorParameters(stiction_force=4.0, coulomb_force=2.0)),
+])
+def test_sampled_leg_controllers_are_the_single_axis_sampled_controller(rate, excitation,
+                                                                        duration, isolator):
+    """A controller sampled with zero-order hold (``controller_rate``): six vertical legs are
+    still six single axes, the single axis's sampled controller included (its forward-Euler
+    integral, the held outputs, breakaway at a sample), to 1e-9 m; and the held motor force
+    is a staircase of the controller's period."""
+    controller = ControllerParameters(controller_rate=rate)
+    platform = PlatformParameters(mass=6 * isolator.mass, inertia=np.diag([1.0, 1.0, 1.5]))
+    single = simulate(excitation, isolator, controller, duration=duration, sample_rate=10000.0)
+    result = simulate_hexapod(vertical_legs(), platform, isolator, controller,
+                              excitation={"z": excitation}, duration=duration,
+                              sample_rate=10000.0)
+    assert single.run["stick_events"] >= 1
+    assert np.max(np.abs(result["relative_position"]
+                         - single["relative_position"][:, None])) < 1e-9
+    assert np.max(np.abs(result["motor_force"] - single["motor_force"][:, None])) < 1e-6
+    assert np.all(result["locked"] == single["locked"][:, None])
+    period = int(round(10000.0 / rate))
+    force = result["motor_force"][:, 0]
+    changes = np.flatnonzero(np.diff(force) != 0) + 1
+    # the sample at t_k = k N dt is taken at the start of that step: the output at t_k (the
+    # previous step's end) still shows the value held before it
+    assert changes.size > 10 and np.all((changes - 1) % period == 0)
+
+
+def test_a_sampled_controller_changes_the_hexapod(cubic):
+    """The hold is not a no-op: a 50 Hz controller's run differs from the continuous one by
+    more than rounding, and less than the response (the loop is slow against 50 Hz)."""
+    runs = [simulate_hexapod(cubic, symmetric_platform(), None,
+                             ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=30.0,
+                                                  controller_rate=rate),
+                             excitation={"z": Chirp(duration=20.0)}, duration=3.0)
+            for rate in (0.0, 50.0)]
+    difference = np.max(np.abs(runs[0]["platform_pose"] - runs[1]["platform_pose"]))
+    motion = np.max(np.abs(runs[0]["platform_pose"][:, 2]))
+    assert 1e-4 * motion < difference < 0.2 * motion
+    assert runs[1].run["controller_rate"] == 50.0
+
+
+# ---------------------------------------------------------------- centralised control
+def test_cartesian_loops_with_the_legs_stiffness_at_the_cube_centre_are_the_per_leg_loops(
+        cubic):
+    """At the cube's centre ``J^T J = diag(2, 2, 2, a^2/2, a^2/2, 2a^2)``, so Cartesian gains
+    ``k * diag(J^T J)`` are ``J^-T K J^-1 = k I``: the centralised loops act on each leg as
+    its own loop. Stick-slip and a base moving in three axes give the same run to 1e-9 m
+    (rounding of the mappings through ``J``), as long as no motor saturates: the anti-windup
+    is per leg in one and per axis in the other (docs/hexapod.md §9.5)."""
+    controller = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=30.0)
+    cartesian = CartesianController.from_legs(cubic, controller, point="origin")
+    a = 0.3
+    assert np.allclose(cartesian.position_gain, 2000.0 * np.array([2, 2, 2, a * a / 2,
+                                                                   a * a / 2, 2 * a * a]))
+    excitation = {"z": Chirp(duration=20.0), "x": base_motion("x"), "ry": base_motion("ry")}
+    runs = [simulate_hexapod(cubic, symmetric_platform(), None, controller,
+                             excitation=excitation, duration=3.0, cartesian=c)
+            for c in (None, cartesian)]
+    assert runs[0]["locked"].any() and not runs[0]["locked"].all()  # stuck, then slipping
+    limit = IsolatorParameters().motor_force_max
+    assert 0.5 * limit < np.max(np.abs(runs[0]["pi_force"] + runs[0]["damping_force"])) < limit
+    assert np.max(np.abs(runs[0]["relative_position"] - runs[1]["relative_position"])) < 1e-9
+    assert np.all(runs[0]["locked"] == runs[1]["locked"])
+    assert runs[1].run["control"] == "centralised" and runs[0].run["control"] == "per leg"
+
+
+def test_a_stiff_cartesian_axis_holds_that_axis_only(cubic):
+    """Centralised control can do what per-leg loops cannot: stiffen one axis alone. With a
+    soft loop on every axis but a 20x stiffer one on x, a lateral base sine moves the
+    platform in x about 20x less than in y under the same sine in y (per-leg loops: 1x).
+    Frictionless legs, the axes at the centre of mass (on the cube's centre: decoupled)."""
+    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    soft = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=30.0)
+    base = CartesianController.from_legs(cubic, soft, point="center_of_mass",
+                                         platform=symmetric_platform())
+    gain = np.array(base.position_gain)
+    gain[0] *= 20
+    cartesian = CartesianController(position_gain=gain, integral_gain=base.integral_gain,
+                                    damping_gain=base.damping_gain, point="center_of_mass")
+    amplitude = {}
+    for axis in ("x", "y"):
+        result = simulate_hexapod(cubic, symmetric_platform(), isolator, soft,
+                                  excitation={axis: Sine(amplitude=1e-3, frequency=0.3)},
+                                  duration=6.0, cartesian=cartesian)
+        i = AXES.index(axis)
+        amplitude[axis] = np.ptp((result["platform_pose"] - result["base_pose"])[-2000:, i])
+    assert 8 < amplitude["y"] / amplitude["x"] < 40
+
+
+@pytest.mark.parametrize("axis, frequency", [("x", 1.5), ("ry", 2.5), ("z", 3.0)])
+def test_frictionless_small_motion_under_cartesian_loops_matches_their_linearisation(
+        cubic, axis, frequency):
+    """The linearisation with ``cartesian`` (loops ``T^T Kp T``, per-axis integrals and
+    damping through ``T = J_c^-1 J``) against the nonlinear run, as the per-leg test above:
+    a skewed platform (nothing decouples), the axes at the cube's centre while the model's
+    coordinates are at the centre of mass, a 10x stiffer x loop; |T| within 1e-3."""
+    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    legs = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=20.0)
+    base = CartesianController.from_legs(cubic, legs)
+    gain = np.array(base.position_gain)
+    gain[0] *= 10
+    cartesian = CartesianController(position_gain=gain, integral_gain=base.integral_gain,
+                                    damping_gain=base.damping_gain)
+    a = AXES.index(axis)
+    amplitude = 1e-4 if a < 3 else 1e-3
+    duration = 14.0
+    result = simulate_hexapod(cubic, skewed_platform(), isolator, legs,
+                              excitation={axis: Sine(amplitude=amplitude, frequency=frequency,
+                                                     fade_in=1.0)}, duration=duration,
+                              cartesian=cartesian)
+    t = result["time"]
+    window = t >= duration - int(6 * frequency) / frequency
+
+    def amplitude_of(x):
+        x = x[window] - x[window].mean()
+        return 2 * np.abs(np.mean(x * np.exp(-2j * np.pi * frequency * t[window])))
+
+    ratio = amplitude_of(result["platform_pose"][:, a]) / amplitude_of(result["base_pose"][:, a])
+    model = hexapod_linearize(cubic, skewed_platform(), isolator, legs, frame="origin",
+                              cartesian=cartesian)
+    per_leg = hexapod_linearize(cubic, skewed_platform(), isolator, legs, frame="origin")
+    expected = model.transmissibility(frequency, magnitude=True)[a, a]
+    assert model.stable
+    assert abs(ratio / expected - 1) < 1e-3
+    other = per_leg.transmissibility(frequency, magnitude=True)[a, a]
+    assert abs(other / expected - 1) > 0.01 or axis != "x"  # the stiffer x loop shows
+
+
+def test_cartesian_linearisation_with_the_legs_stiffness_is_the_per_leg_one(cubic):
+    """At the cube's centre, ``from_legs`` gains: the same 6x6 matrices and transmissibility
+    as the per-leg loops (``T^T diag(k J^T J) T = J^T k J``)."""
+    legs = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=20.0)
+    cartesian = CartesianController.from_legs(cubic, legs)
+    one = hexapod_linearize(cubic, skewed_platform(), None, legs, cartesian=cartesian)
+    two = hexapod_linearize(cubic, skewed_platform(), None, legs)
+    for name in ("stiffness_matrix", "integral_matrix", "active_damping_matrix"):
+        assert np.allclose(getattr(one, name), getattr(two, name), rtol=1e-12, atol=1e-9)
+    frequencies = np.array([0.3, 1.0, 3.0, 10.0])
+    assert np.allclose(one.transmissibility(frequencies), two.transmissibility(frequencies),
+                       rtol=1e-9, atol=1e-12)
+
+
+def test_cartesian_controller_checks_its_arguments(cubic):
+    with pytest.raises(ParameterError, match="position_gain"):
+        CartesianController(position_gain=[1.0] * 5, integral_gain=[0.0] * 6,
+                            damping_gain=[0.0] * 6)
+    with pytest.raises(ParameterError, match="integral_gain"):
+        CartesianController(position_gain=[1.0] * 6, integral_gain=[-1.0] * 6,
+                            damping_gain=[0.0] * 6)
+    with pytest.raises(ParameterError, match="point"):
+        CartesianController(position_gain=[1.0] * 6, integral_gain=[0.0] * 6,
+                            damping_gain=[0.0] * 6, point="centre")
+    with pytest.raises(ParameterError, match="platform"):
+        CartesianController.from_legs(cubic, STABLE, point="center_of_mass")
+    one = CartesianController.from_legs(cubic, STABLE)
+    assert one == CartesianController.from_legs(cubic, STABLE) and hash(one) == hash(
+        CartesianController.from_legs(cubic, STABLE))
+    j = jacobian(cubic)
+    assert np.allclose(one.position_gain, np.diag(j.T @ j) * 2000.0)
+
+
 # ---------------------------------------------------------------- the result
 def test_the_result_repackages_with_units_and_delegates(cubic, tmp_path):
     """``to_xarray`` (dims time, dof, leg; units on every variable), ``summary``, ``plot``."""
@@ -291,7 +455,10 @@ def test_the_result_repackages_with_units_and_delegates(cubic, tmp_path):
     (dict(progress="yes"), "progress"),
     (dict(isolator=IsolatorParameters(stop_model="plastic")), "stop_model"),
     (dict(isolator=IsolatorParameters(stroke_half=0.05)), "stroke_half"),
-    (dict(controller=ControllerParameters(controller_rate=1000.0)), "controller_rate"),
+    (dict(controller=[ControllerParameters(pi_kp=2000.0, pi_ki=800.0, controller_rate=1000.0)]
+          + [STABLE] * 5), "controller_rate"),
+    (dict(controller=ControllerParameters(controller_rate=3000.0)), "controller_rate"),
+    (dict(cartesian=STABLE), "cartesian"),
     (dict(isolator=IsolatorParameters(stop_center=0.1)), "position_setpoint"),
 ])
 def test_bad_inputs_raise_parameter_errors_naming_the_argument(cubic, change, argument):

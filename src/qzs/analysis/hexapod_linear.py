@@ -26,8 +26,8 @@ import numpy as np
 from qzs._validation import as_float, choice
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
-from qzs.model.hexapod import (LEG_COUNT, HexapodGeometry, PlatformParameters, jacobian,
-                               mass_matrix, static_leg_forces)
+from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
+                               PlatformParameters, jacobian, mass_matrix, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
 
 __all__ = ["HexapodLinearModel", "hexapod_linearize", "geometric_stiffness",
@@ -152,7 +152,8 @@ class HexapodLinearModel:
     stiffness_matrix : ndarray, shape (6, 6)
         ``K = J^T diag(k) J + K_g`` [N/m, N, N*m/rad]: legs plus geometric stiffness.
     leg_stiffness_matrix : ndarray, shape (6, 6)
-        ``J^T diag(k) J`` [N/m, N, N*m/rad]: the legs' axial stiffness alone.
+        ``J^T diag(k) J`` [N/m, N, N*m/rad]: the legs' axial stiffness alone (with
+        centralised control, the springs' plus the loops' ``T^T diag(Kp) T``).
     geometric_stiffness_matrix : ndarray, shape (6, 6)
         ``K_g`` [N/m, N, N*m/rad]: preload of the legs and weight (0 without preload).
     base_stiffness_matrix : ndarray, shape (6, 6)
@@ -177,11 +178,17 @@ class HexapodLinearModel:
     leg_damping : ndarray, shape (6,)
         Viscous friction ``c_i`` of each leg [N*s/m].
     leg_integral_gain : ndarray, shape (6,)
-        ``Ki_i`` [N/(m*s)].
+        ``Ki`` of each loop [N/(m*s)]: a leg's, or with centralised control an axis's
+        ([N/(m*s)] or [N*m/(rad*s)]; see ``control``).
     leg_damping_gain : ndarray, shape (6,)
-        ``Kd_i`` [N*s/m].
+        ``Kd`` of each loop [N*s/m] (an axis's [N*s/m] or [N*m*s/rad] when centralised).
     leg_highpass : ndarray, shape (6,)
-        Corner of each leg's velocity high-pass [Hz]; 0 for none.
+        Corner of each loop's velocity high-pass [Hz]; 0 for none.
+    loop_matrix : ndarray, shape (6, 6)
+        From the coordinates ``q`` to the loops' coordinates: ``J`` (leg lengths) for
+        per-leg loops, ``T = J_c^-1 J`` (the controller's axes) when centralised.
+    control : {"per leg", "centralised"}
+        Where the loops act (docs/hexapod.md §9.5).
     include_preload : bool
         Whether ``K_g`` and ``K_gb`` are included [-].
     eigenvalues : ndarray, shape (6,)
@@ -230,6 +237,8 @@ class HexapodLinearModel:
     notes: tuple
     transmissibility_system: object
     compliance_system: object
+    loop_matrix: np.ndarray = None
+    control: str = "per leg"
 
     # ------------------------------------------------------------ responses
     def _solve(self, frequency, wrench):
@@ -245,7 +254,7 @@ class HexapodLinearModel:
         corner = 2 * np.pi * self.leg_highpass
         with np.errstate(divide="ignore", invalid="ignore"):
             highpass = np.where(corner > 0, s[:, :, 0] / (s[:, :, 0] + corner), 1.0)
-        j = self.jacobian
+        j = self.jacobian if self.loop_matrix is None else self.loop_matrix
         active = np.einsum("li,kl,lj->kij", j, self.leg_damping_gain * highpass, j)
         scale = s if np.any(self.leg_integral_gain > 0) else np.ones_like(s)
         denominator = scale * (self.mass_matrix * s ** 2 + self.stiffness_matrix
@@ -373,7 +382,7 @@ def _frame_point(frame, platform):
 
 
 def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg_stiffness=None,
-                      frame="center_of_mass", include_preload=True):
+                      frame="center_of_mass", include_preload=True, cartesian=None):
     """Linearise the hexapod of isolator legs at its home pose.
 
     Each leg is the single-axis loop of :func:`qzs.analysis.linear.linearize` along its
@@ -404,6 +413,13 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
     include_preload : bool
         Include the geometric stiffness of the static leg forces and of the weight
         (nothing changes where ``platform.gravity`` is 0) [-].
+    cartesian : CartesianController, optional
+        Centralised control (docs/hexapod.md §9.5): the loops act on the platform's axes at
+        the controller's point, ``T = J_c^-1 J`` from these coordinates to those axes, so
+        they add ``T^T Kp T`` to the stiffness, ``T^T Kd HP(s) T s`` of damping and an
+        integral per axis; the legs keep their springs and viscous friction
+        (``leg_stiffness``, if given, replaces the springs only) and the legs' gains are not
+        used. The legs' high-pass corners must then be equal (one filter per axis).
 
     Returns
     -------
@@ -422,9 +438,13 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
     controllers = _per_leg("controller",
                            ControllerParameters() if controller is None else controller,
                            ControllerParameters)
+    if cartesian is not None and not isinstance(cartesian, CartesianController):
+        raise ParameterError(f"`cartesian` must be a CartesianController or None, got "
+                             f"{type(cartesian).__name__}.")
     if leg_stiffness is None:
-        stiffness = np.array([float(spring_stiffness(c.position_setpoint, i)) + c.pi_kp
-                              for i, c in zip(isolators, controllers)])
+        loop = 0.0 if cartesian is not None else np.array([c.pi_kp for c in controllers])
+        stiffness = np.array([float(spring_stiffness(c.position_setpoint, i))
+                              for i, c in zip(isolators, controllers)]) + loop
     elif np.ndim(leg_stiffness) == 0:
         stiffness = np.full(LEG_COUNT, as_float("leg_stiffness", leg_stiffness))
     else:
@@ -442,6 +462,18 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
     mass = mass_matrix(platform, point)
     forces = static_leg_forces(geometry, platform)
     legs = j.T @ np.diag(stiffness) @ j
+    loops = j  # from these coordinates to the loops' coordinates: leg lengths, or axes
+    if cartesian is not None:
+        if np.ptp(highpass) != 0:
+            raise ParameterError(
+                f"with `cartesian`, every leg's `velocity_highpass` must be the same (one "
+                f"filter per axis), got {highpass.tolist()} Hz.")
+        loops = np.linalg.solve(jacobian(geometry, point=cartesian.point_in_top_frame(platform)),
+                                j)
+        integral = np.array(cartesian.integral_gain)
+        active = np.array(cartesian.damping_gain)
+        highpass = np.full(LEG_COUNT, highpass[0])
+        legs = legs + loops.T @ np.diag(cartesian.position_gain) @ loops
     if include_preload:
         geometric, geometric_base = geometric_stiffness(geometry, platform, point=point,
                                                         leg_forces=forces)
@@ -450,12 +482,13 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
     stiffness_matrix = legs + geometric
     base_matrix = -legs + geometric_base
     damping_matrix = j.T @ np.diag(damping) @ j
-    active_matrix = j.T @ np.diag(active) @ j
-    integral_matrix = j.T @ np.diag(integral) @ j
+    active_matrix = loops.T @ np.diag(active) @ loops
+    integral_matrix = loops.T @ np.diag(integral) @ loops
 
     eigenvalues, modes, frequencies, notes = _modes(stiffness_matrix, mass)
-    system, compliance_system = _state_space(control, j, mass, stiffness_matrix, base_matrix,
-                                             damping_matrix, integral, active, highpass)
+    system, compliance_system = _state_space(control, loops, mass, stiffness_matrix,
+                                             base_matrix, damping_matrix, integral, active,
+                                             highpass)
     poles = np.linalg.eigvals(system.A) if system.nstates else np.zeros(0)
     stable = bool(np.all(poles.real < 0))
     if not stable:
@@ -471,7 +504,8 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
         leg_damping_gain=active, leg_highpass=highpass, include_preload=bool(include_preload),
         eigenvalues=eigenvalues, natural_frequencies=frequencies, mode_shapes=modes,
         poles=poles, stable=stable, notes=notes, transmissibility_system=system,
-        compliance_system=compliance_system)
+        compliance_system=compliance_system, loop_matrix=loops,
+        control="per leg" if cartesian is None else "centralised")
 
 
 def _modes(stiffness, mass):

@@ -66,7 +66,8 @@ from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, SimulationError, StabilityError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
-from qzs.model.hexapod import LEG_COUNT, HexapodGeometry, PlatformParameters, static_leg_forces
+from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
+                               PlatformParameters, jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import unit_of
 
@@ -86,23 +87,28 @@ LANES = 8
 # (base joint from B's origin, top joint from the COM in the top frame), the mode (0 slipping,
 # 1 locked) and slip direction, the filter and integral states, the kinematics, the forces,
 # the event value, the filter and integral rates, per leg the terms the platform sums (force
-# and moment components, the powers of the ledger: base, friction, motor, stop), and six rows
-# of the legs' coupling ``G_i M^-1 G_j^T`` (row ``C0 + i``, lane ``j``).
+# and moment components, the powers of the ledger: base, friction, motor, stop), a sampled
+# controller's held outputs (PI, damping, motor), and six rows of the legs' coupling
+# ``G_i M^-1 G_j^T`` (row ``C0 + i``, lane ``j``).
 (R_A, R_B, R_FS, R_FC, R_CBC, R_CV, R_ZLOW, R_ZHIGH, R_STOPK, R_STOPC, R_FMAX, R_ZREF, R_KP, R_KI,
  R_KD, R_HP, R_LHOME, R_BX, R_BY, R_BZ, R_TX, R_TY, R_TZ, R_MODE, R_DIR, R_HPS, R_INT, R_UX, R_UY,
  R_UZ, R_GX, R_GY, R_GZ, R_MX, R_MY, R_MZ, R_L, R_VR, R_KAP, R_Z, R_V, R_FSP, R_FST, R_FEL, R_FMO,
  R_FPI, R_FDA, R_VME, R_FFR, R_F, R_XB, R_EV, R_DHP, R_DINT, R_FUX, R_FUY, R_FUZ, R_FGX, R_FGY,
- R_FGZ, R_PB, R_PF, R_PM, R_PS, R_C0) = range(65)
-N_ROWS = 65 + LEG_COUNT - 1
+ R_FGZ, R_PB, R_PF, R_PM, R_PS, R_HPI, R_HDA, R_HMO, R_C0) = range(68)
+N_ROWS = 68 + LEG_COUNT - 1
 (V_A, V_B, V_FS, V_FC, V_CBC, V_CV, V_ZLOW, V_ZHIGH, V_STOPK, V_STOPC, V_FMAX, V_ZREF, V_KP, V_KI,
  V_KD, V_HP, V_LHOME, V_BX, V_BY, V_BZ, V_TX, V_TY, V_TZ, V_MODE, V_DIR, V_HPS, V_INT, V_UX, V_UY,
  V_UZ, V_GX, V_GY, V_GZ, V_MX, V_MY, V_MZ, V_L, V_VR, V_KAP, V_Z, V_V, V_FSP, V_FST, V_FEL, V_FMO,
  V_FPI, V_FDA, V_VME, V_FFR, V_F, V_XB, V_EV, V_DHP, V_DINT, V_FUX, V_FUY, V_FUZ, V_FGX, V_FGY,
- V_FGZ, V_PB, V_PF, V_PM, V_PS, V_C0) = range(0, 65 * LANES, LANES)
+ V_FGZ, V_PB, V_PF, V_PM, V_PS, V_HPI, V_HDA, V_HMO, V_C0) = range(0, 68 * LANES, LANES)
 # Platform ``plat``: mass, gravity, COM in the top frame, inertia and its inverse (row-major),
-# home position, which base axes move, whether the base rotates.
-PL_MASS, PL_G, PL_CT, PL_IC, PL_ICINV, PL_HOME, PL_ACTIVE, PL_ROTATING = 0, 1, 2, 5, 14, 23, 26, 32
-N_PLAT = 33
+# home position, which base axes move, whether the base rotates; the control: grid steps per
+# controller sample (0: continuous), centralised (1) or per leg (0), and the Cartesian loops'
+# ``J^-1`` (row-major) and gains per axis (proportional, integral, damping).
+(PL_MASS, PL_G, PL_CT, PL_IC, PL_ICINV, PL_HOME, PL_ACTIVE, PL_ROTATING, PL_CONTROL_STEPS,
+ PL_CENTRAL, PL_JINV, PL_CKP, PL_CKI, PL_CKD) = (0, 1, 2, 5, 14, 23, 26, 32, 33, 34, 35, 71, 77,
+                                                83)
+N_PLAT = 89
 
 # ODE state.
 S_C, S_Q, S_V, S_W, S_HP, S_INT, S_WB, S_DF, S_WM, S_DS = 0, 3, 7, 10, 13, 19, 25, 26, 27, 28
@@ -110,13 +116,14 @@ N_ODE = 29
 
 # Platform workspace ``ww``: the base motion and frame, the platform's rotation and inertia,
 # its accelerations, the sum of the leg forces, the state of the locked legs' factorisation,
-# its reciprocal pivots, the impulses of the last projection (0 if none), and per axis the
+# its reciprocal pivots, the impulses of the last projection (0 if none), per axis the
 # excitation's phase and its sine and cosine at the start of the step (persistent: carried
-# across kernel calls).
+# across kernel calls), and the Cartesian loops' errors, PI and damping commands per axis.
 (W_Y, W_YD, W_YDD, W_RB, W_OM, W_AL, W_VO, W_AO, W_GH, W_OMW, W_ALW, W_RR, W_IBI, W_ACC,
- W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE) = (0, 6, 12, 18, 27, 30, 33, 36, 39, 42, 45, 48,
-                                                   57, 66, 72, 75, 76, 82, 88)
-N_WORK = 106
+ W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE, W_CART) = (0, 6, 12, 18, 27, 30, 33, 36, 39, 42,
+                                                           45, 48, 57, 66, 72, 75, 76, 82, 88,
+                                                           106)
+N_WORK = 124
 SOLVE_NONE, SOLVE_FACTORED, SOLVE_MIN_NORM = 0.0, 1.0, 2.0
 # Rows of the state buffers ``buf`` (N_BUF, N_ODE).
 B_S, B_K1, B_S1, B_KE, B_TMP, B_K2, B_K3, B_K4, B_TRIAL, B_KT = range(10)
@@ -502,6 +509,82 @@ def _project(s, plat, ww, V, A, idx, vec):
 
 # ---------------------------------------------------------------- the right-hand side
 @njit(**_JIT)
+def _commands(plat, ww, V):
+    """Every leg's controller outputs from its sensors (rows ``Z``, ``VME``, ``INT`` of ``V``).
+
+    Per leg (``PL_CENTRAL`` 0): the single axis's :func:`~qzs.engine.laws.controller_law`
+    on each leg. Centralised: the legs' errors ``e_i = z_ref,i - z_i`` and measured velocities
+    mapped to the platform's axes by ``J^-1``, one PI + damping loop per axis (its integral in
+    the ``INT`` row of that axis), the axes' commands mapped back to leg forces by ``J^-T``,
+    each leg saturated at its own limit; an axis's integral stops while a saturated leg's
+    share of it, ``(J^-T)_ij Ki_j e_j``, pushes that leg further into saturation (the single
+    axis's conditional integration, docs/hexapod.md §9.5). Writes the rows ``FPI``, ``FDA``,
+    ``FMO`` (commands before saturation, the motor force after) and ``DINT`` (the integrals'
+    rates: per leg, or per axis).
+    """
+    if plat[PL_CENTRAL] == 0.0:
+        for i in range(LANES):
+            f_pi, f_damp, f_motor, rate = controller_law(
+                V[V_ZREF + i], V[V_KP + i], V[V_KI + i], V[V_KD + i], V[V_FMAX + i], V[V_Z + i],
+                V[V_VME + i], V[V_INT + i])
+            V[V_FPI + i] = f_pi
+            V[V_FDA + i] = f_damp
+            V[V_FMO + i] = f_motor
+            V[V_DINT + i] = rate
+        return
+    for j in range(6):  # the axes' errors and loops (J^-1 row-major: row j, column i)
+        error, velocity = 0.0, 0.0
+        for i in range(LEG_COUNT):
+            inverse = plat[PL_JINV + 6 * j + i]
+            error += inverse * (V[V_ZREF + i] - V[V_Z + i])
+            velocity += inverse * V[V_VME + i]
+        ww[W_CART + j] = error
+        ww[W_CART + 6 + j] = plat[PL_CKP + j] * error + plat[PL_CKI + j] * V[V_INT + j]
+        ww[W_CART + 12 + j] = -plat[PL_CKD + j] * velocity
+    for i in range(LEG_COUNT):
+        f_pi, f_damp = 0.0, 0.0
+        for j in range(6):
+            inverse = plat[PL_JINV + 6 * j + i]
+            f_pi += inverse * ww[W_CART + 6 + j]
+            f_damp += inverse * ww[W_CART + 12 + j]
+        f_max = V[V_FMAX + i]
+        V[V_FPI + i] = f_pi
+        V[V_FDA + i] = f_damp
+        V[V_FMO + i] = min(max(f_pi + f_damp, -f_max), f_max)
+    for j in range(6):
+        error = ww[W_CART + j]
+        rate = error
+        for i in range(LEG_COUNT):
+            command = V[V_FPI + i] + V[V_FDA + i]
+            push = plat[PL_JINV + 6 * j + i] * (plat[PL_CKI + j] * error)
+            f_max = V[V_FMAX + i]
+            if (command > f_max and push > 0.0) or (command < -f_max and push < 0.0):
+                rate = 0.0
+        V[V_DINT + j] = rate
+    for pad in range(LEG_COUNT, LANES):  # the padding lanes copy leg 1
+        V[V_FPI + pad] = V[V_FPI]
+        V[V_FDA + pad] = V[V_FDA]
+        V[V_FMO + pad] = V[V_FMO]
+        V[V_DINT + pad] = V[V_DINT]
+
+
+@njit(**_JIT)
+def _sample(plat, ww, V, s, h):
+    """A sampled controller's sample: outputs from the sensors of the last evaluation, held.
+
+    As the single axis's (docs/model.md §5): the outputs with the current integrals, then the
+    integrals advanced by forward Euler over the controller's period, ``I + rate N h``.
+    """
+    _commands(plat, ww, V)
+    for i in range(LANES):
+        V[V_HPI + i] = V[V_FPI + i]
+        V[V_HDA + i] = V[V_FDA + i]
+        V[V_HMO + i] = V[V_FMO + i]
+    for i in range(LEG_COUNT):
+        s[S_INT + i] = s[S_INT + i] + V[V_DINT + i] * plat[PL_CONTROL_STEPS] * h
+
+
+@njit(**_JIT)
 def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
     """The right-hand side at ``(t, s)`` into ``d``; every leg's forces and events into ``V``.
 
@@ -579,40 +662,44 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
         V[V_INT + i] = s[S_INT + i]
     obx, oby, obz = ww[W_OM], ww[W_OM + 1], ww[W_OM + 2]
     vox, voy, voz = ww[W_VO], ww[W_VO + 1], ww[W_VO + 2]
-    for i in range(LANES):
-        slipping = V[V_MODE + i] == MODE_SLIP
-        v = V[V_VR + i] if slipping else 0.0
-        z = V[V_L + i] - V[V_LHOME + i] + V[V_ZREF + i]
-        f_spring = spring_law(V[V_A + i], V[V_B + i], z)
-        f_stop, f_elastic = compliant_stop_law(z, v, V[V_ZLOW + i], V[V_ZHIGH + i],
-                                               V[V_STOPK + i], V[V_STOPC + i])
+    for i in range(LANES):  # what each leg's sensors read: encoder, accelerometer
+        v = V[V_VR + i] if V[V_MODE + i] == MODE_SLIP else 0.0
         bx, by, bz = V[V_BX + i], V[V_BY + i], V[V_BZ + i]
         base_rate = V[V_UX + i] * (vox + oby * bz - obz * by) \
             + V[V_UY + i] * (voy + obz * bx - obx * bz) + V[V_UZ + i] * (voz + obx * by - oby * bx)
         xd = base_rate + v
         omega_hp = V[V_HP + i]
-        v_measured = xd - V[V_HPS + i] if omega_hp > 0.0 else xd
-        f_pi, f_damp, f_motor, integral_rate = controller_law(
-            V[V_ZREF + i], V[V_KP + i], V[V_KI + i], V[V_KD + i], V[V_FMAX + i], z, v_measured,
-            V[V_INT + i])
+        V[V_Z + i] = V[V_L + i] - V[V_LHOME + i] + V[V_ZREF + i]
+        V[V_V + i] = v
+        V[V_XB + i] = base_rate
+        V[V_VME + i] = xd - V[V_HPS + i] if omega_hp > 0.0 else xd
+        V[V_DHP + i] = omega_hp * (xd - V[V_HPS + i])
+    if plat[PL_CONTROL_STEPS] > 0.0:  # sampled: the outputs held since the last sample
+        for i in range(LANES):
+            V[V_FPI + i] = V[V_HPI + i]
+            V[V_FDA + i] = V[V_HDA + i]
+            V[V_FMO + i] = V[V_HMO + i]
+            V[V_DINT + i] = 0.0
+    else:
+        _commands(plat, ww, V)
+    for i in range(LANES):
+        slipping = V[V_MODE + i] == MODE_SLIP
+        v = V[V_V + i]
+        z = V[V_Z + i]
+        f_spring = spring_law(V[V_A + i], V[V_B + i], z)
+        f_stop, f_elastic = compliant_stop_law(z, v, V[V_ZLOW + i], V[V_ZHIGH + i],
+                                               V[V_STOPK + i], V[V_STOPC + i])
+        f_motor = V[V_FMO + i]
         f_friction = sliding_friction_law(v, V[V_DIR + i], V[V_FS + i], V[V_FC + i],
                                           V[V_CBC + i], V[V_CV + i], 0.0)  # exact model
         f_friction = f_friction if slipping else 0.0
-        V[V_Z + i] = z
-        V[V_V + i] = v
         V[V_FSP + i] = f_spring
         V[V_FST + i] = f_stop
         V[V_FEL + i] = f_elastic
-        V[V_FMO + i] = f_motor
-        V[V_FPI + i] = f_pi
-        V[V_FDA + i] = f_damp
-        V[V_VME + i] = v_measured
         V[V_FFR + i] = f_friction
         f = f_spring + f_stop + f_motor + f_friction
+        base_rate = V[V_XB + i]
         V[V_F + i] = f
-        V[V_XB + i] = base_rate
-        V[V_DHP + i] = omega_hp * (xd - V[V_HPS + i])
-        V[V_DINT + i] = integral_rate
         V[V_FUX + i] = f * V[V_UX + i]
         V[V_FUY + i] = f * V[V_UY + i]
         V[V_FUZ + i] = f * V[V_UZ + i]
@@ -1020,7 +1107,9 @@ def _finite(s):
 def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counters, row, marks):
     """Settle the modes at t = 0 from all legs locked; evaluate; record the first sample.
 
-    The amplifiers' high-passes start settled (``w_i = xd_i(0)``, measured velocity 0).
+    The amplifiers' high-passes start settled (``w_i = xd_i(0)``, measured velocity 0); a
+    sampled controller holds its outputs at ``t = 0`` (its first sample, which also advances
+    the integrals, is at the start of the first step, as in the single axis).
     """
     for i in range(LEG_COUNT):
         _set_mode(V, i, MODE_LOCK, 1.0)
@@ -1030,6 +1119,13 @@ def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counte
     _evaluate(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
     for i in range(LEG_COUNT):
         s[S_HP + i] = V[V_XB + i]
+    if plat[PL_CONTROL_STEPS] > 0.0:  # a sampled controller's outputs at t = 0, held
+        _evaluate(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
+        _commands(plat, ww, V)
+        for i in range(LANES):
+            V[V_HPI + i] = V[V_FPI + i]
+            V[V_HDA + i] = V[V_FDA + i]
+            V[V_HMO + i] = V[V_FMO + i]
     _settle(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], newly)
     for j in range(N_ODE):
         buf[B_S, j] = s[j]
@@ -1052,8 +1148,17 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
     status = STATUS_OK
     row = row0
     step = counters[CT_STEP]
+    control_steps = int(plat[PL_CONTROL_STEPS])
     for _ in range(n_steps):
         _advance_phases(step * h, step % PHASE_PERIOD == 0, plat, ex, ww)
+        if control_steps > 0 and step % control_steps == 0:
+            # a sample: the held outputs jump, so the modes are settled again (a locked leg
+            # may break away right here) and the rate and event values are those after it
+            _sample(plat, ww, V, buf[B_S], h)
+            _settle(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1],
+                    newly)
+            for i in range(LEG_COUNT):
+                ev[0, i] = V[V_EV + i]
         _grid_step(solver, step * h, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec,
                    newly, counters)
         if not _finite(buf[B_S]):
@@ -1158,10 +1263,11 @@ class _Prepared:
     tables: np.ndarray
     toff: np.ndarray
     state: np.ndarray
+    cartesian: object = None
 
 
 def _prepare(geometry, platform, isolator, controller, excitation, duration, dt, sample_rate,
-             solver, progress):
+             solver, progress, cartesian=None):
     """Validate every argument of :func:`simulate_hexapod` and pack the kernels' arrays."""
     if not isinstance(geometry, HexapodGeometry):
         raise ParameterError(f"`geometry` must be a HexapodGeometry (e.g. from cubic_geometry or "
@@ -1188,10 +1294,11 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
             raise ParameterError(
                 f"leg {leg + 1}: `friction_regularisation` ({iso.friction_regularisation!r} m/s) "
                 "must be 0: the hexapod integrates the exact stick-slip model only.")
-        if con.controller_rate != 0:
+        if con.controller_rate != controllers[0].controller_rate:
             raise ParameterError(
-                f"leg {leg + 1}: `controller_rate` ({con.controller_rate!r} Hz) must be 0: the "
-                "hexapod's leg controllers run in continuous time; set controller_rate=0.")
+                f"leg {leg + 1}: `controller_rate` ({con.controller_rate!r} Hz) differs from leg "
+                f"1's ({controllers[0].controller_rate!r} Hz): the legs' loops run on one "
+                "controller, sampled together; give every leg the same rate.")
         if iso.stroke_half != geometry.stroke_half:
             raise ParameterError(
                 f"leg {leg + 1}: the isolator's `stroke_half` ({iso.stroke_half!r} m) differs "
@@ -1221,6 +1328,13 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
     decimation = steps_per_sample(sample_rate, dt, "sample_rate")
+    control_rate = controllers[0].controller_rate
+    control_steps = 0 if control_rate == 0 else steps_per_sample(control_rate, dt,
+                                                                 "controller_rate")
+    if cartesian is not None and not isinstance(cartesian, CartesianController):
+        raise ParameterError(
+            f"`cartesian` must be a CartesianController (e.g. CartesianController.from_legs("
+            f"geometry, controller)) or None for per-leg loops, got {type(cartesian).__name__}.")
     mass = _effective_leg_mass(geometry, platform)
     for iso, con in zip(isolators, controllers):
         light = replace(iso, mass=mass)
@@ -1257,6 +1371,15 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     plat[PL_IC:PL_IC + 9] = np.asarray(platform.inertia).ravel()
     plat[PL_ICINV:PL_ICINV + 9] = np.linalg.inv(platform.inertia).ravel()
     plat[PL_HOME:PL_HOME + 3] = geometry.home_position
+    plat[PL_CONTROL_STEPS] = control_steps
+    if cartesian is not None:
+        point = cartesian.point_in_top_frame(platform)
+        inverse = np.linalg.inv(jacobian(geometry, point=point))
+        plat[PL_CENTRAL] = 1.0
+        plat[PL_JINV:PL_JINV + 36] = inverse.ravel()
+        plat[PL_CKP:PL_CKP + 6] = cartesian.position_gain
+        plat[PL_CKI:PL_CKI + 6] = cartesian.integral_gain
+        plat[PL_CKD:PL_CKD + 6] = cartesian.damping_gain
     ex = np.zeros((6, 8))
     pieces, offsets = [], [0]
     for a, axis in enumerate(AXES):
@@ -1284,14 +1407,19 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     # PI preload (docs/model.md §5 for each leg): the motor carries the static leg load the
     # spring does not (stops untouched at the setpoint), the base at rest.
     loads = _static_forces(geometry, platform)
+    needed = np.zeros(LEG_COUNT)
     for i, (iso, con) in enumerate(zip(isolators, controllers)):
-        if con.pi_ki > 0:
-            spring = -iso.spring_force * np.tanh(iso.spring_shape * con.position_setpoint)
-            needed = np.clip(loads[i] - spring, -iso.motor_force_max, iso.motor_force_max)
-            state[S_INT + i] = needed / con.pi_ki
+        spring = -iso.spring_force * np.tanh(iso.spring_shape * con.position_setpoint)
+        needed[i] = np.clip(loads[i] - spring, -iso.motor_force_max, iso.motor_force_max)
+        if cartesian is None and con.pi_ki > 0:
+            state[S_INT + i] = needed[i] / con.pi_ki
+    if cartesian is not None:  # the same leg forces from the axes' integrals, J^-T Ki I = f
+        wrench = jacobian(geometry, point=cartesian.point_in_top_frame(platform)).T @ needed
+        held = cartesian.integral_gain > 0
+        state[S_INT:S_INT + LEG_COUNT][held] = wrench[held] / cartesian.integral_gain[held]
     return _Prepared(geometry, platform, isolators, controllers, moving, duration, dt,
                      sample_rate, decimation, solver, solver_code, V, plat, ex, tables, toff,
-                     state)
+                     state, cartesian)
 
 
 def _available_memory():
@@ -1308,7 +1436,7 @@ def _available_memory():
 def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, excitation=None,
                      duration=None, dt=defaults.SIMULATION["dt"],
                      sample_rate=defaults.SIMULATION["sample_rate"],
-                     solver=defaults.SIMULATION["solver"], progress=False):
+                     solver=defaults.SIMULATION["solver"], cartesian=None, progress=False):
     """Simulate a six-leg platform of isolator legs under a base moving in up to six axes.
 
     A rigid platform on six single-axis isolator legs (docs/hexapod.md, "Dynamics"): each
@@ -1330,7 +1458,10 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         used (the platform's are); ``stroke_half`` must equal the geometry's; compliant stops
         only.
     controller : ControllerParameters or sequence of six, optional
-        Each leg's loop; defaults if omitted. Continuous only (``controller_rate`` 0).
+        Each leg's loop; defaults if omitted. Continuous (``controller_rate`` 0) or sampled
+        with zero-order hold, every leg at the same rate (one controller), as the single
+        axis's (docs/model.md §5). With ``cartesian``, its ``position_setpoint``,
+        ``velocity_highpass`` and ``controller_rate`` are used and its gains are not.
     excitation : dict, optional
         Base motion: axis name (``"x"``, ``"y"``, ``"z"`` [m], ``"rx"``, ``"ry"``, ``"rz"``
         [rad]) to a Chirp, Sine, RandomExcitation or DisplacementRecord (its amplitude in that
@@ -1345,6 +1476,9 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         Output sample rate [Hz]; ``1/dt`` must be a whole multiple of it.
     solver : {"ode3", "rk4", "euler"}
         Fixed-step integrator (Bogacki-Shampine 3rd order by default).
+    cartesian : CartesianController, optional
+        Centralised control: the PI and damping loops on the platform's six axes, mapped
+        through the Jacobian (docs/hexapod.md §9.5); default None, a loop per leg.
     progress : bool
         Show a progress bar over the simulated time.
 
@@ -1361,7 +1495,7 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         The state diverged (the message names the time and state).
     """
     run = _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
-                   sample_rate, solver, progress)
+                   sample_rate, solver, progress, cartesian)
     h = run.dt
     n_steps = int(round(run.duration / h))
     n_out = n_steps // run.decimation + 1
@@ -1422,7 +1556,9 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
                 events=int(counters[CT_EVENTS]),
                 stick_events=[int(v) for v in counters[CT_STICKS:CT_STICKS + LEG_COUNT]],
                 stop_contacts=[int(v) for v in counters[CT_CONTACTS:CT_CONTACTS + LEG_COUNT]],
-                stops=[(float(V[V_ZLOW + i]), float(V[V_ZHIGH + i])) for i in range(LEG_COUNT)])
+                stops=[(float(V[V_ZLOW + i]), float(V[V_ZHIGH + i])) for i in range(LEG_COUNT)],
+                control="centralised" if run.cartesian is not None else "per leg",
+                controller_rate=run.controllers[0].controller_rate)
     return HexapodResult(out[:rows], out_flags[:rows], geometry=run.geometry,
                          platform=run.platform, isolators=run.isolators,
                          controllers=run.controllers, excitation=run.excitation, run=info)
@@ -1708,6 +1844,11 @@ def _summary_text(result):
              f"({result.steps_per_second:,.0f} steps/s), {run['events']:,} located transitions",
              f"Base excitation: {moving or 'none'}",
              f"Platform: {result.platform.mass:g} kg, gravity {result.platform.gravity:g} m/s^2",
+             "Control: " + ("PI + damping loops on the platform's axes (centralised)"
+                            if run.get("control") == "centralised" else "a PI + damping loop "
+                            "per leg")
+             + (f", sampled at {run['controller_rate']:g} Hz (zero-order hold)"
+                if run.get("controller_rate") else ", continuous"),
              "",
              "leg  stroke used [mm]  of [mm]  contacts  locked [%]  stick events  "
              "motor RMS [N]  motor max [N]"]

@@ -33,7 +33,7 @@ __all__ = ["HexapodGeometry", "PlatformParameters", "StrokeCheck", "LEG_COUNT",
            "cubic_geometry", "radial_geometry", "rotation_matrix", "rotation_angles",
            "angular_velocity_matrix", "leg_vectors", "leg_unit_vectors", "inverse_kinematics",
            "forward_kinematics", "jacobian", "base_jacobian", "stroke_check", "leg_positions",
-           "mass_matrix", "weight_wrench", "static_leg_forces"]
+           "mass_matrix", "weight_wrench", "static_leg_forces", "CartesianController"]
 
 #: Number of legs of a hexapod [-].
 LEG_COUNT = 6
@@ -775,3 +775,141 @@ def static_leg_forces(geometry, platform, pose=None):
     """
     pose = _pose(pose)
     return np.linalg.solve(jacobian(geometry, pose).T, weight_wrench(platform, pose))
+
+
+# ---------------------------------------------------------------- centralised control
+_GAIN_UNITS = {"position_gain": "N/m, N*m/rad",
+               "integral_gain": "N/(m*s), N*m/(rad*s)",
+               "damping_gain": "N*s/m, N*m*s/rad"}
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class CartesianController(_ArrayFields):
+    """Centralised control: the legs' PI and damping loops run on the platform's six axes.
+
+    The legs' sensors are mapped to the platform's axes at the home pose,
+    ``e = J^-1 (z_ref - z)`` and ``v = J^-1 v_meas`` (``J`` the Jacobian at ``point``, so
+    ``e`` is the small displacement of that point [m] and the rotation [rad]); each axis
+    ``j`` runs ``F_j = Kp_j e_j + Ki_j I_j - Kd_j v_j`` with ``I_j' = e_j``; the wrench goes
+    back to the legs as ``f = J^-T F``, each leg saturated at its motor's limit
+    (docs/hexapod.md §9.5). Diagonal gains in the frame of ``point``; with
+    ``K = J^T diag(k) J`` diagonal (the cubic configuration at the cube's centre, equal
+    legs) it is the decentralised loop exactly.
+
+    Parameters
+    ----------
+    position_gain : array_like, shape (6,)
+        ``Kp`` per axis, x, y, z then rx, ry, rz [N/m, N*m/rad].
+    integral_gain : array_like, shape (6,)
+        ``Ki`` per axis [N/(m*s), N*m/(rad*s)].
+    damping_gain : array_like, shape (6,)
+        ``Kd`` per axis, on the absolute velocity the legs' accelerometers measure
+        [N*s/m, N*m*s/rad].
+    point : {"origin", "center_of_mass"} or array_like, shape (3,)
+        Where the axes are: the top frame origin (the cube's centre of a cubic geometry),
+        the payload's centre of mass, or a point in the top frame [m].
+    """
+
+    position_gain: np.ndarray = parameter(unit=_GAIN_UNITS["position_gain"],
+                                          doc="proportional gain per axis")
+    integral_gain: np.ndarray = parameter(unit=_GAIN_UNITS["integral_gain"],
+                                          doc="integral gain per axis")
+    damping_gain: np.ndarray = parameter(unit=_GAIN_UNITS["damping_gain"],
+                                         doc="active damping gain per axis")
+    point: object = parameter("origin", "m", "the point the axes are taken at (top frame)")
+
+    def __post_init__(self):
+        for name in ("position_gain", "integral_gain", "damping_gain"):
+            value = _vector_array(name, getattr(self, name), (6,))
+            if np.any(value < 0):
+                raise ParameterError(
+                    f"`{name}` must be non-negative on every axis [{_GAIN_UNITS[name]}], got "
+                    f"{value.tolist()}.")
+            object.__setattr__(self, name, _read_only(value))
+        if isinstance(self.point, str):
+            if self.point not in ("origin", "center_of_mass"):
+                raise ParameterError(
+                    f"`point` must be 'origin', 'center_of_mass' or a point in the top frame "
+                    f"[m], got {self.point!r}.")
+        else:
+            object.__setattr__(self, "point", _read_only(_vector_array("point", self.point,
+                                                                       (3,))))
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        if isinstance(self.point, str) or isinstance(other.point, str):
+            if not (isinstance(self.point, str) and isinstance(other.point, str)
+                    and self.point == other.point):
+                return False
+        elif not np.array_equal(self.point, other.point):
+            return False
+        return all(np.array_equal(getattr(self, n), getattr(other, n))
+                   for n in ("position_gain", "integral_gain", "damping_gain"))
+
+    def __hash__(self):
+        point = self.point if isinstance(self.point, str) else self.point.tobytes()
+        return hash((self.position_gain.tobytes(), self.integral_gain.tobytes(),
+                     self.damping_gain.tobytes(), point))
+
+    def point_in_top_frame(self, platform):
+        """The point the axes are taken at, in the top frame [m].
+
+        Parameters
+        ----------
+        platform : PlatformParameters
+            Gives the centre of mass for ``point="center_of_mass"``.
+
+        Returns
+        -------
+        ndarray, shape (3,)
+        """
+        if isinstance(self.point, str):
+            return np.zeros(3) if self.point == "origin" else np.array(platform.center_of_mass)
+        return np.array(self.point)
+
+    @classmethod
+    def from_legs(cls, geometry, controller=None, *, platform=None, point="origin"):
+        """The Cartesian loops with the decentralised loops' stiffness on each axis.
+
+        Each gain is the diagonal of ``J^T diag(k) J`` at ``point`` (``k`` the legs' gain):
+        what the per-leg loops give the platform's axes when the legs are decoupled there.
+
+        Parameters
+        ----------
+        geometry : HexapodGeometry
+            The platform's joints.
+        controller : ControllerParameters or sequence of six, optional
+            The legs' loops (``pi_kp``, ``pi_ki``, ``damping_gain``); defaults if omitted.
+        platform : PlatformParameters, optional
+            Needed for ``point="center_of_mass"``.
+        point : {"origin", "center_of_mass"} or array_like, shape (3,)
+            As for the class.
+
+        Returns
+        -------
+        CartesianController
+        """
+        if not isinstance(geometry, HexapodGeometry):
+            raise ParameterError(f"`geometry` must be a HexapodGeometry, got "
+                                 f"{type(geometry).__name__}.")
+        controllers = ControllerParameters() if controller is None else controller
+        if isinstance(controllers, ControllerParameters):
+            controllers = (controllers,) * LEG_COUNT
+        if not (isinstance(controllers, (list, tuple)) and len(controllers) == LEG_COUNT
+                and all(isinstance(c, ControllerParameters) for c in controllers)):
+            raise ParameterError(f"`controller` must be a ControllerParameters or a sequence of "
+                                 f"six, got {controller!r}.")
+        if point == "center_of_mass" and not isinstance(platform, PlatformParameters):
+            raise ParameterError("`platform` (a PlatformParameters) is needed for "
+                                 "point='center_of_mass'.")
+        probe = cls(position_gain=np.zeros(6), integral_gain=np.zeros(6),
+                    damping_gain=np.zeros(6), point=point)
+        j = jacobian(geometry, point=probe.point_in_top_frame(platform))
+
+        def diagonal(name):
+            gains = np.array([getattr(c, name) for c in controllers])
+            return np.einsum("ij,i,ij->j", j, gains, j)
+
+        return cls(position_gain=diagonal("pi_kp"), integral_gain=diagonal("pi_ki"),
+                   damping_gain=diagonal("damping_gain"), point=point)

@@ -18,6 +18,12 @@ A hexapod file (``qzs hexapod linear --config FILE.toml``)::
     stiction_force = 10.0
     [controller]              # each leg's PI and damping loop (qzs params)
     pi_kp = 50.0
+    controller_rate = 0.0     # [Hz] 0: continuous; else sampled, zero-order hold
+
+    [cartesian]               # optional: centralised control, the loops on the platform's
+    point = "origin"          # axes at this point ("origin", "center_of_mass" or [x, y, z] [m])
+    position_gain = [8000.0, 8000.0, 8000.0, 45.0, 45.0, 180.0]  # per axis x..rz; default the
+    # legs' loops' stiffness on each axis; also integral_gain and damping_gain (docs/hexapod.md §9.5)
 
 ``radial`` takes ``base_radius``, ``top_radius``, ``height`` [m] and ``base_angle``,
 ``top_angle`` [deg]; ``joints`` takes ``base_joints`` and ``top_joints`` (6 x 3) and
@@ -32,8 +38,9 @@ from qzs._validation import read_toml
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped
 from qzs.model.controller import ControllerParameters
-from qzs.model.hexapod import (LEG_COUNT, PlatformParameters, cubic_geometry, leg_unit_vectors,
-                               radial_geometry, HexapodGeometry)
+from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
+                               PlatformParameters, cubic_geometry, leg_unit_vectors,
+                               radial_geometry)
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import PARAMETERS, update_parameters
 
@@ -88,6 +95,8 @@ class HexapodSetup:
         ``[simulation]`` options (for a simulation).
     source : str
         The file it was read from ('' if built from arguments).
+    cartesian : CartesianController or None
+        Centralised control (the ``[cartesian]`` table); None: a loop per leg.
     """
 
     geometry: HexapodGeometry
@@ -98,6 +107,7 @@ class HexapodSetup:
     excitation: dict = field(default_factory=dict)
     simulation: dict = field(default_factory=dict)
     source: str = ""
+    cartesian: CartesianController = None
 
 
 def default_cube_center_height(cube_edge):
@@ -233,8 +243,23 @@ def _platform(table, geometry, isolator, controller, where):
                               gravity=gravity)
 
 
+_CARTESIAN_KEYS = ("point", "position_gain", "integral_gain", "damping_gain")
+
+
+def _cartesian(table, geometry, platform, controller, where):
+    """A ``[cartesian]`` table as a CartesianController (gains left out: the legs' loops')."""
+    unknown = sorted(set(table) - set(_CARTESIAN_KEYS))
+    if unknown:
+        raise ParameterError(f"{where}[cartesian]: unknown key(s) {unknown}; allowed are "
+                             f"{list(_CARTESIAN_KEYS)}.")
+    point = table.get("point", "origin")
+    legs = CartesianController.from_legs(geometry, controller, platform=platform, point=point)
+    return CartesianController(**{name: table.get(name, getattr(legs, name))
+                                  for name in _CARTESIAN_KEYS[1:]}, point=point)
+
+
 def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=None,
-                  settings=None, kind="joints"):
+                  settings=None, kind="joints", cartesian=None):
     """A :class:`HexapodSetup` from objects, with registry overrides applied to every leg.
 
     Parameters
@@ -252,6 +277,9 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
         ``name -> value`` overrides by registry name (``qzs params``; ``--set``).
     kind : str
         How ``geometry`` was described, for reports.
+    cartesian : CartesianController or "legs", optional
+        Centralised control; ``"legs"`` for the Cartesian loops with the legs' stiffness on
+        each axis at the top frame origin (:meth:`CartesianController.from_legs`).
 
     Returns
     -------
@@ -271,8 +299,13 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
     if not isinstance(platform, PlatformParameters):
         raise ParameterError(f"`platform` must be a PlatformParameters, got "
                              f"{type(platform).__name__}.")
+    if isinstance(cartesian, str) and cartesian == "legs":
+        cartesian = CartesianController.from_legs(geometry, controller)
+    if cartesian is not None and not isinstance(cartesian, CartesianController):
+        raise ParameterError(f"`cartesian` must be a CartesianController, 'legs' or None, got "
+                             f"{cartesian!r}.")
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
-                        controller=controller, kind=kind)
+                        controller=controller, kind=kind, cartesian=cartesian)
 
 
 def load_hexapod(path, settings=None):
@@ -297,7 +330,8 @@ def load_hexapod(path, settings=None):
     path = resolve_shipped(path, SHIPPED, "hexapod", "hexapod files")
     document = read_toml(path, "hexapod file")
     where = f"{str(path)!r}: "
-    allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation"}
+    allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation",
+               "cartesian"}
     unknown = sorted(set(document) - allowed)
     if unknown:
         raise ParameterError(f"{where}unknown table(s) {unknown}; allowed are {sorted(allowed)}.")
@@ -329,9 +363,12 @@ def load_hexapod(path, settings=None):
         if not isinstance(options, dict) or "kind" not in options:
             raise ParameterError(f"{where}[excitation.{axis}] needs a `kind` (chirp, sine, "
                                  "random or file) and its options.")
+    cartesian = None
+    if "cartesian" in document:
+        cartesian = _cartesian(document["cartesian"], geometry, platform, controller, where)
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
                         controller=controller, kind=kind, excitation=dict(excitation),
-                        simulation=simulation, source=str(path))
+                        simulation=simulation, source=str(path), cartesian=cartesian)
 
 
 def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_preload=True):
@@ -369,7 +406,7 @@ def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_
         frame = "origin"
     model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller,
                               leg_stiffness=leg_stiffness, frame=frame,
-                              include_preload=include_preload)
+                              include_preload=include_preload, cartesian=setup.cartesian)
     record = {
         "frame": requested if isinstance(requested, str) else np.asarray(frame, dtype=float),
         "axes": list(AXES),
@@ -414,6 +451,12 @@ def linear_text(setup, model, record):
              f"matrices at the "
              f"{_FRAME_WORDS.get(frame, frame) if isinstance(frame, str) else list(frame)}"
              + ("" if record["include_preload"] else ", without the preload stiffness")]
+    if setup.cartesian is not None:
+        point = setup.cartesian.point
+        where = f"the {_FRAME_WORDS[point]}" if isinstance(point, str) else f"{list(point)} m"
+        gains = " ".join(f"{v:.4g}" for v in setup.cartesian.position_gain)
+        lines.append(f"  centralised control: PI and damping loops on the platform's axes at "
+                     f"{where}, Kp {gains} (N/m x3, N*m/rad x3)")
     if record["leg_stiffness"] is not None:
         lines.append(f"  every leg's axial stiffness set to {record['leg_stiffness']:g} N/m")
     forces = np.asarray(record["static_leg_forces"])
@@ -531,4 +574,5 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
                             excitation=built, duration=run.get("duration"),
                             dt=run.get("dt", SIMULATION["dt"]),
                             sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
-                            solver=run.get("solver", SIMULATION["solver"]), progress=progress)
+                            solver=run.get("solver", SIMULATION["solver"]),
+                            cartesian=setup.cartesian, progress=progress)
