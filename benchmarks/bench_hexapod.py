@@ -65,6 +65,9 @@ def main():
                         help="wait up to S seconds before each timed run for the CPUs to idle")
     parser.add_argument("--cold-compile", action="store_true",
                         help="time the hexapod's first call with an empty numba cache")
+    parser.add_argument("--batch", type=int, default=4, metavar="N",
+                        help="also time N platforms through simulate_hexapods on 1 and on all "
+                             "cores (0: skip)")
     args = parser.parse_args()
 
     from qzs import Chirp, ControllerParameters, IsolatorParameters, simulate, simulate_hexapod
@@ -121,6 +124,23 @@ def main():
     verdict = "PASS" if ratio >= TARGET else "FAIL"
     print(f"best: hexapod {best_hexapod:,.0f} steps/s, single axis {best_single:,.0f} steps/s; "
           f"ratio {ratio:.3f} = 1/{1 / ratio:.2f} (target >= 1/8): {verdict}")
+    if args.batch > 0:
+        from qzs import simulate_hexapods
+
+        runs = [dict(geometry=geometry, platform=platform, isolator=isolator,
+                     controller=controller, excitation={"z": chirp}, duration=args.duration)
+                for _ in range(args.batch)]
+        cores = os.cpu_count() or 1
+        best = {}
+        for repeat in range(args.repeats):
+            for workers in ((1, cores) if repeat % 2 == 0 else (cores, 1)):
+                wait_for_idle(args.idle_wait)
+                start = time.perf_counter()
+                simulate_hexapods(runs, workers=workers)
+                best[workers] = min(best.get(workers, np.inf), time.perf_counter() - start)
+        print(f"batch of {args.batch} platforms (simulate_hexapods, threads): "
+              f"{best[1]:.2f} s on 1 core, {best[cores]:.2f} s on {cores}: "
+              f"{best[1] / best[cores]:.2f}x")
     if args.cold_compile:
         with tempfile.TemporaryDirectory() as cache:
             env = dict(os.environ, NUMBA_CACHE_DIR=cache)

@@ -497,3 +497,36 @@ def test_regularised_friction_is_refused_by_the_hexapod():
                              qzs.IsolatorParameters(friction_regularisation=1e-3),
                              setup.controller, excitation={"z": qzs.Sine(frequency=2.0)},
                              duration=0.1)
+
+
+# ---------------------------------------------------------------- batches of platforms
+def test_a_batch_of_platforms_gives_each_its_own_run(cubic):
+    """``simulate_hexapods`` runs platforms in threads: each result is bit for bit the one
+    ``simulate_hexapod`` gives it alone, whatever the number of threads."""
+    from qzs.engine.hexapod import simulate_hexapods
+
+    runs = [dict(geometry=cubic, platform=platform, controller=STABLE,
+                 excitation={"z": Chirp(duration=20.0)}, duration=1.0)
+            for platform in (symmetric_platform(), skewed_platform(), symmetric_platform())]
+    runs[2]["isolator"] = IsolatorParameters(stiction_force=2.0, coulomb_force=1.0)
+    alone = [simulate_hexapod(**arguments) for arguments in runs]
+    for workers in (1, 2):
+        batch = simulate_hexapods(runs, workers=workers)
+        for one, other in zip(alone, batch):
+            assert np.array_equal(one._data, other._data)
+            assert np.array_equal(one._flags, other._flags)
+
+
+def test_a_bad_run_of_a_batch_is_named_before_any_integration(cubic):
+    from qzs.engine.hexapod import simulate_hexapods
+    from qzs.errors import CaseError
+
+    good = dict(geometry=cubic, platform=symmetric_platform(), controller=STABLE,
+                excitation={"z": Chirp(duration=20.0)}, duration=1.0)
+    with pytest.raises(CaseError, match="dt") as caught:
+        simulate_hexapods([good, {**good, "dt": -1.0}])
+    assert caught.value.index == 1
+    with pytest.raises(ParameterError, match="geometry"):
+        simulate_hexapods([{"platform": symmetric_platform()}])
+    with pytest.raises(ParameterError, match="workers"):
+        simulate_hexapods([good], workers=0)

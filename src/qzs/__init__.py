@@ -43,9 +43,12 @@ _LAZY = {
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
     "simulate_hexapod": "qzs.engine.hexapod", "HexapodResult": "qzs.engine.hexapod",
+    "simulate_hexapods": "qzs.engine.hexapod",
     "steady_state_response": "qzs.workflows.response",
     "SteadyStateResponse": "qzs.workflows.response",
     "design_controller": "qzs.workflows.design", "DesignResult": "qzs.workflows.design",
+    "hexapod_transmissibility": "qzs.workflows.hexapod_transmissibility",
+    "HexapodTransmissibility": "qzs.workflows.hexapod_transmissibility",
 }
 
 __all__ = [

@@ -63,7 +63,8 @@ from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_frictio
                              spring_energy_law, spring_law)
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
-from qzs.errors import ParameterError, SimulationError, StabilityError
+from qzs.engine.simulate import PREVIEW_SAMPLES, _DeferredInterrupt
+from qzs.errors import CaseError, ParameterError, SimulationError, StabilityError, Terminated
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
@@ -71,7 +72,8 @@ from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import unit_of
 
-__all__ = ["simulate_hexapod", "HexapodResult", "AXES", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS"]
+__all__ = ["simulate_hexapod", "simulate_hexapods", "HexapodResult", "AXES", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS",
+           "hexapod_file_layout"]
 
 #: The six axes of a pose, in order: translations [m], then rotation angles [rad].
 AXES = ("x", "y", "z", "rx", "ry", "rz")
@@ -1136,7 +1138,7 @@ def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counte
     _record(0.0, s, plat, ww, V, row, marks)
 
 
-@njit(**_JIT)
+@njit(**_JIT, nogil=True)
 def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec,
          newly, counters, out, out_flags, row0):
     """Advance ``n_steps`` grid steps, recording every ``decimation``-th into ``out`` from ``row0``.
@@ -1144,6 +1146,7 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
     The carried state (``buf[B_S]``, its rate ``buf[B_K1]``, event values ``ev[0]``, modes,
     counters and workspaces) persists in the arrays between calls, so cutting a run into
     calls changes nothing. Returns ``(status, rows written)``; ``s`` receives the state.
+    Holds no GIL: platforms of a batch run in threads (:func:`simulate_hexapods`).
     """
     status = STATUS_OK
     row = row0
@@ -1436,7 +1439,8 @@ def _available_memory():
 def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, excitation=None,
                      duration=None, dt=defaults.SIMULATION["dt"],
                      sample_rate=defaults.SIMULATION["sample_rate"],
-                     solver=defaults.SIMULATION["solver"], cartesian=None, progress=False):
+                     solver=defaults.SIMULATION["solver"], cartesian=None, progress=False,
+                     sink=None, interruptible=False):
     """Simulate a six-leg platform of isolator legs under a base moving in up to six axes.
 
     A rigid platform on six single-axis isolator legs (docs/hexapod.md, "Dynamics"): each
@@ -1481,6 +1485,16 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         through the Jacobian (docs/hexapod.md §9.5); default None, a loop per leg.
     progress : bool
         Show a progress bar over the simulated time.
+    sink : callable, optional
+        ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
+        (``data`` with :data:`HEXAPOD_CHANNELS`' columns, ``flags`` with
+        :data:`HEXAPOD_FLAGS`'); memory then stays bounded however long the run, and the
+        result holds every sample only up to 200,000 of them, else every k-th
+        (``run["preview_every"]``); its summary covers every sample
+        (:class:`qzs.iotools.hexapod_files.HexapodWriter` is such a sink).
+    interruptible : bool
+        Ctrl-C ends the run after the chunk under way; the result (and the sink) then hold
+        what was simulated, and ``run["completed"]`` is False.
 
     Returns
     -------
@@ -1496,18 +1510,35 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
     """
     run = _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
                    sample_rate, solver, progress, cartesian)
+    if sink is not None and not callable(sink):
+        raise ParameterError(f"`sink` must be a callable sink(data, flags) or None, got "
+                             f"{type(sink).__name__}.")
+    if not isinstance(interruptible, (bool, np.bool_)):
+        raise ParameterError(f"`interruptible` must be True or False, got {interruptible!r}.")
     h = run.dt
     n_steps = int(round(run.duration / h))
     n_out = n_steps // run.decimation + 1
-    needed = n_out * (8 * N_CHANNELS + N_FLAGS)
-    available = _available_memory()
-    if available is not None and needed > 0.5 * available:
-        raise ParameterError(
-            f"a {run.duration:g} s hexapod run at {run.sample_rate:g} Hz keeps "
-            f"{needed / 1024 ** 3:.2f} GiB of samples, more than half the memory available; "
-            "lower the `sample_rate` or the `duration`.")
-    out = np.empty((n_out, N_CHANNELS))
-    out_flags = np.zeros((n_out, N_FLAGS), dtype=np.bool_)
+    chunk = run.decimation * max(1, 200_000 // run.decimation)
+    if sink is None:
+        needed = n_out * (8 * N_CHANNELS + N_FLAGS)
+        available = _available_memory()
+        if available is not None and needed > 0.5 * available:
+            raise ParameterError(
+                f"a {run.duration:g} s hexapod run at {run.sample_rate:g} Hz keeps "
+                f"{needed / 1024 ** 3:.2f} GiB of samples, more than half the memory available; "
+                "lower the `sample_rate` or the `duration`, or stream it to a file "
+                "(`qzs hexapod simulate --out FILE.nc`, qzs.workflows.hexapod.simulate_setup("
+                "..., out=...)).")
+        every = 1
+        out = np.empty((n_out, N_CHANNELS))
+        out_flags = np.zeros((n_out, N_FLAGS), dtype=np.bool_)
+    else:  # one chunk's buffer; the result keeps every ``every``-th sample as a preview
+        every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // PREVIEW_SAMPLES)
+        out = np.empty((chunk // run.decimation + 1, N_CHANNELS))
+        out_flags = np.zeros((out.shape[0], N_FLAGS), dtype=np.bool_)
+        preview, preview_flags = [], []
+    statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
+                              for i in range(LEG_COUNT)])
     s = run.state
     V = run.V
     buf = np.zeros((N_BUF, N_ODE))
@@ -1519,22 +1550,38 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
     counters = np.zeros(N_COUNTERS, dtype=np.int64)
     arrays = (run.plat, run.ex, run.tables, run.toff)
     work = (buf, ev, ww, V, A, idx, vec, newly, counters)
+
+    def absorb(first, count, total):
+        """Rows ``first:first+count`` of the buffer are new; ``total`` came before them."""
+        block, marks = out[first:first + count], out_flags[first:first + count]
+        statistics.add(block, marks)
+        if sink is not None:
+            sink(block, marks)
+            keep = np.arange((-total) % every, count, every)
+            preview.append(block[keep].copy())
+            preview_flags.append(marks[keep].copy())
+
     _start(s, *arrays, *work, out[0], out_flags[0])
     _run(run.solver_code, 0, run.decimation, h, s, *arrays, *work, out, out_flags,
          1)  # compiles (or loads) the kernel: the clock counts integration only
+    absorb(0, 1, 0)
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
         bar = tqdm(total=run.duration, unit="s", desc="simulating hexapod", leave=False)
-    chunk = run.decimation * max(1, 200_000 // run.decimation)
-    rows, done = 1, 0
+    rows, done, completed, interrupted = 1, 0, True, False
+    deferred = _DeferredInterrupt() if interruptible else None
     start = _time.perf_counter()
     try:
-        while done < n_steps:
+        if deferred is not None:  # Ctrl-C stops the run between chunks: rows stay whole
+            deferred.install()
+        while done < n_steps and not interrupted:
             n = min(chunk, n_steps - done)
+            row0 = rows if sink is None else 0
             status, written = _run(run.solver_code, n, run.decimation, h, s, *arrays, *work,
-                                   out, out_flags, rows)
+                                   out, out_flags, row0)
+            absorb(row0, written, rows)
             rows += written
             if status != STATUS_OK:
                 failed = int(counters[CT_STEP])
@@ -1547,7 +1594,17 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
             done = int(counters[CT_STEP])
             if bar is not None:
                 bar.update(n * h)
+            interrupted = deferred is not None and deferred.requested
+        if deferred is not None and deferred.terminated:
+            raise Terminated(deferred.terminated)
+        completed = done >= n_steps
+    except KeyboardInterrupt:
+        if not interruptible:
+            raise
+        completed = False
     finally:
+        if deferred is not None:
+            deferred.restore()
         if bar is not None:
             bar.close()
     elapsed = _time.perf_counter() - start
@@ -1558,10 +1615,95 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
                 stop_contacts=[int(v) for v in counters[CT_CONTACTS:CT_CONTACTS + LEG_COUNT]],
                 stops=[(float(V[V_ZLOW + i]), float(V[V_ZHIGH + i])) for i in range(LEG_COUNT)],
                 control="centralised" if run.cartesian is not None else "per leg",
-                controller_rate=run.controllers[0].controller_rate)
-    return HexapodResult(out[:rows], out_flags[:rows], geometry=run.geometry,
-                         platform=run.platform, isolators=run.isolators,
-                         controllers=run.controllers, excitation=run.excitation, run=info)
+                controller_rate=run.controllers[0].controller_rate, completed=completed,
+                preview_every=every)
+    if sink is None:
+        data, data_flags = out[:rows], out_flags[:rows]
+    else:
+        data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
+    return HexapodResult(data, data_flags, geometry=run.geometry, platform=run.platform,
+                         isolators=run.isolators, controllers=run.controllers,
+                         excitation=run.excitation, run=info, statistics=statistics.result())
+
+
+def simulate_hexapods(runs, *, workers=None, progress=False):
+    """Simulate several platforms at once, in threads (the hexapod kernel holds no GIL).
+
+    Every run is checked before any integration starts (a bad one is named by its index);
+    each gives the very numbers :func:`simulate_hexapod` gives it alone. The six legs of
+    one platform already fill the kernel's vector lanes (:data:`LANES`), so platforms are
+    batched across cores, one thread each, rather than in lanes.
+
+    Parameters
+    ----------
+    runs : sequence of dict
+        Keyword arguments of :func:`simulate_hexapod`, one dict per platform (``geometry``
+        and ``platform`` required); ``progress`` and ``sink`` are not accepted.
+    workers : int, optional
+        Threads; default the machine's core count (at most the number of runs).
+    progress : bool
+        A progress bar over the platforms.
+
+    Returns
+    -------
+    list of HexapodResult
+        In the order of ``runs``.
+
+    Raises
+    ------
+    CaseError
+        A run's arguments are invalid (attributes ``index`` and ``reason``).
+    ParameterError
+        ``runs`` is empty or holds no dicts, or ``workers`` is not a positive integer.
+    """
+    import os
+    from concurrent.futures import ThreadPoolExecutor
+
+    runs = list(runs)
+    if not runs:
+        raise ParameterError("`runs` is empty: give at least one dict of simulate_hexapod "
+                             "arguments.")
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
+    names = ("geometry", "platform", "isolator", "controller", "excitation", "duration", "dt",
+             "sample_rate", "solver", "cartesian")
+    for i, arguments in enumerate(runs):
+        if not isinstance(arguments, dict):
+            raise ParameterError(f"`runs[{i}]` must be a dict of simulate_hexapod arguments, "
+                                 f"got {type(arguments).__name__}.")
+        unknown = sorted(set(arguments) - set(names))
+        if unknown or "geometry" not in arguments or "platform" not in arguments:
+            raise ParameterError(f"`runs[{i}]` needs `geometry` and `platform` and may have "
+                                 f"{list(names[2:])}; got {sorted(arguments)}.")
+        try:  # every run checked (and packed once, cheaply) before any integration
+            _prepare(arguments["geometry"], arguments["platform"], arguments.get("isolator"),
+                     arguments.get("controller"), arguments.get("excitation"),
+                     arguments.get("duration"),
+                     arguments.get("dt", defaults.SIMULATION["dt"]),
+                     arguments.get("sample_rate", defaults.SIMULATION["sample_rate"]),
+                     arguments.get("solver", defaults.SIMULATION["solver"]), False,
+                     arguments.get("cartesian"))
+        except ParameterError as error:
+            raise CaseError(i, str(error)) from error
+    workers = min(workers or os.cpu_count() or 1, len(runs))
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=len(runs), unit="platform", desc="simulating hexapods")
+
+    def one(arguments):
+        result = simulate_hexapod(**arguments)
+        if bar is not None:
+            bar.update()
+        return result
+
+    try:
+        with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="qzs-hexapod") as pool:
+            return list(pool.map(one, runs))
+    finally:
+        if bar is not None:
+            bar.close()
 
 
 # ---------------------------------------------------------------- the result
@@ -1633,6 +1775,50 @@ def _attribute(value):
     return value
 
 
+def hexapod_file_layout():
+    """The CF-1.10 layout of a hexapod run's file: variables and coordinates with attributes.
+
+    One place for what :meth:`HexapodResult.to_xarray` builds and what
+    :class:`qzs.iotools.hexapod_files.HexapodWriter` streams (docs/model.md §7): every
+    variable has ``units`` and ``long_name``; a ``dof`` variable mixes translations and
+    rotations, so its ``units`` lists one unit per dof (``units_by_dof`` names them); flags
+    are booleans with ``flag_values`` and ``flag_meanings``; time in plain seconds.
+
+    Returns
+    -------
+    dict
+        ``{"variables": {name: (dims, attrs)}, "coordinates": {name: (dims, values,
+        attrs)}}`` (the ``time`` coordinate's values are the run's own).
+    """
+    variables = {}
+    for name, (_, dim, unit, doc) in HEXAPOD_CHANNELS.items():
+        if name == "time":
+            continue
+        attrs = {"long_name": doc}
+        if dim == "dof":
+            attrs["units"] = ", ".join(unit)
+            attrs["units_by_dof"] = "; ".join(f"{a}: {u}" for a, u in zip(AXES, unit))
+        else:
+            attrs["units"] = unit
+        variables[name] = (("time",) if dim is None else ("time", dim), attrs)
+    for name, (_, doc) in HEXAPOD_FLAGS.items():
+        variables[name] = (("time", "leg"), {
+            "units": "1", "long_name": doc, "flag_values": np.array([0, 1], dtype=np.int8),
+            "flag_meanings": _FLAG_MEANINGS[name]})
+    coordinates = {
+        "time": (("time",), None, {
+            "units": "s", "standard_name": "time", "axis": "T",
+            "long_name": "time since the start of the run",
+            "comment": "relative run time without a calendar date: units 's' instead of "
+                       "'s since <date>' (docs/model.md §7)"}),
+        "dof": (("dof",), list(AXES), {"long_name": "degree of freedom: translations x, y, z "
+                                                    "[m], rotations rx, ry, rz [rad]",
+                                       "units": "1"}),
+        "leg": (("leg",), np.arange(1, LEG_COUNT + 1), {"long_name": "leg number",
+                                                         "units": "1"})}
+    return {"variables": variables, "coordinates": coordinates}
+
+
 class HexapodResult:
     """Time series and metadata of one hexapod run (:func:`simulate_hexapod`).
 
@@ -1660,11 +1846,16 @@ class HexapodResult:
     run : dict
         Solver, ``dt`` [s], ``sample_rate`` [Hz], ``duration`` [s], ``steps``, ``elapsed`` [s]
         (integration only), ``samples``, ``events`` (located transitions), per leg
-        ``stick_events`` and ``stop_contacts``, and ``stops`` (per leg, [m]).
+        ``stick_events`` and ``stop_contacts``, ``stops`` (per leg, [m]), ``control``,
+        ``controller_rate`` [Hz], ``completed`` (False if interrupted) and
+        ``preview_every`` (the stride of the samples held when the run streamed to a file).
+    statistics : dict, optional
+        The summary's statistics over every sample (see ``_Statistics``); computed from
+        ``data`` if omitted.
     """
 
     def __init__(self, data, flags, *, geometry, platform, isolators, controllers, excitation,
-                 run):
+                 run, statistics=None):
         self._data = data
         self._flags = flags
         self.geometry = geometry
@@ -1673,6 +1864,11 @@ class HexapodResult:
         self.controllers = tuple(controllers)
         self.excitation = dict(excitation)
         self.run = run
+        if statistics is None:  # from the samples held
+            running = _Statistics([0.5 * (low + high) for low, high in run["stops"]])
+            running.add(data, flags)
+            statistics = running.result()
+        self.statistics = statistics
 
     def __getitem__(self, name):
         if name in HEXAPOD_CHANNELS:
@@ -1761,39 +1957,22 @@ class HexapodResult:
         flags are booleans with ``flag_values`` and ``flag_meanings``. Parameters and run
         settings are global attributes with their units in ``<key>_units``.
         """
-        import datetime
-
         import xarray as xr
+
+        layout = hexapod_file_layout()
+        variables = {name: (dims, self[name], attrs)
+                     for name, (dims, attrs) in layout["variables"].items()}
+        coords = {name: (dims, self["time"] if name == "time" else values, attrs)
+                  for name, (dims, values, attrs) in layout["coordinates"].items()}
+        return xr.Dataset(variables, coords=coords, attrs=self.global_attributes())
+
+    def global_attributes(self):
+        """The file's global attributes: CF conventions, provenance, every parameter and run
+        setting (``<key>`` with its unit in ``<key>_units``)."""
+        import datetime
 
         from qzs._version import __version__
 
-        variables = {}
-        for name, (column, dim, unit, doc) in HEXAPOD_CHANNELS.items():
-            if name == "time":
-                continue
-            attrs = {"long_name": doc}
-            if dim == "dof":
-                attrs["units"] = ", ".join(unit)
-                attrs["units_by_dof"] = "; ".join(f"{a}: {u}" for a, u in zip(AXES, unit))
-            else:
-                attrs["units"] = unit
-            dims = ("time",) if dim is None else ("time", dim)
-            variables[name] = (dims, self[name], attrs)
-        for name, (_, doc) in HEXAPOD_FLAGS.items():
-            variables[name] = (("time", "leg"), self[name], {
-                "units": "1", "long_name": doc, "flag_values": np.array([0, 1], dtype=np.int8),
-                "flag_meanings": _FLAG_MEANINGS[name]})
-        coords = {
-            "time": ("time", self["time"], {
-                "units": "s", "standard_name": "time", "axis": "T",
-                "long_name": "time since the start of the run",
-                "comment": "relative run time without a calendar date: units 's' instead of "
-                           "'s since <date>' (docs/model.md §7)"}),
-            "dof": ("dof", list(AXES), {"long_name": "degree of freedom: translations x, y, z "
-                                                     "[m], rotations rx, ry, rz [rad]",
-                                        "units": "1"}),
-            "leg": ("leg", np.arange(1, LEG_COUNT + 1), {"long_name": "leg number",
-                                                          "units": "1"})}
         now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
         attrs = {"Conventions": "CF-1.10",
                  "title": "qzs simulation of a six-leg platform of semi-active QZS isolator legs",
@@ -1807,7 +1986,7 @@ class HexapodResult:
             attrs[key] = _attribute(value)
             if unit:
                 attrs[f"{key}_units"] = unit
-        return xr.Dataset(variables, coords=coords, attrs=attrs)
+        return attrs
 
     def summary(self):
         """One-screen text summary: per leg stroke used, contacts, time locked, motor RMS."""
@@ -1830,15 +2009,68 @@ class HexapodResult:
         return plot_hexapod(self, **kwargs)
 
 
+class _Statistics:
+    """Running statistics of a hexapod run over every output sample, chunk by chunk.
+
+    What the summary reports, exact over the whole run however it is stored (in memory
+    or streamed to a file with only a preview kept): per leg the largest distance from the
+    stops' centre [m], the share of samples locked [-], the motor force's RMS and largest
+    magnitude [N]; the largest relative translation [m] and rotation [rad] of the platform;
+    the largest energy-ledger residual [J] and |base work| [J].
+    """
+
+    def __init__(self, centers):
+        self._centers = np.asarray(centers, dtype=float)
+        self._rows = 0
+        self._stroke = np.zeros(LEG_COUNT)
+        self._locked = np.zeros(LEG_COUNT)
+        self._motor_square = np.zeros(LEG_COUNT)
+        self._motor_max = np.zeros(LEG_COUNT)
+        self._translation = self._rotation = 0.0
+        self._residual = self._base_work = 0.0
+        self._energy0 = None
+
+    def add(self, block, flags):
+        """Absorb output rows ``block`` (``N_CHANNELS`` columns) and their ``flags``."""
+        if block.shape[0] == 0:
+            return
+        z = block[:, C_Z:C_Z + LEG_COUNT]
+        motor = block[:, C_FMO:C_FMO + LEG_COUNT]
+        self._stroke = np.maximum(self._stroke, np.max(np.abs(z - self._centers), axis=0))
+        self._locked += np.sum(flags[:, O_LOCKED:O_LOCKED + LEG_COUNT], axis=0)
+        self._motor_square += np.sum(motor ** 2, axis=0)
+        self._motor_max = np.maximum(self._motor_max, np.max(np.abs(motor), axis=0))
+        pose = block[:, C_POSE:C_POSE + 6] - block[:, C_BASE_POSE:C_BASE_POSE + 6]
+        self._translation = max(self._translation, float(np.max(np.abs(pose[:, :3]))))
+        self._rotation = max(self._rotation, float(np.max(np.abs(pose[:, 3:]))))
+        energy = block[:, C_EK] + block[:, C_ESP] + block[:, C_EG] + block[:, C_EST]
+        if self._energy0 is None:
+            self._energy0 = float(energy[0])
+        net = block[:, C_WB] + block[:, C_WM] - block[:, C_DF] - block[:, C_DS]
+        self._residual = max(self._residual,
+                             float(np.max(np.abs(energy - self._energy0 - net))))
+        self._base_work = max(self._base_work, float(np.max(np.abs(block[:, C_WB]))))
+        self._rows += block.shape[0]
+
+    def result(self):
+        """The statistics as a dict of floats and per-leg lists, with their units in the keys."""
+        rows = max(self._rows, 1)
+        return {"samples": self._rows, "stroke_used_m": self._stroke.tolist(),
+                "locked_share": (self._locked / rows).tolist(),
+                "motor_rms_N": np.sqrt(self._motor_square / rows).tolist(),
+                "motor_max_N": self._motor_max.tolist(),
+                "relative_translation_max_m": self._translation,
+                "relative_rotation_max_rad": self._rotation,
+                "energy_residual_max_J": self._residual, "base_work_max_J": self._base_work}
+
+
 def _summary_text(result):
-    """The text of :meth:`HexapodResult.summary`."""
+    """The text of :meth:`HexapodResult.summary` (from the statistics of every sample)."""
     run = result.run
-    z = result["relative_position"]
-    locked = result["locked"]
-    motor = result["motor_force"]
+    stats = result.statistics
     moving = ", ".join(f"{axis}: {type(e).__name__}" for axis, e in result.excitation.items())
-    residual = np.max(np.abs(result.energy_residual()))
-    scale = max(float(np.max(np.abs(result["base_work"]))), 1e-300)
+    residual = stats["energy_residual_max_J"]
+    scale = max(stats["base_work_max_J"], 1e-300)
     lines = [f"Hexapod run: {run['duration']:g} s, {run['solver']} dt = {run['dt']:g} s, "
              f"{run['steps']:,} steps in {run['elapsed']:.3g} s "
              f"({result.steps_per_second:,.0f} steps/s), {run['events']:,} located transitions",
@@ -1854,18 +2086,21 @@ def _summary_text(result):
              "motor RMS [N]  motor max [N]"]
     for i in range(LEG_COUNT):
         low, high = run["stops"][i]
-        center = 0.5 * (low + high)
-        used = 1e3 * float(np.max(np.abs(z[:, i] - center)))
-        lines.append(f"{i + 1:>3}  {used:16.2f}  {1e3 * (high - low) / 2:7.1f}  "
-                     f"{run['stop_contacts'][i]:8d}  {100 * float(np.mean(locked[:, i])):10.1f}  "
-                     f"{run['stick_events'][i]:12d}  "
-                     f"{float(np.sqrt(np.mean(motor[:, i] ** 2))):13.2f}  "
-                     f"{float(np.max(np.abs(motor[:, i]))):13.2f}")
-    pose = result["platform_pose"] - result["base_pose"]
+        lines.append(f"{i + 1:>3}  {1e3 * stats['stroke_used_m'][i]:16.2f}  "
+                     f"{1e3 * (high - low) / 2:7.1f}  "
+                     f"{run['stop_contacts'][i]:8d}  {100 * stats['locked_share'][i]:10.1f}  "
+                     f"{run['stick_events'][i]:12d}  {stats['motor_rms_N'][i]:13.2f}  "
+                     f"{stats['motor_max_N'][i]:13.2f}")
     lines += ["",
               f"Platform relative to base: translation up to "
-              f"{1e3 * float(np.max(np.abs(pose[:, :3]))):.3g} mm, rotation up to "
-              f"{1e3 * float(np.max(np.abs(pose[:, 3:]))):.3g} mrad",
+              f"{1e3 * stats['relative_translation_max_m']:.3g} mm, rotation up to "
+              f"{1e3 * stats['relative_rotation_max_rad']:.3g} mrad",
               f"Energy ledger residual: max {residual:.3g} J ({residual / scale:.2g} of the "
               f"largest |base work|)"]
+    if not run.get("completed", True):
+        lines.append(f"Interrupted: {run['samples']:,} samples up to "
+                     f"t = {run['steps'] * run['dt']:.6g} s of {run['duration']:g} s.")
+    if run.get("preview_every", 1) > 1:
+        lines.append(f"In memory: every {run['preview_every']}th sample (a preview; the file "
+                     "holds them all)")
     return "\n".join(lines)

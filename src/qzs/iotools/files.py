@@ -177,6 +177,10 @@ class ResultWriter:
         self._suffix = _suffix(self.path)
         self._isolator, self._controller, self._excitation = isolator, controller, excitation
         self._head, _ = file_attributes(isolator, controller, excitation, None)
+        self._create()
+
+    def _create(self):
+        """The hidden temporary file beside ``path``, its space reserved, opened (``_open``)."""
         self._rows = 0
         self._file = None
         self._tmp = None
@@ -189,10 +193,7 @@ class ResultWriter:
                                              dir=self.path.parent)
             self._tmp = Path(tmp)
             _reserve_space(self._fd, _NC_OVERHEAD + _FREE_MARGIN, self.path.parent)
-            if self._suffix == ".nc":
-                self._open_netcdf()
-            else:
-                self._open_csv()
+            self._open()
         except (OSError, RuntimeError) as error:
             self.abort()
             raise _write_error(self.path, error, "creating the file") from None
@@ -204,6 +205,38 @@ class ResultWriter:
     def rows(self):
         """Samples written so far [samples]."""
         return self._rows
+
+    # -- hooks of the format (a subclass writes another layout through them) ------------
+    def _open(self):
+        if self._suffix == ".nc":
+            self._open_netcdf()
+        else:
+            self._open_csv()
+
+    def _check_block(self, data, flags):
+        """``data, flags`` as arrays of the right shapes, or ParameterError."""
+        data, flags = np.asarray(data, dtype=float), np.asarray(flags)
+        if data.ndim != 2 or data.shape[1] != K.N_CHANNELS or flags.shape != (data.shape[0], 2):
+            raise ParameterError(f"`data` must have shape (n, {K.N_CHANNELS}) and `flags` "
+                                 f"(n, 2), got {data.shape} and {flags.shape}.")
+        return data, flags
+
+    def _write(self, data, flags, start, stop):
+        if self._suffix == ".nc":
+            self._append_netcdf(data, flags, start, stop)
+        else:
+            self._append_csv(data, flags, start, stop)
+
+    def _size(self, rows):
+        """The file's estimated size with ``rows`` samples [bytes]."""
+        return estimated_size(rows, self._suffix)
+
+    def _close_file(self, run):
+        _, tail = file_attributes(self._isolator, self._controller, self._excitation, run)
+        if self._suffix == ".nc":
+            self._finish_netcdf(tail)
+        else:
+            self._finish_csv(tail)
 
     # -- NetCDF -------------------------------------------------------------------------
     def _open_netcdf(self):
@@ -285,20 +318,14 @@ class ResultWriter:
             (attributes ``path`` and ``reason``).
         """
         self._check_open("append")
-        data, flags = np.asarray(data, dtype=float), np.asarray(flags)
-        if data.ndim != 2 or data.shape[1] != K.N_CHANNELS or flags.shape != (data.shape[0], 2):
-            raise ParameterError(f"`data` must have shape (n, {K.N_CHANNELS}) and `flags` "
-                                 f"(n, 2), got {data.shape} and {flags.shape}.")
+        data, flags = self._check_block(data, flags)
         n = data.shape[0]
         if n == 0:
             return
         start, stop = self._rows, self._rows + n
         try:
             self._check_space(n)
-            if self._suffix == ".nc":
-                self._append_netcdf(data, flags, start, stop)
-            else:
-                self._append_csv(data, flags, start, stop)
+            self._write(data, flags, start, stop)
         except (OSError, RuntimeError) as error:  # h5py reports some write failures so
             self.abort()
             raise _write_error(self.path, error) from None
@@ -316,8 +343,7 @@ class ResultWriter:
         that is not possible, the free space is checked: a full disk then raises
         ``OSError(ENOSPC)`` here, before anything is written.
         """
-        grows = (estimated_size(self._rows + n, self._suffix)
-                 - estimated_size(self._rows, self._suffix))
+        grows = self._size(self._rows + n) - self._size(self._rows)
         _reserve_space(self._fd, grows + _FREE_MARGIN, self.path.parent)
 
     def finish(self, run):
@@ -341,12 +367,8 @@ class ResultWriter:
             ``reason``).
         """
         self._check_open("finish")
-        _, tail = file_attributes(self._isolator, self._controller, self._excitation, run)
         try:
-            if self._suffix == ".nc":
-                self._finish_netcdf(tail)
-            else:
-                self._finish_csv(tail)
+            self._close_file(run)
             _release_reserve(self._fd)
             os.close(self._fd)
             self._fd = None
@@ -394,7 +416,7 @@ class ResultWriter:
 
     def __repr__(self):
         state = "finished" if self._finished else ("aborted" if self._tmp is None else "open")
-        return f"<ResultWriter {str(self.path)!r}, {self._rows} rows, {state}>"
+        return f"<{type(self).__name__} {str(self.path)!r}, {self._rows} rows, {state}>"
 
 
 @functools.lru_cache(maxsize=1)

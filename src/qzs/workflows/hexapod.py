@@ -521,8 +521,14 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
 
 
 def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rate=None,
-                   solver=None, progress=False):
+                   solver=None, progress=False, out=None, interruptible=False,
+                   argument="out"):
     """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
+
+    With ``out`` every sample is streamed to that NetCDF file as the run goes
+    (:class:`~qzs.iotools.hexapod_files.HexapodWriter`): memory stays bounded however long
+    the run, the path and the free space are checked before it starts, the file appears
+    complete when it ends, and nothing is left behind on an error.
 
     Parameters
     ----------
@@ -541,6 +547,14 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
         Integrator; default the file's, else ode3.
     progress : bool
         Show a progress bar over simulated time.
+    out : str or Path, optional
+        Stream the run to this ``.nc`` file; the result then holds a preview (every
+        ``run["preview_every"]``-th sample) and the statistics of all of them.
+    interruptible : bool
+        Ctrl-C ends the run after the chunk under way and keeps (and writes) what was
+        simulated; ``run["completed"]`` says so.
+    argument : str
+        How the caller names ``out`` in messages (``"--out"`` on the command line).
 
     Returns
     -------
@@ -551,6 +565,8 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     ParameterError
         No excitation on any axis, an invalid one, or invalid run settings (before any
         integration).
+    OutputPathError
+        ``out`` cannot be written (suffix, folder, permissions, free space), before the run.
     """
     from qzs.defaults import SIMULATION
     from qzs.engine.hexapod import simulate_hexapod
@@ -570,9 +586,27 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
                         ("solver", solver)):
         if value is not None:
             run[name] = value
-    return simulate_hexapod(setup.geometry, setup.platform, setup.isolator, setup.controller,
-                            excitation=built, duration=run.get("duration"),
-                            dt=run.get("dt", SIMULATION["dt"]),
-                            sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
-                            solver=run.get("solver", SIMULATION["solver"]),
-                            cartesian=setup.cartesian, progress=progress)
+    arguments = dict(excitation=built, duration=run.get("duration"),
+                     dt=run.get("dt", SIMULATION["dt"]),
+                     sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
+                     solver=run.get("solver", SIMULATION["solver"]), cartesian=setup.cartesian,
+                     progress=progress, interruptible=interruptible)
+    if out is None:
+        return simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+                                setup.controller, **arguments)
+    from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
+    from qzs.iotools.paths import check_output_path
+
+    length = arguments["duration"]
+    if length is None:
+        lengths = [e.duration for e in built.values() if e.duration is not None]
+        length = min(lengths) if lengths else None
+    size = None
+    if isinstance(length, (int, float)) and length > 0 and arguments["sample_rate"] > 0:
+        size = estimated_hexapod_size(int(round(length * arguments["sample_rate"])) + 1)
+    check_output_path(out, argument=argument, suffixes=(".nc",), estimated_bytes=size)
+    with HexapodWriter(out) as writer:
+        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+                                  setup.controller, sink=writer.append, **arguments)
+        writer.finish(result)
+    return result

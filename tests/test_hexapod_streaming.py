@@ -1,0 +1,114 @@
+"""A hexapod run streamed to NetCDF (``simulate_setup(..., out=)``, ``qzs hexapod simulate
+--out``): the file holds exactly what the in-memory run holds, memory stays bounded (a
+preview), the summary covers every sample, Ctrl-C keeps what was simulated, and a failure
+leaves no file behind."""
+import signal
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from qzs.cli import main
+from qzs.engine import hexapod as engine
+from qzs.errors import OutputPathError, ParameterError
+from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
+from qzs.workflows.hexapod import load_hexapod, simulate_setup
+
+#: Longer than one kernel chunk (200,000 steps at dt 1e-4 s), so that chunks join in the file.
+DURATION = 24.0
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return load_hexapod("paper_legs_cubic", {"stiction_force": 2.0, "coulomb_force": 1.0})
+
+
+@pytest.fixture(scope="module")
+def in_memory(setup):
+    return simulate_setup(setup, duration=DURATION)
+
+
+def test_the_streamed_file_is_the_in_memory_run(setup, in_memory, tmp_path):
+    path = tmp_path / "platform.nc"
+    streamed = simulate_setup(setup, duration=DURATION, out=path)
+    expected = in_memory.to_xarray()
+    with xr.open_dataset(path) as written:
+        assert dict(written.sizes) == dict(expected.sizes)
+        for name in expected.data_vars:
+            assert np.array_equal(written[name].values.astype(expected[name].dtype),
+                                  expected[name].values), name
+            assert written[name].attrs["units"] == expected[name].attrs["units"]
+        assert list(written["dof"].values) == list(expected["dof"].values)
+        assert set(written.attrs) == set(expected.attrs)
+        assert written.attrs["run.samples"] == len(in_memory)
+    assert streamed.statistics == in_memory.statistics
+    assert streamed.run["stick_events"] == in_memory.run["stick_events"]
+    assert [p.name for p in tmp_path.iterdir()] == ["platform.nc"]  # no temporary file left
+
+
+def test_a_long_run_keeps_a_preview_and_summarises_every_sample(setup, in_memory, tmp_path,
+                                                                monkeypatch):
+    """With more samples than the preview holds, the result keeps every k-th sample; the
+    statistics (and so the summary) are still those of all of them, to the last bit."""
+    monkeypatch.setattr(engine, "PREVIEW_SAMPLES", 1000)
+    streamed = simulate_setup(setup, duration=DURATION, out=tmp_path / "long.nc")
+    every = streamed.run["preview_every"]
+    assert every == -(-len(in_memory) // 1000) and len(streamed) <= 1000
+    assert np.array_equal(streamed["relative_position"],
+                          in_memory["relative_position"][::every])
+    assert streamed.statistics == in_memory.statistics
+    assert f"every {every}th sample" in streamed.summary()
+    assert streamed.summary().split("\n")[1:-1] == in_memory.summary().split("\n")[1:]
+
+
+def test_ctrl_c_keeps_what_was_simulated(setup, tmp_path, monkeypatch):
+    """Ctrl-C during an interruptible run: the chunk under way ends, the file holds every
+    sample simulated, and the run says it did not complete."""
+    original = HexapodWriter.append
+    calls = []
+
+    def append(self, data, flags):
+        original(self, data, flags)
+        calls.append(len(data))
+        if len(calls) == 2:  # after the first chunk
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(HexapodWriter, "append", append)
+    path = tmp_path / "stopped.nc"
+    result = simulate_setup(setup, duration=DURATION, out=path, interruptible=True)
+    assert result.run["completed"] is False
+    assert 1 < result.run["samples"] < DURATION * 1000
+    with xr.open_dataset(path) as written:
+        assert written.sizes["time"] == result.run["samples"] == sum(calls)
+        assert written.attrs["run.completed"] == 0
+    assert "Interrupted" in result.summary()
+
+
+def test_a_failure_during_the_run_leaves_nothing(setup, tmp_path, monkeypatch):
+    original = HexapodWriter.append
+    calls = []
+
+    def append(self, data, flags):
+        calls.append(1)
+        if len(calls) == 3:
+            raise OSError(28, "No space left on device")
+        original(self, data, flags)
+
+    monkeypatch.setattr(HexapodWriter, "append", append)
+    with pytest.raises(OSError):
+        simulate_setup(setup, duration=DURATION, out=tmp_path / "full.nc")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_outputs_are_refused_before_the_run(setup, tmp_path, capsys):
+    with pytest.raises(OutputPathError, match="out"):
+        simulate_setup(setup, duration=DURATION, out=tmp_path / "run.csv")
+    with pytest.raises(ParameterError, match=r"\.nc"):
+        HexapodWriter(tmp_path / "run.txt")
+    assert main(["hexapod", "simulate", "--duration", "1", "--out",
+                 str(tmp_path / "missing" / "deeper" / "x.csv")]) == 2
+    assert "--out" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+    small, large = estimated_hexapod_size(1), estimated_hexapod_size(2_000_001)
+    assert small < 4e6 and 1.6e9 < large < 1.8e9  # 99 float channels + 12 flags per sample, in
+    # whole chunks of 4096 samples
