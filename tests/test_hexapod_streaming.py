@@ -112,3 +112,14 @@ def test_bad_outputs_are_refused_before_the_run(setup, tmp_path, capsys):
     small, large = estimated_hexapod_size(1), estimated_hexapod_size(2_000_001)
     assert small < 4e6 and 1.6e9 < large < 1.8e9  # 99 float channels + 12 flags per sample, in
     # whole chunks of 4096 samples
+
+
+def test_save_writes_the_held_run_and_refuses_a_preview(setup, in_memory, tmp_path, monkeypatch):
+    path = in_memory.save(tmp_path / "saved.nc")
+    with xr.open_dataset(path) as written:
+        assert np.array_equal(written["platform_pose"].values, in_memory["platform_pose"])
+        assert written.sizes["time"] == len(in_memory)
+    monkeypatch.setattr(engine, "PREVIEW_SAMPLES", 1000)
+    preview = simulate_setup(setup, duration=DURATION, out=tmp_path / "streamed.nc")
+    with pytest.raises(ParameterError, match="preview"):
+        preview.save(tmp_path / "again.nc")

@@ -1992,6 +1992,22 @@ class HexapodResult:
         """One-screen text summary: per leg stroke used, contacts, time locked, motor RMS."""
         return _summary_text(self)
 
+    def save(self, path):
+        """Write the run to a NetCDF file (:func:`qzs.iotools.hexapod_files.save_hexapod_result`).
+
+        Parameters
+        ----------
+        path : str or Path
+            Target ``.nc`` file.
+
+        Returns
+        -------
+        Path
+        """
+        from qzs.iotools.hexapod_files import save_hexapod_result
+
+        return save_hexapod_result(self, path)
+
     def plot(self, **kwargs):
         """Plot the run (see :func:`qzs.viz.hexapod.plot_hexapod`).
 

@@ -16,7 +16,7 @@ from qzs.engine.hexapod import (HEXAPOD_CHANNELS, HEXAPOD_FLAGS, N_CHANNELS, N_F
 from qzs.errors import ParameterError
 from qzs.iotools.files import ResultWriter, _close
 
-__all__ = ["HexapodWriter", "estimated_hexapod_size"]
+__all__ = ["HexapodWriter", "estimated_hexapod_size", "save_hexapod_result"]
 
 _CHUNK_ROWS = 4096            # HDF5 chunk along time
 _OVERHEAD = 256 << 10         # header, coordinates and attributes [bytes]
@@ -147,3 +147,41 @@ class HexapodWriter(ResultWriter):
             ``reason``).
         """
         return super().finish(result)
+
+
+def save_hexapod_result(result, path):
+    """Write a hexapod run held in memory to a NetCDF file, atomically.
+
+    Parameters
+    ----------
+    result : HexapodResult
+        A run holding every sample (not the preview of a run streamed to a file).
+    path : str or Path
+        Target ``.nc`` file; checked (folder, permissions, free space) before writing.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` holds a preview only (``run["preview_every"]`` > 1).
+    OutputPathError
+        ``path`` cannot be written.
+    """
+    from qzs.iotools.paths import check_output_path
+
+    every = result.run.get("preview_every", 1)
+    if every > 1:
+        raise ParameterError(
+            f"this result holds every {every}th sample only (a preview of a run streamed to a "
+            "file); the whole run is in the file it was streamed to.")
+    check_output_path(path, argument="path", suffixes=(".nc",),
+                      estimated_bytes=estimated_hexapod_size(len(result)))
+    with HexapodWriter(path) as writer:
+        for start in range(0, len(result), 100_000):
+            writer.append(result._data[start:start + 100_000],
+                          result._flags[start:start + 100_000])
+        return writer.finish(result)
