@@ -106,6 +106,26 @@ def test_vertical_base_motion_of_a_symmetric_platform_stays_vertical(cubic, isol
 
 
 # ---------------------------------------------------------------- small signals
+def small_sine_ratio(geometry, platform, isolator, controller, axis, frequency, **options):
+    """|platform / base| in ``axis`` at ``frequency`` [Hz] of a 0.1 mm (1 mrad) base sine: the
+    single-frequency DFT of the last whole periods of a 14 s run (the slowest pole, the
+    integral's, has decayed to 1e-3 by then)."""
+    a = AXES.index(axis)
+    duration = 14.0
+    result = simulate_hexapod(geometry, platform, isolator, controller,
+                              excitation={axis: Sine(amplitude=1e-4 if a < 3 else 1e-3,
+                                                     frequency=frequency, fade_in=1.0)},
+                              duration=duration, **options)
+    t = result["time"]
+    window = t >= duration - int(6 * frequency) / frequency
+
+    def amplitude_of(x):
+        x = x[window] - x[window].mean()
+        return 2 * np.abs(np.mean(x * np.exp(-2j * np.pi * frequency * t[window])))
+
+    return amplitude_of(result["platform_pose"][:, a]) / amplitude_of(result["base_pose"][:, a])
+
+
 @pytest.mark.parametrize("axis, frequency", [("z", 1.0), ("z", 3.0), ("rx", 3.0)])
 def test_frictionless_small_motion_matches_the_linear_transmissibility(cubic, axis, frequency):
     """Fs = Fc = 0 (viscous friction kept), 0.1 mm or 1 mrad sine: |T| of the nonlinear run
@@ -120,19 +140,7 @@ def test_frictionless_small_motion_matches_the_linear_transmissibility(cubic, ax
     isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
     controller = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=20.0)
     a = AXES.index(axis)
-    amplitude = 1e-4 if a < 3 else 1e-3
-    duration = 14.0
-    result = simulate_hexapod(cubic, symmetric_platform(), isolator, controller,
-                              excitation={axis: Sine(amplitude=amplitude, frequency=frequency,
-                                                     fade_in=1.0)}, duration=duration)
-    t = result["time"]
-    window = t >= duration - int(6 * frequency) / frequency
-
-    def amplitude_of(x):
-        x = x[window] - x[window].mean()
-        return 2 * np.abs(np.mean(x * np.exp(-2j * np.pi * frequency * t[window])))
-
-    ratio = amplitude_of(result["platform_pose"][:, a]) / amplitude_of(result["base_pose"][:, a])
+    ratio = small_sine_ratio(cubic, symmetric_platform(), isolator, controller, axis, frequency)
     model = hexapod_linearize(cubic, symmetric_platform(), isolator, controller, frame="origin")
     expected = model.transmissibility(frequency, magnitude=True)[a, a]
     assert abs(ratio / expected - 1) < 1e-3
@@ -356,20 +364,8 @@ def test_frictionless_small_motion_under_cartesian_loops_matches_their_linearisa
     cartesian = CartesianController(position_gain=gain, integral_gain=base.integral_gain,
                                     damping_gain=base.damping_gain)
     a = AXES.index(axis)
-    amplitude = 1e-4 if a < 3 else 1e-3
-    duration = 14.0
-    result = simulate_hexapod(cubic, skewed_platform(), isolator, legs,
-                              excitation={axis: Sine(amplitude=amplitude, frequency=frequency,
-                                                     fade_in=1.0)}, duration=duration,
-                              cartesian=cartesian)
-    t = result["time"]
-    window = t >= duration - int(6 * frequency) / frequency
-
-    def amplitude_of(x):
-        x = x[window] - x[window].mean()
-        return 2 * np.abs(np.mean(x * np.exp(-2j * np.pi * frequency * t[window])))
-
-    ratio = amplitude_of(result["platform_pose"][:, a]) / amplitude_of(result["base_pose"][:, a])
+    ratio = small_sine_ratio(cubic, skewed_platform(), isolator, legs, axis, frequency,
+                             cartesian=cartesian)
     model = hexapod_linearize(cubic, skewed_platform(), isolator, legs, frame="origin",
                               cartesian=cartesian)
     per_leg = hexapod_linearize(cubic, skewed_platform(), isolator, legs, frame="origin")
