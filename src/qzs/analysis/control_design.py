@@ -75,9 +75,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qzs.analysis.linear import loop_constants
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
-from qzs.model.isolator import IsolatorParameters, spring_force, spring_stiffness
+from qzs.model.isolator import IsolatorParameters, spring_force
 
 __all__ = ["StaticDesign", "static_design", "characteristic_polynomial", "RouthHurwitz",
            "routh_hurwitz", "integral_gain_limit", "damping_gain_limits",
@@ -295,13 +296,6 @@ def static_design(isolator=None, controller=None, *, mass_range=None):
 
 
 # ---------------------------------------------------------------- linear stability
-def _plant_numbers(isolator, controller, relative_position):
-    z0 = controller.position_setpoint if relative_position is None else relative_position
-    return (isolator.mass, isolator.viscous_damping, float(spring_stiffness(z0, isolator)),
-            controller.pi_kp, controller.pi_ki, controller.damping_gain,
-            2 * np.pi * controller.velocity_highpass)
-
-
 def _coefficients(m, cv, k, kp, ki, kd, w):
     """Characteristic polynomial, highest power first (fractions cleared, no spurious roots)."""
     big_k = k + kp
@@ -335,7 +329,7 @@ def characteristic_polynomial(isolator=None, controller=None, relative_position=
         Coefficients in SI units (``kg`` for the highest power).
     """
     isolator, controller = _inputs(isolator, controller)
-    return _coefficients(*_plant_numbers(isolator, controller, relative_position))
+    return _coefficients(*loop_constants(isolator, controller, relative_position))
 
 
 def _hurwitz_conditions(a):
@@ -459,7 +453,7 @@ def integral_gain_limit(isolator=None, controller=None, relative_position=None):
         The limit [N/(m*s)]; 0 when no positive ``Ki`` is stable.
     """
     isolator, controller = _inputs(isolator, controller)
-    m, cv, k, kp, _, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not (w > 0 and kd > 0):
         return max(0.0, (cv + kd) * big_k / m)
@@ -499,7 +493,7 @@ def damping_gain_limits(isolator=None, controller=None, relative_position=None):
         when no damping gain is stable.
     """
     isolator, controller = _inputs(isolator, controller)
-    m, cv, k, kp, ki, _, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, _, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not w > 0 or ki == 0:
         if big_k <= 0:
@@ -560,7 +554,7 @@ def routh_hurwitz(isolator=None, controller=None, relative_position=None):
     RouthHurwitz
     """
     isolator, controller = _inputs(isolator, controller)
-    numbers = _plant_numbers(isolator, controller, relative_position)
+    numbers = loop_constants(isolator, controller, relative_position)
     a = _coefficients(*numbers)
     conditions = tuple((text, float(value), bool(value > 0))
                        for text, value in _hurwitz_conditions(a))
@@ -618,7 +612,7 @@ def loop_transfer(isolator=None, controller=None, relative_position=None, *, del
 
     isolator, controller = _inputs(isolator, controller)
     delay = _number("delay", delay)
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
     plant = 1 / (m * s ** 2 + cv * s + k)
     highpass = s / (s + w) if w > 0 else 1
@@ -658,7 +652,7 @@ def _sampled_response(isolator, controller, rate, delay, omega, relative_positio
     ``P(z) = C (zI - Phi)^-1 (G0 + G1/z) z^-n`` and the controller's row
     ``[Kp + Ki T/(z - 1), Kd]``: the same loop, evaluated with the plant's own 2-3 states.
     """
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     a, b, c = _plant_state_space(m, cv, k, w)
     period = 1.0 / rate
     phi, g0, g1, whole, _ = _delayed_hold(a, b, period, delay)
@@ -754,7 +748,7 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
     rate = controller.controller_rate if rate is None else rate
     rate = _number("rate", rate, strict=True,
                    fix="; a sampled loop needs a controller rate in Hz")
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     period = 1.0 / rate
     plant = discretize_with_delay(*_plant_state_space(m, cv, k, w), period, delay)
     # C(z) = [Kp + Ki*T/(z - 1), Kd] on (z, v): state I, I[n+1] = I[n] + T*z[n]
@@ -1104,7 +1098,7 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     rate = _number("rate", rate)
     delay = _number("delay", delay)
     f = np.asarray(frequency, dtype=float)
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, None)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, None)
     s = 2j * np.pi * f
     lag = np.exp(-s * delay)
     if rate > 0:
@@ -1265,7 +1259,7 @@ def slip_jump(isolator=None, controller=None, relative_position=None):
     from scipy.integrate import solve_ivp
 
     isolator, controller = _inputs(isolator, controller)
-    m, cv, k, kp, _, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     fs, fc, cbc = isolator.stiction_force, isolator.coulomb_force, isolator.stribeck_decay
     k_total = k + kp
     if fs <= 0 or k_total <= 0:
@@ -1397,7 +1391,7 @@ def integral_loop(isolator=None, controller=None, relative_position=None):
     import control
 
     isolator, controller = _inputs(isolator, controller)
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
     return control.minreal(control.tf(ki / (s * _fast_denominator(m, cv, k + kp, kd, w))),
                            verbose=False)
@@ -1428,7 +1422,7 @@ def hunting_stiffness(isolator=None, controller=None, half_width=None):
 
     def plateau(kp):
         trial = dataclasses.replace(controller, pi_kp=kp)
-        k_total = _plant_numbers(isolator, trial, None)[2] + kp
+        k_total = loop_constants(isolator, trial, None)[2] + kp
         return slip_jump(isolator, trial)[0] / (2 * k_total)
 
     if plateau(0.0) <= half_width:
@@ -1471,7 +1465,7 @@ def predict_hunting(isolator=None, controller=None, relative_position=None):
     import control
 
     isolator, controller = _inputs(isolator, controller)
-    m, cv, k, kp, ki, kd, w = _plant_numbers(isolator, controller, relative_position)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     k_total = k + kp
     reasons = {}
     # 1. the friction law alone, a memoryless function of slip velocity

@@ -22,7 +22,7 @@ import numpy as np
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
 
-__all__ = ["LinearModel", "linearize", "linear_transmissibility"]
+__all__ = ["LinearModel", "linearize", "linear_transmissibility", "loop_constants"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,31 @@ class LinearModel:
         return np.abs(response)
 
 
+def loop_constants(isolator, controller, relative_position=None):
+    """The linear closed loop's constants at an operating point, the one place they are read.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        PI and damping loops.
+    relative_position : float, optional
+        Operating point z [m]; default the position setpoint.
+
+    Returns
+    -------
+    tuple of float
+        ``(m, c, k, Kp, Ki, Kd, w_hp)``: mass [kg], viscous damping [N*s/m], MagSpring
+        tangent stiffness at the operating point [N/m], PI gains [N/m, N/(m*s)], damping
+        gain [N*s/m] and the high-pass corner [rad/s] (0: none).
+    """
+    z0 = controller.position_setpoint if relative_position is None else relative_position
+    return (isolator.mass, isolator.viscous_damping, float(spring_stiffness(z0, isolator)),
+            controller.pi_kp, controller.pi_ki, controller.damping_gain,
+            2 * np.pi * controller.velocity_highpass)
+
+
 def linearize(isolator=None, controller=None, relative_position=None):
     """Linearise the closed-loop isolator at its operating point.
 
@@ -92,13 +117,8 @@ def linearize(isolator=None, controller=None, relative_position=None):
 
     isolator = isolator or IsolatorParameters()
     controller = controller or ControllerParameters()
-    z0 = controller.position_setpoint if relative_position is None else relative_position
-    m = isolator.mass
-    k = float(spring_stiffness(z0, isolator))
-    c = isolator.viscous_damping
-    kp, ki, kd = controller.pi_kp, controller.pi_ki, controller.damping_gain
+    m, c, k, kp, ki, kd, w_hp = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
-    w_hp = 2 * np.pi * controller.velocity_highpass
     highpass = s / (s + w_hp) if w_hp > 0 else 1
     coupling = c * s + k + kp + (ki / s if ki > 0 else 0)
     transfer = control.minreal(coupling / (m * s ** 2 + coupling + kd * s * highpass),
