@@ -2,7 +2,8 @@
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
 from qzs.errors import ParameterError
 
-__all__ = ["add_parser", "run", "run_linear", "run_simulate"]
+__all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibility",
+           "run_study"]
 
 #: ``--frame`` choices and the name the analysis takes.
 FRAMES = {"center-of-mass": "center_of_mass", "origin": "origin", "cube-center": "cube_center"}
@@ -88,6 +89,55 @@ def add_parser(subparsers):
     simulate.add_argument("--quiet", action="store_true", help="no progress bar")
     add_json_option(simulate)
     simulate.set_defaults(handler=run_simulate)
+    matrix = sub.add_parser(
+        "transmissibility", help="the simulated 6x6 transmissibility: one chirp per axis",
+        description="Simulate one chirp per excited base axis (in parallel processes) and "
+                    "estimate the 6x6 transmissibility matrix with the single axis's Welch "
+                    "estimator and its trusted bins (docs/hexapod.md, \"Simulated "
+                    "transmissibility\"); write the 6x6 grid (linear model dashed) and the "
+                    "matrix as NetCDF to --out and print a summary. Without --config or "
+                    "--cubic: the shipped paper_legs_cubic file.")
+    _add_setup_options(matrix)
+    matrix.add_argument("--axes", metavar="AXES", default="x,y,z,rx,ry,rz",
+                        help="comma-separated base axes to excite, one run each (default "
+                             "all six: x,y,z,rx,ry,rz)")
+    matrix.add_argument("--amplitude", metavar="A | AXIS=A,...",
+                        help="chirp amplitude: one number for every excited axis (all "
+                             "translations [m] or all rotations [rad]) or per axis, e.g. "
+                             "z=0.001,rx=0.005 (default 0.002 m, 0.01 rad)")
+    matrix.add_argument("--f0", type=float, metavar="HZ", help="chirp start [Hz] (default 0)")
+    matrix.add_argument("--f1", type=float, metavar="HZ", help="chirp end [Hz] (default 20)")
+    matrix.add_argument("--duration", type=float, metavar="S",
+                        help="chirp length and run time [s] (default 200)")
+    matrix.add_argument("--dt", type=float, metavar="S",
+                        help="integration step [s] (default: accuracy-driven per run, else "
+                             "the file's)")
+    matrix.add_argument("--sample-rate", type=float, metavar="HZ",
+                        help="output rate [Hz] (default the file's, else 1000)")
+    matrix.add_argument("--workers", type=int, metavar="N",
+                        help="parallel runs (default: all cores)")
+    matrix.add_argument("--out", metavar="DIR", default="results/hexapod_transmissibility",
+                        help="folder for transmissibility.png and transmissibility.nc "
+                             "(default results/hexapod_transmissibility)")
+    matrix.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_option(matrix)
+    matrix.set_defaults(handler=run_transmissibility)
+    study = sub.add_parser(
+        "study", help="the shipped study: paper legs, chirps in z and x, with and without PI",
+        description="Six paper legs carrying what their MagSprings hold (paper_legs_cubic), "
+                    "the 6x6 transmissibility from chirps in z and in x for three loops: PI, "
+                    "P only (Ki = 0) and no position loop (Kp = Ki = 0, statically unstable "
+                    "here); writes report.md, metrics.csv/json, figures and the matrices.")
+    study.add_argument("--quick", action="store_true",
+                       help="60 s chirps at dt = 1 ms instead of 400 s at the "
+                            "accuracy-driven step (well under a minute)")
+    study.add_argument("--out", metavar="DIR", default="results/hexapod_study",
+                       help="output folder (default results/hexapod_study)")
+    study.add_argument("--workers", type=int, metavar="N",
+                       help="parallel runs per case (default: all cores)")
+    study.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json_option(study)
+    study.set_defaults(handler=run_study)
     for command in sub.choices.values():
         command.epilog = EPILOG
     return hexapod
@@ -189,7 +239,6 @@ def run_simulate(args):
     int
         0.
     """
-    from qzs.iotools.files import atomic_path
     from qzs.iotools.paths import check_output_path
     from qzs.workflows.hexapod import simulate_setup
 
@@ -213,12 +262,11 @@ def run_simulate(args):
         excitation = {args.axis: options}
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
                             sample_rate=args.sample_rate, solver=args.solver,
-                            progress=not args.quiet and not args.json)
+                            progress=not args.quiet and not args.json, out=args.out or None,
+                            interruptible=True, argument="--out")
     text = result.summary()
     record = {"summary": text, "run": result.run, "source": setup.source}
     if args.out:
-        with atomic_path(args.out) as tmp:
-            result.to_xarray().to_netcdf(tmp, engine="h5netcdf")
         text += f"\n  wrote            {args.out}"
         record["out"] = args.out
     if args.plot:
@@ -228,4 +276,91 @@ def run_simulate(args):
         text += f"\n  wrote            {args.plot}"
         record["plot"] = args.plot
     emit(args, text, record)
+    return 0
+
+
+def _amplitude(text):
+    """``--amplitude``: one number, or ``AXIS=VALUE`` pairs separated by commas."""
+    if text is None:
+        return None
+    if "=" not in text:
+        try:
+            return float(text)
+        except ValueError:
+            raise ParameterError(f"--amplitude must be a number or AXIS=VALUE pairs (e.g. "
+                                 f"z=0.001,rx=0.005), got {text!r}.") from None
+    values = {}
+    for pair in text.split(","):
+        axis, _, value = pair.partition("=")
+        try:
+            values[axis.strip()] = float(value)
+        except ValueError:
+            raise ParameterError(f"--amplitude: {pair!r} is not AXIS=VALUE with a number "
+                                 "(e.g. z=0.001).") from None
+    return values
+
+
+def run_transmissibility(args):
+    """Run ``qzs hexapod transmissibility`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    from pathlib import Path
+
+    from qzs.iotools.paths import check_output_path
+    from qzs.workflows.hexapod_transmissibility import (CHIRP, hexapod_transmissibility,
+                                                        transmissibility_record)
+
+    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
+    setup = _setup(args, default_file=True)
+    options = {name: getattr(args, name) for name in ("f0", "f1", "duration")
+               if getattr(args, name) is not None}
+    result = hexapod_transmissibility(
+        setup, axes=args.axes, amplitude=_amplitude(args.amplitude),
+        **{**dict(CHIRP), **options}, dt=args.dt, sample_rate=args.sample_rate,
+        workers=args.workers, progress=not args.quiet and not args.json)
+    folder = Path(args.out)
+    figure = folder / "transmissibility.png"
+    data = folder / "transmissibility.nc"
+    import matplotlib.pyplot as plt
+
+    plt.close(result.plot(out=figure))
+    result.save(data)
+    text = result.summary() + f"\n  wrote {figure} and {data}"
+    record = {**transmissibility_record(result), "figure": str(figure), "netcdf": str(data)}
+    emit(args, text, record)
+    return 0
+
+
+def run_study(args):
+    """Run ``qzs hexapod study`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    from qzs.iotools.paths import check_output_path
+    from qzs.workflows.hexapod_study import run_hexapod_study
+
+    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
+    result = run_hexapod_study(args.out, quick=args.quick, workers=args.workers,
+                               progress=not args.quiet and not args.json)
+    record = {"quick": result.quick, "wall_seconds": result.wall_seconds,
+              "rows": list(result.rows), "findings": list(result.findings),
+              "files": {name: str(path) for name, path in result.files.items()}}
+    emit(args, result.summary(), record)
     return 0

@@ -25,7 +25,8 @@ def _db(values):
 
 
 def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trusted=None,
-                                 frequency_range=None, floor_db=-80.0, title=None, out=None):
+                                 frequency_range=None, floor_db=-80.0, title=None, out=None,
+                                 excited=None, linear_label=None, untrusted_below=None):
     """Draw the 6x6 transmissibility matrix; optionally write it.
 
     Parameters
@@ -48,6 +49,15 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
         Figure title.
     out : str or Path, optional
         Write the figure there (atomically; format from the suffix).
+    excited : array_like of bool, shape (6,), optional
+        Which base axes were excited in the simulation; the panels of the others are
+        left empty (no curve, not even the linear one) and marked "not excited". Default:
+        every column drawn.
+    linear_label : str, optional
+        Legend text of the linear curves; default "linear model".
+    untrusted_below : float, optional
+        Shade the band below this frequency [Hz] grey: untrusted in every entry (e.g. a
+        chirp's start).
 
     Returns
     -------
@@ -76,18 +86,41 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
     if not curves:
         raise ParameterError("give `linear`, `simulated` or both.")
     if trusted is None and simulated is not None:
-        trusted = np.isfinite(np.asarray(simulated, dtype=float))
+        trusted = np.isfinite(np.abs(np.asarray(simulated)))
+    if trusted is not None:
+        trusted = np.asarray(trusted, dtype=bool)
+        if trusted.shape != (frequency.size, 6, 6):
+            raise ParameterError(f"`trusted` must have shape ({frequency.size}, 6, 6), got "
+                                 f"{trusted.shape}.")
+    if excited is None:
+        excited = np.ones(6, dtype=bool)
+    excited = np.asarray(excited, dtype=bool)
+    if excited.shape != (6,):
+        raise ParameterError(f"`excited` must be six flags, one per base axis, got shape "
+                             f"{excited.shape}.")
     positive = frequency > 0
     low, high = frequency_range or (frequency[positive].min(), frequency[positive].max())
+    shown = positive & (frequency >= low) & (frequency <= high)
 
     fig, axes = plt.subplots(6, 6, sharex=True, figsize=(15, 12.5), constrained_layout=True)
-    top = max(float(np.nanmax(c[positive])) for c in curves.values())
+    # the vertical range from what is read: the linear curves and the trusted simulated bins
+    peaks = []
+    if "linear" in curves:
+        peaks.append(np.nanmax(np.where(excited[None, None, :], curves["linear"],
+                                        np.nan)[shown], initial=-np.inf))
+    if "simulated" in curves:
+        peaks.append(np.nanmax(np.where(trusted, curves["simulated"], np.nan)[shown],
+                               initial=-np.inf))
+    top = max([float(p) for p in peaks if np.isfinite(p)] or [0.0])
     top = 10 * np.ceil(top / 10 + 0.05)
     for i in range(6):
         for j in range(6):
             ax = axes[i, j]
             drawn = False
-            if "simulated" in curves:
+            if not excited[j]:
+                ax.text(0.5, 0.5, "not excited", transform=ax.transAxes, ha="center",
+                        va="center", color="0.5", fontsize=8)
+            elif "simulated" in curves:
                 level = curves["simulated"][:, i, j]
                 good = positive & np.asarray(trusted)[:, i, j] & np.isfinite(level)
                 ax.plot(frequency[positive], np.where(positive, level, np.nan)[positive],
@@ -95,30 +128,37 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
                 ax.plot(frequency, np.where(good, level, np.nan), color="C0", lw=1.0,
                         label="simulated (trusted bins)")
                 drawn |= bool(np.any(good & (level > floor_db)))
-            if "linear" in curves:
+            if "linear" in curves and excited[j]:
                 level = curves["linear"][:, i, j]
                 ax.plot(frequency[positive], level[positive], color="k", ls="--", lw=0.9,
-                        label="linear model")
+                        label=linear_label or "linear model")
                 drawn |= bool(np.any(level[positive] > floor_db))
-            if not drawn:
-                ax.text(0.5, 0.5, f"< {floor_db:g} dB", transform=ax.transAxes, ha="center",
-                        va="center", color="0.5", fontsize=8)
+            if not drawn and excited[j]:
+                faint = "simulated" in curves and bool(np.any(
+                    curves["simulated"][positive, i, j] > floor_db))
+                ax.text(0.5, 0.5, "no trusted bin" if faint else f"< {floor_db:g} dB",
+                        transform=ax.transAxes, ha="center", va="center", color="0.5",
+                        fontsize=8)
             ax.set_xscale("log")
             ax.set_xlim(low, high)
             ax.set_ylim(floor_db, top)
+            if untrusted_below is not None and untrusted_below > low and excited[j]:
+                ax.axvspan(low, untrusted_below, color="0.92", zorder=0, lw=0)
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
             ax.tick_params(labelsize=7)
             if i == 0:
-                ax.set_title(f"base {AXES[j]}", fontsize=9)
+                ax.set_title(f"base {AXES[j]}" + ("" if excited[j] else " (not excited)"),
+                             fontsize=9)
             if j == 0:
                 ax.set_ylabel(f"platform {AXES[i]}\n|T| [dB]", fontsize=8)
             if i == 5:
                 ax.set_xlabel("frequency [Hz]", fontsize=8)
             ax.text(0.97, 0.95, f"[{_unit(i, j)}]", transform=ax.transAxes, ha="right",
                     va="top", fontsize=6.5, color="0.35")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
+    first = int(np.argmax(excited))
+    handles, labels = axes[first, first].get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labels, loc="upper right", fontsize=8, ncol=2)
+        fig.legend(handles, labels, loc="outside lower center", fontsize=8, ncol=len(handles))
     fig.suptitle(title or "Platform motion per base motion: transmissibility matrix "
                           "(amplitude ratio, dB of its unit)", fontsize=11)
     if out is not None:
