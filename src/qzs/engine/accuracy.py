@@ -21,7 +21,8 @@ from qzs._validation import choice as _choice
 from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
-__all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error"]
+__all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error", "halving_search",
+           "admissible_step"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -268,9 +269,26 @@ def _band(band, excitation, sample_rate):
     return (low, high)
 
 
-def _candidates(sample_rate, controller_rate, stable):
+def admissible_step(sample_rate, controller_rate, stable):
     """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
-    divides the controller's period too."""
+    divides the controller's period too.
+
+    Parameters
+    ----------
+    sample_rate : float
+        Output rate [Hz]; the step divides its period.
+    controller_rate : float
+        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
+    stable : callable
+        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
+
+    Returns
+    -------
+    dt : float
+        The step [s].
+    k : int
+        Steps per output sample [-].
+    """
     from qzs.engine.prepare import steps_per_sample
 
     for k in range(1, 1_000_000):
@@ -288,6 +306,54 @@ def _candidates(sample_rate, controller_rate, stable):
 
 
 # ---------------------------------------------------------------- the search
+def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFETY):
+    """Richardson-style search over ``dt_j = dt0 / 2**j``: the coarsest step that meets a
+    tolerance (the method of :func:`choose_step`, for any model and any measure).
+
+    Parameters
+    ----------
+    difference : callable
+        ``difference(j)``: the measured difference between the runs at ``dt_j`` and
+        ``dt_{j+1}`` (in the tolerance's unit; NaN: no measure, the search stops).
+    order : int
+        The scheme's order of accuracy [-]; the observed ratio ``d_j/d_{j+1}`` is capped at
+        ``2**order``.
+    tolerance : float
+        What the error estimate times ``safety`` must not exceed (its unit).
+    dt0 : float
+        The coarsest candidate [s].
+    max_halvings : int
+        Candidates ``dt_0 .. dt_{max_halvings}`` [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+
+    Returns
+    -------
+    chosen : int or None
+        ``j`` of the chosen step, None if no candidate met the tolerance.
+    history : list of tuple
+        ``(dt_j [s], d_j, estimate_j)`` per candidate compared; the estimate is
+        ``d_j r/(r - 1)``, 0 where ``d_j = 0`` and inf where the differences do not shrink.
+    """
+    history = []
+    for j in range(max_halvings - 1):
+        d, d_next = difference(j), difference(j + 1)
+        if not (np.isfinite(d) and np.isfinite(d_next)):
+            break
+        ratio = d / d_next if d_next > 0 else math.inf
+        if d == 0.0:
+            estimate = 0.0
+        elif ratio <= 1.0:  # not converging yet: no estimate
+            estimate = math.inf
+        else:
+            r = min(ratio, 2.0 ** order)
+            estimate = d * r / (r - 1)
+        history.append((dt0 / 2 ** j, d, estimate))
+        if safety * estimate <= tolerance:
+            return j, history
+    return None, history
+
+
 def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db=None,
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
@@ -387,7 +453,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
 
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
-    dt0, k0 = _candidates(sample_rate, controller.controller_rate, stable)
+    dt0, k0 = admissible_step(sample_rate, controller.controller_rate, stable)
     notes = []
     if k0 == 1:
         notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
@@ -428,22 +494,9 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
                     f"{duration:g} s probe; lengthen `probe_duration` or narrow the band.")
         return differences[j]
 
-    history, chosen = [], None
     try:
-        for j in range(max_halvings - 1):
-            d, d_next = difference(j), difference(j + 1)
-            ratio = d / d_next if d_next > 0 else math.inf
-            if d == 0.0:
-                estimate = 0.0
-            elif ratio <= 1.0:  # not converging yet: no estimate
-                estimate = math.inf
-            else:
-                r = min(ratio, 2.0 ** order)
-                estimate = d * r / (r - 1)
-            history.append((dt0 / 2 ** j, d, estimate))
-            if safety * estimate <= tolerance:
-                chosen = j
-                break
+        chosen, history = halving_search(difference, order, tolerance, dt0, max_halvings,
+                                         safety)
     finally:
         if bar is not None:
             bar.close()

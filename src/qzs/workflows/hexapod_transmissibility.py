@@ -526,7 +526,7 @@ def choose_hexapod_step(task):
         (``(dt, difference to the next finer step [dB])`` per step tried) and
         ``step_reason``.
     """
-    from qzs.engine.accuracy import SAFETY, probe_excitation
+    from qzs.engine.accuracy import SAFETY, admissible_step, halving_search, probe_excitation
     from qzs.engine.stability import SOLVERS
 
     excitation = task["excitation"]
@@ -534,25 +534,13 @@ def choose_hexapod_step(task):
     order = SOLVERS[solver][1]
     band = (min(1.0, 0.5 * task["f1"]) if task["f0"] == 0 else task["f0"], task["f1"])
     probe, duration = probe_excitation(excitation, band)
-    stable = _stable_from_task(task)
     finest = task["setup_dt"]
-    candidates = []
-    from qzs.engine.prepare import steps_per_sample
-
-    controller_rate = task["controller"].controller_rate
-    for k in range(1, 100_000):
-        step = 1.0 / (rate * k)
-        if step < finest * (1 - 1e-9):
-            break
-        if controller_rate > 0:  # a sampled controller's period must be whole steps too
-            try:
-                steps_per_sample(controller_rate, step, "controller_rate")
-            except ParameterError:
-                continue
-        if stable(step):
-            candidates = [step / 2 ** j for j in range(12)
-                          if step / 2 ** j >= finest * (1 - 1e-9)]
-            break
+    try:
+        dt0, _ = admissible_step(rate, task["controller"].controller_rate,
+                                 _stable_from_task(task))
+    except ParameterError:
+        dt0 = finest
+    candidates = [dt0 / 2 ** j for j in range(12) if dt0 / 2 ** j >= finest * (1 - 1e-9)]
     j_axis = AXES.index(task["axis"])
     probe_task = dict(task, fft_length=_default_fft_length(int(round(duration * rate)) + 1))
     estimates = {}
@@ -571,40 +559,27 @@ def choose_hexapod_step(task):
             return math.nan
         return float(np.max(np.abs(20 * np.log10(a.magnitude[keep] / b.magnitude[keep]))))
 
-    history = []
-    reason = ""
-    for j in range(len(candidates) - 2):
-        d, d_next = difference(j), difference(j + 1)
-        history.append((candidates[j], d))
-        if not (np.isfinite(d) and np.isfinite(d_next)):
-            reason = "no bin of the probe's band is trusted in both runs"
-            break
-        ratio = d / d_next if d_next > 0 else math.inf
-        if d == 0.0:
-            error = 0.0
-        elif ratio <= 1.0:
-            continue
-        else:
-            r = min(ratio, 2.0 ** order)
-            error = d * r / (r - 1)
-        if SAFETY * error <= task["tolerance_db"]:
-            return candidates[j], dict(step="accuracy-driven", step_error_db=error,
-                                       step_history=tuple(history),
-                                       step_reason=f"estimated error {error:.3g} dB "
-                                                   f"<= {task['tolerance_db']:g} dB / "
-                                                   f"{SAFETY:g} on a {duration:g} s probe")
-    if not reason:
-        if len(candidates) < 3:
-            reason = (f"fewer than three steps between the largest stable one and the "
-                      f"set-up's ({finest:g} s) to compare")
-        else:
-            shown = ", ".join(f"{d:.3g}" for _, d in history)
-            reason = (f"no step coarser than the set-up's met {task['tolerance_db']:g} dB: the "
-                      f"differences between successive halvings ({shown} dB) do not shrink as "
-                      "the scheme's order predicts (the stick-slip pattern changes with the "
-                      "step)")
-    return finest, dict(step="set-up", step_error_db=math.nan, step_history=tuple(history),
-                       step_reason=reason)
+    chosen, searched = (None, []) if len(candidates) < 3 else halving_search(
+        difference, order, task["tolerance_db"], dt0, len(candidates) - 1, SAFETY)
+    history = tuple((dt, d) for dt, d, _ in searched)
+    if chosen is not None:
+        error = searched[chosen][2]
+        return candidates[chosen], dict(
+            step="accuracy-driven", step_error_db=error, step_history=history,
+            step_reason=f"estimated error {error:.3g} dB <= {task['tolerance_db']:g} dB / "
+                        f"{SAFETY:g} on a {duration:g} s probe")
+    if len(candidates) < 3:
+        reason = (f"fewer than three steps between the largest stable one and the set-up's "
+                  f"({finest:g} s) to compare")
+    elif len(searched) < len(candidates) - 2 and not np.isfinite(difference(len(searched))):
+        reason = "no bin of the probe's band is trusted in both runs"
+    else:
+        shown = ", ".join(f"{d:.3g}" for _, d in history)
+        reason = (f"no step coarser than the set-up's met {task['tolerance_db']:g} dB: the "
+                  f"differences between successive halvings ({shown} dB) do not shrink as the "
+                  "scheme's order predicts (the stick-slip pattern changes with the step)")
+    return finest, dict(step="set-up", step_error_db=math.nan, step_history=history,
+                        step_reason=reason)
 
 
 def _stable_from_task(task):
