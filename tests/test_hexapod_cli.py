@@ -191,3 +191,18 @@ def test_cartesian_table_and_sampled_controller_from_a_file(tmp_path, capsys):
     assert main(["hexapod", "simulate", "--config", str(centralised), "--duration", "0.5"]) == 0
     out = capsys.readouterr().out
     assert "centralised" in out and "sampled at 1000 Hz" in out
+
+
+def test_centralised_option_equals_the_per_leg_loops_at_the_cube_centre(tmp_path, capsys):
+    """``--centralised`` puts the loops on the platform's axes with the legs' stiffness on
+    each: at the cube's centre that is the per-leg linear model to rounding; a file with its
+    own [cartesian] table refuses the option."""
+    per_leg = run_json(capsys, "--cubic", "--set", "pi_kp=2000", "--frame", "cube-center")
+    axes = run_json(capsys, "--cubic", "--set", "pi_kp=2000", "--frame", "cube-center",
+                    "--centralised")
+    assert np.allclose(axes["stiffness_matrix"], per_leg["stiffness_matrix"], atol=1e-8)
+    assert np.allclose(axes["natural_frequencies"], per_leg["natural_frequencies"])
+    path = tmp_path / "axes.toml"
+    path.write_text("[geometry]\nkind = 'cubic'\ncube_edge = 0.15\n[cartesian]\n")
+    assert main(["hexapod", "linear", "--config", str(path), "--centralised"]) == 2
+    assert "[cartesian]" in capsys.readouterr().err

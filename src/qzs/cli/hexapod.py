@@ -20,6 +20,11 @@ def _add_setup_options(parser):
     parser.add_argument("--cube-center-height", metavar="M", type=float,
                         help="height of the cube's centre above the base [m] (with --cubic; "
                              "default: the legs' lower ends on the base plane, edge/(2*sqrt(3)))")
+    parser.add_argument("--centralised", action="store_true",
+                        help="centralised control: the PI and damping loops on the platform's "
+                             "six axes at the top frame origin, with the legs' stiffness on "
+                             "each axis (docs/hexapod.md §9.5); a [cartesian] table in the "
+                             "file sets other gains")
     add_set_option(parser)
 
 
@@ -161,6 +166,13 @@ def run(args):
 
 def _setup(args, default_file=False):
     """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`)."""
+    from qzs.workflows.hexapod import centralised
+
+    setup = _described_setup(args, default_file)
+    return centralised(setup) if args.centralised else setup
+
+
+def _described_setup(args, default_file):
     from qzs.model.hexapod import cubic_geometry
     from qzs.workflows.hexapod import default_cube_center_height, hexapod_setup, load_hexapod
 

@@ -47,7 +47,7 @@ from qzs.model.registry import PARAMETERS, update_parameters
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
            "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
-           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS"]
+           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised"]
 
 #: Folder of the shipped hexapod files, inside the package.
 SHIPPED = "workflows/hexapod_files"
@@ -306,6 +306,36 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
                              f"{cartesian!r}.")
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
                         controller=controller, kind=kind, cartesian=cartesian)
+
+
+def centralised(setup, *, point="origin"):
+    """The set-up with centralised control: Cartesian loops with the legs' stiffness on each
+    axis (:meth:`~qzs.model.hexapod.CartesianController.from_legs`, docs/hexapod.md §9.5).
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        A set-up with per-leg loops.
+    point : {"origin", "center_of_mass"} or array_like, shape (3,)
+        Where the axes are (the top frame origin: the cube's centre of a cubic geometry).
+
+    Returns
+    -------
+    HexapodSetup
+
+    Raises
+    ------
+    ParameterError
+        The set-up has its own ``[cartesian]`` loops already.
+    """
+    import dataclasses
+
+    if setup.cartesian is not None:
+        raise ParameterError("the set-up has centralised loops already (its [cartesian] table); "
+                             "leave out --centralised, or the table.")
+    cartesian = CartesianController.from_legs(setup.geometry, setup.controller,
+                                              platform=setup.platform, point=point)
+    return dataclasses.replace(setup, cartesian=cartesian)
 
 
 def load_hexapod(path, settings=None):
