@@ -18,7 +18,10 @@ Targets (issue 11), each row: the qzs figure, its baseline, the ratio, the targe
 5. the accuracy-driven step (``qzs.engine.accuracy``): its gain at equal accuracy over the
    paper's dt = 1e-4 s on the default chirp;
 6. the lane kernel against JAX on the same (regularised) model, 1024 cases, one and two cores
-   (``bench_jax.py``; needs jax, the ``bench`` extra, never installed by this script).
+   (``bench_jax.py``; needs jax, the ``bench`` extra, never installed by this script);
+7. (issue 14) the tuning page ``qzs app``: a slider's release to the redrawn transmissibility
+   in headless Chromium, every move within 1 s (``bench_app.py``; needs the ``app`` and
+   ``test`` extras and /usr/bin/chromium).
 
 The C baseline is ``benchmarks/c_reference/isolator.c``, compiled here with gcc (flags in
 ``c_reference/reference.py``) into a cache folder outside the repository and run in this
@@ -60,7 +63,7 @@ TARGET_CLUSTER = 0.9      # cluster per core >= 0.9 of local, after one warm-up
 TARGET_ACCURACY = 5.0     # gain at equal accuracy (the issue measured 7x at dt = 1e-3)
 TOLERANCE_DB = 0.01       # the tolerance of the accuracy-driven run
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -475,6 +478,28 @@ def target_jax(table, args):
         table.add("6i" if info else 6, what, value, baseline, ratio, goal, verdict)
 
 
+# --------------------------------------------------------------------------- 7. the page
+
+def target_app(table, args):
+    missing = [name for name in ("panel", "playwright") if importlib.util.find_spec(name) is None]
+    if missing or not Path("/usr/bin/chromium").exists():
+        why = f"{', '.join(missing)} not installed" if missing else "no /usr/bin/chromium"
+        table.add(7, "`qzs app`: slider release -> redrawn transmissibility", "-", "-", "-",
+                  "<= 1 s", f"not measured: {why}")
+        return
+    import bench_app
+
+    results = bench_app.measure(moves=4 if args.quick else 8, idle_wait=args.idle_wait)
+    table.note_runs([dict(seconds=r["drawn"], busy=r["busy"]) for r in results])
+    median, worst, verdict = bench_app.verdict(results)
+    computed = float(np.median([r["computed"] for r in results]))
+    table.add(7, f"`qzs app`: slider release -> redrawn transmissibility, worst of "
+                 f"{len(results)}", f"{worst * 1e3:.0f} ms", "-", "-",
+              f"<= {bench_app.TARGET:g} s", verdict)
+    table.add("7i", "  median release -> redrawn; server computation median",
+              f"{median * 1e3:.0f} ms", f"{computed * 1e3:.0f} ms", "-", "-", "info")
+
+
 # --------------------------------------------------------------------------- main
 
 def main(argv=None):
@@ -537,6 +562,7 @@ def main(argv=None):
         (4, "4. clusters", lambda: target_cluster(table, args), False),
         (5, "5. accuracy-driven step", lambda: target_accuracy(table, args), False),
         (6, "6. lane kernel vs JAX", lambda: target_jax(table, args), False),
+        (7, "7. the tuning page (issue 14)", lambda: target_app(table, args), False),
     ]
     for number, title, fn, needs_c in steps_targets:
         if number not in only:

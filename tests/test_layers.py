@@ -16,7 +16,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 
 #: Layers, lowest first. ``base`` are the top-level modules every layer may use.
 LAYERS = ("base", "model", "analysis", "engine", "iotools", "identify", "viz", "workflows",
-          "cli")
+          "app", "cli")
 #: Top-level modules that are the base layer.
 BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults"}
 #: The facade (``qzs/__init__.py``, ``qzs/__main__.py``) may import anything; no module imports it.

@@ -7,14 +7,17 @@ docs/model.md describes, and the tools to judge it by transmissibility.
 This module is the flat public API. The subpackages are the architecture, each
 importing only from those listed before it:
 
+=============  ====================================================================
 ``model``      parameters, force laws (numpy), excitations, the parameter registry
 ``analysis``   spectral estimation and metrics, linearisation, run statistics
 ``engine``     numba kernels, single and lockstep drivers, simulate, batch, results
 ``iotools``    result and config files, rig-log readers
 ``identify``   spring, friction and transmissibility fits
 ``viz``        every figure
-``workflows``  the paper's studies and report, experiment pipeline, sweeps
+``workflows``  studies and report, experiments, sweeps, response, design, hexapod studies
+``app``        the interactive tuning page (``qzs app``; Panel, optional)
 ``cli``        the ``qzs`` command
+=============  ====================================================================
 """
 from qzs._lazy import lazy_exports
 from qzs._version import __version__
@@ -23,7 +26,7 @@ from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
                         MissingDependencyError, OutputPathError, ParameterError,
-                        ResultTooLargeError, SimulationError, StabilityError,
+                        ResultTooLargeError, SimulationError, SizeLimitError, StabilityError,
                         ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
                        IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
@@ -60,7 +63,7 @@ __all__ = [
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
-    "ToleranceNotMetError",
+    "ToleranceNotMetError", "SizeLimitError",
     "DataWarning", "FitWarning",
     *_LAZY,
 ]

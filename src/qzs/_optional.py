@@ -9,6 +9,8 @@ OPTIONAL = {
     "dask": ("dask", "cluster"),
     "distributed": ("distributed", "cluster"),
     "zarr": ("zarr", "cluster"),
+    "panel": ("panel", "app"),
+    "bokeh": ("bokeh", "app"),
 }
 
 

@@ -9,7 +9,7 @@ message is for people, never for parsing.
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
-           "Terminated",
+           "SizeLimitError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -43,6 +43,34 @@ class CaseError(ParameterError):
 
     def __reduce__(self):  # picklable with its attributes (Dask, process pools)
         return type(self), (self.index, self.reason)
+
+
+class SizeLimitError(ParameterError):
+    """A request asks for more than a bound allows (the tuning page's :data:`qzs.app.compute.LIMITS`
+    and ``MAX_STEPS``: one request must not exhaust the machine).
+
+    Attributes
+    ----------
+    name : str
+        The setting (``excitation.duration``, ``frequency_count``, ``steps``, ...).
+    value : float
+        The value asked for, in ``unit``.
+    low, high : float
+        The bounds, in ``unit`` [1, s, Hz].
+    unit : str
+        SI unit of the setting (``1`` for a count).
+    """
+
+    def __init__(self, name, value, low, high, unit):
+        self.name, self.value = str(name), value
+        self.low, self.high, self.unit = low, high, str(unit)
+        shown = "" if self.unit == "1" else f" {self.unit}"
+        super().__init__(f"`{self.name}` must lie in [{self.low:g}, {self.high:g}]{shown} on "
+                         f"the page, got {self.value:g}{shown}; choose a value inside it, or "
+                         "run it with `qzs simulate` / `qzs response`, which have no such bound.")
+
+    def __reduce__(self):
+        return type(self), (self.name, self.value, self.low, self.high, self.unit)
 
 
 class ToleranceNotMetError(ParameterError):

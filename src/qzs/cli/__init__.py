@@ -11,6 +11,7 @@
     qzs sweep-plot STORE [--metric NAME] [--x PARAM] [--y PARAM]
     qzs response [--frequencies F1,F2,... | --range F0,F1,N] [--direction up|down|both] [--json]
     qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
+    qzs app [--port N] [--host ADDRESS] [--no-browser]
 
 Every subcommand hands its parsed arguments to a function of the layers below.
 Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
@@ -25,7 +26,8 @@ import signal
 import sys
 
 from qzs._version import __version__
-from qzs.cli import design, experiment, hexapod, params, response, simulate, studies, sweep
+from qzs.cli import (app, design, experiment, hexapod, params, response, simulate, studies,
+                     sweep)
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -35,7 +37,7 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "study": studies.run, "experiment": experiment.run,
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
             "hexapod": hexapod.run, "response": response.run,
-            "design": design.run}
+            "design": design.run, "app": app.run}
 
 
 def build_parser():
@@ -54,6 +56,7 @@ def build_parser():
     hexapod.add_parser(sub)
     design.add_parser(sub)
     response.add_parser(sub)
+    app.add_parser(sub)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes
         if EPILOG not in (command.epilog or ""):
             command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG

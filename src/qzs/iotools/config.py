@@ -9,7 +9,7 @@ from qzs.model.excitation import EXCITATION_OPTIONS
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, update_parameters
 
-__all__ = ["load_config", "save_config", "EXCITATION_KEYS",
+__all__ = ["load_config", "save_config", "config_text", "EXCITATION_KEYS",
            "SIMULATION_KEYS"]
 
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
@@ -82,6 +82,33 @@ def save_config(path, isolator=None, controller=None, excitation=None, simulatio
     simulation : dict, optional
         The ``[simulation]`` table.
     """
+    text = config_text(isolator, controller, excitation, simulation)
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def config_text(isolator=None, controller=None, excitation=None, simulation=None, note=None):
+    """A run configuration as TOML text (what :func:`save_config` writes; nothing is written).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; defaults if omitted.
+    controller : ControllerParameters, optional
+        Controller parameters; defaults if omitted.
+    excitation : dict, optional
+        The ``[excitation]`` table.
+    simulation : dict, optional
+        The ``[simulation]`` table.
+    note : str, optional
+        A comment line under the header (where the file comes from).
+
+    Returns
+    -------
+    str
+        UTF-8 TOML text that ``qzs simulate --config`` reads.
+    """
     import tomli_w
 
     document = {"isolator": (isolator or IsolatorParameters()).to_dict(),
@@ -90,7 +117,7 @@ def save_config(path, isolator=None, controller=None, excitation=None, simulatio
         document["excitation"] = dict(excitation)
     if simulation:
         document["simulation"] = dict(simulation)
-    text = "# qzs run configuration: units as in `qzs params` (SI).\n" + tomli_w.dumps(document)
-    with atomic_path(path) as tmp:
-        Path(tmp).write_text(text, encoding="utf-8")
-    return Path(path)
+    header = "# qzs run configuration: units as in `qzs params` (SI).\n"
+    if note:
+        header += f"# {note}\n"
+    return header + tomli_w.dumps(document)

@@ -1,0 +1,411 @@
+"""The tuning page's logic without a browser: qzs.app.compute, .updates, .figure, .server.
+
+Reference checks: the page's transmissibility is what ``qzs.transmissibility`` gives for
+the same run, its linear curve what ``qzs.linearize`` gives, its errors the API's own, its
+TOML export what ``qzs.iotools.load_config`` reads back to the same parameters.
+"""
+import dataclasses
+import math
+import subprocess
+import sys
+from concurrent.futures import Future
+
+import numpy as np
+import pytest
+
+from qzs import ControllerParameters, IsolatorParameters, linearize, simulate, transmissibility
+from qzs.app import compute
+from qzs.app.compute import (LIMITS, MAX_STEPS, PAGE_DEFAULTS, PageRequest, SizeLimitError,
+                             compute_page, config_text, page_request, page_values, welch_length)
+from qzs.app.updates import LatestOnly
+from qzs.errors import ExcitationError, MissingDependencyError, ParameterError
+from qzs.iotools.config import load_config
+from qzs.model.excitation import build_excitation
+from qzs.model.registry import PARAMETERS
+
+
+@pytest.fixture(scope="module")
+def default_page():
+    return compute_page(page_request())
+
+
+@pytest.fixture(scope="module")
+def stepped_page():
+    return compute_page(page_request({"excitation.kind": "stepped", "frequency_count": 4,
+                                      "excitation.f0": 1.0, "excitation.f1": 8.0}))
+
+
+# ---------------------------------------------------------------- the figures' data
+def test_transmissibility_is_the_api_estimate_of_the_same_run(default_page):
+    """The page's curve: qzs.transmissibility of qzs.simulate at the page's step, the
+    trusted bins and nothing else."""
+    request = default_page.request
+    result = simulate(request.chirp(), request.isolator, request.controller,
+                      dt=default_page.dt, sample_rate=request.sample_rate)
+    estimate = transmissibility(result.base_acceleration, result.payload_acceleration,
+                                request.sample_rate, fft_length=welch_length(len(result)))
+    np.testing.assert_array_equal(default_page.frequency, estimate.frequency[estimate.trusted])
+    np.testing.assert_allclose(default_page.transmissibility_db,
+                               20 * np.log10(estimate.magnitude[estimate.trusted]), rtol=0,
+                               atol=1e-12)
+    assert 0 < default_page.frequency.size < estimate.frequency.size  # untrusted bins left out
+    assert default_page.estimate.trusted.sum() == default_page.frequency.size
+
+
+def test_linear_curve_is_the_linearised_loop(default_page):
+    request = default_page.request
+    expected = linearize(request.isolator, request.controller).transmissibility(
+        default_page.linear_frequency)
+    np.testing.assert_allclose(default_page.linear_db, 20 * np.log10(expected), atol=1e-12)
+    assert default_page.linear_frequency[-1] == pytest.approx(request.band[1])
+
+
+def test_default_page_uses_the_accuracy_driven_step(default_page):
+    """The default chirp's step is chosen for 0.01 dB: 1 ms, far inside the tolerance."""
+    assert default_page.dt == pytest.approx(1e-3)
+    assert default_page.step_error < 0.01 / 2
+    assert default_page.notes == ()
+
+
+def test_time_traces_and_limits(default_page):
+    request, data = default_page.request, default_page
+    for name, (time_, values) in data.traces.items():
+        assert time_.size == values.size <= compute.TRACE_POINTS, name
+        assert time_[-1] == pytest.approx(request.sine_duration)
+    base = data.traces["base_displacement"][1]
+    assert np.max(np.abs(base)) == pytest.approx(request.amplitude, rel=1e-3)
+    assert data.traces["payload_displacement"][1][0] == 0.0  # from its rest position
+    assert data.stop_low < data.position_setpoint < data.stop_high
+    assert data.stop_high - data.stop_low == pytest.approx(2 * request.isolator.stroke_half)
+    assert data.motor_force_max == request.isolator.motor_force_max
+    for share in data.locked_share.values():
+        assert 0.0 <= share <= 1.0
+    assert data.summary["peak_stroke"] > 0
+
+
+def test_stepped_sine_points_are_the_workflow_response(stepped_page):
+    response = stepped_page.response
+    branch = response.branch("up")
+    np.testing.assert_allclose(branch["frequency"], np.geomspace(1.0, 8.0, 4))
+    keep = np.isfinite(branch["transmissibility"])
+    np.testing.assert_array_equal(stepped_page.frequency, branch["frequency"][keep])
+    np.testing.assert_allclose(stepped_page.transmissibility_db,
+                               20 * np.log10(branch["transmissibility"][keep]))
+    assert stepped_page.estimate is None
+    assert math.isnan(stepped_page.summary["motor_force_peak"])
+
+
+def test_stepped_frequencies_from_zero_exclude_zero():
+    request = page_request({"excitation.kind": "stepped", "frequency_count": 4,
+                            "excitation.f0": 0.0, "excitation.f1": 8.0})
+    np.testing.assert_allclose(request.stepped_frequencies(), [2.0, 4.0, 6.0, 8.0])
+
+
+# ---------------------------------------------------------------- validation
+@pytest.mark.parametrize("values, same_as", [
+    ({"coulomb_force": 20.0}, lambda: IsolatorParameters(coulomb_force=20.0)),
+    ({"mass": -1.0}, lambda: IsolatorParameters(mass=-1.0)),
+    ({"pi_kp": "a lot"}, lambda: ControllerParameters(pi_kp="a lot")),
+    ({"excitation.amplitude": -0.01}, lambda: build_excitation("chirp", {"amplitude": -0.01})),
+])
+def test_invalid_values_raise_the_api_error(values, same_as):
+    """The page's message is the API's message, word for word."""
+    with pytest.raises(ParameterError) as expected:
+        same_as()
+    with pytest.raises(type(expected.value)) as got:
+        page_request(values)
+    assert str(got.value) == str(expected.value)
+
+
+def test_an_invalid_excitation_is_an_excitation_error():
+    with pytest.raises(ExcitationError):
+        page_request({"excitation.amplitude": math.nan})
+
+
+def test_unknown_setting_is_refused():
+    with pytest.raises(ParameterError, match="unknown page setting 'excitation.phase'"):
+        page_request({"excitation.phase": 1.0})
+    with pytest.raises(ParameterError, match="unknown page setting 'stiction'"):
+        page_request({"stiction": 1.0})  # not a registry name either
+    assert page_request({"stroke_half": 0.05}).isolator.stroke_half == 0.05  # any registry name
+
+
+@pytest.mark.parametrize("name, value", [
+    ("excitation.duration", 601.0), ("excitation.duration", 5.0), ("frequency_count", 41),
+    ("sine.duration", 61.0), ("sine.frequency", 51.0), ("sample_rate", 4000.0),
+    ("excitation.f1", 60.0),
+])
+def test_size_limits_refuse_oversize_requests(name, value):
+    with pytest.raises(SizeLimitError) as error:
+        page_request({name: value})
+    low, high, unit = LIMITS[name]
+    assert (error.value.name, error.value.value) == (name, value)
+    assert (error.value.low, error.value.high, error.value.unit) == (low, high, unit)
+    assert "qzs simulate" in str(error.value)
+
+
+def test_the_limits_hold_at_their_edges():
+    page_request({"excitation.duration": LIMITS["excitation.duration"][1],
+                  "frequency_count": LIMITS["frequency_count"][1]})
+
+
+def test_sample_rate_must_resolve_the_band(monkeypatch):
+    page_request({"sample_rate": 250.0, "excitation.f1": 50.0})  # 5 samples per period
+    monkeypatch.setitem(LIMITS, "excitation.f1", (0.0, 100.0, "Hz"))
+    with pytest.raises(ParameterError, match="at least 5 times"):
+        page_request({"sample_rate": 250.0, "excitation.f1": 60.0})
+    with pytest.raises(ParameterError, match="must be one of"):
+        page_request({"sample_rate": 750.0})
+
+
+def test_step_bound_refuses_a_run_too_long(monkeypatch):
+    """The integration steps are bounded after the step is chosen."""
+    monkeypatch.setattr(compute, "MAX_STEPS", 1000)
+    with pytest.raises(SizeLimitError) as error:
+        compute_page(page_request())
+    assert error.value.name == "integration steps of the chirp"
+    assert error.value.value == pytest.approx(PAGE_DEFAULTS["excitation.duration"] / 1e-3)
+    assert MAX_STEPS >= 600 / 1e-4  # the longest chirp at the paper's step fits the default
+
+
+def test_request_is_frozen_and_keyword_only():
+    request = page_request()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        request.amplitude = 1.0
+    with pytest.raises(TypeError):
+        PageRequest(IsolatorParameters(), ControllerParameters())
+
+
+def test_page_values_round_trip():
+    values = page_values()
+    assert page_request(values) == page_request()
+    for name in compute.MODEL_PARAMETERS:
+        assert values[name] == PARAMETERS[name].default  # the registry's defaults
+    changed = page_request({**values, "stiction_force": 5.0, "excitation.kind": "stepped"})
+    assert page_request(page_values(changed)) == changed
+
+
+# ---------------------------------------------------------------- TOML export
+@pytest.mark.parametrize("kind", ["chirp", "stepped"])
+def test_toml_export_round_trips_through_load_config(tmp_path, kind):
+    request = page_request({"stiction_force": 7.25, "pi_kp": 33.0, "damping_gain": 12.5,
+                            "controller_rate": 1000.0, "excitation.kind": kind,
+                            "excitation.f1": 15.0, "excitation.amplitude": 0.004})
+    path = tmp_path / "page.toml"
+    path.write_text(config_text(request, dt=5e-4), encoding="utf-8")
+    config = load_config(path)
+    assert config["isolator"] == request.isolator
+    assert config["controller"] == request.controller
+    options = dict(config["excitation"])
+    kind_read = options.pop("kind")
+    excitation = build_excitation(kind_read, options)
+    assert excitation == (request.chirp() if kind == "chirp" else request.sine())
+    assert config["simulation"]["dt"] == 5e-4
+    assert config["simulation"]["sample_rate"] == request.sample_rate
+
+
+def test_toml_export_runs_with_qzs_simulate(tmp_path):
+    path = tmp_path / "page.toml"
+    request = page_request({"stiction_force": 6.0, "excitation.duration": 10.0})
+    path.write_text(config_text(request, dt=1e-3), encoding="utf-8")
+    from qzs.cli import main
+
+    assert main(["simulate", "--config", str(path), "--plot", "none", "--quiet"]) == 0
+
+
+# ---------------------------------------------------------------- updates
+class HeldExecutor:
+    """An executor whose futures the test completes, in any order."""
+
+    def __init__(self):
+        self.jobs = []
+
+    def submit(self, function, request):
+        future = Future()
+        self.jobs.append((future, function, request))
+        return future
+
+    def finish(self, index=0):
+        future, function, request = self.jobs.pop(index)
+        try:
+            future.set_result(function(request))
+        except Exception as error:  # noqa: BLE001 - the updater delivers it
+            future.set_exception(error)
+
+
+def test_latest_only_drops_superseded_results():
+    delivered, busy = [], []
+    executor = HeldExecutor()
+    updates = LatestOnly(lambda r: r * 10, lambda r, out: delivered.append((r, out)),
+                         executor=executor, schedule=lambda f: f(), busy=busy.append)
+    updates.submit(1)
+    updates.submit(2)           # waits
+    updates.submit(3)           # replaces 2, which is never computed
+    assert len(executor.jobs) == 1 and updates.running
+    executor.finish()           # 1 is done: superseded, dropped; 3 starts
+    assert delivered == [] and updates.dropped == 1
+    assert [job[2] for job in executor.jobs] == [3]
+    executor.finish()
+    assert delivered == [(3, 30)] and not updates.running
+    assert busy == [True, False] and updates.delivered == 1
+
+
+def test_latest_only_delivers_errors_and_cancels():
+    delivered = []
+    executor = HeldExecutor()
+
+    def compute_or_fail(request):
+        if request < 0:
+            raise ParameterError("negative")
+        return request
+
+    updates = LatestOnly(compute_or_fail, lambda r, out: delivered.append(out),
+                         executor=executor, schedule=lambda f: f())
+    updates.submit(-1)
+    executor.finish()
+    assert isinstance(delivered[0], ParameterError)
+    updates.submit(5)
+    updates.cancel()            # the page's values became invalid meanwhile
+    executor.finish()
+    assert len(delivered) == 1 and updates.dropped == 1 and not updates.running
+
+
+# ---------------------------------------------------------------- figure, server
+def test_png_export_has_every_panel(default_page):
+    from qzs.app.figure import figure_png, page_figure
+
+    pinned = [("pin", default_page.frequency, default_page.transmissibility_db - 1.0)]
+    figure = page_figure(default_page, pinned)
+    labels = [axes.get_ylabel() for axes in figure.axes]
+    assert labels == ["transmissibility [dB]", "time locked [%]", "displacement from rest [mm]",
+                      "relative position z [mm]", "motor force [N]"]
+    assert all("[" in axes.get_xlabel() or axes.get_xlabel() == "" for axes in figure.axes)
+    assert figure_png(default_page, pinned)[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_without_panel_the_app_names_its_extra(monkeypatch):
+    from qzs.app.server import serve
+
+    monkeypatch.setitem(sys.modules, "panel", None)  # import panel -> ImportError
+    with pytest.raises(MissingDependencyError) as error:
+        serve(open_browser=False, warm=False)
+    assert (error.value.package, error.value.extra) == ("panel", "app")
+
+
+def test_qzs_and_the_page_logic_import_without_panel():
+    code = ("import sys; import qzs, qzs.cli, qzs.app, qzs.app.compute, qzs.app.updates, "
+            "qzs.app.server; assert 'panel' not in sys.modules and 'bokeh' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_addresses_and_ports():
+    from qzs.app.server import choose_port, is_loopback
+
+    assert is_loopback("127.0.0.1") and is_loopback("127.8.0.1") and is_loopback("::1")
+    assert is_loopback("localhost")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.4")
+    assert not is_loopback("example.org")
+    port = choose_port("127.0.0.1", 0)
+    assert 0 < port < 65536
+
+
+@pytest.mark.parametrize("argv", [["app", "--port", "70000"], ["app", "--port", "x"],
+                                  ["app", "--unknown"]])
+def test_cli_refuses_bad_options(argv, capsys):
+    from qzs.cli import main
+
+    assert main(argv) == 2
+    assert "error:" in capsys.readouterr().err
+
+
+def test_cli_delegates_to_serve(monkeypatch):
+    """`qzs app` parses and hands its options to qzs.app.server.serve."""
+    import qzs.app.server
+    from qzs.cli import main
+
+    seen = {}
+    monkeypatch.setattr(qzs.app.server, "serve", lambda **kw: seen.update(kw) or 0)
+    assert main(["app", "--no-browser", "--port", "6123", "--host", "::1"]) == 0
+    assert seen == {"port": 6123, "host": "::1", "open_browser": False}
+    assert main(["app"]) == 0
+    assert seen == {"port": None, "host": "127.0.0.1", "open_browser": True}
+
+
+def test_serve_warns_on_a_public_address(monkeypatch, capsys):
+    """Another address than loopback is served with a warning, before anything else."""
+    import qzs.app.server as server
+
+    class Stop(Exception):
+        pass
+
+    def stop():
+        raise Stop
+
+    monkeypatch.setattr(server, "warm_up", stop)
+    with pytest.raises(Stop):
+        server.serve(host="0.0.0.0", port=0, open_browser=False)
+    assert "warning: serving on '0.0.0.0'" in capsys.readouterr().err
+    with pytest.raises(Stop):
+        server.serve(host="127.0.0.1", port=0, open_browser=False)
+    assert "warning" not in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- the platform's tab
+def test_platform_tab_is_the_linear_record_of_the_shipped_platform():
+    from qzs.app.platform import compute_platform
+    from qzs.workflows.hexapod import SHIPPED_DEFAULT, linear_record, load_hexapod
+
+    data = compute_platform()
+    _, record = linear_record(load_hexapod(SHIPPED_DEFAULT))
+    np.testing.assert_allclose(data.natural_frequencies,
+                               np.asarray(record["natural_frequencies"], dtype=float))
+    assert data.stable == record["stable"]
+    assert data.base_joints.shape == data.top_joints.shape == (6, 3)
+    assert np.all(data.top_joints[:, 2] > data.base_joints[:, 2])
+    assert data.grid_png[:8] == b"\x89PNG\r\n\x1a\n"
+    weak = compute_platform({"pi_kp": 50.0, "pi_ki": 20.0})  # the paper's gains: unstable
+    assert not weak.stable and np.isnan(weak.natural_frequencies).any()
+
+
+def test_platform_tab_validates_as_the_api():
+    from qzs.app.platform import compute_platform
+
+    with pytest.raises(ParameterError, match="unknown platform setting"):
+        compute_platform({"mass": 3.0})
+    with pytest.raises(ParameterError) as got:
+        compute_platform({"pi_kp": -1.0})
+    with pytest.raises(ParameterError) as expected:
+        ControllerParameters(pi_kp=-1.0)
+    assert str(expected.value) in str(got.value)
+
+
+def test_ctrl_c_stops_the_server_with_130():
+    """`qzs app` serves until SIGINT, then exits as every command does on Ctrl-C."""
+    import signal
+    import time
+    import urllib.request
+
+    pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app]"')
+    from qzs.app.browser import free_port
+
+    port = free_port()
+    process = subprocess.Popen(
+        [sys.executable, "-m", "qzs", "app", "--no-browser", "--port", str(port)],
+        stderr=subprocess.PIPE, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 600
+        while time.monotonic() < deadline and process.poll() is None:
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as answer:
+                    assert answer.status == 200
+                    break
+            except OSError:
+                time.sleep(0.25)
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 130, err
+    assert f"serving http://127.0.0.1:{port}/" in err and "Traceback" not in err

@@ -1,0 +1,147 @@
+"""The tuning page's widgets and callbacks, driven from Python (no server, no browser).
+
+The page is built outside a Bokeh server with a synchronous executor, so every request is
+computed and delivered before the call returns; the browser tests (test_app_browser.py)
+drive the same page through Chromium.
+"""
+import io
+from concurrent.futures import Future
+
+import numpy as np
+import pytest
+
+pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app]"')
+
+from qzs.app import page as page_module  # noqa: E402
+from qzs.app.compute import MODEL_PARAMETERS, page_request, page_values  # noqa: E402
+from qzs.iotools.config import load_config  # noqa: E402
+from qzs.model.registry import PARAMETERS  # noqa: E402
+
+
+class NowExecutor:
+    """Runs each computation at once, in the caller's thread."""
+
+    def submit(self, function, request):
+        future = Future()
+        try:
+            future.set_result(function(request))
+        except Exception as error:  # noqa: BLE001 - the page shows it
+            future.set_exception(error)
+        return future
+
+
+def make_page():
+    return page_module.TuningPage(schedule=lambda f: f(), executor=NowExecutor())
+
+
+@pytest.fixture(scope="module")
+def page():
+    return make_page()
+
+
+def label(widget):
+    return widget.label if "label" in widget.param else widget.name
+
+
+def set_value(page, name, value):
+    page.widgets[name].value = value
+    return page.request_update()
+
+
+def test_the_page_draws_the_default_request(page):
+    page.reset()
+    assert page.data.request == page_request()
+    source = page.sources["transmissibility"].data
+    np.testing.assert_array_equal(source["x"], page.data.frequency)
+    np.testing.assert_array_equal(source["y"], page.data.transmissibility_db)
+    assert not page.alert.visible
+    assert page.status.object.startswith("ready")
+    assert "dt = 1 ms" in page.summary.object
+
+
+def test_every_label_carries_the_registry_unit(page):
+    for name in MODEL_PARAMETERS:
+        info = PARAMETERS[name]
+        assert label(page.widgets[name]) == f"{info.doc} [{info.unit}]"
+    for name, widget in page.widgets.items():
+        if name != "excitation.kind":
+            assert label(widget).endswith("]"), name
+    for plot in page.plots.values():
+        for axis in (*plot.xaxis, *plot.yaxis):
+            assert axis.axis_label == "run" or axis.axis_label.endswith("]"), axis.axis_label
+
+
+def test_a_changed_value_redraws(page):
+    page.reset()
+    before = np.array(page.sources["transmissibility"].data["y"])
+    set_value(page, "stiction_force", 4.0)
+    assert page.data.request.isolator.stiction_force == 4.0
+    after = np.array(page.sources["transmissibility"].data["y"])
+    assert before.shape != after.shape or not np.array_equal(before, after)
+    page.reset()
+
+
+def test_an_invalid_value_shows_the_api_message_and_keeps_the_plot(page):
+    page.reset()
+    drawn = page.data
+    assert set_value(page, "coulomb_force", 20.0) is None
+    assert page.alert.visible
+    assert "must be >= `coulomb_force`" in page.alert.object
+    assert "Traceback" not in page.alert.object
+    assert page.data is drawn
+    page.reset()
+    assert not page.alert.visible and page.widgets["coulomb_force"].value == 1.0
+
+
+def test_an_oversize_request_is_refused_on_the_page(page):
+    page.reset()
+    set_value(page, "excitation.duration", 5000.0)  # typed past the slider
+    assert page.alert.visible and "must lie in [10, 600] s" in page.alert.object
+    page.reset()
+
+
+def test_an_internal_error_shows_a_message_not_a_traceback(monkeypatch):
+    def broken(request):
+        raise RuntimeError("kaputt")
+
+    monkeypatch.setattr(page_module, "compute_page", broken)
+    broken_page = make_page()
+    assert broken_page.alert.visible
+    assert broken_page.alert.object.startswith("internal error (RuntimeError: kaputt)")
+    assert "Traceback" not in broken_page.alert.object
+
+
+def test_pins_and_reset(page):
+    page.reset()
+    page.pin()
+    set_value(page, "pi_kp", 20.0)
+    page.pin()
+    pinned = page.sources["pinned"].data
+    assert len(pinned["xs"]) == 2 and pinned["label"][0].startswith("pin 1: Fs = 10 N")
+    assert "Kp = 20 N/m" in pinned["label"][1]
+    np.testing.assert_array_equal(pinned["ys"][1], page.data.transmissibility_db)
+    page.reset()
+    assert page.values() == page_values()
+    assert len(page.sources["pinned"].data["xs"]) == 2  # reset keeps the pins
+    page.clear_pins()
+    assert page.sources["pinned"].data["xs"] == []
+
+
+def test_toml_download_round_trips(page, tmp_path):
+    page.reset()
+    set_value(page, "stiction_force", 6.5)
+    set_value(page, "excitation.kind", "stepped")
+    text = page._toml_file().getvalue()
+    path = tmp_path / "page.toml"
+    path.write_text(text, encoding="utf-8")
+    config = load_config(path)
+    assert config["isolator"] == page.data.request.isolator
+    assert config["simulation"]["dt"] == page.data.dt
+    assert config["excitation"]["kind"] == "sine"  # a stepped sine exports its time response
+    page.reset()
+
+
+def test_png_download_is_a_png(page):
+    page.reset()
+    data = page._png_file()
+    assert isinstance(data, io.BytesIO) and data.getvalue()[:4] == b"\x89PNG"
