@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench clean venv
+.PHONY: demo test bench clean venv docs
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -19,6 +19,29 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# The documentation site (docs/conf.py): the closed-form tests first, whose records become
+# docs/validation.md's tables; then Sphinx with warnings as errors, executing the tutorials
+# and the gallery; then every internal link of the built pages. Always a clean build.
+DOCS_STAMP := $(VENV)/.installed-docs
+DOCS_OUT := docs/_build
+
+$(DOCS_STAMP): pyproject.toml $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[all,docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	@start=$$(date +%s); set -e; \
+	rm -rf $(DOCS_OUT) docs/api/generated docs/api/qzs*.rst docs/gallery; \
+	mkdir -p $(DOCS_OUT); \
+	echo "docs: the validation tests (pytest -m validation)"; \
+	QZS_VALIDATION_OUT=$(CURDIR)/$(DOCS_OUT)/validation.jsonl \
+		$(BIN)/python -m pytest -q -m validation -p no:cacheprovider; \
+	echo "docs: sphinx-build"; \
+	QZS_VALIDATION_OUT=$(CURDIR)/$(DOCS_OUT)/validation.jsonl \
+		$(BIN)/python -m sphinx -W --keep-going -q -b html -j 1 docs $(DOCS_OUT)/html; \
+	$(BIN)/python docs/check_links.py $(DOCS_OUT)/html; \
+	echo "docs: $(DOCS_OUT)/html/index.html, built in $$(( $$(date +%s) - start )) s"
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py

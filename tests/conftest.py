@@ -1,8 +1,17 @@
-"""Session-scoped simulation runs shared by the test modules.
+"""Session-scoped simulation runs shared by the test modules, and the validation recorder.
 
 Every run here is short (seconds of simulated time) so that the whole suite stays fast
 once numba has compiled (and cached) the kernel.
+
+A test that checks a closed form or a published result takes the ``validation`` fixture
+and records what it measured; ``make docs`` runs those tests (``pytest -m validation``,
+the marker is added to every test that uses the fixture) with ``QZS_VALIDATION_OUT`` set,
+and the documentation's validation page (docs/validation.md) is built from the records.
 """
+import json
+import math
+import os
+
 import pytest
 from helpers import PASSIVE, SHORT_CHIRP
 
@@ -33,3 +42,62 @@ def sampled_chirp_run():
     """Default plant, PI plus active damping sampled at 1 kHz with zero-order hold."""
     controller = ControllerParameters(controller_rate=1000.0, damping_gain=20.0)
     return simulate(SHORT_CHIRP, controller=controller, dt=1e-4, sample_rate=1e4)
+
+
+# ---------------------------------------------------------------- validation records
+#: Environment variable naming the JSON Lines file the records are appended to.
+VALIDATION_OUT = "QZS_VALIDATION_OUT"
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "validation: checks a closed form or published result and records the "
+                   "measured error for the documentation's validation page (added to every "
+                   "test that uses the `validation` fixture)")
+
+
+@pytest.hookimpl(tryfirst=True)  # before `-m` deselects by marker
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if "validation" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.validation)
+
+
+@pytest.fixture
+def validation(request):
+    """Record a check against a closed form or a published result (docs/validation.md).
+
+    Returns ``record(check, reference, error, tolerance, *, measure="relative error")``:
+
+    check : str
+        What is compared, e.g. "Den Hartog peak amplitude, beta = 0.6".
+    reference : str
+        The closed form or published result, with its source.
+    error : float
+        The measured error, in the units of ``measure``.
+    tolerance : float
+        The bound the test asserts for it (the test's own assertion stays; the record only
+        reports).
+    measure : str
+        What ``error`` is: "relative error", "absolute error [m]", "|slope - 3|" ...
+
+    With ``QZS_VALIDATION_OUT`` unset, ``record`` does nothing but return ``error``; set, it
+    appends one JSON object per call to that file, with the test's id and its module's
+    one-line docstring (the page's section).
+    """
+    path = os.environ.get(VALIDATION_OUT)
+
+    def record(check, reference, error, tolerance, *, measure="relative error"):
+        error, tolerance = float(error), float(tolerance)
+        if path:
+            doc = (request.module.__doc__ or request.module.__name__).strip()
+            entry = {"check": check, "reference": reference,
+                     "error": error if math.isfinite(error) else repr(error),
+                     "tolerance": tolerance, "measure": measure,
+                     "test": request.node.nodeid, "module": request.module.__name__,
+                     "section": " ".join(doc.split("\n\n")[0].split())}
+            with open(path, "a", encoding="utf-8") as stream:
+                stream.write(json.dumps(entry) + "\n")
+        return error
+
+    return record

@@ -132,7 +132,7 @@ def test_an_unreachable_tolerance_is_an_error_not_a_silent_step():
 
 
 @pytest.mark.parametrize("solver, order", [("euler", 1), ("ode3", 3), ("rk4", 4)])
-def test_linear_error_scales_with_the_schemes_order(solver, order):
+def test_linear_error_scales_with_the_schemes_order(solver, order, validation):
     # frictionless, linear spring, smooth sine started at full amplitude (a fade-in's
     # raised-cosine slope is not smooth enough for rk4: it caps the observed order at 3)
     excitation = Sine(frequency=2.0, amplitude=0.01, fade_in=0.0)
@@ -144,9 +144,15 @@ def test_linear_error_scales_with_the_schemes_order(solver, order):
     assert len(differences) >= 2
     ratios = [a / b for a, b in zip(differences, differences[1:])]
     assert ratios == pytest.approx([2.0 ** order] * len(ratios), rel=0.1)
+    validation(f"{solver}: error ratio between steps h and h/2 (accuracy-driven step)",
+               f"2^{order} for a method of order {order}",
+               max(abs(ratio / 2.0 ** order - 1) for ratio in ratios), 0.1)
     # the Richardson estimate is the true error: a run 16 times finer is off by 16**-order
     actual = _check_against_fine(choice, "state_m", 16, isolator, controller)
     assert choice.error == pytest.approx(actual / (1 - 16.0 ** -order), rel=0.05)
+    validation(f"{solver}: Richardson error estimate of the chosen step",
+               "the true error against a run 16 times finer, / (1 - 16^-order)",
+               abs(choice.error / (actual / (1 - 16.0 ** -order)) - 1), 0.05)
     assert not any("observed order" in note for note in choice.notes)
 
 

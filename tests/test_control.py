@@ -24,11 +24,14 @@ DEFAULT_PLANT = IsolatorParameters()
 
 
 # ------------------------------------------------------------------ natural frequency
-def test_default_pi_moves_the_resonance_to_the_papers_0_45_hz():
+def test_default_pi_moves_the_resonance_to_the_papers_0_45_hz(validation):
     controller = ControllerParameters()
     assert controller.pi_kp == 50.0
     frequency = closed_loop_natural_frequency(DEFAULT_PLANT, controller)
     assert frequency == pytest.approx(0.45, abs=0.01)
+    validation("Closed-loop natural frequency with the default PI (Kp = 50 N/m)",
+               "paper, Section 3.1: PI moves the resonance within 0.08-0.45 Hz (upper end)",
+               abs(frequency - 0.45), 0.01, measure=f"absolute error [Hz], {frequency:.4f} Hz")
     k = spring_stiffness(-0.060, DEFAULT_PLANT) + 50.0
     assert frequency == pytest.approx(math.sqrt(k / 6.4) / (2 * math.pi), rel=1e-12)
     assert closed_loop_natural_frequency() == frequency  # defaults
@@ -164,7 +167,7 @@ def test_sampled_controller_law_at_the_sampling_instants():
                                rtol=0, atol=1e-12 * np.abs(r.damping_force).max())
 
 
-def test_charge_amplifier_highpass_closed_form_on_a_stuck_payload():
+def test_charge_amplifier_highpass_closed_form_on_a_stuck_payload(validation):
     """Payload stuck to a sine base: ``xd = A*w*cos(w t)`` exactly, so the measured velocity
     is the first-order high-pass ``s/(s + wh)`` of it, settled at t = 0 (output 0), in closed form.
     """
@@ -182,6 +185,10 @@ def test_charge_amplifier_highpass_closed_form_on_a_stuck_payload():
     lowpass = steady + (u0 - np.real(u0 * lowpass_gain)) * np.exp(-wh * t)
     expected = u0 * np.cos(w * t) - lowpass
     np.testing.assert_allclose(r.measured_payload_velocity, expected, rtol=0, atol=1e-9 * u0)
+    validation("Charge amplifier's high-pass on a stuck payload's velocity",
+               "s/(s + w_hp) of A w cos(w t), transient included",
+               np.abs(r.measured_payload_velocity - expected).max() / u0, 1e-9,
+               measure="absolute error / A w")
     np.testing.assert_allclose(r.damping_force, -10.0 * expected, rtol=0, atol=1e-8 * u0)
 
 
@@ -205,16 +212,19 @@ def _sampled_minus_continuous(excitation, plant, controller, duration, channels)
     return np.array(out).T
 
 
-def test_sampled_controller_converges_to_the_continuous_one_at_first_order():
+def test_sampled_controller_converges_to_the_continuous_one_at_first_order(validation):
     """Zero-order hold delays the command by T/2 on average: the difference is O(T)."""
     plant = linear_isolator(stiffness=100.0, damping=50.0)
     controller = linear_controller(pi_kp=400.0, pi_ki=800.0, damping_gain=30.0, velocity_highpass=1.0)
     differences = _sampled_minus_continuous(Sine(amplitude=0.01, frequency=2.0), plant, controller, 3.0,
                                             ["relative_position", "payload_acceleration"])
-    for difference in differences:
+    for channel, difference in zip(("relative position", "payload acceleration"), differences):
         assert np.all(np.diff(difference) < 0)
         slope = np.polyfit(np.log(1 / RATES), np.log(difference), 1)[0]
         assert slope == pytest.approx(1.0, abs=0.15)
+        validation(f"Sampled controller converges to the continuous one ({channel})",
+                   "order 1 in the period T (zero-order hold delays by T/2), linear plant",
+                   abs(slope - 1.0), 0.15, measure=f"|slope - 1|, slope {slope:.3f}")
     assert differences[0, -1] < 1e-3 * 0.01  # 10 kHz: well below the 10 mm excitation
 
 

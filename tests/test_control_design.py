@@ -34,7 +34,7 @@ def crossing(isolator, controller, name, low, high):
 
 
 # ---------------------------------------------------------------- Routh-Hurwitz
-def test_integral_limit_without_highpass_is_the_cubic_condition_and_the_poles_agree():
+def test_integral_limit_without_highpass_is_the_cubic_condition_and_the_poles_agree(validation):
     isolator = IsolatorParameters()
     controller = ControllerParameters(pi_kp=5.0, damping_gain=30.0, velocity_highpass=0.0)
     k = float(spring_stiffness(controller.position_setpoint, isolator))
@@ -42,15 +42,21 @@ def test_integral_limit_without_highpass_is_the_cubic_condition_and_the_poles_ag
     assert cd.integral_gain_limit(isolator, controller) == pytest.approx(closed, rel=1e-14)
     found = crossing(isolator, controller, "pi_ki", 0.5 * closed, 2 * closed)
     assert found == pytest.approx(closed, rel=1e-6)
+    validation("Routh-Hurwitz: largest stable Ki without the high-pass",
+               "Ki < (Cv + Kd)(k + Kp)/m against the Ki where python-control's poles cross "
+               "the imaginary axis", abs(found / closed - 1), 1e-6)
 
 
-def test_damping_gain_upper_bound_with_the_highpass_is_where_the_poles_cross():
+def test_damping_gain_upper_bound_with_the_highpass_is_where_the_poles_cross(validation):
     isolator = IsolatorParameters()
     controller = ControllerParameters(pi_kp=5.0, pi_ki=2.0, velocity_highpass=1.0)
     low, high = cd.damping_gain_limits(isolator, controller)
     assert low == 0.0 and math.isfinite(high)
     found = crossing(isolator, controller, "damping_gain", 0.5 * high, 2 * high)
     assert found == pytest.approx(high, rel=1e-6)
+    validation("Routh-Hurwitz: largest stable Kd with the high-pass",
+               "the quartic's a3 a2 a1 > a4 a1^2 + a3^2 a0 against the poles' crossing "
+               "(python-control)", abs(found / high - 1), 1e-6)
     # and the Routh table says so on either side
     assert cd.routh_hurwitz(isolator, dataclasses.replace(controller,
                                                           damping_gain=0.99 * high)).stable
@@ -66,7 +72,7 @@ def test_integral_limit_with_the_highpass_is_where_the_poles_cross():
     assert found == pytest.approx(limit, rel=1e-6)
 
 
-def test_on_a_zero_stiffness_spring_kp_must_exceed_m_ki_over_the_damping():
+def test_on_a_zero_stiffness_spring_kp_must_exceed_m_ki_over_the_damping(validation):
     # spring_force = 0: no spring at all, k = 0 exactly
     isolator = IsolatorParameters(spring_force=0.0, gravity=0.0)
     controller = ControllerParameters(pi_ki=20.0, damping_gain=28.0, velocity_highpass=0.0)
@@ -75,6 +81,9 @@ def test_on_a_zero_stiffness_spring_kp_must_exceed_m_ki_over_the_damping():
     assert rh.proportional_gain_minimum == pytest.approx(expected, rel=1e-9)
     found = crossing(isolator, controller, "pi_kp", 0.5 * expected, 2 * expected)
     assert found == pytest.approx(expected, rel=1e-6)
+    validation("Routh-Hurwitz on a zero-stiffness spring: least Kp",
+               "Kp > m Ki / (Cv + Kd) against the poles' crossing (python-control)",
+               abs(found / expected - 1), 1e-6)
 
 
 def test_default_loop_is_stable_and_the_closed_form_agrees_with_the_poles():
@@ -86,7 +95,7 @@ def test_default_loop_is_stable_and_the_closed_form_agrees_with_the_poles():
 
 
 # ---------------------------------------------------------------- margins
-def test_margins_of_a_discrete_integrator_against_the_hand_computation():
+def test_margins_of_a_discrete_integrator_against_the_hand_computation(validation):
     gain, period = 10.0, 0.01
     loop = control.tf([gain * period], [1.0, -1.0], period)  # K*T/(z - 1)
     margins = cd.stability_margins_of(loop)
@@ -97,19 +106,28 @@ def test_margins_of_a_discrete_integrator_against_the_hand_computation():
     # |L| = K*T/(2 sin(wT/2)) = 1; the phase is -(90 deg + wT/2)
     assert margins.phase_margin == pytest.approx(
         90.0 - math.degrees(math.asin(gain * period / 2)), abs=1e-4)
+    validation("Gain margin of a discrete integrator K T/(z - 1)", "20 log10(2/(K T))",
+               abs(margins.gain_margin - 20 * math.log10(2 / (gain * period))), 1e-9,
+               measure="absolute error [dB]")
+    validation("Phase margin of a discrete integrator K T/(z - 1)", "90 deg - asin(K T/2)",
+               abs(margins.phase_margin - (90.0 - math.degrees(math.asin(gain * period / 2)))),
+               1e-4, measure="absolute error [deg]")
 
 
-def test_margins_of_a_delayed_continuous_integrator():
+def test_margins_of_a_delayed_continuous_integrator(validation):
     w0, tau = 2.0, 0.1
     margins = cd.stability_margins_of(control.tf([w0], [1.0, 0.0]), delay=tau)
     assert margins.phase_margin == pytest.approx(90.0 - math.degrees(w0 * tau), abs=1e-3)
     assert margins.gain_margin == pytest.approx(20 * math.log10(math.pi / (2 * w0 * tau)),
                                                 abs=1e-3)
     assert margins.gain_crossover_frequency == pytest.approx(w0 / (2 * math.pi), rel=1e-4)
+    validation("Phase margin of a delayed integrator w0 e^(-s tau)/s (Pade)",
+               "90 deg - w0 tau", abs(margins.phase_margin - (90.0 - math.degrees(w0 * tau))),
+               1e-3, measure="absolute error [deg]")
 
 
 @pytest.mark.parametrize("fraction", [0.0, 0.3, 1.0, 1.5])
-def test_exact_discretisation_of_a_delayed_integrator(fraction):
+def test_exact_discretisation_of_a_delayed_integrator(fraction, validation):
     """ZOH of 1/s delayed by (n + e)*T: T*((1 - e) z + e)/(z^(n+1) (z - 1))."""
     period = 0.02
     system = cd.discretize_with_delay([[0.0]], [[1.0]], [[1.0]], period, fraction * period)
@@ -118,6 +136,9 @@ def test_exact_discretisation_of_a_delayed_integrator(fraction):
     z = np.exp(1j * omega * period)
     expected = period * ((1 - e) * z + e) / (z ** (whole + 1) * (z - 1))
     np.testing.assert_allclose(cd.frequency_response(system, omega), expected, rtol=1e-10)
+    validation(f"Zero-order hold of 1/s delayed by {fraction} T",
+               "modified z-transform T ((1 - e) z + e) / (z^(n+1) (z - 1))",
+               np.abs(cd.frequency_response(system, omega) / expected - 1).max(), 1e-10)
 
 
 def test_sampled_margins_approach_the_continuous_ones_and_a_slow_rate_fails():
@@ -147,13 +168,17 @@ def test_the_sampled_loop_matches_the_simulators_controller_at_low_frequency():
 
 
 # ---------------------------------------------------------------- describing functions
-def test_coulomb_describing_function_against_python_controls_numerical_one():
+def test_coulomb_describing_function_against_python_controls_numerical_one(validation):
     force = 2.0
     isolator = IsolatorParameters(stiction_force=force, coulomb_force=force)
     amplitude = np.array([1e-3, 1e-2, 0.3])
     numeric = cd.friction_describing_function(isolator, amplitude, points=20000)
     np.testing.assert_allclose(numeric.real, cd.coulomb_describing_function(force, amplitude),
                                rtol=1e-6)
+    validation("Describing function of Coulomb friction", "4 Fc / (pi A) against python-control's "
+               "numerical first harmonic", np.abs(
+                   numeric.real / cd.coulomb_describing_function(force, amplitude) - 1).max(),
+               1e-6)
     assert np.all(np.abs(numeric.imag) < 1e-3 * numeric.real)
 
 
@@ -199,7 +224,7 @@ def test_no_stribeck_dip_no_jump_no_hunting_predicted_and_none_simulated():
     assert np.ptp(result.relative_position[late]) < 1e-4  # it settled, no cycle
 
 
-def test_predicted_hunting_matches_the_simulated_cycle():
+def test_predicted_hunting_matches_the_simulated_cycle(validation):
     """The relay's plateau d/K and its exact period against the simulator, at rest."""
     isolator = IsolatorParameters()
     controller = ControllerParameters(pi_kp=200.0, pi_ki=80.0)
@@ -215,6 +240,11 @@ def test_predicted_hunting_matches_the_simulated_cycle():
     breaks = result.time[1:][locked[:-1] & ~locked[1:]]
     period = 2 * np.median(np.diff(breaks[breaks > 200.0]))
     assert period == pytest.approx(prediction.relay_period, rel=0.1)
+    validation("Hunting cycle at rest (Kp = 200 N/m, Ki = 80 N/(m s)): plateau",
+               "stick-slip relay's plateau d/K against a 400 s simulation",
+               abs(0.5 * np.ptp(zeta) / prediction.amplitude - 1), 0.1)
+    validation("Hunting cycle at rest: period", "the relay's exact period 4 h K / (Ki d) "
+               "against the simulated one", abs(period / prediction.relay_period - 1), 0.1)
     # the describing function's own frequency is the usual square-wave approximation
     assert prediction.period == pytest.approx(period, rel=0.35)
 

@@ -56,7 +56,7 @@ def test_sine_closed_form():
     assert excitation.duration is None and excitation.max_frequency == 7.0
 
 
-def test_linear_chirp_closed_form_and_constant_displacement_envelope():
+def test_linear_chirp_closed_form_and_constant_displacement_envelope(validation):
     amplitude, f0, f1, duration = 0.010, 0.0, 20.0, 10.0
     t = np.linspace(0, duration, 5001)
     y, yd, _ = base_motion_series(EXCITATIONS["linear chirp"], t)
@@ -66,6 +66,10 @@ def test_linear_chirp_closed_form_and_constant_displacement_envelope():
     inside = omega > 0
     envelope = (y[inside] / amplitude) ** 2 + (yd[inside] / (amplitude * omega[inside])) ** 2
     np.testing.assert_allclose(envelope, 1.0, rtol=1e-12)
+    validation("Linear chirp displacement", "A sin(2 pi (f0 t + (f1 - f0) t^2 / (2 T)))",
+               np.abs(y - amplitude * np.sin(phase)).max(), 1e-13, measure="absolute error [m]")
+    validation("Linear chirp: constant displacement amplitude", "(y/A)^2 + (y'/(A w(t)))^2 = 1",
+               np.abs(envelope - 1.0).max(), 1e-12)
 
 
 def test_logarithmic_chirp_closed_form():

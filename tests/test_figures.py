@@ -1,6 +1,10 @@
-"""The plotting helpers: what a figure shows of a long trace is its true envelope."""
+"""The plotting helpers: what a figure shows of a long trace is its true envelope; the
+figure factory keeps any backend that needs no display (Jupyter's inline one)."""
+import matplotlib
 import numpy as np
+import pytest
 
+from qzs.viz import figures
 from qzs.viz.figures import envelope
 
 
@@ -23,3 +27,20 @@ def test_envelope_of_a_short_trace_is_the_trace():
     time, values = np.arange(10.0), np.arange(10.0) ** 2
     t, v = envelope(time, values, max_points=2000)
     np.testing.assert_array_equal(v, values)
+
+
+@pytest.mark.parametrize("backend, switched", [
+    ("module://matplotlib_inline.backend_inline", False),  # Jupyter: figures shown inline
+    ("agg", False), ("pdf", False), ("TkAgg", True), ("QtAgg", True), ("GTK4Agg", True)])
+def test_new_figure_replaces_only_a_window_backend_without_a_display(monkeypatch, backend,
+                                                                     switched):
+    import matplotlib.pyplot as plt
+
+    plt.close(plt.figure())  # pyplot's own backend is loaded before get_backend is patched
+    used = []
+    monkeypatch.setattr(matplotlib, "get_backend", lambda: backend)
+    monkeypatch.setattr(matplotlib, "use", lambda name, **kwargs: used.append(name))
+    monkeypatch.setattr(figures, "_has_display", lambda: False)
+    fig, axes = figures.new_figure(1)
+    plt.close(fig)
+    assert used == (["Agg"] if switched else [])

@@ -40,7 +40,7 @@ def test_straight_line_interval_by_hand():
                                rtol=1e-12)
 
 
-def test_spring_fit_half_width():
+def test_spring_fit_half_width(validation):
     """tanh law: the analytic Jacobian at the optimum gives the half-widths."""
     rng = np.random.default_rng(1)
     z = np.linspace(-0.1, 0.1, 15)
@@ -54,9 +54,12 @@ def test_spring_fit_half_width():
     expected = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(covariance))
     got = [np.diff(fit.spring_force_interval)[0] / 2, np.diff(fit.spring_shape_interval)[0] / 2]
     np.testing.assert_allclose(got, expected, rtol=1e-3)
+    validation("MagSpring fit: 95 % half-widths of a and b", "t(0.975, dof) sqrt(diag(s^2 "
+               "(J^T J)^-1)), analytic Jacobian of a tanh(b z)",
+               np.abs(np.array(got) / expected - 1).max(), 1e-3)
 
 
-def test_friction_fit_half_width():
+def test_friction_fit_half_width(validation):
     """Eq. (3): the analytic Jacobian of the fitted law at the samples the fit used."""
     truth = qzs.IsolatorParameters()
     rng = np.random.default_rng(0)
@@ -88,6 +91,10 @@ def test_friction_fit_half_width():
     for name, half in expected.items():
         low, high = fit.intervals[name]
         assert (high - low) / 2 == pytest.approx(half, rel=2e-3), name
+    validation("Friction fit: 95 % half-widths of Fs, Fc, Cbc, Cv and the offset",
+               "t(0.975, dof) sqrt(diag(s^2 (J^T J)^-1)), analytic Jacobian of eq. 3",
+               max(abs(np.diff(fit.intervals[name])[0] / 2 / half - 1)
+                   for name, half in expected.items()), 2e-3)
 
 
 def test_transmissibility_local_interval_uses_the_two_sided_quantile(monkeypatch):

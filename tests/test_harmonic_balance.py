@@ -56,7 +56,7 @@ def monodromy(solution):
     return start, sol.y[:4, -1], sol.y[4:, -1].reshape(4, 4)
 
 
-def test_frictionless_small_motion_is_the_linear_closed_loop():
+def test_frictionless_small_motion_is_the_linear_closed_loop(validation):
     isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
     controller = ControllerParameters(damping_gain=30.0)
     # 0.1 mm: the MagSpring's tangent stiffness, steep on its plateau, stays put
@@ -70,6 +70,13 @@ def test_frictionless_small_motion_is_the_linear_closed_loop():
         # the exponents of the orbit are the closed loop's poles (w, I states included)
         exponents = np.sort_complex(floquet_exponents(solution))
         np.testing.assert_allclose(exponents, np.sort_complex(linear.poles), rtol=2e-5)
+        validation(f"Harmonic balance, frictionless small motion at {frequency} Hz: T",
+                   "the linearised closed loop (python-control)",
+                   abs(solution.transmissibility / float(linear.transmissibility(frequency))
+                       - 1), 1e-7)
+        validation(f"Harmonic balance at {frequency} Hz: Floquet exponents",
+                   "the closed loop's poles", np.abs(
+                       exponents / np.sort_complex(linear.poles) - 1).max(), 2e-5)
 
 
 def test_a_solution_is_a_periodic_orbit_of_the_smooth_ode():
@@ -106,7 +113,7 @@ def test_steep_friction_needs_more_harmonics_and_gets_better_with_them():
 
 
 @pytest.mark.parametrize("index", [40, 150, 250])
-def test_hill_exponents_are_the_monodromy_matrix_multipliers(softening_curve, index):
+def test_hill_exponents_are_the_monodromy_matrix_multipliers(softening_curve, index, validation):
     solution = softening_curve.solution(index)
     _, _, phi = monodromy(solution)
     multipliers = np.linalg.eigvals(phi[:2, :2])  # z, v: w and I are not coupled here
@@ -116,6 +123,14 @@ def test_hill_exponents_are_the_monodromy_matrix_multipliers(softening_curve, in
     # Liouville: the exponents sum to the period-mean trace, -Cv/m without friction
     assert np.sum(floquet_exponents(solution)).real == pytest.approx(
         -solution.model.viscous_damping / solution.model.mass, rel=1e-8)
+    validation(f"Hill's Floquet multipliers, softening orbit at {solution.frequency:.3f} Hz",
+               "eigenvalues of the monodromy matrix (scipy DOP853, variational equations)",
+               np.abs(np.sort_complex(hill) - np.sort_complex(multipliers)).max(),
+               1e-8 + 1e-6 * np.abs(multipliers).max(), measure="absolute error [-]")
+    validation(f"Sum of the Floquet exponents at {solution.frequency:.3f} Hz",
+               "Liouville's formula: -Cv/m", abs(np.sum(floquet_exponents(solution)).real
+                                                 / (-solution.model.viscous_damping
+                                                    / solution.model.mass) - 1), 1e-8)
 
 
 def test_the_softening_resonance_folds_and_is_unstable_between_its_folds(softening_curve):
@@ -135,7 +150,8 @@ def test_the_softening_resonance_folds_and_is_unstable_between_its_folds(softeni
     assert curve.valid.all()
 
 
-def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softening_curve):
+def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softening_curve,
+                                                                          validation):
     """Every stepped-sine point lies on a stable branch of the harmonic balance (solved at
     its frequency from the nearest point of that branch); the sweeps jump where the
     harmonic balance folds: up just after the upper fold, down just below the lower one."""
@@ -143,6 +159,7 @@ def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softe
     response = steady_state_response(frequencies, AMPLITUDE, **SOFTENING, dt=1e-3,
                                      harmonic_balance=False, workers=2)
     curve = softening_curve
+    worst = 0.0
     for direction in ("up", "down"):
         branch = response.branch(direction)
         for f, t in zip(branch["frequency"], branch["transmissibility"]):
@@ -152,6 +169,7 @@ def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softe
                                       initial_guess=curve.solution(nearest))
             assert exact.converged
             assert t == pytest.approx(exact.transmissibility, rel=3e-4), (direction, f)
+            worst = max(worst, abs(t / exact.transmissibility - 1))
     # each sweep leaves its branch at the fold where the branch ends, or a step before it:
     # close to a fold the branch's basin shrinks below what a 0.1 Hz step disturbs
     lower, upper = min(curve.folds), max(curve.folds)
@@ -162,6 +180,9 @@ def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softe
     assert lower < down_from and down_to < lower + 0.1 + 1e-9
     band = response.hysteresis()
     assert band.min() > lower and band.max() < upper
+    validation("Stepped sine up and down a folding softening resonance, 3-4.6 Hz",
+               "harmonic balance (20 harmonics) on the stable branch",
+               worst, 3e-4)
 
 
 def test_regularised_friction_is_odd_continuous_and_dissipative():

@@ -30,7 +30,7 @@ def instron_test(seed=0, isolator=TRUTH, offset=3.0, noise=0.2, rate=1000.0, cyc
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_round_trip_within_confidence_intervals(seed):
+def test_round_trip_within_confidence_intervals(seed, validation):
     time, z, force = instron_test(seed)
     fit = fit_friction(time, z, force, spring=TRUTH, mass=TRUTH.mass)
     for name in NAMES:
@@ -42,6 +42,11 @@ def test_round_trip_within_confidence_intervals(seed):
     assert fit.n_used + fit.n_excluded == time.size and 0 < fit.n_excluded < 0.05 * time.size
     assert np.all(np.abs(fit.velocity[fit.used]) >= 2e-3)
     assert fit.residual_rms == pytest.approx(0.2, rel=0.5)
+    share = max(abs(getattr(fit, name) - getattr(TRUTH, name))
+                / (np.diff(fit.intervals[name])[0] / 2) for name in NAMES)
+    validation(f"Friction fit round trip (seed {seed}, 0.2 N noise)",
+               "Table 1's Fs, Fc, Cbc, Cv (paper eq. 3) inside the 95 % intervals", share, 1.0,
+               measure="largest |fit - truth| / 95 % half-width")
 
 
 def test_interval_coverage_is_close_to_nominal():

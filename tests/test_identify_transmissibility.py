@@ -28,7 +28,7 @@ def curve():
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_round_trip_viscous_damping_within_interval(seed):
+def test_round_trip_viscous_damping_within_interval(seed, validation):
     truth = qzs.IsolatorParameters(viscous_damping=60.0, stiction_force=6.0)
     frequency, magnitude = measured_curve(truth, seed)
     fit = fit_transmissibility(frequency, magnitude, ("viscous_damping",),
@@ -39,6 +39,10 @@ def test_round_trip_viscous_damping_within_interval(seed):
     assert fit.isolator.viscous_damping == fit.parameters["viscous_damping"]
     assert fit.residual_rms == pytest.approx(0.03, rel=0.3)
     assert fit.n_simulations < 110 and fit.frequency.min() >= 1.0
+    validation(f"Transmissibility fit round trip through the simulator (seed {seed})",
+               "Cv = 60 N s/m inside the 95 % interval (3 % noise on |T|)",
+               abs(fit.parameters["viscous_damping"] - 60.0) / ((high - low) / 2), 1.0,
+               measure="|fit - truth| / 95 % half-width")
 
 
 def test_two_parameters_with_stiction(curve, tmp_path):

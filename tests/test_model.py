@@ -38,11 +38,14 @@ def test_spring_energy_derivative_is_minus_force(z):
     np.testing.assert_allclose(central, -spring_force(z, DEFAULT), rtol=1e-7, atol=1e-7)
 
 
-def test_spring_energy_is_zero_at_centre_and_the_log_cosh_closed_form():
+def test_spring_energy_is_zero_at_centre_and_the_log_cosh_closed_form(validation):
     assert spring_energy(0.0, DEFAULT) == 0.0
     a, b = DEFAULT.spring_force, DEFAULT.spring_shape
-    np.testing.assert_allclose(spring_energy(Z_GRID, DEFAULT), a / b * np.log(np.cosh(b * Z_GRID)),
-                               rtol=1e-12, atol=1e-15)
+    exact = a / b * np.log(np.cosh(b * Z_GRID))
+    np.testing.assert_allclose(spring_energy(Z_GRID, DEFAULT), exact, rtol=1e-12, atol=1e-15)
+    inside = exact > 0
+    validation("MagSpring energy", "(a/b) log cosh(b z), the integral of a tanh(b z)",
+               np.abs(spring_energy(Z_GRID, DEFAULT)[inside] / exact[inside] - 1).max(), 1e-12)
 
 
 def test_spring_energy_stays_finite_far_out_where_cosh_overflows():
@@ -73,21 +76,28 @@ def test_friction_limits_stiction_at_zero_and_coulomb_plus_viscous_when_fast():
     assert friction_force(0.0, p) == 0.0
 
 
-def test_friction_stribeck_decay_is_exponential_in_speed():
+def test_friction_stribeck_decay_is_exponential_in_speed(validation):
     p = IsolatorParameters(viscous_damping=0.0)
     v = np.array([0.001, 0.01, 0.03])
     excess = -friction_force(v, p) - p.coulomb_force
-    np.testing.assert_allclose(excess, (p.stiction_force - p.coulomb_force) * np.exp(-p.stribeck_decay * v),
-                               rtol=1e-13)
+    exact = (p.stiction_force - p.coulomb_force) * np.exp(-p.stribeck_decay * v)
+    np.testing.assert_allclose(excess, exact, rtol=1e-13)
+    validation("Stribeck decay of the friction law", "(Fs - Fc) exp(-Cbc |v|) (paper eq. 3)",
+               np.abs(excess / exact - 1).max(), 1e-13)
 
 
 # ------------------------------------------------------------------ operating point
-def test_default_passive_natural_frequency_is_the_papers_0_08_hz():
+def test_default_passive_natural_frequency_is_the_papers_0_08_hz(validation):
     frequency = passive_natural_frequency(DEFAULT, -0.060)
     assert frequency == pytest.approx(0.08, abs=0.003)
     a, b, m = DEFAULT.spring_force, DEFAULT.spring_shape, DEFAULT.mass
     closed_form = math.sqrt(a * b / math.cosh(b * 0.060) ** 2 / m) / (2 * math.pi)
     assert frequency == pytest.approx(closed_form, rel=1e-12)
+    validation("Passive natural frequency at the setpoint (Table 1 values)",
+               "paper, Section 3.1: resonance at approximately 0.08 Hz", abs(frequency - 0.08), 0.003,
+               measure=f"absolute error [Hz], {frequency:.4f} Hz")
+    validation("Passive natural frequency at the setpoint", "sqrt(a b / cosh^2(b z) / m) / 2 pi",
+               abs(frequency / closed_form - 1), 1e-12)
     assert qzs.passive_natural_frequency is passive_natural_frequency
 
 

@@ -45,7 +45,7 @@ def test_the_energy_ledger_closes_with_regularised_friction(chirp_runs):
     assert np.diff(r.friction_dissipation).min() >= -1e-12
 
 
-def test_regularised_run_approaches_the_exact_one_as_v_reg_shrinks():
+def test_regularised_run_approaches_the_exact_one_as_v_reg_shrinks(validation):
     """A payload that slips all the time (it reverses but never sticks): tanh(v/v_reg) -> sign(v).
 
     The payload starts at absolute rest, so slipping (v = -A*omega), and a 15 Hz base
@@ -67,6 +67,9 @@ def test_regularised_run_approaches_the_exact_one_as_v_reg_shrinks():
         errors.append(np.sqrt(np.mean(difference**2)) / size)
     assert errors[0] > 2 * errors[1] > 4 * errors[2]  # shrinks with v_reg ...
     assert errors[0] > 1e-3 and errors[2] < 2e-4      # ... from visible to negligible
+    validation("Regularised friction, v_reg = 1e-4 m/s, against the exact stick-slip model",
+               "tanh(v/v_reg) -> sign(v): the exact model's payload acceleration",
+               errors[2], 2e-4, measure="rms difference / rms acceleration")
 
 
 def test_every_lane_equals_its_single_run_with_regularised_friction():

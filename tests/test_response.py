@@ -98,7 +98,7 @@ def exact_coulomb_oscillator(m, k, c, friction, force, omega):
 
 @pytest.mark.parametrize("beta, force_ratio, viscous", [
     (0.6, 0.3, 0.0), (1.6, 0.3, 0.0), (2.5, 0.5, 0.0), (1.6, 0.3, 5.0)])
-def test_den_hartog_coulomb_oscillator(beta, force_ratio, viscous):
+def test_den_hartog_coulomb_oscillator(beta, force_ratio, viscous, validation):
     """A linear spring (tanh with a tiny shape: bz ~ 1e-5), Coulomb friction F (Fs = Fc) and
     viscous friction, no controller, no gravity: the relative motion is Den Hartog's
     oscillator forced by ``-m y''`` = ``m A w^2 cos(w t)``."""
@@ -122,6 +122,17 @@ def test_den_hartog_coulomb_oscillator(beta, force_ratio, viscous):
     # the sampled peak: 256 samples a period miss the crest by at most 1 - cos(pi/256)
     assert point.relative_peak == pytest.approx(peak, rel=2e-4)
     assert point.locked_fraction == 0.0 and point.stop_contacts == 0.0
+    case = f"beta = {beta}, F/P = {force_ratio}, c = {viscous} N s/m"
+    if viscous == 0.0:
+        validation(f"Den Hartog's construction against his closed form ({case})",
+                   "X = (P/k) sqrt(V^2 - (F/P)^2 U^2) (Den Hartog 1931)",
+                   abs(peak / den_hartog_amplitude(force_ratio, beta, force / k) - 1), 1e-9)
+    validation(f"Stepped sine, fundamental of the relative motion ({case})",
+               "Den Hartog's exact steady state (1931), Coulomb + viscous friction",
+               abs(point.relative_amplitude / fundamental - 1), 1e-5)
+    validation(f"Stepped sine, peak of the relative motion ({case})",
+               "Den Hartog's exact steady state (1931), sampled at 256 points a period",
+               abs(point.relative_peak / peak - 1), 2e-4)
 
 
 # ---------------------------------------------------------------- zero stiffness + Coulomb
@@ -136,7 +147,7 @@ def zero_stiffness(ratio, amplitude, frequency):
 
 
 @pytest.mark.parametrize("ratio", [0.2, 0.5, 0.53])
-def test_zero_stiffness_isolator_slides_with_four_c_over_pi(ratio):
+def test_zero_stiffness_isolator_slides_with_four_c_over_pi(ratio, validation):
     """Below c* the payload slides all the time: its acceleration is a square wave of
     height F/m, whose fundamental is 4F/(pi m), i.e. T = 4c/pi; odd harmonics 4c/(k pi)."""
     amplitude, frequency = 0.005, 3.0
@@ -146,6 +157,11 @@ def test_zero_stiffness_isolator_slides_with_four_c_over_pi(ratio):
     assert point.transmissibility == pytest.approx(4 * ratio / math.pi, rel=1e-5)
     assert point.harmonics[1] == pytest.approx(4 * ratio / (3 * math.pi), rel=1e-4)
     assert point.harmonics[3] == pytest.approx(4 * ratio / (5 * math.pi), rel=1e-3)
+    validation(f"Zero-stiffness Coulomb isolator, c = {ratio}: fundamental T",
+               "4c/pi (square-wave acceleration, docs/response.md §6)",
+               abs(point.transmissibility / (4 * ratio / math.pi) - 1), 1e-5)
+    validation(f"Zero-stiffness Coulomb isolator, c = {ratio}: third harmonic",
+               "4c/(3 pi)", abs(point.harmonics[1] / (4 * ratio / (3 * math.pi)) - 1), 1e-4)
     assert point.harmonics[0] < 1e-6 and point.harmonics[2] < 1e-6  # no even harmonics
     assert point.locked_fraction == 0.0
 
@@ -168,7 +184,7 @@ def test_zero_stiffness_isolator_sticks_above_the_critical_ratio():
 
 
 # ---------------------------------------------------------------- linear closed loop
-def test_frictionless_steady_state_is_the_linear_closed_loop():
+def test_frictionless_steady_state_is_the_linear_closed_loop(validation):
     isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
     controller = ControllerParameters(damping_gain=30.0)
     frequencies = [0.3, 1.0, 3.0, 10.0]
@@ -179,6 +195,12 @@ def test_frictionless_steady_state_is_the_linear_closed_loop():
     assert np.all(up["converged"] == 1)
     np.testing.assert_allclose(up["transmissibility"], np.abs(expected), rtol=1e-4)
     np.testing.assert_allclose(up["phase"], np.angle(expected), atol=1e-4)
+    validation("Frictionless stepped sine, 0.3-10 Hz, |T|", "the linearised closed loop "
+               "(python-control)", np.abs(up["transmissibility"] / np.abs(expected) - 1).max(),
+               1e-4)
+    validation("Frictionless stepped sine, 0.3-10 Hz, phase", "the linearised closed loop "
+               "(python-control)", np.abs(up["phase"] - np.angle(expected)).max(), 1e-4,
+               measure="absolute error [rad]")
     # and the record's linear value is the same model's
     records = response.to_records()
     np.testing.assert_allclose([r["linear_transmissibility"] for r in records],

@@ -101,22 +101,29 @@ REAL_AXIS = {"euler": _real_axis_limit([1, 1]), "ode3": _real_axis_limit([1, 1, 
              "rk4": _real_axis_limit([1, 1, 1 / 2, 1 / 6, 1 / 24])}
 
 
-def test_real_axis_limits_are_the_textbook_values():
+def test_real_axis_limits_are_the_textbook_values(validation):
     assert REAL_AXIS["euler"] == pytest.approx(2.0, rel=1e-12)
     assert REAL_AXIS["ode3"] == pytest.approx(2.5127, abs=1e-4)
     assert REAL_AXIS["rk4"] == pytest.approx(2.7853, abs=1e-4)
+    for solver, textbook in (("ode3", 2.5127), ("rk4", 2.7853)):
+        validation(f"{solver}: stability limit h*|lambda| on the negative real axis",
+                   f"textbook value {textbook}: the root of the stability polynomial sum z^k/k!",
+                   abs(REAL_AXIS[solver] - textbook), 1e-4, measure="absolute error [-]")
 
 
 @pytest.mark.parametrize("solver", list(SOLVERS))
-def test_largest_stable_step_for_a_real_stiff_mode(solver):
+def test_largest_stable_step_for_a_real_stiff_mode(solver, validation):
     """The charge amplifier's high-pass as the stiffest mode: lambda = -2*pi*f_hp, real."""
     plant = linear_isolator(stiffness=1.0, damping=1.0, stop_model="plastic")
     controller = linear_controller(velocity_highpass=2000.0)
     expected = REAL_AXIS[solver] / (2 * np.pi * 2000.0)
-    assert largest_stable_step(plant, controller, solver) == pytest.approx(expected, rel=1e-4)
+    found = largest_stable_step(plant, controller, solver)
+    assert found == pytest.approx(expected, rel=1e-4)
+    validation(f"{solver}: largest stable step, a 2 kHz high-pass as the stiffest mode",
+               "real-axis limit / (2 pi f_hp)", abs(found / expected - 1), 1e-4)
 
 
-def test_largest_stable_step_of_euler_for_the_stop_contact_mode():
+def test_largest_stable_step_of_euler_for_the_stop_contact_mode(validation):
     """Euler on lambda = s +- i*w is stable for h <= -2*s/|lambda|^2 (closed form)."""
     plant = IsolatorParameters(viscous_damping=100.0, stop_stiffness=1e6, stop_damping=1e3)
     controller = ControllerParameters(velocity_highpass=0.0, damping_gain=0.0)
@@ -126,7 +133,10 @@ def test_largest_stable_step_of_euler_for_the_stop_contact_mode():
     eigenvalue = np.roots([m, c, k])[0]
     assert abs(eigenvalue.imag) > 0
     expected = -2 * eigenvalue.real / abs(eigenvalue) ** 2
-    assert largest_stable_step(plant, controller, "euler") == pytest.approx(expected, rel=1e-3)
+    found = largest_stable_step(plant, controller, "euler")
+    assert found == pytest.approx(expected, rel=1e-3)
+    validation("euler: largest stable step on the compliant stop's mode",
+               "h = -2 Re(lambda) / |lambda|^2", abs(found / expected - 1), 1e-3)
 
 
 def test_run_just_below_the_limit_stays_bounded_on_the_stop():

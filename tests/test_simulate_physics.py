@@ -54,7 +54,7 @@ def _closed_loop(controller):
 
 @pytest.mark.parametrize("case", list(CASES))
 @pytest.mark.parametrize("frequency", [0.3, 1.0, 3.0, 10.0])
-def test_frictionless_linear_limit_matches_closed_form_transmissibility(case, frequency):
+def test_frictionless_linear_limit_matches_closed_form_transmissibility(case, frequency, validation):
     """X/Y(s) = (k + c s + Kp + Ki/s) / (m s^2 + k + c s + Kp + Ki/s + Kd s HP(s)).
 
     The run is long enough for the slowest closed-loop pole to decay by 1e-9 (with a
@@ -83,6 +83,12 @@ def test_frictionless_linear_limit_matches_closed_form_transmissibility(case, fr
     assert abs(measured) == pytest.approx(abs(expected), rel=1e-5)
     assert np.angle(measured / expected) == pytest.approx(0.0, abs=1e-5)
     assert np.sqrt(residual[0] / len(t)) < 1e-6 * amplitude  # nothing but the sine is left
+    reference = ("X/Y = (k + c s + Kp + Ki/s) / (m s^2 + k + c s + Kp + Ki/s + Kd s HP(s)) at "
+                 "s = jw, frictionless linear plant")
+    validation(f"Linear limit ({case}): |X/Y| at {frequency} Hz", reference,
+               abs(abs(measured) / abs(expected) - 1), 1e-5)
+    validation(f"Linear limit ({case}): phase of X/Y at {frequency} Hz", reference,
+               abs(np.angle(measured / expected)), 1e-5, measure="absolute error [rad]")
     if case == "pi+damping+highpass":  # the damping term matters: without it the answer differs
         without, _ = _closed_loop(linear_controller(**CASES["pi"]))
         assert abs(without(1j * w) - expected) > 1e-3 * abs(expected)
@@ -148,14 +154,26 @@ def test_oscillating_case_reverses_without_sticking():
     assert r.run["stick_events"] == 0 and r.locked.sum() == 0
 
 
+def _record_order(validation, solver, slope, what):
+    order = ORDERS[solver]
+    validation(f"{solver}: observed convergence order, {what}",
+               f"order {order}: log-log slope of the final-state error over dt = 2^-k "
+               "(reference: rk4 at dt = 2^-20)", abs(slope - order), 0.3,
+               measure=f"|slope - {order}|, slope {slope:.3f}")
+
+
 @pytest.mark.parametrize("solver", list(ORDERS))
-def test_integrator_converges_at_its_order(solver):
-    assert _observed_order(SMOOTH, solver) == pytest.approx(ORDERS[solver], abs=0.3)
+def test_integrator_converges_at_its_order(solver, validation):
+    slope = _observed_order(SMOOTH, solver)
+    assert slope == pytest.approx(ORDERS[solver], abs=0.3)
+    _record_order(validation, solver, slope, "smooth run (frictionless MagSpring, PI + damping)")
 
 
 @pytest.mark.parametrize("solver", ["ode3", "rk4"])
-def test_integrator_keeps_its_order_through_velocity_reversals(solver):
-    assert _observed_order(OSCILLATING, solver) == pytest.approx(ORDERS[solver], abs=0.3)
+def test_integrator_keeps_its_order_through_velocity_reversals(solver, validation):
+    slope = _observed_order(OSCILLATING, solver)
+    assert slope == pytest.approx(ORDERS[solver], abs=0.3)
+    _record_order(validation, solver, slope, "through located velocity reversals")
 
 
 # ====================================================================== 3. energy
@@ -171,12 +189,16 @@ def test_friction_power_is_never_positive(run, request):
 
 
 @pytest.mark.parametrize("run", RUNS)
-def test_energy_ledger_balances(run, request):
+def test_energy_ledger_balances(run, request, validation):
     """dE = W_base + W_motor - D_friction - D_stop, up to the integrator's truncation error."""
     r = request.getfixturevalue(run)
     throughput = np.abs(r.base_work).max()
     assert throughput > 1.0  # J: the ledger is exercised
     assert np.abs(r.energy_residual()).max() < 1e-4 * throughput
+    validation(f"Energy ledger closes ({run.replace('_', ' ')})",
+               "dE = W_base + W_motor - D_friction - D_stop (docs/model.md §8)",
+               np.abs(r.energy_residual()).max() / throughput, 1e-4,
+               measure="largest residual / largest base work")
 
 
 def test_compliant_stop_dissipation_never_decreases(passive_chirp_run):
@@ -198,7 +220,7 @@ def test_plastic_stop_dissipation_never_decreases(plastic_sine_run):
     assert np.diff(r.stop_dissipation).min() >= -1e-6
 
 
-def test_plastic_impact_dissipates_the_relative_kinetic_energy_on_a_still_base():
+def test_plastic_impact_dissipates_the_relative_kinetic_energy_on_a_still_base(validation):
     """A still base (amplitude 0): the impact absorbs m*v^2/2 and the ledger shows it as stop loss."""
     plant = IsolatorParameters(stop_model="plastic", stiction_force=0.0, coulomb_force=0.0,
                                viscous_damping=0.0)
@@ -213,11 +235,14 @@ def test_plastic_impact_dissipates_the_relative_kinetic_energy_on_a_still_base()
     dz = r.relative_position[hit - 1] - low
     v_impact = -np.sqrt(v_before**2 + 2 * deficit / m * dz)  # energy, over the last 0.1 mm
     assert r.stop_dissipation[hit] == pytest.approx(0.5 * m * v_impact**2, rel=1e-4)
+    validation("Plastic impact on a still base: energy booked as stop loss",
+               "m v^2 / 2 at the impact velocity (energy balance over the last 0.1 mm)",
+               abs(r.stop_dissipation[hit] / (0.5 * m * v_impact**2) - 1), 1e-4)
     assert np.all(r.relative_position >= low) and r.locked[hit:].all()
 
 
 # ====================================================================== 4. stuck payload
-def test_large_stiction_moves_the_payload_exactly_with_the_base():
+def test_large_stiction_moves_the_payload_exactly_with_the_base(validation):
     plant = IsolatorParameters(stiction_force=1e6, coulomb_force=1.0)
     r = simulate(SHORT_CHIRP, plant, duration=20.0, dt=1e-4, sample_rate=1000.0)
     assert r.locked.all()
@@ -226,9 +251,12 @@ def test_large_stiction_moves_the_payload_exactly_with_the_base():
     np.testing.assert_array_equal(r.payload_acceleration, r.base_acceleration)
     assert r.run["stick_events"] == 0
     assert np.abs(r.friction_force).max() > 100.0  # friction is really holding (m*ydd up to 1000 N)
+    validation("Huge stiction: the payload moves exactly with the base", "x'' = y'' (locked)",
+               np.abs(r.payload_acceleration - r.base_acceleration).max(), 0.0,
+               measure="absolute error [m/s^2]")
 
 
-def test_breakaway_happens_when_the_holding_force_reaches_stiction():
+def test_breakaway_happens_when_the_holding_force_reaches_stiction(validation):
     """Stuck at rest on a sine base with the motor carrying the weight deficit (bumpless start):
     friction must supply ``m*A*w^2*sin(w t)``, which reaches Fs at ``t* = asin(Fs/(m A w^2))/w``."""
     amplitude, frequency, dt = 0.010, 2.5, 1e-5
@@ -241,6 +269,11 @@ def test_breakaway_happens_when_the_holding_force_reaches_stiction():
     assert r.time[first_slip - 1] <= breakaway < r.time[first_slip]
     np.testing.assert_allclose(r.friction_force[:first_slip],
                                -m * amplitude * w**2 * np.sin(w * r.time[:first_slip]), rtol=0, atol=1e-9)
+    validation("Holding force of a stuck payload until breakaway", "-m A w^2 sin(w t), breaking "
+               "away at t* = asin(Fs / (m A w^2)) / w", np.abs(
+                   r.friction_force[:first_slip]
+                   + m * amplitude * w**2 * np.sin(w * r.time[:first_slip])).max(), 1e-9,
+               measure="absolute error [N]")
 
 
 # ====================================================================== 5. hard stops
@@ -258,10 +291,13 @@ def _penetration_bound(r):
     return v_impact * np.sqrt(p.mass / p.stop_stiffness) + push / p.stop_stiffness
 
 
-def test_compliant_stop_penetration_stays_within_the_energy_bound(passive_chirp_run):
+def test_compliant_stop_penetration_stays_within_the_energy_bound(passive_chirp_run, validation):
     r = passive_chirp_run
     assert r.run["stop_contacts"] > 0 and r.stop_contact.any()
     assert 0 < _penetration(r) <= _penetration_bound(r)
+    validation("Compliant stop: penetration of the passive chirp run",
+               "bound v sqrt(m/k_stop) + F_push/k_stop (impact energy + quasi-static push)",
+               _penetration(r) / _penetration_bound(r), 1.0, measure="penetration / bound")
 
 
 def test_fast_head_on_impact_on_the_compliant_stop():
@@ -385,11 +421,15 @@ def test_frictionless_start_stuck_or_slipping_is_the_same_motion():
 
 # ====================================================================== plain-numpy reference
 @pytest.mark.parametrize("run", RUNS)
-def test_every_sample_obeys_the_equation_of_motion_and_force_laws(run, request):
+def test_every_sample_obeys_the_equation_of_motion_and_force_laws(run, request, validation):
     r = request.getfixturevalue(run)
     p = r.isolator
     forces = r.spring_force + r.friction_force + r.stop_force + r.motor_force - p.mass * p.gravity
     np.testing.assert_allclose(p.mass * r.payload_acceleration, forces, rtol=0, atol=1e-9)
+    validation(f"Equation of motion in every sample ({run.replace('_', ' ')})",
+               "m x'' = F_spring + F_friction + F_stop + F_motor - m g (docs/model.md §2)",
+               np.abs(p.mass * r.payload_acceleration - forces).max(), 1e-9,
+               measure="absolute error [N]")
     np.testing.assert_allclose(r.spring_force, spring_force(r.relative_position, p), rtol=0, atol=1e-11)
     np.testing.assert_allclose(r.spring_energy, spring_energy(r.relative_position, p), rtol=0, atol=1e-12)
     slipping = ~r.locked

@@ -55,12 +55,15 @@ def noisy_record():
 
 # ---------------------------------------------------------------- estimators
 @pytest.mark.parametrize("estimator", ["psd_ratio", "h1", "h2"])
-def test_estimators_match_closed_form_of_linear_system(clean_record, estimator):
+def test_estimators_match_closed_form_of_linear_system(clean_record, estimator, validation):
     base, payload = clean_record
     estimate = transmissibility(base, payload, SAMPLE_RATE, fft_length=4096, estimator=estimator)
     band = (estimate.frequency > 0.3) & (estimate.frequency < 40.0)
     exact = sdof_response(bilinear_analog_frequency(estimate.frequency[band]))
     np.testing.assert_allclose(estimate.magnitude[band], np.abs(exact), rtol=0.03)
+    validation(f"Welch estimate ({estimator}) of a 2 Hz, 10 % damped SDOF, 0.3-40 Hz",
+               "(1 + 2j zeta r) / (1 - r^2 + 2j zeta r), bilinear-warped frequency",
+               np.abs(estimate.magnitude[band] / np.abs(exact) - 1).max(), 0.03)
     assert np.all(estimate.coherence[band] > 0.97)
     assert estimate.estimator == estimator and estimate.n_averages == 60
     if estimator == "psd_ratio":
@@ -102,7 +105,7 @@ def test_estimators_with_payload_noise_follow_their_bias_formulas(noisy_record):
                   < 0.02 + 4 * coherence_error[coherent])
 
 
-def test_sine_amplitude_on_bin_is_its_rms():
+def test_sine_amplitude_on_bin_is_its_rms(validation):
     """As scipy's test_window_correction: a bin-centred sine shows A^2/2 of power, i.e. RMS A/sqrt(2)."""
     sample_rate, fft_length, amplitude, bin_index = 1000.0, 1024, 2.5, 50
     time = np.arange(8 * fft_length) / sample_rate
@@ -111,9 +114,12 @@ def test_sine_amplitude_on_bin_is_its_rms():
                                         fft_length=fft_length)
     assert np.argmax(rms) == bin_index and frequency[bin_index] == pytest.approx(tone)
     assert rms[bin_index] == pytest.approx(amplitude / math.sqrt(2), rel=1e-9)
+    validation("Amplitude spectrum of a bin-centred sine", "A / sqrt(2) (scipy's "
+               "test_window_correction)", abs(rms[bin_index] / (amplitude / math.sqrt(2)) - 1),
+               1e-9)
 
 
-def test_sine_amplitude_between_bins_shows_window_scalloping():
+def test_sine_amplitude_between_bins_shows_window_scalloping(validation):
     sample_rate, fft_length, amplitude = 1000.0, 1024, 1.0
     tone = 50.5 * sample_rate / fft_length
     time = np.arange(16 * fft_length) / sample_rate
@@ -121,6 +127,9 @@ def test_sine_amplitude_between_bins_shows_window_scalloping():
     window = signal.get_window("hann", fft_length)
     scalloping = abs(np.sum(window * np.exp(-1j * np.pi * np.arange(fft_length) / fft_length))) / window.sum()
     assert rms[50] == pytest.approx(amplitude / math.sqrt(2) * scalloping, rel=1e-3)
+    validation("Amplitude spectrum of a sine between two bins", "A / sqrt(2) times the Hann "
+               "window's scalloping loss", abs(rms[50] / (amplitude / math.sqrt(2) * scalloping)
+                                              - 1), 1e-3)
 
 
 # ---------------------------------------------------------------- run sizing
@@ -176,7 +185,7 @@ def sdof_curve():
     return frequency, np.abs(sdof_response(frequency))
 
 
-def test_metrics_of_sdof_curve(sdof_curve):
+def test_metrics_of_sdof_curve(sdof_curve, validation):
     frequency, magnitude = sdof_curve
     zeta, step = DAMPING_RATIO, frequency[1]
     metrics = transmissibility_metrics(frequency, magnitude)
@@ -191,17 +200,27 @@ def test_metrics_of_sdof_curve(sdof_curve):
     assert metrics.isolation_onset == pytest.approx(math.sqrt(2) * NATURAL_FREQUENCY, abs=1e-4)
     half_power = optimize.brentq(lambda f: abs(sdof_response(f)) - peak / math.sqrt(2), peak_frequency, 20.0)
     assert metrics.minus_3db_frequency == pytest.approx(half_power, abs=1e-3)
+    validation("Resonance frequency of an SDOF curve", "r = sqrt(sqrt(1 + 8 zeta^2) - 1)/(2 zeta)",
+               abs(metrics.resonance_frequency - peak_frequency), step,
+               measure="absolute error [Hz]")
+    validation("Isolation onset of an SDOF curve", "|T| = 1 at r = sqrt(2), any damping",
+               abs(metrics.isolation_onset - math.sqrt(2) * NATURAL_FREQUENCY), 1e-4,
+               measure="absolute error [Hz]")
+    validation("-3 dB frequency of an SDOF curve", "root of |T| = peak / sqrt(2) (brentq)",
+               abs(metrics.minus_3db_frequency - half_power), 1e-3, measure="absolute error [Hz]")
     for f, value in metrics.at.items():
         assert value == pytest.approx(abs(sdof_response(f)), rel=1e-5)
     assert metrics.untrusted_below == 0.0
 
 
-def test_metrics_roll_off_of_power_laws():
+def test_metrics_roll_off_of_power_laws(validation):
     frequency = np.logspace(-1, 2, 300)
     for exponent in (1, 2, 3):
         metrics = transmissibility_metrics(frequency, frequency**-exponent)
         assert metrics.isolation_onset == pytest.approx(1.0, rel=1e-3)
         assert metrics.rolloff_db_per_decade == pytest.approx(-20.0 * exponent, rel=1e-9)
+        validation(f"Roll-off of T = f^-{exponent}", f"{-20 * exponent} dB/decade",
+                   abs(metrics.rolloff_db_per_decade / (-20.0 * exponent) - 1), 1e-9)
     # default band starts at twice the isolation onset: a -20 dB/decade stretch below it is left out
     broken = np.where(frequency < 2.0, 1.0 / frequency, 0.5 * (frequency / 2.0) ** -3)
     metrics = transmissibility_metrics(frequency, broken)

@@ -1,12 +1,14 @@
 """Analysis of runs and measurements: spectra, transmissibility metrics, linearisation, statistics.
 
-``spectral``    transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
-``linear``      the linearised closed loop at the operating point (python-control)
-``hexapod_linear``  the six-leg platform of isolator legs linearised at its home pose
-``control_design``  static design, Routh-Hurwitz, sampled-loop margins, hunting (describing functions)
+====================  =============================================================================
+``spectral``          transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
+``linear``            the linearised closed loop at the operating point (python-control)
+``hexapod_linear``    the six-leg platform of isolator legs linearised at its home pose
+``control_design``    static design, Routh-Hurwitz, sampled-loop margins, hunting (describing functions)
 ``harmonic_balance``  periodic responses of the smooth model: AFT, continuation, Hill stability
-``statistics``  run statistics (stroke, time locked, motor effort)
-``summary``     the one-screen text summary of a run
+``statistics``        run statistics (stroke, time locked, motor effort)
+``summary``           the one-screen text summary of a run
+====================  =============================================================================
 """
 from qzs._lazy import lazy_exports
 

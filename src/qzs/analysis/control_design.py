@@ -9,12 +9,12 @@ static deficit ``m*g - F_spring(z_ref)`` the PI integral must supply, the motor 
 for control, and the payloads spring and motor can hold.
 
 **Linear stability** (:func:`routh_hurwitz`): the payload slipping at the setpoint, Coulomb
-and Stribeck terms dropped, motor unsaturated, base at rest (docs/model.md §10):
+and Stribeck terms dropped, motor unsaturated, base at rest (docs/model.md §10)::
 
     m*s^2 + Cv*s + k + Kp + Ki/s + Kd*s*HP(s) = 0,        HP(s) = s/(s + w_hp),
 
 with ``k`` the spring's tangent stiffness (about 1.6 N/m: near zero). Cleared of fractions,
-the characteristic polynomial is
+the characteristic polynomial is::
 
     no high-pass (w_hp = 0):  m*s^3 + (Cv + Kd)*s^2 + (k + Kp)*s + Ki
     with it:                  m*s^4 + (m*w + Cv + Kd)*s^3 + (Cv*w + k + Kp)*s^2
@@ -24,7 +24,7 @@ and Routh-Hurwitz gives, besides positive coefficients, ``a2*a1 > a3*a0`` for th
 i.e. ``Ki < (Cv + Kd)*(k + Kp)/m`` (so on a spring of zero stiffness the proportional gain
 must exceed ``m*Ki/(Cv + Kd)``), and for the quartic ``a3*a2 > a4*a1`` and
 ``a3*a2*a1 > a4*a1^2 + a3^2*a0``. The last is a quadratic in ``a3 = m*w + Cv + Kd``: the
-high-pass bounds the damping gain from above as well,
+high-pass bounds the damping gain from above as well::
 
     Kd < a1*(a2 + sqrt(a2^2 - 4*a0*a4))/(2*a0) - m*w - Cv,
 

@@ -856,7 +856,7 @@ class FrequencyResponseCurve:
     relative_range : ndarray, shape (n, 2)
         Least and greatest relative position over the period [m].
     motor_force_peak : ndarray, shape (n,)
-        Largest |unsaturated motor command| over the period [N].
+        Largest absolute unsaturated motor command over the period [N].
     stable : ndarray of bool, shape (n,)
         All Floquet exponents have negative real parts.
     largest_exponent : ndarray, shape (n,)

@@ -1,5 +1,6 @@
 """The engine: numba kernels, the single and lockstep drivers, and the runs built on them.
 
+===============  ==================================================================
 ``arithmetic``   own exp/tanh and explicit fused multiply-adds (no fast-math)
 ``laws``         the force laws, written once as numba functions
 ``base_motion``  the excitation kernels
@@ -12,6 +13,7 @@
 ``results``      :class:`SimulationResult`
 ``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
 ``hexapod``      :func:`simulate_hexapod`, six isolator legs under a rigid platform
+===============  ==================================================================
 """
 from qzs._lazy import lazy_exports
 

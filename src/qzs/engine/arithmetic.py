@@ -111,7 +111,7 @@ def exp(x):
 
 @njit(**_JIT, inline="always")
 def tanh(u):
-    """tanh from one :func:`exp` (exactly +-1 beyond |u| = 20; error below 3e-16).
+    """tanh from one :func:`exp` (exactly +-1 beyond ``|u| = 20``; error below 3e-16).
 
     Parameters
     ----------

@@ -1,5 +1,7 @@
 """The isolator's controller: PI position loop plus active damping (paper Fig. 6).
 
+The control laws::
+
     e       = z_ref - z
     F_pi    = Kp*e + Ki*integral(e)            (anti-windup: the integral is frozen
                                                 while the motor saturates and e pushes

@@ -1,5 +1,6 @@
 """Every figure qzs draws (matplotlib, Agg when there is no display).
 
+====================  ================================================================
 ``figures``           the figure factory, the atomic writer, long-trace envelopes
 ``simulation``        a run's time series and energy ledger
 ``transmissibility``  transmissibility curves as the paper draws them
@@ -8,6 +9,7 @@
 ``sweeps``            sweep stores: metrics against parameters, transmissibility bands
 ``design``            a controller design's figures (``qzs design``)
 ``hexapod``           a hexapod run: platform pose, leg strokes, motor forces
+====================  ================================================================
 """
 from qzs.viz.figures import envelope, new_figure, save_figure
 from qzs.viz.hexapod import plot_hexapod

@@ -4,6 +4,8 @@ import numpy as np
 __all__ = ["envelope", "new_figure", "save_figure"]
 
 _MAX_POINTS = 4000  # per trace: long runs are drawn as a min/max envelope
+#: Prefixes of matplotlib's backends that open windows (and so need a display).
+_WINDOW_BACKENDS = ("gtk", "qt", "tk", "wx", "macosx")
 
 
 def envelope(time, values, max_points=_MAX_POINTS):
@@ -47,7 +49,7 @@ def envelope(time, values, max_points=_MAX_POINTS):
 
 
 def new_figure(rows, height=2.1, sharex=True, width=9.0, height_ratios=None):
-    """A figure of ``rows`` stacked axes (Agg when there is no display).
+    """A figure of ``rows`` stacked axes (Agg for a window backend without a display).
 
     Parameters
     ----------
@@ -71,7 +73,9 @@ def new_figure(rows, height=2.1, sharex=True, width=9.0, height_ratios=None):
     """
     import matplotlib
 
-    if matplotlib.get_backend().lower() not in ("agg", "svg", "pdf") and not _has_display():
+    # A window backend cannot open without a display: draw with Agg instead. Any other
+    # backend is kept, Jupyter's inline and widget backends included (they need no display).
+    if matplotlib.get_backend().lower().startswith(_WINDOW_BACKENDS) and not _has_display():
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -1,5 +1,6 @@
 """Workflows built on the layers below: the paper's studies and report, experiment logs, sweeps.
 
+==============  ==============================================================================
 ``run``         one run streamed to a file as it is simulated (bounded memory)
 ``studies``     the paper's studies as TOML definitions (``study_files/``), run in parallel
 ``report``      ``qzs paper``: figures, metrics, claims decided from the data
@@ -8,4 +9,5 @@
 ``design``      ``qzs design``: PI and damping gains searched by simulation, with the evidence
 ``response``    steady-state frequency response: stepped-sine sweeps up and down, beside the
                 harmonic balance and the paper's chirp estimate
+==============  ==============================================================================
 """
