@@ -127,7 +127,8 @@ def small_sine_ratio(geometry, platform, isolator, controller, axis, frequency, 
 
 
 @pytest.mark.parametrize("axis, frequency", [("z", 1.0), ("z", 3.0), ("rx", 3.0)])
-def test_frictionless_small_motion_matches_the_linear_transmissibility(cubic, axis, frequency):
+def test_frictionless_small_motion_matches_the_linear_transmissibility(cubic, axis, frequency,
+                                                                       validation):
     """Fs = Fc = 0 (viscous friction kept), 0.1 mm or 1 mrad sine: |T| of the nonlinear run
     equals the diagonal entry of ``hexapod_linearize``'s 6x6 transmissibility (preload
     included) within 1e-3.
@@ -145,6 +146,9 @@ def test_frictionless_small_motion_matches_the_linear_transmissibility(cubic, ax
     expected = model.transmissibility(frequency, magnitude=True)[a, a]
     assert abs(ratio / expected - 1) < 1e-3
     assert abs(expected - 1) > 0.1  # a response, not the platform following the base
+    validation(f"Frictionless small sine on the hexapod, {axis} at {frequency:g} Hz",
+               "the linear 6x6 transmissibility (hexapod_linearize)", abs(ratio / expected - 1),
+               1e-3)
 
 
 # ---------------------------------------------------------------- energy
@@ -153,7 +157,7 @@ def _relative_residual(result):
 
 
 @pytest.mark.parametrize("case", ["chirp_z", "all_axes"])
-def test_energy_ledger_closes_at_the_integrators_order(cubic, case):
+def test_energy_ledger_closes_at_the_integrators_order(cubic, case, validation):
     """Base work + motor work = change of kinetic, spring, gravity, stop energy + dissipation.
 
     With stick-slip (and, for ``all_axes``, a base translating and rotating in six axes,
@@ -178,6 +182,9 @@ def test_energy_ledger_closes_at_the_integrators_order(cubic, case):
         residuals.append(_relative_residual(result))
     assert residuals[0] < 1e-7
     assert residuals[0] / residuals[1] > 4
+    validation(f"Hexapod energy ledger ({case})", "energy balance: base + motor work = "
+               "mechanical energy change + dissipation", residuals[0], 1e-7,
+               measure="largest residual / largest |base work|")
 
 
 # ---------------------------------------------------------------- stops
@@ -237,7 +244,7 @@ def vertical_legs(height=0.5):
     (Sine(amplitude=0.01, frequency=4.0), 6.0, IsolatorParameters(stiction_force=4.0,
                                                                   coulomb_force=2.0)),
 ])
-def test_six_vertical_legs_are_six_single_axes(excitation, duration, isolator):
+def test_six_vertical_legs_are_six_single_axes(excitation, duration, isolator, validation):
     """Six identical vertical legs under a platform of 6 m, base motion in z: each leg is
     the single-axis isolator of mass m (docs/model.md), stick-slip events included.
 
@@ -250,10 +257,14 @@ def test_six_vertical_legs_are_six_single_axes(excitation, duration, isolator):
     result = simulate_hexapod(vertical_legs(), platform, isolator,
                               excitation={"z": excitation}, duration=duration)
     assert single.run["stick_events"] >= 1
-    assert np.max(np.abs(result["relative_position"]
-                         - single["relative_position"][:, None])) < 1e-9
+    difference = np.max(np.abs(result["relative_position"]
+                               - single["relative_position"][:, None]))
+    assert difference < 1e-9
     assert np.all(result["locked"] == single["locked"][:, None])
     assert result.run["stick_events"] == [single.run["stick_events"]] * 6
+    validation(f"Six vertical legs under a platform of six masses, {type(excitation).__name__}",
+               "the single axis (qzs.simulate), stick-slip events included", difference, 1e-9,
+               measure="largest leg position difference [m]")
     assert np.max(np.abs(result["platform_pose"][:, [0, 1, 3, 4, 5]])) < 1e-12
 
 

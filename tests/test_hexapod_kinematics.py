@@ -73,11 +73,16 @@ def test_angular_velocity_matrix_gives_the_base_frame_angular_velocity():
 
 # ---------------------------------------------------------------- kinematics
 @pytest.mark.parametrize("name", GEOMETRIES)
-def test_forward_kinematics_inverts_inverse_kinematics(name):
+def test_forward_kinematics_inverts_inverse_kinematics(name, validation):
     geometry = GEOMETRIES[name]
+    worst = 0.0
     for pose in random_poses(1):
         found = forward_kinematics(geometry, inverse_kinematics(geometry, pose))
         np.testing.assert_allclose(found, pose, rtol=0, atol=1e-12)
+        worst = max(worst, float(np.max(np.abs(found - pose))))
+    validation(f"Forward kinematics (Newton) after inverse kinematics, {name} geometry",
+               "the pose itself (round trip)", worst, 1e-12,
+               measure="largest pose error [m, rad]")
 
 
 def test_inverse_kinematics_is_the_joint_distance():

@@ -41,7 +41,7 @@ def shift(point):
 
 # ---------------------------------------------------------------- stiffness
 @pytest.mark.parametrize("radii", [(None, None), (0.16, 0.13), (0.2, 0.11)])
-def test_cubic_stiffness_at_the_cube_centre_is_the_published_diagonal(radii):
+def test_cubic_stiffness_at_the_cube_centre_is_the_published_diagonal(radii, validation):
     geometry = cubic_geometry(cube_edge=EDGE, cube_center_height=0.2, base_radius=radii[0],
                               top_radius=radii[1])
     k, a = 1234.5, EDGE
@@ -51,6 +51,10 @@ def test_cubic_stiffness_at_the_cube_centre_is_the_published_diagonal(radii):
     np.testing.assert_allclose(model.stiffness_matrix, expected, rtol=0, atol=1e-12 * k)
     np.testing.assert_allclose(model.geometric_stiffness_matrix, 0)
     np.testing.assert_allclose(model.base_stiffness_matrix, -expected, atol=1e-12 * k)
+    validation(f"Cubic hexapod stiffness at the cube's centre, joint radii {radii}",
+               "k diag(2, 2, 2, a^2/2, a^2/2, 2 a^2) (cubic configuration, Preumont)",
+               np.max(np.abs(model.stiffness_matrix - expected)) / k, 1e-12,
+               measure="largest |K - closed form| / k")
 
 
 def test_cubic_stiffness_off_the_centre_couples_translation_and_rotation():
@@ -105,7 +109,7 @@ def nonlinear_wrench(geometry, platform, point, forces, stiffness, q, q_base):
 @pytest.mark.parametrize("geometry, frame", [(CUBE, "center_of_mass"), (RADIAL, "origin"),
                                              (RADIAL, (0.03, 0.02, -0.04))],
                          ids=["cubic-com", "radial-origin", "radial-point"])
-def test_stiffness_with_preload_against_the_exact_nonlinear_wrench(geometry, frame):
+def test_stiffness_with_preload_against_the_exact_nonlinear_wrench(geometry, frame, validation):
     """Both the platform and the base stiffness, geometric terms included."""
     k = np.array([900.0, 1100.0, 1000.0, 1200.0, 950.0, 1050.0])
     model = hexapod_linearize(geometry, OFFSET, leg_stiffness=k, frame=frame)
@@ -130,6 +134,10 @@ def test_stiffness_with_preload_against_the_exact_nonlinear_wrench(geometry, fra
     np.testing.assert_allclose(model.stiffness_matrix, model.stiffness_matrix.T,
                                atol=1e-12 * scale)
     assert np.max(np.abs(model.geometric_stiffness_matrix)) > 1e-3 * scale  # not vacuous
+    validation(f"Hexapod stiffness with preload ({'cubic' if geometry is CUBE else 'radial'}, "
+               f"frame {frame})", "central differences of the exact nonlinear wrench",
+               np.max(np.abs(model.stiffness_matrix - platform_fd)) / scale, 1e-8,
+               measure="largest |K - finite differences| / largest |K|")
 
 
 def test_base_coupling_in_the_rigid_body_limits():
@@ -171,7 +179,7 @@ def test_preload_of_compressed_legs_is_a_negative_stiffness_of_order_f_over_l():
     np.testing.assert_allclose(geometric_stiffness(geometry, weightless)[0], 0)
 
 
-def test_cubic_static_stability_threshold_is_three_f_over_a():
+def test_cubic_static_stability_threshold_is_three_f_over_a(validation):
     """Joints at the vertices, centre of mass at the cube's centre, equal legs: the
     horizontal translation couples with the tilt through the preload, ``K_g[x, ry] =
     -m g/2 = -sqrt(3) f`` (no preload term in tilt itself), and
@@ -180,10 +188,12 @@ def test_cubic_static_stability_threshold_is_three_f_over_a():
     geometry = cubic_geometry(cube_edge=EDGE, cube_center_height=0.2)
     platform = PlatformParameters(mass=20.0, inertia=np.diag([0.2, 0.3, 0.4]))
     f = platform.mass * platform.gravity * np.sqrt(3) / 6
-    np.testing.assert_allclose(
-        hexapod_linearize(geometry, platform, leg_stiffness=1.0,
-                          frame="origin").geometric_stiffness_matrix[0, 4],
-        -np.sqrt(3) * f, rtol=1e-12)
+    coupling = hexapod_linearize(geometry, platform, leg_stiffness=1.0,
+                                 frame="origin").geometric_stiffness_matrix[0, 4]
+    np.testing.assert_allclose(coupling, -np.sqrt(3) * f, rtol=1e-12)
+    validation("Preload coupling of translation and tilt, cubic hexapod",
+               "K_g[x, ry] = -sqrt(3) f (stability threshold k = 3 f/a)",
+               abs(coupling / (-np.sqrt(3) * f) - 1), 1e-12)
     np.testing.assert_allclose(geometric_stiffness(geometry, platform)[0][3:, 3:], 0,
                                atol=1e-12)
     for factor, stable in ((1 - 1e-6, False), (1 + 1e-6, True)):
@@ -303,7 +313,7 @@ def test_high_frequency_roll_off_is_the_viscous_one():
     ControllerParameters(pi_kp=10.0, pi_ki=0.0, damping_gain=30.0),
     ControllerParameters(pi_kp=80.0, pi_ki=5.0, damping_gain=60.0, velocity_highpass=0.0),
 ], ids=["default", "damping", "no-highpass"])
-def test_decoupled_axes_are_single_axis_isolators(controller):
+def test_decoupled_axes_are_single_axis_isolators(controller, validation):
     """Cubic, centre of mass at the cube centre, isotropic inertia, no preload: every
     matrix is ``kappa_j * (per-leg value)`` on the diagonal with ``kappa = (2, 2, 2,
     a^2/2, a^2/2, 2 a^2)``, so axis ``j`` is the single-axis isolator of mass
@@ -316,12 +326,14 @@ def test_decoupled_axes_are_single_axis_isolators(controller):
     f = np.logspace(-2, 1.5, 25)
     response = model.transmissibility(f)
     kappa = np.array([2, 2, 2, a ** 2 / 2, a ** 2 / 2, 2 * a ** 2])
+    worst = 0.0
     for j in range(6):
         equivalent = IsolatorParameters(mass=model.mass_matrix[j, j] / kappa[j],
                                         viscous_damping=60.0)
         single = linearize(equivalent, controller)
         expected = single.transfer_function(2j * np.pi * f)
         np.testing.assert_allclose(response[:, j, j], expected, rtol=1e-9)
+        worst = max(worst, float(np.max(np.abs(response[:, j, j] / expected - 1))))
         off = np.delete(response[:, j, :], j, axis=1)
         assert np.max(np.abs(off)) < 1e-12
     assert model.mass_matrix[2, 2] / kappa[2] == mass / 2
@@ -329,6 +341,8 @@ def test_decoupled_axes_are_single_axis_isolators(controller):
     expected = [linearize(IsolatorParameters(mass=model.mass_matrix[j, j] / kappa[j]),
                           controller).undamped_natural_frequency for j in range(6)]
     np.testing.assert_allclose(model.natural_frequencies, np.sort(expected), rtol=1e-12)
+    validation(f"Decoupled cubic hexapod axes as single-axis isolators ({controller})",
+               "the single axis's linearize with mass M_jj/kappa_j", worst, 1e-9)
 
 
 # ---------------------------------------------------------------- inputs and helpers
