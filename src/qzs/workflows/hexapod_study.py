@@ -46,6 +46,7 @@ from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod_transmissibility import AXES, entry_unit, hexapod_transmissibility
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
+           "comparison_figure",
            "write_study_outputs"]
 
 #: The study's cases: label -> (what it means, registry overrides of every leg's loop).
@@ -113,6 +114,20 @@ class HexapodStudyResult:
         str
         """
         return _summary_text(self)
+
+    def plot(self, out=None):
+        """The comparison figure of the cases (:func:`comparison_figure`).
+
+        Parameters
+        ----------
+        out : str or Path, optional
+            Write the figure there.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        return comparison_figure(self.cases, out=out)
 
 
 # ---------------------------------------------------------------- metrics
@@ -424,42 +439,23 @@ def _json_ready(value):
     return value
 
 
-def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seconds=None):
-    """Write the figures, matrices, ``metrics.csv``, ``metrics.json`` and ``report.md``.
+def comparison_figure(cases, out=None):
+    """The study's comparison figure: the direct and coupled entries of every case.
 
     Parameters
     ----------
     cases : mapping
-        Case label -> HexapodTransmissibility.
-    rows : sequence of dict
-        The metrics rows.
-    findings : sequence of str
-        The findings' sentences.
-    folder : str or Path
-        Output folder, created if missing.
-    quick : bool
-        Whether the runs were the quick ones.
-    wall_seconds : float, optional
-        Wall time of the runs [s].
+        Case label -> :class:`~qzs.workflows.hexapod_transmissibility.HexapodTransmissibility`
+        (:attr:`HexapodStudyResult.cases`), the first the reference (PI).
+    out : str or Path, optional
+        Write the figure there (PNG and SVG beside it).
 
     Returns
     -------
-    dict
-        Name -> path of every file written.
+    matplotlib.figure.Figure
     """
-    import matplotlib.pyplot as plt
-
     from qzs.viz.hexapod_study import plot_study_comparison
 
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    files = {}
-    for label, result in cases.items():
-        name = f"hexapod_matrix_{_slug(label)}"
-        figure = result.plot(out=folder / f"{name}.png")
-        plt.close(figure)
-        files[f"{name}.png"] = folder / f"{name}.png"
-        files[f"{name}.nc"] = result.save(folder / f"{name}.nc")
     first = next(iter(cases.values()))
     entries = []
     for axis in STUDY_AXES:
@@ -487,8 +483,45 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
                f"{settings['duration']:g} s each\n"
                "solid: trusted bins; faint: untrusted; dashed: linear model (stable loops "
                "only); grey: the sweep's start, untrusted"),
-        out=folder / f"{_FIGURE_COMPARISON}.png")
-    plt.close(figure)
+        out=out)
+    return figure
+
+
+def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seconds=None):
+    """Write the figures, matrices, ``metrics.csv``, ``metrics.json`` and ``report.md``.
+
+    Parameters
+    ----------
+    cases : mapping
+        Case label -> HexapodTransmissibility.
+    rows : sequence of dict
+        The metrics rows.
+    findings : sequence of str
+        The findings' sentences.
+    folder : str or Path
+        Output folder, created if missing.
+    quick : bool
+        Whether the runs were the quick ones.
+    wall_seconds : float, optional
+        Wall time of the runs [s].
+
+    Returns
+    -------
+    dict
+        Name -> path of every file written.
+    """
+    import matplotlib.pyplot as plt
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    files = {}
+    for label, result in cases.items():
+        name = f"hexapod_matrix_{_slug(label)}"
+        figure = result.plot(out=folder / f"{name}.png")
+        plt.close(figure)
+        files[f"{name}.png"] = folder / f"{name}.png"
+        files[f"{name}.nc"] = result.save(folder / f"{name}.nc")
+    plt.close(comparison_figure(cases, out=folder / f"{_FIGURE_COMPARISON}.png"))
     files[f"{_FIGURE_COMPARISON}.png"] = folder / f"{_FIGURE_COMPARISON}.png"
     files[f"{_FIGURE_COMPARISON}.svg"] = folder / f"{_FIGURE_COMPARISON}.svg"
 
