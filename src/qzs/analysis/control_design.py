@@ -77,8 +77,8 @@ import numpy as np
 
 from qzs.analysis.linear import loop_constants
 from qzs.errors import ParameterError
-from qzs.model.controller import ControllerParameters
-from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.model.isolator import spring_force
+from qzs.model.registry import model_inputs
 
 __all__ = ["StaticDesign", "static_design", "characteristic_polynomial", "RouthHurwitz",
            "routh_hurwitz", "integral_gain_limit", "damping_gain_limits",
@@ -98,18 +98,6 @@ PHASE_MARGIN_MIN = 30.0
 SLIP_JUMP_FLOOR = 1e-4
 #: Order of the Padé approximant of a delay in a continuous loop [-].
 PADE_ORDER = 6
-
-
-def _inputs(isolator, controller):
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
-    if not isinstance(isolator, IsolatorParameters):
-        raise ParameterError(f"`isolator` must be an IsolatorParameters, got "
-                             f"{type(isolator).__name__}.")
-    if not isinstance(controller, ControllerParameters):
-        raise ParameterError(f"`controller` must be a ControllerParameters, got "
-                             f"{type(controller).__name__}.")
-    return isolator, controller
 
 
 def _number(name, value, *, minimum=0.0, strict=False, fix=""):
@@ -230,7 +218,7 @@ def constant_force_band(isolator=None, controller=None):
     ParameterError
         The setpoint lies above the edge, outside the constant-force region.
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     edge = isolator.constant_force_edge
     setpoint = controller.position_setpoint
     if setpoint >= edge:
@@ -257,7 +245,7 @@ def static_design(isolator=None, controller=None, *, mass_range=None):
     -------
     StaticDesign
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     z_ref = controller.position_setpoint
     lifted = float(spring_force(z_ref, isolator))
     g = isolator.gravity
@@ -328,7 +316,7 @@ def characteristic_polynomial(isolator=None, controller=None, relative_position=
     list of float
         Coefficients in SI units (``kg`` for the highest power).
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     return _coefficients(*loop_constants(isolator, controller, relative_position))
 
 
@@ -452,7 +440,7 @@ def integral_gain_limit(isolator=None, controller=None, relative_position=None):
     float
         The limit [N/(m*s)]; 0 when no positive ``Ki`` is stable.
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not (w > 0 and kd > 0):
@@ -492,7 +480,7 @@ def damping_gain_limits(isolator=None, controller=None, relative_position=None):
         ``(low, high)`` [N*s/m]; ``high`` is ``inf`` without an upper bound; ``(nan, nan)``
         when no damping gain is stable.
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, ki, _, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not w > 0 or ki == 0:
@@ -553,7 +541,7 @@ def routh_hurwitz(isolator=None, controller=None, relative_position=None):
     -------
     RouthHurwitz
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     numbers = loop_constants(isolator, controller, relative_position)
     a = _coefficients(*numbers)
     conditions = tuple((text, float(value), bool(value > 0))
@@ -610,7 +598,7 @@ def loop_transfer(isolator=None, controller=None, relative_position=None, *, del
     """
     import control
 
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     delay = _number("delay", delay)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
@@ -744,7 +732,7 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
     """
     import control
 
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
     rate = _number("rate", rate, strict=True,
                    fix="; a sampled loop needs a controller rate in Hz")
@@ -925,7 +913,7 @@ def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_
     -------
     LoopMargins
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
     rate = _number("rate", rate)
     delay = _number("delay", delay)
@@ -1034,7 +1022,7 @@ def required_controller_rate(isolator=None, controller=None, delay=0.0, *,
     reason : str
         Why NaN ('' otherwise).
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     low, high = _range("rate_range", rate_range, "Hz", minimum=1e-9)
     delay = _number("delay", delay)
 
@@ -1093,7 +1081,7 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     ndarray
         Amplitude ratio [-].
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
     rate = _number("rate", rate)
     delay = _number("delay", delay)
@@ -1187,7 +1175,7 @@ def friction_describing_function(isolator=None, amplitude=None, *, points=4096):
     """
     import control
 
-    isolator, _ = _inputs(isolator, None)
+    isolator, _ = model_inputs(isolator, None)
     if amplitude is None:
         raise ParameterError("`amplitude` is required: the slip-velocity amplitudes in m/s.")
     law = FrictionNonlinearity(isolator.stiction_force, isolator.coulomb_force,
@@ -1213,7 +1201,7 @@ def restick_force(isolator=None):
     float
         ``F_r`` [N].
     """
-    isolator, _ = _inputs(isolator, None)
+    isolator, _ = model_inputs(isolator, None)
     fs, fc = isolator.stiction_force, isolator.coulomb_force
     cbc, cv = isolator.stribeck_decay, isolator.viscous_damping
     drop = cbc * (fs - fc)
@@ -1258,7 +1246,7 @@ def slip_jump(isolator=None, controller=None, relative_position=None):
     """
     from scipy.integrate import solve_ivp
 
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     fs, fc, cbc = isolator.stiction_force, isolator.coulomb_force, isolator.stribeck_decay
     k_total = k + kp
@@ -1390,7 +1378,7 @@ def integral_loop(isolator=None, controller=None, relative_position=None):
     """
     import control
 
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
     return control.minreal(control.tf(ki / (s * _fast_denominator(m, cv, k + kp, kd, w))),
@@ -1417,7 +1405,7 @@ def hunting_stiffness(isolator=None, controller=None, half_width=None):
     float
         The least ``Kp`` [N/m] (0 if no slip jump even at ``Kp = 0``; NaN above 1e5 N/m).
     """
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     half_width = _number("half_width", half_width, strict=True)
 
     def plateau(kp):
@@ -1464,7 +1452,7 @@ def predict_hunting(isolator=None, controller=None, relative_position=None):
 
     import control
 
-    isolator, controller = _inputs(isolator, controller)
+    isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     k_total = k + kp
     reasons = {}

@@ -44,8 +44,7 @@ import numpy as np
 
 from qzs._validation import integer, non_negative, positive
 from qzs.errors import ParameterError
-from qzs.model.controller import ControllerParameters
-from qzs.model.isolator import IsolatorParameters
+from qzs.model.registry import model_inputs
 
 __all__ = ["SmoothModel", "HarmonicBalanceSolution", "FrequencyResponseCurve",
            "periodic_response", "frequency_response_curve", "floquet_exponents",
@@ -168,14 +167,7 @@ class SmoothModel:
         -------
         SmoothModel
         """
-        isolator = IsolatorParameters() if isolator is None else isolator
-        controller = ControllerParameters() if controller is None else controller
-        if not isinstance(isolator, IsolatorParameters):
-            raise ParameterError(f"`isolator` must be an IsolatorParameters, got "
-                                 f"{type(isolator).__name__}.")
-        if not isinstance(controller, ControllerParameters):
-            raise ParameterError(f"`controller` must be a ControllerParameters, got "
-                                 f"{type(controller).__name__}.")
+        isolator, controller = model_inputs(isolator, controller)
         center = (controller.position_setpoint if isolator.stop_center is None
                   else isolator.stop_center)
         return cls(mass=isolator.mass, gravity=isolator.gravity,

@@ -12,6 +12,7 @@ from qzs.errors import ParameterError, StabilityError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.isolator import InitialState, IsolatorParameters
+from qzs.model.registry import model_inputs
 
 __all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample", "chunk_steps",
            "divergence_message"]
@@ -107,13 +108,9 @@ def run_inputs(excitation=None, isolator=None, controller=None):
     ParameterError
         An argument of another type.
     """
-    inputs = (Chirp() if excitation is None else excitation,
-              IsolatorParameters() if isolator is None else isolator,
-              ControllerParameters() if controller is None else controller)
-    for name, value, kinds in zip(("excitation", "isolator", "controller"), inputs,
-                                  (_EXCITATIONS, (IsolatorParameters,), (ControllerParameters,))):
-        _check_type(name, value, kinds)
-    return inputs
+    excitation = Chirp() if excitation is None else excitation
+    _check_type("excitation", excitation, _EXCITATIONS)
+    return (excitation, *model_inputs(isolator, controller))
 
 
 def _check_type(name, value, kinds):

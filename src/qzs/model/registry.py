@@ -19,6 +19,7 @@ from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_fi
 from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "EXCITATION_PARAMETERS", "parameter_info",
+           "model_inputs",
            "unit_of",
            "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
            "format_value"]
@@ -215,3 +216,34 @@ def format_value(value):
     if isinstance(value, float) and math.isfinite(value):
         return f"{value:g}"
     return str(value)
+
+
+def model_inputs(isolator=None, controller=None):
+    """The plant and loops of a computation, Table 1's and the default loops for None.
+
+    The one place every API function puts in these defaults and checks their types.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; default Table 1.
+    controller : ControllerParameters, optional
+        PI and damping loops; default the defaults.
+
+    Returns
+    -------
+    isolator, controller
+
+    Raises
+    ------
+    ParameterError
+        An argument of another type (names it and what it got).
+    """
+    isolator = IsolatorParameters() if isolator is None else isolator
+    controller = ControllerParameters() if controller is None else controller
+    for name, value, kind in (("isolator", isolator, IsolatorParameters),
+                              ("controller", controller, ControllerParameters)):
+        if not isinstance(value, kind):
+            raise ParameterError(f"`{name}` must be a {kind.__name__}, got "
+                                 f"{type(value).__name__}.")
+    return isolator, controller

@@ -61,6 +61,7 @@ from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.isolator import InitialState, IsolatorParameters, spring_force, spring_stiffness
+from qzs.model.registry import model_inputs
 
 __all__ = ["DesignCase", "DesignResult", "design_controller", "COSTS", "FAMILIES",
            "transmissibility_cost", "design_text"]
@@ -1148,14 +1149,7 @@ def design_controller(isolator=None, controller=None, *, excitation=None, sticti
         A bad argument, before any simulation.
     """
     began = time.perf_counter()
-    isolator = IsolatorParameters() if isolator is None else isolator
-    controller = ControllerParameters() if controller is None else controller
-    if not isinstance(isolator, IsolatorParameters):
-        raise ParameterError(f"`isolator` must be an IsolatorParameters, got "
-                             f"{type(isolator).__name__}.")
-    if not isinstance(controller, ControllerParameters):
-        raise ParameterError(f"`controller` must be a ControllerParameters, got "
-                             f"{type(controller).__name__}.")
+    isolator, controller = model_inputs(isolator, controller)
     if controller.pi_kp <= 0 or controller.pi_ki <= 0:
         raise ParameterError(
             f"the search keeps the controller's ratio Ki/Kp; `pi_kp` ({controller.pi_kp:g} N/m) "
