@@ -58,12 +58,12 @@ from qzs._validation import choice, positive
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
-from qzs.engine.kernels import PHASE_PERIOD, n_stages, tableau
+from qzs.engine.kernels import PHASE_PERIOD, illinois_step, n_stages, tableau
 from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
                              spring_energy_law, spring_law)
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
-from qzs.engine.simulate import PREVIEW_SAMPLES, _DeferredInterrupt
+from qzs.engine.simulate import PREVIEW_SAMPLES, _available_memory, _DeferredInterrupt
 from qzs.errors import CaseError, ParameterError, SimulationError, StabilityError, Terminated
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
@@ -863,19 +863,9 @@ def _locate(solver, leg, t, h, s, k1, g0, g1, buf, plat, ex, tables, toff, ww, V
         _rk(solver, t, at, s, k1, trial, buf, plat, ex, tables, toff, ww, V, A, idx, vec)
         _evaluate(t + at, trial, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KT], _FALSE)
         g = V[V_EV + leg]
-        if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
+        done, at, lo, hi, g_lo, g_hi, side = illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi, side)
+        if done:
             break
-        if g > 0.0:
-            lo, g_lo = at, g
-            if side == 1:
-                g_hi *= 0.5
-            side = 1
-        else:
-            hi, g_hi = at, g
-            if side == -1:
-                g_lo *= 0.5
-            side = -1
-        at = lo + (hi - lo) * g_lo / (g_lo - g_hi)
     return at
 
 
@@ -1423,17 +1413,6 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     return _Prepared(geometry, platform, isolators, controllers, moving, duration, dt,
                      sample_rate, decimation, solver, solver_code, V, plat, ex, tables, toff,
                      state, cartesian)
-
-
-def _available_memory():
-    try:
-        with open("/proc/meminfo", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
 
 
 def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, excitation=None,

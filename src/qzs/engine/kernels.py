@@ -405,6 +405,37 @@ def _rk(solver, t, h, s, mode, direction, held, P, E, table):
 
 
 @njit(**_JIT)
+def illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi, side):
+    """One step of regula falsi (Illinois) on an event function ``g`` > 0 before the event.
+
+    ``g`` is the value at the trial time ``at`` in the bracket ``[lo, hi]`` (values ``g_lo``
+    > 0 and ``g_hi`` <= 0) of a step of length ``h`` whose event function started at ``g0``;
+    ``side`` is the side the last trial fell on (0 at first). Converged when ``|g|`` is
+    below 1e-15 of ``|g0|`` or the bracket below 1e-12 of ``h``; otherwise the bracket is
+    narrowed, the retained end's value halved when the same side is kept twice (Illinois),
+    and the next trial time is returned. Every driver's event location goes through it.
+
+    Returns
+    -------
+    tuple
+        ``(converged, at, lo, hi, g_lo, g_hi, side)``.
+    """
+    if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
+        return True, at, lo, hi, g_lo, g_hi, side
+    if g > 0.0:
+        lo, g_lo = at, g
+        if side == 1:
+            g_hi *= 0.5
+        side = 1
+    else:
+        hi, g_hi = at, g
+        if side == -1:
+            g_lo *= 0.5
+        side = -1
+    return False, lo + (hi - lo) * g_lo / (g_lo - g_hi), lo, hi, g_lo, g_hi, side
+
+
+@njit(**_JIT)
 def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table):
     """Refine an event inside ``[t, t + h]`` by regula falsi (Illinois) on its function.
 
@@ -421,19 +452,9 @@ def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, tab
     for _ in range(6):
         state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table)
         g = _event_value(event, t + at, state, mode, direction, held, P, E, table)
-        if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
+        done, at, lo, hi, g_lo, g_hi, side = illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi, side)
+        if done:
             break
-        if g > 0.0:
-            lo, g_lo = at, g
-            if side == 1:
-                g_hi *= 0.5
-            side = 1
-        else:
-            hi, g_hi = at, g
-            if side == -1:
-                g_lo *= 0.5
-            side = -1
-        at = lo + (hi - lo) * g_lo / (g_lo - g_hi)
     return at, state
 
 
