@@ -1654,7 +1654,7 @@ def simulate_hexapods(runs, *, workers=None, progress=False):
         if unknown or "geometry" not in arguments or "platform" not in arguments:
             raise ParameterError(f"`runs[{i}]` needs `geometry` and `platform` and may have "
                                  f"{list(names[2:])}; got {sorted(arguments)}.")
-        try:  # every run checked (and packed once, cheaply) before any integration
+        try:  # every run checked before any integration (it packs again when it starts: cheap)
             _prepare(arguments["geometry"], arguments["platform"], arguments.get("isolator"),
                      arguments.get("controller"), arguments.get("excitation"),
                      arguments.get("duration"),
