@@ -55,6 +55,7 @@ from numba import njit
 
 from qzs import defaults
 from qzs._validation import choice, positive
+from qzs.analysis.statistics import RunStatistics
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
@@ -2015,11 +2016,8 @@ class _Statistics:
     """
 
     def __init__(self, centers):
-        self._centers = np.asarray(centers, dtype=float)
+        self._legs = RunStatistics(centers)  # the single axis's statistics, a leg per case
         self._rows = 0
-        self._stroke = np.zeros(LEG_COUNT)
-        self._locked = np.zeros(LEG_COUNT)
-        self._motor_square = np.zeros(LEG_COUNT)
         self._motor_max = np.zeros(LEG_COUNT)
         self._translation = self._rotation = 0.0
         self._residual = self._base_work = 0.0
@@ -2029,11 +2027,9 @@ class _Statistics:
         """Absorb output rows ``block`` (``N_CHANNELS`` columns) and their ``flags``."""
         if block.shape[0] == 0:
             return
-        z = block[:, C_Z:C_Z + LEG_COUNT]
         motor = block[:, C_FMO:C_FMO + LEG_COUNT]
-        self._stroke = np.maximum(self._stroke, np.max(np.abs(z - self._centers), axis=0))
-        self._locked += np.sum(flags[:, O_LOCKED:O_LOCKED + LEG_COUNT], axis=0)
-        self._motor_square += np.sum(motor ** 2, axis=0)
+        self._legs.add(block[:, C_Z:C_Z + LEG_COUNT].T, motor.T,
+                       flags[:, O_LOCKED:O_LOCKED + LEG_COUNT].T)
         self._motor_max = np.maximum(self._motor_max, np.max(np.abs(motor), axis=0))
         pose = block[:, C_POSE:C_POSE + 6] - block[:, C_BASE_POSE:C_BASE_POSE + 6]
         self._translation = max(self._translation, float(np.max(np.abs(pose[:, :3]))))
@@ -2049,10 +2045,10 @@ class _Statistics:
 
     def result(self):
         """The statistics as a dict of floats and per-leg lists, with their units in the keys."""
-        rows = max(self._rows, 1)
-        return {"samples": self._rows, "stroke_used_m": self._stroke.tolist(),
-                "locked_share": (self._locked / rows).tolist(),
-                "motor_rms_N": np.sqrt(self._motor_square / rows).tolist(),
+        legs = self._legs.result()
+        return {"samples": self._rows, "stroke_used_m": legs["peak_stroke"].tolist(),
+                "locked_share": legs["locked_fraction"].tolist(),
+                "motor_rms_N": legs["motor_force_rms"].tolist(),
                 "motor_max_N": self._motor_max.tolist(),
                 "relative_translation_max_m": self._translation,
                 "relative_rotation_max_rad": self._rotation,
