@@ -73,8 +73,8 @@ from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import unit_of
 
-__all__ = ["simulate_hexapod", "simulate_hexapods", "HexapodResult", "AXES", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS",
-           "hexapod_file_layout"]
+__all__ = ["simulate_hexapod", "simulate_hexapods", "hexapod_stability_test", "HexapodResult",
+           "AXES", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_file_layout"]
 
 #: The six axes of a pose, in order: translations [m], then rotation angles [rad].
 AXES = ("x", "y", "z", "rx", "ry", "rz")
@@ -1226,6 +1226,41 @@ def _static_forces(geometry, platform):
         return np.linalg.lstsq(jacobian(geometry).T, weight_wrench(platform), rcond=None)[0]
 
 
+def hexapod_stability_test(geometry, platform, isolator=None, controller=None,
+                           solver=defaults.SIMULATION["solver"]):
+    """``stable(dt)``: does a step ``dt`` [s] integrate every leg stably (docs/hexapod.md §9.7)?
+
+    Each leg's stiff modes (its stop contact, its loops) acting on the lightest mass the
+    legs move, ``1/max eig(G M^-1 G^T)``, by the single axis's test
+    (:func:`qzs.engine.stability.stability_test`); what :func:`simulate_hexapod` checks.
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        The platform's joints.
+    platform : PlatformParameters
+        Mass and inertia of the moving platform.
+    isolator, controller : IsolatorParameters, ControllerParameters or sequences of six
+        The legs; defaults if omitted.
+    solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator.
+
+    Returns
+    -------
+    callable
+        ``stable(dt) -> bool``.
+    """
+    isolators = _per_leg("isolator", IsolatorParameters() if isolator is None else isolator,
+                         IsolatorParameters)
+    controllers = _per_leg("controller",
+                           ControllerParameters() if controller is None else controller,
+                           ControllerParameters)
+    mass = _effective_leg_mass(geometry, platform)
+    tests = [stability_test(replace(iso, mass=mass), con, solver)
+             for iso, con in zip(isolators, controllers)]
+    return lambda dt: all(test(dt) for test in tests)
+
+
 def _effective_leg_mass(geometry, platform):
     """``1/max eig(G M^-1 G^T)`` [kg]: the lightest mass a leg (or all legs at once) moves."""
     arms = geometry.top_joints - platform.center_of_mass
@@ -1329,17 +1364,15 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
         raise ParameterError(
             f"`cartesian` must be a CartesianController (e.g. CartesianController.from_legs("
             f"geometry, controller)) or None for per-leg loops, got {type(cartesian).__name__}.")
-    mass = _effective_leg_mass(geometry, platform)
-    for iso, con in zip(isolators, controllers):
-        light = replace(iso, mass=mass)
-        if not stability_test(light, con, solver)(dt):
-            limit = min(largest_stable_step(replace(i, mass=mass), c, solver)
-                        for i, c in zip(isolators, controllers))
-            raise StabilityError(
-                f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this hexapod "
-                f"(stiffest mode: a leg's stop contact or loop acting on the {mass:.3g} kg the "
-                f"legs move at least); the largest stable step is {limit:.3g} s. Reduce `dt`, "
-                "or soften `stop_stiffness`.")
+    if not hexapod_stability_test(geometry, platform, isolators, controllers, solver)(dt):
+        mass = _effective_leg_mass(geometry, platform)
+        limit = min(largest_stable_step(replace(i, mass=mass), c, solver)
+                    for i, c in zip(isolators, controllers))
+        raise StabilityError(
+            f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this hexapod "
+            f"(stiffest mode: a leg's stop contact or loop acting on the {mass:.3g} kg the "
+            f"legs move at least); the largest stable step is {limit:.3g} s. Reduce `dt`, "
+            "or soften `stop_stiffness`.")
 
     V = np.zeros(N_ROWS * LANES)
     for i, (iso, con) in enumerate(zip(isolators, controllers)):

@@ -38,7 +38,7 @@ shrink), the run takes the set-up's ``dt`` and its record says why.
 import math
 import os
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 
@@ -328,24 +328,12 @@ def _optional_positive(name, value):
     return None if value is None else positive(name, value)
 
 
-def _effective_leg_mass(setup):
-    """``1/max eig(G M^-1 G^T)`` [kg], the lightest mass a leg moves (docs/hexapod.md §9.7)."""
-    from qzs.model.hexapod import jacobian
-
-    platform = setup.platform
-    rows = jacobian(setup.geometry, point=np.asarray(platform.center_of_mass, dtype=float))
-    inverse = np.zeros((6, 6))
-    inverse[:3, :3] = np.eye(3) / platform.mass
-    inverse[3:, 3:] = np.linalg.inv(np.asarray(platform.inertia, dtype=float))
-    return 1.0 / float(np.max(np.linalg.eigvalsh(rows @ inverse @ rows.T)))
-
-
 def _stable(setup, controller, solver):
-    """``stable(dt)`` of every leg on the lightest mass the legs move (the engine's check)."""
-    from qzs.engine.stability import stability_test
+    """``stable(dt)`` of the set-up's legs, the engine's own check."""
+    from qzs.engine.hexapod import hexapod_stability_test
 
-    light = replace(setup.isolator, mass=_effective_leg_mass(setup))
-    return stability_test(light, controller, solver)
+    return hexapod_stability_test(setup.geometry, setup.platform, setup.isolator, controller,
+                                  solver)
 
 
 def _default_fft_length(n_samples, longest=defaults.ANALYSIS["fft_length"]):
