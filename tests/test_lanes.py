@@ -1,6 +1,7 @@
 """The lockstep driver: every lane gives the one-case driver's numbers, bit for bit."""
 import numpy as np
 import pytest
+from helpers import linear_controller, linear_isolator
 from numba import njit
 
 import qzs
@@ -55,6 +56,26 @@ def test_a_lane_does_not_depend_on_its_neighbours():
                               sample_rate=500.0, channels=("relative_position",), workers=1)
     assert np.array_equal(shuffled.channels["relative_position"],
                           straight.channels["relative_position"][order])
+
+
+@pytest.mark.parametrize("count", [3, 5, 7, 11])
+def test_padded_calls_give_every_lane_its_single_run(count):
+    """Calls whose lanes are not a multiple of LANE_BLOCK run padded with frozen copies of
+    lane 0 (a failed one first, here, so the copies are of a lane that stops early)."""
+    assert count % _lanes.LANE_BLOCK >= _lanes.PAD_FROM  # padded
+    unstable = (linear_isolator(stiffness=1e-9, damping=100.0, stroke_half=1.0,
+                                motor_force_max=1e12),
+                linear_controller(pi_kp=1e6, controller_rate=100.0))
+    cases = [unstable, *CASES[:count - 1]]
+    batch = simulate_batch(cases, EXCITATION, duration=2.0, sample_rate=500.0,
+                           channels=("relative_position", "motor_force"), workers=1)
+    for index, (isolator, controller) in enumerate(cases[1:], start=1):
+        single = qzs.simulate(EXCITATION, isolator, controller, duration=2.0,
+                              sample_rate=500.0)
+        for name in ("relative_position", "motor_force"):
+            assert np.array_equal(batch.channels[name][index], single[name]), (index, name)
+        assert batch.stats["stick_events"][index] == single.run["stick_events"]
+    assert batch.status[0] != 0 and not batch.status[1:].any()
 
 
 def test_batches_larger_than_one_call_are_split(monkeypatch):

@@ -257,16 +257,22 @@ def test_study_physics_is_sensible(quick_paper):
 def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
     """Cases sharing a chirp go through the batch kernel together; every curve, metric and
     statistic equals the one-case path's exactly (a processing case joins the same batch and
-    brings the velocities)."""
+    brings the velocities). A case repeated in another study (the viscous study's Cv = 100
+    N s/m is the stiction study's Fs = 10 N: both are Table 1 with the passive gains) is
+    integrated once and analysed for each."""
     import dataclasses
 
     stiction = load_study("stiction")
     processing = load_study("processing")
+    viscous = load_study("viscous")
     analysis = {"quick_fft_length": 2048, "quick_n_averages": 6}
+    repeated = [case for case in viscous.cases if case["viscous_damping"] == 100.0]
     studies = [dataclasses.replace(stiction, analysis={**stiction.analysis, **analysis},
                                    cases=stiction.cases[::2]),
                dataclasses.replace(processing, analysis={**processing.analysis, **analysis},
-                                   options={**processing.options, "n_averages": 6})]
+                                   options={**processing.options, "n_averages": 6}),
+               dataclasses.replace(viscous, analysis={**viscous.analysis, **analysis},
+                                   cases=repeated)]
     import qzs.engine.batch
 
     batches = []
@@ -278,7 +284,9 @@ def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
 
     monkeypatch.setattr(qzs.engine.batch, "simulate_batch", counted)
     lockstep = run_studies(studies, quick=True, workers=2, progress=False)
-    assert batches == [3]  # two stiction cases and the processing case: one batch
+    # two stiction cases and the processing case: one batch; the viscous case is Fs = 10 N
+    assert batches == [3]
+    assert [case["stiction_force"] for case in stiction.cases[::2]] == [2.0, 10.0]
     single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False)
     assert batches == [3]
 
@@ -305,3 +313,4 @@ def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
                     assert same(str(a.extra[name]), str(b.extra[name])), (a.label, name)
     assert compared > 20
     assert lockstep[1].cases[0].extra["magnitude"].size > 0
+    assert same(lockstep[2].cases[0].magnitude, lockstep[0].cases[1].magnitude)

@@ -41,6 +41,17 @@ N_SCRATCH = K.N_ODE + 5
 MAX_LANES = 1024
 W = MAX_LANES + 8
 STATUS_TOO_MANY_LANES = -1
+#: Pass 1 runs over a multiple of ``LANE_BLOCK`` lanes when the remainder holds at least
+#: ``PAD_FROM`` lanes: LLVM's vectorised lane loops take 4 lanes per AVX2 instruction, two
+#: instructions per iteration, and leave the remainder to scalar code, where a lane costs
+#: about as much as the one-case kernel's step (120-140 ns here) against 60-70 ns in the
+#: vector loop. A call with 7 cases (the paper's 14 distinct cases on 2 cores) ran them all
+#: in the remainder, 920-980 ns a step; padded to 8, 530 ns. A smaller remainder costs less
+#: than the padding. The padding lanes are frozen copies of lane 0: failed lanes, computed
+#: in pass 1 and never stored, stepped, recorded or returned.
+LANE_BLOCK = 8
+PAD_FROM = 3
+assert MAX_LANES % LANE_BLOCK == 0
 #: Pass 1 is compiled in variants, each with a value a call can fix as a constant, so
 #: that LLVM drops the code it makes unreachable (the same bits either way):
 #: ``exact``, every lane of the call has the exact stick-slip friction (``P_VREG = 0``,
@@ -147,11 +158,13 @@ def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, source, at_input, at_
 
 @njit(**_JIT, inline="always")
 def _finish_lanes(slipping, n, b_end, L, T, PP):
-    """End the step of every lane: store it, or flag the lane for pass 2 (returns how many).
+    """End the step of every lane: store it, or flag the lane for pass 2.
 
     What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
     nothing happens in it. A flagged lane keeps its state at ``t``. ``slipping``: no
-    lane is held, so none needs its holding margin.
+    lane is held, so none needs its holding margin. Returns how many lanes pass 2
+    has to step: the flagged ones that have not failed (a failed or padding lane
+    is flagged at every step and left as it is).
     """
     flagged_lanes = 0
     for c in range(n):
@@ -171,10 +184,11 @@ def _finish_lanes(slipping, n, b_end, L, T, PP):
             ready = P[K.P_VREG] > 0.0 or direction * s[K.S_V] >= 0.0
         else:
             ready = margin >= 0.0
+        failed = L[_at(R_FAILED, c)] != 0.0
         flagged = (not ready or K._any_event(s, s1, mode, direction, margin1, P)
-                   or not _finite(s1, P) or L[_at(R_FAILED, c)] != 0.0)
+                   or not _finite(s1, P) or failed)
         T[_at(T_FLAGGED, c)] = 1.0 if flagged else 0.0
-        flagged_lanes += flagged
+        flagged_lanes += flagged and not failed  # a failed lane is left alone
         if not flagged:
             _store(L, c, s1, margin1, K._in_contact(s1, mode, P), P)
     return flagged_lanes
@@ -282,6 +296,13 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
     for c in range(n):
         exact = exact and PP[_at(K.P_VREG, c)] == 0.0
         locked += int(L[_at(R_MODE, c)] != K.MODE_SLIP)
+    lanes = n if n % LANE_BLOCK < PAD_FROM else n + LANE_BLOCK - n % LANE_BLOCK  # padded
+    for c in range(n, lanes):
+        for i in range(K.N_PARAMS):
+            PP[_at(i, c)] = PP[_at(i, 0)]
+        for i in range(N_ROWS):
+            L[_at(i, c)] = L[_at(i, 0)]
+        L[_at(R_FAILED, c)] = 1.0
     step = step0
     row = row0
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
@@ -298,7 +319,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                     L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
-        if _vector_pass(exact, locked == 0, solver, n, h, L, T, PP, bases, b_end) > 0:
+        if _vector_pass(exact, locked == 0, solver, lanes, h, L, T, PP, bases, b_end) > 0:
             for c in range(n):  # pass 2: the flagged lanes
                 if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
