@@ -116,26 +116,32 @@ def test_ctrl_c_while_a_chunk_is_written_keeps_every_chunk_whole(tmp_path, monke
     from qzs.iotools import ResultWriter
 
     monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)  # cut to 128 samples
-    path = tmp_path / "run.nc"
-    calls = []
-    with ResultWriter(path, isolator=qzs.IsolatorParameters(),
-                      controller=qzs.ControllerParameters(), excitation=EXCITATION) as writer:
-        def sink(data, flags):
-            calls.append(len(data))
-            if len(calls) == 3:
-                signal.raise_signal(signal.SIGINT)  # Ctrl-C in the middle of writing
-            writer.append(data, flags)
+    # from Python's own handler, whatever the shell gave: a background job starts with SIGINT
+    # ignored, and raise_signal would then do nothing
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        path = tmp_path / "run.nc"
+        calls = []
+        with ResultWriter(path, isolator=qzs.IsolatorParameters(),
+                          controller=qzs.ControllerParameters(), excitation=EXCITATION) as writer:
+            def sink(data, flags):
+                calls.append(len(data))
+                if len(calls) == 3:
+                    signal.raise_signal(signal.SIGINT)  # Ctrl-C in the middle of writing
+                writer.append(data, flags)
 
-        result = simulate(EXCITATION, duration=10.0, sample_rate=1000.0, sink=sink,
-                          interruptible=True)
-        writer.finish(result.run)
-    assert not result.completed
-    assert calls == [1, 128, 128, 128]  # t = 0, the chunk being written, the one under way
-    data = read_result(path)
-    assert data.sizes["time"] == result.run["samples"] == 1 + 3 * 128
-    np.testing.assert_allclose(np.diff(data.time.values), 1e-3, rtol=1e-9)
-    assert data.attrs["run.completed"] == 0
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+            result = simulate(EXCITATION, duration=10.0, sample_rate=1000.0, sink=sink,
+                              interruptible=True)
+            writer.finish(result.run)
+        assert not result.completed
+        assert calls == [1, 128, 128, 128]  # t = 0, the chunk being written, the one under way
+        data = read_result(path)
+        assert data.sizes["time"] == result.run["samples"] == 1 + 3 * 128
+        np.testing.assert_allclose(np.diff(data.time.values), 1e-3, rtol=1e-9)
+        assert data.attrs["run.completed"] == 0
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # given back
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def test_sigterm_during_an_interruptible_run_is_raised_between_chunks(monkeypatch):
