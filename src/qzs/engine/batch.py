@@ -321,6 +321,6 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
              "stick_events": flags[:, K.I_N_STICKS].astype(float),
              "steps": flags[:, K.I_STEP].astype(float)}
     stats = {name: stats[name] for name in STATS}
-    time = np.arange(n_out) * (decimation * first.dt)
+    time = (np.arange(n_out) * decimation) * first.dt  # step * dt: the kernel's own time channel
     return BatchResult(time, kept, stats, (status != K.STATUS_OK).astype(np.int8), messages,
                        elapsed, cases, params[:, [K.P_Z_LOW, K.P_Z_HIGH]].copy())

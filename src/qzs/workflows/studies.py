@@ -363,8 +363,9 @@ def _analyse_case(task, run, isolator, controller, excitation, rate):
     return result
 
 
-#: What a lockstep case keeps of its run: the series :func:`_analyse_case` reads.
-_LOCKSTEP_CHANNELS = ("time", "base_acceleration", "payload_acceleration", "relative_position",
+#: What a lockstep case keeps of its run: the series :func:`_analyse_case` reads (the time is
+#: the batch's, one array for every case: the kernel's own time channel, step times dt).
+_LOCKSTEP_CHANNELS = ("base_acceleration", "payload_acceleration", "relative_position",
                       "motor_force", "locked")
 #: And, for a ``processing`` case, the velocities the experiment measured.
 _PROCESSING_CHANNELS = ("base_velocity", "payload_velocity")
@@ -444,7 +445,7 @@ def _run_lockstep(tasks, workers, progress):
         b = run_of[c]
         series = {name: batch.channels[name][b] if name in batch.channels else None
                   for name in (*_LOCKSTEP_CHANNELS, *_PROCESSING_CHANNELS)}
-        run = _LockstepRun(**series, steps_per_second=batch.steps_per_second,
+        run = _LockstepRun(time=batch.time, **series, steps_per_second=batch.steps_per_second,
                            run=dict(stop_low=float(batch.stop_limits[b, 0]),
                                     stop_high=float(batch.stop_limits[b, 1]),
                                     stop_contacts=int(batch.stats["stop_contacts"][b]),
