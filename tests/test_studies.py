@@ -59,8 +59,26 @@ def quick_paper(tmp_path_factory):
         studies.append(dataclasses.replace(study, analysis=analysis))
     folder = tmp_path_factory.mktemp("paper")
     results = run_studies(studies, quick=True, workers=2, progress=False)
-    verdicts = write_paper_outputs(results, folder, quick=True, wall_seconds=1.0)
+    verdicts = write_paper_outputs(results, folder, quick=True, wall_seconds=1.0, workers=2)
     return results, verdicts, folder
+
+
+def test_figures_drawn_in_worker_processes_are_those_drawn_in_process(quick_paper, tmp_path):
+    results, _, folder = quick_paper  # drawn by 2 worker processes (the default on 2 cores)
+    write_paper_outputs(results, tmp_path, quick=True, wall_seconds=1.0, workers=1)
+    drawn = sorted(p.name for p in folder.glob("*.png"))
+    assert drawn == sorted(p.name for p in tmp_path.glob("*.png"))
+    assert len(drawn) == sum(len(r.study.views) or 1 for r in results)
+    for name in drawn:
+        assert (folder / name).read_bytes() == (tmp_path / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("workers", [0, 1.5, True, "2"])
+def test_paper_outputs_refuse_bad_workers_before_writing(quick_paper, tmp_path, workers):
+    results, _, _ = quick_paper
+    with pytest.raises(ParameterError, match="`workers` must be a positive integer"):
+        write_paper_outputs(results, tmp_path / "out", workers=workers)
+    assert not (tmp_path / "out").exists()
 
 
 def test_quick_report_decides_every_claim_from_data(quick_paper):

@@ -26,6 +26,7 @@ import numpy as np
 
 from qzs._version import __version__
 from qzs.analysis.spectral import METRIC_NAMES, band_mask, transmissibility_at
+from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
@@ -509,7 +510,15 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
     -------
     list of Verdict
         As :func:`decide_claims` gives them.
+
+    Raises
+    ------
+    ParameterError
+        ``workers`` not a positive integer.
     """
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     figures = _draw(study_results, folder, workers)
