@@ -194,3 +194,21 @@ def test_unknown_keyword_is_a_type_error():
 def test_invalid_initial_state(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         InitialState(**kwargs)
+
+
+def test_worker_count_defaults_to_the_cores_and_respects_its_limit():
+    import os
+
+    import numpy as np
+
+    from qzs._validation import worker_count
+
+    cores = os.cpu_count() or 1
+    assert worker_count(None) == cores
+    assert worker_count(None, limit=1) == 1
+    assert worker_count(np.int64(3)) == 3 and type(worker_count(np.int64(3))) is int
+    assert worker_count(5, limit=2) == 2
+    assert worker_count(5, limit=0) == 1  # nothing to share out: one worker
+    for bad in (0, -1, 1.0, True, np.bool_(True), "2"):
+        with pytest.raises(ParameterError, match="`workers` must be a positive integer"):
+            worker_count(bad)

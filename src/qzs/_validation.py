@@ -4,6 +4,7 @@ Messages follow scipy's style: name the argument, the value received and the fix
 """
 import dataclasses
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,16 @@ def integer(name, value, minimum, error=ParameterError):
             or value < minimum:
         raise error(f"`{name}` must be an integer >= {minimum}, got {value!r}.")
     return int(value)
+
+
+def worker_count(workers, limit=None, error=ParameterError):
+    """The workers (threads or processes) to use: ``workers``, an integer >= 1 (not a bool),
+    or the machine's core count if it is None; at most ``limit`` (>= 1) if given."""
+    if workers is not None and (isinstance(workers, (bool, np.bool_))
+                                or not isinstance(workers, (int, np.integer)) or workers < 1):
+        raise error(f"`workers` must be a positive integer, got {workers!r}.")
+    count = int(workers) if workers is not None else (os.cpu_count() or 1)
+    return count if limit is None else max(1, min(count, limit))
 
 
 def positive(name, value, error=ParameterError):

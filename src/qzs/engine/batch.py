@@ -8,7 +8,6 @@ reduced while integrating: only the requested channels are kept, and per-case
 statistics (stroke, stop contacts, RMS motor force, time locked) are
 accumulated chunk by chunk.
 """
-import os
 import time as _time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -16,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs import defaults
+from qzs._validation import worker_count
 from qzs.analysis.statistics import STATISTICS, RunStatistics
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
@@ -258,9 +258,7 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
         statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
                        out_flags[cases, first_row:first_row + rows, K.O_LOCKED], cases)
 
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
-    workers = min(workers or os.cpu_count() or 1, n)
+    workers = worker_count(workers, n)
     bounds = np.linspace(0, n, workers + 1).astype(int)
     written = np.zeros(n, dtype=np.int64)
     pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None

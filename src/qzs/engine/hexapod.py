@@ -54,7 +54,7 @@ import numpy as np
 from numba import njit
 
 from qzs import defaults
-from qzs._validation import choice, positive
+from qzs._validation import choice, positive, worker_count
 from qzs.analysis.statistics import RunStatistics
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
@@ -1669,15 +1669,13 @@ def simulate_hexapods(runs, *, workers=None, progress=False):
     ParameterError
         ``runs`` is empty or holds no dicts, or ``workers`` is not a positive integer.
     """
-    import os
     from concurrent.futures import ThreadPoolExecutor
 
     runs = list(runs)
     if not runs:
         raise ParameterError("`runs` is empty: give at least one dict of simulate_hexapod "
                              "arguments.")
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
+    workers = worker_count(workers, len(runs))  # checked before any run is set up
     names = ("geometry", "platform", "isolator", "controller", "excitation", "duration", "dt",
              "sample_rate", "solver", "cartesian")
     for i, arguments in enumerate(runs):
@@ -1698,7 +1696,6 @@ def simulate_hexapods(runs, *, workers=None, progress=False):
                      arguments.get("cartesian"))
         except ParameterError as error:
             raise CaseError(i, str(error)) from error
-    workers = min(workers or os.cpu_count() or 1, len(runs))
     bar = None
     if progress:
         from tqdm.auto import tqdm

@@ -41,7 +41,6 @@ import dataclasses
 import html
 import json
 import math
-import os
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -50,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs import defaults
+from qzs._validation import worker_count
 from qzs._version import __version__
 from qzs.analysis import control_design as cd
 from qzs.analysis.spectral import band_mask, transmissibility
@@ -1190,10 +1190,7 @@ def design_controller(isolator=None, controller=None, *, excitation=None, sticti
     damping_gain_max = _float("damping_gain_max", damping_gain_max, minimum=0.0, strict=True)
     gain_margin_min = _float("gain_margin_min", gain_margin_min, minimum=0.0)
     phase_margin_min = _float("phase_margin_min", phase_margin_min, minimum=0.0)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
-    workers = workers or os.cpu_count() or 1
+    workers = worker_count(workers)
     sample_rate = SAMPLE_RATE if band[1] <= SAMPLE_RATE / 5 else float(
         100 * math.ceil(band[1] * 5 / 100))
     stroke_band = cd.constant_force_band(isolator, controller)

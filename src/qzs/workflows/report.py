@@ -18,15 +18,14 @@ import html
 import io as _io
 import json
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from qzs._validation import worker_count
 from qzs._version import __version__
 from qzs.analysis.spectral import METRIC_NAMES, band_mask, transmissibility_at
-from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
@@ -472,12 +471,11 @@ def _settings(result):
 
 
 def _draw(study_results, folder, workers):
-    """Every study's figures (:func:`_figures`), in ``workers`` processes when worth it.
+    """Every study's figures (:func:`_figures`), in ``workers`` processes if more than one.
 
     Matplotlib holds the GIL, so figures draw in parallel only in processes; about 0.3 s
     a figure, 3 s for the paper's on one core. Returns ``{study name: drawn}``.
     """
-    workers = min(workers or os.cpu_count() or 1, len(study_results))
     if workers <= 1:
         return {r.study.name: _figures(r, folder) for r in study_results}
     from concurrent.futures import ProcessPoolExecutor
@@ -516,9 +514,7 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
     ParameterError
         ``workers`` not a positive integer.
     """
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
+    workers = worker_count(workers, len(study_results))  # checked before anything is written
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     figures = _draw(study_results, folder, workers)

@@ -22,7 +22,6 @@ Kinds:
 its bins are trusted (docs/model.md §10), and every metric comes from those bins only.
 """
 import dataclasses
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -30,7 +29,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from qzs._validation import known_keys, read_toml
+from qzs._validation import known_keys, read_toml, worker_count
 from qzs.analysis.linear import linearize
 from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
                                    transmissibility_metrics)
@@ -542,9 +541,7 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
              for j, task in enumerate(study_tasks)]
     results = [[None] * len(study_tasks) for study_tasks in per_study]
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise ParameterError(f"`workers` must be a positive integer, got {workers!r}.")
-    workers = workers or os.cpu_count() or 1
+    workers = worker_count(workers)
     groups, single = {}, []
     for entry in tasks:
         if lockstep and entry[2]["kind"] in ("transmissibility", "processing"):
