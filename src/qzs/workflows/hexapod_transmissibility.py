@@ -36,7 +36,6 @@ meets it (stick-slip whose pattern changes with the step, so that the difference
 shrink), the run takes the set-up's ``dt`` and its record says why.
 """
 import math
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,7 +44,7 @@ from types import MappingProxyType
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import as_float, choice, integer, positive
+from qzs._validation import as_float, choice, integer, positive, worker_count
 from qzs.errors import ParameterError
 
 __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "CHIRP",
@@ -699,7 +698,7 @@ def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"]
     from tqdm.auto import tqdm
 
     _dry_run(tasks[0])
-    workers = min(workers or os.cpu_count() or 1, len(tasks))
+    workers = worker_count(workers, len(tasks))
     columns = {}
     bar = tqdm(total=len(tasks), unit="run", desc="hexapod chirps", disable=not progress)
     try:

@@ -19,7 +19,6 @@ it (:func:`chirp_transmissibility`).
 """
 import dataclasses
 import math
-import os
 import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -29,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import choice, integer, positive
+from qzs._validation import choice, integer, positive, worker_count
 from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, Sine
 
@@ -1194,8 +1193,8 @@ def steady_state_response(frequencies, amplitude=0.010, isolator=None, controlle
                                            dt=min(dt, defaults.SIMULATION["dt"] * 10),
                                            solver=solver))
     concurrent = len(chains) + len(extra)
-    if workers is None:
-        workers = max(1, min(concurrent, os.cpu_count() or 1))
+    if workers is None:  # an explicit count is the user's; the default, no more than there is to do
+        workers = worker_count(None, concurrent)
     settings["workers"] = workers
     points, outcomes = _run_chains(chains, base, extra, workers, progress)
     balance, note = outcomes.get("balance", (None, ""))
