@@ -1,0 +1,190 @@
+#!/usr/bin/env python
+"""Fingerprint of qzs's numerical results, to show that a refactor changes no bit.
+
+Run from the repository root with the project's interpreter, once before a change and
+once after, and compare the two files::
+
+    .venv/bin/python benchmarks/fingerprint.py > before.txt
+    ... the change ...
+    .venv/bin/python benchmarks/fingerprint.py > after.txt
+    diff before.txt after.txt        # empty: bit-identical
+
+Each line is ``name  sha256-prefix  a few values``: the SHA-256 of the raw bytes of every
+array a result holds (data, flags, statistics), so that one differing bit anywhere changes
+the line. What is covered: single runs over several parameter sets and all three solvers
+(exact and regularised friction, compliant and plastic stops, continuous and sampled
+control, a random excitation), files written by streaming, a lockstep batch, a six-axis run
+(per-leg and centralised control), a steady-state response sweep (both directions, with the
+harmonic balance) and the metrics of ``qzs paper --quick``. ``--skip-paper`` leaves the
+last out (it takes a minute on a warm cache).
+"""
+import argparse
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+
+def digest(*arrays):
+    """SHA-256 (first 16 hex digits) of the raw bytes of ``arrays``."""
+    h = hashlib.sha256()
+    for a in arrays:
+        a = np.ascontiguousarray(np.asarray(a))
+        h.update(str(a.dtype).encode())
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()[:16]
+
+
+def line(name, *arrays, show=()):
+    values = " ".join(f"{v:.17g}" for v in show)
+    print(f"{name:40s} {digest(*arrays)}  {values}", flush=True)
+
+
+def single_runs():
+    from qzs import (Chirp, ControllerParameters, InitialState, IsolatorParameters,
+                     RandomExcitation, Sine, simulate)
+
+    chirp = Chirp(duration=20.0, f1=20.0)
+    cases = {
+        "default-ode3": dict(excitation=chirp),
+        "default-rk4": dict(excitation=chirp, solver="rk4"),
+        "default-euler": dict(excitation=chirp, solver="euler", dt=2e-5, sample_rate=1e3),
+        "passive": dict(excitation=chirp, controller=ControllerParameters(pi_kp=0.0, pi_ki=0.0)),
+        "plastic": dict(excitation=Sine(amplitude=0.010, frequency=3.0), duration=10.0,
+                        isolator=IsolatorParameters(stop_model="plastic"),
+                        controller=ControllerParameters(pi_kp=0.0, pi_ki=0.0)),
+        "sampled-damping": dict(excitation=chirp, controller=ControllerParameters(
+            controller_rate=1000.0, damping_gain=20.0)),
+        "regularised": dict(excitation=chirp, isolator=IsolatorParameters(
+            friction_regularisation=1e-3)),
+        "stiction-high": dict(excitation=chirp, isolator=IsolatorParameters(
+            stiction_force=15.0, coulomb_force=5.0), controller=ControllerParameters(
+            pi_kp=200.0, damping_gain=100.0)),
+        "random": dict(excitation=RandomExcitation(duration=10.0, amplitude=0.002, seed=3)),
+        "initial-state": dict(excitation=chirp, duration=5.0,
+                              initial_state=InitialState(relative_position=0.004, relative_velocity=0.01)),
+    }
+    for name, options in cases.items():
+        options = dict(options)
+        options.setdefault("dt", 1e-4)
+        options.setdefault("sample_rate", 1e4 if name != "random" else 1e3)
+        excitation = options.pop("excitation")
+        result = simulate(excitation, **options)
+        stats = [result.statistics[k] for k in sorted(result.statistics)]
+        line(f"simulate/{name}", result._data, result._flags, np.array(stats, dtype=float),
+             show=(float(result._data[-1, 7]), result.run["steps"], result.run["stick_events"]))
+
+
+def streamed_run(folder):
+    import xarray as xr
+
+    from qzs import Chirp
+    from qzs.workflows.run import simulate_to_file
+
+    path = os.path.join(folder, "run.nc")
+    simulate_to_file(path, Chirp(duration=30.0, f1=20.0), dt=1e-4, sample_rate=1e4)
+    with xr.open_dataset(path) as ds:
+        names = sorted(ds.data_vars)
+        line("streamed/run.nc", *[ds[n].values for n in names], ds["time"].values,
+             show=(float(ds["relative_position"].values[-1]),))
+
+
+def batch():
+    from qzs import Chirp, ControllerParameters, IsolatorParameters, simulate_batch
+
+    cases = [(IsolatorParameters(stiction_force=fs), ControllerParameters(pi_kp=kp,
+                                                                           damping_gain=kd))
+             for fs in (5.0, 10.0, 15.0) for kp, kd in ((0.0, 0.0), (50.0, 0.0), (50.0, 100.0))]
+    cases.append((IsolatorParameters(friction_regularisation=1e-3), ControllerParameters()))
+    channels = ("relative_position", "payload_acceleration", "motor_force", "locked")
+    result = simulate_batch(cases, Chirp(duration=20.0, f1=20.0), dt=1e-4, sample_rate=1e3,
+                            channels=channels, workers=2)
+    line("batch/channels", result.time, *[result.channels[c] for c in channels])
+    line("batch/stats", *[result.stats[k] for k in sorted(result.stats)], result.status)
+
+
+def hexapod():
+    from qzs import Chirp, ControllerParameters, Sine, simulate_hexapod
+    from qzs.model.hexapod import PlatformParameters, cubic_geometry
+
+    geometry = cubic_geometry(cube_edge=0.3, cube_center_height=0.3)
+    platform = PlatformParameters(mass=22.17, inertia=np.diag([0.3, 0.3, 0.5]))
+    controller = ControllerParameters(pi_kp=2000.0, pi_ki=800.0)
+    runs = {
+        "chirp-z": dict(excitation={"z": Chirp(duration=5.0)}, duration=5.0),
+        "sine-xrx": dict(excitation={"x": Sine(amplitude=0.005, frequency=3.0),
+                                     "rx": Sine(amplitude=0.01, frequency=2.0)}, duration=3.0,
+                         solver="rk4"),
+    }
+    for name, options in runs.items():
+        result = simulate_hexapod(geometry, platform, controller=controller, dt=1e-4,
+                                  sample_rate=1e3, **options)
+        line(f"hexapod/{name}", result._data, result._flags,
+             show=(result.run["steps"], result.run["events"]))
+    from qzs.model.hexapod import CartesianController
+
+    cartesian = CartesianController(position_gain=[2000.0] * 6, integral_gain=[800.0] * 6,
+                                    damping_gain=[50.0] * 6)
+    result = simulate_hexapod(geometry, platform, controller=controller, dt=1e-4,
+                              sample_rate=1e3, excitation={"z": Sine(amplitude=0.005,
+                                                                     frequency=4.0)},
+                              duration=2.0, cartesian=cartesian)
+    line("hexapod/cartesian", result._data, result._flags, show=(result.run["events"],))
+
+
+def response():
+    from qzs.workflows.response import steady_state_response
+
+    result = steady_state_response([1.0, 2.0, 3.5, 6.0], 0.010, direction="both", dt=1e-3,
+                                   workers=1, harmonic_balance=True)
+    ds = result.to_xarray()
+    skip = {"seconds"}
+    names = sorted(n for n in ds.data_vars if n not in skip and ds[n].dtype.kind in "fiub")
+    line("response/points", *[ds[n].values for n in names],
+         show=tuple(float(v) for v in np.ravel(ds["transmissibility"].values)[:4]))
+
+
+def paper(folder):
+    out = os.path.join(folder, "paper")
+    subprocess.run([sys.executable, "-m", "qzs", "paper", "--quick", "--out", out],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    with open(os.path.join(out, "metrics.json"), encoding="utf-8") as handle:
+        metrics = json.load(handle)
+    drop = {"wall_seconds", "generated", "elapsed", "seconds", "version", "qzs_version",
+            "created", "date", "timestamp", "runs_seconds"}
+
+    def clean(value):
+        if isinstance(value, dict):
+            return {k: clean(v) for k, v in value.items() if k not in drop}
+        if isinstance(value, list):
+            return [clean(v) for v in value]
+        return value
+
+    text = json.dumps(clean(metrics), sort_keys=True)
+    print(f"{'paper/metrics.json':40s} {hashlib.sha256(text.encode()).hexdigest()[:16]}",
+          flush=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--skip-paper", action="store_true")
+    parser.add_argument("--only", default="", help="comma-separated parts to run")
+    args = parser.parse_args()
+    parts = dict(single=single_runs, batch=batch, hexapod=hexapod, response=response)
+    with tempfile.TemporaryDirectory() as folder:
+        parts["streamed"] = lambda: streamed_run(folder)
+        if not args.skip_paper:
+            parts["paper"] = lambda: paper(folder)
+        only = [p for p in args.only.split(",") if p]
+        for name, part in parts.items():
+            if not only or name in only:
+                part()
+
+
+if __name__ == "__main__":
+    main()
