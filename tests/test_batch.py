@@ -82,7 +82,7 @@ def test_chunking_changes_no_bit(monkeypatch):
     bit: calls are cut on multiples of lcm(decimation, PHASE_PERIOD) steps, where the
     excitation's sine and cosine are exact, and the holding margin carries across calls
     (docs/model.md §9). Stick-slip on a slow chirp crosses many of the boundaries."""
-    from qzs.engine import batch as batch_module, simulate as simulate_module
+    from qzs.engine import batch as batch_module, driver as driver_module
     from qzs.engine.kernels import PHASE_PERIOD
 
     excitation = qzs.Chirp(duration=20.0, f0=0.5, f1=3.0)
@@ -90,7 +90,7 @@ def test_chunking_changes_no_bit(monkeypatch):
              for fs in (3.0, 8.0, 15.0)]
     runs = {}
     for label, steps in (("whole", 10 ** 7), ("short", 1_330), ("odd", 9_990)):  # asked for
-        monkeypatch.setattr(simulate_module, "CHUNK_STEPS", steps)
+        monkeypatch.setattr(driver_module, "CHUNK_STEPS", steps)
         runs[label] = [qzs.simulate(excitation, iso, ctrl, sample_rate=1000.0)
                        for iso, ctrl in cases]
     monkeypatch.setattr(batch_module, "_ROWS_PER_CHUNK", 3 * 777)  # 777 samples per case

@@ -158,16 +158,18 @@ def test_a_bad_output_path_fails_at_once_and_leaves_nothing(tmp_path, capsys, op
 
 def test_ctrl_c_writes_what_was_simulated(tmp_path, monkeypatch):
     """An interrupted streamed run keeps its samples, says so (run.completed = 0), exit 130."""
-    from qzs.engine import lanes, simulate as simulate_module
+    import os
+    import signal
+    from qzs.engine import driver as driver_module, lanes
 
-    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)  # cut to 128: lcm(10, 256) steps
+    monkeypatch.setattr(driver_module, "CHUNK_SAMPLES", 100)  # cut to 128: lcm(10, 256) steps
     real, calls = lanes.run_single, []
 
     def interrupted(*args):
         calls.append(args[1])
         result = real(*args)
-        if len(calls) == 4:  # the warm-up call, then three chunks of 128 samples
-            raise KeyboardInterrupt
+        if len(calls) == 4:  # the warm-up call, then three chunks of 128 samples: Ctrl-C
+            os.kill(os.getpid(), signal.SIGINT)  # (Python delivers it to the main thread)
         return result
 
     monkeypatch.setattr(lanes, "run_single", interrupted)

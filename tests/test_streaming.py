@@ -13,7 +13,7 @@ import pytest
 
 import qzs
 from qzs import Chirp, Sine, simulate
-from qzs.engine import simulate as simulate_module
+from qzs.engine import driver as driver_module, simulate as simulate_module
 from qzs.errors import ResultTooLargeError
 from qzs.iotools import read_result
 from qzs.workflows.run import simulate_to_file
@@ -24,8 +24,8 @@ EXCITATION = Sine(amplitude=0.004, frequency=3.0)
 def test_streamed_statistics_equal_those_of_the_whole_run(monkeypatch):
     """Chunked statistics are the statistics of every sample: a run in 7 chunks whose result
     keeps every 4th sample reports what the same run held whole reports."""
-    monkeypatch.setattr(simulate_module, "CHUNK_STEPS", 1_500)  # cut to 1280: lcm(10, 256)
-    monkeypatch.setattr(simulate_module, "PREVIEW_SAMPLES", 250)
+    monkeypatch.setattr(driver_module, "CHUNK_STEPS", 1_500)  # cut to 1280: lcm(10, 256)
+    monkeypatch.setattr(driver_module, "PREVIEW_SAMPLES", 250)
     whole = simulate(EXCITATION, duration=1.0, sample_rate=1000.0)
     blocks = []
     streamed = simulate(EXCITATION, duration=1.0, sample_rate=1000.0,
@@ -60,8 +60,8 @@ def test_streamed_statistics_equal_those_of_the_whole_run(monkeypatch):
 
 
 def test_simulate_to_file_writes_every_sample(tmp_path, monkeypatch):
-    monkeypatch.setattr(simulate_module, "CHUNK_STEPS", 2_000)
-    monkeypatch.setattr(simulate_module, "PREVIEW_SAMPLES", 100)
+    monkeypatch.setattr(driver_module, "CHUNK_STEPS", 2_000)
+    monkeypatch.setattr(driver_module, "PREVIEW_SAMPLES", 100)
     path = tmp_path / "run.nc"
     result = simulate_to_file(path, EXCITATION, duration=1.0, sample_rate=500.0)
     data = read_result(path)
@@ -73,7 +73,7 @@ def test_simulate_to_file_writes_every_sample(tmp_path, monkeypatch):
 
 
 def test_too_large_a_result_is_refused_before_the_run(monkeypatch):
-    monkeypatch.setattr(simulate_module, "_available_memory", lambda: 100 * 2 ** 20)
+    monkeypatch.setattr(driver_module, "available_memory", lambda: 100 * 2 ** 20)
     start = time.perf_counter()
     with pytest.raises(ResultTooLargeError, match="stream it to a file") as caught:
         simulate(Chirp(), duration=2000.0, sample_rate=1000.0)  # 2e6 samples, ~390 MB
@@ -115,7 +115,7 @@ def test_ctrl_c_while_a_chunk_is_written_keeps_every_chunk_whole(tmp_path, monke
 
     from qzs.iotools import ResultWriter
 
-    monkeypatch.setattr(simulate_module, "CHUNK_SAMPLES", 100)  # cut to 128 samples
+    monkeypatch.setattr(driver_module, "CHUNK_SAMPLES", 100)  # cut to 128 samples
     # from Python's own handler, whatever the shell gave: a background job starts with SIGINT
     # ignored, and raise_signal would then do nothing
     before = signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -9,7 +9,7 @@ message is for people, never for parsing.
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
-           "SizeLimitError", "Terminated",
+           "SizeLimitError", "RunTooLongError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -148,19 +148,73 @@ class ResultTooLargeError(ParameterError):
         The run's output rate [Hz].
     """
 
-    def __init__(self, needed, available, duration, sample_rate):
+    #: The advice of a single run's message.
+    STREAM = ("stream it to a file instead (`--out FILE.nc` on the command line, "
+              "`qzs.simulate_to_file` in Python), or lower the `sample_rate` or the `duration`")
+
+    def __init__(self, needed, available, duration, sample_rate, remedy=None):
         self.needed, self.available = int(needed), int(available)
         self.duration, self.sample_rate = float(duration), float(sample_rate)
+        self.remedy = str(remedy) if remedy is not None else self.STREAM
         gib = 1024 ** 3
         super().__init__(
             f"a {self.duration:g} s run at {self.sample_rate:g} Hz keeps "
             f"{self.needed / gib:.2f} GiB of samples, more than half the {self.available / gib:.2f} "
-            "GiB of memory available; stream it to a file instead (`--out FILE.nc` on the "
-            "command line, `qzs.simulate_to_file` in Python), or lower the "
-            "`sample_rate` or the `duration`.")
+            f"GiB of memory available; {self.remedy}.")
 
     def __reduce__(self):
-        return type(self), (self.needed, self.available, self.duration, self.sample_rate)
+        return type(self), (self.needed, self.available, self.duration, self.sample_rate,
+                            self.remedy)
+
+
+class RunTooLongError(ParameterError):
+    """A run would take absurdly long (more than a day at best); raised before it starts.
+
+    Attributes
+    ----------
+    steps : int
+        Integration steps the run would take [-].
+    seconds : float
+        Wall time it would take at the kernel's best speed [s] (a lower bound).
+    limit : float
+        The longest run qzs starts [s].
+    duration : float
+        The run's simulated time [s].
+    dt : float
+        Its integration step [s].
+    cases : int
+        Cases stepped together [-].
+    """
+
+    def __init__(self, *, steps, seconds, limit, duration, dt, cases=1):
+        self.steps, self.seconds, self.limit = int(steps), float(seconds), float(limit)
+        self.duration, self.dt, self.cases = float(duration), float(dt), int(cases)
+        of = f" of {self.cases} cases" if self.cases > 1 else ""
+        super().__init__(
+            f"`dt` = {self.dt:g} s over `duration` = {self.duration:g} s is {self.steps:.3g} "
+            f"integration steps{of}: at least {_span(self.seconds)} of computing even at the "
+            f"kernel's best speed, and qzs starts no run of more than {_span(self.limit)}; use "
+            "a larger `dt` (the paper's is 1e-4 s; qzs.largest_stable_step gives the largest "
+            "stable one) or a shorter `duration`.")
+
+    def __reduce__(self):
+        return _rebuild_keywords, (type(self), dict(
+            steps=self.steps, seconds=self.seconds, limit=self.limit, duration=self.duration,
+            dt=self.dt, cases=self.cases))
+
+
+def _rebuild_keywords(kind, keywords):
+    return kind(**keywords)
+
+
+def _span(seconds):
+    """A wall time in the largest unit that keeps it at least 1 (s, min, h, days, years)."""
+    for unit, size in (("year", 365.25 * 86400), ("day", 86400), ("h", 3600), ("min", 60)):
+        if seconds >= size:
+            value = seconds / size
+            plural = "s" if len(unit) > 3 and f"{value:.3g}" != "1" else ""
+            return f"{value:.3g} {unit}{plural}"
+    return f"{seconds:.3g} s"
 
 
 class SimulationError(RuntimeError):

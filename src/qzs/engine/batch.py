@@ -8,7 +8,6 @@ reduced while integrating: only the requested channels are kept, and per-case
 statistics (stroke, stop contacts, RMS motor force, time locked) are
 accumulated chunk by chunk.
 """
-import time as _time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -17,9 +16,10 @@ import numpy as np
 from qzs import defaults
 from qzs._validation import worker_count
 from qzs.analysis.statistics import STATISTICS, RunStatistics
+from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
-from qzs.engine.prepare import chunk_steps, divergence_message, prepare_run
+from qzs.engine.prepare import divergence_message, prepare_run
 from qzs.engine.results import CHANNELS, FLAGS
 from qzs.errors import CaseError, ParameterError
 
@@ -140,25 +140,6 @@ class BatchResult:
         return xr.Dataset(variables, coords=coords, attrs=attrs)
 
 
-def _advance(solver, done, steps, decimation, states, flags, params, ex, table, out, out_flags,
-             status, written, first, last):
-    """Advance cases ``first..last-1`` by ``steps`` steps (one thread's share)."""
-    if last - first == 1:  # the one-case kernel: the same numbers, without lane bookkeeping
-        if status[first] == K.STATUS_OK:
-            status[first], written[first] = _lanes.run_single(
-                solver, steps, decimation, states[first], flags[first], params[first], ex, table,
-                out[first], out_flags[first], 0)
-        return
-    for a in range(first, last, _lanes.MAX_LANES):
-        b = min(a + _lanes.MAX_LANES, last)
-        code = _lanes.run_lanes(solver, done, steps, decimation, states[a:b], flags[a:b],
-                                params[a:b], ex, table, out[a:b], out_flags[a:b], 0,
-                                status[a:b], written[a:b])
-        if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long
-            raise RuntimeError(f"the batch kernel refused {b - a} cases (at most "
-                               f"{_lanes.MAX_LANES} per call)")
-
-
 def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULATION["dt"],
                    sample_rate=defaults.SIMULATION["sample_rate"],
                    solver=defaults.SIMULATION["solver"],
@@ -221,104 +202,154 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
             raise CaseError(index, error) from error
     first = prepared[0]
     n = len(prepared)
-    n_steps = int(round(first.duration / first.dt))
     decimation = first.decimation
-    n_out = n_steps // decimation + 1
-    states = np.stack([r.state for r in prepared])
-    flags = np.stack([r.flags for r in prepared])
-    params = np.stack([r.params for r in prepared])
     ex, table = first.packed
-    values = [c for c in channels if c in CHANNELS]
-    columns = [CHANNELS[c][0] for c in values]
-    flag_names = [c for c in channels if c in FLAGS]
-    flag_columns = [FLAGS[c][0] for c in flag_names]
-    kept = {c: (np.empty((n, n_out)) if c in CHANNELS else np.zeros((n, n_out), dtype=bool))
-            for c in channels}
-    status = np.zeros(n, dtype=np.int64)
-
-    rows_per_chunk = max(1, _ROWS_PER_CHUNK // n)
-    chunk = chunk_steps(decimation, n_steps, rows_per_chunk)
-    out = np.empty((n, min(n_out, chunk // decimation + 1), K.N_CHANNELS))
-    out_flags = np.zeros((n, out.shape[1], 2), dtype=np.bool_)
-    for c in range(n):
-        K.evaluate(0.0, states[c], flags[c], params[c], ex, table, out[c, 0], out_flags[c, 0])
-    statistics = RunStatistics(0.5 * (params[:, K.P_Z_LOW] + params[:, K.P_Z_HIGH]))
-    failed_at = np.full(n, -1, dtype=np.int64)
-
-    def absorb(rows, start_row, first_row, a=0, b=n):
-        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics."""
-        cases = slice(a, b)
-        block = out[cases, first_row:first_row + rows]
-        for name, col in zip(values, columns):
-            kept[name][cases, start_row:start_row + rows] = block[:, :, col]
-        for name, col in zip(flag_names, flag_columns):
-            kept[name][cases, start_row:start_row + rows] = out_flags[cases,
-                                                                      first_row:first_row + rows,
-                                                                      col]
-        statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
-                       out_flags[cases, first_row:first_row + rows, K.O_LOCKED], cases)
-
     workers = worker_count(workers, n)
-    bounds = np.linspace(0, n, workers + 1).astype(int)
-    written = np.zeros(n, dtype=np.int64)
-    pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
-    from tqdm.auto import tqdm
-
-    bar = tqdm(total=n_steps, unit="step", unit_scale=True, desc=f"{n} cases",
-               disable=not progress, leave=False)
-    def advance(a, b):  # cases a..b-1 by `steps` steps from step `done` (read at call time)
-        _advance(first.solver_code, done, steps, decimation, states, flags, params, ex, table,
-                 out, out_flags, status, written, a, b)
-
-    def chunk_of(a, b):
-        """One thread's share of a chunk: advance cases a..b-1, then absorb their rows
-        (in the thread too, so that the statistics do not wait for the slowest share)."""
-        advance(a, b)
-        rows = steps // decimation
-        ok = status[a:b] == K.STATUS_OK
-        if np.any(written[a:b][ok] != rows):  # pragma: no cover
-            raise RuntimeError("batch kernel wrote an unexpected number of rows")
-        for c in a + np.flatnonzero(~ok):  # keep the part that finished
-            out[c, written[c]:rows] = np.nan
-            out_flags[c, written[c]:rows] = False
-        absorb(rows, row, 0, a, b)
-
-    # zero-step calls compile (or load) the kernels first, only those the shares will use (a
-    # fresh worker compiles nothing it does not run): the clock counts integration only
-    done, steps = 0, 0
-    sizes = {int(b - a) for a, b in zip(bounds[:-1], bounds[1:]) if b > a}
-    if 1 in sizes:
-        advance(0, 1)
-    if any(size > 1 for size in sizes):
-        advance(0, min(n, _lanes.MAX_LANES))
-    start = _time.perf_counter()
+    plan = driver.plan_run(first.duration, first.dt, decimation, kernel="lanes", cases=n,
+                           workers=workers, max_samples=max(1, _ROWS_PER_CHUNK // n),
+                           max_steps=int(round(first.duration / first.dt)))
+    flag_count = sum(c in FLAGS for c in channels)
+    driver.check_memory(n * plan.samples * (8 * (len(channels) - flag_count) + flag_count),
+                        first.duration, first.sample_rate,
+                        remedy="keep fewer `channels`, lower the `sample_rate`, or run the cases "
+                               "in several batches")
+    lanes = _Lanes(prepared, channels, workers, plan)
+    for c in range(n):
+        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], ex, table,
+                   lanes.out[c, 0], lanes.out_flags[c, 0])
+    lanes.absorb(1, 0, 0)
+    recorder = _Rows()
+    recorder.rows = 1
     try:
-        absorb(1, 0, 0)
-        done, row = 0, 1
-        while done < n_steps:
-            steps = min(chunk, n_steps - done)
-            before = status.copy()
-            if pool is None:
-                chunk_of(0, n)
-            else:
-                list(pool.map(lambda i: chunk_of(bounds[i], bounds[i + 1]), range(workers)))
-            newly = (before == K.STATUS_OK) & (status != K.STATUS_OK)
-            failed_at[newly] = flags[newly, K.I_STEP]
-            row += steps // decimation
-            done += steps
-            bar.update(steps)
+        outcome = driver.drive(lanes, plan, recorder,
+                               progress=f"{n} cases" if progress else None)
     finally:
-        bar.close()
-        if pool is not None:
-            pool.shutdown()
-    elapsed = _time.perf_counter() - start
-
+        lanes.close()
+    states, flags, status = lanes.states, lanes.flags, lanes.status
     messages = ["" if status[c] == K.STATUS_OK else
-                divergence_message(states[c], failed_at[c], first.dt) for c in range(n)]
-    stats = {"stop_contacts": flags[:, K.I_N_CONTACTS].astype(float), **statistics.result(),
+                divergence_message(states[c], lanes.failed_at[c], first.dt) for c in range(n)]
+    stats = {"stop_contacts": flags[:, K.I_N_CONTACTS].astype(float),
+             **lanes.statistics.result(),
              "stick_events": flags[:, K.I_N_STICKS].astype(float),
              "steps": flags[:, K.I_STEP].astype(float)}
     stats = {name: stats[name] for name in STATS}
-    time = (np.arange(n_out) * decimation) * first.dt  # step * dt: the kernel's own time channel
-    return BatchResult(time, kept, stats, (status != K.STATUS_OK).astype(np.int8), messages,
-                       elapsed, cases, params[:, [K.P_Z_LOW, K.P_Z_HIGH]].copy())
+    time = (np.arange(plan.samples) * decimation) * first.dt  # step * dt: the kernel's time
+    return BatchResult(time, lanes.kept, stats, (status != K.STATUS_OK).astype(np.int8),
+                       messages, outcome.elapsed, cases,
+                       lanes.params[:, [K.P_Z_LOW, K.P_Z_HIGH]].copy())
+
+
+class _Rows:
+    """The batch's recorder for the driver: the lanes keep their channels themselves (each
+    thread its share, see :class:`_Lanes`), so that the next chunk may start at once."""
+
+    def target(self, chunk_index, rows):
+        return 0, 0
+
+    def absorb(self, buffer, first, count):
+        self.rows += count
+
+
+class _Lanes(driver.Stepper):
+    """The lockstep kernel (:func:`qzs.engine.lanes.run_lanes`) as the driver's stepper.
+
+    The cases are shared over ``workers`` threads; each thread advances its share and then
+    takes its rows out of the chunk buffer into the kept channels and statistics (so that
+    the statistics do not wait for the slowest share). A share of one case runs the
+    one-case kernel (the same numbers, without the lanes' bookkeeping). A case that
+    diverges keeps what it finished; the rest of its rows are NaN.
+    """
+
+    def __init__(self, prepared, channels, workers, plan):
+        first = prepared[0]
+        n = len(prepared)
+        self.solver, self.decimation, self.plan = first.solver_code, first.decimation, plan
+        self.ex, self.table = first.packed
+        self.states = np.stack([r.state for r in prepared])
+        self.flags = np.stack([r.flags for r in prepared])
+        self.params = np.stack([r.params for r in prepared])
+        self.status = np.zeros(n, dtype=np.int64)
+        self.written = np.zeros(n, dtype=np.int64)
+        self.failed_at = np.full(n, -1, dtype=np.int64)
+        self.kept = {c: (np.empty((n, plan.samples)) if c in CHANNELS
+                         else np.zeros((n, plan.samples), dtype=bool)) for c in channels}
+        self.values = [(c, CHANNELS[c][0]) for c in channels if c in CHANNELS]
+        self.flag_columns = [(c, FLAGS[c][0]) for c in channels if c in FLAGS]
+        self.out = np.empty((n, min(plan.samples, plan.chunk_samples), K.N_CHANNELS))
+        self.out_flags = np.zeros((n, self.out.shape[1], 2), dtype=np.bool_)
+        self.statistics = RunStatistics(0.5 * (self.params[:, K.P_Z_LOW]
+                                               + self.params[:, K.P_Z_HIGH]))
+        self.bounds = np.linspace(0, n, workers + 1).astype(int)
+        self.pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
+        self.done = 0  # steps done
+        self.row = 1  # rows kept
+        self.diverged = False  # a failing case fails alone: the batch goes on
+
+    def close(self):
+        if self.pool is not None:
+            self.pool.shutdown()
+
+    def absorb(self, rows, start_row, first_row, a=0, b=None):
+        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics."""
+        cases = slice(a, b)
+        block = self.out[cases, first_row:first_row + rows]
+        marks = self.out_flags[cases, first_row:first_row + rows]
+        for name, col in self.values:
+            self.kept[name][cases, start_row:start_row + rows] = block[:, :, col]
+        for name, col in self.flag_columns:
+            self.kept[name][cases, start_row:start_row + rows] = marks[:, :, col]
+        self.statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
+                            marks[:, :, K.O_LOCKED], cases)
+
+    def _kernel(self, steps, a, b):
+        """Advance cases ``a..b-1`` by ``steps`` steps from step ``self.done``."""
+        if b - a == 1:  # the one-case kernel: the same numbers, without lane bookkeeping
+            if self.status[a] == K.STATUS_OK:
+                self.status[a], self.written[a] = _lanes.run_single(
+                    self.solver, steps, self.decimation, self.states[a], self.flags[a],
+                    self.params[a], self.ex, self.table, self.out[a], self.out_flags[a], 0)
+            return
+        for first in range(a, b, _lanes.MAX_LANES):
+            last = min(first + _lanes.MAX_LANES, b)
+            code = _lanes.run_lanes(self.solver, self.done, steps, self.decimation,
+                                    self.states[first:last], self.flags[first:last],
+                                    self.params[first:last], self.ex, self.table,
+                                    self.out[first:last], self.out_flags[first:last], 0,
+                                    self.status[first:last], self.written[first:last])
+            if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long
+                raise RuntimeError(f"the batch kernel refused {last - first} cases (at most "
+                                   f"{_lanes.MAX_LANES} per call)")
+
+    def _share(self, steps, rows, a, b):
+        """One thread's share of a chunk: advance cases a..b-1, then keep their rows."""
+        self._kernel(steps, a, b)
+        ok = self.status[a:b] == K.STATUS_OK
+        if np.any(self.written[a:b][ok] != rows):  # pragma: no cover
+            raise RuntimeError("batch kernel wrote an unexpected number of rows")
+        for c in a + np.flatnonzero(~ok):  # keep the part that finished
+            self.out[c, self.written[c]:rows] = np.nan
+            self.out_flags[c, self.written[c]:rows] = False
+        self.absorb(rows, self.row, 0, a, b)
+
+    def advance(self, steps, buffer, row0):
+        """Advance every case ``steps`` steps; returns the rows each kept."""
+        if steps == 0:  # compile (or load) only the kernels the shares will use
+            sizes = {int(b - a) for a, b in zip(self.bounds[:-1], self.bounds[1:]) if b > a}
+            if 1 in sizes:
+                self._kernel(0, 0, 1)
+            if any(size > 1 for size in sizes):
+                self._kernel(0, 0, min(len(self.status), _lanes.MAX_LANES))
+            return 0
+        rows = (self.done + steps) // self.decimation - self.done // self.decimation
+        before = self.status.copy()
+        shares = range(len(self.bounds) - 1)
+        if self.pool is None:
+            self._share(steps, rows, 0, len(self.status))
+        else:
+            list(self.pool.map(lambda i: self._share(steps, rows, self.bounds[i],
+                                                     self.bounds[i + 1]), shares))
+        newly = (before == K.STATUS_OK) & (self.status != K.STATUS_OK)
+        self.failed_at[newly] = self.flags[newly, K.I_STEP]
+        self.row += rows
+        self.done += steps
+        return rows

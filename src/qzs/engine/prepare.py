@@ -14,7 +14,7 @@ from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Si
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample", "chunk_steps",
+__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample",
            "divergence_message"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
@@ -117,34 +117,6 @@ def _check_type(name, value, kinds):
     if not isinstance(value, kinds):
         names = " or ".join(k.__name__ for k in kinds)
         raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
-
-
-def chunk_steps(decimation, max_steps, max_samples):
-    """Integration steps per kernel call [-]: the one rule for every driver.
-
-    A whole number of output samples and of :data:`~qzs.engine.kernels.PHASE_PERIOD` (the
-    excitation's sine and cosine are exact on those steps), so that cutting a run into
-    calls changes no bit: a single run and a batch give the same numbers whatever their
-    chunks (docs/model.md §9).
-
-    Parameters
-    ----------
-    decimation : int
-        Integration steps per output sample [-].
-    max_steps : int
-        Most steps per call [-] (progress and Ctrl-C granularity).
-    max_samples : int
-        Most output samples per call [-] (the buffer).
-
-    Returns
-    -------
-    int
-        A multiple of ``lcm(decimation, PHASE_PERIOD)``, at least one, within both bounds
-        where one multiple fits.
-    """
-    unit = int(np.lcm(int(decimation), K.PHASE_PERIOD))
-    steps = min(int(max_steps), int(max_samples) * int(decimation))
-    return unit * max(1, steps // unit)
 
 
 def _initial_state(initial, isolator, controller, p, excitation, packed_excitation):
