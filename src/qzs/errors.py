@@ -212,7 +212,7 @@ def _span(seconds):
     for unit, size in (("year", 365.25 * 86400), ("day", 86400), ("h", 3600), ("min", 60)):
         if seconds >= size:
             value = seconds / size
-            plural = "s" if len(unit) > 3 and f"{value:.3g}" != "1" else ""
+            plural = "s" if unit in ("year", "day") and f"{value:.3g}" != "1" else ""
             return f"{value:.3g} {unit}{plural}"
     return f"{seconds:.3g} s"
 
