@@ -115,8 +115,9 @@ class PeriodicRun:
         steps = int(round(ratio))
         if steps < 1 or abs(ratio - steps) > 1e-6 * ratio or steps % run.decimation:
             raise ParameterError(
-                f"`period` ({period!r} s) must be a whole number of output samples of "
-                f"{run.decimation} steps dt = {run.dt!r} s; got {ratio:g} steps.")
+                f"`period` ({period!r} s) must hold a whole number of output samples of "
+                f"{run.decimation} steps of dt = {run.dt!r} s each; got {ratio:g} steps. Use "
+                f"dt = period/n with n a multiple of {run.decimation}.")
         self._run = run
         self._state, self._flags = run.state, run.flags
         if carried is not None:
