@@ -12,6 +12,7 @@
 ``batch``        :func:`simulate_batch`, many parameter sets at once
 ``results``      :class:`SimulationResult`
 ``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
+``periodic``     :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
 ``hexapod``      :func:`simulate_hexapod`, six isolator legs under a rigid platform
 ===============  ==================================================================
 """

@@ -49,7 +49,7 @@ def _draw_balance(axes, curve, values, scale=1.0):
 
 
 def plot_response(response, path=None, title=None):
-    """Draw a :class:`~qzs.workflows.response.SteadyStateResponse`.
+    """Draw a :class:`~qzs.workflows.response.result.SteadyStateResponse`.
 
     Parameters
     ----------
