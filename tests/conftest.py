@@ -94,7 +94,10 @@ def validation(request):
             entry = {"check": check, "reference": reference,
                      "error": error if math.isfinite(error) else repr(error),
                      "tolerance": tolerance, "measure": measure,
-                     "test": request.node.nodeid, "module": request.module.__name__,
+                     "test": request.node.nodeid,
+                     # the test module's path under tests/, dotted (importlib mode names
+                     # it tests.engine.test_driver): the key of the page's SECTIONS
+                     "module": request.module.__name__.removeprefix("tests."),
                      "section": " ".join(doc.split("\n\n")[0].split())}
             with open(path, "a", encoding="utf-8") as stream:
                 stream.write(json.dumps(entry) + "\n")
