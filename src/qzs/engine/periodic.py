@@ -26,8 +26,8 @@ import numpy as np
 
 from qzs import defaults
 from qzs.engine import kernels as K
-from qzs.engine import lanes
 from qzs.engine.prepare import divergence_message, prepare_run
+from qzs.engine.simulate import SingleAxis
 from qzs.errors import ParameterError
 
 __all__ = ["PeriodicRun", "CarriedState", "STATE_VARIABLES"]
@@ -120,6 +120,9 @@ class PeriodicRun:
                 f"dt = period/n with n a multiple of {run.decimation}.")
         self._run = run
         self._state, self._flags = run.state, run.flags
+        # the one-case stepper of the run driver (qzs.engine.driver), one period per call
+        self._buffers = [None]
+        self._stepper = SingleAxis(run, self._buffers)
         if carried is not None:
             self._state[:] = carried.state
             self._state[K.S_W_BASE:K.S_D_STOP + 1] = 0.0  # a fresh energy ledger
@@ -172,11 +175,11 @@ class PeriodicRun:
         return self._advance(self.steps_per_period, rows, marks)
 
     def _advance(self, steps, rows, marks):
-        """The kernel call: ``steps`` steps from the current state; True if it diverged."""
-        run = self._run
-        status, _ = lanes.run_single(run.solver_code, steps, run.decimation, self._state,
-                                     self._flags, run.params, *run.packed, rows, marks, 0)
-        return status != K.STATUS_OK
+        """``steps`` steps from the current state through the single-axis stepper of the run
+        driver (:class:`qzs.engine.simulate.SingleAxis`); True if it diverged."""
+        self._buffers[0] = (rows, marks)
+        self._stepper.advance(steps, 0, 0)
+        return self._stepper.diverged
 
     def state_of(self, names):
         """The state now (at a period boundary) by name.
