@@ -2,7 +2,7 @@
 A controller design's figures
 =============================
 
-:meth:`DesignResult.plot <qzs.workflows.design.DesignResult.plot>` (that is,
+:meth:`DesignResult.plot <qzs.workflows.design.result.DesignResult.plot>` (that is,
 :func:`qzs.viz.design.plot_design`) draws one figure per question ``qzs design`` answers, in
 this order:
 

@@ -49,7 +49,8 @@ _LAZY = {
     "simulate_hexapods": "qzs.engine.hexapod",
     "steady_state_response": "qzs.workflows.response.sweep",
     "SteadyStateResponse": "qzs.workflows.response.result",
-    "design_controller": "qzs.workflows.design", "DesignResult": "qzs.workflows.design",
+    "design_controller": "qzs.workflows.design.driver",
+    "DesignResult": "qzs.workflows.design.result",
     "hexapod_transmissibility": "qzs.workflows.hexapod_transmissibility",
     "HexapodTransmissibility": "qzs.workflows.hexapod_transmissibility",
 }

@@ -1,7 +1,8 @@
 """Figures of a controller design (``qzs design``): every axis with its quantity and unit.
 
-Each function takes plain numbers (the records of :class:`qzs.workflows.design.DesignResult`)
-and returns a matplotlib figure; :func:`plot_design` draws them all from a result.
+Each function takes plain numbers (the records of
+:class:`qzs.workflows.design.result.DesignResult`) and returns a matplotlib figure;
+:func:`plot_design` draws them all from a result.
 """
 import math
 
@@ -34,7 +35,7 @@ def plot_static_design(static, gravity=9.81):
     Parameters
     ----------
     static : StaticDesign
-        The static design (:func:`qzs.analysis.control_design.static_design`).
+        The static design (:func:`qzs.analysis.control_design.static.static_design`).
     gravity : float
         Gravitational acceleration [m/s^2].
 
@@ -429,7 +430,7 @@ def plot_design(result):
     Parameters
     ----------
     result : DesignResult
-        The design (:func:`qzs.workflows.design.design_controller`).
+        The design (:func:`qzs.workflows.design.driver.design_controller`).
 
     Returns
     -------

@@ -1,0 +1,416 @@
+"""Hunting at rest: the stick-slip element in the integral loop, by describing functions.
+
+Combining the payload with its friction (Olsson's remedy) gives a stick-slip element in the
+*integral* loop: the payload stays stuck while the integral force ``u`` is within ``Fs`` of
+``K*zeta`` (``K = k + Kp``, ``zeta = z - z_ref``); when it breaks away it slides, and stops
+(inertia carries it past the least force that keeps it sliding, the quasi-static re-stick
+level ``F_r = min_v [Fc + (Fs - Fc)*exp(-Cbc*v) + Cv*v]``, :func:`restick_force`) with its
+stuck position moved by a jump ``J`` in force units, integrated from rest over the one slip
+(:func:`slip_jump`). While one slip happens per half cycle this element is a relay with
+hysteresis in force units: output ``K*zeta = +-d``, ``d = J/2``, switching at ``u = +-h``,
+``h = Fs - d``. The linear part from its output back to its input is
+``G(s) = Ki/(s*(m s^2 + Cv s + K + Kd s HP(s)))`` (:func:`integral_loop`). Its describing
+function (python-control's ``relay_hysteresis_nonlinearity``) meets ``G`` at one amplitude
+and frequency: a hunting cycle, square in position with plateaus ``+-d/K`` [m], whose exact
+period with instant slips is ``4*h*K/(Ki*d)``. No slip jump (the Stribeck dip does not beat
+the damping: the payload creeps) or no integral: no hunting. :func:`predict_hunting` runs
+both analyses, this one and the memoryless friction law's of :mod:`.describing_functions`.
+
+References
+----------
+H. Olsson, K. J. Åström, "Friction generated limit cycles", IEEE Trans. Control Syst.
+Technol. 9(4), 2001.
+"""
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs.analysis.control_design._arguments import _number
+from qzs.analysis.control_design.describing_functions import FrictionNonlinearity
+from qzs.analysis.control_design.linear_stability import _stable
+from qzs.analysis.linear import loop_constants
+from qzs.model.registry import model_inputs
+
+__all__ = ["restick_force", "slip_jump", "HuntingPrediction", "integral_loop",
+           "hunting_stiffness", "predict_hunting", "SLIP_JUMP_FLOOR"]
+
+#: A slip jump below this share of the stiction force is the start kick's creep, not a slip [-].
+SLIP_JUMP_FLOOR = 1e-4
+
+
+def restick_force(isolator=None):
+    """Least driving force [N] that keeps the payload sliding: the re-stick level.
+
+    ``min over v >= 0 of Fc + (Fs - Fc)*exp(-Cbc*v) + Cv*v``: at ``v* = ln(Cbc*(Fs - Fc)/Cv)/Cbc``
+    when ``Cbc*(Fs - Fc) > Cv`` (the Stribeck dip is steeper than the viscous rise), else at
+    ``v = 0`` (then ``Fs``: no slip jump, no hunting).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+
+    Returns
+    -------
+    float
+        ``F_r`` [N].
+    """
+    isolator, _ = model_inputs(isolator, None)
+    fs, fc = isolator.stiction_force, isolator.coulomb_force
+    cbc, cv = isolator.stribeck_decay, isolator.viscous_damping
+    drop = cbc * (fs - fc)
+    if cv <= 0:
+        return fc
+    if drop <= cv:
+        return fs
+    velocity = math.log(drop / cv) / cbc
+    return fc + cv / cbc + cv * velocity
+
+
+def slip_jump(isolator=None, controller=None, relative_position=None):
+    """Force [N] by which one slip from rest moves the stuck position ``K*zeta``.
+
+    The payload stuck, the loop's force on it ``F = u - K*zeta`` just above the breakaway
+    force ``Fs``, the integral force ``u`` held (it changes little during the short slip):
+
+        m v' = F - [Fc + (Fs - Fc) exp(-Cbc v)] - Cv v - Kd (v - w),
+        F'   = -K v,      w' = w_hp (v - w)      (the amplifier's high-pass, settled at rest)
+
+    integrated (scipy, LSODA) from ``F = Fs*(1 + 1e-6)`` until the payload stops (``v`` back
+    to 0). The jump is ``Fs - F`` at that instant: the inertia carries the payload past the
+    quasi-static re-stick level :func:`restick_force`, so the jump is larger than
+    ``Fs - F_r``. No jump when the Stribeck dip cannot beat the damping: the payload creeps
+    by the start kick's share only (below :data:`SLIP_JUMP_FLOOR` of ``Fs``, reported as 0).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        Supplies ``Kp`` (with the spring's tangent stiffness, ``K``), ``Kd`` and the high-pass.
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+
+    Returns
+    -------
+    jump : float
+        ``Fs - F`` when the payload stops [N] (0: it never broke into a slip).
+    duration : float
+        Length of the slip [s] (NaN if it did not end within the time allowed).
+    """
+    from scipy.integrate import solve_ivp
+
+    isolator, controller = model_inputs(isolator, controller)
+    m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
+    fs, fc, cbc = isolator.stiction_force, isolator.coulomb_force, isolator.stribeck_decay
+    k_total = k + kp
+    if fs <= 0 or k_total <= 0:
+        return 0.0, math.nan
+
+    def rates(_, y):
+        v, force, lagged = y
+        friction = fc + (fs - fc) * math.exp(-cbc * max(v, 0.0))
+        return [(force - friction - cv * v - kd * (v - lagged)) / m, -k_total * v,
+                w * (v - lagged)]
+
+    def stopped(_, y):
+        return y[0] + 1e-15
+    stopped.terminal, stopped.direction = True, -1
+    horizon = 40 * (m / max(cv, 1e-9) + max(cv, 1e-9) / k_total + (1 / w if w > 0 else 0))
+    horizon = min(horizon, 1e4)
+    solution = solve_ivp(rates, (0.0, horizon), [0.0, fs * (1 + 1e-6), 0.0], method="LSODA",
+                         events=stopped, rtol=1e-8, atol=[1e-12, 1e-9 * max(fs, 1.0), 1e-12])
+    if solution.status != 1:
+        return 0.0, math.nan
+    jump = max(0.0, fs - float(solution.y[1, -1]))
+    if jump < SLIP_JUMP_FLOOR * fs:  # the kick's own creep: no slip
+        jump = 0.0
+    return jump, float(solution.t[-1])
+
+
+@dataclass(frozen=True)
+class HuntingPrediction:
+    """What describing functions predict about a stick-slip limit cycle at rest.
+
+    Attributes
+    ----------
+    friction_intersections : tuple of (float, float)
+        Intersections (velocity amplitude [m/s], frequency [Hz]) of the memoryless friction
+        law's ``-1/N`` with the PI loop's Nyquist curve: none for a linearly stable loop.
+    steady_restick_force : float
+        Quasi-static re-stick level ``F_r`` [N] (:func:`restick_force`).
+    slip_jump : float
+        Jump ``J`` of the stuck position in force units over one slip [N] (:func:`slip_jump`).
+    relay_output : float
+        Half the slip jump, ``d = J/2`` [N].
+    switching_force : float
+        Switching level of the relay, ``h = Fs - d`` [N].
+    stiffness : float
+        ``K = k(z_ref) + Kp`` [N/m].
+    hunts : bool
+        The stick-slip element's describing function meets the integral loop.
+    integral_force_amplitude : float
+        Amplitude of the integral force at the intersection [N] (NaN if none).
+    frequency : float
+        Predicted hunting frequency [Hz] (NaN if none).
+    period : float
+        ``1/frequency`` [s].
+    amplitude : float
+        Predicted plateau of the position about the setpoint, ``d/K`` [m].
+    first_harmonic_amplitude : float
+        First harmonic of the position at the intersection [m].
+    relay_period : float
+        Exact period of the relay-integrator cycle with instant slips, ``4*h*K/(Ki*d)`` [s]
+        (the describing function's square-wave error is about 23 %).
+    in_regime : bool
+        The intersection lies where the element slips once per half cycle
+        (``A < h + 2*d``), the regime in which it is a relay with hysteresis.
+    reasons : dict
+        Name -> why a number is undefined.
+    """
+
+    friction_intersections: tuple
+    steady_restick_force: float
+    slip_jump: float
+    relay_output: float
+    switching_force: float
+    stiffness: float
+    hunts: bool
+    integral_force_amplitude: float
+    frequency: float
+    period: float
+    amplitude: float
+    first_harmonic_amplitude: float
+    relay_period: float
+    in_regime: bool
+    reasons: dict = field(default_factory=dict)
+
+    def to_dict(self):
+        """The prediction as a plain ``dict``."""
+        out = dict(self.__dict__)
+        out["friction_intersections"] = [list(p) for p in self.friction_intersections]
+        return out
+
+
+def _fast_denominator(m, cv, k_total, kd, w):
+    """``m s^2 + Cv s + K + Kd s HP(s)`` as a python-control transfer function."""
+    import control
+
+    s = control.tf("s")
+    highpass = s / (s + w) if w > 0 else 1
+    return m * s ** 2 + cv * s + k_total + kd * s * highpass
+
+
+def _velocity_loop(m, cv, k_total, ki, kd, w):
+    """Slip velocity per friction force with the PI loop closed (base at rest)."""
+    import control
+
+    s = control.tf("s")
+    integral = ki / s if ki > 0 else 0
+    return control.minreal(control.tf(s / (_fast_denominator(m, cv, k_total, kd, w) + integral)),
+                           verbose=False)
+
+
+def integral_loop(isolator=None, controller=None, relative_position=None):
+    """``G(s) = Ki/(s*(m s^2 + Cv s + K + Kd s HP(s)))`` [-]: the stick-slip element's loop.
+
+    From the element's output (the stuck position in force units, ``K*zeta`` [N]) back to
+    its input (the integral force [N]), sign of negative feedback.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+
+    Returns
+    -------
+    control.TransferFunction
+    """
+    import control
+
+    isolator, controller = model_inputs(isolator, controller)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
+    s = control.tf("s")
+    return control.minreal(control.tf(ki / (s * _fast_denominator(m, cv, k + kp, kd, w))),
+                           verbose=False)
+
+
+def hunting_stiffness(isolator=None, controller=None, half_width=None):
+    """Least proportional gain [N/m] whose predicted hunting plateau ``d/K`` fits a half-width.
+
+    ``d = J(K)/2`` from :func:`slip_jump`, which depends on ``K = k + Kp`` only mildly: the
+    smallest ``Kp`` with ``J/(2K) <= half_width`` by bisection (the plateau falls with ``K``).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        Damping loop and high-pass (its ``Kp`` is varied).
+    half_width : float
+        Half-width of the band about the setpoint [m].
+
+    Returns
+    -------
+    float
+        The least ``Kp`` [N/m] (0 if no slip jump even at ``Kp = 0``; NaN above 1e5 N/m).
+    """
+    isolator, controller = model_inputs(isolator, controller)
+    half_width = _number("half_width", half_width, strict=True)
+
+    def plateau(kp):
+        trial = dataclasses.replace(controller, pi_kp=kp)
+        k_total = loop_constants(isolator, trial, None)[2] + kp
+        return slip_jump(isolator, trial)[0] / (2 * k_total)
+
+    if plateau(0.0) <= half_width:
+        return 0.0
+    low, high = 0.0, 1.0
+    while plateau(high) > half_width:
+        low, high = high, 2 * high
+        if high > 1e5:
+            return math.nan
+    while high - low > 1e-3 * high:
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if plateau(mid) > half_width else (low, mid)
+    return high
+
+
+def predict_hunting(isolator=None, controller=None, relative_position=None):
+    """Describing-function prediction of hunting at rest (python-control).
+
+    Two analyses (see the module's text): the memoryless friction law in the velocity loop
+    (:func:`control.describing_function_response` with :class:`FrictionNonlinearity`), and
+    the stick-slip element (python-control's ``relay_hysteresis_nonlinearity(d, h)``,
+    ``d = J/2``, ``h = Fs - d``, ``J`` from :func:`slip_jump`) in the integral loop
+    :func:`integral_loop`.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+
+    Returns
+    -------
+    HuntingPrediction
+    """
+    isolator, controller = model_inputs(isolator, controller)
+    numbers = tuple(loop_constants(isolator, controller, relative_position))
+    m, cv, k, kp, ki, kd, w = numbers
+    k_total = k + kp
+    reasons = {}
+    friction = _memoryless_intersections(isolator, numbers)
+    jump = slip_jump(isolator, controller, relative_position)[0]
+    d = 0.5 * jump
+    h = isolator.stiction_force - d
+    nan = math.nan
+    amplitude_u = frequency = first = nan
+    hunts = in_regime = False
+    reason = _why_no_relay_cycle(isolator, ki, d, k_total)
+    if reason:
+        reasons["hunts"] = reason
+    else:
+        cycle = _relay_cycle(isolator, controller, relative_position, numbers, d, h, reasons)
+        if cycle is not None:
+            amplitude_u, frequency, first, in_regime = cycle
+            hunts = True
+    for name in ("integral_force_amplitude", "frequency", "period", "first_harmonic_amplitude"):
+        if not hunts:
+            reasons.setdefault(name, reasons.get("hunts", "no limit cycle predicted"))
+    plateau = d / k_total if (d > 0 and k_total > 0) else nan
+    relay_period = 4 * h * k_total / (ki * d) if (ki > 0 and d > 0 and k_total > 0) else nan
+    if not math.isfinite(plateau):
+        reasons.setdefault("amplitude", reasons.get("hunts", "no slip jump"))
+    if not math.isfinite(relay_period):
+        reasons.setdefault("relay_period", reasons.get("hunts", "no cycle"))
+    return HuntingPrediction(
+        friction_intersections=tuple(friction), steady_restick_force=restick_force(isolator),
+        slip_jump=jump, relay_output=d, switching_force=h, stiffness=k_total, hunts=hunts,
+        integral_force_amplitude=amplitude_u, frequency=frequency,
+        period=1 / frequency if hunts and frequency > 0 else nan,
+        amplitude=plateau, first_harmonic_amplitude=first, relay_period=relay_period,
+        in_regime=in_regime, reasons=reasons)
+
+
+def _memoryless_intersections(isolator, numbers):
+    """The friction law alone, a memoryless function of slip velocity, in the PI loop.
+
+    Intersections (velocity amplitude [m/s], frequency [Hz]) of its ``-1/N`` with the velocity
+    loop's Nyquist curve; none without stiction or for a linearly unstable loop.
+    """
+    import warnings
+
+    import control
+
+    m, cv, k, kp, ki, kd, w = numbers
+    if not (isolator.stiction_force > 0 and _stable((m, cv, k, kp, ki, kd, w))):
+        return []
+    law = FrictionNonlinearity(isolator.stiction_force, isolator.coulomb_force,
+                               isolator.stribeck_decay)
+    loop = _velocity_loop(m, cv, k + kp, ki, kd, w)
+    amplitudes = np.logspace(-6, 1, 36)
+    omega = np.logspace(-4, 4, 400)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        response = control.describing_function_response(loop, law, amplitudes, omega=omega)
+    return [(float(a), float(wi) / (2 * np.pi)) for a, wi in response.intersections]
+
+
+def _why_no_relay_cycle(isolator, ki, d, k_total):
+    """Why the stick-slip element cannot cycle ('' when it may)."""
+    if ki <= 0:
+        return "no integral action: nothing winds up while the payload is stuck"
+    if isolator.stiction_force <= 0:
+        return "no stiction: the payload never sticks"
+    if d <= 0:
+        return ("no slip jump: after breaking away the payload creeps and stops "
+                "where it broke away (the Stribeck dip does not beat the damping)")
+    if k_total <= 0:
+        return "no stiffness K = k + Kp: the stuck position is undefined"
+    return ""
+
+
+def _relay_cycle(isolator, controller, relative_position, numbers, d, h, reasons):
+    """The stick-slip relay ``(d, h)`` in the integral loop: its cycle, or None.
+
+    Returns ``(integral force amplitude [N], frequency [Hz], first harmonic of the position
+    [m], in regime)`` at the first intersection of the relay's ``-1/N`` with
+    :func:`integral_loop`'s Nyquist curve; writes why into ``reasons`` when there is none, or
+    when the intersection lies outside the one-slip-per-half-cycle regime.
+    """
+    import warnings
+
+    import control
+
+    m, cv, k, kp, ki, kd, w = numbers
+    element = control.relay_hysteresis_nonlinearity(d, h)
+    g = integral_loop(isolator, controller, relative_position)
+    top = h + 2 * d
+    amplitudes = h * (1 + np.logspace(-9, math.log10(20 * top / h), 80))
+    omega = np.logspace(-5, 3, 500)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        response = control.describing_function_response(g, element, amplitudes, omega=omega)
+    found = [(float(a), float(wi)) for a, wi in response.intersections if a >= h and wi > 0]
+    if not found:
+        reasons["hunts"] = "the element's -1/N does not meet the integral loop's Nyquist curve"
+        return None
+    amplitude_u, w_cycle = found[0]
+    in_regime = amplitude_u < top
+    harmonic_force = abs(element.describing_function(amplitude_u)) * amplitude_u
+    first = harmonic_force / abs(_fast_denominator(m, cv, k + kp, kd, w)(1j * w_cycle))
+    if not in_regime:
+        reasons["in_regime"] = (f"the intersection's amplitude {amplitude_u:.3g} N exceeds "
+                                f"h + 2d = {top:.3g} N: the element slips more than once "
+                                "per half cycle there, the relay is a rough model")
+    return amplitude_u, w_cycle / (2 * np.pi), first, in_regime

@@ -1,0 +1,300 @@
+"""The loop broken at the motor force: continuous, sampled with a delay, and its responses.
+
+``L = (Kp + Ki/s)*P_z + Kd*P_v`` with ``P_z = 1/(m s^2 + Cv s + k)`` and
+``P_v = s*HP(s)*P_z`` (:func:`loop_transfer`); sampled as the simulator samples
+(docs/model.md §5: forward-Euler integral, zero-order hold, analog high-pass), with an exact
+discrete input delay (integer and fractional part of the period, Åström and Wittenmark's
+modified z-transform: :func:`discretize_with_delay`, :func:`sampled_loop`). A continuous
+loop with a delay uses a Padé approximant. :func:`frequency_response` evaluates any of them
+on a grid; :func:`sampled_transmissibility` is the transmissibility of the linear loop with
+a sampled, delayed controller.
+
+References
+----------
+K. J. Åström, B. Wittenmark, *Computer-Controlled Systems*, 3rd ed., §2.3 (sampling a
+system with a time delay).
+"""
+import math
+
+import numpy as np
+
+from qzs.analysis.control_design._arguments import _number
+from qzs.analysis.linear import loop_constants
+from qzs.model.registry import model_inputs
+
+__all__ = ["loop_transfer", "sampled_loop", "discretize_with_delay", "frequency_response",
+           "sampled_transmissibility", "PADE_ORDER"]
+
+#: Order of the Padé approximant of a delay in a continuous loop [-].
+PADE_ORDER = 6
+
+
+def _plant_state_space(m, cv, k, w):
+    """Force -> (z, measured velocity) with the base at rest: states z, v, high-pass w."""
+    if w > 0:
+        a = np.array([[0.0, 1.0, 0.0], [-k / m, -cv / m, 0.0], [0.0, w, -w]])
+        b = np.array([[0.0], [1.0 / m], [0.0]])
+        c = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, -1.0]])
+    else:
+        a = np.array([[0.0, 1.0], [-k / m, -cv / m]])
+        b = np.array([[0.0], [1.0 / m]])
+        c = np.array([[1.0, 0.0], [0.0, 1.0]])
+    return a, b, c
+
+
+def loop_transfer(isolator=None, controller=None, relative_position=None, *, delay=0.0):
+    """The continuous loop transfer ``L(s)`` broken at the motor force (python-control).
+
+    ``L = (Kp + Ki/s)*P_z + Kd*P_v`` with ``P_z = 1/(m s^2 + Cv s + k)`` (force to relative
+    position, base at rest) and ``P_v = s*HP(s)*P_z`` (force to the measured velocity); the
+    loop closes as ``u = -L u``. A delay enters as a Padé approximant of order
+    :data:`PADE_ORDER`.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+    delay : float
+        Delay between the measurements and the motor force [s].
+
+    Returns
+    -------
+    control.TransferFunction
+        ``L(s)`` [-] (force per force).
+    """
+    import control
+
+    isolator, controller = model_inputs(isolator, controller)
+    delay = _number("delay", delay)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
+    s = control.tf("s")
+    plant = 1 / (m * s ** 2 + cv * s + k)
+    highpass = s / (s + w) if w > 0 else 1
+    pi = kp + (ki / s if ki > 0 else 0)
+    loop = pi * plant + kd * s * highpass * plant
+    if delay > 0:
+        num, den = control.pade(delay, PADE_ORDER)
+        loop = loop * control.tf(num, den)
+    return control.minreal(control.tf(loop), verbose=False)
+
+
+def _delayed_hold(a, b, period, delay):
+    """``Phi, G0, G1``, whole periods and fraction [s] of a zero-order hold delayed by ``delay``."""
+    from scipy.linalg import expm
+
+    n_states = a.shape[0]
+    whole = int(math.floor(delay / period + 1e-9))
+    fraction = delay - whole * period
+    if fraction < 1e-12 * period:
+        fraction = 0.0
+
+    def held(t):  # int_0^t exp(A s) ds B
+        block = np.zeros((n_states + 1, n_states + 1))
+        block[:n_states, :n_states] = a
+        block[:n_states, n_states:] = b
+        return expm(block * t)[:n_states, n_states:]
+
+    phi = expm(a * period)
+    g0 = held(period - fraction)
+    g1 = expm(a * (period - fraction)) @ held(fraction) if fraction > 0 else np.zeros_like(g0)
+    return phi, g0, g1, whole, fraction
+
+
+def _sampled_response(isolator, controller, rate, delay, omega, relative_position=None):
+    """``L(exp(j w T))`` of :func:`sampled_loop` on a grid, without its delay-line states.
+
+    ``P(z) = C (zI - Phi)^-1 (G0 + G1/z) z^-n`` and the controller's row
+    ``[Kp + Ki T/(z - 1), Kd]``: the same loop, evaluated with the plant's own 2-3 states.
+    """
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
+    a, b, c = _plant_state_space(m, cv, k, w)
+    period = 1.0 / rate
+    phi, g0, g1, whole, _ = _delayed_hold(a, b, period, delay)
+    z = np.exp(1j * np.asarray(omega, dtype=float) * period)
+    n = a.shape[0]
+    shifted = z[:, None, None] * np.eye(n)[None] - phi[None]
+    held = g0[None] + g1[None] / z[:, None, None]
+    plant = c[None] @ np.linalg.solve(shifted, held)  # (N, 2, 1)
+    plant = plant[:, :, 0] * (z ** -whole)[:, None]
+    pi = kp + (ki * period / (z - 1) if ki > 0 else 0)
+    return pi * plant[:, 0] + kd * plant[:, 1]
+
+
+def discretize_with_delay(a, b, c, period, delay=0.0):
+    """Exact zero-order-hold discretisation with an input delay (modified z-transform).
+
+    A delay ``tau = n*T + e*T`` (``0 <= e < 1``) holds each input for ``T`` starting ``tau``
+    after its sample: ``x[k+1] = Phi*x[k] + G0*u[k-n] + G1*u[k-n-1]`` with
+    ``G0 = int_0^{T-eT} exp(A s) ds B`` and ``G1 = exp(A (T-eT)) int_0^{eT} exp(A s) ds B``
+    (Åström and Wittenmark §2.3); past inputs become states.
+
+    Parameters
+    ----------
+    a, b, c : array_like
+        Continuous state-space matrices (no feed-through), shapes (n, n), (n, 1), (p, n).
+    period : float
+        Sampling period T [s].
+    delay : float
+        Input delay [s].
+
+    Returns
+    -------
+    control.StateSpace
+        The discrete system, ``dt = period``.
+    """
+    import control
+
+    a, b, c = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (a, b, c))
+    period = _number("period", period, strict=True)
+    delay = _number("delay", delay)
+    n_states = a.shape[0]
+    phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
+    line = whole + (1 if fraction > 0 else 0)  # past inputs kept as states
+    size = n_states + line
+    ad = np.zeros((size, size))
+    bd = np.zeros((size, 1))
+    ad[:n_states, :n_states] = phi
+    # past inputs q_1 = u[k-1], ..., q_line = u[k-line]
+    if line:
+        bd[n_states, 0] = 1.0
+        for i in range(1, line):
+            ad[n_states + i, n_states + i - 1] = 1.0
+    if whole == 0:
+        bd[:n_states] += g0
+    else:
+        ad[:n_states, n_states + whole - 1] += g0[:, 0]
+    if fraction > 0:
+        ad[:n_states, n_states + whole] += g1[:, 0]
+    cd = np.hstack([c, np.zeros((c.shape[0], line))])
+    return control.ss(ad, bd, cd, np.zeros((c.shape[0], 1)), period)
+
+
+def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_position=None):
+    """The sampled loop transfer ``L(z)`` at the controller's rate (python-control).
+
+    The simulator's sampled controller (docs/model.md §5): it reads the relative position and
+    the measured velocity (the amplifier's analog high-pass stays in the plant), computes
+    ``Kp*e + Ki*I`` with the forward-Euler integral ``I[n+1] = I[n] + T*e[n]``
+    (``C_pi(z) = Kp + Ki*T/(z - 1)``) minus ``Kd*v``, and holds the force (zero-order hold)
+    after ``delay``. The plant is discretised exactly (:func:`discretize_with_delay`).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    rate : float, optional
+        Controller rate [Hz]; default the controller's ``controller_rate`` (must then be > 0).
+    delay : float
+        Delay from sampling to the motor force [s].
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+
+    Returns
+    -------
+    control.StateSpace
+        ``L(z)`` [-] with ``dt = 1/rate``.
+    """
+    import control
+
+    isolator, controller = model_inputs(isolator, controller)
+    rate = controller.controller_rate if rate is None else rate
+    rate = _number("rate", rate, strict=True,
+                   fix="; a sampled loop needs a controller rate in Hz")
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
+    period = 1.0 / rate
+    plant = discretize_with_delay(*_plant_state_space(m, cv, k, w), period, delay)
+    # C(z) = [Kp + Ki*T/(z - 1), Kd] on (z, v): state I, I[n+1] = I[n] + T*z[n]
+    if ki > 0:
+        gains = control.ss([[1.0]], [[period, 0.0]], [[ki]], [[kp, kd]], period)
+    else:
+        gains = control.ss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), [[kp, kd]],
+                           period)
+    return gains * plant
+
+
+def frequency_response(system, omega):
+    """Complex response of a SISO python-control system on a grid, vectorised.
+
+    Parameters
+    ----------
+    system : control.StateSpace or control.TransferFunction
+        Continuous (``dt = 0``) or discrete.
+    omega : array_like
+        Angular frequencies [rad/s].
+
+    Returns
+    -------
+    ndarray of complex
+        ``L(j*omega)``, or ``L(exp(j*omega*dt))`` for a discrete system [-].
+    """
+    import control
+
+    space = control.ss(system)
+    a, b, c, d = (np.asarray(x, dtype=float) for x in (space.A, space.B, space.C, space.D))
+    omega = np.asarray(omega, dtype=float)
+    dt = space.dt if space.dt not in (None, True) else 0
+    points = np.exp(1j * omega * dt) if dt else 1j * omega
+    if a.size == 0:
+        return np.full(omega.shape, d[0, 0], dtype=complex)
+    n = a.shape[0]
+    shifted = points[:, None, None] * np.eye(n)[None] - a[None]
+    solved = np.linalg.solve(shifted, np.broadcast_to(b.astype(complex), (omega.size, n, 1)))
+    return (c[None] @ solved)[:, 0, 0] + d[0, 0]
+
+
+def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=None,
+                             delay=0.0):
+    """``|X/Y|`` [-] of the linear loop with a sampled controller and a delay.
+
+    The controller's fundamental-frequency response (the sampled-data loop's response at the
+    excitation's own frequency; aliased components left out, fine well below the Nyquist
+    frequency): each gain times the zero-order hold ``(1 - exp(-jwT))/(jwT)`` and
+    ``exp(-jw delay)``, the integral as ``Ki*T/(exp(jwT) - 1)``:
+
+        T(jw) = (Cv s + k + C_pi) / (m s^2 + Cv s + k + C_pi + C_d s HP(s)).
+
+    With ``rate`` 0 the controller is continuous (``C_pi = Kp + Ki/s``), delayed by ``delay``.
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequencies [Hz], > 0.
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    rate : float, optional
+        Controller rate [Hz]; 0 continuous; default the controller's.
+    delay : float
+        Delay from sampling to the motor force [s].
+
+    Returns
+    -------
+    ndarray
+        Amplitude ratio [-].
+    """
+    isolator, controller = model_inputs(isolator, controller)
+    rate = controller.controller_rate if rate is None else rate
+    rate = _number("rate", rate)
+    delay = _number("delay", delay)
+    f = np.asarray(frequency, dtype=float)
+    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, None)
+    s = 2j * np.pi * f
+    lag = np.exp(-s * delay)
+    if rate > 0:
+        period = 1.0 / rate
+        zoh = np.where(np.abs(s) > 0, (1 - np.exp(-s * period)) / (s * period + 1e-300), 1.0)
+        pi = (kp + ki * period / (np.exp(s * period) - 1)) * zoh * lag
+        damping = kd * zoh * lag
+    else:
+        pi = (kp + ki / s) * lag
+        damping = kd * lag
+    highpass = s / (s + w) if w > 0 else 1.0
+    coupling = cv * s + k + pi
+    return np.abs(coupling / (m * s ** 2 + coupling + damping * s * highpass))

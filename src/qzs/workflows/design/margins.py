@@ -1,0 +1,32 @@
+"""The sampled loop's margins at the design's gains, over rates and delays; the rate needed."""
+from qzs.analysis import control_design as cd
+from qzs.workflows.design.settings import DELAYS, RATES
+
+
+def _margins(settings, kp, kd):
+    controller = settings.controller_at(kp, kd)
+    design = cd.loop_margins(settings.isolator, controller, settings.controller_rate,
+                             settings.delay)
+    continuous = cd.loop_margins(settings.isolator, controller, 0.0, 0.0)
+    table = [cd.loop_margins(settings.isolator, controller, rate, settings.delay).to_dict()
+             for rate in RATES]
+    needed, reason = cd.required_controller_rate(
+        settings.isolator, controller, settings.delay, gain_margin_min=settings.gain_margin_min,
+        phase_margin_min=settings.phase_margin_min)
+    needed0, reason0 = cd.required_controller_rate(
+        settings.isolator, controller, 0.0, gain_margin_min=settings.gain_margin_min,
+        phase_margin_min=settings.phase_margin_min)
+    by_delay = []
+    for delay in sorted({*DELAYS, settings.delay}):
+        rate, why = cd.required_controller_rate(
+            settings.isolator, controller, delay, gain_margin_min=settings.gain_margin_min,
+            phase_margin_min=settings.phase_margin_min)
+        continuous_delayed = cd.loop_margins(settings.isolator, controller, 0.0, delay)
+        by_delay.append({"delay": delay, "required_rate": rate, "reason": why,
+                         "continuous_gain_margin": continuous_delayed.gain_margin,
+                         "continuous_phase_margin": continuous_delayed.phase_margin})
+    return {"design": design.to_dict(), "continuous": continuous.to_dict(), "table": table,
+            "by_delay": by_delay,
+            "required_rate": needed, "required_rate_reason": reason,
+            "required_rate_without_delay": needed0, "required_rate_without_delay_reason": reason0,
+            "meets": design.meets(settings.gain_margin_min, settings.phase_margin_min)}

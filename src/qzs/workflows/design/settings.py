@@ -1,0 +1,106 @@
+"""The design's defaults and search sizes, and the validated settings every stage shares."""
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from qzs.errors import ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.isolator import IsolatorParameters
+
+__all__ = ["COSTS", "FAMILIES", "SAMPLE_RATE", "FFT_LENGTH", "QUICK_CHIRP", "KP_GRID",
+           "BISECTIONS", "HUNTING_MAX", "DAMPING_POINTS", "DAMPING_GAIN_MAX",
+           "STROKE_STEP_MAX", "TRUSTED_SHARE_MIN", "RATES", "DELAYS"]
+
+
+#: Transmissibility costs over the band: RMS of the amplitude ratio over the trusted bins
+#: (equally spaced in frequency: the payload's RMS acceleration per RMS of a base acceleration
+#: white over the band), or its largest value.
+COSTS = ("rms", "peak")
+#: Case families (see the module's text).
+FAMILIES = ("base", "step", "hunting")
+#: Output rate of the design's runs [Hz] (ten times the default band's top).
+SAMPLE_RATE = 200.0
+#: Welch segment length of the cost [samples]: quick and full.
+FFT_LENGTH = {True: 2048, False: 8192}
+#: Length of the quick runs' chirp [s] (the same sweep, ten times faster than the paper's).
+QUICK_CHIRP = 200.0
+#: Proportional gains tried first [N/m]: quick and full.
+KP_GRID = {True: tuple(np.geomspace(1.0, 1000.0, 7)), False: tuple(np.geomspace(1.0, 1000.0, 10))}
+#: Bisection steps between the bracketing gains: quick and full.
+BISECTIONS = {True: 3, False: 5}
+#: Longest hunting run [s]: quick and full.
+HUNTING_MAX = {True: 600.0, False: 1500.0}
+#: Damping gains tried in the coarse pass (besides 0) and the refinement: quick and full.
+DAMPING_POINTS = {True: (5, 3), False: (7, 4)}
+#: Largest damping gain tried by default [N*s/m]: ten times the guide's viscous friction.
+#: The model has no sensor noise, motor bandwidth or structural mode, which bound a real
+#: gain: beyond this it is not to be trusted.
+DAMPING_GAIN_MAX = 1000.0
+#: Largest step of the PI search's runs [s] (see _stroke_step).
+STROKE_STEP_MAX = 2.5e-3
+#: Least share of the band's bins that must be trusted for a cost to be defined [-].
+TRUSTED_SHARE_MIN = 0.5
+#: Controller rates [Hz] of the margin table and the rate experiments.
+RATES = (20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0, 10000.0)
+#: Delays [s] of the linear delay experiment.
+DELAYS = (0.0, 0.001, 0.002, 0.005)
+
+
+def _float(name, value, *, minimum=None, strict=False, fix=""):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"`{name}` must be a number, got {value!r}{fix}.")
+    value = float(value)
+    if not math.isfinite(value) or (minimum is not None and (
+            value < minimum or (strict and value == minimum))):
+        bound = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
+        raise ParameterError(f"`{name}` must be a finite number{bound}, got {value!r}{fix}.")
+    return value
+
+
+def _pair(name, value, unit, *, minimum=0.0, example="(1, 2)"):
+    try:
+        low, high = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"`{name}` must be two numbers (low, high) in {unit}, got "
+                             f"{value!r}; e.g. {example}.") from None
+    if not (math.isfinite(low) and math.isfinite(high) and minimum <= low <= high):
+        raise ParameterError(f"`{name}` must satisfy {minimum:g} <= low <= high (finite, in "
+                             f"{unit}), got {value!r}; e.g. {example}.")
+    return (low, high)
+
+
+@dataclass
+class _Settings:
+    """The validated inputs every stage shares."""
+
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    excitation: object
+    duration: float
+    stiction_range: tuple
+    mass_range: tuple
+    force_steps: tuple
+    band: tuple
+    cost: str
+    controller_rate: float
+    delay: float
+    quick: bool
+    dt: float
+    dt_note: str
+    sample_rate: float
+    fft_length: int
+    ratio: float
+    stroke_band: tuple
+    stroke_dt: float
+    damping_gain_max: float
+    gain_margin_min: float
+    phase_margin_min: float
+    workers: int
+    progress: bool
+
+    def controller_at(self, kp, kd=None):
+        return dataclasses.replace(self.controller, pi_kp=float(kp), pi_ki=float(self.ratio * kp),
+                                   damping_gain=self.controller.damping_gain if kd is None
+                                   else float(kd), controller_rate=self.controller_rate)

@@ -1,0 +1,39 @@
+"""The transmissibility cost against signals whose amplitude ratio is known."""
+import math
+
+import numpy as np
+import pytest
+
+from qzs import DataWarning
+from qzs.workflows.design.cost import transmissibility_cost
+
+
+def white(seed, count):
+    return np.random.default_rng(seed).standard_normal(count)
+
+
+def test_a_payload_that_is_half_the_base_costs_one_half_rms_and_peak():
+    base = white(1, 40_000)
+    for cost in ("rms", "peak"):
+        value, share, estimate = transmissibility_cost(base, 0.5 * base, 200.0, band=(1.0, 20.0),
+                                                       cost=cost, fft_length=2048)
+        assert value == pytest.approx(0.5, rel=1e-9) and share == 1.0
+        assert estimate.magnitude.shape == estimate.frequency.shape
+
+
+def test_the_peak_is_the_largest_and_the_rms_lies_between_the_bins_extremes():
+    base = white(2, 40_000)
+    payload = np.convolve(base, [0.3, 0.5, 0.2], mode="same")  # a smooth low-pass
+    rms, _, estimate = transmissibility_cost(base, payload, 200.0, band=(1.0, 20.0))
+    peak, _, _ = transmissibility_cost(base, payload, 200.0, band=(1.0, 20.0), cost="peak")
+    inside = (estimate.frequency >= 1.0) & (estimate.frequency <= 20.0) & estimate.trusted
+    t = estimate.magnitude[inside]
+    assert peak == t.max() and t.min() <= rms <= peak
+    assert rms == pytest.approx(np.sqrt(np.mean(t ** 2)), rel=1e-12)
+
+
+def test_an_unrelated_payload_has_too_few_trusted_bins_and_no_cost():
+    with pytest.warns(DataWarning, match="no trusted bin"):
+        value, share, _ = transmissibility_cost(white(3, 40_000), white(4, 40_000), 200.0,
+                                                band=(1.0, 20.0))
+    assert math.isnan(value) and share < 0.5

@@ -1,0 +1,54 @@
+"""Every bad argument of ``design_controller`` fails, naming it, before any simulation."""
+import pytest
+
+import qzs
+from qzs import Chirp, ControllerParameters, ParameterError
+from qzs.workflows import design as D
+from qzs.workflows.design import hunting, integration_step, proportional_search
+from qzs.workflows.design import cost
+
+#: Where the design simulates: (module, name) of every simulating function it calls.
+SIMULATORS = [(proportional_search, "simulate"), (proportional_search, "simulate_batch"),
+              (cost, "simulate_batch"), (hunting, "simulate"),
+              (integration_step, "choose_step")]
+
+
+def forbid_simulation(monkeypatch):
+    """Make every simulation of the design fail the test."""
+    def forbidden(*args, **kwargs):
+        raise AssertionError("simulated before checking the input")
+
+    for module, name in SIMULATORS:
+        monkeypatch.setattr(module, name, forbidden)
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(stiction_range=(0.5, 2.0)), "stiction_range"),
+    (dict(band=(1.0, 50.0)), "band"),
+    (dict(band=(0.0, 20.0)), "band"),
+    (dict(cost="mean"), "cost"),
+    (dict(controller=ControllerParameters(pi_kp=0.0)), "pi_kp"),
+    (dict(excitation=qzs.Sine()), "excitation"),
+    (dict(force_steps=("a",)), "force_steps"),
+    (dict(force_steps=2.0), "force_steps"),
+    (dict(delay=-1.0), "delay"),
+    (dict(controller_rate=300.0), "controller_rate"),
+    (dict(excitation=Chirp(duration=15.0, f1=20.0)), "too short"),
+    (dict(mass_range=(6.0,)), "mass_range"),
+    (dict(dt=0.0), "`dt`"),
+    (dict(damping_gain_max=0.0), "damping_gain_max"),
+])
+def test_bad_input_fails_before_any_simulation(monkeypatch, design_options, change, words):
+    forbid_simulation(monkeypatch)
+    with pytest.raises(ParameterError, match=words):
+        D.design_controller(**{**design_options, **change})
+
+
+def test_a_quick_design_shortens_a_long_chirp_to_the_same_sweep_in_200_s():
+    from qzs.workflows.design.inputs import _excitation
+
+    long = Chirp(duration=2000.0)
+    quick, duration = _excitation(long, quick=True)
+    assert duration == 200.0 and quick.duration == 200.0
+    assert (quick.f0, quick.f1, quick.amplitude) == (long.f0, long.f1, long.amplitude)
+    assert _excitation(long, quick=False) == (long, 2000.0)

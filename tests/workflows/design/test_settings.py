@@ -1,0 +1,41 @@
+"""The design's settings: the gain grid, the number checks, the gains a stage tries."""
+import math
+
+import numpy as np
+import pytest
+
+from qzs import ParameterError
+from qzs.workflows.design.settings import KP_GRID, _float, _pair
+
+
+def test_the_gain_grids_are_geometric_from_1_to_1000_n_per_m():
+    for quick, count in ((True, 7), (False, 10)):
+        grid = np.array(KP_GRID[quick])
+        assert len(grid) == count and grid[0] == 1.0 and grid[-1] == pytest.approx(1000.0)
+        np.testing.assert_allclose(grid[1:] / grid[:-1], 1000 ** (1 / (count - 1)), rtol=1e-12)
+
+
+def test_numbers_and_pairs_are_checked_with_the_argument_named():
+    assert _float("delay", 1) == 1.0 and _float("offset", -3.0) == -3.0  # no bound by default
+    with pytest.raises(ParameterError, match=r"`dt` must be a finite number > 0, got 0\.0"):
+        _float("dt", 0.0, minimum=0.0, strict=True)
+    with pytest.raises(ParameterError, match="`delay` must be a number"):
+        _float("delay", True)
+    with pytest.raises(ParameterError, match="`delay` must be a finite number"):
+        _float("delay", math.inf)
+    assert _pair("band", [1, 20], "Hz") == (1.0, 20.0)
+    with pytest.raises(ParameterError, match=r"`band` must satisfy .* e\.g\. \(1, 20\)"):
+        _pair("band", (20.0, 1.0), "Hz", example="(1, 20)")
+
+
+def test_the_gains_a_stage_tries_keep_the_ratio_and_the_rate(design_options):
+    from qzs.workflows.design.inputs import _design_settings
+
+    arguments = dict(design_options, stiction_range=(8.0, 12.0), cost="rms",
+                     controller_rate=500.0, delay=0.0, gain_margin_min=6.0,
+                     phase_margin_min=30.0, workers=1, progress=False)
+    settings = _design_settings(None, None, **arguments)
+    trial = settings.controller_at(300.0, kd=25.0)
+    assert (trial.pi_kp, trial.damping_gain, trial.controller_rate) == (300.0, 25.0, 500.0)
+    assert trial.pi_ki == pytest.approx(0.4 * 300.0, rel=1e-15)
+    assert settings.controller_at(10.0).damping_gain == settings.controller.damping_gain
