@@ -168,7 +168,7 @@ class ValidationRecords(SphinxDirective):
             section = nodes.section(ids=[nodes.make_id(f"validation-{module}")])
             title = _title(module, rows[0]["section"])
             section += nodes.title(title, title)
-            source = f"tests/{module}.py"
+            source = f"tests/{module.replace('.', '/')}.py"
             intro = nodes.paragraph()
             intro += nodes.Text(f"{len(rows)} checks, from ")
             intro += nodes.literal(source, source)
