@@ -64,7 +64,6 @@ from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_frictio
 RANK_TOLERANCE = 1e-10
 
 
-
 # ---------------------------------------------------------------- small vector helpers
 @njit(**_JIT, inline="always")
 def _cross(ax, ay, az, bx, by, bz):

@@ -30,6 +30,7 @@ __all__ = ["hexapod_stability_test"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 
+
 def _per_leg(name, value, kind):
     """One parameter object or a sequence of six (one per leg), as a tuple of six."""
     if isinstance(value, kind):
@@ -283,8 +284,8 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     _evaluate(0.0, state, plat, ex, tables, toff, ww, V, np.zeros((6, 6)),
               np.zeros(LEG_COUNT, dtype=np.int64), np.zeros((2, LEG_COUNT)), np.zeros(N_ODE),
               False)
-    V[V_LHOME:V_LHOME + LANES] = V[V_L:V_L + LANES]  # the kernels' own arithmetic: z = z_ref
-    # exactly at home
+    # the kernels' own arithmetic: z = z_ref exactly at home
+    V[V_LHOME:V_LHOME + LANES] = V[V_L:V_L + LANES]
     # PI preload (docs/model.md §5 for each leg): the motor carries the static leg load the
     # spring does not (stops untouched at the setpoint), the base at rest.
     loads = _static_forces(geometry, platform)

@@ -162,8 +162,7 @@ class HexapodResult:
         ``preview_every`` (the stride of the samples held when the run streamed to a file).
     statistics : dict, optional
         The summary's statistics over every sample (see
-        :mod:`qzs.engine.hexapod.statistics`); computed from
-        ``data`` if omitted.
+        :mod:`qzs.engine.hexapod.statistics`); computed from ``data`` if omitted.
     """
 
     def __init__(self, data, flags, *, geometry, platform, isolators, controllers, excitation,

@@ -76,9 +76,9 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
     sink : callable, optional
         ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
         (``data`` with :data:`~qzs.engine.hexapod.result.HEXAPOD_CHANNELS`' columns, ``flags``
-        with :data:`~qzs.engine.hexapod.result.HEXAPOD_FLAGS`'); memory then stays bounded however long the run, and the
-        result holds every sample only up to 200,000 of them, else every k-th
-        (``run["preview_every"]``); its summary covers every sample
+        with :data:`~qzs.engine.hexapod.result.HEXAPOD_FLAGS`'); memory then stays bounded
+        however long the run, and the result holds every sample only up to 200,000 of them,
+        else every k-th (``run["preview_every"]``); its summary covers every sample
         (:class:`qzs.iotools.hexapod_files.HexapodWriter` is such a sink).
     interruptible : bool
         Ctrl-C ends the run after the chunk under way; the result (and the sink) then hold
@@ -220,8 +220,8 @@ def simulate_hexapods(runs, *, workers=None, progress=False):
     Every run is checked before any integration starts (a bad one is named by its index);
     each gives the very numbers :func:`simulate_hexapod` gives it alone. The six legs of
     one platform already fill the kernel's vector lanes
-    (:data:`~qzs.engine.hexapod.layout.LANES`), so platforms are
-    batched across cores, one thread each, rather than in lanes.
+    (:data:`~qzs.engine.hexapod.layout.LANES`), so platforms are batched across cores, one
+    thread each, rather than in lanes.
 
     Parameters
     ----------

@@ -17,7 +17,7 @@ from qzs.engine.arithmetic import fma
 from qzs.engine.hexapod.dynamics import (_advance_phases, _commands, _cross, _evaluate,
                                          _inertia_times, _matvec, _rest_frame, _sample)
 from qzs.engine.hexapod.layout import (
-    B_K2, B_K1, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
+    B_K1, B_K2, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
     C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR, C_FMO, C_FPI, C_FSP, C_FST,
     C_POSE, C_TIME, C_TWIST, C_V, C_VME, C_WB, C_WM, C_Z, CT_CONTACTS, CT_EVENTS,
     CT_IN_CONTACT, CT_STEP, CT_STICKS, LANES, LEG_COUNT, MODE_LOCK, MODE_SLIP, N_ODE,
