@@ -9,7 +9,7 @@ import pytest
 import xarray as xr
 
 from qzs.cli import main
-from qzs.engine import hexapod as engine
+from qzs.engine.hexapod import simulate as engine
 from qzs.errors import OutputPathError, ParameterError
 from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
 from qzs.workflows.hexapod import load_hexapod, simulate_setup

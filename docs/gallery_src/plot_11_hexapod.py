@@ -2,7 +2,7 @@
 A hexapod run
 =============
 
-:meth:`HexapodResult.plot <qzs.engine.hexapod.HexapodResult.plot>` (that is,
+:meth:`HexapodResult.plot <qzs.engine.hexapod.result.HexapodResult.plot>` (that is,
 :func:`qzs.viz.plot_hexapod`) draws a run of the six-leg platform: the platform's pose
 relative to the base, each leg's stroke between its stops, and the motor forces. The shipped
 cubic platform of six paper legs (``paper_legs_cubic``), its base shaken sideways by a 3 mm,

@@ -12,8 +12,9 @@
 ``batch``        :func:`simulate_batch`, many parameter sets at once
 ``results``      :class:`SimulationResult`
 ``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
+``driver``       the one run loop: plan, chunks, memory guard, preview, progress, signals
 ``periodic``     :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
-``hexapod``      :func:`simulate_hexapod`, six isolator legs under a rigid platform
+``hexapod``      subpackage: :func:`simulate_hexapod`, six isolator legs under a rigid platform
 ===============  ==================================================================
 """
 from qzs._lazy import lazy_exports
@@ -26,7 +27,8 @@ _EXPORTS = {
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",
     "choose_step": "qzs.engine.accuracy", "StepChoice": "qzs.engine.accuracy",
-    "simulate_hexapod": "qzs.engine.hexapod", "HexapodResult": "qzs.engine.hexapod",
+    "simulate_hexapod": "qzs.engine.hexapod.simulate",
+    "HexapodResult": "qzs.engine.hexapod.result",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

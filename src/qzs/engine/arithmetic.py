@@ -130,10 +130,13 @@ def tanh(u):
 
 
 # ---------------------------------------------------------------- stale kernel caches
-#: The modules whose compiled kernels numba caches, and the source files they are built from
-#: (the excitation's packed-layout constants are compiled in as globals).
-_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes", "hexapod")
-_KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "model/excitation.py")
+#: The modules whose compiled kernels numba caches (below ``engine/``), and the source files
+#: they are built from (the packed-layout constants of the excitation and of the six-axis
+#: kernels are compiled in as globals).
+_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes", "hexapod/dynamics",
+                   "hexapod/stepping")
+_KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "engine/hexapod/layout.py",
+                   "model/excitation.py")
 #: The fingerprint of those sources, kept beside numba's cache files.
 _STAMP = "qzs-kernel-sources.sha256"
 
@@ -141,6 +144,18 @@ _STAMP = "qzs-kernel-sources.sha256"
 @njit(**JIT)
 def _cache_probe():  # pragma: no cover - only its cache location is used
     return 0
+
+
+def _cache_folder(source):
+    """The folder numba caches the kernels of the module file ``source`` in.
+
+    Found as numba finds :func:`_cache_probe`'s (the same locator: ``__pycache__`` beside the
+    source, or below ``NUMBA_CACHE_DIR`` or the user's cache), for a subpackage's modules.
+    """
+    from pathlib import Path
+
+    locator = _cache_probe._cache._impl.locator
+    return Path(type(locator)(_cache_probe.py_func, str(source)).get_cache_path())
 
 
 def _drop_stale_kernel_caches():
@@ -166,15 +181,17 @@ def _drop_stale_kernel_caches():
         fingerprint = digest.hexdigest()
         if stamp.exists() and stamp.read_text(encoding="ascii").strip() == fingerprint:
             return False
-        for path in folder.glob("*.nb[ic]"):
-            if path.name.split(".", 1)[0] in _KERNEL_MODULES:
+        for name in _KERNEL_MODULES:
+            package, _, module = name.rpartition("/")
+            where = _cache_folder(root / "engine" / f"{name}.py") if package else folder
+            for path in where.glob(f"{module}.*.nb[ic]"):
                 path.unlink(missing_ok=True)
         folder.mkdir(parents=True, exist_ok=True)
         partial = folder / f".{_STAMP}.{os.getpid()}"
         partial.write_text(fingerprint + "\n", encoding="ascii")
         os.replace(partial, stamp)
         return True
-    except (OSError, AttributeError):  # no cache folder, read-only install, other numba
+    except (OSError, AttributeError, TypeError):  # no cache folder, read-only, other numba
         return False
 
 

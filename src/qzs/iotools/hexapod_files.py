@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs.engine.hexapod import (HEXAPOD_CHANNELS, HEXAPOD_FLAGS, N_CHANNELS, N_FLAGS,
-                                hexapod_file_layout)
+from qzs.engine.hexapod.layout import N_CHANNELS, N_FLAGS
+from qzs.engine.hexapod.result import HEXAPOD_CHANNELS, HEXAPOD_FLAGS, hexapod_file_layout
 from qzs.errors import ParameterError
 from qzs.iotools.files import ResultWriter, _close
 

@@ -1,0 +1,76 @@
+"""The six-axis kernels' packed layouts: per-leg rows, platform constants, state, output.
+
+Named offsets into the flat arrays that the kernels (:mod:`~qzs.engine.hexapod.dynamics`,
+:mod:`~qzs.engine.hexapod.stepping`), the packing (:mod:`~qzs.engine.hexapod.prepare`),
+the driver (:mod:`~qzs.engine.hexapod.simulate`) and the result
+(:mod:`~qzs.engine.hexapod.result`) share; numba compiles these module-level integers in
+as constants.
+"""
+from qzs.model.hexapod import LEG_COUNT
+
+__all__ = ["AXES", "LANES"]
+
+#: The six axes of a pose, in order: translations [m], then rotation angles [rad].
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+
+# ---------------------------------------------------------------- packed layouts
+#: Lanes of the per-leg arrays: the six legs and two padding lanes (copies of leg 1), so that
+#: every per-leg loop runs over 8 lanes that LLVM vectorises (docs/model.md §9: no fast-math,
+#: a vector lane computes the very bits scalar code would).
+LANES = 8
+# Rows of the flat per-leg array ``V`` (row ``r`` of lane ``i`` at ``r * LANES + i``, a
+# compile-time stride: LLVM sees that the rows cannot overlap). Parameters and geometry
+# (base joint from B's origin, top joint from the COM in the top frame), the mode (0 slipping,
+# 1 locked) and slip direction, the filter and integral states, the kinematics, the forces,
+# the event value, the filter and integral rates, per leg the terms the platform sums (force
+# and moment components, the powers of the ledger: base, friction, motor, stop), a sampled
+# controller's held outputs (PI, damping, motor), and six rows of the legs' coupling
+# ``G_i M^-1 G_j^T`` (row ``C0 + i``, lane ``j``); ``V_*`` is each row's offset.
+N_ROWS = 68 + LEG_COUNT - 1
+(V_A, V_B, V_FS, V_FC, V_CBC, V_CV, V_ZLOW, V_ZHIGH, V_STOPK, V_STOPC, V_FMAX, V_ZREF, V_KP, V_KI,
+ V_KD, V_HP, V_LHOME, V_BX, V_BY, V_BZ, V_TX, V_TY, V_TZ, V_MODE, V_DIR, V_HPS, V_INT, V_UX, V_UY,
+ V_UZ, V_GX, V_GY, V_GZ, V_MX, V_MY, V_MZ, V_L, V_VR, V_KAP, V_Z, V_V, V_FSP, V_FST, V_FEL, V_FMO,
+ V_FPI, V_FDA, V_VME, V_FFR, V_F, V_XB, V_EV, V_DHP, V_DINT, V_FUX, V_FUY, V_FUZ, V_FGX, V_FGY,
+ V_FGZ, V_PB, V_PF, V_PM, V_PS, V_HPI, V_HDA, V_HMO, V_C0) = range(0, 68 * LANES, LANES)
+# Platform ``plat``: mass, gravity, COM in the top frame, inertia and its inverse (row-major),
+# home position, which base axes move, whether the base rotates; the control: grid steps per
+# controller sample (0: continuous), centralised (1) or per leg (0), and the Cartesian loops'
+# ``J^-1`` (row-major) and gains per axis (proportional, integral, damping).
+(PL_MASS, PL_G, PL_CT, PL_IC, PL_ICINV, PL_HOME, PL_ACTIVE, PL_ROTATING, PL_CONTROL_STEPS,
+ PL_CENTRAL, PL_JINV, PL_CKP, PL_CKI, PL_CKD) = (0, 1, 2, 5, 14, 23, 26, 32, 33, 34, 35, 71, 77,
+                                                83)
+N_PLAT = 89
+
+# ODE state.
+S_C, S_Q, S_V, S_W, S_HP, S_INT, S_WB, S_DF, S_WM, S_DS = 0, 3, 7, 10, 13, 19, 25, 26, 27, 28
+N_ODE = 29
+
+# Platform workspace ``ww``: the base motion and frame, the platform's rotation and inertia,
+# its accelerations, the sum of the leg forces, the state of the locked legs' factorisation,
+# its reciprocal pivots, the impulses of the last projection (0 if none), per axis the
+# excitation's phase and its sine and cosine at the start of the step (persistent: carried
+# across kernel calls), and the Cartesian loops' errors, PI and damping commands per axis.
+(W_Y, W_YD, W_YDD, W_RB, W_OM, W_AL, W_VO, W_AO, W_GH, W_OMW, W_ALW, W_RR, W_IBI, W_ACC,
+ W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE, W_CART) = (0, 6, 12, 18, 27, 30, 33, 36, 39, 42,
+                                                           45, 48, 57, 66, 72, 75, 76, 82, 88,
+                                                           106)
+N_WORK = 124
+SOLVE_NONE, SOLVE_FACTORED, SOLVE_MIN_NORM = 0.0, 1.0, 2.0
+# Rows of the state buffers ``buf`` (N_BUF, N_ODE).
+B_S, B_K1, B_S1, B_KE, B_TMP, B_K2, B_K3, B_K4, B_TRIAL, B_KT = range(10)
+N_BUF = 10
+# Counters.
+CT_STEP, CT_EVENTS, CT_STICKS, CT_CONTACTS, CT_IN_CONTACT = 0, 1, 2, 8, 14
+N_COUNTERS = 20
+
+MODE_SLIP, MODE_LOCK = 0.0, 1.0
+STATUS_OK, STATUS_DIVERGED = 0, 1
+
+# Output channels: time, poses and motions [6 each], per-leg blocks [6 each], the ledger.
+C_TIME, C_POSE, C_TWIST, C_BASE_POSE, C_BASE_VEL, C_BASE_ACC, C_ACC = 0, 1, 7, 13, 19, 25, 31
+(C_Z, C_V, C_FSP, C_FFR, C_FST, C_FMO, C_FPI, C_FDA, C_VME) = (37, 43, 49, 55, 61, 67, 73, 79,
+                                                               85)
+C_WB, C_DF, C_WM, C_DS, C_EK, C_ESP, C_EG, C_EST = 91, 92, 93, 94, 95, 96, 97, 98
+N_CHANNELS = 99
+O_LOCKED, O_CONTACT = 0, 6
+N_FLAGS = 12

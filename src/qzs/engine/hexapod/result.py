@@ -1,0 +1,336 @@
+"""The result of a six-axis run: :class:`HexapodResult`, its channels and flags, its file layout.
+
+:data:`HEXAPOD_CHANNELS` and :data:`HEXAPOD_FLAGS` name the columns of the output samples
+(:mod:`qzs.engine.hexapod.layout`); :func:`hexapod_file_layout` is the CF-1.10 layout that
+:meth:`HexapodResult.to_xarray` builds and :class:`qzs.iotools.hexapod_files.HexapodWriter`
+streams.
+"""
+import numpy as np
+
+from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
+                                       C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR,
+                                       C_FMO, C_FPI, C_FSP, C_FST, C_POSE, C_TIME, C_TWIST,
+                                       C_V, C_VME, C_WB, C_WM, C_Z, LEG_COUNT, O_CONTACT,
+                                       O_LOCKED)
+from qzs.engine.hexapod.statistics import _Statistics, _summary_text
+from qzs.model.registry import unit_of
+
+__all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_file_layout"]
+
+_TRANSLATION = ("m", "m", "m", "rad", "rad", "rad")
+_RATE = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
+_ACCELERATION = ("m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2")
+#: Output channels: name -> (first column, dimension (None: time only, "dof" or "leg"),
+#: unit (per dof for "dof" variables), description).
+HEXAPOD_CHANNELS = {
+    "time": (C_TIME, None, "s", "time since the start of the run"),
+    "platform_pose": (C_POSE, "dof", _TRANSLATION,
+                      "platform pose relative to home: displacement of the top frame origin "
+                      "and rotation angles (R = Rz Ry Rx), world frame"),
+    "platform_twist": (C_TWIST, "dof", _RATE,
+                       "velocity of the top frame origin and angular velocity, world frame"),
+    "platform_acceleration": (C_ACC, "dof", _ACCELERATION,
+                              "acceleration of the top frame origin and angular acceleration, "
+                              "world frame"),
+    "base_pose": (C_BASE_POSE, "dof", _TRANSLATION,
+                  "base pose: displacement of the base point under the top frame origin at "
+                  "home and rotation angles (R = Rz Ry Rx)"),
+    "base_velocity": (C_BASE_VEL, "dof", _RATE,
+                      "velocity of that base point and the base's angular velocity, world frame"),
+    "base_acceleration": (C_BASE_ACC, "dof", _ACCELERATION,
+                          "acceleration of that base point and the base's angular "
+                          "acceleration, world frame"),
+    "relative_position": (C_Z, "leg", "m",
+                          "leg relative position z_i = L_i - L_i,home + z_ref (its encoder)"),
+    "relative_velocity": (C_V, "leg", "m/s", "leg slip velocity v_i = dL_i/dt (0 when locked)"),
+    "spring_force": (C_FSP, "leg", "N", "MagSpring force along the leg, on the platform"),
+    "friction_force": (C_FFR, "leg", "N",
+                       "friction force along the leg (the holding force when locked)"),
+    "stop_force": (C_FST, "leg", "N", "hard-stop force along the leg"),
+    "motor_force": (C_FMO, "leg", "N", "motor force along the leg (saturated)"),
+    "pi_force": (C_FPI, "leg", "N", "PI position-loop command (before saturation)"),
+    "damping_force": (C_FDA, "leg", "N", "active damping command (before saturation)"),
+    "measured_velocity": (C_VME, "leg", "m/s",
+                          "top joint's absolute velocity along the leg seen by the controller "
+                          "(high-passed)"),
+    "base_work": (C_WB, None, "J", "work done by the base through the legs"),
+    "friction_dissipation": (C_DF, None, "J", "energy dissipated by the legs' friction"),
+    "motor_work": (C_WM, None, "J", "work done by the motors"),
+    "stop_dissipation": (C_DS, None, "J", "energy dissipated in the hard stops"),
+    "kinetic_energy": (C_EK, None, "J", "kinetic energy of the platform (translation + rotation)"),
+    "spring_energy": (C_ESP, None, "J", "energy stored in the six MagSprings"),
+    "gravity_energy": (C_EG, None, "J", "gravitational potential energy m*g*z of the centre of "
+                                        "mass (world frame)"),
+    "stop_energy": (C_EST, None, "J", "elastic energy stored in the compliant stops"),
+}
+#: Boolean outputs per leg: name -> (first column, description).
+HEXAPOD_FLAGS = {
+    "locked": (O_LOCKED, "leg held at zero slip by friction"),
+    "stop_contact": (O_CONTACT, "leg beyond one of its stops (in contact)"),
+}
+_FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
+
+
+def _attribute(value):
+    """A value as a NetCDF-storable attribute (None -> "none", booleans -> 0/1)."""
+    if value is None:
+        return "none"
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, np.ndarray):
+        return value.astype(float).ravel()
+    if isinstance(value, (list, tuple)):
+        array = np.asarray(value)
+        return array.astype(np.int64 if array.dtype.kind in "iub" else float).ravel()
+    return value
+
+
+def hexapod_file_layout():
+    """The CF-1.10 layout of a hexapod run's file: variables and coordinates with attributes.
+
+    One place for what :meth:`HexapodResult.to_xarray` builds and what
+    :class:`qzs.iotools.hexapod_files.HexapodWriter` streams (docs/model.md §7): every
+    variable has ``units`` and ``long_name``; a ``dof`` variable mixes translations and
+    rotations, so its ``units`` lists one unit per dof (``units_by_dof`` names them); flags
+    are booleans with ``flag_values`` and ``flag_meanings``; time in plain seconds.
+
+    Returns
+    -------
+    dict
+        ``{"variables": {name: (dims, attrs)}, "coordinates": {name: (dims, values,
+        attrs)}}`` (the ``time`` coordinate's values are the run's own).
+    """
+    variables = {}
+    for name, (_, dim, unit, doc) in HEXAPOD_CHANNELS.items():
+        if name == "time":
+            continue
+        attrs = {"long_name": doc}
+        if dim == "dof":
+            attrs["units"] = ", ".join(unit)
+            attrs["units_by_dof"] = "; ".join(f"{a}: {u}" for a, u in zip(AXES, unit))
+        else:
+            attrs["units"] = unit
+        variables[name] = (("time",) if dim is None else ("time", dim), attrs)
+    for name, (_, doc) in HEXAPOD_FLAGS.items():
+        variables[name] = (("time", "leg"), {
+            "units": "1", "long_name": doc, "flag_values": np.array([0, 1], dtype=np.int8),
+            "flag_meanings": _FLAG_MEANINGS[name]})
+    coordinates = {
+        "time": (("time",), None, {
+            "units": "s", "standard_name": "time", "axis": "T",
+            "long_name": "time since the start of the run",
+            "comment": "relative run time without a calendar date: units 's' instead of "
+                       "'s since <date>' (docs/model.md §7)"}),
+        "dof": (("dof",), list(AXES), {"long_name": "degree of freedom: translations x, y, z "
+                                                    "[m], rotations rx, ry, rz [rad]",
+                                       "units": "1"}),
+        "leg": (("leg",), np.arange(1, LEG_COUNT + 1), {"long_name": "leg number",
+                                                         "units": "1"})}
+    return {"variables": variables, "coordinates": coordinates}
+
+
+class HexapodResult:
+    """Time series and metadata of one hexapod run
+    (:func:`~qzs.engine.hexapod.simulate.simulate_hexapod`).
+
+    Channels are attributes and items (``result.platform_pose``, ``result["locked"]``):
+    arrays of shape (n,) for ``time`` and the energy ledger, (n, 6) per degree of freedom
+    (``x, y, z, rx, ry, rz``) or per leg (legs 1 to 6); see :data:`HEXAPOD_CHANNELS` and
+    :data:`HEXAPOD_FLAGS` for names and units. The object only holds and delegates.
+
+    Parameters
+    ----------
+    data : ndarray, shape (n_samples, N_CHANNELS)
+        The output samples.
+    flags : ndarray of bool, shape (n_samples, 12)
+        Locked and contact flags of the six legs.
+    geometry : HexapodGeometry
+        The platform's joints.
+    platform : PlatformParameters
+        Mass, inertia, centre of mass and gravity.
+    isolators : tuple of IsolatorParameters
+        The six legs' plants.
+    controllers : tuple of ControllerParameters
+        The six legs' loops.
+    excitation : dict
+        Axis name -> excitation of the axes that moved.
+    run : dict
+        Solver, ``dt`` [s], ``sample_rate`` [Hz], ``duration`` [s], ``steps``, ``elapsed`` [s]
+        (integration only), ``samples``, ``events`` (located transitions), per leg
+        ``stick_events`` and ``stop_contacts``, ``stops`` (per leg, [m]), ``control``,
+        ``controller_rate`` [Hz], ``completed`` (False if interrupted) and
+        ``preview_every`` (the stride of the samples held when the run streamed to a file).
+    statistics : dict, optional
+        The summary's statistics over every sample (see
+        :mod:`qzs.engine.hexapod.statistics`); computed from ``data`` if omitted.
+    """
+
+    def __init__(self, data, flags, *, geometry, platform, isolators, controllers, excitation,
+                 run, statistics=None):
+        self._data = data
+        self._flags = flags
+        self.geometry = geometry
+        self.platform = platform
+        self.isolators = tuple(isolators)
+        self.controllers = tuple(controllers)
+        self.excitation = dict(excitation)
+        self.run = run
+        if statistics is None:  # from the samples held
+            running = _Statistics([0.5 * (low + high) for low, high in run["stops"]])
+            running.add(data, flags)
+            statistics = running.result()
+        self.statistics = statistics
+
+    def __getitem__(self, name):
+        if name in HEXAPOD_CHANNELS:
+            column, dim = HEXAPOD_CHANNELS[name][:2]
+            return self._data[:, column] if dim is None else self._data[:, column:column + 6]
+        if name in HEXAPOD_FLAGS:
+            column = HEXAPOD_FLAGS[name][0]
+            return self._flags[:, column:column + 6]
+        raise KeyError(f"no channel {name!r}; channels are "
+                       f"{', '.join([*HEXAPOD_CHANNELS, *HEXAPOD_FLAGS])}.")
+
+    def __getattr__(self, name):
+        if name.startswith("_") or (name not in HEXAPOD_CHANNELS and name not in HEXAPOD_FLAGS):
+            raise AttributeError(name)
+        return self[name]
+
+    def __len__(self):
+        return self._data.shape[0]
+
+    def __repr__(self):
+        return (f"<HexapodResult {len(self)} samples, {self['time'][-1]:.6g} s, "
+                f"{self.run['solver']} dt={self.run['dt']:g} s>")
+
+    @property
+    def steps_per_second(self):
+        """Integration throughput of the run [steps/s]."""
+        return self.run["steps"] / max(self.run["elapsed"], 1e-12)
+
+    def mechanical_energy(self):
+        """Kinetic + spring + gravity + stop elastic energy [J] at each sample."""
+        return (self["kinetic_energy"] + self["spring_energy"] + self["gravity_energy"]
+                + self["stop_energy"])
+
+    def energy_residual(self):
+        """Energy-ledger imbalance [J]: change of mechanical energy minus the net work.
+
+        ``dE - (W_base + W_motor - D_friction - D_stop)``; zero up to the integrator's
+        truncation error.
+        """
+        energy = self.mechanical_energy()
+        net = (self["base_work"] + self["motor_work"] - self["friction_dissipation"]
+               - self["stop_dissipation"])
+        return energy - energy[0] - net
+
+    def metadata(self):
+        """Every parameter and run setting with its unit: ``{key: (value, unit)}``.
+
+        Keys ``platform.<name>``, ``geometry.<name>``, ``isolator.<name>`` and
+        ``controller.<name>`` (one value, or six per leg where the legs differ),
+        ``excitation.<axis>`` (the class) and ``excitation.<axis>.<field>``, ``run.<key>``.
+        """
+        import dataclasses
+
+        meta = {}
+        for name in ("base_joints", "top_joints", "home_position", "stroke_half"):
+            meta[f"geometry.{name}"] = (getattr(self.geometry, name), "m")
+        for field in dataclasses.fields(self.platform):
+            meta[f"platform.{field.name}"] = (getattr(self.platform, field.name),
+                                              field.metadata.get("unit", ""))
+        for section, objects in (("isolator", self.isolators), ("controller", self.controllers)):
+            for field in dataclasses.fields(objects[0]):
+                values = [getattr(o, field.name) for o in objects]
+                value = values[0] if all(v == values[0] for v in values) else values
+                meta[f"{section}.{field.name}"] = (value, unit_of(field.name))
+        for axis, value in self.excitation.items():
+            meta[f"excitation.{axis}"] = (type(value).__name__, "")
+            for field in dataclasses.fields(value):
+                item = getattr(value, field.name)
+                if not isinstance(item, np.ndarray):
+                    unit = field.metadata.get("unit", "")
+                    if axis in AXES[3:]:
+                        unit = unit.replace("m", "rad") if unit in ("m", "m/s", "m/s^2") else unit
+                    meta[f"excitation.{axis}.{field.name}"] = (item, unit)
+        units = {"dt": "s", "sample_rate": "Hz", "duration": "s", "elapsed": "s", "stops": "m"}
+        for key, value in self.run.items():
+            meta[f"run.{key}"] = (value, units.get(key, "1" if key != "solver" else "-"))
+        return meta
+
+    def to_xarray(self):
+        """The run as an ``xarray.Dataset`` with dimensions ``time``, ``dof`` and ``leg``.
+
+        CF-1.10 as :meth:`qzs.engine.results.SimulationResult.to_xarray` (time in plain
+        seconds, docs/model.md §7): every variable has ``units`` and ``long_name``; a
+        ``dof`` variable mixes translations and rotations, so its ``units`` lists one unit
+        per dof in the order of the ``dof`` coordinate (``units_by_dof`` says so by name);
+        flags are booleans with ``flag_values`` and ``flag_meanings``. Parameters and run
+        settings are global attributes with their units in ``<key>_units``.
+        """
+        import xarray as xr
+
+        layout = hexapod_file_layout()
+        variables = {name: (dims, self[name], attrs)
+                     for name, (dims, attrs) in layout["variables"].items()}
+        coords = {name: (dims, self["time"] if name == "time" else values, attrs)
+                  for name, (dims, values, attrs) in layout["coordinates"].items()}
+        return xr.Dataset(variables, coords=coords, attrs=self.global_attributes())
+
+    def global_attributes(self):
+        """The file's global attributes: CF conventions, provenance, every parameter and run
+        setting (``<key>`` with its unit in ``<key>_units``)."""
+        import datetime
+
+        from qzs._version import __version__
+
+        now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
+        attrs = {"Conventions": "CF-1.10",
+                 "title": "qzs simulation of a six-leg platform of semi-active QZS isolator legs",
+                 "source": f"qzs {__version__}: fixed-step hexapod dynamics with exact stick-slip "
+                           "per leg (model: docs/hexapod.md, docs/model.md)",
+                 "history": f"{now} qzs {__version__}: qzs.simulate_hexapod (Python), solver "
+                            f"{self.run['solver']}, dt {self.run['dt']} s, "
+                            f"{self.run['steps']} steps",
+                 "qzs_version": __version__}
+        for key, (value, unit) in self.metadata().items():
+            attrs[key] = _attribute(value)
+            if unit:
+                attrs[f"{key}_units"] = unit
+        return attrs
+
+    def summary(self):
+        """One-screen text summary: per leg stroke used, contacts, time locked, motor RMS."""
+        return _summary_text(self)
+
+    def save(self, path):
+        """Write the run to a NetCDF file (:func:`qzs.iotools.hexapod_files.save_hexapod_result`).
+
+        Parameters
+        ----------
+        path : str or Path
+            Target ``.nc`` file.
+
+        Returns
+        -------
+        Path
+        """
+        from qzs.iotools.hexapod_files import save_hexapod_result
+
+        return save_hexapod_result(self, path)
+
+    def plot(self, **kwargs):
+        """Plot the run (see :func:`qzs.viz.hexapod.plot_hexapod`).
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to :func:`qzs.viz.hexapod.plot_hexapod` (``path``, ``title``).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.hexapod import plot_hexapod
+
+        return plot_hexapod(self, **kwargs)

@@ -1,0 +1,292 @@
+"""The six-axis drivers: :func:`simulate_hexapod` (one platform) and
+:func:`simulate_hexapods` (several, in threads).
+
+Validated and packed by :mod:`qzs.engine.hexapod.prepare`, integrated in chunks by the
+kernels of :mod:`qzs.engine.hexapod.stepping`, returned as a
+:class:`~qzs.engine.hexapod.result.HexapodResult` (or streamed to a sink).
+"""
+import time as _time
+
+import numpy as np
+
+from qzs import defaults
+from qzs._validation import worker_count
+from qzs.engine.hexapod.layout import (CT_CONTACTS, CT_EVENTS, CT_STEP, CT_STICKS, LEG_COUNT,
+                                       N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS, N_ODE, N_WORK,
+                                       S_C, S_V, STATUS_OK, V_Z, V_ZHIGH, V_ZLOW)
+from qzs.engine.hexapod.prepare import _prepare
+from qzs.engine.hexapod.result import HexapodResult
+from qzs.engine.hexapod.statistics import _Statistics
+from qzs.engine.hexapod.stepping import _run, _start
+from qzs.engine.simulate import PREVIEW_SAMPLES, _available_memory, _DeferredInterrupt
+from qzs.errors import CaseError, ParameterError, SimulationError, Terminated
+
+__all__ = ["simulate_hexapod", "simulate_hexapods"]
+
+
+def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, excitation=None,
+                     duration=None, dt=defaults.SIMULATION["dt"],
+                     sample_rate=defaults.SIMULATION["sample_rate"],
+                     solver=defaults.SIMULATION["solver"], cartesian=None, progress=False,
+                     sink=None, interruptible=False):
+    """Simulate a six-leg platform of isolator legs under a base moving in up to six axes.
+
+    A rigid platform on six single-axis isolator legs (docs/hexapod.md, "Dynamics"): each
+    leg's MagSpring, Stribeck friction with exact stick-slip, compliant stops and its own PI
+    loop with active damping through the amplifier's high-pass, exactly the laws of
+    docs/model.md §3-5; the platform by Newton-Euler with gravity; the legs' moving masses
+    lumped into the platform. Every argument is checked before any integration.
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        Joints and legs' stroke (:func:`~qzs.model.hexapod.cubic_geometry`,
+        :func:`~qzs.model.hexapod.radial_geometry`).
+    platform : PlatformParameters
+        Mass (platform, payload and the legs' moving parts), inertia about the centre of
+        mass, centre of mass and gravity.
+    isolator : IsolatorParameters or sequence of six, optional
+        Each leg's plant; Table 1 defaults if omitted. Its ``mass`` and ``gravity`` are not
+        used (the platform's are); ``stroke_half`` must equal the geometry's; compliant stops
+        only.
+    controller : ControllerParameters or sequence of six, optional
+        Each leg's loop; defaults if omitted. Continuous (``controller_rate`` 0) or sampled
+        with zero-order hold, every leg at the same rate (one controller), as the single
+        axis's (docs/model.md §5). With ``cartesian``, its ``position_setpoint``,
+        ``velocity_highpass`` and ``controller_rate`` are used and its gains are not.
+    excitation : dict, optional
+        Base motion: axis name (``"x"``, ``"y"``, ``"z"`` [m], ``"rx"``, ``"ry"``, ``"rz"``
+        [rad]) to a Chirp, Sine, RandomExcitation or DisplacementRecord (its amplitude in that
+        axis's unit). The base pose is the displacement of the base point under the top frame
+        origin at home and the base's rotation ``Rz Ry Rx`` about it. Default: no base motion.
+    duration : float, optional
+        Simulated time [s]; default the shortest excitation's length (required when none
+        defines one).
+    dt : float
+        Integration step [s]; default 1e-4.
+    sample_rate : float
+        Output sample rate [Hz]; ``1/dt`` must be a whole multiple of it.
+    solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator (Bogacki-Shampine 3rd order by default).
+    cartesian : CartesianController, optional
+        Centralised control: the PI and damping loops on the platform's six axes, mapped
+        through the Jacobian (docs/hexapod.md §9.5); default None, a loop per leg.
+    progress : bool
+        Show a progress bar over the simulated time.
+    sink : callable, optional
+        ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
+        (``data`` with :data:`~qzs.engine.hexapod.result.HEXAPOD_CHANNELS`' columns, ``flags``
+        with :data:`~qzs.engine.hexapod.result.HEXAPOD_FLAGS`'); memory then stays bounded
+        however long the run, and the result holds every sample only up to 200,000 of them,
+        else every k-th (``run["preview_every"]``); its summary covers every sample
+        (:class:`qzs.iotools.hexapod_files.HexapodWriter` is such a sink).
+    interruptible : bool
+        Ctrl-C ends the run after the chunk under way; the result (and the sink) then hold
+        what was simulated, and ``run["completed"]`` is False.
+
+    Returns
+    -------
+    HexapodResult
+
+    Raises
+    ------
+    ParameterError
+        Invalid argument (names it, its value and the fix); ``StabilityError`` if ``dt``
+        exceeds the largest stable step.
+    SimulationError
+        The state diverged (the message names the time and state).
+    """
+    run = _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
+                   sample_rate, solver, progress, cartesian)
+    if sink is not None and not callable(sink):
+        raise ParameterError(f"`sink` must be a callable sink(data, flags) or None, got "
+                             f"{type(sink).__name__}.")
+    if not isinstance(interruptible, (bool, np.bool_)):
+        raise ParameterError(f"`interruptible` must be True or False, got {interruptible!r}.")
+    h = run.dt
+    n_steps = int(round(run.duration / h))
+    n_out = n_steps // run.decimation + 1
+    chunk = run.decimation * max(1, 200_000 // run.decimation)
+    if sink is None:
+        needed = n_out * (8 * N_CHANNELS + N_FLAGS)
+        available = _available_memory()
+        if available is not None and needed > 0.5 * available:
+            raise ParameterError(
+                f"a {run.duration:g} s hexapod run at {run.sample_rate:g} Hz keeps "
+                f"{needed / 1024 ** 3:.2f} GiB of samples, more than half the memory available; "
+                "lower the `sample_rate` or the `duration`, or stream it to a file "
+                "(`qzs hexapod simulate --out FILE.nc`, qzs.workflows.hexapod.simulate_setup("
+                "..., out=...)).")
+        every = 1
+        out = np.empty((n_out, N_CHANNELS))
+        out_flags = np.zeros((n_out, N_FLAGS), dtype=np.bool_)
+    else:  # one chunk's buffer; the result keeps every ``every``-th sample as a preview
+        every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // PREVIEW_SAMPLES)
+        out = np.empty((chunk // run.decimation + 1, N_CHANNELS))
+        out_flags = np.zeros((out.shape[0], N_FLAGS), dtype=np.bool_)
+        preview, preview_flags = [], []
+    statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
+                              for i in range(LEG_COUNT)])
+    s = run.state
+    V = run.V
+    buf = np.zeros((N_BUF, N_ODE))
+    ev = np.zeros((2, LEG_COUNT))
+    ww = np.zeros(N_WORK)
+    A, vec = np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros((2, LEG_COUNT))
+    idx = np.zeros(LEG_COUNT, dtype=np.int64)
+    newly = np.zeros(LEG_COUNT, dtype=np.int64)
+    counters = np.zeros(N_COUNTERS, dtype=np.int64)
+    arrays = (run.plat, run.ex, run.tables, run.toff)
+    work = (buf, ev, ww, V, A, idx, vec, newly, counters)
+
+    def absorb(first, count, total):
+        """Rows ``first:first+count`` of the buffer are new; ``total`` came before them."""
+        block, marks = out[first:first + count], out_flags[first:first + count]
+        statistics.add(block, marks)
+        if sink is not None:
+            sink(block, marks)
+            keep = np.arange((-total) % every, count, every)
+            preview.append(block[keep].copy())
+            preview_flags.append(marks[keep].copy())
+
+    _start(s, *arrays, *work, out[0], out_flags[0])
+    _run(run.solver_code, 0, run.decimation, h, s, *arrays, *work, out, out_flags,
+         1)  # compiles (or loads) the kernel: the clock counts integration only
+    absorb(0, 1, 0)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=run.duration, unit="s", desc="simulating hexapod", leave=False)
+    rows, done, completed, interrupted = 1, 0, True, False
+    deferred = _DeferredInterrupt() if interruptible else None
+    start = _time.perf_counter()
+    try:
+        if deferred is not None:  # Ctrl-C stops the run between chunks: rows stay whole
+            deferred.install()
+        while done < n_steps and not interrupted:
+            n = min(chunk, n_steps - done)
+            row0 = rows if sink is None else 0
+            status, written = _run(run.solver_code, n, run.decimation, h, s, *arrays, *work,
+                                   out, out_flags, row0)
+            absorb(row0, written, rows)
+            rows += written
+            if status != STATUS_OK:
+                failed = int(counters[CT_STEP])
+                raise SimulationError(
+                    f"the hexapod simulation diverged at t = {failed * h:.6g} s (last state: "
+                    f"centre of mass {s[S_C:S_C + 3].tolist()} m and velocity "
+                    f"{s[S_V:S_V + 3].tolist()} m/s relative to the base, leg positions "
+                    f"{V[V_Z:V_Z + LEG_COUNT].tolist()} m); check the gains and parameters, or "
+                    "reduce `dt`.")
+            done = int(counters[CT_STEP])
+            if bar is not None:
+                bar.update(n * h)
+            interrupted = deferred is not None and deferred.requested
+        if deferred is not None and deferred.terminated:
+            raise Terminated(deferred.terminated)
+        completed = done >= n_steps
+    except KeyboardInterrupt:
+        if not interruptible:
+            raise
+        completed = False
+    finally:
+        if deferred is not None:
+            deferred.restore()
+        if bar is not None:
+            bar.close()
+    elapsed = _time.perf_counter() - start
+    info = dict(solver=run.solver, dt=h, sample_rate=run.sample_rate, duration=run.duration,
+                steps=int(counters[CT_STEP]), elapsed=elapsed, samples=rows,
+                events=int(counters[CT_EVENTS]),
+                stick_events=[int(v) for v in counters[CT_STICKS:CT_STICKS + LEG_COUNT]],
+                stop_contacts=[int(v) for v in counters[CT_CONTACTS:CT_CONTACTS + LEG_COUNT]],
+                stops=[(float(V[V_ZLOW + i]), float(V[V_ZHIGH + i])) for i in range(LEG_COUNT)],
+                control="centralised" if run.cartesian is not None else "per leg",
+                controller_rate=run.controllers[0].controller_rate, completed=completed,
+                preview_every=every)
+    if sink is None:
+        data, data_flags = out[:rows], out_flags[:rows]
+    else:
+        data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
+    return HexapodResult(data, data_flags, geometry=run.geometry, platform=run.platform,
+                         isolators=run.isolators, controllers=run.controllers,
+                         excitation=run.excitation, run=info, statistics=statistics.result())
+
+
+def simulate_hexapods(runs, *, workers=None, progress=False):
+    """Simulate several platforms at once, in threads (the hexapod kernel holds no GIL).
+
+    Every run is checked before any integration starts (a bad one is named by its index);
+    each gives the very numbers :func:`simulate_hexapod` gives it alone. The six legs of
+    one platform already fill the kernel's vector lanes
+    (:data:`~qzs.engine.hexapod.layout.LANES`), so platforms are batched across cores, one
+    thread each, rather than in lanes.
+
+    Parameters
+    ----------
+    runs : sequence of dict
+        Keyword arguments of :func:`simulate_hexapod`, one dict per platform (``geometry``
+        and ``platform`` required); ``progress`` and ``sink`` are not accepted.
+    workers : int, optional
+        Threads; default the machine's core count (at most the number of runs).
+    progress : bool
+        A progress bar over the platforms.
+
+    Returns
+    -------
+    list of HexapodResult
+        In the order of ``runs``.
+
+    Raises
+    ------
+    CaseError
+        A run's arguments are invalid (attributes ``index`` and ``reason``).
+    ParameterError
+        ``runs`` is empty or holds no dicts, or ``workers`` is not a positive integer.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    runs = list(runs)
+    if not runs:
+        raise ParameterError("`runs` is empty: give at least one dict of simulate_hexapod "
+                             "arguments.")
+    workers = worker_count(workers, len(runs))  # checked before any run is set up
+    names = ("geometry", "platform", "isolator", "controller", "excitation", "duration", "dt",
+             "sample_rate", "solver", "cartesian")
+    for i, arguments in enumerate(runs):
+        if not isinstance(arguments, dict):
+            raise ParameterError(f"`runs[{i}]` must be a dict of simulate_hexapod arguments, "
+                                 f"got {type(arguments).__name__}.")
+        unknown = sorted(set(arguments) - set(names))
+        if unknown or "geometry" not in arguments or "platform" not in arguments:
+            raise ParameterError(f"`runs[{i}]` needs `geometry` and `platform` and may have "
+                                 f"{list(names[2:])}; got {sorted(arguments)}.")
+        try:  # every run checked before any integration (it packs again when it starts: cheap)
+            _prepare(arguments["geometry"], arguments["platform"], arguments.get("isolator"),
+                     arguments.get("controller"), arguments.get("excitation"),
+                     arguments.get("duration"),
+                     arguments.get("dt", defaults.SIMULATION["dt"]),
+                     arguments.get("sample_rate", defaults.SIMULATION["sample_rate"]),
+                     arguments.get("solver", defaults.SIMULATION["solver"]), False,
+                     arguments.get("cartesian"))
+        except ParameterError as error:
+            raise CaseError(i, str(error)) from error
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=len(runs), unit="platform", desc="simulating hexapods")
+
+    def one(arguments):
+        result = simulate_hexapod(**arguments)
+        if bar is not None:
+            bar.update()
+        return result
+
+    try:
+        with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="qzs-hexapod") as pool:
+            return list(pool.map(one, runs))
+    finally:
+        if bar is not None:
+            bar.close()
