@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs._validation import non_negative, positive
+from qzs.model.isolator import (friction_force, friction_slope, spring_force,
+                                spring_stiffness)
 from qzs.model.registry import model_inputs
 
 __all__ = ["SmoothModel", "smooth_right_hand_side", "FRICTION_VELOCITY"]
@@ -142,6 +144,16 @@ class SmoothModel:
                    stop_low=center - isolator.stroke_half, stop_high=center + isolator.stroke_half)
 
     @property
+    def friction_regularisation(self):
+        """The regularisation velocity under the name the model's laws read [m/s].
+
+        The spring and friction laws of :mod:`qzs.model.isolator` take the plant's
+        parameters by name; a smooth model carries the same names, and its
+        ``friction_velocity`` is their ``friction_regularisation``.
+        """
+        return self.friction_velocity
+
+    @property
     def highpass_omega(self):
         """Corner of the high-pass as an angular frequency [rad/s]."""
         return 2 * np.pi * self.velocity_highpass
@@ -174,8 +186,35 @@ class SmoothModel:
         v = np.linspace(0.0, top, 20001)
         return float(np.max(-(self.friction(v)[0] + self.viscous_damping * v)))
 
+    def motor_force(self, relative_position, pi_integral, payload_velocity, highpass_state):
+        """Unsaturated motor command [N]: PI on the position error, damping on the measured
+        payload velocity (through the high-pass when ``velocity_highpass > 0``).
+
+        Parameters
+        ----------
+        relative_position : float or ndarray
+            Relative position z [m].
+        pi_integral : float or ndarray
+            Integral I of the position error [m*s].
+        payload_velocity : float or ndarray
+            Payload velocity dx/dt [m/s].
+        highpass_state : float or ndarray
+            State w of the high-pass [m/s] (unused without it).
+
+        Returns
+        -------
+        float or ndarray
+            ``Kp (z_ref - z) + Ki I - Kd v_measured`` [N], ``v_measured = dx/dt - w``.
+        """
+        measured = (payload_velocity - highpass_state if self.velocity_highpass > 0
+                    else payload_velocity)
+        return (self.pi_kp * (self.position_setpoint - relative_position)
+                + self.pi_ki * pi_integral - self.damping_gain * measured)
+
     def spring(self, relative_position):
-        """Spring force [N] and its slope dF/dz [N/m] at ``relative_position`` [m].
+        """Spring force [N] and its slope dF/dz [N/m] at ``relative_position`` [m]: the
+        model's laws, :func:`~qzs.model.isolator.spring_force` and minus
+        :func:`~qzs.model.isolator.spring_stiffness`.
 
         Parameters
         ----------
@@ -187,11 +226,12 @@ class SmoothModel:
         force, slope : ndarray
             ``-a tanh(b z)`` [N] and ``-a b / cosh(b z)^2`` [N/m].
         """
-        t = np.tanh(self.spring_shape * np.asarray(relative_position, dtype=float))
-        return -self.spring_force * t, -self.spring_force * self.spring_shape * (1 - t * t)
+        return spring_force(relative_position, self), -spring_stiffness(relative_position, self)
 
     def friction(self, relative_velocity):
-        """Regularised friction force [N] and its slope dF/dv [N*s/m] at ``relative_velocity``.
+        """Regularised friction force [N] and its slope dF/dv [N*s/m] at ``relative_velocity``:
+        the model's laws, :func:`~qzs.model.isolator.friction_force` and
+        :func:`~qzs.model.isolator.friction_slope`, with ``friction_velocity`` as v_reg.
 
         Parameters
         ----------
@@ -204,15 +244,7 @@ class SmoothModel:
             ``-[Fc + (Fs - Fc) exp(-Cbc |v|)] tanh(v/v_reg) - Cv v`` [N] and its derivative
             [N*s/m] (continuous: the kink of ``|v|`` is multiplied by ``tanh(0) = 0``).
         """
-        v = np.asarray(relative_velocity, dtype=float)
-        th = np.tanh(v / self.friction_velocity)
-        decay = np.exp(-self.stribeck_decay * np.abs(v))
-        excess = self.stiction_force - self.coulomb_force
-        level = self.coulomb_force + excess * decay
-        force = -level * th - self.viscous_damping * v
-        slope = (excess * self.stribeck_decay * decay * np.abs(th)
-                 - level * (1 - th * th) / self.friction_velocity - self.viscous_damping)
-        return force, slope
+        return friction_force(relative_velocity, self), friction_slope(relative_velocity, self)
 
 
 def smooth_right_hand_side(time, state, frequency, model):
@@ -245,8 +277,7 @@ def smooth_right_hand_side(time, state, frequency, model):
     yd = -a * omega * np.sin(omega * time)
     ydd = -a * omega ** 2 * np.cos(omega * time)
     xd = yd + v
-    measured = xd - w if model.velocity_highpass > 0 else xd
-    error = model.position_setpoint - z
-    motor = model.pi_kp * error + model.pi_ki * integral - model.damping_gain * measured
-    force = model.spring(z)[0] + model.friction(v)[0] + motor - model.mass * model.gravity
-    return np.array([v, force / model.mass - ydd, model.highpass_omega * (xd - w), error])
+    motor = model.motor_force(z, integral, xd, w)
+    force = spring_force(z, model) + friction_force(v, model) + motor - model.mass * model.gravity
+    return np.array([v, force / model.mass - ydd, model.highpass_omega * (xd - w),
+                     model.position_setpoint - z])

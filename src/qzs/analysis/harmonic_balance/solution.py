@@ -16,6 +16,7 @@ from qzs.analysis.harmonic_balance.residual import (_force_scale, _linear_terms,
                                                     _relative_coefficients, _residual, _scales)
 from qzs.analysis.harmonic_balance.smooth_model import SmoothModel
 from qzs.errors import ParameterError
+from qzs.model.isolator import friction_level, friction_slope, spring_force, spring_stiffness
 
 __all__ = ["HarmonicBalanceSolution", "periodic_response"]
 
@@ -175,9 +176,7 @@ class HarmonicBalanceSolution:
 
         z, v, w, integral = synth(z_k), synth(s * z_k), synth(w_k), synth(integral_k)
         xd = synth(xd_k)
-        measured = xd - w if m.highpass_omega > 0 else xd
-        motor = (m.pi_kp * (m.position_setpoint - z) + m.pi_ki * integral
-                 - m.damping_gain * measured)
+        motor = m.motor_force(z, integral, xd, w)
         return {"time": basis.tau / omega, "relative_position": z, "relative_velocity": v,
                 "highpass_state": w, "pi_integral": integral, "motor_force": motor,
                 "payload_acceleration": synth(s * xd_k)}
@@ -202,8 +201,8 @@ def _linear_guess(omega, model, basis):
     ``4 F(V)/(pi V) + Cv`` at the velocity amplitude ``V`` of the fundamental (at most the
     regularised law's slope at rest), found by a few fixed-point iterations."""
     q = np.zeros(basis.size)
-    k_spring = -model.spring(model.position_setpoint)[1]
-    rest_slope = -model.friction(0.0)[1]
+    k_spring = spring_stiffness(model.position_setpoint, model)
+    rest_slope = -friction_slope(0.0, model)
     on_z, on_y, _, _ = _linear_terms(omega, model, 1)
     damping = rest_slope
     z1 = 0.0
@@ -211,12 +210,11 @@ def _linear_guess(omega, model, basis):
         z1_new = -on_y[0] * model.amplitude / (on_z[0] + k_spring + 1j * omega * damping)
         z1 = z1_new if z1 == 0.0 else 0.5 * (z1 + z1_new)
         velocity = omega * abs(z1)
-        level = (model.coulomb_force + (model.stiction_force - model.coulomb_force)
-                 * np.exp(-model.stribeck_decay * velocity))
+        level = float(friction_level(velocity, model))
         equivalent = 4 * level / (np.pi * velocity) if velocity > 0 else np.inf
         damping = min(equivalent, rest_slope - model.viscous_damping) + model.viscous_damping
     q[1], q[2] = z1.real, -z1.imag
-    static = model.mass * model.gravity - model.spring(model.position_setpoint)[0]
+    static = model.mass * model.gravity - spring_force(model.position_setpoint, model)
     if model.pi_ki > 0:
         q[0] = float(static) / model.pi_ki
     else:
