@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+import qzs
 from qzs import ControllerParameters, IsolatorParameters
 from qzs.analysis.harmonic_balance import (SmoothModel, frequency_response_curve,
-                                           smooth_right_hand_side)
+                                           periodic_response, smooth_right_hand_side)
 
 #: The MagSpring about z = 0, frictionless and lightly damped, no controller, no gravity:
 #: a softening oscillator of 4.34 Hz whose resonance leans left and folds.
@@ -103,3 +104,17 @@ def monodromy():
 def linear_curve():
     """The frequency-response curve of the default linear model, 0.3-8 Hz, 3 harmonics."""
     return frequency_response_curve(_linear_model(), (0.3, 8.0), harmonics=3)
+
+
+@pytest.fixture(scope="session")
+def frictionless_small_motion():
+    """``(solutions, linear)``: the default plant without dry friction, with active damping,
+    at 0.1 mm (the MagSpring's tangent stiffness, steep on its plateau, stays put), solved
+    at 0.2, 1, 3 and 10 Hz with 5 harmonics, and its linearised closed loop
+    (python-control)."""
+    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    controller = ControllerParameters(damping_gain=30.0)
+    model = SmoothModel.from_parameters(isolator, controller, amplitude=1e-4)
+    solutions = {frequency: periodic_response(frequency, model, harmonics=5)
+                 for frequency in (0.2, 1.0, 3.0, 10.0)}
+    return solutions, qzs.linearize(isolator, controller)

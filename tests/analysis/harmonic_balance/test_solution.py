@@ -4,8 +4,7 @@ time by scipy."""
 import numpy as np
 import pytest
 
-import qzs
-from qzs import ControllerParameters, IsolatorParameters, ParameterError
+from qzs import ParameterError
 from qzs.analysis.harmonic_balance import SmoothModel, periodic_response
 
 
@@ -56,14 +55,10 @@ def test_the_time_series_is_the_response_over_one_period(linear_model, linear_tr
         "relative_position", "relative_velocity", "highpass_state", "pi_integral")], abs=1e-15)
 
 
-def test_frictionless_small_motion_is_the_linear_closed_loop(validation):
-    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
-    controller = ControllerParameters(damping_gain=30.0)
-    # 0.1 mm: the MagSpring's tangent stiffness, steep on its plateau, stays put
-    model = SmoothModel.from_parameters(isolator, controller, amplitude=1e-4)
-    linear = qzs.linearize(isolator, controller)
-    for frequency in (0.2, 1.0, 3.0, 10.0):
-        solution = periodic_response(frequency, model, harmonics=5)
+def test_frictionless_small_motion_is_the_linear_closed_loop(frictionless_small_motion,
+                                                             validation):
+    solutions, linear = frictionless_small_motion
+    for frequency, solution in solutions.items():
         assert solution.converged
         assert solution.transmissibility == pytest.approx(
             float(linear.transmissibility(frequency)), rel=1e-7)

@@ -4,9 +4,7 @@ Liouville's formula."""
 import numpy as np
 import pytest
 
-import qzs
-from qzs import ControllerParameters, IsolatorParameters
-from qzs.analysis.harmonic_balance import SmoothModel, floquet_exponents, periodic_response
+from qzs.analysis.harmonic_balance import floquet_exponents, periodic_response
 from qzs.analysis.harmonic_balance.stability import STABILITY_MARGIN, _is_stable
 
 
@@ -30,13 +28,10 @@ def test_a_linear_orbit_has_the_closed_loops_poles(linear_model):
     assert np.sum(exponents).real == pytest.approx(np.sum(poles).real, rel=1e-9)
 
 
-def test_frictionless_small_motion_has_the_closed_loops_poles(validation):
-    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
-    controller = ControllerParameters(damping_gain=30.0)
-    model = SmoothModel.from_parameters(isolator, controller, amplitude=1e-4)
-    linear = qzs.linearize(isolator, controller)
-    for frequency in (0.2, 1.0, 3.0, 10.0):
-        solution = periodic_response(frequency, model, harmonics=5)
+def test_frictionless_small_motion_has_the_closed_loops_poles(frictionless_small_motion,
+                                                              validation):
+    solutions, linear = frictionless_small_motion
+    for frequency, solution in solutions.items():
         # the exponents of the orbit are the closed loop's poles (w, I states included)
         exponents = np.sort_complex(floquet_exponents(solution))
         np.testing.assert_allclose(exponents, np.sort_complex(linear.poles), rtol=2e-5)
