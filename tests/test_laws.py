@@ -9,7 +9,9 @@ from qzs import IsolatorParameters
 from qzs.engine import laws
 from qzs.model.isolator import friction_force, spring_energy, spring_force
 
-ENGINE = Path(__file__).resolve().parents[1] / "src" / "qzs" / "engine"
+SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
+ENGINE = SOURCE / "engine"
+HARMONIC_BALANCE = SOURCE / "analysis" / "harmonic_balance"
 P = IsolatorParameters(stiction_force=12.0, coulomb_force=2.5, stribeck_decay=40.0,
                        viscous_damping=80.0)
 
@@ -77,15 +79,34 @@ def test_controller_law_saturates_and_stops_integrating_into_saturation():
     assert f_motor == -44.0 and rate == 0.0
 
 
+def called_names(path):
+    """Names of everything a source file calls (``f(...)`` and ``module.f(...)``)."""
+    tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    return {node.func.attr if isinstance(node.func, ast.Attribute) else
+            getattr(node.func, "id", None)
+            for node in ast.walk(tree) if isinstance(node, ast.Call)}
+
+
 def test_drivers_write_no_force_law_of_their_own():
     """tanh and exp (the spring and the Stribeck curve) appear only in laws and arithmetic."""
     for name in ("kernels.py", "lanes.py", "base_motion.py"):
-        tree = ast.parse((ENGINE / name).read_text())
-        called = {node.func.attr if isinstance(node.func, ast.Attribute) else
-                  getattr(node.func, "id", None)
-                  for node in ast.walk(tree) if isinstance(node, ast.Call)}
+        called = called_names(ENGINE / name)
         assert not called & {"tanh", "_tanh", "cosh"}, name
         assert "spring_law" in called or name != "kernels.py"
         assert "sliding_friction_law" in called or name != "kernels.py"
         assert "compliant_stop_law" in called or name != "kernels.py"
         assert "controller_law" in called or name != "kernels.py"
+
+
+def test_the_harmonic_balance_writes_no_force_law_of_its_own():
+    """The smooth model's spring and friction are the model's numpy laws (qzs.model.isolator),
+    which tests/test_model.py and the test above hold equal to the kernels' laws: no tanh,
+    cosh, exp or sign anywhere in the harmonic balance, and the smooth model calls the laws
+    and their slopes."""
+    modules = sorted(HARMONIC_BALANCE.glob("*.py"))
+    assert len(modules) > 1
+    for path in modules:
+        called = called_names(path)
+        assert not called & {"tanh", "cosh", "exp", "sign"}, path.name
+    assert {"spring_force", "spring_stiffness", "friction_force", "friction_slope"} <= (
+        called_names(HARMONIC_BALANCE / "smooth_model.py"))

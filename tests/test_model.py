@@ -8,6 +8,7 @@ import pytest
 import qzs
 from qzs import InitialState, IsolatorParameters, ParameterError
 from qzs.model import friction_force, passive_natural_frequency, spring_energy, spring_force, spring_stiffness
+from qzs.model.isolator import friction_level, friction_slope
 
 DEFAULT = IsolatorParameters()
 Z_GRID = np.linspace(-0.15, 0.15, 61)
@@ -84,6 +85,32 @@ def test_friction_stribeck_decay_is_exponential_in_speed(validation):
     np.testing.assert_allclose(excess, exact, rtol=1e-13)
     validation("Stribeck decay of the friction law", "(Fs - Fc) exp(-Cbc |v|) (paper eq. 3)",
                np.abs(excess / exact - 1).max(), 1e-13)
+
+
+@pytest.mark.parametrize("regularisation", [0.0, 2e-3])
+def test_friction_slope_is_the_derivative_of_the_friction_force(regularisation):
+    p = IsolatorParameters(stiction_force=12.0, coulomb_force=2.5, stribeck_decay=40.0,
+                           viscous_damping=80.0, friction_regularisation=regularisation)
+    speeds = np.logspace(-5, 0.5, 60)
+    v = np.concatenate([-speeds[::-1], speeds])
+    if regularisation:  # smooth through 0: the steep tanh is resolved by a small step
+        v = np.concatenate([v, np.linspace(-5 * regularisation, 5 * regularisation, 41)])
+        h = np.full(v.shape, 1e-6 * regularisation)  # |v| v at 0: an error of order h
+    else:  # the exact law jumps at 0: differences on one side only
+        h = 1e-4 * np.abs(v)
+    central = (friction_force(v + h, p) - friction_force(v - h, p)) / (2 * h)
+    slope = friction_slope(v, p)
+    np.testing.assert_allclose(slope, central, rtol=1e-6, atol=1e-8 * np.abs(slope).max())
+    # the Stribeck level is the force's size without direction and viscous part
+    direction = np.tanh(v / regularisation) if regularisation else np.sign(v)
+    np.testing.assert_allclose(friction_force(v, p),
+                               -friction_level(v, p) * direction - p.viscous_damping * v,
+                               rtol=1e-15, atol=1e-15)
+    assert friction_level(0.0, p) == p.stiction_force
+    assert friction_level(-1e3, p) == pytest.approx(p.coulomb_force, rel=1e-15)
+    # at rest: the viscous slope alone (exact law, its jump left out), or steep (regularised)
+    expected = -p.viscous_damping - (p.stiction_force / regularisation if regularisation else 0)
+    assert friction_slope(0.0, p) == pytest.approx(expected, rel=1e-15)
 
 
 # ------------------------------------------------------------------ operating point

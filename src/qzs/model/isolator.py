@@ -19,7 +19,9 @@ __all__ = [
     "spring_force",
     "spring_stiffness",
     "spring_energy",
+    "friction_level",
     "friction_force",
+    "friction_slope",
     "passive_natural_frequency",
 ]
 
@@ -238,6 +240,27 @@ def spring_energy(relative_position, params):
     return params.spring_force / params.spring_shape * (u + np.log1p(np.exp(-2 * u)) - np.log(2))
 
 
+def friction_level(relative_velocity, params):
+    """Dry-friction level ``Fc + (Fs - Fc)*exp(-Cbc*|v|)`` [N] at slip velocity ``v`` [m/s] (eq. 3).
+
+    The size of the friction force before its direction and the viscous part: Fs at rest,
+    decaying to Fc (the Stribeck curve).
+
+    Parameters
+    ----------
+    relative_velocity : float or array_like
+        Relative (slip) velocity v [m/s].
+    params : IsolatorParameters
+        Supplies ``stiction_force``, ``coulomb_force`` and ``stribeck_decay``.
+
+    Returns
+    -------
+    float or ndarray
+        Dry-friction level [N], between Fc and Fs.
+    """
+    return _friction_level(np.asarray(relative_velocity, dtype=float), params)[0]
+
+
 def friction_force(relative_velocity, params):
     """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, signs of docs/model.md §3).
 
@@ -252,7 +275,7 @@ def friction_force(relative_velocity, params):
         Relative (slip) velocity v [m/s].
     params : IsolatorParameters
         Supplies the friction parameters (``stiction_force``, ``coulomb_force``,
-        ``stribeck_decay``, ``viscous_damping``).
+        ``stribeck_decay``, ``viscous_damping``, ``friction_regularisation``).
 
     Returns
     -------
@@ -260,13 +283,52 @@ def friction_force(relative_velocity, params):
         Friction force on the payload [N].
     """
     v = np.asarray(relative_velocity, dtype=float)
+    level = _friction_level(v, params)[0]
+    return -level * _slip_direction(v, params) - params.viscous_damping * v
+
+
+def friction_slope(relative_velocity, params):
+    """Slope ``dF/dv`` [N*s/m] of :func:`friction_force` at slip velocity ``v`` [m/s].
+
+    ``(Fs - Fc)*Cbc*exp(-Cbc*|v|)*|d| - level*d'(v) - Cv`` with ``d`` the direction
+    (``sign(v)``, or ``tanh(v/v_reg)`` with regularisation) and ``d'`` its derivative:
+    ``(1 - tanh^2)/v_reg`` regularised, 0 otherwise (the exact law's jump at ``v = 0`` is
+    left out: there the slope is ``-Cv``). Regularised, the slope is continuous: the kink of
+    ``|v|`` is multiplied by ``tanh(0) = 0``.
+
+    Parameters
+    ----------
+    relative_velocity : float or array_like
+        Relative (slip) velocity v [m/s].
+    params : IsolatorParameters
+        Supplies the friction parameters, as for :func:`friction_force`.
+
+    Returns
+    -------
+    float or ndarray
+        Slope of the friction force [N*s/m].
+    """
+    v = np.asarray(relative_velocity, dtype=float)
     p = params
-    level = p.coulomb_force + (p.stiction_force - p.coulomb_force) * np.exp(-p.stribeck_decay * np.abs(v))
+    level, decay = _friction_level(v, p)
+    direction = _slip_direction(v, p)
+    slope = (p.stiction_force - p.coulomb_force) * p.stribeck_decay * decay * np.abs(direction)
     if p.friction_regularisation > 0.0:
-        direction = np.tanh(v / p.friction_regularisation)
-    else:
-        direction = np.sign(v)
-    return -level * direction - p.viscous_damping * v
+        slope = slope - level * (1 - direction * direction) / p.friction_regularisation
+    return slope - p.viscous_damping
+
+
+def _friction_level(v, p):
+    """``(level, decay)``: the dry-friction level [N] and ``exp(-Cbc*|v|)`` [-] at ``v`` [m/s]."""
+    decay = np.exp(-p.stribeck_decay * np.abs(v))
+    return p.coulomb_force + (p.stiction_force - p.coulomb_force) * decay, decay
+
+
+def _slip_direction(v, p):
+    """``sign(v)``, or ``tanh(v/v_reg)`` with a regularisation velocity v_reg > 0 [-]."""
+    if p.friction_regularisation > 0.0:
+        return np.tanh(v / p.friction_regularisation)
+    return np.sign(v)
 
 
 def passive_natural_frequency(params, relative_position):
