@@ -128,6 +128,9 @@ def hexapod():
                                   sample_rate=1e3, **options)
         line(f"hexapod/{name}", result._data, result._flags,
              show=(result.run["steps"], result.run["events"]))
+        stats = result.statistics
+        line(f"hexapod/{name}/statistics",
+             *[np.asarray(stats[k], dtype=float) for k in sorted(stats)])
     from qzs.model.hexapod import CartesianController
 
     cartesian = CartesianController(position_gain=[2000.0] * 6, integral_gain=[800.0] * 6,
@@ -149,6 +152,10 @@ def response():
     names = sorted(n for n in ds.data_vars if n not in skip and ds[n].dtype.kind in "fiub")
     line("response/points", *[ds[n].values for n in names],
          show=tuple(float(v) for v in np.ravel(ds["transmissibility"].values)[:4]))
+    # the same, split: the stepped-sine points, and the harmonic balance's curve beside them
+    stepped = [n for n in names if not n.startswith("balance")]
+    line("response/stepped-sine", *[ds[n].values for n in stepped])
+    line("response/balance", *[ds[n].values for n in names if n.startswith("balance")])
 
 
 def _balance_residual():

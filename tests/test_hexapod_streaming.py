@@ -9,7 +9,8 @@ import pytest
 import xarray as xr
 
 from qzs.cli import main
-from qzs.engine.hexapod import simulate as engine
+from qzs.engine import driver as driver_module
+from qzs.engine.hexapod import simulate as hexapod_simulate
 from qzs.errors import OutputPathError, ParameterError
 from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
 from qzs.workflows.hexapod import load_hexapod, simulate_setup
@@ -48,16 +49,25 @@ def test_the_streamed_file_is_the_in_memory_run(setup, in_memory, tmp_path):
 
 def test_a_long_run_keeps_a_preview_and_summarises_every_sample(setup, in_memory, tmp_path,
                                                                 monkeypatch):
-    """With more samples than the preview holds, the result keeps every k-th sample; the
-    statistics (and so the summary) are still those of all of them, to the last bit."""
-    monkeypatch.setattr(engine, "PREVIEW_SAMPLES", 1000)
+    """With more samples than the preview holds, the result keeps the min/max envelope of
+    groups of k samples, as a single run's preview does (before, every k-th sample: an
+    aliased pick); the statistics (and so the summary) are still those of all of them, to
+    the last bit."""
+    monkeypatch.setattr(driver_module, "PREVIEW_SAMPLES", 1000)
     streamed = simulate_setup(setup, duration=DURATION, out=tmp_path / "long.nc")
     every = streamed.run["preview_every"]
-    assert every == -(-len(in_memory) // 1000) and len(streamed) <= 1000
-    assert np.array_equal(streamed["relative_position"],
-                          in_memory["relative_position"][::every])
+    assert every == -(-len(in_memory) // 500) and len(streamed) <= 1000
+    full = in_memory["relative_position"]
+    groups = [full[i:i + every] for i in range(0, len(full), every)]
+    preview = streamed["relative_position"]
+    np.testing.assert_array_equal(preview[0::2], [g.min(axis=0) for g in groups])
+    np.testing.assert_array_equal(preview[1::2], [g.max(axis=0) for g in groups])
+    locked = streamed["locked"]
+    np.testing.assert_array_equal(locked[1::2], [g.any(axis=0) for g in
+                                                 (in_memory["locked"][i:i + every]
+                                                  for i in range(0, len(full), every))])
     assert streamed.statistics == in_memory.statistics
-    assert f"every {every}th sample" in streamed.summary()
+    assert f"envelope of groups of {every} samples" in streamed.summary()
     assert streamed.summary().split("\n")[1:-1] == in_memory.summary().split("\n")[1:]
 
 
@@ -74,10 +84,12 @@ def test_ctrl_c_keeps_what_was_simulated(setup, tmp_path, monkeypatch):
             signal.raise_signal(signal.SIGINT)
 
     monkeypatch.setattr(HexapodWriter, "append", append)
+    monkeypatch.setattr(hexapod_simulate, "PREVIEW_CHUNK", 2000)  # 13 chunks
     path = tmp_path / "stopped.nc"
     result = simulate_setup(setup, duration=DURATION, out=path, interruptible=True)
     assert result.run["completed"] is False
-    assert 1 < result.run["samples"] < DURATION * 1000
+    # the kernel steps the next chunk while the last is written: it ends after that one
+    assert result.run["samples"] == 1 + 2 * 2000
     with xr.open_dataset(path) as written:
         assert written.sizes["time"] == result.run["samples"] == sum(calls)
         assert written.attrs["run.completed"] == 0
@@ -119,7 +131,7 @@ def test_save_writes_the_held_run_and_refuses_a_preview(setup, in_memory, tmp_pa
     with xr.open_dataset(path) as written:
         assert np.array_equal(written["platform_pose"].values, in_memory["platform_pose"])
         assert written.sizes["time"] == len(in_memory)
-    monkeypatch.setattr(engine, "PREVIEW_SAMPLES", 1000)
+    monkeypatch.setattr(driver_module, "PREVIEW_SAMPLES", 1000)
     preview = simulate_setup(setup, duration=DURATION, out=tmp_path / "streamed.nc")
     with pytest.raises(ParameterError, match="preview"):
         preview.save(tmp_path / "again.nc")

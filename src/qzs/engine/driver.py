@@ -130,7 +130,7 @@ class RunPlan:
         return self.chunk // self.decimation + 1
 
 
-def chunk_steps(decimation, max_steps, max_samples, affordable=None):
+def chunk_steps(decimation, max_steps, max_samples, affordable=None, phase_period=PHASE_PERIOD):
     """Integration steps per kernel call [-]: the one rule for every driver.
 
     A whole number of :data:`PHASE_PERIOD` (the excitation's sine and cosine are exact
@@ -150,6 +150,9 @@ def chunk_steps(decimation, max_steps, max_samples, affordable=None):
     affordable : int, optional
         Most steps a call may take whatever its samples [-] (progress and Ctrl-C
         granularity); default ``max_steps``.
+    phase_period : int
+        The kernel's exact-phase grid [steps]; 1 for a kernel that carries its phase
+        across calls (the six-leg kernel).
 
     Returns
     -------
@@ -158,15 +161,15 @@ def chunk_steps(decimation, max_steps, max_samples, affordable=None):
     """
     decimation = int(decimation)
     affordable = int(max_steps if affordable is None else affordable)
-    unit = math.lcm(decimation, PHASE_PERIOD)
+    unit = math.lcm(decimation, phase_period)
     if unit > affordable:  # not even one sample's steps fit: bound the steps only
-        return PHASE_PERIOD * max(1, affordable // PHASE_PERIOD)
+        return phase_period * max(1, affordable // phase_period)
     steps = min(int(max_steps), affordable, int(max_samples) * decimation)
     return unit * max(1, steps // unit)
 
 
 def plan_run(duration, dt, decimation, *, kernel="single", cases=1, workers=1,
-             max_samples=None, max_steps=None):
+             max_samples=None, max_steps=None, phase_period=PHASE_PERIOD):
     """The plan of a run, refused before it starts if it would take absurdly long.
 
     Parameters
@@ -191,6 +194,8 @@ def plan_run(duration, dt, decimation, *, kernel="single", cases=1, workers=1,
         Most steps per chunk [-], below the bound the kernel's cost sets. The batch gives
         its run's steps: its statistics are summed chunk by chunk, and the same cuts give
         the same bits.
+    phase_period : int
+        The kernel's exact-phase grid [steps] (:func:`chunk_steps`).
 
     Returns
     -------
@@ -212,7 +217,7 @@ def plan_run(duration, dt, decimation, *, kernel="single", cases=1, workers=1,
     affordable = max(PHASE_PERIOD, int(CHUNK_STEPS / relative))
     chunk = chunk_steps(decimation, affordable if max_steps is None else max_steps,
                         max(1, CHUNK_SAMPLES if max_samples is None else max_samples),
-                        affordable)
+                        affordable, phase_period)
     return RunPlan(steps=steps, decimation=int(decimation), samples=steps // decimation + 1,
                    chunk=chunk)
 
@@ -300,8 +305,8 @@ class Recorder:
     buffers (the kernel fills one while the other is written) and handed to
     ``sink(data, flags)``; the result keeps every sample if there are at most
     :data:`PREVIEW_SAMPLES`, else per group of k samples one row of each channel's
-    minimum and one of its maximum, so that a figure shows the true envelope and never
-    an aliased pick.
+    minimum and one of its maximum (a group that a chunk boundary cuts is merged), so
+    that a figure shows the true envelope and never an aliased pick.
 
     Parameters
     ----------
@@ -334,6 +339,7 @@ class Recorder:
             self.every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // (PREVIEW_SAMPLES // 2))
             rows = min(n_out, plan.chunk_samples)
             self._preview, self._preview_flags = [], []
+            self._pending = None  # the envelope of the last group, until it is complete
         self.buffers = [(np.empty((rows, channels)), np.zeros((rows, flags), dtype=np.bool_))]
         if sink is not None:  # two buffers: the kernel fills one while the other is written
             self.buffers.append((np.empty_like(self.buffers[0][0]),
@@ -357,16 +363,40 @@ class Recorder:
                 self._preview.append(block.copy())
                 self._preview_flags.append(block_flags.copy())
             elif count:
-                low, high = envelope_rows(block, block_flags, self.rows, self.every)
-                self._preview.append(low)
-                self._preview_flags.append(high)
+                self._envelope(block, block_flags)
         self.rows += count
+
+    def _envelope(self, block, block_flags):
+        """Add a block's min/max envelope to the preview: one pair of rows per group of
+        ``every`` samples, a group cut by a block boundary merged with its first part."""
+        rows, marks = envelope_rows(block, block_flags, self.rows, self.every)
+        first_group = self.rows // self.every
+        if self._pending is not None:  # the group the last block ended in goes on here
+            low, high, low_flags, high_flags = self._pending
+            if first_group * self.every < self.rows:
+                rows[0] = np.minimum(rows[0], low)
+                rows[1] = np.maximum(rows[1], high)
+                marks[0] &= low_flags
+                marks[1] |= high_flags
+            self._pending = None
+        end = self.rows + block.shape[0]
+        if end % self.every:  # the last group is not complete: hold it back
+            self._pending = (rows[-2].copy(), rows[-1].copy(), marks[-2].copy(),
+                             marks[-1].copy())
+            rows, marks = rows[:-2], marks[:-2]
+        self._preview.append(rows)
+        self._preview_flags.append(marks)
 
     def result(self):
         """``(data, flags)``: every sample, or the preview of a streamed run."""
         if self.sink is None:
             data, marks = self.buffers[0]
             return data[:self.rows], marks[:self.rows]
+        if self.every > 1 and self._pending is not None:  # the run ended inside a group
+            low, high, low_flags, high_flags = self._pending
+            self._preview.append(np.stack([low, high]))
+            self._preview_flags.append(np.stack([low_flags, high_flags]))
+            self._pending = None
         return np.concatenate(self._preview), np.concatenate(self._preview_flags)
 
 
@@ -517,7 +547,7 @@ def drive(stepper, plan, recorder, *, progress=None, interruptible=False):
                 bar.update(steps)
         if deferred.terminated:
             raise Terminated(deferred.terminated)
-        if interrupted:
+        if interrupted and done < plan.steps:  # a signal during the last chunk ends nothing
             raise KeyboardInterrupt
     except KeyboardInterrupt:
         if not interruptible:

@@ -159,7 +159,8 @@ class HexapodResult:
         (integration only), ``samples``, ``events`` (located transitions), per leg
         ``stick_events`` and ``stop_contacts``, ``stops`` (per leg, [m]), ``control``,
         ``controller_rate`` [Hz], ``completed`` (False if interrupted) and
-        ``preview_every`` (the stride of the samples held when the run streamed to a file).
+        ``preview_every`` (1, or k if the result of a run streamed to a file keeps the min/max
+        envelope of groups of k samples).
     statistics : dict, optional
         The summary's statistics over every sample (see
         :mod:`qzs.engine.hexapod.statistics`); computed from ``data`` if omitted.

@@ -5,7 +5,6 @@ Validated and packed by :mod:`qzs.engine.hexapod.prepare`, integrated in chunks 
 kernels of :mod:`qzs.engine.hexapod.stepping`, returned as a
 :class:`~qzs.engine.hexapod.result.HexapodResult` (or streamed to a sink).
 """
-import time as _time
 
 import numpy as np
 
@@ -18,8 +17,11 @@ from qzs.engine.hexapod.prepare import _prepare
 from qzs.engine.hexapod.result import HexapodResult
 from qzs.engine.hexapod.statistics import _Statistics
 from qzs.engine.hexapod.stepping import _run, _start
-from qzs.engine.simulate import PREVIEW_SAMPLES, _available_memory, _DeferredInterrupt
-from qzs.errors import CaseError, ParameterError, SimulationError, Terminated
+from qzs.engine import driver
+from qzs.errors import CaseError, ParameterError, SimulationError
+
+#: Output samples per kernel call at most (the hexapod's 99 channels: 158 MB).
+PREVIEW_CHUNK = 200_000
 
 __all__ = ["simulate_hexapod", "simulate_hexapods"]
 
@@ -78,7 +80,9 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         (``data`` with :data:`~qzs.engine.hexapod.result.HEXAPOD_CHANNELS`' columns, ``flags``
         with :data:`~qzs.engine.hexapod.result.HEXAPOD_FLAGS`'); memory then stays bounded
         however long the run, and the result holds every sample only up to 200,000 of them,
-        else every k-th (``run["preview_every"]``); its summary covers every sample
+        else per group of k samples (``run["preview_every"]``) one row of each channel's
+        minimum and one of its maximum, the flags' all and any (the run driver's preview,
+        :class:`qzs.engine.driver.Recorder`, as a single run's); its summary covers every sample
         (:class:`qzs.iotools.hexapod_files.HexapodWriter` is such a sink).
     interruptible : bool
         Ctrl-C ends the run after the chunk under way; the result (and the sink) then hold
@@ -103,115 +107,75 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
                              f"{type(sink).__name__}.")
     if not isinstance(interruptible, (bool, np.bool_)):
         raise ParameterError(f"`interruptible` must be True or False, got {interruptible!r}.")
-    h = run.dt
-    n_steps = int(round(run.duration / h))
-    n_out = n_steps // run.decimation + 1
-    chunk = run.decimation * max(1, 200_000 // run.decimation)
-    if sink is None:
-        needed = n_out * (8 * N_CHANNELS + N_FLAGS)
-        available = _available_memory()
-        if available is not None and needed > 0.5 * available:
-            raise ParameterError(
-                f"a {run.duration:g} s hexapod run at {run.sample_rate:g} Hz keeps "
-                f"{needed / 1024 ** 3:.2f} GiB of samples, more than half the memory available; "
-                "lower the `sample_rate` or the `duration`, or stream it to a file "
-                "(`qzs hexapod simulate --out FILE.nc`, qzs.workflows.hexapod.simulate_setup("
-                "..., out=...)).")
-        every = 1
-        out = np.empty((n_out, N_CHANNELS))
-        out_flags = np.zeros((n_out, N_FLAGS), dtype=np.bool_)
-    else:  # one chunk's buffer; the result keeps every ``every``-th sample as a preview
-        every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // PREVIEW_SAMPLES)
-        out = np.empty((chunk // run.decimation + 1, N_CHANNELS))
-        out_flags = np.zeros((out.shape[0], N_FLAGS), dtype=np.bool_)
-        preview, preview_flags = [], []
+    plan = driver.plan_run(run.duration, run.dt, run.decimation, kernel="hexapod",
+                           max_samples=PREVIEW_CHUNK, phase_period=1)
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
                               for i in range(LEG_COUNT)])
-    s = run.state
-    V = run.V
-    buf = np.zeros((N_BUF, N_ODE))
-    ev = np.zeros((2, LEG_COUNT))
-    ww = np.zeros(N_WORK)
-    A, vec = np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros((2, LEG_COUNT))
-    idx = np.zeros(LEG_COUNT, dtype=np.int64)
-    newly = np.zeros(LEG_COUNT, dtype=np.int64)
-    counters = np.zeros(N_COUNTERS, dtype=np.int64)
-    arrays = (run.plat, run.ex, run.tables, run.toff)
-    work = (buf, ev, ww, V, A, idx, vec, newly, counters)
-
-    def absorb(first, count, total):
-        """Rows ``first:first+count`` of the buffer are new; ``total`` came before them."""
-        block, marks = out[first:first + count], out_flags[first:first + count]
-        statistics.add(block, marks)
-        if sink is not None:
-            sink(block, marks)
-            keep = np.arange((-total) % every, count, every)
-            preview.append(block[keep].copy())
-            preview_flags.append(marks[keep].copy())
-
-    _start(s, *arrays, *work, out[0], out_flags[0])
-    _run(run.solver_code, 0, run.decimation, h, s, *arrays, *work, out, out_flags,
-         1)  # compiles (or loads) the kernel: the clock counts integration only
-    absorb(0, 1, 0)
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=run.duration, unit="s", desc="simulating hexapod", leave=False)
-    rows, done, completed, interrupted = 1, 0, True, False
-    deferred = _DeferredInterrupt() if interruptible else None
-    start = _time.perf_counter()
-    try:
-        if deferred is not None:  # Ctrl-C stops the run between chunks: rows stay whole
-            deferred.install()
-        while done < n_steps and not interrupted:
-            n = min(chunk, n_steps - done)
-            row0 = rows if sink is None else 0
-            status, written = _run(run.solver_code, n, run.decimation, h, s, *arrays, *work,
-                                   out, out_flags, row0)
-            absorb(row0, written, rows)
-            rows += written
-            if status != STATUS_OK:
-                failed = int(counters[CT_STEP])
-                raise SimulationError(
-                    f"the hexapod simulation diverged at t = {failed * h:.6g} s (last state: "
-                    f"centre of mass {s[S_C:S_C + 3].tolist()} m and velocity "
-                    f"{s[S_V:S_V + 3].tolist()} m/s relative to the base, leg positions "
-                    f"{V[V_Z:V_Z + LEG_COUNT].tolist()} m); check the gains and parameters, or "
-                    "reduce `dt`.")
-            done = int(counters[CT_STEP])
-            if bar is not None:
-                bar.update(n * h)
-            interrupted = deferred is not None and deferred.requested
-        if deferred is not None and deferred.terminated:
-            raise Terminated(deferred.terminated)
-        completed = done >= n_steps
-    except KeyboardInterrupt:
-        if not interruptible:
-            raise
-        completed = False
-    finally:
-        if deferred is not None:
-            deferred.restore()
-        if bar is not None:
-            bar.close()
-    elapsed = _time.perf_counter() - start
-    info = dict(solver=run.solver, dt=h, sample_rate=run.sample_rate, duration=run.duration,
-                steps=int(counters[CT_STEP]), elapsed=elapsed, samples=rows,
+    recorder = driver.Recorder(
+        plan, N_CHANNELS, N_FLAGS, statistics=statistics.add, sink=sink,
+        duration=run.duration, sample_rate=run.sample_rate,
+        remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
+               "qzs.workflows.hexapod.simulate_setup(..., out=...)), or lower the "
+               "`sample_rate` or the `duration`")
+    stepper = _SixLegs(run, recorder.buffers)
+    data, marks = recorder.buffers[0]
+    _start(stepper.s, *stepper.arrays, *stepper.work, data[0], marks[0])
+    recorder.absorb(0, 0, 1)
+    outcome = driver.drive(stepper, plan, recorder,
+                           progress="simulating hexapod" if progress else None,
+                           interruptible=interruptible)
+    counters, V = stepper.counters, run.V
+    info = dict(solver=run.solver, dt=run.dt, sample_rate=run.sample_rate, duration=run.duration,
+                steps=int(counters[CT_STEP]), elapsed=outcome.elapsed, samples=recorder.rows,
                 events=int(counters[CT_EVENTS]),
                 stick_events=[int(v) for v in counters[CT_STICKS:CT_STICKS + LEG_COUNT]],
                 stop_contacts=[int(v) for v in counters[CT_CONTACTS:CT_CONTACTS + LEG_COUNT]],
                 stops=[(float(V[V_ZLOW + i]), float(V[V_ZHIGH + i])) for i in range(LEG_COUNT)],
                 control="centralised" if run.cartesian is not None else "per leg",
-                controller_rate=run.controllers[0].controller_rate, completed=completed,
-                preview_every=every)
-    if sink is None:
-        data, data_flags = out[:rows], out_flags[:rows]
-    else:
-        data, data_flags = np.concatenate(preview), np.concatenate(preview_flags)
+                controller_rate=run.controllers[0].controller_rate,
+                completed=outcome.completed, preview_every=recorder.every)
+    data, data_flags = recorder.result()
     return HexapodResult(data, data_flags, geometry=run.geometry, platform=run.platform,
                          isolators=run.isolators, controllers=run.controllers,
                          excitation=run.excitation, run=info, statistics=statistics.result())
+
+
+class _SixLegs(driver.Stepper):
+    """The six-leg kernel (:func:`qzs.engine.hexapod.stepping._run`) as the driver's stepper.
+
+    Holds the kernel's workspaces; the state, modes, counters and the excitation's phase
+    persist in them between calls, so that cutting a run into calls changes nothing.
+    """
+
+    def __init__(self, run, buffers):
+        self.run = run
+        self.buffers = buffers
+        self.s = run.state
+        self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
+        self.arrays = (run.plat, run.ex, run.tables, run.toff)
+        self.work = (np.zeros((N_BUF, N_ODE)), np.zeros((2, LEG_COUNT)), np.zeros(N_WORK),
+                     run.V, np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64),
+                     np.zeros((2, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64), self.counters)
+        self.diverged = False
+
+    def advance(self, steps, buffer, row0):
+        """Advance ``steps`` steps; returns the rows written into ``buffers[buffer]``."""
+        data, marks = self.buffers[buffer]
+        status, written = _run(self.run.solver_code, steps, self.run.decimation, self.run.dt,
+                               self.s, *self.arrays, *self.work, data, marks, row0)
+        self.diverged = status != STATUS_OK
+        return written
+
+    def divergence(self):
+        """The :class:`~qzs.errors.SimulationError` of a diverged run (time and last state)."""
+        s, V = self.s, self.run.V
+        failed = int(self.counters[CT_STEP])
+        return SimulationError(
+            f"the hexapod simulation diverged at t = {failed * self.run.dt:.6g} s (last state: "
+            f"centre of mass {s[S_C:S_C + 3].tolist()} m and velocity "
+            f"{s[S_V:S_V + 3].tolist()} m/s relative to the base, leg positions "
+            f"{V[V_Z:V_Z + LEG_COUNT].tolist()} m); check the gains and parameters, or reduce "
+            "`dt`.")
 
 
 def simulate_hexapods(runs, *, workers=None, progress=False):

@@ -97,6 +97,6 @@ def _summary_text(result):
         lines.append(f"Interrupted: {run['samples']:,} samples up to "
                      f"t = {run['steps'] * run['dt']:.6g} s of {run['duration']:g} s.")
     if run.get("preview_every", 1) > 1:
-        lines.append(f"In memory: every {run['preview_every']}th sample (a preview; the file "
-                     "holds them all)")
+        lines.append(f"In memory: the min/max envelope of groups of {run['preview_every']} "
+                     "samples (a preview; the file holds them all)")
     return "\n".join(lines)
