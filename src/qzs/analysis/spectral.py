@@ -23,7 +23,7 @@ from typing import Mapping
 import numpy as np
 from scipy import signal
 
-from qzs._validation import finite_series, integer
+from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
 
@@ -38,14 +38,6 @@ _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
 
 
 # ---------------------------------------------------------------- validation
-def _positive(name, value, allow_none=False):
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"`{name}` must be a positive finite number, got {value!r}.")
-    return float(value)
-
-
 def _noverlap(fft_length, overlap):
     if isinstance(overlap, bool) or not isinstance(overlap, numbers.Real) or not 0 <= overlap < 1:
         raise ParameterError(f"`overlap` must be a fraction in [0, 1), got {overlap!r}.")
@@ -162,8 +154,8 @@ def trusted_bins(frequency, coherence, base_share, *, coherence_min=ANALYSIS["co
     if isinstance(base_share_min, bool) or not isinstance(base_share_min, numbers.Real) \
             or not 0 <= base_share_min < 1:
         raise ParameterError(f"`base_share_min` must be in [0, 1), got {base_share_min!r}.")
-    corner = _positive("highpass_corner", highpass_corner, allow_none=True)
-    factor = _positive("highpass_factor", highpass_factor)
+    corner = optional(positive_real)("highpass_corner", highpass_corner)
+    factor = positive_real("highpass_factor", highpass_factor)
     with np.errstate(invalid="ignore"):
         mask = ((f > 0) & (np.asarray(coherence, dtype=float) >= coherence_min)
                 & (np.asarray(base_share, dtype=float) >= base_share_min))
@@ -244,7 +236,8 @@ def required_duration(fft_length, n_averages, sample_rate, overlap=0.5):
     float
         Record duration [s]: :func:`required_samples` divided by ``sample_rate``.
     """
-    return required_samples(fft_length, n_averages, overlap) / _positive("sample_rate", sample_rate)
+    return (required_samples(fft_length, n_averages, overlap)
+            / positive_real("sample_rate", sample_rate))
 
 
 # ---------------------------------------------------------------- estimation
@@ -458,10 +451,10 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
     DataError
         Signals not 1-D, of different lengths, non-finite, or too short.
     """
-    sample_rate = _positive("sample_rate", sample_rate)
+    sample_rate = positive_real("sample_rate", sample_rate)
     fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
-    highpass_corner = _positive("highpass_corner", highpass_corner, allow_none=True)
+    highpass_corner = optional(positive_real)("highpass_corner", highpass_corner)
     if estimator not in ESTIMATORS:
         raise ParameterError(f"`estimator` must be one of {ESTIMATORS}, got {estimator!r}.")
     base, payload = _signal("base", base), _signal("payload", payload)
@@ -544,7 +537,7 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
     rms_amplitude : ndarray
         RMS amplitude per bin [u].
     """
-    sample_rate = _positive("sample_rate", sample_rate)
+    sample_rate = positive_real("sample_rate", sample_rate)
     fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     values = _signal("signal_values", signal_values)
@@ -833,10 +826,10 @@ def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequenci
         No bin of the curve is trusted: every metric is NaN.
     """
     f, t, ok = _curve(frequency, magnitude, trusted)
-    corner = _positive("highpass_corner", highpass_corner, allow_none=True)
-    factor = _positive("untrusted_factor", untrusted_factor)
+    corner = optional(positive_real)("highpass_corner", highpass_corner)
+    factor = positive_real("untrusted_factor", untrusted_factor)
     peak_min = (1.0 / np.sqrt(ANALYSIS["coherence_min"]) if peak_min is None
-                else _positive("peak_min", peak_min))
+                else positive_real("peak_min", peak_min))
     untrusted_below = 0.0 if corner is None else factor * corner
     ok = ok & (f >= untrusted_below)
     spots = np.atleast_1d(np.asarray(at_frequencies, dtype=float))

@@ -7,6 +7,7 @@ from types import MappingProxyType
 import numpy as np
 from scipy import optimize
 
+from qzs._validation import integer
 from qzs.analysis.spectral import transmissibility
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
@@ -295,9 +296,7 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
     keep = (f >= low) & (f <= high) & (f > 0)
     f, measured = f[keep], measured[keep]
     free, start = _free_parameters(free, isolator, controller, initial)
-    if (isinstance(jitter_samples, bool) or not isinstance(jitter_samples, (int, np.integer))
-            or jitter_samples < 0):
-        raise ParameterError(f"`jitter_samples` must be an integer >= 0, got {jitter_samples!r}.")
+    integer("jitter_samples", jitter_samples, 0)
     if f.size < len(free) + 2:
         raise DataError(f"only {f.size} points of the curve lie in the band [{low:g}, {high:g}] "
                         f"Hz; fitting {len(free)} parameter(s) needs at least {len(free) + 2}.")
