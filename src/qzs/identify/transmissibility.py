@@ -9,6 +9,7 @@ from scipy import optimize
 
 from qzs._validation import integer
 from qzs.analysis.spectral import transmissibility
+from qzs.defaults import EXCITATION
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
 from qzs.errors import DataError, FitError, ParameterError, SimulationError
@@ -304,7 +305,8 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
         raise DataError(f"`magnitude` has {np.count_nonzero(measured <= 0)} values <= 0 in the "
                         "band; the fit compares logs, drop those bins or narrow `band`.")
     if excitation is None:
-        excitation = Chirp(amplitude=0.010, f0=0.0, f1=max(20.0, float(high)), duration=duration)
+        excitation = Chirp(amplitude=EXCITATION["amplitude"], f0=0.0, f1=max(20.0, float(high)),
+                           duration=duration)
     if excitation.max_frequency < high:
         raise ParameterError(f"the chirp ends at {excitation.max_frequency:g} Hz, below the band's "
                              f"top {high:g} Hz; extend `excitation` or narrow `band`.")

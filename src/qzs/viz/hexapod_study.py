@@ -9,21 +9,17 @@ response is then no steady state).
 """
 import numpy as np
 
+from qzs.analysis.hexapod_linear import entry_unit
+from qzs.defaults import AXES
 from qzs.viz.figures import save_figure
 
 __all__ = ["plot_study_comparison", "AXES"]
 
-AXES = ("x", "y", "z", "rx", "ry", "rz")
 _FLOOR = 1e-12
 
 
 def _db(values):
     return 20 * np.log10(np.maximum(np.abs(np.asarray(values, dtype=complex)), _FLOOR))
-
-
-def _unit(i, j):
-    row, column = ("m" if i < 3 else "rad"), ("m" if j < 3 else "rad")
-    return "-" if row == column else f"{row}/{column}"
 
 
 def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=(0.1, 20.0),
@@ -92,10 +88,11 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
             ax.set_xlim(low, high)
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
             kind = "transmissibility" if i == j else "cross-axis response"
-            ax.set_title(f"platform {AXES[i]} per base {AXES[j]}: {kind} [{_unit(i, j)}]",
+            unit = entry_unit(i, j, dimensionless="-")
+            ax.set_title(f"platform {AXES[i]} per base {AXES[j]}: {kind} [{unit}]",
                          fontsize=10)
             ax.set_ylabel("|T| [dB]" if i < 3 and j < 3 or i >= 3 and j >= 3
-                          else f"|T| [dB re 1 {_unit(i, j)}]", fontsize=9)
+                          else f"|T| [dB re 1 {unit}]", fontsize=9)
             if untrusted_below:
                 ax.axvspan(low, untrusted_below, color="0.92", zorder=0, lw=0)
         ax = axes[rows - 1, c]

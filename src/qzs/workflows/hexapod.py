@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs._validation import read_toml
+from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped
 from qzs.model.controller import ControllerParameters
@@ -64,8 +65,6 @@ GEOMETRY_KINDS = {
                ("stroke_half",)),
     "joints": (("base_joints", "top_joints", "home_position"), ("stroke_half",)),
 }
-#: The six axes of a pose, a twist or a base motion, in order.
-AXES = ("x", "y", "z", "rx", "ry", "rz")
 #: Units of the stiffness matrix's blocks (translation rows/columns first).
 STIFFNESS_UNITS = (("N/m", "N/rad"), ("N", "N*m/rad"))
 _FRAME_WORDS = {"center_of_mass": "payload's centre of mass", "origin": "top frame origin",
@@ -286,8 +285,10 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
     HexapodSetup
     """
     if geometry is None:
-        geometry, kind = cubic_geometry(cube_edge=0.15, cube_center_height=(
-            default_cube_center_height(0.15))), "cubic"
+        edge = HEXAPOD["cube_edge"]
+        geometry = cubic_geometry(cube_edge=edge,
+                                  cube_center_height=default_cube_center_height(edge))
+        kind = "cubic"
     if not isinstance(geometry, HexapodGeometry):
         raise ParameterError(f"`geometry` must be a HexapodGeometry, got "
                              f"{type(geometry).__name__}.")

@@ -39,11 +39,13 @@ from types import MappingProxyType
 import numpy as np
 
 from qzs._version import __version__
+from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
+from qzs.defaults import AXES
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
-from qzs.workflows.hexapod_transmissibility import AXES, entry_unit, hexapod_transmissibility
+from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
            "comparison_figure",
@@ -229,7 +231,7 @@ def _metrics_row(label, result, axis):
             continue
         i, peak, frequency, linear = coupling
         row.update({f"{prefix}_entry": f"{AXES[i]}/{axis}", f"{prefix}_peak": peak,
-                    f"{prefix}_unit": entry_unit(i, j).replace("1", "-"),
+                    f"{prefix}_unit": entry_unit(i, j, dimensionless="-"),
                     f"{prefix}_frequency_hz": frequency,
                     f"{prefix}_linear": linear if result.linear_stable else math.nan})
         if not result.linear_stable:
