@@ -23,12 +23,13 @@ from typing import Mapping
 import numpy as np
 from scipy import signal
 
+from qzs._format import decibels
 from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
-           "highpass", "required_duration", "required_samples", "transmissibility",
+           "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
            "welch_average_count"]
 
@@ -298,8 +299,7 @@ class TransmissibilityEstimate:
 
     def magnitude_db(self):
         """Magnitude in decibels, ``20 * log10(magnitude)`` [dB] (-inf where it is 0)."""
-        with np.errstate(divide="ignore"):
-            return 20.0 * np.log10(self.magnitude)
+        return decibels(self.magnitude)
 
     def metrics(self, **options):
         """Scalar metrics of this curve's trusted bins (:func:`transmissibility_metrics`).
@@ -555,6 +555,24 @@ METRIC_NAMES = ("resonance_frequency", "resonance_peak", "isolation_onset", "min
                 "rolloff_db_per_decade", "untrusted_below")
 
 
+def rolloff_slope(frequency, magnitude):
+    """Least-squares slope of ``20 log10 T`` against ``log10 f`` [dB/decade].
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequencies [Hz] of the bins to fit, all > 0 (at least two distinct ones).
+    magnitude : array_like
+        Transmissibility at them, an amplitude ratio [-], all > 0.
+
+    Returns
+    -------
+    float
+        The slope [dB/decade]: -40 for a curve falling as ``1/f^2``.
+    """
+    return float(np.polyfit(np.log10(frequency), decibels(magnitude), 1)[0])
+
+
 def _spot_key(frequency):
     return f"transmissibility_at_{frequency:g}_hz"
 
@@ -726,7 +744,7 @@ def _resonance(f, t, ok, peak_min):
         problems.append(f"borders untrusted bins above it ({f[i + 1]:.3g} Hz), where a peak "
                         "cannot be seen")
     if t[i] <= peak_min:
-        problems.append(f"is not above {peak_min:.3g} (+{20 * np.log10(peak_min):.2g} dB), which "
+        problems.append(f"is not above {peak_min:.3g} (+{decibels(peak_min):.2g} dB), which "
                         "a payload moving with the base (T = 1: locked by stiction, or "
                         "overdamped) can show at the least trusted coherence")
     if problems:
@@ -880,8 +898,7 @@ def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequenci
         low, high = (2.0 * values["isolation_onset"], f[-1]) if edges is None else edges
         band = band_mask(f, low, high) & ok & (t > 0)
         if np.count_nonzero(band) >= 3:
-            values["rolloff_db_per_decade"] = float(
-                np.polyfit(np.log10(f[band]), 20.0 * np.log10(t[band]), 1)[0])
+            values["rolloff_db_per_decade"] = rolloff_slope(f[band], t[band])
         else:
             reasons["rolloff_db_per_decade"] = (f"{np.count_nonzero(band)} trusted bin(s) in the "
                                                 f"roll-off band [{low:.3g}, {high:.3g}] Hz; a fit "

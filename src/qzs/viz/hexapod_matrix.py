@@ -8,16 +8,13 @@ model is drawn dashed; a simulated estimate solid on its trusted bins only (docs
 import numpy as np
 
 from qzs.analysis.hexapod_linear import entry_unit
-from qzs.defaults import AXES
+from qzs._format import decibels
+from qzs.defaults import AXES, FIGURES
 from qzs.viz.figures import save_figure
 
 __all__ = ["plot_transmissibility_matrix", "AXES"]
 
-_FLOOR = 1e-12
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.abs(np.asarray(values)), _FLOOR))
+_FLOOR = FIGURES["magnitude_floor"]
 
 
 def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trusted=None,
@@ -78,7 +75,7 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
         if values.shape != (frequency.size, 6, 6):
             raise ParameterError(f"`{name}` must have shape ({frequency.size}, 6, 6), got "
                                  f"{values.shape}.")
-        curves[name] = _db(values)
+        curves[name] = decibels(values, _FLOOR)
     if not curves:
         raise ParameterError("give `linear`, `simulated` or both.")
     if trusted is None and simulated is not None:

@@ -10,16 +10,13 @@ response is then no steady state).
 import numpy as np
 
 from qzs.analysis.hexapod_linear import entry_unit
-from qzs.defaults import AXES
+from qzs._format import decibels
+from qzs.defaults import AXES, FIGURES
 from qzs.viz.figures import save_figure
 
 __all__ = ["plot_study_comparison", "AXES"]
 
-_FLOOR = 1e-12
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.abs(np.asarray(values, dtype=complex)), _FLOOR))
+_FLOOR = FIGURES["magnitude_floor"]
 
 
 def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=(0.1, 20.0),
@@ -66,7 +63,7 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
             for k, (label, result) in enumerate(cases):
                 f = result.frequency
                 keep = (f > 0) & (f >= low) & (f <= high)
-                level = _db(result.response[:, i, j])
+                level = decibels(result.response[:, i, j], _FLOOR)
                 good = keep & result.trusted[:, i, j]
                 color = f"C{k}"
                 width = max(2.6 - 0.8 * k, 0.9)  # the first case widest: equal curves stay visible
@@ -75,7 +72,7 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
                         label=f"{label}: simulated (trusted)")
                 levels.append(level[good])
                 if result.linear_stable:
-                    linear = _db(result.linear_response[:, i, j])
+                    linear = decibels(result.linear_response[:, i, j], _FLOOR)
                     if np.nanmax(linear[keep]) > -150:
                         ax.plot(f[keep], linear[keep], color=color, ls="--", lw=0.9,
                                 label=f"{label}: linear model")

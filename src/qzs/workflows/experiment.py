@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs._format import decibels
 from qzs.analysis.spectral import (band_mask, highpass, required_samples, transmissibility,
                                    transmissibility_metrics, welch_average_count)
 from qzs.defaults import ANALYSIS
@@ -196,7 +197,7 @@ class ExperimentResult:
         trusted &= simulated_trusted & (measured > 0) & (simulated > 0)
         if not trusted.any():
             return float("nan")
-        return float(np.median(np.abs(20 * np.log10(measured[trusted] / simulated[trusted]))))
+        return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
     def plot(self, path=None, title=None):
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).

@@ -38,6 +38,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from qzs._format import decibels
 from qzs._version import __version__
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
@@ -260,10 +261,6 @@ def _fmt(value, digits=3):
     return str(value)
 
 
-def _db(value):
-    return 20 * math.log10(value) if value > 0 and math.isfinite(value) else math.nan
-
-
 def _findings(cases, rows):
     """Sentences derived from the numbers (nothing here is fixed text about the outcome)."""
     by = {(row["case"], row["axis"]): row for row in rows}
@@ -286,8 +283,7 @@ def _findings(cases, rows):
                 continue
             both = a.trusted[:, j, j] & b.trusted[:, j, j]
             if both.any():
-                difference = np.abs(20 * np.log10(a.magnitude[both, j, j]
-                                                  / b.magnitude[both, j, j]))
+                difference = np.abs(decibels(a.magnitude[both, j, j] / b.magnitude[both, j, j]))
                 k = int(np.argmax(difference))
                 largest = float(difference[k])
                 text = (f"Switching the integral off (P only) changes {axis}/{axis} by at "
@@ -324,12 +320,14 @@ def _findings(cases, rows):
                     row["linear_coupling_peak"]):
                 continue
             linear = row["linear_coupling_linear"]
+            ratio = row["linear_coupling_peak"] / linear
+            ratio_db = decibels(ratio) if 0 < ratio < math.inf else math.nan
             out.append(f"{label}, {axis} chirp: {row['linear_coupling_entry']}, the coupling "
                        "the linear model has (the legs' preload and the weight couple "
                        "translation and tilt, docs/hexapod.md §6), peaks at "
                        f"{_fmt(row['linear_coupling_peak'])} {row['linear_coupling_unit']} at "
                        f"{row['linear_coupling_frequency_hz']:.3g} Hz, where the linear model "
-                       f"gives {_fmt(linear)} ({_db(row['linear_coupling_peak'] / linear):+.1f}"
+                       f"gives {_fmt(linear)} ({ratio_db:+.1f}"
                        " dB): stick-slip moves the response to the break-away.")
     odd, even = [], []
     for label, result in cases.items():

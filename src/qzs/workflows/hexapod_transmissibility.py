@@ -44,6 +44,7 @@ from types import MappingProxyType
 import numpy as np
 
 from qzs import defaults
+from qzs._format import decibels
 from qzs._validation import as_float, choice, integer, positive, worker_count
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
@@ -525,7 +526,7 @@ def choose_hexapod_step(task):
                 & (a.magnitude > 0) & (b.magnitude > 0))
         if not keep.any():
             return math.nan
-        return float(np.max(np.abs(20 * np.log10(a.magnitude[keep] / b.magnitude[keep]))))
+        return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
 
     chosen, searched = (None, []) if len(candidates) < 3 else halving_search(
         difference, order, task["tolerance_db"], dt0, len(candidates) - 1, SAFETY)

@@ -23,9 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs._format import decibels
 from qzs._validation import worker_count
 from qzs._version import __version__
-from qzs.analysis.spectral import METRIC_NAMES, band_mask, transmissibility_at
+from qzs.analysis.spectral import METRIC_NAMES, band_mask, rolloff_slope, transmissibility_at
 from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
@@ -253,7 +254,7 @@ def _damping_small_effect(result):
         if not keep.any():
             changes.append(float("nan"))
             continue
-        ratio_db = 20 * np.log10(case.magnitude[keep] / reference.magnitude[keep])
+        ratio_db = decibels(case.magnitude[keep] / reference.magnitude[keep])
         changes.append(float(-np.min(ratio_db)))
     _defined(changes, "the reduction over 1.5-20 Hz", damped)
     ok = all(c < 3.0 for c in changes)
@@ -282,7 +283,7 @@ def _experiment_shape(result):
     rolloff = band_mask(f, 4.0, np.inf, trusted=trusted)
     if np.count_nonzero(rolloff) < 3:
         raise _Undecidable("fewer than 3 trusted bins above 4 Hz for the roll-off")
-    slope = np.polyfit(np.log10(f[rolloff]), 20 * np.log10(t[rolloff]), 1)[0]
+    slope = rolloff_slope(f[rolloff], t[rolloff])
     t12 = float(transmissibility_at(f, t, 12.0, trusted=trusted)[0])
     if not np.isfinite(t12):
         raise _Undecidable("T(12 Hz) lies in untrusted bins")
