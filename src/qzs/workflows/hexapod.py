@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qzs._format import number
 from qzs._validation import read_toml
 from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
@@ -503,7 +504,7 @@ def linear_text(setup, model, record):
     for j, frequency in enumerate(np.asarray(record["natural_frequencies"], dtype=float)):
         shape = shapes[:, j]
         main = AXES[int(np.argmax(np.abs(shape)))]
-        shown = "unstable" if not np.isfinite(frequency) else f"{frequency:9.4g} Hz"
+        shown = number(frequency, digits=4, unit="Hz", undefined="unstable")
         lines.append(f"  mode {j + 1}  {shown:>12}   mostly {main:<3} "
                      + " ".join(f"{v:8.3g}" for v in shape))
     for note in record["notes"]:

@@ -44,7 +44,7 @@ from types import MappingProxyType
 import numpy as np
 
 from qzs import defaults
-from qzs._format import decibels
+from qzs._format import decibels, number
 from qzs._validation import as_float, choice, integer, positive, worker_count
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
@@ -799,8 +799,7 @@ def transmissibility_summary(result):
              f"{s['duration']:g} s, in {', '.join(result.excited_axes)}; {s['estimator'].upper()} "
              f"Welch estimate, {s['fft_length']} samples per segment at {s['sample_rate']:g} Hz",
              "  linear model: natural frequencies "
-             + ", ".join("unstable" if not np.isfinite(f) else f"{f:.3g}"
-                         for f in result.linear_natural_frequencies)
+             + ", ".join(number(f, undefined="unstable") for f in result.linear_natural_frequencies)
              + " Hz" + ("" if result.linear_stable else "; the loop is UNSTABLE"),
              "",
              "run  amplitude      dt [s]   step             locked [%]  stop contacts  "
