@@ -18,7 +18,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 LAYERS = ("base", "model", "analysis", "engine", "iotools", "identify", "viz", "workflows",
           "app", "cli")
 #: Top-level modules that are the base layer.
-BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults"}
+BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults", "_format"}
 #: The facade (``qzs/__init__.py``, ``qzs/__main__.py``) may import anything; no module imports it.
 FACADE = {"qzs", "qzs.__main__"}
 #: Methods that may delegate to a higher layer (result objects: ``.plot()``, ``.save()``).

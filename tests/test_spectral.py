@@ -10,6 +10,7 @@ from qzs.analysis.spectral import (
     amplitude_spectrum,
     required_duration,
     required_samples,
+    rolloff_slope,
     transmissibility,
     transmissibility_metrics,
     welch_average_count,
@@ -250,6 +251,14 @@ def test_metrics_roll_off_of_power_laws(validation):
     lightly_damped = np.abs(sdof_response(frequency, 1.0, 1e-4))
     banded = transmissibility_metrics(frequency, lightly_damped, rolloff_band=(10.0, 100.0))
     assert banded.rolloff_db_per_decade == pytest.approx(-40.0, abs=0.2)
+
+
+def test_rolloff_slope_of_a_power_law_is_20_db_per_decade_per_power():
+    frequency = np.geomspace(2.0, 200.0, 50)
+    for exponent in (0.5, 1.0, 2.0, 4.0):
+        slope = rolloff_slope(frequency, 3.0 * frequency ** -exponent)
+        assert type(slope) is float
+        assert slope == pytest.approx(-20.0 * exponent, rel=1e-12)
 
 
 def test_minus_3db_of_piecewise_linear_curve():

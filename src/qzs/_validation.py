@@ -4,6 +4,7 @@ Messages follow scipy's style: name the argument, the value received and the fix
 """
 import dataclasses
 import math
+import numbers
 import os
 from pathlib import Path
 
@@ -41,6 +42,57 @@ def worker_count(workers, limit=None, error=ParameterError):
         raise error(f"`workers` must be a positive integer, got {workers!r}.")
     count = int(workers) if workers is not None else (os.cpu_count() or 1)
     return count if limit is None else max(1, min(count, limit))
+
+
+def _real(value):
+    """``value`` as a float if it is a real number (not a bool), else None."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return None
+    return float(value)
+
+
+def real(name, value, *, minimum=None, strict=False, fix="", error=ParameterError):
+    """Return ``value`` as a float: a real number (not a bool), finite, at least ``minimum``.
+
+    A number that is not one says ``"`name` must be a number, got 'x'."``; NaN, inf or a
+    value below ``minimum`` (or equal to it if ``strict``) says
+    ``"`name` must be a finite number >= 0, got -1.0."`` (no bound without ``minimum``).
+    ``fix`` ends either message (e.g. ``"; e.g. 0.5"``).
+    """
+    number = _real(value)
+    if number is None:
+        raise error(f"`{name}` must be a number, got {value!r}{fix}.")
+    if not math.isfinite(number) or (minimum is not None and (
+            number < minimum or (strict and number == minimum))):
+        bound = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
+        raise error(f"`{name}` must be a finite number{bound}, got {number!r}{fix}.")
+    return number
+
+
+def finite_real(name, value, *, positive=False, error=ParameterError):
+    """Return ``value`` as a float: a real number (not a bool), finite, and > 0 if ``positive``.
+
+    Says ``"`name` must be a finite number, got 'x'."`` or, for a finite number that
+    is not positive, ``"`name` must be positive, got 0."`` (the value as given).
+    """
+    number = _real(value)
+    if number is None or not math.isfinite(number):
+        raise error(f"`{name}` must be a finite number, got {value!r}.")
+    if positive and number <= 0.0:
+        raise error(f"`{name}` must be positive, got {value!r}.")
+    return number
+
+
+def positive_real(name, value, error=ParameterError):
+    """Return ``value`` as a float: a real number (not a bool), finite and > 0.
+
+    Every refusal says ``"`name` must be a positive finite number, got 0."`` (the value
+    as given).
+    """
+    number = _real(value)
+    if number is None or not math.isfinite(number) or number <= 0.0:
+        raise error(f"`{name}` must be a positive finite number, got {value!r}.")
+    return number
 
 
 def positive(name, value, error=ParameterError):

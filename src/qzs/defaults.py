@@ -3,11 +3,14 @@
 Model parameters carry their defaults in their own fields (:mod:`qzs.model.registry`
 lists them with units); this module holds the settings of a run and of the spectral
 analysis that several layers share: :func:`qzs.simulate`, the paper's studies, sweeps,
-identification and the command line all read them here.
+identification and the command line all read them here. It also names what several
+layers must spell alike: the six axes of the platform and their units, the paper's
+excitation amplitude, the shipped cube's edge, and the amplitude ratio figures draw for 0.
 """
 from types import MappingProxyType
 
-__all__ = ["SIMULATION", "ANALYSIS", "REPORTED_FREQUENCIES", "ACCURACY"]
+__all__ = ["SIMULATION", "ANALYSIS", "REPORTED_FREQUENCIES", "ACCURACY", "EXCITATION",
+           "HEXAPOD", "AXES", "AXIS_UNITS", "AXIS_RATE_UNITS", "FIGURES"]
 
 #: Integration settings: the paper's (Section 3): Simulink's ode3 at dt = 1e-4 s [s],
 #: output at 1 kHz [Hz].
@@ -32,3 +35,23 @@ REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 #: Accuracy-driven step (docs/model.md §7): the tolerance on the transmissibility [dB] that
 #: sweeps meet by default when their file gives no ``dt``; the paper keeps its dt = 1e-4 s.
 ACCURACY = MappingProxyType({"tolerance_db": 0.01})
+
+#: Base excitation: the paper's displacement amplitude, 10 mm [m] (the default of
+#: :class:`~qzs.model.excitation.Chirp` and :class:`~qzs.model.excitation.Sine`, of the
+#: steady-state response and of the transmissibility fits).
+EXCITATION = MappingProxyType({"amplitude": 0.010})
+
+#: Six-axis platform: the edge [m] of the cubic configuration used when none is given
+#: (``qzs hexapod --cubic``, :func:`qzs.workflows.hexapod.hexapod_setup`).
+HEXAPOD = MappingProxyType({"cube_edge": 0.15})
+
+#: The six axes of a pose, a twist and the 6x6 matrices, in order: translations x, y, z,
+#: then rotations rx, ry, rz about them.
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+#: Units of a pose along :data:`AXES`, and of its rate.
+AXIS_UNITS = ("m", "m", "m", "rad", "rad", "rad")
+AXIS_RATE_UNITS = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
+
+#: Figures: the amplitude ratio [-] drawn for 0 on a dB axis (-240 dB), so that a zero
+#: magnitude stays on the plot.
+FIGURES = MappingProxyType({"magnitude_floor": 1e-12})

@@ -13,7 +13,7 @@
 from qzs._lazy import lazy_exports
 
 _SPECTRAL = ("TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
-             "band_mask", "highpass", "required_duration", "required_samples",
+             "band_mask", "rolloff_slope", "highpass", "required_duration", "required_samples",
              "transmissibility", "transmissibility_at", "transmissibility_metrics",
              "trusted_bins", "welch_average_count")
 _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
@@ -30,6 +30,6 @@ _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
                             "floquet_exponents", "smooth_right_hand_side")},
             **{name: "qzs.analysis.hexapod_linear"
                for name in ("HexapodLinearModel", "hexapod_linearize", "geometric_stiffness",
-                            "off_diagonal_coupling")}}
+                            "off_diagonal_coupling", "entry_unit")}}
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)  # scipy.signal, python-control on use

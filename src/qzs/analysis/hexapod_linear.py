@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs._validation import as_float, choice
+from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
 from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
@@ -31,12 +32,10 @@ from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
 
 __all__ = ["HexapodLinearModel", "hexapod_linearize", "geometric_stiffness",
-           "off_diagonal_coupling", "FRAMES"]
+           "off_diagonal_coupling", "entry_unit", "FRAMES"]
 
 #: Named frame points of :func:`hexapod_linearize` (or give a point in the top frame).
 FRAMES = ("center_of_mass", "origin")
-#: Names of the six pose coordinates, for the systems' signals.
-_AXES = ("x", "y", "z", "rx", "ry", "rz")
 #: |omega^2| below this share of the largest counts as zero (a neutral mode) [-].
 _NEUTRAL = 1e-12
 
@@ -136,6 +135,26 @@ def geometric_stiffness(geometry, platform, *, point=None, leg_forces=None):
                                                              platform.center_of_mass - point)
     return platform_stiffness, base_stiffness
 
+
+
+def entry_unit(output, input, dimensionless="1"):
+    """Unit of the entry platform axis ``output`` per base axis ``input`` (indices 0-5).
+
+    Parameters
+    ----------
+    output, input : int
+        Axis indices (0-2 translations, 3-5 rotations).
+    dimensionless : str
+        What to say for an entry without unit (translation per translation, rotation
+        per rotation).
+
+    Returns
+    -------
+    str
+        ``dimensionless``, ``"m/rad"`` or ``"rad/m"``.
+    """
+    row, column = AXIS_UNITS[output], AXIS_UNITS[input]
+    return dimensionless if row == column else f"{row}/{column}"
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class HexapodLinearModel:
@@ -523,7 +542,7 @@ def _modes(stiffness, mass):
     notes = []
     for k, value in enumerate(eigenvalues):
         if value < -threshold:
-            shape = ", ".join(f"{_AXES[i]} {modes[i, k]:+.3g}" for i in range(6)
+            shape = ", ".join(f"{AXES[i]} {modes[i, k]:+.3g}" for i in range(6)
                               if abs(modes[i, k]) >= 0.1 * np.max(np.abs(modes[:, k])))
             notes.append(f"mode {k + 1} (of 6, lowest omega^2 first) is statically unstable: "
                          f"omega^2 = {value:.4g} rad^2/s^2 < 0 (negative stiffness along "
@@ -573,11 +592,11 @@ def _state_space(control, j, mass, stiffness, base, damping, integral, active, h
     b_base[w_s] = corner @ select_w @ j @ inverse_mass @ damping
     c = np.zeros((6, n))
     c[:, q] = np.eye(6)
-    outputs = [f"platform_{axis}" for axis in _AXES]
-    states = ([f"q_{axis}" for axis in _AXES] + [f"p_{axis}" for axis in _AXES]
+    outputs = [f"platform_{axis}" for axis in AXES]
+    states = ([f"q_{axis}" for axis in AXES] + [f"p_{axis}" for axis in AXES]
               + [f"integral_{i}" for i in with_integral] + [f"highpass_{i}" for i in with_highpass])
     transmissibility = control.ss(a, b_base, c, np.zeros((6, 6)), states=states, outputs=outputs,
-                                  inputs=[f"base_{axis}" for axis in _AXES])
+                                  inputs=[f"base_{axis}" for axis in AXES])
     compliance = control.ss(a, b_wrench, c, np.zeros((6, 6)), states=states, outputs=outputs,
                             inputs=["force_x", "force_y", "force_z", "moment_x", "moment_y",
                                     "moment_z"])

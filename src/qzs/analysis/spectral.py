@@ -23,12 +23,13 @@ from typing import Mapping
 import numpy as np
 from scipy import signal
 
-from qzs._validation import finite_series, integer
+from qzs._format import decibels
+from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
-           "highpass", "required_duration", "required_samples", "transmissibility",
+           "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
            "welch_average_count"]
 
@@ -38,14 +39,6 @@ _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
 
 
 # ---------------------------------------------------------------- validation
-def _positive(name, value, allow_none=False):
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not np.isfinite(value) or value <= 0:
-        raise ParameterError(f"`{name}` must be a positive finite number, got {value!r}.")
-    return float(value)
-
-
 def _noverlap(fft_length, overlap):
     if isinstance(overlap, bool) or not isinstance(overlap, numbers.Real) or not 0 <= overlap < 1:
         raise ParameterError(f"`overlap` must be a fraction in [0, 1), got {overlap!r}.")
@@ -162,8 +155,8 @@ def trusted_bins(frequency, coherence, base_share, *, coherence_min=ANALYSIS["co
     if isinstance(base_share_min, bool) or not isinstance(base_share_min, numbers.Real) \
             or not 0 <= base_share_min < 1:
         raise ParameterError(f"`base_share_min` must be in [0, 1), got {base_share_min!r}.")
-    corner = _positive("highpass_corner", highpass_corner, allow_none=True)
-    factor = _positive("highpass_factor", highpass_factor)
+    corner = optional(positive_real)("highpass_corner", highpass_corner)
+    factor = positive_real("highpass_factor", highpass_factor)
     with np.errstate(invalid="ignore"):
         mask = ((f > 0) & (np.asarray(coherence, dtype=float) >= coherence_min)
                 & (np.asarray(base_share, dtype=float) >= base_share_min))
@@ -244,7 +237,8 @@ def required_duration(fft_length, n_averages, sample_rate, overlap=0.5):
     float
         Record duration [s]: :func:`required_samples` divided by ``sample_rate``.
     """
-    return required_samples(fft_length, n_averages, overlap) / _positive("sample_rate", sample_rate)
+    return (required_samples(fft_length, n_averages, overlap)
+            / positive_real("sample_rate", sample_rate))
 
 
 # ---------------------------------------------------------------- estimation
@@ -305,8 +299,7 @@ class TransmissibilityEstimate:
 
     def magnitude_db(self):
         """Magnitude in decibels, ``20 * log10(magnitude)`` [dB] (-inf where it is 0)."""
-        with np.errstate(divide="ignore"):
-            return 20.0 * np.log10(self.magnitude)
+        return decibels(self.magnitude)
 
     def metrics(self, **options):
         """Scalar metrics of this curve's trusted bins (:func:`transmissibility_metrics`).
@@ -458,10 +451,10 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
     DataError
         Signals not 1-D, of different lengths, non-finite, or too short.
     """
-    sample_rate = _positive("sample_rate", sample_rate)
+    sample_rate = positive_real("sample_rate", sample_rate)
     fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
-    highpass_corner = _positive("highpass_corner", highpass_corner, allow_none=True)
+    highpass_corner = optional(positive_real)("highpass_corner", highpass_corner)
     if estimator not in ESTIMATORS:
         raise ParameterError(f"`estimator` must be one of {ESTIMATORS}, got {estimator!r}.")
     base, payload = _signal("base", base), _signal("payload", payload)
@@ -544,7 +537,7 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
     rms_amplitude : ndarray
         RMS amplitude per bin [u].
     """
-    sample_rate = _positive("sample_rate", sample_rate)
+    sample_rate = positive_real("sample_rate", sample_rate)
     fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     values = _signal("signal_values", signal_values)
@@ -560,6 +553,24 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
 #: The scalar metrics, in the order of :meth:`TransmissibilityMetrics.to_dict`.
 METRIC_NAMES = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
                 "rolloff_db_per_decade", "untrusted_below")
+
+
+def rolloff_slope(frequency, magnitude):
+    """Least-squares slope of ``20 log10 T`` against ``log10 f`` [dB/decade].
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequencies [Hz] of the bins to fit, all > 0 (at least two distinct ones).
+    magnitude : array_like
+        Transmissibility at them, an amplitude ratio [-], all > 0.
+
+    Returns
+    -------
+    float
+        The slope [dB/decade]: -40 for a curve falling as ``1/f^2``.
+    """
+    return float(np.polyfit(np.log10(frequency), decibels(magnitude), 1)[0])
 
 
 def _spot_key(frequency):
@@ -733,7 +744,7 @@ def _resonance(f, t, ok, peak_min):
         problems.append(f"borders untrusted bins above it ({f[i + 1]:.3g} Hz), where a peak "
                         "cannot be seen")
     if t[i] <= peak_min:
-        problems.append(f"is not above {peak_min:.3g} (+{20 * np.log10(peak_min):.2g} dB), which "
+        problems.append(f"is not above {peak_min:.3g} (+{decibels(peak_min):.2g} dB), which "
                         "a payload moving with the base (T = 1: locked by stiction, or "
                         "overdamped) can show at the least trusted coherence")
     if problems:
@@ -833,10 +844,10 @@ def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequenci
         No bin of the curve is trusted: every metric is NaN.
     """
     f, t, ok = _curve(frequency, magnitude, trusted)
-    corner = _positive("highpass_corner", highpass_corner, allow_none=True)
-    factor = _positive("untrusted_factor", untrusted_factor)
+    corner = optional(positive_real)("highpass_corner", highpass_corner)
+    factor = positive_real("untrusted_factor", untrusted_factor)
     peak_min = (1.0 / np.sqrt(ANALYSIS["coherence_min"]) if peak_min is None
-                else _positive("peak_min", peak_min))
+                else positive_real("peak_min", peak_min))
     untrusted_below = 0.0 if corner is None else factor * corner
     ok = ok & (f >= untrusted_below)
     spots = np.atleast_1d(np.asarray(at_frequencies, dtype=float))
@@ -887,8 +898,7 @@ def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequenci
         low, high = (2.0 * values["isolation_onset"], f[-1]) if edges is None else edges
         band = band_mask(f, low, high) & ok & (t > 0)
         if np.count_nonzero(band) >= 3:
-            values["rolloff_db_per_decade"] = float(
-                np.polyfit(np.log10(f[band]), 20.0 * np.log10(t[band]), 1)[0])
+            values["rolloff_db_per_decade"] = rolloff_slope(f[band], t[band])
         else:
             reasons["rolloff_db_per_decade"] = (f"{np.count_nonzero(band)} trusted bin(s) in the "
                                                 f"roll-off band [{low:.3g}, {high:.3g}] Hz; a fit "

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs import defaults
+from qzs._format import decibels
 from qzs._validation import as_float, choice, integer
 from qzs.errors import ParameterError, SizeLimitError, ToleranceNotMetError
 from qzs.model.controller import ControllerParameters
@@ -419,11 +420,6 @@ class PageData:
     elapsed: float = 0.0
 
 
-def _db(magnitude):
-    with np.errstate(divide="ignore"):
-        return 20.0 * np.log10(np.asarray(magnitude, dtype=float))
-
-
 def welch_length(samples):
     """Welch segment length [samples] of a chirp run of ``samples`` samples.
 
@@ -452,8 +448,8 @@ def _linear_curve(request):
         low = high / request.frequency_count
     low = max(low, high / LINEAR_POINTS)
     frequency = np.linspace(low, high, LINEAR_POINTS)
-    return frequency, _db(linearize(request.isolator, request.controller)
-                          .transmissibility(frequency))
+    return frequency, decibels(linearize(request.isolator, request.controller)
+                               .transmissibility(frequency))
 
 
 def _chirp(request):
@@ -482,7 +478,7 @@ def _chirp(request):
                   f"{estimate.coherence_min:g} everywhere): nothing to draw; raise the "
                   "amplitude or lengthen the chirp",)
     return dict(frequency=estimate.frequency[keep],
-                transmissibility_db=_db(estimate.magnitude[keep]), dt=dt, step_error=error,
+                transmissibility_db=decibels(estimate.magnitude[keep]), dt=dt, step_error=error,
                 estimate=estimate, locked=statistics["locked_fraction"], summary=summary,
                 notes=notes)
 
@@ -517,7 +513,7 @@ def _stepped(request):
     locked = branch["locked_fraction"]
     notes = ((note,) if note else ()) + tuple(response.notes)
     return dict(frequency=branch["frequency"][keep],
-                transmissibility_db=_db(branch["transmissibility"][keep]), dt=dt,
+                transmissibility_db=decibels(branch["transmissibility"][keep]), dt=dt,
                 step_error=error, response=response,
                 locked=float(np.nanmean(locked)) if np.isfinite(locked).any() else math.nan,
                 summary=summary, notes=notes)

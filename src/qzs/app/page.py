@@ -21,6 +21,7 @@ import panel as pn
 from bokeh.models import ColumnDataSource, FactorRange, Legend, Span
 from bokeh.plotting import figure
 
+from qzs._format import markdown_table, number
 from qzs.app.compute import (CONTROLLER_RATES, LIMITS, MODEL_PARAMETERS, SAMPLE_RATES,
                              compute_page, config_text, page_request, page_values)
 from qzs.app.figure import PIN_COLORS, describe_request, figure_png
@@ -578,12 +579,12 @@ class PlatformTab:
         self.source.data = {f"{axis}{end}": mm[end][:, k] for end in (0, 1)
                             for k, axis in enumerate("xyz")}
         lines = [f"**platform {outcome.platform_mass:.3g} kg, "
-                 f"{'statically stable' if outcome.stable else 'statically UNSTABLE'}**",
-                 "", "| mode | frequency [Hz] | mostly |", "|---|---|---|"]
-        for j, (f, axis) in enumerate(zip(outcome.natural_frequencies, outcome.mode_axes)):
-            lines.append(f"| {j + 1} | {'unstable' if not np.isfinite(f) else f'{f:.3g}'} "
-                         f"| {axis} |")
-        lines += ["", *[f"note: {note}" for note in outcome.notes]]
+                 f"{'statically stable' if outcome.stable else 'statically UNSTABLE'}**", "",
+                 *markdown_table(["mode", "frequency [Hz]", "mostly"],
+                                 [[j + 1, number(f, undefined="unstable"), axis]
+                                  for j, (f, axis) in enumerate(zip(outcome.natural_frequencies,
+                                                                    outcome.mode_axes))]),
+                 "", *[f"note: {note}" for note in outcome.notes]]
         if not outcome.stable:
             lines.append("raise the PI proportional gain Kp (docs/hexapod.md §6)")
         self.modes.object = "\n".join(lines)

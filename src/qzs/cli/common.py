@@ -17,10 +17,9 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
 """
 import dataclasses
 import json
-import math
 import sys
-from pathlib import Path
 
+from qzs._format import json_ready
 from qzs.errors import (DataError, FitError, MissingDependencyError, ParameterError,
                         SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
@@ -86,9 +85,10 @@ def emit(args, text, record):
 def jsonable(value):
     """``value`` as plain JSON types: NaN and inf -> None, numpy -> Python, Path -> str.
 
-    Dicts (keys as strings), lists, tuples and sets are converted item by item; a
-    dataclass, or an object with ``to_dict()``, through its fields; anything else
-    unknown becomes its ``str``.
+    What :func:`qzs._format.json_ready` converts (mappings, lists, tuples and sets item by
+    item, numbers, arrays, paths), and beyond it: numpy's other scalars (bytes decoded,
+    dates), anything with ``items()``, a dataclass or an object with ``to_dict()``
+    through its fields; anything else unknown becomes its ``str``.
 
     Parameters
     ----------
@@ -100,28 +100,18 @@ def jsonable(value):
     object
         None, bool, int, float (finite), str, list or dict.
     """
+    return json_ready(value, _jsonable_other)
+
+
+def _jsonable_other(value):
+    """What :func:`jsonable` makes of what ``json_ready`` leaves."""
     import numpy as np
 
-    if value is None or isinstance(value, (bool, str)):
-        return value
     if isinstance(value, np.generic):
         value = value.item()
-        if isinstance(value, (bool, str, bytes)) or value is None:
-            return value.decode() if isinstance(value, bytes) else value
-    if isinstance(value, int):
-        return int(value)
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, complex):
-        return [jsonable(value.real), jsonable(value.imag)]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, dict) or hasattr(value, "items") and callable(value.items):
+        return value.decode() if isinstance(value, bytes) else jsonable(value)
+    if hasattr(value, "items") and callable(value.items):
         return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, set, frozenset)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, Path):
-        return str(value)
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
     if callable(getattr(value, "to_dict", None)):

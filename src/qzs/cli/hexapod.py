@@ -1,5 +1,6 @@
 """``qzs hexapod``: the six-axis platform of six isolator legs (docs/hexapod.md)."""
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
+from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
 
 __all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibility",
@@ -16,7 +17,7 @@ def _add_setup_options(parser):
     parser.add_argument("--cubic", action="store_true",
                         help="a cubic configuration without a file (with --cube-edge)")
     parser.add_argument("--cube-edge", metavar="M", type=float,
-                        help="edge of the cube [m] (with --cubic; default 0.15)")
+                        help=f"edge of the cube [m] (with --cubic; default {HEXAPOD['cube_edge']:g})")
     parser.add_argument("--cube-center-height", metavar="M", type=float,
                         help="height of the cube's centre above the base [m] (with --cubic; "
                              "default: the legs' lower ends on the base plane, edge/(2*sqrt(3)))")
@@ -50,8 +51,9 @@ def add_parser(subparsers):
         "linear", help="stiffness matrix and modes at the operating point",
         description="Linearise the platform about its home pose (every leg slipping, motors "
                     "unsaturated) and print the 6x6 stiffness matrix and the modes. Without "
-                    "--config or --cubic: the cubic configuration of edge 0.15 m carrying "
-                    "the payload its six MagSprings hold.")
+                    "--config or --cubic: the cubic configuration of edge "
+                    f"{HEXAPOD['cube_edge']:g} m carrying the payload its six MagSprings "
+                    "hold.")
     _add_setup_options(linear)
     linear.add_argument("--leg-stiffness", metavar="N_PER_M", type=float,
                         help="replace every leg's axial stiffness [N/m] (a purely linear "
@@ -73,7 +75,7 @@ def add_parser(subparsers):
                     "summary per leg: stroke used, stop contacts, time locked, motor RMS. "
                     "Without --config or --cubic: the shipped paper_legs_cubic file.")
     _add_setup_options(simulate)
-    simulate.add_argument("--axis", choices=("x", "y", "z", "rx", "ry", "rz"),
+    simulate.add_argument("--axis", choices=AXES,
                           help="the base axis --excitation drives (replaces the file's table "
                                "for that axis); rotations in [rad]")
     simulate.add_argument("--excitation", choices=("chirp", "sine", "random"),
@@ -103,9 +105,9 @@ def add_parser(subparsers):
                     "matrix as NetCDF to --out and print a summary. Without --config or "
                     "--cubic: the shipped paper_legs_cubic file.")
     _add_setup_options(matrix)
-    matrix.add_argument("--axes", metavar="AXES", default="x,y,z,rx,ry,rz",
+    matrix.add_argument("--axes", metavar="AXES", default=",".join(AXES),
                         help="comma-separated base axes to excite, one run each (default "
-                             "all six: x,y,z,rx,ry,rz)")
+                             f"all six: {','.join(AXES)})")
     matrix.add_argument("--amplitude", metavar="A | AXIS=A,...",
                         help="chirp amplitude: one number for every excited axis (all "
                              "translations [m] or all rotations [rad]) or per axis, e.g. "
@@ -190,7 +192,7 @@ def _described_setup(args, default_file):
 
         return load_hexapod(SHIPPED_DEFAULT, overrides)
     if args.cubic:
-        edge = 0.15 if args.cube_edge is None else args.cube_edge
+        edge = HEXAPOD["cube_edge"] if args.cube_edge is None else args.cube_edge
         if not edge > 0:
             raise ParameterError(f"--cube-edge must be a positive length [m], got {edge!r}.")
         height = (default_cube_center_height(edge) if args.cube_center_height is None

@@ -6,6 +6,7 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
+from qzs.defaults import EXCITATION
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, build_excitation
@@ -49,7 +50,8 @@ def add_parser(subparsers):
     sim.add_argument("--excitation", choices=tuple(EXCITATION_KINDS),
                      help="base excitation (default chirp)")
     sim.add_argument("--amplitude", type=float, metavar="M",
-                     help="displacement amplitude [m] (RMS for random; default 0.010)")
+                     help="displacement amplitude [m] (RMS for random; default "
+                          f"{EXCITATION['amplitude']:.3f})")
     sim.add_argument("--f0", type=float, metavar="HZ", help="chirp start / random band low [Hz]")
     sim.add_argument("--f1", type=float, metavar="HZ", help="chirp end / random band high [Hz]")
     sim.add_argument("--frequency", type=float, metavar="HZ", help="sine frequency [Hz]")

@@ -7,7 +7,9 @@ from types import MappingProxyType
 import numpy as np
 from scipy import optimize
 
+from qzs._validation import integer
 from qzs.analysis.spectral import transmissibility
+from qzs.defaults import EXCITATION
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
 from qzs.errors import DataError, FitError, ParameterError, SimulationError
@@ -295,9 +297,7 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
     keep = (f >= low) & (f <= high) & (f > 0)
     f, measured = f[keep], measured[keep]
     free, start = _free_parameters(free, isolator, controller, initial)
-    if (isinstance(jitter_samples, bool) or not isinstance(jitter_samples, (int, np.integer))
-            or jitter_samples < 0):
-        raise ParameterError(f"`jitter_samples` must be an integer >= 0, got {jitter_samples!r}.")
+    integer("jitter_samples", jitter_samples, 0)
     if f.size < len(free) + 2:
         raise DataError(f"only {f.size} points of the curve lie in the band [{low:g}, {high:g}] "
                         f"Hz; fitting {len(free)} parameter(s) needs at least {len(free) + 2}.")
@@ -305,7 +305,8 @@ def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stictio
         raise DataError(f"`magnitude` has {np.count_nonzero(measured <= 0)} values <= 0 in the "
                         "band; the fit compares logs, drop those bins or narrow `band`.")
     if excitation is None:
-        excitation = Chirp(amplitude=0.010, f0=0.0, f1=max(20.0, float(high)), duration=duration)
+        excitation = Chirp(amplitude=EXCITATION["amplitude"], f0=0.0, f1=max(20.0, float(high)),
+                           duration=duration)
     if excitation.max_frequency < high:
         raise ParameterError(f"the chirp ends at {excitation.max_frequency:g} Hz, below the band's "
                              f"top {high:g} Hz; extend `excitation` or narrow `band`.")

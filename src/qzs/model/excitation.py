@@ -17,6 +17,7 @@ import numpy as np
 
 from qzs._validation import (as_float, choice, non_negative, parameter, positive,
                              strictly_increasing, validate_fields)
+from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
 __all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
@@ -91,7 +92,7 @@ class Chirp:
         default 0 (a chirp from 0 Hz starts gently; give one for ``f0 > 0``).
     """
 
-    amplitude: float = parameter(0.010, "m", "chirp displacement amplitude")
+    amplitude: float = parameter(EXCITATION["amplitude"], "m", "chirp displacement amplitude")
     f0: float = parameter(0.0, "Hz", "chirp start frequency")
     f1: float = parameter(20.0, "Hz", "chirp end frequency")
     duration: float = parameter(2000.0, "s", "sweep time")
@@ -160,7 +161,7 @@ class Sine:
         kicks the payload off its setpoint (docs/model.md §6).
     """
 
-    amplitude: float = parameter(0.010, "m", "sine displacement amplitude")
+    amplitude: float = parameter(EXCITATION["amplitude"], "m", "sine displacement amplitude")
     frequency: float = parameter(1.0, "Hz", "sine frequency")
     phase: float = parameter(0.0, "rad", "phase at t = 0")
     fade_in: float = parameter(None, "s", _FADE_DOC)

@@ -3,15 +3,13 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs._format import decibels
 from qzs.analysis.spectral import band_mask
+from qzs.defaults import FIGURES
 from qzs.viz.figures import new_figure, save_figure
 from qzs.viz.transmissibility import COINCIDE_DB, coinciding
 
 __all__ = ["plot_experiment"]
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.asarray(values, dtype=float), 1e-12))
 
 
 def plot_experiment(result, *, path=None, title=None):
@@ -56,7 +54,7 @@ def plot_experiment(result, *, path=None, title=None):
         keep = band_mask(f, *band)
         trusted = getattr(estimate, "trusted", None)
         trusted = keep if trusted is None else keep & trusted
-        db = _db(estimate.magnitude)
+        db = decibels(estimate.magnitude, FIGURES["magnitude_floor"])
         top.plot(f[keep], db[keep], color=color, lw=0.8, ls=ls, alpha=0.25)
         top.plot(f[keep], np.where(trusted, db, np.nan)[keep], color=color, lw=1.1, ls=ls,
                  label=label)

@@ -1,11 +1,10 @@
 """Figures of a hexapod run: platform pose against the base, leg strokes, motor forces."""
 import numpy as np
 
+from qzs.defaults import AXES
 from qzs.viz.figures import envelope, new_figure, save_figure
 
 __all__ = ["plot_hexapod"]
-
-_AXES = ("x", "y", "z", "rx", "ry", "rz")
 
 
 def plot_hexapod(result, path=None, title=None):
@@ -39,9 +38,9 @@ def plot_hexapod(result, path=None, title=None):
             color = f"C{a % 3}"
             if np.any(base[:, a] != 0):
                 tt, vv = envelope(t, base[:, a] * scale)
-                ax.plot(tt, vv, lw=0.7, ls="--", color=color, label=f"base {_AXES[a]}")
+                ax.plot(tt, vv, lw=0.7, ls="--", color=color, label=f"base {AXES[a]}")
             tt, vv = envelope(t, pose[:, a] * scale)
-            ax.plot(tt, vv, lw=0.8, color=color, label=f"platform {_AXES[a]}")
+            ax.plot(tt, vv, lw=0.8, color=color, label=f"platform {AXES[a]}")
         kind = "translation" if panel == 0 else "rotation"
         ax.set_ylabel(f"{kind} [{unit}]")
     z = result["relative_position"]

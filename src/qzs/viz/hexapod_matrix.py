@@ -7,21 +7,14 @@ model is drawn dashed; a simulated estimate solid on its trusted bins only (docs
 """
 import numpy as np
 
+from qzs.analysis.hexapod_linear import entry_unit
+from qzs._format import decibels
+from qzs.defaults import AXES, FIGURES
 from qzs.viz.figures import save_figure
 
 __all__ = ["plot_transmissibility_matrix", "AXES"]
 
-AXES = ("x", "y", "z", "rx", "ry", "rz")
-_FLOOR = 1e-12
-
-
-def _unit(i, j):
-    row, column = ("m" if i < 3 else "rad"), ("m" if j < 3 else "rad")
-    return "1" if row == column else f"{row}/{column}"
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.abs(np.asarray(values)), _FLOOR))
+_FLOOR = FIGURES["magnitude_floor"]
 
 
 def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trusted=None,
@@ -82,7 +75,7 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
         if values.shape != (frequency.size, 6, 6):
             raise ParameterError(f"`{name}` must have shape ({frequency.size}, 6, 6), got "
                                  f"{values.shape}.")
-        curves[name] = _db(values)
+        curves[name] = decibels(values, _FLOOR)
     if not curves:
         raise ParameterError("give `linear`, `simulated` or both.")
     if trusted is None and simulated is not None:
@@ -153,7 +146,7 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
                 ax.set_ylabel(f"platform {AXES[i]}\n|T| [dB]", fontsize=8)
             if i == 5:
                 ax.set_xlabel("frequency [Hz]", fontsize=8)
-            ax.text(0.97, 0.95, f"[{_unit(i, j)}]", transform=ax.transAxes, ha="right",
+            ax.text(0.97, 0.95, f"[{entry_unit(i, j)}]", transform=ax.transAxes, ha="right",
                     va="top", fontsize=6.5, color="0.35")
     first = int(np.argmax(excited))
     handles, labels = axes[first, first].get_legend_handles_labels()

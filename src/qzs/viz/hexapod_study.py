@@ -9,21 +9,14 @@ response is then no steady state).
 """
 import numpy as np
 
+from qzs.analysis.hexapod_linear import entry_unit
+from qzs._format import decibels
+from qzs.defaults import AXES, FIGURES
 from qzs.viz.figures import save_figure
 
 __all__ = ["plot_study_comparison", "AXES"]
 
-AXES = ("x", "y", "z", "rx", "ry", "rz")
-_FLOOR = 1e-12
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.abs(np.asarray(values, dtype=complex)), _FLOOR))
-
-
-def _unit(i, j):
-    row, column = ("m" if i < 3 else "rad"), ("m" if j < 3 else "rad")
-    return "-" if row == column else f"{row}/{column}"
+_FLOOR = FIGURES["magnitude_floor"]
 
 
 def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=(0.1, 20.0),
@@ -70,7 +63,7 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
             for k, (label, result) in enumerate(cases):
                 f = result.frequency
                 keep = (f > 0) & (f >= low) & (f <= high)
-                level = _db(result.response[:, i, j])
+                level = decibels(result.response[:, i, j], _FLOOR)
                 good = keep & result.trusted[:, i, j]
                 color = f"C{k}"
                 width = max(2.6 - 0.8 * k, 0.9)  # the first case widest: equal curves stay visible
@@ -79,7 +72,7 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
                         label=f"{label}: simulated (trusted)")
                 levels.append(level[good])
                 if result.linear_stable:
-                    linear = _db(result.linear_response[:, i, j])
+                    linear = decibels(result.linear_response[:, i, j], _FLOOR)
                     if np.nanmax(linear[keep]) > -150:
                         ax.plot(f[keep], linear[keep], color=color, ls="--", lw=0.9,
                                 label=f"{label}: linear model")
@@ -92,10 +85,11 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
             ax.set_xlim(low, high)
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
             kind = "transmissibility" if i == j else "cross-axis response"
-            ax.set_title(f"platform {AXES[i]} per base {AXES[j]}: {kind} [{_unit(i, j)}]",
+            unit = entry_unit(i, j, dimensionless="-")
+            ax.set_title(f"platform {AXES[i]} per base {AXES[j]}: {kind} [{unit}]",
                          fontsize=10)
             ax.set_ylabel("|T| [dB]" if i < 3 and j < 3 or i >= 3 and j >= 3
-                          else f"|T| [dB re 1 {_unit(i, j)}]", fontsize=9)
+                          else f"|T| [dB re 1 {unit}]", fontsize=9)
             if untrusted_below:
                 ax.axvspan(low, untrusted_below, color="0.92", zorder=0, lw=0)
         ax = axes[rows - 1, c]

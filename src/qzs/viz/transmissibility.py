@@ -8,18 +8,15 @@ import textwrap
 
 import numpy as np
 
-from qzs.defaults import ANALYSIS
+from qzs._format import decibels
+from qzs.defaults import ANALYSIS, FIGURES
 from qzs.viz.figures import new_figure, save_figure
 
 __all__ = ["plot_transmissibility", "coinciding", "overlap_notes"]
 
 #: Curves whose trusted bins all lie within this many dB of each other coincide [dB].
 COINCIDE_DB = 0.5
-_FLOOR = 1e-12  # amplitude ratio drawn for 0 [-]
-
-
-def _db(values):
-    return 20 * np.log10(np.maximum(np.asarray(values, dtype=float), _FLOOR))
+_FLOOR = FIGURES["magnitude_floor"]  # amplitude ratio drawn for 0 [-]
 
 
 def _trusted(curve):
@@ -68,7 +65,7 @@ def coinciding(curves, *, key="magnitude", frequency_range=(0.0, np.inf), tolera
         c = curves[i]
         f = np.asarray(c["frequency"], dtype=float)
         ok = (_trusted(c) if key == "magnitude" else np.ones(f.shape, bool)) & _in_range(f, frequency_range)
-        grids[i] = dict(zip(f[ok], _db(np.asarray(c[key])[ok])))
+        grids[i] = dict(zip(f[ok], decibels(np.asarray(c[key])[ok], _FLOOR)))
         common = set(grids[i]) if common is None else common & set(grids[i])
     groups, assigned = [], set()
     for i in use:
@@ -133,13 +130,13 @@ def _ylimits(curves, frequency_range):
     for curve in curves:
         f = np.asarray(curve["frequency"], dtype=float)
         keep = _trusted(curve) & _in_range(f, frequency_range)
-        values.append(_db(np.asarray(curve["magnitude"])[keep]))
+        values.append(decibels(np.asarray(curve["magnitude"])[keep], _FLOOR))
         if curve.get("linear") is not None and keep.any():
             lowest = f[keep][0]
             band = _in_range(f, frequency_range) & (f >= lowest)
-            values.append(_db(np.asarray(curve["linear"])[band]))
+            values.append(decibels(np.asarray(curve["linear"])[band], _FLOOR))
     values = np.concatenate(values) if values else np.array([])
-    values = values[np.isfinite(values) & (values > 20 * np.log10(_FLOOR))]
+    values = values[np.isfinite(values) & (values > decibels(_FLOOR))]
     if values.size == 0:
         return None
     low, high = min(values.min(), 0.0), max(values.max(), 0.0)
@@ -198,7 +195,7 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
         keep = _in_range(f, frequency_range)
         ok = _trusted(curve)
         style = {"color": f"C{i}", "lw": 1.3, **curve.get("style", {})}
-        db = _db(curve["magnitude"])
+        db = decibels(curve["magnitude"], _FLOOR)
         ax.plot(f[keep], db[keep], color=style["color"], lw=0.8, alpha=0.25)
         solid = np.where(ok, db, np.nan)
         label = curve["label"]
@@ -223,8 +220,8 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
             color = first.get("style", {}).get("color", f"C{group[0]}")
             names = "; ".join(curves[i]["label"] for i in group)
             label = f"linearised: {names}" + (" (on top of each other)" if len(group) > 1 else "")
-        (line,) = ax.plot(f[keep], _db(first["linear"])[keep], color=color, lw=0.9, ls="--",
-                          label=label)
+        (line,) = ax.plot(f[keep], decibels(first["linear"], _FLOOR)[keep], color=color, lw=0.9,
+                          ls="--", label=label)
         handles.append(line)
     handles.append(Line2D([], [], color="0.45", lw=1.0, alpha=0.45,
                           label=f"faint: untrusted (coherence < {coherence_min:g} or no base power)"))

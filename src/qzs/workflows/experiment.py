@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs._format import decibels, markdown_table
 from qzs.analysis.spectral import (band_mask, highpass, required_samples, transmissibility,
                                    transmissibility_metrics, welch_average_count)
 from qzs.defaults import ANALYSIS
@@ -196,7 +197,7 @@ class ExperimentResult:
         trusted &= simulated_trusted & (measured > 0) & (simulated > 0)
         if not trusted.any():
             return float("nan")
-        return float(np.median(np.abs(20 * np.log10(measured[trusted] / simulated[trusted]))))
+        return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
     def plot(self, path=None, title=None):
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
@@ -337,7 +338,7 @@ def _metric_rows(result):
              "rolloff_db_per_decade": "dB/decade", "untrusted_below": "Hz"}
     for name, value in measured.items():
         other = simulated.get(name, float("nan"))
-        rows.append(f"| {name} | {units.get(name, '-')} | {value:.4g} | {other:.4g} |")
+        rows.append([name, units.get(name, "-"), f"{value:.4g}", f"{other:.4g}"])
     return rows
 
 
@@ -358,8 +359,8 @@ def _markdown(result, figure):
              "below 1.5x its corner the signals are small and distorted. The band is shaded in "
              "the figure and left out of the resonance metrics.", "",
              f"![transmissibility]({figure})", "",
-             "| metric | unit | experiment | simulation |", "|---|---|---|---|",
-             *_metric_rows(result), ""]
+             *markdown_table(["metric", "unit", "experiment", "simulation"],
+                             _metric_rows(result)), ""]
     if result.simulated is not None:
         given = result.isolator is not None or result.controller is not None
         lines += [f"Simulation: the model ({'given parameters' if given else 'Table 1 defaults'}"

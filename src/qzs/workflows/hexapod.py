@@ -34,7 +34,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qzs._format import number
 from qzs._validation import read_toml
+from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped
 from qzs.model.controller import ControllerParameters
@@ -64,8 +66,6 @@ GEOMETRY_KINDS = {
                ("stroke_half",)),
     "joints": (("base_joints", "top_joints", "home_position"), ("stroke_half",)),
 }
-#: The six axes of a pose, a twist or a base motion, in order.
-AXES = ("x", "y", "z", "rx", "ry", "rz")
 #: Units of the stiffness matrix's blocks (translation rows/columns first).
 STIFFNESS_UNITS = (("N/m", "N/rad"), ("N", "N*m/rad"))
 _FRAME_WORDS = {"center_of_mass": "payload's centre of mass", "origin": "top frame origin",
@@ -286,8 +286,10 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
     HexapodSetup
     """
     if geometry is None:
-        geometry, kind = cubic_geometry(cube_edge=0.15, cube_center_height=(
-            default_cube_center_height(0.15))), "cubic"
+        edge = HEXAPOD["cube_edge"]
+        geometry = cubic_geometry(cube_edge=edge,
+                                  cube_center_height=default_cube_center_height(edge))
+        kind = "cubic"
     if not isinstance(geometry, HexapodGeometry):
         raise ParameterError(f"`geometry` must be a HexapodGeometry, got "
                              f"{type(geometry).__name__}.")
@@ -502,7 +504,7 @@ def linear_text(setup, model, record):
     for j, frequency in enumerate(np.asarray(record["natural_frequencies"], dtype=float)):
         shape = shapes[:, j]
         main = AXES[int(np.argmax(np.abs(shape)))]
-        shown = "unstable" if not np.isfinite(frequency) else f"{frequency:9.4g} Hz"
+        shown = number(frequency, digits=4, unit="Hz", undefined="unstable")
         lines.append(f"  mode {j + 1}  {shown:>12}   mostly {main:<3} "
                      + " ".join(f"{v:8.3g}" for v in shape))
     for note in record["notes"]:

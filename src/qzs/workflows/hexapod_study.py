@@ -27,9 +27,7 @@ units, figures, findings derived from the numbers), ``metrics.csv`` and ``metric
 (one row per case and excited axis, NaN as empty/null with ``<metric>_reason`` beside it),
 the figures (PNG and SVG) and each case's matrix as NetCDF.
 """
-import csv
-import io
-import json
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -38,12 +36,16 @@ from types import MappingProxyType
 
 import numpy as np
 
+from qzs._format import (csv_text, decibels, footnoted, json_text, markdown_table,
+                         number)
 from qzs._version import __version__
+from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
+from qzs.defaults import AXES
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
-from qzs.workflows.hexapod_transmissibility import AXES, entry_unit, hexapod_transmissibility
+from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
            "comparison_figure",
@@ -229,7 +231,7 @@ def _metrics_row(label, result, axis):
             continue
         i, peak, frequency, linear = coupling
         row.update({f"{prefix}_entry": f"{AXES[i]}/{axis}", f"{prefix}_peak": peak,
-                    f"{prefix}_unit": entry_unit(i, j).replace("1", "-"),
+                    f"{prefix}_unit": entry_unit(i, j, dimensionless="-"),
                     f"{prefix}_frequency_hz": frequency,
                     f"{prefix}_linear": linear if result.linear_stable else math.nan})
         if not result.linear_stable:
@@ -248,18 +250,8 @@ def _metrics_row(label, result, axis):
     return row
 
 
-def _fmt(value, digits=3):
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if isinstance(value, (int, np.integer)):
-        return f"{value}"
-    if isinstance(value, (float, np.floating)):
-        return "—" if not math.isfinite(value) else f"{value:.{digits}g}"
-    return str(value)
-
-
-def _db(value):
-    return 20 * math.log10(value) if value > 0 and math.isfinite(value) else math.nan
+#: A number in the study's text and tables: three significant digits, a dash if undefined.
+_fmt = functools.partial(number, undefined="—")
 
 
 def _findings(cases, rows):
@@ -284,8 +276,7 @@ def _findings(cases, rows):
                 continue
             both = a.trusted[:, j, j] & b.trusted[:, j, j]
             if both.any():
-                difference = np.abs(20 * np.log10(a.magnitude[both, j, j]
-                                                  / b.magnitude[both, j, j]))
+                difference = np.abs(decibels(a.magnitude[both, j, j] / b.magnitude[both, j, j]))
                 k = int(np.argmax(difference))
                 largest = float(difference[k])
                 text = (f"Switching the integral off (P only) changes {axis}/{axis} by at "
@@ -322,12 +313,14 @@ def _findings(cases, rows):
                     row["linear_coupling_peak"]):
                 continue
             linear = row["linear_coupling_linear"]
+            ratio = row["linear_coupling_peak"] / linear
+            ratio_db = decibels(ratio) if 0 < ratio < math.inf else math.nan
             out.append(f"{label}, {axis} chirp: {row['linear_coupling_entry']}, the coupling "
                        "the linear model has (the legs' preload and the weight couple "
                        "translation and tilt, docs/hexapod.md §6), peaks at "
                        f"{_fmt(row['linear_coupling_peak'])} {row['linear_coupling_unit']} at "
                        f"{row['linear_coupling_frequency_hz']:.3g} Hz, where the linear model "
-                       f"gives {_fmt(linear)} ({_db(row['linear_coupling_peak'] / linear):+.1f}"
+                       f"gives {_fmt(linear)} ({ratio_db:+.1f}"
                        " dB): stick-slip moves the response to the break-away.")
     odd, even = [], []
     for label, result in cases.items():
@@ -421,24 +414,6 @@ def _slug(label):
     return label.lower().replace(" ", "_")
 
 
-def _json_ready(value):
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_ready(value.tolist())
-    if isinstance(value, (np.bool_, bool)):
-        return bool(value)
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
 def comparison_figure(cases, out=None):
     """The study's comparison figure: the direct and coupled entries of every case.
 
@@ -525,15 +500,8 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
     files[f"{_FIGURE_COMPARISON}.png"] = folder / f"{_FIGURE_COMPARISON}.png"
     files[f"{_FIGURE_COMPARISON}.svg"] = folder / f"{_FIGURE_COMPARISON}.svg"
 
-    columns = list(dict.fromkeys(key for row in rows for key in row))
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=columns)
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: ("" if isinstance(v, float) and not math.isfinite(v) else v)
-                         for k, v in row.items()})
     with atomic_path(folder / "metrics.csv") as tmp:
-        tmp.write_text(buffer.getvalue(), encoding="utf-8")
+        tmp.write_text(csv_text(rows), encoding="utf-8")
     files["metrics.csv"] = folder / "metrics.csv"
     document = {"qzs_version": __version__, "quick": quick, "wall_seconds": wall_seconds,
                 "setup": SHIPPED_DEFAULT, "axes": list(STUDY_AXES),
@@ -548,8 +516,7 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
                           for label, result in cases.items()},
                 "rows": list(rows), "findings": list(findings)}
     with atomic_path(folder / "metrics.json") as tmp:
-        tmp.write_text(json.dumps(_json_ready(document), indent=2, allow_nan=False),
-                       encoding="utf-8")
+        tmp.write_text(json_text(document), encoding="utf-8")
     files["metrics.json"] = folder / "metrics.json"
     with atomic_path(folder / "report.md") as tmp:
         tmp.write_text(_markdown(cases, rows, findings, files, quick, wall_seconds),
@@ -572,9 +539,8 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
     def cell(row, key):
         value = row.get(key, math.nan)
         if isinstance(value, float) and not math.isfinite(value):
-            reason = row.get(f"{key}_reason", "not defined on the trusted bins")
-            number = notes.setdefault(reason, len(notes) + 1)
-            return f"—<sup>{number}</sup>"
+            return footnoted("—", row.get(f"{key}_reason", "not defined on the trusted bins"),
+                             notes)
         return _fmt(value)
 
     lines = [
@@ -610,7 +576,7 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
     for label, (meaning, _) in CASES.items():
         if label in cases:
             result = cases[label]
-            frequencies = ", ".join("unstable" if not np.isfinite(f) else f"{f:.3g}"
+            frequencies = ", ".join(number(f, undefined="unstable")
                                     for f in result.linear_natural_frequencies)
             lines.append(f"- **{label}**: {meaning}. Linear model: "
                          f"{'stable' if result.linear_stable else 'UNSTABLE'}, natural "
@@ -619,28 +585,28 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
               "\"P only\" answers what the integral does; \"no position loop\" is the paper's "
               "\"without PI\", reported for what it does to the platform rather than as an "
               "isolator's curve.", "",
-              "## Runs and analysis", "",
-              "| setting | value |", "|---|---|",
-              f"| base axes excited | {', '.join(STUDY_AXES)} (one run each, the others at rest) |",
-              f"| chirp | linear, {s['f0']:g} → {s['f1']:g} Hz, constant displacement "
-              f"amplitude {first.amplitude['z'] * 1e3:g} mm, {s['duration']:g} s |",
-              f"| solver, output rate | {s['solver']}, {s['sample_rate']:g} Hz |"]
+              "## Runs and analysis", ""]
     steps = []
     for label, result in cases.items():
         for axis in result.excited_axes:
             r = result.runs[axis]
             steps.append(f"{label}/{axis}: {r['dt']:g} s ({r['step']})")
-    lines += [f"| integration step [s] | {'; '.join(steps)} |",
-              f"| estimate | {s['estimator'].upper()} Welch, Hann segments of "
-              f"{s['fft_length']} samples ({s['fft_length'] / s['sample_rate']:g} s), "
-              f"{100 * s['overlap']:g} % overlap, from the base point's velocity to the "
-              "platform's twist at the cube's centre |",
-              f"| trusted bins | coherence ≥ {s['coherence_min']:g}, base power share ≥ "
-              f"{s['base_share_min']:g}, at or above {s['trusted_from']:.3g} Hz (the sweep's "
-              f"start), response above {s['floor_db']:g} dB of the base motion "
-              "(dimensionless, rotations times the platform size "
-              f"{s['platform_size'] * 1e3:.0f} mm) |",
-              ""]
+    lines += markdown_table(["setting", "value"], [
+        ["base axes excited", f"{', '.join(STUDY_AXES)} (one run each, the others at rest)"],
+        ["chirp", f"linear, {s['f0']:g} → {s['f1']:g} Hz, constant displacement amplitude "
+                  f"{first.amplitude['z'] * 1e3:g} mm, {s['duration']:g} s"],
+        ["solver, output rate", f"{s['solver']}, {s['sample_rate']:g} Hz"],
+        ["integration step [s]", "; ".join(steps)],
+        ["estimate", f"{s['estimator'].upper()} Welch, Hann segments of {s['fft_length']} "
+                     f"samples ({s['fft_length'] / s['sample_rate']:g} s), "
+                     f"{100 * s['overlap']:g} % overlap, from the base point's velocity to the "
+                     "platform's twist at the cube's centre"],
+        ["trusted bins", f"coherence ≥ {s['coherence_min']:g}, base power share ≥ "
+                         f"{s['base_share_min']:g}, at or above {s['trusted_from']:.3g} Hz (the "
+                         f"sweep's start), response above {s['floor_db']:g} dB of the base "
+                         "motion (dimensionless, rotations times the platform size "
+                         f"{s['platform_size'] * 1e3:.0f} mm)"]])
+    lines.append("")
     if quick:
         lines.append("Quick runs: 60 s chirps at a fixed step of 1 ms, the output period, "
                      "coarser than the accuracy-driven choice for the runs whose stick-slip "
@@ -658,49 +624,39 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
     lines += ["", "## Metrics", "",
               "Diagonal entries (platform axis per the same base axis, amplitude ratio), "
               "read on trusted bins only; a dash with a note where they do not define it.", ""]
-    head = ["case", "chirp", *(title for _, title in _TABLE)]
-    lines.append("| " + " | ".join(head) + " |")
-    lines.append("|" + "---|" * len(head))
-    for row in rows:
-        a = row["axis"]
-        cells = [row["case"], f"{a} ({a}/{a})",
-                 *(cell(row, key) for key, _ in _TABLE)]
-        lines.append("| " + " | ".join(cells) + " |")
+    lines += markdown_table(["case", "chirp", *(title for _, title in _TABLE)],
+                            [[row["case"], f"{row['axis']} ({row['axis']}/{row['axis']})",
+                              *(cell(row, key) for key, _ in _TABLE)] for row in rows])
     lines += ["", "Cross-axis entries: the coupling the linear model has (its largest "
                   "off-diagonal entry of the column, dimensionless; none for z, which the "
                   "symmetric platform keeps to itself) and the strongest trusted off-diagonal "
                   "entry of the simulation; peaks over trusted bins, with the linear model at "
                   "the same frequency:", ""]
-    head = ["case", "chirp", "linear coupling", "peak", "at [Hz]", "linear there",
-            "strongest cross-axis entry", "peak", "at [Hz]", "linear there"]
-    lines.append("| " + " | ".join(head) + " |")
-    lines.append("|" + "---|" * len(head))
-
     def peak(row, prefix):
         unit = row[f"{prefix}_unit"]
         return cell(row, f"{prefix}_peak") + (f" {unit}" if unit not in ("", "-") else "")
 
-    for row in rows:
-        cells = [row["case"], row["axis"]]
-        for prefix in ("linear_coupling", "cross"):
-            cells += [row[f"{prefix}_entry"], peak(row, prefix),
-                      cell(row, f"{prefix}_frequency_hz"), cell(row, f"{prefix}_linear")]
-        lines.append("| " + " | ".join(cells) + " |")
+    def entries(row, prefix):
+        return [row[f"{prefix}_entry"], peak(row, prefix), cell(row, f"{prefix}_frequency_hz"),
+                cell(row, f"{prefix}_linear")]
+
+    lines += markdown_table(["case", "chirp", "linear coupling", "peak", "at [Hz]",
+                             "linear there", "strongest cross-axis entry", "peak", "at [Hz]",
+                             "linear there"],
+                            [[row["case"], row["axis"], *entries(row, "linear_coupling"),
+                              *entries(row, "cross")] for row in rows])
     lines += ["", "The legs and the energy ledger:", ""]
-    head = ["case", "chirp", "locked [%]", "stop contacts", "stroke used [mm]",
-            "platform − base, max [mm; mrad]", "ledger closure [-]", "run [s]"]
-    lines.append("| " + " | ".join(head) + " |")
-    lines.append("|" + "---|" * len(head))
-    for row in rows:
-        cells = [row["case"], row["axis"], f"{row['locked_percent']:.1f}",
-                 f"{row['stop_contacts']}", f"{row['stroke_used_mm']:.2f}",
-                 f"{row['relative_translation_mm']:.3g}; {row['relative_rotation_mrad']:.3g}",
-                 f"{row['ledger_closure']:.2g}", f"{row['run_seconds']:.1f}"]
-        lines.append("| " + " | ".join(cells) + " |")
+    lines += markdown_table(
+        ["case", "chirp", "locked [%]", "stop contacts", "stroke used [mm]",
+         "platform − base, max [mm; mrad]", "ledger closure [-]", "run [s]"],
+        [[row["case"], row["axis"], f"{row['locked_percent']:.1f}", f"{row['stop_contacts']}",
+          f"{row['stroke_used_mm']:.2f}",
+          f"{row['relative_translation_mm']:.3g}; {row['relative_rotation_mrad']:.3g}",
+          f"{row['ledger_closure']:.2g}", f"{row['run_seconds']:.1f}"] for row in rows])
     if notes:
         lines.append("")
-        for reason, number in notes.items():
-            lines.append(f"<sup>{number}</sup> {reason}  ")
+        for reason, note in notes.items():
+            lines.append(f"<sup>{note}</sup> {reason}  ")
     lines += ["", "## Findings", ""]
     lines += [f"- {finding}" for finding in findings]
     lines += ["", "## Figures", "",

@@ -44,7 +44,10 @@ from types import MappingProxyType
 import numpy as np
 
 from qzs import defaults
+from qzs._format import decibels, number
 from qzs._validation import as_float, choice, integer, positive, worker_count
+from qzs.analysis.hexapod_linear import entry_unit
+from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 
 __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "CHIRP",
@@ -52,8 +55,6 @@ __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "
            "transmissibility_record", "choose_hexapod_step", "sweep_trusted_from",
            "platform_size", "entry_unit"]
 
-#: The six base and platform axes, in order (translations [m], rotations [rad]).
-AXES = ("x", "y", "z", "rx", "ry", "rz")
 #: Default chirp amplitude per base axis: 2 mm in translation [m], 0.01 rad in rotation
 #: [rad] (1.2 mm at the top joints of the 0.15 m cube).
 AMPLITUDE = MappingProxyType({"x": 0.002, "y": 0.002, "z": 0.002,
@@ -69,25 +70,6 @@ FLOOR_DB = -100.0
 ESTIMATORS = ("h1", "h2")
 #: Welch segments a run averages at least when ``fft_length`` is not given.
 MIN_SEGMENTS = 8
-_UNITS = ("m", "m", "m", "rad", "rad", "rad")
-_RATE_UNITS = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
-
-
-def entry_unit(output, input):
-    """Unit of the entry platform axis ``output`` per base axis ``input`` (indices 0-5).
-
-    Parameters
-    ----------
-    output, input : int
-        Axis indices (0-2 translations, 3-5 rotations).
-
-    Returns
-    -------
-    str
-        ``"1"``, ``"m/rad"`` or ``"rad/m"``.
-    """
-    row, column = _UNITS[output], _UNITS[input]
-    return "1" if row == column else f"{row}/{column}"
 
 
 def platform_size(geometry):
@@ -314,7 +296,7 @@ def _amplitudes(amplitude, axes):
                 "--amplitude z=0.002,rx=0.01).")
         given = dict.fromkeys(axes, amplitude)
     for axis, value in given.items():
-        unit = _UNITS[AXES.index(axis)]
+        unit = AXIS_UNITS[AXES.index(axis)]
         number = as_float(f"amplitude[{axis!r}]", value)
         if not number > 0:
             raise ParameterError(f"`amplitude[{axis!r}]` must be a positive amplitude [{unit}], "
@@ -544,7 +526,7 @@ def choose_hexapod_step(task):
                 & (a.magnitude > 0) & (b.magnitude > 0))
         if not keep.any():
             return math.nan
-        return float(np.max(np.abs(20 * np.log10(a.magnitude[keep] / b.magnitude[keep]))))
+        return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
 
     chosen, searched = (None, []) if len(candidates) < 3 else halving_search(
         difference, order, task["tolerance_db"], dt0, len(candidates) - 1, SAFETY)
@@ -817,15 +799,14 @@ def transmissibility_summary(result):
              f"{s['duration']:g} s, in {', '.join(result.excited_axes)}; {s['estimator'].upper()} "
              f"Welch estimate, {s['fft_length']} samples per segment at {s['sample_rate']:g} Hz",
              "  linear model: natural frequencies "
-             + ", ".join("unstable" if not np.isfinite(f) else f"{f:.3g}"
-                         for f in result.linear_natural_frequencies)
+             + ", ".join(number(f, undefined="unstable") for f in result.linear_natural_frequencies)
              + " Hz" + ("" if result.linear_stable else "; the loop is UNSTABLE"),
              "",
              "run  amplitude      dt [s]   step             locked [%]  stop contacts  "
              "stroke used [mm]  ledger closure [-]"]
     for axis in result.excited_axes:
         r = result.runs[axis]
-        unit = _UNITS[AXES.index(axis)]
+        unit = AXIS_UNITS[AXES.index(axis)]
         lines.append(f"{axis:<4} {result.amplitude[axis]:8.3g} {unit:<4} {r['dt']:9.3g}   "
                      f"{r['step']:<16} {100 * float(np.mean(r['locked_fraction'])):10.1f}  "
                      f"{int(np.sum(r['stop_contacts'])):13d}  "
@@ -944,8 +925,8 @@ def transmissibility_dataset(result):
             "units": "1", "long_name": "1 where the base axis was excited",
             "flag_meanings": "not_excited excited", **flags}),
         "amplitude": (("input_dof",), np.array([result.amplitude.get(a, np.nan) for a in AXES]),
-                      {"units": ", ".join(_UNITS), "long_name": "chirp displacement amplitude",
-                       "units_by_dof": "; ".join(f"{a}: {u}" for a, u in zip(AXES, _UNITS))}),
+                      {"units": ", ".join(AXIS_UNITS), "long_name": "chirp displacement amplitude",
+                       "units_by_dof": "; ".join(f"{a}: {u}" for a, u in zip(AXES, AXIS_UNITS))}),
         "energy_residual": (("input_dof",), np.array([result.energy_residual.get(a, np.nan)
                                                       for a in AXES]), {
             "units": "1", "long_name": "largest energy-ledger imbalance over the largest "

@@ -13,19 +13,18 @@ report. A trend claim (a quantity rising with a swept parameter) is decided over
 case, ordered by that parameter, and needs at least three cases; with fewer it is
 "not decidable".
 """
-import csv
 import html
-import io as _io
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from qzs._format import (csv_text, decibels, footnoted, html_figure, html_head, html_table,
+                         json_ready, json_text, number)
 from qzs._validation import worker_count
 from qzs._version import __version__
-from qzs.analysis.spectral import METRIC_NAMES, band_mask, transmissibility_at
+from qzs.analysis.spectral import METRIC_NAMES, band_mask, rolloff_slope, transmissibility_at
 from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
@@ -130,8 +129,8 @@ def _increasing(values):
     return all(b > a for a, b in zip(values, values[1:]))
 
 
-def _fmt(values, digits=3):
-    return ", ".join("undefined" if not np.isfinite(v) else f"{v:.{digits}g}" for v in values)
+def _fmt(values):
+    return ", ".join(number(v) for v in values)
 
 
 def _labels(cases):
@@ -253,7 +252,7 @@ def _damping_small_effect(result):
         if not keep.any():
             changes.append(float("nan"))
             continue
-        ratio_db = 20 * np.log10(case.magnitude[keep] / reference.magnitude[keep])
+        ratio_db = decibels(case.magnitude[keep] / reference.magnitude[keep])
         changes.append(float(-np.min(ratio_db)))
     _defined(changes, "the reduction over 1.5-20 Hz", damped)
     ok = all(c < 3.0 for c in changes)
@@ -282,7 +281,7 @@ def _experiment_shape(result):
     rolloff = band_mask(f, 4.0, np.inf, trusted=trusted)
     if np.count_nonzero(rolloff) < 3:
         raise _Undecidable("fewer than 3 trusted bins above 4 Hz for the roll-off")
-    slope = np.polyfit(np.log10(f[rolloff]), 20 * np.log10(t[rolloff]), 1)[0]
+    slope = rolloff_slope(f[rolloff], t[rolloff])
     t12 = float(transmissibility_at(f, t, 12.0, trusted=trusted)[0])
     if not np.isfinite(t12):
         raise _Undecidable("T(12 Hz) lies in untrusted bins")
@@ -432,28 +431,6 @@ def _metric_rows(study_results):
     return rows
 
 
-def _json_ready(value):
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        return None if not np.isfinite(value) else float(value)
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
-def _csv_cell(value):
-    if isinstance(value, (float, np.floating)) and not np.isfinite(value):
-        return ""
-    return value
-
-
 def _claims_record(verdicts):
     return [{"claim": v.claim, "study": v.study, "statement": v.statement, "verdict": v.label,
              "evidence": v.evidence} for v in verdicts]
@@ -529,15 +506,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
                             for r in study_results},
                 "claims": _claims_record(verdicts)}
     with atomic_path(folder / "metrics.json") as tmp:
-        tmp.write_text(json.dumps(_json_ready(document), indent=2, allow_nan=False),
-                       encoding="utf-8")
-    columns = list(dict.fromkeys(k for row in rows for k in row))
-    buffer = _io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=columns)
-    writer.writeheader()
-    writer.writerows({k: _csv_cell(v) for k, v in row.items()} for row in rows)
+        tmp.write_text(json_text(document), encoding="utf-8")
     with atomic_path(folder / "metrics.csv") as tmp:
-        tmp.write_text(buffer.getvalue(), encoding="utf-8")
+        tmp.write_text(csv_text(rows), encoding="utf-8")
     with atomic_path(folder / "report.html") as tmp:
         tmp.write_text(_html(study_results, figures, verdicts, quick, wall_seconds),
                        encoding="utf-8")
@@ -587,7 +558,7 @@ def paper_summary(study_results, verdicts, folder, *, quick=False, wall_seconds=
                                       "settings": _settings(result), "cases": cases}
     figures = [str(folder / f"{name}{suffix}") for result in study_results
                for name in _figure_names(result) for suffix in (".png", ".svg")]
-    return _json_ready({
+    return json_ready({
         "qzs_version": __version__, "quick": quick, "wall_seconds": wall_seconds,
         "claims": _claims_record(verdicts), "studies": studies,
         "outputs": {"report": str(folder / "report.html"),
@@ -623,8 +594,7 @@ _RUN_ROWS = (("solver", "solver", ""), ("dt", "time step", "s"),
 
 def _html(study_results, figures, verdicts, quick, wall_seconds):
     e = html.escape
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>qzs paper report"
-             f"</title><style>{_STYLE}</style></head><body>",
+    parts = [html_head("qzs paper report", _STYLE),
              "<h1>Semi-active QZS isolator: the paper's studies, reproduced</h1>",
              f"<p>qzs {e(__version__)}; {'quick' if quick else 'full-length'} runs"
              + (f"; wall time {wall_seconds:.1f} s" if wall_seconds else "") +
@@ -652,16 +622,12 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
         if study.kind != "spring_characteristic":
             parts.append(_settings_table(result))
         for name, path, notes in figures.get(study.name, []):
-            svg = path.with_suffix(".svg").name
             caption = [f"<b>{e(name)}</b>."]
             if study.kind != "spring_characteristic":
                 caption.append("Solid: trusted bins; faint: untrusted bins. Lower panel: "
                                "coherence of base and payload.")
             caption.extend(e(note) for note in notes)
-            parts.append(f"<figure><a href='{e(path.name)}'><img src='{e(path.name)}' "
-                         f"alt='{e(name)}'></a><figcaption>{' '.join(caption)} Full size: "
-                         f"<a href='{e(path.name)}'>PNG</a>, <a href='{e(svg)}'>SVG</a>."
-                         "</figcaption></figure>")
+            parts.append(html_figure(path, name, " ".join(caption)))
         for verdict in verdicts:
             if verdict.study != study.name:
                 continue
@@ -675,7 +641,6 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
 
 
 def _settings_table(result):
-    e = html.escape
     settings = _settings(result)
     head, cells = [], []
     for key, name, unit in _RUN_ROWS:
@@ -684,19 +649,16 @@ def _settings_table(result):
         value = settings[key]
         text = ", ".join(format_value(v) for v in value) if isinstance(value, list) \
             else format_value(value)
-        head.append(f"<th>{e(name)}{f' [{e(unit)}]' if unit else ''}</th>")
-        cells.append(f"<td>{e(text)}</td>")
-    rows = ["<p>Run settings (every case):</p>",
-            f"<table><tr>{''.join(head)}</tr><tr>{''.join(cells)}</tr></table>"]
+        head.append(f"{name} [{unit}]" if unit else name)
+        cells.append(text)
     names = list(dict.fromkeys(k for c in result.cases for k in c.settings))
-    head = "".join(f"<th>{e(n)} [{e(unit_of(n))}]</th>" for n in names)
-    rows.append(f"<table><tr><th>case</th>{head}</tr>")
-    for case in result.cases:
-        values = "".join(f"<td>{e(format_value(_value(case, n)))}</td>" for n in names)
-        rows.append(f"<tr><td>{e(case.label)}</td>{values}</tr>")
-    rows.append("</table><p class='notes'>Every other parameter at its default (Table 1, "
-                "docs/model.md §11; <code>qzs params</code>).</p>")
-    return "\n".join(rows)
+    parameters = html_table(["case", *(f"{n} [{unit_of(n)}]" for n in names)],
+                            ([case.label, *(format_value(_value(case, n)) for n in names)]
+                             for case in result.cases))
+    return "\n".join(["<p>Run settings (every case):</p>",
+                      html_table(head, [cells], separator=""),
+                      parameters + "<p class='notes'>Every other parameter at its default "
+                      "(Table 1, docs/model.md §11; <code>qzs params</code>).</p>"])
 
 
 _TABLE = (("trusted_from", "trusted from [Hz]"), ("resonance_frequency", "peak of T at [Hz]"),
@@ -722,25 +684,22 @@ def _case_table(result):
         value = metrics.get(name, float("nan"))
         if isinstance(value, (float, np.floating)) and np.isfinite(value):
             return f"{value:.3g}"
-        reason = reasons.get(name, "not computed")
-        number = notes.setdefault(reason, len(notes) + 1)
-        return f"&mdash;<sup>{number}</sup>"
+        return footnoted("&mdash;", reasons.get(name, "not computed"), notes)
 
     head = ["case", *(title for _, title in _TABLE), "stop contacts", "locked [%]",
             "f_n linear [Hz]"]
-    rows = ["<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>"]
     entries = [(case.label, case.metrics, case.reasons, case) for case in result.cases]
     if result.study.kind == "processing":
         case = result.cases[0]
         entries.append((f"{case.label}, experiment-style", case.extra["metrics"],
                         case.extra.get("reasons", {}), case))
+    table = []
     for label, metrics, reasons, case in entries:
         s = case.stats
-        cells = [e(label), *(cell(metrics, reasons, name) for name, _ in _TABLE),
-                 e(f"{s['stop_contacts']}"), e(f"{100 * s['locked_fraction']:.1f}"),
-                 e(f"{case.linear['undamped_natural_frequency']:.3g}")]
-        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    rows.append("</table>")
+        table.append([e(label), *(cell(metrics, reasons, name) for name, _ in _TABLE),
+                      e(f"{s['stop_contacts']}"), e(f"{100 * s['locked_fraction']:.1f}"),
+                      e(f"{case.linear['undamped_natural_frequency']:.3g}")])
+    rows = [html_table(head, table, cells_html=True)]
     if notes:
         rows.append("<ol class='notes'>" + "".join(f"<li>{e(reason)}</li>" for reason in notes)
                     + "</ol>")

@@ -14,7 +14,7 @@ import numbers
 from dataclasses import dataclass, field
 import numpy as np
 
-from qzs._validation import integer, known_keys, read_toml
+from qzs._validation import finite_real, integer, known_keys, read_toml
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
@@ -185,14 +185,6 @@ def _keys(table, name, allowed):
     return known_keys(table, allowed, f"[{name}]")
 
 
-def _number(name, value, *, positive=False):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise ParameterError(f"`{name}` must be a finite number, got {value!r}.")
-    if positive and value <= 0:
-        raise ParameterError(f"`{name}` must be positive, got {value!r}.")
-    return float(value)
-
-
 def _check_name(name, kind):
     """A varied parameter must be a model parameter or ``excitation.<parameter of kind>``."""
     excitation = [f"excitation.{k}" for k in EXCITATION_PARAMETERS[kind]]
@@ -273,11 +265,11 @@ def _definition(document, where, stem):
         raise ParameterError("give either `dt` (a fixed step [s]) or `tolerance_db` (the "
                              "accuracy the step is chosen for [dB]) in [simulation], not both.")
     if "dt" in given:
-        simulation["dt"] = _number("dt", simulation["dt"], positive=True)
+        simulation["dt"] = finite_real("dt", simulation["dt"], positive=True)
         simulation["tolerance_db"] = None
     else:
-        simulation["tolerance_db"] = _number("tolerance_db", simulation["tolerance_db"],
-                                             positive=True)
+        simulation["tolerance_db"] = finite_real("tolerance_db", simulation["tolerance_db"],
+                                                 positive=True)
     analysis = _analysis(document.get("analysis", {}), simulation["dt"])
     top = excitation.get("f1")
     if (kind != "sine" and "band" not in document.get("analysis", {})
@@ -329,8 +321,8 @@ def _grid_values(name, spec):
     if "start" not in spec or "stop" not in spec or ("num" in spec) == ("step" in spec):
         raise ParameterError(f"range {name!r} needs `start`, `stop` and one of `num` or "
                              f"`step`, got {spec!r}.")
-    start = _number(f"{name}.start", spec["start"])
-    stop = _number(f"{name}.stop", spec["stop"])
+    start = finite_real(f"{name}.start", spec["start"])
+    stop = finite_real(f"{name}.stop", spec["stop"])
     scale = spec.get("scale", "linear")
     if scale not in ("linear", "log"):
         raise ParameterError(f"`{name}.scale` must be 'linear' or 'log', got {scale!r}.")
@@ -345,7 +337,7 @@ def _grid_values(name, spec):
                                      f"`stop` > 0, got {start!r} and {stop!r}.")
             return tuple(float(v) for v in np.geomspace(start, stop, int(num)))
         return tuple(float(v) for v in np.linspace(start, stop, int(num)))
-    step = _number(f"{name}.step", spec["step"], positive=True)
+    step = finite_real(f"{name}.step", spec["step"], positive=True)
     if scale == "log":
         raise ParameterError(f"range {name!r}: `step` is for linear ranges; use `num` with "
                              "scale = 'log'.")
@@ -376,7 +368,7 @@ def _distribution(name, spec):
         raise ParameterError(f"distribution {kind!r} of {name!r} takes keys "
                              f"{list(required)} (optional {list(optional)}); missing "
                              f"{missing}, unknown {extra}.")
-    values = {k: _number(f"{name}.{k}", v) for k, v in keys.items()}
+    values = {k: finite_real(f"{name}.{k}", v) for k, v in keys.items()}
     for key in ("std", "sigma", "median"):
         if key in values and values[key] <= 0:
             raise ParameterError(f"`{name}.{key}` must be positive, got {values[key]!r}.")
@@ -394,16 +386,16 @@ def _analysis(table, dt):
     analysis = {**_analysis_defaults(), **given}
     if "duration" in given and "n_averages" in given:
         raise ParameterError("give either `n_averages` or `duration` in [analysis], not both.")
-    rate = analysis["sample_rate"] = _number("sample_rate", analysis["sample_rate"],
-                                             positive=True)
+    rate = analysis["sample_rate"] = finite_real("sample_rate", analysis["sample_rate"],
+                                                 positive=True)
     ratio = 1.0 / (rate * dt) if dt is not None else 1.0  # a chosen step divides it
     if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
         raise ParameterError(f"`sample_rate` ({rate!r} Hz) must divide the integration rate "
                              f"1/dt = {1 / dt:g} Hz into a whole number of steps.")
     fft_length = analysis["fft_length"] = integer("fft_length", analysis["fft_length"], 8)
-    overlap = analysis["overlap"] = _number("overlap", analysis["overlap"])
+    overlap = analysis["overlap"] = finite_real("overlap", analysis["overlap"])
     if "duration" in given:
-        analysis["duration"] = _number("duration", given["duration"], positive=True)
+        analysis["duration"] = finite_real("duration", given["duration"], positive=True)
         samples = int(analysis["duration"] * rate)
         analysis["n_averages"] = welch_average_count(samples, fft_length, overlap)
         if analysis["n_averages"] < 1:
@@ -415,7 +407,7 @@ def _analysis(table, dt):
                                                  overlap)
     band = analysis["band"]
     if (not isinstance(band, list) or len(band) != 2
-            or not 0 <= _number("band", band[0]) < _number("band", band[1])):
+            or not 0 <= finite_real("band", band[0]) < finite_real("band", band[1])):
         raise ParameterError(f"`band` must be [low, high] with 0 <= low < high [Hz], got "
                              f"{band!r}.")
     analysis["band"] = [float(band[0]), float(min(band[1], rate / 2))]
@@ -423,7 +415,7 @@ def _analysis(table, dt):
     if not isinstance(spots, list):
         raise ParameterError(f"`at_frequencies` must be a list of frequencies [Hz], got "
                              f"{spots!r}.")
-    analysis["at_frequencies"] = [_number("at_frequencies", f, positive=True) for f in spots]
+    analysis["at_frequencies"] = [finite_real("at_frequencies", f, positive=True) for f in spots]
     return analysis
 
 
@@ -457,8 +449,8 @@ def _outputs(table, analysis):
             raise ParameterError(f"band name {label!r} must be a plain identifier (letters, "
                                  "digits, underscore).")
         if (not isinstance(edges, list) or len(edges) != 2
-                or not 0 <= _number(f"bands.{label}", edges[0])
-                < _number(f"bands.{label}", edges[1])):
+                or not 0 <= finite_real(f"bands.{label}", edges[0])
+                < finite_real(f"bands.{label}", edges[1])):
             raise ParameterError(f"band {label!r} must be [low, high] with 0 <= low < high "
                                  f"[Hz], got {edges!r}.")
         if not np.any((f > 0) & (f >= edges[0]) & (f <= edges[1])):
