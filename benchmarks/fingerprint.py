@@ -221,7 +221,7 @@ def paper(folder):
     with open(os.path.join(out, "metrics.json"), encoding="utf-8") as handle:
         metrics = json.load(handle)
     drop = {"wall_seconds", "generated", "elapsed", "seconds", "version", "qzs_version",
-            "created", "date", "timestamp", "runs_seconds"}
+            "created", "date", "timestamp", "runs_seconds", "steps_per_second"}
 
     def clean(value):
         if isinstance(value, dict):
