@@ -98,6 +98,16 @@ def test_drivers_write_no_force_law_of_their_own():
         assert "controller_law" in called or name != "kernels.py"
 
 
+def test_the_six_leg_engine_writes_no_force_law_of_its_own():
+    """The six-axis kernels and their packing call the same laws (engine.laws in the kernels,
+    the model's numpy laws in the preload): no tanh, cosh or exp of their own."""
+    modules = sorted((ENGINE / "hexapod").glob("*.py"))
+    assert len(modules) > 3
+    for path in modules:
+        assert not called_names(path) & {"tanh", "_tanh", "cosh", "exp"}, path.name
+    assert "spring_force" in called_names(ENGINE / "hexapod" / "prepare.py")
+
+
 def test_the_harmonic_balance_writes_no_force_law_of_its_own():
     """The smooth model's spring and friction are the model's numpy laws (qzs.model.isolator),
     which tests/test_model.py and the test above hold equal to the kernels' laws: no tanh,

@@ -10,6 +10,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs._validation import choice, positive
+from qzs.engine import driver
 from qzs.engine.hexapod.dynamics import _evaluate, _rest_frame
 from qzs.engine.hexapod.layout import (
     AXES, LANES, LEG_COUNT, N_ODE, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE, PL_CENTRAL, PL_CKD,
@@ -24,7 +25,7 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
-from qzs.model.isolator import IsolatorParameters
+from qzs.model.isolator import IsolatorParameters, spring_force
 
 __all__ = ["hexapod_stability_test"]
 
@@ -211,6 +212,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
     decimation = steps_per_sample(sample_rate, dt, "sample_rate")
+    driver.plan_run(duration, dt, decimation, kernel="hexapod")  # absurd runs: before any kernel
     control_rate = controllers[0].controller_rate
     control_steps = 0 if control_rate == 0 else steps_per_sample(control_rate, dt,
                                                                  "controller_rate")
@@ -291,7 +293,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     loads = _static_forces(geometry, platform)
     needed = np.zeros(LEG_COUNT)
     for i, (iso, con) in enumerate(zip(isolators, controllers)):
-        spring = -iso.spring_force * np.tanh(iso.spring_shape * con.position_setpoint)
+        spring = spring_force(con.position_setpoint, iso)
         needed[i] = np.clip(loads[i] - spring, -iso.motor_force_max, iso.motor_force_max)
         if cartesian is None and con.pi_ki > 0:
             state[S_INT + i] = needed[i] / con.pi_ki
