@@ -48,7 +48,7 @@ def add_parser(subparsers):
                         help="spacing of a --range (default log)")
     parser.add_argument("--amplitude", type=float, metavar="M",
                         help="base displacement amplitude [m] (default the config's, else "
-                             f"{EXCITATION['amplitude']:g})")
+                             f"{EXCITATION['amplitude']:.3f})")
     parser.add_argument("--config", metavar="FILE.toml",
                         help="run configuration (see `qzs params --toml`)")
     add_set_option(parser)
