@@ -54,5 +54,4 @@ def test_the_axis_names_are_spelled_nowhere_else_in_the_package():
             if isinstance(node, ast.Tuple) and [getattr(e, "value", None)
                                                 for e in node.elts] == list(AXES):
                 spelled.append(str(path.relative_to(SOURCE)))
-    # the six-axis engine is being split by another change; it reads AXES after the merge
-    assert [path for path in spelled if not path.startswith("engine")] == ["defaults.py"], spelled
+    assert spelled == ["defaults.py"], spelled

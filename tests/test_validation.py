@@ -5,7 +5,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from qzs._validation import finite_real, integer, optional, positive_real, real
+from qzs._validation import finite_real, integer, interval, optional, positive_real, real
 from qzs.errors import DataError, ParameterError
 
 NOT_NUMBERS = [True, np.True_, "1.0", None, [1.0], 1 + 2j]
@@ -86,3 +86,19 @@ def test_integer_refuses_bools_floats_and_values_below_the_minimum(value):
         integer("jitter_samples", value, 0)
     assert str(info.value) == f"`jitter_samples` must be an integer >= 0, got {value!r}."
     assert integer("jitter_samples", np.int64(4), 0) == 4
+
+
+def test_an_interval_is_two_ordered_finite_numbers_above_its_minimum():
+    assert interval("mass_range", (6, 6.5), "kg") == (6.0, 6.5)
+    assert interval("mass_range", np.array([2.0, 2.0]), "kg") == (2.0, 2.0)
+    for value in [(7.0, 6.0), (1.0,), (1.0, math.nan), "ab", (-1.0, 1.0), 3.0]:
+        with pytest.raises(ParameterError, match="`mass_range`"):
+            interval("mass_range", value, "kg")
+    with pytest.raises(ParameterError) as info:
+        interval("rate_range", (0.0, 10.0), "Hz", minimum=1e-9)
+    assert str(info.value) == ("`rate_range` must satisfy 1e-09 <= low <= high (finite, in Hz), "
+                               "got (0.0, 10.0); e.g. (1, 2) Hz.")
+    with pytest.raises(ParameterError) as info:
+        interval("band", "ab", "Hz", example="(1, 20)")
+    assert str(info.value) == ("`band` must be two numbers (low, high) in Hz, got 'ab'; "
+                               "e.g. (1, 20).")

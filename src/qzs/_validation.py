@@ -69,6 +69,26 @@ def real(name, value, *, minimum=None, strict=False, fix="", error=ParameterErro
     return number
 
 
+def interval(name, value, unit, *, minimum=0.0, example=None, error=ParameterError):
+    """Return ``value``, two numbers ``(low, high)``, as floats with ``minimum <= low <= high``.
+
+    ``unit`` names their unit in the messages, ``example`` (default ``"(1, 2) unit"``, or
+    ``minimum`` for 1 when it is larger) the fix they end with: ``"`band` must satisfy
+    0 <= low <= high (finite, in Hz), got (5, 1); e.g. (1, 20)."``.
+    """
+    if example is None:
+        example = f"({max(minimum, 1.0):g}, 2) {unit}"
+    try:
+        low, high = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise error(f"`{name}` must be two numbers (low, high) in {unit}, got {value!r}; "
+                    f"e.g. {example}.") from None
+    if not (math.isfinite(low) and math.isfinite(high) and minimum <= low <= high):
+        raise error(f"`{name}` must satisfy {minimum:g} <= low <= high (finite, in {unit}), "
+                    f"got {value!r}; e.g. {example}.")
+    return (low, high)
+
+
 def finite_real(name, value, *, positive=False, error=ParameterError):
     """Return ``value`` as a float: a real number (not a bool), finite, and > 0 if ``positive``.
 

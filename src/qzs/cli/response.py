@@ -4,6 +4,7 @@ It parses and delegates to :func:`qzs.workflows.response.steady_state_response`
 (docs/response.md); ``--json`` prints the list of points, one record each.
 """
 from qzs.cli.common import add_set_option, emit, integer_at_least, parameters
+from qzs.defaults import EXCITATION
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
 
@@ -46,7 +47,8 @@ def add_parser(subparsers):
     parser.add_argument("--spacing", choices=("log", "linear"), default="log",
                         help="spacing of a --range (default log)")
     parser.add_argument("--amplitude", type=float, metavar="M",
-                        help="base displacement amplitude [m] (default the config's, else 0.010)")
+                        help="base displacement amplitude [m] (default the config's, else "
+                             f"{EXCITATION['amplitude']:.3f})")
     parser.add_argument("--config", metavar="FILE.toml",
                         help="run configuration (see `qzs params --toml`)")
     add_set_option(parser)
@@ -168,7 +170,7 @@ def run(args):
     simulation = dict(config["simulation"])
     amplitude = args.amplitude
     if amplitude is None:
-        amplitude = config["excitation"].get("amplitude", 0.010)
+        amplitude = config["excitation"].get("amplitude", EXCITATION["amplitude"])
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qzs import defaults
+from qzs import _validation, defaults
+from qzs._format import decibels
 from qzs._validation import choice as _choice
 from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
@@ -224,7 +225,7 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
     keep &= (a.magnitude > 0) & (b.magnitude > 0)
     if not keep.any():
         return float("nan")
-    return float(np.max(np.abs(20 * np.log10(a.magnitude[keep] / b.magnitude[keep]))))
+    return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
 
 
 # ---------------------------------------------------------------- validation
@@ -237,11 +238,8 @@ def _tolerance(tolerance_db, tolerance_state):
             "give exactly one of `tolerance_db` (transmissibility, dB) and `tolerance_state` "
             f"(relative position, m); got {' and '.join(n for n, _ in given) or 'neither'}.")
     name, value = given[0]
-    if (isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer))
-            or not np.isfinite(value) or value <= 0):
-        raise ParameterError(f"`{name}` must be a positive finite number, got {value!r}.")
     measure = "transmissibility_db" if name == "tolerance_db" else "state_m"
-    return measure, float(value)
+    return measure, _validation.positive_real(name, value)
 
 
 def _band(band, excitation, sample_rate):
@@ -426,21 +424,11 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     measure, tolerance = _tolerance(tolerance_db, tolerance_state)
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
     _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
-    if (isinstance(sample_rate, bool) or not isinstance(sample_rate, (int, float, np.number))
-            or not np.isfinite(sample_rate) or sample_rate <= 0):
-        raise ParameterError(f"`sample_rate` must be a positive finite number, got {sample_rate!r}.")
-    sample_rate = float(sample_rate)
-    if probe_duration is not None and (
-            isinstance(probe_duration, bool) or not isinstance(probe_duration, (int, float))
-            or not np.isfinite(probe_duration) or probe_duration <= 0):
-        raise ParameterError(f"`probe_duration` must be a positive number of seconds, got "
-                             f"{probe_duration!r}.")
-    if (isinstance(safety, bool) or not isinstance(safety, (int, float))
-            or not np.isfinite(safety) or safety < 1):
-        raise ParameterError(f"`safety` must be a number >= 1, got {safety!r}.")
-    if (isinstance(max_halvings, bool) or not isinstance(max_halvings, (int, np.integer))
-            or max_halvings < 2):
-        raise ParameterError(f"`max_halvings` must be an integer >= 2, got {max_halvings!r}.")
+    sample_rate = _validation.positive_real("sample_rate", sample_rate)
+    if probe_duration is not None:
+        _validation.positive_real("probe_duration", probe_duration)
+    _validation.real("safety", safety, minimum=1.0)
+    _validation.integer("max_halvings", max_halvings, 2)
     band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
     probe, duration = probe_excitation(
         excitation, band or _frequency_range(excitation, sample_rate), probe_duration)

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+from qzs._format import decibels
+from qzs.defaults import FIGURES
 from qzs.viz.figures import new_figure
 
 __all__ = ["plot_design", "plot_static_design", "plot_pi_search", "plot_hunting",
@@ -213,10 +215,6 @@ def plot_hunting(locus, traces, rows):
     return fig
 
 
-def _db(values):
-    return 20 * np.log10(np.maximum(np.asarray(values, dtype=float), 1e-12))
-
-
 def plot_damping_search(rows, curves, chosen, bound, band, cost):
     """Cost against the damping gain, and transmissibility without and with the chosen gain.
 
@@ -264,11 +262,12 @@ def plot_damping_search(rows, curves, chosen, bound, band, cost):
     for gain, color in zip(shown, ("tab:gray", "tab:green")):
         frequency, magnitude, trusted = curves[gain]
         trusted = np.asarray(trusted, bool) & (frequency > 0)
-        solid = np.where(trusted, _db(magnitude), np.nan)
-        ax.plot(frequency, _db(magnitude), color=color, alpha=0.25, lw=0.8)
+        db = decibels(magnitude, FIGURES["magnitude_floor"])
+        solid = np.where(trusted, db, np.nan)
+        ax.plot(frequency, db, color=color, alpha=0.25, lw=0.8)
         ax.plot(frequency, solid, color=color, lw=1.3, label=f"Kd = {gain:g} N*s/m")
         inside = trusted & (frequency >= band[0]) & (frequency <= band[1])
-        levels.extend(_db(magnitude[inside]))
+        levels.extend(db[inside])
     if levels:
         ax.set_ylim(min(levels) - 6, max(levels) + 6)
     ax.axvspan(*band, color="tab:blue", alpha=0.06, label="cost band")

@@ -7,19 +7,15 @@ amplitude [mm], and the share of the period the payload is locked [-].
 """
 import numpy as np
 
+from qzs._format import decibels
+from qzs.defaults import FIGURES
 from qzs.viz.figures import new_figure, save_figure
 
 __all__ = ["plot_response"]
 
-_FLOOR = 1e-12
+_FLOOR = FIGURES["magnitude_floor"]  # amplitude ratio drawn for 0 [-]
 _SWEEPS = {"up": ("C0", "^", "stepped sine, sweep up"),
            "down": ("C3", "v", "stepped sine, sweep down")}
-
-
-def _db(values):
-    values = np.asarray(values, dtype=float)
-    with np.errstate(invalid="ignore"):
-        return 20 * np.log10(np.maximum(values, _FLOOR))
 
 
 def _segments(mask):
@@ -69,18 +65,20 @@ def plot_response(response, path=None, title=None):
     log = f_all.size > 1 and f_all[-1] / f_all[0] >= 10
     curve = response.balance
     if response.linear:
-        ax_t.plot(response.linear["frequency"], _db(response.linear["transmissibility"]),
-                  color="0.45", ls=":", lw=1.2, label="linearised loop (no friction)", zorder=1)
+        ax_t.plot(response.linear["frequency"],
+                  decibels(response.linear["transmissibility"], _FLOOR), color="0.45", ls=":",
+                  lw=1.2, label="linearised loop (no friction)", zorder=1)
     if response.chirp is not None:
         est = response.chirp
         keep = (est.frequency >= f_all[0]) & (est.frequency <= f_all[-1])
         trusted = est.trusted & keep
-        ax_t.plot(est.frequency[keep], _db(est.magnitude[keep]), color="C2", lw=0.6,
-                  alpha=0.25, zorder=1)
-        ax_t.plot(np.where(trusted, est.frequency, np.nan), _db(est.magnitude), color="C2",
-                  lw=0.9, alpha=0.8, label="chirp + Welch (paper), trusted bins", zorder=1)
+        ax_t.plot(est.frequency[keep], decibels(est.magnitude[keep], _FLOOR), color="C2",
+                  lw=0.6, alpha=0.25, zorder=1)
+        ax_t.plot(np.where(trusted, est.frequency, np.nan), decibels(est.magnitude, _FLOOR),
+                  color="C2", lw=0.9, alpha=0.8, label="chirp + Welch (paper), trusted bins",
+                  zorder=1)
     if curve is not None:
-        _draw_balance(ax_t, curve, _db(curve.transmissibility))
+        _draw_balance(ax_t, curve, decibels(curve.transmissibility, _FLOOR))
         _draw_balance(ax_z, curve, curve.relative_amplitude, scale=1e3)
         for fold in curve.folds:
             for ax in (ax_t, ax_z, ax_l):
@@ -96,8 +94,8 @@ def plot_response(response, path=None, title=None):
         f = b["frequency"]
         ok = b["converged"] == 1
         t = np.where(ok, b["transmissibility"], np.nan)
-        ax_t.plot(f, _db(t), color=colour, marker=marker, ms=4.5, lw=0.8, label=label,
-                  zorder=3, mfc="none" if direction == "down" else colour)
+        ax_t.plot(f, decibels(t, _FLOOR), color=colour, marker=marker, ms=4.5, lw=0.8,
+                  label=label, zorder=3, mfc="none" if direction == "down" else colour)
         ax_z.plot(f, np.where(ok, b["relative_amplitude"], np.nan) * 1e3, color=colour,
                   marker=marker, ms=4, lw=0.8, zorder=3,
                   mfc="none" if direction == "down" else colour)
@@ -106,23 +104,24 @@ def plot_response(response, path=None, title=None):
                   mfc="none" if direction == "down" else colour)
         contact = ok & (b["stop_contacts"] > 0)
         if contact.any():
-            ax_t.plot(f[contact], _db(t[contact]), ls="none", marker="o", ms=9, mfc="none",
-                      mec="k", mew=0.8, zorder=4,
+            ax_t.plot(f[contact], decibels(t[contact], _FLOOR), ls="none", marker="o", ms=9,
+                      mfc="none", mec="k", mew=0.8, zorder=4,
                       label="hits the stops" if contact_label else None)
             contact_label = False
         for i in np.flatnonzero(ok & (b["period_multiple"] > 1)):
-            ax_t.annotate(f"period {int(b['period_multiple'][i])}", (f[i], _db(t[i])),
-                          textcoords="offset points", xytext=(4, 6), fontsize=7,
-                          color=colour)
+            ax_t.annotate(f"period {int(b['period_multiple'][i])}",
+                          (f[i], decibels(np.asarray(t[i]), _FLOOR)), textcoords="offset points",
+                          xytext=(4, 6), fontsize=7, color=colour)
         if (~ok).any():  # no value: a cross on the bottom edge of the top panel
             ax_t.plot(f[~ok], np.full((~ok).sum(), 0.04), ls="none", marker="x", ms=6,
                       color=colour, zorder=4, transform=ax_t.get_xaxis_transform(),
                       label="not periodic (NaN)" if unconverged_label else None)
             unconverged_label = False
     # vertical range from the data actually plotted, not from estimator artefacts
-    values = [_db(response.branch(d)["transmissibility"]) for d in response.directions]
+    values = [decibels(response.branch(d)["transmissibility"], _FLOOR)
+              for d in response.directions]
     if curve is not None:
-        values.append(_db(curve.transmissibility[curve.valid]))
+        values.append(decibels(curve.transmissibility[curve.valid], _FLOOR))
     values = np.concatenate([v[np.isfinite(v) & (v > -200)] for v in values] or [[0.0]])
     if values.size:
         low, high = values.min(), values.max()

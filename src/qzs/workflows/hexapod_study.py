@@ -41,7 +41,7 @@ from qzs._format import (csv_text, decibels, footnoted, json_text, markdown_tabl
 from qzs._version import __version__
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
-from qzs.defaults import AXES
+from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
@@ -185,7 +185,7 @@ def _metrics_row(label, result, axis):
     ok = result.trusted[:, j, j]
     row = {"case": label, "axis": axis, "diagonal_entry": f"{axis}/{axis}",
            "amplitude": result.amplitude[axis],
-           "amplitude_unit": "m" if j < 3 else "rad",
+           "amplitude_unit": AXIS_UNITS[j],
            "dt_s": run["dt"], "step": run["step"],
            "chirp_duration_s": result.settings["duration"],
            "trusted_from_hz": result.settings["trusted_from"],

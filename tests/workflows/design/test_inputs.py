@@ -44,6 +44,22 @@ def test_bad_input_fails_before_any_simulation(monkeypatch, design_options, chan
         D.design_controller(**{**design_options, **change})
 
 
+@pytest.mark.parametrize("change, message", [
+    (dict(delay=True), "`delay` must be a number, got True (seconds)."),
+    (dict(dt=0.0), "`dt` must be a finite number > 0, got 0.0 (seconds)."),
+    (dict(band=(20.0, 1.0)), "`band` must satisfy 0 <= low <= high (finite, in Hz), got "
+                             "(20.0, 1.0); e.g. (1, 20)."),
+    (dict(mass_range="heavy"), "`mass_range` must be two numbers (low, high) in kg, got "
+                               "'heavy'; e.g. (6.2, 6.6)."),
+])
+def test_a_bad_number_or_range_is_named_with_its_unit_and_an_example(monkeypatch, design_options,
+                                                                      change, message):
+    forbid_simulation(monkeypatch)
+    with pytest.raises(ParameterError) as info:
+        D.design_controller(**{**design_options, **change})
+    assert str(info.value) == message
+
+
 def test_a_quick_design_shortens_a_long_chirp_to_the_same_sweep_in_200_s():
     from qzs.workflows.design.inputs import _excitation
 

@@ -1,7 +1,7 @@
-"""The design for people: number formats, escaped tables, the summary and the HTML sections."""
+"""The design for people: number formats, figures, the summary and the HTML sections."""
 import math
 
-from qzs.workflows.design.report import _figure, _fmt, _html, _table, design_text
+from qzs.workflows.design.report import _figure, _fmt, _html, design_text
 
 SECTIONS = ("Chosen gains", "Problem", "Static design", "PI gains", "Linear stability",
             "Hunting at rest", "Damping gain", "Sampled loop",
@@ -15,13 +15,11 @@ def test_numbers_are_formatted_with_their_unit_and_undefined_ones_say_so():
     assert _fmt(math.nan, unit="Hz") == "undefined" and _fmt(None) == "undefined"
 
 
-def test_tables_escape_their_cells_and_a_missing_figure_is_left_out(tmp_path):
-    table = _table(["a<b", "c"], [["x & y", 1.5]])
-    assert table.splitlines() == ["<table><tr><th>a&lt;b</th><th>c</th></tr>",
-                                  "<tr><td>x &amp; y</td><td>1.5</td></tr>", "</table>"]
+def test_a_missing_figure_is_left_out_and_a_caption_is_escaped(tmp_path):
     assert _figure({}, "margins", "caption") == ""
-    shown = _figure({"margins": tmp_path / "margins.png"}, "margins", "Margins.")
+    shown = _figure({"margins": tmp_path / "margins.png"}, "margins", "Margins < 1.")
     assert "src='margins.png'" in shown and "href='margins.svg'" in shown
+    assert "Margins &lt; 1." in shown
 
 
 def test_the_summary_and_the_report_carry_the_gains_and_every_section_in_order(design):

@@ -12,7 +12,6 @@ python-control. Every public name is importable from here
 ``stability_margins``     gain and phase margins, continuous or sampled; the rate a design needs
 ``describing_functions``  the friction law as a memoryless nonlinearity of slip velocity
 ``hunting``               the stick-slip relay in the integral loop: slip jump, hunting prediction
-``_arguments``            the argument checks the modules share
 ========================  ======================================================================
 
 References

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qzs.analysis.control_design._arguments import _number
+from qzs._validation import real
 from qzs.analysis.control_design.describing_functions import FrictionNonlinearity
 from qzs.analysis.control_design.linear_stability import _stable
 from qzs.analysis.linear import loop_constants
@@ -262,7 +262,7 @@ def hunting_stiffness(isolator=None, controller=None, half_width=None):
         The least ``Kp`` [N/m] (0 if no slip jump even at ``Kp = 0``; NaN above 1e5 N/m).
     """
     isolator, controller = model_inputs(isolator, controller)
-    half_width = _number("half_width", half_width, strict=True)
+    half_width = real("half_width", half_width, minimum=0.0, strict=True)
 
     def plateau(kp):
         trial = dataclasses.replace(controller, pi_kp=kp)

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from qzs.analysis.control_design._arguments import _number
+from qzs._validation import real
 from qzs.analysis.linear import loop_constants
 from qzs.model.registry import model_inputs
 
@@ -69,7 +69,7 @@ def loop_transfer(isolator=None, controller=None, relative_position=None, *, del
     import control
 
     isolator, controller = model_inputs(isolator, controller)
-    delay = _number("delay", delay)
+    delay = real("delay", delay, minimum=0.0)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
     plant = 1 / (m * s ** 2 + cv * s + k)
@@ -149,8 +149,8 @@ def discretize_with_delay(a, b, c, period, delay=0.0):
     import control
 
     a, b, c = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (a, b, c))
-    period = _number("period", period, strict=True)
-    delay = _number("delay", delay)
+    period = real("period", period, minimum=0.0, strict=True)
+    delay = real("delay", delay, minimum=0.0)
     n_states = a.shape[0]
     phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
     line = whole + (1 if fraction > 0 else 0)  # past inputs kept as states
@@ -204,8 +204,8 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
 
     isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
-    rate = _number("rate", rate, strict=True,
-                   fix="; a sampled loop needs a controller rate in Hz")
+    rate = real("rate", rate, minimum=0.0, strict=True,
+                 fix="; a sampled loop needs a controller rate in Hz")
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     period = 1.0 / rate
     plant = discretize_with_delay(*_plant_state_space(m, cv, k, w), period, delay)
@@ -281,8 +281,8 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     """
     isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
-    rate = _number("rate", rate)
-    delay = _number("delay", delay)
+    rate = real("rate", rate, minimum=0.0)
+    delay = real("delay", delay, minimum=0.0)
     f = np.asarray(frequency, dtype=float)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, None)
     s = 2j * np.pi * f

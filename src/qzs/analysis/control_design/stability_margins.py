@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qzs.analysis.control_design._arguments import _number, _range
+from qzs._format import decibels
+from qzs._validation import interval, real
 from qzs.analysis.control_design.loop_transfers import (PADE_ORDER, _sampled_response,
                                                         frequency_response, loop_transfer,
                                                         sampled_loop)
@@ -100,7 +101,7 @@ def _crossings(x, values):
 def _margins(response, omega, stable, rate, delay, extra_reasons=None):
     """Margins from a loop's response on a grid: every crossover, the worst of each kind."""
     log_w = np.log(omega)
-    magnitude_db = 20 * np.log10(np.maximum(np.abs(response), 1e-300))
+    magnitude_db = decibels(response, 1e-300)
     phase = np.unwrap(np.angle(response))
     reasons = dict(extra_reasons or {})
     pm, f_gc = math.inf, math.nan
@@ -161,8 +162,8 @@ def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_
     """
     isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
-    rate = _number("rate", rate)
-    delay = _number("delay", delay)
+    rate = real("rate", rate, minimum=0.0)
+    delay = real("delay", delay, minimum=0.0)
     if rate > 0:
         import control
 
@@ -206,7 +207,7 @@ def stability_margins_of(loop, *, delay=0.0):
     """
     import control
 
-    delay = _number("delay", delay)
+    delay = real("delay", delay, minimum=0.0)
     dt = loop.dt if loop.dt not in (None, True) else 0
     if dt:
         if delay > 0:
@@ -269,8 +270,8 @@ def required_controller_rate(isolator=None, controller=None, delay=0.0, *,
         Why NaN ('' otherwise).
     """
     isolator, controller = model_inputs(isolator, controller)
-    low, high = _range("rate_range", rate_range, "Hz", minimum=1e-9)
-    delay = _number("delay", delay)
+    low, high = interval("rate_range", rate_range, "Hz", minimum=1e-9)
+    delay = real("delay", delay, minimum=0.0)
 
     def ok(rate):
         return loop_margins(isolator, controller, rate, delay).meets(gain_margin_min,

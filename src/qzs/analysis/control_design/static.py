@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qzs.analysis.control_design._arguments import _range
+from qzs._validation import interval
 from qzs.errors import ParameterError
 from qzs.model.isolator import spring_force
 from qzs.model.registry import model_inputs
@@ -160,7 +160,7 @@ def static_design(isolator=None, controller=None, *, mass_range=None):
         reasons.update(balanced_mass=reason, holdable_mass=reason)
     band = constant_force_band(isolator, controller)
     forces = spring_force(np.linspace(band[0], band[1], 201), isolator)
-    masses = (isolator.mass, isolator.mass) if mass_range is None else _range(
+    masses = (isolator.mass, isolator.mass) if mass_range is None else interval(
         "mass_range", mass_range, "kg", minimum=1e-12)
     deficits = (masses[0] * g - lifted, masses[1] * g - lifted)
     left_min = f_max - max(abs(d) for d in deficits)

@@ -6,12 +6,10 @@ the driver (:mod:`~qzs.engine.hexapod.simulate`) and the result
 (:mod:`~qzs.engine.hexapod.result`) share; numba compiles these module-level integers in
 as constants.
 """
+from qzs.defaults import AXES  # the six axes of a pose: translations [m], rotation angles [rad]
 from qzs.model.hexapod import LEG_COUNT
 
 __all__ = ["AXES", "LANES"]
-
-#: The six axes of a pose, in order: translations [m], then rotation angles [rad].
-AXES = ("x", "y", "z", "rx", "ry", "rz")
 
 # ---------------------------------------------------------------- packed layouts
 #: Lanes of the per-leg arrays: the six legs and two padding lanes (copies of leg 1), so that

@@ -7,6 +7,7 @@ streams.
 """
 import numpy as np
 
+from qzs.defaults import AXIS_RATE_UNITS, AXIS_UNITS
 from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
                                        C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR,
                                        C_FMO, C_FPI, C_FSP, C_FST, C_POSE, C_TIME, C_TWIST,
@@ -17,25 +18,23 @@ from qzs.model.registry import unit_of
 
 __all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_file_layout"]
 
-_TRANSLATION = ("m", "m", "m", "rad", "rad", "rad")
-_RATE = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
 _ACCELERATION = ("m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2")
 #: Output channels: name -> (first column, dimension (None: time only, "dof" or "leg"),
 #: unit (per dof for "dof" variables), description).
 HEXAPOD_CHANNELS = {
     "time": (C_TIME, None, "s", "time since the start of the run"),
-    "platform_pose": (C_POSE, "dof", _TRANSLATION,
+    "platform_pose": (C_POSE, "dof", AXIS_UNITS,
                       "platform pose relative to home: displacement of the top frame origin "
                       "and rotation angles (R = Rz Ry Rx), world frame"),
-    "platform_twist": (C_TWIST, "dof", _RATE,
+    "platform_twist": (C_TWIST, "dof", AXIS_RATE_UNITS,
                        "velocity of the top frame origin and angular velocity, world frame"),
     "platform_acceleration": (C_ACC, "dof", _ACCELERATION,
                               "acceleration of the top frame origin and angular acceleration, "
                               "world frame"),
-    "base_pose": (C_BASE_POSE, "dof", _TRANSLATION,
+    "base_pose": (C_BASE_POSE, "dof", AXIS_UNITS,
                   "base pose: displacement of the base point under the top frame origin at "
                   "home and rotation angles (R = Rz Ry Rx)"),
-    "base_velocity": (C_BASE_VEL, "dof", _RATE,
+    "base_velocity": (C_BASE_VEL, "dof", AXIS_RATE_UNITS,
                       "velocity of that base point and the base's angular velocity, world frame"),
     "base_acceleration": (C_BASE_ACC, "dof", _ACCELERATION,
                           "acceleration of that base point and the base's angular "

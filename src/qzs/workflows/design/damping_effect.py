@@ -7,6 +7,7 @@ sampled model: the simulator has none).
 import dataclasses
 import math
 
+from qzs._format import decibels
 from qzs.workflows.design.integration_step import _divides
 from qzs.workflows.design.settings import DELAYS
 from qzs.workflows.design.cost import _band_grid, _costs, _linear_cost
@@ -54,14 +55,14 @@ def _why(settings, kp, kd_chosen, damping_rows=(), bar=None):
             damped = dataclasses.replace(ctrl, damping_gain=g)
             linear = _linear_cost(frequency, iso, damped, settings, rate=ctrl.controller_rate,
                                   delay=0.0)
-            change = 20 * math.log10(cost / reference) if (
+            change = decibels(cost / reference) if (
                 math.isfinite(cost) and math.isfinite(reference) and reference > 0) else math.nan
             rows.append({"factor": factor, "value": value, "damping_gain": g,
                          "viscous_damping": iso.viscous_damping,
                          "velocity_highpass": ctrl.velocity_highpass,
                          "controller_rate": ctrl.controller_rate, "cost_undamped": reference,
                          "cost_damped": cost, "change_db": change,
-                         "linear_change_db": 20 * math.log10(linear / linear_reference),
+                         "linear_change_db": decibels(linear / linear_reference),
                          "reason": "" if math.isfinite(change) else
                          "a cost is undefined (too few trusted bins)"})
     delay_rows = []
@@ -75,7 +76,7 @@ def _why(settings, kp, kd_chosen, damping_rows=(), bar=None):
                                   settings, delay=delay)
             delay_rows.append({"delay": delay, "damping_gain": g,
                                "controller_rate": settings.controller_rate,
-                               "linear_change_db": 20 * math.log10(damped / reference)})
+                               "linear_change_db": decibels(damped / reference)})
     return {"rows": rows, "delay_rows": delay_rows, "gains": [g for g in gains if g > 0],
             "answer": _why_answer(rows, delay_rows, moderate, kd_chosen, settings,
                                   damping_rows)}

@@ -8,15 +8,14 @@ runs, and the coarser step of the PI search's runs).
 import dataclasses
 import math
 
-from qzs._validation import worker_count
+from qzs._validation import interval, real, worker_count
 from qzs.analysis import control_design as cd
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation
 from qzs.model.registry import model_inputs
 from qzs.workflows.design.cases import DesignCase
 from qzs.workflows.design.integration_step import _choose_dt, _divides, _stroke_step
-from qzs.workflows.design.settings import (COSTS, FFT_LENGTH, QUICK_CHIRP, SAMPLE_RATE,
-                                           _float, _pair, _Settings)
+from qzs.workflows.design.settings import COSTS, FFT_LENGTH, QUICK_CHIRP, SAMPLE_RATE, _Settings
 
 
 def _design_settings(isolator, controller, *, excitation, stiction_range, mass_range,
@@ -41,12 +40,12 @@ def _design_settings(isolator, controller, *, excitation, stiction_range, mass_r
     band = _band(band, excitation)
     if cost not in COSTS:
         raise ParameterError(f"`cost` must be one of {', '.join(COSTS)}, got {cost!r}.")
-    rate = controller.controller_rate if controller_rate is None else _float(
+    rate = controller.controller_rate if controller_rate is None else real(
         "controller_rate", controller_rate, minimum=0.0, fix=" (Hz; 0 for continuous)")
-    delay = _float("delay", delay, minimum=0.0, fix=" (seconds)")
-    damping_gain_max = _float("damping_gain_max", damping_gain_max, minimum=0.0, strict=True)
-    gain_margin_min = _float("gain_margin_min", gain_margin_min, minimum=0.0)
-    phase_margin_min = _float("phase_margin_min", phase_margin_min, minimum=0.0)
+    delay = real("delay", delay, minimum=0.0, fix=" (seconds)")
+    damping_gain_max = real("damping_gain_max", damping_gain_max, minimum=0.0, strict=True)
+    gain_margin_min = real("gain_margin_min", gain_margin_min, minimum=0.0)
+    phase_margin_min = real("phase_margin_min", phase_margin_min, minimum=0.0)
     workers = worker_count(workers)
     sample_rate = SAMPLE_RATE if band[1] <= SAMPLE_RATE / 5 else float(
         100 * math.ceil(band[1] * 5 / 100))
@@ -99,15 +98,16 @@ def _excitation(excitation, quick):
 def _ranges(isolator, stiction_range, mass_range):
     """The stiction [N, N] and mass [kg, kg] ranges, checked; defaults about the isolator's."""
     stiction_range = ((0.5 * isolator.stiction_force, 1.5 * isolator.stiction_force)
-                      if stiction_range is None else _pair("stiction_range", stiction_range, "N",
-                                                           example="(5, 15)"))
+                      if stiction_range is None else interval("stiction_range", stiction_range,
+                                                              "N", example="(5, 15)"))
     if stiction_range[0] < isolator.coulomb_force:
         raise ParameterError(
             f"`stiction_range` starts at {stiction_range[0]:g} N, below the Coulomb friction "
             f"({isolator.coulomb_force:g} N); the breakaway force cannot be below it: start the "
             f"range at {isolator.coulomb_force:g} N or more.")
     mass_range = ((max(0.1, isolator.mass - 0.2), isolator.mass + 0.2) if mass_range is None
-                  else _pair("mass_range", mass_range, "kg", minimum=1e-9, example="(6.2, 6.6)"))
+                  else interval("mass_range", mass_range, "kg", minimum=1e-9,
+                                example="(6.2, 6.6)"))
     if mass_range[0] <= 0:
         raise ParameterError(f"`mass_range` must be positive masses in kg, got {mass_range!r}.")
     return stiction_range, mass_range
@@ -116,7 +116,7 @@ def _ranges(isolator, stiction_range, mass_range):
 def _force_steps(force_steps):
     """The payload force steps [N] as a tuple of floats."""
     try:
-        return tuple(_float("force_steps", s) for s in force_steps)
+        return tuple(real("force_steps", s) for s in force_steps)
     except TypeError:
         raise ParameterError(f"`force_steps` must be a sequence of forces in N, got "
                              f"{force_steps!r}; e.g. (-2, 2).") from None
@@ -124,7 +124,7 @@ def _force_steps(force_steps):
 
 def _band(band, excitation):
     """The cost's band [Hz, Hz], checked against what the base motion excites."""
-    band = _pair("band", band, "Hz", example="(1, 20)")
+    band = interval("band", band, "Hz", example="(1, 20)")
     if band[0] <= 0:
         raise ParameterError(f"`band` must start above 0 Hz, got {band!r}; e.g. (1, 20).")
     top = excitation.max_frequency if not isinstance(excitation, RandomExcitation) else \
@@ -153,7 +153,7 @@ def _set_steps(settings, dt):
     if dt is None:
         settings.dt, settings.dt_note = _choose_dt(settings, settings.controller.pi_kp)
     else:
-        settings.dt = _float("dt", dt, minimum=0.0, strict=True, fix=" (seconds)")
+        settings.dt = real("dt", dt, minimum=0.0, strict=True, fix=" (seconds)")
         settings.dt_note = "given"
     if rate > 0 and not _divides(rate, settings.dt):
         raise ParameterError(f"`controller_rate` ({rate:g} Hz) must divide 1/dt "

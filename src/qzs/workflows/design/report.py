@@ -1,20 +1,16 @@
 """The design for people: the text summary and the HTML report."""
 import html
 import math
-from pathlib import Path
 
+from qzs._format import html_figure, html_head, html_table, number
 from qzs._version import __version__
 
 __all__ = ["design_text"]
 
 
 def _fmt(value, digits=4, unit=""):
-    if isinstance(value, float) and math.isinf(value):
-        return "infinite"
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "undefined"
-    text = f"{value:.{digits}g}"
-    return f"{text} {unit}".rstrip()
+    """A number of the summary and the report (4 significant digits; +-inf "infinite")."""
+    return number(value, digits, unit, infinite="infinite")
 
 
 def design_text(result):
@@ -92,24 +88,8 @@ td:first-child,th:first-child{text-align:left}.answer{padding:.6em 1em;border-le
 #2a8a2a;background:#f7f7f7}.warn{border-color:#c0392b}pre{white-space:pre-wrap;font-size:.85em}"""
 
 
-def _table(headers, rows):
-    e = html.escape
-    out = ["<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in headers) + "</tr>"]
-    for row in rows:
-        out.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in row) + "</tr>")
-    out.append("</table>")
-    return "\n".join(out)
-
-
 def _figure(written, name, caption):
-    e = html.escape
-    if name not in written:
-        return ""
-    png = Path(written[name]).name
-    svg = Path(written[name]).with_suffix(".svg").name
-    return (f"<figure><a href='{e(png)}'><img src='{e(png)}' alt='{e(name)}'></a>"
-            f"<figcaption>{e(caption)} Full size: <a href='{e(png)}'>PNG</a>, "
-            f"<a href='{e(svg)}'>SVG</a>.</figcaption></figure>")
+    return html_figure(written[name], name, html.escape(caption)) if name in written else ""
 
 
 def _html(result, record, written):
@@ -125,15 +105,14 @@ def _html_opening(result):
     """The page's head, title, chosen gains and the text summary (a list of parts)."""
     e = html.escape
     g, s = result.gains, result.settings
-    return [f"<!doctype html><html><head><meta charset='utf-8'><title>qzs design</title>"
-            f"<style>{_STYLE}</style></head><body>",
+    return [html_head("qzs design", _STYLE),
             "<h1>Semi-active QZS isolator: controller design</h1>",
             f"<p>qzs {e(__version__)}; {'quick' if s['quick'] else 'full'} design, "
             f"{result.seconds['total']:.0f} s. Method and decisions: docs/design.md. Every "
             "number comes from simulations of the nonlinear model (stick-slip friction, stops, "
             "saturation) unless it says linear.</p>",
             "<h2>Chosen gains</h2>",
-            _table(["quantity", "value", "unit", "evidence"], [
+            html_table(["quantity", "value", "unit", "evidence"], [
                 ["Kp", _fmt(g["pi_kp"]), "N/m", "PI search (smallest passing gain)"],
                 ["Ki", _fmt(g["pi_ki"]), "N/(m*s)", f"Ki/Kp = {s['integral_ratio']:g} 1/s kept"],
                 ["Kd", _fmt(g["damping_gain"]), "N*s/m", "damping search (least cost"
@@ -143,7 +122,7 @@ def _html_opening(result):
 
 def _html_problem(s):
     """The problem as solved, from the result's settings."""
-    return "<section><h2>Problem</h2>" + _table(["setting", "value"], [
+    return "<section><h2>Problem</h2>" + html_table(["setting", "value"], [
         ["base motion", f"{s['excitation']['kind']} "
                         + ", ".join(f"{k} = {v} {s['excitation']['units'].get(k, '')}".rstrip()
                                     for k, v in s["excitation"].items()
@@ -164,7 +143,7 @@ def _html_problem(s):
 
 def _html_static(st, written):
     """The static design section."""
-    return "<section><h2>Static design</h2>" + _table(["quantity", "value"], [
+    return "<section><h2>Static design</h2>" + html_table(["quantity", "value"], [
         ["spring force at the setpoint [N]", f"{st.spring_force_at_setpoint:.3f}"],
         ["payload the spring alone carries [kg]", _fmt(st.balanced_mass)],
         ["weight m*g [N]", f"{st.weight:.3f}"],
@@ -194,7 +173,7 @@ def _html_pi(result, written):
         f"Smallest Kp (Ki = {s['integral_ratio']:g}*Kp) keeping every case inside the band and "
         f"off the stops: {_fmt(pi['pi_kp'])} N/m; {_fmt(pi['failing_kp'])} N/m fails. "
         + (pi["reason"] or "")) + "</p>" \
-        + _table(["Kp [N/m]", "Ki [N/(m*s)]", "all cases", "band used [%]", "z min [mm]",
+        + html_table(["Kp [N/m]", "Ki [N/(m*s)]", "all cases", "band used [%]", "z min [mm]",
                   "z max [mm]", "stop contacts", "worst case"], rows) \
         + _figure(written, "pi_search", "Largest excursion above and below the setpoint over "
                   "every case, against the proportional gain.") + "</section>"
@@ -209,7 +188,7 @@ def _html_stability(rh):
         "<section><h2>Linear stability</h2><p>Characteristic polynomial (fractions cleared) "
         "m s^4 + (m w + Cv + Kd) s^3 + (Cv w + k + Kp) s^2 + ((k + Kp) w + Ki) s + Ki w, "
         "w = 2 pi f_hp: coefficients " + e(", ".join(f"{c:.5g}" for c in rh.coefficients))
-        + ". Routh-Hurwitz conditions:</p>" + _table(["condition", "value", ""], conditions)
+        + ". Routh-Hurwitz conditions:</p>" + html_table(["condition", "value", ""], conditions)
         + "<p>" + e(f"Closed form: stable = {rh.stable}; python-control's poles: largest real "
                     f"part {rh.largest_real_part:.4g} 1/s (agree: {rh.agrees}). Stable Kd at these "
                     f"PI gains: {_fmt(rh.damping_gain_limits[0])} to "
@@ -237,7 +216,7 @@ def _html_hunting(result, written):
         "friction law alone, as a function of slip velocity, predicts no limit cycle for a "
         "stable loop; the payload and its friction as a stick-slip relay in the integral loop "
         "predicts one. Simulation: the base at rest, the payload stuck at the predicted plateau "
-        "with the loop in balance.</p>" + _table(
+        "with the loop in balance.</p>" + html_table(
             ["Fs [N]", "relay DF: hunts", "plateau [mm]", "DF period [s]", "relay period [s]",
              "simulated: hunts", "amplitude [mm]", "period [s]", "memoryless DF cycles",
              "relay DF"], hunt_rows)
@@ -257,7 +236,7 @@ def _html_damping(result, written):
     return "<section><h2>Damping gain</h2><p>" + e(
         f"Bound: {_fmt(d['bound'])} N*s/m (" + "; ".join(d["bound_notes"]) + f"). Chosen: "
         f"{_fmt(d['chosen'])} N*s/m. {d['reason']}") + "</p>" \
-        + _table(["Kd [N*s/m]", "cost (simulated)", "cost (linear)", "bins trusted [%]",
+        + html_table(["Kd [N*s/m]", "cost (simulated)", "cost (linear)", "bins trusted [%]",
                   "motor force RMS [N]", "note"], d_rows) \
         + _figure(written, "damping", "Cost against the damping gain, and the transmissibility "
                   "without damping and at the chosen gain.") + "</section>"
@@ -279,9 +258,9 @@ def _html_margins(result, written):
         f"{_fmt(mg['required_rate'], 3, 'Hz')} with the delay, "
         f"{_fmt(mg['required_rate_without_delay'], 3, 'Hz')} without. "
         f"{mg['required_rate_reason']}") + "</p>" \
-        + _table(["rate [Hz]", "stable", "gain margin [dB]", "phase margin [deg]",
+        + html_table(["rate [Hz]", "stable", "gain margin [dB]", "phase margin [deg]",
                   "crossover [Hz]"], m_rows) \
-        + _table(["delay [ms]", "needed rate [Hz]", "continuous: gain margin [dB]",
+        + html_table(["delay [ms]", "needed rate [Hz]", "continuous: gain margin [dB]",
                   "continuous: phase margin [deg]"],
                  [[f"{1e3 * r['delay']:g}", _fmt(r["required_rate"], 3),
                    _fmt(r["continuous_gain_margin"], 3), _fmt(r["continuous_phase_margin"], 3)]
@@ -299,7 +278,7 @@ def _html_why(result, written):
               for r in w["rows"]]
     return ("<section><h2>Why active damping did not help much</h2>"
             f"<div class='answer'>{e(w['answer'])}</div>"
-            + _table(["factor", "value", "Kd [N*s/m]", "cost Kd = 0", "cost damped",
+            + html_table(["factor", "value", "Kd [N*s/m]", "cost Kd = 0", "cost damped",
                       "change [dB]", "linear [dB]"], w_rows)
             + _figure(written, "damping_effect", "Change of the cost with damping against "
                       "each factor: simulated (markers), linear (lines).") + "</section>")
@@ -307,5 +286,5 @@ def _html_why(result, written):
 
 def _html_run(result):
     """The wall time of each stage, and the page's end."""
-    return "<section><h2>Run</h2>" + _table(["stage", "seconds"], [
+    return "<section><h2>Run</h2>" + html_table(["stage", "seconds"], [
         [k, f"{v:.1f}"] for k, v in result.seconds.items()]) + "</section></body></html>"

@@ -1,11 +1,7 @@
 """The design's result: the chosen gains with the evidence for each choice, and its files."""
-import json
-import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
-import numpy as np
-
+from qzs._format import json_ready, json_text
 from qzs._version import __version__
 from qzs.iotools.files import atomic_path
 from qzs.workflows.design.report import _html, design_text
@@ -70,12 +66,12 @@ class DesignResult:
         """
         pi = {k: v for k, v in self.pi_search.items() if k != "details"}
         hunting = {k: v for k, v in self.hunting.items() if k != "loop"}
-        return _json_ready({"qzs_version": __version__, "gains": self.gains,
-                            "settings": self.settings, "static": self.static.to_dict(),
-                            "pi_search": pi, "stability": self.stability.to_dict(),
-                            "hunting": hunting, "damping": self.damping,
-                            "margins": self.margins, "why": self.why,
-                            "verification": self.verification, "seconds": self.seconds})
+        return json_ready({"qzs_version": __version__, "gains": self.gains,
+                           "settings": self.settings, "static": self.static.to_dict(),
+                           "pi_search": pi, "stability": self.stability.to_dict(),
+                           "hunting": hunting, "damping": self.damping,
+                           "margins": self.margins, "why": self.why,
+                           "verification": self.verification, "seconds": self.seconds})
 
     def summary(self):
         """The design in a few lines of text (what ``qzs design`` prints).
@@ -129,29 +125,10 @@ class DesignResult:
             written[name] = path
         record = self.to_dict()
         with atomic_path(folder / "design.json") as tmp:
-            tmp.write_text(json.dumps(record, indent=2, allow_nan=False), encoding="utf-8")
+            tmp.write_text(json_text(record), encoding="utf-8")
         written["json"] = folder / "design.json"
         with atomic_path(folder / "report.html") as tmp:
             tmp.write_text(_html(self, record, written), encoding="utf-8")
         written["report"] = folder / "report.html"
         return written
 
-
-def _json_ready(value):
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, complex):
-        return [_json_ready(value.real), _json_ready(value.imag)]
-    if isinstance(value, np.ndarray):
-        return _json_ready(value.tolist())
-    if isinstance(value, Path):
-        return str(value)
-    return value

@@ -1,11 +1,9 @@
 """The design's defaults and search sizes, and the validated settings every stage shares."""
 import dataclasses
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 
@@ -46,29 +44,6 @@ TRUSTED_SHARE_MIN = 0.5
 RATES = (20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0, 10000.0)
 #: Delays [s] of the linear delay experiment.
 DELAYS = (0.0, 0.001, 0.002, 0.005)
-
-
-def _float(name, value, *, minimum=None, strict=False, fix=""):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError(f"`{name}` must be a number, got {value!r}{fix}.")
-    value = float(value)
-    if not math.isfinite(value) or (minimum is not None and (
-            value < minimum or (strict and value == minimum))):
-        bound = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
-        raise ParameterError(f"`{name}` must be a finite number{bound}, got {value!r}{fix}.")
-    return value
-
-
-def _pair(name, value, unit, *, minimum=0.0, example="(1, 2)"):
-    try:
-        low, high = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"`{name}` must be two numbers (low, high) in {unit}, got "
-                             f"{value!r}; e.g. {example}.") from None
-    if not (math.isfinite(low) and math.isfinite(high) and minimum <= low <= high):
-        raise ParameterError(f"`{name}` must satisfy {minimum:g} <= low <= high (finite, in "
-                             f"{unit}), got {value!r}; e.g. {example}.")
-    return (low, high)
 
 
 @dataclass

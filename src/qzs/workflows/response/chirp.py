@@ -17,8 +17,9 @@ def _run_chirp(task):
                                   top=task["top"], dt=task["dt"], solver=task["solver"])
 
 
-def chirp_transmissibility(amplitude=0.010, isolator=None, controller=None, *, top=20.0,
-                           dt=defaults.SIMULATION["dt"], solver=defaults.SIMULATION["solver"],
+def chirp_transmissibility(amplitude=defaults.EXCITATION["amplitude"], isolator=None,
+                           controller=None, *, top=20.0, dt=defaults.SIMULATION["dt"],
+                           solver=defaults.SIMULATION["solver"],
                            fft_length=defaults.ANALYSIS["fft_length"]):
     """The paper's transmissibility estimate: a slow chirp and a Welch ratio.
 

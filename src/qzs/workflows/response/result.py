@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qzs._format import decibels
 from qzs._validation import choice
 from qzs.workflows.response.files import POINT_FIELDS, response_dataset
 
@@ -230,7 +231,7 @@ class SteadyStateResponse:
             return np.array([])
         up, down = self.branch("up"), self.branch("down")
         with np.errstate(divide="ignore", invalid="ignore"):
-            gap = np.abs(20 * np.log10(up["transmissibility"] / down["transmissibility"]))
+            gap = np.abs(decibels(up["transmissibility"] / down["transmissibility"]))
         return up["frequency"][gap > threshold_db]
 
     def jumps(self, threshold_db=1.0, agreement_db=0.1):
@@ -257,7 +258,7 @@ class SteadyStateResponse:
         if self.directions != ("up", "down"):
             return {}
         with np.errstate(divide="ignore", invalid="ignore"):
-            db = {d: 20 * np.log10(self.branch(d)["transmissibility"]) for d in self.directions}
+            db = {d: decibels(self.branch(d)["transmissibility"]) for d in self.directions}
             agree = np.abs(db["up"] - db["down"]) <= agreement_db
         f = self.frequencies
         up, down = [], []
@@ -341,11 +342,11 @@ class SteadyStateResponse:
             for d in self.directions:
                 b = branches[d]
                 t = b["transmissibility"][i]
-                db = f"{20 * math.log10(t):+8.2f}" if t > 0 else "     nan"
+                db = f"{decibels(t):+8.2f}" if t > 0 else "     nan"
                 row += (f"  {db}    {b['locked_fraction'][i]:5.2f}  "
                         f"{int(b['periods'][i]):4d}")
             if self.chirp is not None:
-                row += (f"  {20 * math.log10(chirp[i]):+8.2f}" if chirp[i] > 0 else "       nan")
+                row += (f"  {decibels(chirp[i]):+8.2f}" if chirp[i] > 0 else "       nan")
             lines.append(row)
         for direction, pairs in self.jumps().items():
             if pairs:

@@ -137,8 +137,9 @@ def _choose_step(frequencies, amplitude, isolator, controller, solver, tolerance
                            f"{step.error:.2g} dB)")
 
 
-def steady_state_response(frequencies, amplitude=0.010, isolator=None, controller=None, *,
-                          direction="both", dt=None, tolerance_db=None,
+def steady_state_response(frequencies, amplitude=defaults.EXCITATION["amplitude"],
+                          isolator=None, controller=None, *, direction="both", dt=None,
+                          tolerance_db=None,
                           solver=defaults.SIMULATION["solver"],
                           periodic_tolerance=PERIODIC_TOLERANCE, max_periods=MAX_PERIODS,
                           max_time=None, fade_in=FADE_IN, harmonics=HARMONICS,
