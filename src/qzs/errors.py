@@ -146,6 +146,8 @@ class ResultTooLargeError(ParameterError):
         The run's simulated time [s].
     sample_rate : float
         The run's output rate [Hz].
+    remedy : str
+        What to do instead, the message's end (default: stream the run to a file).
     """
 
     #: The advice of a single run's message.

@@ -347,13 +347,36 @@ class Recorder:
         self.rows = 0
 
     def target(self, chunk_index, rows):
-        """Buffer and first row of chunk ``chunk_index`` when ``rows`` rows came before."""
+        """Where the kernel writes a chunk: which buffer, from which row.
+
+        Parameters
+        ----------
+        chunk_index : int
+            The chunk's index in the run [-] (streamed chunks alternate buffers).
+        rows : int
+            Output rows written before the chunk [-].
+
+        Returns
+        -------
+        (int, int)
+            The buffer's index and the first row.
+        """
         if self.sink is None:
             return 0, rows
         return chunk_index % 2, 0
 
     def absorb(self, buffer, first, count):
-        """Rows ``first:first+count`` of ``buffer`` are new samples, following the others."""
+        """Take new samples: to the statistics, and to the sink and preview when streaming.
+
+        Parameters
+        ----------
+        buffer : int
+            The buffer the kernel wrote.
+        first : int
+            Its first new row [-].
+        count : int
+            New rows, which follow every sample taken before [-].
+        """
         data, marks = self.buffers[buffer]
         block, block_flags = data[first:first + count], marks[first:first + count]
         self.statistics(block, block_flags)

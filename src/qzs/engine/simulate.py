@@ -120,7 +120,22 @@ class SingleAxis(driver.Stepper):
         self.diverged = False
 
     def advance(self, steps, buffer, row0):
-        """Advance ``steps`` steps; returns the rows written into ``buffers[buffer]``."""
+        """Advance the kernel, recording the samples that fall in the steps.
+
+        Parameters
+        ----------
+        steps : int
+            Integration steps [-].
+        buffer : int
+            Index of the buffer the kernel writes.
+        row0 : int
+            First row to write.
+
+        Returns
+        -------
+        int
+            Rows written [-].
+        """
         run = self.run
         data, marks = self.buffers[buffer]
         status, written = _lanes.run_single(run.solver_code, steps, run.decimation, run.state,
