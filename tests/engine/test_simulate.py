@@ -1,6 +1,6 @@
 """Tests of qzs.simulate's interface: argument checking, stability limit, divergence, results.
 
-The physics of the runs is in test_simulate_physics.py.
+The physics of the runs is in test_kernels.py.
 """
 import numpy as np
 import pytest
