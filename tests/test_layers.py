@@ -190,7 +190,6 @@ TESTS = Path(__file__).resolve().parent
 #: content is constants or re-exports may be here (checked: it defines no function or class).
 UNTESTED = {
     "_version": "the version string only",
-    "defaults": "constants only: the values other modules read (tested where they are read)",
     "engine.hexapod.layout": "the six-axis kernels' packed offsets only (that the output "
                              "channels tile them: tests/engine/hexapod/test_result.py)",
 }
