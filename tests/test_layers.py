@@ -6,8 +6,14 @@ only from the layers before it in :data:`LAYERS`. The one exception: a result ob
 ``plot``/``save`` method may hand itself to the figure and file layers above it
 (pvlib-style delegation). The test of the checker itself adds an upward import and sees
 it fail.
+
+The tests mirror the tree (as pvlib's do): every module has its test file at the same path
+under tests/ (``tests/engine/test_driver.py`` beside ``src/qzs/engine/driver.py``), every
+test file names a module of its folder's package, each package's docstring lists exactly
+its modules and subpackages, and no source file is over :data:`MAX_LINES` lines.
 """
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -176,3 +182,130 @@ def test_the_checker_sees_an_upward_import(source, upward):
 
 def test_the_checker_sees_a_relative_upward_import():
     assert violations("qzs.model.example", "from ..viz import figures\n")
+
+
+# ---------------------------------------------------------------- the tests mirror the tree
+TESTS = Path(__file__).resolve().parent
+#: Modules without a test file of their own, with the reason. Only a module whose whole
+#: content is constants or re-exports may be here (checked: it defines no function or class).
+UNTESTED = {
+    "_version": "the version string only",
+    "engine.hexapod.layout": "the six-axis kernels' packed offsets only (that the output "
+                             "channels tile them: tests/engine/hexapod/test_result.py)",
+}
+#: The suites at the top of tests/ that test the package as a whole, not one module.
+CROSS_CUTTING = {
+    "layers": "this file: the folder tree, the imports between layers, the tests' own tree",
+    "docstrings": "every public callable's numpydoc, whatever its module",
+    "cli_contract": "exit codes, signals, output paths and --json, the same for every subcommand",
+    "bad_inputs": "inputs that used to end in a traceback, through the API and every command",
+    "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "
+             "and the experiment's tests)",
+    "benchmark_reference": "the benchmarks' C reference model against qzs",
+}
+#: The longest a source file of qzs may be [lines] (one concept per module).
+MAX_LINES = 1000
+
+
+def source_modules():
+    """Every module of qzs but ``__init__`` and ``__main__``, as a path under src/qzs."""
+    return sorted(path.relative_to(SOURCE) for path in SOURCE.rglob("*.py")
+                  if path.name not in ("__init__.py", "__main__.py"))
+
+
+def packages():
+    """Every package of qzs (qzs itself first), as a path under src/qzs."""
+    return sorted(path.parent.relative_to(SOURCE) for path in SOURCE.rglob("__init__.py"))
+
+
+def package_contents(package):
+    """The modules and subpackages of a package, by name (``__main__`` left out)."""
+    folder = SOURCE / package
+    modules = [path.stem for path in folder.glob("*.py")
+               if path.name not in ("__init__.py", "__main__.py")]
+    return sorted(modules + [path.parent.name for path in folder.glob("*/__init__.py")])
+
+
+def mirrored_test(module):
+    """tests/<package path>/test_<module name without a leading underscore>.py"""
+    return TESTS.joinpath(*module.parent.parts, f"test_{module.stem.lstrip('_')}.py")
+
+
+def defined_names(path):
+    return [node.name for node in ast.walk(ast.parse(path.read_text()))
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))]
+
+
+@pytest.mark.parametrize("module", source_modules(), ids=str)
+def test_every_module_has_a_test_file_at_its_mirrored_path(module):
+    """tests/engine/test_driver.py beside src/qzs/engine/driver.py, as pvlib does."""
+    name = ".".join(module.with_suffix("").parts)
+    test = mirrored_test(module).relative_to(TESTS.parent)
+    if name in UNTESTED:
+        defined = defined_names(SOURCE / module)
+        assert not defined, (f"src/qzs/{module} defines {defined}: no longer constants only, "
+                             f"so test it in {test} and drop it from UNTESTED")
+        assert not (TESTS.parent / test).exists(), f"{test} exists: drop {name} from UNTESTED"
+        return
+    assert (TESTS.parent / test).exists(), f"src/qzs/{module} has no test file: write {test}"
+
+
+def test_every_test_file_names_a_module_of_its_mirrored_package():
+    """tests/<package>/test_<module>.py or test_<module>_<aspect>.py (a second file of one
+    module), test_init.py for a package's ``__init__``; at the top of tests/, the top-level
+    modules' files and the cross-cutting suites of :data:`CROSS_CUTTING`."""
+    problems = []
+    for test in sorted(TESTS.rglob("test_*.py")):
+        folder = test.parent.relative_to(TESTS)
+        stem = test.stem.removeprefix("test_")
+        if not (SOURCE / folder / "__init__.py").exists():
+            problems.append(f"{test.relative_to(TESTS.parent)}: no package src/qzs/{folder}")
+            continue
+        modules = [path.stem.lstrip("_") for path in (SOURCE / folder).glob("*.py")
+                   if path.name not in ("__init__.py", "__main__.py")]
+        named = (stem == "init" and folder.parts
+                 or (not folder.parts and stem in CROSS_CUTTING)
+                 or any(stem == m or stem.startswith(m + "_") for m in modules))
+        if not named:
+            problems.append(f"{test.relative_to(TESTS.parent)}: names no module of "
+                            f"src/qzs/{folder}")
+    assert not problems, "\n".join(problems)
+
+
+def listed_modules(docstring):
+    """The names a package's docstring lists: the ````name```` entries that start a line
+    of its table (between the first and the last rule of ``=`` columns)."""
+    lines = (docstring or "").splitlines()
+    rules = [i for i, line in enumerate(lines) if re.fullmatch(r"=+( +=+)+", line.strip())]
+    if len(rules) < 2:
+        return None
+    return [match.group(1) for line in lines[rules[0] + 1:rules[-1]]
+            if (match := re.match(r"``(\w+)``( |$)", line))]
+
+
+@pytest.mark.parametrize("package", packages(), ids=lambda p: ".".join(("qzs", *p.parts)))
+def test_each_package_docstring_lists_exactly_its_modules(package):
+    """The package's docstring has a table, one ``name`` line per module and subpackage,
+    in the format of qzs.engine's; a module added, moved or removed changes it."""
+    docstring = ast.get_docstring(ast.parse((SOURCE / package / "__init__.py").read_text()))
+    listed = listed_modules(docstring)
+    assert listed is not None, "no table of modules in the docstring"
+    assert len(listed) == len(set(listed)), f"listed twice: {listed}"
+    contents = package_contents(package)
+    assert sorted(listed) == contents, (f"not listed: {sorted(set(contents) - set(listed))}; "
+                                        f"listed but absent: {sorted(set(listed) - set(contents))}")
+
+
+def test_no_source_file_is_over_the_line_limit():
+    lengths = {path.relative_to(SOURCE): len(path.read_text().splitlines())
+               for path in sorted(SOURCE.rglob("*.py"))}
+    over = [f"src/qzs/{path}: {count} lines" for path, count in lengths.items()
+            if count > MAX_LINES]
+    assert not over, f"over {MAX_LINES} lines (split by concept):\n" + "\n".join(over)
+
+
+def test_the_docstring_reader_sees_only_the_table():
+    doc = ("Intro.\n\n``base``\n    not a module\n\n====  ====\n``a``  one\n``bb`` two\n"
+           "           more of two\n====  ====\n\n``after``  not either\n")
+    assert listed_modules(doc) == ["a", "bb"]
+    assert listed_modules("No table.\n``a``  one\n") is None

@@ -27,25 +27,38 @@ DEFAULT_RECORDS = "_build/validation.jsonl"
 #: Columns and their relative widths.
 COLUMNS = (("check", 23), ("reference", 25), ("measured error", 15), ("tolerance", 8),
            ("share", 7), ("test", 22))
-#: The page's sections, in reading order: a short title per test module. A module not listed
-#: gets a section of its own at the end, titled by its docstring's first clause.
+#: The page's sections, in reading order: a short title per test module, named by its dotted
+#: path under tests/ (``engine.test_kernels`` for tests/engine/test_kernels.py). A module not
+#: listed gets a section of its own at the end, titled by its docstring's first clause.
 SECTIONS = {
-    "test_model": "Force laws of the model",
-    "test_simulate_physics": "The simulator: linear limit, convergence, energy, stick-slip, stops",
-    "test_simulate": "Integrators' stability limits",
-    "test_accuracy": "The accuracy-driven step",
-    "test_excitation": "Excitations",
-    "test_control": "The controller",
-    "test_regularised": "The regularised friction option",
-    "test_linear": "The linearised loop, and the paper's natural frequencies",
-    "test_control_design": "Controller design: stability bounds, margins, describing functions",
-    "test_spectral": "Spectral estimation and transmissibility metrics",
-    "test_response": "The steady-state response against Den Hartog and other exact results",
-    "test_harmonic_balance": "Harmonic balance",
-    "test_identify": "Fits: the MagSpring",
-    "test_identify_friction": "Fits: the friction law",
-    "test_identify_transmissibility": "Fits: the transmissibility",
-    "test_fit_intervals": "Fits: confidence intervals",
+    "model.test_isolator": "Force laws of the model",
+    "engine.test_kernels": "The simulator: linear limit, convergence, energy, stick-slip, stops",
+    "engine.test_stability": "Integrators' stability limits",
+    "engine.test_accuracy": "The accuracy-driven step",
+    "model.test_excitation": "Excitations",
+    "model.test_controller": "The controller",
+    "engine.test_laws_regularised": "The regularised friction option",
+    "analysis.test_linear": "The linearised loop, and the paper's natural frequencies",
+    "analysis.control_design.test_linear_stability":
+        "Controller design: Routh-Hurwitz bounds on the gains",
+    "analysis.control_design.test_loop_transfers":
+        "Controller design: the sampled loop with a delay",
+    "analysis.control_design.test_stability_margins": "Controller design: margins",
+    "analysis.control_design.test_describing_functions":
+        "Controller design: describing functions",
+    "analysis.control_design.test_hunting": "Controller design: hunting at rest",
+    "analysis.test_spectral": "Spectral estimation and transmissibility metrics",
+    "workflows.response.test_frequency":
+        "The steady-state response against Den Hartog and other exact results",
+    "analysis.harmonic_balance.test_residual": "Harmonic balance: the residual and its Jacobian",
+    "analysis.harmonic_balance.test_solution": "Harmonic balance: one periodic response",
+    "analysis.harmonic_balance.test_stability": "Harmonic balance: Floquet exponents",
+    "analysis.harmonic_balance.test_continuation":
+        "Harmonic balance: continuation in frequency",
+    "identify.test_spring": "Fits: the MagSpring",
+    "identify.test_friction": "Fits: the friction law",
+    "identify.test_transmissibility": "Fits: the transmissibility",
+    "identify.test_statistics": "Fits: confidence intervals",
 }
 
 

@@ -4,20 +4,27 @@ The isolator of Leav et al. (constant-force MagSpring + linear motor, stick-slip
 friction, guide hard stops, PI position loop and active damping), simulated as
 docs/model.md describes, and the tools to judge it by transmissibility.
 
-This module is the flat public API. The subpackages are the architecture, each
-importing only from those listed before it:
+This module is the flat public API. The top-level modules are the base every layer may
+use; the subpackages are the architecture, each importing only from those listed before it:
 
-=============  ====================================================================
-``model``      parameters, force laws (numpy), excitations, the parameter registry
-``analysis``   spectral estimation and metrics, linearisation, run statistics
-``engine``     numba kernels, single and lockstep drivers, simulate, batch, results
-``iotools``    result and config files, rig-log readers
-``identify``   spring, friction and transmissibility fits
-``viz``        every figure
-``workflows``  studies and report, experiments, sweeps, response, design, hexapod studies
-``app``        the interactive tuning page (``qzs app``; Panel, optional)
-``cli``        the ``qzs`` command
-=============  ====================================================================
+===============  ====================================================================
+``errors``       every exception and warning class, each subclassing a built-in
+``defaults``     the settings and names the layers share: run, analysis, the six axes
+``_validation``  the argument checks of the parameter classes and public functions
+``_format``      how numbers are shown: dB, text, JSON, CSV, report tables
+``_optional``    optional dependencies: imported, or named with the extra to install
+``_lazy``        names a package exports but imports on first use (PEP 562)
+``_version``     the installed version
+``model``        parameters, force laws (numpy), excitations, the parameter registry
+``analysis``     spectral estimation and metrics, linearisation, run statistics
+``engine``       numba kernels, single and lockstep drivers, simulate, batch, results
+``iotools``      result and config files, rig-log readers
+``identify``     spring, friction and transmissibility fits
+``viz``          every figure
+``workflows``    studies and report, experiments, sweeps, response, design, hexapod studies
+``app``          the interactive tuning page (``qzs app``; Panel, optional)
+``cli``          the ``qzs`` command
+===============  ====================================================================
 """
 from qzs._lazy import lazy_exports
 from qzs._version import __version__

@@ -13,7 +13,22 @@
     qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
 
-Every subcommand hands its parsed arguments to a function of the layers below.
+Every subcommand hands its parsed arguments to a function of the layers below; one module
+per subcommand (or pair of subcommands), and what they share:
+
+==============  =======================================================================
+``common``      ``--set`` pairs, parameter loading, ``--json``, the exit codes
+``simulate``    ``qzs simulate``: one run, its summary, figure and time series
+``params``      ``qzs params``: every parameter with its value and unit
+``studies``     ``qzs paper`` and ``qzs study``: the paper's studies and report
+``experiment``  ``qzs experiment``: an experiment log beside the matching simulation
+``sweep``       ``qzs sweep`` and ``qzs sweep-plot``: sweeps into a Zarr store, figures
+``response``    ``qzs response``: the steady-state response by stepped-sine simulation
+``design``      ``qzs design``: PI and damping gains from the isolator and its disturbance
+``hexapod``     ``qzs hexapod``: the six-axis platform of six isolator legs
+``app``         ``qzs app``: the interactive tuning page in the browser
+==============  =======================================================================
+
 Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
 1 a failed run, 2 bad input or usage (one line on stderr, never a traceback), 130 Ctrl-C,
 141 the output pipe was closed by its reader (``qzs params | head -1`` ends quietly),

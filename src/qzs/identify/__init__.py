@@ -1,11 +1,15 @@
 """Model identification from test-rig data (paper Section 2.1.2), one module per fit.
 
-- :func:`fit_spring`: the MagSpring's static force-displacement pairs -> ``a``, ``b`` of
-  ``F = -a*tanh(b*z)`` with confidence intervals, in either displacement convention.
-- :func:`fit_friction`: a dynamic test with imposed displacement and measured force (the
-  paper's Instron tests) -> stiction, Coulomb, Stribeck and viscous friction (eq. 3).
-- :func:`fit_transmissibility`: chosen model parameters fitted to a measured
-  transmissibility curve through the simulator.
+====================  =============================================================================
+``spring``            :func:`fit_spring`: the MagSpring's static force-displacement pairs -> ``a``,
+                      ``b`` of ``F = -a*tanh(b*z)``, in either displacement convention
+``friction``          :func:`fit_friction`: a dynamic test with imposed displacement and measured
+                      force (the paper's Instron tests) -> stiction, Coulomb, Stribeck and viscous
+                      friction (eq. 3)
+``transmissibility``  :func:`fit_transmissibility`: chosen model parameters fitted to a measured
+                      transmissibility curve through the simulator
+``_statistics``       the fits' covariance, Student-t quantile and profile threshold
+====================  =============================================================================
 
 All intervals are Student-t intervals on the covariance ``s^2 (J^T J)^-1`` of the
 least-squares Jacobian ``J`` at the optimum (``s^2`` the residual variance): they assume

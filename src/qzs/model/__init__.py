@@ -3,6 +3,14 @@
 No numba here: the kernels that integrate this model are in :mod:`qzs.engine`, and
 they call the same laws written once as numba functions (:mod:`qzs.engine.laws`).
 The equations, signs and defaults are described in docs/model.md.
+
+==============  ==================================================================
+``isolator``    the plant's parameters and force laws (spring, friction), the rest state
+``controller``  the PI position loop with active damping, its closed-loop frequency
+``excitation``  base excitations (chirp, sine, random, a displacement record)
+``registry``    every parameter's name, unit, doc and default; ``--set`` parsing
+``hexapod``     a six-leg platform of isolator legs: geometry, kinematics, statics
+==============  ==================================================================
 """
 from qzs.model.controller import ControllerParameters, closed_loop_natural_frequency
 from qzs.model.excitation import (EXCITATION_KINDS, EXCITATION_OPTIONS, Chirp, DisplacementRecord,

@@ -8,7 +8,10 @@
 ``experiment``        a measured log beside its simulation
 ``sweeps``            sweep stores: metrics against parameters, transmissibility bands
 ``design``            a controller design's figures (``qzs design``)
+``response``          the steady-state response: branches, harmonic balance, chirp
 ``hexapod``           a hexapod run: platform pose, leg strokes, motor forces
+``hexapod_matrix``    the six-axis platform's 6x6 transmissibility as a grid
+``hexapod_study``     the hexapod study's cases side by side
 ====================  ================================================================
 """
 from qzs.viz.figures import envelope, new_figure, save_figure

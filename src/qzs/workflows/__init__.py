@@ -1,13 +1,20 @@
 """Workflows built on the layers below: the paper's studies and report, experiment logs, sweeps.
 
-==============  ==============================================================================
-``run``         one run streamed to a file as it is simulated (bounded memory)
-``studies``     the paper's studies as TOML definitions (``study_files/``), run in parallel
-``report``      ``qzs paper``: figures, metrics, claims decided from the data
-``experiment``  a measured log beside its simulation
-``sweeps``      parameter sweeps and Monte Carlo runs into Zarr stores, locally or on Dask
-``design``      ``qzs design``: PI and damping gains searched by simulation, with the evidence
-``response``    steady-state frequency response: stepped-sine sweeps up and down, beside the
-                harmonic balance and the paper's chirp estimate
-==============  ==============================================================================
+============================  ================================================================
+``run``                       one run streamed to a file as it is simulated (bounded memory)
+``studies``                   the paper's studies as TOML definitions (``study_files/``), run
+                              in parallel
+``report``                    ``qzs paper``: figures, metrics, claims decided from the data
+``experiment``                a measured log beside its simulation
+``sweeps``                    parameter sweeps and Monte Carlo runs into Zarr stores, locally
+                              or on Dask
+``design``                    ``qzs design``: PI and damping gains searched by simulation,
+                              with the evidence
+``response``                  steady-state frequency response: stepped-sine sweeps up and
+                              down, beside the harmonic balance and the paper's chirp estimate
+``hexapod``                   six-axis set-ups: hexapod files (``hexapod_files/``), defaults,
+                              the reports behind ``qzs hexapod``
+``hexapod_transmissibility``  the simulated 6x6 transmissibility of a platform, chirp per axis
+``hexapod_study``             ``qzs hexapod study``: six paper legs with and without PI
+============================  ================================================================
 """

@@ -38,9 +38,14 @@ writes each finished batch to a Zarr store (:mod:`qzs.workflows.sweeps.store`) t
 interrupted run resumes. Shipped examples: ``qzs/workflows/sweep_files/*.toml``; the
 guide is ``docs/sweeps.md``.
 
-Modules: :mod:`~qzs.workflows.sweeps.definition` (files, grids, sampling),
-:mod:`~qzs.workflows.sweeps.backends` (the batch task, local and Dask backends),
-:mod:`~qzs.workflows.sweeps.store` (the Zarr store); figures in :mod:`qzs.viz.sweeps`.
+:func:`run_sweep`, :func:`open_sweep`, :func:`plot_sweep` and :func:`stored_count` are
+here; figures in :mod:`qzs.viz.sweeps`. The modules:
+
+==============  =================================================================
+``definition``  sweep files: validation, grids, random and Latin-hypercube sampling
+``backends``    the batch task, its reduction, the local and Dask backends
+``store``       the Zarr store: layout, creation, batch writes, resume checks
+==============  =================================================================
 """
 from pathlib import Path
 

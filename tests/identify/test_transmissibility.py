@@ -51,7 +51,7 @@ def test_two_parameters_with_stiction(curve, tmp_path):
     fit = fit_transmissibility(*curve, ("viscous_damping", "stiction_force"), excitation=CHIRP)
     assert fit.parameters["viscous_damping"] == pytest.approx(60.0, rel=0.02)
     assert fit.parameters["stiction_force"] == pytest.approx(6.0, rel=0.1)  # plateaus: see doc
-    low, high = fit.intervals["stiction_force"]  # coverage: tests/test_fit_coverage.py
+    low, high = fit.intervals["stiction_force"]  # coverage: tests/identify/test_transmissibility_coverage.py
     assert low < fit.parameters["stiction_force"] < high and high - low < 0.3 * 6.0
     plt.close(fit.plot(path=tmp_path / "fit.png"))
     assert (tmp_path / "fit.png").exists()

@@ -6,7 +6,7 @@ the entries a symmetric platform keeps at zero come out untrusted, which the coh
 would not do; the energy ledger closes; bad arguments are refused before any run; the
 command line writes its files; the study's quick report states its choices.
 
-The platform of the small-signal checks is ``tests/test_hexapod_dynamics.py``'s: the cube of
+The platform of the small-signal checks is ``tests/engine/hexapod/test_dynamics.py``'s: the cube of
 edge 0.3 m, 22.17 kg, ``Kp`` 2000 N/m, ``Ki`` 800 N/(m*s), ``Kd`` 20 N*s/m (a stable loop).
 Chirps are 100 s or shorter at dt = 1 ms: each run takes well under a second.
 """

@@ -1,26 +1,10 @@
-"""The `qzs` command: it only parses, calls the API and reports."""
+"""The `qzs` command (qzs.cli.main): it only parses, calls the API and reports; bad input
+is one clear line and exit code 2."""
 import numpy as np
 import pytest
 
 from qzs.cli import main
 from qzs.iotools import read_result, save_config
-
-
-def test_params_lists_every_parameter_with_units(capsys):
-    assert main(["params"]) == 0
-    out = capsys.readouterr().out
-    for name, unit in (("mass", "kg"), ("stiction_force", "N"), ("pi_ki", "N/(m*s)"),
-                       ("velocity_highpass", "Hz"), ("stop_center", "m")):
-        line = next(line for line in out.splitlines() if f" {name} " in f" {line} ")
-        assert unit in line
-
-
-def test_params_toml_round_trips(tmp_path):
-    path = tmp_path / "p.toml"
-    assert main(["params", "--toml", str(path), "--set", "mass=7"]) == 0
-    from qzs.iotools import load_config
-
-    assert load_config(path)["isolator"].mass == 7.0
 
 
 def test_simulate_writes_outputs_and_summary(tmp_path, capsys):
@@ -79,34 +63,3 @@ def test_errors_are_one_clear_line(capsys, argv, message):
     err = capsys.readouterr().err
     assert err.startswith("qzs: error:") and message in err
     assert "Traceback" not in err
-
-
-def test_study_runs_a_user_file(tmp_path, capsys):
-    study = tmp_path / "mine.toml"
-    study.write_text("""
-[study]
-name = "mine"
-title = "Two stictions"
-kind = "transmissibility"
-claims = []
-[[study.view]]
-figure = "mine"
-frequency_range = [0.0, 10.0]
-[analysis]
-quick_fft_length = 2048
-quick_n_averages = 4
-band = [0.0, 10.0]
-[excitation]
-f1 = 10.0
-[[case]]
-label = "a"
-stiction_force = 2.0
-[[case]]
-label = "b"
-stiction_force = 8.0
-""")
-    out = tmp_path / "out"
-    assert main(["study", str(study), "--quick", "--out", str(out), "--workers", "1",
-                 "--quiet"]) == 0
-    assert (out / "mine.png").exists() and (out / "mine.svg").exists()
-    assert (out / "metrics.csv").read_text().count("\nmine,") == 2

@@ -1,6 +1,6 @@
 """Sweep definitions: validation messages, grids, random and Latin-hypercube sampling.
 
-No simulation runs here (see test_sweep_run.py).
+No simulation runs here (see test_init.py).
 """
 import math
 

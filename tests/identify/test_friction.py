@@ -12,7 +12,7 @@ from qzs.viz.identify import plot_friction_fit
 
 TRUTH = qzs.IsolatorParameters()
 NAMES = ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping")
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "data"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "data"
 
 
 def instron_test(seed=0, isolator=TRUTH, offset=3.0, noise=0.2, rate=1000.0, cycles=4,

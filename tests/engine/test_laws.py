@@ -9,7 +9,7 @@ from qzs import IsolatorParameters
 from qzs.engine import laws
 from qzs.model.isolator import friction_force, spring_energy, spring_force
 
-SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
+SOURCE = Path(__file__).resolve().parents[2] / "src" / "qzs"
 ENGINE = SOURCE / "engine"
 HARMONIC_BALANCE = SOURCE / "analysis" / "harmonic_balance"
 P = IsolatorParameters(stiction_force=12.0, coulomb_force=2.5, stribeck_decay=40.0,
@@ -110,7 +110,7 @@ def test_the_six_leg_engine_writes_no_force_law_of_its_own():
 
 def test_the_harmonic_balance_writes_no_force_law_of_its_own():
     """The smooth model's spring and friction are the model's numpy laws (qzs.model.isolator),
-    which tests/test_model.py and the test above hold equal to the kernels' laws: no tanh,
+    which tests/model/test_isolator.py and the test above hold equal to the kernels' laws: no tanh,
     cosh, exp or sign anywhere in the harmonic balance, and the smooth model calls the laws
     and their slopes."""
     modules = sorted(HARMONIC_BALANCE.glob("*.py"))

@@ -1,4 +1,4 @@
-"""The tuning page's logic without a browser: qzs.app.compute, .updates, .figure, .server.
+"""The tuning page's logic without a browser: qzs.app.compute, what the page shows as data.
 
 Reference checks: the page's transmissibility is what ``qzs.transmissibility`` gives for
 the same run, its linear curve what ``qzs.linearize`` gives, its errors the API's own, its
@@ -6,9 +6,6 @@ TOML export what ``qzs.iotools.load_config`` reads back to the same parameters.
 """
 import dataclasses
 import math
-import subprocess
-import sys
-from concurrent.futures import Future
 
 import numpy as np
 import pytest
@@ -17,16 +14,10 @@ from qzs import ControllerParameters, IsolatorParameters, linearize, simulate, t
 from qzs.app import compute
 from qzs.app.compute import (LIMITS, MAX_STEPS, PAGE_DEFAULTS, PageRequest, SizeLimitError,
                              compute_page, config_text, page_request, page_values, welch_length)
-from qzs.app.updates import LatestOnly
-from qzs.errors import ExcitationError, MissingDependencyError, ParameterError
+from qzs.errors import ExcitationError, ParameterError
 from qzs.iotools.config import load_config
 from qzs.model.excitation import build_excitation
 from qzs.model.registry import PARAMETERS
-
-
-@pytest.fixture(scope="module")
-def default_page():
-    return compute_page(page_request())
 
 
 @pytest.fixture(scope="module")
@@ -211,201 +202,3 @@ def test_toml_export_runs_with_qzs_simulate(tmp_path):
     from qzs.cli import main
 
     assert main(["simulate", "--config", str(path), "--plot", "none", "--quiet"]) == 0
-
-
-# ---------------------------------------------------------------- updates
-class HeldExecutor:
-    """An executor whose futures the test completes, in any order."""
-
-    def __init__(self):
-        self.jobs = []
-
-    def submit(self, function, request):
-        future = Future()
-        self.jobs.append((future, function, request))
-        return future
-
-    def finish(self, index=0):
-        future, function, request = self.jobs.pop(index)
-        try:
-            future.set_result(function(request))
-        except Exception as error:  # noqa: BLE001 - the updater delivers it
-            future.set_exception(error)
-
-
-def test_latest_only_drops_superseded_results():
-    delivered, busy = [], []
-    executor = HeldExecutor()
-    updates = LatestOnly(lambda r: r * 10, lambda r, out: delivered.append((r, out)),
-                         executor=executor, schedule=lambda f: f(), busy=busy.append)
-    updates.submit(1)
-    updates.submit(2)           # waits
-    updates.submit(3)           # replaces 2, which is never computed
-    assert len(executor.jobs) == 1 and updates.running
-    executor.finish()           # 1 is done: superseded, dropped; 3 starts
-    assert delivered == [] and updates.dropped == 1
-    assert [job[2] for job in executor.jobs] == [3]
-    executor.finish()
-    assert delivered == [(3, 30)] and not updates.running
-    assert busy == [True, False] and updates.delivered == 1
-
-
-def test_latest_only_delivers_errors_and_cancels():
-    delivered = []
-    executor = HeldExecutor()
-
-    def compute_or_fail(request):
-        if request < 0:
-            raise ParameterError("negative")
-        return request
-
-    updates = LatestOnly(compute_or_fail, lambda r, out: delivered.append(out),
-                         executor=executor, schedule=lambda f: f())
-    updates.submit(-1)
-    executor.finish()
-    assert isinstance(delivered[0], ParameterError)
-    updates.submit(5)
-    updates.cancel()            # the page's values became invalid meanwhile
-    executor.finish()
-    assert len(delivered) == 1 and updates.dropped == 1 and not updates.running
-
-
-# ---------------------------------------------------------------- figure, server
-def test_png_export_has_every_panel(default_page):
-    from qzs.app.figure import figure_png, page_figure
-
-    pinned = [("pin", default_page.frequency, default_page.transmissibility_db - 1.0)]
-    figure = page_figure(default_page, pinned)
-    labels = [axes.get_ylabel() for axes in figure.axes]
-    assert labels == ["transmissibility [dB]", "time locked [%]", "displacement from rest [mm]",
-                      "relative position z [mm]", "motor force [N]"]
-    assert all("[" in axes.get_xlabel() or axes.get_xlabel() == "" for axes in figure.axes)
-    assert figure_png(default_page, pinned)[:8] == b"\x89PNG\r\n\x1a\n"
-
-
-def test_without_panel_the_app_names_its_extra(monkeypatch):
-    from qzs.app.server import serve
-
-    monkeypatch.setitem(sys.modules, "panel", None)  # import panel -> ImportError
-    with pytest.raises(MissingDependencyError) as error:
-        serve(open_browser=False, warm=False)
-    assert (error.value.package, error.value.extra) == ("panel", "app")
-
-
-def test_qzs_and_the_page_logic_import_without_panel():
-    code = ("import sys; import qzs, qzs.cli, qzs.app, qzs.app.compute, qzs.app.updates, "
-            "qzs.app.server; assert 'panel' not in sys.modules and 'bokeh' not in sys.modules")
-    subprocess.run([sys.executable, "-c", code], check=True)
-
-
-def test_addresses_and_ports():
-    from qzs.app.server import choose_port, is_loopback
-
-    assert is_loopback("127.0.0.1") and is_loopback("127.8.0.1") and is_loopback("::1")
-    assert is_loopback("localhost")
-    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.4")
-    assert not is_loopback("example.org")
-    port = choose_port("127.0.0.1", 0)
-    assert 0 < port < 65536
-
-
-@pytest.mark.parametrize("argv", [["app", "--port", "70000"], ["app", "--port", "x"],
-                                  ["app", "--unknown"]])
-def test_cli_refuses_bad_options(argv, capsys):
-    from qzs.cli import main
-
-    assert main(argv) == 2
-    assert "error:" in capsys.readouterr().err
-
-
-def test_cli_delegates_to_serve(monkeypatch):
-    """`qzs app` parses and hands its options to qzs.app.server.serve."""
-    import qzs.app.server
-    from qzs.cli import main
-
-    seen = {}
-    monkeypatch.setattr(qzs.app.server, "serve", lambda **kw: seen.update(kw) or 0)
-    assert main(["app", "--no-browser", "--port", "6123", "--host", "::1"]) == 0
-    assert seen == {"port": 6123, "host": "::1", "open_browser": False}
-    assert main(["app"]) == 0
-    assert seen == {"port": None, "host": "127.0.0.1", "open_browser": True}
-
-
-def test_serve_warns_on_a_public_address(monkeypatch, capsys):
-    """Another address than loopback is served with a warning, before anything else."""
-    import qzs.app.server as server
-
-    class Stop(Exception):
-        pass
-
-    def stop():
-        raise Stop
-
-    monkeypatch.setattr(server, "warm_up", stop)
-    with pytest.raises(Stop):
-        server.serve(host="0.0.0.0", port=0, open_browser=False)
-    assert "warning: serving on '0.0.0.0'" in capsys.readouterr().err
-    with pytest.raises(Stop):
-        server.serve(host="127.0.0.1", port=0, open_browser=False)
-    assert "warning" not in capsys.readouterr().err
-
-
-# ---------------------------------------------------------------- the platform's tab
-def test_platform_tab_is_the_linear_record_of_the_shipped_platform():
-    from qzs.app.platform import compute_platform
-    from qzs.workflows.hexapod import SHIPPED_DEFAULT, linear_record, load_hexapod
-
-    data = compute_platform()
-    _, record = linear_record(load_hexapod(SHIPPED_DEFAULT))
-    np.testing.assert_allclose(data.natural_frequencies,
-                               np.asarray(record["natural_frequencies"], dtype=float))
-    assert data.stable == record["stable"]
-    assert data.base_joints.shape == data.top_joints.shape == (6, 3)
-    assert np.all(data.top_joints[:, 2] > data.base_joints[:, 2])
-    assert data.grid_png[:8] == b"\x89PNG\r\n\x1a\n"
-    weak = compute_platform({"pi_kp": 50.0, "pi_ki": 20.0})  # the paper's gains: unstable
-    assert not weak.stable and np.isnan(weak.natural_frequencies).any()
-
-
-def test_platform_tab_validates_as_the_api():
-    from qzs.app.platform import compute_platform
-
-    with pytest.raises(ParameterError, match="unknown platform setting"):
-        compute_platform({"mass": 3.0})
-    with pytest.raises(ParameterError) as got:
-        compute_platform({"pi_kp": -1.0})
-    with pytest.raises(ParameterError) as expected:
-        ControllerParameters(pi_kp=-1.0)
-    assert str(expected.value) in str(got.value)
-
-
-def test_ctrl_c_stops_the_server_with_130():
-    """`qzs app` serves until SIGINT, then exits as every command does on Ctrl-C."""
-    import signal
-    import time
-    import urllib.request
-
-    pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app]"')
-    from qzs.app.browser import free_port
-
-    port = free_port()
-    process = subprocess.Popen(
-        [sys.executable, "-m", "qzs", "app", "--no-browser", "--port", str(port)],
-        stderr=subprocess.PIPE, text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    try:
-        deadline = time.monotonic() + 600
-        while time.monotonic() < deadline and process.poll() is None:
-            try:
-                with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as answer:
-                    assert answer.status == 200
-                    break
-            except OSError:
-                time.sleep(0.25)
-        process.send_signal(signal.SIGINT)
-        _, err = process.communicate(timeout=60)
-    finally:
-        if process.poll() is None:
-            process.kill()
-    assert process.returncode == 130, err
-    assert f"serving http://127.0.0.1:{port}/" in err and "Traceback" not in err

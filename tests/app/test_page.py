@@ -1,7 +1,7 @@
 """The tuning page's widgets and callbacks, driven from Python (no server, no browser).
 
 The page is built outside a Bokeh server with a synchronous executor, so every request is
-computed and delivered before the call returns; the browser tests (test_app_browser.py)
+computed and delivered before the call returns; the browser tests (test_browser.py)
 drive the same page through Chromium.
 """
 import io

@@ -19,7 +19,7 @@ from qzs.errors import DataWarning
 from qzs.iotools.readers import Recording, read_recording
 from qzs.analysis.spectral import transmissibility
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "examples" / "data"
 
 

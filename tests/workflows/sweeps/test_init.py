@@ -31,7 +31,7 @@ def document(batch_size=2, **outputs):
 
 
 #: A weightless, frictionless linear plant whose P loop, sampled at 100 Hz with a gain of
-#: 1e6 N/m, is violently unstable (tests/test_simulate.py's divergence test).
+#: 1e6 N/m, is violently unstable (tests/engine/test_simulate.py's divergence test).
 DIVERGING = {
     "sweep": {"name": "diverging", "batch_size": 4},
     "parameters": {"gravity": 0.0, "stiction_force": 0.0, "coulomb_force": 0.0,

@@ -1,0 +1,85 @@
+"""The Bokeh server behind ``qzs app`` (qzs.app.server): Panel imported lazily and named when
+missing, loopback addresses, a warning before serving a public one, Ctrl-C ends it with 130."""
+import subprocess
+import sys
+
+import pytest
+
+from qzs.errors import MissingDependencyError
+
+
+def test_without_panel_the_app_names_its_extra(monkeypatch):
+    from qzs.app.server import serve
+
+    monkeypatch.setitem(sys.modules, "panel", None)  # import panel -> ImportError
+    with pytest.raises(MissingDependencyError) as error:
+        serve(open_browser=False, warm=False)
+    assert (error.value.package, error.value.extra) == ("panel", "app")
+
+
+def test_qzs_and_the_page_logic_import_without_panel():
+    code = ("import sys; import qzs, qzs.cli, qzs.app, qzs.app.compute, qzs.app.updates, "
+            "qzs.app.server; assert 'panel' not in sys.modules and 'bokeh' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_addresses_and_ports():
+    from qzs.app.server import choose_port, is_loopback
+
+    assert is_loopback("127.0.0.1") and is_loopback("127.8.0.1") and is_loopback("::1")
+    assert is_loopback("localhost")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.4")
+    assert not is_loopback("example.org")
+    port = choose_port("127.0.0.1", 0)
+    assert 0 < port < 65536
+
+
+def test_serve_warns_on_a_public_address(monkeypatch, capsys):
+    """Another address than loopback is served with a warning, before anything else."""
+    import qzs.app.server as server
+
+    class Stop(Exception):
+        pass
+
+    def stop():
+        raise Stop
+
+    monkeypatch.setattr(server, "warm_up", stop)
+    with pytest.raises(Stop):
+        server.serve(host="0.0.0.0", port=0, open_browser=False)
+    assert "warning: serving on '0.0.0.0'" in capsys.readouterr().err
+    with pytest.raises(Stop):
+        server.serve(host="127.0.0.1", port=0, open_browser=False)
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_ctrl_c_stops_the_server_with_130():
+    """`qzs app` serves until SIGINT, then exits as every command does on Ctrl-C."""
+    import signal
+    import time
+    import urllib.request
+
+    pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app]"')
+    from qzs.app.browser import free_port
+
+    port = free_port()
+    process = subprocess.Popen(
+        [sys.executable, "-m", "qzs", "app", "--no-browser", "--port", str(port)],
+        stderr=subprocess.PIPE, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 600
+        while time.monotonic() < deadline and process.poll() is None:
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as answer:
+                    assert answer.status == 200
+                    break
+            except OSError:
+                time.sleep(0.25)
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 130, err
+    assert f"serving http://127.0.0.1:{port}/" in err and "Traceback" not in err

@@ -1,0 +1,64 @@
+"""What every subcommand shares (qzs.cli.common): strict JSON, ``--set`` pairs, bounded
+integers, and the exit code chosen by the error's class, never by its message."""
+import argparse
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from qzs.cli.common import EXIT_CODES, integer_at_least, jsonable, run_handler, settings
+from qzs.errors import (CaseError, DataError, FitError, MissingDependencyError,
+                        ParameterError, SimulationError, Terminated, WriteError)
+
+
+@dataclass
+class _Point:
+    x: float
+    label: str
+
+
+def test_jsonable_gives_strict_json_of_the_same_values():
+    value = {"nan": math.nan, "inf": np.float64(np.inf), "count": np.int64(3),
+             "flag": np.bool_(True), "array": np.array([1.5, np.nan]), "path": Path("a/b.nc"),
+             "point": _Point(x=2.0, label="p"), 7: (1, {2}), "z": 1 + 2j}
+    plain = jsonable(value)
+    assert plain == {"nan": None, "inf": None, "count": 3, "flag": True, "array": [1.5, None],
+                     "path": "a/b.nc", "point": {"x": 2.0, "label": "p"}, "7": [1, [2]],
+                     "z": [1.0, 2.0]}
+    assert json.loads(json.dumps(plain, allow_nan=False)) == plain
+    assert type(plain["count"]) is int and type(plain["flag"]) is bool
+
+
+def test_set_pairs_split_at_the_first_equals_sign():
+    assert settings([" mass = 7 ", "excitation.kind=a=b"]) == {"mass": "7",
+                                                               "excitation.kind": "a=b"}
+    with pytest.raises(ParameterError, match="--set expects NAME=VALUE, got 'mass'"):
+        settings(["mass"])
+
+
+def test_integer_at_least_names_the_bound_and_the_value():
+    parse = integer_at_least(8)
+    assert parse("8") == 8
+    for text, shown in (("7", "got 7"), ("x", "got 'x'"), ("8.5", "got '8.5'")):
+        with pytest.raises(argparse.ArgumentTypeError, match=f"must be an integer >= 8, {shown}"):
+            parse(text)
+
+
+@pytest.mark.parametrize("error, code", [
+    (SimulationError("diverged"), 1), (FitError("no fit"), 1),
+    (WriteError("run.nc", "No space left on device"), 1),  # a DataError, yet a failed run
+    (OSError(13, "Permission denied", "out.nc"), 1), (MemoryError(), 1),
+    (ParameterError("bad"), 2), (CaseError(2, "bad"), 2), (DataError("bad log"), 2),
+    (MissingDependencyError("zarr", "cluster", "sweeps"), 2),
+    (KeyboardInterrupt(), 130), (Terminated(15), 143)])
+def test_the_exit_code_follows_the_errors_class(error, code, capsys):
+    def handler(args):
+        raise error
+
+    assert run_handler(handler, argparse.Namespace()) == code
+    assert code in EXIT_CODES
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("qzs: ") and "Traceback" not in err

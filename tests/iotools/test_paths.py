@@ -1,0 +1,67 @@
+"""Output paths checked before the work (qzs.iotools.paths): each way a path cannot be
+written is refused with the argument's name, and nothing is left behind by the check."""
+import os
+import shutil
+from collections import namedtuple
+
+import pytest
+
+from qzs.errors import OutputPathError
+from qzs.iotools import paths
+from qzs.iotools.paths import check_output_path, format_bytes
+
+
+def test_a_writable_path_passes_and_the_check_writes_nothing(tmp_path):
+    target = tmp_path / "new" / "deeper" / "run.NC"   # missing folders can be created
+    assert check_output_path(target, argument="--out", suffixes=("nc", ".csv")) == target
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("make, name, options, reason", [
+    (None, "run.txt", {"suffixes": (".nc", ".csv")},
+     "has extension '.txt'; it must end in .nc or .csv"),
+    (None, "run", {"suffixes": (".nc",)}, "has no extension"),
+    ("folder", "run.nc", {"suffixes": (".nc",)}, "is a folder; give a file name"),
+    ("file", "out", {"suffixes": None, "directory": True}, "is a file, not a folder"),
+    ("parent file", "run.nc", {"suffixes": (".nc",)}, "is a file, not a folder"),
+])
+def test_each_unwritable_path_is_named_with_its_reason(tmp_path, make, name, options, reason):
+    path = tmp_path / name
+    if make == "folder":
+        path.mkdir()
+    elif make == "file":
+        path.write_text("")
+    elif make == "parent file":
+        (tmp_path / "blocker").write_text("")
+        path = tmp_path / "blocker" / "sub" / name
+    with pytest.raises(OutputPathError, match=reason) as error:
+        check_output_path(path, argument="--out", **options)
+    assert (error.value.argument, error.value.value) == ("--out", str(path))
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_read_only_folder_is_refused(tmp_path):
+    folder = tmp_path / "locked"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        with pytest.raises(OutputPathError, match="is read-only"):
+            check_output_path(folder / "run.nc", argument="out", suffixes=(".nc",))
+    finally:
+        folder.chmod(0o700)
+
+
+def test_too_little_free_space_says_how_much_is_needed(tmp_path, monkeypatch):
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(2 ** 40, 0, 3 * 2 ** 20))
+    assert paths.shutil is shutil
+    check_output_path(tmp_path / "a.nc", argument="out", suffixes=None,
+                      estimated_bytes=3 * 2 ** 20)
+    with pytest.raises(OutputPathError, match=r"needs about 4\.0 MiB but only 3\.0 MiB are free"):
+        check_output_path(tmp_path / "a.nc", argument="out", suffixes=None,
+                          estimated_bytes=4 * 2 ** 20)
+
+
+def test_byte_counts_in_binary_units():
+    assert [format_bytes(n) for n in (0, 1023, 1024, 1536, 5 * 2 ** 30, 3 * 2 ** 50)] == [
+        "0 B", "1023 B", "1.0 KiB", "1.5 KiB", "5.0 GiB", "3072.0 TiB"]

@@ -1,0 +1,62 @@
+"""Errors that carry data (qzs.errors): attributes a caller can act on, kept through pickling
+(process pools, Dask), each error a subclass of the built-in its callers already catch."""
+import pickle
+
+import pytest
+
+import qzs
+from qzs import errors
+from qzs.errors import CaseError, ParameterError
+
+
+def test_a_failing_case_is_named_by_an_attribute_not_by_text():
+    cases = [(qzs.IsolatorParameters(), qzs.ControllerParameters()),
+             (qzs.IsolatorParameters(stop_stiffness=1e12), qzs.ControllerParameters())]
+    with pytest.raises(CaseError) as error:
+        qzs.simulate_batch(cases, qzs.Chirp(duration=1.0), sample_rate=100.0)
+    assert error.value.index == 1 and "largest stable step" in error.value.reason
+    assert isinstance(error.value, ParameterError)
+    copy = pickle.loads(pickle.dumps(error.value))  # crosses process and Dask boundaries
+    assert (copy.index, copy.reason) == (error.value.index, error.value.reason)
+
+
+#: One instance of every error class that carries data, and the attributes it carries.
+CARRIERS = [
+    (errors.CaseError(3, "too stiff"), {"index": 3, "reason": "too stiff"}),
+    (errors.SizeLimitError("duration", 1e9, 0.1, 600.0, "s"),
+     {"name": "duration", "value": 1e9, "low": 0.1, "high": 600.0, "unit": "s"}),
+    (errors.OutputPathError("--out", "x.txt", "has an unknown extension"),
+     {"argument": "--out", "value": "x.txt", "reason": "has an unknown extension"}),
+    (errors.ResultTooLargeError(2 ** 30, 2 ** 20, 2000.0, 1000.0),
+     {"needed": 2 ** 30, "available": 2 ** 20, "duration": 2000.0, "sample_rate": 1000.0}),
+    (errors.RunTooLongError(steps=10 ** 15, seconds=1e7, limit=1e4, duration=100.0, dt=1e-13),
+     {"steps": 10 ** 15, "limit": 1e4, "duration": 100.0, "dt": 1e-13}),
+    (errors.WriteError("run.nc", "No space left on device"),
+     {"reason": "No space left on device"}),
+    (errors.MissingDependencyError("zarr", "cluster", "writing sweep stores"),
+     {"package": "zarr", "extra": "cluster"}),
+    (errors.Terminated(15), {"signum": 15, "exit_code": 143}),
+]
+
+
+@pytest.mark.parametrize("error, attributes", CARRIERS, ids=lambda v: type(v).__name__)
+def test_errors_keep_their_data_and_message_through_pickling(error, attributes):
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is type(error) and str(copy) == str(error)
+    for name, value in attributes.items():
+        assert getattr(error, name) == value and getattr(copy, name) == value, name
+
+
+def test_each_error_is_caught_by_its_built_in():
+    """``except ValueError`` catches bad input, ``except RuntimeError`` a failed run,
+    ``except ImportError`` a missing extra; SIGTERM is not swallowed by ``except Exception``."""
+    expected = {"ParameterError": ValueError, "DataError": ValueError,
+                "SimulationError": RuntimeError, "FitError": RuntimeError,
+                "MissingDependencyError": ImportError, "DataWarning": UserWarning}
+    for name, base in expected.items():
+        assert issubclass(getattr(errors, name), base), name
+    for name in errors.__all__:
+        if name.endswith("Error") and name not in expected:
+            assert issubclass(getattr(errors, name), (ParameterError, errors.DataError)), name
+    assert not issubclass(errors.Terminated, Exception)
+    assert issubclass(errors.Terminated, BaseException)

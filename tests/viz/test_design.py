@@ -1,0 +1,29 @@
+"""Figures of a controller design (qzs.viz.design): the static design's curve is the motor
+force m*g - F_spring(z_ref) the payload needs, zero at the mass the spring alone carries."""
+import numpy as np
+import pytest
+
+from qzs import ControllerParameters, IsolatorParameters
+from qzs.analysis.control_design import static_design
+from qzs.model.isolator import spring_force
+from qzs.viz.design import plot_static_design
+
+
+def test_the_static_design_draws_the_force_the_payload_needs():
+    isolator, controller = IsolatorParameters(), ControllerParameters()
+    lifted = float(spring_force(controller.position_setpoint, isolator))
+    static = static_design(isolator, controller, mass_range=(5.0, 8.0))
+    figure = plot_static_design(static, gravity=isolator.gravity)
+    ax = figure.axes[0]
+    needed = next(line for line in ax.lines if line.get_label().startswith("needed"))
+    mass = needed.get_xdata()
+    np.testing.assert_allclose(needed.get_ydata(), mass * isolator.gravity - lifted, rtol=1e-14,
+                               atol=1e-12)
+    balanced = next(line for line in ax.lines if line.get_label().startswith("spring alone"))
+    assert balanced.get_xdata()[0] == pytest.approx(lifted / isolator.gravity, rel=1e-14)
+    limits = sorted(line.get_ydata()[0] for line in ax.lines if line.get_linestyle() == "--")
+    assert limits == [-isolator.motor_force_max, isolator.motor_force_max]
+    design = next(line for line in ax.lines if line.get_label().startswith("design mass"))
+    assert design.get_xdata()[0] == pytest.approx(isolator.mass, rel=1e-14)
+    assert design.get_ydata()[0] == pytest.approx(isolator.mass * isolator.gravity - lifted,
+                                                  rel=1e-12)

@@ -1,0 +1,19 @@
+"""Figures of the identification (qzs.viz.identify): the spring fit's curve is the tanh law
+with the fitted coefficients, over the measured span."""
+import numpy as np
+
+from qzs.viz.identify import plot_spring_fit
+
+
+def test_the_spring_fit_draws_the_measured_points_and_the_fitted_tanh():
+    z = np.linspace(-0.05, 0.02, 15)
+    force = -60.0 * np.tanh(35.0 * z) + 0.1 * np.sin(40 * z)
+    figure = plot_spring_fit(z, force, 60.5, 34.0)
+    points, fit = figure.axes[0].lines
+    np.testing.assert_array_equal(points.get_xdata(), z * 1e3)
+    np.testing.assert_array_equal(points.get_ydata(), force)
+    x = fit.get_xdata() / 1e3
+    assert (x[0], x[-1]) == (z.min(), z.max())
+    np.testing.assert_allclose(fit.get_ydata(), -60.5 * np.tanh(34.0 * x), rtol=1e-12)
+    assert fit.get_label() == "fit: a = 60.50 N, b = 34.00 1/m"
+    assert figure.axes[0].get_xlabel() == "relative position z [mm]"
