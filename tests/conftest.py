@@ -104,3 +104,15 @@ def validation(request):
         return error
 
     return record
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Close every pyplot figure a test left open: matplotlib warns (an error here) once more
+    than 20 are open, which made a later test fail by the order the tests happen to run in."""
+    yield
+    import sys
+
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close("all")
