@@ -455,7 +455,9 @@ class ResultWriter(StreamWriter):
     CSV files have the parameters as ``# key = value [unit]`` header lines, the rows, and
     the run's outcome as trailing ``# run.key = value`` lines (known only at the end).
     :func:`save_result` writes through this class; so does :func:`qzs.simulate`'s
-    ``sink`` when a run is streamed to a file.
+    ``sink`` when a run is streamed to a file. :meth:`append` takes ``data, flags``: output
+    rows of shape (n, N_CHANNELS), one column per channel of :data:`CHANNELS`, and the flags
+    of :data:`FLAGS`, shape (n, 2).
 
     Parameters
     ----------
@@ -489,27 +491,6 @@ class ResultWriter(StreamWriter):
         head, _ = file_attributes(isolator, controller, excitation, None)
         super().__init__(path, simulation_schema(), blocks={"data": K.N_CHANNELS, "flags": 2},
                          columns=_COLUMNS, attributes=head, suffixes=tuple(RESULT_SUFFIXES))
-
-    def append(self, data, flags):
-        """Append samples to the file.
-
-        Parameters
-        ----------
-        data : ndarray, shape (n, N_CHANNELS)
-            Output samples, one column per kernel channel (the columns of
-            :data:`CHANNELS`), in their units.
-        flags : ndarray of bool, shape (n, 2)
-            The flags of :data:`FLAGS`.
-
-        Raises
-        ------
-        ParameterError
-            Wrong shapes, or the writer is finished.
-        WriteError
-            Writing failed (disk full, permissions): the temporary file is removed
-            (attributes ``path`` and ``reason``).
-        """
-        super().append(data, flags)
 
     def finish(self, run):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.

@@ -927,7 +927,8 @@ def transmissibility_schema(estimator="h1"):
                  flag_meanings="not_excited excited"),
         Variable(name="amplitude", dims=on[2:], units=", ".join(_UNITS),
                  long_name="chirp displacement amplitude",
-                 attributes={"units_by_dof": "; ".join(f"{a}: {u}" for a, u in zip(AXES, _UNITS))}),
+                 attributes={"units_by_dof": "; ".join(
+                     f"{a}: {u}" for a, u in zip(AXES, _UNITS))}),
         Variable(name="energy_residual", dims=on[2:], units="1",
                  long_name="largest energy-ledger imbalance over the largest |base work| of the "
                            "run"))

@@ -167,7 +167,9 @@ class HexapodWriter(StreamWriter):
     hidden temporary file beside the target, disk space reserved before each chunk,
     renamed onto the target only when the run has ended (:meth:`finish`); on any error or
     interruption nothing is left behind. Flags are stored as int8 (0/1) with
-    ``flag_values`` and ``flag_meanings``.
+    ``flag_values`` and ``flag_meanings``. :meth:`append` takes ``data, flags``: output rows
+    of shape (n, N_CHANNELS), the columns of :data:`HEXAPOD_CHANNELS`, and the flags of
+    :data:`HEXAPOD_FLAGS`, shape (n, 12).
 
     Parameters
     ----------
@@ -191,26 +193,6 @@ class HexapodWriter(StreamWriter):
     def __init__(self, path):
         super().__init__(path, hexapod_schema(), blocks={"data": N_CHANNELS, "flags": N_FLAGS},
                          columns=_COLUMNS, values=_LABELS, suffixes=(".nc",))
-
-    def append(self, data, flags):
-        """Append samples to the file.
-
-        Parameters
-        ----------
-        data : ndarray, shape (n, N_CHANNELS)
-            Output samples, the columns of :data:`HEXAPOD_CHANNELS`.
-        flags : ndarray of bool, shape (n, 12)
-            The flags of :data:`HEXAPOD_FLAGS`, six legs each.
-
-        Raises
-        ------
-        ParameterError
-            Wrong shapes, or the writer is finished.
-        WriteError
-            Writing failed (disk full, permissions): the temporary file is removed
-            (attributes ``path`` and ``reason``).
-        """
-        super().append(data, flags)
 
     def finish(self, result):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.
