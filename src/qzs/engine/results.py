@@ -8,7 +8,6 @@ streams it to NetCDF or CSV (``.save()``, :func:`save_result`, :func:`read_resul
 """
 import dataclasses
 import datetime
-import functools
 import os
 import shlex
 import sys
@@ -75,7 +74,6 @@ _COLUMNS = {**{name: ("data", column) for name, (column, _, _) in CHANNELS.items
             **{name: ("flags", column) for name, (column, _) in FLAGS.items()}}
 
 
-@functools.cache
 def simulation_schema():
     """The CF-1.10 layout of a run's dataset and file (docs/model.md §7).
 

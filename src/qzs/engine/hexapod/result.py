@@ -5,8 +5,6 @@
 :meth:`HexapodResult.to_xarray` builds and :class:`HexapodWriter` (a configuration of
 :class:`qzs.iotools.writer.StreamWriter`) streams.
 """
-import functools
-
 import numpy as np
 
 from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
@@ -101,7 +99,6 @@ _COLUMNS = {**{name: ("data", column if dim is None else slice(column, column + 
 _LABELS = {"dof": list(AXES), "leg": np.arange(1, LEG_COUNT + 1)}
 
 
-@functools.cache
 def hexapod_schema():
     """The CF-1.10 layout of a hexapod run's dataset and file (docs/model.md §7).
 
