@@ -888,16 +888,12 @@ def transmissibility_record(result):
 
 
 def transmissibility_schema(estimator="h1"):
-    """The CF-1.10 layout of :func:`transmissibility_dataset`: the matrix and its flags.
+    """The CF-1.10 layout (a ``Schema``) of :func:`transmissibility_dataset`.
 
     Parameters
     ----------
     estimator : str
         The estimator, named in the magnitude's ``long_name``.
-
-    Returns
-    -------
-    Schema
     """
     mixed = ("1 on the diagonal blocks, m/rad for a translation per rotation, rad/m for a "
              "rotation per translation (see entry_units)")
@@ -922,9 +918,8 @@ def transmissibility_schema(estimator="h1"):
         Variable(name="linear_phase", dims=on, units="rad", long_name="phase of the linear model"),
         Variable(name="entry_units", dims=on[1:], dtype="str",
                  long_name="unit of each matrix entry"),
-        Variable(name="excited", dims=on[2:], units="1", dtype="int8", order=flag,
-                 long_name="1 where the base axis was excited",
-                 flag_meanings="not_excited excited"),
+        Variable(name="excited", dims=on[2:], units="1", dtype="int8", order=flag, long_name=(
+            "1 where the base axis was excited"), flag_meanings="not_excited excited"),
         Variable(name="amplitude", dims=on[2:], units=", ".join(_UNITS),
                  long_name="chirp displacement amplitude",
                  attributes={"units_by_dof": "; ".join(
@@ -949,9 +944,8 @@ def transmissibility_dataset(result):
     ``units`` attribute says so in words and the string variable ``entry_units`` gives
     it per entry; ``magnitude`` and ``phase`` [rad] carry the complex estimate (NetCDF has
     no complex type), likewise ``linear_magnitude`` and ``linear_phase``. Flags are int8
-    with ``flag_values``/``flag_meanings`` (:func:`transmissibility_schema`); settings, the
-    runs' records and the set-up's parameters are global attributes with their units in
-    ``<key>_units``.
+    with ``flag_values``/``flag_meanings``; settings, the runs' records and the set-up's
+    parameters are global attributes with their units in ``<key>_units``.
 
     Parameters
     ----------
@@ -971,9 +965,8 @@ def transmissibility_dataset(result):
         "magnitude": result.magnitude, "phase": np.angle(result.response),
         "coherence": result.coherence, "trusted": result.trusted,
         "below_floor": result.below_floor, "linear_magnitude": np.abs(result.linear_response),
-        "linear_phase": np.angle(result.linear_response),
+        "linear_phase": np.angle(result.linear_response), "excited": result.excited,
         "entry_units": [[entry_unit(i, j) for j in range(6)] for i in range(6)],
-        "excited": result.excited,
         "amplitude": [result.amplitude.get(a, np.nan) for a in AXES],
         "energy_residual": [result.energy_residual.get(a, np.nan) for a in AXES],
         "frequency": result.frequency, "output_dof": list(AXES), "input_dof": list(AXES)}
