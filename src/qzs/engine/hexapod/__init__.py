@@ -27,6 +27,7 @@ _EXPORTS = {
     "HEXAPOD_CHANNELS": "qzs.engine.hexapod.result",
     "HEXAPOD_FLAGS": "qzs.engine.hexapod.result",
     "hexapod_schema": "qzs.engine.hexapod.result",
+    "hexapod_file_layout": "qzs.engine.hexapod.result",
     "HexapodWriter": "qzs.engine.hexapod.result",
 }
 __all__ = list(_EXPORTS)

@@ -20,7 +20,8 @@ from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
 
 __all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_schema",
-           "HexapodWriter", "estimated_hexapod_size", "save_hexapod_result"]
+           "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size",
+           "save_hexapod_result"]
 
 _TRANSLATION = ("m", "m", "m", "rad", "rad", "rad")
 _RATE = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
@@ -137,6 +138,21 @@ def hexapod_schema():
                  order=("long_name", "units")))
     return Schema(kind="a hexapod run", dimensions={"time": None, "dof": 6, "leg": LEG_COUNT},
                   coordinates=coordinates, variables=variables, header_bytes=256 << 10)
+
+
+def hexapod_file_layout():
+    """:func:`hexapod_schema` as plain dicts (the form this layout had before the schema).
+
+    Returns
+    -------
+    dict
+        ``{"variables": {name: (dims, attrs)}, "coordinates": {name: (dims, values,
+        attrs)}}`` (the ``time`` coordinate's values are None: the run's own).
+    """
+    schema = hexapod_schema()
+    return {"variables": {v.name: (v.dims, v.attrs()) for v in schema.variables},
+            "coordinates": {c.name: (c.dims, _LABELS.get(c.name), c.attrs())
+                            for c in schema.coordinates}}
 
 
 def estimated_hexapod_size(n_samples):
