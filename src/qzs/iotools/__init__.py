@@ -13,15 +13,18 @@ This layer knows no result type: each declares its own schema beside its class
 ``shipped``  the study and sweep files shipped with qzs
 ===========  ==================================================================
 """
-from qzs.iotools.config import load_config, save_config
-from qzs.iotools.files import atomic_path, read_displacement_csv, read_result
-from qzs.iotools.paths import check_output_path
-from qzs.iotools.readers import (ChannelMap, Recording, load_channel_map, read_recording,
-                                 write_dspace_mat)
-from qzs.iotools.schema import Schema, Variable, to_dataset
-from qzs.iotools.writer import StreamWriter, estimated_file_size
+from qzs._lazy import lazy_exports
 
-__all__ = ["atomic_path", "read_result", "check_output_path", "read_displacement_csv",
-           "load_config", "save_config", "Recording", "ChannelMap", "load_channel_map",
-           "read_recording", "write_dspace_mat", "Schema", "Variable", "to_dataset",
-           "StreamWriter", "estimated_file_size"]
+# Loaded on first use: the engine imports the schema and the writer, not the rig-log readers.
+_EXPORTS = {
+    "atomic_path": "qzs.iotools.files", "read_result": "qzs.iotools.files",
+    "read_displacement_csv": "qzs.iotools.files", "check_output_path": "qzs.iotools.paths",
+    "load_config": "qzs.iotools.config", "save_config": "qzs.iotools.config",
+    "Recording": "qzs.iotools.readers", "ChannelMap": "qzs.iotools.readers",
+    "load_channel_map": "qzs.iotools.readers", "read_recording": "qzs.iotools.readers",
+    "write_dspace_mat": "qzs.iotools.readers", "Schema": "qzs.iotools.schema",
+    "Variable": "qzs.iotools.schema", "to_dataset": "qzs.iotools.schema",
+    "StreamWriter": "qzs.iotools.writer", "estimated_file_size": "qzs.iotools.writer",
+}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

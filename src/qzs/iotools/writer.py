@@ -16,7 +16,6 @@ while writing (a full disk, no permission) raise :class:`~qzs.errors.WriteError`
 attributes ``path`` and ``reason`` and leave neither the target nor a temporary file behind.
 """
 import contextlib
-import ctypes
 import errno
 import functools
 import os
@@ -428,6 +427,8 @@ class StreamWriter:
 @functools.lru_cache(maxsize=1)
 def _fallocate():
     """libc's ``fallocate`` (Linux), or None."""
+    import ctypes
+
     if not sys.platform.startswith("linux"):
         return None
     try:
@@ -459,6 +460,8 @@ def _reserve_space(fd, length, folder):
         end = os.fstat(fd).st_size
         if function(fd, _FALLOC_FL_KEEP_SIZE, end, int(length)) == 0:
             return
+        import ctypes
+
         code = ctypes.get_errno()
         if code not in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
             raise OSError(code, os.strerror(code))
