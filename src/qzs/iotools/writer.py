@@ -196,7 +196,7 @@ class StreamWriter:
         self._fd = None  # kept open to reserve disk space ahead of the library's writes
         self._variables = {}
         self._finished = False
-        try:
+        with self._aborting("creating the file"):
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part",
                                              dir=self.path.parent)
@@ -206,9 +206,16 @@ class StreamWriter:
                 self._open_netcdf()
             else:
                 self._open_csv()
-        except (OSError, RuntimeError) as error:
+
+    @contextlib.contextmanager
+    def _aborting(self, action):
+        """Abort (remove the temporary file) on any exception; an ``OSError`` (or the HDF5
+        library's ``RuntimeError``) becomes a :class:`WriteError` saying what failed."""
+        try:
+            yield
+        except (OSError, RuntimeError) as error:  # h5py reports some write failures so
             self.abort()
-            raise _write_error(self.path, error, "creating the file") from None
+            raise _write_error(self.path, error, action) from None
         except BaseException:
             self.abort()
             raise
@@ -321,18 +328,12 @@ class StreamWriter:
         if n == 0:
             return
         start, stop = self._rows, self._rows + n
-        try:
+        with self._aborting("writing"):
             self._check_space(n)
             if self._suffix == ".nc":
                 self._append_netcdf(blocks, start, stop)
             else:
                 self._append_csv(blocks, start, stop)
-        except (OSError, RuntimeError) as error:  # h5py reports some write failures so
-            self.abort()
-            raise _write_error(self.path, error) from None
-        except BaseException:
-            self.abort()
-            raise
         self._rows = stop
 
     def _check_space(self, n):
@@ -369,7 +370,7 @@ class StreamWriter:
         """
         self._check_open("finish")
         tail = dict(attributes or {})
-        try:
+        with self._aborting("finishing the file"):
             if self._suffix == ".nc":
                 self._finish_netcdf(tail)
             else:
@@ -379,12 +380,6 @@ class StreamWriter:
             self._fd = None
             os.chmod(self._tmp, 0o666 & ~_umask())  # mkstemp makes 0600
             os.replace(self._tmp, self.path)
-        except (OSError, RuntimeError) as error:
-            self.abort()
-            raise _write_error(self.path, error, "finishing the file") from None
-        except BaseException:
-            self.abort()
-            raise
         self._tmp = None
         self._finished = True
         return self.path
