@@ -21,7 +21,7 @@ import pytest
 SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 
 #: Layers, lowest first. ``base`` are the top-level modules every layer may use.
-LAYERS = ("base", "model", "analysis", "engine", "iotools", "identify", "viz", "workflows",
+LAYERS = ("base", "model", "iotools", "analysis", "engine", "identify", "viz", "workflows",
           "app", "cli")
 #: Top-level modules that are the base layer.
 BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults", "_format"}

@@ -26,9 +26,9 @@ import qzs
 #: The subpackages documented, in the order of the layers (tests/test_layers.py), with a title.
 SUBPACKAGES = {
     "model": "parameters, force laws, excitations, the parameter registry",
+    "iotools": "the file schema and its streaming writer, config files, rig-log readers",
     "analysis": "spectra, transmissibility metrics, linearisation, statistics",
     "engine": "kernels, single and lockstep runs, results",
-    "iotools": "result and config files, rig-log readers",
     "identify": "spring, friction and transmissibility fits",
     "viz": "every figure",
     "workflows": "the paper's studies, experiments, sweeps, response, design, six axes",

@@ -16,9 +16,9 @@ use; the subpackages are the architecture, each importing only from those listed
 ``_lazy``        names a package exports but imports on first use (PEP 562)
 ``_version``     the installed version
 ``model``        parameters, force laws (numpy), excitations, the parameter registry
+``iotools``      the file schema and its streaming writer, config files, rig-log readers
 ``analysis``     spectral estimation and metrics, linearisation, run statistics
 ``engine``       numba kernels, single and lockstep drivers, simulate, batch, results
-``iotools``      result and config files, rig-log readers
 ``identify``     spring, friction and transmissibility fits
 ``viz``          every figure
 ``workflows``    studies and report, experiments, sweeps, response, design, hexapod studies
@@ -49,7 +49,7 @@ _LAZY = {
     "fit_spring": "qzs.identify", "fit_friction": "qzs.identify",
     "fit_transmissibility": "qzs.identify",
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
-    "load_config": "qzs.iotools", "read_result": "qzs.iotools",
+    "load_config": "qzs.iotools", "read_result": "qzs.engine.results",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
     "simulate_hexapod": "qzs.engine.hexapod.simulate",

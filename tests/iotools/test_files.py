@@ -1,4 +1,6 @@
-"""The streaming result writer: same file in chunks, bounded memory, clean I/O failures."""
+"""The single run's streaming writer (:class:`qzs.engine.results.ResultWriter`, a
+configuration of :class:`qzs.iotools.writer.StreamWriter`): same file in chunks, bounded
+memory, clean I/O failures."""
 import errno
 import os
 import subprocess
@@ -12,8 +14,8 @@ import xarray as xr
 import qzs
 from qzs.engine import kernels as K
 from qzs.errors import DataError, ParameterError, Terminated
-from qzs.iotools import files
-from qzs.iotools.files import ResultWriter, estimated_size, read_result, save_result
+from qzs.engine.results import ResultWriter, estimated_size, read_result, save_result
+from qzs.iotools import writer as stream
 
 
 @pytest.fixture(scope="module")
@@ -107,12 +109,12 @@ def test_full_disk_is_a_clean_error(tmp_path, run, monkeypatch, suffix, stage):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
     if stage == "create":
-        monkeypatch.setattr(files, "_reserve_space", full)
+        monkeypatch.setattr(stream, "_reserve_space", full)
     elif stage == "append":
         name = "_append_netcdf" if suffix == ".nc" else "_append_csv"
         monkeypatch.setattr(ResultWriter, name, full)
     else:
-        monkeypatch.setattr(files, "_release_reserve", full)
+        monkeypatch.setattr(stream, "_release_reserve", full)
     target = tmp_path / f"r{suffix}"
     with pytest.raises(DataError, match="disk is full") as caught:
         run.save(target)
@@ -124,7 +126,7 @@ def test_permission_denied_is_a_clean_error(tmp_path, run, monkeypatch):
     def denied(*args, **kwargs):
         raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
 
-    monkeypatch.setattr(files.tempfile, "mkstemp", denied)
+    monkeypatch.setattr(stream.tempfile, "mkstemp", denied)
     with pytest.raises(DataError, match="permission denied") as caught:
         run.save(tmp_path / "r.nc")
     assert caught.value.reason == "permission denied"
@@ -184,7 +186,7 @@ import numpy as np
 import h5netcdf, xarray
 import qzs
 from qzs.engine import kernels as K
-from qzs.iotools.files import ResultWriter
+from qzs.engine.results import ResultWriter
 
 rows, chunk, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 run = qzs.simulate(qzs.Sine(amplitude=0.001, frequency=1.0), duration=0.01, sample_rate=1000.0)

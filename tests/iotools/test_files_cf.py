@@ -7,7 +7,7 @@ import xarray as xr
 
 import qzs
 from qzs.engine.results import CHANNELS, FLAGS, RUN_UNITS
-from qzs.iotools import read_result
+from qzs.engine.results import read_result
 from qzs.model.registry import unit_of
 
 ISOLATOR = qzs.IsolatorParameters(stiction_force=6.0)  # stop_center stays None
@@ -159,3 +159,19 @@ def test_batch_to_xarray():
         if variable.dtype.kind == "f":
             assert "units" in variable.attrs, name
     data.to_netcdf(engine="h5netcdf")
+
+
+def test_the_file_readers_agree(run, tmp_path):
+    """``qzs.read_result`` reads a run's file with the run's schema; ``qzs.iotools.read_result``
+    reads any result file: a NetCDF file the same (it describes itself), a CSV one given the
+    schema."""
+    from qzs import iotools
+    from qzs.engine.results import simulation_schema
+
+    assert qzs.read_result is read_result
+    path = run.save(tmp_path / "run.nc")
+    xr.testing.assert_identical(iotools.read_result(path), read_result(path))
+    path = run.save(tmp_path / "run.csv")
+    xr.testing.assert_identical(iotools.read_result(path, simulation_schema()),
+                                read_result(path))
+    assert iotools.read_result(path)["locked"].dtype == np.float64  # no schema: plain columns

@@ -12,7 +12,7 @@ from qzs.cli import main
 from qzs.engine import driver as driver_module
 from qzs.engine.hexapod import simulate as hexapod_simulate
 from qzs.errors import OutputPathError, ParameterError
-from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
+from qzs.engine.hexapod.result import HexapodWriter, estimated_hexapod_size
 from qzs.workflows.hexapod import load_hexapod, simulate_setup
 
 #: Longer than one kernel chunk (200,000 steps at dt 1e-4 s), so that chunks join in the file.
@@ -38,7 +38,12 @@ def test_the_streamed_file_is_the_in_memory_run(setup, in_memory, tmp_path):
         for name in expected.data_vars:
             assert np.array_equal(written[name].values.astype(expected[name].dtype),
                                   expected[name].values), name
-            assert written[name].attrs["units"] == expected[name].attrs["units"]
+            assert written[name].dims == expected[name].dims, name
+            assert list(written[name].attrs) == list(expected[name].attrs), name
+            for key in ("units", "long_name", "flag_meanings", "units_by_dof"):
+                assert written[name].attrs.get(key) == expected[name].attrs.get(key), name
+        for name in ("dof", "leg"):  # one schema (hexapod_schema) for both
+            assert written[name].attrs == expected[name].attrs
         assert list(written["dof"].values) == list(expected["dof"].values)
         assert set(written.attrs) == set(expected.attrs)
         assert written.attrs["run.samples"] == len(in_memory)

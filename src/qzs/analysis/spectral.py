@@ -27,11 +27,12 @@ from qzs._format import decibels
 from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
+from qzs.iotools.schema import Schema, Variable, to_dataset
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
            "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
-           "welch_average_count"]
+           "welch_average_count", "estimate_schema"]
 
 ESTIMATORS = ("psd_ratio", "h1", "h2")
 _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
@@ -320,30 +321,50 @@ class TransmissibilityEstimate:
         return transmissibility_metrics(self.frequency, self.magnitude, **options)
 
     def to_xarray(self):
-        """Repackage as an ``xarray.Dataset`` on coordinate ``frequency`` [Hz], with units attrs."""
-        import xarray as xr
-
-        name = _MAGNITUDE_NAMES[self.estimator]
+        """Repackage as an ``xarray.Dataset`` on coordinate ``frequency`` [Hz], with units attrs
+        (:func:`estimate_schema`)."""
         attrs = {"estimator": self.estimator, "fft_length": self.fft_length,
                  "n_averages": self.n_averages, "sample_rate": self.sample_rate,
                  "coherence_min": self.coherence_min, "base_share_min": self.base_share_min,
                  "highpass_factor": self.highpass_factor}
         if self.highpass_corner is not None:
             attrs["highpass_corner"] = self.highpass_corner
-        variables = {"magnitude": (self.magnitude, "1", f"transmissibility, {name}"),
-                     "phase": (self.phase, "rad", "phase of payload relative to base"),
-                     "coherence": (self.coherence, "1", "magnitude-squared coherence"),
-                     "base_share": (self.base_share, "1", "share of the base's power"),
-                     "trusted": (self.trusted.astype("i1"), "1",
-                                 "1 where the bin is trusted (docs/model.md section 10)")}
-        dataset = xr.Dataset({key: ("frequency", values, {"units": units, "long_name": long_name})
-                              for key, (values, units, long_name) in variables.items()},
-                              coords={"frequency": ("frequency", self.frequency,
-                                                    {"units": "Hz", "long_name": "frequency"})},
-                              attrs=attrs)
-        dataset["trusted"].attrs.update(flag_values=np.array([0, 1], dtype="i1"),
-                                        flag_meanings="untrusted trusted")
-        return dataset
+        values = {"frequency": self.frequency, "magnitude": self.magnitude, "phase": self.phase,
+                  "coherence": self.coherence, "base_share": self.base_share,
+                  "trusted": self.trusted}
+        return to_dataset(estimate_schema(self.estimator), values, attrs)
+
+
+def estimate_schema(estimator="h1"):
+    """The CF-1.10 layout of a :class:`TransmissibilityEstimate`'s dataset.
+
+    Coordinate ``frequency`` [Hz]; ``magnitude`` [-], ``phase`` [rad], ``coherence`` [-],
+    ``base_share`` [-] and the ``trusted`` flag (int8), each with ``units`` and
+    ``long_name``.
+
+    Parameters
+    ----------
+    estimator : {"psd_ratio", "h1", "h2"}
+        The estimator, named in the magnitude's ``long_name``.
+
+    Returns
+    -------
+    Schema
+    """
+    on = ("frequency",)
+    variables = (
+        Variable(name="magnitude", dims=on, units="1",
+                 long_name=f"transmissibility, {_MAGNITUDE_NAMES[estimator]}"),
+        Variable(name="phase", dims=on, units="rad", long_name="phase of payload relative to base"),
+        Variable(name="coherence", dims=on, units="1", long_name="magnitude-squared coherence"),
+        Variable(name="base_share", dims=on, units="1", long_name="share of the base's power"),
+        Variable(name="trusted", dims=on, units="1", dtype="int8",
+                 long_name="1 where the bin is trusted (docs/model.md section 10)",
+                 flag_meanings="untrusted trusted"))
+    return Schema(kind="a transmissibility estimate", dimensions={"frequency": None},
+                  coordinates=(Variable(name="frequency", dims=on, units="Hz",
+                                        long_name="frequency"),),
+                  variables=variables)
 
 
 def welch_spectra(base, payload, sample_rate, *, window, fft_length, noverlap, detrend):

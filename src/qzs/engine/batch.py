@@ -8,6 +8,7 @@ reduced while integrating: only the requested channels are kept, and per-case
 statistics (stroke, stop contacts, RMS motor force, time locked) are
 accumulated chunk by chunk.
 """
+import dataclasses
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -20,10 +21,12 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.results import CHANNELS, FLAGS
+from qzs.engine.results import CHANNELS, FLAGS, _now, simulation_schema
 from qzs.errors import CaseError, ParameterError
+from qzs.iotools.schema import Schema, Variable, to_dataset
+from qzs.model.registry import PARAMETERS
 
-__all__ = ["BatchResult", "simulate_batch", "STATS"]
+__all__ = ["BatchResult", "simulate_batch", "batch_schema", "STATS"]
 
 #: Per-case statistics: name -> (unit, description).
 STATS = {
@@ -32,6 +35,7 @@ STATS = {
     "stick_events": ("1", "number of stick events"),
     "steps": ("1", "integration steps done"),
 }
+_COUNTS = ("stop_contacts", "stick_events", "steps")  # statistics stored as int64
 #: Output rows held at once, over all cases (~190 MB of the kernel's 24 channels): the kernel
 #: writes them, each chunk's kept channels and statistics are taken out. A buffer of 4e6 rows
 #: (770 MB) cost `qzs paper` about 0.9 s of first touch in a fresh process (17.2-17.5 s against
@@ -85,59 +89,83 @@ class BatchResult:
         flag, 0 completed, 1 failed) and ``message`` on ``case``, and every parameter
         of each case as a coordinate on ``case`` (registry name, unit in ``units``;
         a ``None`` value as NaN, a choice as a string). Counts are integers. The
-        conventions are those of a single run's file (docs/model.md §7).
+        conventions are those of a single run's file (docs/model.md §7;
+        :func:`batch_schema`).
 
         Returns
         -------
         xarray.Dataset
         """
-        import xarray as xr
-
         from qzs._version import __version__
-        from qzs.engine.results import CONVENTIONS, _now, variable_attributes
-        from qzs.model.registry import PARAMETERS
 
-        attributes = variable_attributes()
+        parameters = _parameter_values(self.cases, len(self.status))
+        values = {"case": np.arange(len(self.status)), "time": self.time, **self.channels,
+                  **self.stats, "status": self.status,
+                  "message": [str(m) for m in self.messages],
+                  **{name: [np.nan if v is None else v for v in column]
+                     for name, column in parameters.items()}}
         n = len(self.status)
-        variables = {name: (("case", "time"),
-                            values.astype(np.int8) if values.dtype == bool else values,
-                            attributes[name])
-                     for name, values in self.channels.items()}
-        for name, values in self.stats.items():
-            unit, doc = STATS[name]
-            values = np.asarray(values)
-            if name in ("stop_contacts", "stick_events", "steps"):
-                values = values.astype(np.int64)
-            variables[name] = (("case",), values, {"units": unit, "long_name": doc})
-        variables["status"] = (("case",), np.asarray(self.status, dtype=np.int8),
-                               {"units": "1", "long_name": "case status",
-                                "flag_values": np.array([0, 1], dtype=np.int8),
-                                "flag_meanings": "completed failed"})
-        variables["message"] = (("case",), np.array([str(m) for m in self.messages], dtype=str),
-                                {"long_name": "failure message ('' if completed)"})
-        coords = {"case": ("case", np.arange(n), {"long_name": "case index", "units": "1"}),
-                  "time": ("time", self.time, attributes["time"])}
-        for name, info in PARAMETERS.items():
-            if len(self.cases) != n:
-                break
-            values = [getattr(pair[0] if info.section == "isolator" else pair[1], name)
-                      for pair in self.cases]
-            if all(isinstance(v, str) for v in values):
-                column, extra = np.array(values, dtype=str), {}
-            else:
-                column = np.array([np.nan if v is None else float(v) for v in values])
-                extra = ({"comment": "NaN: none"} if any(v is None for v in values) else {})
-            coords[name] = ("case", column, {"units": info.unit, "long_name": info.doc,
-                                             **extra})
-        attrs = {"Conventions": CONVENTIONS,
-                 "title": f"qzs batch of {n} simulations of the semi-active QZS isolator",
+        attrs = {"title": f"qzs batch of {n} simulations of the semi-active QZS isolator",
                  "source": f"qzs {__version__}: fixed-step simulations of the semi-active "
                            "quasi-zero-stiffness isolator (model: docs/model.md)",
                  "history": f"{_now()} qzs {__version__}: simulate_batch, {n} cases, "
                             f"{int(np.sum(self.status))} failed",
                  "qzs_version": __version__, "elapsed": float(self.elapsed),
                  "elapsed_units": "s"}
-        return xr.Dataset(variables, coords=coords, attrs=attrs)
+        return to_dataset(batch_schema(self), values, attrs)
+
+
+def _parameter_values(cases, n):
+    """Every registry parameter's value in each case: name -> list (none if ``cases`` is not
+    one pair per case)."""
+    if len(cases) != n:
+        return {}
+    return {name: [getattr(pair[0] if info.section == "isolator" else pair[1], name)
+                   for pair in cases] for name, info in PARAMETERS.items()}
+
+
+def batch_schema(batch):
+    """The CF-1.10 layout of a batch's dataset (:meth:`BatchResult.to_xarray`).
+
+    Dimensions ``case`` and ``time``; the kept channels as in a single run's file
+    (:func:`qzs.engine.results.simulation_schema`) on ``(case, time)``; the statistics of
+    :data:`STATS` (counts int64), ``status`` (int8 flag) and ``message`` on ``case``; the
+    coordinates ``case``, ``time`` and every parameter (a string where all cases give one,
+    else float64 with NaN for none).
+
+    Parameters
+    ----------
+    batch : BatchResult
+        The batch (its channels, statistics, cases and sizes).
+
+    Returns
+    -------
+    Schema
+    """
+    single = simulation_schema()
+    n = len(batch.status)
+    variables = [dataclasses.replace(single[name], dims=("case", "time"))
+                 for name in batch.channels]
+    variables += [Variable(name=name, dims=("case",), units=STATS[name][0],
+                           long_name=STATS[name][1],
+                           dtype="int64" if name in _COUNTS else "float64")
+                  for name in batch.stats]
+    variables += [Variable(name="status", dims=("case",), units="1", long_name="case status",
+                           dtype="int8", flag_meanings="completed failed"),
+                  Variable(name="message", dims=("case",), dtype="str",
+                           long_name="failure message ('' if completed)")]
+    coordinates = [Variable(name="case", dims=("case",), units="1", long_name="case index",
+                            dtype="int64", order=("long_name", "units")), single["time"]]
+    for name, column in _parameter_values(batch.cases, n).items():
+        info = PARAMETERS[name]
+        text = all(isinstance(v, str) for v in column)
+        coordinates.append(Variable(
+            name=name, dims=("case",), units=info.unit, long_name=info.doc,
+            dtype="str" if text else "float64",
+            attributes=({"comment": "NaN: none"} if not text and any(v is None for v in column)
+                        else {})))
+    return Schema(kind="a batch", dimensions={"case": n, "time": len(batch.time)},
+                  coordinates=coordinates, variables=variables)
 
 
 def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULATION["dt"],

@@ -1,8 +1,10 @@
 """Result objects: they hold arrays and metadata, and delegate (pvlib style).
 
-``SimulationResult.plot()`` calls :mod:`qzs.viz`, ``.save()`` calls
-:mod:`qzs.iotools`, ``.summary()`` calls :mod:`qzs.analysis.summary`, and
-``.to_xarray()`` only repackages.
+``SimulationResult.plot()`` calls :mod:`qzs.viz`, ``.summary()`` calls
+:mod:`qzs.analysis.summary`, and ``.to_xarray()`` only repackages. A run's file layout is
+:func:`simulation_schema` (:mod:`qzs.iotools.schema`): ``to_xarray()`` builds its dataset
+and :class:`ResultWriter`, a configuration of :class:`qzs.iotools.writer.StreamWriter`,
+streams it to NetCDF or CSV (``.save()``, :func:`save_result`, :func:`read_result`).
 """
 import dataclasses
 import datetime
@@ -13,11 +15,17 @@ import sys
 import numpy as np
 
 from qzs.engine import kernels as K
+from qzs.errors import ParameterError
+from qzs.iotools import files
+from qzs.iotools.schema import (CONVENTIONS, NONE_VALUE, Schema, Variable, time_coordinate,
+                                to_dataset)
+from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
 
 __all__ = ["SimulationResult", "CHANNELS", "FLAGS", "FLAG_MEANINGS", "RUN_UNITS", "CONVENTIONS",
-           "NONE_VALUE", "variable_attributes", "parameter_metadata", "run_metadata",
-           "history_line", "file_attributes", "named_block"]
+           "NONE_VALUE", "simulation_schema", "variable_attributes", "parameter_metadata",
+           "run_metadata", "history_line", "file_attributes", "named_block", "ResultWriter",
+           "estimated_size", "save_result", "read_result"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -59,36 +67,46 @@ FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
 RUN_UNITS = {"solver": "-", "dt": "s", "sample_rate": "Hz", "duration": "s", "steps": "1",
              "elapsed": "s", "completed": "1", "stop_contacts": "1", "stick_events": "1",
              "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1"}
-#: The metadata conventions result files follow (docs/model.md §7).
-CONVENTIONS = "CF-1.10"
-#: How a parameter whose value is ``None`` is stored (NetCDF has no null); the keys stored
-#: so are listed in the global attribute ``none_parameters``.
-NONE_VALUE = "none"
-_TIME_ATTRS = {"units": "s", "standard_name": "time", "axis": "T",
-               "long_name": "time since the start of the run",
-               "comment": "relative run time without a calendar date: units 's' instead of "
-                          "'s since <date>' (docs/model.md §7)"}
+#: File formats of a run's result: suffix -> name.
+RESULT_SUFFIXES = files.RESULT_SUFFIXES
+#: Where a run's output rows go in its file: variable -> (block, column) of ``(data, flags)``.
+_COLUMNS = {**{name: ("data", column) for name, (column, _, _) in CHANNELS.items()},
+            **{name: ("flags", column) for name, (column, _) in FLAGS.items()}}
+
+
+def simulation_schema():
+    """The CF-1.10 layout of a run's dataset and file (docs/model.md §7).
+
+    Dimension ``time`` (unlimited: a run is streamed along it); coordinate ``time`` [s]; a
+    float64 variable per channel of :data:`CHANNELS` and an int8 flag per flag of
+    :data:`FLAGS` (``flag_values`` 0 and 1, ``flag_meanings``), each with ``units`` and
+    ``long_name``.
+
+    Returns
+    -------
+    Schema
+    """
+    channels = [Variable(name=name, dims=("time",), units=unit, long_name=doc)
+                for name, (_, unit, doc) in CHANNELS.items() if name != "time"]
+    flags = [Variable(name=name, dims=("time",), units="1", long_name=doc, dtype="int8",
+                      flag_meanings=FLAG_MEANINGS[name]) for name, (_, doc) in FLAGS.items()]
+    return Schema(kind="a run", dimensions={"time": None}, coordinates=(time_coordinate(),),
+                  variables=(*channels, *flags))
 
 
 def variable_attributes():
     """CF attributes of every variable of a result, ``time`` first, then channels and flags.
 
     Every variable has ``units`` and ``long_name``; ``time`` also ``standard_name`` and
-    ``axis``; the flags (stored as int8 0/1) ``flag_values`` and ``flag_meanings``.
+    ``axis``; the flags (stored as int8 0/1) ``flag_values`` and ``flag_meanings``
+    (:func:`simulation_schema`).
 
     Returns
     -------
     dict of str to dict
         Variable name -> attributes.
     """
-    attrs = {"time": dict(_TIME_ATTRS)}
-    attrs.update({name: {"units": unit, "long_name": doc}
-                  for name, (_, unit, doc) in CHANNELS.items() if name != "time"})
-    attrs.update({name: {"units": "1", "long_name": doc,
-                         "flag_values": np.array([0, 1], dtype=np.int8),
-                         "flag_meanings": FLAG_MEANINGS[name]}
-                  for name, (_, doc) in FLAGS.items()})
-    return attrs
+    return simulation_schema().attributes()
 
 
 def _plain(value):
@@ -379,22 +397,14 @@ class SimulationResult:
     def to_xarray(self):
         """The run as an ``xarray.Dataset`` on dimension ``time``, with CF-1.10 metadata.
 
-        The same variables and attributes as a saved NetCDF file (see
-        :func:`variable_attributes` and docs/model.md §7), except that the flags stay
-        boolean and ``None`` parameters are ``"none"`` (listed in ``none_parameters``).
+        The same variables and attributes as a saved NetCDF file (:func:`simulation_schema`,
+        docs/model.md §7), except that the flags stay boolean and ``None`` parameters are
+        ``"none"`` (listed in ``none_parameters``).
         """
-        import xarray as xr
-
-        attributes = variable_attributes()
-        variables = {
-            name: ("time", self._data[:, col], attributes[name])
-            for name, (col, _, _) in CHANNELS.items() if name != "time"}
-        variables.update({
-            name: ("time", self._flags[:, col], attributes[name])
-            for name, (col, _) in FLAGS.items()})
+        schema = simulation_schema()
         head, tail = file_attributes(self.isolator, self.controller, self.excitation, self.run)
-        return xr.Dataset(variables, coords={"time": ("time", self["time"], attributes["time"])},
-                          attrs={**head, **tail})
+        return to_dataset(schema, {name: self[name] for name in schema.names},
+                          {**head, **tail}, boolean_flags=True)
 
     def summary(self):
         """One-screen text summary of the run."""
@@ -419,10 +429,8 @@ class SimulationResult:
         Returns
         -------
         Path
-            The path written (see :func:`qzs.iotools.files.save_result`).
+            The path written (see :func:`save_result`).
         """
-        from qzs.iotools.files import save_result
-
         return save_result(self, path)
 
     def __repr__(self):
@@ -430,3 +438,169 @@ class SimulationResult:
                 f"{self.run['solver']} dt={self.run['dt']:g} s, "
                 f"{'complete' if self.completed else 'interrupted'}>")
 
+
+
+class ResultWriter(StreamWriter):
+    """Stream a run's result to NetCDF (``.nc``) or CSV (``.csv``), chunk by chunk.
+
+    :class:`~qzs.iotools.writer.StreamWriter` configured with :func:`simulation_schema`:
+    memory grows with the chunk appended, not with the run; the file is written to a
+    hidden temporary file beside ``path`` and renamed onto ``path`` by :meth:`finish`;
+    :meth:`abort` (also called on any exception, ``KeyboardInterrupt`` included, when
+    used as a context manager) removes it. NetCDF files follow CF-1.10 (docs/model.md §7):
+    ``time`` is an unlimited dimension, the flags are int8 with
+    ``flag_values``/``flag_meanings``, the parameters global attributes with their units.
+    CSV files have the parameters as ``# key = value [unit]`` header lines, the rows, and
+    the run's outcome as trailing ``# run.key = value`` lines (known only at the end).
+    :func:`save_result` writes through this class; so does :func:`qzs.simulate`'s
+    ``sink`` when a run is streamed to a file. :meth:`append` takes ``data, flags``: output
+    rows of shape (n, N_CHANNELS), one column per channel of :data:`CHANNELS`, and the flags
+    of :data:`FLAGS`, shape (n, 2).
+
+    Parameters
+    ----------
+    path : str or Path
+        Target file, ending in ``.nc`` or ``.csv``; its folder is created if missing.
+    isolator : IsolatorParameters
+        Plant parameters of the run.
+    controller : ControllerParameters
+        Controller parameters of the run.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base excitation of the run.
+
+    Raises
+    ------
+    ParameterError
+        A suffix other than ``.nc`` or ``.csv``.
+    WriteError
+        The temporary file cannot be created (attributes ``path`` and ``reason``).
+
+    Examples
+    --------
+    >>> with ResultWriter("run.nc", isolator=iso, controller=ctrl,
+    ...                   excitation=ex) as writer:  # doctest: +SKIP
+    ...     for data, flags in chunks:
+    ...         writer.append(data, flags)
+    ...     writer.finish(run)
+    """
+
+    def __init__(self, path, *, isolator, controller, excitation):
+        self._parameters = (isolator, controller, excitation)
+        head, _ = file_attributes(isolator, controller, excitation, None)
+        super().__init__(path, simulation_schema(), blocks={"data": K.N_CHANNELS, "flags": 2},
+                         columns=_COLUMNS, attributes=head, suffixes=tuple(RESULT_SUFFIXES))
+
+    def finish(self, run):
+        """Write the run's settings and outcome, flush, and rename the file onto ``path``.
+
+        Parameters
+        ----------
+        run : dict
+            :attr:`SimulationResult.run` (its entries become ``run.*`` global attributes,
+            with the ``history`` line).
+
+        Returns
+        -------
+        Path
+            The path written.
+
+        Raises
+        ------
+        WriteError
+            Writing failed: the temporary file is removed (attributes ``path`` and
+            ``reason``).
+        """
+        _, tail = file_attributes(*self._parameters, run)
+        return super().finish(tail)
+
+
+def estimated_size(n_samples, suffix):
+    """Size of a run's result file of ``n_samples`` samples [bytes], an upper estimate.
+
+    NetCDF: 8 bytes per channel value and 1 per flag, in whole chunks of 4096
+    samples, plus about 128 KiB of header and the chunk index; CSV: about 17 bytes
+    per value (the ``%.10g`` format and a comma) plus the header lines
+    (:func:`qzs.iotools.writer.estimated_file_size` of :func:`simulation_schema`).
+
+    Parameters
+    ----------
+    n_samples : int
+        Output samples of the run [samples] (``duration * sample_rate + 1``).
+    suffix : {".nc", ".csv"}
+        The file format (a path's suffix; a path is accepted too).
+
+    Returns
+    -------
+    int
+        Estimated size [bytes].
+    """
+    return estimated_file_size(simulation_schema(), n_samples, suffix)
+
+
+def save_result(result, path):
+    """Write a :class:`SimulationResult` to NetCDF (``.nc``) or CSV (``.csv``).
+
+    Both carry every parameter with its unit, the excitation, the run settings and
+    the qzs version as metadata (NetCDF: CF-1.10 global attributes; CSV:
+    ``# key = value [unit]`` lines), see docs/model.md §7. Written through
+    :class:`ResultWriter` in chunks, atomically.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The run.
+    path : str or Path
+        Target file, ending in ``.nc`` or ``.csv``.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    ParameterError
+        Any other suffix, or a preview of a streamed run (``run["preview_every"] > 1``).
+    WriteError
+        Writing failed (disk full, permissions; attributes ``path`` and ``reason``);
+        nothing is left behind.
+    """
+    every = result.run.get("preview_every", 1)
+    if every != 1:
+        raise ParameterError(f"this result keeps only every {every}th sample of a run streamed "
+                             "to a file (a preview); its full samples are in that file.")
+    data, flags = result._data, result._flags
+    with ResultWriter(path, isolator=result.isolator, controller=result.controller,
+                      excitation=result.excitation) as writer:
+        step = 1 << 17
+        for start in range(0, max(len(result), 1), step):
+            writer.append(data[start:start + step], flags[start:start + step])
+        return writer.finish(result.run)
+
+
+def read_result(path):
+    """Read a saved run (``.nc`` or ``.csv``) back as an ``xarray.Dataset``.
+
+    The flags come back boolean and ``None`` parameters as ``None``, so that a
+    NetCDF file reads back as the run's :meth:`SimulationResult.to_xarray` (a CSV one
+    too, to its 10 significant digits): :func:`qzs.iotools.files.read_result` with
+    :func:`simulation_schema`.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file written by :func:`save_result` or :class:`ResultWriter` (any suffix other
+        than ``.nc`` is read as CSV).
+
+    Returns
+    -------
+    xarray.Dataset
+        The channels on coordinate ``time`` [s], units and metadata in attributes.
+
+    Raises
+    ------
+    DataError
+        Missing or unreadable file, or a CSV without a header line or with mismatched
+        columns.
+    """
+    return files.read_result(path, simulation_schema())

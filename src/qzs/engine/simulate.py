@@ -59,7 +59,7 @@ def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
         consecutive samples (``result.run["preview_every"]``) one row of each channel's
         minimum and one of its maximum (the flags' all and any), so memory stays bounded
         however long the run and a plot shows the true envelope, never an aliased pick
-        (:class:`qzs.iotools.files.ResultWriter` is such a sink). The summary's
+        (:class:`qzs.engine.results.ResultWriter` is such a sink). The summary's
         statistics always come from every sample.
 
     Returns

@@ -1,22 +1,30 @@
-"""Files in and out: results and configs, rig logs, shipped definitions.
+"""Files in and out: the file schema, results and configs, rig logs, shipped definitions.
 
-=================  ==================================================================
-``files``          atomic writes; results as NetCDF or CSV, streamed chunk by chunk
-``hexapod_files``  a six-leg platform's run streamed to NetCDF
-``paths``          output paths checked before the work starts
-``config``         run configurations (TOML)
-``readers``        test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
-``shipped``        the study, sweep and hexapod files shipped with qzs
-=================  ==================================================================
+This layer knows no result type: each declares its own schema beside its class
+(``qzs.engine.results.simulation_schema``, ...) and hands it to the functions here.
+
+===========  ==================================================================
+``schema``   a result's variables, dimensions, units and flags; its dataset
+``writer``   the streaming, atomic CF writer (NetCDF, CSV) of a schema
+``files``    atomic writes; result files read back
+``paths``    output paths checked before the work starts
+``config``   run configurations (TOML)
+``readers``  test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
+``shipped``  the study, sweep and hexapod files shipped with qzs
+===========  ==================================================================
 """
-from qzs.iotools.config import load_config, save_config
-from qzs.iotools.files import (ResultWriter, atomic_path, read_displacement_csv, read_result,
-                              save_result)
-from qzs.iotools.paths import check_output_path
-from qzs.iotools.readers import (ChannelMap, Recording, load_channel_map, read_recording,
-                                 write_dspace_mat)
+from qzs._lazy import lazy_exports
 
-__all__ = ["atomic_path", "save_result", "read_result", "ResultWriter", "check_output_path",
-           "read_displacement_csv", "load_config",
-           "save_config", "Recording", "ChannelMap", "load_channel_map", "read_recording",
-           "write_dspace_mat"]
+# Loaded on first use: the engine imports the schema and the writer, not the rig-log readers.
+_EXPORTS = {
+    "atomic_path": "qzs.iotools.files", "read_result": "qzs.iotools.files",
+    "read_displacement_csv": "qzs.iotools.files", "check_output_path": "qzs.iotools.paths",
+    "load_config": "qzs.iotools.config", "save_config": "qzs.iotools.config",
+    "Recording": "qzs.iotools.readers", "ChannelMap": "qzs.iotools.readers",
+    "load_channel_map": "qzs.iotools.readers", "read_recording": "qzs.iotools.readers",
+    "write_dspace_mat": "qzs.iotools.readers", "Schema": "qzs.iotools.schema",
+    "Variable": "qzs.iotools.schema", "to_dataset": "qzs.iotools.schema",
+    "StreamWriter": "qzs.iotools.writer", "estimated_file_size": "qzs.iotools.writer",
+}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

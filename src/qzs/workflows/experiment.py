@@ -40,10 +40,11 @@ from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
+from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.excitation import Chirp
 
 __all__ = ["ExperimentResult", "process_experiment", "experiment_metrics", "infer_chirp",
-           "run_experiment"]
+           "run_experiment", "experiment_schema"]
 
 #: Welch averages of the paper's experiment (Section 4).
 EXPERIMENT_AVERAGES = 29
@@ -218,26 +219,17 @@ class ExperimentResult:
         return plot_experiment(self, path=path, title=title)
 
     def to_xarray(self):
-        """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag."""
-        import xarray as xr
-
+        """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag
+        (:func:`experiment_schema`)."""
         f, measured, coherence, trusted = self._in_band(self.measured)
-        variables = {"experiment": ("frequency", measured, {"units": "1", "long_name":
-                                    "measured transmissibility sqrt(S_payload/S_base)"}),
-                     "coherence": ("frequency", coherence, {"units": "1"}),
-                     "trusted": ("frequency", trusted.astype("i1"),
-                                 {"units": "1", "flag_values": [0, 1],
-                                  "flag_meanings": "untrusted trusted",
-                                  "long_name": "1 where the measured estimate is trusted "
-                                               "(coherence, base power, at or above "
-                                               f"{self.untrusted_below:g} Hz)"})}
+        values = {"frequency": f, "experiment": measured, "coherence": coherence,
+                  "trusted": trusted}
         if self.simulated is not None:
-            variables["simulation"] = ("frequency", np.interp(f, self.simulated.frequency,
-                                                              self.simulated.magnitude),
-                                       {"units": "1", "long_name": "simulated transmissibility"})
-        return xr.Dataset(variables, coords={"frequency": ("frequency", f, {"units": "Hz"})},
-                          attrs={"source": self.recording.source,
-                                 "untrusted_below": self.untrusted_below})
+            values["simulation"] = np.interp(f, self.simulated.frequency,
+                                             self.simulated.magnitude)
+        return to_dataset(experiment_schema(self), values,
+                          {"source": self.recording.source,
+                           "untrusted_below": self.untrusted_below})
 
     def summary(self):
         """A few lines: the log, the chirp, the flagged band, key metrics of both."""
@@ -324,6 +316,38 @@ class ExperimentResult:
         with atomic_path(paths["report"]) as tmp:
             Path(tmp).write_text(_markdown(self, paths["figure"].name), encoding="utf-8")
         return paths
+
+
+def experiment_schema(result):
+    """The CF-1.10 layout of an experiment's dataset (:meth:`ExperimentResult.to_xarray`).
+
+    Coordinate ``frequency`` [Hz]; the measured transmissibility ``experiment``, its
+    ``coherence``, the ``trusted`` flag (int8) and, with a simulation, ``simulation``.
+
+    Parameters
+    ----------
+    result : ExperimentResult
+        The experiment (whether it has a simulation, and its flagged band).
+
+    Returns
+    -------
+    Schema
+    """
+    variables = [
+        Variable(name="experiment", dims=("frequency",), units="1",
+                 long_name="measured transmissibility sqrt(S_payload/S_base)"),
+        Variable(name="coherence", dims=("frequency",), units="1"),
+        Variable(name="trusted", dims=("frequency",), units="1", dtype="int8",
+                 flag_meanings="untrusted trusted",
+                 long_name="1 where the measured estimate is trusted (coherence, base power, "
+                           f"at or above {result.untrusted_below:g} Hz)",
+                 order=("units", "flag_values", "flag_meanings", "long_name"))]
+    if result.simulated is not None:
+        variables.append(Variable(name="simulation", dims=("frequency",), units="1",
+                                  long_name="simulated transmissibility"))
+    return Schema(kind="an experiment", dimensions={"frequency": None},
+                  coordinates=(Variable(name="frequency", dims=("frequency",), units="Hz"),),
+                  variables=variables)
 
 
 def _origin(result):

@@ -558,7 +558,7 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
 
     With ``out`` every sample is streamed to that NetCDF file as the run goes
-    (:class:`~qzs.iotools.hexapod_files.HexapodWriter`): memory stays bounded however long
+    (:class:`~qzs.engine.hexapod.result.HexapodWriter`): memory stays bounded however long
     the run, the path and the free space are checked before it starts, the file appears
     complete when it ends, and nothing is left behind on an error.
 
@@ -626,7 +626,7 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     if out is None:
         return simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
                                 setup.controller, **arguments)
-    from qzs.iotools.hexapod_files import HexapodWriter, estimated_hexapod_size
+    from qzs.engine.hexapod.result import HexapodWriter, estimated_hexapod_size
     from qzs.iotools.paths import check_output_path
 
     length = arguments["duration"]

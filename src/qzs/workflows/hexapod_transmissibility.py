@@ -49,11 +49,12 @@ from qzs._validation import as_float, choice, integer, positive, worker_count
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
+from qzs.iotools.schema import Schema, Variable, to_dataset
 
 __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "CHIRP",
            "FLOOR_DB", "ESTIMATORS", "transmissibility_summary", "transmissibility_dataset",
            "transmissibility_record", "choose_hexapod_step", "sweep_trusted_from",
-           "platform_size", "entry_unit"]
+           "platform_size", "entry_unit", "transmissibility_schema"]
 
 #: Default chirp amplitude per base axis: 2 mm in translation [m], 0.01 rad in rotation
 #: [rad] (1.2 mm at the top joints of the 0.15 m cube).
@@ -867,6 +868,55 @@ def transmissibility_record(result):
             "source": result.setup.source}
 
 
+def transmissibility_schema(estimator="h1"):
+    """The CF-1.10 layout (a ``Schema``) of :func:`transmissibility_dataset`.
+
+    Parameters
+    ----------
+    estimator : str
+        The estimator, named in the magnitude's ``long_name``.
+    """
+    mixed = ("1 on the diagonal blocks, m/rad for a translation per rotation, rad/m for a "
+             "rotation per translation (see entry_units)")
+    on = ("frequency", "output_dof", "input_dof")
+    flag = ("units", "long_name", "flag_meanings", "flag_values")
+    dof_doc = "degree of freedom: translations x, y, z [m], rotations rx, ry, rz [rad]"
+    variables = (
+        Variable(name="magnitude", dims=on, units=mixed,
+                 long_name=f"|{estimator.upper()}| platform motion per base motion"),
+        Variable(name="phase", dims=on, units="rad",
+                 long_name="phase of the platform motion relative to the base's"),
+        Variable(name="coherence", dims=on, units="1",
+                 long_name="magnitude-squared coherence of base and platform axis"),
+        Variable(name="trusted", dims=on, units="1", dtype="int8", order=flag,
+                 long_name="1 where the bin may be read (docs/model.md section 10 and the "
+                           "numerical floor)", flag_meanings="untrusted trusted"),
+        Variable(name="below_floor", dims=on, units="1", dtype="int8", order=flag,
+                 long_name="1 where the dimensionless response is below the numerical floor "
+                           "(rounding, not response)", flag_meanings="above below"),
+        Variable(name="linear_magnitude", dims=on, units=mixed,
+                 long_name="|T| of the linear model at the top frame origin"),
+        Variable(name="linear_phase", dims=on, units="rad", long_name="phase of the linear model"),
+        Variable(name="entry_units", dims=on[1:], dtype="str",
+                 long_name="unit of each matrix entry"),
+        Variable(name="excited", dims=on[2:], units="1", dtype="int8", order=flag, long_name=(
+            "1 where the base axis was excited"), flag_meanings="not_excited excited"),
+        Variable(name="amplitude", dims=on[2:], units=", ".join(AXIS_UNITS),
+                 long_name="chirp displacement amplitude",
+                 attributes={"units_by_dof": "; ".join(
+                     f"{a}: {u}" for a, u in zip(AXES, AXIS_UNITS))}),
+        Variable(name="energy_residual", dims=on[2:], units="1",
+                 long_name="largest energy-ledger imbalance over the largest |base work| of the "
+                           "run"))
+    coordinates = (
+        Variable(name="frequency", dims=on[:1], units="Hz", long_name="frequency"),
+        *(Variable(name=name, dims=(name,), units="1", long_name=f"{side} {dof_doc}",
+                   dtype="str", order=("long_name", "units"))
+          for name, side in (("output_dof", "platform"), ("input_dof", "base"))))
+    return Schema(kind="a 6x6 transmissibility", coordinates=coordinates, variables=variables,
+                  dimensions={"frequency": None, "output_dof": 6, "input_dof": 6})
+
+
 def transmissibility_dataset(result):
     """:meth:`HexapodTransmissibility.to_xarray`: the matrix as an ``xarray.Dataset``.
 
@@ -889,59 +939,20 @@ def transmissibility_dataset(result):
     """
     import datetime
 
-    import xarray as xr
-
     from qzs._version import __version__
     from qzs.model.registry import unit_of
 
-    mixed = ("1 on the diagonal blocks, m/rad for a translation per rotation, rad/m for a "
-             "rotation per translation (see entry_units)")
-    dims = ("frequency", "output_dof", "input_dof")
-    flags = {"flag_values": np.array([0, 1], dtype=np.int8)}
-    variables = {
-        "magnitude": (dims, result.magnitude, {
-            "units": mixed, "long_name": f"|{result.settings['estimator'].upper()}| "
-                                         "platform motion per base motion"}),
-        "phase": (dims, np.angle(result.response), {
-            "units": "rad", "long_name": "phase of the platform motion relative to the base's"}),
-        "coherence": (dims, result.coherence, {
-            "units": "1", "long_name": "magnitude-squared coherence of base and platform axis"}),
-        "trusted": (dims, result.trusted.astype(np.int8), {
-            "units": "1", "long_name": "1 where the bin may be read (docs/model.md section 10 "
-                                       "and the numerical floor)",
-            "flag_meanings": "untrusted trusted", **flags}),
-        "below_floor": (dims, result.below_floor.astype(np.int8), {
-            "units": "1", "long_name": "1 where the dimensionless response is below the "
-                                       "numerical floor (rounding, not response)",
-            "flag_meanings": "above below", **flags}),
-        "linear_magnitude": (dims, np.abs(result.linear_response), {
-            "units": mixed, "long_name": "|T| of the linear model at the top frame origin"}),
-        "linear_phase": (dims, np.angle(result.linear_response), {
-            "units": "rad", "long_name": "phase of the linear model"}),
-        "entry_units": (("output_dof", "input_dof"),
-                        np.array([[entry_unit(i, j) for j in range(6)] for i in range(6)],
-                                 dtype=object), {"long_name": "unit of each matrix entry"}),
-        "excited": (("input_dof",), result.excited.astype(np.int8), {
-            "units": "1", "long_name": "1 where the base axis was excited",
-            "flag_meanings": "not_excited excited", **flags}),
-        "amplitude": (("input_dof",), np.array([result.amplitude.get(a, np.nan) for a in AXES]),
-                      {"units": ", ".join(AXIS_UNITS), "long_name": "chirp displacement amplitude",
-                       "units_by_dof": "; ".join(f"{a}: {u}" for a, u in zip(AXES, AXIS_UNITS))}),
-        "energy_residual": (("input_dof",), np.array([result.energy_residual.get(a, np.nan)
-                                                      for a in AXES]), {
-            "units": "1", "long_name": "largest energy-ledger imbalance over the largest "
-                                       "|base work| of the run"}),
-    }
-    dof_doc = "degree of freedom: translations x, y, z [m], rotations rx, ry, rz [rad]"
-    coords = {"frequency": ("frequency", result.frequency, {"units": "Hz",
-                                                            "long_name": "frequency"}),
-              "output_dof": ("output_dof", list(AXES), {"long_name": "platform " + dof_doc,
-                                                        "units": "1"}),
-              "input_dof": ("input_dof", list(AXES), {"long_name": "base " + dof_doc,
-                                                      "units": "1"})}
+    values = {
+        "magnitude": result.magnitude, "phase": np.angle(result.response),
+        "coherence": result.coherence, "trusted": result.trusted,
+        "below_floor": result.below_floor, "linear_magnitude": np.abs(result.linear_response),
+        "linear_phase": np.angle(result.linear_response), "excited": result.excited,
+        "entry_units": [[entry_unit(i, j) for j in range(6)] for i in range(6)],
+        "amplitude": [result.amplitude.get(a, np.nan) for a in AXES],
+        "energy_residual": [result.energy_residual.get(a, np.nan) for a in AXES],
+        "frequency": result.frequency, "output_dof": list(AXES), "input_dof": list(AXES)}
     now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
-    attrs = {"Conventions": "CF-1.10",
-             "title": "qzs simulated 6x6 transmissibility of a six-leg platform",
+    attrs = {"title": "qzs simulated 6x6 transmissibility of a six-leg platform",
              "source": f"qzs {__version__}: one chirp per base axis through "
                        "simulate_hexapod, single-axis Welch estimates (docs/hexapod.md)",
              "history": f"{now} qzs {__version__}: qzs.hexapod_transmissibility (Python)",
@@ -992,7 +1003,7 @@ def transmissibility_dataset(result):
                   "geometry.base_joints_units": "m", "geometry.top_joints_units": "m",
                   "geometry.home_position_units": "m", "geometry.stroke_half_units": "m",
                   "source_file": setup.source or "none"})
-    return xr.Dataset(variables, coords=coords, attrs=attrs)
+    return to_dataset(transmissibility_schema(result.settings["estimator"]), values, attrs)
 
 
 def _attribute(value):

@@ -8,14 +8,15 @@ from pathlib import Path
 
 from qzs import defaults
 from qzs.engine.prepare import run_inputs
+from qzs.engine.results import ResultWriter, estimated_size
 from qzs.engine.simulate import simulate
-from qzs.iotools.files import ResultWriter, estimated_size
+from qzs.iotools.files import RESULT_SUFFIXES as _FORMATS
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["simulate_to_file", "RESULT_SUFFIXES"]
 
 #: File formats a run can be written to, by extension.
-RESULT_SUFFIXES = (".nc", ".csv")
+RESULT_SUFFIXES = tuple(_FORMATS)
 
 
 def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, duration=None,
@@ -26,7 +27,7 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
     """Simulate and stream every output sample to ``path`` (NetCDF ``.nc`` or CSV ``.csv``).
 
     The path, its folder and the free space are checked before the run starts; samples are
-    written chunk by chunk (:class:`~qzs.iotools.files.ResultWriter`), so memory stays
+    written chunk by chunk (:class:`~qzs.engine.results.ResultWriter`), so memory stays
     bounded however long the run; the file appears, complete, only when the run ends (an
     interrupted run, with ``interruptible``, writes what was simulated and says so in
     ``run.completed``); on an error nothing is left behind.

@@ -12,7 +12,7 @@ damping), driven by a base moving in up to six axes. The modules mirror the sing
 ``stepping``    kernels: Runge-Kutta, events and transitions, output samples, the run
 ``prepare``     validation and packing, :func:`hexapod_stability_test`
 ``simulate``    :func:`simulate_hexapod` and :func:`simulate_hexapods`, the drivers
-``result``      :class:`HexapodResult`, its channels, flags and file layout
+``result``      :class:`HexapodResult`, its channels, flags, schema and writer
 ``statistics``  run statistics over every sample and the summary text
 ==============  ====================================================================
 """
@@ -26,7 +26,9 @@ _EXPORTS = {
     "AXES": "qzs.engine.hexapod.layout",
     "HEXAPOD_CHANNELS": "qzs.engine.hexapod.result",
     "HEXAPOD_FLAGS": "qzs.engine.hexapod.result",
+    "hexapod_schema": "qzs.engine.hexapod.result",
     "hexapod_file_layout": "qzs.engine.hexapod.result",
+    "HexapodWriter": "qzs.engine.hexapod.result",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

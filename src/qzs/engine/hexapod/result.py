@@ -1,9 +1,9 @@
-"""The result of a six-axis run: :class:`HexapodResult`, its channels and flags, its file layout.
+"""The result of a six-axis run: :class:`HexapodResult`, its channels and flags, its file.
 
 :data:`HEXAPOD_CHANNELS` and :data:`HEXAPOD_FLAGS` name the columns of the output samples
-(:mod:`qzs.engine.hexapod.layout`); :func:`hexapod_file_layout` is the CF-1.10 layout that
-:meth:`HexapodResult.to_xarray` builds and :class:`qzs.iotools.hexapod_files.HexapodWriter`
-streams.
+(:mod:`qzs.engine.hexapod.layout`); :func:`hexapod_schema` is the CF-1.10 layout that
+:meth:`HexapodResult.to_xarray` builds and :class:`HexapodWriter` (a configuration of
+:class:`qzs.iotools.writer.StreamWriter`) streams.
 """
 import numpy as np
 
@@ -11,12 +11,18 @@ from qzs.defaults import AXIS_RATE_UNITS, AXIS_UNITS
 from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
                                        C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR,
                                        C_FMO, C_FPI, C_FSP, C_FST, C_POSE, C_TIME, C_TWIST,
-                                       C_V, C_VME, C_WB, C_WM, C_Z, LEG_COUNT, O_CONTACT,
-                                       O_LOCKED)
+                                       C_V, C_VME, C_WB, C_WM, C_Z, LEG_COUNT, N_CHANNELS,
+                                       N_FLAGS, O_CONTACT, O_LOCKED)
 from qzs.engine.hexapod.statistics import _Statistics, _summary_text
+from qzs.errors import ParameterError
+from qzs.iotools.paths import check_output_path
+from qzs.iotools.schema import CONVENTIONS, Schema, Variable, time_coordinate, to_dataset
+from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
 
-__all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_file_layout"]
+__all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_schema",
+           "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size",
+           "save_hexapod_result"]
 
 _ACCELERATION = ("m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2")
 #: Output channels: name -> (first column, dimension (None: time only, "dof" or "leg"),
@@ -84,48 +90,178 @@ def _attribute(value):
     return value
 
 
-def hexapod_file_layout():
-    """The CF-1.10 layout of a hexapod run's file: variables and coordinates with attributes.
+#: Where a run's output rows go in its file: variable -> (block, column or the six columns).
+_COLUMNS = {**{name: ("data", column if dim is None else slice(column, column + 6))
+               for name, (column, dim, _, _) in HEXAPOD_CHANNELS.items()},
+            **{name: ("flags", slice(column, column + 6))
+               for name, (column, _) in HEXAPOD_FLAGS.items()}}
+#: The values of the coordinates that are labels: the degrees of freedom and the legs.
+_LABELS = {"dof": list(AXES), "leg": np.arange(1, LEG_COUNT + 1)}
 
-    One place for what :meth:`HexapodResult.to_xarray` builds and what
-    :class:`qzs.iotools.hexapod_files.HexapodWriter` streams (docs/model.md §7): every
-    variable has ``units`` and ``long_name``; a ``dof`` variable mixes translations and
-    rotations, so its ``units`` lists one unit per dof (``units_by_dof`` names them); flags
-    are booleans with ``flag_values`` and ``flag_meanings``; time in plain seconds.
+
+def hexapod_schema():
+    """The CF-1.10 layout of a hexapod run's dataset and file (docs/model.md §7).
+
+    What :meth:`HexapodResult.to_xarray` builds and :class:`HexapodWriter` streams:
+    dimensions ``time`` (unlimited), ``dof`` and ``leg``; every variable has ``units`` and
+    ``long_name``; a ``dof`` variable mixes translations and rotations, so its ``units``
+    lists one unit per dof (``units_by_dof`` names them); flags are int8 0/1 with
+    ``flag_values`` and ``flag_meanings``; time in plain seconds.
+
+    Returns
+    -------
+    Schema
+    """
+    variables = []
+    for name, (_, dim, unit, doc) in HEXAPOD_CHANNELS.items():
+        if name == "time":
+            continue
+        dims = ("time",) if dim is None else ("time", dim)
+        if dim == "dof":
+            variables.append(Variable(
+                name=name, dims=dims, units=", ".join(unit), long_name=doc,
+                attributes={"units_by_dof": "; ".join(f"{a}: {u}" for a, u in zip(AXES, unit))},
+                order=("long_name", "units", "units_by_dof")))
+        else:
+            variables.append(Variable(name=name, dims=dims, units=unit, long_name=doc,
+                                      order=("long_name", "units")))
+    variables += [Variable(name=name, dims=("time", "leg"), units="1", long_name=doc,
+                           dtype="int8", flag_meanings=_FLAG_MEANINGS[name])
+                  for name, (_, doc) in HEXAPOD_FLAGS.items()]
+    coordinates = (
+        time_coordinate(),
+        Variable(name="dof", dims=("dof",), units="1", dtype="str",
+                 long_name="degree of freedom: translations x, y, z [m], rotations rx, ry, rz "
+                           "[rad]", order=("long_name", "units")),
+        Variable(name="leg", dims=("leg",), units="1", long_name="leg number", dtype="int64",
+                 order=("long_name", "units")))
+    return Schema(kind="a hexapod run", dimensions={"time": None, "dof": 6, "leg": LEG_COUNT},
+                  coordinates=coordinates, variables=variables, header_bytes=256 << 10)
+
+
+def hexapod_file_layout():
+    """:func:`hexapod_schema` as plain dicts (the form this layout had before the schema).
 
     Returns
     -------
     dict
         ``{"variables": {name: (dims, attrs)}, "coordinates": {name: (dims, values,
-        attrs)}}`` (the ``time`` coordinate's values are the run's own).
+        attrs)}}`` (the ``time`` coordinate's values are None: the run's own).
     """
-    variables = {}
-    for name, (_, dim, unit, doc) in HEXAPOD_CHANNELS.items():
-        if name == "time":
-            continue
-        attrs = {"long_name": doc}
-        if dim == "dof":
-            attrs["units"] = ", ".join(unit)
-            attrs["units_by_dof"] = "; ".join(f"{a}: {u}" for a, u in zip(AXES, unit))
-        else:
-            attrs["units"] = unit
-        variables[name] = (("time",) if dim is None else ("time", dim), attrs)
-    for name, (_, doc) in HEXAPOD_FLAGS.items():
-        variables[name] = (("time", "leg"), {
-            "units": "1", "long_name": doc, "flag_values": np.array([0, 1], dtype=np.int8),
-            "flag_meanings": _FLAG_MEANINGS[name]})
-    coordinates = {
-        "time": (("time",), None, {
-            "units": "s", "standard_name": "time", "axis": "T",
-            "long_name": "time since the start of the run",
-            "comment": "relative run time without a calendar date: units 's' instead of "
-                       "'s since <date>' (docs/model.md §7)"}),
-        "dof": (("dof",), list(AXES), {"long_name": "degree of freedom: translations x, y, z "
-                                                    "[m], rotations rx, ry, rz [rad]",
-                                       "units": "1"}),
-        "leg": (("leg",), np.arange(1, LEG_COUNT + 1), {"long_name": "leg number",
-                                                         "units": "1"})}
-    return {"variables": variables, "coordinates": coordinates}
+    schema = hexapod_schema()
+    return {"variables": {v.name: (v.dims, v.attrs()) for v in schema.variables},
+            "coordinates": {c.name: (c.dims, _LABELS.get(c.name), c.attrs())
+                            for c in schema.coordinates}}
+
+
+def estimated_hexapod_size(n_samples):
+    """Size of a hexapod result file of ``n_samples`` samples [bytes], an upper estimate.
+
+    Parameters
+    ----------
+    n_samples : int
+        Output samples [samples] (``duration * sample_rate + 1``).
+
+    Returns
+    -------
+    int
+        Estimated size [bytes]: 8 bytes per channel value, 1 per flag, in whole chunks of
+        4096 samples, plus the chunk index and about 256 KiB of header
+        (:func:`qzs.iotools.writer.estimated_file_size` of :func:`hexapod_schema`).
+    """
+    return estimated_file_size(hexapod_schema(), n_samples, ".nc")
+
+
+class HexapodWriter(StreamWriter):
+    """Stream a hexapod run (:func:`qzs.simulate_hexapod`'s ``sink``) to a NetCDF file.
+
+    :class:`~qzs.iotools.writer.StreamWriter` configured with :func:`hexapod_schema`: a
+    hidden temporary file beside the target, disk space reserved before each chunk,
+    renamed onto the target only when the run has ended (:meth:`finish`); on any error or
+    interruption nothing is left behind. Flags are stored as int8 (0/1) with
+    ``flag_values`` and ``flag_meanings``. :meth:`append` takes ``data, flags``: output rows
+    of shape (n, N_CHANNELS), the columns of :data:`HEXAPOD_CHANNELS`, and the flags of
+    :data:`HEXAPOD_FLAGS`, shape (n, 12).
+
+    Parameters
+    ----------
+    path : str or Path
+        Target file, ending in ``.nc``; its folder is created if missing.
+
+    Raises
+    ------
+    ParameterError
+        A suffix other than ``.nc``.
+    WriteError
+        The temporary file cannot be created (attributes ``path`` and ``reason``).
+
+    Examples
+    --------
+    >>> with HexapodWriter("platform.nc") as writer:  # doctest: +SKIP
+    ...     result = simulate_hexapod(geometry, platform, sink=writer.append)
+    ...     writer.finish(result)
+    """
+
+    def __init__(self, path):
+        super().__init__(path, hexapod_schema(), blocks={"data": N_CHANNELS, "flags": N_FLAGS},
+                         columns=_COLUMNS, values=_LABELS, suffixes=(".nc",))
+
+    def finish(self, result):
+        """Write the run's settings and outcome, flush, and rename the file onto ``path``.
+
+        Parameters
+        ----------
+        result : HexapodResult
+            The run (its parameters and ``run`` dict become global attributes).
+
+        Returns
+        -------
+        Path
+            The path written.
+
+        Raises
+        ------
+        WriteError
+            Writing failed: the temporary file is removed (attributes ``path`` and
+            ``reason``).
+        """
+        return super().finish(result.global_attributes())
+
+
+def save_hexapod_result(result, path):
+    """Write a hexapod run held in memory to a NetCDF file, atomically.
+
+    Parameters
+    ----------
+    result : HexapodResult
+        A run holding every sample (not the preview of a run streamed to a file).
+    path : str or Path
+        Target ``.nc`` file; checked (folder, permissions, free space) before writing.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    ParameterError
+        ``result`` holds a preview only (``run["preview_every"]`` > 1).
+    OutputPathError
+        ``path`` cannot be written.
+    """
+    every = result.run.get("preview_every", 1)
+    if every > 1:
+        raise ParameterError(
+            f"this result holds every {every}th sample only (a preview of a run streamed to a "
+            "file); the whole run is in the file it was streamed to.")
+    check_output_path(path, argument="path", suffixes=(".nc",),
+                      estimated_bytes=estimated_hexapod_size(len(result)))
+    with HexapodWriter(path) as writer:
+        for start in range(0, len(result), 100_000):
+            writer.append(result._data[start:start + 100_000],
+                          result._flags[start:start + 100_000])
+        return writer.finish(result)
 
 
 class HexapodResult:
@@ -262,20 +398,17 @@ class HexapodResult:
         """The run as an ``xarray.Dataset`` with dimensions ``time``, ``dof`` and ``leg``.
 
         CF-1.10 as :meth:`qzs.engine.results.SimulationResult.to_xarray` (time in plain
-        seconds, docs/model.md §7): every variable has ``units`` and ``long_name``; a
-        ``dof`` variable mixes translations and rotations, so its ``units`` lists one unit
-        per dof in the order of the ``dof`` coordinate (``units_by_dof`` says so by name);
-        flags are booleans with ``flag_values`` and ``flag_meanings``. Parameters and run
-        settings are global attributes with their units in ``<key>_units``.
+        seconds, docs/model.md §7; :func:`hexapod_schema`): every variable has ``units`` and
+        ``long_name``; a ``dof`` variable mixes translations and rotations, so its ``units``
+        lists one unit per dof in the order of the ``dof`` coordinate (``units_by_dof`` says
+        so by name); flags are booleans with ``flag_values`` and ``flag_meanings``.
+        Parameters and run settings are global attributes with their units in
+        ``<key>_units``.
         """
-        import xarray as xr
-
-        layout = hexapod_file_layout()
-        variables = {name: (dims, self[name], attrs)
-                     for name, (dims, attrs) in layout["variables"].items()}
-        coords = {name: (dims, self["time"] if name == "time" else values, attrs)
-                  for name, (dims, values, attrs) in layout["coordinates"].items()}
-        return xr.Dataset(variables, coords=coords, attrs=self.global_attributes())
+        schema = hexapod_schema()
+        values = {name: _LABELS[name] if name in _LABELS else self[name]
+                  for name in schema.names}
+        return to_dataset(schema, values, self.global_attributes(), boolean_flags=True)
 
     def global_attributes(self):
         """The file's global attributes: CF conventions, provenance, every parameter and run
@@ -285,7 +418,7 @@ class HexapodResult:
         from qzs._version import __version__
 
         now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
-        attrs = {"Conventions": "CF-1.10",
+        attrs = {"Conventions": CONVENTIONS,
                  "title": "qzs simulation of a six-leg platform of semi-active QZS isolator legs",
                  "source": f"qzs {__version__}: fixed-step hexapod dynamics with exact stick-slip "
                            "per leg (model: docs/hexapod.md, docs/model.md)",
@@ -304,7 +437,7 @@ class HexapodResult:
         return _summary_text(self)
 
     def save(self, path):
-        """Write the run to a NetCDF file (:func:`qzs.iotools.hexapod_files.save_hexapod_result`).
+        """Write the run to a NetCDF file (:func:`save_hexapod_result`).
 
         Parameters
         ----------
@@ -315,8 +448,6 @@ class HexapodResult:
         -------
         Path
         """
-        from qzs.iotools.hexapod_files import save_hexapod_result
-
         return save_hexapod_result(self, path)
 
     def plot(self, **kwargs):

@@ -7,7 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["RESPONSE_SUFFIXES", "POINT_FIELDS", "response_dataset", "write_response"]
+from qzs.iotools.schema import Schema, Variable, to_dataset
+
+__all__ = ["RESPONSE_SUFFIXES", "POINT_FIELDS", "response_schema", "response_dataset",
+           "write_response"]
 
 #: File formats :meth:`~qzs.workflows.response.result.SteadyStateResponse.save` writes, by
 #: extension.
@@ -34,15 +37,81 @@ POINT_FIELDS = {
 }
 
 
+#: Stored types of the fields of :data:`POINT_FIELDS` that are not float64.
+_POINT_TYPES = {"period_multiple": "int64", "periods": "int64", "converged": "int8"}
+
+
+def response_schema(response):
+    """The CF-1.10 layout of a response's dataset (:func:`response_dataset`).
+
+    Dimensions ``direction``, ``frequency``, ``harmonic`` and ``linear_frequency``, and
+    ``balance_point`` and ``chirp_frequency`` where the response has a harmonic balance
+    or a chirp estimate; the fields of :data:`POINT_FIELDS` on ``(direction, frequency)``
+    (counts int64, ``converged`` int8), ``harmonics``, ``reason`` and ``start`` (strings),
+    the linear model, the harmonic balance and the chirp estimate.
+
+    Parameters
+    ----------
+    response : SteadyStateResponse
+        The response (its sizes, and whether it has a balance and a chirp estimate).
+
+    Returns
+    -------
+    Schema
+    """
+    points = ("direction", "frequency")
+    dimensions = {"direction": len(response.directions),
+                  "frequency": response.frequencies.size,
+                  "harmonic": len(response.points[0].harmonics) if response.points else 0,
+                  "linear_frequency": np.asarray(response.linear.get("frequency", [])).size}
+    variables = [Variable(name=name, dims=points, units=unit, long_name=doc,
+                          dtype=_POINT_TYPES.get(name, "float64"))
+                 for name, (unit, doc) in POINT_FIELDS.items()]
+    variables += [
+        Variable(name="harmonics", dims=(*points, "harmonic"), units="1",
+                 long_name="payload acceleration at the harmonic over the base's fundamental"),
+        Variable(name="reason", dims=points, dtype="str"),
+        Variable(name="start", dims=points, dtype="str"),
+        Variable(name="linear_transmissibility", dims=("linear_frequency",), units="1",
+                 long_name="linearised closed loop |X/Y|")]
+    coordinates = [Variable(name="direction", dims=("direction",), dtype="str"),
+                   Variable(name="frequency", dims=("frequency",), units="Hz"),
+                   Variable(name="harmonic", dims=("harmonic",), units="1", dtype="int64"),
+                   Variable(name="linear_frequency", dims=("linear_frequency",), units="Hz")]
+    if response.balance is not None:
+        dimensions["balance_point"] = response.balance.frequency.size
+        coordinates.append(Variable(name="balance_point", dims=("balance_point",),
+                                    dtype="int64"))
+        variables += [
+            Variable(name="balance_frequency", dims=("balance_point",), units="Hz"),
+            Variable(name="balance_transmissibility", dims=("balance_point",), units="1",
+                     long_name="harmonic balance, fundamental amplitude ratio"),
+            Variable(name="balance_relative_amplitude", dims=("balance_point",), units="m"),
+            Variable(name="balance_stable", dims=("balance_point",), units="1", dtype="int8",
+                     long_name="1 where stable (Hill)"),
+            Variable(name="balance_valid", dims=("balance_point",), units="1", dtype="int8",
+                     long_name="1 within stops and saturation")]
+    if response.chirp is not None:
+        dimensions["chirp_frequency"] = response.chirp.frequency.size
+        coordinates.append(Variable(name="chirp_frequency", dims=("chirp_frequency",),
+                                    units="Hz"))
+        variables += [
+            Variable(name="chirp_transmissibility", dims=("chirp_frequency",), units="1",
+                     long_name="chirp and Welch amplitude ratio (PSD ratio)"),
+            Variable(name="chirp_trusted", dims=("chirp_frequency",), units="1", dtype="int8")]
+    return Schema(kind="a steady-state response", dimensions=dimensions,
+                  coordinates=coordinates, variables=variables)
+
+
 def response_dataset(response):
     """The response as an ``xarray.Dataset``: sweeps on ``(direction, frequency)``.
 
     Variables of :class:`~qzs.workflows.response.result.ResponsePoint` on
     ``(direction, frequency)`` (``harmonics`` on ``(direction, frequency, harmonic)``,
     ``reason`` and ``start`` as strings), the linear model on ``linear_frequency``, the
-    harmonic balance on ``balance_point``, the chirp estimate on ``chirp_frequency``; every
-    parameter as a global attribute ``isolator.<name>`` / ``controller.<name>`` with its
-    unit.
+    harmonic balance on ``balance_point``, the chirp estimate on ``chirp_frequency``
+    (:func:`response_schema`); every parameter as a global attribute ``isolator.<name>`` /
+    ``controller.<name>`` with its unit.
 
     Parameters
     ----------
@@ -53,63 +122,32 @@ def response_dataset(response):
     -------
     xarray.Dataset
     """
-    import xarray as xr
-
     from qzs._version import __version__
 
-    directions = list(response.directions)
-    n_harm = len(response.points[0].harmonics) if response.points else 0
-    variables = {}
-    branches = [response.branch(d) for d in directions]
-    for name, (unit, doc) in POINT_FIELDS.items():
-        values = np.array([b[name] for b in branches])
-        if name in ("period_multiple", "periods"):
-            values = values.astype(np.int64)
-        elif name == "converged":
-            values = values.astype(np.int8)
-        variables[name] = (("direction", "frequency"), values,
-                           {"units": unit, "long_name": doc})
-    variables["harmonics"] = (("direction", "frequency", "harmonic"),
-                              np.array([b["harmonics"] for b in branches]).reshape(
-                                  len(directions), response.frequencies.size, n_harm),
-                              {"units": "1", "long_name": "payload acceleration at the "
-                               "harmonic over the base's fundamental"})
-    for name in ("reason", "start"):
-        variables[name] = (("direction", "frequency"),
-                           np.array([b[name] for b in branches], dtype=str), {})
-    variables["linear_transmissibility"] = (
-        ("linear_frequency",), np.asarray(response.linear.get("transmissibility", [])),
-        {"units": "1", "long_name": "linearised closed loop |X/Y|"})
-    coords = {"direction": ("direction", np.array(directions, dtype=str)),
-              "frequency": ("frequency", response.frequencies, {"units": "Hz"}),
-              "harmonic": ("harmonic", np.arange(2, 2 + n_harm), {"units": "1"}),
-              "linear_frequency": ("linear_frequency",
-                                   np.asarray(response.linear.get("frequency", [])),
-                                   {"units": "Hz"})}
+    schema = response_schema(response)
+    sizes = schema.dimensions
+    branches = [response.branch(d) for d in response.directions]
+    values = {name: [b[name] for b in branches] for name in POINT_FIELDS}
+    values.update({
+        "harmonics": np.array([b["harmonics"] for b in branches]).reshape(
+            sizes["direction"], sizes["frequency"], sizes["harmonic"]),
+        "reason": [b["reason"] for b in branches], "start": [b["start"] for b in branches],
+        "linear_transmissibility": response.linear.get("transmissibility", []),
+        "direction": list(response.directions), "frequency": response.frequencies,
+        "harmonic": np.arange(2, 2 + sizes["harmonic"]),
+        "linear_frequency": response.linear.get("frequency", [])})
     if response.balance is not None:
         b = response.balance
-        coords["balance_point"] = ("balance_point", np.arange(b.frequency.size))
-        variables.update({
-            "balance_frequency": ("balance_point", b.frequency, {"units": "Hz"}),
-            "balance_transmissibility": ("balance_point", b.transmissibility,
-                                         {"units": "1", "long_name": "harmonic balance, "
-                                          "fundamental amplitude ratio"}),
-            "balance_relative_amplitude": ("balance_point", b.relative_amplitude,
-                                           {"units": "m"}),
-            "balance_stable": ("balance_point", b.stable.astype(np.int8),
-                               {"units": "1", "long_name": "1 where stable (Hill)"}),
-            "balance_valid": ("balance_point", b.valid.astype(np.int8),
-                              {"units": "1", "long_name": "1 within stops and saturation"})})
+        values.update({"balance_point": np.arange(b.frequency.size),
+                       "balance_frequency": b.frequency,
+                       "balance_transmissibility": b.transmissibility,
+                       "balance_relative_amplitude": b.relative_amplitude,
+                       "balance_stable": b.stable, "balance_valid": b.valid})
     if response.chirp is not None:
-        coords["chirp_frequency"] = ("chirp_frequency", response.chirp.frequency,
-                                     {"units": "Hz"})
-        variables["chirp_transmissibility"] = (
-            "chirp_frequency", response.chirp.magnitude,
-            {"units": "1", "long_name": "chirp and Welch amplitude ratio (PSD ratio)"})
-        variables["chirp_trusted"] = ("chirp_frequency", response.chirp.trusted.astype(np.int8),
-                                      {"units": "1"})
-    attrs = {"Conventions": "CF-1.10",
-             "title": "qzs steady-state frequency response of the semi-active QZS isolator",
+        values.update({"chirp_frequency": response.chirp.frequency,
+                       "chirp_transmissibility": response.chirp.magnitude,
+                       "chirp_trusted": response.chirp.trusted})
+    attrs = {"title": "qzs steady-state frequency response of the semi-active QZS isolator",
              "source": f"qzs {__version__}: stepped-sine simulation (docs/response.md)",
              "qzs_version": __version__, "amplitude": response.amplitude,
              "amplitude_units": "m", "dt": response.dt, "dt_units": "s",
@@ -118,7 +156,7 @@ def response_dataset(response):
     for key, value in response.settings.items():
         attrs[f"settings.{key}"] = value
     attrs.update(_parameter_attributes(response.isolator, response.controller))
-    return xr.Dataset(variables, coords=coords, attrs=attrs)
+    return to_dataset(schema, values, attrs)
 
 
 def write_response(response, path):

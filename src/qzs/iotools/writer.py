@@ -1,0 +1,513 @@
+"""One streaming, atomic CF writer: a result's file written chunk by chunk from its schema.
+
+:class:`StreamWriter` writes the layout of a :class:`~qzs.iotools.schema.Schema` to NetCDF
+(``.nc``, CF-1.10, the unlimited dimension growing with each appended block) or, for a schema
+whose streamed variables are all one-dimensional, to CSV (``.csv``). Which column of an
+appended block goes to which variable is the caller's mapping; the single run's
+:class:`~qzs.engine.results.ResultWriter` and the six-axis run's
+:class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
+
+The file is written to a hidden temporary file beside the target (``.<name>.*.part``) and
+renamed onto the target by :meth:`StreamWriter.finish`; the disk space of each chunk is
+reserved before it is written. :meth:`StreamWriter.abort` removes the temporary file; so
+does any exception (``KeyboardInterrupt`` and :class:`~qzs.errors.Terminated` included)
+while appending or finishing, or when the writer is used as a context manager. Failures
+while writing (a full disk, no permission) raise :class:`~qzs.errors.WriteError` with
+attributes ``path`` and ``reason`` and leave neither the target nor a temporary file behind.
+"""
+import contextlib
+import errno
+import functools
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from qzs.errors import ParameterError, WriteError
+from qzs.iotools.files import RESULT_SUFFIXES, _umask
+from qzs.iotools.schema import CONVENTIONS
+
+__all__ = ["StreamWriter", "estimated_file_size"]
+
+_CSV_FORMAT = "%.10g"
+_FREE_MARGIN = 1 << 20         # bytes kept free beyond an estimate or a chunk
+_CSV_BYTES_PER_VALUE = 17      # "-1.234567891e-05," at the %.10g format
+_NC_CHUNK_INDEX = 128          # chunk index per chunk and variable (B-tree) [bytes]
+_CSV_OVERHEAD = 8 << 10        # header and trailer lines [bytes]
+
+
+def _suffix(path, suffixes=tuple(RESULT_SUFFIXES), kind=None):
+    suffix = Path(path).suffix.lower()
+    if suffix not in suffixes:
+        of = f" of {kind}" if kind else ""
+        raise ParameterError(f"`path`{of} must end in {' or '.join(suffixes)}, got "
+                             f"{str(path)!r}.")
+    return suffix
+
+
+def _row_bytes(schema, variable):
+    """Bytes one sample of a streamed variable takes in a NetCDF file [bytes]."""
+    width = int(np.prod([schema.dimensions[d] for d in variable.dims[1:]], dtype=np.int64))
+    return width * np.dtype(variable.cast([]).dtype).itemsize
+
+
+def estimated_file_size(schema, n_samples, suffix):
+    """Size of a file of ``n_samples`` samples of ``schema`` [bytes], an upper estimate.
+
+    NetCDF: each streamed variable's bytes per sample (8 per float value, 1 per flag) in
+    whole chunks of ``schema.chunk_rows`` samples, plus the chunk index and
+    ``schema.header_bytes``; CSV: about 17 bytes per value (the ``%.10g`` format and a
+    comma) plus the header lines.
+
+    Parameters
+    ----------
+    schema : Schema
+        What the file holds.
+    n_samples : int
+        Samples along the unlimited dimension [samples].
+    suffix : {".nc", ".csv"}
+        The file format (a path's suffix; a path is accepted too).
+
+    Returns
+    -------
+    int
+        Estimated size [bytes].
+    """
+    suffix = _suffix(f"x{suffix}" if str(suffix).startswith(".") else suffix)
+    n = max(int(n_samples), 0)
+    streamed = schema.streamed()
+    if suffix == ".nc":
+        chunks = -(-n // schema.chunk_rows)
+        row = sum(_row_bytes(schema, v) for v in streamed)
+        return (chunks * (schema.chunk_rows * row + _NC_CHUNK_INDEX * len(streamed))
+                + schema.header_bytes)
+    return n * _CSV_BYTES_PER_VALUE * len(streamed) + _CSV_OVERHEAD
+
+
+def _write_error(path, error, action="writing"):
+    """A :class:`WriteError` for an ``OSError`` while writing ``path`` (``path``, ``reason``)."""
+    code = getattr(error, "errno", None)
+    if code is None:  # HDF5 wraps the system error in its message
+        text = str(error)
+        code = next((c for c in (errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EROFS)
+                     if os.strerror(c).lower() in text.lower()), None)
+    reasons = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
+               errno.EACCES: "permission denied", errno.EPERM: "permission denied",
+               errno.EROFS: "the file system is read-only",
+               errno.ENOENT: "the folder does not exist"}
+    reason = reasons.get(code) or (getattr(error, "strerror", None) or str(error)).split("\n")[0]
+    return WriteError(path, reason, f"cannot write {str(path)!r} ({action}): {reason}; "
+                                    "nothing was written.")
+
+
+class StreamWriter:
+    """Stream a result to NetCDF (``.nc``) or CSV (``.csv``) chunk by chunk, atomically.
+
+    Memory grows with the block appended, not with the result. NetCDF files follow the
+    schema (CF-1.10): the unlimited dimension grows with each block, streamed variables
+    are chunked by ``schema.chunk_rows`` samples (and the whole of their other
+    dimensions), flags are int8 with ``flag_values``/``flag_meanings``, variables not
+    along the unlimited dimension are written from ``values`` when the file is created,
+    and the global attributes (``Conventions``, ``attributes``, then those given to
+    :meth:`finish`) at the end. CSV files (a schema whose streamed variables are all one-dimensional) have the
+    ``attributes`` as ``# key = value [unit]`` header lines, one column per streamed
+    variable at the ``%.10g`` format, and the attributes given to :meth:`finish` as
+    trailing ``# key = value`` lines (known only at the end).
+
+    Parameters
+    ----------
+    path : str or Path
+        Target file; its folder is created if missing.
+    schema : Schema
+        What the file holds; one dimension of unlimited length (size None).
+    blocks : mapping of str to int
+        The arrays :meth:`append` takes, in order, by name, with their number of columns
+        (``{"data": 24, "flags": 2}``).
+    columns : mapping of str to (str, int or slice)
+        Each streamed variable -> (block name, column or slice of columns): where its
+        values are in an appended block.
+    values : mapping of str to array_like, optional
+        The values of the variables not along the unlimited dimension (coordinate labels).
+    attributes : mapping, optional
+        Global attributes known before the result (head lines of a CSV file), after
+        ``Conventions`` (CF-1.10).
+    suffixes : tuple of str
+        The formats allowed, by suffix (``.nc``, and ``.csv`` for a one-dimensional
+        schema).
+
+    Raises
+    ------
+    ParameterError
+        A suffix not in ``suffixes``, a CSV file of a schema with variables of more than
+        one dimension, or ``columns``/``values`` that do not name the schema's variables.
+    WriteError
+        The temporary file cannot be created (attributes ``path`` and ``reason``).
+
+    Examples
+    --------
+    >>> with StreamWriter("run.nc", schema, blocks={"data": 3},
+    ...                   columns={"time": ("data", 0), "x": ("data", 1),
+    ...                            "v": ("data", 2)}) as writer:  # doctest: +SKIP
+    ...     for block in blocks:
+    ...         writer.append(block)
+    ...     writer.finish({"history": "..."})
+    """
+
+    def __init__(self, path, schema, *, blocks, columns, values=None, attributes=None,
+                 suffixes=(".nc",)):
+        self.path = Path(path)
+        self.schema = schema
+        self._suffix = _suffix(self.path, tuple(suffixes), schema.kind)
+        if schema.unlimited is None:
+            raise ParameterError(f"{schema.kind} has no dimension of unlimited length (size "
+                                 "None) to stream along.")
+        self._blocks = dict(blocks)
+        self._streamed = schema.streamed()
+        streamed = {v.name for v in self._streamed}
+        self._columns = [(v, list(self._blocks).index(columns[v.name][0]),
+                          columns[v.name][1]) for v in self._streamed
+                         if v.name in columns and columns[v.name][0] in self._blocks]
+        fixed = [v.name for v in schema if v.name not in streamed]
+        values = dict(values or {})
+        wrong = ([n for n in columns if n not in streamed]
+                 + [n for n in values if n not in fixed])
+        missing = ([v.name for v in self._streamed if v.name not in columns]
+                   + [n for n in fixed if n not in values])
+        if wrong or missing or len(self._columns) != len(self._streamed):
+            raise ParameterError(f"`columns` of {schema.kind} must place each streamed "
+                                 f"variable {[v.name for v in self._streamed]} in a block of "
+                                 f"{list(self._blocks)} and `values` give {fixed}; missing "
+                                 f"{missing}, unknown {wrong}.")
+        if self._suffix == ".csv" and (fixed or any(len(v.dims) > 1 for v in self._streamed)):
+            raise ParameterError(f"{schema.kind} has variables of more than one dimension: "
+                                 "write it as NetCDF (.nc), not CSV.")
+        self._values = values
+        self._head = {"Conventions": CONVENTIONS, **(attributes or {})}
+        self._create()
+
+    def _create(self):
+        """The hidden temporary file beside ``path``, its space reserved, opened (``_open``)."""
+        self._rows = 0
+        self._file = None
+        self._tmp = None
+        self._fd = None  # kept open to reserve disk space ahead of the library's writes
+        self._variables = {}
+        self._finished = False
+        with self._aborting("creating the file"):
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part",
+                                             dir=self.path.parent)
+            self._tmp = Path(tmp)
+            _reserve_space(self._fd, self.schema.header_bytes + _FREE_MARGIN, self.path.parent)
+            if self._suffix == ".nc":
+                self._open_netcdf()
+            else:
+                self._open_csv()
+
+    @contextlib.contextmanager
+    def _aborting(self, action):
+        """Abort (remove the temporary file) on any exception; an ``OSError`` (or the HDF5
+        library's ``RuntimeError``) becomes a :class:`WriteError` saying what failed."""
+        try:
+            yield
+        except (OSError, RuntimeError) as error:  # h5py reports some write failures so
+            self.abort()
+            raise _write_error(self.path, error, action) from None
+        except BaseException:
+            self.abort()
+            raise
+
+    @property
+    def rows(self):
+        """Samples written so far [samples]."""
+        return self._rows
+
+    def _size(self, rows):
+        """The file's estimated size with ``rows`` samples [bytes]."""
+        return estimated_file_size(self.schema, rows, self._suffix)
+
+    # -- NetCDF -------------------------------------------------------------------------
+    def _open_netcdf(self):
+        import h5netcdf
+        import h5py
+
+        schema = self.schema
+        self._file = h5netcdf.File(self._tmp, "w")
+        self._file.dimensions = dict(schema.dimensions)
+        self._variables = {}
+        for variable in schema:
+            if variable.dims[:1] == (schema.unlimited,):
+                chunks = (schema.chunk_rows, *(schema.dimensions[d] for d in variable.dims[1:]))
+                created = self._file.create_variable(variable.name, variable.dims,
+                                                     variable.cast([]).dtype, chunks=chunks)
+                self._variables[variable.name] = created
+            elif variable.dtype == "str":  # variable-length strings, as xarray writes them
+                created = self._file.create_variable(variable.name, variable.dims,
+                                                     dtype=h5py.string_dtype())
+                created[:] = np.array(variable.cast(self._values[variable.name]), dtype=object)
+            else:
+                created = self._file.create_variable(
+                    variable.name, variable.dims, data=variable.cast(self._values[variable.name]))
+            for key, value in variable.attrs().items():
+                created.attrs[key] = value
+
+    def _append_netcdf(self, blocks, start, stop):
+        self._file.resize_dimension(self.schema.unlimited, stop)
+        for variable, block, column in self._columns:
+            self._variables[variable.name][start:stop] = variable.cast(blocks[block][:, column])
+        self._file._h5file.flush()  # on disk, inside the space reserved for it
+
+    def _finish_netcdf(self, tail):
+        for key, value in {**self._head, **tail}.items():
+            self._file.attrs[key] = value
+        handle, self._file = self._file, None
+        self._variables = {}
+        _close(handle)
+
+    # -- CSV ----------------------------------------------------------------------------
+    def _open_csv(self):
+        self._file = open(self._tmp, "w", encoding="utf-8", newline="\n")
+        for line in _header_lines(self._head):
+            self._file.write(f"# {line}\n")
+        self._file.write(",".join(v.name for v in self._streamed) + "\n")
+
+    def _append_csv(self, blocks, start, stop):
+        columns = np.empty((stop - start, len(self._columns)))
+        for i, (_, block, column) in enumerate(self._columns):
+            columns[:, i] = blocks[block][:, column]
+        np.savetxt(self._file, columns, delimiter=",", fmt=_CSV_FORMAT)
+
+    def _finish_csv(self, tail):
+        for line in _header_lines(tail):
+            self._file.write(f"# {line}\n")
+        self._file.flush()
+        os.fsync(self._file.fileno())
+        handle, self._file = self._file, None
+        _close(handle)
+
+    # -- public -------------------------------------------------------------------------
+    def _check_open(self, action):
+        if self._finished or self._tmp is None:
+            raise ParameterError(f"cannot {action}: the {type(self).__name__} of "
+                                 f"{str(self.path)!r} is already finished or aborted.")
+
+    def _check_blocks(self, blocks):
+        """The appended blocks as 2-D arrays of one length and their widths, or ParameterError."""
+        arrays = [np.asarray(b) for b in blocks]
+        n = arrays[0].shape[0] if arrays and arrays[0].ndim == 2 else None
+        if (len(arrays) != len(self._blocks) or n is None
+                or any(a.shape != (n, width) for a, width in zip(arrays, self._blocks.values()))):
+            wanted = " and ".join(f"`{name}` (n, {width})" for name, width in self._blocks.items())
+            got = " and ".join(str(a.shape) for a in arrays)
+            raise ParameterError(f"the blocks must have shape {wanted}, got {got or 'none'}.")
+        return arrays
+
+    def append(self, *blocks):
+        """Append samples: one array per block, rows along the unlimited dimension.
+
+        Parameters
+        ----------
+        *blocks : ndarray, shape (n, width)
+            The blocks named by ``blocks`` at creation (e.g. ``data, flags``), with the same
+            number of rows ``n``.
+
+        Raises
+        ------
+        ParameterError
+            Wrong number of blocks or shapes, or the writer is finished.
+        WriteError
+            Writing failed (disk full, permissions): the temporary file is removed
+            (attributes ``path`` and ``reason``).
+        """
+        self._check_open("append")
+        blocks = self._check_blocks(blocks)
+        n = blocks[0].shape[0]
+        if n == 0:
+            return
+        start, stop = self._rows, self._rows + n
+        with self._aborting("writing"):
+            self._check_space(n)
+            if self._suffix == ".nc":
+                self._append_netcdf(blocks, start, stop)
+            else:
+                self._append_csv(blocks, start, stop)
+        self._rows = stop
+
+    def _check_space(self, n):
+        """Reserve the disk space of a chunk before the library writes it.
+
+        The HDF5 library does not survive a full disk (a write that fails with ENOSPC
+        can end in a segmentation fault when the file is closed), so the space is
+        reserved first (``fallocate`` beyond the end of the file, Linux), or, where
+        that is not possible, the free space is checked: a full disk then raises
+        ``OSError(ENOSPC)`` here, before anything is written.
+        """
+        grows = self._size(self._rows + n) - self._size(self._rows)
+        _reserve_space(self._fd, grows + _FREE_MARGIN, self.path.parent)
+
+    def finish(self, attributes=None):
+        """Write the global attributes known at the end, flush, and rename onto ``path``.
+
+        Parameters
+        ----------
+        attributes : mapping, optional
+            Global attributes known only at the end (the run's outcome, ``history``):
+            NetCDF writes them after those given at creation, CSV as trailing lines.
+
+        Returns
+        -------
+        Path
+            The path written.
+
+        Raises
+        ------
+        WriteError
+            Writing failed: the temporary file is removed (attributes ``path`` and
+            ``reason``).
+        """
+        self._check_open("finish")
+        tail = dict(attributes or {})
+        with self._aborting("finishing the file"):
+            if self._suffix == ".nc":
+                self._finish_netcdf(tail)
+            else:
+                self._finish_csv(tail)
+            _release_reserve(self._fd)
+            os.close(self._fd)
+            self._fd = None
+            os.chmod(self._tmp, 0o666 & ~_umask())  # mkstemp makes 0600
+            os.replace(self._tmp, self.path)
+        self._tmp = None
+        self._finished = True
+        return self.path
+
+    def abort(self):
+        """Close and remove the temporary file; ``path`` is left untouched. Idempotent."""
+        handle, self._file = self._file, None
+        self._variables = {}
+        if handle is not None:
+            with contextlib.suppress(Exception):
+                _close(handle)
+        fd, self._fd = self._fd, None
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+        tmp, self._tmp = self._tmp, None
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        if kind is not None or not self._finished:
+            self.abort()
+        return False
+
+    def __del__(self):  # a writer dropped unfinished leaves no temporary file
+        try:
+            self.abort()
+        except Exception:  # noqa: BLE001 - at interpreter exit anything may be gone
+            pass
+
+    def __repr__(self):
+        state = "finished" if self._finished else ("aborted" if self._tmp is None else "open")
+        return f"<{type(self).__name__} {str(self.path)!r}, {self._rows} rows, {state}>"
+
+
+@functools.lru_cache(maxsize=1)
+def _fallocate():
+    """libc's ``fallocate`` (Linux), or None."""
+    import ctypes
+
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        function = ctypes.CDLL(None, use_errno=True).fallocate64
+    except (OSError, AttributeError):  # pragma: no cover - other libcs
+        return None
+    function.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64]
+    function.restype = ctypes.c_int
+    return function
+
+
+_FALLOC_FL_KEEP_SIZE = 1
+
+
+def _reserve_space(fd, length, folder):
+    """Reserve ``length`` bytes of disk beyond the end of the file ``fd`` [bytes].
+
+    ``fallocate(FALLOC_FL_KEEP_SIZE)``: the blocks are allocated, the file's size is
+    unchanged, so later writes there cannot fail for lack of space. Where the system
+    or file system cannot, the free space is compared with ``length`` instead.
+
+    Raises
+    ------
+    OSError
+        ``ENOSPC`` if the disk has not ``length`` bytes free.
+    """
+    function = _fallocate()
+    if function is not None:
+        end = os.fstat(fd).st_size
+        if function(fd, _FALLOC_FL_KEEP_SIZE, end, int(length)) == 0:
+            return
+        import ctypes
+
+        code = ctypes.get_errno()
+        if code not in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+            raise OSError(code, os.strerror(code))
+    if shutil.disk_usage(folder).free < length:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def _release_reserve(fd):
+    """Give back the blocks reserved beyond the end of the file (shrinking frees them)."""
+    size = os.fstat(fd).st_size
+    os.ftruncate(fd, size + 1)
+    os.ftruncate(fd, size)
+
+
+def _close(handle):
+    """Close a file; after a failure make sure the HDF5 library never touches it again.
+
+    h5netcdf's ``close`` flushes attributes and then closes the HDF5 file; when that
+    fails (a full disk), a second attempt, e.g. from its ``__del__``, crashes the
+    interpreter (segmentation fault). So on failure the h5netcdf object is marked
+    closed and only the underlying h5py file is closed (which releases the file
+    descriptor), and the error is raised again.
+    """
+    try:
+        handle.close()
+    except BaseException:
+        if hasattr(handle, "_closed"):  # an h5netcdf.File
+            h5file = getattr(handle, "_File__h5file", None)
+            handle._closed = True
+            handle._File__h5file = None
+            if h5file is not None:
+                with contextlib.suppress(Exception):
+                    h5file.close()
+        raise
+
+
+def _header_lines(attrs):
+    """``key = value [unit]`` lines of a CSV header or trailer; ``<key>_units`` folded in."""
+    lines = []
+    for key, value in attrs.items():
+        if key.endswith("_units") and key[:-len("_units")] in attrs:
+            continue
+        unit = attrs.get(f"{key}_units")
+        text = _format(value)
+        lines.append(f"{key} = {text} [{unit}]" if unit else f"{key} = {text}")
+    return lines
+
+
+def _format(value):
+    if isinstance(value, np.ndarray):
+        return " ".join(_format(v) for v in value.tolist())
+    if isinstance(value, float):
+        return repr(value)
+    return str(value).replace("\n", " ")
