@@ -83,7 +83,7 @@ def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, exci
         else per group of k samples (``run["preview_every"]``) one row of each channel's
         minimum and one of its maximum, the flags' all and any (the run driver's preview,
         :class:`qzs.engine.driver.Recorder`, as a single run's); its summary covers every sample
-        (:class:`qzs.iotools.hexapod_files.HexapodWriter` is such a sink).
+        (:class:`qzs.engine.hexapod.result.HexapodWriter` is such a sink).
     interruptible : bool
         Ctrl-C ends the run after the chunk under way; the result (and the sink) then hold
         what was simulated, and ``run["completed"]`` is False.

@@ -22,7 +22,8 @@ from qzs.cli import main
 from qzs.model.excitation import Chirp
 from qzs.model.hexapod import PlatformParameters, cubic_geometry
 from qzs.workflows.hexapod import hexapod_setup, load_hexapod
-from qzs.workflows.hexapod_transmissibility import (AXES, HexapodTransmissibility,
+from qzs.defaults import AXES
+from qzs.workflows.hexapod_transmissibility import (HexapodTransmissibility,
                                                     hexapod_transmissibility)
 
 FRICTIONLESS = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
@@ -158,10 +159,10 @@ def test_coherent_rounding_and_the_sweeps_start_are_untrusted():
     """The two rules beyond the single axis's, on a column built by hand: an entry at 1e-14
     of the base motion with coherence 1 is rounding, not response; bins the chirp crossed
     in the first quarter of the first segment carry a coherence of 1 by construction."""
-    from qzs.workflows import hexapod_transmissibility as module
+    from qzs.workflows.hexapod_transmissibility import matrix, plan
 
     setup = setup_with(FRICTIONLESS)
-    axes, amplitudes, common, _, _ = module._plan(
+    axes, amplitudes, common, _, _ = plan._plan(
         setup, ("z",), None, 0.0, 20.0, 60.0, 1e-3, None, None, None, "h1", -100.0, 1, False)
     n = common["fft_length"] // 2 + 1
     frequency = np.arange(n) * common["sample_rate"] / common["fft_length"]
@@ -171,7 +172,7 @@ def test_coherent_rounding_and_the_sweeps_start_are_untrusted():
     column = dict(axis="z", frequency=frequency, response=response,
                   coherence=np.ones((6, n)), trusted=np.ones((6, n), dtype=bool),
                   record=dict(energy_residual=0.0, base_work_max=1.0))
-    result = module._assemble(setup, axes, amplitudes, common, {"z": column})
+    result = matrix._assemble(setup, axes, amplitudes, common, {"z": column})
     start = common["trusted_from"]
     assert start == pytest.approx(20.0 / 60.0 * (common["fft_length"] / 1000.0) / 4)
     late = result.frequency >= start

@@ -1,0 +1,208 @@
+"""Validation and the plan of the runs: axes, amplitudes, step, segments, trusted band."""
+from types import MappingProxyType
+
+import numpy as np
+
+from qzs import defaults
+from qzs._validation import as_float, choice, integer, positive
+from qzs.defaults import AXES, AXIS_UNITS
+from qzs.errors import ParameterError
+from qzs.workflows.hexapod_transmissibility.settings import (AMPLITUDE, ESTIMATORS,
+                                                             MIN_SEGMENTS, platform_size)
+
+
+# ---------------------------------------------------------------- validation
+def _axes(axes):
+    if isinstance(axes, str):
+        axes = tuple(a.strip() for a in axes.split(",") if a.strip())
+    try:
+        axes = tuple(axes)
+    except TypeError:
+        raise ParameterError(f"`axes` must be a sequence of base axes among {AXES}, got "
+                             f"{axes!r}.") from None
+    unknown = [a for a in axes if a not in AXES]
+    if unknown or not axes:
+        raise ParameterError(f"`axes` must name at least one base axis among {AXES}, got "
+                             f"{axes!r}" + (f" (unknown: {unknown})" if unknown else "")
+                             + "; e.g. axes=('z', 'x').")
+    twice = sorted({a for a in axes if axes.count(a) > 1})
+    if twice:
+        raise ParameterError(f"`axes` names {twice} more than once ({axes!r}); each axis is "
+                             "one run.")
+    return tuple(a for a in AXES if a in axes)
+
+
+def _amplitudes(amplitude, axes):
+    values = {axis: AMPLITUDE[axis] for axis in axes}
+    if amplitude is None:
+        return values
+    if isinstance(amplitude, dict) or isinstance(amplitude, MappingProxyType):
+        extra = [a for a in amplitude if a not in axes]
+        if extra:
+            raise ParameterError(f"`amplitude` gives {extra}, which are not among the excited "
+                                 f"`axes` {axes}; add them to `axes` or drop them.")
+        given = dict(amplitude)
+    else:
+        kinds = {axis in AXES[3:] for axis in axes}
+        if len(kinds) > 1:
+            raise ParameterError(
+                f"`amplitude` {amplitude!r} is one number, but the `axes` {axes} mix "
+                "translations [m] and rotations [rad]; give a mapping, e.g. "
+                "amplitude={'z': 0.002, 'rx': 0.01} (on the command line "
+                "--amplitude z=0.002,rx=0.01).")
+        given = dict.fromkeys(axes, amplitude)
+    for axis, value in given.items():
+        unit = AXIS_UNITS[AXES.index(axis)]
+        number = as_float(f"amplitude[{axis!r}]", value)
+        if not number > 0:
+            raise ParameterError(f"`amplitude[{axis!r}]` must be a positive amplitude [{unit}], "
+                                 f"got {value!r}.")
+        values[axis] = number
+    return values
+
+
+def _optional_positive(name, value):
+    return None if value is None else positive(name, value)
+
+
+def _stable(setup, controller, solver):
+    """``stable(dt)`` of the set-up's legs, the engine's own check."""
+    from qzs.engine.hexapod import hexapod_stability_test
+
+    return hexapod_stability_test(setup.geometry, setup.platform, setup.isolator, controller,
+                                  solver)
+
+
+def _default_fft_length(n_samples, longest=defaults.ANALYSIS["fft_length"]):
+    """A power of two giving at least :data:`MIN_SEGMENTS` half-overlapping segments."""
+    fitting = 2 * n_samples / (MIN_SEGMENTS + 1)
+    length = 2 ** int(np.floor(np.log2(max(fitting, 64))))
+    return int(min(length, longest))
+
+
+def sweep_trusted_from(f0, f1, duration, fft_length, sample_rate):
+    """Lowest frequency [Hz] a linear chirp's estimate may be trusted at.
+
+    The chirp crosses the bins below ``f0 + (f1 - f0) * T/(4 * duration)`` (``T`` the
+    Welch segment's length) in the first quarter of the first segment: under its rising
+    Hann taper and in no other segment. There a single windowed stretch, dominated by the
+    motions' slow trends (the constant detrend removes only the mean), carries the bin,
+    and its coherence is 1 by construction, whatever caused the platform's motion.
+
+    Parameters
+    ----------
+    f0, f1 : float
+        The chirp's start and end frequency [Hz].
+    duration : float
+        Its sweep time [s].
+    fft_length : int
+        Welch segment length [samples].
+    sample_rate : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    float
+        [Hz].
+    """
+    return f0 + (f1 - f0) * (fft_length / sample_rate) / (4.0 * duration)
+
+
+def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
+          estimator, floor_db, workers, progress):
+    """Check every argument; the runs' common settings and one task per axis."""
+    from qzs.model.excitation import Chirp
+    from qzs.workflows.hexapod import HexapodSetup
+
+    if not isinstance(setup, HexapodSetup):
+        raise ParameterError(f"`setup` must be a HexapodSetup (qzs.workflows.hexapod."
+                             f"load_hexapod or hexapod_setup), got {type(setup).__name__}.")
+    axes = _axes(axes)
+    amplitudes = _amplitudes(amplitude, axes)
+    f0 = as_float("f0", f0)
+    f1 = as_float("f1", f1)
+    if not 0 <= f0 < f1:
+        raise ParameterError(f"the chirp must rise: 0 <= `f0` < `f1` [Hz], got f0={f0!r}, "
+                             f"f1={f1!r}.")
+    duration = positive("duration", duration)
+    sample_rate = positive("sample_rate", sample_rate if sample_rate is not None else
+                           setup.simulation.get("sample_rate",
+                                                defaults.SIMULATION["sample_rate"]))
+    if f1 >= 0.5 * sample_rate:
+        raise ParameterError(f"`f1` ({f1:g} Hz) must lie below the output's Nyquist frequency "
+                             f"{0.5 * sample_rate:g} Hz; raise `sample_rate` or lower `f1`.")
+    solver = choice("solver", solver if solver is not None else
+                    setup.simulation.get("solver", defaults.SIMULATION["solver"]),
+                    ("ode3", "rk4", "euler"))
+    setup_dt = positive("the set-up's [simulation] dt",
+                        setup.simulation.get("dt", defaults.SIMULATION["dt"]))
+    dt = _optional_positive("dt", dt)
+    from qzs.engine.prepare import steps_per_sample
+
+    for name, step in (("dt", dt), ("the set-up's [simulation] dt", setup_dt)):
+        if step is not None:
+            if step > duration:
+                raise ParameterError(f"`{name}` ({step!r} s) must not exceed `duration` "
+                                     f"({duration!r} s).")
+            steps_per_sample(sample_rate, step, "sample_rate")  # a whole number of steps
+    n_samples = int(round(duration * sample_rate)) + 1
+    if fft_length is None:
+        fft_length = _default_fft_length(n_samples, defaults.ANALYSIS["quick_fft_length"])
+    fft_length = integer("fft_length", fft_length, 8)
+    if fft_length > n_samples:
+        raise ParameterError(f"`fft_length` ({fft_length} samples) exceeds the run's "
+                             f"{n_samples} samples ({duration:g} s at {sample_rate:g} Hz); "
+                             "lower it or lengthen `duration`.")
+    estimator = choice("estimator", estimator, ESTIMATORS)
+    floor_db = as_float("floor_db", floor_db)
+    if not floor_db < 0:
+        raise ParameterError(f"`floor_db` must be negative (a level below the base motion) "
+                             f"[dB], got {floor_db!r}.")
+    if workers is not None:
+        workers = integer("workers", workers, 1)
+    if not isinstance(progress, (bool, np.bool_)):
+        raise ParameterError(f"`progress` must be True or False, got {progress!r}.")
+    stable = _stable(setup, setup.controller, solver)
+    step = dt if dt is not None else setup_dt
+    if not stable(step):
+        from qzs.errors import StabilityError
+
+        which = "`dt`" if dt is not None else "the set-up's [simulation] dt"
+        raise StabilityError(f"{which} ({step!r} s) is too large for a stable {solver} "
+                             "integration of this hexapod (a leg's stop contact or loop on "
+                             "the lightest mass the legs move); reduce it.")
+    chirps = {}
+    for axis in axes:
+        try:
+            chirps[axis] = Chirp(amplitude=amplitudes[axis], f0=f0, f1=f1, duration=duration)
+        except ValueError as error:
+            raise ParameterError(f"the chirp of axis {axis!r}: {error}") from None
+    common = dict(f0=f0, f1=f1, duration=duration, sample_rate=sample_rate, solver=solver,
+                  fft_length=fft_length, overlap=defaults.ANALYSIS["overlap"],
+                  estimator=estimator, coherence_min=defaults.ANALYSIS["coherence_min"],
+                  base_share_min=defaults.ANALYSIS["base_share_min"], floor_db=floor_db,
+                  platform_size=platform_size(setup.geometry),
+                  trusted_from=sweep_trusted_from(f0, f1, duration, fft_length, sample_rate),
+                  tolerance_db=defaults.ACCURACY["tolerance_db"], setup_dt=setup_dt,
+                  dt=dt, frame="top frame origin (the cube's centre of a cubic geometry)")
+    tasks = [dict(axis=axis, excitation=chirps[axis], geometry=setup.geometry,
+                  platform=setup.platform, isolator=setup.isolator,
+                  controller=setup.controller, cartesian=getattr(setup, "cartesian", None),
+                  **common) for axis in axes]
+    return axes, amplitudes, common, tasks, workers
+
+
+def _dry_run(task):
+    """One step of the first run: the engine checks the set-up before any long run."""
+    from qzs.engine.hexapod import simulate_hexapod
+
+    step = task["dt"] or task["setup_dt"]
+    simulate_hexapod(task["geometry"], task["platform"], task["isolator"], task["controller"],
+                     excitation={task["axis"]: task["excitation"]}, duration=step, dt=step,
+                     sample_rate=task["sample_rate"], solver=task["solver"],
+                     **_control(task))
+
+
+def _control(task):
+    """The centralised controller keyword, where the set-up has one."""
+    return {} if task.get("cartesian") is None else {"cartesian": task["cartesian"]}
