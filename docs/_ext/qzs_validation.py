@@ -53,6 +53,7 @@ SECTIONS = {
     "analysis.harmonic_balance.test_residual": "Harmonic balance: the residual and its Jacobian",
     "analysis.harmonic_balance.test_solution": "Harmonic balance: one periodic response",
     "analysis.harmonic_balance.test_stability": "Harmonic balance: Floquet exponents",
+    "analysis.harmonic_balance.test_curve": "Harmonic balance: folds along the curve",
     "analysis.harmonic_balance.test_continuation":
         "Harmonic balance: continuation in frequency",
     "identify.test_spring": "Fits: the MagSpring",

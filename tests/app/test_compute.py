@@ -3,6 +3,14 @@
 Reference checks: the page's transmissibility is what ``qzs.transmissibility`` gives for
 the same run, its linear curve what ``qzs.linearize`` gives, its errors the API's own, its
 TOML export what ``qzs.iotools.load_config`` reads back to the same parameters.
+
+Properties that fail if the page's numbers are wrong: its Welch segment length is the longest
+power of two (256 to 32768) whose half-overlapping segments number at least 24, counted
+here as scipy's Welch counts them (``1 + (n - L) // (L/2)``), and the estimate averages
+that many; its locked shares, strokes and motor peak are those of ``qzs.simulate`` runs of
+the same sine and chirp at the page's steps, each under its own name ("sine" the
+time-response sine, "excitation" the chirp, or the stepped sine's mean over its
+frequencies).
 """
 import dataclasses
 import math
@@ -202,3 +210,70 @@ def test_toml_export_runs_with_qzs_simulate(tmp_path):
     from qzs.cli import main
 
     assert main(["simulate", "--config", str(path), "--plot", "none", "--quiet"]) == 0
+
+
+# ---------------------------------------------------------------- the page's numbers
+def welch_segments(samples, length):
+    """Half-overlapping segments of ``length`` in ``samples``, as scipy.signal.welch takes
+    them (the last partial segment dropped)."""
+    return 0 if samples < length else 1 + (samples - length) // (length // 2)
+
+
+def test_welch_length_is_the_longest_power_of_two_with_24_segments():
+    """docs/app.md: segments of about 1/24 of the run, a power of two, at most the paper's
+    32768; at least 256 however short the run. Checked on both sides of every boundary."""
+    powers = [2 ** k for k in range(8, 16)]
+    samples = [n for length in powers for n in (25 * length // 2 - 1, 25 * length // 2,
+                                                25 * length // 2 + 1, 40 * length)]
+    samples += [1000, 200_001, 10 ** 7]
+    for n in samples:
+        fitting = [length for length in powers if welch_segments(n, length) >= 24]
+        assert welch_length(n) == (max(fitting) if fitting else 256), n
+
+
+@pytest.fixture(scope="module")
+def default_runs(default_page):
+    """The default page's chirp and sine, run by qzs.simulate at the page's steps."""
+    request = default_page.request
+    chirp = simulate(request.chirp(), request.isolator, request.controller,
+                     dt=default_page.dt, sample_rate=request.sample_rate)
+    sine = simulate(request.sine(), request.isolator, request.controller,
+                    duration=request.sine_duration, dt=default_page.sine_dt,
+                    sample_rate=request.sample_rate)
+    return chirp, sine
+
+
+def test_the_chirps_estimate_averages_24_segments_or_more(default_page, default_runs):
+    chirp, _ = default_runs
+    estimate = default_page.estimate
+    assert estimate.fft_length == 8192  # docs/app.md, for the default 200 s at 1 kHz
+    assert welch_segments(len(chirp), 8192) >= 24 > welch_segments(len(chirp), 16384)
+    assert estimate.n_averages == welch_segments(len(chirp), estimate.fft_length)
+
+
+def test_locked_shares_and_summary_are_the_runs_own(default_page, default_runs):
+    """Each share is the mean of that run's ``locked`` flag; the two differ (10.2 % and
+    10.3 %), so shares given to the wrong run fail."""
+    chirp, sine = default_runs
+    shares = default_page.locked_share
+    assert shares["sine"] == np.mean(sine["locked"])
+    assert shares["excitation"] == np.mean(chirp["locked"])
+    assert shares["sine"] != shares["excitation"]
+    center = 0.5 * (chirp.run["stop_low"] + chirp.run["stop_high"])
+    summary = default_page.summary
+    assert summary["peak_stroke"] == np.max(np.abs(chirp.relative_position - center))
+    assert summary["sine_peak_stroke"] == np.max(np.abs(sine.relative_position - center))
+    assert summary["motor_force_peak"] == np.max(np.abs(chirp.motor_force))
+    assert summary["sine_motor_force_peak"] == np.max(np.abs(sine.motor_force))
+    assert summary["stop_contacts"] == chirp.run["stop_contacts"]
+    # the time traces are the sine run's, not the chirp's
+    assert default_page.traces["relative_position"][1].max() == sine.relative_position.max()
+
+
+def test_a_stepped_sines_locked_share_is_the_mean_over_its_frequencies(stepped_page):
+    """docs/app.md: the stepped sine's share is the mean over its frequencies (here 1, 0.34,
+    0 and 0: the mean, not the largest or the last)."""
+    locked = stepped_page.response.branch("up")["locked_fraction"]
+    assert np.ptp(locked) > 0.5
+    assert stepped_page.locked_share["excitation"] == pytest.approx(np.mean(locked), rel=1e-12)
+

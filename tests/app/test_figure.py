@@ -1,4 +1,5 @@
 """The page's figure drawn with matplotlib (qzs.app.figure): every panel, and the PNG export."""
+import pytest
 
 
 def test_png_export_has_every_panel(default_page):
@@ -11,3 +12,18 @@ def test_png_export_has_every_panel(default_page):
                       "relative position z [mm]", "motor force [N]"]
     assert all("[" in axes.get_xlabel() or axes.get_xlabel() == "" for axes in figure.axes)
     assert figure_png(default_page, pinned)[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_each_locked_share_is_drawn_on_its_own_bar(default_page):
+    """The bar named for the sine shows the sine run's share, the chirp's bar the chirp's."""
+    from qzs.app.figure import page_figure
+
+    figure = page_figure(default_page)
+    (axes,) = [a for a in figure.axes if a.get_ylabel() == "time locked [%]"]
+    names = [label.get_text() for label in axes.get_xticklabels()]
+    heights = [bar.get_height() for bar in axes.patches]
+    shares = default_page.locked_share
+    assert names == ["3 Hz sine", "chirp"]
+    assert heights == pytest.approx([100 * shares["sine"], 100 * shares["excitation"]],
+                                    rel=1e-12)
+

@@ -57,6 +57,10 @@ def test_the_page_draws_the_default_request(page):
     assert not page.alert.visible
     assert page.status.object.startswith("ready")
     assert "dt = 1 ms" in page.summary.object
+    # each locked share on the bar named for its run
+    bars = dict(zip(*(page.sources["locked"].data[key] for key in ("run", "share"))))
+    assert bars == {"time-response sine": 100 * page.data.locked_share["sine"],
+                    "chirp or stepped sine": 100 * page.data.locked_share["excitation"]}
 
 
 def test_every_label_carries_the_registry_unit(page):

@@ -1,4 +1,16 @@
-"""The accuracy-driven step (qzs.engine.accuracy, docs/model.md §7 "Accuracy-driven step")."""
+"""The accuracy-driven step (qzs.engine.accuracy, docs/model.md §7 "Accuracy-driven step").
+
+Properties that fail if the step chooser is wrong:
+
+* its error estimate is the Richardson extrapolation ``d r/(r - 1)`` of the difference ``d``
+  to the next finer step, ``r`` the observed ratio capped at ``2**order``: on an exact power
+  law ``e_j = C dt_j**p`` it equals the error ``e_j`` to round-off, and on a linear plant it
+  equals the error measured against a run 512 (state) or 128 (dB) times finer to 1 %
+  (relative: a factor wrong by a few percent fails);
+* the step chosen is the largest candidate that meets the tolerance: with the tolerance set
+  between the measured errors (times ``safety``) of two neighbouring candidates, the finer
+  one is chosen, the coarser one fails it.
+"""
 import math
 
 import numpy as np
@@ -8,7 +20,8 @@ import qzs.engine.simulate as simulate_module
 from helpers import linear_controller, linear_isolator
 from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine, simulate
 from qzs.engine import StepChoice, choose_step
-from qzs.engine.accuracy import probe_excitation, step_error
+from qzs.engine.accuracy import (SAFETY, admissible_step, halving_search, probe_excitation,
+                                 step_error)
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.stability import largest_stable_step, stability_test
 from qzs.errors import ParameterError
@@ -176,3 +189,92 @@ def test_summary_names_the_step_and_the_binding_limit():
     with pytest.raises(AttributeError):
         choice.dt = 1.0  # frozen
     assert np.isfinite(choice.error)
+
+
+
+# ---------------------------------------------------------------- the estimate and the choice
+@pytest.mark.parametrize("order", [1, 3, 4])
+def test_on_an_exact_power_law_the_estimate_is_the_error(order):
+    """``e_j = C dt_j**p``: the differences fall by exactly ``2**p``, and the extrapolation
+    ``d_j 2**p/(2**p - 1)`` is ``e_j``. The tolerance lies between ``safety*e_{k-1}`` and
+    ``safety*e_k``: candidate k is chosen, every coarser one's estimate fails it."""
+    dt0, constant = 1e-3, 5e4
+
+    def error(j):
+        return constant * (dt0 / 2 ** j) ** order
+
+    for k in range(0, 5):
+        tolerance = SAFETY * error(k) * (2 ** (order / 2) if k else 1.5)
+        chosen, history = halving_search(lambda j: error(j) - error(j + 1), order, tolerance,
+                                         dt0, 8)
+        assert chosen == k
+        for j, (dt, difference, estimate) in enumerate(history):
+            assert dt == dt0 / 2 ** j
+            assert difference == pytest.approx(error(j) - error(j + 1), rel=1e-12)
+            assert estimate == pytest.approx(error(j), rel=1e-12)
+            assert (SAFETY * estimate <= tolerance) == (j == k)
+
+
+@pytest.mark.parametrize("ratio, used", [(30.0, 8.0), (8.0, 8.0), (3.0, 3.0), (1.5, 1.5)])
+def test_the_observed_ratio_extrapolates_capped_at_the_schemes(ratio, used):
+    """Third order: differences falling faster than 8 per halving extrapolate with 8 (the
+    asymptotic ratio), slower ones (stick-slip events) with the observed ratio."""
+    differences = [ratio ** -j for j in range(10)]
+    _, history = halving_search(lambda j: differences[j], 3, 1e-30, 1.0, 5)
+    for j, (_, difference, estimate) in enumerate(history):
+        assert estimate == pytest.approx(differences[j] * used / (used - 1), rel=1e-12)
+
+
+def test_no_estimate_where_the_differences_do_not_shrink():
+    _, history = halving_search(lambda j: [1.0, 1.0, 0.5, 0.25, 0.1][j], 3, 1e-30, 1.0, 4)
+    assert history[0][2] == math.inf  # 1.0 then 1.0: ratio 1
+    assert history[1][2] == pytest.approx(1.0 * 2.0 / (2.0 - 1))  # 1.0 then 0.5: ratio 2
+    assert halving_search(lambda j: 0.0, 3, 1e-9, 1.0, 4)[0] == 0  # exact: no error
+
+
+def _candidate_errors(excitation, isolator, controller, measure, run, count, finer, band=None):
+    """Errors of the candidates ``dt_0/2**j``, j < count, against a run ``2**finer`` times
+    finer than ``dt_0``, measured as :func:`step_error` measures them."""
+    dt0 = admissible_step(run["sample_rate"], 0.0,
+                          stability_test(isolator, controller, run["solver"]))[0]
+    reference = simulate(excitation, isolator, controller, dt=dt0 / 2 ** finer, **run)
+    return dt0, [step_error(simulate(excitation, isolator, controller, dt=dt0 / 2 ** j, **run),
+                            reference, measure, band=band) for j in range(count)]
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_the_chosen_step_is_the_largest_whose_state_error_meets_the_tolerance(k):
+    """Linear plant, smooth sine, third order: the candidates' state errors against a run
+    512 times finer. With the tolerance between ``safety`` times the errors of candidates
+    k-1 and k, candidate k is chosen and its reported error is its measured one."""
+    excitation = Sine(frequency=2.0, amplitude=0.01, fade_in=0.0)
+    isolator, controller = linear_isolator(), linear_controller(pi_kp=50.0)
+    run = dict(duration=10.0, sample_rate=100.0, solver="ode3")
+    dt0, errors = _candidate_errors(excitation, isolator, controller, "state_m", run, k + 1, 9)
+    tolerance = SAFETY * math.sqrt(errors[k - 1] * errors[k])
+    choice = choose_step(excitation, isolator, controller, tolerance_state=tolerance,
+                         solver="ode3", sample_rate=100.0, probe_duration=10.0)
+    assert choice.probe is excitation
+    assert choice.dt == dt0 / 2 ** k
+    assert SAFETY * errors[k] <= tolerance < SAFETY * errors[k - 1]  # the next larger fails
+    assert choice.error == pytest.approx(errors[k], rel=0.01)
+    assert choice.history[-1][2] == choice.error
+
+
+def test_the_chosen_step_is_the_largest_whose_db_error_meets_the_tolerance():
+    """The same for the transmissibility [dB] over 1-20 Hz of a chirp's probe (a linear
+    plant: the Welch estimates of two steps differ by a power of the step)."""
+    isolator, controller = linear_isolator(), linear_controller(pi_kp=50.0)
+    band = (1.0, 20.0)
+    probe, duration = probe_excitation(Chirp(duration=20.0), band, 20.0)
+    run = dict(duration=duration, sample_rate=1000.0, solver="ode3")
+    dt0, errors = _candidate_errors(probe, isolator, controller, "transmissibility_db", run, 2,
+                                    7, band)
+    tolerance = SAFETY * math.sqrt(errors[0] * errors[1])
+    choice = choose_step(Chirp(duration=20.0), isolator, controller, tolerance_db=tolerance,
+                         band=band, probe_duration=20.0)
+    assert choice.probe == probe
+    assert choice.dt == dt0 / 2
+    assert SAFETY * errors[1] <= tolerance < SAFETY * errors[0]
+    assert choice.error == pytest.approx(errors[1], rel=0.01)
+

@@ -1,13 +1,16 @@
 """Continuation in frequency (qzs.analysis.harmonic_balance.continuation): the closed-form
 transmissibility of a linear model over the whole range, and the stepped-sine simulation where
 the response is smooth (a frictionless MagSpring driven into its softening bend, with folds,
-an unstable branch and jumps)."""
+an unstable branch and jumps), and the same curve whatever frequency the continuation started
+from (followed down and up from a start above the bottom: the same folds, no fold at the
+start, the points in arclength order)."""
 import numpy as np
 import pytest
 
 from qzs import ParameterError
 from qzs.analysis.harmonic_balance import (SmoothModel, frequency_response_curve,
                                            periodic_response)
+from qzs.analysis.harmonic_balance import continuation
 from qzs.workflows.response import steady_state_response
 
 
@@ -69,6 +72,33 @@ def test_harmonic_balance_is_the_stepped_sine_where_the_response_is_smooth(softe
     validation("Stepped sine up and down a folding softening resonance, 3-4.6 Hz",
                "harmonic balance (20 harmonics) on the stable branch",
                worst, 3e-4)
+
+
+def test_a_curve_started_above_the_bottom_is_the_same_curve(softening_curve, softening,
+                                                           monkeypatch):
+    """Newton made to fail below 3.3 Hz: the continuation starts at the fourth geometric
+    frequency (3.371 Hz) and is followed down to 3 Hz and up from there. The part below,
+    reversed (points and tangents), joins the rest without a fold at the start; the folds
+    are the curve's from the bottom (to the placement's interpolation error, 5e-4 Hz) and
+    the fundamental's phase rises along the whole curve."""
+    newton = continuation._newton
+
+    def failing_below(q, omega, *args):
+        if omega < 2 * np.pi * 3.3:
+            return q, False, 1, 1.0
+        return newton(q, omega, *args)
+
+    monkeypatch.setattr(continuation, "_newton", failing_below)
+    curve = frequency_response_curve(softening_curve.model, (3.0, 4.6),
+                                     harmonics=softening["harmonics"])
+    assert curve.notes == ("the continuation started at 3.371 Hz (Newton failed below) and "
+                           "went both ways from there",)
+    assert curve.frequency[0] <= 3.0 < 3.3 < curve.frequency[np.argmax(curve.frequency > 3.3)]
+    phase = np.unwrap(np.arctan2(curve.coefficients[:, 2], curve.coefficients[:, 1]))
+    assert np.all(np.diff(phase) > 0)
+    assert len(curve.folds) == 2
+    assert sorted(curve.folds) == pytest.approx(sorted(softening_curve.folds), abs=5e-4)
+    assert np.count_nonzero(np.diff(curve.stable.astype(int))) == 2
 
 
 @pytest.mark.parametrize("call, name", [

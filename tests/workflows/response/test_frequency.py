@@ -8,17 +8,30 @@ no one here wrote.
   c* = 1/sqrt(1 + pi^2/4), with fundamental transmissibility 4c/pi (docs/response.md §6);
 * the linearised closed loop (python-control) for a frictionless guide;
 * sub-harmonic responses of an impact oscillator, confirmed on one uncut simulation;
-* a response that does not settle: NaN with its reason.
+* a response that does not settle: NaN with its reason;
+* the decision that a response is periodic (docs/response.md §3), on sequences of changes
+  whose answer is known, and on a linear plant whose decay is known in closed form.
+
+Property that fails if the periodicity rule is loosened or tightened: a geometric approach
+of known ratio rho is accepted exactly when its last 3 changes are within the tolerance and
+its extrapolated remainder ``d rho^m/(1 - rho^m)`` is (on either side of the boundary, to 1
+part in 1e9); 2 periods of 3 within the tolerance are not enough; the ratio used is the
+largest of the changes'; a period-m answer needs every shorter period's change above 1000
+tolerances; and an overdamped linear plant started from rest settles in the number of periods
+after which its closed-form transient ``expm(A T)^k e_0`` is within the tolerance, to one.
 """
 import math
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
 from scipy.optimize import root
 
 import qzs
 from qzs import ControllerParameters, IsolatorParameters, Sine
+from helpers import linear_controller, linear_isolator
 from qzs.workflows.response import SAMPLES_PER_PERIOD, steady_state_response, steps_for
+from qzs.workflows.response.frequency import _period_multiple
 
 MASS = 6.4
 PASSIVE = ControllerParameters(pi_kp=0.0, pi_ki=0.0, position_setpoint=0.0)
@@ -269,3 +282,114 @@ def test_a_response_that_does_not_settle_is_nan_with_its_reason():
     assert math.isnan(held.transmissibility) and math.isnan(held.locked_fraction)
     assert "not periodic after 300 periods" in held.reason and "PI integral" in held.reason
     assert any("NaN" in note for note in response.notes)
+
+
+# ---------------------------------------------------------------- when is it periodic?
+TOLERANCE = 1e-6
+
+
+def decide(history, multiple=1, shorter=1.0):
+    """The rule's answer for the m-period changes ``history`` (oldest first); every shorter
+    period's changes are ``shorter`` (default: far from settling)."""
+    changes = {m: [] for m in (1, 2, 3)}
+    for j in range(1, multiple):
+        changes[j] = [shorter] * len(history)
+    changes[multiple] = list(history)
+    return _period_multiple(changes, TOLERANCE)
+
+
+def geometric(rho, multiple, count=6):
+    """Changes of a geometric approach of per-period ratio ``rho`` scaled so that it sits on
+    the rule's boundary: its binding quantity (the largest of the last 3 changes, or the
+    extrapolated remainder ``d rho^m/(1 - rho^m)``) equals the tolerance."""
+    d = rho ** np.arange(count)
+    remainder = d[-1] * rho ** multiple / (1 - rho ** multiple)
+    return d * TOLERANCE / max(d[-3:].max(), remainder)
+
+
+@pytest.mark.parametrize("multiple", [1, 2, 3])
+@pytest.mark.parametrize("rho", [0.3, 0.5, 0.8, 0.95, 0.999])
+def test_a_geometric_approach_settles_exactly_when_its_remainder_is_within_tolerance(rho,
+                                                                                   multiple):
+    history = geometric(rho, multiple)
+    assert decide(history * (1 - 1e-9), multiple) == multiple
+    assert decide(history * (1 + 1e-9), multiple) == 0
+    remainder = history[-1] * rho ** multiple / (1 - rho ** multiple)
+    if remainder > history[-3:].max():  # the remainder binds: changes within it are not enough
+        assert remainder == pytest.approx(TOLERANCE, rel=1e-12)
+        assert history[-3:].max() * (1 + 1e-9) < TOLERANCE
+
+
+def test_two_periods_of_three_within_the_tolerance_are_not_enough():
+    """Changes falling a thousandfold a period: the remainder is tiny at once, but the
+    change three periods back is above the tolerance; one more period settles it."""
+    history = [10.0, 2 * TOLERANCE, 1e-3 * TOLERANCE, 1e-6 * TOLERANCE]
+    assert decide(history) == 0
+    assert decide(history[1:]) == 0  # no matter how long the history
+    assert decide(history + [1e-9 * TOLERANCE]) == 1
+    assert decide(history[2:]) == 0  # two periods only: not yet three
+
+
+def test_the_remainder_uses_the_largest_ratio_of_the_last_changes():
+    """Ratios 0.9 then 0.5: the approach may be as slow as 0.9, remainder ``d 0.9/0.1``
+    (not ``d 0.5/0.5`` from the last ratio alone)."""
+    d = np.array([1.0, 0.9, 0.45])
+    scale = TOLERANCE / (d[-1] * 0.9 / 0.1)
+    assert decide(d * scale * (1 - 1e-9)) == 1
+    assert decide(d * scale * (1 + 1e-9)) == 0
+    # and only the last three periods count: an early slow stretch is forgotten
+    assert decide(np.concatenate([[10.0, 9.99], 0.1 ** np.arange(3) * TOLERANCE])) == 1
+
+
+def test_round_off_changes_are_exact_repetition_and_growth_never_settles():
+    assert decide([0.0, 0.0, 0.0]) == 1  # a locked payload repeats bit for bit
+    assert decide([1e-12, 1e-13, 0.0]) == 1  # below round-off (1e-11): zero
+    assert decide([0.0, 0.5 * TOLERANCE, 0.4 * TOLERANCE]) == 0  # from zero to non-zero
+    assert decide([0.1, 0.1, 0.1] * np.array(TOLERANCE)) == 0  # not shrinking: inf
+    assert decide([0.2, 0.3, 0.1] * np.array(TOLERANCE)) == 0  # a ratio above one
+
+
+@pytest.mark.parametrize("multiple", [2, 3])
+def test_a_subharmonic_needs_every_shorter_period_far_from_settling(multiple):
+    """A period-1 response approached slowly meets the 2-period test a little before the
+    1-period one: period m is taken only with the shorter changes above 1000 tolerances."""
+    settled = [0.0, 0.0, 0.0]
+    assert decide(settled, multiple, shorter=1001 * TOLERANCE) == multiple
+    assert decide(settled, multiple, shorter=999 * TOLERANCE) == 0
+    # and period 1 is tried first: settled in both, the answer is 1
+    assert _period_multiple({1: settled, 2: settled, 3: settled}, TOLERANCE) == 1
+
+
+def closed_form_settling(mass, stiffness, damping, amplitude, frequency, tolerance):
+    """Periods after which the transient of ``m z'' + c z' + k z = m A w^2 cos(w t)`` from
+    rest (z = z' = 0) is within ``tolerance`` of the periodic orbit, in the rule's scaled
+    state (z / A, z' / (A w)): ``e_k = expm(M T)^k e_0``, ``e_0`` minus the orbit at t = 0."""
+    omega = 2 * np.pi * frequency
+    orbit = mass * amplitude * omega ** 2 / (stiffness - mass * omega ** 2 + 1j * damping * omega)
+    error = -np.array([orbit.real, (1j * omega * orbit).real])
+    monodromy = expm(np.array([[0.0, 1.0], [-stiffness / mass, -damping / mass]]) / frequency)
+    scale = np.array([amplitude, amplitude * omega])
+    for periods in range(1, 10_000):
+        error = monodromy @ error
+        if np.max(np.abs(error) / scale) <= tolerance:
+            return periods, float(np.max(np.abs(np.linalg.eigvals(monodromy))))
+    raise AssertionError("no settling")
+
+
+@pytest.mark.parametrize("stiffness, damping, frequency", [
+    (100.0, 100.0, 5.0), (100.0, 200.0, 5.0), (100.0, 100.0, 2.0)])
+def test_a_linear_plant_settles_when_its_closed_form_transient_is_within_tolerance(
+        stiffness, damping, frequency):
+    """Overdamped (one slow real pole): the approach is geometric, ratio 0.58-0.90 per
+    period, and the rule's remainder is the distance to the orbit. Without the remainder
+    (changes alone within the tolerance) the run would stop 8-40 periods too soon."""
+    amplitude = 0.005
+    isolator = linear_isolator(stiffness=stiffness, damping=damping)
+    expected, rho = closed_form_settling(MASS, stiffness, damping, amplitude, frequency,
+                                         TOLERANCE)
+    point = run([frequency], amplitude, isolator, linear_controller(), fade_in=0.0,
+                periodic_tolerance=TOLERANCE).points[0]
+    assert point.converged and point.period_multiple == 1, point.reason
+    assert abs(point.periods - expected) <= 1, (point.periods, expected, rho)
+    assert point.residual <= TOLERANCE
+

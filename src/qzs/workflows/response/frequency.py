@@ -89,6 +89,38 @@ def _remaining(history, multiple):
     return last * contraction / (1.0 - contraction)
 
 
+def _period_multiple(changes, tolerance):
+    """The period multiple the response has settled on, 0 if none (docs/response.md §3).
+
+    Period m when, over the last :data:`CONSECUTIVE_PERIODS` periods, every m-period change
+    is within ``tolerance``, so is the extrapolated rest of the approach
+    (:func:`_remaining`), and every shorter period's last change stays above
+    :data:`SUBHARMONIC_SEPARATION` tolerances (a period-1 response approached slowly can
+    meet the 2-period test a little before the 1-period one: it is not period 2). m = 1
+    is tried first.
+
+    Parameters
+    ----------
+    changes : mapping of int to sequence of float
+        For m = 1 .. :data:`MAX_PERIOD_MULTIPLE`, the scaled changes ``d_m`` of the periods
+        so far (oldest first; only the last :data:`CONSECUTIVE_PERIODS` count) [-].
+    tolerance : float
+        Tolerance of periodicity [-].
+
+    Returns
+    -------
+    int
+    """
+    for m in range(1, MAX_PERIOD_MULTIPLE + 1):
+        history = list(changes[m])[-CONSECUTIVE_PERIODS:]
+        shorter_apart = all(changes[j] and changes[j][-1] > SUBHARMONIC_SEPARATION * tolerance
+                            for j in range(1, m))
+        if (len(history) == CONSECUTIVE_PERIODS and max(history) <= tolerance
+                and _remaining(history, m) <= tolerance and shorter_apart):
+            return m
+    return 0
+
+
 _STATE_NAMES = {"relative_position": "the relative position",
                 "relative_velocity": "the relative velocity",
                 "highpass_state": "the high-pass state", "pi_integral": "the PI integral"}
@@ -224,18 +256,9 @@ def _run_frequency(task):
             if len(boundaries) > m and periods - m >= fade_periods:
                 changes[m].append(_scaled_distance(boundaries[-1], boundaries[-1 - m], scale))
         residual = changes[1][-1] if changes[1] else math.inf
-        for m in range(1, MAX_PERIOD_MULTIPLE + 1):
-            history = changes[m]
-            # a period-m response: its m-period changes settle while every shorter period's
-            # changes stay large (a period-1 response approached slowly can meet the
-            # 2-period test a little before the 1-period one: it is not period 2)
-            shorter_apart = all(changes[j] and changes[j][-1] > SUBHARMONIC_SEPARATION * tolerance
-                                for j in range(1, m))
-            if (len(history) == CONSECUTIVE_PERIODS and max(history) <= tolerance
-                    and _remaining(history, m) <= tolerance and shorter_apart):
-                multiple, residual = m, history[-1]
-                break
+        multiple = _period_multiple(changes, tolerance)
         if multiple:
+            residual = changes[multiple][-1]
             break
     start = "continued" if carried is not None else "rest"
     if multiple:
