@@ -4,6 +4,7 @@ Every case names the argument (or file), the value and the fix, raises a
 ParameterError or DataError from the API, and ends the command with exit code 2 and
 one ``qzs: error:`` line on stderr.
 """
+import time
 from pathlib import Path
 
 import numpy as np
@@ -180,3 +181,101 @@ def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
                  "--no-simulation", "--fft-length", "512", "--averages", "4",
                  "--out", str(tmp_path / "out"), "--json"]) == 0
     assert (tmp_path / "out" / "report.md").exists()
+
+
+# ---------------------------------------------------------------- every bad input of the CLI
+#: A bad input that used to hang, or fail only after the work, must fail within this [s].
+AT_ONCE = 2.0
+#: Files the bad inputs read, written into the test's ``in`` folder ({in} in an argument).
+INPUTS = {
+    "junk.csv": BINARY,
+    "heavy.toml": b'[geometry]\nkind = "cubic"\ncube_edge = 0.15\n[platform]\nmass = "heavy"\n',
+}
+
+
+class Bad:
+    """One bad command line: its arguments, what its one error line must hold (the flag or
+    name, the value, the fix), and whether it used to hang or fail after the work (then it
+    must fail within :data:`AT_ONCE`)."""
+
+    def __init__(self, argv, *needles, hang=False):
+        self.argv, self.needles, self.hang = list(argv), needles, hang
+
+
+BAD = {
+    # hangs
+    "simulate-dt-1e-13": Bad(["simulate", "--dt", "1e-13", "--duration", "100", "--out",
+                              "run.nc"], "`dt` = 1e-13 s", "larger `dt`", hang=True),
+    "design-controller-rate-333": Bad(["design", "--quick", "--controller-rate", "333",
+                                       "--out", "design"], "`controller_rate` (333 Hz)",
+                                      "divides the output rate", "e.g.", hang=True),
+    # tracebacks
+    "simulate-binary-record": Bad(["simulate", "--excitation", "file", "--record",
+                                   "{in}/junk.csv"], "--record", "junk.csv",
+                                  "not UTF-8 text", "Pass the CSV file"),
+    "hexapod-linear-heavy": Bad(["hexapod", "linear", "--config", "{in}/heavy.toml"],
+                                "heavy.toml", "`[platform] mass`", "'heavy'", "e.g. mass ="),
+    "hexapod-simulate-heavy": Bad(["hexapod", "simulate", "--config", "{in}/heavy.toml"],
+                                  "heavy.toml", "`[platform] mass`", "'heavy'"),
+    # silent
+    "simulate-sine-4000-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "4000",
+                                  "--duration", "2"], "4000 Hz", "`frequency`",
+                                 "2.5 integration steps per period", "reduce `dt`"),
+    # unclear
+    "simulate-negative-dt": Bad(["simulate", "--dt", "-1e-4"], "`dt`", "-0.0001", "positive"),
+    "response-negative-frequency": Bad(["response", "--frequencies", "-1,2"], "`frequencies`",
+                                       "-1.0 Hz", "positive"),
+    "design-negative-mass": Bad(["design", "--mass-range", "-1,6.4"], "`mass_range`",
+                                "(-1.0, 6.4)", "e.g. (6.2, 6.6)"),
+    "simulate-excitation-duration-0": Bad(["simulate", "--excitation-duration", "0"],
+                                          "`--excitation-duration`", "got 0.0", "positive"),
+    "hexapod-excitation-duration-0": Bad(["hexapod", "simulate", "--axis", "z",
+                                          "--excitation-duration", "0"],
+                                         "`--excitation-duration`", "got 0.0"),
+    "simulate-random-f0-above-f1": Bad(["simulate", "--excitation", "random", "--f0", "30",
+                                        "--f1", "10"], "`--f0` (30.0 Hz)", "`--f1` (10.0 Hz)",
+                                       "swap them"),
+    "simulate-sine-1e9-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "1e9",
+                                 "--duration", "1"], "1e+09 Hz", "`frequency`", "lower"),
+    "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
+                                  "--record", "is a folder", "pass the CSV file"),
+}
+
+
+@pytest.fixture
+def workspace(tmp_path, monkeypatch):
+    """``(in, run)``: the inputs' folder and the working directory, an empty folder."""
+    inputs, run = tmp_path / "in", tmp_path / "run"
+    inputs.mkdir()
+    run.mkdir()
+    for name, content in INPUTS.items():
+        (inputs / name).write_bytes(content)
+    monkeypatch.chdir(run)
+    return inputs, run
+
+
+def listing(*folders):
+    return [sorted(str(p.relative_to(folder)) for p in folder.rglob("*")) for folder in folders]
+
+
+@pytest.mark.parametrize("case", BAD.values(), ids=list(BAD))
+def test_every_bad_input_is_one_line_and_exit_2_before_any_work(workspace, capsys, case):
+    """One ``qzs: error:`` line naming the flag, the value and the fix; exit code 2; nothing
+    new in the working directory or beside the inputs; at once where it used to hang."""
+    inputs, run = workspace
+    argv = [a.replace("{in}", str(inputs)) for a in case.argv]
+    if argv[0] in ("simulate", "response", "hexapod") and "--plot" not in argv and (
+            argv[:2] != ["hexapod", "linear"]):
+        argv += ["--quiet"]
+    before = listing(inputs, run)
+    if case.hang:  # the first call pays Python's imports (scipy.signal: seconds when cold)
+        main(argv)
+        capsys.readouterr()
+    began = time.perf_counter()
+    code = main(argv)
+    elapsed = time.perf_counter() - began
+    err = one_error_line(capsys, *[n.replace("{in}", str(inputs)) for n in case.needles])
+    assert code == 2, err
+    assert listing(inputs, run) == before
+    if case.hang:
+        assert elapsed < AT_ONCE, f"{argv} took {elapsed:.2f} s to fail"

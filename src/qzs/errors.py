@@ -9,7 +9,8 @@ message is for people, never for parsing.
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
-           "SizeLimitError", "RunTooLongError", "Terminated",
+           "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
+           "ControllerRateError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -18,7 +19,42 @@ class ParameterError(ValueError):
 
 
 class ExcitationError(ParameterError):
-    """An excitation definition or a displacement record is invalid."""
+    """An excitation definition or a displacement record is invalid.
+
+    Attributes
+    ----------
+    options : tuple of str
+        The options the message is about, each written ```name``` in it (empty when it
+        names none in particular), so that a caller that spells them its own way (the
+        command line's ``--excitation-duration`` for ``duration``) can say them so
+        (:meth:`renamed`).
+    """
+
+    def __init__(self, message, options=()):
+        self.options = tuple(str(option) for option in options)
+        super().__init__(message)
+
+    def renamed(self, spelling):
+        """The same error with each of its options written as ``spelling`` says.
+
+        Parameters
+        ----------
+        spelling : dict
+            Option -> how the caller names it (``{"duration": "--excitation-duration"}``);
+            options it leaves out keep their name.
+
+        Returns
+        -------
+        ExcitationError
+        """
+        message = str(self)
+        for option in self.options:
+            if option in spelling:
+                message = message.replace(f"`{option}`", f"`{spelling[option]}`")
+        return type(self)(message, tuple(spelling.get(o, o) for o in self.options))
+
+    def __reduce__(self):
+        return type(self), (str(self), self.options)
 
 
 class StabilityError(ParameterError):
@@ -203,6 +239,82 @@ class RunTooLongError(ParameterError):
         return _rebuild_keywords, (type(self), dict(
             steps=self.steps, seconds=self.seconds, limit=self.limit, duration=self.duration,
             dt=self.dt, cases=self.cases))
+
+
+class UnresolvedExcitationError(ParameterError):
+    """The integration step is too coarse for the excitation's frequency; raised before the run.
+
+    A fixed-step integrator needs several steps per period of the base motion to follow it:
+    at 2.5 steps per period of a 4000 Hz sine (dt = 1e-4 s) the energy ledger is 15 % off,
+    and a 1e9 Hz sine diverges.
+
+    Attributes
+    ----------
+    frequency : float
+        The excitation's highest frequency within the run [Hz].
+    dt : float
+        The integration step [s].
+    minimum : int
+        The fewest steps per period a run is started with [-].
+    name : str
+        The excitation's option that sets the frequency (``frequency``, ``f1``, ...).
+    """
+
+    def __init__(self, *, frequency, dt, minimum, name="frequency"):
+        self.frequency, self.dt = float(frequency), float(dt)
+        self.minimum, self.name = int(minimum), str(name)
+        finest = 1.0 / (self.minimum * self.frequency)
+        super().__init__(
+            f"the excitation reaches {self.frequency:g} Hz (`{self.name}`), where `dt` = "
+            f"{self.dt:g} s gives {1.0 / (self.frequency * self.dt):.3g} integration steps per "
+            f"period, fewer than the {self.minimum} a run needs to follow it; lower `{self.name}` "
+            f"to at most {1.0 / (self.minimum * self.dt):.3g} Hz, or reduce `dt` to at most "
+            f"{finest:.3g} s.")
+
+    def __reduce__(self):
+        return _rebuild_keywords, (type(self), dict(
+            frequency=self.frequency, dt=self.dt, minimum=self.minimum, name=self.name))
+
+
+class ControllerRateError(ParameterError):
+    """A sampled controller's rate shares a step with the output rate only at a far finer step.
+
+    Every step must divide both the output period and the controller's: 333 Hz against a
+    1000 Hz output needs 1/333000 s, a run hundreds of times longer than at the stable
+    step. Raised before any run, by :func:`qzs.engine.accuracy.admissible_step`.
+
+    Attributes
+    ----------
+    controller_rate : float
+        The controller's rate [Hz].
+    sample_rate : float
+        The output rate [Hz].
+    step : float
+        The largest step stability and the output rate allow [s].
+    refinement : int
+        How much finer than ``step`` the search went [-].
+    suggestions : tuple of float
+        Rates [Hz] near ``controller_rate`` that divide the output rate or are whole
+        multiples of it.
+    """
+
+    def __init__(self, *, controller_rate, sample_rate, step, refinement, suggestions=()):
+        self.controller_rate, self.sample_rate = float(controller_rate), float(sample_rate)
+        self.step, self.refinement = float(step), int(refinement)
+        self.suggestions = tuple(float(f) for f in suggestions)
+        near = " or ".join(f"{f:g}" for f in self.suggestions)
+        super().__init__(
+            f"`controller_rate` ({self.controller_rate:g} Hz) and the output rate "
+            f"`sample_rate` ({self.sample_rate:g} Hz) share no integration step down to "
+            f"{self.refinement} times finer than the stable {self.step:.3g} s: every run would "
+            f"take that much longer or more; choose a controller rate that divides the output "
+            f"rate or is a whole multiple of it" + (f" (e.g. {near} Hz)" if near else "")
+            + ", or 0 for a continuous controller.")
+
+    def __reduce__(self):
+        return _rebuild_keywords, (type(self), dict(
+            controller_rate=self.controller_rate, sample_rate=self.sample_rate, step=self.step,
+            refinement=self.refinement, suggestions=self.suggestions))
 
 
 def _rebuild_keywords(kind, keywords):

@@ -277,7 +277,9 @@ def run_simulate(args):
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
                             sample_rate=args.sample_rate, solver=args.solver,
                             progress=not args.quiet and not args.json, out=args.out or None,
-                            interruptible=True, argument="--out")
+                            interruptible=True, argument="--out",
+                            names={**{name: f"--{name}" for name in _EXCITATION_OPTIONS},
+                                   "duration": "--excitation-duration"})
     text = result.summary()
     record = {"summary": text, "run": result.run, "source": setup.source}
     if args.out:
