@@ -4,6 +4,7 @@ Every case names the argument (or file), the value and the fix, raises a
 ParameterError or DataError from the API, and ends the command with exit code 2 and
 one ``qzs: error:`` line on stderr.
 """
+import socket
 import time
 from pathlib import Path
 
@@ -187,9 +188,17 @@ def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
 #: A bad input that used to hang, or fail only after the work, must fail within this [s].
 AT_ONCE = 2.0
 #: Files the bad inputs read, written into the test's ``in`` folder ({in} in an argument).
+SWEEP = ('[sweep]\nname = "tiny"\nbatch_size = 1\n[grid]\n{grid}\n[excitation]\nf1 = 10.0\n'
+         '[analysis]\nfft_length = 1024\nn_averages = 4\nband = [0.0, 10.0]\n')
 INPUTS = {
     "junk.csv": BINARY,
     "heavy.toml": b'[geometry]\nkind = "cubic"\ncube_edge = 0.15\n[platform]\nmass = "heavy"\n',
+    "tiny.toml": SWEEP.format(grid="pi_kp = [5.0]").encode(),
+    "negative.toml": SWEEP.format(grid="pi_kp = [5.0, 10.0]\nstiction_force = [10.0, -5.0]"
+                                  ).encode(),
+    "nan.toml": SWEEP.format(grid="pi_kp = [5.0, nan]").encode(),
+    "huge.toml": SWEEP.format(grid="pi_kp = { start = 1.0, stop = 100.0, num = 100000000 }"
+                              ).encode(),
 }
 
 
@@ -218,6 +227,28 @@ BAD = {
     "hexapod-simulate-heavy": Bad(["hexapod", "simulate", "--config", "{in}/heavy.toml"],
                                   "heavy.toml", "`[platform] mass`", "'heavy'"),
     # silent
+    "sweep-negative-stiction": Bad(["sweep", "{in}/negative.toml", "--out", "s.zarr"],
+                                   "2 of 4 cases are invalid, so none runs",
+                                   "case 1 (pi_kp = 5.0, stiction_force = -5.0)",
+                                   "must be non-negative, got -5.0", "fix or drop"),
+    "sweep-nan-gain": Bad(["sweep", "{in}/nan.toml", "--out", "s.zarr"],
+                          "case 1 (pi_kp = nan)", "`pi_kp` must be finite"),
+    "sweep-resume-missing-store": Bad(["sweep", "{in}/tiny.toml", "--out", "missing.zarr",
+                                       "--resume"], "--out 'missing.zarr'",
+                                      "nothing to resume", "leave out `resume` (--resume)"),
+    "sweep-resume-and-overwrite": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--resume",
+                                       "--overwrite"], "--resume", "--overwrite",
+                                      "give one of them"),
+    "sweep-out-nc": Bad(["sweep", "{in}/tiny.toml", "--out", "store.nc"], "--out 'store.nc'",
+                        "'.nc'", "must end in .zarr"),
+    "sweep-plot-y-without-x": Bad(["sweep-plot", "{in}/tiny.zarr", "--y", "pi_kp"],
+                                  "`y` (--y) 'pi_kp'", "needs `x` (--x)", "add --x"),
+    "response-unsorted": Bad(["response", "--frequencies", "3,1,2"], "--frequencies 3,1,2",
+                             "1 Hz comes after 3 Hz", "e.g. --frequencies 1,2,3"),
+    "response-repeated": Bad(["response", "--frequencies", "2,2,3"], "--frequencies 2,2,3",
+                             "2 Hz is given twice", "e.g. --frequencies 2,3"),
+    "response-spacing-with-list": Bad(["response", "--frequencies", "1,2", "--spacing",
+                                       "linear"], "--spacing linear", "leave out --spacing"),
     "simulate-sine-4000-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "4000",
                                   "--duration", "2"], "4000 Hz", "`frequency`",
                                  "2.5 integration steps per period", "reduce `dt`"),
@@ -237,6 +268,15 @@ BAD = {
                                        "swap them"),
     "simulate-sine-1e9-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "1e9",
                                  "--duration", "1"], "1e+09 Hz", "`frequency`", "lower"),
+    # after the work (now before it)
+    "sweep-1e8-cases": Bad(["sweep", "{in}/huge.toml"], "`[grid] pi_kp.num`",
+                           "100,000,000 cases", "split", hang=True),
+    "response-1e8-frequencies": Bad(["response", "--range", "0.5,20,100000000"], "`--range`",
+                                    "100,000,000 frequencies", "smaller N", hang=True),
+    "sweep-closed-scheduler": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--scheduler",
+                                   "tcp://127.0.0.1:{closed_port}"],
+                                  "tcp://127.0.0.1:{closed_port}", "nothing listens",
+                                  "leave out --scheduler", hang=True),
     "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
                                   "--record", "is a folder", "pass the CSV file"),
 }
@@ -244,14 +284,25 @@ BAD = {
 
 @pytest.fixture
 def workspace(tmp_path, monkeypatch):
-    """``(in, run)``: the inputs' folder and the working directory, an empty folder."""
+    """``(in, run, names)``: the inputs' folder, the working directory (an empty folder),
+    and what the arguments' placeholders stand for (``{in}``, ``{closed_port}``: a port
+    nothing listens on)."""
     inputs, run = tmp_path / "in", tmp_path / "run"
     inputs.mkdir()
     run.mkdir()
     for name, content in INPUTS.items():
         (inputs / name).write_bytes(content)
     monkeypatch.chdir(run)
-    return inputs, run
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        closed = probe.getsockname()[1]
+    return inputs, run, {"{in}": str(inputs), "{closed_port}": str(closed)}
+
+
+def substitute(text, names):
+    for placeholder, value in names.items():
+        text = text.replace(placeholder, value)
+    return text
 
 
 def listing(*folders):
@@ -262,8 +313,8 @@ def listing(*folders):
 def test_every_bad_input_is_one_line_and_exit_2_before_any_work(workspace, capsys, case):
     """One ``qzs: error:`` line naming the flag, the value and the fix; exit code 2; nothing
     new in the working directory or beside the inputs; at once where it used to hang."""
-    inputs, run = workspace
-    argv = [a.replace("{in}", str(inputs)) for a in case.argv]
+    inputs, run, names = workspace
+    argv = [substitute(a, names) for a in case.argv]
     if argv[0] in ("simulate", "response", "hexapod") and "--plot" not in argv and (
             argv[:2] != ["hexapod", "linear"]):
         argv += ["--quiet"]
@@ -274,7 +325,7 @@ def test_every_bad_input_is_one_line_and_exit_2_before_any_work(workspace, capsy
     began = time.perf_counter()
     code = main(argv)
     elapsed = time.perf_counter() - began
-    err = one_error_line(capsys, *[n.replace("{in}", str(inputs)) for n in case.needles])
+    err = one_error_line(capsys, *[substitute(n, names) for n in case.needles])
     assert code == 2, err
     assert listing(inputs, run) == before
     if case.hang:

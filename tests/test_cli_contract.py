@@ -337,6 +337,8 @@ def test_bad_output_paths_fail_at_once_and_leave_nothing(tmp_path, capsys, small
                                                          sweep_file):
     blocker = tmp_path / "a-file"
     blocker.write_text("in the way")
+    store_blocker = tmp_path / "a-file.zarr"  # a file where the store's folder must go
+    store_blocker.write_text("in the way")
     experiment = ["experiment", str(DATA / "experiment.csv"), "--map",
                   str(DATA / "experiment_map.toml")]
     cases = [
@@ -344,7 +346,8 @@ def test_bad_output_paths_fail_at_once_and_leave_nothing(tmp_path, capsys, small
         (["params", "--toml", str(blocker / "p.toml")], "--toml", "is a file, not a folder"),
         ([*experiment, "--out", str(blocker)], "--out", "is a file, not a folder"),
         ([*experiment, "--out", str(blocker / "sub")], "--out", "is a file"),
-        (["sweep", str(sweep_file), "--out", str(blocker)], "--out", "is a file"),
+        (["sweep", str(sweep_file), "--out", str(store_blocker)], "--out", "is a file"),
+        (["sweep", str(sweep_file), "--out", str(tmp_path / "store.nc")], "--out", ".zarr"),
         (["sweep", str(sweep_file), "--out", str(small_store)], "--out", "--resume"),
         (["sweep-plot", str(small_store), "--out", str(tmp_path / "x.xyz")], "--out",
          "'.xyz'", ".png", ".svg", ".pdf"),

@@ -10,7 +10,8 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
-           "ControllerRateError", "Terminated",
+           "ControllerRateError", "CountLimitError", "InvalidCasesError",
+           "SchedulerError", "AddressError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -79,6 +80,115 @@ class CaseError(ParameterError):
 
     def __reduce__(self):  # picklable with its attributes (Dask, process pools)
         return type(self), (self.index, self.reason)
+
+
+class InvalidCasesError(CaseError):
+    """Cases of a sweep are invalid; found before any case runs, so none runs.
+
+    A :class:`CaseError` whose ``index`` and ``reason`` are the first invalid case's.
+
+    Attributes
+    ----------
+    cases : tuple of tuple
+        ``(index, values, reason)`` per invalid case: its position [-] counted from 0, its
+        varied parameters (a dict) and why it is invalid.
+    total : int
+        Cases in the sweep [-].
+    """
+
+    #: Invalid cases the message lists at most (the attribute holds them all).
+    SHOWN = 3
+
+    def __init__(self, cases, total):
+        self.cases = tuple((int(i), dict(values), str(reason)) for i, values, reason in cases)
+        self.total = int(total)
+        shown = "; ".join(
+            f"case {i} ({', '.join(f'{k} = {v!r}' for k, v in values.items())}): "
+            f"{reason.rstrip('.')}" for i, values, reason in self.cases[:self.SHOWN])
+        more = len(self.cases) - self.SHOWN
+        self.index, self.reason = self.cases[0][0], self.cases[0][2]
+        ParameterError.__init__(  # CaseError's attributes, a message of its own
+            self, f"{len(self.cases)} of {self.total} cases are invalid, so none runs: {shown}"
+                  + (f"; and {more} more" if more > 0 else "")
+                  + "; fix or drop those values in the sweep file.")
+
+    def __reduce__(self):
+        return type(self), (self.cases, self.total)
+
+
+class CountLimitError(ParameterError):
+    """A request asks for more items (sweep cases, frequencies) than qzs runs in one go;
+    raised before any is built, so it fails at once instead of after seconds of work.
+
+    Attributes
+    ----------
+    name : str
+        What sets the count (``--range``, ``grid``, ``samples``, ``frequencies``).
+    count : int
+        How many were asked for [-].
+    limit : int
+        The most qzs runs in one go [-].
+    items : str
+        What is counted (``cases``, ``frequencies``).
+    fix : str
+        What to do instead.
+    """
+
+    def __init__(self, name, count, limit, items, fix):
+        self.name, self.count, self.limit = str(name), int(count), int(limit)
+        self.items, self.fix = str(items), str(fix)
+        super().__init__(f"`{self.name}` asks for {self.count:,} {self.items}, more than the "
+                         f"{self.limit:,} qzs runs in one go; {self.fix}.")
+
+    def __reduce__(self):
+        return type(self), (self.name, self.count, self.limit, self.items, self.fix)
+
+
+class SchedulerError(ParameterError):
+    """No Dask scheduler answers at the address given; raised before any case runs.
+
+    Attributes
+    ----------
+    address : str
+        The scheduler's address as given (``tcp://host:8786``).
+    reason : str
+        What went wrong (refused, timed out, unknown host).
+    """
+
+    def __init__(self, address, reason):
+        self.address, self.reason = str(address), str(reason)
+        super().__init__(f"no Dask scheduler answers at `scheduler` {self.address!r}: "
+                         f"{self.reason}; start one there (`dask scheduler`), check the "
+                         "address, or leave out --scheduler to run here.")
+
+    def __reduce__(self):
+        return type(self), (self.address, self.reason)
+
+
+class AddressError(ParameterError):
+    """The tuning page cannot listen where asked: a busy port, or an address that is not
+    this machine's; raised before the kernels warm up.
+
+    Attributes
+    ----------
+    argument : str
+        The option at fault: ``--host`` or ``--port``.
+    host : str
+        The address asked for.
+    port : int or None
+        The port asked for (None: any free one).
+    reason : str
+        What is wrong and the fix.
+    """
+
+    def __init__(self, argument, host, port, reason):
+        self.argument, self.host, self.reason = str(argument), str(host), str(reason)
+        self.port = None if port is None else int(port)
+        value = self.host if self.argument == "--host" else self.port
+        super().__init__(f"{self.argument} {value!r}: {self.reason}.")
+
+    def __reduce__(self):
+        return type(self), (self.argument, self.host, self.port, self.reason)
 
 
 class SizeLimitError(ParameterError):
