@@ -277,6 +277,21 @@ BAD = {
                                    "tcp://127.0.0.1:{closed_port}"],
                                   "tcp://127.0.0.1:{closed_port}", "nothing listens",
                                   "leave out --scheduler", hang=True),
+    "app-busy-port": Bad(["app", "--no-browser", "--port", "{busy_port}"],
+                         "--port {busy_port} is in use", "choose another port", hang=True),
+    "app-unknown-host": Bad(["app", "--no-browser", "--host", "no-such-host.invalid"],
+                            "--host 'no-such-host.invalid' is not an address",
+                            "use 127.0.0.1"),
+    "app-unknown-host-and-port": Bad(["app", "--no-browser", "--host", "no-such-host.invalid",
+                                      "--port", "8123"], "--host 'no-such-host.invalid'",
+                                     "use 127.0.0.1"),
+    "app-invalid-ip": Bad(["app", "--no-browser", "--host", "999.1.1.1"],
+                          "--host '999.1.1.1' is not an address", "use 127.0.0.1"),
+    "app-foreign-ip": Bad(["app", "--no-browser", "--host", "192.0.2.1"],
+                          "--host '192.0.2.1' is not an address of this machine",
+                          "use 127.0.0.1"),
+    "app-foreign-ip-and-port": Bad(["app", "--no-browser", "--host", "192.0.2.1", "--port",
+                                    "8123"], "--host '192.0.2.1'", "use 127.0.0.1"),
     "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
                                   "--record", "is a folder", "pass the CSV file"),
 }
@@ -286,7 +301,7 @@ BAD = {
 def workspace(tmp_path, monkeypatch):
     """``(in, run, names)``: the inputs' folder, the working directory (an empty folder),
     and what the arguments' placeholders stand for (``{in}``, ``{closed_port}``: a port
-    nothing listens on)."""
+    nothing listens on, ``{busy_port}``: one another program listens on)."""
     inputs, run = tmp_path / "in", tmp_path / "run"
     inputs.mkdir()
     run.mkdir()
@@ -296,7 +311,11 @@ def workspace(tmp_path, monkeypatch):
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         closed = probe.getsockname()[1]
-    return inputs, run, {"{in}": str(inputs), "{closed_port}": str(closed)}
+    with socket.socket() as busy:  # a port another program listens on
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        yield inputs, run, {"{in}": str(inputs), "{closed_port}": str(closed),
+                            "{busy_port}": str(busy.getsockname()[1])}
 
 
 def substitute(text, names):

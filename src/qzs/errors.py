@@ -185,7 +185,7 @@ class AddressError(ParameterError):
         self.argument, self.host, self.reason = str(argument), str(host), str(reason)
         self.port = None if port is None else int(port)
         value = self.host if self.argument == "--host" else self.port
-        super().__init__(f"{self.argument} {value!r}: {self.reason}.")
+        super().__init__(f"{self.argument} {value!r} {self.reason}.")
 
     def __reduce__(self):
         return type(self), (self.argument, self.host, self.port, self.reason)
