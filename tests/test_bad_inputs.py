@@ -277,6 +277,16 @@ BAD = {
                                    "tcp://127.0.0.1:{closed_port}"],
                                   "tcp://127.0.0.1:{closed_port}", "nothing listens",
                                   "leave out --scheduler", hang=True),
+    "paper-out-file": Bad(["paper", "--quick", "--out", "{in}/junk.csv"], "--out",
+                          "junk.csv' is a file, not a folder", "choose a folder name",
+                          hang=True),
+    "study-out-file": Bad(["study", "stiction", "--quick", "--out", "{in}/junk.csv"], "--out",
+                          "junk.csv' is a file, not a folder", hang=True),
+    "paper-out-read-only": Bad(["paper", "--quick", "--out", "{read_only}/report"],
+                               "--out '{read_only}/report'", "read-only",
+                               "choose a writable folder", hang=True),
+    "study-out-read-only": Bad(["study", "stiction", "--quick", "--out", "{read_only}"],
+                               "--out '{read_only}'", "read-only", hang=True),
     "app-busy-port": Bad(["app", "--no-browser", "--port", "{busy_port}"],
                          "--port {busy_port} is in use", "choose another port", hang=True),
     "app-unknown-host": Bad(["app", "--no-browser", "--host", "no-such-host.invalid"],
@@ -298,10 +308,11 @@ BAD = {
 
 
 @pytest.fixture
-def workspace(tmp_path, monkeypatch):
+def workspace(tmp_path, monkeypatch, request):
     """``(in, run, names)``: the inputs' folder, the working directory (an empty folder),
     and what the arguments' placeholders stand for (``{in}``, ``{closed_port}``: a port
-    nothing listens on, ``{busy_port}``: one another program listens on)."""
+    nothing listens on, ``{busy_port}``: one another program listens on, ``{read_only}``:
+    a folder nobody can write into)."""
     inputs, run = tmp_path / "in", tmp_path / "run"
     inputs.mkdir()
     run.mkdir()
@@ -314,8 +325,11 @@ def workspace(tmp_path, monkeypatch):
     with socket.socket() as busy:  # a port another program listens on
         busy.bind(("127.0.0.1", 0))
         busy.listen()
-        yield inputs, run, {"{in}": str(inputs), "{closed_port}": str(closed),
-                            "{busy_port}": str(busy.getsockname()[1])}
+        names = {"{in}": str(inputs), "{closed_port}": str(closed),
+                 "{busy_port}": str(busy.getsockname()[1])}
+        if any("{read_only}" in a for a in request.node.callspec.params["case"].argv):
+            names["{read_only}"] = str(request.getfixturevalue("read_only_folder"))
+        yield inputs, run, names
 
 
 def substitute(text, names):

@@ -281,23 +281,6 @@ def test_params_toml_does_not_overwrite_without_force(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------- output paths checked first
-@pytest.fixture
-def read_only_folder(tmp_path):
-    """A folder nobody can write into, even root (a read-only mount), or skip."""
-    from qzs.iotools.paths import _writable
-
-    folder = tmp_path / "read-only"
-    folder.mkdir()
-    folder.chmod(0o555)
-    if not _writable(folder):
-        yield folder
-    elif Path("/sys").is_dir() and not _writable(Path("/sys")):  # root ignores the mode bits
-        yield Path("/sys")
-    else:
-        pytest.skip("no read-only folder available")
-    folder.chmod(0o755)
-
-
 @pytest.fixture(scope="module")
 def small_store(tmp_path_factory):
     from qzs.workflows.sweeps import run_sweep
