@@ -114,7 +114,7 @@ def add_parser(subparsers):
     matrix.add_argument("--axes", metavar="AXES", default=",".join(AXES),
                         help="comma-separated base axes to excite, one run each (default "
                              f"all six: {','.join(AXES)})")
-    matrix.add_argument("--amplitude", metavar="A_OR_AXIS=A,...",
+    matrix.add_argument("--amplitude", metavar="AMPLITUDE",
                         help="chirp amplitude: one number for every excited axis (all "
                              "translations [m] or all rotations [rad]) or per axis, e.g. "
                              "z=0.001,rx=0.005 (default 0.002 m, 0.01 rad)")
