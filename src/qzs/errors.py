@@ -22,6 +22,13 @@ class ParameterError(ValueError):
 class ExcitationError(ParameterError):
     """An excitation definition or a displacement record is invalid.
 
+    Parameters
+    ----------
+    message : str
+        What is wrong, the value and the fix; each option it is about written ```name```.
+    options : tuple of str
+        Those options (see the attribute).
+
     Attributes
     ----------
     options : tuple of str
