@@ -97,9 +97,9 @@ def resolving_step(excitation, duration=None):
     Parameters
     ----------
     excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
-        The base motion.
+        The base motion the step must follow.
     duration : float, optional
-        Simulated time [s]; default the whole excitation.
+        The run's simulated time [s] (a chirp cut short ends lower); default its length.
 
     Returns
     -------
