@@ -44,6 +44,25 @@ def sampled_chirp_run():
     return simulate(SHORT_CHIRP, controller=controller, dt=1e-4, sample_rate=1e4)
 
 
+@pytest.fixture
+def read_only_folder(tmp_path):
+    """A folder nobody can write into, even root (a read-only mount), or skip."""
+    from pathlib import Path
+
+    from qzs.iotools.paths import _writable
+
+    folder = tmp_path / "read-only"
+    folder.mkdir()
+    folder.chmod(0o555)
+    if not _writable(folder):
+        yield folder
+    elif Path("/sys").is_dir() and not _writable(Path("/sys")):  # root ignores the mode bits
+        yield Path("/sys")
+    else:
+        pytest.skip("no read-only folder available")
+    folder.chmod(0o755)
+
+
 # ---------------------------------------------------------------- validation records
 #: Environment variable naming the JSON Lines file the records are appended to.
 VALIDATION_OUT = "QZS_VALIDATION_OUT"

@@ -4,6 +4,8 @@ Every case names the argument (or file), the value and the fix, raises a
 ParameterError or DataError from the API, and ends the command with exit code 2 and
 one ``qzs: error:`` line on stderr.
 """
+import socket
+import time
 from pathlib import Path
 
 import numpy as np
@@ -180,3 +182,184 @@ def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
                  "--no-simulation", "--fft-length", "512", "--averages", "4",
                  "--out", str(tmp_path / "out"), "--json"]) == 0
     assert (tmp_path / "out" / "report.md").exists()
+
+
+# ---------------------------------------------------------------- every bad input of the CLI
+#: A bad input that used to hang, or fail only after the work, must fail within this [s].
+AT_ONCE = 2.0
+#: Files the bad inputs read, written into the test's ``in`` folder ({in} in an argument).
+SWEEP = ('[sweep]\nname = "tiny"\nbatch_size = 1\n[grid]\n{grid}\n[excitation]\nf1 = 10.0\n'
+         '[analysis]\nfft_length = 1024\nn_averages = 4\nband = [0.0, 10.0]\n')
+INPUTS = {
+    "junk.csv": BINARY,
+    "heavy.toml": b'[geometry]\nkind = "cubic"\ncube_edge = 0.15\n[platform]\nmass = "heavy"\n',
+    "tiny.toml": SWEEP.format(grid="pi_kp = [5.0]").encode(),
+    "negative.toml": SWEEP.format(grid="pi_kp = [5.0, 10.0]\nstiction_force = [10.0, -5.0]"
+                                  ).encode(),
+    "nan.toml": SWEEP.format(grid="pi_kp = [5.0, nan]").encode(),
+    "huge.toml": SWEEP.format(grid="pi_kp = { start = 1.0, stop = 100.0, num = 100000000 }"
+                              ).encode(),
+}
+
+
+class Bad:
+    """One bad command line: its arguments, what its one error line must hold (the flag or
+    name, the value, the fix), and whether it used to hang or fail after the work (then it
+    must fail within :data:`AT_ONCE`)."""
+
+    def __init__(self, argv, *needles, hang=False):
+        self.argv, self.needles, self.hang = list(argv), needles, hang
+
+
+BAD = {
+    # hangs
+    "simulate-dt-1e-13": Bad(["simulate", "--dt", "1e-13", "--duration", "100", "--out",
+                              "run.nc"], "`dt` = 1e-13 s", "larger `dt`", hang=True),
+    "design-controller-rate-333": Bad(["design", "--quick", "--controller-rate", "333",
+                                       "--out", "design"], "`controller_rate` (333 Hz)",
+                                      "divides the output rate", "e.g.", hang=True),
+    # tracebacks
+    "simulate-binary-record": Bad(["simulate", "--excitation", "file", "--record",
+                                   "{in}/junk.csv"], "--record", "junk.csv",
+                                  "not UTF-8 text", "Pass the CSV file"),
+    "hexapod-linear-heavy": Bad(["hexapod", "linear", "--config", "{in}/heavy.toml"],
+                                "heavy.toml", "`[platform] mass`", "'heavy'", "e.g. mass ="),
+    "hexapod-simulate-heavy": Bad(["hexapod", "simulate", "--config", "{in}/heavy.toml"],
+                                  "heavy.toml", "`[platform] mass`", "'heavy'"),
+    # silent
+    "sweep-negative-stiction": Bad(["sweep", "{in}/negative.toml", "--out", "s.zarr"],
+                                   "2 of 4 cases are invalid, so none runs",
+                                   "case 1 (pi_kp = 5.0, stiction_force = -5.0)",
+                                   "must be non-negative, got -5.0", "fix or drop"),
+    "sweep-nan-gain": Bad(["sweep", "{in}/nan.toml", "--out", "s.zarr"],
+                          "case 1 (pi_kp = nan)", "`pi_kp` must be finite"),
+    "sweep-resume-missing-store": Bad(["sweep", "{in}/tiny.toml", "--out", "missing.zarr",
+                                       "--resume"], "--out 'missing.zarr'",
+                                      "nothing to resume", "leave out `resume` (--resume)"),
+    "sweep-resume-and-overwrite": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--resume",
+                                       "--overwrite"], "--resume", "--overwrite",
+                                      "give one of them"),
+    "sweep-out-nc": Bad(["sweep", "{in}/tiny.toml", "--out", "store.nc"], "--out 'store.nc'",
+                        "'.nc'", "must end in .zarr"),
+    "sweep-plot-y-without-x": Bad(["sweep-plot", "{in}/tiny.zarr", "--y", "pi_kp"],
+                                  "`y` (--y) 'pi_kp'", "needs `x` (--x)", "add --x"),
+    "response-unsorted": Bad(["response", "--frequencies", "3,1,2"], "--frequencies 3,1,2",
+                             "1 Hz comes after 3 Hz", "e.g. --frequencies 1,2,3"),
+    "response-repeated": Bad(["response", "--frequencies", "2,2,3"], "--frequencies 2,2,3",
+                             "2 Hz is given twice", "e.g. --frequencies 2,3"),
+    "response-spacing-with-list": Bad(["response", "--frequencies", "1,2", "--spacing",
+                                       "linear"], "--spacing linear", "leave out --spacing"),
+    "simulate-sine-4000-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "4000",
+                                  "--duration", "2"], "4000 Hz", "`frequency`",
+                                 "2.5 integration steps per period", "reduce `dt`"),
+    # unclear
+    "simulate-negative-dt": Bad(["simulate", "--dt", "-1e-4"], "`dt`", "-0.0001", "positive"),
+    "response-negative-frequency": Bad(["response", "--frequencies", "-1,2"], "`frequencies`",
+                                       "-1.0 Hz", "positive"),
+    "design-negative-mass": Bad(["design", "--mass-range", "-1,6.4"], "`mass_range`",
+                                "(-1.0, 6.4)", "e.g. (6.2, 6.6)"),
+    "simulate-excitation-duration-0": Bad(["simulate", "--excitation-duration", "0"],
+                                          "`--excitation-duration`", "got 0.0", "positive"),
+    "hexapod-excitation-duration-0": Bad(["hexapod", "simulate", "--axis", "z",
+                                          "--excitation-duration", "0"],
+                                         "`--excitation-duration`", "got 0.0"),
+    "simulate-random-f0-above-f1": Bad(["simulate", "--excitation", "random", "--f0", "30",
+                                        "--f1", "10"], "`--f0` (30.0 Hz)", "`--f1` (10.0 Hz)",
+                                       "swap them"),
+    "simulate-sine-1e9-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "1e9",
+                                 "--duration", "1"], "1e+09 Hz", "`frequency`", "lower"),
+    # after the work (now before it)
+    "sweep-1e8-cases": Bad(["sweep", "{in}/huge.toml"], "`[grid] pi_kp.num`",
+                           "100,000,000 cases", "split", hang=True),
+    "response-1e8-frequencies": Bad(["response", "--range", "0.5,20,100000000"], "`--range`",
+                                    "100,000,000 frequencies", "smaller N", hang=True),
+    "sweep-closed-scheduler": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--scheduler",
+                                   "tcp://127.0.0.1:{closed_port}"],
+                                  "tcp://127.0.0.1:{closed_port}", "nothing listens",
+                                  "leave out --scheduler", hang=True),
+    "paper-out-file": Bad(["paper", "--quick", "--out", "{in}/junk.csv"], "--out",
+                          "junk.csv' is a file, not a folder", "choose a folder name",
+                          hang=True),
+    "study-out-file": Bad(["study", "stiction", "--quick", "--out", "{in}/junk.csv"], "--out",
+                          "junk.csv' is a file, not a folder", hang=True),
+    "paper-out-read-only": Bad(["paper", "--quick", "--out", "{read_only}/report"],
+                               "--out '{read_only}/report'", "read-only",
+                               "choose a writable folder", hang=True),
+    "study-out-read-only": Bad(["study", "stiction", "--quick", "--out", "{read_only}"],
+                               "--out '{read_only}'", "read-only", hang=True),
+    "app-busy-port": Bad(["app", "--no-browser", "--port", "{busy_port}"],
+                         "--port {busy_port} is in use", "choose another port", hang=True),
+    "app-unknown-host": Bad(["app", "--no-browser", "--host", "no-such-host.invalid"],
+                            "--host 'no-such-host.invalid' is not an address",
+                            "use 127.0.0.1"),
+    "app-unknown-host-and-port": Bad(["app", "--no-browser", "--host", "no-such-host.invalid",
+                                      "--port", "8123"], "--host 'no-such-host.invalid'",
+                                     "use 127.0.0.1"),
+    "app-invalid-ip": Bad(["app", "--no-browser", "--host", "999.1.1.1"],
+                          "--host '999.1.1.1' is not an address", "use 127.0.0.1"),
+    "app-foreign-ip": Bad(["app", "--no-browser", "--host", "192.0.2.1"],
+                          "--host '192.0.2.1' is not an address of this machine",
+                          "use 127.0.0.1"),
+    "app-foreign-ip-and-port": Bad(["app", "--no-browser", "--host", "192.0.2.1", "--port",
+                                    "8123"], "--host '192.0.2.1'", "use 127.0.0.1"),
+    "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
+                                  "--record", "is a folder", "pass the CSV file"),
+}
+
+
+@pytest.fixture
+def workspace(tmp_path, monkeypatch, request):
+    """``(in, run, names)``: the inputs' folder, the working directory (an empty folder),
+    and what the arguments' placeholders stand for (``{in}``, ``{closed_port}``: a port
+    nothing listens on, ``{busy_port}``: one another program listens on, ``{read_only}``:
+    a folder nobody can write into)."""
+    inputs, run = tmp_path / "in", tmp_path / "run"
+    inputs.mkdir()
+    run.mkdir()
+    for name, content in INPUTS.items():
+        (inputs / name).write_bytes(content)
+    monkeypatch.chdir(run)
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        closed = probe.getsockname()[1]
+    with socket.socket() as busy:  # a port another program listens on
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        names = {"{in}": str(inputs), "{closed_port}": str(closed),
+                 "{busy_port}": str(busy.getsockname()[1])}
+        if any("{read_only}" in a for a in request.node.callspec.params["case"].argv):
+            names["{read_only}"] = str(request.getfixturevalue("read_only_folder"))
+        yield inputs, run, names
+
+
+def substitute(text, names):
+    for placeholder, value in names.items():
+        text = text.replace(placeholder, value)
+    return text
+
+
+def listing(*folders):
+    return [sorted(str(p.relative_to(folder)) for p in folder.rglob("*")) for folder in folders]
+
+
+@pytest.mark.parametrize("case", BAD.values(), ids=list(BAD))
+def test_every_bad_input_is_one_line_and_exit_2_before_any_work(workspace, capsys, case):
+    """One ``qzs: error:`` line naming the flag, the value and the fix; exit code 2; nothing
+    new in the working directory or beside the inputs; at once where it used to hang."""
+    inputs, run, names = workspace
+    argv = [substitute(a, names) for a in case.argv]
+    if argv[0] in ("simulate", "response", "hexapod") and "--plot" not in argv and (
+            argv[:2] != ["hexapod", "linear"]):
+        argv += ["--quiet"]
+    before = listing(inputs, run)
+    if case.hang:  # the first call pays Python's imports (scipy.signal: seconds when cold)
+        main(argv)
+        capsys.readouterr()
+    began = time.perf_counter()
+    code = main(argv)
+    elapsed = time.perf_counter() - began
+    err = one_error_line(capsys, *[substitute(n, names) for n in case.needles])
+    assert code == 2, err
+    assert listing(inputs, run) == before
+    if case.hang:
+        assert elapsed < AT_ONCE, f"{argv} took {elapsed:.2f} s to fail"

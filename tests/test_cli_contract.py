@@ -281,23 +281,6 @@ def test_params_toml_does_not_overwrite_without_force(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------- output paths checked first
-@pytest.fixture
-def read_only_folder(tmp_path):
-    """A folder nobody can write into, even root (a read-only mount), or skip."""
-    from qzs.iotools.paths import _writable
-
-    folder = tmp_path / "read-only"
-    folder.mkdir()
-    folder.chmod(0o555)
-    if not _writable(folder):
-        yield folder
-    elif Path("/sys").is_dir() and not _writable(Path("/sys")):  # root ignores the mode bits
-        yield Path("/sys")
-    else:
-        pytest.skip("no read-only folder available")
-    folder.chmod(0o755)
-
-
 @pytest.fixture(scope="module")
 def small_store(tmp_path_factory):
     from qzs.workflows.sweeps import run_sweep
@@ -337,6 +320,8 @@ def test_bad_output_paths_fail_at_once_and_leave_nothing(tmp_path, capsys, small
                                                          sweep_file):
     blocker = tmp_path / "a-file"
     blocker.write_text("in the way")
+    store_blocker = tmp_path / "a-file.zarr"  # a file where the store's folder must go
+    store_blocker.write_text("in the way")
     experiment = ["experiment", str(DATA / "experiment.csv"), "--map",
                   str(DATA / "experiment_map.toml")]
     cases = [
@@ -344,7 +329,8 @@ def test_bad_output_paths_fail_at_once_and_leave_nothing(tmp_path, capsys, small
         (["params", "--toml", str(blocker / "p.toml")], "--toml", "is a file, not a folder"),
         ([*experiment, "--out", str(blocker)], "--out", "is a file, not a folder"),
         ([*experiment, "--out", str(blocker / "sub")], "--out", "is a file"),
-        (["sweep", str(sweep_file), "--out", str(blocker)], "--out", "is a file"),
+        (["sweep", str(sweep_file), "--out", str(store_blocker)], "--out", "is a file"),
+        (["sweep", str(sweep_file), "--out", str(tmp_path / "store.nc")], "--out", ".zarr"),
         (["sweep", str(sweep_file), "--out", str(small_store)], "--out", "--resume"),
         (["sweep-plot", str(small_store), "--out", str(tmp_path / "x.xyz")], "--out",
          "'.xyz'", ".png", ".svg", ".pdf"),

@@ -36,6 +36,14 @@ CARRIERS = [
     (errors.MissingDependencyError("zarr", "cluster", "writing sweep stores"),
      {"package": "zarr", "extra": "cluster"}),
     (errors.Terminated(15), {"signum": 15, "exit_code": 143}),
+    (errors.ExcitationError("`f_low` must be below `f_high`", ("f_low", "f_high")),
+     {"options": ("f_low", "f_high")}),
+    (errors.UnresolvedExcitationError(frequency=4000.0, dt=1e-4, minimum=10),
+     {"frequency": 4000.0, "dt": 1e-4, "minimum": 10, "name": "frequency"}),
+    (errors.ControllerRateError(controller_rate=333.0, sample_rate=1000.0, step=1e-3,
+                                refinement=32, suggestions=(250.0, 500.0)),
+     {"controller_rate": 333.0, "sample_rate": 1000.0, "refinement": 32,
+      "suggestions": (250.0, 500.0)}),
 ]
 
 
@@ -60,3 +68,12 @@ def test_each_error_is_caught_by_its_built_in():
             assert issubclass(getattr(errors, name), (ParameterError, errors.DataError)), name
     assert not issubclass(errors.Terminated, Exception)
     assert issubclass(errors.Terminated, BaseException)
+
+
+def test_an_excitation_error_names_its_options_the_callers_way():
+    error = errors.ExcitationError("`f_low` (30 Hz) must be below `f_high` (10 Hz)",
+                                   ("f_low", "f_high"))
+    renamed = error.renamed({"f_low": "--f0", "f_high": "--f1"})
+    assert str(renamed) == "`--f0` (30 Hz) must be below `--f1` (10 Hz)"
+    assert renamed.options == ("--f0", "--f1") and isinstance(renamed, ParameterError)
+    assert str(error.renamed({"other": "--x"})) == str(error)  # the others keep their name

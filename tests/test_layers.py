@@ -198,6 +198,7 @@ CROSS_CUTTING = {
     "layers": "this file: the folder tree, the imports between layers, the tests' own tree",
     "docstrings": "every public callable's numpydoc, whatever its module",
     "cli_contract": "exit codes, signals, output paths and --json, the same for every subcommand",
+    "cli_doc": "docs/workflows/command-line.md's promises, read from the page, against the parser",
     "bad_inputs": "inputs that used to end in a traceback, through the API and every command",
     "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "
              "and the experiment's tests)",

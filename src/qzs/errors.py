@@ -9,7 +9,9 @@ message is for people, never for parsing.
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
-           "SizeLimitError", "RunTooLongError", "Terminated",
+           "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
+           "ControllerRateError", "CountLimitError", "InvalidCasesError",
+           "SchedulerError", "AddressError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -18,7 +20,49 @@ class ParameterError(ValueError):
 
 
 class ExcitationError(ParameterError):
-    """An excitation definition or a displacement record is invalid."""
+    """An excitation definition or a displacement record is invalid.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, the value and the fix; each option it is about written ```name```.
+    options : tuple of str
+        Those options (see the attribute).
+
+    Attributes
+    ----------
+    options : tuple of str
+        The options the message is about, each written ```name``` in it (empty when it
+        names none in particular), so that a caller that spells them its own way (the
+        command line's ``--excitation-duration`` for ``duration``) can say them so
+        (:meth:`renamed`).
+    """
+
+    def __init__(self, message, options=()):
+        self.options = tuple(str(option) for option in options)
+        super().__init__(message)
+
+    def renamed(self, spelling):
+        """The same error with each of its options written as ``spelling`` says.
+
+        Parameters
+        ----------
+        spelling : dict
+            Option -> how the caller names it (``{"duration": "--excitation-duration"}``);
+            options it leaves out keep their name.
+
+        Returns
+        -------
+        ExcitationError
+        """
+        message = str(self)
+        for option in self.options:
+            if option in spelling:
+                message = message.replace(f"`{option}`", f"`{spelling[option]}`")
+        return type(self)(message, tuple(spelling.get(o, o) for o in self.options))
+
+    def __reduce__(self):
+        return type(self), (str(self), self.options)
 
 
 class StabilityError(ParameterError):
@@ -43,6 +87,115 @@ class CaseError(ParameterError):
 
     def __reduce__(self):  # picklable with its attributes (Dask, process pools)
         return type(self), (self.index, self.reason)
+
+
+class InvalidCasesError(CaseError):
+    """Cases of a sweep are invalid; found before any case runs, so none runs.
+
+    A :class:`CaseError` whose ``index`` and ``reason`` are the first invalid case's.
+
+    Attributes
+    ----------
+    cases : tuple of tuple
+        ``(index, values, reason)`` per invalid case: its position [-] counted from 0, its
+        varied parameters (a dict) and why it is invalid.
+    total : int
+        Cases in the sweep [-].
+    """
+
+    #: Invalid cases the message lists at most (the attribute holds them all).
+    SHOWN = 3
+
+    def __init__(self, cases, total):
+        self.cases = tuple((int(i), dict(values), str(reason)) for i, values, reason in cases)
+        self.total = int(total)
+        shown = "; ".join(
+            f"case {i} ({', '.join(f'{k} = {v!r}' for k, v in values.items())}): "
+            f"{reason.rstrip('.')}" for i, values, reason in self.cases[:self.SHOWN])
+        more = len(self.cases) - self.SHOWN
+        self.index, self.reason = self.cases[0][0], self.cases[0][2]
+        ParameterError.__init__(  # CaseError's attributes, a message of its own
+            self, f"{len(self.cases)} of {self.total} cases are invalid, so none runs: {shown}"
+                  + (f"; and {more} more" if more > 0 else "")
+                  + "; fix or drop those values in the sweep file.")
+
+    def __reduce__(self):
+        return type(self), (self.cases, self.total)
+
+
+class CountLimitError(ParameterError):
+    """A request asks for more items (sweep cases, frequencies) than qzs runs in one go;
+    raised before any is built, so it fails at once instead of after seconds of work.
+
+    Attributes
+    ----------
+    name : str
+        What sets the count (``--range``, ``grid``, ``samples``, ``frequencies``).
+    count : int
+        How many were asked for [-].
+    limit : int
+        The most qzs runs in one go [-].
+    items : str
+        What is counted (``cases``, ``frequencies``).
+    fix : str
+        What to do instead.
+    """
+
+    def __init__(self, name, count, limit, items, fix):
+        self.name, self.count, self.limit = str(name), int(count), int(limit)
+        self.items, self.fix = str(items), str(fix)
+        super().__init__(f"`{self.name}` asks for {self.count:,} {self.items}, more than the "
+                         f"{self.limit:,} qzs runs in one go; {self.fix}.")
+
+    def __reduce__(self):
+        return type(self), (self.name, self.count, self.limit, self.items, self.fix)
+
+
+class SchedulerError(ParameterError):
+    """No Dask scheduler answers at the address given; raised before any case runs.
+
+    Attributes
+    ----------
+    address : str
+        The scheduler's address as given (``tcp://host:8786``).
+    reason : str
+        What went wrong (refused, timed out, unknown host).
+    """
+
+    def __init__(self, address, reason):
+        self.address, self.reason = str(address), str(reason)
+        super().__init__(f"no Dask scheduler answers at `scheduler` {self.address!r}: "
+                         f"{self.reason}; start one there (`dask scheduler`), check the "
+                         "address, or leave out --scheduler to run here.")
+
+    def __reduce__(self):
+        return type(self), (self.address, self.reason)
+
+
+class AddressError(ParameterError):
+    """The tuning page cannot listen where asked: a busy port, or an address that is not
+    this machine's; raised before the kernels warm up.
+
+    Attributes
+    ----------
+    argument : str
+        The option at fault: ``--host`` or ``--port``.
+    host : str
+        The address asked for.
+    port : int or None
+        The port asked for (None: any free one).
+    reason : str
+        What is wrong and the fix.
+    """
+
+    def __init__(self, argument, host, port, reason):
+        self.argument, self.host, self.reason = str(argument), str(host), str(reason)
+        self.port = None if port is None else int(port)
+        value = self.host if self.argument == "--host" else self.port
+        super().__init__(f"{self.argument} {value!r} {self.reason}.")
+
+    def __reduce__(self):
+        return type(self), (self.argument, self.host, self.port, self.reason)
 
 
 class SizeLimitError(ParameterError):
@@ -203,6 +356,82 @@ class RunTooLongError(ParameterError):
         return _rebuild_keywords, (type(self), dict(
             steps=self.steps, seconds=self.seconds, limit=self.limit, duration=self.duration,
             dt=self.dt, cases=self.cases))
+
+
+class UnresolvedExcitationError(ParameterError):
+    """The integration step is too coarse for the excitation's frequency; raised before the run.
+
+    A fixed-step integrator needs several steps per period of the base motion to follow it:
+    at 2.5 steps per period of a 4000 Hz sine (dt = 1e-4 s) the energy ledger is 15 % off,
+    and a 1e9 Hz sine diverges.
+
+    Attributes
+    ----------
+    frequency : float
+        The excitation's highest frequency within the run [Hz].
+    dt : float
+        The integration step [s].
+    minimum : int
+        The fewest steps per period a run is started with [-].
+    name : str
+        The excitation's option that sets the frequency (``frequency``, ``f1``, ...).
+    """
+
+    def __init__(self, *, frequency, dt, minimum, name="frequency"):
+        self.frequency, self.dt = float(frequency), float(dt)
+        self.minimum, self.name = int(minimum), str(name)
+        finest = 1.0 / (self.minimum * self.frequency)
+        super().__init__(
+            f"the excitation reaches {self.frequency:g} Hz (`{self.name}`), where `dt` = "
+            f"{self.dt:g} s gives {1.0 / (self.frequency * self.dt):.3g} integration steps per "
+            f"period, fewer than the {self.minimum} a run needs to follow it; lower `{self.name}` "
+            f"to at most {1.0 / (self.minimum * self.dt):.3g} Hz, or reduce `dt` to at most "
+            f"{finest:.3g} s.")
+
+    def __reduce__(self):
+        return _rebuild_keywords, (type(self), dict(
+            frequency=self.frequency, dt=self.dt, minimum=self.minimum, name=self.name))
+
+
+class ControllerRateError(ParameterError):
+    """A sampled controller's rate shares a step with the output rate only at a far finer step.
+
+    Every step must divide both the output period and the controller's: 333 Hz against a
+    1000 Hz output needs 1/333000 s, a run hundreds of times longer than at the stable
+    step. Raised before any run, by :func:`qzs.engine.accuracy.admissible_step`.
+
+    Attributes
+    ----------
+    controller_rate : float
+        The controller's rate [Hz].
+    sample_rate : float
+        The output rate [Hz].
+    step : float
+        The largest step stability and the output rate allow [s].
+    refinement : int
+        How much finer than ``step`` the search went [-].
+    suggestions : tuple of float
+        Rates [Hz] near ``controller_rate`` that divide the output rate or are whole
+        multiples of it.
+    """
+
+    def __init__(self, *, controller_rate, sample_rate, step, refinement, suggestions=()):
+        self.controller_rate, self.sample_rate = float(controller_rate), float(sample_rate)
+        self.step, self.refinement = float(step), int(refinement)
+        self.suggestions = tuple(float(f) for f in suggestions)
+        near = " or ".join(f"{f:g}" for f in self.suggestions)
+        super().__init__(
+            f"`controller_rate` ({self.controller_rate:g} Hz) and the output rate "
+            f"`sample_rate` ({self.sample_rate:g} Hz) share no integration step down to "
+            f"{self.refinement} times finer than the stable {self.step:.3g} s: every run would "
+            f"take that much longer or more; choose a controller rate that divides the output "
+            f"rate or is a whole multiple of it" + (f" (e.g. {near} Hz)" if near else "")
+            + ", or 0 for a continuous controller.")
+
+    def __reduce__(self):
+        return _rebuild_keywords, (type(self), dict(
+            controller_rate=self.controller_rate, sample_rate=self.sample_rate, step=self.step,
+            refinement=self.refinement, suggestions=self.suggestions))
 
 
 def _rebuild_keywords(kind, keywords):

@@ -83,3 +83,43 @@ def test_ctrl_c_stops_the_server_with_130():
             process.kill()
     assert process.returncode == 130, err
     assert f"serving http://127.0.0.1:{port}/" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("host, port, argument, words", [
+    ("no-such-host.invalid", None, "--host", "is not an address, nor a host name"),
+    ("no-such-host.invalid", 8123, "--host", "is not an address, nor a host name"),
+    ("999.1.1.1", None, "--host", "is not an address, nor a host name"),
+    ("192.0.2.1", None, "--host", "is not an address of this machine"),   # TEST-NET-1
+    ("192.0.2.1", 8123, "--host", "is not an address of this machine"),
+])
+def test_an_address_that_is_not_this_machines_is_named_with_its_option(host, port, argument,
+                                                                       words):
+    """It used to say "no free port; pass --port", even when a port was given."""
+    from qzs.app.server import check_address
+    from qzs.errors import AddressError, ParameterError
+
+    with pytest.raises(AddressError) as caught:
+        check_address(host, port)
+    error = caught.value
+    assert isinstance(error, ParameterError)
+    assert (error.argument, error.host, error.port) == (argument, host, port)
+    assert str(error).startswith(f"--host {host!r} {words}") and "127.0.0.1" in str(error)
+
+
+def test_a_busy_port_fails_before_the_warm_up(monkeypatch):
+    """`qzs app --port <busy>` used to warm up, print "serving", then fail with 4 lines."""
+    import socket
+
+    import qzs.app.server as server
+    from qzs.errors import AddressError
+
+    monkeypatch.setattr(server, "warm_up", lambda: pytest.fail("warmed up before the check"))
+    monkeypatch.setattr(server, "require", lambda *args: None)  # no Panel needed to fail
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        with pytest.raises(AddressError, match=f"--port {port} is in use on 127.0.0.1"):
+            server.serve(port=port, open_browser=False)
+        assert server.check_address("127.0.0.1", 0) != port  # 0: any free one
+        assert server.choose_port("127.0.0.1", port) != port  # the default's fallback

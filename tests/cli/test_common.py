@@ -62,3 +62,28 @@ def test_the_exit_code_follows_the_errors_class(error, code, capsys):
     assert code in EXIT_CODES
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("qzs: ") and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv, words, foreign", [
+    (["simulate"], ["--sample-rate", "--out"], []),
+    (["sweep", "s.toml"], ["batch_size", "time_series"], ["--sample-rate", "--out"]),
+    (["response"], ["--range", "--workers"], ["--sample-rate", "--out"]),
+    (["hexapod", "transmissibility"], ["--workers"], ["--out"]),
+    (["params"], ["close other programs"], ["--sample-rate", "--out"]),
+])
+def test_the_out_of_memory_hint_names_the_commands_own_options(monkeypatch, capsys, argv,
+                                                                words, foreign):
+    """It used to tell sweep and response users to use --sample-rate and --out."""
+    from qzs.cli import HANDLERS, main
+
+    def handler(args):
+        raise MemoryError()
+
+    monkeypatch.setitem(HANDLERS, argv[0], handler)
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error: out of memory; ") and err.count("\n") == 1
+    for word in words:
+        assert word in err, (word, err)
+    for word in foreign:
+        assert word not in err, (word, err)

@@ -68,13 +68,40 @@ def test_set_stiffens_every_leg(capsys):
 
 def test_paper_legs_are_statically_unstable_under_their_own_preload(capsys):
     """Compressed legs on spherical joints: negative stiffness -4 f/a in each translation
-    of the cube, far above the legs' 2 (k_spring + Kp): unstable directions get no frequency."""
-    record = run_json(capsys)
+    of the cube, far above the legs' 2 (k_spring + Kp) with the paper's Kp = 50 N/m:
+    unstable directions get no frequency."""
+    record = run_json(capsys, "--cubic")
     assert record["stable"] is False
     assert any(f is None for f in record["natural_frequencies"])
     assert any("statically unstable" in note for note in record["notes"])
-    text_code = main(["hexapod", "linear"])
+    text_code = main(["hexapod", "linear", "--cubic"])
     assert text_code == 0
+
+
+@pytest.mark.parametrize("command", ["linear", "simulate", "transmissibility"])
+def test_every_subcommand_defaults_to_the_shipped_platform(capsys, command):
+    """One default platform for every six-axis command: without --config or --cubic,
+    `hexapod linear` analysed a bare cube with Kp = 50 N/m (three unstable modes) while
+    `simulate` and `transmissibility` ran the shipped paper_legs_cubic."""
+    from qzs.cli import build_parser
+    from qzs.cli.hexapod import DEFAULT_SETUP, _setup
+    from qzs.workflows.hexapod import SHIPPED_DEFAULT
+
+    setup = _setup(build_parser().parse_args(["hexapod", command]))
+    shipped = load_hexapod(SHIPPED_DEFAULT)
+    assert setup.source == shipped.source and setup.controller == shipped.controller
+    assert setup.platform.mass == shipped.platform.mass
+    assert main(["hexapod", command, "--help"]) == 0
+    assert SHIPPED_DEFAULT in DEFAULT_SETUP
+    assert " ".join(DEFAULT_SETUP.split()) in " ".join(capsys.readouterr().out.split())
+
+
+def test_the_default_linear_model_is_the_shipped_platforms_and_stable(capsys):
+    from qzs.workflows.hexapod import SHIPPED_DEFAULT
+
+    default = run_json(capsys)
+    assert default == run_json(capsys, "--config", SHIPPED_DEFAULT)
+    assert default["stable"] is True  # Kp = 2000 N/m holds the preload (docs/hexapod.md §6)
 
 
 def test_hexapod_file(tmp_path, capsys):

@@ -22,7 +22,7 @@ from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine, simulate
 from qzs.engine import StepChoice, choose_step
 from qzs.engine.accuracy import (SAFETY, admissible_step, halving_search, probe_excitation,
                                  step_error)
-from qzs.engine.prepare import steps_per_sample
+from qzs.engine.prepare import resolving_step, steps_per_sample
 from qzs.engine.stability import largest_stable_step, stability_test
 from qzs.errors import ParameterError
 
@@ -85,11 +85,16 @@ def test_the_step_respects_stability_and_divides_the_output_period(sample_rate, 
     assert steps_per_sample(sample_rate, choice.dt) == choice.steps_per_sample
     if controller_rate:
         steps_per_sample(controller_rate, choice.dt, "controller_rate")  # raises if not whole
-    # stability-bound cases start at the largest stable multiple of the output period
-    if 1.0 / sample_rate > limit:
+    # stability- or resolution-bound cases start at the largest such multiple of the
+    # output period: stable, and 10 steps per period of the probe's highest frequency
+    resolving = resolving_step(choice.probe, choice.probe_duration)
+    assert choice.history[0][0] <= resolving
+    bound = min(limit, resolving)
+    if 1.0 / sample_rate > bound:
         k = steps_per_sample(sample_rate, choice.history[0][0])
-        assert 1.0 / (sample_rate * (k - 1)) > limit
-        assert any("stability bounds" in note for note in choice.notes)
+        assert 1.0 / (sample_rate * (k - 1)) > bound
+        which = "stability bounds" if limit <= resolving else "the base motion bounds"
+        assert any(which in note for note in choice.notes)
 
 
 def test_stiff_stops_lower_the_step():
@@ -278,3 +283,24 @@ def test_the_chosen_step_is_the_largest_whose_db_error_meets_the_tolerance():
     assert SAFETY * errors[1] <= tolerance < SAFETY * errors[0]
     assert choice.error == pytest.approx(errors[1], rel=0.01)
 
+
+def test_a_controller_rate_that_shares_no_step_with_the_output_is_refused_at_once():
+    """333 Hz against a 1000 Hz output shares a step only at 1/333000 s: refused before any
+    probe runs, with rates that would do."""
+    from qzs.engine.accuracy import RATE_REFINEMENT_MAX, admissible_step
+    from qzs.errors import ControllerRateError
+
+    def stable(dt):
+        return dt <= 2.5e-4
+
+    with pytest.raises(ControllerRateError, match=r"`controller_rate` \(333 Hz\)") as caught:
+        admissible_step(1000.0, 333.0, stable)
+    error = caught.value
+    assert error.step == pytest.approx(2.5e-4) and error.refinement == RATE_REFINEMENT_MAX
+    for rate in error.suggestions:  # each suggestion is admissible
+        dt, _ = admissible_step(1000.0, rate, stable)
+        steps_per_sample(rate, dt, "controller_rate")
+    assert admissible_step(1000.0, 3000.0, stable) == (pytest.approx(1 / 6000), 6)
+    with pytest.raises(ControllerRateError):
+        choose_step(CHIRP, controller=ControllerParameters(controller_rate=333.0),
+                    tolerance_db=0.5, probe_duration=PROBE)

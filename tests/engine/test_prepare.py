@@ -11,7 +11,7 @@ from qzs import ControllerParameters, IsolatorParameters, Sine, simulate
 from qzs.engine.base_motion import base_motion_series
 from qzs.engine.prepare import prepare_run
 from qzs.engine import kernels as K
-from qzs.errors import ExcitationError
+from qzs.errors import ExcitationError, ParameterError
 from qzs.model.excitation import (DEFAULT_FADE_IN, Chirp, DisplacementRecord, RandomExcitation,
                                   build_excitation)
 
@@ -105,3 +105,38 @@ def test_fade_in_defaults_and_switch():
 def test_bad_seed_is_named(seed):
     with pytest.raises(ExcitationError, match="`seed` must be a non-negative integer"):
         RandomExcitation(seed=seed)
+
+
+# ---------------------------------------------------------------- steps per period
+@pytest.mark.parametrize("excitation, duration, name", [
+    (Sine(frequency=4000.0), 2.0, "frequency"),   # 2.5 steps per period at dt = 1e-4 s
+    (Sine(frequency=1e9), 1.0, "frequency"),      # used to diverge without naming it
+    (RandomExcitation(f_low=1.0, f_high=2000.0, duration=1.0), 1.0, "f1"),
+])
+def test_a_step_too_coarse_for_the_excitation_is_refused_before_the_run(excitation, duration,
+                                                                        name):
+    from qzs.errors import UnresolvedExcitationError
+
+    with pytest.raises(UnresolvedExcitationError, match=f"`{name}`") as caught:
+        prepare_run(excitation, duration=duration, dt=1e-4)
+    error = caught.value
+    assert error.frequency == pytest.approx(excitation.max_frequency) and error.dt == 1e-4
+    assert error.frequency * error.dt * error.minimum > 1.0  # it does fall short
+
+
+def test_the_resolution_limit_is_the_step_that_gives_ten_steps_per_period():
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD, check_resolution, resolving_step
+
+    sine = Sine(frequency=400.0)
+    assert resolving_step(sine) == pytest.approx(1.0 / (MIN_STEPS_PER_PERIOD * 400.0))
+    check_resolution(sine, 2.5e-4)  # exactly 10 steps per period: accepted
+    with pytest.raises(ParameterError):
+        check_resolution(sine, 2.6e-4)
+    # a chirp cut short reaches only the frequency of its end
+    chirp = Chirp(f0=0.0, f1=2000.0, duration=100.0)
+    check_resolution(chirp, 1e-4, duration=50.0)  # 1000 Hz: 10 steps per period
+    with pytest.raises(ParameterError):
+        check_resolution(chirp, 1e-4)
+    # a record's sample rate bounds its content from above only: not checked
+    record = DisplacementRecord(time=np.arange(100) / 1e4, displacement=np.zeros(100))
+    assert resolving_step(record) == np.inf

@@ -6,6 +6,8 @@ from scipy import signal
 
 from qzs import Chirp, DisplacementRecord, ExcitationError, ParameterError, RandomExcitation, Sine, simulate
 from qzs.engine import base_motion_series
+from qzs.errors import DataError
+from qzs.model.excitation import build_excitation, highest_frequency, read_displacement_csv
 
 
 def _record(nonuniform=False):
@@ -169,15 +171,15 @@ def test_record_of_a_sine_drives_the_simulator_like_the_sine():
 
 # ------------------------------------------------------------------ errors
 @pytest.mark.parametrize("factory, match", [
-    (lambda: Chirp(f0=0.0, method="logarithmic"), r"logarithmic chirp needs `f0` > 0.*f0=0.0"),
+    (lambda: Chirp(f0=0.0, method="logarithmic"), r"logarithmic chirp needs `f0` > 0.*`f0` = 0.0"),
     (lambda: Chirp(method="exponential"), r"`method` must be one of 'linear', 'logarithmic'; got 'exponential'"),
     (lambda: Chirp(amplitude=-0.01), r"`amplitude` must be non-negative, got -0.01"),
     (lambda: Chirp(duration=0.0), r"`duration` must be positive, got 0.0"),
     (lambda: Chirp(f1=float("nan")), r"`f1` must be finite, got nan"),
     (lambda: Sine(frequency=-1.0), r"`frequency` must be non-negative, got -1.0"),
     (lambda: Sine(phase=True), r"`phase` must be a number, got the boolean True"),
-    (lambda: RandomExcitation(f_low=5.0, f_high=5.0), r"`f_low` must be below `f_high`, got f_low=5.0"),
-    (lambda: RandomExcitation(f_low=8.0, f_high=2.0), r"`f_low` must be below `f_high`, got f_low=8.0"),
+    (lambda: RandomExcitation(f_low=5.0, f_high=5.0), r"`f_low` \(5.0 Hz\) must be below `f_high`"),
+    (lambda: RandomExcitation(f_low=8.0, f_high=2.0), r"`f_low` \(8.0 Hz\) must be below `f_high`"),
     (lambda: RandomExcitation(seed=1.5), r"`seed` must be a non-negative integer .*, got 1.5"),
     (lambda: RandomExcitation(seed=True), r"`seed` must be a non-negative integer .*, got True"),
     (lambda: DisplacementRecord(time=[0, 1, 2], displacement=[0, 1, 2]), "at least 4 samples, got 3"),
@@ -214,3 +216,45 @@ def test_excitations_reject_unknown_keywords():
         Chirp(frequency=1.0)
     with pytest.raises(TypeError):
         Sine(duration=3.0)
+
+
+# ---------------------------------------------------------------- names in the messages
+@pytest.mark.parametrize("kind, options, names, message", [
+    ("random", {"f0": 30.0, "f1": 10.0}, {"f0": "--f0", "f1": "--f1"},
+     r"`--f0` \(30.0 Hz\) must be below `--f1` \(10.0 Hz\)"),
+    ("random", {"f0": 30.0, "f1": 10.0}, None, r"`f0` \(30.0 Hz\) must be below `f1`"),
+    ("chirp", {"duration": 0.0}, {"duration": "--excitation-duration"},
+     r"`--excitation-duration` must be positive, got 0.0"),
+    ("sine", {"fade_in": -1.0}, {"fade_in": "[excitation] fade_in"},
+     r"`\[excitation\] fade_in` must be non-negative"),
+])
+def test_build_excitation_names_the_options_as_the_caller_does(kind, options, names, message):
+    """A random band's fields are f_low/f_high, its options f0/f1: a message names what the
+    caller wrote (the command line's flags), never a field the caller has not seen."""
+    with pytest.raises(ExcitationError, match=message):
+        build_excitation(kind, options, names=names)
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda folder: folder, "is a folder; pass the CSV file"),
+    (lambda folder: _write(folder / "junk.csv", bytes(range(256))), "is not UTF-8 text"),
+])
+def test_a_record_that_is_a_folder_or_binary_is_a_data_error(tmp_path, make, message):
+    path = make(tmp_path)
+    with pytest.raises(DataError, match=message):
+        read_displacement_csv(path)
+    with pytest.raises(DataError, match=f"^--record: .*{message}"):
+        build_excitation("file", {"record": str(path)}, names={"record": "--record"})
+
+
+def _write(path, content):
+    path.write_bytes(content)
+    return path
+
+
+def test_highest_frequency_within_the_run():
+    assert highest_frequency(Chirp(f0=0.0, f1=20.0, duration=100.0), 50.0) == pytest.approx(10.0)
+    assert highest_frequency(Chirp(f0=20.0, f1=0.0, duration=100.0), 50.0) == 20.0
+    assert highest_frequency(Chirp(f0=0.0, f1=20.0, duration=100.0)) == 20.0
+    assert highest_frequency(Sine(frequency=3.0)) == 3.0
+    assert highest_frequency(RandomExcitation(f_low=1.0, f_high=15.0)) == 15.0

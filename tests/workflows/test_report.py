@@ -368,3 +368,21 @@ def test_unknown_claim_id_names_the_file_the_id_and_the_known_ids(tmp_path):
                     "[[case]]\nlabel='a'\n")
     with pytest.raises(ParameterError, match="must be a list of claim ids"):
         load_study(path)
+
+
+@pytest.mark.parametrize("make", ["file", "read-only"])
+def test_a_bad_output_folder_fails_before_any_study_runs(tmp_path, monkeypatch, make, request):
+    """`qzs paper --out <file>` used to fail only after the studies ran (minutes, cold)."""
+    import qzs.workflows.report as report
+    from qzs.errors import OutputPathError
+
+    monkeypatch.setattr(report, "run_studies",
+                        lambda *args, **kwargs: pytest.fail("a study ran before the check"))
+    if make == "file":
+        folder = tmp_path / "a-file"
+        folder.write_text("in the way")
+    else:
+        folder = request.getfixturevalue("read_only_folder") / "report"
+    with pytest.raises(OutputPathError) as caught:
+        report.run_paper(["stiction"], folder, quick=True, argument="--out")
+    assert (caught.value.argument, caught.value.value) == ("--out", str(folder))

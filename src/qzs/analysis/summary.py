@@ -97,10 +97,9 @@ def run_warnings(result):
 
 def _highest_frequency(result):
     """Highest frequency [Hz] the excitation reaches within the run."""
-    exc = result.excitation
-    if hasattr(exc, "frequency_at"):
-        return float(max(exc.frequency_at(0.0), exc.frequency_at(result.run["duration"])))
-    return float(exc.max_frequency)
+    from qzs.model.excitation import highest_frequency
+
+    return highest_frequency(result.excitation, result.run["duration"])
 
 
 def _residual_share(stats):

@@ -7,6 +7,7 @@ otherwise, warns on stderr when it is told otherwise, accepts the page's websock
 from the address it serves, and reads and writes no file: exports are browser downloads
 (docs/app.md).
 """
+import errno
 import ipaddress
 import signal
 import socket
@@ -15,9 +16,10 @@ import threading
 import time
 
 from qzs._optional import require
-from qzs.errors import ParameterError
+from qzs.errors import AddressError, ParameterError
 
-__all__ = ["serve", "warm_up", "choose_port", "is_loopback", "DEFAULT_PORT", "DEFAULT_HOST"]
+__all__ = ["serve", "warm_up", "choose_port", "check_address", "is_loopback", "DEFAULT_PORT",
+           "DEFAULT_HOST"]
 
 #: Port tried first when none is given (Bokeh's own default) [-].
 DEFAULT_PORT = 5006
@@ -59,16 +61,83 @@ def choose_port(host=DEFAULT_HOST, preferred=DEFAULT_PORT):
     Returns
     -------
     int
+
+    Raises
+    ------
+    AddressError
+        ``host`` is not a name this machine resolves, or not one of its addresses.
     """
-    family = socket.AF_INET6 if ":" in host else socket.AF_INET
-    for port in (preferred, 0):
-        with socket.socket(family, socket.SOCK_STREAM) as probe:
-            try:
-                probe.bind((host, port))
-            except OSError:
-                continue
-            return probe.getsockname()[1]
-    raise ParameterError(f"no free port on {host!r}; pass --port.")  # pragma: no cover
+    for port in dict.fromkeys((preferred, 0)):
+        try:
+            return _bind(host, port)
+        except AddressError as error:
+            if error.argument == "--host" or port == 0:
+                raise
+    raise AssertionError("unreachable")  # pragma: no cover - port 0 either binds or raises
+
+
+def check_address(host=DEFAULT_HOST, port=None):
+    """The port the server will listen on, checked before anything else starts.
+
+    Asked of the operating system by binding a probe socket (closed at once), so a busy
+    port or an address that is not this machine's fails in milliseconds, with the option
+    to change, instead of after the warm-up.
+
+    Parameters
+    ----------
+    host : str
+        The address to bind (an IP address or a host name).
+    port : int, optional
+        The port asked for; None: :data:`DEFAULT_PORT` if it is free, else a free one; 0:
+        a free one.
+
+    Returns
+    -------
+    int
+        The port, free on ``host`` a moment ago.
+
+    Raises
+    ------
+    AddressError
+        ``--host``: not a name this machine resolves (``no-such-host.invalid``,
+        ``999.1.1.1``), or not one of its addresses (``192.0.2.1``); ``--port``: in use,
+        or below 1024 without the rights.
+    """
+    if port is None:
+        try:
+            return choose_port(host, DEFAULT_PORT)
+        except AddressError as error:  # the port was not asked for: say none was
+            raise AddressError(error.argument, host, None, error.reason) from None
+    return _bind(host, port)
+
+
+def _bind(host, port):
+    """Bind a probe socket to ``(host, port)`` like the server does; returns the port."""
+    try:
+        family, kind, protocol, _, address = socket.getaddrinfo(
+            host, port, type=socket.SOCK_STREAM)[0]
+    except (socket.gaierror, UnicodeError) as error:
+        raise AddressError("--host", host, port, f"is not an address, nor a host name this "
+                           f"machine resolves ({getattr(error, 'strerror', None) or error}); "
+                           "use 127.0.0.1 (this machine only), 0.0.0.0 (every network "
+                           "interface) or one of this machine's addresses") from None
+    with socket.socket(family, kind, protocol) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as the server does
+        try:
+            probe.bind(address)
+        except OSError as error:
+            if error.errno == errno.EADDRINUSE:
+                raise AddressError("--port", host, port, f"is in use on {host} by another "
+                                   "program; choose another port, or leave out --port for a "
+                                   "free one") from None
+            if error.errno == errno.EACCES:
+                raise AddressError("--port", host, port, "needs administrator rights (a port "
+                                   "below 1024); choose a port above 1023") from None
+            raise AddressError("--host", host, port, f"is not an address of this machine "
+                               f"({error.strerror}), so nothing can listen there; use "
+                               "127.0.0.1 (this machine only), 0.0.0.0 (every network "
+                               "interface) or one of this machine's addresses") from None
+        return probe.getsockname()[1]
 
 
 def warm_up(stream=None):
@@ -123,13 +192,15 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
         Panel is not installed (``pip install "qzs[app]"``).
     ParameterError
         A port outside 0-65535.
+    AddressError
+        A busy port, or a host that is not this machine's (:func:`check_address`), before
+        the warm-up.
     """
-    require("panel", "the tuning page (qzs app)")
     if port is not None and (isinstance(port, bool) or not isinstance(port, int)
                              or not 0 <= port <= 65535):
         raise ParameterError(f"`port` must be an integer in [0, 65535], got {port!r}.")
-    if port is None or port == 0:
-        port = choose_port(host, DEFAULT_PORT if port is None else 0)
+    port = check_address(host, port)  # a busy port, an address not this machine's: fail now
+    require("panel", "the tuning page (qzs app)")
     if is_loopback(host):
         origins = [f"{name}:{port}" for name in ("127.0.0.1", "localhost")]
     else:

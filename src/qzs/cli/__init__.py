@@ -37,6 +37,7 @@ temporary file stays behind).
 """
 import argparse
 import os
+import re
 import signal
 import sys
 
@@ -55,9 +56,24 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "design": design.run, "app": app.run}
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser that reads every negative number as a value, as Python 3.13's does.
+
+    Python 3.11's argparse takes only ``-1`` and ``-1.5`` for numbers: ``--dt -1e-4``,
+    ``--frequencies -1,2`` or ``--mass-range -1,6.4`` stopped at "expected one argument"
+    before the option's check could say what is wrong with the value. No option of qzs
+    looks like a number, so an argument that starts with ``-`` and a digit (or ``-.`` and
+    a digit) is always a value; the subparsers inherit the class.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
+
+
 def build_parser():
     """The ``qzs`` argument parser with every subcommand."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="qzs", description="Semi-active quasi-zero-stiffness isolator toolkit.",
         epilog="The model, its signs, defaults and every modelling decision: docs/model.md "
                "(in the qzs repository). Parameter names and units: `qzs params`. " + EPILOG)

@@ -28,12 +28,32 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
 __all__ = ["settings", "parameters", "add_set_option", "add_json_option", "emit", "jsonable",
-           "integer_at_least", "run_handler", "EXIT_CODES", "EPILOG"]
+           "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
+           "MEMORY_HINTS", "MEMORY_HINT"]
 
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
               130: "interrupted (Ctrl-C)", 141: "output pipe closed by its reader",
               143: "terminated (SIGTERM), after cleanup"}
+#: What to do after running out of memory, per subcommand (``hexapod <sub>`` for the
+#: six-axis ones): the options that apply to it, never another command's.
+MEMORY_HINTS = {
+    "simulate": "choose a shorter run (--duration), a lower --sample-rate, or stream it to a "
+                "file with --out",
+    "hexapod simulate": "choose a shorter run (--duration), a lower --sample-rate, or stream "
+                        "it to a file with --out",
+    "hexapod transmissibility": "choose fewer --workers (each holds one run), a shorter "
+                                "--duration or a lower --sample-rate",
+    "hexapod study": "choose fewer --workers, or --quick",
+    "sweep": "choose a smaller batch_size in [sweep] (cases held at once), keep fewer "
+             "[outputs] time_series, or run fewer --threads",
+    "response": "give fewer frequencies (--range F0,F1,N), or fewer --workers",
+    "paper": "choose fewer --workers, or --quick",
+    "study": "choose fewer --workers, or --quick",
+    "design": "choose fewer --workers, or --quick",
+}
+#: What to do after running out of memory in any other subcommand.
+MEMORY_HINT = "close other programs, or ask for less (a shorter run, fewer cases)"
 #: The exit codes as a help epilog.
 EPILOG = "exit codes: " + ", ".join(f"{code} {text}" for code, text in EXIT_CODES.items()) + "."
 
@@ -239,8 +259,28 @@ def run_handler(handler, args):
         where = f" {str(error.filename)!r}" if error.filename else ""
         return _fail(f"cannot access{where}: {error.strerror or error}", 1)
     except MemoryError as error:
-        return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; choose a "
-                     "shorter run, a lower --sample-rate, or write with --out", 1)
+        return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; "
+                     f"{memory_hint(args)}", 1)
+
+
+def memory_hint(args):
+    """What to do after running out of memory in the command ``args`` describe.
+
+    Parameters
+    ----------
+    args : argparse.Namespace or None
+        The parsed arguments (``command``, and ``hexapod_command`` for ``qzs hexapod``).
+
+    Returns
+    -------
+    str
+        The options of that command that make it take less memory (:data:`MEMORY_HINTS`),
+        else :data:`MEMORY_HINT`.
+    """
+    command = getattr(args, "command", None)
+    if command == "hexapod":
+        command = f"hexapod {getattr(args, 'hexapod_command', '')}"
+    return MEMORY_HINTS.get(command, MEMORY_HINT)
 
 
 def _fail(error, code):

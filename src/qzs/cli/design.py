@@ -113,7 +113,8 @@ def add_parser(subparsers):
                           "bins, or its peak (default rms)")
     cmd.add_argument("--controller-rate", metavar="HZ", type=float,
                      help="controller rate with zero-order hold [Hz]; 0 continuous (default: "
-                          "the controller's controller_rate, 0); it must divide 1/dt")
+                          "the controller's controller_rate, 0); it must share the integration "
+                          "step with the runs' output rate: a divisor or whole multiple of it")
     cmd.add_argument("--delay", metavar="S", type=float, default=0.0,
                      help="delay from sampling to the motor force [s], for the margins and the "
                           "linear delay experiment (the simulator has none; default 0)")

@@ -26,7 +26,8 @@ def add_parser(subparsers):
                "the map's [options]). " + EPILOG)
     parser.add_argument("log", metavar="LOG", help="log file (.csv, .mat, .mf4, .nc)")
     parser.add_argument("--map", required=True, metavar="MAP.toml",
-                        help="channel map (see qzs.iotools.readers)")
+                        help="channel map: each signal's source channel and unit (layout: "
+                             "docs/workflows/identification.md)")
     parser.add_argument("--out", metavar="DIR", default="qzs-experiment",
                         help="output folder (default qzs-experiment)")
     parser.add_argument("--no-simulation", action="store_true",

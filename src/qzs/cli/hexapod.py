@@ -2,20 +2,28 @@
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
 from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
+from qzs.workflows.hexapod import SHIPPED_DEFAULT
 
 __all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibility",
            "run_study"]
 
+#: What every subcommand takes without --config or --cubic (one default for all of them).
+DEFAULT_SETUP = (f"Without --config or --cubic: the shipped {SHIPPED_DEFAULT} platform (cube "
+                 f"edge {HEXAPOD['cube_edge']:g} m, Kp = 2000 N/m, carrying what its six "
+                 "MagSprings hold; docs/hexapod.md §8).")
 #: ``--frame`` choices and the name the analysis takes.
 FRAMES = {"center-of-mass": "center_of_mass", "origin": "origin", "cube-center": "cube_center"}
 
 
 def _add_setup_options(parser):
     parser.add_argument("--config", metavar="FILE.toml",
-                        help="hexapod file: [geometry], [platform], [leg], [controller] "
-                             "(see qzs.workflows.hexapod)")
+                        help="hexapod file, or a shipped one's name: [geometry], [platform], "
+                             "[leg], [controller], [excitation.<axis>], [simulation] (layout: "
+                             "docs/hexapod.md §8; default the shipped "
+                             f"{SHIPPED_DEFAULT})")
     parser.add_argument("--cubic", action="store_true",
-                        help="a cubic configuration without a file (with --cube-edge)")
+                        help="a cubic configuration without a file (with --cube-edge; the "
+                             "legs' default loops, Kp = 50 N/m)")
     parser.add_argument("--cube-edge", metavar="M", type=float,
                         help=f"edge of the cube [m] (with --cubic; default {HEXAPOD['cube_edge']:g})")
     parser.add_argument("--cube-center-height", metavar="M", type=float,
@@ -50,10 +58,8 @@ def add_parser(subparsers):
     linear = sub.add_parser(
         "linear", help="stiffness matrix and modes at the operating point",
         description="Linearise the platform about its home pose (every leg slipping, motors "
-                    "unsaturated) and print the 6x6 stiffness matrix and the modes. Without "
-                    "--config or --cubic: the cubic configuration of edge "
-                    f"{HEXAPOD['cube_edge']:g} m carrying the payload its six MagSprings "
-                    "hold.")
+                    "unsaturated) and print the 6x6 stiffness matrix and the modes. "
+                    + DEFAULT_SETUP)
     _add_setup_options(linear)
     linear.add_argument("--leg-stiffness", metavar="N_PER_M", type=float,
                         help="replace every leg's axial stiffness [N/m] (a purely linear "
@@ -73,7 +79,7 @@ def add_parser(subparsers):
                     "per-leg PI and damping, docs/hexapod.md §9) under the base motion of the "
                     "file's [excitation.<axis>] tables or of --axis/--excitation, and print a "
                     "summary per leg: stroke used, stop contacts, time locked, motor RMS. "
-                    "Without --config or --cubic: the shipped paper_legs_cubic file.")
+                    + DEFAULT_SETUP)
     _add_setup_options(simulate)
     simulate.add_argument("--axis", choices=AXES,
                           help="the base axis --excitation drives (replaces the file's table "
@@ -90,7 +96,8 @@ def add_parser(subparsers):
     simulate.add_argument("--duration", type=float, metavar="S", help="simulated time [s]")
     simulate.add_argument("--dt", type=float, metavar="S", help="integration step [s]")
     simulate.add_argument("--sample-rate", type=float, metavar="HZ", help="output rate [Hz]")
-    simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"))
+    simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"),
+                          help="integrator (default the file's, else ode3)")
     simulate.add_argument("--out", metavar="FILE.nc", help="write the run as NetCDF (CF-1.10)")
     simulate.add_argument("--plot", metavar="FILE.png", help="draw the run")
     simulate.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -102,13 +109,12 @@ def add_parser(subparsers):
                     "estimate the 6x6 transmissibility matrix with the single axis's Welch "
                     "estimator and its trusted bins (docs/hexapod.md, \"Simulated "
                     "transmissibility\"); write the 6x6 grid (linear model dashed) and the "
-                    "matrix as NetCDF to --out and print a summary. Without --config or "
-                    "--cubic: the shipped paper_legs_cubic file.")
+                    "matrix as NetCDF to --out and print a summary. " + DEFAULT_SETUP)
     _add_setup_options(matrix)
     matrix.add_argument("--axes", metavar="AXES", default=",".join(AXES),
                         help="comma-separated base axes to excite, one run each (default "
                              f"all six: {','.join(AXES)})")
-    matrix.add_argument("--amplitude", metavar="A | AXIS=A,...",
+    matrix.add_argument("--amplitude", metavar="AMPLITUDE",
                         help="chirp amplitude: one number for every excited axis (all "
                              "translations [m] or all rotations [rad]) or per axis, e.g. "
                              "z=0.001,rx=0.005 (default 0.002 m, 0.01 rad)")
@@ -166,15 +172,17 @@ def run(args):
     return args.handler(args)
 
 
-def _setup(args, default_file=False):
-    """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`)."""
+def _setup(args):
+    """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`): the
+    --config file, else a --cubic configuration, else the shipped default
+    (:data:`DEFAULT_SETUP`, the same for every subcommand)."""
     from qzs.workflows.hexapod import centralised
 
-    setup = _described_setup(args, default_file)
+    setup = _described_setup(args)
     return centralised(setup) if args.centralised else setup
 
 
-def _described_setup(args, default_file):
+def _described_setup(args):
     from qzs.model.hexapod import cubic_geometry
     from qzs.workflows.hexapod import default_cube_center_height, hexapod_setup, load_hexapod
 
@@ -187,10 +195,6 @@ def _described_setup(args, default_file):
                              "configuration: add --cubic.")
     if args.config:
         return load_hexapod(args.config, overrides)
-    if default_file:
-        from qzs.workflows.hexapod import SHIPPED_DEFAULT
-
-        return load_hexapod(SHIPPED_DEFAULT, overrides)
     if args.cubic:
         edge = HEXAPOD["cube_edge"] if args.cube_edge is None else args.cube_edge
         if not edge > 0:
@@ -199,7 +203,7 @@ def _described_setup(args, default_file):
                   else args.cube_center_height)
         geometry = cubic_geometry(cube_edge=edge, cube_center_height=height)
         return hexapod_setup(geometry=geometry, settings=overrides, kind="cubic")
-    return hexapod_setup(settings=overrides)
+    return load_hexapod(SHIPPED_DEFAULT, overrides)
 
 
 def run_linear(args):
@@ -265,7 +269,7 @@ def run_simulate(args):
         check_output_path(args.out, argument="--out", suffixes=(".nc",))
     if args.plot:
         check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
-    setup = _setup(args, default_file=True)
+    setup = _setup(args)
     excitation = None
     if args.axis is not None:
         options = {"kind": args.excitation or "chirp"}
@@ -277,7 +281,9 @@ def run_simulate(args):
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
                             sample_rate=args.sample_rate, solver=args.solver,
                             progress=not args.quiet and not args.json, out=args.out or None,
-                            interruptible=True, argument="--out")
+                            interruptible=True, argument="--out",
+                            names={**{name: f"--{name}" for name in _EXCITATION_OPTIONS},
+                                   "duration": "--excitation-duration"})
     text = result.summary()
     record = {"summary": text, "run": result.run, "source": setup.source}
     if args.out:
@@ -334,7 +340,7 @@ def run_transmissibility(args):
                                                         transmissibility_record)
 
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
-    setup = _setup(args, default_file=True)
+    setup = _setup(args)
     options = {name: getattr(args, name) for name in ("f0", "f1", "duration")
                if getattr(args, name) is not None}
     result = hexapod_transmissibility(

@@ -41,10 +41,11 @@ def add_parser(subparsers):
                     "20 Hz, 10 mm, both sweeps, the step chosen for 0.01 dB.")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--frequencies", metavar="F1,F2,...",
-                       help="the frequencies [Hz], comma-separated")
+                       help="the frequencies [Hz], comma-separated, increasing (the sweeps "
+                            "go up and down over them: --direction)")
     where.add_argument("--range", metavar="F0,F1,N",
                        help="N frequencies from F0 to F1 [Hz] (default 0.5,20,40)")
-    parser.add_argument("--spacing", choices=("log", "linear"), default="log",
+    parser.add_argument("--spacing", choices=("log", "linear"),
                         help="spacing of a --range (default log)")
     parser.add_argument("--amplitude", type=float, metavar="M",
                         help="base displacement amplitude [m] (default the config's, else "
@@ -97,36 +98,59 @@ def add_parser(subparsers):
     return parser
 
 
-def parse_frequencies(frequencies=None, frequency_range=None, spacing="log"):
+def parse_frequencies(frequencies=None, frequency_range=None, spacing=None):
     """The frequencies of ``--frequencies`` or ``--range`` (default :data:`DEFAULT_RANGE`).
+
+    What was typed is taken as it is or refused, never silently changed: a list out of
+    order or with a repeat, and a ``--spacing`` without ``--range``, are errors.
 
     Parameters
     ----------
     frequencies : str, optional
-        ``"F1,F2,..."`` [Hz].
+        ``"F1,F2,..."`` [Hz], increasing.
     frequency_range : str, optional
         ``"F0,F1,N"``: N frequencies from F0 to F1 [Hz].
-    spacing : {"log", "linear"}
-        Spacing of a range.
+    spacing : {"log", "linear"}, optional
+        Spacing of a range; default log.
 
     Returns
     -------
     list of float
-        The frequencies [Hz], unchecked (the workflow checks them).
+        The frequencies [Hz] (the workflow checks that they are positive and finite).
 
     Raises
     ------
     ParameterError
-        Text that is not numbers, or a range that is not ``F0,F1,N`` with ``N >= 1``.
+        Text that is not numbers, a list that is not increasing, a range that is not
+        ``F0,F1,N`` with ``N >= 1``, ``spacing`` with a list;
+        :class:`~qzs.errors.CountLimitError` for more than
+        :data:`qzs.workflows.response.sweep.MAX_FREQUENCIES` (before any is made).
     """
     import numpy as np
 
+    from qzs.errors import CountLimitError
+    from qzs.workflows.response.sweep import MAX_FREQUENCIES
+
     if frequencies is not None:
+        if spacing is not None:
+            raise ParameterError(f"--spacing {spacing} spaces a --range; --frequencies "
+                                 f"{frequencies} lists them: leave out --spacing, or give "
+                                 "--range F0,F1,N instead.")
         try:
-            return [float(item) for item in frequencies.split(",") if item.strip()]
+            values = [float(item) for item in frequencies.split(",") if item.strip()]
         except ValueError:
             raise ParameterError(f"--frequencies must be numbers in Hz separated by commas, "
                                  f"got {frequencies!r}; e.g. --frequencies 1,2,5.") from None
+        for before, after in zip(values, values[1:]):
+            if after <= before:
+                what = (f"{after:g} Hz is given twice" if after == before
+                        else f"{after:g} Hz comes after {before:g} Hz")
+                raise ParameterError(
+                    f"--frequencies {frequencies} must be increasing, each once: {what}; "
+                    f"give them in increasing order, e.g. --frequencies "
+                    f"{','.join(f'{v:g}' for v in sorted(set(values)))} (the sweeps go up "
+                    "and down over them: --direction).")
+        return values
     if frequency_range is None:
         low, high, count = DEFAULT_RANGE
     else:
@@ -142,9 +166,13 @@ def parse_frequencies(frequencies=None, frequency_range=None, spacing="log"):
         if not (np.isfinite(low) and np.isfinite(high) and 0 < low <= high):
             raise ParameterError(f"--range needs 0 < F0 <= F1 (finite, Hz), got "
                                  f"{frequency_range!r}; e.g. --range 0.5,20,40.")
+        if count > MAX_FREQUENCIES:
+            raise CountLimitError("--range", count, MAX_FREQUENCIES, "frequencies",
+                                  "give a smaller N, or split the band into several responses")
     if count == 1:
         return [low]
-    grid = np.geomspace(low, high, count) if spacing == "log" else np.linspace(low, high, count)
+    grid = (np.linspace(low, high, count) if spacing == "linear"
+            else np.geomspace(low, high, count))
     return [float(f) for f in grid]
 
 

@@ -94,11 +94,13 @@ def _excitation(args, table, source):
     options = dict(table)
     kind = args.excitation or options.get("kind", "chirp")
     options.pop("kind", None)
+    names = {name: f"[excitation] {name}" for name in options}
     origin = {name: f"`{name}` in the [excitation] table of {source}" for name in options}
     for flag, name in _FLAGS.items():
         value = getattr(args, flag[2:].replace("-", "_"))
         if value is not None:
             options[name] = value
+            names[name] = flag
             origin[name] = f"`{flag}`"
     unused = [origin[name] for name in options if name not in EXCITATION_OPTIONS[kind]]
     if unused:
@@ -108,7 +110,7 @@ def _excitation(args, table, source):
             f"{', '.join(unused)} is not used by a {kind} excitation (it takes "
             f"{', '.join(usable)}); drop it or choose the excitation that uses it "
             "(--excitation).")
-    return build_excitation(kind, options)
+    return build_excitation(kind, options, names=names)
 
 
 def run(args):

@@ -51,7 +51,8 @@ def run(args):
         raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
-                                        workers=args.workers, progress=not args.quiet)
+                                        workers=args.workers, progress=not args.quiet,
+                                        argument="--out")
     lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"
              for result in results]
     lines.append(f"{'total':<12}    wall {wall:7.1f} s")

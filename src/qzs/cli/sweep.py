@@ -28,13 +28,17 @@ def add_parsers(subparsers):
         description="Run every case of a sweep file (grid, random or Latin-hypercube "
                     "sampling) and store per-case metrics, statistics and transmissibility "
                     "in a Zarr store, batch by batch; Ctrl-C and --resume continue it.",
-        epilog="The store is checked before any case runs: its folder must be writable and "
-               "hold its uncompressed size, and an existing store needs --resume or "
-               "--overwrite. Ctrl-C (130) and SIGTERM (143) keep the batches already stored. "
+        epilog="The sweep is checked before any case runs: every case's values (the invalid "
+               "ones are named), at most 1,000,000 cases, the store's name (.zarr), its folder "
+               "(writable, room for its uncompressed size); an existing store needs --resume or "
+               "--overwrite, --resume a store. Ctrl-C (130) and SIGTERM (143) keep the batches "
+               "already stored. "
                + EPILOG)
     cmd.add_argument("definition", metavar="FILE.toml",
                      help="sweep file, or a shipped sweep name (e.g. pi_vs_stiction)")
-    cmd.add_argument("--out", metavar="STORE.zarr", help="store (default NAME.zarr)")
+    cmd.add_argument("--out", metavar="STORE.zarr",
+                     help="the Zarr store, a folder whose name ends in .zarr (default "
+                          "NAME.zarr)")
     cmd.add_argument("--resume", action="store_true",
                      help="continue an interrupted sweep in --out (same sweep file)")
     cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")

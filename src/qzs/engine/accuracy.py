@@ -19,7 +19,7 @@ import numpy as np
 from qzs import _validation, defaults
 from qzs._format import decibels
 from qzs._validation import choice as _choice
-from qzs.errors import ParameterError, ToleranceNotMetError
+from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error", "halving_search",
@@ -37,6 +37,11 @@ OVERSHOOT = 1.1
 SAFETY = 2.0
 #: Welch segments the probe's transmissibility averages at least.
 PROBE_SEGMENTS = 8
+#: A sampled controller may make the step at most this much finer than the largest stable
+#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
+#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
+#: of times longer (:class:`~qzs.errors.ControllerRateError`).
+RATE_REFINEMENT_MAX = 32
 _MEASURES = {"transmissibility_db": "dB", "state_m": "m"}
 
 
@@ -286,21 +291,35 @@ def admissible_step(sample_rate, controller_rate, stable):
         The step [s].
     k : int
         Steps per output sample [-].
+
+    Raises
+    ------
+    ControllerRateError
+        The controller's period is a whole number of steps only at a step more than
+        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
     """
     from qzs.engine.prepare import steps_per_sample
 
-    for k in range(1, 1_000_000):
+    first = next((k for k in range(1, 1_000_000) if stable(1.0 / (sample_rate * k))), None)
+    if first is None:
+        raise ParameterError("no step 1/(sample_rate*k) with k < 1e6 is stable; check the "
+                             "model's stiffness and the `sample_rate`.")
+    if controller_rate <= 0:
+        return 1.0 / (sample_rate * first), first
+    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
         dt = 1.0 / (sample_rate * k)
         if not stable(dt):
             continue
-        if controller_rate > 0:
-            try:
-                steps_per_sample(controller_rate, dt, "controller_rate")
-            except ParameterError:
-                continue
+        try:
+            steps_per_sample(controller_rate, dt, "controller_rate")
+        except ParameterError:
+            continue
         return dt, k
-    raise ParameterError("no step 1/(sample_rate*k) with k < 1e6 is both stable and a whole "
-                         "fraction of the controller's period; check `controller_rate`.")
+    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
+    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
+    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
+                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
+                              suggestions=sorted(near))
 
 
 # ---------------------------------------------------------------- the search
@@ -417,7 +436,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import run_inputs
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD, resolving_step, run_inputs
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 
@@ -441,12 +460,18 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
 
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
-    dt0, k0 = admissible_step(sample_rate, controller.controller_rate, stable)
+    resolving = resolving_step(probe, duration)  # the step must follow the base motion too
+    dt0, k0 = admissible_step(sample_rate, controller.controller_rate,
+                              lambda dt: dt <= resolving and stable(dt))
     notes = []
     if k0 == 1:
         notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
                      f"(a lower sample_rate would allow larger steps; stability allows "
                      f"{limit:.3g} s)")
+    elif resolving < limit:
+        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
+                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
+                     f"of its highest frequency (stability allows {limit:.3g} s)")
     else:
         notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
                      f"<= {limit:.3g} s")

@@ -8,14 +8,21 @@ from qzs._validation import choice, positive
 from qzs.engine import kernels as K
 from qzs.engine.base_motion import base_motion_series
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
-from qzs.errors import ParameterError, StabilityError
+from qzs.errors import ParameterError, StabilityError, UnresolvedExcitationError
 from qzs.model.controller import ControllerParameters
-from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
+from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, Sine,
+                                  highest_frequency)
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
 __all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample",
-           "divergence_message"]
+           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
+
+#: Fewest integration steps per period of the excitation's highest frequency a run is
+#: started with [-]: below, the fixed-step integrator does not follow the base motion (at
+#: 2.5 steps per period the energy ledger is 15 % off; far below, the run diverges). The
+#: summary warns below 20 (:data:`qzs.analysis.summary.WARNING_LIMITS`).
+MIN_STEPS_PER_PERIOD = 10
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 # A base at rest, for the static load of the PI preload.
@@ -82,6 +89,56 @@ def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
             f"`{name}` ({rate!r} Hz) must divide the integration rate 1/dt = {1 / dt:g} Hz into "
             f"a whole number of steps; got {ratio:g} steps. Use e.g. {name}={hint:g}.")
     return steps
+
+
+def resolving_step(excitation, duration=None):
+    """The largest step [s] that resolves the excitation (:func:`check_resolution`).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The base motion the step must follow.
+    duration : float, optional
+        The run's simulated time [s] (a chirp cut short ends lower); default its length.
+
+    Returns
+    -------
+    float
+        ``1/(MIN_STEPS_PER_PERIOD * f_max)`` [s]; inf for a record or a base at rest.
+    """
+    if isinstance(excitation, DisplacementRecord):
+        return np.inf
+    top = highest_frequency(excitation, duration)
+    return np.inf if top <= 0 else 1.0 / (MIN_STEPS_PER_PERIOD * top)
+
+
+def check_resolution(excitation, dt, duration=None):
+    """Refuse a step too coarse for the excitation: fewer than :data:`MIN_STEPS_PER_PERIOD`
+    per period of its highest frequency within the run.
+
+    A record is not checked: its samples' Nyquist frequency bounds its content from above
+    only (a measured record sampled fast is common and usually slow in content).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The base motion.
+    dt : float
+        Integration step [s].
+    duration : float, optional
+        Simulated time [s] (a chirp cut short reaches only the frequency of its end).
+
+    Raises
+    ------
+    UnresolvedExcitationError
+        The step gives fewer than :data:`MIN_STEPS_PER_PERIOD` steps per period.
+    """
+    if dt > resolving_step(excitation, duration) * (1.0 + 1e-9):
+        top = highest_frequency(excitation, duration)
+        name = ("frequency" if isinstance(excitation, Sine) else "f1" if (
+            isinstance(excitation, RandomExcitation) or excitation.f1 >= excitation.f0) else "f0")
+        raise UnresolvedExcitationError(frequency=top, dt=dt, minimum=MIN_STEPS_PER_PERIOD,
+                                        name=name)
 
 
 def run_inputs(excitation=None, isolator=None, controller=None):
@@ -271,6 +328,7 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
             f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this model "
             f"(stiffest mode: {mode}); the largest stable step is {limit:.3g} s. Reduce `dt`, "
             f"or soften {remedy}.")
+    check_resolution(excitation, dt, duration)
     decimation = steps_per_sample(sample_rate, dt, "sample_rate")
     control_steps = 0
     if controller.controller_rate > 0:

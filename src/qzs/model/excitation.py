@@ -21,7 +21,8 @@ from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
 __all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
-           "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv"]
+           "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv",
+           "highest_frequency"]
 
 KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
 # Indices into the packed scalars; a table is a (5, n) array: breakpoints in row 0
@@ -37,8 +38,9 @@ _NO_TABLE = np.zeros((5, 2))
 
 
 def _excitation_rule(rule):
-    """A :mod:`qzs._validation` checker that raises :class:`ExcitationError`."""
-    return lambda name, value: rule(name, value, ExcitationError)
+    """A :mod:`qzs._validation` checker that raises :class:`ExcitationError` naming the field."""
+    return lambda name, value: rule(name, value,
+                                    lambda message: ExcitationError(message, (name,)))
 
 
 def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=0.0,
@@ -50,7 +52,7 @@ def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=
 
 
 def _fade_rule(name, value):
-    return non_negative(name, value, ExcitationError)
+    return _excitation_rule(non_negative)(name, value)
 
 
 def _resolve_fade(excitation):
@@ -64,7 +66,8 @@ def _resolve_fade(excitation):
     if duration is not None and excitation.fade_in > duration:
         raise ExcitationError(
             f"`fade_in` ({excitation.fade_in!r} s) must not exceed the excitation's length "
-            f"({duration!r} s); shorten it, or set fade_in=0 to start at full amplitude.")
+            f"`duration` ({duration!r} s); shorten it, or set fade_in=0 to start at full "
+            "amplitude.", ("fade_in", "duration"))
 
 
 _FADE_DOC = ("fade-in [s]: smooth ramp (slope a raised cosine) of the amplitude from 0 at "
@@ -105,13 +108,15 @@ class Chirp:
             "f0": _excitation_rule(non_negative),
             "f1": _excitation_rule(non_negative),
             "duration": _excitation_rule(positive),
-            "method": lambda n, v: choice(n, v, ("linear", "logarithmic"), ExcitationError),
+            "method": lambda n, v: choice(n, v, ("linear", "logarithmic"),
+                                          lambda message: ExcitationError(message, (n,))),
         })
         _resolve_fade(self)
         if self.method == "logarithmic" and (self.f0 <= 0 or self.f1 <= 0):
             raise ExcitationError(
-                f"a logarithmic chirp needs `f0` > 0 and `f1` > 0, got f0={self.f0!r} Hz, "
-                f"f1={self.f1!r} Hz; start at e.g. 0.1 Hz or use method='linear'.")
+                f"a logarithmic chirp needs `f0` > 0 and `f1` > 0, got `f0` = {self.f0!r} Hz, "
+                f"`f1` = {self.f1!r} Hz; start at e.g. 0.1 Hz or use `method` = 'linear'.",
+                ("f0", "f1", "method"))
 
     @property
     def max_frequency(self):
@@ -242,12 +247,12 @@ class RandomExcitation(_Tabulated):
         })
         if self.f_low >= self.f_high:
             raise ExcitationError(
-                f"`f_low` must be below `f_high`, got f_low={self.f_low!r} Hz, "
-                f"f_high={self.f_high!r} Hz.")
+                f"`f_low` ({self.f_low!r} Hz) must be below `f_high` ({self.f_high!r} Hz), the "
+                "band's upper edge; swap them or widen the band.", ("f_low", "f_high"))
         if (not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool)
                 or self.seed < 0):
             raise ExcitationError(f"`seed` must be a non-negative integer (numpy's generators "
-                                  f"take 0 .. 2**128-1), got {self.seed!r}.")
+                                  f"take 0 .. 2**128-1), got {self.seed!r}.", ("seed",))
         _resolve_fade(self)
 
     @property
@@ -267,7 +272,8 @@ class RandomExcitation(_Tabulated):
         if not band.any():
             raise ExcitationError(
                 f"no frequency line of a {self.duration!r} s record falls in "
-                f"[{self.f_low!r}, {self.f_high!r}] Hz; lengthen `duration` or widen the band.")
+                f"[{self.f_low!r}, {self.f_high!r}] Hz; lengthen `duration` or widen the band.",
+                ("duration",))
         rng = np.random.default_rng(self.seed)
         spectrum = np.zeros(freqs.size, complex)
         spectrum[band] = np.exp(1j * rng.uniform(0, 2 * np.pi, band.sum()))
@@ -372,12 +378,37 @@ EXCITATION_OPTIONS = {
 _FIELD_NAMES = {"random": {"f0": "f_low", "f1": "f_high"}}
 
 
+def highest_frequency(excitation, duration=None):
+    """The highest frequency [Hz] an excitation reaches within its first ``duration`` seconds.
+
+    A chirp cut short reaches only the frequency of its end; a sine its frequency; a random
+    excitation its band's upper edge; a record the Nyquist frequency of its samples (an
+    upper bound of its content).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The base motion.
+    duration : float, optional
+        Simulated time [s]; default the whole excitation.
+
+    Returns
+    -------
+    float
+        The frequency [Hz].
+    """
+    if isinstance(excitation, Chirp):
+        end = excitation.duration if duration is None else duration
+        return float(max(excitation.frequency_at(0.0), excitation.frequency_at(end)))
+    return float(excitation.max_frequency)
+
+
 def option_field(kind, option):
     """The field of ``kind``'s class that the option ``option`` sets (its name, usually)."""
     return _FIELD_NAMES.get(kind, {}).get(option, option)
 
 
-def build_excitation(kind, options=None):
+def build_excitation(kind, options=None, *, names=None):
     """The excitation of kind ``kind`` built from ``options`` (the one factory).
 
     Parameters
@@ -390,6 +421,9 @@ def build_excitation(kind, options=None):
         ``frequency`` [Hz] and ``phase`` [rad] (sine), ``duration`` [s], ``method``
         (chirp), ``seed`` (random), ``record`` (file: a CSV path), ``fade_in`` [s]
         (every kind). Missing options take the class defaults.
+    names : dict, optional
+        Option -> how the caller names it, for the messages (the command line's
+        ``{"duration": "--excitation-duration", "f0": "--f0"}``); default the option's name.
 
     Returns
     -------
@@ -398,12 +432,28 @@ def build_excitation(kind, options=None):
     Raises
     ------
     ExcitationError
-        Unknown kind, an option the kind does not take, or an invalid value.
+        Unknown kind, an option the kind does not take, or an invalid value (its
+        :attr:`~qzs.errors.ExcitationError.options` named as ``names`` says).
+    DataError
+        The record of a ``file`` excitation cannot be read (prefixed with its ``names``
+        spelling, if any).
     """
+    names = dict(names or {})
+    try:
+        return _build(kind, dict(options or {}))
+    except ExcitationError as error:
+        fields = {option_field(kind, option): option for option in EXCITATION_OPTIONS.get(kind, ())}
+        raise error.renamed(fields).renamed(names) from None
+    except DataError as error:
+        if "record" not in names:
+            raise
+        raise DataError(f"{names['record']}: {error}") from None
+
+
+def _build(kind, options):
     if kind not in EXCITATION_KINDS:
         raise ExcitationError(f"excitation `kind` must be one of {tuple(EXCITATION_KINDS)}, "
                               f"got {kind!r}.")
-    options = dict(options or {})
     unknown = sorted(set(options) - set(EXCITATION_OPTIONS[kind]))
     if unknown:
         raise ExcitationError(f"a {kind} excitation takes no option(s) {unknown}; its options "
@@ -441,14 +491,25 @@ def read_displacement_csv(path, time_column="time", displacement_column="displac
     Raises
     ------
     DataError
-        Missing file or columns (the message lists the columns found), non-numeric
-        or non-finite samples.
+        Missing file, a folder, a file that is not UTF-8 text, missing columns (the
+        message lists the columns found), non-numeric or non-finite samples.
     """
     path = Path(path)
     if not path.exists():
         raise DataError(f"displacement record not found: {str(path)!r}.")
-    with open(path, encoding="utf-8") as handle:
-        lines = [line for line in handle if line.strip() and not line.startswith("#")]
+    if path.is_dir():
+        raise DataError(f"displacement record {str(path)!r} is a folder; pass the CSV file "
+                        f"(a header with {time_column!r} and {displacement_column!r}, then rows "
+                        "of numbers).")
+    try:
+        with open(path, encoding="utf-8") as handle:
+            lines = [line for line in handle if line.strip() and not line.startswith("#")]
+    except UnicodeDecodeError as error:
+        raise DataError(
+            f"displacement record {str(path)!r} is not UTF-8 text (byte "
+            f"{error.object[error.start]:#04x} at position {error.start}), so it is not a CSV "
+            "file; was a binary file (a log, a figure, a result) given by mistake? Pass the CSV "
+            f"file with columns {time_column!r} and {displacement_column!r}.") from None
     if not lines:
         raise DataError(f"{str(path)!r} is empty.")
     names = [n.strip() for n in lines[0].split(",")]

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs._format import number
-from qzs._validation import read_toml
+from qzs._validation import read_toml, real
 from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped
@@ -193,8 +193,29 @@ def default_platform(geometry, isolator=None, controller=None, *, gravity=9.81):
     return PlatformParameters(mass=mass, inertia=inertia, gravity=gravity)
 
 
+#: Units of the scalar keys of a hexapod file's tables, for the messages.
+_SCALAR_UNITS = {"cube_edge": "m", "cube_center_height": "m", "base_radius": "m",
+                 "top_radius": "m", "stroke_half": "m", "height": "m", "base_angle": "deg",
+                 "top_angle": "deg", "mass": "kg", "gravity": "m/s^2"}
+_EXAMPLES = {"mass": 21.5, "gravity": 9.81, "base_angle": 10.0, "top_angle": 10.0,
+             "cube_edge": 0.15}
+
+
+def _numbers(table, section, where):
+    """The table with its scalar keys checked: each a real number (a TOML string such as
+    ``mass = "heavy"`` is an error naming the file, the table, the key and the value)."""
+    checked = dict(table)
+    for key, unit in _SCALAR_UNITS.items():
+        if key in checked:
+            checked[key] = real(f"[{section}] {key}", checked[key],
+                                fix=f"; give a number in {unit}, e.g. {key} = "
+                                    f"{_EXAMPLES.get(key, 0.1)}",
+                                error=lambda message: ParameterError(where + message))
+    return checked
+
+
 def _geometry(table, where):
-    table = dict(table)
+    table = _numbers(table, "geometry", where)
     kind = table.pop("kind", None)
     if kind not in GEOMETRY_KINDS:
         raise ParameterError(f"{where}[geometry] `kind` must be one of {sorted(GEOMETRY_KINDS)}, "
@@ -217,6 +238,7 @@ def _geometry(table, where):
 
 
 def _platform(table, geometry, isolator, controller, where):
+    table = _numbers(table, "platform", where)
     unknown = sorted(set(table) - set(_PLATFORM_KEYS))
     if unknown:
         raise ParameterError(f"{where}[platform]: unknown key(s) {unknown}; allowed are "
@@ -229,7 +251,11 @@ def _platform(table, geometry, isolator, controller, where):
         "mass" not in table or not ("inertia" in table or "principal_inertia" in table)) else None
     mass = table.get("mass", default.mass if default else None)
     if "principal_inertia" in table:
-        values = np.asarray(table["principal_inertia"], dtype=float)
+        given = table["principal_inertia"]
+        values = np.full(0, np.nan)
+        if isinstance(given, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                           for v in given):
+            values = np.asarray(given, dtype=float)
         if values.shape != (3,):
             raise ParameterError(f"{where}[platform] `principal_inertia` must be 3 moments "
                                  f"[kg*m^2], got {table['principal_inertia']!r}.")
@@ -554,7 +580,7 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
 
 def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rate=None,
                    solver=None, progress=False, out=None, interruptible=False,
-                   argument="out"):
+                   argument="out", names=None):
     """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
 
     With ``out`` every sample is streamed to that NetCDF file as the run goes
@@ -587,6 +613,10 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
         simulated; ``run["completed"]`` says so.
     argument : str
         How the caller names ``out`` in messages (``"--out"`` on the command line).
+    names : dict, optional
+        How the caller names the options of ``excitation`` in messages (the command line's
+        ``{"duration": "--excitation-duration"}``); the file's are named by their table
+        (``[excitation.z] duration``).
 
     Returns
     -------
@@ -612,7 +642,9 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     for axis, options in tables.items():
         options = dict(options)
         kind = options.pop("kind", None)
-        built[axis] = build_excitation(kind, options)
+        spelling = ({**{o: o for o in options}, **(names or {})} if axis in (excitation or {})
+                    else {o: f"[excitation.{axis}] {o}" for o in options})
+        built[axis] = build_excitation(kind, options, names=spelling)
     run = {**setup.simulation}
     for name, value in (("duration", duration), ("dt", dt), ("sample_rate", sample_rate),
                         ("solver", solver)):

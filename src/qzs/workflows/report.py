@@ -37,6 +37,9 @@ from qzs.workflows.studies import load_study, run_studies, shipped_studies
 __all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "paper_summary",
            "write_paper_outputs", "run_paper"]
 
+#: Free space [bytes] the output folder must have before the studies run: a generous bound
+#: of the report, its figures (PNG) and metrics.
+PAPER_BYTES = 20_000_000
 #: Least number of cases, with different values of the swept parameter, a trend needs.
 TREND_CASES = 3
 #: Trend claims -> the parameter they are a trend in (cases are ordered by it).
@@ -707,7 +710,7 @@ def _case_table(result):
 
 
 def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=None,
-              progress=True):
+              progress=True, argument="folder"):
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
     Parameters
@@ -723,6 +726,8 @@ def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=
         the figures; default all cores.
     progress : bool
         Show a progress bar over cases.
+    argument : str
+        How the caller names ``folder`` in messages (``"--out"`` on the command line).
 
     Returns
     -------
@@ -730,9 +735,21 @@ def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=
     verdicts : list of Verdict
     wall_seconds : float
         Wall time of the runs [s].
+
+    Raises
+    ------
+    OutputPathError
+        ``folder`` is a file, or cannot be created or written (checked before any study
+        runs: on a cold cache they take minutes).
+    ParameterError
+        A study file is invalid.
     """
     import time
 
+    from qzs.iotools.paths import check_output_path
+
+    check_output_path(folder, argument=argument, suffixes=None, directory=True,
+                      estimated_bytes=PAPER_BYTES)
     paths = shipped_studies() if definitions is None else definitions
     studies = [load_study(p) for p in paths]
     start = time.perf_counter()

@@ -33,6 +33,7 @@ def forbid_simulation(monkeypatch):
     (dict(force_steps=2.0), "force_steps"),
     (dict(delay=-1.0), "delay"),
     (dict(controller_rate=300.0), "controller_rate"),
+    (dict(controller_rate=333.0, dt=None), r"`controller_rate` \(333 Hz\).*share no integration step"),
     (dict(excitation=Chirp(duration=15.0, f1=20.0)), "too short"),
     (dict(mass_range=(6.0,)), "mass_range"),
     (dict(dt=0.0), "`dt`"),

@@ -38,3 +38,19 @@ def test_the_step_is_chosen_for_accuracy_by_default():
     assert any("chosen for 0.01 dB" in note for note in response.notes)
     for p in response.points:
         assert p.dt <= response.dt and round(1 / (p.frequency * p.dt)) % SAMPLES_PER_PERIOD == 0
+
+
+def test_1e8_frequencies_fail_at_once():
+    import time
+
+    import numpy as np
+
+    from qzs.errors import CountLimitError
+    from qzs.workflows.response.sweep import MAX_FREQUENCIES
+
+    frequencies = np.linspace(1.0, 20.0, 10 ** 8)
+    began = time.perf_counter()
+    with pytest.raises(CountLimitError) as caught:
+        steady_state_response(frequencies)
+    assert time.perf_counter() - began < 2.0
+    assert (caught.value.count, caught.value.limit) == (10 ** 8, MAX_FREQUENCIES)

@@ -31,3 +31,59 @@ def test_each_case_is_the_grid_point_it_names():
         assert duration == pytest.approx(12.0) == case_duration(definition, case)
         keys.append(key)
     assert keys[0] == keys[1] != keys[2] == keys[3]
+
+
+# ---------------------------------------------------------------- invalid cases, before any run
+def test_invalid_cases_are_named_before_any_case_runs():
+    """A negative stiction and a NaN gain: every such case is listed with its values and
+    reason, and none runs (a CaseError, so `except CaseError` still catches it)."""
+    import math
+
+    from qzs.errors import CaseError, InvalidCasesError
+    from qzs.workflows.sweeps.backends import check_cases
+
+    sweep = load_sweep({"sweep": {"name": "bad"}, "analysis": {"fft_length": 1024,
+                                                              "n_averages": 4},
+                        "grid": {"pi_kp": [5.0, math.nan], "stiction_force": [10.0, -5.0]}})
+    with pytest.raises(InvalidCasesError) as caught:
+        check_cases(sweep, case_settings(sweep, sample_cases(sweep)))
+    error = caught.value
+    assert isinstance(error, CaseError) and error.total == 4
+    assert [i for i, _, _ in error.cases] == [1, 2, 3]
+    assert error.cases[0][1] == {"pi_kp": 5.0, "stiction_force": -5.0}
+    assert "`stiction_force` must be non-negative, got -5.0" in error.cases[0][2]
+    assert "`pi_kp` must be finite, got nan" in error.cases[1][2]
+    assert (error.index, error.reason) == (1, error.cases[0][2])
+    assert str(error).startswith("3 of 4 cases are invalid, so none runs: case 1 ("
+                                 "pi_kp = 5.0, stiction_force = -5.0)")
+
+
+def test_an_invalid_excitation_value_names_its_cases():
+    from qzs.errors import InvalidCasesError
+    from qzs.workflows.sweeps.backends import check_cases
+
+    sweep = load_sweep({"sweep": {"name": "bad"}, "analysis": {"fft_length": 1024,
+                                                              "n_averages": 4},
+                        "grid": {"excitation.amplitude": [0.01, -0.01], "pi_kp": [5.0, 10.0]}})
+    with pytest.raises(InvalidCasesError) as caught:
+        check_cases(sweep, case_settings(sweep, sample_cases(sweep)))
+    assert [i for i, _, _ in caught.value.cases] == [2, 3]
+    assert "`amplitude` must be non-negative" in caught.value.reason
+
+
+def test_connecting_to_a_scheduler_says_what_it_waits_for(monkeypatch, capsys):
+    """A scheduler that does not answer at once (a filtered port, a slow network): stderr
+    says where it connects and how long it waits, before it waits."""
+    pytest.importorskip("distributed")
+    from qzs.errors import SchedulerError
+    from qzs.workflows.sweeps import backends
+
+    class Silent:  # the client of a scheduler that never answers
+        def __init__(self, address, timeout):
+            assert "connecting to the Dask scheduler at tcp://10.1.2.3:8786" in \
+                capsys.readouterr().err  # said before the wait
+            raise OSError(f"Timed out trying to connect to {address} after {timeout}")
+
+    monkeypatch.setattr(backends, "_probe", lambda address: None)
+    with pytest.raises(SchedulerError, match=r"'tcp://10.1.2.3:8786': Timed out"):
+        backends._connect(Silent, "tcp://10.1.2.3:8786")

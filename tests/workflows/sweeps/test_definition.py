@@ -268,3 +268,29 @@ def test_a_case_no_step_can_settle_is_named_and_the_others_set_the_step():
     assert [i for i, _ in choices] == [1]
     assert chosen.simulation["dt"] == choices[0][1].dt
     assert "case 0: no step" in chosen.simulation["step_note"]
+
+
+# ---------------------------------------------------------------- too many cases, at once
+@pytest.mark.parametrize("tables, name", [
+    (dict(grid={"pi_kp": {"start": 1.0, "stop": 100.0, "num": 10 ** 8}}), "[grid] pi_kp.num"),
+    (dict(grid={"pi_kp": {"start": 0.0, "stop": 1e8, "step": 1.0}}), "[grid] pi_kp.step"),
+    (dict(grid={"pi_kp": {"start": 1.0, "stop": 100.0, "num": 10 ** 4},
+                "stiction_force": {"start": 5.0, "stop": 15.0, "num": 10 ** 4}}), "[grid]"),
+    (dict(sweep={"method": "random", "samples": 10 ** 8},
+          distributions={"pi_kp": {"distribution": "uniform", "low": 1.0, "high": 2.0}}),
+     "[sweep] samples"),
+])
+def test_a_sweep_of_1e8_cases_fails_before_building_any(tables, name):
+    """The count is known from the file: nothing is built, so the error comes at once."""
+    import time
+
+    from qzs.errors import CountLimitError
+    from qzs.workflows.sweeps.definition import MAX_CASES
+
+    began = time.perf_counter()
+    with pytest.raises(CountLimitError) as caught:
+        load_sweep(definition(**tables))
+    assert time.perf_counter() - began < 1.0
+    error = caught.value
+    assert (error.name, error.limit, error.items) == (name, MAX_CASES, "cases")
+    assert error.count >= 10 ** 8 and f"`{name}`" in str(error) and "split" in str(error)

@@ -151,6 +151,14 @@ def _set_steps(settings, dt):
     """Set ``settings.dt`` (given, or accuracy-driven) and the PI search's ``stroke_dt``."""
     rate = settings.controller_rate
     if dt is None:
+        if rate > 0:  # a rate that shares no step with the output fails here, not after probes
+            from qzs import defaults
+            from qzs.engine.accuracy import admissible_step
+            from qzs.engine.stability import stability_test
+
+            stiffest = settings.controller_at(settings.controller.pi_kp, settings.damping_gain_max)
+            admissible_step(settings.sample_rate, rate, stability_test(
+                settings.isolator, stiffest, defaults.SIMULATION["solver"]))
         settings.dt, settings.dt_note = _choose_dt(settings, settings.controller.pi_kp)
     else:
         settings.dt = real("dt", dt, minimum=0.0, strict=True, fix=" (seconds)")

@@ -12,7 +12,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs._validation import choice, integer, positive, worker_count
-from qzs.errors import ParameterError, ToleranceNotMetError
+from qzs.errors import CountLimitError, ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp
 from qzs.workflows.response.chirp import _run_chirp
 from qzs.workflows.response.frequency import (CONSECUTIVE_PERIODS, MAX_PERIOD_MULTIPLE,
@@ -42,15 +42,21 @@ HARMONICS = 5
 #: A frequency needs at least this many integration steps per period at ``dt`` [-]: a
 #: tenth of the step's Nyquist rate (the simulate summary warns below 20 as well).
 MIN_STEPS_PER_PERIOD = 20
+#: Most frequencies one response steps through [-]: each is a simulation of many periods,
+#: and the list is checked before anything is built, so 1e8 of them fail at once.
+MAX_FREQUENCIES = 10_000
 
 
 def _frequencies(frequencies):
     try:
-        values = np.array(frequencies, dtype=float).ravel()
+        values = np.asarray(frequencies, dtype=float).ravel()
     except (TypeError, ValueError):
         raise ParameterError(f"`frequencies` must be numbers in Hz, got {frequencies!r}.") from None
     if values.size == 0:
         raise ParameterError("`frequencies` is empty; give at least one frequency in Hz.")
+    if values.size > MAX_FREQUENCIES:
+        raise CountLimitError("frequencies", values.size, MAX_FREQUENCIES, "frequencies",
+                              "give fewer, or split the band into several responses")
     bad = values[~np.isfinite(values) | (values <= 0)]
     if bad.size:
         raise ParameterError(f"`frequencies` must be positive and finite, got "
@@ -223,17 +229,19 @@ def steady_state_response(frequencies, amplitude=defaults.EXCITATION["amplitude"
     Raises
     ------
     ParameterError
-        Invalid input, found before any simulation: frequencies not positive and finite or
+        Invalid input, found before any simulation: frequencies not positive and finite,
+        more than :data:`MAX_FREQUENCIES` of them (:class:`~qzs.errors.CountLimitError`) or
         above a tenth of the step's Nyquist rate, a non-positive amplitude, an unknown
         direction, both ``dt`` and ``tolerance_db``, an unstable ``dt``, a sampled
         controller.
     """
+    started = time.perf_counter()
+    frequencies = _frequencies(frequencies)
+
     import qzs.analysis.harmonic_balance as hb
     from qzs.analysis.linear import linearize
     from qzs.engine.prepare import run_inputs
 
-    started = time.perf_counter()
-    frequencies = _frequencies(frequencies)
     amplitude = positive("amplitude", amplitude)
     _, isolator, controller = run_inputs(None, isolator, controller)
     direction = choice("direction", direction, DIRECTIONS)

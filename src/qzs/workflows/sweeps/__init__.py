@@ -96,10 +96,13 @@ def run_sweep(definition, store=None, *, resume=False, overwrite=False, schedule
     Raises
     ------
     ParameterError
-        Invalid definition, an existing store without `resume`/`overwrite`, a store
-        written by a different definition, or a store that cannot be written (a
-        read-only folder, less free space than its uncompressed size), all checked
-        before any case runs.
+        Invalid definition (more than :data:`~qzs.workflows.sweeps.definition.MAX_CASES`
+        cases: :class:`~qzs.errors.CountLimitError`), invalid cases
+        (:class:`~qzs.errors.InvalidCasesError`, naming each), an existing store without
+        `resume`/`overwrite`, both of them, `resume` of no store, a store written by a
+        different definition, a store not named ``*.zarr`` or that cannot be written (a
+        read-only folder, less free space than its uncompressed size), a scheduler that
+        does not answer (:class:`~qzs.errors.SchedulerError`), all before any case runs.
     KeyboardInterrupt
         On Ctrl-C, after the batches that finished have been stored.
     """
@@ -161,13 +164,19 @@ def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None)
     Raises
     ------
     ParameterError
-        ``out`` cannot be written (checked before the store is read), ``store`` is not a
-        sweep store, an unknown metric or parameter.
+        ``y`` without ``x`` or equal to it, ``out`` cannot be written (both checked before
+        the store is read), ``store`` is not a sweep store, an unknown metric or parameter.
     """
     from qzs.iotools.paths import check_output_path
     from qzs.viz.sweeps import (FIGURE_BYTES, figure_suffixes, plot_metric,
                                 plot_transmissibility_band, scalar_outputs, varied_parameters)
 
+    if y is not None and x is None:
+        raise ParameterError(f"`y` (--y) {y!r} needs `x` (--x): a heat map draws the metric "
+                             "over two parameters; add --x PARAM, or leave out --y for a line.")
+    if y is not None and y == x:
+        raise ParameterError(f"`x` (--x) and `y` (--y) are both {x!r}: a heat map needs two "
+                             "different parameters; choose another for one of them.")
     if out is not None:
         check_output_path(out, argument="out", suffixes=figure_suffixes(),
                           estimated_bytes=FIGURE_BYTES)

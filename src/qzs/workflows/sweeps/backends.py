@@ -23,8 +23,8 @@ from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_
 from qzs.engine.batch import simulate_batch
 from qzs.engine.prepare import steps_per_sample
 from qzs.defaults import SIMULATION
-from qzs.errors import (CaseError, DataError, DataWarning, OutputPathError, ParameterError,
-                        ToleranceNotMetError)
+from qzs.errors import (CaseError, DataError, DataWarning, InvalidCasesError, OutputPathError,
+                        ParameterError, SchedulerError, ToleranceNotMetError)
 from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -35,7 +35,11 @@ from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID
                                         write_batch)
 
 __all__ = ["run_batch", "execute", "case_settings", "check_store_path", "build_case",
-           "choose_sweep_step"]
+           "check_cases", "choose_sweep_step", "STORE_SUFFIX"]
+
+#: The extension of a sweep store: a Zarr folder, not a NetCDF file (``--out store.nc``
+#: would make a folder named like a file of another format).
+STORE_SUFFIX = ".zarr"
 
 _LOCK = threading.Lock()  # one multi-threaded batch at a time per process
 
@@ -113,6 +117,50 @@ def build_case(definition, case):
         IsolatorParameters(), ControllerParameters(), {**definition.parameters, **model})
     built = case_excitation(definition.excitation_kind, excitation, definition.analysis)
     return isolator, controller, built, tuple(sorted(excitation.items()))
+
+
+def check_cases(definition, settings):
+    """Refuse a sweep with invalid cases before any runs, naming every one of them.
+
+    Each case's parameters are built (:func:`qzs.model.registry.update_parameters`: a
+    negative stiction, a NaN gain, a Coulomb force above the stiction), and each distinct
+    excitation once. A step too coarse or a model too stiff for it is found per batch
+    instead (the case is then recorded ``invalid`` with its reason).
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    settings : list of dict
+        The varied parameters of each case (:func:`case_settings`).
+
+    Raises
+    ------
+    InvalidCasesError
+        Some cases are invalid (a :class:`~qzs.errors.CaseError`): their indices, values
+        and reasons.
+    """
+    invalid, excitations = [], {}
+    isolator, controller = IsolatorParameters(), ControllerParameters()
+    for i, case in enumerate(settings):
+        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
+        varied = {k.split(".", 1)[1]: v for k, v in case.items() if k.startswith("excitation.")}
+        try:
+            update_parameters(isolator, controller, {**definition.parameters, **model})
+            key = tuple(sorted(varied.items()))
+            if key not in excitations:
+                try:
+                    case_excitation(definition.excitation_kind,
+                                    {**definition.excitation, **varied}, definition.analysis)
+                    excitations[key] = None
+                except (ParameterError, TypeError) as error:
+                    excitations[key] = error
+            if excitations[key] is not None:
+                raise excitations[key]
+        except (ParameterError, TypeError) as error:
+            invalid.append((i, case, str(error)))
+    if invalid:
+        raise InvalidCasesError(invalid, len(settings))
 
 
 #: Cases of a sweep the accuracy-driven step is chosen on: the first, the middle and the
@@ -365,10 +413,49 @@ def _client(scheduler, workers):
     if isinstance(scheduler, Client):
         return scheduler, None
     if scheduler is not None:
-        return Client(scheduler), None
+        return _connect(Client, scheduler), None
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None,
                            processes=True)
     return Client(cluster), cluster
+
+
+def _connect(client_class, address):
+    """A client of the scheduler at ``address``, saying on stderr what it waits for."""
+    import sys
+
+    from dask import config
+
+    _probe(address)
+    timeout = config.get("distributed.comm.timeouts.connect")
+    print(f"qzs: connecting to the Dask scheduler at {address} (giving up after {timeout}) ...",
+          file=sys.stderr, flush=True)
+    try:
+        return client_class(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as error:
+        raise SchedulerError(address, str(error) or type(error).__name__) from None
+
+
+def _probe(address):
+    """Fail at once where nothing can answer: an unknown host, or a refused connection (a
+    slow or filtered one is left to the client's own timeout)."""
+    import socket
+
+    from distributed.comm import get_address_host_port
+
+    try:
+        host, port = get_address_host_port(address)
+    except (ValueError, TypeError):  # not a TCP address the probe understands: let Dask try
+        return
+    try:
+        socket.create_connection((host, port), timeout=1.0).close()
+    except socket.gaierror as error:
+        raise SchedulerError(address, f"the host {host!r} is unknown ({error.strerror})") \
+            from None
+    except ConnectionRefusedError:
+        raise SchedulerError(address, f"nothing listens on port {port} of {host!r} (the "
+                             "connection was refused)") from None
+    except OSError:
+        pass
 
 
 def execute(definition, store, *, resume=False, overwrite=False, scheduler=None, workers=None,
@@ -403,19 +490,24 @@ def execute(definition, store, *, resume=False, overwrite=False, scheduler=None,
     """
     from tqdm.auto import tqdm
 
+    _check_resume(store, "store", resume, overwrite)
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
-    definition, _ = choose_sweep_step(definition, settings)
-    n_time = _n_time(definition, settings)
-    _check_store(definition, store, n_time, argument="store", resume=resume,
-                 overwrite=overwrite)
+    check_cases(definition, settings)
+    if definition.simulation["dt"] is None:  # sized at the output period until dt is chosen
+        _check_store(definition, store, _n_time(definition, settings), argument="store",
+                     resume=resume, overwrite=overwrite)
     client = cluster = None
     report = {"cases": 0, "failed": 0, "steps": 0, "wall": 0.0}
     began = time.perf_counter()
     bar = results = None
     try:
-        if scheduler is not None or workers is not None:  # before the store: fail early
+        if scheduler is not None or workers is not None:  # before any probe or store
             client, cluster = _client(scheduler, workers)
+        definition, _ = choose_sweep_step(definition, settings)
+        n_time = _n_time(definition, settings)
+        _check_store(definition, store, n_time, argument="store", resume=resume,
+                     overwrite=overwrite)
         done = prepare_store(store, definition, columns, n_time, resume=resume,
                              overwrite=overwrite)
         size = definition.batch_size
@@ -487,17 +579,32 @@ def check_store_path(definition, store, *, argument="store", resume=False, overw
     Raises
     ------
     OutputPathError
-        The folder cannot be written, the file system has less free space than the
-        store's uncompressed size, or the store exists without ``resume``/``overwrite``.
+        The store is not named ``*.zarr``, the folder cannot be written, the file system
+        has less free space than the store's uncompressed size, the store exists without
+        ``resume``/``overwrite``, or ``resume`` names no store.
+    ParameterError
+        Both ``resume`` and ``overwrite``.
     """
+    _check_resume(store, argument, resume, overwrite)
     settings = case_settings(definition, sample_cases(definition))
     _check_store(definition, store, _n_time(definition, settings), argument=argument,
                  resume=resume, overwrite=overwrite)
 
 
+def _check_resume(store, argument, resume, overwrite):
+    """``resume`` and ``overwrite`` together, or ``resume`` of no store, are errors."""
+    if resume and overwrite:
+        raise ParameterError("`resume` (--resume) continues the store and `overwrite` "
+                             "(--overwrite) replaces it: give one of them, not both.")
+    if resume and not Path(store).exists():
+        raise OutputPathError(argument, store, "does not exist, so there is nothing to resume; "
+                              "check the name, or leave out `resume` (--resume) to start the "
+                              "sweep")
+
+
 def _check_store(definition, store, n_time, *, argument, resume, overwrite):
     size = None if resume else estimated_bytes(definition, n_time)
-    check_output_path(store, argument=argument, suffixes=None, directory=True,
+    check_output_path(store, argument=argument, suffixes=(STORE_SUFFIX,), directory=True,
                       estimated_bytes=size)
     if Path(store).exists() and not resume and not overwrite:
         raise OutputPathError(argument, store, "exists; pass `resume` (--resume) to continue "

@@ -20,7 +20,7 @@ from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
 from qzs.engine.results import CHANNELS
 from qzs.engine.stability import SOLVERS
-from qzs.errors import ParameterError
+from qzs.errors import CountLimitError, ParameterError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
@@ -29,9 +29,14 @@ from qzs.model import registry
 from qzs.model.registry import PARAMETERS, update_parameters
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "shipped_sweeps",
-           "plan_text", "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS"]
+           "plan_text", "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS", "MAX_CASES"]
 
 METHODS = ("grid", "random", "lhs")
+#: Most cases one sweep holds [-]: its case table lives in memory and every case is a
+#: simulation of seconds; a larger study is several sweeps. Checked before any case is
+#: built, so a grid of 1e8 points fails at once.
+MAX_CASES = 1_000_000
+_SPLIT = "split the study into several sweep files or coarsen the grid"
 #: Distributions of uncertain parameters: name -> (required keys, optional keys).
 DISTRIBUTIONS = {
     "uniform": (("low", "high"), ()),
@@ -177,6 +182,8 @@ def load_sweep(source):
         where, stem = repr(str(path)), path.stem
     try:
         return _definition(document, where, stem)
+    except CountLimitError:  # names its table and key already; keeps its data
+        raise
     except ParameterError as error:
         raise ParameterError(f"{where}: {error}") from None
 
@@ -252,6 +259,14 @@ def _definition(document, where, stem):
             raise ParameterError(f"method {method!r} needs a [distributions] table of the "
                                  "parameters to sample.")
         samples = integer("samples", head.get("samples", 0), 1)
+        if samples > MAX_CASES:
+            raise CountLimitError("[sweep] samples", samples, MAX_CASES, "cases",
+                                  "draw fewer samples, or split the study into several sweep "
+                                  "files (different seeds)")
+    count = math.prod(len(v) for v in grid.values()) * samples
+    if count > MAX_CASES:
+        raise CountLimitError("[grid]" if grid else "[sweep] samples", count, MAX_CASES,
+                              "cases", _SPLIT)
     if not grid and not distributions:
         raise ParameterError("nothing varies: add a [grid] or a [distributions] table.")
 
@@ -331,6 +346,8 @@ def _grid_values(name, spec):
         if isinstance(num, bool) or not isinstance(num, numbers.Integral) or num < 1:
             raise ParameterError(f"empty range for {name!r}: `num` must be an integer >= 1, "
                                  f"got {num!r}.")
+        if num > MAX_CASES:
+            raise CountLimitError(f"[grid] {name}.num", num, MAX_CASES, "cases", _SPLIT)
         if scale == "log":
             if start <= 0 or stop <= 0:
                 raise ParameterError(f"a log range for {name!r} needs `start` > 0 and "
@@ -345,6 +362,9 @@ def _grid_values(name, spec):
         raise ParameterError(f"empty range for {name!r}: `stop` ({stop!r}) is below `start` "
                              f"({start!r}).")
     count = int(math.floor((stop - start) / step * (1 + 1e-12))) + 1
+    if count > MAX_CASES:
+        raise CountLimitError(f"[grid] {name}.step", count, MAX_CASES, "cases",
+                              f"{_SPLIT} (a larger `step`)")
     return tuple(float(start + i * step) for i in range(count))
 
 
