@@ -386,7 +386,7 @@ def _rk(solver, t, h, s, mode, direction, held, P, E, table):
     return result
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s] and its event value.
 

@@ -93,7 +93,7 @@ def _first_event(V, ev0, ev1):
     return leg, min(max(best, 0.0), 1.0)
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s], leg ``leg``'s event.
 
