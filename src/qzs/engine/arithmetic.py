@@ -133,8 +133,8 @@ def tanh(u):
 #: The modules whose compiled kernels numba caches (below ``engine/``), and the source files
 #: they are built from (the packed-layout constants of the excitation and of the six-axis
 #: kernels are compiled in as globals).
-_KERNEL_MODULES = ("arithmetic", "laws", "base_motion", "kernels", "lanes", "hexapod/dynamics",
-                   "hexapod/stepping")
+_KERNEL_MODULES = ("arithmetic", "laws", "stickslip", "base_motion", "kernels", "lanes",
+                   "hexapod/dynamics", "hexapod/stepping")
 _KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "engine/hexapod/layout.py",
                    "model/excitation.py")
 #: The fingerprint of those sources, kept beside numba's cache files.

@@ -30,6 +30,9 @@ from qzs.engine.arithmetic import fma
 from qzs.engine.base_motion import advance_phase, base_motion, base_motion_near, excitation_tuple
 from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
                              spring_energy_law, spring_law)
+from qzs.engine.stickslip import (MODE_SLIP, MODE_STICK, MODE_WALL_HIGH, MODE_WALL_LOW,
+                                  crossed_zero, hold_margin, locate, release_direction,
+                                  secant_fraction, slip_event)
 
 # Packed parameters. P_VREG > 0 selects the regularised friction model: no stick-slip events,
 # the mode stays slipping (docs/model.md §3).
@@ -53,7 +56,7 @@ PHASE_PERIOD = 256
 # Integer flags.
 I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)
 N_FLAGS = 6
-MODE_SLIP, MODE_STICK, MODE_WALL_LOW, MODE_WALL_HIGH = 0, 1, 2, 3
+# The modes (MODE_SLIP, MODE_STICK, MODE_WALL_LOW, MODE_WALL_HIGH) are qzs.engine.stickslip's.
 
 # Force breakdown returned by the right-hand side.
 (F_Y, F_YD, F_YDD, F_SPRING, F_FRICTION, F_STOP, F_STOP_ELASTIC, F_MOTOR, F_PI, F_DAMP,
@@ -248,23 +251,6 @@ def _with(s, index, value):
             value if index == 6 else s[6], value if index == 7 else s[7])
 
 
-@njit(**_JIT, inline="always")
-def _hold_margin(mode, f_hold, fs):
-    """How far the holding force is inside what friction (and a plastic stop) can give [N]."""
-    if mode == MODE_STICK:
-        return fs - abs(f_hold)
-    if mode == MODE_WALL_LOW:
-        return f_hold + fs
-    return fs - f_hold
-
-
-@njit(**_JIT, inline="always")
-def _release_direction(mode, f_hold):
-    if mode == MODE_STICK:
-        return -1 if f_hold > 0.0 else 1
-    return 1 if mode == MODE_WALL_LOW else -1
-
-
 @njit(**_JIT)
 def _book_impulse(t, s, ledger, E, table, P):
     """Set v to exactly 0 and book the impulse that does it (closes the energy ledger).
@@ -292,7 +278,7 @@ def _settle(t, s, direction, held, P, E, table):
     f_hold = rhs_at(t, s, MODE_STICK, 0.0, held, P, E, table)[1][F_HOLD]
     if abs(f_hold) <= P[P_FS]:
         return s, MODE_STICK, direction
-    return s, MODE_SLIP, -1 if f_hold > 0.0 else 1
+    return s, MODE_SLIP, release_direction(MODE_STICK, f_hold)
 
 
 @njit(**_JIT)
@@ -311,8 +297,8 @@ def _hit_wall(t, s, low, held, P, E, table):
                                                                     table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
     f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
-    if _hold_margin(mode, f_hold, P[P_FS]) < 0.0:
-        return s, MODE_SLIP, _release_direction(mode, f_hold)
+    if hold_margin(mode, f_hold, P[P_FS]) < 0.0:
+        return s, MODE_SLIP, release_direction(mode, f_hold)
     return s, mode, 0
 
 
@@ -320,41 +306,36 @@ def _hit_wall(t, s, low, held, P, E, table):
 def _event_value(event, t, s, mode, direction, held, P, E, table):
     """The function whose sign change defines ``event`` (positive before it)."""
     if event == 1:
-        return direction * s[S_V]
+        return slip_event(direction, s[S_V])
     if event == 2:
         return s[S_Z] - P[P_Z_LOW]
     if event == 3:
         return P[P_Z_HIGH] - s[S_Z]
     f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
-    return _hold_margin(mode, f_hold, P[P_FS])
+    return hold_margin(mode, f_hold, P[P_FS])
 
 
 @njit(**_JIT)
 def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
     """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    return _hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
-
-
-@njit(**_JIT, inline="always")
-def _crossed_zero(v0, v1, P):
-    """Did the slip velocity reach zero in the step (``v0``, ``v1``: ``d*v`` at its ends)?
-
-    Only the exact model tracks it; the regularised one (``P_VREG > 0``) slips through.
-    """
-    return P[P_VREG] == 0.0 and (v1 < 0.0 or (v1 == 0.0 and v0 > 0.0))
+    return hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
 
 
 @njit(**_JIT, inline="always")
 def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
-    """Kind (0: none) and time fraction (secant) of the first transition in a step."""
+    """Kind (0: none) and time fraction (secant) of the first transition in a step.
+
+    Only the exact friction model tracks the slip's zero crossing; the regularised one
+    (``P_VREG > 0``) slips through it.
+    """
     theta = 2.0
     event = 0
     if mode == MODE_SLIP:
-        v0 = direction * s[S_V]
-        v1 = direction * s1[S_V]
-        if _crossed_zero(v0, v1, P):  # v reached zero: stick or reverse
-            theta = v0 / (v0 - v1) if v0 > v1 else 0.0
+        v0 = slip_event(direction, s[S_V])
+        v1 = slip_event(direction, s1[S_V])
+        if P[P_VREG] == 0.0 and crossed_zero(v0, v1):  # v reached zero: stick or reverse
+            theta = secant_fraction(v0, v1)
             event = 1
         if P[P_PLASTIC] != 0.0:  # reached a plastic stop
             if s1[S_Z] < P[P_Z_LOW]:
@@ -366,7 +347,7 @@ def _first_event(t, h, s, s1, mode, direction, margin, margin1, P):
                 if fraction < theta:
                     theta, event = fraction, 3
     elif margin1 < 0.0:  # friction (and stop) can no longer hold the payload
-        theta = margin / (margin - margin1) if margin > margin1 else 0.0
+        theta = secant_fraction(margin, margin1)
         event = 4
     return event, min(max(theta, 0.0), 1.0)
 
@@ -379,7 +360,8 @@ def _any_event(s, s1, mode, direction, margin1, P):
     hands every other one to :func:`grid_step`, which decides (docs/model.md §9).
     """
     if mode == MODE_SLIP:
-        return (_crossed_zero(direction * s[S_V], direction * s1[S_V], P)
+        return ((P[P_VREG] == 0.0
+                 and crossed_zero(slip_event(direction, s[S_V]), slip_event(direction, s1[S_V])))
                 or (P[P_PLASTIC] != 0.0 and (s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH])))
     return margin1 < 0.0
 
@@ -404,58 +386,27 @@ def _rk(solver, t, h, s, mode, direction, held, P, E, table):
     return result
 
 
-@njit(**_JIT)
-def illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi, side):
-    """One step of regula falsi (Illinois) on an event function ``g`` > 0 before the event.
+@njit(**_JIT, inline="always")
+def _event_trial(at, data):
+    """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s] and its event value.
 
-    ``g`` is the value at the trial time ``at`` in the bracket ``[lo, hi]`` (values ``g_lo``
-    > 0 and ``g_hi`` <= 0) of a step of length ``h`` whose event function started at ``g0``;
-    ``side`` is the side the last trial fell on (0 at first). Converged when ``|g|`` is
-    below 1e-15 of ``|g0|`` or the bracket below 1e-12 of ``h``; otherwise the bracket is
-    narrowed, the retained end's value halved when the same side is kept twice (Illinois),
-    and the next trial time is returned. Every driver's event location goes through it.
-
-    Returns
-    -------
-    tuple
-        ``(converged, at, lo, hi, g_lo, g_hi, side)``.
+    ``data`` is ``(solver, event, t, s, mode, direction, held, P, E, table)``, the step's
+    start; returns ``(event value, state)`` at ``t + at`` (:func:`_rk`, :func:`_event_value`).
     """
-    if abs(g) <= 1e-15 * (abs(g0) + 1e-300) or hi - lo <= 1e-12 * h:
-        return True, at, lo, hi, g_lo, g_hi, side
-    if g > 0.0:
-        lo, g_lo = at, g
-        if side == 1:
-            g_hi *= 0.5
-        side = 1
-    else:
-        hi, g_hi = at, g
-        if side == -1:
-            g_lo *= 0.5
-        side = -1
-    return False, lo + (hi - lo) * g_lo / (g_lo - g_hi), lo, hi, g_lo, g_hi, side
+    solver, event, t, s, mode, direction, held, P, E, table = data
+    state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table)
+    return _event_value(event, t + at, state, mode, direction, held, P, E, table), state
 
 
 @njit(**_JIT)
-def _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E, table):
-    """Refine an event inside ``[t, t + h]`` by regula falsi (Illinois) on its function.
+def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table):
+    """Event ``event`` located in ``[t, t + h]`` (:func:`qzs.engine.stickslip.locate`).
 
-    Returns ``(time from t, state there)``; the event function is then zero to
-    round-off (at most 6 refinements, each one Runge-Kutta step).
+    Returns ``(time from t, state there)``: at most 6 Runge-Kutta steps from ``t`` (each an
+    :func:`_event_trial`), the event function then zero to round-off.
     """
-    lo, hi = 0.0, h
-    g_lo, g_hi = g0, g1
-    if g0 <= 0.0:
-        return 0.0, s
-    at = h * g0 / (g0 - g1)
-    state = s1
-    side = 0
-    for _ in range(6):
-        state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table)
-        g = _event_value(event, t + at, state, mode, direction, held, P, E, table)
-        done, at, lo, hi, g_lo, g_hi, side = illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi, side)
-        if done:
-            break
-    return at, state
+    return locate(_event_trial, (solver, event, t, s, mode, direction, held, P, E, table), g0,
+                  g1, h, s)
 
 
 @njit(**_JIT)
@@ -470,7 +421,8 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     """
     sticks = 0
     impacts = 0
-    if mode == MODE_SLIP and P[P_VREG] == 0.0 and direction * s[S_V] < 0.0:  # missed earlier
+    # a zero crossing missed earlier
+    if mode == MODE_SLIP and P[P_VREG] == 0.0 and slip_event(direction, s[S_V]) < 0.0:
         s, mode, direction = _settle(t, s, direction, held, P, E, table)
         sticks += mode == MODE_STICK
         margin = np.nan
@@ -479,7 +431,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
             margin = _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0)
         if margin < 0.0:
             f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
-            direction = _release_direction(mode, f_hold)
+            direction = release_direction(mode, f_hold)
             mode = MODE_SLIP
 
     s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, E, table, phase, sin0, cos0)
@@ -493,8 +445,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, E, table)
     g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
                                                  E, table)
-    at, s_event = _locate(solver, event, t, h, s, s1, g0, g1, mode, direction, held, P, E,
-                          table)
+    at, s_event = _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table)
     t_event = t + at
     if event == 1:
         s_event, mode, direction = _settle(t_event, s_event, direction, held, P, E, table)
@@ -504,7 +455,7 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
         impacts += 1
     else:
         f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, E, table)[1][F_HOLD]
-        direction = _release_direction(mode, f_hold)
+        direction = release_direction(mode, f_hold)
         mode = MODE_SLIP
     rest = h - at
     s1 = s_event

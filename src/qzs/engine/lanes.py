@@ -25,6 +25,7 @@ from numba.extending import intrinsic
 
 from qzs.engine import kernels as K
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
+from qzs.engine.stickslip import hold_margin, slip_event
 
 # Rows of the lane-state array: the persistent state (``K.S_*`` and ``K.A_*``) first.
 R_MARGIN = K.A_MARGIN  # the holding margin is part of the persistent state
@@ -179,9 +180,9 @@ def _finish_lanes(slipping, n, b_end, L, T, PP):
         margin1 = np.nan
         if mode != K.MODE_SLIP:
             force = K.rhs(b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c), P)[1]
-            margin1 = K._hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
+            margin1 = hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
         if mode == K.MODE_SLIP:  # no zero crossing missed (none is tracked when regularised)
-            ready = P[K.P_VREG] > 0.0 or direction * s[K.S_V] >= 0.0
+            ready = P[K.P_VREG] > 0.0 or slip_event(direction, s[K.S_V]) >= 0.0
         else:
             ready = margin >= 0.0
         failed = L[_at(R_FAILED, c)] != 0.0

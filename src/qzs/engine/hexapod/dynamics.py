@@ -59,6 +59,7 @@ from qzs.engine.hexapod.layout import (
     W_OMW, W_PHASE, W_PIVOTS, W_RB, W_RR, W_SOLVE, W_VO, W_Y, W_YD, W_YDD)
 from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
                              spring_law)
+from qzs.engine.stickslip import MODE_STICK, hold_margin, slip_event
 
 #: A Cholesky pivot below this share of the largest diagonal entry marks redundant locked legs.
 RANK_TOLERANCE = 1e-10
@@ -617,7 +618,7 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
         V[V_PF + i] = -f_friction * v
         V[V_PM + i] = f_motor * v
         V[V_PS + i] = -(f_stop - f_elastic) * v
-        V[V_EV + i] = V[V_DIR + i] * V[V_VR + i]  # slipping; a locked leg's comes with lambda
+        V[V_EV + i] = slip_event(V[V_DIR + i], V[V_VR + i])  # a locked leg's comes with lambda
     # 5. the platform: Newton-Euler in the moving frame B
     fx, fy, fz = _sum_legs(V, V_FUX), _sum_legs(V, V_FUY), _sum_legs(V, V_FUZ)
     tx, ty, tz = _sum_legs(V, V_FGX), _sum_legs(V, V_FGY), _sum_legs(V, V_FGZ)
@@ -675,7 +676,7 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
             rot_z += p * V[V_MZ + i]
             V[V_FFR + i] = p
             V[V_F + i] += p
-            V[V_EV + i] = V[V_FS + i] - abs(p)
+            V[V_EV + i] = hold_margin(MODE_STICK, p, V[V_FS + i])
             fx += p * V[V_UX + i]
             fy += p * V[V_UY + i]
             fz += p * V[V_UZ + i]
