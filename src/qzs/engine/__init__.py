@@ -4,6 +4,7 @@
 ``arithmetic``   own exp/tanh and explicit fused multiply-adds (no fast-math)
 ``laws``         the force laws, written once as numba functions
 ``base_motion``  the excitation kernels
+``stickslip``    the stick-slip decisions and event location, once for every kernel
 ``kernels``      right-hand side, Runge-Kutta steps, stick-slip events (one case)
 ``lanes``        the drivers: one case, or many in lockstep
 ``stability``    the solvers and their linear stability limit
