@@ -42,8 +42,7 @@ BASELINE = "026d44b"
 
 COLD = {
     "qzs simulate": ["simulate", "--duration", "5", "--plot", "none", "--quiet"],
-    "qzs hexapod simulate": ["hexapod", "simulate", "--duration", "0.1", "--plot", "none",
-                             "--quiet"],
+    "qzs hexapod simulate": ["hexapod", "simulate", "--duration", "0.1", "--quiet"],
     "qzs response": ["response", "--frequencies", "2", "--dt", "1e-3", "--direction", "up",
                      "--no-harmonic-balance", "--workers", "1", "--plot", "none", "--quiet"],
 }
