@@ -69,10 +69,25 @@ VALIDATION_OUT = "QZS_VALIDATION_OUT"
 
 
 def pytest_configure(config):
+    # the step cache (qzs.engine.step_cache) of the tests' own: a choice made by the code
+    # under test, never one left on this machine by an earlier version or another checkout;
+    # subprocesses of the tests inherit it
+    import tempfile
+
+    config._qzs_cache = os.environ["QZS_CACHE_DIR"] = tempfile.mkdtemp(prefix="qzs-test-cache-")
+
     config.addinivalue_line(
         "markers", "validation: checks a closed form or published result and records the "
                    "measured error for the documentation's validation page (added to every "
                    "test that uses the `validation` fixture)")
+
+
+def pytest_unconfigure(config):
+    import shutil
+
+    folder = getattr(config, "_qzs_cache", None)
+    if folder:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.hookimpl(tryfirst=True)  # before `-m` deselects by marker

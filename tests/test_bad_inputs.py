@@ -250,7 +250,7 @@ BAD = {
     "response-spacing-with-list": Bad(["response", "--frequencies", "1,2", "--spacing",
                                        "linear"], "--spacing linear", "leave out --spacing"),
     "simulate-sine-4000-hz": Bad(["simulate", "--excitation", "sine", "--frequency", "4000",
-                                  "--duration", "2"], "4000 Hz", "`frequency`",
+                                  "--duration", "2", "--dt", "1e-4"], "4000 Hz", "`frequency`",
                                  "2.5 integration steps per period", "reduce `dt`"),
     # unclear
     "simulate-negative-dt": Bad(["simulate", "--dt", "-1e-4"], "`dt`", "-0.0001", "positive"),

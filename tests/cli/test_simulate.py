@@ -21,8 +21,8 @@ def test_cli_and_api_give_the_same_base_motion_for_the_same_duration(tmp_path, f
     motion sample for sample (the chirp is not squeezed into the 5 s)."""
     out = tmp_path / "run.nc"
     assert main(["simulate", *flags, "--duration", "5", "--sample-rate", "100", "--out", str(out),
-                 "--plot", "none", "--quiet"]) == 0
-    api = simulate(excitation, duration=5.0, sample_rate=100.0)
+                 "--plot", "none", "--quiet", "--dt", "1e-4"]) == 0
+    api = simulate(excitation, duration=5.0, sample_rate=100.0, dt=1e-4)
     data = read_result(out)
     np.testing.assert_array_equal(data["base_displacement"].values, api.base_displacement)
     np.testing.assert_array_equal(data["relative_position"].values, api.relative_position)
@@ -60,7 +60,7 @@ def test_a_config_option_of_another_kind_is_named_with_its_file(tmp_path, capsys
 
 def test_json_summary_is_strict_json_with_the_statistics(capsys):
     assert main(["simulate", "--excitation", "sine", "--frequency", "300", "--amplitude", "1e-4",
-                 "--duration", "3", "--plot", "none", "--json"]) == 0
+                 "--duration", "3", "--plot", "none", "--json", "--dt", "1e-4"]) == 0
     record = json.loads(capsys.readouterr().out)
     assert record["excitation"] == "Sine"
     assert record["run"]["steps"] == 30000 and record["run"]["completed"] is True
@@ -175,7 +175,7 @@ def test_ctrl_c_writes_what_was_simulated(tmp_path, monkeypatch):
     monkeypatch.setattr(lanes, "run_single", interrupted)
     out = tmp_path / "run.nc"
     assert main(["simulate", "--excitation", "sine", "--duration", "10", "--out", str(out),
-                 "--plot", "none", "--quiet"]) == 130
+                 "--plot", "none", "--quiet", "--dt", "1e-4"]) == 130
     data = read_result(out)
     assert data.attrs["run.completed"] == 0
     assert data.sizes["time"] == 1 + 3 * 128  # t = 0 and three chunks
@@ -221,5 +221,51 @@ def test_tolerance_chooses_the_step_the_run_uses(capsys):
     record = json.loads(capsys.readouterr().out)
     expected = choose_step(Chirp(duration=100.0), tolerance_db=0.05, sample_rate=500.0)
     assert record["step"]["dt"] == record["run"]["dt"] == expected.dt
-    assert record["step"]["error_db"] <= 0.05
+    assert record["step"]["chosen"] and record["step"]["unit"] == "dB"
+    assert record["step"]["error"] <= 0.05 and record["run"]["step_error_db"] <= 0.05
+    assert record["run"]["step_tolerance_db"] == 0.05
     assert main(["simulate", "--tolerance", "0.1", "--dt", "1e-3"]) == 2
+
+
+def test_without_a_step_the_default_tolerance_chooses_it_and_dt_stays_literal(capsys):
+    """No --dt: the step meeting defaults.ACCURACY (dB for a chirp, metres for a sine), stated
+    in the summary and the JSON; --dt is taken as it is."""
+    from qzs.defaults import ACCURACY
+    from qzs.engine.accuracy import choose_step
+
+    common = ["--excitation-duration", "100", "--duration", "5", "--sample-rate", "500",
+              "--plot", "none"]
+    assert main(["simulate", *common, "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    expected = choose_step(Chirp(duration=100.0), tolerance_db=ACCURACY["tolerance_db"],
+                           sample_rate=500.0)
+    assert record["run"]["dt"] == expected.dt > 1e-4
+    assert record["step"]["tolerance"] == ACCURACY["tolerance_db"]
+    assert main(["simulate", *common, "--quiet"]) == 0
+    assert (f"chosen for the transmissibility within {ACCURACY['tolerance_db']:g} dB"
+            in capsys.readouterr().out)
+    assert main(["simulate", *common, "--dt", "2e-4", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["run"]["dt"] == 2e-4 and record["step"] == {"dt": 2e-4, "chosen": False}
+    assert "step_tolerance_db" not in record["run"]
+    # a sine has no band: its relative position within the state tolerance
+    assert main(["simulate", "--excitation", "sine", "--frequency", "2", "--duration", "3",
+                 "--sample-rate", "500", "--plot", "none", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["step"]["unit"] == "m" and record["step"]["error"] <= ACCURACY["tolerance_state"]
+    assert main(["simulate", "--excitation", "sine", "--frequency", "2", "--tolerance", "0.01",
+                 "--plot", "none"]) == 2
+    assert "--tolerance-state" in capsys.readouterr().err
+
+
+def test_the_chosen_step_is_kept_in_the_file(tmp_path, capsys):
+    """The streamed file's run attributes carry the chosen step's tolerance and estimate."""
+    import xarray as xr
+
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--excitation-duration", "100", "--duration", "2",
+                 "--sample-rate", "500", "--plot", "none", "--quiet", "--out", str(out)]) == 0
+    with xr.open_dataset(out) as data:
+        assert data.attrs["run.step_tolerance_db"] == 0.01
+        assert 0 <= data.attrs["run.step_error_db"] <= 0.01
+        assert data.attrs["run.dt"] > 1e-4

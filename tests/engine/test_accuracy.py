@@ -304,3 +304,24 @@ def test_a_controller_rate_that_shares_no_step_with_the_output_is_refused_at_onc
     with pytest.raises(ControllerRateError):
         choose_step(CHIRP, controller=ControllerParameters(controller_rate=333.0),
                     tolerance_db=0.5, probe_duration=PROBE)
+
+
+def test_a_sine_probe_of_a_fraction_of_an_output_period_is_compared_sample_for_sample():
+    """A 300 Hz sine's probe (40 periods, 0.1333 s beyond its fade-in) is no whole number of
+    1 ms samples: it is cut to whole samples, so every candidate records the same ones (the
+    runs at dt and dt/2 had differed by one sample: a broadcast error)."""
+    from qzs import Sine
+
+    choice = choose_step(Sine(frequency=300.0, amplitude=1e-4), tolerance_state=1e-5)
+    assert choice.error <= 1e-5
+    assert abs(choice.probe_duration * 1000.0 - round(choice.probe_duration * 1000.0)) < 1e-9
+
+
+def test_an_excitation_no_admissible_step_follows_is_named_before_any_probe():
+    """1e9 Hz: no candidate 1/(sample_rate*k), k < 1e6, gives the steps per period a run needs;
+    refused with the frequency and the option that sets it, not as a stability failure."""
+    from qzs import Sine
+    from qzs.errors import UnresolvedExcitationError
+
+    with pytest.raises(UnresolvedExcitationError, match=r"1e\+09 Hz \(`frequency`\)"):
+        choose_step(Sine(frequency=1e9), tolerance_state=1e-5)

@@ -117,6 +117,21 @@ def _coverage(result):
             f"{exc.f0:g} -> {reached:.3g} Hz of {exc.f0:g} -> {exc.f1:g} Hz")
 
 
+def _step_line(run):
+    """How the run's step was chosen, as a line (docs/model.md §7); '' for a literal step."""
+    for suffix, unit, what in (("db", "dB", "the transmissibility"),
+                               ("m", "m", "the relative position")):
+        tolerance = run.get(f"step_tolerance_{suffix}")
+        if tolerance is None:
+            continue
+        error = run.get(f"step_error_{suffix}", float("nan"))
+        estimate = (f"estimated error {error:.2g} {unit}" if error == error
+                    else "no step tried met it: error not estimated")
+        return (f"  step             dt = {run['dt']:g} s chosen for {what} within "
+                f"{tolerance:g} {unit}; {estimate}")
+    return ""
+
+
 def summary_record(result):
     """The summary as data: run settings, statistics (SI units) and warnings.
 
@@ -161,6 +176,9 @@ def summary_text(result):
         f"({result.steps_per_second / 1e6:.2f} M steps/s, compilation excluded), "
         f"{samples:,} samples at {run['sample_rate']:g} Hz{kept}",
     ]
+    step = _step_line(run)
+    if step:
+        lines.append(step)
     coverage = _coverage(result)
     if coverage:
         lines.append(coverage)

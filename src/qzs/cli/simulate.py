@@ -6,10 +6,10 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
-from qzs.defaults import EXCITATION
+from qzs.defaults import ACCURACY, EXCITATION
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
-from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, build_excitation
+from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, Sine, build_excitation
 
 __all__ = ["add_parser", "run"]
 
@@ -38,7 +38,9 @@ def add_parser(subparsers):
     sim = subparsers.add_parser(
         "simulate", help="simulate the isolator under a base excitation",
         description="Simulate the isolator. With no options: the paper's default case "
-                    "(10 mm chirp, 0-20 Hz, 2000 s, ode3, dt = 1e-4 s), summary and plot. "
+                    "(10 mm chirp, 0-20 Hz, 2000 s, ode3) at the largest step that keeps its "
+                    "transmissibility within 0.01 dB (the paper's dt = 1e-4 s with --dt 1e-4), "
+                    "summary and plot. "
                     "--duration is the simulated time (default: the whole excitation); "
                     "the excitation's own length is --excitation-duration, so "
                     "`--duration 60` simulates the first 60 s of the 2000 s chirp, as "
@@ -70,11 +72,18 @@ def add_parser(subparsers):
     sim.add_argument("--duration", type=float, metavar="S",
                      help="simulated time [s] (default the excitation's length; 10 for a sine)")
     step = sim.add_mutually_exclusive_group()
-    step.add_argument("--dt", type=float, metavar="S", help="integration step [s] (default 1e-4)")
+    step.add_argument("--dt", type=float, metavar="S",
+                      help="a literal integration step [s] (the paper's: 1e-4); default: the "
+                           "largest step meeting --tolerance")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the largest step whose transmissibility stays within DB "
                            "[dB] of a finer one, on a short probe of the excitation "
-                           "(docs/model.md §7), instead of --dt")
+                           f"(docs/model.md §7; default {ACCURACY['tolerance_db']:g}; a sine: "
+                           "--tolerance-state)")
+    step.add_argument("--tolerance-state", type=float, metavar="M",
+                      help="choose the largest step whose relative position stays within M "
+                           f"[m] of a finer one (default for a sine: "
+                           f"{ACCURACY['tolerance_state']:g})")
     sim.add_argument("--sample-rate", type=float, metavar="HZ",
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
@@ -113,6 +122,39 @@ def _excitation(args, table, source):
     return build_excitation(kind, options, names=names)
 
 
+def _choose_step(args, excitation, config, settings):
+    """The step of a run given no literal ``--dt``: the largest meeting the tolerance asked
+    for (``--tolerance``, ``--tolerance-state``) or the default one, from the step cache
+    when the same choice was made before (docs/model.md §7)."""
+    from qzs.engine.accuracy import choose_step_or_finest, default_tolerance
+
+    if args.tolerance is not None:
+        tolerance = {"tolerance_db": args.tolerance}
+    elif args.tolerance_state is not None:
+        tolerance = {"tolerance_state": args.tolerance_state}
+    else:
+        tolerance = default_tolerance(excitation)
+    if "tolerance_db" in tolerance and isinstance(excitation, Sine):
+        raise ParameterError(
+            f"--tolerance {args.tolerance:g} is on the transmissibility [dB], which a sine "
+            "has no band to estimate; give --tolerance-state M [m] or a literal --dt.")
+    return choose_step_or_finest(
+        excitation, config["isolator"], config["controller"], **tolerance,
+        **{k: settings[k] for k in ("solver", "sample_rate") if k in settings},
+        progress=not args.quiet and not args.json, cache=True)
+
+
+def _step_record(choice, settings):
+    """The step as the JSON record gives it: literal, or chosen with its tolerance and error."""
+    if choice is None:
+        return {"dt": settings["dt"], "chosen": False}
+    unit = {"transmissibility_db": "dB", "state_m": "m"}[choice.measure]
+    return {"dt": choice.dt, "chosen": True, "measure": choice.measure, "unit": unit,
+            "tolerance": choice.tolerance, "error": choice.error, "met": choice.met,
+            "reference_dt": choice.reference_dt, "cached": choice.cached,
+            "notes": list(choice.notes)}
+
+
 def run(args):
     """Run ``qzs simulate`` from parsed arguments; returns the exit code (130 if interrupted).
 
@@ -128,6 +170,7 @@ def run(args):
     """
     import sys
 
+    from qzs.engine.accuracy import step_run_entries
     from qzs.engine.simulate import simulate
     from qzs.workflows.run import simulate_to_file
 
@@ -141,38 +184,33 @@ def run(args):
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
-    notes = ""
-    if args.tolerance is not None:
-        from qzs.engine.accuracy import choose_step
-
-        choice = choose_step(excitation, config["isolator"], config["controller"],
-                             tolerance_db=args.tolerance,
-                             **{k: settings[k] for k in ("solver", "sample_rate") if k in settings},
-                             progress=not args.quiet and not args.json)
+    choice = None
+    if "dt" not in settings or args.tolerance is not None or args.tolerance_state is not None:
+        choice = _choose_step(args, excitation, config, settings)
         settings["dt"] = choice.dt
-        notes = "\n  step             " + choice.summary().replace("\n", "\n                   ")
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
     common = dict(progress=not args.quiet and not args.json, interruptible=True)
+    entries = {} if choice is None else step_run_entries(choice)
     if args.out:
         result = simulate_to_file(args.out, excitation, config["isolator"],
-                                  config["controller"], **settings, **common, argument="--out")
+                                  config["controller"], **settings, **common, argument="--out",
+                                  run_entries=entries)
     else:
         result = simulate(excitation, config["isolator"], config["controller"], **settings,
                           **common)
+        result.run.update(entries)
     files = {}
     if args.out:
         files["out"] = args.out
     if plot is not None:
         result.plot(path=plot)
         files["plot"] = plot
+    notes = "" if choice is None else "".join(f"\n                   note: {note}"
+                                              for note in choice.notes)
     text = (result.summary() + notes
             + "".join(f"\n  wrote            {p}" for p in files.values()))
-    record = {**summary_record(result), "files": files}
-    if args.tolerance is not None:
-        record["step"] = {"dt": choice.dt, "error_db": choice.error,
-                          "tolerance_db": choice.tolerance, "reference_dt": choice.reference_dt,
-                          "notes": list(choice.notes)}
+    record = {**summary_record(result), "files": files, "step": _step_record(choice, settings)}
     emit(args, text, record)
     return 0 if result.completed else 130

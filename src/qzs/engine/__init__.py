@@ -13,6 +13,7 @@
 ``batch``        :func:`simulate_batch`, many parameter sets at once
 ``results``      :class:`SimulationResult`
 ``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
+``step_cache``   the step choices kept on disk, keyed by their inputs and the code
 ``driver``       the one run loop: plan, chunks, memory guard, preview, progress, signals
 ``periodic``     :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
 ``hexapod``      subpackage: :func:`simulate_hexapod`, six isolator legs under a rigid platform

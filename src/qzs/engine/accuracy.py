@@ -11,7 +11,9 @@ step halving on a short representative stretch of the excitation (the *probe*):
 >>> choice.dt, choice.error  # doctest: +SKIP
 (0.001, 0.0004...)
 """
+import importlib
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,8 +24,8 @@ from qzs._validation import choice as _choice
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
-__all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error", "halving_search",
-           "admissible_step"]
+__all__ = ["StepChoice", "choose_step", "choose_step_or_finest", "default_tolerance",
+           "probe_excitation", "step_error", "halving_search", "admissible_step"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -43,6 +45,8 @@ PROBE_SEGMENTS = 8
 #: of times longer (:class:`~qzs.errors.ControllerRateError`).
 RATE_REFINEMENT_MAX = 32
 _MEASURES = {"transmissibility_db": "dB", "state_m": "m"}
+#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
+ADMISSIBLE_REFINEMENT = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,11 @@ class StepChoice:
         coarsest first; the difference and estimate are in the unit of ``measure``.
     notes : tuple of str
         What the caller should know (the limit that bound the step, caveats).
+    met : bool
+        Whether ``dt`` meets the tolerance; False only for the fallback of
+        :func:`choose_step_or_finest` (``error`` is then NaN: no estimate holds for it).
+    cached : bool
+        Whether the choice was read from the step cache (:mod:`qzs.engine.step_cache`).
     """
 
     dt: float
@@ -94,6 +103,8 @@ class StepChoice:
     band: tuple
     history: tuple
     notes: tuple
+    met: bool = True
+    cached: bool = False
 
     @property
     def steps_per_sample(self):
@@ -108,6 +119,10 @@ class StepChoice:
         str
         """
         unit = _MEASURES[self.measure]
+        if not self.met:
+            return "\n".join([f"dt = {self.dt:.6g} s ({self.solver}): no step tried meets the "
+                              f"tolerance {self.tolerance:g} {unit}"]
+                             + [f"  note: {note}" for note in self.notes])
         lines = [f"dt = {self.dt:.6g} s ({self.solver}, {self.steps_per_sample} step(s) per "
                  f"{self.sample_rate:g} Hz sample): estimated error {self.error:.3g} {unit} "
                  f"(tolerance {self.tolerance:g} {unit}, reference dt = {self.reference_dt:.3g} s, "
@@ -300,10 +315,11 @@ def admissible_step(sample_rate, controller_rate, stable):
     """
     from qzs.engine.prepare import steps_per_sample
 
-    first = next((k for k in range(1, 1_000_000) if stable(1.0 / (sample_rate * k))), None)
+    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
+                  if stable(1.0 / (sample_rate * k))), None)
     if first is None:
-        raise ParameterError("no step 1/(sample_rate*k) with k < 1e6 is stable; check the "
-                             "model's stiffness and the `sample_rate`.")
+        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
+                             "is stable; check the model's stiffness and the `sample_rate`.")
     if controller_rate <= 0:
         return 1.0 / (sample_rate * first), first
     for k in range(first, RATE_REFINEMENT_MAX * first + 1):
@@ -375,7 +391,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS,
-                safety=SAFETY, progress=False):
+                safety=SAFETY, progress=False, cache=False):
     """The largest fixed step whose error stays within a tolerance (docs/model.md §7).
 
     Candidates are ``dt_j = dt_0 / 2**j`` with ``dt_0 = 1/(sample_rate*k)`` the largest
@@ -425,6 +441,10 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         the paper's 2000 s run was 1.9 times the probe's (docs/model.md §7).
     progress : bool
         Show a progress bar over the probe runs.
+    cache : bool
+        Read the choice from, and keep it in, the step cache on disk
+        (:mod:`qzs.engine.step_cache`, keyed by every input above and by the code that
+        chooses): a repeated command skips the probe. The command line uses it.
 
     Returns
     -------
@@ -436,7 +456,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD, resolving_step, run_inputs
+    from qzs.engine.prepare import (MIN_STEPS_PER_PERIOD, check_resolution, resolving_step,
+                                    run_inputs)
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 
@@ -451,6 +472,12 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
     probe, duration = probe_excitation(
         excitation, band or _frequency_range(excitation, sample_rate), probe_duration)
+    # a whole number of output periods: every candidate step then records the same samples
+    # (a sine's probe of 40 periods need not be; its runs at dt and dt/2 differed by one)
+    duration = math.floor(duration * sample_rate * (1 + 1e-12)) / sample_rate
+    if duration <= 0:
+        raise ParameterError(f"the probe ({duration:g} s) holds no output sample at "
+                             f"`sample_rate` {sample_rate:g} Hz; lengthen `probe_duration`.")
     if fft_length is not None and measure == "transmissibility_db":
         n = int(round(duration * sample_rate)) + 1
         if (isinstance(fft_length, bool) or not isinstance(fft_length, (int, np.integer))
@@ -458,9 +485,30 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
             raise ParameterError(f"`fft_length` must be an integer in [8, {n}] (the probe's "
                                  f"samples), got {fft_length!r}.")
 
+    key = None
+    if cache:
+        from qzs.engine import step_cache
+
+        key = step_cache.cache_key(
+            excitation=excitation, isolator=isolator, controller=controller,
+            initial_state=initial_state, measure=measure, tolerance=tolerance, solver=solver,
+            sample_rate=sample_rate, band=band, probe_duration=probe_duration,
+            fft_length=fft_length, max_halvings=max_halvings, safety=safety)
+        hit = _from_record(step_cache.load(key), probe, duration)
+        if hit is not None:
+            return hit
+    if measure == "transmissibility_db":
+        # the spectral analysis (scipy.signal: about 0.5 s to import) loads in a thread
+        # while the probe's first runs integrate, in a kernel that holds no GIL
+        threading.Thread(target=importlib.import_module, args=("qzs.analysis.spectral",),
+                         name="qzs-import-spectral", daemon=True).start()
+
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
     resolving = resolving_step(probe, duration)  # the step must follow the base motion too
+    # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
+    # step follows is refused as a literal step too coarse for it would be, naming it
+    check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
     dt0, k0 = admissible_step(sample_rate, controller.controller_rate,
                               lambda dt: dt <= resolving and stable(dt))
     notes = []
@@ -522,8 +570,139 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         if observed < order - 0.5:
             notes.append(f"observed order {observed:.2f} below the scheme's {order} (stick-slip "
                          "events lower it): the estimate extrapolates with the observed ratio")
-    return StepChoice(dt=dt0 / 2 ** j, error=float(history[-1][2]), measure=measure,
-                      tolerance=tolerance, reference_dt=dt0 / 2 ** (j + 2),
-                      stability_limit=float(limit), sample_rate=sample_rate, solver=solver,
-                      probe=probe, probe_duration=float(duration), band=band,
-                      history=tuple(history), notes=tuple(notes))
+    choice = StepChoice(dt=dt0 / 2 ** j, error=float(history[-1][2]), measure=measure,
+                        tolerance=tolerance, reference_dt=dt0 / 2 ** (j + 2),
+                        stability_limit=float(limit), sample_rate=sample_rate, solver=solver,
+                        probe=probe, probe_duration=float(duration), band=band,
+                        history=tuple(history), notes=tuple(notes))
+    if key is not None:
+        from qzs.engine import step_cache
+
+        step_cache.store(key, _to_record(choice))
+    return choice
+
+
+#: The fields of a :class:`StepChoice` a cache record keeps (the probe is made again).
+_RECORD_FIELDS = ("dt", "error", "measure", "tolerance", "reference_dt", "stability_limit",
+                  "sample_rate", "solver", "probe_duration", "band", "history", "notes")
+
+
+def _to_record(choice):
+    """A :class:`StepChoice` as the JSON-able record of the step cache."""
+    return {name: getattr(choice, name) for name in _RECORD_FIELDS}
+
+
+def _from_record(record, probe, duration):
+    """The :class:`StepChoice` of a cache record (None for none or a damaged one)."""
+    if record is None:
+        return None
+    try:
+        values = {name: record[name] for name in _RECORD_FIELDS}
+        band = values["band"]
+        values.update(band=None if band is None else (float(band[0]), float(band[1])),
+                      history=tuple(tuple(float(x) for x in row) for row in values["history"]),
+                      notes=tuple(str(note) for note in values["notes"]))
+        choice = StepChoice(probe=probe, cached=True, **values)
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+    if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in _MEASURES
+            and math.isclose(choice.probe_duration, duration)):
+        return None
+    return choice
+
+
+def default_tolerance(excitation):
+    """The accuracy a command asks for when given no step and no tolerance.
+
+    The transmissibility within ``defaults.ACCURACY["tolerance_db"]`` where the excitation
+    has a band to estimate it over (a chirp, a random excitation, a record); a sine has one
+    frequency and no Welch estimate, so its relative position within
+    ``defaults.ACCURACY["tolerance_state"]``.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+
+    Returns
+    -------
+    dict
+        One keyword of :func:`choose_step`: ``{"tolerance_db": ...}`` [dB] or
+        ``{"tolerance_state": ...}`` [m].
+    """
+    if isinstance(excitation, Sine):
+        return {"tolerance_state": float(defaults.ACCURACY["tolerance_state"])}
+    return {"tolerance_db": float(defaults.ACCURACY["tolerance_db"])}
+
+
+def choose_step_or_finest(excitation=None, isolator=None, controller=None, **options):
+    """:func:`choose_step`, or, where no step tried meets the tolerance, a fallback that says so.
+
+    Stick-slip and stop contacts can redraw a response at every step, so that the
+    differences between steps stop shrinking; a command must still run. The fallback is
+    the finer of the paper's step (``defaults.SIMULATION["dt"]``) and the finest step
+    tried, with ``met`` False, ``error`` NaN (no estimate holds for it) and a note giving
+    the smallest estimate found.
+
+    Parameters
+    ----------
+    excitation, isolator, controller
+        As for :func:`choose_step`.
+    **options
+        Every keyword of :func:`choose_step`.
+
+    Returns
+    -------
+    StepChoice
+    """
+    try:
+        return choose_step(excitation, isolator, controller, **options)
+    except ToleranceNotMetError as error:
+        from qzs.engine.prepare import run_inputs
+
+        excitation = run_inputs(excitation, isolator, controller)[0]
+        measure, tolerance = _tolerance(options.get("tolerance_db"),
+                                        options.get("tolerance_state"))
+        sample_rate = float(options.get("sample_rate", defaults.SIMULATION["sample_rate"]))
+        dt = min(defaults.SIMULATION["dt"], error.smallest_step)
+        note = (f"no step down to {error.smallest_step:.3g} s met {tolerance:g} {error.unit} "
+                f"(smallest estimate {error.smallest_error:.3g} {error.unit}: stick-slip or stop "
+                f"contacts redraw the response at every step); running at dt = {dt:.3g} s, "
+                "whose error is not estimated")
+        band = None
+        if measure == "transmissibility_db":
+            band = _band(options.get("band"), excitation, sample_rate)
+        probe, duration = probe_excitation(
+            excitation, band or _frequency_range(excitation, sample_rate),
+            options.get("probe_duration"))
+        return StepChoice(dt=dt, error=math.nan, measure=measure, tolerance=tolerance,
+                          reference_dt=error.smallest_step, stability_limit=math.nan,
+                          sample_rate=sample_rate,
+                          solver=options.get("solver", defaults.SIMULATION["solver"]),
+                          probe=probe, probe_duration=float(duration), band=band, history=(),
+                          notes=(note,), met=False)
+
+
+#: Suffix of the run entries of a chosen step, by measure (their unit: dB or m).
+_RUN_SUFFIX = {"transmissibility_db": "db", "state_m": "m"}
+
+
+def step_run_entries(choice):
+    """What a run records of its chosen step: tolerance and estimated error, in units.
+
+    Parameters
+    ----------
+    choice : StepChoice
+        The step the run was made at.
+
+    Returns
+    -------
+    dict
+        ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the state
+        measure; the error NaN where no step met the tolerance), for
+        :attr:`SimulationResult.run <qzs.engine.results.SimulationResult.run>` and the
+        file's ``run.*`` attributes.
+    """
+    suffix = _RUN_SUFFIX[choice.measure]
+    return {f"step_tolerance_{suffix}": float(choice.tolerance),
+            f"step_error_{suffix}": float(choice.error)}

@@ -66,7 +66,9 @@ FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
 #: "-" for a choice).
 RUN_UNITS = {"solver": "-", "dt": "s", "sample_rate": "Hz", "duration": "s", "steps": "1",
              "elapsed": "s", "completed": "1", "stop_contacts": "1", "stick_events": "1",
-             "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1"}
+             "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1",
+             "step_tolerance_db": "dB", "step_error_db": "dB", "step_tolerance_m": "m",
+             "step_error_m": "m"}
 #: File formats of a run's result: suffix -> name.
 RESULT_SUFFIXES = files.RESULT_SUFFIXES
 #: Where a run's output rows go in its file: variable -> (block, column) of ``(data, flags)``.

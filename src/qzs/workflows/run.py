@@ -23,7 +23,7 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
                      dt=defaults.SIMULATION["dt"],
                      sample_rate=defaults.SIMULATION["sample_rate"],
                      solver=defaults.SIMULATION["solver"], initial_state=None, progress=False,
-                     interruptible=False, argument="path"):
+                     interruptible=False, argument="path", run_entries=None):
     """Simulate and stream every output sample to ``path`` (NetCDF ``.nc`` or CSV ``.csv``).
 
     The path, its folder and the free space are checked before the run starts; samples are
@@ -58,6 +58,9 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
         Ctrl-C ends the run early and writes what was simulated.
     argument : str
         How the caller names ``path`` in messages (``"--out"`` on the command line).
+    run_entries : dict, optional
+        More entries of ``result.run`` (and of the file's ``run.*`` attributes), such as a
+        chosen step's tolerance and error (:func:`qzs.engine.accuracy.step_run_entries`).
 
     Returns
     -------
@@ -82,6 +85,7 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
         result = simulate(excitation, isolator, controller, duration=duration, dt=dt,
                           sample_rate=sample_rate, solver=solver, initial_state=initial_state,
                           progress=progress, interruptible=interruptible, sink=writer.append)
+        result.run.update(run_entries or {})
         # the file holds every sample: the in-memory preview's stride is no property of it
         writer.finish({k: v for k, v in result.run.items() if k != "preview_every"})
     return result

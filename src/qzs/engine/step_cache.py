@@ -1,0 +1,180 @@
+"""A cache of accuracy-driven step choices on disk, keyed by everything the choice reads.
+
+:func:`qzs.engine.accuracy.choose_step` integrates a short probe of the excitation at three
+or more steps and compares them: 0.1-0.2 s warm on the paper's chirp, plus about 0.5 s to
+import the spectral analysis in a new process. A command run twice with the same model,
+excitation and settings asks the same question twice; the answer is a pure function of its
+inputs and of the code that computes it, so it is kept on disk under a key made of both:
+
+- every input of the choice (excitation, isolator, controller, initial state, solver,
+  output rate, tolerance and measure, band, probe length, Welch length, halvings, safety),
+  each dataclass field by its exact ``repr`` (arrays by the SHA-256 of their bytes);
+- the version of qzs and the SHA-256 of the sources the choice depends on (the kernels,
+  the packing, the spectral estimate and this search): an edited kernel never reuses a
+  choice made by the old one.
+
+Records are small JSON files in ``$QZS_CACHE_DIR/steps`` (default
+``$XDG_CACHE_HOME/qzs/steps``, else ``~/.cache/qzs/steps``), written atomically. The cache is
+best effort: a folder that cannot be read or written, or a damaged record, means the choice
+is made again, never an error (docs/model.md §7).
+"""
+import dataclasses
+import functools
+import hashlib
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["CACHE_ENV", "cache_folder", "cache_key", "load", "store"]
+
+#: Environment variable naming the folder of qzs's caches (the step choices go to ``steps/``).
+CACHE_ENV = "QZS_CACHE_DIR"
+#: The sources (below ``src/qzs``) a step choice depends on, besides the kernels numba caches.
+_SOURCES = ("engine/arithmetic.py", "engine/laws.py", "engine/stickslip.py",
+            "engine/base_motion.py", "engine/kernels.py", "engine/lanes.py",
+            "engine/prepare.py", "engine/simulate.py", "engine/stability.py",
+            "engine/accuracy.py", "engine/driver.py", "model/excitation.py",
+            "model/isolator.py", "model/controller.py", "analysis/spectral.py")
+#: Version of the record's layout; a record of another version is ignored.
+_FORMAT = 1
+
+
+def cache_folder():
+    """The folder of the step cache (not created here).
+
+    Returns
+    -------
+    Path
+        ``$QZS_CACHE_DIR/steps``, else ``$XDG_CACHE_HOME/qzs/steps``, else
+        ``~/.cache/qzs/steps``.
+    """
+    root = os.environ.get(CACHE_ENV)
+    if not root:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        root = os.path.join(base, "qzs")
+    return Path(root) / "steps"
+
+
+@functools.lru_cache(maxsize=1)
+def _code_fingerprint():
+    """SHA-256 of qzs's version and of the sources a choice depends on."""
+    from qzs._version import __version__
+
+    digest = hashlib.sha256(__version__.encode())
+    root = Path(__file__).resolve().parents[1]
+    for name in _SOURCES:
+        try:
+            digest.update((root / name).read_bytes())
+        except OSError:
+            digest.update(f"missing {name}".encode())
+    return digest.hexdigest()
+
+
+def _canonical(value):
+    """A text that differs whenever ``value`` differs: exact reprs, arrays by their bytes."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        fields = ", ".join(f"{f.name}={_canonical(getattr(value, f.name))}"
+                           for f in dataclasses.fields(value))
+        return f"{type(value).__name__}({fields})"
+    if isinstance(value, np.ndarray):
+        array = np.ascontiguousarray(value)
+        return (f"array({array.dtype.str}, {array.shape}, "
+                f"{hashlib.sha256(array.tobytes()).hexdigest()})")
+    if isinstance(value, (list, tuple)):
+        return "(" + ", ".join(_canonical(v) for v in value) + ")"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k!r}: {_canonical(v)}" for k, v in sorted(value.items())) + "}"
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return repr(value)
+
+
+def cache_key(**inputs):
+    """The key of a step choice: SHA-256 of its inputs and of the code that makes it.
+
+    Parameters
+    ----------
+    **inputs
+        Every input of the choice, by name (dataclasses, arrays, numbers, strings, None).
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+    """
+    text = _code_fingerprint() + "\n" + "\n".join(f"{name}={_canonical(value)}"
+                                                   for name, value in sorted(inputs.items()))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _encode(value):
+    """JSON for floats that may be inf or NaN (stored as strings)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return repr(value)
+    if isinstance(value, (list, tuple)):
+        return [_encode(v) for v in value]
+    return value
+
+
+def _decode(value):
+    if value in ("inf", "-inf", "nan"):
+        return float(value)
+    if isinstance(value, list):
+        return [_decode(v) for v in value]
+    return value
+
+
+def load(key):
+    """The record stored under ``key``, or None (absent, unreadable or of another layout).
+
+    Parameters
+    ----------
+    key : str
+        From :func:`cache_key`.
+
+    Returns
+    -------
+    dict or None
+    """
+    try:
+        with open(cache_folder() / f"{key}.json", encoding="utf-8") as handle:
+            record = json.load(handle)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(record, dict) or record.get("format") != _FORMAT:
+        return None
+    return {name: _decode(value) for name, value in record.items()}
+
+
+def store(key, record):
+    """Keep ``record`` under ``key`` (atomically; silently skipped where it cannot be written).
+
+    Parameters
+    ----------
+    key : str
+        From :func:`cache_key`.
+    record : dict
+        JSON-serialisable values (floats may be inf or NaN).
+
+    Returns
+    -------
+    bool
+        Whether the record was written.
+    """
+    folder = cache_folder()
+    tmp = None
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".part", dir=folder)
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            json.dump({"format": _FORMAT, **{k: _encode(v) for k, v in record.items()}}, handle)
+        os.replace(tmp, folder / f"{key}.json")
+        return True
+    except (OSError, TypeError, ValueError):
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        return False

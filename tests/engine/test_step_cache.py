@@ -1,0 +1,114 @@
+"""The step cache (qzs.engine.step_cache): a repeated choice is read back, never made from a
+stale or different question.
+
+Properties that fail if the cache is wrong:
+
+* the key changes with every input of the choice (a model parameter, the excitation, an
+  array's content, the tolerance) and with the code that chooses;
+* a choice read back equals the one made (every field), and reading it runs no probe;
+* a damaged record, or a folder that cannot be written, costs a new choice, never an error,
+  and no temporary file is left behind.
+"""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from qzs import Chirp, DisplacementRecord, IsolatorParameters
+from qzs.engine import step_cache
+from qzs.engine.accuracy import choose_step, choose_step_or_finest
+
+PROBE = 12.0
+CHIRP = Chirp(duration=100.0, f1=5.0)
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv(step_cache.CACHE_ENV, str(tmp_path))
+    return tmp_path / "steps"
+
+
+def test_the_key_changes_with_every_input_and_with_the_code(monkeypatch):
+    base = dict(excitation=CHIRP, isolator=IsolatorParameters(), tolerance=0.01, band=None)
+    key = step_cache.cache_key(**base)
+    assert key == step_cache.cache_key(**dict(base))  # equal inputs, equal keys
+    changed = [
+        dict(base, excitation=dataclasses.replace(CHIRP, f1=5.000000001)),
+        dict(base, isolator=IsolatorParameters(stiction_force=10.000001)),
+        dict(base, tolerance=0.02),
+        dict(base, band=(1.0, 5.0)),
+    ]
+    assert len({step_cache.cache_key(**inputs) for inputs in changed} | {key}) == 5
+    # an array by its content, not by numpy's abbreviated repr
+    t = np.linspace(0.0, 10.0, 5001)
+    displacement = 1e-3 * np.sin(t)
+    nudged = displacement.copy()
+    nudged[2500] += 1e-9  # numpy's repr of either array shows the same abbreviated values
+    record = DisplacementRecord(time=t, displacement=displacement)
+    other = DisplacementRecord(time=t, displacement=nudged)
+    assert step_cache.cache_key(excitation=record) != step_cache.cache_key(excitation=other)
+    # another version of the code: another key
+    step_cache._code_fingerprint.cache_clear()
+    monkeypatch.setattr(step_cache, "_SOURCES", step_cache._SOURCES[:-1])
+    assert step_cache.cache_key(**base) != key
+    step_cache._code_fingerprint.cache_clear()
+
+
+def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch):
+    first = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    assert not first.cached and len(list(cache.glob("*.json"))) == 1
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a cached choice ran a probe")
+
+    import qzs.engine.simulate as simulate_module
+    monkeypatch.setattr(simulate_module, "simulate", no_run)
+    again = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    assert again.cached
+    for field in dataclasses.fields(first):
+        if field.name not in ("cached", "probe"):
+            assert getattr(again, field.name) == getattr(first, field.name), field.name
+    assert again.probe == first.probe
+    # another tolerance is another question: it needs the probe (and so fails here)
+    with pytest.raises(AssertionError, match="ran a probe"):
+        choose_step(CHIRP, tolerance_db=0.04, probe_duration=PROBE, cache=True)
+    # without cache=True the disk is neither read nor written
+    with pytest.raises(AssertionError, match="ran a probe"):
+        choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE)
+
+
+def test_a_damaged_record_or_an_unwritable_folder_costs_a_new_choice(cache, tmp_path,
+                                                                      monkeypatch):
+    first = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    (record,) = cache.glob("*.json")
+    record.write_text('{"format": 1, "dt": "not a step"')
+    again = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    assert not again.cached and again.dt == first.dt
+    record.write_text('{"format": 1, "dt": -1.0}')
+    assert step_cache.load(record.stem) is not None
+    assert not choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True).cached
+    # a file where the folder should be: nothing is written, the choice is still made
+    blocked = tmp_path / "blocked"
+    blocked.write_text("")
+    monkeypatch.setenv(step_cache.CACHE_ENV, str(blocked))
+    assert not step_cache.store("k", {"dt": 1.0})
+    assert choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True).dt == first.dt
+    assert not list(cache.glob("*.part")) and not list(cache.glob(".*"))
+
+
+def test_records_keep_infinite_and_missing_numbers(cache):
+    assert step_cache.store("k", {"history": [[1e-3, 0.1, math.inf]], "error": math.nan})
+    record = step_cache.load("k")
+    assert record["history"][0][2] == math.inf and math.isnan(record["error"])
+
+
+def test_without_a_step_meeting_the_tolerance_the_fallback_says_so():
+    """choose_step_or_finest: the finer of the paper's step and the finest tried, met False,
+    no error estimate, and a note with the smallest estimate."""
+    choice = choose_step_or_finest(CHIRP, tolerance_state=1e-15, probe_duration=PROBE,
+                                   max_halvings=2)
+    assert not choice.met and math.isnan(choice.error)
+    assert choice.dt == min(1e-4, choice.reference_dt)
+    assert "no step down to" in choice.notes[0] and "not estimated" in choice.notes[0]
+    assert "no step tried meets" in choice.summary()
