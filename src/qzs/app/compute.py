@@ -27,7 +27,7 @@ import numpy as np
 from qzs import defaults
 from qzs._format import decibels
 from qzs._validation import as_float, choice, integer
-from qzs.errors import ParameterError, SizeLimitError, ToleranceNotMetError
+from qzs.errors import ParameterError, SizeLimitError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
 from qzs.model.isolator import IsolatorParameters
@@ -287,18 +287,13 @@ def page_request(values=None):
 # ---------------------------------------------------------------- the step
 @functools.lru_cache(maxsize=64)
 def _cached_step(excitation, isolator, controller, sample_rate, measure, tolerance):
-    from qzs.engine.accuracy import choose_step
+    from qzs.engine.accuracy import choose_step_or_finest
 
     keyword = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}[measure]
-    try:
-        choice_ = choose_step(excitation, isolator, controller, sample_rate=sample_rate,
-                              max_halvings=MAX_HALVINGS, **{keyword: tolerance})
-    except ToleranceNotMetError as error:
-        dt = min(defaults.SIMULATION["dt"], error.smallest_step)
-        return dt, math.nan, (f"no step down to {error.smallest_step:.3g} s met "
-                              f"{tolerance:g} {error.unit} (stick-slip or stop contacts redraw "
-                              f"the response at every step); using dt = {dt:.3g} s")
-    return choice_.dt, choice_.error, ""
+    choice_ = choose_step_or_finest(excitation, isolator, controller, sample_rate=sample_rate,
+                                    max_halvings=MAX_HALVINGS, cache=True,
+                                    **{keyword: tolerance})
+    return choice_.dt, choice_.error, "" if choice_.met else choice_.notes[0]
 
 
 def choose_page_step(excitation, isolator, controller, sample_rate, *, tolerance_db=None,
