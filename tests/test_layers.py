@@ -189,7 +189,6 @@ TESTS = Path(__file__).resolve().parent
 #: Modules without a test file of their own, with the reason. Only a module whose whole
 #: content is constants or re-exports may be here (checked: it defines no function or class).
 UNTESTED = {
-    "_version": "the version string only",
     "engine.hexapod.layout": "the six-axis kernels' packed offsets only (that the output "
                              "channels tile them: tests/engine/hexapod/test_result.py)",
 }
