@@ -17,3 +17,22 @@ def test_a_lazy_name_is_imported_on_first_use_and_kept(monkeypatch):
     assert vars(package)["sqrt"] is math.sqrt   # kept: the next use is a plain lookup
     with pytest.raises(AttributeError, match="module 'lazy_example' has no attribute 'cbrt'"):
         package.cbrt
+
+
+def test_a_module_imported_in_the_background_is_imported_once_and_errors_stay_there(
+        monkeypatch):
+    """import_in_background: the module is in sys.modules after the thread (and a later import
+    gets the same object); a module that fails to import does not raise in the thread's
+    caller, and the caller's own import still raises it."""
+    import importlib
+
+    from qzs._lazy import import_in_background
+
+    monkeypatch.delitem(sys.modules, "colorsys", raising=False)
+    monkeypatch.delitem(sys.modules, "tabnanny", raising=False)
+    import_in_background("colorsys", "qzs_no_such_module", "tabnanny").join(timeout=30)
+    assert "colorsys" in sys.modules
+    assert importlib.import_module("colorsys") is sys.modules["colorsys"]
+    assert "tabnanny" not in sys.modules  # after a failure the thread stops quietly
+    with pytest.raises(ModuleNotFoundError):
+        importlib.import_module("qzs_no_such_module")

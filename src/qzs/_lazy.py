@@ -1,8 +1,9 @@
 """Names a package exports but imports only on first use (PEP 562), so ``import qzs`` stays lean."""
 import importlib
 import sys
+import threading
 
-__all__ = ["lazy_exports"]
+__all__ = ["lazy_exports", "import_in_background"]
 
 
 def lazy_exports(package, exports):
@@ -34,3 +35,35 @@ def lazy_exports(package, exports):
         return sorted(set(namespace) | set(exports))
 
     return __getattr__, __dir__
+
+
+def import_in_background(*modules):
+    """Import ``modules`` in a daemon thread, while the caller goes on.
+
+    For modules a command will need after a long phase that holds no GIL (a kernel
+    integrating): scipy.signal or matplotlib cost 0.3-0.5 s to import, which then overlaps
+    the integration instead of following it. Python's per-module import locks make a later
+    ``import`` of the same module in the caller wait for the thread's, never import it
+    twice. Errors stay in the thread: the caller's own import raises them where it needs
+    the module.
+
+    Parameters
+    ----------
+    *modules : str
+        Dotted module names, imported in order.
+
+    Returns
+    -------
+    threading.Thread
+        The started thread (joining it is never needed).
+    """
+    def load():
+        for name in modules:
+            try:
+                importlib.import_module(name)
+            except Exception:  # noqa: BLE001 - the caller's own import reports it
+                return
+
+    thread = threading.Thread(target=load, name="qzs-import", daemon=True)
+    thread.start()
+    return thread

@@ -4,6 +4,7 @@
 excitation's own length (a chirp's sweep time, a random record's length) is
 ``--excitation-duration``. An option the chosen excitation does not use is an error.
 """
+from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
 from qzs.defaults import ACCURACY, EXCITATION
@@ -191,6 +192,8 @@ def run(args):
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+        # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it
+        import_in_background("matplotlib.pyplot", "qzs.viz.simulation")
     common = dict(progress=not args.quiet and not args.json, interruptible=True)
     entries = {} if choice is None else step_run_entries(choice)
     if args.out:

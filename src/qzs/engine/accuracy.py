@@ -11,15 +11,14 @@ step halving on a short representative stretch of the excitation (the *probe*):
 >>> choice.dt, choice.error  # doctest: +SKIP
 (0.001, 0.0004...)
 """
-import importlib
 import math
-import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from qzs import _validation, defaults
 from qzs._format import decibels
+from qzs._lazy import import_in_background
 from qzs._validation import choice as _choice
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
@@ -500,8 +499,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     if measure == "transmissibility_db":
         # the spectral analysis (scipy.signal: about 0.5 s to import) loads in a thread
         # while the probe's first runs integrate, in a kernel that holds no GIL
-        threading.Thread(target=importlib.import_module, args=("qzs.analysis.spectral",),
-                         name="qzs-import-spectral", daemon=True).start()
+        import_in_background("qzs.analysis.spectral")
 
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
