@@ -2,7 +2,7 @@
 
 Everything else about the package is in pyproject.toml. The repository's docs/ stays the one
 copy of the model and workflow pages; building copies the pages named in
-``qzs.iotools.documentation.TOPICS`` (read from that file's source, without importing qzs)
+``qzs.iotools.docs.TOPICS`` (read from that file's source, without importing qzs)
 into the built package as ``qzs/_docs/``. An editable install copies nothing: ``qzs docs``
 reads the source tree's docs/ there. A build without the pages (an sdist that lost docs/)
 fails here, instead of making a wheel whose ``qzs docs`` cannot work.
@@ -15,7 +15,7 @@ from setuptools import setup
 from setuptools.command.build_py import build_py
 
 ROOT = Path(__file__).resolve().parent
-DOCUMENTATION = ROOT / "src" / "qzs" / "iotools" / "documentation.py"
+DOCUMENTATION = ROOT / "src" / "qzs" / "iotools" / "docs.py"
 
 
 def shipped_pages():

@@ -95,7 +95,7 @@ def build_parser():
     response.add_parser(sub)
     app.add_parser(sub)
     docs.add_parser(sub)
-    completion.add_parser(sub)
+    completion.add_parser(sub, parser)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes
         if EPILOG not in (command.epilog or ""):
             command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG

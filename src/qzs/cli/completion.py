@@ -1,6 +1,6 @@
 """``qzs completion bash|zsh``: a shell completion script generated from the parser.
 
-The script is written from :func:`qzs.cli.build_parser` itself, so it knows every
+The script is written from the ``qzs`` parser itself (:func:`qzs.cli.build_parser`), so it knows every
 subcommand, option and choice of the qzs that printed it and needs nothing at completion
 time (no Python start per TAB, no new dependency). It completes subcommands (nested ones
 such as ``qzs hexapod simulate`` too), a command's options, an option's choices
@@ -22,13 +22,16 @@ __all__ = ["add_parser", "run", "command_tree", "bash_script", "zsh_script", "SH
 WORDS_ATTRIBUTE = "completion_words"
 
 
-def add_parser(subparsers):
+def add_parser(subparsers, root):
     """Add ``completion`` to an ``argparse`` sub-parser collection; returns the parser.
 
     Parameters
     ----------
     subparsers : argparse._SubParsersAction
         What ``ArgumentParser.add_subparsers`` returned.
+    root : argparse.ArgumentParser
+        The ``qzs`` parser itself, whose script the command prints (complete by the time
+        the command runs).
 
     Returns
     -------
@@ -44,6 +47,7 @@ def add_parser(subparsers):
                "file: qzs completion bash > ~/.local/share/bash-completion/completions/qzs. "
                + EPILOG)
     parser.add_argument("shell", choices=SHELLS, help="the shell: bash or zsh")
+    parser.set_defaults(root_parser=root)
     return parser
 
 
@@ -53,16 +57,14 @@ def run(args):
     Parameters
     ----------
     args : argparse.Namespace
-        The parsed ``qzs completion`` arguments.
+        The parsed ``qzs completion`` arguments (``root_parser``: the ``qzs`` parser).
 
     Returns
     -------
     int
         The exit code, 0.
     """
-    from qzs.cli import build_parser  # the package imports this module
-
-    print(SHELLS[args.shell](command_tree(build_parser())), end="")
+    print(SHELLS[args.shell](command_tree(args.root_parser)), end="")
     return 0
 
 

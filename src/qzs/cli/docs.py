@@ -1,7 +1,7 @@
 """``qzs docs``: the model and workflow pages shipped inside the package, in the terminal."""
 from qzs.cli.common import EPILOG
 from qzs.errors import ParameterError
-from qzs.iotools.documentation import read_topic, topic_names, topics
+from qzs.iotools.docs import read_topic, topic_names, topics
 
 __all__ = ["add_parser", "run"]
 

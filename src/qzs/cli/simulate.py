@@ -74,7 +74,7 @@ def add_parser(subparsers):
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the largest step whose transmissibility stays within DB "
                            "[dB] of a finer one, on a short probe of the excitation "
-                           "(docs/model.md §7), instead of --dt")
+                           "(`qzs docs model` §7), instead of --dt")
     sim.add_argument("--sample-rate", type=float, metavar="HZ",
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),

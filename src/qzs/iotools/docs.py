@@ -18,7 +18,8 @@ from pathlib import Path
 
 from qzs.errors import DataError, ParameterError
 
-__all__ = ["TOPICS", "topics", "topic_names", "resolve_topic", "read_topic", "find_section", "section_numbers"]
+__all__ = ["TOPICS", "topics", "topic_names", "resolve_topic", "read_topic", "find_section",
+           "section_numbers"]
 
 #: Topic name -> page, relative to ``docs/``. The name is the page's path without ``.md``;
 #: a workflow page may be named by its last part alone (``simulate``) where no other topic
@@ -43,7 +44,8 @@ TOPICS = {
 #: Where the pages are inside an installed package.
 PACKAGE_FOLDER = "_docs"
 
-_ROLE = re.compile(r"\{(?:py:)?(?:func|class|mod|meth|attr|data|ref|doc|exc|obj)\}`~?([^`]+)`")
+_ROLE = re.compile(r"\{(?:py:)?(?:func|class|mod|meth|attr|data|ref|doc|exc|obj)\}"
+                   r"`~?([^`<]+?)(?:\s*<[^`>]*>)?`")
 _DIRECTIVE = re.compile(r"^```\{([a-z-]+)\}[^\n]*\n.*?^```[ \t]*$", re.MULTILINE | re.DOTALL)
 _HEADING = re.compile(r"^(#{1,6})\s+(?:§\s*)?(\d+(?:\.\d+)*[a-z]?)\.?\s")
 #: What a directive that only the site can fill says in a terminal.
