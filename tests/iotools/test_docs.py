@@ -1,6 +1,7 @@
 """The shipped documentation pages (qzs.iotools.docs) and the build step that ships
 them (setup.py): every topic is a page of docs/, the wheel's copy reads the same as the
 source tree's, a section is exactly its heading down to the next at its level."""
+import re
 import runpy
 import shutil
 import subprocess
@@ -143,7 +144,6 @@ def test_a_missing_section_lists_the_sections():
 
 def test_the_model_page_has_the_sections_the_code_cites():
     """Every "`qzs docs model` §N" / "docs/model.md §N" in the package names a real section."""
-    import re
 
     cited = {"model": set(), "hexapod": set()}
     for path in (ROOT / "src" / "qzs").rglob("*.py"):
@@ -183,3 +183,34 @@ def test_the_built_wheel_ships_every_page(tmp_path):
     names = set(zipfile.ZipFile(wheel).namelist())
     assert {f"qzs/_docs/{page}" for page in TOPICS.values()} <= names
     assert not any(name.startswith("qzs/_docs/") and not name.endswith(".md") for name in names)
+
+
+# ---------------------------------------------------------------- the README outside the repo
+README = ROOT / "README.md"
+_LINK = re.compile(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)")
+_REFERENCE = re.compile(r"^\s*\[[^\]]+\]:\s*(\S+)", re.MULTILINE)
+_HTML = re.compile(r"""<(?:a|img)\b[^>]*?\b(?:href|src)\s*=\s*["']([^"']+)""", re.IGNORECASE)
+
+
+def relative_links(text):
+    """Link and image targets of Markdown that only work inside the repository."""
+    targets = _LINK.findall(text) + _REFERENCE.findall(text) + _HTML.findall(text)
+    return [target for target in targets if not target.startswith(("https://", "http://"))]
+
+
+def test_the_link_check_sees_relative_links():
+    text = ("[a](docs/model.md) ![b](docs/app.png) [c](https://x.org/y) <img src='app.png'>\n"
+            "[d]: CONTRIBUTING.md\n")
+    assert relative_links(text) == ["docs/model.md", "docs/app.png", "CONTRIBUTING.md",
+                                    "app.png"]
+
+
+def test_the_readme_works_outside_the_repository():
+    """PyPI shows the README as the long description: no link or image may be relative, and
+    every page it names (`qzs docs TOPIC [SECTION]`) ships inside the package."""
+    text = README.read_text(encoding="utf-8")
+    assert relative_links(text) == []
+    cited = re.findall(r"`qzs docs ([a-z/-]+)(?: (\d+(?:\.\d+)?))?`", text)
+    assert len(cited) >= 10
+    for topic, section in cited:
+        read_topic(topic, section or None)
