@@ -161,7 +161,7 @@ def test_site_only_markup_is_reduced_for_a_terminal():
     assert "{func}" not in text and "`qzs.read_recording`" in text
     assert "`FrictionFit.to_isolator`" in text          # a role with its own title
     command_line = read_topic("command-line")
-    assert "{qzs-command-help}" not in command_line and "qzs COMMAND --help" in command_line
+    assert "{qzs-command-help}" not in command_line and "`qzs COMMAND --help`" in command_line
     assert command_line.endswith("\n") and not command_line.endswith("\n\n")
 
 

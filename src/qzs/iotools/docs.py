@@ -50,7 +50,7 @@ _DIRECTIVE = re.compile(r"^```\{([a-z-]+)\}[^\n]*\n.*?^```[ \t]*$", re.MULTILINE
 _HEADING = re.compile(r"^(#{1,6})\s+(?:§\s*)?(\d+(?:\.\d+)*[a-z]?)\.?\s")
 #: What a directive that only the site can fill says in a terminal.
 _PLACEHOLDERS = {
-    "qzs-command-help": "(Each command's help: `qzs --help`, `qzs COMMAND --help`.)",
+    "qzs-command-help": "(In the terminal: `qzs --help` and `qzs COMMAND --help`.)",
     "toctree": "(The pages of this part: `qzs docs` lists them.)",
 }
 
