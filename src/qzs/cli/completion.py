@@ -1,11 +1,11 @@
 """``qzs completion bash|zsh``: a shell completion script generated from the parser.
 
-The script is written from the ``qzs`` parser itself (:func:`qzs.cli.build_parser`), so it knows every
-subcommand, option and choice of the qzs that printed it and needs nothing at completion
-time (no Python start per TAB, no new dependency). It completes subcommands (nested ones
-such as ``qzs hexapod simulate`` too), a command's options, an option's choices
+The script is written from the ``qzs`` parser itself (:func:`qzs.cli.build_parser`), so it
+knows every subcommand, option and choice of the qzs that printed it and needs nothing at
+completion time (no Python start per TAB, no new dependency). It completes subcommands
+(nested ones such as ``qzs hexapod simulate`` too), a command's options, an option's choices
 (``--solver ode3|rk4|euler``), the words of a positional argument that lists them (the
-topics of ``qzs docs``) and, for every other value, file names.
+topics of ``qzs docs``) and, for every other value, file names::
 
     eval "$(qzs completion bash)"          # in ~/.bashrc
     eval "$(qzs completion zsh)"           # in ~/.zshrc, after compinit

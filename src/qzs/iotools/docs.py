@@ -7,10 +7,10 @@ the package as ``qzs/_docs/<page>`` (``setup.py``, its ``build_py`` step, reads
 ("`qzs docs model` §7"). At run time a page is read from ``qzs/_docs`` if the package has it,
 else from the ``docs/`` folder of the source tree (a checkout or an editable install).
 
-A page is printed as its Markdown source, with Sphinx's cross-reference roles reduced to
-their targets (``{func}`~qzs.simulate``` -> ```qzs.simulate```) and the blocks only the
-documentation site can fill (generated command help, tables of contents) replaced by a
-line that says where that content is.
+A page is printed as its Markdown source, with Sphinx's cross-reference roles (``{func}``,
+``{mod}``, ...) reduced to their targets in backquotes, and the blocks only the documentation
+site can fill (generated command help, tables of contents) replaced by a line that says
+where that content is.
 """
 import re
 from importlib import resources

@@ -2,12 +2,13 @@
 
 ``qzs experiment LOG --map MAP.toml`` needs a channel map (:mod:`qzs.iotools.readers`):
 which signal of the log plays which role, in which unit and with which scale.
-:func:`channel_map_template` writes one from the reader's own tables (:data:`ROLES`,
-:data:`UNITS`, the ``[time]``, ``[options]`` and ``[experiment]`` keys) and the experiment's
-defaults, so that the template names every key the reader takes and nothing else. The two
-velocity channels the experiment needs are active tables with a placeholder ``source``; the
-other roles and the optional keys are commented out. With the placeholders
-replaced by the log's signal names, the file is a valid map.
+:func:`channel_map_template` writes one from the reader's own tables
+(:data:`~qzs.iotools.readers.ROLES`, :data:`~qzs.iotools.readers.UNITS`, the ``[time]``,
+``[options]`` and ``[experiment]`` keys) and the experiment's defaults, so that the template
+names every key the reader takes and nothing else. The two velocity channels the experiment
+needs are active tables with a placeholder ``source``; the other roles and the optional keys
+are commented out. With the placeholders replaced by the log's signal names, the file is a
+valid map.
 
 Command line: ``qzs experiment --write-map FILE.toml``.
 """
