@@ -43,7 +43,8 @@ def experiment_log(folder, rng):
 
 
 CSV_MAP = """\
-# Channel map of experiment.csv (see qzs.readers): which column is which, and its unit.
+# Channel map of experiment.csv (read by qzs.iotools.readers; `qzs docs identification`):
+# which column is which, and its unit. Every key, commented: `qzs experiment --write-map F.toml`.
 [time]
 source = "time"
 unit = "s"

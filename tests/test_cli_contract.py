@@ -88,7 +88,8 @@ ARGV = {"simulate": ["simulate"], "params": ["params"], "paper": ["paper"],
         "study": ["study", "x.toml"], "experiment": ["experiment", "log.csv", "--map", "m.toml"],
         "sweep": ["sweep", "s.toml"], "sweep-plot": ["sweep-plot", "s.zarr"],
         "hexapod": ["hexapod", "linear"], "response": ["response"],
-        "design": ["design"], "app": ["app", "--no-browser"]}
+        "design": ["design"], "app": ["app", "--no-browser"], "docs": ["docs"],
+        "completion": ["completion", "bash"]}
 
 
 def test_every_subcommand_has_the_same_exit_codes(monkeypatch, capsys):

@@ -45,3 +45,30 @@ def test_an_output_folder_that_is_a_file_is_refused_before_reading(tmp_path, cap
     assert main(["experiment", str(Path("no-such-log.csv")), "--map", "map.toml",
                  "--out", str(tmp_path / "taken")]) == 2
     assert "is a file, not a folder" in capsys.readouterr().err
+
+
+def test_write_map_writes_the_template_without_a_log(tmp_path, capsys):
+    from qzs.iotools.readers import load_channel_map
+    from qzs.workflows.experiment_map import PLACEHOLDER, channel_map_template
+
+    path = tmp_path / "sub" / "map.toml"
+    assert main(["experiment", "--write-map", str(path)]) == 0
+    assert path.read_text() == channel_map_template()
+    assert f"wrote {path}" in capsys.readouterr().out
+    load_channel_map(path)  # placeholders included, it parses
+
+
+@pytest.mark.parametrize("name, reason", [("map.toml", "exists; choose another name"),
+                                          ("map.txt", "it must end in .toml")])
+def test_write_map_refuses_a_taken_or_wrong_name(tmp_path, capsys, name, reason):
+    (tmp_path / "map.toml").write_text("mine")
+    assert main(["experiment", "--write-map", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error: --write-map ") and reason in err and err.count("\n") == 1
+    assert (tmp_path / "map.toml").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.toml"]
+
+
+def test_a_run_still_needs_log_and_map(capsys):
+    assert main(["experiment", "log.csv"]) == 2
+    assert "required: --map" in capsys.readouterr().err

@@ -12,6 +12,8 @@
     qzs response [--frequencies F1,F2,... | --range F0,F1,N] [--direction up|down|both] [--json]
     qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
+    qzs docs [TOPIC [SECTION]]
+    qzs completion bash|zsh
 
 Every subcommand hands its parsed arguments to a function of the layers below; one module
 per subcommand (or pair of subcommands), and what they share:
@@ -27,6 +29,8 @@ per subcommand (or pair of subcommands), and what they share:
 ``design``      ``qzs design``: PI and damping gains from the isolator and its disturbance
 ``hexapod``     ``qzs hexapod``: the six-axis platform of six isolator legs
 ``app``         ``qzs app``: the interactive tuning page in the browser
+``docs``        ``qzs docs``: the model and workflow pages shipped inside the package
+``completion``  ``qzs completion``: bash and zsh completion scripts from the parser
 ==============  =======================================================================
 
 Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
@@ -42,8 +46,8 @@ import signal
 import sys
 
 from qzs._version import __version__
-from qzs.cli import (app, design, experiment, hexapod, params, response, simulate, studies,
-                     sweep)
+from qzs.cli import (app, completion, design, docs, experiment, hexapod, params, response,
+                     simulate, studies, sweep)
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -53,7 +57,8 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "study": studies.run, "experiment": experiment.run,
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
             "hexapod": hexapod.run, "response": response.run,
-            "design": design.run, "app": app.run}
+            "design": design.run, "app": app.run, "docs": docs.run,
+            "completion": completion.run}
 
 
 class Parser(argparse.ArgumentParser):
@@ -75,8 +80,9 @@ def build_parser():
     """The ``qzs`` argument parser with every subcommand."""
     parser = Parser(
         prog="qzs", description="Semi-active quasi-zero-stiffness isolator toolkit.",
-        epilog="The model, its signs, defaults and every modelling decision: docs/model.md "
-               "(in the qzs repository). Parameter names and units: `qzs params`. " + EPILOG)
+        epilog="The model, its signs, defaults and every modelling decision: `qzs docs model` "
+               "(`qzs docs` lists every page). Parameter names and units: `qzs params`. "
+               "Shell completion: `qzs completion bash|zsh`. " + EPILOG)
     parser.add_argument("--version", action="version", version=f"qzs {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     simulate.add_parser(sub)
@@ -88,6 +94,8 @@ def build_parser():
     design.add_parser(sub)
     response.add_parser(sub)
     app.add_parser(sub)
+    docs.add_parser(sub)
+    completion.add_parser(sub, parser)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes
         if EPILOG not in (command.epilog or ""):
             command.epilog = f"{command.epilog} {EPILOG}" if command.epilog else EPILOG

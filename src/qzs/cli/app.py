@@ -40,7 +40,7 @@ def add_parser(subparsers):
                     "locked share within a second of a slider's release. Pin curves, reset to "
                     "the paper's defaults, export the parameters as a TOML config for "
                     "`qzs simulate --config` and the figure as PNG (browser downloads: the "
-                    "server writes no file). Runs until Ctrl-C (docs/app.md).")
+                    "server writes no file). Runs until Ctrl-C (`qzs docs app`).")
     parser.add_argument("--port", type=_port, metavar="N",
                         help="port to listen on (default 5006 if free, else a free one; "
                              "0: any free port)")

@@ -88,7 +88,7 @@ def add_parser(subparsers):
                     "the damping gain that minimises a transmissibility cost; the sampled "
                     "loop's margins and the rate it needs; why active damping did not help "
                     "much in the paper; the static design. Writes report.html, design.json "
-                    "and figures (docs/design.md).",
+                    "and figures (`qzs docs design`).",
         epilog="The base motion is the config's [excitation] (default the paper's 10 mm, "
                "0-20 Hz, 2000 s chirp; --quick: the same sweep in 200 s, the ranges' ends "
                "only, a coarser search: about a minute). The output folder is checked before "

@@ -1,5 +1,13 @@
-"""``qzs experiment``: an experiment log beside the matching simulation."""
-from qzs.cli.common import EPILOG, add_json_option, emit, integer_at_least
+"""``qzs experiment``: an experiment log beside the matching simulation.
+
+``qzs experiment --write-map FILE.toml`` writes a commented channel map template instead and
+ends the command, as ``--help`` does (LOG and ``--map`` are not needed then).
+"""
+import argparse
+from pathlib import Path
+
+from qzs.cli.common import EPILOG, add_json_option, emit, integer_at_least, run_handler
+from qzs.errors import OutputPathError
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parser", "run"]
@@ -27,7 +35,10 @@ def add_parser(subparsers):
     parser.add_argument("log", metavar="LOG", help="log file (.csv, .mat, .mf4, .nc)")
     parser.add_argument("--map", required=True, metavar="MAP.toml",
                         help="channel map: each signal's source channel and unit (layout: "
-                             "docs/workflows/identification.md)")
+                             "`qzs docs identification`; a template: --write-map)")
+    parser.add_argument("--write-map", metavar="FILE.toml", action=WriteMap,
+                        help="write a commented channel map template (every key the map "
+                             "reader accepts) to FILE.toml and exit; never replaces a file")
     parser.add_argument("--out", metavar="DIR", default="qzs-experiment",
                         help="output folder (default qzs-experiment)")
     parser.add_argument("--no-simulation", action="store_true",
@@ -44,6 +55,33 @@ def add_parser(subparsers):
                         help="resample a non-uniform time base onto a uniform grid")
     add_json_option(parser)
     return parser
+
+
+class WriteMap(argparse.Action):
+    """``--write-map FILE.toml``: write the channel map template, then end the command.
+
+    Like ``--help``, it acts while the arguments are parsed, so that LOG and ``--map`` stay
+    required for a run. Its errors end as every command's do (:func:`run_handler`): one line
+    ``qzs: error: ...`` and exit code 2 for a bad path or an existing file.
+    """
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser.exit(run_handler(_write_map, argparse.Namespace(write_map=values,
+                                                               option=option_string)))
+
+
+def _write_map(args):
+    check_output_path(args.write_map, argument=args.option, suffixes=(".toml",),
+                      estimated_bytes=16 * 1024)
+    if Path(args.write_map).exists():
+        raise OutputPathError(args.option, args.write_map, "exists; choose another name (a map "
+                              "someone filled in is never replaced)")
+    from qzs.workflows.experiment_map import PLACEHOLDER, write_channel_map_template
+
+    path = write_channel_map_template(args.write_map)
+    print(f'wrote {path}: replace each source = "{PLACEHOLDER}" with the signal\'s name in '
+          f"your log, then: qzs experiment LOG --map {path}")
+    return 0
 
 
 def run(args):

@@ -10,7 +10,7 @@ __all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibil
 #: What every subcommand takes without --config or --cubic (one default for all of them).
 DEFAULT_SETUP = (f"Without --config or --cubic: the shipped {SHIPPED_DEFAULT} platform (cube "
                  f"edge {HEXAPOD['cube_edge']:g} m, Kp = 2000 N/m, carrying what its six "
-                 "MagSprings hold; docs/hexapod.md §8).")
+                 "MagSprings hold; `qzs docs hexapod` §8).")
 #: ``--frame`` choices and the name the analysis takes.
 FRAMES = {"center-of-mass": "center_of_mass", "origin": "origin", "cube-center": "cube_center"}
 
@@ -19,7 +19,7 @@ def _add_setup_options(parser):
     parser.add_argument("--config", metavar="FILE.toml",
                         help="hexapod file, or a shipped one's name: [geometry], [platform], "
                              "[leg], [controller], [excitation.<axis>], [simulation] (layout: "
-                             "docs/hexapod.md §8; default the shipped "
+                             "`qzs docs hexapod` §8; default the shipped "
                              f"{SHIPPED_DEFAULT})")
     parser.add_argument("--cubic", action="store_true",
                         help="a cubic configuration without a file (with --cube-edge; the "
@@ -32,7 +32,7 @@ def _add_setup_options(parser):
     parser.add_argument("--centralised", action="store_true",
                         help="centralised control: the PI and damping loops on the platform's "
                              "six axes at the top frame origin, with the legs' stiffness on "
-                             "each axis (docs/hexapod.md §9.5); a [cartesian] table in the "
+                             "each axis (`qzs docs hexapod` §9.5); a [cartesian] table in the "
                              "file sets other gains")
     add_set_option(parser)
 
@@ -53,7 +53,7 @@ def add_parser(subparsers):
     hexapod = subparsers.add_parser(
         "hexapod", help="six isolator legs in a Stewart platform",
         description="The six-axis platform of the paper's future work: six semi-active QZS "
-                    "legs between a base and a rigid top (docs/hexapod.md).")
+                    "legs between a base and a rigid top (`qzs docs hexapod`).")
     sub = hexapod.add_subparsers(dest="hexapod_command", required=True)
     linear = sub.add_parser(
         "linear", help="stiffness matrix and modes at the operating point",
@@ -76,8 +76,9 @@ def add_parser(subparsers):
     simulate = sub.add_parser(
         "simulate", help="simulate the platform: stick-slip on every leg",
         description="Simulate the six-leg platform (exact stick-slip on every leg, stops, "
-                    "per-leg PI and damping, docs/hexapod.md §9) under the base motion of the "
-                    "file's [excitation.<axis>] tables or of --axis/--excitation, and print a "
+                    "per-leg PI and damping, `qzs docs hexapod` §9) under the base motion "
+                    "of the file's [excitation.<axis>] tables or of --axis/--excitation, and "
+                    "print a "
                     "summary per leg: stroke used, stop contacts, time locked, motor RMS. "
                     + DEFAULT_SETUP)
     _add_setup_options(simulate)
@@ -107,9 +108,9 @@ def add_parser(subparsers):
         "transmissibility", help="the simulated 6x6 transmissibility: one chirp per axis",
         description="Simulate one chirp per excited base axis (in parallel processes) and "
                     "estimate the 6x6 transmissibility matrix with the single axis's Welch "
-                    "estimator and its trusted bins (docs/hexapod.md, \"Simulated "
-                    "transmissibility\"); write the 6x6 grid (linear model dashed) and the "
-                    "matrix as NetCDF to --out and print a summary. " + DEFAULT_SETUP)
+                    "estimator and its trusted bins (`qzs docs hexapod` §10); write the 6x6 "
+                    "grid (linear model dashed) and the matrix as NetCDF to --out and print a "
+                    "summary. " + DEFAULT_SETUP)
     _add_setup_options(matrix)
     matrix.add_argument("--axes", metavar="AXES", default=",".join(AXES),
                         help="comma-separated base axes to excite, one run each (default "

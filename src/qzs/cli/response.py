@@ -37,8 +37,8 @@ def add_parser(subparsers):
                     "fundamental transmissibility (payload over base acceleration), the "
                     "harmonics, the relative amplitude, the locked share of the period and the "
                     "stop contacts; the harmonic balance of the smooth model is drawn over it "
-                    "(docs/response.md). Without options: 40 log-spaced frequencies from 0.5 to "
-                    "20 Hz, 10 mm, both sweeps, the step chosen for 0.01 dB.")
+                    "(`qzs docs response`). Without options: 40 log-spaced frequencies from "
+                    "0.5 to 20 Hz, 10 mm, both sweeps, the step chosen for 0.01 dB.")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--frequencies", metavar="F1,F2,...",
                        help="the frequencies [Hz], comma-separated, increasing (the sweeps "
@@ -61,7 +61,7 @@ def add_parser(subparsers):
                            "at most this with whole samples per period)")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the step for this accuracy [dB] on a chirp over the band "
-                           "(default 0.01; docs/model.md §7)")
+                           "(default 0.01; `qzs docs model` §7)")
     parser.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                         help="integrator (default ode3)")
     parser.add_argument("--periodic-tolerance", type=float, metavar="X",

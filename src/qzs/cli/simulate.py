@@ -79,7 +79,7 @@ def add_parser(subparsers):
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the largest step whose transmissibility stays within DB "
                            "[dB] of a finer one, on a short probe of the excitation "
-                           f"(docs/model.md §7; default {ACCURACY['tolerance_db']:g}; a sine: "
+                           f"(`qzs docs model` §7; default {ACCURACY['tolerance_db']:g}; a sine: "
                            "--tolerance-state)")
     step.add_argument("--tolerance-state", type=float, metavar="M",
                       help="choose the largest step whose relative position stays within M "

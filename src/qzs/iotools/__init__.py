@@ -11,6 +11,7 @@ This layer knows no result type: each declares its own schema beside its class
 ``config``   run configurations (TOML)
 ``readers``  test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
 ``shipped``  the study, sweep and hexapod files shipped with qzs
+``docs``     the model and workflow pages shipped inside the package (``qzs docs``)
 ===========  ==================================================================
 """
 from qzs._lazy import lazy_exports

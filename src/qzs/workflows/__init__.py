@@ -6,6 +6,7 @@
                               in parallel
 ``report``                    ``qzs paper``: figures, metrics, claims decided from the data
 ``experiment``                a measured log beside its simulation
+``experiment_map``            the commented channel map template (``--write-map``)
 ``sweeps``                    parameter sweeps and Monte Carlo runs into Zarr stores, locally
                               or on Dask
 ``design``                    ``qzs design``: PI and damping gains searched by simulation,

@@ -537,7 +537,7 @@ def linear_text(setup, model, record):
         lines.append(f"  note: {note}")
     if not record["stable"]:
         lines.append("  the platform is statically unstable in the directions without a "
-                     "frequency: raise pi_kp (see docs/hexapod.md §6)")
+                     "frequency: raise pi_kp (see `qzs docs hexapod` §6)")
     return "\n".join(lines)
 
 
