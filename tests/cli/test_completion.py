@@ -49,7 +49,7 @@ def complete(script, words, cwd):
 @pytest.mark.skipif(shutil.which("bash") is None, reason="no bash")
 @pytest.mark.parametrize("words, expected", [
     (["qzs", "simu"], ["simulate"]),
-    (["qzs", "simulate", "--to"], ["--tolerance"]),
+    (["qzs", "simulate", "--to"], ["--tolerance", "--tolerance-state"]),
     (["qzs", "simulate", "--solver", ""], ["ode3", "rk4", "euler"]),
     (["qzs", "simulate", "--solver", "rk4", "--dur"], ["--duration"]),
     (["qzs", "s"], ["simulate", "study", "sweep", "sweep-plot"]),

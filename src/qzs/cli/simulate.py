@@ -192,18 +192,23 @@ def run(args):
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
-        # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it
-        import_in_background("matplotlib.pyplot", "qzs.viz.simulation")
     common = dict(progress=not args.quiet and not args.json, interruptible=True)
     entries = {} if choice is None else step_run_entries(choice)
-    if args.out:
-        result = simulate_to_file(args.out, excitation, config["isolator"],
-                                  config["controller"], **settings, **common, argument="--out",
-                                  run_entries=entries)
-    else:
-        result = simulate(excitation, config["isolator"], config["controller"], **settings,
-                          **common)
-        result.run.update(entries)
+    # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
+    # returning, so that no import is left half done (an error in the run ends it too)
+    loading = import_in_background("matplotlib.pyplot", "qzs.viz.simulation") if plot else None
+    try:
+        if args.out:
+            result = simulate_to_file(args.out, excitation, config["isolator"],
+                                      config["controller"], **settings, **common,
+                                      argument="--out", run_entries=entries)
+        else:
+            result = simulate(excitation, config["isolator"], config["controller"],
+                              **settings, **common)
+            result.run.update(entries)
+    finally:
+        if loading is not None:
+            loading.join()
     files = {}
     if args.out:
         files["out"] = args.out
