@@ -66,7 +66,7 @@ def test_netcdf_time_is_unlimited(tmp_path, run):
 
 
 def test_writer_rejects_bad_input(tmp_path, run):
-    with pytest.raises(ParameterError, match=r"must end in \.nc or \.csv"):
+    with pytest.raises(ParameterError, match=r"must end in \.nc, \.csv or \.mat"):
         writer(tmp_path / "r.txt", run)
     with writer(tmp_path / "r.nc", run) as w:
         with pytest.raises(ParameterError, match="must have shape"):
