@@ -74,6 +74,15 @@ def test_names_that_collide_in_matlab_are_an_error():
         mat_layout({"units": {}}, {})
 
 
+def test_a_parameter_that_heads_a_section_is_its_value():
+    _, structs = mat_layout({}, {"excitation.z.amplitude": 0.01, "excitation.z": "Chirp",
+                                 "excitation.z.amplitude_units": "m"})
+    assert structs["parameters"] == {"excitation": {"z": {"amplitude": 0.01, "value": "Chirp"}}}
+    assert structs["parameter_units"]["excitation"]["z"] == {"amplitude": "m", "value": ""}
+    with pytest.raises(ParameterError, match="which is taken"):
+        mat_layout({}, {"a.b": 1, "a_b": 2, "a.b_c": 3, "a.b.c": 4, "a.b.value": 5})
+
+
 def test_the_layout_splits_parameters_from_the_other_attributes(dataset):
     names, structs = mat_layout({n: dict(dataset[n].attrs) for n in dataset.variables},
                                 dataset.attrs)

@@ -25,7 +25,9 @@ every coordinate, variable  a MATLAB variable of the same name, same values and 
 
 A global attribute is a parameter when its name has a section (``isolator.mass``,
 ``run.steps``, ``settings.f0``) or a unit beside it (``amplitude`` with
-``amplitude_units``); its unit is that ``<name>_units`` attribute.
+``amplitude_units``); its unit is that ``<name>_units`` attribute. A parameter whose name
+also heads a section (a hexapod run's ``excitation.z``, the excitation's class, beside
+``excitation.z.amplitude``) is that section's field ``value``.
 
 Names: MATLAB's are identifiers of at most 63 characters (``namelengthmax``), a letter
 first, then letters, digits and ``_``, no keyword. Every name of qzs is one already; any
@@ -150,20 +152,23 @@ def _struct(items, where):
 
 
 def _nested(items, where):
-    """``{"isolator.mass": v}`` -> ``{"isolator": {"mass": v}}``, MATLAB names throughout."""
+    """``{"isolator.mass": v}`` -> ``{"isolator": {"mass": v}}``, MATLAB names throughout.
+
+    A value whose name also heads a section (a hexapod's ``excitation.z``, the class of
+    the excitation, beside ``excitation.z.amplitude``) is that section's field ``value``.
+    """
+    paths = {key: tuple(matlab_name(p) for p in str(key).split(".")) for key in items}
+    sections = {path[:i] for path in paths.values() for i in range(1, len(path))}
     tree = {}
     for key, value in items.items():
-        parts = [matlab_name(p) for p in str(key).split(".")]
+        path = paths[key] + (("value",) if paths[key] in sections else ())
         node = tree
-        for part in parts[:-1]:
+        for part in path[:-1]:
             node = node.setdefault(part, {})
-            if not isinstance(node, dict):
-                raise ParameterError(f"{where} {key!r} is below {part!r}, which is a value "
-                                     "itself; rename one of them.")
-        if parts[-1] in node:
+        if path[-1] in node:
             raise ParameterError(f"{where} {key!r} becomes the MATLAB field "
-                                 f"{'.'.join(parts)!r}, which is taken; rename it.")
-        node[parts[-1]] = value
+                                 f"{'.'.join(path)!r}, which is taken; rename it.")
+        node[path[-1]] = value
     return tree
 
 
