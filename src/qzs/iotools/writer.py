@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs.errors import ParameterError, WriteError
+from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error
 from qzs.iotools.matfile import MatStream
 from qzs.iotools.schema import CONVENTIONS
@@ -264,6 +264,12 @@ class StreamWriter:
         self._variables = {}
         _close(handle)
 
+    # -- MATLAB -------------------------------------------------------------------------
+    def _append_mat(self, blocks, start, stop):
+        for variable, block, column in self._columns:
+            self._file.append(variable.name, blocks[block][:, column], start, stop)
+        self._file.flush()
+
     # -- CSV ----------------------------------------------------------------------------
     def _open_csv(self):
         self._file = open(self._tmp, "w", encoding="utf-8", newline="\n")
@@ -330,9 +336,7 @@ class StreamWriter:
             if self._suffix == ".nc":
                 self._append_netcdf(blocks, start, stop)
             elif self._suffix == ".mat":
-                for variable, block, column in self._columns:
-                    self._file.append(variable.name, blocks[block][:, column], start, stop)
-                self._file.flush()
+                self._append_mat(blocks, start, stop)
             else:
                 self._append_csv(blocks, start, stop)
         self._rows = stop
