@@ -86,7 +86,6 @@ _ELEMENT_OVERHEAD = 1 << 10   # a MAT 5 element's tags, dimensions and name [byt
 _SLAB = 1 << 24               # bytes copied at once when a large variable is written
 _CLASSES = {"f8": "double", "f4": "single", "i1": "int8", "u1": "uint8", "i2": "int16",
             "u2": "uint16", "i4": "int32", "u4": "uint32", "i8": "int64", "u8": "uint64"}
-_VALID = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
 
 def matlab_name(name):
