@@ -87,6 +87,7 @@ def test_an_os_error_names_its_file(capsys):
 ARGV = {"simulate": ["simulate"], "params": ["params"], "paper": ["paper"],
         "study": ["study", "x.toml"], "experiment": ["experiment", "log.csv", "--map", "m.toml"],
         "sweep": ["sweep", "s.toml"], "sweep-plot": ["sweep-plot", "s.zarr"],
+        "sweep-export": ["sweep-export", "s.zarr"],
         "hexapod": ["hexapod", "linear"], "response": ["response"],
         "design": ["design"], "app": ["app", "--no-browser"], "docs": ["docs"],
         "completion": ["completion", "bash"]}

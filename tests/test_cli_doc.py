@@ -80,6 +80,7 @@ NEEDS = {
                    "--no-simulation"],
     "sweep": ["pi_vs_stiction"],
     "sweep-plot": ["{tmp}/missing.zarr"],
+    "sweep-export": ["{tmp}/missing.zarr"],
     "params": [],
     "hexapod linear": [],
     "hexapod simulate": [],
@@ -90,7 +91,8 @@ NEEDS = {
 }
 NAMES = {"--toml": "p.toml", "--plot": "figure.png", "sweep --out": "store.zarr",
          "simulate --out": "run.nc", "hexapod simulate --out": "run.nc",
-         "response --out": "response.nc", "sweep-plot --out": "figure.png"}
+         "response --out": "response.nc", "sweep-plot --out": "figure.png",
+         "sweep-export --out": "sweep.mat"}
 
 
 def promised_options():

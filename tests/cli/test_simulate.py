@@ -269,3 +269,30 @@ def test_the_chosen_step_is_kept_in_the_file(tmp_path, capsys):
         assert data.attrs["run.step_tolerance_db"] == 0.01
         assert 0 <= data.attrs["run.step_error_db"] <= 0.01
         assert data.attrs["run.dt"] > 1e-4
+
+
+def test_out_mat_writes_what_matlab_and_scipy_load(tmp_path):
+    """`--out run.mat`: a MAT 5 file whose variables are the NetCDF file's, same values,
+    with the units and the parameters in structs."""
+    import scipy.io
+    import xarray as xr
+
+    mat, nc = tmp_path / "run.mat", tmp_path / "run.nc"
+    for out in (mat, nc):
+        assert main(["simulate", "--duration", "2", "--out", str(out), "--plot", "none",
+                     "--quiet"]) == 0
+    read = scipy.io.loadmat(mat)
+    with xr.open_dataset(nc) as netcdf:
+        np.testing.assert_array_equal(read["relative_position"][:, 0],
+                                      netcdf["relative_position"].values)
+        np.testing.assert_array_equal(read["time"][:, 0], netcdf["time"].values)
+        np.testing.assert_array_equal(read["locked"][:, 0], netcdf["locked"].values)
+        names = set(netcdf.variables)
+        assert names <= set(read)
+        assert read["units"][0, 0]["relative_position"][0] == \
+            netcdf["relative_position"].attrs["units"]
+        mass = read["parameters"][0, 0]["isolator"][0, 0]["mass"][0, 0]
+        assert mass == netcdf.attrs["isolator.mass"]
+        assert read["parameter_units"][0, 0]["isolator"][0, 0]["mass"][0] == "kg"
+        assert read["parameters"][0, 0]["run"][0, 0]["samples"][0, 0] == netcdf.sizes["time"]
+    assert sorted(os.listdir(tmp_path)) == ["run.mat", "run.nc"]

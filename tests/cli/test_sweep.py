@@ -30,3 +30,28 @@ def test_a_dry_run_prints_the_cases_and_batches_and_runs_nothing(sweep_file, tmp
 def test_fewer_than_one_worker_or_thread_is_refused(sweep_file, option, capsys):
     assert main(["sweep", str(sweep_file), option, "0"]) == 2
     assert f"`{option}` must be >= 1, got 0" in capsys.readouterr().err
+
+
+def test_sweep_export_writes_the_store_as_a_mat_file(tmp_path, capsys):
+    """`qzs sweep-export STORE` -> STORE's name with .mat: every per-case output under its
+    own name; a wrong extension is refused before the store is read."""
+    import numpy as np
+    import scipy.io
+
+    from qzs.workflows.sweeps import open_sweep, run_sweep
+
+    store = tmp_path / "tiny.zarr"
+    run_sweep({"sweep": {"name": "tiny", "batch_size": 2}, "grid": {"pi_kp": [5.0, 20.0]},
+               "excitation": {"f1": 10.0},
+               "analysis": {"fft_length": 1024, "n_averages": 4, "band": [0.0, 10.0]}},
+              store, progress=False)
+    assert main(["sweep-export", str(store)]) == 0
+    assert f"wrote {tmp_path / 'tiny.mat'}" in capsys.readouterr().out
+    read, data = scipy.io.loadmat(tmp_path / "tiny.mat"), open_sweep(store).load()
+    np.testing.assert_array_equal(read["pi_kp"][:, 0], data["pi_kp"].values)
+    np.testing.assert_array_equal(read["transmissibility"], data["transmissibility"].values)
+    np.testing.assert_array_equal(read["done"][:, 0], data["done"].values)
+    assert read["units"][0, 0]["frequency"][0] == "Hz"
+    assert read["attributes"][0, 0]["sweep_name"][0] == "tiny"
+    assert main(["sweep-export", str(store), "--out", str(tmp_path / "t.nc")]) == 2
+    assert "--out" in capsys.readouterr().err and not (tmp_path / "t.nc").exists()

@@ -83,7 +83,7 @@ def test_result_round_trip(tmp_path, short_run, suffix):
 
 
 def test_bad_result_suffix(tmp_path, short_run):
-    with pytest.raises(ParameterError, match=r"must end in \.nc or \.csv"):
+    with pytest.raises(ParameterError, match=r"must end in \.nc, \.csv or \.mat"):
         short_run.save(tmp_path / "run.txt")
 
 

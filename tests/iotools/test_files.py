@@ -45,10 +45,23 @@ def leftovers(folder):
     return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
 
 
-@pytest.mark.parametrize("suffix", [".nc", ".csv"])
+@pytest.mark.parametrize("suffix", [".nc", ".csv", ".mat"])
 def test_many_appends_make_the_same_file(tmp_path, run, fixed_clock, suffix):
     at_once = save_result(run, tmp_path / f"once{suffix}")
     chunked = write_in_chunks(tmp_path / f"chunked{suffix}", run, 97)
+    if suffix == ".mat":
+        import scipy.io
+
+        once, parts = scipy.io.loadmat(at_once), scipy.io.loadmat(chunked)
+        assert set(once) == set(parts)
+        for name in set(once) - {"__header__"}:  # the header holds the time of writing
+            assert str(once[name]) == str(parts[name]), name
+        np.testing.assert_array_equal(once["payload_acceleration"][:, 0],
+                                      run.payload_acceleration)
+        with pytest.raises(DataError, match="is a MATLAB file"):
+            read_result(at_once)
+        assert leftovers(tmp_path) == []
+        return
     if suffix == ".nc":
         xr.testing.assert_identical(xr.load_dataset(at_once, engine="h5netcdf"),
                                     xr.load_dataset(chunked, engine="h5netcdf"))
@@ -66,7 +79,7 @@ def test_netcdf_time_is_unlimited(tmp_path, run):
 
 
 def test_writer_rejects_bad_input(tmp_path, run):
-    with pytest.raises(ParameterError, match=r"must end in \.nc or \.csv"):
+    with pytest.raises(ParameterError, match=r"must end in \.nc, \.csv or \.mat"):
         writer(tmp_path / "r.txt", run)
     with writer(tmp_path / "r.nc", run) as w:
         with pytest.raises(ParameterError, match="must have shape"):
@@ -83,7 +96,7 @@ def test_writer_rejects_bad_input(tmp_path, run):
 
 @pytest.mark.parametrize("interruption", [KeyboardInterrupt, SystemExit, Terminated,
                                           RuntimeError])
-@pytest.mark.parametrize("suffix", [".nc", ".csv"])
+@pytest.mark.parametrize("suffix", [".nc", ".csv", ".mat"])
 def test_interrupted_writer_leaves_nothing(tmp_path, run, suffix, interruption):
     target = tmp_path / f"r{suffix}"
     target.write_text("old")
@@ -101,7 +114,7 @@ def test_unfinished_writer_leaves_nothing(tmp_path, run):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("suffix", [".nc", ".csv"])
+@pytest.mark.parametrize("suffix", [".nc", ".csv", ".mat"])
 @pytest.mark.parametrize("stage", ["create", "append", "finish"])
 def test_full_disk_is_a_clean_error(tmp_path, run, monkeypatch, suffix, stage):
     """ENOSPC at any stage: a DataError with path and reason, nothing left behind."""
@@ -111,7 +124,7 @@ def test_full_disk_is_a_clean_error(tmp_path, run, monkeypatch, suffix, stage):
     if stage == "create":
         monkeypatch.setattr(stream, "_reserve_space", full)
     elif stage == "append":
-        name = "_append_netcdf" if suffix == ".nc" else "_append_csv"
+        name = {".nc": "_append_netcdf", ".csv": "_append_csv", ".mat": "_append_mat"}[suffix]
         monkeypatch.setattr(ResultWriter, name, full)
     else:
         monkeypatch.setattr(stream, "_release_reserve", full)

@@ -20,6 +20,8 @@ def test_a_writable_path_passes_and_the_check_writes_nothing(tmp_path):
 @pytest.mark.parametrize("make, name, options, reason", [
     (None, "run.txt", {"suffixes": (".nc", ".csv")},
      "has extension '.txt'; it must end in .nc or .csv"),
+    (None, "run.txt", {"suffixes": (".nc", ".csv", ".mat")},
+     "has extension '.txt'; it must end in .nc, .csv or .mat"),
     (None, "run", {"suffixes": (".nc",)}, "has no extension"),
     ("folder", "run.nc", {"suffixes": (".nc",)}, "is a folder; give a file name"),
     ("file", "out", {"suffixes": None, "directory": True}, "is a file, not a folder"),

@@ -2,13 +2,14 @@
 
     qzs simulate [--config FILE.toml] [--set NAME=VALUE ...] [--excitation chirp|sine|random|file]
                  [--amplitude M] [--f0 HZ] [--f1 HZ] [--frequency HZ] [--duration S]
-                 [--dt S] [--sample-rate HZ] [--solver ode3|rk4|euler] [--out FILE.nc|FILE.csv]
+                 [--dt S] [--sample-rate HZ] [--solver ode3|rk4|euler] [--out FILE.nc|.csv|.mat]
     qzs params [--toml FILE]
     qzs study FILE.toml [--quick] [--out DIR] [--workers N]
     qzs paper [--quick] [--out DIR] [--workers N]
     qzs experiment LOG --map MAP.toml [--out DIR]
     qzs sweep FILE.toml [--resume] [--workers N | --scheduler ADDRESS]
     qzs sweep-plot STORE [--metric NAME] [--x PARAM] [--y PARAM]
+    qzs sweep-export STORE [--out FILE.mat]
     qzs response [--frequencies F1,F2,... | --range F0,F1,N] [--direction up|down|both] [--json]
     qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
@@ -24,7 +25,7 @@ per subcommand (or pair of subcommands), and what they share:
 ``params``      ``qzs params``: every parameter with its value and unit
 ``studies``     ``qzs paper`` and ``qzs study``: the paper's studies and report
 ``experiment``  ``qzs experiment``: an experiment log beside the matching simulation
-``sweep``       ``qzs sweep`` and ``qzs sweep-plot``: sweeps into a Zarr store, figures
+``sweep``       ``qzs sweep``, ``sweep-plot``, ``sweep-export``: Zarr store, figures, .mat
 ``response``    ``qzs response``: the steady-state response by stepped-sine simulation
 ``design``      ``qzs design``: PI and damping gains from the isolator and its disturbance
 ``hexapod``     ``qzs hexapod``: the six-axis platform of six isolator legs
@@ -56,6 +57,7 @@ __all__ = ["main", "build_parser"]
 HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run,
             "study": studies.run, "experiment": experiment.run,
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
+            "sweep-export": sweep.run_export_command,
             "hexapod": hexapod.run, "response": response.run,
             "design": design.run, "app": app.run, "docs": docs.run,
             "completion": completion.run}

@@ -99,7 +99,8 @@ def add_parser(subparsers):
     simulate.add_argument("--sample-rate", type=float, metavar="HZ", help="output rate [Hz]")
     simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                           help="integrator (default the file's, else ode3)")
-    simulate.add_argument("--out", metavar="FILE.nc", help="write the run as NetCDF (CF-1.10)")
+    simulate.add_argument("--out", metavar="FILE",
+                          help="write the run as NetCDF (.nc, CF-1.10) or MATLAB (.mat)")
     simulate.add_argument("--plot", metavar="FILE.png", help="draw the run")
     simulate.add_argument("--quiet", action="store_true", help="no progress bar")
     add_json_option(simulate)
@@ -258,6 +259,7 @@ def run_simulate(args):
     int
         0.
     """
+    from qzs.engine.hexapod.result import HEXAPOD_SUFFIXES
     from qzs.iotools.paths import check_output_path
     from qzs.workflows.hexapod import simulate_setup
 
@@ -267,7 +269,7 @@ def run_simulate(args):
         raise ParameterError(f"--{given[0].replace('_', '-')} describes the base motion of "
                              "one axis: add --axis (x, y, z, rx, ry or rz).")
     if args.out:
-        check_output_path(args.out, argument="--out", suffixes=(".nc",))
+        check_output_path(args.out, argument="--out", suffixes=HEXAPOD_SUFFIXES)
     if args.plot:
         check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
     setup = _setup(args)

@@ -87,7 +87,7 @@ def add_parser(subparsers):
     parser.add_argument("--workers", type=integer_at_least(1), metavar="N",
                         help="processes (default: the sweeps and extra tasks, at most the cores)")
     parser.add_argument("--out", metavar="FILE",
-                        help="write the response to FILE (.nc, .csv or .json)")
+                        help="write the response to FILE (.nc, .csv, .json or .mat)")
     parser.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
                         help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")

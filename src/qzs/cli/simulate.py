@@ -90,7 +90,8 @@ def add_parser(subparsers):
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                      help="integrator (default ode3)")
     sim.add_argument("--out", metavar="FILE",
-                     help="stream the time series to FILE (.nc or .csv) while simulating")
+                     help="stream the time series to FILE (.nc, .csv or .mat for MATLAB) "
+                          "while simulating")
     sim.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
                      help=f"figure of the run (.png, .svg or .pdf; default {DEFAULT_PLOT}; "
                           "'none' to skip)")

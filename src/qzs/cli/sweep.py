@@ -1,4 +1,5 @@
-"""``qzs sweep`` and ``qzs sweep-plot``: parameter sweeps into a Zarr store, and their figures."""
+"""``qzs sweep``, ``qzs sweep-plot`` and ``qzs sweep-export``: parameter sweeps into a Zarr
+store, their figures, and the store as a MATLAB file."""
 import sys
 from pathlib import Path
 
@@ -7,11 +8,11 @@ from qzs.errors import ParameterError, Terminated
 from qzs.iotools.paths import check_output_path
 from qzs.viz.sweeps import FIGURE_BYTES, REDUCTIONS, figure_suffixes
 
-__all__ = ["add_parsers", "run_sweep_command", "run_plot_command"]
+__all__ = ["add_parsers", "run_sweep_command", "run_plot_command", "run_export_command"]
 
 
 def add_parsers(subparsers):
-    """Add ``sweep`` and ``sweep-plot`` to an ``argparse`` sub-parser collection.
+    """Add ``sweep``, ``sweep-plot`` and ``sweep-export`` to a sub-parser collection.
 
     Parameters
     ----------
@@ -70,6 +71,17 @@ def add_parsers(subparsers):
                       help="combine the cases at one grid point (default median; max = worst)")
     plot.add_argument("--out", metavar="FILE",
                       help="figure file, format from its extension (default <sweep>-<...>.png)")
+
+    export = subparsers.add_parser(
+        "sweep-export", help="write a sweep store to a MATLAB file (.mat)",
+        description="Write every variable of a sweep store (per-case outputs, varied "
+                    "parameters, transmissibility, kept time series) to a MATLAB file, with "
+                    "their units and the sweep's settings in structs (MAT 5; MAT 7.3 if a "
+                    "variable exceeds 2 GiB).",
+        epilog="The file's name is checked before the store is read. " + EPILOG)
+    export.add_argument("store", metavar="STORE.zarr", help="sweep store written by `qzs sweep`")
+    export.add_argument("--out", metavar="FILE.mat",
+                        help="the MATLAB file (default the store's name with .mat)")
     return cmd
 
 
@@ -138,5 +150,25 @@ def run_plot_command(args):
                           estimated_bytes=FIGURE_BYTES)
     out = plot_sweep(args.store, metric=args.metric, x=args.x, y=args.y, reduce=args.reduce,
                      out=args.out)
+    print(f"wrote {out}")
+    return 0
+
+
+def run_export_command(args):
+    """Run ``qzs sweep-export`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs sweep-export`` arguments.
+
+    Returns
+    -------
+    int
+        The exit code, 0.
+    """
+    from qzs.workflows.sweeps import export_sweep
+
+    out = export_sweep(args.store, args.out, argument="--out")
     print(f"wrote {out}")
     return 0

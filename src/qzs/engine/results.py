@@ -4,7 +4,7 @@
 :mod:`qzs.analysis.summary`, and ``.to_xarray()`` only repackages. A run's file layout is
 :func:`simulation_schema` (:mod:`qzs.iotools.schema`): ``to_xarray()`` builds its dataset
 and :class:`ResultWriter`, a configuration of :class:`qzs.iotools.writer.StreamWriter`,
-streams it to NetCDF or CSV (``.save()``, :func:`save_result`, :func:`read_result`).
+streams it to NetCDF, CSV or MATLAB (``.save()``, :func:`save_result`, :func:`read_result`).
 """
 import dataclasses
 import datetime
@@ -421,12 +421,12 @@ class SimulationResult:
         return plot_simulation(self, **kwargs)
 
     def save(self, path):
-        """Write the run atomically to NetCDF (``.nc``) or CSV (``.csv``), with metadata.
+        """Write the run atomically to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).
 
         Parameters
         ----------
         path : str or Path
-            Target file; its suffix (``.nc`` or ``.csv``) chooses the format.
+            Target file; its suffix (``.nc``, ``.csv`` or ``.mat``) chooses the format.
 
         Returns
         -------
@@ -443,7 +443,7 @@ class SimulationResult:
 
 
 class ResultWriter(StreamWriter):
-    """Stream a run's result to NetCDF (``.nc``) or CSV (``.csv``), chunk by chunk.
+    """Stream a run's result to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).
 
     :class:`~qzs.iotools.writer.StreamWriter` configured with :func:`simulation_schema`:
     memory grows with the chunk appended, not with the run; the file is written to a
@@ -454,6 +454,8 @@ class ResultWriter(StreamWriter):
     ``flag_values``/``flag_meanings``, the parameters global attributes with their units.
     CSV files have the parameters as ``# key = value [unit]`` header lines, the rows, and
     the run's outcome as trailing ``# run.key = value`` lines (known only at the end).
+    MATLAB files (:mod:`qzs.iotools.matfile`) hold the same variables, with the units and
+    parameters in structs.
     :func:`save_result` writes through this class; so does :func:`qzs.simulate`'s
     ``sink`` when a run is streamed to a file. :meth:`append` takes ``data, flags``: output
     rows of shape (n, N_CHANNELS), one column per channel of :data:`CHANNELS`, and the flags
@@ -462,7 +464,8 @@ class ResultWriter(StreamWriter):
     Parameters
     ----------
     path : str or Path
-        Target file, ending in ``.nc`` or ``.csv``; its folder is created if missing.
+        Target file, ending in ``.nc``, ``.csv`` or ``.mat``; its folder is created if
+        missing.
     isolator : IsolatorParameters
         Plant parameters of the run.
     controller : ControllerParameters
@@ -473,7 +476,7 @@ class ResultWriter(StreamWriter):
     Raises
     ------
     ParameterError
-        A suffix other than ``.nc`` or ``.csv``.
+        A suffix other than ``.nc``, ``.csv`` or ``.mat``.
     WriteError
         The temporary file cannot be created (attributes ``path`` and ``reason``).
 
@@ -540,19 +543,19 @@ def estimated_size(n_samples, suffix):
 
 
 def save_result(result, path):
-    """Write a :class:`SimulationResult` to NetCDF (``.nc``) or CSV (``.csv``).
+    """Write a :class:`SimulationResult` to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).
 
-    Both carry every parameter with its unit, the excitation, the run settings and
+    Each carries every parameter with its unit, the excitation, the run settings and
     the qzs version as metadata (NetCDF: CF-1.10 global attributes; CSV:
-    ``# key = value [unit]`` lines), see docs/model.md §7. Written through
-    :class:`ResultWriter` in chunks, atomically.
+    ``# key = value [unit]`` lines; MATLAB: structs, :mod:`qzs.iotools.matfile`), see
+    docs/model.md §7. Written through :class:`ResultWriter` in chunks, atomically.
 
     Parameters
     ----------
     result : SimulationResult
         The run.
     path : str or Path
-        Target file, ending in ``.nc`` or ``.csv``.
+        Target file, ending in ``.nc``, ``.csv`` or ``.mat``.
 
     Returns
     -------

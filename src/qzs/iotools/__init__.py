@@ -5,7 +5,8 @@ This layer knows no result type: each declares its own schema beside its class
 
 ===========  ==================================================================
 ``schema``   a result's variables, dimensions, units and flags; its dataset
-``writer``   the streaming, atomic CF writer (NetCDF, CSV) of a schema
+``writer``   the streaming, atomic CF writer (NetCDF, CSV, MATLAB) of a schema
+``matfile``  MATLAB files (MAT 5, MAT 7.3) of a dataset or a streamed schema
 ``files``    atomic writes; result files read back
 ``paths``    output paths checked before the work starts
 ``config``   run configurations (TOML)
@@ -26,6 +27,7 @@ _EXPORTS = {
     "write_dspace_mat": "qzs.iotools.readers", "Schema": "qzs.iotools.schema",
     "Variable": "qzs.iotools.schema", "to_dataset": "qzs.iotools.schema",
     "StreamWriter": "qzs.iotools.writer", "estimated_file_size": "qzs.iotools.writer",
+    "write_mat": "qzs.iotools.matfile",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

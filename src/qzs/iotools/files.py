@@ -6,13 +6,14 @@ file. A result streamed chunk by chunk goes through :class:`~qzs.iotools.writer.
 :func:`read_result` reads such a file back as an ``xarray.Dataset``.
 """
 import contextlib
+import errno
 import os
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from qzs.errors import DataError
+from qzs.errors import DataError, WriteError
 from qzs.iotools.schema import NONE_VALUE
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
@@ -20,7 +21,7 @@ from qzs.model.registry import parse_value
 __all__ = ["atomic_path", "read_result", "read_displacement_csv", "RESULT_SUFFIXES"]
 
 #: File formats of a result streamed to a file: suffix -> name.
-RESULT_SUFFIXES = {".nc": "NetCDF", ".csv": "CSV"}
+RESULT_SUFFIXES = {".nc": "NetCDF", ".csv": "CSV", ".mat": "MATLAB"}
 
 @contextlib.contextmanager
 def atomic_path(path):
@@ -56,6 +57,22 @@ def _umask():
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def _write_error(path, error, action="writing"):
+    """A :class:`WriteError` for an ``OSError`` while writing ``path`` (``path``, ``reason``)."""
+    code = getattr(error, "errno", None)
+    if code is None:  # HDF5 wraps the system error in its message
+        text = str(error)
+        code = next((c for c in (errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EROFS)
+                     if os.strerror(c).lower() in text.lower()), None)
+    reasons = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
+               errno.EACCES: "permission denied", errno.EPERM: "permission denied",
+               errno.EROFS: "the file system is read-only",
+               errno.ENOENT: "the folder does not exist"}
+    reason = reasons.get(code) or (getattr(error, "strerror", None) or str(error)).split("\n")[0]
+    return WriteError(path, reason, f"cannot write {str(path)!r} ({action}): {reason}; "
+                                    "nothing was written.")
 
 
 def _restore_none(attrs):
@@ -116,14 +133,18 @@ def read_result(path, schema=None):
     Raises
     ------
     DataError
-        Missing or unreadable file, or a CSV without a header line or with mismatched
-        columns.
+        Missing or unreadable file, a MATLAB (``.mat``) file, or a CSV without a header
+        line or with mismatched columns.
     """
     import xarray as xr
 
     path = Path(path)
     if not path.exists():
         raise DataError(f"no such file: {str(path)!r}.")
+    if path.suffix.lower() == ".mat":
+        raise DataError(f"{str(path)!r} is a MATLAB file: load it in MATLAB (load), or in "
+                        "Python with scipy.io.loadmat (MAT 5) or h5py (MAT 7.3); qzs reads "
+                        "results back from .nc or .csv files.")
     if path.suffix.lower() == ".nc":
         try:
             dataset = xr.load_dataset(path, engine="h5netcdf")

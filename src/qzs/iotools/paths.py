@@ -60,7 +60,8 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
     if suffixes is not None:
         allowed = tuple(dict.fromkeys("." + s.lower().lstrip(".") for s in suffixes))
         if path.suffix.lower() not in allowed:
-            shown = " or ".join(allowed)
+            shown = " or ".join([", ".join(allowed[:-1]), allowed[-1]] if len(allowed) > 2
+                                else allowed)
             got = f"extension {path.suffix!r}" if path.suffix else "no extension"
             fail(f"has {got}; it must end in {shown} (the format is chosen by the "
                  "extension)")

@@ -1,8 +1,10 @@
 """One streaming, atomic CF writer: a result's file written chunk by chunk from its schema.
 
 :class:`StreamWriter` writes the layout of a :class:`~qzs.iotools.schema.Schema` to NetCDF
-(``.nc``, CF-1.10, the unlimited dimension growing with each appended block) or, for a schema
-whose streamed variables are all one-dimensional, to CSV (``.csv``). Which column of an
+(``.nc``, CF-1.10, the unlimited dimension growing with each appended block), to MATLAB
+(``.mat``, :mod:`qzs.iotools.matfile`: MAT 7.3 grown chunk by chunk, MAT 5 at the end if
+it fits) or, for a schema whose streamed variables are all one-dimensional, to CSV
+(``.csv``). Which column of an
 appended block goes to which variable is the caller's mapping; the single run's
 :class:`~qzs.engine.results.ResultWriter` and the six-axis run's
 :class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
@@ -26,8 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from qzs.errors import ParameterError, WriteError
-from qzs.iotools.files import RESULT_SUFFIXES, _umask
+from qzs.errors import ParameterError
+from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error
+from qzs.iotools.matfile import MatStream
 from qzs.iotools.schema import CONVENTIONS
 
 __all__ = ["StreamWriter", "estimated_file_size"]
@@ -43,8 +46,9 @@ def _suffix(path, suffixes=tuple(RESULT_SUFFIXES), kind=None):
     suffix = Path(path).suffix.lower()
     if suffix not in suffixes:
         of = f" of {kind}" if kind else ""
-        raise ParameterError(f"`path`{of} must end in {' or '.join(suffixes)}, got "
-                             f"{str(path)!r}.")
+        shown = " or ".join([", ".join(suffixes[:-1]), suffixes[-1]] if len(suffixes) > 2
+                            else suffixes)
+        raise ParameterError(f"`path`{of} must end in {shown}, got {str(path)!r}.")
     return suffix
 
 
@@ -60,7 +64,8 @@ def estimated_file_size(schema, n_samples, suffix):
     NetCDF: each streamed variable's bytes per sample (8 per float value, 1 per flag) in
     whole chunks of ``schema.chunk_rows`` samples, plus the chunk index and
     ``schema.header_bytes``; CSV: about 17 bytes per value (the ``%.10g`` format and a
-    comma) plus the header lines.
+    comma) plus the header lines; MATLAB: twice the NetCDF estimate (a ``.mat`` file is
+    streamed as MAT 7.3 and, if it fits, copied to MAT 5 at the end: both are on disk then).
 
     Parameters
     ----------
@@ -68,7 +73,7 @@ def estimated_file_size(schema, n_samples, suffix):
         What the file holds.
     n_samples : int
         Samples along the unlimited dimension [samples].
-    suffix : {".nc", ".csv"}
+    suffix : {".nc", ".csv", ".mat"}
         The file format (a path's suffix; a path is accepted too).
 
     Returns
@@ -79,6 +84,8 @@ def estimated_file_size(schema, n_samples, suffix):
     suffix = _suffix(f"x{suffix}" if str(suffix).startswith(".") else suffix)
     n = max(int(n_samples), 0)
     streamed = schema.streamed()
+    if suffix == ".mat":  # streamed as MAT 7.3, then copied to MAT 5: both on disk at once
+        return 2 * estimated_file_size(schema, n, ".nc")
     if suffix == ".nc":
         chunks = -(-n // schema.chunk_rows)
         row = sum(_row_bytes(schema, v) for v in streamed)
@@ -87,24 +94,8 @@ def estimated_file_size(schema, n_samples, suffix):
     return n * _CSV_BYTES_PER_VALUE * len(streamed) + _CSV_OVERHEAD
 
 
-def _write_error(path, error, action="writing"):
-    """A :class:`WriteError` for an ``OSError`` while writing ``path`` (``path``, ``reason``)."""
-    code = getattr(error, "errno", None)
-    if code is None:  # HDF5 wraps the system error in its message
-        text = str(error)
-        code = next((c for c in (errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EROFS)
-                     if os.strerror(c).lower() in text.lower()), None)
-    reasons = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
-               errno.EACCES: "permission denied", errno.EPERM: "permission denied",
-               errno.EROFS: "the file system is read-only",
-               errno.ENOENT: "the folder does not exist"}
-    reason = reasons.get(code) or (getattr(error, "strerror", None) or str(error)).split("\n")[0]
-    return WriteError(path, reason, f"cannot write {str(path)!r} ({action}): {reason}; "
-                                    "nothing was written.")
-
-
 class StreamWriter:
-    """Stream a result to NetCDF (``.nc``) or CSV (``.csv``) chunk by chunk, atomically.
+    """Stream a result to NetCDF (``.nc``), MATLAB (``.mat``) or CSV (``.csv``), atomically.
 
     Memory grows with the block appended, not with the result. NetCDF files follow the
     schema (CF-1.10): the unlimited dimension grows with each block, streamed variables
@@ -112,10 +103,14 @@ class StreamWriter:
     dimensions), flags are int8 with ``flag_values``/``flag_meanings``, variables not
     along the unlimited dimension are written from ``values`` when the file is created,
     and the global attributes (``Conventions``, ``attributes``, then those given to
-    :meth:`finish`) at the end. CSV files (a schema whose streamed variables are all one-dimensional) have the
-    ``attributes`` as ``# key = value [unit]`` header lines, one column per streamed
+    :meth:`finish`) at the end. CSV files (a schema whose streamed variables are all
+    one-dimensional) have the ``attributes`` as ``# key = value [unit]`` header lines, one column per streamed
     variable at the ``%.10g`` format, and the attributes given to :meth:`finish` as
-    trailing ``# key = value`` lines (known only at the end).
+    trailing ``# key = value`` lines (known only at the end). MATLAB files hold the same
+    variables, names and attributes in the layout of :mod:`qzs.iotools.matfile`; they are
+    grown as MAT 7.3 (resizable HDF5 datasets, memory bounded by the block) and, when every
+    variable fits MAT 5 (2 GiB), copied to MAT 5 by :meth:`finish`, one variable in memory
+    at a time.
 
     Parameters
     ----------
@@ -135,8 +130,8 @@ class StreamWriter:
         Global attributes known before the result (head lines of a CSV file), after
         ``Conventions`` (CF-1.10).
     suffixes : tuple of str
-        The formats allowed, by suffix (``.nc``, and ``.csv`` for a one-dimensional
-        schema).
+        The formats allowed, by suffix (``.nc``, ``.mat``, and ``.csv`` for a
+        one-dimensional schema).
 
     Raises
     ------
@@ -204,6 +199,8 @@ class StreamWriter:
             _reserve_space(self._fd, self.schema.header_bytes + _FREE_MARGIN, self.path.parent)
             if self._suffix == ".nc":
                 self._open_netcdf()
+            elif self._suffix == ".mat":
+                self._file = MatStream(self._tmp, self.schema, self._values)
             else:
                 self._open_csv()
 
@@ -272,6 +269,12 @@ class StreamWriter:
         self._variables = {}
         _close(handle)
 
+    # -- MATLAB -------------------------------------------------------------------------
+    def _append_mat(self, blocks, start, stop):
+        for variable, block, column in self._columns:
+            self._file.append(variable.name, blocks[block][:, column], start, stop)
+        self._file.flush()
+
     # -- CSV ----------------------------------------------------------------------------
     def _open_csv(self):
         self._file = open(self._tmp, "w", encoding="utf-8", newline="\n")
@@ -337,6 +340,8 @@ class StreamWriter:
             self._check_space(n)
             if self._suffix == ".nc":
                 self._append_netcdf(blocks, start, stop)
+            elif self._suffix == ".mat":
+                self._append_mat(blocks, start, stop)
             else:
                 self._append_csv(blocks, start, stop)
         self._rows = stop
@@ -378,6 +383,10 @@ class StreamWriter:
         with self._aborting("finishing the file"):
             if self._suffix == ".nc":
                 self._finish_netcdf(tail)
+            elif self._suffix == ".mat":
+                _release_reserve(self._fd)  # the space of the MAT 5 copy, if it is one
+                self._file.finish({**self._head, **tail})
+                self._file = None
             else:
                 self._finish_csv(tail)
             _release_reserve(self._fd)

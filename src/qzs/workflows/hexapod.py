@@ -606,8 +606,8 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     progress : bool
         Show a progress bar over simulated time.
     out : str or Path, optional
-        Stream the run to this ``.nc`` file; the result then holds a preview (every
-        ``run["preview_every"]``-th sample) and the statistics of all of them.
+        Stream the run to this ``.nc`` or ``.mat`` (MATLAB) file; the result then holds a
+        preview (every ``run["preview_every"]``-th sample) and the statistics of all of them.
     interruptible : bool
         Ctrl-C ends the run after the chunk under way and keeps (and writes) what was
         simulated; ``run["completed"]`` says so.
@@ -658,7 +658,10 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
     if out is None:
         return simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
                                 setup.controller, **arguments)
-    from qzs.engine.hexapod.result import HexapodWriter, estimated_hexapod_size
+    from pathlib import Path
+
+    from qzs.engine.hexapod.result import (HEXAPOD_SUFFIXES, HexapodWriter,
+                                           estimated_hexapod_size)
     from qzs.iotools.paths import check_output_path
 
     length = arguments["duration"]
@@ -667,8 +670,10 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rat
         length = min(lengths) if lengths else None
     size = None
     if isinstance(length, (int, float)) and length > 0 and arguments["sample_rate"] > 0:
-        size = estimated_hexapod_size(int(round(length * arguments["sample_rate"])) + 1)
-    check_output_path(out, argument=argument, suffixes=(".nc",), estimated_bytes=size)
+        suffix = Path(out).suffix.lower()
+        size = estimated_hexapod_size(int(round(length * arguments["sample_rate"])) + 1,
+                                      suffix if suffix in HEXAPOD_SUFFIXES else ".nc")
+    check_output_path(out, argument=argument, suffixes=HEXAPOD_SUFFIXES, estimated_bytes=size)
     with HexapodWriter(out) as writer:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
                                   setup.controller, sink=writer.append, **arguments)

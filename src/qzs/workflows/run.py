@@ -24,7 +24,7 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
                      sample_rate=defaults.SIMULATION["sample_rate"],
                      solver=defaults.SIMULATION["solver"], initial_state=None, progress=False,
                      interruptible=False, argument="path", run_entries=None):
-    """Simulate and stream every output sample to ``path`` (NetCDF ``.nc`` or CSV ``.csv``).
+    """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are
     written chunk by chunk (:class:`~qzs.engine.results.ResultWriter`), so memory stays
@@ -35,7 +35,8 @@ def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, d
     Parameters
     ----------
     path : str or Path
-        The file to write; ``.nc`` (CF-1.10 NetCDF) or ``.csv``.
+        The file to write; ``.nc`` (CF-1.10 NetCDF), ``.csv`` or ``.mat`` (MATLAB, the
+        layout of :mod:`qzs.iotools.matfile`).
     excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
         Base motion; default the paper's chirp.
     isolator : IsolatorParameters, optional

@@ -131,6 +131,27 @@ def test_bad_outputs_are_refused_before_the_run(setup, tmp_path, capsys):
     # whole chunks of 4096 samples
 
 
+def test_a_run_streamed_to_mat_is_the_netcdf_in_matlab_layout(setup, tmp_path):
+    """`out="run.mat"` (`qzs hexapod simulate --out run.mat`): the same variables as the
+    NetCDF file, (time, dof) arrays n x 6, flags logical, labels a cell array."""
+    import scipy.io
+
+    nc, mat = tmp_path / "p.nc", tmp_path / "p.mat"
+    simulate_setup(setup, duration=0.5, out=nc)
+    simulate_setup(setup, duration=0.5, out=mat)
+    read = scipy.io.loadmat(mat)
+    with xr.open_dataset(nc) as netcdf:
+        for name in ("platform_pose", "relative_position", "kinetic_energy", "time"):
+            expected = netcdf[name].values
+            assert np.array_equal(read[name], expected if expected.ndim == 2
+                                  else expected[:, None]), name
+        assert np.array_equal(read["locked"], netcdf["locked"].values)
+        assert read["units"][0, 0]["relative_position"][0] == "m"
+    assert [str(c[0]) for c in read["dof"][:, 0]] == ["x", "y", "z", "rx", "ry", "rz"]
+    assert dict((n, c) for n, _, c in scipy.io.whosmat(mat))["locked"] == "logical"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.mat", "p.nc"]
+
+
 def test_save_writes_the_held_run_and_refuses_a_preview(setup, in_memory, tmp_path, monkeypatch):
     path = in_memory.save(tmp_path / "saved.nc")
     with xr.open_dataset(path) as written:

@@ -8,7 +8,7 @@ import pytest
 from qzs import ParameterError
 
 
-@pytest.mark.parametrize("suffix", [".nc", ".csv", ".json"])
+@pytest.mark.parametrize("suffix", [".nc", ".csv", ".json", ".mat"])
 def test_save_writes_whole_files(small_response, tmp_path, suffix):
     path = small_response.save(tmp_path / f"response{suffix}")
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
@@ -20,6 +20,16 @@ def test_save_writes_whole_files(small_response, tmp_path, suffix):
                                    small_response.branch("up")["transmissibility"])
         assert data["frequency"].attrs["units"] == "Hz"
         assert data.attrs["isolator.stiction_force_units"] == "N"
+    elif suffix == ".mat":  # the dataset's variables; strings as cells, units in a struct
+        import scipy.io
+
+        read = scipy.io.loadmat(path)
+        np.testing.assert_allclose(read["transmissibility"][0],
+                                   small_response.branch("up")["transmissibility"])
+        assert read["transmissibility"].shape == (2, 3)  # (direction, frequency)
+        assert [str(d[0]) for d in read["direction"][:, 0]] == ["up", "down"]
+        assert read["units"][0, 0]["frequency"][0] == "Hz"
+        assert read["parameter_units"][0, 0]["isolator"][0, 0]["stiction_force"][0] == "N"
     elif suffix == ".json":
         record = json.loads(path.read_text())
         assert {"frequency", "transmissibility"} <= set(record["points"][0])

@@ -408,3 +408,25 @@ def test_command_sigterm_exits_143_with_the_resume_hint(sweep_file, tmp_path, ca
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml", "term.zarr"]
     assert run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store), "--resume",
                                    "--quiet")) == 0
+
+
+def test_export_writes_the_time_series_in_matlab_order(reference, tmp_path, monkeypatch):
+    """A sweep store to .mat: (case, time) series read back cases x samples, in MAT 5 and,
+    above the limit, MAT 7.3 (stored transposed, as MATLAB reads HDF5)."""
+    import h5py
+    import scipy.io
+
+    from qzs.iotools import matfile
+    from qzs.workflows.sweeps import export_sweep
+
+    _, data, store = reference
+    read = scipy.io.loadmat(export_sweep(store, tmp_path / "s5.mat"))
+    np.testing.assert_array_equal(read["relative_position"], data["relative_position"].values)
+    np.testing.assert_array_equal(read["stiction_force"][:, 0], data["stiction_force"].values)
+    assert read["units"][0, 0]["relative_position"][0] == "m"
+    monkeypatch.setattr(matfile, "MAT5_LIMIT", 4096)
+    with h5py.File(export_sweep(store, tmp_path / "s73.mat"), "r") as f:
+        np.testing.assert_array_equal(f["relative_position"][()].T,
+                                      data["relative_position"].values)
+        assert f["relative_position"].shape == data["relative_position"].shape[::-1]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s5.mat", "s73.mat"]

@@ -21,7 +21,7 @@ from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
 
 __all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_schema",
-           "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size",
+           "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size", "HEXAPOD_SUFFIXES",
            "save_hexapod_result"]
 
 _ACCELERATION = ("m/s^2", "m/s^2", "m/s^2", "rad/s^2", "rad/s^2", "rad/s^2")
@@ -154,13 +154,16 @@ def hexapod_file_layout():
                             for c in schema.coordinates}}
 
 
-def estimated_hexapod_size(n_samples):
+def estimated_hexapod_size(n_samples, suffix=".nc"):
     """Size of a hexapod result file of ``n_samples`` samples [bytes], an upper estimate.
 
     Parameters
     ----------
     n_samples : int
         Output samples [samples] (``duration * sample_rate + 1``).
+    suffix : {".nc", ".mat"}
+        The file format (a path's suffix; a path is accepted too); a ``.mat`` file needs
+        twice the space while it is written (:func:`~qzs.iotools.writer.estimated_file_size`).
 
     Returns
     -------
@@ -169,11 +172,15 @@ def estimated_hexapod_size(n_samples):
         4096 samples, plus the chunk index and about 256 KiB of header
         (:func:`qzs.iotools.writer.estimated_file_size` of :func:`hexapod_schema`).
     """
-    return estimated_file_size(hexapod_schema(), n_samples, ".nc")
+    return estimated_file_size(hexapod_schema(), n_samples, suffix)
+
+
+#: File formats of a hexapod run, by extension (its variables are not columns: no CSV).
+HEXAPOD_SUFFIXES = (".nc", ".mat")
 
 
 class HexapodWriter(StreamWriter):
-    """Stream a hexapod run (:func:`qzs.simulate_hexapod`'s ``sink``) to a NetCDF file.
+    """Stream a hexapod run (:func:`qzs.simulate_hexapod`'s ``sink``) to NetCDF or MATLAB.
 
     :class:`~qzs.iotools.writer.StreamWriter` configured with :func:`hexapod_schema`: a
     hidden temporary file beside the target, disk space reserved before each chunk,
@@ -186,12 +193,13 @@ class HexapodWriter(StreamWriter):
     Parameters
     ----------
     path : str or Path
-        Target file, ending in ``.nc``; its folder is created if missing.
+        Target file, ending in ``.nc`` or ``.mat`` (:mod:`qzs.iotools.matfile`); its folder
+        is created if missing.
 
     Raises
     ------
     ParameterError
-        A suffix other than ``.nc``.
+        A suffix other than ``.nc`` or ``.mat``.
     WriteError
         The temporary file cannot be created (attributes ``path`` and ``reason``).
 
@@ -204,7 +212,7 @@ class HexapodWriter(StreamWriter):
 
     def __init__(self, path):
         super().__init__(path, hexapod_schema(), blocks={"data": N_CHANNELS, "flags": N_FLAGS},
-                         columns=_COLUMNS, values=_LABELS, suffixes=(".nc",))
+                         columns=_COLUMNS, values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
 
     def finish(self, result):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.
@@ -228,15 +236,22 @@ class HexapodWriter(StreamWriter):
         return super().finish(result.global_attributes())
 
 
+def _format(path):
+    """The suffix of ``path`` if it is a hexapod run's format, else ``.nc`` (for estimates)."""
+    suffix = str(path).lower().rsplit(".", 1)[-1]
+    return f".{suffix}" if f".{suffix}" in HEXAPOD_SUFFIXES else ".nc"
+
+
 def save_hexapod_result(result, path):
-    """Write a hexapod run held in memory to a NetCDF file, atomically.
+    """Write a hexapod run held in memory to NetCDF or MATLAB (``.mat``), atomically.
 
     Parameters
     ----------
     result : HexapodResult
         A run holding every sample (not the preview of a run streamed to a file).
     path : str or Path
-        Target ``.nc`` file; checked (folder, permissions, free space) before writing.
+        Target ``.nc`` or ``.mat`` file; checked (folder, permissions, free space) before
+        writing.
 
     Returns
     -------
@@ -255,8 +270,8 @@ def save_hexapod_result(result, path):
         raise ParameterError(
             f"this result holds every {every}th sample only (a preview of a run streamed to a "
             "file); the whole run is in the file it was streamed to.")
-    check_output_path(path, argument="path", suffixes=(".nc",),
-                      estimated_bytes=estimated_hexapod_size(len(result)))
+    check_output_path(path, argument="path", suffixes=HEXAPOD_SUFFIXES,
+                      estimated_bytes=estimated_hexapod_size(len(result), _format(path)))
     with HexapodWriter(path) as writer:
         for start in range(0, len(result), 100_000):
             writer.append(result._data[start:start + 100_000],
@@ -437,12 +452,12 @@ class HexapodResult:
         return _summary_text(self)
 
     def save(self, path):
-        """Write the run to a NetCDF file (:func:`save_hexapod_result`).
+        """Write the run to NetCDF or MATLAB (:func:`save_hexapod_result`).
 
         Parameters
         ----------
         path : str or Path
-            Target ``.nc`` file.
+            Target ``.nc`` or ``.mat`` file.
 
         Returns
         -------

@@ -14,7 +14,7 @@ __all__ = ["RESPONSE_SUFFIXES", "POINT_FIELDS", "response_schema", "response_dat
 
 #: File formats :meth:`~qzs.workflows.response.result.SteadyStateResponse.save` writes, by
 #: extension.
-RESPONSE_SUFFIXES = (".nc", ".csv", ".json")
+RESPONSE_SUFFIXES = (".nc", ".csv", ".json", ".mat")
 #: Numeric fields of :class:`~qzs.workflows.response.result.ResponsePoint` with their units
 #: and descriptions.
 POINT_FIELDS = {
@@ -160,8 +160,9 @@ def response_dataset(response):
 
 
 def write_response(response, path):
-    """Write ``response`` atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point) or
-    ``.json`` (its ``to_record()``).
+    """Write ``response`` atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point),
+    ``.json`` (its ``to_record()``) or ``.mat`` (MATLAB: its dataset, the variables and
+    names of the NetCDF file, :func:`qzs.iotools.matfile.write_mat`).
 
     Parameters
     ----------
@@ -179,6 +180,10 @@ def write_response(response, path):
 
     path = check_output_path(path, argument="path", suffixes=RESPONSE_SUFFIXES)
     suffix = path.suffix.lower()
+    if suffix == ".mat":
+        from qzs.iotools.matfile import write_mat
+
+        return write_mat(response.to_xarray(), path)
     with atomic_path(path) as tmp:
         if suffix == ".nc":
             response.to_xarray().to_netcdf(tmp, engine="h5netcdf")

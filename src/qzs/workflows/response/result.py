@@ -396,8 +396,8 @@ class SteadyStateResponse:
         return plot_response(self, path=path, title=title)
 
     def save(self, path):
-        """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point) or
-        ``.json`` (:meth:`to_record`).
+        """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point),
+        ``.json`` (:meth:`to_record`) or ``.mat`` (MATLAB, the NetCDF's variables).
 
         Parameters
         ----------

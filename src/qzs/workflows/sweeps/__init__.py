@@ -38,8 +38,8 @@ writes each finished batch to a Zarr store (:mod:`qzs.workflows.sweeps.store`) t
 interrupted run resumes. Shipped examples: ``qzs/workflows/sweep_files/*.toml``; the
 guide is ``docs/sweeps.md``.
 
-:func:`run_sweep`, :func:`open_sweep`, :func:`plot_sweep` and :func:`stored_count` are
-here; figures in :mod:`qzs.viz.sweeps`. The modules:
+:func:`run_sweep`, :func:`open_sweep`, :func:`plot_sweep`, :func:`export_sweep` (a store
+to a MATLAB file) and :func:`stored_count` are here; figures in :mod:`qzs.viz.sweeps`. The modules:
 
 ==============  =================================================================
 ``definition``  sweep files: validation, grids, random and Latin-hypercube sampling
@@ -54,7 +54,7 @@ from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETER
                                              SweepDefinition, draw_samples, load_sweep,
                                              plan_text, sample_cases, shipped_sweeps)
 
-__all__ = ["run_sweep", "open_sweep", "plot_sweep", "stored_count", "load_sweep",
+__all__ = ["run_sweep", "open_sweep", "plot_sweep", "export_sweep", "stored_count", "load_sweep",
            "sample_cases", "draw_samples", "shipped_sweeps", "plan_text", "SweepDefinition",
            "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS"]
 
@@ -136,6 +136,49 @@ def open_sweep(store):
     from qzs.workflows.sweeps.store import open_store
 
     return open_store(store)
+
+
+def export_sweep(store, out=None, *, argument="out"):
+    """Write a sweep store to a MATLAB file (``.mat``), one variable in memory at a time.
+
+    The store's variables and coordinates under their own names (a varied excitation
+    parameter such as ``excitation.f1`` becomes ``excitation_f1``, listed in
+    ``netcdf_names``), their units and the sweep's settings in structs: the layout of
+    :mod:`qzs.iotools.matfile`. MAT 5, or MAT 7.3 if a variable (kept time series) holds
+    more than 2 GiB.
+
+    Parameters
+    ----------
+    store : str or Path
+        The Zarr store written by :func:`run_sweep`.
+    out : str or Path, optional
+        The ``.mat`` file; default the store's name with ``.mat`` (``gains.zarr`` ->
+        ``gains.mat``).
+    argument : str
+        How the caller names ``out`` in messages (``"--out"`` on the command line).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    OutputPathError
+        ``out`` does not end in ``.mat`` or cannot be written (checked before the store
+        is read).
+    ParameterError
+        ``store`` is not a sweep store.
+    """
+    from qzs.iotools.matfile import write_mat
+    from qzs.iotools.paths import check_output_path
+
+    out = Path(out) if out is not None else Path(store).with_suffix(".mat")
+    check_output_path(out, argument=argument, suffixes=(".mat",))
+    dataset = open_sweep(store)
+    title = (f"qzs sweep {dataset.attrs.get('sweep_name', Path(store).stem)}: "
+             f"{dataset.attrs.get('sweep_title', '')}").rstrip(": ")
+    return write_mat(dataset.assign_attrs(title=title), out)
 
 
 def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None):
