@@ -75,7 +75,7 @@ class BatchResult:
     messages: list
     elapsed: float = 0.0
     cases: list = field(default_factory=list)
-    stop_limits: np.ndarray = None
+    stop_limits: np.ndarray | None = None
 
     @property
     def steps_per_second(self):

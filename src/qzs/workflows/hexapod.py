@@ -107,7 +107,7 @@ class HexapodSetup:
     excitation: dict = field(default_factory=dict)
     simulation: dict = field(default_factory=dict)
     source: str = ""
-    cartesian: CartesianController = None
+    cartesian: CartesianController | None = None
 
 
 def default_cube_center_height(cube_edge):

@@ -114,7 +114,7 @@ class _Choice:
     curves: dict
     kd: float
     verification: dict
-    first_search: dict = None
+    first_search: dict | None = None
 
 
 def _bar(settings, total, desc):
