@@ -22,7 +22,7 @@ from qzs._validation import (as_float, choice, non_negative, parameter, positive
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
-__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
+__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "Excitation", "EXCITATION_KINDS",
            "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv",
            "highest_frequency"]
 
@@ -378,6 +378,9 @@ class DisplacementRecord(_Tabulated):
 
 
 #: Excitation kinds by the names configs, the command line and sweeps use.
+#: Any base excitation (a type for hints: ``excitation: Excitation``).
+Excitation = Chirp | Sine | RandomExcitation | DisplacementRecord
+
 EXCITATION_KINDS = {"chirp": Chirp, "sine": Sine, "random": RandomExcitation,
                     "file": DisplacementRecord}
 #: Options of each kind, as configs, the command line and sweeps spell them.
