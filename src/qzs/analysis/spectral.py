@@ -427,14 +427,16 @@ def welch_spectra(base, payload, sample_rate, *, window, fft_length, noverlap, d
 
 
 def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
-                     fft_length: int = ANALYSIS["fft_length"], overlap: float = ANALYSIS["overlap"],
+                     fft_length: int = ANALYSIS["fft_length"],
+                     overlap: float = ANALYSIS["overlap"],
                      window: str | tuple[Any, ...] | ArrayLike = "hann",
                      n_averages: int | None = None, estimator: str = "psd_ratio",
                      detrend: str | Callable[..., Any] | Literal[False] = "constant",
                      highpass_corner: float | None = None,
                      coherence_min: float = ANALYSIS["coherence_min"],
                      base_share_min: float = ANALYSIS["base_share_min"],
-                     highpass_factor: float = ANALYSIS["highpass_factor"]) -> TransmissibilityEstimate:
+                     highpass_factor: float = ANALYSIS["highpass_factor"],
+                     ) -> TransmissibilityEstimate:
     """Estimate the transmissibility from base to payload acceleration by Welch averaging.
 
     Parameters
@@ -532,13 +534,13 @@ def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
     arrays.append(trusted)
     for array in arrays:
         array.setflags(write=False)
-    # six arrays for the six array fields (mypy cannot count a starred list)
-    return TransmissibilityEstimate(*arrays, estimator=estimator, fft_length=fft_length,  # type: ignore[misc, arg-type]
-                                    n_averages=welch_average_count(base.size, fft_length, overlap),
-                                    sample_rate=sample_rate, highpass_corner=highpass_corner,
-                                    coherence_min=float(coherence_min),
-                                    base_share_min=float(base_share_min),
-                                    highpass_factor=float(highpass_factor))
+    # six arrays for the six array fields: mypy cannot count a starred list
+    return TransmissibilityEstimate(  # type: ignore[misc, arg-type]
+        *arrays, estimator=estimator, fft_length=fft_length,
+        n_averages=welch_average_count(base.size, fft_length, overlap),
+        sample_rate=sample_rate, highpass_corner=highpass_corner,
+        coherence_min=float(coherence_min), base_share_min=float(base_share_min),
+        highpass_factor=float(highpass_factor))
 
 
 def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_length"], window="hann",
@@ -897,8 +899,9 @@ def transmissibility_metrics(frequency: ArrayLike, magnitude: ArrayLike, *,
                                  f"got {rolloff_band!r}.")
 
     nan = float("nan")
-    values: dict[str, Any] = dict.fromkeys(("resonance_frequency", "resonance_peak", "isolation_onset",
-                            "minus_3db_frequency", "rolloff_db_per_decade"), nan)
+    values: dict[str, Any] = dict.fromkeys((
+        "resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
+        "rolloff_db_per_decade"), nan)
     reasons = {}
     at = {}
     if not ok.any():

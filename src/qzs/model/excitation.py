@@ -22,9 +22,9 @@ from qzs._validation import (as_float, choice, non_negative, parameter, positive
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
-__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "Excitation", "EXCITATION_KINDS",
-           "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv",
-           "highest_frequency"]
+__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "Excitation",
+           "EXCITATION_KINDS", "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation",
+           "read_displacement_csv", "highest_frequency"]
 
 KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
 # Indices into the packed scalars; a table is a (5, n) array: breakpoints in row 0
