@@ -535,8 +535,8 @@ def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
     for array in arrays:
         array.setflags(write=False)
     # six arrays for the six array fields: mypy cannot count a starred list
-    return TransmissibilityEstimate(  # type: ignore[misc, arg-type]
-        *arrays, estimator=estimator, fft_length=fft_length,
+    return TransmissibilityEstimate(  # type: ignore[misc]
+        *arrays, estimator=estimator, fft_length=fft_length,  # type: ignore[arg-type]
         n_averages=welch_average_count(base.size, fft_length, overlap),
         sample_rate=sample_rate, highpass_corner=highpass_corner,
         coherence_min=float(coherence_min), base_share_min=float(base_share_min),
