@@ -11,7 +11,10 @@ import itertools
 import json
 import math
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 import numpy as np
 
 from qzs._validation import finite_real, integer, known_keys, read_toml
@@ -154,7 +157,7 @@ def shipped_sweeps():
     return shipped_files(SHIPPED)
 
 
-def load_sweep(source):
+def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
     """Read and validate a sweep definition.
 
     Parameters
@@ -560,7 +563,7 @@ def sample_cases(definition):
     return columns
 
 
-def plan_text(definition):
+def plan_text(definition: SweepDefinition) -> str:
     """What a sweep will run: cases, batches, varied parameters and simulated steps.
 
     Parameters
