@@ -39,10 +39,16 @@ CACHE = ROOT / ".mypy_cache"
 RESULT_CLASSES = {
     "qzs.analysis.linear": ["LinearModel"],
     "qzs.analysis.spectral": ["TransmissibilityMetrics"],
+    "qzs.analysis.harmonic_balance": ["FrequencyResponseCurve"],
     "qzs.identify": ["SpringFit", "FrictionFit", "TransmissibilityFit"],
     "qzs.iotools.readers": ["Recording", "ChannelMap"],
     "qzs.workflows.response": ["ResponsePoint"],
     "qzs.workflows.experiment": ["ExperimentResult"],
+    "qzs.workflows.hexapod": ["HexapodSetup"],
+    "qzs.workflows.hexapod_study": ["HexapodStudyResult"],
+    "qzs.workflows.report": ["Verdict"],
+    "qzs.workflows.studies": ["StudyResult"],
+    "qzs.workflows.sweeps": ["SweepDefinition"],
 }
 
 

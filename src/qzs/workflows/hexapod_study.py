@@ -34,7 +34,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -48,6 +48,9 @@ from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
            "comparison_figure",
@@ -110,7 +113,7 @@ class HexapodStudyResult:
     folder: Path
     files: MappingProxyType
 
-    def summary(self):
+    def summary(self) -> str:
         """Short text: the metrics of each case and axis, and the findings.
 
         Returns
@@ -119,7 +122,7 @@ class HexapodStudyResult:
         """
         return _summary_text(self)
 
-    def plot(self, out=None):
+    def plot(self, out: str | Path | None = None) -> "Figure":
         """The comparison figure of the cases (:func:`comparison_figure`).
 
         Parameters

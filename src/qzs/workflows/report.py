@@ -73,13 +73,13 @@ class Verdict:
 
     claim: str
     statement: str
-    reproduced: object
+    reproduced: bool | None
     evidence: str
     study: str = ""
     decidable: bool = True
 
     @property
-    def label(self):
+    def label(self) -> str:
         """``"reproduced"``, ``"not reproduced"``, ``"partly reproduced"`` or ``"not decidable"``."""
         if not self.decidable:
             return "not decidable"
