@@ -47,4 +47,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 
 clean:
-	rm -rf $(VENV) results build src/*.egg-info
+	rm -rf $(VENV) results build src/*.egg-info .mypy_cache

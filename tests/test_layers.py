@@ -202,6 +202,8 @@ CROSS_CUTTING = {
     "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "
              "and the experiment's tests)",
     "benchmark_reference": "the benchmarks' C reference model against qzs",
+    "typing": "mypy over the annotated public API and over scripts using it (one it must reject)",
+    "wheel": "the built wheel and sdist: LICENSE, py.typed, every declared package-data file",
 }
 #: The longest a source file of qzs may be [lines] (one concept per module).
 MAX_LINES = 1000

@@ -26,6 +26,8 @@ use; the subpackages are the architecture, each importing only from those listed
 ``cli``          the ``qzs`` command
 ===============  ====================================================================
 """
+from typing import TYPE_CHECKING
+
 from qzs._lazy import lazy_exports
 from qzs._version import __version__
 from qzs.engine.results import SimulationResult
@@ -62,6 +64,26 @@ _LAZY = {
     "hexapod_transmissibility": "qzs.workflows.hexapod_transmissibility",
     "HexapodTransmissibility": "qzs.workflows.hexapod_transmissibility",
 }
+
+if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
+    from qzs.analysis.linear import linearize
+    from qzs.analysis.spectral import (TransmissibilityEstimate, transmissibility,
+                                       transmissibility_metrics)
+    from qzs.engine.batch import BatchResult, simulate_batch
+    from qzs.engine.hexapod.result import HexapodResult
+    from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
+    from qzs.engine.results import read_result
+    from qzs.identify import fit_friction, fit_spring, fit_transmissibility
+    from qzs.iotools.config import load_config
+    from qzs.iotools.readers import load_channel_map, read_recording
+    from qzs.workflows.design.driver import design_controller
+    from qzs.workflows.design.result import DesignResult
+    from qzs.workflows.hexapod_transmissibility import (HexapodTransmissibility,
+                                                        hexapod_transmissibility)
+    from qzs.workflows.response.result import SteadyStateResponse
+    from qzs.workflows.response.sweep import steady_state_response
+    from qzs.workflows.run import simulate_to_file
+    from qzs.workflows.sweeps import open_sweep, run_sweep
 
 __all__ = [
     "__version__",

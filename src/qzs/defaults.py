@@ -7,14 +7,16 @@ identification and the command line all read them here. It also names what sever
 layers must spell alike: the six axes of the platform and their units, the paper's
 excitation amplitude, the shipped cube's edge, and the amplitude ratio figures draw for 0.
 """
+from collections.abc import Mapping
 from types import MappingProxyType
+from typing import Any
 
 __all__ = ["SIMULATION", "ANALYSIS", "REPORTED_FREQUENCIES", "ACCURACY", "EXCITATION",
            "HEXAPOD", "AXES", "AXIS_UNITS", "AXIS_RATE_UNITS", "FIGURES"]
 
 #: Integration settings: the paper's (Section 3): Simulink's ode3 at dt = 1e-4 s [s],
 #: output at 1 kHz [Hz].
-SIMULATION = MappingProxyType({"dt": 1e-4, "solver": "ode3", "sample_rate": 1000.0})
+SIMULATION: Mapping[str, Any] = MappingProxyType({"dt": 1e-4, "solver": "ode3", "sample_rate": 1000.0})
 
 #: Spectral analysis: the paper's Welch settings (32768-point Hann segments, 122
 #: averages at 1 kHz, half overlap) [samples, -, Hz], the quick variant used by
@@ -24,7 +26,7 @@ SIMULATION = MappingProxyType({"dt": 1e-4, "solver": "ode3", "sample_rate": 1000
 #: |H1| by at most 1/sqrt(0.9) = +0.46 dB), the bin holding at least ``base_share_min``
 #: [-] of the base's own power (DC excluded; below it the base did not excite the bin),
 #: and at least ``highpass_factor`` [-] times a measurement high-pass corner.
-ANALYSIS = MappingProxyType({
+ANALYSIS: Mapping[str, Any] = MappingProxyType({
     "sample_rate": 1000.0, "fft_length": 32768, "n_averages": 122, "overlap": 0.5,
     "quick_fft_length": 16384, "quick_n_averages": 30, "band": (0.0, 20.0),
     "coherence_min": 0.9, "base_share_min": 1e-10, "highpass_factor": 1.5})
@@ -36,16 +38,16 @@ REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 #: transmissibility within ``tolerance_db`` [dB], or, for a sine (no band to estimate it
 #: over), the relative position within ``tolerance_state`` [m] (0.1 % of the paper's 10 mm).
 #: ``--dt`` gives a literal step instead; the Python functions keep ``SIMULATION["dt"]``.
-ACCURACY = MappingProxyType({"tolerance_db": 0.01, "tolerance_state": 1e-5})
+ACCURACY: Mapping[str, Any] = MappingProxyType({"tolerance_db": 0.01, "tolerance_state": 1e-5})
 
 #: Base excitation: the paper's displacement amplitude, 10 mm [m] (the default of
 #: :class:`~qzs.model.excitation.Chirp` and :class:`~qzs.model.excitation.Sine`, of the
 #: steady-state response and of the transmissibility fits).
-EXCITATION = MappingProxyType({"amplitude": 0.010})
+EXCITATION: Mapping[str, Any] = MappingProxyType({"amplitude": 0.010})
 
 #: Six-axis platform: the edge [m] of the cubic configuration used when none is given
 #: (``qzs hexapod --cubic``, :func:`qzs.workflows.hexapod.hexapod_setup`).
-HEXAPOD = MappingProxyType({"cube_edge": 0.15})
+HEXAPOD: Mapping[str, Any] = MappingProxyType({"cube_edge": 0.15})
 
 #: The six axes of a pose, a twist and the 6x6 matrices, in order: translations x, y, z,
 #: then rotations rx, ry, rz about them.
@@ -56,4 +58,4 @@ AXIS_RATE_UNITS = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
 
 #: Figures: the amplitude ratio [-] drawn for 0 on a dB axis (-240 dB), so that a zero
 #: magnitude stays on the plot.
-FIGURES = MappingProxyType({"magnitude_floor": 1e-12})
+FIGURES: Mapping[str, Any] = MappingProxyType({"magnitude_floor": 1e-12})

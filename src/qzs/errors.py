@@ -6,6 +6,8 @@ caller may act on it (:class:`CaseError`, :class:`MissingDependencyError`); the
 message is for people, never for parsing.
 """
 
+from collections.abc import Iterable, Mapping
+
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
@@ -38,11 +40,11 @@ class ExcitationError(ParameterError):
         (:meth:`renamed`).
     """
 
-    def __init__(self, message, options=()):
+    def __init__(self, message: str, options: Iterable[str] = ()) -> None:
         self.options = tuple(str(option) for option in options)
         super().__init__(message)
 
-    def renamed(self, spelling):
+    def renamed(self, spelling: Mapping[str, str]) -> "ExcitationError":
         """The same error with each of its options written as ``spelling`` says.
 
         Parameters
@@ -80,7 +82,7 @@ class CaseError(ParameterError):
         Why that case is invalid (the message of the underlying error).
     """
 
-    def __init__(self, index, reason):
+    def __init__(self, index: int, reason: str | BaseException) -> None:
         self.index = int(index)
         self.reason = str(reason)
         super().__init__(f"case {self.index}: {self.reason}")
@@ -214,7 +216,7 @@ class SizeLimitError(ParameterError):
         SI unit of the setting (``1`` for a count).
     """
 
-    def __init__(self, name, value, low, high, unit):
+    def __init__(self, name: str, value: float, low: float, high: float, unit: str) -> None:
         self.name, self.value = str(name), value
         self.low, self.high, self.unit = low, high, str(unit)
         shown = "" if self.unit == "1" else f" {self.unit}"
@@ -246,7 +248,8 @@ class ToleranceNotMetError(ParameterError):
         The factor [-] the estimate had to stay below the tolerance by.
     """
 
-    def __init__(self, tolerance, unit, smallest_step, smallest_error, safety):
+    def __init__(self, tolerance: float, unit: str, smallest_step: float, smallest_error: float,
+                 safety: float) -> None:
         self.tolerance = float(tolerance)
         self.unit = str(unit)
         self.smallest_step = float(smallest_step)
@@ -278,7 +281,7 @@ class OutputPathError(ParameterError):
         What is wrong and the fix.
     """
 
-    def __init__(self, argument, value, reason):
+    def __init__(self, argument: str, value: object, reason: str) -> None:
         self.argument, self.value, self.reason = str(argument), str(value), str(reason)
         super().__init__(f"{self.argument} {self.value!r} {self.reason}.")
 
@@ -307,7 +310,8 @@ class ResultTooLargeError(ParameterError):
     STREAM = ("stream it to a file instead (`--out FILE.nc` on the command line, "
               "`qzs.simulate_to_file` in Python), or lower the `sample_rate` or the `duration`")
 
-    def __init__(self, needed, available, duration, sample_rate, remedy=None):
+    def __init__(self, needed: int, available: int, duration: float, sample_rate: float,
+                 remedy: str | None = None) -> None:
         self.needed, self.available = int(needed), int(available)
         self.duration, self.sample_rate = float(duration), float(sample_rate)
         self.remedy = str(remedy) if remedy is not None else self.STREAM
@@ -498,7 +502,7 @@ class MissingDependencyError(ImportError):
         What needs it (e.g. "reading MF4 logs").
     """
 
-    def __init__(self, package, extra, feature):
+    def __init__(self, package: str, extra: str, feature: str) -> None:
         self.package, self.extra, self.feature = package, extra, feature
         super().__init__(f"{feature} needs the optional package {package!r}, which is not "
                          f"installed; install it with: pip install \"qzs[{extra}]\"",

@@ -256,7 +256,7 @@ class HexapodLinearModel:
     notes: tuple
     transmissibility_system: object
     compliance_system: object
-    loop_matrix: np.ndarray = None
+    loop_matrix: np.ndarray | None = None
     control: str = "per leg"
 
     # ------------------------------------------------------------ responses

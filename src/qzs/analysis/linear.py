@@ -16,11 +16,16 @@ This is the frictionless-guide limit the nonlinear simulator must reproduce
 (tests), and the overlay shown with nonlinear transmissibility curves.
 """
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
+
+if TYPE_CHECKING:
+    import control
 
 __all__ = ["LinearModel", "linearize", "linear_transmissibility", "loop_constants"]
 
@@ -47,15 +52,15 @@ class LinearModel:
         Closed-loop poles [rad/s].
     """
 
-    transfer_function: object
-    state_space: object
+    transfer_function: "control.TransferFunction"
+    state_space: "control.StateSpace"
     stiffness: float
     undamped_natural_frequency: float
     natural_frequency: float
     damping_ratio: float
     poles: np.ndarray
 
-    def transmissibility(self, frequency):
+    def transmissibility(self, frequency: ArrayLike) -> float | NDArray[np.float64]:
         """``|X/Y|`` at ``frequency`` [Hz] (amplitude ratio).
 
         Parameters
@@ -97,7 +102,9 @@ def loop_constants(isolator, controller, relative_position=None):
             2 * np.pi * controller.velocity_highpass)
 
 
-def linearize(isolator=None, controller=None, relative_position=None):
+def linearize(isolator: IsolatorParameters | None = None,
+              controller: ControllerParameters | None = None,
+              relative_position: float | None = None) -> LinearModel:
     """Linearise the closed-loop isolator at its operating point.
 
     Parameters

@@ -17,10 +17,12 @@ from __future__ import annotations
 import numbers
 import warnings
 from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
 from types import MappingProxyType
-from typing import Mapping
+from typing import TYPE_CHECKING, Any, Literal, Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy import signal
 
 from qzs._format import decibels
@@ -28,6 +30,9 @@ from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
            "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
@@ -294,15 +299,15 @@ class TransmissibilityEstimate:
     highpass_factor: float = ANALYSIS["highpass_factor"]
 
     @property
-    def untrusted_below(self):
+    def untrusted_below(self) -> float:
         """Upper edge of the high-pass's untrusted band [Hz]: ``highpass_factor * highpass_corner``, or 0."""
         return 0.0 if self.highpass_corner is None else self.highpass_factor * self.highpass_corner
 
-    def magnitude_db(self):
+    def magnitude_db(self) -> NDArray[np.float64]:
         """Magnitude in decibels, ``20 * log10(magnitude)`` [dB] (-inf where it is 0)."""
         return decibels(self.magnitude)
 
-    def metrics(self, **options):
+    def metrics(self, **options: Any) -> TransmissibilityMetrics:
         """Scalar metrics of this curve's trusted bins (:func:`transmissibility_metrics`).
 
         Parameters
@@ -320,7 +325,7 @@ class TransmissibilityEstimate:
         options.setdefault("untrusted_factor", self.highpass_factor)
         return transmissibility_metrics(self.frequency, self.magnitude, **options)
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """Repackage as an ``xarray.Dataset`` on coordinate ``frequency`` [Hz], with units attrs
         (:func:`estimate_schema`)."""
         attrs = {"estimator": self.estimator, "fft_length": self.fft_length,
@@ -421,11 +426,17 @@ def welch_spectra(base, payload, sample_rate, *, window, fft_length, noverlap, d
     return transform.f, spectra[0], spectra[1], spectra[2]
 
 
-def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_length"],
-                     overlap=ANALYSIS["overlap"], window="hann",
-                     n_averages=None, estimator="psd_ratio", detrend="constant", highpass_corner=None,
-                     coherence_min=ANALYSIS["coherence_min"], base_share_min=ANALYSIS["base_share_min"],
-                     highpass_factor=ANALYSIS["highpass_factor"]):
+def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
+                     fft_length: int = ANALYSIS["fft_length"],
+                     overlap: float = ANALYSIS["overlap"],
+                     window: str | tuple[Any, ...] | ArrayLike = "hann",
+                     n_averages: int | None = None, estimator: str = "psd_ratio",
+                     detrend: str | Callable[..., Any] | Literal[False] = "constant",
+                     highpass_corner: float | None = None,
+                     coherence_min: float = ANALYSIS["coherence_min"],
+                     base_share_min: float = ANALYSIS["base_share_min"],
+                     highpass_factor: float = ANALYSIS["highpass_factor"],
+                     ) -> TransmissibilityEstimate:
     """Estimate the transmissibility from base to payload acceleration by Welch averaging.
 
     Parameters
@@ -523,12 +534,13 @@ def transmissibility(base, payload, sample_rate, *, fft_length=ANALYSIS["fft_len
     arrays.append(trusted)
     for array in arrays:
         array.setflags(write=False)
-    return TransmissibilityEstimate(*arrays, estimator=estimator, fft_length=fft_length,
-                                    n_averages=welch_average_count(base.size, fft_length, overlap),
-                                    sample_rate=sample_rate, highpass_corner=highpass_corner,
-                                    coherence_min=float(coherence_min),
-                                    base_share_min=float(base_share_min),
-                                    highpass_factor=float(highpass_factor))
+    # six arrays for the six array fields: mypy cannot count a starred list
+    return TransmissibilityEstimate(  # type: ignore[misc]
+        *arrays, estimator=estimator, fft_length=fft_length,  # type: ignore[arg-type]
+        n_averages=welch_average_count(base.size, fft_length, overlap),
+        sample_rate=sample_rate, highpass_corner=highpass_corner,
+        coherence_min=float(coherence_min), base_share_min=float(base_share_min),
+        highpass_factor=float(highpass_factor))
 
 
 def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_length"], window="hann",
@@ -637,13 +649,13 @@ class TransmissibilityMetrics:
     reasons: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     trusted_range: tuple = (float("nan"), float("nan"))
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, float]:
         """Flat dict of the values; ``at`` becomes keys ``transmissibility_at_<f>_hz``."""
         out = {name: getattr(self, name) for name in METRIC_NAMES}
         out.update({_spot_key(f): value for f, value in self.at.items()})
         return out
 
-    def reason(self, name):
+    def reason(self, name: str) -> str:
         """Why metric ``name`` (a key of :meth:`to_dict`) is NaN; ``""`` if it is defined.
 
         Parameters
@@ -808,9 +820,13 @@ def _minus_3db(f, t, ok, i):
     return float("nan"), f"T stays above peak/sqrt(2) = {level:.3g} up to the top of the curve"
 
 
-def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequencies=REPORTED_FREQUENCIES,
-                             highpass_corner=None, untrusted_factor=ANALYSIS["highpass_factor"],
-                             rolloff_band=None, peak_min=None):
+def transmissibility_metrics(frequency: ArrayLike, magnitude: ArrayLike, *,
+                             trusted: ArrayLike | None = None,
+                             at_frequencies: Sequence[float] = REPORTED_FREQUENCIES,
+                             highpass_corner: float | None = None,
+                             untrusted_factor: float = ANALYSIS["highpass_factor"],
+                             rolloff_band: tuple[float, float] | None = None,
+                             peak_min: float | None = None) -> TransmissibilityMetrics:
     """Resonance, isolation band, roll-off and spot values of a transmissibility curve.
 
     Every metric comes from trusted bins only: the DC bin is never used, nor bins
@@ -883,8 +899,9 @@ def transmissibility_metrics(frequency, magnitude, *, trusted=None, at_frequenci
                                  f"got {rolloff_band!r}.")
 
     nan = float("nan")
-    values = dict.fromkeys(("resonance_frequency", "resonance_peak", "isolation_onset",
-                            "minus_3db_frequency", "rolloff_db_per_decade"), nan)
+    values: dict[str, Any] = dict.fromkeys((
+        "resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
+        "rolloff_db_per_decade"), nan)
     reasons = {}
     at = {}
     if not ok.any():

@@ -21,6 +21,7 @@ import functools
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -53,7 +54,7 @@ CONTROLLER_RATES = (0.0, 250.0, 500.0, 1000.0, 2000.0, 5000.0, 10000.0)
 #: (0.1 Hz/s, ten times the paper's rate; its trusted transmissibility lies within a median
 #: 0.01 dB of the paper's 2000 s chirp over 1-19 Hz, docs/app.md), the payload's response
 #: to a 3 Hz sine over 10 s, 12 frequencies for a stepped sine.
-PAGE_DEFAULTS = {"excitation.kind": "chirp", "excitation.duration": 200.0,
+PAGE_DEFAULTS: dict[str, Any] = {"excitation.kind": "chirp", "excitation.duration": 200.0,
                  "frequency_count": 12, "sine.frequency": 3.0, "sine.duration": 10.0,
                  "sample_rate": defaults.SIMULATION["sample_rate"]}
 

@@ -10,6 +10,8 @@ plain arithmetic so that loops over cases vectorise; the divergence check needs
 import math
 import os
 
+from typing import Any
+
 import numpy as np
 from llvmlite import ir
 from numba import njit, types
@@ -18,7 +20,7 @@ from numba.extending import intrinsic, overload
 __all__ = ["JIT", "fma", "exp", "tanh"]
 
 #: Options of every kernel: cached on disk, numpy's error model, no fast-math.
-JIT = dict(cache=True, error_model="numpy")
+JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
 _JIT = JIT
 
 
@@ -37,7 +39,7 @@ def _pow2_bits(typingctx, k):
     return types.float64(types.int64), codegen
 
 
-@overload(_pow2, jit_options=dict(cache=True))
+@overload(_pow2, jit_options=dict(cache=True))  # type: ignore[typeddict-unknown-key]
 def _pow2_jit(k):
     return lambda k: _pow2_bits(k)
 
@@ -70,7 +72,7 @@ def _fma_instruction(typingctx, a, b, c):
     return types.float64(types.float64, types.float64, types.float64), codegen
 
 
-@overload(fma, jit_options=dict(cache=True))
+@overload(fma, jit_options=dict(cache=True))  # type: ignore[typeddict-unknown-key]
 def _fma_jit(a, b, c):
     return lambda a, b, c: _fma_instruction(float(a), float(b), float(c))
 

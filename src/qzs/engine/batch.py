@@ -8,9 +8,13 @@ reduced while integrating: only the requested channels are kept, and per-case
 statistics (stroke, stop contacts, RMS motor force, time locked) are
 accumulated chunk by chunk.
 """
+from __future__ import annotations
+
 import dataclasses
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,6 +29,13 @@ from qzs.engine.results import CHANNELS, FLAGS, _now, simulation_schema
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.registry import PARAMETERS
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["BatchResult", "simulate_batch", "batch_schema", "STATS"]
 
@@ -69,20 +80,20 @@ class BatchResult:
     """
 
     time: np.ndarray
-    channels: dict
-    stats: dict
+    channels: dict[str, np.ndarray]
+    stats: dict[str, np.ndarray]
     status: np.ndarray
-    messages: list
+    messages: list[str]
     elapsed: float = 0.0
-    cases: list = field(default_factory=list)
-    stop_limits: np.ndarray = None
+    cases: list[tuple[IsolatorParameters, ControllerParameters]] = field(default_factory=list)
+    stop_limits: np.ndarray | None = None
 
     @property
-    def steps_per_second(self):
+    def steps_per_second(self) -> float:
         """Simulated steps per second over all cases [steps/s]."""
         return float(self.stats["steps"].sum()) / max(self.elapsed, 1e-12)
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The batch as an ``xarray.Dataset`` on dimensions ``case`` and ``time``, CF-1.10.
 
         The kept channels on ``(case, time)``, the statistics and ``status`` (int8
@@ -168,11 +179,13 @@ def batch_schema(batch):
                   coordinates=coordinates, variables=variables)
 
 
-def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULATION["dt"],
-                   sample_rate=defaults.SIMULATION["sample_rate"],
-                   solver=defaults.SIMULATION["solver"],
-                   channels=("base_acceleration", "payload_acceleration"),
-                   workers=None, progress=False):
+def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameters]],
+                   excitation: Excitation | None = None, *, duration: float | None = None,
+                   dt: float = defaults.SIMULATION["dt"],
+                   sample_rate: float = defaults.SIMULATION["sample_rate"],
+                   solver: str = defaults.SIMULATION["solver"],
+                   channels: Sequence[str] = ("base_acceleration", "payload_acceleration"),
+                   workers: int | None = None, progress: bool = False) -> BatchResult:
     """Simulate many parameter sets under one excitation, in parallel.
 
     Parameters
@@ -270,6 +283,8 @@ def simulate_batch(cases, excitation=None, *, duration=None, dt=defaults.SIMULAT
 class _Rows:
     """The batch's recorder for the driver: the lanes keep their channels themselves (each
     thread its share, see :class:`_Lanes`), so that the next chunk may start at once."""
+
+    rows: int  # set by simulate_batch
 
     def target(self, chunk_index, rows):
         return 0, 0

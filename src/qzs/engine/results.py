@@ -6,13 +6,18 @@
 and :class:`ResultWriter`, a configuration of :class:`qzs.iotools.writer.StreamWriter`,
 streams it to NetCDF, CSV or MATLAB (``.save()``, :func:`save_result`, :func:`read_result`).
 """
+from __future__ import annotations
+
 import dataclasses
 import datetime
 import os
 import shlex
 import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from qzs.engine import kernels as K
 from qzs.errors import ParameterError
@@ -21,6 +26,14 @@ from qzs.iotools.schema import (CONVENTIONS, NONE_VALUE, Schema, Variable, time_
                                 to_dataset)
 from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["SimulationResult", "CHANNELS", "FLAGS", "FLAG_MEANINGS", "RUN_UNITS", "CONVENTIONS",
            "NONE_VALUE", "simulation_schema", "variable_attributes", "parameter_metadata",
@@ -318,7 +331,10 @@ class SimulationResult:
         envelope of groups of k samples, for figures).
     """
 
-    def __init__(self, data, flags, *, isolator, controller, excitation, run, statistics=None):
+    def __init__(self, data: NDArray[np.float64], flags: NDArray[np.bool_], *,
+                 isolator: IsolatorParameters, controller: ControllerParameters,
+                 excitation: Excitation, run: dict[str, Any],
+                 statistics: dict[str, Any] | None = None) -> None:
         self._data = data
         self._flags = flags
         self.isolator = isolator
@@ -328,7 +344,7 @@ class SimulationResult:
         self._statistics = statistics
 
     @property
-    def statistics(self):
+    def statistics(self) -> dict[str, Any]:
         """What the summary reports, from every sample of the run (also of a streamed one).
 
         A dict, see :data:`qzs.analysis.statistics.SUMMARY_STATISTICS` for names and units.
@@ -342,37 +358,38 @@ class SimulationResult:
             self._statistics = statistics.result()
         return self._statistics
 
-    def __getitem__(self, name):
+    def __getitem__(self, name: str) -> NDArray[Any]:
         if name in CHANNELS:
             return self._data[:, CHANNELS[name][0]]
         if name in FLAGS:
             return self._flags[:, FLAGS[name][0]]
         raise KeyError(f"no channel {name!r}; channels are {', '.join([*CHANNELS, *FLAGS])}.")
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> NDArray[Any]:
         if name.startswith("_") or (name not in CHANNELS and name not in FLAGS):
             raise AttributeError(name)
         return self[name]
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self._data.shape[0]
 
     @property
-    def completed(self):
+    def completed(self) -> bool:
         """False if the run was interrupted before its end."""
         return self.run["completed"]
 
     @property
-    def steps_per_second(self):
+    def steps_per_second(self) -> float:
         """Integration throughput of the run [steps/s]."""
         return self.run["steps"] / max(self.run["elapsed"], 1e-12)
 
-    def mechanical_energy(self):
+    def mechanical_energy(self) -> NDArray[np.float64]:
         """Kinetic + spring + gravity + stop elastic energy [J] at each sample."""
-        return sum(self[n] for n in ("kinetic_energy", "spring_energy", "gravity_energy",
-                                     "stop_energy"))
+        return cast("NDArray[np.float64]",  # a sum of four arrays, never the start value 0
+                    sum(self[n] for n in ("kinetic_energy", "spring_energy", "gravity_energy",
+                                          "stop_energy")))
 
-    def energy_residual(self):
+    def energy_residual(self) -> NDArray[np.float64]:
         """Energy-ledger imbalance [J]: change of mechanical energy minus net work.
 
         ``dE - (W_base + W_motor - D_friction - D_stop)``; zero up to the
@@ -382,7 +399,7 @@ class SimulationResult:
         net = self.base_work + self.motor_work - self.friction_dissipation - self.stop_dissipation
         return energy - energy[0] - net
 
-    def metadata(self):
+    def metadata(self) -> dict[str, Any]:
         """Flat ``dict`` of every parameter, the excitation, the run settings and the version.
 
         ``None`` values are kept, booleans are 0/1; the units are in
@@ -390,13 +407,13 @@ class SimulationResult:
         """
         from qzs._version import __version__
 
-        meta = {"qzs_version": __version__}
+        meta: dict[str, Any] = {"qzs_version": __version__}
         meta.update({k: v for k, (v, _) in parameter_metadata(
             self.isolator, self.controller, self.excitation).items()})
         meta.update({k: v for k, (v, _) in run_metadata(self.run).items()})
         return meta
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The run as an ``xarray.Dataset`` on dimension ``time``, with CF-1.10 metadata.
 
         The same variables and attributes as a saved NetCDF file (:func:`simulation_schema`,
@@ -408,19 +425,19 @@ class SimulationResult:
         return to_dataset(schema, {name: self[name] for name in schema.names},
                           {**head, **tail}, boolean_flags=True)
 
-    def summary(self):
+    def summary(self) -> str:
         """One-screen text summary of the run."""
         from qzs.analysis.summary import summary_text
 
         return summary_text(self)
 
-    def plot(self, **kwargs):
+    def plot(self, **kwargs: Any) -> Figure:
         """Plot the time series (see :func:`qzs.viz.plot_simulation`)."""
         from qzs.viz.simulation import plot_simulation
 
         return plot_simulation(self, **kwargs)
 
-    def save(self, path):
+    def save(self, path: str | Path) -> Path:
         """Write the run atomically to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).
 
         Parameters
@@ -583,7 +600,7 @@ def save_result(result, path):
         return writer.finish(result.run)
 
 
-def read_result(path):
+def read_result(path: str | Path) -> xr.Dataset:
     """Read a saved run (``.nc`` or ``.csv``) back as an ``xarray.Dataset``.
 
     The flags come back boolean and ``None`` parameters as ``None``, so that a

@@ -4,6 +4,10 @@
 >>> result = simulate(Chirp(duration=20.0, f1=5.0), dt=1e-4, sample_rate=500.0)
 >>> result.summary()  # doctest: +SKIP
 """
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from qzs import defaults
 from qzs.analysis.statistics import SummaryStatistics
@@ -14,16 +18,25 @@ from qzs.engine.prepare import divergence_message, prepare_run
 from qzs.engine.results import SimulationResult, named_block
 from qzs.errors import SimulationError
 
+if TYPE_CHECKING:
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.isolator import InitialState, IsolatorParameters
+
 __all__ = ["simulate", "result_bytes", "SingleAxis"]
 
 #: Bytes one output sample takes in memory: every channel as float64, the flags as bool.
 BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
 
 
-def simulate(excitation=None, isolator=None, controller=None, *, duration=None,
-             dt=defaults.SIMULATION["dt"], sample_rate=defaults.SIMULATION["sample_rate"],
-             solver=defaults.SIMULATION["solver"], initial_state=None, progress=False,
-             interruptible=False, sink=None):
+def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters | None = None,
+             controller: ControllerParameters | None = None, *, duration: float | None = None,
+             dt: float = defaults.SIMULATION["dt"],
+             sample_rate: float = defaults.SIMULATION["sample_rate"],
+             solver: str = defaults.SIMULATION["solver"],
+             initial_state: InitialState | None = None, progress: bool = False,
+             interruptible: bool = False,
+             sink: Callable[[Any, Any], Any] | None = None) -> SimulationResult:
     """Simulate the isolator under a base excitation with a fixed-step integrator.
 
     Parameters

@@ -61,7 +61,9 @@ def stability_test(isolator, controller, solver):
     return stable
 
 
-def largest_stable_step(isolator=None, controller=None, solver="ode3"):
+def largest_stable_step(isolator: IsolatorParameters | None = None,
+                        controller: ControllerParameters | None = None,
+                        solver: str = "ode3") -> float:
     """Largest time step [s] for which the explicit integrator stays stable.
 
     Linear stability of the stiffest modes (the payload on its spring, PI gain

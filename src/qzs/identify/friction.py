@@ -1,15 +1,21 @@
 """Friction law fitted to an imposed-motion test (the paper's Instron tests, eq. 3)."""
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
 from qzs._validation import strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["FrictionFit", "fit_friction", "FRICTION_PARAMETERS", "FORCE_SIGNS"]
 
@@ -69,7 +75,7 @@ class FrictionFit:
     residual: np.ndarray
     used: np.ndarray
 
-    def friction_force(self, velocity):
+    def friction_force(self, velocity: ArrayLike) -> float | NDArray[np.float64]:
         """Fitted sliding friction on the payload [N] at ``velocity`` [m/s] (docs/model.md §3 sign).
 
         Parameters
@@ -85,7 +91,7 @@ class FrictionFit:
 
         return friction_force(velocity, self.to_isolator())
 
-    def to_isolator(self, isolator=None):
+    def to_isolator(self, isolator: IsolatorParameters | None = None) -> IsolatorParameters:
         """``isolator`` (default Table 1) with the fitted friction parameters.
 
         Parameters
@@ -102,7 +108,7 @@ class FrictionFit:
         return dataclasses.replace(isolator or IsolatorParameters(),
                                    **{n: getattr(self, n) for n in FRICTION_PARAMETERS[:4]})
 
-    def plot(self, path=None, title=""):
+    def plot(self, path: str | Path | None = None, title: str = "") -> "Figure":
         """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`).
 
         Parameters
@@ -159,9 +165,12 @@ def _friction_columns(speed, decay):
     return np.column_stack([np.ones_like(speed), np.exp(-decay * speed), speed])
 
 
-def fit_friction(time, displacement, force, *, spring=None, mass=None,
-                 exclude_below_velocity=2e-3, force_sign="auto", fit_offset=True,
-                 smoothing_window=0.02, polyorder=3, confidence=0.95, tolerance=1e-3):
+def fit_friction(time: ArrayLike, displacement: ArrayLike, force: ArrayLike, *,
+                 spring: tuple[float, float] | IsolatorParameters | None = None,
+                 mass: float | None = None, exclude_below_velocity: float = 2e-3,
+                 force_sign: str = "auto", fit_offset: bool = True,
+                 smoothing_window: float = 0.02, polyorder: int = 3, confidence: float = 0.95,
+                 tolerance: float = 1e-3) -> FrictionFit:
     """Fit the friction law (eq. 3) to a dynamic test: imposed displacement, measured force.
 
     The test machine drives the carriage through ``z(t)`` and measures the force it
@@ -280,7 +289,7 @@ def fit_friction(time, displacement, force, *, spring=None, mass=None,
         cost = float(np.sum((design(decay) @ coefficients - y) ** 2))
         if best is None or cost < best[0]:
             best = (cost, decay, coefficients)
-    _, decay, c = best
+    _, decay, c = best  # type: ignore[misc]  # set by the first of the 41 decays
     start = np.array([max(c[0], 0.0), max(c[1], 0.0), decay, max(c[2], 0.0), *c[3:]])
     lower = [0.0, 0.0, 0.0, 0.0, -np.inf][:n_parameters]
     solution = optimize.least_squares(residual, start, bounds=(lower, np.inf), x_scale="jac",

@@ -2,6 +2,7 @@
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import optimize
 
 from qzs.errors import DataError, ParameterError
@@ -44,12 +45,13 @@ class SpringFit:
     residual_rms: float
     outliers: tuple
 
-    def as_paper_reports(self):
+    def as_paper_reports(self) -> tuple[float, float]:
         """``(a, b)`` as the test machine's convention would print them (paper Fig. 5)."""
         return -self.spring_force, self.spring_shape
 
 
-def fit_spring(displacement, force, *, convention="model", confidence=0.95):
+def fit_spring(displacement: ArrayLike, force: ArrayLike, *, convention: str = "model",
+               confidence: float = 0.95) -> SpringFit:
     """Fit the MagSpring's tanh law to static force-displacement pairs.
 
     Parameters

@@ -2,9 +2,13 @@
 import dataclasses
 import time as _time
 from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import optimize
 
 from qzs._validation import integer
@@ -19,6 +23,9 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, numeric_parameters
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["TransmissibilityFit", "fit_transmissibility"]
 
@@ -65,7 +72,7 @@ class TransmissibilityFit:
     n_simulations: int
     elapsed: float
 
-    def plot(self, path=None, title=""):
+    def plot(self, path: str | Path | None = None, title: str = "") -> "Figure":
         """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
 
         Parameters
@@ -182,11 +189,19 @@ def _jitter_covariance(residual, x, jacobian, samples, size, lower, upper, seed=
     return shifts.T @ shifts / samples
 
 
-def fit_transmissibility(frequency, magnitude, free=("viscous_damping", "stiction_force"), *,
-                         isolator=None, controller=None, bounds=None, initial=None, band=None,
-                         excitation=None, duration=60.0, dt=5e-4, sample_rate=None,
-                         fft_length=1024, confidence=0.95, max_simulations=100,
-                         scan_points=9, diff_step=0.05, jitter_samples=16):
+def fit_transmissibility(frequency: ArrayLike, magnitude: ArrayLike,
+                         free: Sequence[str] = ("viscous_damping", "stiction_force"), *,
+                         isolator: IsolatorParameters | None = None,
+                         controller: ControllerParameters | None = None,
+                         bounds: Mapping[str, tuple[float, float]] | None = None,
+                         initial: Mapping[str, float] | None = None,
+                         band: tuple[float, float] | None = None,
+                         excitation: Chirp | None = None, duration: float = 60.0,
+                         dt: float = 5e-4, sample_rate: float | None = None,
+                         fft_length: int = 1024, confidence: float = 0.95,
+                         max_simulations: int = 100, scan_points: int = 9,
+                         diff_step: float = 0.05,
+                         jitter_samples: int = 16) -> TransmissibilityFit:
     """Fit chosen model parameters to a measured transmissibility curve.
 
     Each evaluation simulates the isolator under a chirp covering the band

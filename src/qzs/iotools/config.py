@@ -1,5 +1,6 @@
 """Run configuration files (TOML): model parameters, excitation and simulation tables."""
 from pathlib import Path
+from typing import Any
 
 from qzs._validation import known_keys, read_toml
 from qzs.errors import ParameterError
@@ -17,7 +18,7 @@ EXCITATION_KEYS = ("kind", *dict.fromkeys(o for v in EXCITATION_OPTIONS.values()
 SIMULATION_KEYS = ("dt", "sample_rate", "solver", "duration")
 
 
-def load_config(path):
+def load_config(path: str | Path) -> dict[str, Any]:
     """Read a TOML run configuration.
 
     Tables ``[isolator]`` and ``[controller]`` take the registry's parameter names

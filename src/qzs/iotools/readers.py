@@ -48,13 +48,16 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
 from qzs._validation import known_keys, read_toml, strictly_increasing
 from qzs._optional import require
 from qzs.errors import DataError, DataWarning, ParameterError
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["Recording", "ChannelMap", "ChannelSpec", "ROLES", "UNITS",
            "load_channel_map", "read_recording", "write_dspace_mat"]
@@ -129,7 +132,7 @@ class Recording:
         object.__setattr__(self, "units", MappingProxyType(dict(self.units)))
         object.__setattr__(self, "sample_rate", float(self.sample_rate))
 
-    def __getitem__(self, role):
+    def __getitem__(self, role: str) -> np.ndarray:
         try:
             return self.channels[role]
         except KeyError:
@@ -137,11 +140,11 @@ class Recording:
                            f"{sorted(self.channels)}.") from None
 
     @property
-    def duration(self):
+    def duration(self) -> float:
         """Time span of the recording [s]."""
         return float(self.time[-1] - self.time[0])
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """Repackage as an ``xarray.Dataset`` on coordinate ``time`` [s], units in attrs."""
         import xarray as xr
 
@@ -217,7 +220,7 @@ def _check_keys(table, allowed, where):
     known_keys(table, allowed, where, "channel map: ")
 
 
-def load_channel_map(source):
+def load_channel_map(source: str | Path | Mapping[str, Any] | ChannelMap) -> ChannelMap:
     """Parse a channel map from a TOML file, a TOML-like ``dict``, or pass a ChannelMap.
 
     Parameters
@@ -301,7 +304,8 @@ def _channel_spec(role, table):
 
 
 # ---------------------------------------------------------------- reading
-def read_recording(path, channel_map, *, resample=None, format=None):
+def read_recording(path: str | Path, channel_map: str | Path | Mapping[str, Any] | ChannelMap, *,
+                   resample: bool | None = None, format: str | None = None) -> Recording:
     """Read a test-rig log into a :class:`Recording`.
 
     Parameters

@@ -80,10 +80,10 @@ class Variable:
 
     name: str
     dims: tuple
-    units: str = None
-    long_name: str = None
+    units: str | None = None
+    long_name: str | None = None
     dtype: str = "float64"
-    flag_meanings: str = None
+    flag_meanings: str | None = None
     attributes: Mapping = field(default_factory=dict)
     order: tuple = ()
 

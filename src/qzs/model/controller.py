@@ -13,6 +13,7 @@ The control laws::
 Continuous, or sampled at ``controller_rate`` with zero-order hold (dSPACE DS1104).
 """
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -62,12 +63,14 @@ class ControllerParameters:
             "controller_rate": non_negative,
         })
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """Return the parameters as a plain ``dict``."""
         return asdict(self)
 
 
-def closed_loop_natural_frequency(isolator=None, controller=None, relative_position=None):
+def closed_loop_natural_frequency(isolator: IsolatorParameters | None = None,
+                                  controller: "ControllerParameters | None" = None,
+                                  relative_position: float | None = None) -> float:
     """Undamped natural frequency [Hz] of the payload with the PI loop closed.
 
     ``sqrt((k_spring(z) + Kp)/m) / (2*pi)`` with ``k_spring`` the MagSpring's

@@ -12,17 +12,19 @@ signal as the output samples (docs/model.md §6).
 """
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from qzs._validation import (as_float, choice, non_negative, parameter, positive,
                              strictly_increasing, validate_fields)
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
-__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
-           "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation", "read_displacement_csv",
-           "highest_frequency"]
+__all__ = ["Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "Excitation",
+           "EXCITATION_KINDS", "EXCITATION_OPTIONS", "DEFAULT_FADE_IN", "build_excitation",
+           "read_displacement_csv", "highest_frequency"]
 
 KIND_CHIRP_LINEAR, KIND_CHIRP_LOG, KIND_SINE, KIND_TABLE = 0, 1, 2, 3
 # Indices into the packed scalars; a table is a (5, n) array: breakpoints in row 0
@@ -119,11 +121,16 @@ class Chirp:
                 ("f0", "f1", "method"))
 
     @property
-    def max_frequency(self):
+    def max_frequency(self) -> float:
         """Highest frequency in the signal [Hz]."""
         return max(self.f0, self.f1)
 
-    def frequency_at(self, time):
+    @overload
+    def frequency_at(self, time: float) -> float: ...
+    @overload
+    def frequency_at(self, time: ArrayLike) -> float | NDArray[np.float64]: ...
+
+    def frequency_at(self, time: ArrayLike) -> float | NDArray[np.float64]:
         """Instantaneous frequency [Hz] at ``time`` [s] (held at ``f1`` after the sweep).
 
         Parameters
@@ -141,7 +148,7 @@ class Chirp:
             return self.f0 + (self.f1 - self.f0) * fraction
         return self.f0 * (self.f1 / self.f0) ** fraction
 
-    def pack(self):
+    def pack(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kernel form: ``(scalars, table)``."""
         kind = KIND_CHIRP_LINEAR if self.method == "linear" else KIND_CHIRP_LOG
         return (_pack(kind, self.amplitude, self.f0, self.f1, self.duration, fade=self.fade_in),
@@ -169,7 +176,7 @@ class Sine:
     amplitude: float = parameter(EXCITATION["amplitude"], "m", "sine displacement amplitude")
     frequency: float = parameter(1.0, "Hz", "sine frequency")
     phase: float = parameter(0.0, "rad", "phase at t = 0")
-    fade_in: float = parameter(None, "s", _FADE_DOC)
+    fade_in: float | None = parameter(None, "s", _FADE_DOC)
     duration = None  # unbounded: the run's duration is chosen by the caller
 
     def __post_init__(self):
@@ -181,11 +188,11 @@ class Sine:
         _resolve_fade(self)
 
     @property
-    def max_frequency(self):
+    def max_frequency(self) -> float:
         """Highest frequency in the signal [Hz]."""
         return self.frequency
 
-    def pack(self):
+    def pack(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kernel form: ``(scalars, table)``."""
         return (_pack(KIND_SINE, self.amplitude, self.frequency, phase=self.phase,
                       fade=self.fade_in), _NO_TABLE)
@@ -194,10 +201,15 @@ class Sine:
 class _Tabulated:
     """An excitation held as a C2 cubic spline of displacement (consistent derivatives)."""
 
+    if TYPE_CHECKING:  # defined by the subclasses: a field or a property
+        @property
+        def duration(self) -> float: ...
+        fade_in: float | None
+
     def _spline(self):  # pragma: no cover - defined by subclasses
         raise NotImplementedError
 
-    def pack(self):
+    def pack(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kernel form: ``(scalars, table)`` of the cubic spline."""
         spline, spacing = self._spline()
         table = np.zeros((5, spline.x.size))
@@ -236,7 +248,7 @@ class RandomExcitation(_Tabulated):
     f_high: float = parameter(20.0, "Hz", "upper band edge")
     duration: float = parameter(100.0, "s", "record length")
     seed: int = parameter(0, "1", "random seed")
-    fade_in: float = parameter(None, "s", _FADE_DOC)
+    fade_in: float | None = parameter(None, "s", _FADE_DOC)
 
     def __post_init__(self):
         validate_fields(self, {
@@ -256,7 +268,7 @@ class RandomExcitation(_Tabulated):
         _resolve_fade(self)
 
     @property
-    def max_frequency(self):
+    def max_frequency(self) -> float:
         """Highest frequency in the signal [Hz]."""
         return self.f_high
 
@@ -306,7 +318,7 @@ class DisplacementRecord(_Tabulated):
 
     time: np.ndarray = parameter(unit="s", doc="sample times")
     displacement: np.ndarray = parameter(unit="m", doc="base displacement")
-    fade_in: float = parameter(None, "s", _FADE_DOC)
+    fade_in: float | None = parameter(None, "s", _FADE_DOC)
 
     def __post_init__(self):
         time = np.asarray(self.time, dtype=float)
@@ -329,12 +341,12 @@ class DisplacementRecord(_Tabulated):
         _resolve_fade(self)
 
     @property
-    def duration(self):
+    def duration(self) -> float:
         """Length of the record [s]."""
         return float(self.time[-1])
 
     @property
-    def max_frequency(self):
+    def max_frequency(self) -> float:
         """Nyquist frequency of the record [Hz] (an upper bound of its content)."""
         return 0.5 / float(np.median(np.diff(self.time)))
 
@@ -346,8 +358,9 @@ class DisplacementRecord(_Tabulated):
         return CubicSpline(self.time, self.displacement), (steps.mean() if uniform else 0.0)
 
     @classmethod
-    def from_file(cls, path, *, time_column="time", displacement_column="displacement",
-                  fade_in=None):
+    def from_file(cls, path: str | Path, *, time_column: str = "time",
+                  displacement_column: str = "displacement",
+                  fade_in: float | None = None) -> "DisplacementRecord":
         """Read a record from a CSV file with a header (see :func:`read_displacement_csv`).
 
         Parameters
@@ -365,6 +378,9 @@ class DisplacementRecord(_Tabulated):
 
 
 #: Excitation kinds by the names configs, the command line and sweeps use.
+#: Any base excitation (a type for hints: ``excitation: Excitation``).
+Excitation = Chirp | Sine | RandomExcitation | DisplacementRecord
+
 EXCITATION_KINDS = {"chirp": Chirp, "sine": Sine, "random": RandomExcitation,
                     "file": DisplacementRecord}
 #: Options of each kind, as configs, the command line and sweeps spell them.

@@ -6,8 +6,10 @@ relative position (encoder), ``v = xd - yd`` relative (slip) velocity; upward po
     m * xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m * g
 """
 from dataclasses import asdict, dataclass
+from typing import Any, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from qzs._validation import as_float, choice, non_negative, optional, parameter, positive, validate_fields
 from qzs.errors import ParameterError
@@ -129,17 +131,17 @@ class IsolatorParameters:
             )
 
     @property
-    def weight_deficit(self):
+    def weight_deficit(self) -> float:
         """``m*g - a`` [N]: how much of the weight the spring's plateau cannot carry."""
         return self.mass * self.gravity - self.spring_force
 
     @property
-    def constant_force_edge(self):
+    def constant_force_edge(self) -> float:
         """Edge of the spring's constant-force region [m]: ``z`` below it is compressed so far
         that ``|F_spring| >= 0.99 a`` (docs/model.md §3); ``-atanh(0.99)/b``."""
         return -float(np.arctanh(1.0 - CONSTANT_FORCE_TOLERANCE)) / self.spring_shape
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """Return the parameters as a plain ``dict`` (``None`` values omitted)."""
         return {k: v for k, v in asdict(self).items() if v is not None}
 
@@ -183,7 +185,15 @@ class InitialState:
             )
 
 
-def spring_force(relative_position, params):
+@overload
+def spring_force(relative_position: float, params: "IsolatorParameters") -> float: ...
+@overload
+def spring_force(relative_position: ArrayLike,
+                 params: "IsolatorParameters") -> float | NDArray[np.float64]: ...
+
+
+def spring_force(relative_position: ArrayLike,
+                 params: "IsolatorParameters") -> float | NDArray[np.float64]:
     """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2).
 
     Parameters
@@ -202,7 +212,15 @@ def spring_force(relative_position, params):
     return -params.spring_force * np.tanh(params.spring_shape * z)
 
 
-def spring_stiffness(relative_position, params):
+@overload
+def spring_stiffness(relative_position: float, params: "IsolatorParameters") -> float: ...
+@overload
+def spring_stiffness(relative_position: ArrayLike,
+                     params: "IsolatorParameters") -> float | NDArray[np.float64]: ...
+
+
+def spring_stiffness(relative_position: ArrayLike,
+                     params: "IsolatorParameters") -> float | NDArray[np.float64]:
     """Tangent stiffness ``a*b/cosh(b*z)^2`` [N/m] of the MagSpring at ``z`` [m].
 
     Parameters
@@ -261,7 +279,15 @@ def friction_level(relative_velocity, params):
     return _friction_level(np.asarray(relative_velocity, dtype=float), params)[0]
 
 
-def friction_force(relative_velocity, params):
+@overload
+def friction_force(relative_velocity: float, params: "IsolatorParameters") -> float: ...
+@overload
+def friction_force(relative_velocity: ArrayLike,
+                   params: "IsolatorParameters") -> float | NDArray[np.float64]: ...
+
+
+def friction_force(relative_velocity: ArrayLike,
+                   params: "IsolatorParameters") -> float | NDArray[np.float64]:
     """Sliding friction [N] at slip velocity ``v`` [m/s] (eq. 3, signs of docs/model.md §3).
 
     ``-[Fc + (Fs - Fc)*exp(-Cbc*|v|)]*sign(v) - Cv*v``: it always opposes slip.
@@ -331,7 +357,7 @@ def _slip_direction(v, p):
     return np.sign(v)
 
 
-def passive_natural_frequency(params, relative_position):
+def passive_natural_frequency(params: "IsolatorParameters", relative_position: float) -> float:
     """Natural frequency [Hz] of the payload on the MagSpring alone, linearised at ``z`` [m].
 
     ``sqrt(k/m)/(2*pi)`` with ``k`` the tangent stiffness; about 0.08 Hz at the

@@ -25,6 +25,7 @@ import time as _time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -42,6 +43,14 @@ from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.excitation import Chirp
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.analysis.spectral import TransmissibilityEstimate, TransmissibilityMetrics
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["ExperimentResult", "process_experiment", "experiment_metrics", "infer_chirp",
            "run_experiment", "experiment_schema"]
@@ -162,18 +171,18 @@ class ExperimentResult:
 
     recording: Recording
     signal: str
-    measured: object
-    simulated: object
-    metrics: object
-    simulated_metrics: object
+    measured: TransmissibilityEstimate
+    simulated: TransmissibilityEstimate | None
+    metrics: TransmissibilityMetrics
+    simulated_metrics: TransmissibilityMetrics | None
     band: tuple
     highpass_corner: float
     untrusted_below: float
-    excitation: object
+    excitation: Chirp
     excitation_inferred: bool
-    isolator: object
-    controller: object
-    notes: tuple
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    notes: tuple[str, ...]
     simulation_seconds: float
 
     def _in_band(self, estimate):
@@ -187,7 +196,7 @@ class ExperimentResult:
         trusted = estimate.trusted[keep] & (f >= self.untrusted_below)
         return f, estimate.magnitude[keep], estimate.coherence[keep], trusted
 
-    def discrepancy_db(self):
+    def discrepancy_db(self) -> float:
         """Median ``|20 log10(measured/simulated)|`` [dB] over the trusted band (NaN if none)."""
         if self.simulated is None:
             return float("nan")
@@ -200,7 +209,7 @@ class ExperimentResult:
             return float("nan")
         return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
-    def plot(self, path=None, title=None):
+    def plot(self, path: str | Path | None = None, title: str | None = None) -> Figure:
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
 
         Parameters
@@ -218,7 +227,7 @@ class ExperimentResult:
 
         return plot_experiment(self, path=path, title=title)
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag
         (:func:`experiment_schema`)."""
         f, measured, coherence, trusted = self._in_band(self.measured)
@@ -231,7 +240,7 @@ class ExperimentResult:
                           {"source": self.recording.source,
                            "untrusted_below": self.untrusted_below})
 
-    def summary(self):
+    def summary(self) -> str:
         """A few lines: the log, the chirp, the flagged band, key metrics of both."""
         rec, chirp = self.recording, self.excitation
         lines = [f"experiment       {rec.source}",
@@ -257,7 +266,7 @@ class ExperimentResult:
         lines.extend(f"  note           {note}" for note in self.notes)
         return "\n".join(lines)
 
-    def to_record(self):
+    def to_record(self) -> dict[str, Any]:
         """The summary as data (plain types; NaN where a metric is undefined), for ``--json``.
 
         Returns
@@ -286,7 +295,7 @@ class ExperimentResult:
             "discrepancy_db": self.discrepancy_db(),
             "simulation_seconds": self.simulation_seconds, "notes": list(self.notes)}
 
-    def write_report(self, folder):
+    def write_report(self, folder: str | Path) -> dict[str, Path]:
         """Write ``transmissibility.png`` (+ .svg), ``transmissibility.csv`` and ``report.md``.
 
         Parameters
@@ -548,8 +557,10 @@ def _simulate_like(recording, kind, excitation, isolator, controller, corner, we
     return transmissibility(base, payload, rate, **welch), _time.perf_counter() - began
 
 
-def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, config=None,
-                   resample=False, simulate_match=True):
+def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
+                   fft_length: int | None = None, n_averages: int | None = None,
+                   config: str | Path | None = None, resample: bool = False,
+                   simulate_match: bool = True) -> tuple[ExperimentResult, dict[str, Path]]:
     """Read a log, process it (:func:`process_experiment`) and write its report (``qzs experiment``).
 
     The channel map's ``[experiment]`` table gives the high-pass corner [Hz], the chirp
@@ -608,7 +619,8 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
         loaded = load_config(config)
         isolator, controller = loaded["isolator"], loaded["controller"]
     corner = settings.get("highpass_corner", 1.0)
-    given = {k: settings[k] for k in ("amplitude", "f0", "f1", "method") if k in settings}
+    given: dict[str, Any] = {k: settings[k] for k in ("amplitude", "f0", "f1", "method")
+                             if k in settings}
     excitation = None
     if given:
         inferred = (infer_chirp(recording, highpass_corner=corner)

@@ -29,10 +29,16 @@ A hexapod file (``qzs hexapod linear --config FILE.toml``)::
 ``top_angle`` [deg]; ``joints`` takes ``base_joints`` and ``top_joints`` (6 x 3) and
 ``home_position`` (3) [m]. The model is described in docs/hexapod.md.
 """
+from __future__ import annotations
+
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from qzs._format import number
 from qzs._validation import read_toml, real
@@ -45,6 +51,10 @@ from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
                                radial_geometry)
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import PARAMETERS, update_parameters
+
+if TYPE_CHECKING:
+    from qzs.analysis.hexapod_linear import HexapodLinearModel
+    from qzs.engine.hexapod.result import HexapodResult
 
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
@@ -107,10 +117,10 @@ class HexapodSetup:
     excitation: dict = field(default_factory=dict)
     simulation: dict = field(default_factory=dict)
     source: str = ""
-    cartesian: CartesianController = None
+    cartesian: CartesianController | None = None
 
 
-def default_cube_center_height(cube_edge):
+def default_cube_center_height(cube_edge: float) -> float:
     """Height [m] of the cube's centre that puts the legs' lower ends on the base plane.
 
     The six legs of the cubic configuration run along six edges of a cube standing on a
@@ -284,8 +294,12 @@ def _cartesian(table, geometry, platform, controller, where):
                                   for name in _CARTESIAN_KEYS[1:]}, point=point)
 
 
-def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=None,
-                  settings=None, kind="joints", cartesian=None):
+def hexapod_setup(*, geometry: HexapodGeometry | None = None,
+                  platform: PlatformParameters | None = None,
+                  isolator: IsolatorParameters | None = None,
+                  controller: ControllerParameters | None = None,
+                  settings: Mapping[str, Any] | None = None, kind: str = "joints",
+                  cartesian: CartesianController | str | None = None) -> HexapodSetup:
     """A :class:`HexapodSetup` from objects, with registry overrides applied to every leg.
 
     Parameters
@@ -336,7 +350,8 @@ def hexapod_setup(*, geometry=None, platform=None, isolator=None, controller=Non
                         controller=controller, kind=kind, cartesian=cartesian)
 
 
-def centralised(setup, *, point="origin"):
+def centralised(setup: HexapodSetup, *,
+                point: str | ArrayLike = "origin") -> HexapodSetup:
     """The set-up with centralised control: Cartesian loops with the legs' stiffness on each
     axis (:meth:`~qzs.model.hexapod.CartesianController.from_legs`, docs/hexapod.md §9.5).
 
@@ -366,7 +381,8 @@ def centralised(setup, *, point="origin"):
     return dataclasses.replace(setup, cartesian=cartesian)
 
 
-def load_hexapod(path, settings=None):
+def load_hexapod(path: str | Path,
+                 settings: Mapping[str, Any] | None = None) -> HexapodSetup:
     """Read a hexapod TOML file (the layout of this module's docstring).
 
     Parameters
@@ -429,7 +445,9 @@ def load_hexapod(path, settings=None):
                         simulation=simulation, source=str(path), cartesian=cartesian)
 
 
-def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_preload=True):
+def linear_record(setup: HexapodSetup, *, leg_stiffness: float | None = None,
+                  frame: str | ArrayLike = "center_of_mass",
+                  include_preload: bool = True) -> tuple[HexapodLinearModel, dict[str, Any]]:
     """The linear analysis of a set-up as data (``qzs hexapod linear --json``).
 
     Parameters
@@ -488,7 +506,8 @@ def linear_record(setup, *, leg_stiffness=None, frame="center_of_mass", include_
     return model, record
 
 
-def linear_text(setup, model, record):
+def linear_text(setup: HexapodSetup, model: HexapodLinearModel,
+                record: Mapping[str, Any]) -> str:
     """The linear analysis as text for people (``qzs hexapod linear``).
 
     Parameters
@@ -511,7 +530,8 @@ def linear_text(setup, model, record):
              + ("" if record["include_preload"] else ", without the preload stiffness")]
     if setup.cartesian is not None:
         point = setup.cartesian.point
-        where = f"the {_FRAME_WORDS[point]}" if isinstance(point, str) else f"{list(point)} m"
+        where = (f"the {_FRAME_WORDS[point]}" if isinstance(point, str)
+                 else f"{list(point)} m")  # type: ignore[call-overload]  # a 3-vector
         gains = " ".join(f"{v:.4g}" for v in setup.cartesian.position_gain)
         lines.append(f"  centralised control: PI and damping loops on the platform's axes at "
                      f"{where}, Kp {gains} (N/m x3, N*m/rad x3)")
@@ -541,7 +561,10 @@ def linear_text(setup, model, record):
     return "\n".join(lines)
 
 
-def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50.0), points=400):
+def plot_linear_transmissibility(setup: HexapodSetup, model: HexapodLinearModel,
+                                 out: str | Path, *,
+                                 frequency_range: tuple[float, float] = (0.05, 50.0),
+                                 points: int = 400) -> Path:
     """Write the linear model's 6x6 transmissibility grid (:mod:`qzs.viz.hexapod_matrix`).
 
     Parameters
@@ -578,9 +601,13 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
     return Path(out)
 
 
-def simulate_setup(setup, *, excitation=None, duration=None, dt=None, sample_rate=None,
-                   solver=None, progress=False, out=None, interruptible=False,
-                   argument="out", names=None):
+def simulate_setup(setup: HexapodSetup, *,
+                   excitation: Mapping[str, Mapping[str, Any]] | None = None,
+                   duration: float | None = None, dt: float | None = None,
+                   sample_rate: float | None = None, solver: str | None = None,
+                   progress: bool = False, out: str | Path | None = None,
+                   interruptible: bool = False, argument: str = "out",
+                   names: Mapping[str, str] | None = None) -> HexapodResult:
     """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
 
     With ``out`` every sample is streamed to that NetCDF file as the run goes

@@ -30,9 +30,11 @@ the figures (PNG and SVG) and each case's matrix as NetCDF.
 import functools
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -46,6 +48,9 @@ from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
            "comparison_figure",
@@ -64,7 +69,7 @@ STUDY_AXES = ("z", "x")
 #: Run settings of the full and the quick study: chirp length [s] and step [s] (None: the
 #: accuracy-driven step of :mod:`qzs.workflows.hexapod_transmissibility`, falling back to
 #: the file's 1e-4 s where the probe's differences do not shrink).
-RUNS = MappingProxyType({
+RUNS: Mapping[str, Mapping[str, Any]] = MappingProxyType({
     "full": MappingProxyType({"duration": 400.0, "dt": None}),
     "quick": MappingProxyType({"duration": 60.0, "dt": 1e-3}),
 })
@@ -108,7 +113,7 @@ class HexapodStudyResult:
     folder: Path
     files: MappingProxyType
 
-    def summary(self):
+    def summary(self) -> str:
         """Short text: the metrics of each case and axis, and the findings.
 
         Returns
@@ -117,7 +122,7 @@ class HexapodStudyResult:
         """
         return _summary_text(self)
 
-    def plot(self, out=None):
+    def plot(self, out: str | Path | None = None) -> "Figure":
         """The comparison figure of the cases (:func:`comparison_figure`).
 
         Parameters
@@ -359,8 +364,8 @@ def _findings(cases, rows):
 
 
 # ---------------------------------------------------------------- the run
-def run_hexapod_study(folder="results/hexapod_study", *, quick=False, workers=None,
-                      progress=True):
+def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bool = False,
+                      workers: int | None = None, progress: bool = True) -> HexapodStudyResult:
     """Run the shipped hexapod study and write its report (``qzs hexapod study``).
 
     Parameters

@@ -15,8 +15,10 @@ case, ordered by that parameter, and needs at least three cases; with fewer it i
 """
 import html
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +34,7 @@ from qzs.model.registry import PARAMETERS, format_value, unit_of, update_paramet
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.studies import CLAIMS as STATEMENTS
-from qzs.workflows.studies import load_study, run_studies, shipped_studies
+from qzs.workflows.studies import StudyResult, load_study, run_studies, shipped_studies
 
 __all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "paper_summary",
            "write_paper_outputs", "run_paper"]
@@ -71,13 +73,13 @@ class Verdict:
 
     claim: str
     statement: str
-    reproduced: object
+    reproduced: bool | None
     evidence: str
     study: str = ""
     decidable: bool = True
 
     @property
-    def label(self):
+    def label(self) -> str:
         """``"reproduced"``, ``"not reproduced"``, ``"partly reproduced"`` or ``"not decidable"``."""
         if not self.decidable:
             return "not decidable"
@@ -518,7 +520,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
     return verdicts
 
 
-def paper_summary(study_results, verdicts, folder, *, quick=False, wall_seconds=None):
+def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdict],
+                  folder: str | Path, *, quick: bool = False,
+                  wall_seconds: float | None = None) -> dict[str, Any]:
     """What ``qzs paper --json`` prints: claims, per-case metrics, output paths.
 
     Parameters
@@ -709,8 +713,10 @@ def _case_table(result):
     return "\n".join(rows)
 
 
-def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=None,
-              progress=True, argument="folder"):
+def run_paper(definitions: Sequence[str | Path] | None = None,
+              folder: str | Path = "results/paper", *, quick: bool = False,
+              workers: int | None = None, progress: bool = True,
+              argument: str = "folder") -> tuple[list[StudyResult], list[Verdict], float]:
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
     Parameters

@@ -4,7 +4,11 @@
 >>> from qzs.workflows.run import simulate_to_file
 >>> result = simulate_to_file("run.nc", Chirp(duration=100.0, f1=5.0))  # doctest: +SKIP
 """
+from __future__ import annotations
+
+from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from qzs import defaults
 from qzs.engine.prepare import run_inputs
@@ -13,17 +17,27 @@ from qzs.engine.simulate import simulate
 from qzs.iotools.files import RESULT_SUFFIXES as _FORMATS
 from qzs.iotools.paths import check_output_path
 
+if TYPE_CHECKING:
+    from qzs.engine.results import SimulationResult
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.isolator import InitialState, IsolatorParameters
+
 __all__ = ["simulate_to_file", "RESULT_SUFFIXES"]
 
 #: File formats a run can be written to, by extension.
 RESULT_SUFFIXES = tuple(_FORMATS)
 
 
-def simulate_to_file(path, excitation=None, isolator=None, controller=None, *, duration=None,
-                     dt=defaults.SIMULATION["dt"],
-                     sample_rate=defaults.SIMULATION["sample_rate"],
-                     solver=defaults.SIMULATION["solver"], initial_state=None, progress=False,
-                     interruptible=False, argument="path", run_entries=None):
+def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
+                     isolator: IsolatorParameters | None = None,
+                     controller: ControllerParameters | None = None, *,
+                     duration: float | None = None, dt: float = defaults.SIMULATION["dt"],
+                     sample_rate: float = defaults.SIMULATION["sample_rate"],
+                     solver: str = defaults.SIMULATION["solver"],
+                     initial_state: InitialState | None = None, progress: bool = False,
+                     interruptible: bool = False, argument: str = "path",
+                     run_entries: Mapping[str, Any] | None = None) -> SimulationResult:
     """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are

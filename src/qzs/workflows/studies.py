@@ -164,10 +164,10 @@ class CaseResult:
 
     label: str
     settings: dict
-    frequency: np.ndarray = None
-    magnitude: np.ndarray = None
-    coherence: np.ndarray = None
-    trusted: np.ndarray = None
+    frequency: np.ndarray | None = None
+    magnitude: np.ndarray | None = None
+    coherence: np.ndarray | None = None
+    trusted: np.ndarray | None = None
     metrics: dict = field(default_factory=dict)
     reasons: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)

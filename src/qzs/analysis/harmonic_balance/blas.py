@@ -25,7 +25,7 @@ def _single_threaded_blas():
         setter(previous)
 
 
-_BLAS_CONTROL = []
+_BLAS_CONTROL: list[tuple] = []
 
 
 def _blas_thread_control():

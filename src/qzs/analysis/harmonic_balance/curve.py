@@ -1,5 +1,6 @@
 """The frequency-response curve: a branch of periodic responses with stability and folds."""
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -71,7 +72,7 @@ class FrequencyResponseCurve:
     harmonics: int
     notes: tuple = field(default=())
 
-    def solution(self, index):
+    def solution(self, index: int) -> HarmonicBalanceSolution:
         """The periodic solution of one point of the curve.
 
         Parameters
@@ -88,7 +89,7 @@ class FrequencyResponseCurve:
                                        float(self.integral_mean[index]), self.model, True, 0,
                                        0.0)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The curve as plain lists (NaN kept), for JSON.
 
         Returns

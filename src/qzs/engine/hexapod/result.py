@@ -5,7 +5,14 @@
 :meth:`HexapodResult.to_xarray` builds and :class:`HexapodWriter` (a configuration of
 :class:`qzs.iotools.writer.StreamWriter`) streams.
 """
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from numpy.typing import NDArray
 
 from qzs.defaults import AXIS_RATE_UNITS, AXIS_UNITS
 from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
@@ -19,6 +26,15 @@ from qzs.iotools.paths import check_output_path
 from qzs.iotools.schema import CONVENTIONS, Schema, Variable, time_coordinate, to_dataset
 from qzs.iotools.writer import StreamWriter, estimated_file_size
 from qzs.model.registry import unit_of
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.hexapod import HexapodGeometry, PlatformParameters
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_schema",
            "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size", "HEXAPOD_SUFFIXES",
@@ -316,8 +332,12 @@ class HexapodResult:
         :mod:`qzs.engine.hexapod.statistics`); computed from ``data`` if omitted.
     """
 
-    def __init__(self, data, flags, *, geometry, platform, isolators, controllers, excitation,
-                 run, statistics=None):
+    def __init__(self, data: NDArray[np.float64], flags: NDArray[np.bool_], *,
+                 geometry: HexapodGeometry, platform: PlatformParameters,
+                 isolators: Iterable[IsolatorParameters],
+                 controllers: Iterable[ControllerParameters],
+                 excitation: Mapping[str, Excitation], run: dict[str, Any],
+                 statistics: dict[str, Any] | None = None) -> None:
         self._data = data
         self._flags = flags
         self.geometry = geometry
@@ -332,7 +352,7 @@ class HexapodResult:
             statistics = running.result()
         self.statistics = statistics
 
-    def __getitem__(self, name):
+    def __getitem__(self, name: str) -> NDArray[Any]:
         if name in HEXAPOD_CHANNELS:
             column, dim = HEXAPOD_CHANNELS[name][:2]
             return self._data[:, column] if dim is None else self._data[:, column:column + 6]
@@ -342,12 +362,12 @@ class HexapodResult:
         raise KeyError(f"no channel {name!r}; channels are "
                        f"{', '.join([*HEXAPOD_CHANNELS, *HEXAPOD_FLAGS])}.")
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> NDArray[Any]:
         if name.startswith("_") or (name not in HEXAPOD_CHANNELS and name not in HEXAPOD_FLAGS):
             raise AttributeError(name)
         return self[name]
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self._data.shape[0]
 
     def __repr__(self):
@@ -355,16 +375,16 @@ class HexapodResult:
                 f"{self.run['solver']} dt={self.run['dt']:g} s>")
 
     @property
-    def steps_per_second(self):
+    def steps_per_second(self) -> float:
         """Integration throughput of the run [steps/s]."""
         return self.run["steps"] / max(self.run["elapsed"], 1e-12)
 
-    def mechanical_energy(self):
+    def mechanical_energy(self) -> NDArray[np.float64]:
         """Kinetic + spring + gravity + stop elastic energy [J] at each sample."""
         return (self["kinetic_energy"] + self["spring_energy"] + self["gravity_energy"]
                 + self["stop_energy"])
 
-    def energy_residual(self):
+    def energy_residual(self) -> NDArray[np.float64]:
         """Energy-ledger imbalance [J]: change of mechanical energy minus the net work.
 
         ``dE - (W_base + W_motor - D_friction - D_stop)``; zero up to the integrator's
@@ -375,7 +395,7 @@ class HexapodResult:
                - self["stop_dissipation"])
         return energy - energy[0] - net
 
-    def metadata(self):
+    def metadata(self) -> dict[str, tuple[Any, str]]:
         """Every parameter and run setting with its unit: ``{key: (value, unit)}``.
 
         Keys ``platform.<name>``, ``geometry.<name>``, ``isolator.<name>`` and
@@ -409,7 +429,7 @@ class HexapodResult:
             meta[f"run.{key}"] = (value, units.get(key, "1" if key != "solver" else "-"))
         return meta
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The run as an ``xarray.Dataset`` with dimensions ``time``, ``dof`` and ``leg``.
 
         CF-1.10 as :meth:`qzs.engine.results.SimulationResult.to_xarray` (time in plain
@@ -425,7 +445,7 @@ class HexapodResult:
                   for name in schema.names}
         return to_dataset(schema, values, self.global_attributes(), boolean_flags=True)
 
-    def global_attributes(self):
+    def global_attributes(self) -> dict[str, Any]:
         """The file's global attributes: CF conventions, provenance, every parameter and run
         setting (``<key>`` with its unit in ``<key>_units``)."""
         import datetime
@@ -447,11 +467,11 @@ class HexapodResult:
                 attrs[f"{key}_units"] = unit
         return attrs
 
-    def summary(self):
+    def summary(self) -> str:
         """One-screen text summary: per leg stroke used, contacts, time locked, motor RMS."""
         return _summary_text(self)
 
-    def save(self, path):
+    def save(self, path: str | Path) -> Path:
         """Write the run to NetCDF or MATLAB (:func:`save_hexapod_result`).
 
         Parameters
@@ -465,7 +485,7 @@ class HexapodResult:
         """
         return save_hexapod_result(self, path)
 
-    def plot(self, **kwargs):
+    def plot(self, **kwargs: Any) -> Figure:
         """Plot the run (see :func:`qzs.viz.hexapod.plot_hexapod`).
 
         Parameters

@@ -6,6 +6,11 @@ kernels of :mod:`qzs.engine.hexapod.stepping`, returned as a
 :class:`~qzs.engine.hexapod.result.HexapodResult` (or streamed to a sink).
 """
 
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from qzs import defaults
@@ -20,17 +25,28 @@ from qzs.engine.hexapod.stepping import _run, _start
 from qzs.engine import driver
 from qzs.errors import CaseError, ParameterError, SimulationError
 
+if TYPE_CHECKING:
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.hexapod import CartesianController, HexapodGeometry, PlatformParameters
+    from qzs.model.isolator import IsolatorParameters
+
 #: Output samples per kernel call at most (the hexapod's 99 channels: 158 MB).
 PREVIEW_CHUNK = 200_000
 
 __all__ = ["simulate_hexapod", "simulate_hexapods"]
 
 
-def simulate_hexapod(geometry, platform, isolator=None, controller=None, *, excitation=None,
-                     duration=None, dt=defaults.SIMULATION["dt"],
-                     sample_rate=defaults.SIMULATION["sample_rate"],
-                     solver=defaults.SIMULATION["solver"], cartesian=None, progress=False,
-                     sink=None, interruptible=False):
+def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
+                     isolator: IsolatorParameters | Sequence[IsolatorParameters] | None = None,
+                     controller: ControllerParameters | Sequence[ControllerParameters]
+                     | None = None, *, excitation: Mapping[str, Excitation] | None = None,
+                     duration: float | None = None, dt: float = defaults.SIMULATION["dt"],
+                     sample_rate: float = defaults.SIMULATION["sample_rate"],
+                     solver: str = defaults.SIMULATION["solver"],
+                     cartesian: CartesianController | None = None, progress: bool = False,
+                     sink: Callable[[Any, Any], Any] | None = None,
+                     interruptible: bool = False) -> HexapodResult:
     """Simulate a six-leg platform of isolator legs under a base moving in up to six axes.
 
     A rigid platform on six single-axis isolator legs (docs/hexapod.md, "Dynamics"): each
@@ -178,7 +194,8 @@ class _SixLegs(driver.Stepper):
             "`dt`.")
 
 
-def simulate_hexapods(runs, *, workers=None, progress=False):
+def simulate_hexapods(runs: Sequence[Mapping[str, Any]], *, workers: int | None = None,
+                      progress: bool = False) -> list[HexapodResult]:
     """Simulate several platforms at once, in threads (the hexapod kernel holds no GIL).
 
     Every run is checked before any integration starts (a bad one is named by its index);

@@ -7,9 +7,13 @@ need; hunting at rest (:mod:`.hunting`); the sampled loop's margins (:mod:`.marg
 damping did not help much (:mod:`.damping_effect`); the linear stability and the static
 design of the final gains. Each stage's wall time is in :attr:`DesignResult.seconds`.
 """
+from __future__ import annotations
+
 import dataclasses
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,14 +28,27 @@ from qzs.workflows.design.proportional_search import _run_cases, _search_pi, _su
 from qzs.workflows.design.result import DesignResult
 from qzs.workflows.design.settings import BISECTIONS, DAMPING_GAIN_MAX, DAMPING_POINTS, KP_GRID
 
+if TYPE_CHECKING:
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation
+    from qzs.model.isolator import IsolatorParameters
+
 __all__ = ["design_controller"]
 
 
-def design_controller(isolator=None, controller=None, *, excitation=None, stiction_range=None,
-                      mass_range=None, force_steps=(-2.0, 2.0), band=(1.0, 20.0), cost="rms",
-                      controller_rate=None, delay=0.0, quick=False, dt=None,
-                      damping_gain_max=DAMPING_GAIN_MAX, gain_margin_min=cd.GAIN_MARGIN_MIN,
-                      phase_margin_min=cd.PHASE_MARGIN_MIN, workers=None, progress=False):
+def design_controller(isolator: IsolatorParameters | None = None,
+                      controller: ControllerParameters | None = None, *,
+                      excitation: Chirp | RandomExcitation | DisplacementRecord | None = None,
+                      stiction_range: tuple[float, float] | None = None,
+                      mass_range: tuple[float, float] | None = None,
+                      force_steps: Sequence[float] = (-2.0, 2.0),
+                      band: tuple[float, float] = (1.0, 20.0), cost: str = "rms",
+                      controller_rate: float | None = None, delay: float = 0.0,
+                      quick: bool = False, dt: float | None = None,
+                      damping_gain_max: float = DAMPING_GAIN_MAX,
+                      gain_margin_min: float = cd.GAIN_MARGIN_MIN,
+                      phase_margin_min: float = cd.PHASE_MARGIN_MIN, workers: int | None = None,
+                      progress: bool = False) -> DesignResult:
     """Design the PI and damping gains of the isolator by simulation (docs/design.md).
 
     Parameters
@@ -114,7 +131,7 @@ class _Choice:
     curves: dict
     kd: float
     verification: dict
-    first_search: dict = None
+    first_search: dict | None = None
 
 
 def _bar(settings, total, desc):

@@ -1,10 +1,19 @@
 """The design's result: the chosen gains with the evidence for each choice, and its files."""
+from __future__ import annotations
+
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from qzs._format import json_ready, json_text
 from qzs._version import __version__
 from qzs.iotools.files import atomic_path
 from qzs.workflows.design.report import _html, design_text
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from qzs.analysis.control_design import RouthHurwitz, StaticDesign
 
 __all__ = ["DesignResult"]
 
@@ -46,9 +55,9 @@ class DesignResult:
 
     gains: dict
     settings: dict
-    static: object
+    static: StaticDesign
     pi_search: dict
-    stability: object
+    stability: RouthHurwitz
     hunting: dict
     damping: dict
     margins: dict
@@ -57,7 +66,7 @@ class DesignResult:
     seconds: dict
     series: dict = field(default_factory=dict, repr=False)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """Everything but the figures' series, as JSON-ready data (NaN and inf as None).
 
         Returns
@@ -73,7 +82,7 @@ class DesignResult:
                            "margins": self.margins, "why": self.why,
                            "verification": self.verification, "seconds": self.seconds})
 
-    def summary(self):
+    def summary(self) -> str:
         """The design in a few lines of text (what ``qzs design`` prints).
 
         Returns
@@ -82,7 +91,7 @@ class DesignResult:
         """
         return design_text(self)
 
-    def plot(self):
+    def plot(self) -> dict[str, Figure]:
         """Draw every figure of the design.
 
         Returns
@@ -94,7 +103,7 @@ class DesignResult:
 
         return plot_design(self)
 
-    def save(self, folder):
+    def save(self, folder: str | Path) -> dict[str, Path]:
         """Write ``report.html``, ``design.json`` and the figures (PNG and SVG) into ``folder``.
 
         Each file is written atomically (a temporary file renamed onto it).

@@ -1,5 +1,9 @@
 """The entry point: the runs in parallel processes, assembled into the 6x6 matrix."""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -10,12 +14,19 @@ from qzs.workflows.hexapod_transmissibility.result import HexapodTransmissibilit
 from qzs.workflows.hexapod_transmissibility.runs import run_axis
 from qzs.workflows.hexapod_transmissibility.settings import CHIRP, FLOOR_DB, _scale
 
+if TYPE_CHECKING:
+    from qzs.workflows.hexapod import HexapodSetup
+
 
 # ---------------------------------------------------------------- the matrix
-def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"],
-                             f1=CHIRP["f1"], duration=CHIRP["duration"], dt=None,
-                             sample_rate=None, solver=None, fft_length=None, estimator="h1",
-                             floor_db=FLOOR_DB, workers=None, progress=True):
+def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str = AXES,
+                             amplitude: float | Mapping[str, float] | None = None,
+                             f0: float = CHIRP["f0"], f1: float = CHIRP["f1"],
+                             duration: float = CHIRP["duration"], dt: float | None = None,
+                             sample_rate: float | None = None, solver: str | None = None,
+                             fft_length: int | None = None, estimator: str = "h1",
+                             floor_db: float = FLOOR_DB, workers: int | None = None,
+                             progress: bool = True) -> HexapodTransmissibility:
     """Simulate one chirp per base axis and estimate the 6x6 transmissibility matrix.
 
     Each axis of ``axes`` is one run of :func:`qzs.engine.hexapod.simulate_hexapod` with

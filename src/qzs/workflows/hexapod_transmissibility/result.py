@@ -1,8 +1,11 @@
 """The result: the 6x6 matrix with its trusted entries, and its views (summary, record, file)."""
+from __future__ import annotations
+
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -11,6 +14,12 @@ from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.workflows.hexapod import HexapodSetup
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)
@@ -88,19 +97,19 @@ class HexapodTransmissibility:
     energy_residual: MappingProxyType
     runs: MappingProxyType
     settings: MappingProxyType
-    setup: object = field(repr=False)
+    setup: HexapodSetup = field(repr=False)
 
     @property
-    def magnitude(self):
+    def magnitude(self) -> np.ndarray:
         """``|response|`` [1, m/rad, rad/m], shape (n, 6, 6); NaN in columns not excited."""
         return np.abs(self.response)
 
     @property
-    def excited(self):
+    def excited(self) -> np.ndarray:
         """Which base axes were excited, one flag per axis of :data:`AXES` [-]."""
         return np.array([axis in self.excited_axes for axis in AXES])
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """Repackage as an ``xarray.Dataset`` (:func:`transmissibility_dataset`).
 
         Dimensions ``frequency`` [Hz], ``output_dof`` and ``input_dof`` (``x … rz``);
@@ -112,7 +121,7 @@ class HexapodTransmissibility:
         """
         return transmissibility_dataset(self)
 
-    def plot(self, out=None, *, title=None):
+    def plot(self, out: str | Path | None = None, *, title: str | None = None) -> Figure:
         """The 6x6 grid with the linear model dashed (:func:`qzs.viz.hexapod_matrix.
         plot_transmissibility_matrix`); columns not excited are left empty.
 
@@ -136,7 +145,7 @@ class HexapodTransmissibility:
             linear_label=None if self.linear_stable else "linear model (UNSTABLE loop)",
             untrusted_below=self.settings["trusted_from"])
 
-    def save(self, path):
+    def save(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` as NetCDF (h5netcdf), atomically.
 
         Parameters
@@ -158,7 +167,7 @@ class HexapodTransmissibility:
             self.to_xarray().to_netcdf(tmp, engine="h5netcdf")
         return path
 
-    def summary(self):
+    def summary(self) -> str:
         """One-screen text (:func:`transmissibility_summary`).
 
         Returns
@@ -255,7 +264,7 @@ def transmissibility_summary(result):
     return "\n".join(lines)
 
 
-def transmissibility_record(result):
+def transmissibility_record(result: HexapodTransmissibility) -> dict[str, Any]:
     """The matrix's summary as data (``qzs hexapod transmissibility --json``).
 
     Parameters

@@ -6,15 +6,30 @@ linear model and the chirp beside them, and reads them (branches, jumps, hystere
 table). Its files are written by :mod:`~qzs.workflows.response.files`, its figure by
 :mod:`qzs.viz.response`.
 """
+from __future__ import annotations
+
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from qzs._format import decibels
 from qzs._validation import choice
 from qzs.workflows.response.files import POINT_FIELDS, response_dataset
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.analysis.harmonic_balance import FrequencyResponseCurve
+    from qzs.analysis.spectral import TransmissibilityEstimate
+    from qzs.engine.accuracy import StepChoice
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["ResponsePoint", "SteadyStateResponse"]
 
@@ -96,7 +111,7 @@ class ResponsePoint:
     dt: float
     seconds: float
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The point as a plain dict (``harmonics`` as a list).
 
         Returns
@@ -148,28 +163,28 @@ class SteadyStateResponse:
         Wall time of the whole response [s].
     """
 
-    points: tuple
+    points: tuple[ResponsePoint, ...]
     frequencies: np.ndarray
     amplitude: float
-    isolator: object
-    controller: object
+    isolator: IsolatorParameters
+    controller: ControllerParameters
     solver: str
     dt: float
-    step: object
+    step: StepChoice | None
     settings: dict
-    balance: object = None
+    balance: FrequencyResponseCurve | None = None
     linear: dict = field(default_factory=dict)
-    chirp: object = None
-    notes: tuple = ()
+    chirp: TransmissibilityEstimate | None = None
+    notes: tuple[str, ...] = ()
     elapsed: float = 0.0
 
     @property
-    def directions(self):
+    def directions(self) -> tuple[str, ...]:
         """The sweeps run, in the order ``up``, ``down`` [-]."""
         present = {p.direction for p in self.points}
         return tuple(d for d in ("up", "down") if d in present)
 
-    def branch(self, direction):
+    def branch(self, direction: str) -> dict[str, np.ndarray]:
         """One sweep's points as arrays in ascending frequency.
 
         Parameters
@@ -193,7 +208,7 @@ class SteadyStateResponse:
             out[name] = np.array([getattr(p, name) for p in points], dtype=object)
         return out
 
-    def chirp_at(self, frequencies=None):
+    def chirp_at(self, frequencies: ArrayLike | None = None) -> np.ndarray:
         """The chirp estimate at ``frequencies``, between trusted bins only (NaN elsewhere).
 
         Parameters
@@ -214,7 +229,7 @@ class SteadyStateResponse:
         return transmissibility_at(self.chirp.frequency, self.chirp.magnitude, at,
                                    trusted=self.chirp.trusted)
 
-    def hysteresis(self, threshold_db=0.1):
+    def hysteresis(self, threshold_db: float = 0.1) -> np.ndarray:
         """Frequencies where the up and down sweeps settle on different responses.
 
         Parameters
@@ -234,7 +249,8 @@ class SteadyStateResponse:
             gap = np.abs(decibels(up["transmissibility"] / down["transmissibility"]))
         return up["frequency"][gap > threshold_db]
 
-    def jumps(self, threshold_db=1.0, agreement_db=0.1):
+    def jumps(self, threshold_db: float = 1.0,
+              agreement_db: float = 0.1) -> dict[str, list[tuple[float, float]]]:
         """Where each sweep jumps from one branch to another.
 
         A sweep jumps between neighbouring frequencies where it lands on the other sweep's
@@ -274,7 +290,7 @@ class SteadyStateResponse:
                 down.append((float(f[i + 1]), float(f[i])))
         return {"up": up, "down": down[::-1]}
 
-    def to_records(self):
+    def to_records(self) -> list[dict[str, Any]]:
         """One plain dict per point (``frequency`` [Hz], ``transmissibility`` [-] and the
         rest of :class:`ResponsePoint`), with the chirp estimate and the linear model's
         value at its frequency.
@@ -299,7 +315,7 @@ class SteadyStateResponse:
             return [math.nan] * len(frequencies)
         return np.asarray(self.linear["at_frequencies"], dtype=float).tolist()
 
-    def to_record(self):
+    def to_record(self) -> dict[str, Any]:
         """The whole response as data, for ``--json``.
 
         Returns
@@ -320,7 +336,7 @@ class SteadyStateResponse:
                 "hysteresis": self.hysteresis().tolist(), "notes": list(self.notes),
                 "elapsed": self.elapsed}
 
-    def summary(self):
+    def summary(self) -> str:
         """A table of the sweeps and what to know about them.
 
         Returns
@@ -362,7 +378,7 @@ class SteadyStateResponse:
         lines.extend(f"  note: {note}" for note in self.notes)
         return "\n".join(lines)
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The response as an ``xarray.Dataset``: sweeps on ``(direction, frequency)``.
 
         Variables of :class:`ResponsePoint` on ``(direction, frequency)`` (``harmonics`` on
@@ -377,7 +393,7 @@ class SteadyStateResponse:
         """
         return response_dataset(self)
 
-    def plot(self, path=None, title=None):
+    def plot(self, path: str | Path | None = None, title: str | None = None) -> Figure:
         """The figure (:func:`qzs.viz.response.plot_response`).
 
         Parameters
@@ -395,7 +411,7 @@ class SteadyStateResponse:
 
         return plot_response(self, path=path, title=title)
 
-    def save(self, path):
+    def save(self, path: str | Path) -> Path:
         """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point),
         ``.json`` (:meth:`to_record`) or ``.mat`` (MATLAB, the NetCDF's variables).
 

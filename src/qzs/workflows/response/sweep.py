@@ -5,10 +5,14 @@ chirp over the band) and the time cap per frequency, then runs the sweeps
 (:mod:`~qzs.workflows.response.pool`) beside the harmonic balance and the chirp, and
 gathers a :class:`~qzs.workflows.response.result.SteadyStateResponse`.
 """
+from __future__ import annotations
+
 import math
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from qzs import defaults
 from qzs._validation import choice, integer, positive, worker_count
@@ -19,6 +23,10 @@ from qzs.workflows.response.frequency import (CONSECUTIVE_PERIODS, MAX_PERIOD_MU
                                               PERIODIC_TOLERANCE, SAMPLES_PER_PERIOD)
 from qzs.workflows.response.pool import _run_chains
 from qzs.workflows.response.result import SteadyStateResponse
+
+if TYPE_CHECKING:
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["steady_state_response", "settle_time_cap", "DIRECTIONS", "MAX_PERIODS"]
 
@@ -143,15 +151,20 @@ def _choose_step(frequencies, amplitude, isolator, controller, solver, tolerance
                            f"{step.error:.2g} dB)")
 
 
-def steady_state_response(frequencies, amplitude=defaults.EXCITATION["amplitude"],
-                          isolator=None, controller=None, *, direction="both", dt=None,
-                          tolerance_db=None,
-                          solver=defaults.SIMULATION["solver"],
-                          periodic_tolerance=PERIODIC_TOLERANCE, max_periods=MAX_PERIODS,
-                          max_time=None, fade_in=FADE_IN, harmonics=HARMONICS,
-                          harmonic_balance=True,
-                          friction_velocity=None, balance_harmonics=None, compare_chirp=False,
-                          workers=None, progress=False):
+def steady_state_response(frequencies: ArrayLike,
+                          amplitude: float = defaults.EXCITATION["amplitude"],
+                          isolator: IsolatorParameters | None = None,
+                          controller: ControllerParameters | None = None, *,
+                          direction: str = "both", dt: float | None = None,
+                          tolerance_db: float | None = None,
+                          solver: str = defaults.SIMULATION["solver"],
+                          periodic_tolerance: float = PERIODIC_TOLERANCE,
+                          max_periods: int = MAX_PERIODS, max_time: float | None = None,
+                          fade_in: float = FADE_IN, harmonics: int = HARMONICS,
+                          harmonic_balance: bool = True, friction_velocity: float | None = None,
+                          balance_harmonics: int | None = None, compare_chirp: bool = False,
+                          workers: int | None = None,
+                          progress: bool = False) -> SteadyStateResponse:
     """Steady-state frequency response by stepped-sine simulation.
 
     Each sweep (``up``: rising frequency, ``down``: falling) starts from rest at its first

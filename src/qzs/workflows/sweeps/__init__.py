@@ -47,12 +47,19 @@ to a MATLAB file) and :func:`stored_count` are here; figures in :mod:`qzs.viz.sw
 ``store``       the Zarr store: layout, creation, batch writes, resume checks
 ==============  =================================================================
 """
+from __future__ import annotations
+
+from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from qzs.errors import ParameterError
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, METHODS,
                                              SweepDefinition, draw_samples, load_sweep,
                                              plan_text, sample_cases, shipped_sweeps)
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["run_sweep", "open_sweep", "plot_sweep", "export_sweep", "stored_count", "load_sweep",
            "sample_cases", "draw_samples", "shipped_sweeps", "plan_text", "SweepDefinition",
@@ -60,8 +67,10 @@ __all__ = ["run_sweep", "open_sweep", "plot_sweep", "export_sweep", "stored_coun
 
 
 # ---------------------------------------------------------------- running
-def run_sweep(definition, store=None, *, resume=False, overwrite=False, scheduler=None,
-              workers=None, threads=None, progress=True):
+def run_sweep(definition: SweepDefinition | str | Path | Mapping[str, Any],
+              store: str | Path | None = None, *, resume: bool = False,
+              overwrite: bool = False, scheduler: Any = None, workers: int | None = None,
+              threads: int | None = None, progress: bool = True) -> xr.Dataset:
     """Run a sweep and write every finished batch to a Zarr store.
 
     Parameters
@@ -116,7 +125,7 @@ def run_sweep(definition, store=None, *, resume=False, overwrite=False, schedule
     return open_sweep(store)
 
 
-def open_sweep(store):
+def open_sweep(store: str | Path) -> xr.Dataset:
     """Open a sweep store as an ``xarray.Dataset`` (lazy; ``.load()`` to read it all).
 
     Parameters
@@ -138,7 +147,8 @@ def open_sweep(store):
     return open_store(store)
 
 
-def export_sweep(store, out=None, *, argument="out"):
+def export_sweep(store: str | Path, out: str | Path | None = None, *,
+                 argument: str = "out") -> Path:
     """Write a sweep store to a MATLAB file (``.mat``), one variable in memory at a time.
 
     The store's variables and coordinates under their own names (a varied excitation
@@ -181,7 +191,9 @@ def export_sweep(store, out=None, *, argument="out"):
     return write_mat(dataset.assign_attrs(title=title), out)
 
 
-def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None):
+def plot_sweep(store: str | Path, *, metric: str | None = None, x: str | None = None,
+               y: str | None = None, reduce: str = "median",
+               out: str | Path | None = None) -> str | Path:
     """Draw a sweep store's figure, choosing what the arguments leave open; returns the path.
 
     Parameters
@@ -243,7 +255,7 @@ def plot_sweep(store, *, metric=None, x=None, y=None, reduce="median", out=None)
     return out
 
 
-def stored_count(store):
+def stored_count(store: str | Path) -> int:
     """Cases already stored in ``store`` [-] (0 if there is no store yet).
 
     Parameters

@@ -15,6 +15,7 @@ import warnings
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import nullcontext
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -29,7 +30,7 @@ from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
-from qzs.workflows.sweeps.definition import case_excitation, sample_cases
+from qzs.workflows.sweeps.definition import SweepDefinition, case_excitation, sample_cases
 from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID, OK,
                                         estimated_bytes, open_store, prepare_store, schema,
                                         write_batch)
@@ -458,8 +459,9 @@ def _probe(address):
         pass
 
 
-def execute(definition, store, *, resume=False, overwrite=False, scheduler=None, workers=None,
-            threads=None, progress=True):
+def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = False,
+            overwrite: bool = False, scheduler: Any = None, workers: int | None = None,
+            threads: int | None = None, progress: bool = True) -> dict[str, Any]:
     """Run the batches of `definition` not yet in `store`, storing each as it finishes.
 
     The engine of :func:`qzs.workflows.sweeps.run_sweep`, which says more.
@@ -560,7 +562,9 @@ def _n_time(definition, settings):
     return int(round(longest / dt)) // decimation + 1
 
 
-def check_store_path(definition, store, *, argument="store", resume=False, overwrite=False):
+def check_store_path(definition: SweepDefinition, store: str | Path, *,
+                     argument: str = "store", resume: bool = False,
+                     overwrite: bool = False) -> None:
     """Check a sweep's store before any case runs: writable, room for it, not in the way.
 
     Parameters

@@ -11,7 +11,10 @@ import itertools
 import json
 import math
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 import numpy as np
 
 from qzs._validation import finite_real, integer, known_keys, read_toml
@@ -123,24 +126,24 @@ class SweepDefinition:
     source: str = ""
 
     @property
-    def varied(self):
+    def varied(self) -> tuple[str, ...]:
         """Names of the parameters that vary, grid first."""
         return (*self.grid, *self.distributions)
 
     @property
-    def n_cases(self):
+    def n_cases(self) -> int:
         """Number of cases: grid points times samples."""
         return math.prod(len(v) for v in self.grid.values()) * self.samples
 
     @property
-    def hash(self):
+    def hash(self) -> str:
         """SHA-256 of the canonical sweep document (what a store must match to resume)."""
         text = json.dumps({"format": _FORMAT, "document": self.document}, sort_keys=True,
                           default=str)
         return hashlib.sha256(text.encode()).hexdigest()
 
     @property
-    def frequency(self):
+    def frequency(self) -> np.ndarray:
         """Frequencies [Hz] kept for the transmissibility curve: the bins inside ``band``."""
         a = self.analysis
         f = np.fft.rfftfreq(a["fft_length"], 1.0 / a["sample_rate"])
@@ -154,7 +157,7 @@ def shipped_sweeps():
     return shipped_files(SHIPPED)
 
 
-def load_sweep(source):
+def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
     """Read and validate a sweep definition.
 
     Parameters
@@ -560,7 +563,7 @@ def sample_cases(definition):
     return columns
 
 
-def plan_text(definition):
+def plan_text(definition: SweepDefinition) -> str:
     """What a sweep will run: cases, batches, varied parameters and simulated steps.
 
     Parameters

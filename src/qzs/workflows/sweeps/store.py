@@ -17,12 +17,16 @@ chunk file is replaced atomically by zarr, and the batch's ``done`` flags are
 written last. A process killed mid-batch leaves that batch not done, and
 ``--resume`` recomputes exactly the batches that are not done.
 """
+from __future__ import annotations
+
 import json
 import os
 import shutil
 import warnings
+from collections.abc import Mapping
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,6 +36,9 @@ from qzs.engine.batch import STATS
 from qzs.engine.results import CHANNELS
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["STATUS", "PENDING", "OK", "INVALID", "FAILED", "ANALYSIS_FAILED", "COUNTS",
            "COUNT_FILL", "schema", "prepare_store", "write_batch", "open_store",
@@ -347,7 +354,7 @@ def _open_zarr(path):
                              f"{error}); give a store written by `qzs sweep`.") from None
 
 
-def summary_text(dataset, report=None):
+def summary_text(dataset: xr.Dataset, report: Mapping[str, Any] | None = None) -> str:
     """A few lines: cases by status, the commonest failures, this run's throughput.
 
     Parameters
@@ -368,7 +375,8 @@ def summary_text(dataset, report=None):
     failed = done & (status > OK)
     if failed.any():
         messages = dataset["message"].values[failed]
-        kinds, first = {}, {}
+        kinds: dict[str, int] = {}
+        first: dict[str, tuple[np.integer[Any], str]] = {}
         for index, message in zip(np.flatnonzero(failed), messages):
             key = str(message).split(" at t = ")[0][:80]
             kinds[key] = kinds.get(key, 0) + 1
