@@ -16,7 +16,9 @@ while writing (a full disk, no permission) raise :class:`~qzs.errors.WriteError`
 attributes ``path`` and ``reason`` and leave neither the target nor a temporary file behind.
 """
 import contextlib
+import csv
 import errno
+import io
 import functools
 import os
 import shutil
@@ -27,10 +29,19 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import ParameterError, WriteError
-from qzs.iotools.files import RESULT_SUFFIXES, _umask
+from qzs.iotools.files import RESULT_SUFFIXES, _umask, atomic_path
 from qzs.iotools.schema import CONVENTIONS
 
-__all__ = ["StreamWriter", "estimated_file_size"]
+__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "CSV_LAYOUT"]
+
+#: How every CSV file of qzs lays out its table (docs/model.md §7): ``#`` comment lines
+#: (``key = value [unit]``), the last of which says on which lines the table starts; a row
+#: of column names; a row of their units (CF ``units``; empty for a text column); the data;
+#: trailing ``#`` lines. Read with pandas ``read_csv(path, comment="#", header=[0, 1])``
+#: (columns ``(name, unit)``), numpy ``loadtxt(path, delimiter=",", skiprows=N + 1)`` (N:
+#: the names' line, given in the layout line) or MATLAB ``readtable`` with
+#: ``VariableNamesLine`` N and ``VariableUnitsLine`` N + 1.
+CSV_LAYOUT = "column names on line {names}, units on line {units}, data from line {data}"
 
 _CSV_FORMAT = "%.10g"
 _FREE_MARGIN = 1 << 20         # bytes kept free beyond an estimate or a chunk
@@ -113,9 +124,10 @@ class StreamWriter:
     along the unlimited dimension are written from ``values`` when the file is created,
     and the global attributes (``Conventions``, ``attributes``, then those given to
     :meth:`finish`) at the end. CSV files (a schema whose streamed variables are all one-dimensional) have the
-    ``attributes`` as ``# key = value [unit]`` header lines, one column per streamed
-    variable at the ``%.10g`` format, and the attributes given to :meth:`finish` as
-    trailing ``# key = value`` lines (known only at the end).
+    ``attributes`` as ``# key = value [unit]`` header lines, then the table of
+    :data:`CSV_LAYOUT` (a row of column names, a row of their units, the data), one column
+    per streamed variable at the ``%.10g`` format, and the attributes given to
+    :meth:`finish` as trailing ``# key = value`` lines (known only at the end).
 
     Parameters
     ----------
@@ -270,9 +282,8 @@ class StreamWriter:
     # -- CSV ----------------------------------------------------------------------------
     def _open_csv(self):
         self._file = open(self._tmp, "w", encoding="utf-8", newline="\n")
-        for line in _header_lines(self._head):
-            self._file.write(f"# {line}\n")
-        self._file.write(",".join(v.name for v in self._streamed) + "\n")
+        self._file.write(_csv_head(self._head, [v.name for v in self._streamed],
+                                   [v.units or "" for v in self._streamed]))
 
     def _append_csv(self, blocks, start, stop):
         columns = np.empty((stop - start, len(self._columns)))
@@ -491,6 +502,89 @@ def _close(handle):
                 with contextlib.suppress(Exception):
                     h5file.close()
         raise
+
+
+def _csv_head(attrs, names, units):
+    """The head of a CSV table: ``#`` attribute lines, the layout line, names, units."""
+    lines = [f"# {line}" for line in _header_lines(attrs)]
+    n = len(lines) + 2  # the names' line number, counting from 1, after the layout line
+    lines.append("# " + CSV_LAYOUT.format(names=n, units=n + 1, data=n + 2))
+    rows = io.StringIO()
+    writer = csv.writer(rows, lineterminator="\n")
+    writer.writerow(names)
+    writer.writerow(units)
+    return "\n".join(lines) + "\n" + rows.getvalue()
+
+
+def write_dataset(dataset, path):
+    """Write a dataset built from a schema (``to_dataset``) to NetCDF or CSV, atomically.
+
+    ``.nc``: the dataset as it is (CF-1.10, h5netcdf). ``.csv``: one row per point of its
+    dimensions (long format: a curve of each case one row per frequency), the
+    coordinates first, then the data variables, laid out as :data:`CSV_LAYOUT` says (a
+    row of names, a row of units from the variables' ``units``), the global attributes as
+    ``# key = value [unit]`` header lines, numbers at the ``%.10g`` format, flags 0/1.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The data, with CF attributes (:func:`qzs.iotools.schema.to_dataset`).
+    path : str or Path
+        Target file, ``.nc`` or ``.csv``; its folder is created if missing.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ParameterError
+        Another suffix.
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    suffix = _suffix(path, (".nc", ".csv"), "a dataset")
+    try:
+        with atomic_path(path) as tmp:
+            if suffix == ".nc":
+                dataset.to_netcdf(tmp, engine="h5netcdf")
+            else:
+                tmp.write_text(_table_text(dataset), encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
+
+
+def _table_text(dataset):
+    """A dataset as a long CSV table (:func:`write_dataset`)."""
+    dims = list(dataset.dims)
+    extra = [name for name in dataset.coords if name not in dims]
+    names = [*dims, *extra, *dataset.data_vars]
+    shape = tuple(dataset.sizes[d] for d in dims)
+    columns = []
+    for name in names:
+        variable = dataset[name]
+        values = variable.transpose(*[d for d in dims if d in variable.dims]).values
+        values = np.broadcast_to(
+            values.reshape([dataset.sizes[d] if d in variable.dims else 1 for d in dims]),
+            shape).ravel()
+        columns.append(values)
+    units = [str(dataset[name].attrs.get("units", "")) for name in names]
+    rows = io.StringIO()
+    writer = csv.writer(rows, lineterminator="\n")
+    for row in zip(*columns):
+        writer.writerow([_cell(value) for value in row])
+    return _csv_head(dataset.attrs, names, units) + rows.getvalue()
+
+
+def _cell(value):
+    if isinstance(value, (bool, np.bool_)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return "" if np.isnan(value) else _CSV_FORMAT % value
+    return str(value)
 
 
 def _header_lines(attrs):
