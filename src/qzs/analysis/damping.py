@@ -172,11 +172,11 @@ def damping_change(frequency, reference, damped, *, band, reference_trusted=None
     if both.any():
         reduction = -decibels(damped[both] / reference[both])
         i = int(np.argmax(reduction))
-        largest, at = float(reduction[i]), float(frequency[both][i])
+        largest, at = float(reduction[i]) + 0.0, float(frequency[both][i])  # no -0
     else:
         largest = at = math.nan
     change = (decibels(damped_rms / reference_rms)
               if reference_rms > 0 and math.isfinite(damped_rms) and damped_rms > 0 else math.nan)
     return DampingChange(largest_reduction_db=largest, largest_reduction_frequency=at,
-                         band_rms_change_db=float(change), reference_rms=reference_rms,
+                         band_rms_change_db=float(change) + 0.0, reference_rms=reference_rms,
                          damped_rms=damped_rms, bins=int(both.sum()), band=band)

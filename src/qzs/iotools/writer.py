@@ -32,7 +32,7 @@ from qzs.errors import ParameterError, WriteError
 from qzs.iotools.files import RESULT_SUFFIXES, _umask, atomic_path
 from qzs.iotools.schema import CONVENTIONS
 
-__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "CSV_LAYOUT"]
+__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_table", "CSV_LAYOUT"]
 
 #: How every CSV file of qzs lays out its table (docs/model.md §7): ``#`` comment lines
 #: (``key = value [unit]``), the last of which says on which lines the table starts; a row
@@ -557,6 +557,52 @@ def write_dataset(dataset, path):
     return path
 
 
+def write_table(rows, path, *, units, attrs=None):
+    """Write rows of a table (dicts) as CSV with a units row (:data:`CSV_LAYOUT`), atomically.
+
+    The columns are every key, in the order met; a key a row lacks, ``None`` and a float
+    that is NaN or +-inf are empty cells.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Column name -> value.
+    path : str or Path
+        Target ``.csv`` file; its folder is created if missing.
+    units : callable
+        Column name -> its unit (``""`` for a text column).
+    attrs : mapping, optional
+        Global attributes, as ``# key = value [unit]`` head lines.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ParameterError
+        A suffix other than ``.csv``.
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    _suffix(path, (".csv",), "a table")
+    columns = list(dict.fromkeys(key for row in rows for key in row))
+    body = io.StringIO()
+    writer = csv.writer(body, lineterminator="\n")
+    for row in rows:
+        writer.writerow(["" if row.get(key) is None else _cell(row[key], repr)
+                         for key in columns])
+    text = _csv_head(attrs or {}, columns, [units(key) or "" for key in columns])
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text + body.getvalue(), encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
+
+
 def _table_text(dataset):
     """A dataset as a long CSV table (:func:`write_dataset`)."""
     dims = list(dataset.dims)
@@ -579,11 +625,11 @@ def _table_text(dataset):
     return _csv_head(dataset.attrs, names, units) + rows.getvalue()
 
 
-def _cell(value):
+def _cell(value, number=lambda value: _CSV_FORMAT % value):
     if isinstance(value, (bool, np.bool_)):
         return str(int(value))
     if isinstance(value, (float, np.floating)):
-        return "" if np.isnan(value) else _CSV_FORMAT % value
+        return "" if not np.isfinite(value) else number(float(value))
     return str(value)
 
 
