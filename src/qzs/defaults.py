@@ -32,6 +32,12 @@ ANALYSIS = MappingProxyType({
 #: Frequencies [Hz] at which reports and sweeps quote the transmissibility.
 REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 
+#: The paper's claim "active damping did not help much" (``qzs paper``, ``qzs design``,
+#: :mod:`qzs.analysis.damping`): the band it is read over [Hz] (above the low end where
+#: stiction locks the payload) and the change below which damping "did not help much",
+#: per bin and over the band [dB].
+DAMPING_CLAIM = MappingProxyType({"band": (1.5, 20.0), "small_db": 3.0})
+
 #: Accuracy-driven step (docs/model.md §7): the tolerance on the transmissibility [dB] that
 #: sweeps meet by default when their file gives no ``dt``; the paper keeps its dt = 1e-4 s.
 ACCURACY = MappingProxyType({"tolerance_db": 0.01})

@@ -63,3 +63,18 @@ def test_bad_inputs_name_the_argument():
         band_rms(FREQUENCY, np.ones_like(FREQUENCY), (5.0, 1.0))
     with pytest.raises(ParameterError, match="`damped`"):
         damping_change(FREQUENCY, np.ones_like(FREQUENCY), np.ones(3), band=(1.0, 2.0))
+
+
+def test_the_band_change_is_read_on_the_bins_both_curves_trust():
+    """A high reference bin the damped curve does not trust counts in neither RMS: the band
+    cannot fall more than the largest per-bin reduction."""
+    reference = np.ones_like(FREQUENCY)
+    reference[100] = 30.0                      # a tall peak at 10 Hz...
+    damped = np.full_like(FREQUENCY, 0.9)
+    trusted = np.ones(FREQUENCY.shape, bool)
+    trusted[100] = False                       # ...that the damped curve does not trust
+    change = damping_change(FREQUENCY, reference, damped, band=(1.0, 20.0),
+                            damped_trusted=trusted)
+    assert change.largest_reduction_db == pytest.approx(-20 * math.log10(0.9), rel=1e-12)
+    assert change.band_rms_change_db == pytest.approx(20 * math.log10(0.9), rel=1e-12)
+    assert change.reference_rms == pytest.approx(1.0)

@@ -9,9 +9,15 @@ without damping (the reference) and one with, in two ways, and the two can disag
     (positive: a reduction).
 ``band_rms_change_db``
     The change of the band RMS, ``20 log10(rms_damped / rms_reference)`` [dB], where
-    ``rms = sqrt(mean(T^2))`` over each curve's trusted bins of the band
-    (:func:`band_rms`, the cost ``qzs design`` minimises): what damping does to the band
+    ``rms = sqrt(mean(T^2))`` (:func:`band_rms`, the cost ``qzs design`` minimises) over
+    the same bins, those of the band trusted in both curves: what damping does to the band
     as a whole (negative: a reduction).
+
+Both compare the curves bin by bin on one set of bins, so the band's reduction is never
+larger than the largest per-bin one. (The ratio of two costs each read from its own
+curve's trusted bins, which ``qzs design`` also shows as the change of its cost, can be:
+bins the damped curve does not trust, where the reference is high, count only in the
+reference's cost.)
 
 ``qzs paper`` decides the claim from both (:mod:`qzs.workflows.report`) and ``qzs design``
 shows both for every gain it tries (:mod:`qzs.workflows.design`), through
@@ -23,12 +29,14 @@ shows both for every gain it tries (:mod:`qzs.workflows.design`), through
 (6.02, 3.0)
 """
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from qzs._format import decibels
-from qzs.errors import ParameterError
+from qzs.analysis.spectral import band_mask
+from qzs.errors import DataWarning, ParameterError
 
 __all__ = ["DampingChange", "band_rms", "damping_change", "DAMPING_METRICS"]
 
@@ -42,18 +50,13 @@ DAMPING_METRICS = {
 
 
 def _mask(frequency, band, trusted):
-    frequency = np.asarray(frequency, dtype=float)
+    """The bins of the band (:func:`qzs.analysis.spectral.band_mask`: closed, never DC)."""
     low, high = band
     if not low < high:
         raise ParameterError(f"`band` must be (low, high) with low < high [Hz], got {band!r}.")
-    keep = (frequency >= low) & (frequency <= high)
-    if trusted is not None:
-        trusted = np.asarray(trusted, dtype=bool)
-        if trusted.shape != frequency.shape:
-            raise ParameterError(f"`trusted` must have the shape of `frequency` "
-                                 f"{frequency.shape}, got {trusted.shape}.")
-        keep &= trusted
-    return keep
+    with warnings.catch_warnings():  # a band without a trusted bin is NaN here, said so
+        warnings.simplefilter("ignore", DataWarning)
+        return band_mask(frequency, low, high, trusted=trusted)
 
 
 def band_rms(frequency, magnitude, band, *, trusted=None):
@@ -66,7 +69,8 @@ def band_rms(frequency, magnitude, band, *, trusted=None):
     magnitude : array_like
         Transmissibility, an amplitude ratio [-], at ``frequency``.
     band : tuple of float
-        The band [Hz, Hz], both ends included.
+        The band [Hz, Hz], both ends included, never the 0 Hz bin
+        (:func:`qzs.analysis.spectral.band_mask`).
     trusted : array_like of bool, optional
         The bins that may be used; default all.
 
@@ -99,10 +103,10 @@ class DampingChange:
     largest_reduction_frequency : float
         The bin where it is [Hz]; NaN without one.
     band_rms_change_db : float
-        Change of the band RMS [dB]; negative: a reduction; NaN when either RMS is
-        undefined.
+        Change of the band RMS over the bins trusted in both curves [dB]; negative: a
+        reduction; NaN without such a bin.
     reference_rms, damped_rms : float
-        The two band RMS values [-] (:func:`band_rms`).
+        The two band RMS values over those bins [-] (:func:`band_rms`).
     bins : int
         Bins of the band trusted in both curves.
     band : tuple of float
@@ -165,10 +169,10 @@ def damping_change(frequency, reference, damped, *, band, reference_trusted=None
             raise ParameterError(f"`{name}` must have the shape of `frequency` "
                                  f"{frequency.shape}, got {values.shape}.")
     band = (float(band[0]), float(band[1]))
-    reference_rms = band_rms(frequency, reference, band, trusted=reference_trusted)
-    damped_rms = band_rms(frequency, damped, band, trusted=damped_trusted)
     both = _mask(frequency, band, reference_trusted) & _mask(frequency, band, damped_trusted)
     both &= (reference > 0) & (damped > 0)
+    reference_rms = band_rms(frequency, reference, band, trusted=both)
+    damped_rms = band_rms(frequency, damped, band, trusted=both)
     if both.any():
         reduction = -decibels(damped[both] / reference[both])
         i = int(np.argmax(reduction))

@@ -29,6 +29,7 @@ from qzs._version import __version__
 from qzs.analysis.damping import damping_change
 from qzs.analysis.spectral import (METRIC_NAMES, band_mask, metric_unit, rolloff_slope,
                                    transmissibility_at)
+from qzs.defaults import DAMPING_CLAIM
 from qzs.iotools.files import atomic_path
 from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
@@ -41,8 +42,8 @@ from qzs.workflows.studies import CLAIMS as STATEMENTS
 from qzs.workflows.studies import (RUN_UNITS, STATS_UNITS, load_study, run_studies,
                                    shipped_studies)
 
-__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "paper_summary",
-           "write_paper_outputs", "run_paper"]
+__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
+           "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
 #: of the report, its figures (PNG) and metrics.
@@ -248,26 +249,54 @@ def _no_pi_stops(result):
     return ok, f"stop contacts without PI: {describe(without)}; with PI: {describe(with_pi)}"
 
 
-#: The band of the damping claim [Hz]: above the stiction-dominated low end.
-DAMPING_BAND = (1.5, 20.0)
-#: Damping "did not help much" while it changes T by less than this [dB], per bin and over
-#: the band (:mod:`qzs.analysis.damping`).
-DAMPING_SMALL_DB = 3.0
+#: The band of the damping claim [Hz] and the change below which damping "did not help
+#: much" [dB] (:data:`qzs.defaults.DAMPING_CLAIM`).
+DAMPING_BAND, DAMPING_SMALL_DB = DAMPING_CLAIM["band"], DAMPING_CLAIM["small_db"]
 #: Where the design analysis explains the damping claim (``qzs design``).
 DAMPING_EXPLAINED = ("docs/design.md section 7, \"Why active damping did not help much\" "
                      "(qzs design)")
 
 
-def _damping_small_effect(result):
-    reference = [c for c in result.cases if _value(c, "damping_gain") == 0]
+def damping_changes(result, band=DAMPING_BAND):
+    """What damping changes in each damped case of a study, against its case with Kd = 0.
+
+    The two metrics of :func:`qzs.analysis.damping.damping_change` (largest per-bin
+    reduction, band-RMS change), from each curve's trusted bins: what the damping claim is
+    decided from, and what ``qzs design`` reports for every gain it tries.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study with a case at ``damping_gain`` 0 (the first is the reference).
+    band : tuple of float
+        The band [Hz, Hz]; default the claim's (:data:`qzs.defaults.DAMPING_CLAIM`).
+
+    Returns
+    -------
+    reference : CaseResult or None
+        The case with Kd = 0; None if there is none.
+    changes : list of (CaseResult, DampingChange)
+        Each case with Kd > 0, in the study's order.
+    """
+    reference = next((c for c in result.cases if _value(c, "damping_gain") == 0), None)
     damped = [c for c in result.cases if _value(c, "damping_gain") > 0]
-    if not reference or not damped:
+    if reference is None:
+        return None, [(case, None) for case in damped]
+    return reference, [(case, damping_change(reference.frequency, reference.magnitude,
+                                             case.magnitude, band=band,
+                                             reference_trusted=_trusted(reference),
+                                             damped_trusted=_trusted(case)))
+                       for case in damped]
+
+
+def _damping_small_effect(result):
+    reference, pairs = damping_changes(result)
+    damped = [case for case, _ in pairs]
+    if reference is None or not damped:
         raise _Undecidable(f"needs a case with Kd = 0 and one with Kd > 0; study "
-                           f"{result.study.name!r} has {len(reference)} and {len(damped)}")
-    reference = reference[0]
-    changes = [damping_change(reference.frequency, reference.magnitude, case.magnitude,
-                              band=DAMPING_BAND, reference_trusted=_trusted(reference),
-                              damped_trusted=_trusted(case)) for case in damped]
+                           f"{result.study.name!r} has {int(reference is not None)} and "
+                           f"{len(damped)}")
+    changes = [change for _, change in pairs]
     largest = [c.largest_reduction_db for c in changes]
     rms = [c.band_rms_change_db for c in changes]
     low, high = DAMPING_BAND
