@@ -12,7 +12,7 @@ import xarray as xr
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import unit_of
 from qzs.workflows import report
-from qzs.workflows.curves import curves_dataset, curves_schema, write_curves
+from qzs.workflows.curves import curves_dataset, curves_schema, spring_dataset, write_curves
 from qzs.workflows.studies import CaseResult, Study, StudyResult
 
 FREQUENCY = np.round(np.arange(0.0, 20.0 + 1e-9, 0.25), 10)
@@ -140,3 +140,16 @@ def test_metrics_csv_has_a_units_row_from_the_definitions(damping_study, tmp_pat
 def test_a_column_without_a_unit_is_a_programming_error():
     with pytest.raises(KeyError, match="no unit"):
         report.column_unit("made_up_column")
+
+
+def test_the_spring_data_holds_the_points_and_the_fitted_law(tmp_path):
+    """The fitted force at the points is the model's law -a tanh(b z) (docs/model.md)."""
+    z = np.linspace(-0.1, 0.1, 21)
+    data = spring_dataset(z, 60.0 * np.tanh(80.0 * z), 60.0, 80.0)
+    np.testing.assert_allclose(data["fitted_force"].values, -60.0 * np.tanh(80.0 * z),
+                               rtol=1e-12)
+    assert data["displacement"].attrs["units"] == "m" and data.attrs["spring_shape_units"] == "1/m"
+    nc, csv = write_curves(data, tmp_path, "spring")
+    table = pd.read_csv(csv, comment="#", header=[0, 1])
+    assert list(table.columns) == [("displacement", "m"), ("force", "N"), ("fitted_force", "N")]
+    xr.testing.assert_identical(xr.load_dataset(nc), data)

@@ -606,8 +606,9 @@ def write_table(rows, path, *, units, attrs=None):
 def _table_text(dataset):
     """A dataset as a long CSV table (:func:`write_dataset`)."""
     dims = list(dataset.dims)
+    indexed = [d for d in dims if d in dataset.coords]  # a dimension without labels: no column
     extra = [name for name in dataset.coords if name not in dims]
-    names = [*dims, *extra, *dataset.data_vars]
+    names = [*indexed, *extra, *dataset.data_vars]
     shape = tuple(dataset.sizes[d] for d in dims)
     columns = []
     for name in names:

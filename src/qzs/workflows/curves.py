@@ -16,6 +16,8 @@ writes them beside its figures, through :func:`curves_dataset` and
     header=[0, 1])``.
 
 Curves of one file share their frequency bins; bins a curve lacks are NaN (untrusted).
+The spring's characteristic (paper Fig. 5) is written the same way by :func:`spring_dataset`:
+the measured points and the fitted law on ``point``.
 """
 import numpy as np
 
@@ -23,7 +25,8 @@ from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import PARAMETERS, unit_of
 
-__all__ = ["curves_schema", "curves_dataset", "write_curves", "CURVE_SUFFIXES"]
+__all__ = ["curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
+           "CURVE_SUFFIXES"]
 
 #: The files :func:`write_curves` writes, by suffix.
 CURVE_SUFFIXES = (".nc", ".csv")
@@ -146,3 +149,61 @@ def write_curves(dataset, folder, name):
 
     return [write_dataset(dataset, Path(folder) / f"{name}_curves{suffix}")
             for suffix in CURVE_SUFFIXES]
+
+
+def spring_schema(points):
+    """The CF-1.10 layout of the spring's characteristic: the points and the fitted law.
+
+    Parameters
+    ----------
+    points : int
+        Number of measured points.
+
+    Returns
+    -------
+    Schema
+    """
+    on = ("point",)
+    return Schema(kind="the spring's characteristic", dimensions={"point": int(points)},
+                  coordinates=(Variable(name="displacement", dims=on, units="m",
+                                        long_name="displacement z of the MagSpring"),),
+                  variables=(Variable(name="force", dims=on, units="N",
+                                      long_name="measured spring force"),
+                             Variable(name="fitted_force", dims=on, units="N",
+                                      long_name="fitted law -a tanh(b z) at the points")))
+
+
+def spring_dataset(displacement, force, spring_force, spring_shape, attrs=None):
+    """The spring's measured characteristic and its fitted tanh law, as a dataset.
+
+    Parameters
+    ----------
+    displacement : array_like
+        Displacements of the points [m].
+    force : array_like
+        Measured forces [N].
+    spring_force : float
+        Fitted force amplitude a [N].
+    spring_shape : float
+        Fitted shape b [1/m].
+    attrs : mapping, optional
+        Further global attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+        With the fit as attributes ``spring_force`` [N] and ``spring_shape`` [1/m].
+    """
+    import dataclasses
+
+    from qzs.model.isolator import IsolatorParameters, spring_force as law
+
+    z = np.asarray(displacement, dtype=float)
+    fitted = law(z, dataclasses.replace(IsolatorParameters(), spring_force=spring_force,
+                                        spring_shape=spring_shape))
+    return to_dataset(spring_schema(z.size), {"displacement": z, "force": force,
+                                               "fitted_force": fitted},
+                      {**(attrs or {}), "spring_force": float(spring_force),
+                       "spring_force_units": unit_of("spring_force"),
+                       "spring_shape": float(spring_shape),
+                       "spring_shape_units": unit_of("spring_shape")})

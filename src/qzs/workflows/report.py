@@ -37,7 +37,7 @@ from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
 from qzs.model.registry import PARAMETERS, format_value, unit_of, update_parameters
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
-from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, write_curves
+from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
 from qzs.workflows.studies import CLAIMS as STATEMENTS
 from qzs.workflows.studies import (RUN_UNITS, STATS_UNITS, load_study, run_studies,
                                    shipped_studies)
@@ -432,15 +432,17 @@ def _curves(result):
 
 
 def curves_of(result, *, quick=False):
-    """A transmissibility study's curves as a dataset (:func:`qzs.workflows.curves.curves_dataset`).
+    """A study's curves as a dataset (:func:`qzs.workflows.curves.curves_dataset`).
 
     The curves its figures draw, on ``case`` and ``frequency``, with each case's
-    parameters as coordinates and the run settings, study and definition as attributes.
+    parameters as coordinates and the run settings, study and definition as attributes;
+    for the spring's characteristic, its points and fitted law
+    (:func:`qzs.workflows.curves.spring_dataset`).
 
     Parameters
     ----------
     result : StudyResult
-        A study of kind ``transmissibility`` or ``processing``.
+        A study.
     quick : bool
         Whether the runs were the quick ones (an attribute).
 
@@ -451,6 +453,10 @@ def curves_of(result, *, quick=False):
     attrs = {"title": result.study.title, "study": result.study.name,
              "definition": Path(result.study.source).name if result.study.source else "",
              "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
+    if result.study.kind == "spring_characteristic":
+        extra = result.cases[0].extra
+        return spring_dataset(extra["displacement"], extra["force"],
+                              extra["fit"]["spring_force"], extra["fit"]["spring_shape"], attrs)
     for key, value in _settings(result).items():
         attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
                       else value)
@@ -496,9 +502,7 @@ def _figures(result, folder):
 
 
 def _curve_files(result, folder):
-    """The data files of a study's curves (none for the spring's characteristic)."""
-    if result.study.kind == "spring_characteristic":
-        return []
+    """The data files of a study's curves."""
     return [Path(folder) / f"{result.study.name}_curves{suffix}" for suffix in CURVE_SUFFIXES]
 
 
@@ -666,8 +670,7 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         tmp.write_text(json_text(document), encoding="utf-8")
     write_table(rows, folder / "metrics.csv", units=column_unit)
     for result in study_results:
-        if result.study.kind != "spring_characteristic":
-            write_curves(curves_of(result, quick=quick), folder, result.study.name)
+        write_curves(curves_of(result, quick=quick), folder, result.study.name)
     with atomic_path(folder / "report.html") as tmp:
         tmp.write_text(_html(study_results, figures, verdicts, quick, wall_seconds),
                        encoding="utf-8")
@@ -793,11 +796,13 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
         files = [p.name for p in _curve_files(result, ".")]
         if files:
             links = " and ".join(f"<a href='{e(f)}'>{e(f)}</a>" for f in files)
+            what = ("the measured points and the fitted law at them"
+                    if study.kind == "spring_characteristic" else
+                    "per case and frequency the transmissibility, its phase, the coherence, "
+                    "the trusted flag and the linearised model, the case's parameters beside it")
             parts.append(f"<p class='notes'>The curves of these figures as data: {links} "
-                         "(NetCDF CF-1.10; CSV with a units row under the column names): per "
-                         "case and frequency the transmissibility, its phase, the coherence, "
-                         "the trusted flag and the linearised model, the case's parameters "
-                         "beside it.</p>")
+                         f"(NetCDF CF-1.10; CSV with a units row under the column names): "
+                         f"{e(what)}.</p>")
         for verdict in verdicts:
             if verdict.study != study.name:
                 continue
