@@ -142,7 +142,11 @@ def test_run_writes_the_report(tmp_path, capsys):
     assert run(args) == 0
     out = capsys.readouterr().out
     assert "flagged band   below 1.5 Hz" in out and "29 averages" in out
-    assert "simulation" not in (tmp_path / "transmissibility.csv").read_text().splitlines()[0]
+    import pandas as pd
+
+    table = pd.read_csv(tmp_path / "transmissibility.csv", comment="#", header=[0, 1])
+    assert list(table.columns) == [("frequency", "Hz"), ("experiment", "1"), ("coherence", "1"),
+                                   ("trusted", "1")]  # no simulation column, a units row
 
 
 def test_run_lets_data_errors_through(tmp_path):
