@@ -7,6 +7,9 @@ appended block goes to which variable is the caller's mapping; the single run's
 :class:`~qzs.engine.results.ResultWriter` and the six-axis run's
 :class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
 
+:func:`write_dataset` writes a whole dataset of a schema (NetCDF, or CSV in long format) and
+:func:`write_table` rows of a table (CSV), both with the units row of :data:`CSV_LAYOUT`.
+
 The file is written to a hidden temporary file beside the target (``.<name>.*.part``) and
 renamed onto the target by :meth:`StreamWriter.finish`; the disk space of each chunk is
 reserved before it is written. :meth:`StreamWriter.abort` removes the temporary file; so
@@ -18,8 +21,8 @@ attributes ``path`` and ``reason`` and leave neither the target nor a temporary 
 import contextlib
 import csv
 import errno
-import io
 import functools
+import io
 import os
 import shutil
 import sys
@@ -34,7 +37,7 @@ from qzs.iotools.schema import CONVENTIONS
 
 __all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_table", "CSV_LAYOUT"]
 
-#: How every CSV file of qzs lays out its table (docs/model.md §7): ``#`` comment lines
+#: How the CSV files of qzs lay out their table (docs/model.md §7): ``#`` comment lines
 #: (``key = value [unit]``), the last of which says on which lines the table starts; a row
 #: of column names; a row of their units (CF ``units``; empty for a text column); the data;
 #: trailing ``#`` lines. Read with pandas ``read_csv(path, comment="#", header=[0, 1])``
