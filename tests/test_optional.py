@@ -19,13 +19,22 @@ def test_a_missing_optional_dependency_names_its_extra(monkeypatch):
     assert pickle.loads(pickle.dumps(error.value)).extra == "rig"
 
 
+# An import of a blocked package fails, and asking whether it is there
+# (importlib.util.find_spec, as xarray does for dask) says no, as for a package not installed.
 BLOCKER = """
+import importlib.util
 import sys
 class Block:
     def find_spec(self, name, path=None, target=None):
         if name.split('.')[0] in {blocked!r}:
             raise ImportError(f"blocked: {{name}}")
 sys.meta_path.insert(0, Block())
+_find_spec = importlib.util.find_spec
+def find_spec(name, package=None):
+    if name.split('.')[0] in {blocked!r}:
+        return None
+    return _find_spec(name, package)
+importlib.util.find_spec = find_spec
 """
 
 

@@ -34,6 +34,12 @@ ANALYSIS: Mapping[str, Any] = MappingProxyType({
 #: Frequencies [Hz] at which reports and sweeps quote the transmissibility.
 REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 
+#: The paper's claim "active damping did not help much" (``qzs paper``, ``qzs design``,
+#: :mod:`qzs.analysis.damping`): the band it is read over [Hz] (above the low end where
+#: stiction locks the payload) and the change below which damping "did not help much",
+#: per bin and over the band [dB].
+DAMPING_CLAIM: Mapping[str, Any] = MappingProxyType({"band": (1.5, 20.0), "small_db": 3.0})
+
 #: Accuracy-driven step (docs/model.md §7): what a command meets when given no step: the
 #: transmissibility within ``tolerance_db`` [dB], or, for a sine (no band to estimate it
 #: over), the relative position within ``tolerance_state`` [m] (0.1 % of the paper's 10 mm).

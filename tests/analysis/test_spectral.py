@@ -68,11 +68,9 @@ def test_estimators_match_closed_form_of_linear_system(clean_record, estimator, 
                np.abs(estimate.magnitude[band] / np.abs(exact) - 1).max(), 0.03)
     assert np.all(estimate.coherence[band] > 0.97)
     assert estimate.estimator == estimator and estimate.n_averages == 60
-    if estimator == "psd_ratio":
-        assert np.all(np.isnan(estimate.phase))
-    else:
-        phase_error = np.angle(np.exp(1j * (estimate.phase[band] - np.angle(exact))))
-        assert np.max(np.abs(phase_error)) < 0.03
+    # every estimator carries the phase of S_bp (S_bb and S_pp are real)
+    phase_error = np.angle(np.exp(1j * (estimate.phase[band] - np.angle(exact))))
+    assert np.max(np.abs(phase_error)) < 0.03
 
 
 def test_estimators_with_payload_noise_follow_their_bias_formulas(noisy_record):

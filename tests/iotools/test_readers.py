@@ -32,6 +32,15 @@ def write_csv(path, time=TIME, base=BASE, payload=PAYLOAD):
     return path
 
 
+def test_a_csv_with_a_units_row_reads_as_without(tmp_path):
+    """The layout qzs writes (a row of units under the names) reads as a rig log too."""
+    path = write_csv(tmp_path / "log.csv")
+    lines = path.read_text().splitlines()
+    lines.insert(2, "s, mm/s, mm/s, 1")
+    path.write_text("\n".join(lines) + "\n")
+    check(read_recording(path, MAP))
+
+
 def test_csv(tmp_path):
     recording = read_recording(write_csv(tmp_path / "log.csv"), MAP)
     check(recording)

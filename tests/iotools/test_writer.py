@@ -12,7 +12,7 @@ from qzs.errors import DataError, ParameterError, Terminated, WriteError
 from qzs.iotools import writer as stream
 from qzs.iotools.files import read_result
 from qzs.iotools.schema import Schema, Variable, time_coordinate
-from qzs.iotools.writer import StreamWriter, estimated_file_size
+from qzs.iotools.writer import StreamWriter, estimated_file_size, write_dataset
 
 LINE = Schema(kind="a toy line", dimensions={"time": None}, coordinates=(time_coordinate(),),
               variables=(Variable(name="x", dims=("time",), units="m", long_name="position"),
@@ -97,9 +97,10 @@ def test_a_one_dimensional_schema_streams_to_csv(tmp_path):
             writer.append(*block(min(40, 100 - start), start))
         path = writer.finish({"outcome": 3, "outcome_units": "1"})
     lines = path.read_text().splitlines()
-    assert lines[:4] == ["# Conventions = CF-1.10", "# title = toy", "# mass = 6.4 [kg]",
-                         "time,x,held"]
-    assert lines[-1] == "# outcome = 3 [1]" and len(lines) == 4 + 100 + 1
+    assert lines[:6] == ["# Conventions = CF-1.10", "# title = toy", "# mass = 6.4 [kg]",
+                         "# column names on line 5, units on line 6, data from line 7",
+                         "time,x,held", "s,m,1"]
+    assert lines[-1] == "# outcome = 3 [1]" and len(lines) == 6 + 100 + 1
     data = read_result(path, LINE)
     assert data["held"].dtype == bool and data["x"].attrs["units"] == "m"
     np.testing.assert_allclose(data["x"].values, np.sin(np.arange(100) * 1e-3), rtol=1e-9)
@@ -127,3 +128,53 @@ def test_the_size_estimate_bounds_the_file(tmp_path):
     chunks = -(-10**6 // 4096)
     assert estimated_file_size(LINE, 10**6, ".nc") == (chunks * (4096 * 17 + 128 * 3)
                                                        + (128 << 10))
+
+
+def test_the_units_row_reads_with_pandas_and_numpy(tmp_path):
+    """The CSV layout's promise: pandas reads (name, unit) columns, numpy the numbers after
+    the line the layout line names, and both agree with the schema's units."""
+    import pandas as pd
+
+    with line_writer(tmp_path / "line.csv") as writer:
+        writer.append(*block(30))
+        path = writer.finish({"outcome": 3})
+    table = pd.read_csv(path, comment="#", header=[0, 1])
+    assert list(table.columns) == [(v.name, v.units) for v in LINE]
+    np.testing.assert_allclose(table[("x", "m")].to_numpy(), np.sin(np.arange(30) * 1e-3),
+                               rtol=1e-9)
+    layout = next(line for line in path.read_text().splitlines() if "column names on line" in line)
+    names_line = int(layout.split("column names on line ")[1].split(",")[0])
+    numbers = np.loadtxt(path, delimiter=",", skiprows=names_line + 1)
+    assert numbers.shape == (30, 3)
+    np.testing.assert_allclose(numbers[:, 1], table[("x", "m")].to_numpy())
+
+
+def test_a_dataset_of_two_dimensions_writes_a_long_table_with_units(tmp_path):
+    import pandas as pd
+    import xarray as xr
+
+    frequency = np.array([1.0, 2.0, 3.0])
+    data = xr.Dataset(
+        {"magnitude": (("case", "frequency"), np.array([[1.0, 0.5, np.nan], [2.0, 1.0, 0.5]]),
+                       {"units": "1"}),
+         "trusted": (("case", "frequency"), np.array([[1, 1, 0], [1, 0, 1]], np.int8),
+                     {"units": "1"})},
+        coords={"case": ("case", ["a, with comma", "b"]),
+                "frequency": ("frequency", frequency, {"units": "Hz"}),
+                "mass": ("case", [6.4, 7.0], {"units": "kg"})},
+        attrs={"Conventions": "CF-1.10", "title": "toy"})
+    path = write_dataset(data, tmp_path / "curves.csv")
+    table = pd.read_csv(path, comment="#", header=[0, 1])
+    assert list(table.columns) == [("case", "Unnamed: 0_level_1"), ("frequency", "Hz"),
+                                   ("mass", "kg"), ("magnitude", "1"), ("trusted", "1")]
+    table.columns = [name for name, _ in table.columns]
+    back = table.set_index(["case", "frequency"]).to_xarray()
+    np.testing.assert_array_equal(back["magnitude"].sel(case="a, with comma").values,
+                                  [1.0, 0.5, np.nan])
+    np.testing.assert_array_equal(back["trusted"].values, data["trusted"].values)
+    assert list(back["mass"].isel(frequency=0).values) == [6.4, 7.0]
+    nc = write_dataset(data, tmp_path / "curves.nc")
+    xr.testing.assert_identical(xr.load_dataset(nc), data)
+    with pytest.raises(ParameterError, match=r"\.nc or \.csv"):
+        write_dataset(data, tmp_path / "curves.txt")
+    assert leftovers(tmp_path) == ["curves.csv", "curves.nc"]

@@ -301,6 +301,18 @@ def test_damping_small_effect_reproduced_and_flipped():
                    "damping_small_effect").label == "not decidable"
 
 
+def test_damping_verdict_shows_both_metrics_and_is_partly_when_they_disagree():
+    """A 6 dB dip in one bin: a large per-bin reduction, a small band-RMS change."""
+    cases = damping_cases((0.0, 0.0), spike=False)
+    cases[2].magnitude = with_spike(cases[2].magnitude, 6.0,
+                                    cases[0].magnitude[120] * 10 ** (-6 / 20))
+    found = verdict(study("d", ["damping_small_effect"], cases), "damping_small_effect")
+    assert found.label == "partly reproduced"
+    assert "largest per-bin reduction of T 0, 6 dB" in found.evidence
+    assert "change of the band RMS" in found.evidence and "docs/design.md" in found.evidence
+    assert "per bin not small, over the band small" in found.evidence
+
+
 # ---------------------------------------------------------------- experiment_shape
 def processing_case(peak=2.0, t12=0.3, rising=False, spike=True):
     f = np.maximum(FREQUENCY, 1e-9)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from qzs.errors import ParameterError
+from qzs.model.registry import unit_of
 from qzs.workflows.report import CLAIMS, decide_claims, write_paper_outputs
 from qzs.workflows.studies import load_study, run_studies, shipped_studies
 
@@ -97,8 +98,38 @@ def test_quick_report_decides_every_claim_from_data(quick_paper):
         assert (folder / f"{name}.png").exists() and (folder / f"{name}.svg").exists()
         assert f"{name}.png" in html
     csv_lines = (folder / "metrics.csv").read_text().splitlines()
-    assert len(csv_lines) == 1 + sum(len(r.cases) for r in results)
-    assert "transmissibility_at_12_hz" in csv_lines[0]
+    assert csv_lines[0] == "# column names on line 2, units on line 3, data from line 4"
+    assert len(csv_lines) == 3 + sum(len(r.cases) for r in results)
+    assert "transmissibility_at_12_hz" in csv_lines[1]
+
+
+def test_every_transmissibility_study_writes_its_curves_as_data(quick_paper):
+    """Each study's curves file holds each case's simulated curve, bit for bit (NetCDF) and
+    to 10 digits (CSV), with its parameters."""
+    import pandas as pd
+    import xarray as xr
+
+    results, _, folder = quick_paper
+    for result in results:
+        nc, csv = folder / f"{result.study.name}_curves.nc", folder / f"{result.study.name}_curves.csv"
+        if result.study.kind == "spring_characteristic":  # the points and the fitted law
+            data, extra = xr.load_dataset(nc), result.cases[0].extra
+            np.testing.assert_array_equal(data["force"].values, extra["force"])
+            table = pd.read_csv(csv, comment="#", header=[0, 1])
+            np.testing.assert_allclose(table[("displacement", "m")], extra["displacement"],
+                                       rtol=1e-9)
+            continue
+        data = xr.load_dataset(nc)
+        table = pd.read_csv(csv, comment="#", header=[0, 1])
+        assert len(table) == data.sizes["case"] * data.sizes["frequency"]
+        case = result.cases[-1]
+        row = data.isel(case=len(result.cases) - 1 if result.study.kind != "processing" else 0)
+        np.testing.assert_array_equal(row["magnitude"].values, case.magnitude)
+        np.testing.assert_array_equal(row["phase"].values, case.phase)
+        np.testing.assert_array_equal(row["trusted"].values.astype(bool), case.trusted)
+        assert np.isfinite(case.phase[case.trusted]).all()
+        for name, value in case.settings.items():
+            assert float(row[name]) == value and data[name].attrs["units"] == unit_of(name)
 
 
 def test_claims_follow_the_numbers(quick_paper):
@@ -181,7 +212,8 @@ def test_outputs_say_why_a_metric_is_undefined(quick_paper):
     import csv
 
     results, _, folder = quick_paper
-    rows = list(csv.DictReader((folder / "metrics.csv").open()))
+    lines = [line for line in (folder / "metrics.csv").open() if not line.startswith("#")]
+    rows = list(csv.DictReader(lines[:1] + lines[2:]))  # the names, not the units row
     cases = [row for row in rows if row["study"] != "spring"]
     assert "resonance_frequency_reason" in rows[0]
     for row in cases:
@@ -255,8 +287,9 @@ def test_study_cli_prints_json(tmp_path, capsys):
     outputs = record["outputs"]
     assert outputs["report"] == str(out / "report.html")
     assert str(out / "tiny.png") in outputs["figures"] and str(out / "tiny.svg") in outputs["figures"]
+    assert outputs["curves"] == [str(out / "tiny_curves.nc"), str(out / "tiny_curves.csv")]
     for path in (outputs["report"], outputs["metrics_json"], outputs["metrics_csv"],
-                 *outputs["figures"]):
+                 *outputs["figures"], *outputs["curves"]):
         assert (tmp_path / path).exists() or __import__("pathlib").Path(path).exists()
 
 

@@ -2,6 +2,7 @@
 
 ====================  =============================================================================
 ``spectral``          transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
+``damping``           what active damping changes: largest per-bin reduction and band-RMS change
 ``linear``            the linearised closed loop at the operating point (python-control)
 ``hexapod_linear``    the six-leg platform of isolator legs linearised at its home pose
 ``control_design``    static design, Routh-Hurwitz, sampled-loop margins, hunting (describing functions)

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
            "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
-           "welch_average_count", "estimate_schema"]
+           "welch_average_count", "estimate_schema", "METRIC_UNITS", "metric_unit"]
 
 ESTIMATORS = ("psd_ratio", "h1", "h2")
 _MAGNITUDE_NAMES = {"psd_ratio": "amplitude ratio sqrt(S_payload / S_base)",
@@ -259,7 +259,9 @@ class TransmissibilityEstimate:
     magnitude : ndarray, shape (n,)
         Amplitude ratio [-]; for ``psd_ratio`` it is ``sqrt(S_payload / S_base)``.
     phase : ndarray, shape (n,)
-        Phase of payload relative to base [rad]; NaN for ``psd_ratio``.
+        Phase of payload relative to base [rad]: the phase of the cross spectrum
+        ``S_bp``, which H1 and H2 share (``S_bb`` and ``S_pp`` are real); every estimator
+        has it.
     coherence : ndarray, shape (n,)
         Magnitude-squared coherence [-], 0..1.
     base_share : ndarray, shape (n,)
@@ -455,7 +457,8 @@ def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
         Average exactly this many segments, using only the start of the record.
         Default: as many as fit.
     estimator : {"psd_ratio", "h1", "h2"}
-        ``psd_ratio``: ``sqrt(S_pp / S_bb)`` (the paper's definition, no phase);
+        ``psd_ratio``: ``sqrt(S_pp / S_bb)`` (the paper's definition; its phase is that of
+        ``S_bp``, as for H1 and H2);
         ``h1``: ``S_bp / S_bb`` (unbiased by payload noise);
         ``h2``: ``S_pp / S_pb`` (unbiased by base noise).
     detrend : str, callable or False
@@ -512,7 +515,8 @@ def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
         coherence = np.abs(s_bp) ** 2 / s_bb / s_pp
         if estimator == "psd_ratio":
             magnitude = np.sqrt(np.divide(s_pp, s_bb, out=np.full_like(s_pp, np.nan), where=s_bb > 0))
-            phase = np.full_like(magnitude, np.nan)
+            # S_bb and S_pp are real: H1 = S_bp/S_bb and H2 = S_pp/S_pb share the phase of S_bp
+            phase = np.where(s_bb > 0, np.angle(s_bp), np.nan)
         else:
             if estimator == "h1":
                 numerator, denominator = s_bp, s_bb
@@ -586,6 +590,31 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
 #: The scalar metrics, in the order of :meth:`TransmissibilityMetrics.to_dict`.
 METRIC_NAMES = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
                 "rolloff_db_per_decade", "untrusted_below")
+#: The unit of each metric (of :meth:`TransmissibilityMetrics.to_dict`, and the trusted range
+#: ``trusted_from``/``trusted_to`` beside it); a spot value ``transmissibility_at_<f>_hz`` is
+#: an amplitude ratio, "1" (:func:`metric_unit`).
+METRIC_UNITS = MappingProxyType({
+    "resonance_frequency": "Hz", "resonance_peak": "1", "isolation_onset": "Hz",
+    "minus_3db_frequency": "Hz", "rolloff_db_per_decade": "dB/decade", "untrusted_below": "Hz",
+    "trusted_from": "Hz", "trusted_to": "Hz"})
+
+
+def metric_unit(name):
+    """The unit of a transmissibility metric (a key of :meth:`TransmissibilityMetrics.to_dict`).
+
+    Parameters
+    ----------
+    name : str
+        The metric's name: one of :data:`METRIC_UNITS` or ``transmissibility_at_<f>_hz``.
+
+    Returns
+    -------
+    str or None
+        Its unit ("1" for an amplitude ratio); None for a name that is not a metric.
+    """
+    if name.startswith("transmissibility_at_") and name.endswith("_hz"):
+        return "1"
+    return METRIC_UNITS.get(name)
 
 
 def rolloff_slope(frequency, magnitude):

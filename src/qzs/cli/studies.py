@@ -58,7 +58,8 @@ def run(args):
     lines.append(f"{'total':<12}    wall {wall:7.1f} s")
     lines.extend(f"  [{verdict.label}] {verdict.statement} ({verdict.study})\n"
                  f"      {verdict.evidence}" for verdict in verdicts)
-    lines.append(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv and figures")
+    lines.append(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv, figures and "
+                 "their curves (<study>_curves.nc, .csv)")
     emit(args, "\n".join(lines),
          paper_summary(results, verdicts, args.out, quick=args.quick, wall_seconds=wall))
     return 0

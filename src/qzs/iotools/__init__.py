@@ -5,7 +5,7 @@ This layer knows no result type: each declares its own schema beside its class
 
 ===========  ==================================================================
 ``schema``   a result's variables, dimensions, units and flags; its dataset
-``writer``   the streaming, atomic CF writer (NetCDF, CSV, MATLAB) of a schema
+``writer``   the atomic CF writer of a schema: streamed (NetCDF, CSV, MATLAB), whole datasets, tables
 ``matfile``  MATLAB files (MAT 5, MAT 7.3) of a dataset or a streamed schema
 ``files``    atomic writes; result files read back
 ``paths``    output paths checked before the work starts
@@ -28,6 +28,7 @@ _EXPORTS = {
     "Variable": "qzs.iotools.schema", "to_dataset": "qzs.iotools.schema",
     "StreamWriter": "qzs.iotools.writer", "estimated_file_size": "qzs.iotools.writer",
     "write_mat": "qzs.iotools.matfile",
+    "write_dataset": "qzs.iotools.writer", "write_table": "qzs.iotools.writer",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -18,7 +18,8 @@ from qzs.iotools.schema import NONE_VALUE
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
 
-__all__ = ["atomic_path", "read_result", "read_displacement_csv", "RESULT_SUFFIXES"]
+__all__ = ["atomic_path", "read_result", "read_displacement_csv", "RESULT_SUFFIXES",
+           "is_units_row"]
 
 #: File formats of a result streamed to a file: suffix -> name.
 RESULT_SUFFIXES = {".nc": "NetCDF", ".csv": "CSV", ".mat": "MATLAB"}
@@ -90,6 +91,33 @@ def _parse_line(text):
     if value.endswith("]") and " [" in value:
         value, unit = value[:-1].rsplit(" [", 1)
     return key, parse_value(value), unit
+
+
+def is_units_row(cells):
+    """Whether a CSV row after the column names is a row of units, not data: some cell is
+    not a number (the layout of ``qzs.iotools.writer.CSV_LAYOUT``).
+
+    Every table of qzs has a unit that is not a number (``s``, ``Hz``); a data row has
+    only numbers (or empty cells, where NaN was written).
+
+    Parameters
+    ----------
+    cells : sequence of str
+        The row's cells.
+
+    Returns
+    -------
+    bool
+    """
+    for cell in cells:
+        cell = cell.strip()
+        if not cell:
+            continue
+        try:
+            float(cell)
+        except ValueError:
+            return True
+    return False
 
 
 def _trailer(path, size=1 << 16):
@@ -165,7 +193,10 @@ def read_result(path, schema=None):
         raise DataError(f"cannot read {str(path)!r}: {error.strerror}.") from None
     with handle:
         try:
-            for line in handle:
+            while True:
+                line = handle.readline()
+                if not line:
+                    raise DataError(f"{str(path)!r} has no column header line.")
                 if not line.startswith("#"):
                     names = line.strip().split(",")
                     break
@@ -177,8 +208,12 @@ def read_result(path, schema=None):
                     attrs[key] = value
                     if unit is not None:
                         attrs[f"{key}_units"] = unit
+            start = handle.tell()
+            row = handle.readline().strip().split(",")
+            if is_units_row(row):  # the units row (writer.CSV_LAYOUT); older files have none
+                units = row
             else:
-                raise DataError(f"{str(path)!r} has no column header line.")
+                handle.seek(start)
             data = np.loadtxt(handle, delimiter=",", ndmin=2, comments="#")
         except DataError:
             raise

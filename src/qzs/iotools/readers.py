@@ -55,6 +55,7 @@ import numpy as np
 from qzs._validation import known_keys, read_toml, strictly_increasing
 from qzs._optional import require
 from qzs.errors import DataError, DataWarning, ParameterError
+from qzs.iotools.files import is_units_row
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -391,6 +392,8 @@ def _read_csv(path, spec):
         raise DataError(f"{str(path)!r} is not a readable CSV file with a header: "
                         f"{error}") from None
     names = [str(c).strip() for c in table.columns]
+    if len(table) and is_units_row([str(v) for v in table.iloc[0] if not pd.isna(v)]):
+        table = table.iloc[1:]  # a units row under the names (a CSV file qzs wrote)
     columns = {}
     for key, source in [("time", spec.time_source or "time"),
                         *((r, _name_part(s.source)) for r, s in spec.channels.items())]:

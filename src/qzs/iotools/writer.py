@@ -9,6 +9,9 @@ appended block goes to which variable is the caller's mapping; the single run's
 :class:`~qzs.engine.results.ResultWriter` and the six-axis run's
 :class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
 
+:func:`write_dataset` writes a whole dataset of a schema (NetCDF, or CSV in long format) and
+:func:`write_table` rows of a table (CSV), both with the units row of :data:`CSV_LAYOUT`.
+
 The file is written to a hidden temporary file beside the target (``.<name>.*.part``) and
 renamed onto the target by :meth:`StreamWriter.finish`; the disk space of each chunk is
 reserved before it is written. :meth:`StreamWriter.abort` removes the temporary file; so
@@ -18,8 +21,10 @@ while writing (a full disk, no permission) raise :class:`~qzs.errors.WriteError`
 attributes ``path`` and ``reason`` and leave neither the target nor a temporary file behind.
 """
 import contextlib
+import csv
 import errno
 import functools
+import io
 import os
 import shutil
 import sys
@@ -29,11 +34,20 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import ParameterError
-from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error
+from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error, atomic_path
 from qzs.iotools.matfile import MatStream
 from qzs.iotools.schema import CONVENTIONS
 
-__all__ = ["StreamWriter", "estimated_file_size"]
+__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_table", "CSV_LAYOUT"]
+
+#: How the CSV files of qzs lay out their table (docs/model.md §7): ``#`` comment lines
+#: (``key = value [unit]``), the last of which says on which lines the table starts; a row
+#: of column names; a row of their units (CF ``units``; empty for a text column); the data;
+#: trailing ``#`` lines. Read with pandas ``read_csv(path, comment="#", header=[0, 1])``
+#: (columns ``(name, unit)``), numpy ``loadtxt(path, delimiter=",", skiprows=N + 1)`` (N:
+#: the names' line, given in the layout line) or MATLAB ``readtable`` with
+#: ``VariableNamesLine`` N and ``VariableUnitsLine`` N + 1.
+CSV_LAYOUT = "column names on line {names}, units on line {units}, data from line {data}"
 
 _CSV_FORMAT = "%.10g"
 _FREE_MARGIN = 1 << 20         # bytes kept free beyond an estimate or a chunk
@@ -104,13 +118,14 @@ class StreamWriter:
     along the unlimited dimension are written from ``values`` when the file is created,
     and the global attributes (``Conventions``, ``attributes``, then those given to
     :meth:`finish`) at the end. CSV files (a schema whose streamed variables are all
-    one-dimensional) have the ``attributes`` as ``# key = value [unit]`` header lines, one column per streamed
-    variable at the ``%.10g`` format, and the attributes given to :meth:`finish` as
-    trailing ``# key = value`` lines (known only at the end). MATLAB files hold the same
-    variables, names and attributes in the layout of :mod:`qzs.iotools.matfile`; they are
-    grown as MAT 7.3 (resizable HDF5 datasets, memory bounded by the block) and, when every
-    variable fits MAT 5 (2 GiB), copied to MAT 5 by :meth:`finish`, one variable in memory
-    at a time.
+    one-dimensional) have the ``attributes`` as ``# key = value [unit]`` header lines, then
+    the table of :data:`CSV_LAYOUT` (a row of column names, a row of their units, the data),
+    one column per streamed variable at the ``%.10g`` format, and the attributes given to
+    :meth:`finish` as trailing ``# key = value`` lines (known only at the end). MATLAB files
+    hold the same variables, names and attributes in the layout of :mod:`qzs.iotools.matfile`;
+    they are grown as MAT 7.3 (resizable HDF5 datasets, memory bounded by the block) and,
+    when every variable fits MAT 5 (2 GiB), copied to MAT 5 by :meth:`finish`, one variable
+    in memory at a time.
 
     Parameters
     ----------
@@ -278,9 +293,8 @@ class StreamWriter:
     # -- CSV ----------------------------------------------------------------------------
     def _open_csv(self):
         self._file = open(self._tmp, "w", encoding="utf-8", newline="\n")
-        for line in _header_lines(self._head):
-            self._file.write(f"# {line}\n")
-        self._file.write(",".join(v.name for v in self._streamed) + "\n")
+        self._file.write(_csv_head(self._head, [v.name for v in self._streamed],
+                                   [v.units or "" for v in self._streamed]))
 
     def _append_csv(self, blocks, start, stop):
         columns = np.empty((stop - start, len(self._columns)))
@@ -505,6 +519,136 @@ def _close(handle):
                 with contextlib.suppress(Exception):
                     h5file.close()
         raise
+
+
+def _csv_head(attrs, names, units):
+    """The head of a CSV table: ``#`` attribute lines, the layout line, names, units."""
+    lines = [f"# {line}" for line in _header_lines(attrs)]
+    n = len(lines) + 2  # the names' line number, counting from 1, after the layout line
+    lines.append("# " + CSV_LAYOUT.format(names=n, units=n + 1, data=n + 2))
+    rows = io.StringIO()
+    writer = csv.writer(rows, lineterminator="\n")
+    writer.writerow(names)
+    writer.writerow(units)
+    return "\n".join(lines) + "\n" + rows.getvalue()
+
+
+def write_dataset(dataset, path):
+    """Write a dataset built from a schema (``to_dataset``) to NetCDF or CSV, atomically.
+
+    ``.nc``: the dataset as it is (CF-1.10, h5netcdf). ``.csv``: one row per point of its
+    dimensions (long format: a curve of each case one row per frequency), the
+    coordinates first, then the data variables, laid out as :data:`CSV_LAYOUT` says (a
+    row of names, a row of units from the variables' ``units``), the global attributes as
+    ``# key = value [unit]`` header lines, numbers at the ``%.10g`` format, flags 0/1.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The data, with CF attributes (:func:`qzs.iotools.schema.to_dataset`).
+    path : str or Path
+        Target file, ``.nc`` or ``.csv``; its folder is created if missing.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ParameterError
+        Another suffix.
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    suffix = _suffix(path, (".nc", ".csv"), "a dataset")
+    try:
+        with atomic_path(path) as tmp:
+            if suffix == ".nc":
+                dataset.to_netcdf(tmp, engine="h5netcdf")
+            else:
+                tmp.write_text(_table_text(dataset), encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
+
+
+def write_table(rows, path, *, units, attrs=None):
+    """Write rows of a table (dicts) as CSV with a units row (:data:`CSV_LAYOUT`), atomically.
+
+    The columns are every key, in the order met; a key a row lacks, ``None`` and a float
+    that is NaN or +-inf are empty cells.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Column name -> value.
+    path : str or Path
+        Target ``.csv`` file; its folder is created if missing.
+    units : callable
+        Column name -> its unit (``""`` for a text column).
+    attrs : mapping, optional
+        Global attributes, as ``# key = value [unit]`` head lines.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ParameterError
+        A suffix other than ``.csv``.
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    _suffix(path, (".csv",), "a table")
+    columns = list(dict.fromkeys(key for row in rows for key in row))
+    body = io.StringIO()
+    writer = csv.writer(body, lineterminator="\n")
+    for row in rows:
+        writer.writerow(["" if row.get(key) is None else _cell(row[key], repr)
+                         for key in columns])
+    text = _csv_head(attrs or {}, columns, [units(key) or "" for key in columns])
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text + body.getvalue(), encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
+
+
+def _table_text(dataset):
+    """A dataset as a long CSV table (:func:`write_dataset`)."""
+    dims = list(dataset.dims)
+    indexed = [d for d in dims if d in dataset.coords]  # a dimension without labels: no column
+    extra = [name for name in dataset.coords if name not in dims]
+    names = [*indexed, *extra, *dataset.data_vars]
+    shape = tuple(dataset.sizes[d] for d in dims)
+    columns = []
+    for name in names:
+        variable = dataset[name]
+        values = variable.transpose(*[d for d in dims if d in variable.dims]).values
+        values = np.broadcast_to(
+            values.reshape([dataset.sizes[d] if d in variable.dims else 1 for d in dims]),
+            shape).ravel()
+        columns.append(values)
+    units = [str(dataset[name].attrs.get("units", "")) for name in names]
+    rows = io.StringIO()
+    writer = csv.writer(rows, lineterminator="\n")
+    for row in zip(*columns):
+        writer.writerow([_cell(value) for value in row])
+    return _csv_head(dataset.attrs, names, units) + rows.getvalue()
+
+
+def _cell(value, number=lambda value: _CSV_FORMAT % value):
+    if isinstance(value, (bool, np.bool_)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return "" if not np.isfinite(value) else number(float(value))
+    return str(value)
 
 
 def _header_lines(attrs):

@@ -5,6 +5,7 @@
 ``studies``                   the paper's studies as TOML definitions (``study_files/``), run
                               in parallel
 ``report``                    ``qzs paper``: figures, metrics, claims decided from the data
+``curves``                    the curves behind a figure as data: NetCDF and CSV per study
 ``experiment``                a measured log beside its simulation
 ``experiment_map``            the commented channel map template (``--write-map``)
 ``sweeps``                    parameter sweeps and Monte Carlo runs into Zarr stores, locally

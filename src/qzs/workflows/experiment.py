@@ -42,6 +42,7 @@ from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
+from qzs.iotools.writer import write_dataset
 from qzs.model.excitation import Chirp
 
 if TYPE_CHECKING:
@@ -315,13 +316,7 @@ class ExperimentResult:
         paths = {"figure": folder / "transmissibility.png",
                  "table": folder / "transmissibility.csv", "report": folder / "report.md"}
         plt.close(self.plot(path=paths["figure"]))
-        data = self.to_xarray()
-        names = [n for n in ("experiment", "simulation", "coherence", "trusted") if n in data]
-        with atomic_path(paths["table"]) as tmp:
-            np.savetxt(tmp, np.column_stack([data["frequency"].values,
-                                             *(data[n].values for n in names)]),
-                       delimiter=",", fmt="%.8g", comments="",
-                       header=",".join(["frequency", *names]))
+        write_dataset(self.to_xarray(), paths["table"])  # a units row under the names
         with atomic_path(paths["report"]) as tmp:
             Path(tmp).write_text(_markdown(self, paths["figure"].name), encoding="utf-8")
         return paths

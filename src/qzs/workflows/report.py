@@ -1,7 +1,9 @@
 """``qzs paper``: run the paper's studies, draw its figures, decide its claims from the data.
 
-Writes to an output folder: one figure per paper figure (PNG and SVG),
-``metrics.json`` and ``metrics.csv`` (per study and case), and ``report.html``,
+Writes to an output folder: one figure per paper figure (PNG and SVG), the curves behind
+each study's figures as data (``<study>_curves.nc`` and ``<study>_curves.csv``,
+:mod:`qzs.workflows.curves`), ``metrics.json`` and ``metrics.csv`` (per study and case,
+with a units row), and ``report.html``,
 which states how every curve was computed, puts each figure beside the paper's claims
 the study names (docs/model.md §13, "What the paper reports") and says, from the numbers,
 whether each claim is reproduced.
@@ -22,22 +24,28 @@ from typing import Any
 
 import numpy as np
 
-from qzs._format import (csv_text, decibels, footnoted, html_figure, html_head, html_table,
-                         json_ready, json_text, number)
+from qzs._format import (footnoted, html_figure, html_head, html_table, json_ready, json_text,
+                         number)
 from qzs._validation import worker_count
 from qzs._version import __version__
-from qzs.analysis.spectral import METRIC_NAMES, band_mask, rolloff_slope, transmissibility_at
+from qzs.analysis.damping import damping_change
+from qzs.analysis.spectral import (METRIC_NAMES, band_mask, metric_unit, rolloff_slope,
+                                   transmissibility_at)
+from qzs.defaults import DAMPING_CLAIM
 from qzs.iotools.files import atomic_path
+from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
 from qzs.model.registry import PARAMETERS, format_value, unit_of, update_parameters
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
+from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
 from qzs.workflows.studies import CLAIMS as STATEMENTS
-from qzs.workflows.studies import StudyResult, load_study, run_studies, shipped_studies
+from qzs.workflows.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
+                                   run_studies, shipped_studies)
 
-__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "paper_summary",
-           "write_paper_outputs", "run_paper"]
+__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
+           "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
 #: of the report, its figures (PNG) and metrics.
@@ -243,27 +251,80 @@ def _no_pi_stops(result):
     return ok, f"stop contacts without PI: {describe(without)}; with PI: {describe(with_pi)}"
 
 
-def _damping_small_effect(result):
-    reference = [c for c in result.cases if _value(c, "damping_gain") == 0]
+#: The band of the damping claim [Hz] and the change below which damping "did not help
+#: much" [dB] (:data:`qzs.defaults.DAMPING_CLAIM`).
+DAMPING_BAND, DAMPING_SMALL_DB = DAMPING_CLAIM["band"], DAMPING_CLAIM["small_db"]
+#: Where the design analysis explains the damping claim (``qzs design``).
+DAMPING_EXPLAINED = ("docs/design.md section 7, \"Why active damping did not help much\" "
+                     "(qzs design)")
+
+
+def damping_changes(result, band=DAMPING_BAND):
+    """What damping changes in each damped case of a study, against its case with Kd = 0.
+
+    The two metrics of :func:`qzs.analysis.damping.damping_change` (largest per-bin
+    reduction, band-RMS change), from each curve's trusted bins: what the damping claim is
+    decided from, and what ``qzs design`` reports for every gain it tries.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study with a case at ``damping_gain`` 0 (the first is the reference).
+    band : tuple of float
+        The band [Hz, Hz]; default the claim's (:data:`qzs.defaults.DAMPING_CLAIM`).
+
+    Returns
+    -------
+    reference : CaseResult or None
+        The case with Kd = 0; None if there is none.
+    changes : list of (CaseResult, DampingChange)
+        Each case with Kd > 0, in the study's order.
+    """
+    reference = next((c for c in result.cases if _value(c, "damping_gain") == 0), None)
     damped = [c for c in result.cases if _value(c, "damping_gain") > 0]
-    if not reference or not damped:
+    if reference is None:
+        return None, [(case, None) for case in damped]
+    return reference, [(case, damping_change(reference.frequency, reference.magnitude,
+                                             case.magnitude, band=band,
+                                             reference_trusted=_trusted(reference),
+                                             damped_trusted=_trusted(case)))
+                       for case in damped]
+
+
+def _damping_small_effect(result):
+    reference, pairs = damping_changes(result)
+    damped = [case for case, _ in pairs]
+    if reference is None or not damped:
         raise _Undecidable(f"needs a case with Kd = 0 and one with Kd > 0; study "
-                           f"{result.study.name!r} has {len(reference)} and {len(damped)}")
-    reference = reference[0]
-    changes = []
-    for case in damped:
-        both = _trusted(case) & _trusted(reference)
-        keep = band_mask(case.frequency, 1.5, 20.0, trusted=both)
-        if not keep.any():
-            changes.append(float("nan"))
-            continue
-        ratio_db = decibels(case.magnitude[keep] / reference.magnitude[keep])
-        changes.append(float(-np.min(ratio_db)))
-    _defined(changes, "the reduction over 1.5-20 Hz", damped)
-    ok = all(c < 3.0 for c in changes)
-    return ok, (f"largest reduction of T over the trusted bins of 1.5-20 Hz against "
-                f"{reference.label} for {_labels(damped)}: {_fmt(changes)} dB "
-                "(\"did not help much\" if < 3 dB)")
+                           f"{result.study.name!r} has {int(reference is not None)} and "
+                           f"{len(damped)}")
+    changes = [change for _, change in pairs]
+    largest = [c.largest_reduction_db for c in changes]
+    rms = [c.band_rms_change_db for c in changes]
+    low, high = DAMPING_BAND
+    _defined(largest, f"the reduction over {low:g}-{high:g} Hz", damped)
+    _defined(rms, f"the band RMS over {low:g}-{high:g} Hz", damped)
+    linear = []
+    if reference.linear.get("magnitude") is not None:
+        linear = [damping_change(reference.frequency, reference.linear["magnitude"],
+                                 case.linear["magnitude"], band=DAMPING_BAND).band_rms_change_db
+                  for case in damped if case.linear.get("magnitude") is not None]
+    per_bin = all(v < DAMPING_SMALL_DB for v in largest)
+    band = all(-v < DAMPING_SMALL_DB for v in rms)
+    ok = True if per_bin and band else (False if not (per_bin or band) else None)
+    said = {True: "small", False: "not small"}
+    text = (f"against {reference.label}, over the trusted bins of {low:g}-{high:g} Hz, for "
+            f"{_labels(damped)}: largest per-bin reduction of T {_fmt(largest)} dB (at "
+            f"{_fmt([c.largest_reduction_frequency for c in changes])} Hz); change of the band "
+            f"RMS of T {_fmt(rms)} dB")
+    if len(linear) == len(damped):
+        text += f" (linearised model: {_fmt(linear)} dB)"
+    text += (f". \"Did not help much\" if both stay under {DAMPING_SMALL_DB:g} dB: per bin "
+             f"{said[per_bin]}, over the band {said[band]}. Why damping helps little, and "
+             f"which factor limits it (the guide's viscous friction Cv, the high-pass, the "
+             f"controller rate, a delay), is analysed in {DAMPING_EXPLAINED}, which reports "
+             "the same two metrics (qzs.analysis.damping) for every gain it tries")
+    return ok, text
 
 
 def _trusted(case):
@@ -348,19 +409,62 @@ def decide_claims(study_results):
 
 # ---------------------------------------------------------------- figures
 def _curves(result):
+    """The curves a study's figures draw, each with its case's ``parameters`` and ``phase``."""
     cases = result.cases
+    names = list(dict.fromkeys(k for c in cases for k in c.settings))
+
+    def parameters(case):
+        return {name: _value(case, name) for name in names}
+
     if result.study.kind == "processing":
         case = cases[0]
         return [dict(label=f"ideal: accelerations, {case.stats['n_averages']} averages",
                      frequency=case.frequency, magnitude=case.magnitude, trusted=case.trusted,
-                     coherence=case.coherence, linear=case.linear.get("magnitude")),
+                     coherence=case.coherence, linear=case.linear.get("magnitude"),
+                     phase=case.phase, parameters=parameters(case)),
                 dict(label=f"experiment-style: velocities through the "
                            f"{case.extra['highpass']:g} Hz high-pass, "
                            f"{case.extra['n_averages']} averages",
                      frequency=case.extra["frequency"], magnitude=case.extra["magnitude"],
-                     trusted=case.extra.get("trusted"), coherence=case.extra.get("coherence"))]
+                     trusted=case.extra.get("trusted"), coherence=case.extra.get("coherence"),
+                     phase=case.extra.get("phase"), parameters=parameters(case))]
     return [dict(label=c.label, frequency=c.frequency, magnitude=c.magnitude, trusted=c.trusted,
-                 coherence=c.coherence, linear=c.linear.get("magnitude")) for c in cases]
+                 coherence=c.coherence, linear=c.linear.get("magnitude"), phase=c.phase,
+                 parameters=parameters(c)) for c in cases]
+
+
+def curves_of(result, *, quick=False):
+    """A study's curves as a dataset (:func:`qzs.workflows.curves.curves_dataset`).
+
+    The curves its figures draw, on ``case`` and ``frequency``, with each case's
+    parameters as coordinates and the run settings, study and definition as attributes;
+    for the spring's characteristic, its points and fitted law
+    (:func:`qzs.workflows.curves.spring_dataset`).
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study.
+    quick : bool
+        Whether the runs were the quick ones (an attribute).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    attrs = {"title": result.study.title, "study": result.study.name,
+             "definition": Path(result.study.source).name if result.study.source else "",
+             "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
+    if result.study.kind == "spring_characteristic":
+        extra = result.cases[0].extra
+        return spring_dataset(extra["displacement"], extra["force"],
+                              extra["fit"]["spring_force"], extra["fit"]["spring_shape"], attrs)
+    for key, value in _settings(result).items():
+        attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
+                      else value)
+        if RUN_UNITS.get(key):
+            attrs[f"{key}_units"] = RUN_UNITS[key]
+    return curves_dataset(_curves(result), attrs)
 
 
 def _figures(result, folder):
@@ -397,6 +501,11 @@ def _figures(result, folder):
         plt.close(fig)
         drawn.append((view["figure"], path, overlap_notes(curves, frequency_range=span)))
     return drawn
+
+
+def _curve_files(result, folder):
+    """The data files of a study's curves."""
+    return [Path(folder) / f"{result.study.name}_curves{suffix}" for suffix in CURVE_SUFFIXES]
 
 
 def _figure_names(result):
@@ -436,6 +545,51 @@ def _metric_rows(study_results):
     return rows
 
 
+#: Columns of ``metrics.csv`` that are not one of a case's metrics, statistics or run
+#: settings, with their units ("" for text).
+_COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
+                 "seconds": "s"}
+
+
+def column_unit(name):
+    """The unit of a column of ``metrics.csv`` (its units row), from where it is defined.
+
+    Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
+    :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
+    ``spring_shape`` from the registry), statistics and run settings from
+    :data:`qzs.workflows.studies.STATS_UNITS` and :data:`~qzs.workflows.studies.RUN_UNITS`.
+
+    Parameters
+    ----------
+    name : str
+        The column's name.
+
+    Returns
+    -------
+    str
+        The unit; ``""`` for a text column (labels, reasons, the solver's name).
+
+    Raises
+    ------
+    KeyError
+        A column no definition gives a unit for (a programming error).
+    """
+    if name.endswith("_reason") or name in _COLUMN_UNITS:
+        return _COLUMN_UNITS.get(name, "")
+    for prefix, units in (("run.", RUN_UNITS), ("param.", None), ("processed.", None)):
+        if name.startswith(prefix):
+            key = name[len(prefix):]
+            if units is not None:
+                return units[key] or ""
+            return unit_of(key) if prefix == "param." else column_unit(key)
+    unit = metric_unit(name) or STATS_UNITS.get(name)
+    if unit is None and name in PARAMETERS:
+        unit = unit_of(name)
+    if unit is None:
+        raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")
+    return unit
+
+
 def _claims_record(verdicts):
     return [{"claim": v.claim, "study": v.study, "statement": v.statement, "verdict": v.label,
              "evidence": v.evidence} for v in verdicts]
@@ -471,7 +625,11 @@ def _draw(study_results, folder, workers):
 
 def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None,
                         workers=None):
-    """Write figures, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
+    """Write figures, curves, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
+
+    The curves of each transmissibility study go to ``<study>_curves.nc`` and
+    ``<study>_curves.csv`` (:func:`curves_of`); ``metrics.csv`` has a units row under its
+    column names (:func:`column_unit`).
 
     Parameters
     ----------
@@ -512,8 +670,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
                 "claims": _claims_record(verdicts)}
     with atomic_path(folder / "metrics.json") as tmp:
         tmp.write_text(json_text(document), encoding="utf-8")
-    with atomic_path(folder / "metrics.csv") as tmp:
-        tmp.write_text(csv_text(rows), encoding="utf-8")
+    write_table(rows, folder / "metrics.csv", units=column_unit)
+    for result in study_results:
+        write_curves(curves_of(result, quick=quick), folder, result.study.name)
     with atomic_path(folder / "report.html") as tmp:
         tmp.write_text(_html(study_results, figures, verdicts, quick, wall_seconds),
                        encoding="utf-8")
@@ -545,7 +704,7 @@ def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdi
         ``qzs_version``, ``quick``, ``wall_seconds``, ``claims`` (claim, study,
         statement, verdict, evidence), ``studies`` (name -> title, seconds, settings,
         cases with their metrics), ``outputs`` (report, metrics_json, metrics_csv,
-        figures: PNG and SVG paths).
+        figures: PNG and SVG paths, curves: the ``<study>_curves.nc`` and ``.csv`` files).
     """
     folder = Path(folder)
     studies = {}
@@ -570,7 +729,9 @@ def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdi
         "claims": _claims_record(verdicts), "studies": studies,
         "outputs": {"report": str(folder / "report.html"),
                     "metrics_json": str(folder / "metrics.json"),
-                    "metrics_csv": str(folder / "metrics.csv"), "figures": figures}})
+                    "metrics_csv": str(folder / "metrics.csv"), "figures": figures,
+                    "curves": [str(path) for result in study_results
+                               for path in _curve_files(result, folder)]}})
 
 
 # ---------------------------------------------------------------- report.html
@@ -588,15 +749,16 @@ padding:.2em .5em;text-align:right}th{background:#eee}td:first-child,th:first-ch
 _CSS = {"reproduced": "reproduced", "not reproduced": "not", "partly reproduced": "partly",
         "not decidable": "undecidable"}
 
-_RUN_ROWS = (("solver", "solver", ""), ("dt", "time step", "s"),
-             ("sample_rate", "sample rate", "Hz"),
-             ("chirp_amplitude", "chirp amplitude", "m"),
-             ("chirp_f0", "chirp from", "Hz"), ("chirp_f1", "chirp to", "Hz"),
-             ("chirp_duration", "chirp duration", "s"), ("window", "window", ""),
-             ("fft_length", "FFT length", "samples"), ("n_averages", "averages", ""),
-             ("overlap", "overlap", "-"),
-             ("coherence_min", "trusted: coherence at least", "-"),
-             ("base_share_min", "trusted: base power share at least", "-"))
+#: The run settings a study's section lists: key of :attr:`CaseResult.run
+#: <qzs.workflows.studies.CaseResult>` -> name (units from
+#: :data:`qzs.workflows.studies.RUN_UNITS`).
+_RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample rate"),
+             ("chirp_amplitude", "chirp amplitude"), ("chirp_f0", "chirp from"),
+             ("chirp_f1", "chirp to"), ("chirp_duration", "chirp duration"),
+             ("window", "window"), ("fft_length", "FFT length [samples]"),
+             ("n_averages", "averages"), ("overlap", "overlap"),
+             ("coherence_min", "trusted: coherence at least"),
+             ("base_share_min", "trusted: base power share at least"))
 
 
 def _html(study_results, figures, verdicts, quick, wall_seconds):
@@ -635,6 +797,16 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
                                "coherence of base and payload.")
             caption.extend(e(note) for note in notes)
             parts.append(html_figure(path, name, " ".join(caption)))
+        files = [p.name for p in _curve_files(result, ".")]
+        if files:
+            links = " and ".join(f"<a href='{e(f)}'>{e(f)}</a>" for f in files)
+            what = ("the measured points and the fitted law at them"
+                    if study.kind == "spring_characteristic" else
+                    "per case and frequency the transmissibility, its phase, the coherence, "
+                    "the trusted flag and the linearised model, the case's parameters beside it")
+            parts.append(f"<p class='notes'>The curves of these figures as data: {links} "
+                         f"(NetCDF CF-1.10; CSV with a units row under the column names): "
+                         f"{e(what)}.</p>")
         for verdict in verdicts:
             if verdict.study != study.name:
                 continue
@@ -650,9 +822,10 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
 def _settings_table(result):
     settings = _settings(result)
     head, cells = [], []
-    for key, name, unit in _RUN_ROWS:
+    for key, name in _RUN_ROWS:
         if key not in settings:
             continue
+        unit = RUN_UNITS[key] if RUN_UNITS[key] != "1" else ""
         value = settings[key]
         text = ", ".join(format_value(v) for v in value) if isinstance(value, list) \
             else format_value(value)

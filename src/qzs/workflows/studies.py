@@ -45,7 +45,7 @@ from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import update_parameters
 
 __all__ = ["CLAIMS", "Study", "StudyResult", "CaseResult", "load_study", "shipped_studies",
-           "run_studies", "run_study"]
+           "run_studies", "run_study", "RUN_UNITS", "STATS_UNITS"]
 
 KINDS = ("transmissibility", "processing", "spring_characteristic")
 #: Folder of the shipped study files, inside the package.
@@ -67,6 +67,17 @@ CLAIMS = MappingProxyType({
     "experiment_shape": "Experiment: resonance peaks below 3.5 Hz, roll-off from 4 Hz, "
                         "transmissibility 0.3 at 12 Hz.",
 })
+#: The unit of each entry of :attr:`CaseResult.run` (None: a word, no unit; "1": a count or
+#: a ratio).
+RUN_UNITS = MappingProxyType({
+    "solver": None, "dt": "s", "sample_rate": "Hz", "chirp_amplitude": "m", "chirp_f0": "Hz",
+    "chirp_f1": "Hz", "chirp_duration": "s", "window": None, "fft_length": "1",
+    "n_averages": "1", "overlap": "1", "coherence_min": "1", "base_share_min": "1"})
+#: The unit of each entry of :attr:`CaseResult.stats`.
+STATS_UNITS = MappingProxyType({
+    "stop_contacts": "1", "z_min": "m", "z_max": "m", "z_final": "m", "locked_fraction": "1",
+    "motor_force_rms": "N", "duration": "s", "steps": "1", "n_averages": "1",
+    "fft_length": "1", "steps_per_second": "1/s", "locked_fraction_below_half_hz": "1"})
 # Keys of the optional tables (the sample rate is the analysis's).
 _TABLE_KEYS = {"excitation": EXCITATION_OPTIONS["chirp"], "analysis": (*ANALYSIS, "duration"),
                "simulation": ("dt", "solver")}
@@ -133,6 +144,8 @@ class CaseResult:
         Frequencies of the transmissibility curve over the analysed band [Hz].
     magnitude : ndarray
         Transmissibility, amplitude ratio [-], at ``frequency``.
+    phase : ndarray
+        Phase of payload relative to base [rad] (of the cross spectrum), at ``frequency``.
     coherence : ndarray
         Magnitude-squared coherence [-] at ``frequency``.
     trusted : ndarray of bool
@@ -145,12 +158,13 @@ class CaseResult:
     reasons : dict
         For each NaN metric, why it is undefined.
     stats : dict
-        Run statistics (stop contacts, stroke, time locked, Welch settings, speed).
+        Run statistics (stop contacts, stroke, time locked, Welch settings, speed); units
+        in :data:`STATS_UNITS`.
     run : dict
         How the case was run and analysed: ``solver``, ``dt`` [s], ``sample_rate`` [Hz],
         the chirp's ``chirp_amplitude`` [m], ``chirp_f0``, ``chirp_f1`` [Hz] and
         ``chirp_duration`` [s], ``window``, ``fft_length`` [samples], ``n_averages``,
-        ``overlap`` [-], ``coherence_min`` and ``base_share_min`` [-].
+        ``overlap`` [-], ``coherence_min`` and ``base_share_min`` [-] (:data:`RUN_UNITS`).
     linear : dict
         The linearised model: natural frequencies [Hz], damping ratio [-] and its
         ``magnitude`` at ``frequency``.
@@ -175,6 +189,7 @@ class CaseResult:
     linear: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
     seconds: float = 0.0
+    phase: np.ndarray = None
 
 
 @dataclass
@@ -331,7 +346,8 @@ def _analyse_case(task, run, isolator, controller, excitation, rate):
     frequency = estimate.frequency[keep]
     magnitude = estimate.magnitude[keep]
     result = CaseResult(task["label"], task["settings"], frequency, magnitude,
-                        estimate.coherence[keep], estimate.trusted[keep])
+                        estimate.coherence[keep], estimate.trusted[keep],
+                        phase=estimate.phase[keep])
     result.metrics, result.reasons = _metrics(estimate, keep)
     result.run = dict(solver=task["simulation"]["solver"], dt=float(task["simulation"]["dt"]),
                       sample_rate=float(rate), chirp_amplitude=excitation.amplitude,
@@ -473,7 +489,8 @@ def _experiment_processing(run, rate, welch, options, band):
     keep = band_mask(estimate.frequency, *band)
     metrics, reasons = _metrics(estimate, keep)
     return dict(frequency=estimate.frequency[keep], magnitude=estimate.magnitude[keep],
-                coherence=estimate.coherence[keep], trusted=estimate.trusted[keep],
+                phase=estimate.phase[keep], coherence=estimate.coherence[keep],
+                trusted=estimate.trusted[keep],
                 metrics=metrics, reasons=reasons, highpass=corner,
                 untrusted_below=estimate.untrusted_below, n_averages=estimate.n_averages)
 

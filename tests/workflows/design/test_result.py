@@ -24,3 +24,27 @@ def test_save_writes_report_json_and_every_figure_atomically(design, tmp_path):
     assert record["gains"]["damping_gain"] == pytest.approx(design.gains["damping_gain"])
     html = written["report"].read_text()
     assert "Why active damping did not help much" in html and "pi_search.png" in html
+
+
+def test_save_writes_the_damping_curves_the_figure_draws(design, tmp_path):
+    """The curves file holds every gain tried; those the figure draws read back exactly."""
+    import numpy as np
+    import pandas as pd
+    import xarray as xr
+
+    written = design.save(tmp_path / "out")
+    data = xr.load_dataset(written["curves_nc"])
+    table = pd.read_csv(written["curves_csv"], comment="#", header=[0, 1])
+    assert dict(table.columns)["damping_gain"] == "N*s/m" == data["damping_gain"].attrs["units"]
+    assert dict(table.columns)["frequency"] == "Hz"
+    drawn = design.series["damping_curves"]
+    assert sorted(data["damping_gain"].values) == sorted(drawn)
+    for gain in (0.0, design.gains["damping_gain"]):
+        frequency, magnitude, trusted = drawn[gain]
+        row = data.isel(case=int(np.flatnonzero(data["damping_gain"].values == gain)[0]))
+        np.testing.assert_array_equal(row["frequency"].values, frequency)
+        np.testing.assert_array_equal(row["magnitude"].values, magnitude)
+        np.testing.assert_array_equal(row["trusted"].values.astype(bool), trusted)
+        rows = table[table[("damping_gain", "N*s/m")] == gain]
+        np.testing.assert_allclose(rows[("magnitude", "1")].to_numpy(), magnitude, rtol=1e-9)
+    assert "href='damping_curves.nc'" in written["report"].read_text()

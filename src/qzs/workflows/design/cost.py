@@ -4,6 +4,7 @@ import math
 import numpy as np
 
 from qzs.analysis import control_design as cd
+from qzs.analysis.damping import band_rms, damping_change
 from qzs.analysis.spectral import band_mask, transmissibility
 from qzs.engine.batch import simulate_batch
 from qzs.workflows.design.settings import FFT_LENGTH, TRUSTED_SHARE_MIN
@@ -26,7 +27,9 @@ def transmissibility_cost(base_acceleration, payload_acceleration, sample_rate, 
     band : tuple of float
         Band of the cost [Hz, Hz].
     cost : {"rms", "peak"}
-        RMS of the amplitude ratio over the trusted bins of the band, or its largest value.
+        RMS of the amplitude ratio over the trusted bins of the band
+        (:func:`qzs.analysis.damping.band_rms`, the band RMS ``qzs paper`` uses too), or its
+        largest value.
     fft_length : int
         Welch segment length [samples].
 
@@ -46,9 +49,25 @@ def transmissibility_cost(base_acceleration, payload_acceleration, sample_rate, 
     share = float(keep.sum() / max(inside.sum(), 1))
     if share < TRUSTED_SHARE_MIN:
         return math.nan, share, estimate
-    t = estimate.magnitude[keep]
-    value = float(np.sqrt(np.mean(t ** 2))) if cost == "rms" else float(np.max(t))
+    value = (band_rms(estimate.frequency, estimate.magnitude, band, trusted=estimate.trusted)
+             if cost == "rms" else float(np.max(estimate.magnitude[keep])))
     return value, share, estimate
+
+
+def _damping_metrics(reference, damped, band, defined=True):
+    """Both damping metrics of ``damped`` against ``reference`` (estimates), as row entries.
+
+    :func:`qzs.analysis.damping.damping_change`, the definitions ``qzs paper`` decides the
+    damping claim with; NaN when an estimate is missing or ``defined`` is False (a cost
+    undefined for too few trusted bins).
+    """
+    if reference is None or damped is None or not defined:
+        return {"largest_reduction_db": math.nan, "band_rms_change_db": math.nan}
+    change = damping_change(reference.frequency, reference.magnitude, damped.magnitude,
+                            band=band, reference_trusted=reference.trusted,
+                            damped_trusted=damped.trusted)
+    return {"largest_reduction_db": change.largest_reduction_db,
+            "band_rms_change_db": change.band_rms_change_db}
 
 
 def _linear_cost(frequency, isolator, controller, settings, *, rate=None, delay=None):

@@ -10,7 +10,7 @@ import numpy as np
 
 from qzs.analysis import control_design as cd
 from qzs.workflows.design.settings import DAMPING_POINTS
-from qzs.workflows.design.cost import _band_grid, _costs, _linear_cost
+from qzs.workflows.design.cost import _band_grid, _costs, _damping_metrics, _linear_cost
 
 
 def _damping_bound(settings, kp):
@@ -99,6 +99,12 @@ def _search_damping(settings, kp, bar=None):
         if refine:
             evaluate(refine)
     rows = sorted(record["rows"], key=lambda r: r["damping_gain"])
+    reference = rows[0] if rows and rows[0]["damping_gain"] == 0 else None
+    for row in rows:  # both damping metrics against Kd = 0 (qzs.analysis.damping)
+        defined = (reference is not None and math.isfinite(reference["cost"])
+                   and math.isfinite(row["cost"]))
+        row.update(_damping_metrics(curves.get(0.0), curves.get(row["damping_gain"]),
+                                    settings.band, defined))
     record["rows"] = rows
     best_row = min((r for r in rows if math.isfinite(r["cost"])), key=lambda r: r["cost"])
     record["chosen"] = best_row["damping_gain"]

@@ -274,6 +274,7 @@ def _result(settings, cases, choice, checks, stability, static, seconds):
     gains = {"pi_kp": float(kp), "pi_ki": float(settings.ratio * kp), "damping_gain": float(kd)}
     series = {"damping_curves": {k: (v.frequency, v.magnitude, v.trusted)
                                  for k, v in choice.curves.items()},
+              "damping_estimates": dict(choice.curves),
               "hunting_traces": checks["traces"], "hunting_loop": checks["hunting"].get("loop"),
               "pi_details": pi.get("details", {}),
               "pi_details_first": (first_search or {}).get("details", {})}

@@ -4,8 +4,20 @@ import math
 
 from qzs._format import html_figure, html_head, html_table, number
 from qzs._version import __version__
+from qzs.defaults import DAMPING_CLAIM
 
 __all__ = ["design_text"]
+
+
+#: How the damping metrics relate to the paper report's damping claim.
+_METRICS_NOTE = ("The band RMS change and the largest per-bin reduction against Kd = 0 are "
+                 "the two metrics qzs paper decides \"active damping did not help much\" "
+                 "with (qzs.analysis.damping; there over the trusted bins of "
+                 f"{DAMPING_CLAIM['band'][0]:g}-{DAMPING_CLAIM['band'][1]:g} Hz, small below "
+                 f"{DAMPING_CLAIM['small_db']:g} dB each; here over the design's band). Both "
+                 "compare the two curves on the bins trusted in both: the band RMS change is "
+                 "what damping does to the band as a whole, the per-bin reduction where it "
+                 "helps most. The change of the cost compares each curve's own trusted bins.")
 
 
 def _fmt(value, digits=4, unit=""):
@@ -231,15 +243,30 @@ def _html_damping(result, written):
     e = html.escape
     d = result.damping
     d_rows = [[_fmt(r["damping_gain"]), _fmt(r["cost"]), _fmt(r["linear_cost"]),
+               _fmt(r.get("band_rms_change_db", math.nan), 3),
+               _fmt(r.get("largest_reduction_db", math.nan), 3),
                f"{100 * r['trusted_share']:.0f}", _fmt(r["motor_force_rms"], 3), r["reason"]]
               for r in d["rows"]]
     return "<section><h2>Damping gain</h2><p>" + e(
         f"Bound: {_fmt(d['bound'])} N*s/m (" + "; ".join(d["bound_notes"]) + f"). Chosen: "
         f"{_fmt(d['chosen'])} N*s/m. {d['reason']}") + "</p>" \
-        + html_table(["Kd [N*s/m]", "cost (simulated)", "cost (linear)", "bins trusted [%]",
-                  "motor force RMS [N]", "note"], d_rows) \
+        + html_table(["Kd [N*s/m]", "cost (simulated)", "cost (linear)",
+                      "band RMS change [dB]", "largest per-bin reduction [dB]",
+                      "bins trusted [%]", "motor force RMS [N]", "note"], d_rows) \
+        + "<p>" + e(_METRICS_NOTE) + "</p>" \
         + _figure(written, "damping", "Cost against the damping gain, and the transmissibility "
-                  "without damping and at the chosen gain.") + "</section>"
+                  "without damping and at the chosen gain.") + _curve_links(written) \
+        + "</section>"
+
+
+def _curve_links(written):
+    """Links to the damping search's curves as data, when they were written."""
+    files = [written[k].name for k in ("curves_nc", "curves_csv") if k in written]
+    if not files:
+        return ""
+    links = " and ".join(f"<a href='{html.escape(f)}'>{html.escape(f)}</a>" for f in files)
+    return (f"<p>The curves of every gain tried, as data: {links} (NetCDF CF-1.10; CSV with a "
+            "units row under the column names).</p>")
 
 
 def _html_margins(result, written):
@@ -274,12 +301,15 @@ def _html_why(result, written):
     e = html.escape
     w = result.why
     w_rows = [[r["factor"], r["value"], _fmt(r["damping_gain"]), _fmt(r["cost_undamped"]),
-               _fmt(r["cost_damped"]), _fmt(r["change_db"], 3), _fmt(r["linear_change_db"], 3)]
+               _fmt(r["cost_damped"]), _fmt(r["change_db"], 3),
+               _fmt(r.get("largest_reduction_db", math.nan), 3), _fmt(r["linear_change_db"], 3)]
               for r in w["rows"]]
     return ("<section><h2>Why active damping did not help much</h2>"
             f"<div class='answer'>{e(w['answer'])}</div>"
             + html_table(["factor", "value", "Kd [N*s/m]", "cost Kd = 0", "cost damped",
-                      "change [dB]", "linear [dB]"], w_rows)
+                          "change of the cost [dB]", "largest per-bin reduction [dB]",
+                          "linear [dB]"], w_rows)
+            + "<p>" + e(_METRICS_NOTE) + "</p>"
             + _figure(written, "damping_effect", "Change of the cost with damping against "
                       "each factor: simulated (markers), linear (lines).") + "</section>")
 

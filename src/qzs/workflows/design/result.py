@@ -5,12 +5,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from qzs._format import json_ready, json_text
 from qzs._version import __version__
 from qzs.iotools.files import atomic_path
+from qzs.workflows.curves import curves_dataset, write_curves
 from qzs.workflows.design.report import _html, design_text
 
 if TYPE_CHECKING:
+    import xarray as xr
     from matplotlib.figure import Figure
 
     from qzs.analysis.control_design import RouthHurwitz, StaticDesign
@@ -103,8 +107,42 @@ class DesignResult:
 
         return plot_design(self)
 
+    def curves(self) -> xr.Dataset | None:
+        """The damping search's transmissibility curves as a dataset, one case per gain tried.
+
+        The curves the ``damping`` figure draws (Kd = 0 and the chosen gain) among them, on
+        ``case`` and ``frequency`` (:func:`qzs.workflows.curves.curves_dataset`), with
+        ``damping_gain`` [N*s/m], ``pi_kp`` [N/m] and ``pi_ki`` [N/(m*s)] as coordinates.
+
+        Returns
+        -------
+        xarray.Dataset or None
+            None when the search ran no simulation (no admissible damping gain).
+        """
+        estimates = self.series.get("damping_estimates") or {}
+        if not estimates:
+            return None
+        gains = self.gains
+        curves = [{"label": f"Kd = {kd:g} N*s/m", "frequency": e.frequency,
+                   "magnitude": e.magnitude, "phase": e.phase, "coherence": e.coherence,
+                   "trusted": e.trusted,
+                   "parameters": {"damping_gain": kd, "pi_kp": gains["pi_kp"],
+                                  "pi_ki": gains["pi_ki"]}}
+                  for kd, e in sorted(estimates.items())]
+        first = next(iter(estimates.values()))
+        band = self.settings.get("band")
+        attrs = {"title": "qzs design: transmissibility against the damping gain",
+                 "source": f"qzs {__version__} (qzs design)", "fft_length": first.fft_length,
+                 "n_averages": first.n_averages, "sample_rate": first.sample_rate,
+                 "sample_rate_units": "Hz", "chosen_damping_gain": gains["damping_gain"],
+                 "chosen_damping_gain_units": "N*s/m"}
+        if band is not None:
+            attrs.update({"band": np.asarray(band, dtype=float), "band_units": "Hz"})
+        return curves_dataset(curves, attrs)
+
     def save(self, folder: str | Path) -> dict[str, Path]:
-        """Write ``report.html``, ``design.json`` and the figures (PNG and SVG) into ``folder``.
+        """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
+        search's curves (``damping_curves.nc`` and ``.csv``, :meth:`curves`) into ``folder``.
 
         Each file is written atomically (a temporary file renamed onto it).
 
@@ -116,7 +154,8 @@ class DesignResult:
         Returns
         -------
         dict of str to Path
-            ``report``, ``json`` and one entry per figure (its PNG).
+            ``report``, ``json``, one entry per figure (its PNG) and ``curves_nc``,
+            ``curves_csv`` (when the damping search simulated).
         """
         import matplotlib.pyplot as plt
 
@@ -132,6 +171,9 @@ class DesignResult:
             save_figure(figure, path, also_svg=True)
             plt.close(figure)
             written[name] = path
+        curves = self.curves()
+        if curves is not None:
+            written["curves_nc"], written["curves_csv"] = write_curves(curves, folder, "damping")
         record = self.to_dict()
         with atomic_path(folder / "design.json") as tmp:
             tmp.write_text(json_text(record), encoding="utf-8")

@@ -1,0 +1,209 @@
+"""The curves behind a figure, as data: one dataset per study, written as NetCDF and CSV.
+
+``qzs paper``, ``qzs study`` and ``qzs design`` draw transmissibility curves; each also
+writes them beside its figures, through :func:`curves_dataset` and
+:func:`qzs.iotools.writer.write_dataset`:
+
+``<name>_curves.nc``
+    CF-1.10, dimensions ``case`` and ``frequency``: ``magnitude`` [1], ``phase`` [rad],
+    ``coherence`` [1], the ``trusted`` flag (docs/model.md §10) and the linearised model's
+    ``linear_magnitude`` [1]; coordinates ``case`` (the label of the figure's legend),
+    ``frequency`` [Hz] and every parameter the cases set, on ``case``, with its unit from
+    :mod:`qzs.model.registry`.
+``<name>_curves.csv``
+    The same in long format (one row per case and frequency) with the units row of
+    :data:`qzs.iotools.writer.CSV_LAYOUT`: ``pandas.read_csv(path, comment="#",
+    header=[0, 1])``.
+
+Curves of one file share their frequency bins; bins a curve lacks are NaN (untrusted).
+The spring's characteristic (paper Fig. 5) is written the same way by :func:`spring_dataset`:
+the measured points and the fitted law on ``point``.
+"""
+import numpy as np
+
+from qzs.iotools.schema import Schema, Variable, to_dataset
+from qzs.iotools.writer import write_dataset
+from qzs.model.registry import PARAMETERS, unit_of
+
+__all__ = ["curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
+           "CURVE_SUFFIXES"]
+
+#: The files :func:`write_curves` writes, by suffix.
+CURVE_SUFFIXES = (".nc", ".csv")
+_ON = ("case", "frequency")
+
+
+def curves_schema(parameters, cases, bins):
+    """The CF-1.10 layout of a study's curves (the module docstring).
+
+    Parameters
+    ----------
+    parameters : mapping of str to tuple
+        The parameters the cases set -> ``(unit, description, dtype)`` (dtype "float64" or
+        "str"): coordinates on ``case``.
+    cases : int
+        Number of curves.
+    bins : int
+        Number of frequency bins.
+
+    Returns
+    -------
+    Schema
+    """
+    coordinates = [Variable(name="case", dims=("case",), dtype="str",
+                            long_name="the curve's label in the figure"),
+                   Variable(name="frequency", dims=("frequency",), units="Hz",
+                            long_name="frequency")]
+    for name, (unit, doc, dtype) in parameters.items():
+        coordinates.append(Variable(name=name, dims=("case",), units=unit, long_name=doc,
+                                    dtype=dtype))
+    variables = (
+        Variable(name="magnitude", dims=_ON, units="1",
+                 long_name="transmissibility, amplitude ratio sqrt(S_payload / S_base)"),
+        Variable(name="phase", dims=_ON, units="rad",
+                 long_name="phase of payload relative to base (of the cross spectrum)"),
+        Variable(name="coherence", dims=_ON, units="1", long_name="magnitude-squared coherence"),
+        Variable(name="trusted", dims=_ON, units="1", dtype="int8",
+                 flag_meanings="untrusted trusted",
+                 long_name="1 where the bin is trusted (docs/model.md section 10)"),
+        Variable(name="linear_magnitude", dims=_ON, units="1",
+                 long_name="transmissibility of the linearised model (NaN: not drawn)"))
+    return Schema(kind="the curves of a figure", dimensions={"case": int(cases), "frequency": bins},
+                  coordinates=tuple(coordinates), variables=variables)
+
+
+def _parameter_info(name, units, values):
+    """``(unit, description, dtype)`` of a parameter: the registry's, or ``units``'."""
+    numeric = all(isinstance(v, (int, float, np.number)) for v in values if v is not None)
+    dtype = "float64" if numeric else "str"
+    if name in units:
+        return (*units[name], dtype)
+    info = PARAMETERS.get(name)
+    return (unit_of(name), info.doc if info is not None else name, dtype)
+
+
+def curves_dataset(curves, attrs=None, *, units=None):
+    """A dataset of transmissibility curves on one frequency axis (:func:`curves_schema`).
+
+    Parameters
+    ----------
+    curves : sequence of dict
+        One per case, as the figure draws them: ``label``, ``frequency`` [Hz],
+        ``magnitude`` [-], and optionally ``phase`` [rad], ``coherence`` [-], ``trusted``
+        (bool per bin; default all above 0 Hz), ``linear`` (the linearised model's
+        magnitude [-]) and ``parameters`` (name -> value: the case's parameters).
+    attrs : mapping, optional
+        Global attributes (title, study, run settings with ``<key>_units``).
+    units : mapping of str to (str, str), optional
+        ``(unit, description)`` of parameters that are not in the registry.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    units = dict(units or {})
+    frequency = np.unique(np.concatenate([np.asarray(c["frequency"], float) for c in curves]))
+    names = list(dict.fromkeys(k for c in curves for k in c.get("parameters", {})))
+    parameters = {name: _parameter_info(name, units, [c.get("parameters", {}).get(name)
+                                                      for c in curves]) for name in names}
+    n, m = len(curves), frequency.size
+    values = {name: np.full((n, m), np.nan) for name in
+              ("magnitude", "phase", "coherence", "linear_magnitude")}
+    values["trusted"] = np.zeros((n, m), bool)
+    for i, curve in enumerate(curves):
+        f = np.asarray(curve["frequency"], float)
+        at = np.searchsorted(frequency, f)
+        trusted = curve.get("trusted")
+        values["trusted"][i, at] = f > 0 if trusted is None else np.asarray(trusted, bool)
+        for name, key in (("magnitude", "magnitude"), ("phase", "phase"),
+                          ("coherence", "coherence"), ("linear_magnitude", "linear")):
+            if curve.get(key) is not None:
+                values[name][i, at] = np.asarray(curve[key], float)
+    values["case"] = [str(c["label"]) for c in curves]
+    values["frequency"] = frequency
+    for name in names:
+        given = [c.get("parameters", {}).get(name) for c in curves]
+        values[name] = ([np.nan if v is None else float(v) for v in given]
+                        if parameters[name][2] == "float64" else [str(v) for v in given])
+    return to_dataset(curves_schema(parameters, n, m), values, attrs)
+
+
+def write_curves(dataset, folder, name):
+    """Write a curves dataset as ``<name>_curves.nc`` and ``<name>_curves.csv``, atomically.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The curves (:func:`curves_dataset`).
+    folder : str or Path
+        The output folder (the figures').
+    name : str
+        The files' stem before ``_curves``: the study's or the figure's name.
+
+    Returns
+    -------
+    list of Path
+        The files written, in the order of :data:`CURVE_SUFFIXES`.
+    """
+    from pathlib import Path
+
+    return [write_dataset(dataset, Path(folder) / f"{name}_curves{suffix}")
+            for suffix in CURVE_SUFFIXES]
+
+
+def spring_schema(points):
+    """The CF-1.10 layout of the spring's characteristic: the points and the fitted law.
+
+    Parameters
+    ----------
+    points : int
+        Number of measured points.
+
+    Returns
+    -------
+    Schema
+    """
+    on = ("point",)
+    return Schema(kind="the spring's characteristic", dimensions={"point": int(points)},
+                  coordinates=(Variable(name="displacement", dims=on, units="m",
+                                        long_name="displacement z of the MagSpring"),),
+                  variables=(Variable(name="force", dims=on, units="N",
+                                      long_name="measured spring force"),
+                             Variable(name="fitted_force", dims=on, units="N",
+                                      long_name="fitted law -a tanh(b z) at the points")))
+
+
+def spring_dataset(displacement, force, spring_force, spring_shape, attrs=None):
+    """The spring's measured characteristic and its fitted tanh law, as a dataset.
+
+    Parameters
+    ----------
+    displacement : array_like
+        Displacements of the points [m].
+    force : array_like
+        Measured forces [N].
+    spring_force : float
+        Fitted force amplitude a [N].
+    spring_shape : float
+        Fitted shape b [1/m].
+    attrs : mapping, optional
+        Further global attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+        With the fit as attributes ``spring_force`` [N] and ``spring_shape`` [1/m].
+    """
+    import dataclasses
+
+    from qzs.model.isolator import IsolatorParameters, spring_force as law
+
+    z = np.asarray(displacement, dtype=float)
+    fitted = law(z, dataclasses.replace(IsolatorParameters(), spring_force=spring_force,
+                                        spring_shape=spring_shape))
+    return to_dataset(spring_schema(z.size), {"displacement": z, "force": force,
+                                               "fitted_force": fitted},
+                      {**(attrs or {}), "spring_force": float(spring_force),
+                       "spring_force_units": unit_of("spring_force"),
+                       "spring_shape": float(spring_shape),
+                       "spring_shape_units": unit_of("spring_shape")})
