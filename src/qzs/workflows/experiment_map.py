@@ -88,7 +88,7 @@ def _channel_table(role):
             f"{prefix}scale = 1.0", ""]
 
 
-def channel_map_template():
+def channel_map_template() -> str:
     """The text of a commented channel map naming every key the map reader accepts.
 
     Returns
@@ -147,7 +147,7 @@ def channel_map_template():
     return "\n".join(lines) + "\n"
 
 
-def write_channel_map_template(path, *, overwrite=False):
+def write_channel_map_template(path: str | Path, *, overwrite: bool = False) -> Path:
     """Write :func:`channel_map_template` to a file, atomically.
 
     Parameters

@@ -189,7 +189,7 @@ class CaseResult:
     linear: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
     seconds: float = 0.0
-    phase: np.ndarray = None
+    phase: np.ndarray | None = None
 
 
 @dataclass
