@@ -357,14 +357,7 @@ def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFET
         d, d_next = difference(j), difference(j + 1)
         if not (np.isfinite(d) and np.isfinite(d_next)):
             break
-        ratio = d / d_next if d_next > 0 else math.inf
-        if d == 0.0:
-            estimate = 0.0
-        elif ratio <= 1.0:  # not converging yet: no estimate
-            estimate = math.inf
-        else:
-            r = min(ratio, 2.0 ** order)
-            estimate = d * r / (r - 1)
+        estimate = _estimate(d, d_next, order)
         history.append((dt0 / 2 ** j, d, estimate))
         if safety * estimate <= tolerance:
             return j, history
@@ -436,48 +429,23 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD, resolving_step, run_inputs
+    from qzs.engine.prepare import resolving_step, run_inputs
     from qzs.engine.simulate import simulate
-    from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
+    from qzs.engine.stability import largest_stable_step, stability_test
 
     measure, tolerance = _tolerance(tolerance_db, tolerance_state)
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
-    sample_rate = _validation.positive_real("sample_rate", sample_rate)
-    if probe_duration is not None:
-        _validation.positive_real("probe_duration", probe_duration)
-    _validation.real("safety", safety, minimum=1.0)
-    _validation.integer("max_halvings", max_halvings, 2)
-    band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
-    probe, duration = probe_excitation(
-        excitation, band or _frequency_range(excitation, sample_rate), probe_duration)
-    if fft_length is not None and measure == "transmissibility_db":
-        n = int(round(duration * sample_rate)) + 1
-        if (isinstance(fft_length, bool) or not isinstance(fft_length, (int, np.integer))
-                or not 8 <= fft_length <= n):
-            raise ParameterError(f"`fft_length` must be an integer in [8, {n}] (the probe's "
-                                 f"samples), got {fft_length!r}.")
+    order, sample_rate, band, probe, duration = _probe_settings(
+        excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
+        max_halvings)
 
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
     resolving = resolving_step(probe, duration)  # the step must follow the base motion too
     dt0, k0 = admissible_step(sample_rate, controller.controller_rate,
                               lambda dt: dt <= resolving and stable(dt))
-    notes = []
-    if k0 == 1:
-        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
-                     f"(a lower sample_rate would allow larger steps; stability allows "
-                     f"{limit:.3g} s)")
-    elif resolving < limit:
-        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
-                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
-                     f"of its highest frequency (stability allows {limit:.3g} s)")
-    else:
-        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
-                     f"<= {limit:.3g} s")
-    if measure == "state_m" and probe is not excitation:
-        notes.append("the state error is measured on a shortened chirp; on the full sweep "
-                     "phase errors accumulate over a longer time")
+    notes = _bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
+                         probe is not excitation)
 
     bar = None
     if progress:
@@ -517,13 +485,79 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         raise ToleranceNotMetError(tolerance, _MEASURES[measure], dt0 / 2 ** (max_halvings - 1),
                                    min(h[2] for h in history), safety)
     j = chosen
-    if differences[j] > 0 and differences[j + 1] > 0:
-        observed = math.log2(differences[j] / differences[j + 1])
-        if observed < order - 0.5:
-            notes.append(f"observed order {observed:.2f} below the scheme's {order} (stick-slip "
-                         "events lower it): the estimate extrapolates with the observed ratio")
+    notes += _order_notes(differences[j], differences[j + 1], order)
     return StepChoice(dt=dt0 / 2 ** j, error=float(history[-1][2]), measure=measure,
                       tolerance=tolerance, reference_dt=dt0 / 2 ** (j + 2),
                       stability_limit=float(limit), sample_rate=sample_rate, solver=solver,
                       probe=probe, probe_duration=float(duration), band=band,
                       history=tuple(history), notes=tuple(notes))
+
+
+# ---------------------------------------------------------------- shared by the searches
+
+def _estimate(d, d_next, order):
+    """The Richardson estimate of the error of ``dt_j`` from ``d_j`` and ``d_{j+1}``
+    (:func:`halving_search`): 0 where ``d_j = 0``, inf where the differences do not shrink."""
+    ratio = d / d_next if d_next > 0 else math.inf
+    if d == 0.0:
+        return 0.0
+    if ratio <= 1.0:  # not converging yet: no estimate
+        return math.inf
+    r = min(ratio, 2.0 ** order)
+    return d * r / (r - 1)
+
+
+def _probe_settings(excitation, measure, solver, sample_rate, band, probe_duration, fft_length,
+                    safety, max_halvings):
+    """Check a step search's settings; ``(order, sample_rate, band, probe, probe duration)``."""
+    from qzs.engine.stability import SOLVERS
+
+    _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
+    sample_rate = _validation.positive_real("sample_rate", sample_rate)
+    if probe_duration is not None:
+        _validation.positive_real("probe_duration", probe_duration)
+    _validation.real("safety", safety, minimum=1.0)
+    _validation.integer("max_halvings", max_halvings, 2)
+    band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
+    probe, duration = probe_excitation(
+        excitation, band or _frequency_range(excitation, sample_rate), probe_duration)
+    if fft_length is not None and measure == "transmissibility_db":
+        n = int(round(duration * sample_rate)) + 1
+        if (isinstance(fft_length, bool) or not isinstance(fft_length, (int, np.integer))
+                or not 8 <= fft_length <= n):
+            raise ParameterError(f"`fft_length` must be an integer in [8, {n}] (the probe's "
+                                 f"samples), got {fft_length!r}.")
+    return order, sample_rate, band, probe, duration
+
+
+def _bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
+    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people."""
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
+
+    notes = []
+    if k0 == 1:
+        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
+                     f"(a lower sample_rate would allow larger steps; stability allows "
+                     f"{limit:.3g} s)")
+    elif resolving < limit:
+        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
+                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
+                     f"of its highest frequency (stability allows {limit:.3g} s)")
+    else:
+        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
+                     f"<= {limit:.3g} s")
+    if measure == "state_m" and shortened:
+        notes.append("the state error is measured on a shortened chirp; on the full sweep "
+                     "phase errors accumulate over a longer time")
+    return notes
+
+
+def _order_notes(d, d_next, order):
+    """A note when the observed order of the chosen step lies below the scheme's."""
+    if d > 0 and d_next > 0:
+        observed = math.log2(d / d_next)
+        if observed < order - 0.5:
+            return [f"observed order {observed:.2f} below the scheme's {order} (stick-slip "
+                    "events lower it): the estimate extrapolates with the observed ratio"]
+    return []
+
