@@ -33,7 +33,8 @@ ANALYSIS = MappingProxyType({
 REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 
 #: Accuracy-driven step (docs/model.md §7): the tolerance on the transmissibility [dB] that
-#: sweeps meet by default when their file gives no ``dt``; the paper keeps its dt = 1e-4 s.
+#: sweeps, the paper's studies (``qzs paper``, ``qzs study``) and the page meet by default when
+#: no ``dt`` is given.
 ACCURACY = MappingProxyType({"tolerance_db": 0.01})
 
 #: Base excitation: the paper's displacement amplitude, 10 mm [m] (the default of

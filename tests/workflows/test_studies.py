@@ -301,11 +301,12 @@ def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
         return original(cases, *args, **kwargs)
 
     monkeypatch.setattr(qzs.engine.batch, "simulate_batch", counted)
-    lockstep = run_studies(studies, quick=True, workers=2, progress=False)
+    lockstep = run_studies(studies, quick=True, workers=2, progress=False, dt=1e-3)
     # two stiction cases and the processing case: one batch; the viscous case is Fs = 10 N
     assert batches == [3]
     assert [case["stiction_force"] for case in stiction.cases[::2]] == [2.0, 10.0]
-    single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False)
+    single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False,
+                         dt=1e-3)
     assert batches == [3]
 
     def same(a, b):
