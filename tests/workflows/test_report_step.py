@@ -102,7 +102,7 @@ def test_the_chosen_step_is_coarser_than_the_papers_and_says_so(both):
         assert step["dt"] > SIMULATION["dt"]  # else this test compares nothing
         assert 0 <= step["estimated_error_db"] <= ACCURACY["tolerance_db"]
     assert [d["case"] for d in record["step_dependent"]] == ["no PI (Kp = 0, Ki = 0)"]
-    assert "agree with the paper's own step" in record["statement"]
+    assert "agrees with the paper's own step" in record["statement"]
 
 
 @pytest.mark.slow
@@ -153,3 +153,34 @@ def test_every_tabulated_number_agrees_within_its_criterion(both):
                     problems.append(f"{case.label}: linear natural frequency differs")
     assert compared > 200
     assert not problems, "\n".join(problems)
+
+
+def _result(name, **step):
+    """A StudyResult of no case, with the step record ``step``."""
+    from qzs.workflows.studies import Study, StudyResult
+
+    return StudyResult(Study(name=name, title=name, kind="transmissibility", cases=()), [],
+                       quick=True, step=step)
+
+
+def chosen_step(tolerance, unmet=(), seconds=1.0, group=0):
+    return dict(dt=1e-3, source="chosen", tolerance_db=tolerance, estimated_error_db=0.002,
+                reference_dt=2.5e-4, probe_duration=60.0, unmet=list(unmet), notes=[],
+                seconds=seconds, group=group)
+
+
+def test_the_statement_claims_agreement_only_where_the_test_checks_it():
+    """At the default tolerance the statement claims the agreement the test checks; at
+    another it says the check is at the default only; a given step claims nothing."""
+    tol = ACCURACY["tolerance_db"]
+    default = step_record([_result("a", **chosen_step(tol, unmet=["no PI"])),
+                           _result("b", **chosen_step(tol, seconds=2.0, group=1))])
+    assert len(default["steps"]) == 1 and default["steps"][0]["studies"] == ["a", "b"]
+    assert default["steps"][0]["seconds"] == 3.0  # two choices, one per group
+    assert default["step_dependent"] == [{"study": "a", "case": "no PI"}]
+    assert "agrees with the paper's own step" in default["statement"]
+    assert "no PI (a)" in default["statement"]
+    other = step_record([_result("a", **chosen_step(10 * tol))])["statement"]
+    assert "agrees" not in other and f"at the default {tol:g} dB only" in other
+    given = step_record([_result("a", dt=SIMULATION["dt"], source="given")])["statement"]
+    assert "the paper's own" in given and "as given" in given and "agrees" not in given

@@ -570,13 +570,35 @@ BATCH_MAX_HALVINGS = 5
 class BatchStepChoice(StepChoice):
     """The outcome of :func:`choose_batch_step`: one step for every case of a lockstep batch.
 
-    The attributes of :class:`StepChoice` describe the batch: ``error`` is the largest
-    estimate over the cases that met the tolerance, ``stability_limit`` the smallest over
-    the cases, ``history`` holds per candidate the largest difference and estimate over
-    the cases still searched. And:
-
     Attributes
     ----------
+    dt : float
+        The chosen step [s]: the finest of the cases' coarsest steps meeting the tolerance.
+    error : float
+        The largest estimated error over the cases that met the tolerance ([dB] or [m]).
+    measure : str
+        As for :class:`StepChoice`.
+    tolerance : float
+        The tolerance asked for, in the unit of ``measure``.
+    reference_dt : float
+        The finest step integrated on the probe for the case(s) that set ``dt`` [s].
+    stability_limit : float
+        The smallest over the cases of the solver's largest stable step [s].
+    sample_rate : float
+        Output rate [Hz]; ``dt`` divides its period.
+    solver : str
+        The integrator.
+    probe : object
+        The excitation integrated to choose the step.
+    probe_duration : float
+        Length of the probe [s].
+    band : tuple of float
+        Frequency band [Hz] of the transmissibility measure (None for the state).
+    history : tuple
+        ``(dt, difference, estimate)`` per step tried, the largest difference and estimate
+        over the cases still searched at that step.
+    notes : tuple of str
+        What the caller should know (the limit that bound the step, the unmet cases).
     case_errors : tuple of float
         Each case's estimated error at the coarsest step that met the tolerance for it
         (``dt`` is that step or finer), in the unit of ``measure``; inf for a case no
