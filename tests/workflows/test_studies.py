@@ -369,3 +369,21 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
         run_studies([study], dt=1e-3, tolerance_db=0.01)
     with pytest.raises(ParameterError, match="tolerance_db"):
         run_studies([study], tolerance_db=-1.0)
+
+
+def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
+    """Every case on the stops (no PI): no step meets the tolerance for any; the batch runs
+    at the paper's dt = 1e-4 s, and the record and the statement say why."""
+    from qzs.workflows.report import step_record
+
+    path = tmp_path / "stops.toml"
+    path.write_text("[study]\nname = 'stops'\nkind = 'transmissibility'\n"
+                    "[analysis]\nquick_fft_length = 8192\nquick_n_averages = 6\n"
+                    "[[case]]\nlabel = 'no PI'\npi_kp = 0.0\npi_ki = 0.0\n")
+    result = run_studies([load_study(path)], quick=True, workers=1, progress=False)[0]
+    assert result.step["source"] == "fallback" and result.step["dt"] == 1e-4
+    assert result.step["unmet"] == ["no PI"] and "no step down to" in result.step["notes"][0]
+    assert result.cases[0].run["dt"] == 1e-4
+    statement = step_record([result])["statement"]
+    assert "the paper's own: no step met 0.01 dB for any case" in statement
+    assert "agrees" not in statement

@@ -787,7 +787,8 @@ def step_record(study_results):
     -------
     dict
         ``steps``: one entry per distinct step (``dt`` [s], ``source``: ``"chosen"``,
-        ``"given"`` or ``"file"``, ``studies``, and for a chosen step ``tolerance_db``,
+        ``"given"``, ``"file"`` or ``"fallback"`` (no step met the tolerance: the paper's),
+        ``studies``, and for a chosen step ``tolerance_db``,
         ``estimated_error_db`` (the largest over its studies' cases that met it),
         ``reference_dt`` [s], ``probe_duration`` [s], ``seconds`` [s] and ``notes``);
         ``step_dependent``: the cases no step met (study, case); ``paper_dt`` [s];
@@ -802,7 +803,10 @@ def step_record(study_results):
         entry = steps.setdefault((step["dt"], step["source"]),
                                  {"dt": step["dt"], "source": step["source"], "studies": []})
         entry["studies"].append(result.study.name)
-        if step["source"] == "chosen":
+        if step["source"] == "fallback":
+            entry.update(tolerance_db=step["tolerance_db"], notes=step["notes"])
+            dependent += [{"study": result.study.name, "case": label} for label in step["unmet"]]
+        elif step["source"] == "chosen":
             for key in ("tolerance_db", "reference_dt", "probe_duration"):
                 entry[key] = step[key]
             entry["estimated_error_db"] = max(entry.get("estimated_error_db", 0.0),
@@ -852,6 +856,9 @@ def step_statement(study_results, record=None):
                          f"{step['estimated_error_db']:.2g} dB (against dt = "
                          f"{step['reference_dt']:g} s on a {step['probe_duration']:g} s probe, "
                          f"{step['seconds']:.1f} s to choose)")
+        elif step["source"] == "fallback":
+            parts.append(f"dt = {step['dt']:g} s{where}, the paper's own: no step met "
+                         f"{step['tolerance_db']:g} dB for any case ({'; '.join(step['notes'])})")
         else:
             mark = " (the paper's own)" if step["dt"] == record["paper_dt"] else ""
             how = "as given" if step["source"] == "given" else "from the study file"

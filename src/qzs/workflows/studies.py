@@ -43,7 +43,7 @@ from qzs.analysis.spectral import (band_mask, highpass, required_duration, trans
 from qzs.analysis.statistics import run_statistics
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
-from qzs.errors import ParameterError
+from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.identify.spring import fit_spring
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
@@ -200,7 +200,9 @@ class StudyResult:
         Time spent on its cases [s], summed over them (they may run in parallel).
     step : dict
         How the integration step was set (:func:`_step_record`): ``dt`` [s], ``source``
-        (``"chosen"``, ``"given"`` or ``"file"``) and, for a chosen step, ``tolerance_db``,
+        (``"chosen"``, ``"given"``, ``"file"``, or ``"fallback"``: no step met the tolerance
+        for any case of the batch, which runs at the paper's dt = 1e-4 s, with ``unmet``,
+        ``notes`` and ``tolerance_db``) and, for a chosen step, ``tolerance_db``,
         ``estimated_error_db`` (the largest over the cases that met it), ``reference_dt``
         [s], ``probe_duration`` [s], ``unmet`` (labels of the cases no step met: their
         response depends on the step), ``notes``, ``seconds`` (time of the choice) [s] and
@@ -662,14 +664,17 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
         for task in tasks:
             isolator, controller, _, _ = _case_inputs(task)
             index.setdefault((isolator, controller), []).append(task)
-        choice = choose_batch_step(list(index), excitation, tolerance_db=tolerance_db,
-                                   solver=solver, sample_rate=rate, workers=workers,
-                                   progress=progress,
-                                   labels=[members[0]["label"] for members in index.values()])
+        try:
+            choice = choose_batch_step(
+                list(index), excitation, tolerance_db=tolerance_db, solver=solver,
+                sample_rate=rate, workers=workers, progress=progress,
+                labels=[members[0]["label"] for members in index.values()])
+        except ToleranceNotMetError as error:  # every case depends on the step: the paper's
+            choice = error
         seconds = time.perf_counter() - start
         for c, members in enumerate(index.values()):
             for task in members:
-                task["simulation"]["dt"] = choice.dt
+                task["simulation"]["dt"] = getattr(choice, "dt", SIMULATION["dt"])
                 choices[id(task)] = (choice, c, seconds, group)
     return [_step_record(tasks, choices) for tasks in per_study]
 
@@ -681,7 +686,12 @@ def _step_record(tasks, choices):
         return {}
     first = simulated[0]
     record = {"dt": float(first["simulation"]["dt"]), "source": first["step_source"]}
-    if id(first) in choices:
+    if id(first) in choices and isinstance(choices[id(first)][0], ToleranceNotMetError):
+        error, _, seconds, group = choices[id(first)]
+        record.update(source="fallback", tolerance_db=error.tolerance, notes=[str(error)],
+                      unmet=[task["label"] for task in simulated], seconds=seconds,
+                      group=group)
+    elif id(first) in choices:
         choice, _, seconds, group = choices[id(first)]
         mine = [(task["label"], choices[id(task)][1]) for task in simulated]
         errors = [choice.case_errors[c] for _, c in mine if c not in choice.unmet]
