@@ -11,7 +11,7 @@ The criteria, per kind of number, for a tolerance ``tol`` on the transmissibilit
   can change a least-squares slope over half a decade or more;
 * a count (hard-stop contacts): equal;
 * a share (the time locked, overall and below 0.5 Hz): within ``10**(tol/20) - 1``, the
-  relative change of an amplitude the tolerance allows (0.12 % at 0.01 dB);
+  relative change of an amplitude the tolerance allows (0.0012 at 0.01 dB);
 * a number that does not depend on the step (the linearised natural frequency, the spring
   fit): equal;
 * whether a number is defined on the trusted bins: the same at both steps.
