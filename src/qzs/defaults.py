@@ -40,7 +40,8 @@ REPORTED_FREQUENCIES = (1.0, 2.0, 3.0, 4.0, 8.0, 12.0, 16.0)
 #: per bin and over the band [dB].
 DAMPING_CLAIM: Mapping[str, Any] = MappingProxyType({"band": (1.5, 20.0), "small_db": 3.0})
 
-#: Accuracy-driven step (docs/model.md §7): what a command meets when given no step: the
+#: Accuracy-driven step (docs/model.md §7): what a command (simulate, paper, study, sweep, the
+#: six-axis runs, the page) meets when given no step: the
 #: transmissibility within ``tolerance_db`` [dB], or, for a sine (no band to estimate it
 #: over), the relative position within ``tolerance_state`` [m] (0.1 % of the paper's 10 mm).
 #: ``--dt`` gives a literal step instead; the Python functions keep ``SIMULATION["dt"]``.

@@ -334,11 +334,12 @@ def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
         return original(cases, *args, **kwargs)
 
     monkeypatch.setattr(qzs.engine.batch, "simulate_batch", counted)
-    lockstep = run_studies(studies, quick=True, workers=2, progress=False)
+    lockstep = run_studies(studies, quick=True, workers=2, progress=False, dt=1e-3)
     # two stiction cases and the processing case: one batch; the viscous case is Fs = 10 N
     assert batches == [3]
     assert [case["stiction_force"] for case in stiction.cases[::2]] == [2.0, 10.0]
-    single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False)
+    single = run_studies(studies, quick=True, workers=1, progress=False, lockstep=False,
+                         dt=1e-3)
     assert batches == [3]
 
     def same(a, b):
@@ -365,3 +366,57 @@ def test_lockstep_studies_match_the_one_case_path_to_the_last_bit(monkeypatch):
     assert compared > 20
     assert lockstep[1].cases[0].extra["magnitude"].size > 0
     assert same(lockstep[2].cases[0].magnitude, lockstep[0].cases[1].magnitude)
+
+
+def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, monkeypatch):
+    """No ``dt``: one step for the batch, chosen for the tolerance and recorded with its
+    estimate; ``dt`` given: used as given, nothing probed, over a file's; a file's
+    ``[simulation] dt``: used as written; ``dt`` and a tolerance both: refused at once."""
+    import qzs.engine.accuracy
+    from qzs.engine.accuracy import SAFETY
+
+    text = ("[study]\nname = 'tiny'\nkind = 'transmissibility'\n"
+            "[analysis]\nquick_fft_length = 2048\nquick_n_averages = 6\n"
+            "[[case]]\nlabel = 'Table 1'\n[[case]]\nlabel = 'Cv = 200'\nviscous_damping = 200.0\n")
+    path = tmp_path / "tiny.toml"
+    path.write_text(text)
+    study = load_study(path)
+    chosen = run_studies([study], quick=True, workers=1, progress=False)[0]
+    step = chosen.step
+    assert step["source"] == "chosen" and step["tolerance_db"] == 0.01 and not step["unmet"]
+    assert 1e-4 < step["dt"] <= 1e-3 and 0 <= step["estimated_error_db"] * SAFETY <= 0.01
+    assert [case.run["dt"] for case in chosen.cases] == [step["dt"]] * 2
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a step was chosen where one was given")
+
+    monkeypatch.setattr(qzs.engine.accuracy, "choose_batch_step", refuse)
+    path.write_text(text + "[simulation]\ndt = 5e-4\n")
+    from_file = run_studies([load_study(path)], quick=True, workers=1, progress=False)[0]
+    assert from_file.step == {"dt": 5e-4, "source": "file"}
+    assert [case.run["dt"] for case in from_file.cases] == [5e-4] * 2
+    given = run_studies([load_study(path)], quick=True, workers=1, progress=False, dt=2.5e-4)[0]
+    assert given.step == {"dt": 2.5e-4, "source": "given"}
+    assert [case.run["dt"] for case in given.cases] == [2.5e-4] * 2
+    with pytest.raises(ParameterError, match="not both"):
+        run_studies([study], dt=1e-3, tolerance_db=0.01)
+    with pytest.raises(ParameterError, match="tolerance_db"):
+        run_studies([study], tolerance_db=-1.0)
+
+
+def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
+    """Every case on the stops (no PI): no step meets the tolerance for any; the batch runs
+    at the paper's dt = 1e-4 s, and the record and the statement say why."""
+    from qzs.workflows.report import step_record
+
+    path = tmp_path / "stops.toml"
+    path.write_text("[study]\nname = 'stops'\nkind = 'transmissibility'\n"
+                    "[analysis]\nquick_fft_length = 8192\nquick_n_averages = 6\n"
+                    "[[case]]\nlabel = 'no PI'\npi_kp = 0.0\npi_ki = 0.0\n")
+    result = run_studies([load_study(path)], quick=True, workers=1, progress=False)[0]
+    assert result.step["source"] == "fallback" and result.step["dt"] == 1e-4
+    assert result.step["unmet"] == ["no PI"] and "no step down to" in result.step["notes"][0]
+    assert result.cases[0].run["dt"] == 1e-4
+    statement = step_record([result])["statement"]
+    assert "the paper's own: no step met 0.01 dB for any case" in statement
+    assert "agrees" not in statement

@@ -24,6 +24,14 @@ def add_parsers(subparsers):
                              help="study file, or a shipped study name (e.g. stiction)")
         cmd.add_argument("--quick", action="store_true",
                          help="shorter runs (fewer, shorter Welch segments)")
+        step = cmd.add_mutually_exclusive_group()
+        step.add_argument("--dt", type=float, metavar="S",
+                          help="integration step [s] of every case, as given (the paper's: "
+                               "1e-4); default chosen for --tolerance")
+        step.add_argument("--tolerance", type=float, metavar="DB",
+                          help="choose one step per batch of cases, the largest keeping every "
+                               "case's transmissibility within DB [dB] (default 0.01; "
+                               "docs/model.md §7); a study file's [simulation] dt is kept")
         cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
                          help=f"output folder (default results/{name})")
         cmd.add_argument("--workers", type=int, metavar="N",
@@ -45,17 +53,19 @@ def run(args):
     int
         The exit code, 0.
     """
-    from qzs.workflows.report import paper_summary, run_paper
+    from qzs.workflows.report import paper_summary, run_paper, step_statement
 
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
                                         workers=args.workers, progress=not args.quiet,
-                                        argument="--out")
+                                        argument="--out", dt=args.dt,
+                                        tolerance_db=args.tolerance)
     lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"
              for result in results]
     lines.append(f"{'total':<12}    wall {wall:7.1f} s")
+    lines.append(step_statement(results))
     lines.extend(f"  [{verdict.label}] {verdict.statement} ({verdict.study})\n"
                  f"      {verdict.evidence}" for verdict in verdicts)
     lines.append(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv, figures and "

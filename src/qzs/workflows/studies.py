@@ -20,6 +20,13 @@ Kinds:
 ``[study] claims`` names, by id, the paper's claims the study's cases decide (the keys of
 :data:`CLAIMS`; docs/model.md §13); an unknown id is an error. Each curve keeps which of
 its bins are trusted (docs/model.md §10), and every metric comes from those bins only.
+
+The integration step: a ``[simulation] dt`` in the file, or ``dt`` given to
+:func:`run_studies` (``qzs paper --dt``), is used as it is; otherwise the cases that share
+an excitation get one step, the coarsest that keeps every one's transmissibility within
+``tolerance_db`` (default :data:`qzs.defaults.ACCURACY`), chosen by
+:func:`qzs.engine.accuracy.choose_batch_step` on one lockstep probe of them all
+(docs/model.md §7).
 """
 import dataclasses
 import time
@@ -34,9 +41,9 @@ from qzs.analysis.linear import linearize
 from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
                                    transmissibility_metrics)
 from qzs.analysis.statistics import run_statistics
-from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
+from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
-from qzs.errors import ParameterError
+from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.identify.spring import fit_spring
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
@@ -206,12 +213,22 @@ class StudyResult:
         Whether the runs were the quick ones.
     seconds : float
         Time spent on its cases [s], summed over them (they may run in parallel).
+    step : dict
+        How the integration step was set (:func:`_step_record`): ``dt`` [s], ``source``
+        (``"chosen"``, ``"given"``, ``"file"``, or ``"fallback"``: no step met the tolerance
+        for any case of the batch, which runs at the paper's dt = 1e-4 s, with ``unmet``,
+        ``notes`` and ``tolerance_db``) and, for a chosen step, ``tolerance_db``,
+        ``estimated_error_db`` (the largest over the cases that met it), ``reference_dt``
+        [s], ``probe_duration`` [s], ``unmet`` (labels of the cases no step met: their
+        response depends on the step), ``notes``, ``seconds`` (time of the choice) [s] and
+        ``group`` (studies with equal numbers share the choice).
     """
 
     study: Study
     cases: list
     quick: bool
     seconds: float = 0.0
+    step: dict = field(default_factory=dict)
 
 
 def shipped_studies():
@@ -282,8 +299,9 @@ def load_study(path):
                  source=str(path))
 
 
-def _tasks(study, quick):
-    """One picklable task per case: everything a worker needs to run it."""
+def _tasks(study, quick, dt=None):
+    """One picklable task per case: everything a worker needs to run it (``dt`` None: the
+    file's, else chosen later by :func:`_choose_steps`)."""
     analysis = {**ANALYSIS, **study.analysis}
     if quick:
         analysis["fft_length"] = analysis["quick_fft_length"]
@@ -297,8 +315,10 @@ def _tasks(study, quick):
     return [dict(kind=study.kind, label=case.get("label", f"case {i + 1}"),
                  settings={**study.defaults, **{k: v for k, v in case.items() if k != "label"}},
                  excitation=dict(study.excitation), analysis=analysis,
-                 simulation={"dt": SIMULATION["dt"], "solver": SIMULATION["solver"],
-                             **study.simulation}, options=study.options)
+                 simulation={"dt": None, "solver": SIMULATION["solver"], **study.simulation,
+                             **({} if dt is None else {"dt": dt})},
+                 step_source="given" if dt is not None else
+                 ("file" if "dt" in study.simulation else "chosen"), options=study.options)
             for i, case in enumerate(study.cases)]
 
 
@@ -525,7 +545,8 @@ def _spring_case(task):
     return result
 
 
-def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True):
+def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True, dt=None,
+                tolerance_db=None):
     """Run several studies, all their cases in parallel.
 
     Cases that share their chirp, sample rate, step and solver (the paper's
@@ -547,14 +568,35 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     lockstep : bool
         Share steps between cases through the batch kernel; False runs every case
         through the one-case driver, one per process (the same numbers, slower).
+    dt : float, optional
+        Integration step [s] of every case (the paper's: 1e-4); default a file's
+        ``[simulation] dt``, else chosen for ``tolerance_db``.
+    tolerance_db : float, optional
+        Tolerance on the transmissibility [dB] the chosen step meets (one step per group
+        of cases sharing an excitation, :func:`qzs.engine.accuracy.choose_batch_step`);
+        default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
 
     Returns
     -------
     list of StudyResult
+
+    Raises
+    ------
+    ParameterError
+        Both ``dt`` and ``tolerance_db``, or a non-positive one.
     """
     from tqdm.auto import tqdm
 
-    per_study = [_tasks(study, quick) for study in studies]
+    from qzs._validation import positive_real
+
+    if dt is not None and tolerance_db is not None:
+        raise ParameterError("give `dt` (a literal step [s]) or `tolerance_db` (the accuracy "
+                             "the step is chosen for [dB]), not both.")
+    dt = None if dt is None else positive_real("dt", dt)
+    tolerance_db = positive_real("tolerance_db", ACCURACY["tolerance_db"] if tolerance_db is None
+                                 else tolerance_db)
+    per_study = [_tasks(study, quick, dt) for study in studies]
+    steps = _choose_steps(per_study, tolerance_db, worker_count(workers), progress)
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
              for j, task in enumerate(study_tasks)]
     results = [[None] * len(study_tasks) for study_tasks in per_study]
@@ -594,8 +636,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         if pool is not None:
             pool.shutdown(cancel_futures=True)
     elapsed = time.perf_counter() - start
-    return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed)
-            for study, cases in zip(studies, results)]
+    return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed, step)
+            for study, cases, step in zip(studies, results, steps)]
 
 
 def run_study(study, **options):
@@ -615,3 +657,64 @@ def run_study(study, **options):
     if not isinstance(study, Study):
         study = load_study(study)
     return run_studies([study], **options)[0]
+
+
+def _choose_steps(per_study, tolerance_db, workers, progress):
+    """Fill in the step of every task without one; returns each study's :func:`_step_record`.
+
+    The tasks that share their chirp, sample rate and solver (a lockstep batch) get one
+    step: :func:`qzs.engine.accuracy.choose_batch_step` over their distinct cases.
+    """
+    from qzs.engine.accuracy import choose_batch_step
+
+    groups = {}
+    for tasks in per_study:
+        for task in tasks:
+            if task.get("simulation", {}).get("dt", 0) is None:
+                _, _, excitation, rate = _case_inputs(task)
+                key = (excitation, float(rate), task["simulation"]["solver"])
+                groups.setdefault(key, []).append(task)
+    choices = {}
+    for group, ((excitation, rate, solver), tasks) in enumerate(groups.items()):
+        start = time.perf_counter()
+        index = {}
+        for task in tasks:
+            isolator, controller, _, _ = _case_inputs(task)
+            index.setdefault((isolator, controller), []).append(task)
+        try:
+            choice = choose_batch_step(
+                list(index), excitation, tolerance_db=tolerance_db, solver=solver,
+                sample_rate=rate, workers=workers, progress=progress,
+                labels=[members[0]["label"] for members in index.values()])
+        except ToleranceNotMetError as error:  # every case depends on the step: the paper's
+            choice = error
+        seconds = time.perf_counter() - start
+        for c, members in enumerate(index.values()):
+            for task in members:
+                task["simulation"]["dt"] = getattr(choice, "dt", SIMULATION["dt"])
+                choices[id(task)] = (choice, c, seconds, group)
+    return [_step_record(tasks, choices) for tasks in per_study]
+
+
+def _step_record(tasks, choices):
+    """How a study's step was set (:attr:`StudyResult.step`); empty without a simulation."""
+    simulated = [task for task in tasks if "simulation" in task]
+    if not simulated:
+        return {}
+    first = simulated[0]
+    record = {"dt": float(first["simulation"]["dt"]), "source": first["step_source"]}
+    if id(first) in choices and isinstance(choices[id(first)][0], ToleranceNotMetError):
+        error, _, seconds, group = choices[id(first)]
+        record.update(source="fallback", tolerance_db=error.tolerance, notes=[str(error)],
+                      unmet=[task["label"] for task in simulated], seconds=seconds,
+                      group=group)
+    elif id(first) in choices:
+        choice, _, seconds, group = choices[id(first)]
+        mine = [(task["label"], choices[id(task)][1]) for task in simulated]
+        errors = [choice.case_errors[c] for _, c in mine if c not in choice.unmet]
+        record.update(tolerance_db=choice.tolerance,
+                      estimated_error_db=max(errors) if errors else float("nan"),
+                      reference_dt=choice.reference_dt, probe_duration=choice.probe_duration,
+                      unmet=[label for label, c in mine if c in choice.unmet],
+                      notes=list(choice.notes), seconds=seconds, group=group)
+    return record

@@ -172,11 +172,13 @@ STEP_CASES = 3
 def choose_sweep_step(definition, settings, *, progress=False):
     """Fix a sweep's step: the largest meeting its ``tolerance_db`` on every case probed.
 
-    A sweep whose file gives no ``dt`` is integrated at the step
-    :func:`qzs.engine.accuracy.choose_step` picks for ``[simulation] tolerance_db``
-    (default :data:`qzs.defaults.ACCURACY`), probed on :data:`STEP_CASES` cases spread
-    over the sweep; the smallest of their steps serves every case (all cases of a batch
-    share their steps). Choosing is deterministic, so a resumed sweep gets the same step.
+    A sweep whose file gives no ``dt`` is integrated at the step chosen for
+    ``[simulation] tolerance_db`` (default :data:`qzs.defaults.ACCURACY`) on
+    :data:`STEP_CASES` cases spread over the sweep, probed at once
+    (:func:`qzs.engine.accuracy.choose_batch_step`, each group of them sharing an
+    excitation in one batch); the smallest of their steps serves every case (all cases of
+    a batch share their steps). Choosing is deterministic, so a resumed sweep gets the
+    same step.
 
     Parameters
     ----------
@@ -191,8 +193,9 @@ def choose_sweep_step(definition, settings, *, progress=False):
     -------
     definition : SweepDefinition
         With ``simulation["dt"]`` set (the same object if the file gave ``dt``).
-    choices : tuple of (int, StepChoice)
-        The probed cases' indices and their choices (empty if the file gave ``dt``).
+    choices : tuple of (int, BatchStepChoice)
+        The probed cases' indices and their choices, each with the case's own ``dt`` and
+        ``error`` (empty if the file gave ``dt``; a case no step meets is left out).
 
     Raises
     ------
@@ -208,30 +211,40 @@ def choose_sweep_step(definition, settings, *, progress=False):
     """
     import dataclasses
 
-    from qzs.engine.accuracy import choose_step
+    from qzs.engine.accuracy import MAX_HALVINGS, choose_batch_step
 
     simulation = definition.simulation
     if simulation["dt"] is not None:
         return definition, ()
     picks = sorted({int(i) for i in np.linspace(0, len(settings) - 1, STEP_CASES).round()})
-    choices, reasons, unmet = [], [], []
-    tolerance = simulation["tolerance_db"]
+    groups, reasons = {}, []
     for i in picks:
         try:
-            isolator, controller, (excitation, _), _ = build_case(definition, settings[i])
+            isolator, controller, (excitation, _), key = build_case(definition, settings[i])
         except (ParameterError, TypeError) as error:
             reasons.append(f"case {i}: {error}")
             continue
-        try:
-            choices.append((i, choose_step(excitation, isolator, controller,
-                                           tolerance_db=tolerance, solver=simulation["solver"],
-                                           sample_rate=definition.analysis["sample_rate"],
-                                           progress=progress)))
-        except ToleranceNotMetError as error:
-            unmet.append((i, error))
-    if not choices and not unmet:
+        groups.setdefault(key, (excitation, []))[1].append((i, (isolator, controller)))
+    if not groups:
         raise ParameterError("no step could be chosen for `tolerance_db`: the cases probed "
                              f"are invalid ({'; '.join(reasons)}); fix them or give `dt`.")
+    tolerance = simulation["tolerance_db"]
+    choices, unmet = [], []
+    for excitation, members in groups.values():  # the probed cases of one excitation at once
+        labels = [f"case {i}" for i, _ in members]
+        try:
+            batch = choose_batch_step([pair for _, pair in members], excitation,
+                                      tolerance_db=tolerance, solver=simulation["solver"],
+                                      sample_rate=definition.analysis["sample_rate"],
+                                      max_halvings=MAX_HALVINGS, progress=progress,
+                                      labels=labels)
+        except ToleranceNotMetError as error:
+            unmet.append(f"{', '.join(labels)}: {error}")
+            continue
+        choices += [(i, dataclasses.replace(batch, dt=batch.case_steps[c],
+                                            error=batch.case_errors[c]))
+                    for c, (i, _) in enumerate(members) if c not in batch.unmet]
+        unmet += [note for note in batch.notes if note.startswith(tuple(labels))]
     if choices:
         dt = min(choice.dt for _, choice in choices)
         note = (f"dt = {dt:g} s chosen for the transmissibility within {tolerance:g} dB on "
@@ -241,12 +254,7 @@ def choose_sweep_step(definition, settings, *, progress=False):
         dt = SIMULATION["dt"]
         note = f"dt = {dt:g} s, the paper's step: no case probed meets {tolerance:g} dB"
     if unmet:
-        note += ("; " + ", ".join(f"case {i}" for i, _ in unmet) + ": no step down to "
-                 f"{unmet[0][1].smallest_step:.3g} s meets {tolerance:g} dB (best estimate "
-                 + ", ".join(f"{e.smallest_error:.2g} dB" for _, e in unmet)
-                 + "): the response of such cases depends on the step (stop contacts or a "
-                 "stick-slip pattern each refinement redraws) and their curves carry that "
-                 "uncertainty")
+        note += "; " + "; ".join(unmet) + "; their curves carry that uncertainty"
         warnings.warn(note, DataWarning, stacklevel=2)
     simulation = {**simulation, "dt": dt, "step_note": note}
     return dataclasses.replace(definition, simulation=simulation), tuple(choices)

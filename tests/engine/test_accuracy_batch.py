@@ -1,0 +1,70 @@
+"""One step for many cases (qzs.engine.accuracy.choose_batch_step, docs/model.md §7).
+
+The batch search probes every case at once through the lockstep kernel, which gives each
+case :func:`qzs.simulate`'s numbers to the last bit; so each case's step and estimate must
+be exactly what :func:`~qzs.engine.accuracy.choose_step` finds for it alone, and the
+batch's step the finest of them. A case no step meets (the payload without PI rides on the
+hard stops) is reported and does not hold the others back.
+"""
+import math
+
+import pytest
+
+from qzs import Chirp, ControllerParameters, IsolatorParameters
+from qzs.engine.accuracy import BatchStepChoice, choose_batch_step, choose_step
+from qzs.errors import ParameterError, ToleranceNotMetError
+
+CHIRP = Chirp(duration=20.0)
+PROBE = 20.0  # s: short probes keep the tests quick
+NO_PI = (IsolatorParameters(), ControllerParameters(pi_kp=0.0, pi_ki=0.0))
+CASES = [(IsolatorParameters(), ControllerParameters()),
+         (IsolatorParameters(viscous_damping=400.0), ControllerParameters()),
+         (IsolatorParameters(stiction_force=15.0), ControllerParameters()),
+         NO_PI]
+
+
+def test_each_case_gets_its_own_choice_and_the_batch_the_finest_step():
+    tolerance = 1e-3
+    batch = choose_batch_step(CASES, CHIRP, tolerance_db=tolerance, probe_duration=PROBE,
+                              labels=["table 1", "Cv = 400", "Fs = 15", "no PI"])
+    assert isinstance(batch, BatchStepChoice)
+    alone = [choose_step(CHIRP, *case, tolerance_db=tolerance, probe_duration=PROBE)
+             for case in CASES[:3]]
+    # the lockstep probe is the one-case probe, bit for bit: the same steps and estimates
+    assert list(batch.case_steps[:3]) == [choice.dt for choice in alone]
+    assert list(batch.case_errors[:3]) == [choice.error for choice in alone]
+    assert len({choice.dt for choice in alone}) > 1  # the cases disagree: the test decides
+    assert batch.dt == min(choice.dt for choice in alone)
+    assert batch.error == max(choice.error for choice in alone)
+    assert batch.reference_dt == batch.dt / 4
+    # the case without PI: no step meets it, alone an error, in the batch a note
+    with pytest.raises(ToleranceNotMetError):
+        choose_step(CHIRP, *NO_PI, tolerance_db=tolerance, probe_duration=PROBE)
+    assert batch.unmet == (3,)
+    assert math.isinf(batch.case_errors[3]) and math.isnan(batch.case_steps[3])
+    assert any(note.startswith("no PI: no step down to") for note in batch.notes)
+    assert "no PI" in batch.summary()
+
+
+def test_no_case_meeting_the_tolerance_is_an_error():
+    with pytest.raises(ToleranceNotMetError, match="no step down to"):
+        choose_batch_step([NO_PI], CHIRP, tolerance_db=1e-3, probe_duration=PROBE)
+
+
+@pytest.mark.parametrize("cases, options, match", [
+    ([], {"tolerance_db": 0.01}, "at least one"),
+    (CASES[:1], {}, "exactly one of"),
+    (CASES[:1], {"tolerance_db": 0.01, "tolerance_state": 1e-6}, "exactly one of"),
+    (CASES[:1], {"tolerance_db": -1.0}, "tolerance_db"),
+    (CASES[:1], {"tolerance_db": 0.01, "labels": ["a", "b"]}, "labels"),
+    (CASES[:1], {"tolerance_db": 0.01, "band": (1.0, 50.0)}, "band"),
+])
+def test_bad_arguments_raise_before_any_simulation(monkeypatch, cases, options, match):
+    import qzs.engine.batch
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("simulated before the arguments were checked")
+
+    monkeypatch.setattr(qzs.engine.batch, "simulate_batch", refuse)
+    with pytest.raises(ParameterError, match=match):
+        choose_batch_step(cases, CHIRP, probe_duration=PROBE, **options)
