@@ -1,4 +1,4 @@
-"""One step for many cases (qzs.engine.accuracy.choose_batch_step, docs/model.md §7).
+"""One step for many cases (qzs.engine.accuracy_batch.choose_batch_step, docs/model.md §7).
 
 The batch search probes every case at once through the lockstep kernel, which gives each
 case :func:`qzs.simulate`'s numbers to the last bit; so each case's step and estimate must
@@ -11,7 +11,8 @@ import math
 import pytest
 
 from qzs import Chirp, ControllerParameters, IsolatorParameters
-from qzs.engine.accuracy import BatchStepChoice, choose_batch_step, choose_step
+from qzs.engine.accuracy import choose_step
+from qzs.engine.accuracy_batch import BatchStepChoice, choose_batch_step
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 CHIRP = Chirp(duration=20.0)

@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 
 from qzs.defaults import ACCURACY, SIMULATION
-from qzs.workflows.report import AGREEMENT_TEST, decide_claims, step_record
+from qzs.workflows.report import decide_claims
+from qzs.workflows.report_step import AGREEMENT_TEST, step_record
 from qzs.workflows.studies import load_study, run_studies, shipped_studies
 
 TRANSMISSIBILITY = ("resonance_peak",)

@@ -372,7 +372,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
     """No ``dt``: one step for the batch, chosen for the tolerance and recorded with its
     estimate; ``dt`` given: used as given, nothing probed, over a file's; a file's
     ``[simulation] dt``: used as written; ``dt`` and a tolerance both: refused at once."""
-    import qzs.engine.accuracy
+    import qzs.engine.accuracy_batch
     from qzs.engine.accuracy import SAFETY
 
     text = ("[study]\nname = 'tiny'\nkind = 'transmissibility'\n"
@@ -390,7 +390,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
     def refuse(*args, **kwargs):
         raise AssertionError("a step was chosen where one was given")
 
-    monkeypatch.setattr(qzs.engine.accuracy, "choose_batch_step", refuse)
+    monkeypatch.setattr(qzs.engine.accuracy_batch, "choose_batch_step", refuse)
     path.write_text(text + "[simulation]\ndt = 5e-4\n")
     from_file = run_studies([load_study(path)], quick=True, workers=1, progress=False)[0]
     assert from_file.step == {"dt": 5e-4, "source": "file"}
@@ -407,7 +407,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
 def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
     """Every case on the stops (no PI): no step meets the tolerance for any; the batch runs
     at the paper's dt = 1e-4 s, and the record and the statement say why."""
-    from qzs.workflows.report import step_record
+    from qzs.workflows.report_step import step_record
 
     path = tmp_path / "stops.toml"
     path.write_text("[study]\nname = 'stops'\nkind = 'transmissibility'\n"

@@ -5,6 +5,7 @@
 ``studies``                   the paper's studies as TOML definitions (``study_files/``), run
                               in parallel
 ``report``                    ``qzs paper``: figures, metrics, claims decided from the data
+``report_step``               the studies' integration step as the report states it
 ``curves``                    the curves behind a figure as data: NetCDF and CSV per study
 ``experiment``                a measured log beside its simulation
 ``experiment_map``            the commented channel map template (``--write-map``)

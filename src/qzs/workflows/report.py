@@ -31,7 +31,7 @@ from qzs._version import __version__
 from qzs.analysis.damping import damping_change
 from qzs.analysis.spectral import (METRIC_NAMES, band_mask, metric_unit, rolloff_slope,
                                    transmissibility_at)
-from qzs.defaults import ACCURACY, DAMPING_CLAIM, SIMULATION
+from qzs.defaults import DAMPING_CLAIM
 from qzs.iotools.files import atomic_path
 from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
@@ -41,12 +41,12 @@ from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
 from qzs.workflows.studies import CLAIMS as STATEMENTS
+from qzs.workflows.report_step import step_record, step_statement
 from qzs.workflows.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
                                    run_studies, shipped_studies)
 
 __all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
-           "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper",
-           "step_record", "step_statement"]
+           "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
 #: of the report, its figures (PNG) and metrics.
@@ -704,7 +704,7 @@ def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdi
         JSON-ready (NaN as None, the reason beside it as ``<metric>_reason``):
         ``qzs_version``, ``quick``, ``wall_seconds``, ``claims`` (claim, study,
         statement, verdict, evidence), ``studies`` (name -> title, seconds, settings,
-        cases with their metrics), ``step`` (:func:`step_record`), ``outputs`` (report,
+        cases with their metrics), ``step`` (:func:`~qzs.workflows.report_step.step_record`), ``outputs`` (report,
         metrics_json, metrics_csv, figures: PNG and SVG paths, curves: the
         ``<study>_curves.nc`` and ``.csv`` files).
     """
@@ -948,112 +948,3 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
                                    workers=workers)
     return results, verdicts, wall
-
-
-# ---------------------------------------------------------------- the integration step
-#: The test that runs a shortened paper at the chosen step and at the paper's own, and
-#: checks every verdict and tabulated number against the criteria of docs/workflows/paper.md.
-AGREEMENT_TEST = "tests/workflows/test_report_step.py"
-
-
-def step_record(study_results):
-    """How the studies' integration steps were set, with the agreement the test checks.
-
-    Parameters
-    ----------
-    study_results : sequence of StudyResult
-        The studies run.
-
-    Returns
-    -------
-    dict
-        ``steps``: one entry per distinct step (``dt`` [s], ``source``: ``"chosen"``,
-        ``"given"``, ``"file"`` or ``"fallback"`` (no step met the tolerance: the paper's),
-        ``studies``, and for a chosen step ``tolerance_db``,
-        ``estimated_error_db`` (the largest over its studies' cases that met it),
-        ``reference_dt`` [s], ``probe_duration`` [s], ``seconds`` [s] and ``notes``);
-        ``step_dependent``: the cases no step met (study, case); ``paper_dt`` [s];
-        ``agreement``: what :data:`AGREEMENT_TEST` checks; ``statement``:
-        :func:`step_statement`.
-    """
-    steps, dependent = {}, []
-    for result in study_results:
-        step = result.step
-        if not step:
-            continue
-        entry = steps.setdefault((step["dt"], step["source"]),
-                                 {"dt": step["dt"], "source": step["source"], "studies": []})
-        entry["studies"].append(result.study.name)
-        if step["source"] == "fallback":
-            entry.update(tolerance_db=step["tolerance_db"], notes=step["notes"])
-            dependent += [{"study": result.study.name, "case": label} for label in step["unmet"]]
-        elif step["source"] == "chosen":
-            for key in ("tolerance_db", "reference_dt", "probe_duration"):
-                entry[key] = step[key]
-            entry["estimated_error_db"] = max(entry.get("estimated_error_db", 0.0),
-                                              step["estimated_error_db"])
-            groups = entry.setdefault("groups", {})
-            groups[step["group"]] = step["seconds"]
-            entry["seconds"] = sum(groups.values())
-            entry.setdefault("notes", [])
-            entry["notes"] += [n for n in step["notes"] if n not in entry["notes"]]
-            dependent += [{"study": result.study.name, "case": label} for label in step["unmet"]]
-    for entry in steps.values():
-        entry.pop("groups", None)
-    record = {"steps": list(steps.values()), "step_dependent": dependent,
-              "paper_dt": SIMULATION["dt"],
-              "agreement": (f"every claim's verdict and every tabulated number agrees with the "
-                            f"paper's own step dt = {SIMULATION['dt']:g} s within the tolerance "
-                            f"(criteria: docs/workflows/paper.md; checked by {AGREEMENT_TEST} "
-                            "on the quick paper at the default tolerance); the numbers of the "
-                            "step-dependent cases differ between any two steps")}
-    record["statement"] = step_statement(study_results, record)
-    return record
-
-
-def step_statement(study_results, record=None):
-    """The integration step in one paragraph, for the report and the console.
-
-    Parameters
-    ----------
-    study_results : sequence of StudyResult
-        The studies run.
-    record : dict, optional
-        Their :func:`step_record` (computed if omitted).
-
-    Returns
-    -------
-    str
-    """
-    record = step_record(study_results) if record is None else record
-    if not record["steps"]:
-        return "no simulation."
-    parts = []
-    for step in record["steps"]:
-        where = "" if len(record["steps"]) == 1 else f" ({', '.join(step['studies'])})"
-        if step["source"] == "chosen":
-            parts.append(f"dt = {step['dt']:g} s{where}, chosen for the transmissibility within "
-                         f"{step['tolerance_db']:g} dB: estimated error "
-                         f"{step['estimated_error_db']:.2g} dB (against dt = "
-                         f"{step['reference_dt']:g} s on a {step['probe_duration']:g} s probe, "
-                         f"{step['seconds']:.1f} s to choose)")
-        elif step["source"] == "fallback":
-            parts.append(f"dt = {step['dt']:g} s{where}, the paper's own: no step met "
-                         f"{step['tolerance_db']:g} dB for any case ({'; '.join(step['notes'])})")
-        else:
-            mark = " (the paper's own)" if step["dt"] == record["paper_dt"] else ""
-            how = "as given" if step["source"] == "given" else "from the study file"
-            parts.append(f"dt = {step['dt']:g} s{mark}{where}, {how}")
-    text = "; ".join(parts) + "."
-    if record["step_dependent"]:
-        text += (" No step met the tolerance for " + "; ".join(
-            f"{d['case']} ({d['study']})" for d in record["step_dependent"])
-            + ": its response depends on the step (stop contacts), so its numbers differ "
-            "between any two steps, the paper's own included.")
-    chosen = [step for step in record["steps"] if step["source"] == "chosen"]
-    if chosen and all(step["tolerance_db"] == ACCURACY["tolerance_db"] for step in chosen):
-        text += " " + record["agreement"][0].upper() + record["agreement"][1:] + "."
-    elif chosen:
-        text += (f" The agreement of verdicts and tabulated numbers with the paper's own step is "
-                 f"checked ({AGREEMENT_TEST}) at the default {ACCURACY['tolerance_db']:g} dB only.")
-    return text

@@ -25,7 +25,7 @@ The integration step: a ``[simulation] dt`` in the file, or ``dt`` given to
 :func:`run_studies` (``qzs paper --dt``), is used as it is; otherwise the cases that share
 an excitation get one step, the coarsest that keeps every one's transmissibility within
 ``tolerance_db`` (default :data:`qzs.defaults.ACCURACY`), chosen by
-:func:`qzs.engine.accuracy.choose_batch_step` on one lockstep probe of them all
+:func:`qzs.engine.accuracy_batch.choose_batch_step` on one lockstep probe of them all
 (docs/model.md §7).
 """
 import dataclasses
@@ -573,7 +573,7 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         ``[simulation] dt``, else chosen for ``tolerance_db``.
     tolerance_db : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets (one step per group
-        of cases sharing an excitation, :func:`qzs.engine.accuracy.choose_batch_step`);
+        of cases sharing an excitation, :func:`qzs.engine.accuracy_batch.choose_batch_step`);
         default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
 
     Returns
@@ -663,9 +663,9 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
     """Fill in the step of every task without one; returns each study's :func:`_step_record`.
 
     The tasks that share their chirp, sample rate and solver (a lockstep batch) get one
-    step: :func:`qzs.engine.accuracy.choose_batch_step` over their distinct cases.
+    step: :func:`qzs.engine.accuracy_batch.choose_batch_step` over their distinct cases.
     """
-    from qzs.engine.accuracy import choose_batch_step
+    from qzs.engine.accuracy_batch import choose_batch_step
 
     groups = {}
     for tasks in per_study:

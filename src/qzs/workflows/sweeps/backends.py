@@ -175,7 +175,7 @@ def choose_sweep_step(definition, settings, *, progress=False):
     A sweep whose file gives no ``dt`` is integrated at the step chosen for
     ``[simulation] tolerance_db`` (default :data:`qzs.defaults.ACCURACY`) on
     :data:`STEP_CASES` cases spread over the sweep, probed at once
-    (:func:`qzs.engine.accuracy.choose_batch_step`, each group of them sharing an
+    (:func:`qzs.engine.accuracy_batch.choose_batch_step`, each group of them sharing an
     excitation in one batch); the smallest of their steps serves every case (all cases of
     a batch share their steps). Choosing is deterministic, so a resumed sweep gets the
     same step.
@@ -211,7 +211,8 @@ def choose_sweep_step(definition, settings, *, progress=False):
     """
     import dataclasses
 
-    from qzs.engine.accuracy import MAX_HALVINGS, choose_batch_step
+    from qzs.engine.accuracy import MAX_HALVINGS
+    from qzs.engine.accuracy_batch import choose_batch_step
 
     simulation = definition.simulation
     if simulation["dt"] is not None:
