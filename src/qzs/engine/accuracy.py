@@ -23,7 +23,7 @@ from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error", "halving_search",
-           "admissible_step"]
+           "admissible_step", "estimate_difference_db"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -225,12 +225,35 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
                          fft_length=length)
     b = transmissibility(fine.base_acceleration, fine.payload_acceleration, rate,
                          fft_length=length)
-    f = a.frequency
-    keep = (f > 0) & (f >= band[0]) & (f <= band[1]) & a.trusted & b.trusted
-    keep &= (a.magnitude > 0) & (b.magnitude > 0)
+    return estimate_difference_db(a, b, band)
+
+
+def estimate_difference_db(coarse, fine, band):
+    """The largest difference [dB] of two transmissibility estimates over a band.
+
+    The measure of :func:`step_error` (and of the six-axis step,
+    :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`): max ``|20 log10(|T_coarse| /
+    |T_fine|)|`` over the bins of ``band`` above 0 Hz that both estimates trust and where
+    both magnitudes are positive.
+
+    Parameters
+    ----------
+    coarse, fine : TransferEstimate
+        Two estimates on the same bins (:func:`qzs.analysis.spectral.transmissibility`).
+    band : tuple of float
+        ``(low, high)`` [Hz].
+
+    Returns
+    -------
+    float
+        The difference [dB]; ``nan`` if no bin of the band is trusted in both.
+    """
+    f = coarse.frequency
+    keep = (f > 0) & (f >= band[0]) & (f <= band[1]) & coarse.trusted & fine.trusted
+    keep &= (coarse.magnitude > 0) & (fine.magnitude > 0)
     if not keep.any():
         return float("nan")
-    return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
+    return float(np.max(np.abs(decibels(coarse.magnitude[keep] / fine.magnitude[keep]))))
 
 
 # ---------------------------------------------------------------- validation

@@ -14,8 +14,8 @@ from qzs.workflows.hexapod_transmissibility.settings import CHIRP, FLOOR_DB, _sc
 # ---------------------------------------------------------------- the matrix
 def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"],
                              f1=CHIRP["f1"], duration=CHIRP["duration"], dt=None,
-                             sample_rate=None, solver=None, fft_length=None, estimator="h1",
-                             floor_db=FLOOR_DB, workers=None, progress=True):
+                             tolerance_db=None, sample_rate=None, solver=None, fft_length=None,
+                             estimator="h1", floor_db=FLOOR_DB, workers=None, progress=True):
     """Simulate one chirp per base axis and estimate the 6x6 transmissibility matrix.
 
     Each axis of ``axes`` is one run of :func:`qzs.engine.hexapod.simulate_hexapod` with
@@ -44,9 +44,12 @@ def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"]
     duration : float
         Sweep time and run length [s]; default 200.
     dt : float, optional
-        Integration step [s]. Default: accuracy-driven per run (module docstring),
-        falling back to the set-up's ``[simulation] dt`` (1e-4 s if it gives none); each
-        run's record says which.
+        A literal integration step [s] for every run. Default: accuracy-driven per run
+        (module docstring), falling back to the set-up's ``[simulation] dt`` (1e-4 s if it
+        gives none); each run's record says which, with the estimated error.
+    tolerance_db : float, optional
+        Tolerance [dB] of the accuracy-driven step on the driven axis's transmissibility;
+        default ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     sample_rate : float, optional
         Output rate [Hz]; default the set-up's, else 1000.
     solver : {"ode3", "rk4", "euler"}, optional
@@ -82,7 +85,7 @@ def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"]
     """
     axes, amplitudes, common, tasks, workers = _plan(
         setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
-        estimator, floor_db, workers, progress)
+        estimator, floor_db, workers, progress, tolerance_db)
     from tqdm.auto import tqdm
 
     _dry_run(tasks[0])
