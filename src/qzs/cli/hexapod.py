@@ -43,7 +43,7 @@ def _add_step_options(parser):
                       help="a literal integration step [s] for every run (default: each "
                            "run's step chosen for --tolerance, else the file's dt)")
     step.add_argument("--tolerance", type=float, metavar="DB",
-                      help="tolerance of each run's step on its diagonal entry [dB] (default "
+                      help="tolerance of each run's step on its column of the matrix [dB] (default "
                            f"{ACCURACY['tolerance_db']:g}, docs/hexapod.md §10.3)")
 
 
@@ -110,7 +110,7 @@ def add_parser(subparsers):
                            "the tolerance, halving down to the file's dt, docs/hexapod.md "
                            "§10.3)")
     step.add_argument("--tolerance", type=float, metavar="DB",
-                      help="tolerance on the driven axis's transmissibility [dB] (the "
+                      help="tolerance on the driven axis's transmissibility column [dB] (the "
                            f"default measure for a chirp along one axis; default "
                            f"{ACCURACY['tolerance_db']:g})")
     step.add_argument("--state-tolerance", type=float, metavar="M",

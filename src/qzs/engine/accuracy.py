@@ -228,7 +228,7 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
     return estimate_difference_db(a, b, band)
 
 
-def estimate_difference_db(coarse, fine, band):
+def estimate_difference_db(coarse, fine, band, keep=None):
     """The largest difference [dB] of two transmissibility estimates over a band.
 
     The measure of :func:`step_error` (and of the six-axis step,
@@ -242,6 +242,8 @@ def estimate_difference_db(coarse, fine, band):
         Two estimates on the same bins (:func:`qzs.analysis.spectral.transmissibility`).
     band : tuple of float
         ``(low, high)`` [Hz].
+    keep : ndarray of bool, optional
+        Bins the caller keeps besides (default all).
 
     Returns
     -------
@@ -249,7 +251,8 @@ def estimate_difference_db(coarse, fine, band):
         The difference [dB]; ``nan`` if no bin of the band is trusted in both.
     """
     f = coarse.frequency
-    keep = (f > 0) & (f >= band[0]) & (f <= band[1]) & coarse.trusted & fine.trusted
+    keep = np.ones(f.shape, dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
+    keep = keep & (f > 0) & (f >= band[0]) & (f <= band[1]) & coarse.trusted & fine.trusted
     keep &= (coarse.magnitude > 0) & (fine.magnitude > 0)
     if not keep.any():
         return float("nan")

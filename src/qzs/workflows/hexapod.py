@@ -603,8 +603,9 @@ def simulate_setup(setup, *, excitation=None, duration=None, dt=None, tolerance_
         file's ``[simulation] dt`` (else 1e-4 s) and taking it where no coarser step meets
         the tolerance; ``result.run`` says which (:func:`step_record`).
     tolerance_db : float, optional
-        Tolerance [dB] on the driven axis's transmissibility (one moving axis); the default
-        measure, at ``qzs.defaults.ACCURACY["tolerance_db"]``, for a chirp along one axis.
+        Tolerance [dB] on the driven axis's column of the transmissibility (one moving
+        axis); the default measure, at ``qzs.defaults.ACCURACY["tolerance_db"]``, for a
+        chirp along one axis.
     tolerance_state : float, optional
         Tolerance [m] on the platform's pose (rotations as arcs at the platform's size); the
         default measure, at ``ACCURACY["tolerance_state"]``, for any other base motion.

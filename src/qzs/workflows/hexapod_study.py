@@ -374,7 +374,7 @@ def run_hexapod_study(folder="results/hexapod_study", *, quick=False, dt=None,
         A literal step [s] for every run; default the accuracy-driven step of each run
         (:mod:`qzs.workflows.hexapod_transmissibility`).
     tolerance_db : float, optional
-        Tolerance [dB] of the accuracy-driven step on each run's diagonal entry; default
+        Tolerance [dB] of the accuracy-driven step on each run's column; default
         ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     workers : int, optional
         Processes per case (one per excited axis); default the machine's cores.
@@ -646,7 +646,8 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
     else:
         lines.append("Steps: accuracy-driven where the probe's differences shrink with the "
                      "step as the scheme's order predicts (tolerance "
-                     f"{s['tolerance_db']:g} dB on the diagonal); elsewhere the file's "
+                     f"{s['tolerance_db']:g} dB on each run's column of the matrix); elsewhere the "
+                     "file's "
                      f"{s['setup_dt']:g} s. Per run:")
         for label, result in cases.items():
             for axis in result.excited_axes:

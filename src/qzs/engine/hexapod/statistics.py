@@ -111,7 +111,7 @@ def _step_line(run):
         return [f"Step: dt = {run['dt']:g} s, given (no error estimate)"]
     unit = "dB" if "tolerance_db" in run else "m"
     key = "db" if unit == "dB" else "m"
-    measure = "the driven axis's transmissibility" if unit == "dB" else "the pose"
+    measure = "the transmissibility" if unit == "dB" else "the pose"
     if run["step"] == "accuracy-driven":
         return [f"Step: dt = {run['dt']:g} s, accuracy-driven: estimated error "
                 f"{run['step_error_' + key]:.2g} {unit} on {measure} (tolerance "

@@ -48,7 +48,7 @@ def hexapod_transmissibility(setup, *, axes=AXES, amplitude=None, f0=CHIRP["f0"]
         (module docstring), falling back to the set-up's ``[simulation] dt`` (1e-4 s if it
         gives none); each run's record says which, with the estimated error.
     tolerance_db : float, optional
-        Tolerance [dB] of the accuracy-driven step on the driven axis's transmissibility;
+        Tolerance [dB] of the accuracy-driven step on each run's column of the matrix;
         default ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     sample_rate : float, optional
         Output rate [Hz]; default the set-up's, else 1000.

@@ -3,6 +3,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from qzs.defaults import HEXAPOD
 from qzs.model.hexapod import platform_size
 
 #: Default chirp amplitude per base axis: 2 mm in translation [m], 0.01 rad in rotation
@@ -15,7 +16,7 @@ AMPLITUDE = MappingProxyType({"x": 0.002, "y": 0.002, "z": 0.002,
 CHIRP = MappingProxyType({"f0": 0.0, "f1": 20.0, "duration": 200.0})
 #: Numerical floor of a trusted entry [dB]: the dimensionless response relative to the
 #: base motion (see the module docstring).
-FLOOR_DB = -100.0
+FLOOR_DB = HEXAPOD["floor_db"]
 #: Welch estimators with a phase (the matrix is complex).
 ESTIMATORS = ("h1", "h2")
 #: Welch segments a run averages at least when ``fft_length`` is not given.
