@@ -264,7 +264,7 @@ def step_text(run, settings):
     run : mapping
         The run's record (:attr:`HexapodTransmissibility.runs`).
     settings : mapping
-        The matrix's settings (``tolerance_db``).
+        The matrix's settings (``tolerance_db`` [dB]).
 
     Returns
     -------
@@ -277,8 +277,7 @@ def step_text(run, settings):
         return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
                 f"{run['step_error_db']:.2g} dB (tolerance {tolerance:g} dB, reference dt "
                 f"{run['step_reference_dt']:.3g} s)")
-    return (f"dt = {run['dt']:g} s, the set-up's: tolerance {tolerance:g} dB not met "
-            f"({run['step_reason']})")
+    return f"dt = {run['dt']:g} s, the set-up's: {run['step_reason']}"
 
 
 def run_steps(result):
