@@ -193,7 +193,8 @@ def test_hexapod_simulate_command(tmp_path, capsys):
         assert data.sizes["time"] == 2001
         # the file states the step, its estimated error and the tolerance
         assert data.attrs["run.step"] in ("accuracy-driven", "set-up")
-        assert data.attrs["run.tolerance_m"] == 1e-5 and data.attrs["run.tolerance_m_units"] == "m"
+        assert data.attrs["run.step_tolerance_m"] == 1e-5
+        assert data.attrs["run.step_tolerance_m_units"] == "m"
         assert data.attrs["run.step_error_m_units"] == "m" and data.attrs["run.dt_units"] == "s"
         assert "run.step_error_m" in data.attrs
     assert figure.stat().st_size > 10_000
@@ -215,14 +216,14 @@ def test_hexapod_simulate_chooses_the_step_for_a_tolerance_unless_dt_is_given(ca
 
     chirp = run("--f1", "8", "--tolerance", "0.05")
     step = chirp["step"]
-    assert step["step"] == "accuracy-driven" and step["tolerance_db"] == 0.05
+    assert step["step"] == "accuracy-driven" and step["step_tolerance_db"] == 0.05
     assert 0 < step["step_error_db"] <= 0.05 / 2 and step["dt"] == chirp["run"]["dt"]
     assert step["step_reference_dt"] == step["dt"] / 4
     random = run("--excitation", "random", "--f1", "8")
-    assert random["step"]["tolerance_m"] == 1e-5 and "step_error_m" in random["step"]
+    assert random["step"]["step_tolerance_m"] == 1e-5 and "step_error_m" in random["step"]
     literal = run("--dt", "5e-4")
     assert literal["run"]["dt"] == 5e-4 and literal["step"]["step"] == "given"
-    assert not any(key.startswith("tolerance") for key in literal["step"])
+    assert not any("tolerance" in key for key in literal["step"])
     assert main(["hexapod", "simulate", "--axis", "x", "--dt", "1e-3", "--tolerance",
                  "0.01"]) == 2
     assert "not allowed with argument" in capsys.readouterr().err

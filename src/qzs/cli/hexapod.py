@@ -113,7 +113,7 @@ def add_parser(subparsers):
                       help="tolerance on the driven axis's transmissibility column [dB] (the "
                            f"default measure for a chirp along one axis; default "
                            f"{ACCURACY['tolerance_db']:g})")
-    step.add_argument("--state-tolerance", type=float, metavar="M",
+    step.add_argument("--tolerance-state", type=float, metavar="M",
                       help="tolerance on the platform's pose [m], rotations as arcs at the "
                            "platform's size (the default measure for other base motions; "
                            f"default {ACCURACY['tolerance_state']:g})")
@@ -299,7 +299,7 @@ def run_simulate(args):
             options["duration"] = args.excitation_duration
         excitation = {args.axis: options}
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
-                            tolerance_db=args.tolerance, tolerance_state=args.state_tolerance,
+                            tolerance_db=args.tolerance, tolerance_state=args.tolerance_state,
                             sample_rate=args.sample_rate, solver=args.solver,
                             progress=not args.quiet and not args.json, out=args.out or None,
                             interruptible=True, argument="--out",

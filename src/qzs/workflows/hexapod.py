@@ -764,10 +764,10 @@ def step_record(choice):
     -------
     dict
         ``step`` (``"accuracy-driven"``, or ``"set-up"`` where no coarser step than the
-        file's met the tolerance), ``step_error_db`` and ``tolerance_db`` [dB] or
-        ``step_error_m`` and ``tolerance_m`` [m] (the estimated error, NaN if none, and the
-        tolerance), ``step_reference_dt`` [s], ``step_probe_duration`` [s] and
-        ``step_reason``.
+        file's met the tolerance), ``step_error_db`` and ``step_tolerance_db`` [dB] or
+        ``step_error_m`` and ``step_tolerance_m`` [m] (the estimated error, NaN if none,
+        and the tolerance: the names of :mod:`qzs.engine.accuracy`'s run entries),
+        ``step_reference_dt`` [s], ``step_probe_duration`` [s] and ``step_reason``.
     """
     import math
 
@@ -777,6 +777,7 @@ def step_record(choice):
     reason = (f"estimated error {choice.error:.2g} {unit} <= {choice.tolerance:g} {unit} / "
               f"safety on a {choice.probe_duration:g} s probe" if met else choice.notes[-1])
     return {"step": "accuracy-driven" if met else "set-up",
-            f"step_error_{suffix}": float(choice.error), f"tolerance_{suffix}": choice.tolerance,
+            f"step_error_{suffix}": float(choice.error),
+            f"step_tolerance_{suffix}": choice.tolerance,
             "step_reference_dt": choice.reference_dt,
             "step_probe_duration": choice.probe_duration, "step_reason": reason}

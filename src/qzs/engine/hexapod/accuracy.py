@@ -35,9 +35,10 @@ import numpy as np
 
 from qzs import _validation, defaults
 from qzs._validation import choice as _choice
-from qzs.engine.accuracy import (MAX_HALVINGS, PROBE_DURATION, SAFETY, StepChoice, _band, _frequency_range,
-                                 _probe_fft_length, _tolerance, admissible_step,
-                                 estimate_difference_db, halving_search, probe_excitation)
+from qzs.engine.accuracy import (MAX_HALVINGS, PROBE_DURATION, SAFETY, StepChoice, _band,
+                                 _frequency_range, _probe_fft_length, _tolerance,
+                                 admissible_step, estimate_difference_db, halving_search,
+                                 probe_excitation)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 __all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error"]

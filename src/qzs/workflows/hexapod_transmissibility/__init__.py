@@ -26,15 +26,15 @@ centroid), so a rotation per translation counts as ``|T| r`` and a translation p
 rotation as ``|T| / r``.
 
 **Integration step.** Where ``dt`` is not given, each run's step is chosen for a tolerance
-on the run's column of the matrix (``tolerance_db``, default
-``ACCURACY["tolerance_db"]``, 0.01 dB) by :func:`qzs.engine.hexapod.accuracy.
-choose_hexapod_step` (the single axis's method, docs/model.md §7): the probe of
-:func:`~qzs.engine.accuracy.probe_excitation`, steps halved from the largest stable one that
-divides the output period down to the set-up's ``dt``, the column's entries compared between
-successive steps over their trusted bins above the numerical floor, the error extrapolated with the observed ratio
-(capped at the scheme's order), a safety factor of 2. Where no step coarser than the
-set-up's meets it (stick-slip whose pattern changes with the step, so that the differences
-do not shrink), the run takes the set-up's ``dt`` and its record says why.
+on the run's column of the matrix (``tolerance_db``, default ``ACCURACY["tolerance_db"]``,
+0.01 dB) by :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step` (the single axis's
+method, docs/model.md §7): the probe of :func:`~qzs.engine.accuracy.probe_excitation`,
+steps halved from the largest stable one that divides the output period down to the
+set-up's ``dt``, the column's entries compared between successive steps over their trusted
+bins above the numerical floor, the error extrapolated with the observed ratio (capped at
+the scheme's order), a safety factor of 2. Where no step coarser than the set-up's meets it
+(stick-slip whose pattern changes with the step, so that the differences do not shrink),
+the run takes the set-up's ``dt`` and its record says why.
 
 =============  ================================================================
 ``settings``   default chirp and amplitudes, the numerical floor, the platform's size
