@@ -221,6 +221,8 @@ def test_hexapod_simulate_chooses_the_step_for_a_tolerance_unless_dt_is_given(ca
     assert step["step_reference_dt"] == step["dt"] / 4
     random = run("--excitation", "random", "--f1", "8")
     assert random["step"]["step_tolerance_m"] == 1e-5 and "step_error_m" in random["step"]
+    assert set(random["step"]) == {"dt", "step", "step_error_m", "step_tolerance_m",
+                                   "step_reference_dt", "step_probe_duration", "step_reason"}
     literal = run("--dt", "5e-4")
     assert literal["run"]["dt"] == 5e-4 and literal["step"]["step"] == "given"
     assert not any("tolerance" in key for key in literal["step"])

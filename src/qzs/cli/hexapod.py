@@ -308,7 +308,7 @@ def run_simulate(args):
     text = result.summary()
     record = {"summary": text, "run": result.run, "source": setup.source,
               "step": {key: value for key, value in result.run.items()
-                       if key == "dt" or key.startswith(("step", "tolerance"))}}
+                       if key in ("dt", "step") or key.startswith("step_")}}
     if args.out:
         text += f"\n  wrote            {args.out}"
         record["out"] = args.out
