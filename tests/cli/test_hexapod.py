@@ -187,13 +187,51 @@ def test_hexapod_simulate_command(tmp_path, capsys):
                  str(figure), "--quiet"]) == 0
     text = capsys.readouterr().out
     assert "stroke used" in text and "Energy ledger residual" in text
+    assert "Step: dt = " in text and "on the pose (tolerance 1e-05 m" in text
     with xr.open_dataset(out, engine="h5netcdf") as data:
         assert data.sizes["dof"] == 6 and data.sizes["leg"] == 6
         assert data.sizes["time"] == 2001
+        # the file states the step, its estimated error and the tolerance
+        assert data.attrs["run.step"] in ("accuracy-driven", "set-up")
+        assert data.attrs["run.step_tolerance_m"] == 1e-5
+        assert data.attrs["run.step_tolerance_m_units"] == "m"
+        assert data.attrs["run.step_error_m_units"] == "m" and data.attrs["run.dt_units"] == "s"
+        assert "run.step_error_m" in data.attrs
     assert figure.stat().st_size > 10_000
     assert main(["hexapod", "simulate", "--amplitude", "0.01"]) == 2
     assert "add --axis" in capsys.readouterr().err
     assert main(["hexapod", "simulate", "--out", str(tmp_path / "x.csv")]) == 2
+
+
+def test_hexapod_simulate_chooses_the_step_for_a_tolerance_unless_dt_is_given(capsys):
+    """By default the step is chosen (a chirp along one axis: its transmissibility in dB; a
+    random motion: the pose in m) and the JSON's ``step`` says how, with the estimated error
+    and the tolerance; ``--dt`` is literal; both at once, or a bad tolerance, is refused."""
+    import json
+
+    def run(*options):
+        assert main(["hexapod", "simulate", "--axis", "z", "--excitation-duration", "4",
+                     "--quiet", "--json", *options]) == 0
+        return json.loads(capsys.readouterr().out)
+
+    chirp = run("--f1", "8", "--tolerance", "0.05")
+    step = chirp["step"]
+    assert step["step"] == "accuracy-driven" and step["step_tolerance_db"] == 0.05
+    assert 0 < step["step_error_db"] <= 0.05 / 2 and step["dt"] == chirp["run"]["dt"]
+    assert step["step_reference_dt"] == step["dt"] / 4
+    random = run("--excitation", "random", "--f1", "8")
+    assert random["step"]["step_tolerance_m"] == 1e-5 and "step_error_m" in random["step"]
+    assert set(random["step"]) == {"dt", "step", "step_error_m", "step_tolerance_m",
+                                   "step_reference_dt", "step_probe_duration", "step_reason"}
+    literal = run("--dt", "5e-4")
+    assert literal["run"]["dt"] == 5e-4 and literal["step"]["step"] == "given"
+    assert not any("tolerance" in key for key in literal["step"])
+    assert main(["hexapod", "simulate", "--axis", "x", "--dt", "1e-3", "--tolerance",
+                 "0.01"]) == 2
+    assert "not allowed with argument" in capsys.readouterr().err
+    assert main(["hexapod", "simulate", "--axis", "x", "--tolerance", "-1"]) == 2
+    error = capsys.readouterr().err
+    assert "`tolerance_db`" in error and "-1" in error
 
 
 def test_cartesian_table_and_sampled_controller_from_a_file(tmp_path, capsys):

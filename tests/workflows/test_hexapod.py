@@ -57,3 +57,61 @@ def test_a_geometry_with_text_for_a_number_names_the_key(tmp_path, geometry, mes
     path.write_text("[geometry]\n" + geometry)
     with pytest.raises(ParameterError, match=message):
         load_hexapod(path)
+
+
+@pytest.mark.parametrize("excitation, options, measure", [
+    ({"z": {"kind": "chirp", "duration": 4.0}}, {}, "transmissibility_db"),
+    ({"z": {"kind": "sine", "frequency": 3.0}}, {}, "state_m"),
+    ({"x": {"kind": "chirp", "duration": 4.0}}, {}, "state_m"),  # with the file's z: two axes
+    ({"z": {"kind": "sine", "frequency": 3.0}}, {"tolerance_db": 0.1}, "transmissibility_db"),
+])
+def test_simulate_setup_measures_the_step_by_what_the_run_answers(monkeypatch, excitation,
+                                                                  options, measure):
+    """A chirp along one axis answers a transmissibility (dB), anything else a motion (m);
+    the tolerance defaults to ACCURACY's and the choice is what the run's record says."""
+    import qzs.engine.hexapod.accuracy as accuracy
+    from qzs.defaults import ACCURACY
+    from qzs.workflows.hexapod import simulate_setup
+
+    seen = {}
+
+    def chooser(*args, **kwargs):
+        seen.update(kwargs)
+        raise RuntimeError("stop")  # the choice is all this test looks at
+
+    monkeypatch.setattr(accuracy, "choose_hexapod_step", chooser)
+    with pytest.raises(RuntimeError, match="stop"):
+        simulate_setup(load_hexapod(SHIPPED_DEFAULT), excitation=excitation, duration=2.0,
+                       **options)
+    key = "tolerance_db" if measure == "transmissibility_db" else "tolerance_state"
+    assert seen[key] == options.get(key, ACCURACY[key])
+    assert seen["finest"] == seen["fallback"] == 1e-4  # the file's dt: finest and fallback
+
+
+@pytest.mark.parametrize("options, match", [
+    (dict(dt=1e-3, tolerance_db=0.01), "either `dt`.*or `tolerance_db`"),
+    (dict(dt=1e-3, tolerance_state=1e-5), "either `dt`.*or `tolerance_state`"),
+    (dict(tolerance_db=0.01, tolerance_state=1e-5), "at most one of"),
+    (dict(tolerance_state=-1.0), "`tolerance_state` must be a positive.*-1"),
+    (dict(tolerance_db=float("inf")), "`tolerance_db`.*inf"),
+    (dict(duration=-1.0), "`duration`"),  # the run's own settings, before any probe
+])
+def test_simulate_setup_refuses_bad_steps_before_any_run(monkeypatch, options, match):
+    import qzs.engine.hexapod.simulate as simulate
+    from qzs.errors import ParameterError
+    from qzs.workflows.hexapod import simulate_setup
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run started")
+
+    monkeypatch.setattr(simulate, "simulate_hexapod", no_run)
+    with pytest.raises(ParameterError, match=match):
+        simulate_setup(load_hexapod(SHIPPED_DEFAULT), **{"duration": 1.0, **options})
+
+
+def test_a_given_dt_is_literal_and_recorded_as_given():
+    from qzs.workflows.hexapod import simulate_setup
+
+    result = simulate_setup(load_hexapod(SHIPPED_DEFAULT), duration=0.5, dt=5e-4)
+    assert result.run["dt"] == 5e-4 and result.run["steps"] == 1000
+    assert result.run["step"] == "given" and "Step: dt = 0.0005 s, given" in result.summary()

@@ -1,6 +1,6 @@
 """``qzs hexapod``: the six-axis platform of six isolator legs (docs/hexapod.md)."""
 from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
-from qzs.defaults import AXES, HEXAPOD
+from qzs.defaults import ACCURACY, AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.workflows.hexapod import SHIPPED_DEFAULT
 
@@ -35,6 +35,16 @@ def _add_setup_options(parser):
                              "each axis (`qzs docs hexapod` §9.5); a [cartesian] table in the "
                              "file sets other gains")
     add_set_option(parser)
+
+
+def _add_step_options(parser):
+    step = parser.add_mutually_exclusive_group()
+    step.add_argument("--dt", type=float, metavar="S",
+                      help="a literal integration step [s] for every run (default: each "
+                           "run's step chosen for --tolerance, else the file's dt)")
+    step.add_argument("--tolerance", type=float, metavar="DB",
+                      help="tolerance of each run's step on its column of the matrix [dB] (default "
+                           f"{ACCURACY['tolerance_db']:g}, docs/hexapod.md §10.3)")
 
 
 def add_parser(subparsers):
@@ -95,7 +105,19 @@ def add_parser(subparsers):
     simulate.add_argument("--excitation-duration", type=float, metavar="S",
                           help="length of the chirp or random excitation [s]")
     simulate.add_argument("--duration", type=float, metavar="S", help="simulated time [s]")
-    simulate.add_argument("--dt", type=float, metavar="S", help="integration step [s]")
+    step = simulate.add_mutually_exclusive_group()
+    step.add_argument("--dt", type=float, metavar="S",
+                      help="a literal integration step [s] (default: the step chosen for "
+                           "the tolerance, halving down to the file's dt, docs/hexapod.md "
+                           "§10.3)")
+    step.add_argument("--tolerance", type=float, metavar="DB",
+                      help="tolerance on the driven axis's transmissibility column [dB] (the "
+                           f"default measure for a chirp along one axis; default "
+                           f"{ACCURACY['tolerance_db']:g})")
+    step.add_argument("--tolerance-state", type=float, metavar="M",
+                      help="tolerance on the platform's pose [m], rotations as arcs at the "
+                           "platform's size (the default measure for other base motions; "
+                           f"default {ACCURACY['tolerance_state']:g})")
     simulate.add_argument("--sample-rate", type=float, metavar="HZ", help="output rate [Hz]")
     simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                           help="integrator (default the file's, else ode3)")
@@ -124,9 +146,7 @@ def add_parser(subparsers):
     matrix.add_argument("--f1", type=float, metavar="HZ", help="chirp end [Hz] (default 20)")
     matrix.add_argument("--duration", type=float, metavar="S",
                         help="chirp length and run time [s] (default 200)")
-    matrix.add_argument("--dt", type=float, metavar="S",
-                        help="integration step [s] (default: accuracy-driven per run, else "
-                             "the file's)")
+    _add_step_options(matrix)
     matrix.add_argument("--sample-rate", type=float, metavar="HZ",
                         help="output rate [Hz] (default the file's, else 1000)")
     matrix.add_argument("--workers", type=int, metavar="N",
@@ -144,8 +164,8 @@ def add_parser(subparsers):
                     "P only (Ki = 0) and no position loop (Kp = Ki = 0, statically unstable "
                     "here); writes report.md, metrics.csv/json, figures and the matrices.")
     study.add_argument("--quick", action="store_true",
-                       help="60 s chirps at dt = 1 ms instead of 400 s at the "
-                            "accuracy-driven step (well under a minute)")
+                       help="60 s chirps instead of 400 s (well under a minute)")
+    _add_step_options(study)
     study.add_argument("--out", metavar="DIR", default="results/hexapod_study",
                        help="output folder (default results/hexapod_study)")
     study.add_argument("--workers", type=int, metavar="N",
@@ -282,13 +302,16 @@ def run_simulate(args):
             options["duration"] = args.excitation_duration
         excitation = {args.axis: options}
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
+                            tolerance_db=args.tolerance, tolerance_state=args.tolerance_state,
                             sample_rate=args.sample_rate, solver=args.solver,
                             progress=not args.quiet and not args.json, out=args.out or None,
                             interruptible=True, argument="--out",
                             names={**{name: f"--{name}" for name in _EXCITATION_OPTIONS},
                                    "duration": "--excitation-duration"})
     text = result.summary()
-    record = {"summary": text, "run": result.run, "source": setup.source}
+    record = {"summary": text, "run": result.run, "source": setup.source,
+              "step": {key: value for key, value in result.run.items()
+                       if key in ("dt", "step") or key.startswith("step_")}}
     if args.out:
         text += f"\n  wrote            {args.out}"
         record["out"] = args.out
@@ -348,7 +371,8 @@ def run_transmissibility(args):
                if getattr(args, name) is not None}
     result = hexapod_transmissibility(
         setup, axes=args.axes, amplitude=_amplitude(args.amplitude),
-        **{**dict(CHIRP), **options}, dt=args.dt, sample_rate=args.sample_rate,
+        **{**dict(CHIRP), **options}, dt=args.dt, tolerance_db=args.tolerance,
+        sample_rate=args.sample_rate,
         workers=args.workers, progress=not args.quiet and not args.json)
     folder = Path(args.out)
     figure = folder / "transmissibility.png"
@@ -377,12 +401,14 @@ def run_study(args):
         0.
     """
     from qzs.iotools.paths import check_output_path
-    from qzs.workflows.hexapod_study import run_hexapod_study
+    from qzs.workflows.hexapod_study import run_hexapod_study, study_steps
 
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
-    result = run_hexapod_study(args.out, quick=args.quick, workers=args.workers,
+    result = run_hexapod_study(args.out, quick=args.quick, dt=args.dt,
+                               tolerance_db=args.tolerance, workers=args.workers,
                                progress=not args.quiet and not args.json)
     record = {"quick": result.quick, "wall_seconds": result.wall_seconds,
+              "steps": study_steps(result),
               "rows": list(result.rows), "findings": list(result.findings),
               "files": {name: str(path) for name, path in result.files.items()}}
     emit(args, result.summary(), record)

@@ -25,7 +25,7 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "choose_step_or_finest", "default_tolerance",
            "probe_excitation", "step_error", "halving_search", "admissible_step",
-           "step_run_entries"]
+           "step_run_entries", "estimate_difference_db"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -236,12 +236,38 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
     rate = coarse.run["sample_rate"]
     length = _probe_fft_length(coarse.relative_position.size, rate, band, fft_length)
     a, b = (_probe_transmissibility(run, rate, length) for run in (coarse, fine))
-    f = a.frequency
-    keep = (f > 0) & (f >= band[0]) & (f <= band[1]) & a.trusted & b.trusted
-    keep &= (a.magnitude > 0) & (b.magnitude > 0)
+    return estimate_difference_db(a, b, band)
+
+
+def estimate_difference_db(coarse, fine, band, keep=None):
+    """The largest difference [dB] of two transmissibility estimates over a band.
+
+    The measure of :func:`step_error` (and of the six-axis step,
+    :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`): max ``|20 log10(|T_coarse| /
+    |T_fine|)|`` over the bins of ``band`` above 0 Hz that both estimates trust and where
+    both magnitudes are positive.
+
+    Parameters
+    ----------
+    coarse, fine : TransferEstimate
+        Two estimates on the same bins (:func:`qzs.analysis.spectral.transmissibility`).
+    band : tuple of float
+        ``(low, high)`` [Hz].
+    keep : ndarray of bool, optional
+        Bins the caller keeps besides (default all).
+
+    Returns
+    -------
+    float
+        The difference [dB]; ``nan`` if no bin of the band is trusted in both.
+    """
+    f = coarse.frequency
+    keep = np.ones(f.shape, dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
+    keep = keep & (f > 0) & (f >= band[0]) & (f <= band[1]) & coarse.trusted & fine.trusted
+    keep &= (coarse.magnitude > 0) & (fine.magnitude > 0)
     if not keep.any():
         return float("nan")
-    return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
+    return float(np.max(np.abs(decibels(coarse.magnitude[keep] / fine.magnitude[keep]))))
 
 
 # ---------------------------------------------------------------- validation

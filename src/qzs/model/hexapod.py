@@ -33,7 +33,8 @@ __all__ = ["HexapodGeometry", "PlatformParameters", "StrokeCheck", "LEG_COUNT",
            "cubic_geometry", "radial_geometry", "rotation_matrix", "rotation_angles",
            "angular_velocity_matrix", "leg_vectors", "leg_unit_vectors", "inverse_kinematics",
            "forward_kinematics", "jacobian", "base_jacobian", "stroke_check", "leg_positions",
-           "mass_matrix", "weight_wrench", "static_leg_forces", "CartesianController"]
+           "mass_matrix", "weight_wrench", "static_leg_forces", "CartesianController",
+           "platform_size"]
 
 #: Number of legs of a hexapod [-].
 LEG_COUNT = 6
@@ -241,11 +242,29 @@ class HexapodGeometry(_ArrayFields):
         return self._home_lengths
 
 
-def _platform_size(geometry):
-    """A length [m] to make rotations comparable with translations: the joints' spread."""
+def platform_size(geometry):
+    """The length [m] that makes a rotation comparable with a translation.
+
+    The top joints' RMS distance from their centroid (what :class:`HexapodGeometry` scales
+    its Jacobian's rotation columns by), or the mean leg length if the joints coincide: a
+    rotation of ``theta`` [rad] moves the joints by about ``theta * platform_size``.
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        The platform.
+
+    Returns
+    -------
+    float
+        [m].
+    """
     spread = np.sqrt(np.mean(np.sum((geometry.top_joints - geometry.top_joints.mean(axis=0)) ** 2,
                                     axis=1)))
     return float(spread) if spread > 0 else float(np.mean(geometry.home_lengths))
+
+
+_platform_size = platform_size
 
 
 def cubic_geometry(*, cube_edge, cube_center_height, base_radius=None, top_radius=None,

@@ -59,7 +59,7 @@ if TYPE_CHECKING:
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
            "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
-           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised"]
+           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised", "step_record"]
 
 #: Folder of the shipped hexapod files, inside the package.
 SHIPPED = "workflows/hexapod_files"
@@ -604,6 +604,7 @@ def plot_linear_transmissibility(setup: HexapodSetup, model: HexapodLinearModel,
 def simulate_setup(setup: HexapodSetup, *,
                    excitation: Mapping[str, Mapping[str, Any]] | None = None,
                    duration: float | None = None, dt: float | None = None,
+                   tolerance_db: float | None = None, tolerance_state: float | None = None,
                    sample_rate: float | None = None, solver: str | None = None,
                    progress: bool = False, out: str | Path | None = None,
                    interruptible: bool = False, argument: str = "out",
@@ -625,13 +626,24 @@ def simulate_setup(setup: HexapodSetup, *,
     duration : float, optional
         Simulated time [s]; default the file's, else the shortest excitation's length.
     dt : float, optional
-        Integration step [s]; default the file's, else 1e-4.
+        A literal integration step [s]. Default: the step chosen for a tolerance
+        (:func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`), halving down to the
+        file's ``[simulation] dt`` (else 1e-4 s) and taking it where no coarser step meets
+        the tolerance; ``result.run`` says which (:func:`step_record`).
+    tolerance_db : float, optional
+        Tolerance [dB] on the driven axis's column of the transmissibility (one moving
+        axis); the default measure, at ``qzs.defaults.ACCURACY["tolerance_db"]``, for a
+        chirp along one axis.
+    tolerance_state : float, optional
+        Tolerance [m] on the platform's pose (rotations as arcs at the platform's size); the
+        default measure, at ``ACCURACY["tolerance_state"]``, for any other base motion.
+        At most one of the two, and neither with ``dt``.
     sample_rate : float, optional
         Output rate [Hz]; default the file's, else 1000.
     solver : {"ode3", "rk4", "euler"}, optional
         Integrator; default the file's, else ode3.
     progress : bool
-        Show a progress bar over simulated time.
+        Show a progress bar over the step's probes and simulated time.
     out : str or Path, optional
         Stream the run to this ``.nc`` or ``.mat`` (MATLAB) file; the result then holds a
         preview (every ``run["preview_every"]``-th sample) and the statistics of all of them.
@@ -673,22 +685,50 @@ def simulate_setup(setup: HexapodSetup, *,
                     else {o: f"[excitation.{axis}] {o}" for o in options})
         built[axis] = build_excitation(kind, options, names=spelling)
     run = {**setup.simulation}
-    for name, value in (("duration", duration), ("dt", dt), ("sample_rate", sample_rate),
+    for name, value in (("duration", duration), ("sample_rate", sample_rate),
                         ("solver", solver)):
         if value is not None:
             run[name] = value
     arguments = dict(excitation=built, duration=run.get("duration"),
-                     dt=run.get("dt", SIMULATION["dt"]),
+                     dt=run.get("dt", SIMULATION["dt"]) if dt is None else dt,
                      sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
                      solver=run.get("solver", SIMULATION["solver"]), cartesian=setup.cartesian,
                      progress=progress, interruptible=interruptible)
+    measure, tolerance = _step_tolerance(built, dt, tolerance_db, tolerance_state)
+    if out is not None:
+        check_out = _out_check(out, argument, arguments, built)
+        check_out()
+    step = {"step": "given", "step_reason": "given by the caller"}
+    if measure is not None:  # bad settings fail before any probe
+        from qzs.engine.hexapod.prepare import check_hexapod_run
+
+        check_hexapod_run(setup.geometry, setup.platform, setup.isolator, setup.controller,
+                          **{key: arguments[key] for key in (
+                              "excitation", "duration", "dt", "sample_rate", "solver",
+                              "cartesian")})
+        arguments["dt"], step = _chosen_step(setup, built, arguments, measure, tolerance,
+                                             progress)
     if out is None:
-        return simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                setup.controller, **arguments)
+        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+                                  setup.controller, **arguments)
+        result.run.update(step)
+        return result
+    from qzs.engine.hexapod.result import HexapodWriter
+
+    check_out()  # again: the probes took a while
+    with HexapodWriter(out) as writer:
+        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+                                  setup.controller, sink=writer.append, **arguments)
+        result.run.update(step)
+        writer.finish(result)
+    return result
+
+
+def _out_check(out, argument, arguments, built):
+    """``check()``: can ``out`` take the run (suffix, folder, free space)?"""
     from pathlib import Path
 
-    from qzs.engine.hexapod.result import (HEXAPOD_SUFFIXES, HexapodWriter,
-                                           estimated_hexapod_size)
+    from qzs.engine.hexapod.result import HEXAPOD_SUFFIXES, estimated_hexapod_size
     from qzs.iotools.paths import check_output_path
 
     length = arguments["duration"]
@@ -700,9 +740,76 @@ def simulate_setup(setup: HexapodSetup, *,
         suffix = Path(out).suffix.lower()
         size = estimated_hexapod_size(int(round(length * arguments["sample_rate"])) + 1,
                                       suffix if suffix in HEXAPOD_SUFFIXES else ".nc")
-    check_output_path(out, argument=argument, suffixes=HEXAPOD_SUFFIXES, estimated_bytes=size)
-    with HexapodWriter(out) as writer:
-        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                  setup.controller, sink=writer.append, **arguments)
-        writer.finish(result)
-    return result
+    return lambda: check_output_path(out, argument=argument, suffixes=HEXAPOD_SUFFIXES,
+                                     estimated_bytes=size)
+
+
+def _step_tolerance(built, dt, tolerance_db, tolerance_state):
+    """The step's measure and tolerance (None, None for a literal ``dt``)."""
+    from qzs._validation import positive_real
+    from qzs.defaults import ACCURACY
+    from qzs.model.excitation import Chirp
+
+    given = [name for name, value in (("tolerance_db", tolerance_db),
+                                      ("tolerance_state", tolerance_state)) if value is not None]
+    if dt is not None:
+        if given:
+            raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or "
+                                 f"`{given[0]}` (the step chosen to meet it), not both.")
+        return None, None
+    if len(given) == 2:
+        raise ParameterError("give at most one of `tolerance_db` (the driven axis's "
+                             "transmissibility, dB) and `tolerance_state` (the pose, m).")
+    if tolerance_db is not None:
+        return "transmissibility_db", positive_real("tolerance_db", tolerance_db)
+    if tolerance_state is not None:
+        return "state_m", positive_real("tolerance_state", tolerance_state)
+    if len(built) == 1 and isinstance(next(iter(built.values())), Chirp):
+        return "transmissibility_db", ACCURACY["tolerance_db"]
+    return "state_m", ACCURACY["tolerance_state"]
+
+
+def _chosen_step(setup, built, arguments, measure, tolerance, progress):
+    """The accuracy-driven step of a run and its record (:func:`step_record`)."""
+    from qzs.engine.hexapod.accuracy import choose_hexapod_step
+
+    finest = arguments["dt"]
+    choice = choose_hexapod_step(
+        setup.geometry, setup.platform, setup.isolator, setup.controller, excitation=built,
+        **{("tolerance_db" if measure == "transmissibility_db" else "tolerance_state"):
+           tolerance},
+        solver=arguments["solver"], sample_rate=arguments["sample_rate"],
+        duration=arguments["duration"], finest=finest, fallback=finest,
+        cartesian=setup.cartesian, progress=progress)
+    return choice.dt, step_record(choice)
+
+
+def step_record(choice):
+    """A chosen step as the keys a run's ``run`` dict (and its file) carries.
+
+    Parameters
+    ----------
+    choice : StepChoice
+        :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`'s.
+
+    Returns
+    -------
+    dict
+        ``step`` (``"accuracy-driven"``, or ``"set-up"`` where no coarser step than the
+        file's met the tolerance), ``step_error_db`` and ``step_tolerance_db`` [dB] or
+        ``step_error_m`` and ``step_tolerance_m`` [m] (the estimated error, NaN if none,
+        and the tolerance: the names of :mod:`qzs.engine.accuracy`'s run entries),
+        ``step_reference_dt`` [s], ``step_probe_duration`` [s] and ``step_reason``.
+    """
+    import math
+
+    suffix = "db" if choice.measure == "transmissibility_db" else "m"
+    unit = "dB" if suffix == "db" else "m"
+    met = not math.isnan(choice.error)
+    reason = (f"estimated error {choice.error:.2g} {unit} <= {choice.tolerance:g} {unit} / "
+              f"safety on a {choice.probe_duration:g} s probe" if met else choice.notes[-1])
+    return {"step": "accuracy-driven" if met else "set-up",
+            f"step_error_{suffix}": float(choice.error),
+            f"step_tolerance_{suffix}": choice.tolerance,
+            "step_reference_dt": choice.reference_dt,
+            "step_probe_duration": choice.probe_duration, "step_reason": reason}

@@ -48,12 +48,13 @@ from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
+from qzs.workflows.hexapod_transmissibility.result import step_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
-           "comparison_figure",
+           "comparison_figure", "study_steps",
            "write_study_outputs"]
 
 #: The study's cases: label -> (what it means, registry overrides of every leg's loop).
@@ -66,12 +67,12 @@ CASES = MappingProxyType({
 })
 #: Base axes excited, one chirp each.
 STUDY_AXES = ("z", "x")
-#: Run settings of the full and the quick study: chirp length [s] and step [s] (None: the
-#: accuracy-driven step of :mod:`qzs.workflows.hexapod_transmissibility`, falling back to
+#: Chirp length [s] of the full and the quick study; both take the accuracy-driven step of
+#: :mod:`qzs.workflows.hexapod_transmissibility` unless a ``dt`` is given (falling back to
 #: the file's 1e-4 s where the probe's differences do not shrink).
 RUNS: Mapping[str, Mapping[str, Any]] = MappingProxyType({
-    "full": MappingProxyType({"duration": 400.0, "dt": None}),
-    "quick": MappingProxyType({"duration": 60.0, "dt": 1e-3}),
+    "full": MappingProxyType({"duration": 400.0}),
+    "quick": MappingProxyType({"duration": 60.0}),
 })
 #: Frequencies [Hz] the report quotes the diagonal at.
 SPOT_FREQUENCIES = (1.0, 2.0, 4.0, 8.0, 16.0)
@@ -365,6 +366,7 @@ def _findings(cases, rows):
 
 # ---------------------------------------------------------------- the run
 def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bool = False,
+                      dt: float | None = None, tolerance_db: float | None = None,
                       workers: int | None = None, progress: bool = True) -> HexapodStudyResult:
     """Run the shipped hexapod study and write its report (``qzs hexapod study``).
 
@@ -373,9 +375,13 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     folder : str or Path
         Output folder, created if missing.
     quick : bool
-        60 s chirps at a fixed dt of 1 ms (the output period; stable, and a coarser step
-        than the accuracy-driven one for the runs whose stick-slip pattern does not
-        converge) instead of 400 s chirps at the accuracy-driven step.
+        60 s chirps instead of 400 s.
+    dt : float, optional
+        A literal step [s] for every run; default the accuracy-driven step of each run
+        (:mod:`qzs.workflows.hexapod_transmissibility`).
+    tolerance_db : float, optional
+        Tolerance [dB] of the accuracy-driven step on each run's column; default
+        ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     workers : int, optional
         Processes per case (one per excited axis); default the machine's cores.
     progress : bool
@@ -402,7 +408,8 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     for label, setup in setups.items():
         cases[label] = hexapod_transmissibility(setup, axes=STUDY_AXES,
                                                 duration=settings["duration"],
-                                                dt=settings["dt"], workers=workers,
+                                                dt=dt, tolerance_db=tolerance_db,
+                                                workers=workers,
                                                 progress=progress)
     wall = time.perf_counter() - start
     rows = tuple(_metrics_row(label, result, axis) for label, result in cases.items()
@@ -412,6 +419,27 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     return HexapodStudyResult(cases=MappingProxyType(cases), rows=rows, findings=findings,
                               quick=quick, wall_seconds=wall, folder=Path(folder),
                               files=MappingProxyType(files))
+
+
+def study_steps(study):
+    """Each run's step as data: ``{case: {axis: {dt, step, error_db, tolerance_db,
+    reference_dt, reason}}}`` (``qzs hexapod study --json``).
+
+    Parameters
+    ----------
+    study : HexapodStudyResult
+        The study.
+
+    Returns
+    -------
+    dict
+        ``dt`` [s], ``step`` (how chosen), ``error_db`` (estimated error [dB], NaN if
+        none), ``tolerance_db`` [dB] (None with a given ``dt``), ``reference_dt`` [s],
+        ``reason``.
+    """
+    from qzs.workflows.hexapod_transmissibility.result import run_steps
+
+    return {label: run_steps(result) for label, result in study.cases.items()}
 
 
 # ---------------------------------------------------------------- outputs
@@ -516,6 +544,9 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
                                       result.linear_natural_frequencies,
                                   "settings": dict(result.settings),
                                   "steps": {a: {"dt_s": r["dt"], "step": r["step"],
+                                                "error_db": r["step_error_db"],
+                                                "tolerance_db":
+                                                    result.settings["tolerance_db"],
                                                 "reason": r["step_reason"]}
                                             for a, r in result.runs.items()}}
                           for label, result in cases.items()},
@@ -613,19 +644,20 @@ def _markdown(cases, rows, findings, files, quick, wall_seconds):
                          f"{s['platform_size'] * 1e3:.0f} mm)"]])
     lines.append("")
     if quick:
-        lines.append("Quick runs: 60 s chirps at a fixed step of 1 ms, the output period, "
-                     "coarser than the accuracy-driven choice for the runs whose stick-slip "
-                     "pattern changes with the step; the full study (400 s chirps, the "
-                     "accuracy-driven step falling back to the file's 0.1 ms) is "
+        lines.append(f"Quick runs: {s['duration']:g} s chirps instead of 400 s (trusted from "
+                     f"{s['trusted_from']:.2g} Hz instead of 0.2 Hz); the full study is "
                      "`qzs hexapod study`.")
+    if s["dt"] is not None:
+        lines.append(f"Steps: {s['dt']:g} s, given (no error estimate).")
     else:
         lines.append("Steps: accuracy-driven where the probe's differences shrink with the "
                      "step as the scheme's order predicts (tolerance "
-                     f"{s['tolerance_db']:g} dB on the diagonal); elsewhere the file's "
-                     f"{s['setup_dt']:g} s. Why, per run:")
+                     f"{s['tolerance_db']:g} dB on each run's column of the matrix); elsewhere the "
+                     "file's "
+                     f"{s['setup_dt']:g} s. Per run:")
         for label, result in cases.items():
             for axis in result.excited_axes:
-                lines.append(f"- {label}, {axis}: {result.runs[axis]['step_reason']}")
+                lines.append(f"- {label}, {axis}: {step_text(result.runs[axis], s)}")
     lines += ["", "## Metrics", "",
               "Diagonal entries (platform axis per the same base axis, amplitude ratio), "
               "read on trusted bins only; a dash with a note where they do not define it.", ""]
@@ -706,6 +738,10 @@ def _summary_text(study):
                      f"{row['locked_percent']:10.1f}  {row['stop_contacts']:8d}  "
                      f"{row['ledger_closure']:.1g}")
     lines += [f"  - {finding}" for finding in study.findings]
+    for label, result in study.cases.items():
+        for axis in result.excited_axes:
+            lines.append(f"  step {label}/{axis}: "
+                         f"{step_text(result.runs[axis], result.settings)}")
     lines.append(f"wrote {study.folder / 'report.md'}, metrics.csv, metrics.json, figures and "
                  "matrices")
     return "\n".join(lines)

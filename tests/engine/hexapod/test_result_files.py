@@ -113,7 +113,7 @@ def test_a_failure_during_the_run_leaves_nothing(setup, tmp_path, monkeypatch):
 
     monkeypatch.setattr(HexapodWriter, "append", append)
     with pytest.raises(OSError):
-        simulate_setup(setup, duration=DURATION, out=tmp_path / "full.nc")
+        simulate_setup(setup, duration=DURATION, dt=1e-4, out=tmp_path / "full.nc")
     assert list(tmp_path.iterdir()) == []
 
 

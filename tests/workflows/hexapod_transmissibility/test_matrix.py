@@ -257,10 +257,14 @@ def test_the_command_writes_the_grid_and_the_matrix(tmp_path, capsys):
     record = json.loads(capsys.readouterr().out)
     assert record["excited_axes"] == ["z"] and record["amplitude"] == {"z": 0.001}
     assert record["runs"]["z"]["dt"] == 1e-3
+    assert record["steps"]["z"]["step"] == "given"  # --dt is literal: no probe, no estimate
+    assert record["steps"]["z"]["error_db"] is None and record["settings"]["tolerance_db"] is None
     assert record["trusted_bins"]["z/z"] > 0 and record["trusted_bins"]["x/z"] == 0
     assert (out / "transmissibility.png").stat().st_size > 10_000
     assert (out / "transmissibility.nc").stat().st_size > 0
     assert record["source"].endswith("paper_legs_cubic.toml")
+    assert main(["hexapod", "transmissibility", "--dt", "1e-3", "--tolerance", "0.01",
+                 "--out", str(out)]) == 2  # a literal step or a tolerance, not both
     assert main(["hexapod", "transmissibility", "--axes", "z,q", "--out", str(out)]) == 2
     assert "`axes`" in capsys.readouterr().err
     assert main(["hexapod", "transmissibility", "--amplitude", "z=big", "--out",
@@ -284,7 +288,7 @@ def test_the_quick_study_writes_its_report_and_states_its_choices(quick_study):
     out, record = quick_study
     report = (out / "report.md").read_text(encoding="utf-8")
     for text in ("What \"without PI\" means here", "P only", "no position loop",
-                 "statically unstable", "fixed step of 1 ms", "ledger closure",
+                 "statically unstable", "tolerance 0.01 dB", "ledger closure",
                  "## Findings", "trusted"):
         assert text in report, text
     figures = [line.split("(")[1].rstrip(")") for line in report.splitlines()
@@ -301,3 +305,15 @@ def test_the_quick_study_writes_its_report_and_states_its_choices(quick_study):
     assert rows[("PI", "z")]["linear_stable"] and not rows[("no position loop", "z")][
         "linear_stable"]
     assert all(row["ledger_closure"] < 1e-2 for row in record["rows"])
+    # every run's step: chosen for the default tolerance, with its estimated error, or the
+    # file's where none coarser met it (the z runs' stick-slip pattern), saying why
+    for case, steps in record["steps"].items():
+        for axis, step in steps.items():
+            assert step["tolerance_db"] == 0.01, (case, axis)
+            if step["step"] == "accuracy-driven":
+                assert 0 <= step["error_db"] <= 0.01 / 2 and step["dt"] > 1e-4
+                assert f"dt = {step['dt']:g} s, accuracy-driven" in report
+            else:
+                assert step["step"] == "set-up" and step["dt"] == 1e-4
+                assert step["error_db"] is None and "do not shrink" in report  # NaN is null
+    assert record["steps"]["PI"]["x"]["step"] == "accuracy-driven"

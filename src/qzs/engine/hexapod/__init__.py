@@ -14,6 +14,7 @@ damping), driven by a base moving in up to six axes. The modules mirror the sing
 ``simulate``    :func:`simulate_hexapod` and :func:`simulate_hexapods`, the drivers
 ``result``      :class:`HexapodResult`, its channels, flags, schema and writer
 ``statistics``  run statistics over every sample and the summary text
+``accuracy``    :func:`choose_hexapod_step`, the largest step meeting a tolerance
 ==============  ====================================================================
 """
 from qzs._lazy import lazy_exports
@@ -22,6 +23,8 @@ _EXPORTS = {
     "simulate_hexapod": "qzs.engine.hexapod.simulate",
     "simulate_hexapods": "qzs.engine.hexapod.simulate",
     "hexapod_stability_test": "qzs.engine.hexapod.prepare",
+    "check_hexapod_run": "qzs.engine.hexapod.prepare",
+    "choose_hexapod_step": "qzs.engine.hexapod.accuracy",
     "HexapodResult": "qzs.engine.hexapod.result",
     "AXES": "qzs.engine.hexapod.layout",
     "HEXAPOD_CHANNELS": "qzs.engine.hexapod.result",

@@ -27,7 +27,7 @@ from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformPar
                                jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_force
 
-__all__ = ["hexapod_stability_test"]
+__all__ = ["hexapod_stability_test", "check_hexapod_run"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 
@@ -115,6 +115,13 @@ def hexapod_stability_test(geometry, platform, isolator=None, controller=None,
     return lambda dt: all(test(dt) for test in tests)
 
 
+def _stability_limit(geometry, platform, isolators, controllers, solver):
+    """The largest stable step [s]: the stiffest leg's on the lightest mass the legs move."""
+    mass = _effective_leg_mass(geometry, platform)
+    return min(largest_stable_step(replace(i, mass=mass), c, solver)
+               for i, c in zip(isolators, controllers))
+
+
 def _effective_leg_mass(geometry, platform):
     """``1/max eig(G M^-1 G^T)`` [kg]: the lightest mass a leg (or all legs at once) moves."""
     arms = geometry.top_joints - platform.center_of_mass
@@ -147,6 +154,35 @@ class _Prepared:
     toff: np.ndarray
     state: np.ndarray
     cartesian: object = None
+
+
+def check_hexapod_run(geometry, platform, isolator=None, controller=None, *, excitation=None,
+                      duration=None, dt=defaults.SIMULATION["dt"],
+                      sample_rate=defaults.SIMULATION["sample_rate"],
+                      solver=defaults.SIMULATION["solver"], cartesian=None):
+    """Check a six-axis run's arguments as :func:`~qzs.engine.hexapod.simulate.simulate_hexapod`
+    does, without integrating (before long work that leads to the run, such as choosing its
+    step).
+
+    Parameters
+    ----------
+    geometry, platform, isolator, controller, excitation, solver, cartesian
+        As :func:`~qzs.engine.hexapod.simulate.simulate_hexapod`'s.
+    duration : float, optional
+        Simulated time [s].
+    dt : float
+        Integration step [s].
+    sample_rate : float
+        Output rate [Hz].
+
+    Raises
+    ------
+    ParameterError
+        The first invalid argument, named with its value and the fix (``StabilityError``
+        for a step beyond the stable one).
+    """
+    _prepare(geometry, platform, isolator, controller, excitation, duration, dt, sample_rate,
+             solver, False, cartesian)
 
 
 def _prepare(geometry, platform, isolator, controller, excitation, duration, dt, sample_rate,
@@ -222,8 +258,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
             f"geometry, controller)) or None for per-leg loops, got {type(cartesian).__name__}.")
     if not hexapod_stability_test(geometry, platform, isolators, controllers, solver)(dt):
         mass = _effective_leg_mass(geometry, platform)
-        limit = min(largest_stable_step(replace(i, mass=mass), c, solver)
-                    for i, c in zip(isolators, controllers))
+        limit = _stability_limit(geometry, platform, isolators, controllers, solver)
         raise StabilityError(
             f"`dt` ({dt!r} s) is too large for a stable {solver} integration of this hexapod "
             f"(stiffest mode: a leg's stop contact or loop acting on the {mass:.3g} kg the "

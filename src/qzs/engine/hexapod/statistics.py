@@ -70,6 +70,7 @@ def _summary_text(result):
     lines = [f"Hexapod run: {run['duration']:g} s, {run['solver']} dt = {run['dt']:g} s, "
              f"{run['steps']:,} steps in {run['elapsed']:.3g} s "
              f"({result.steps_per_second:,.0f} steps/s), {run['events']:,} located transitions",
+             *_step_line(run),
              f"Base excitation: {moving or 'none'}",
              f"Platform: {result.platform.mass:g} kg, gravity {result.platform.gravity:g} m/s^2",
              "Control: " + ("PI + damping loops on the platform's axes (centralised)"
@@ -100,3 +101,20 @@ def _summary_text(result):
         lines.append(f"In memory: the min/max envelope of groups of {run['preview_every']} "
                      "samples (a preview; the file holds them all)")
     return "\n".join(lines)
+
+
+def _step_line(run):
+    """How the run's step was chosen, where the caller recorded it (``run["step"]``)."""
+    if "step" not in run:
+        return []
+    if run["step"] == "given":
+        return [f"Step: dt = {run['dt']:g} s, given (no error estimate)"]
+    unit = "dB" if "step_tolerance_db" in run else "m"
+    key = "db" if unit == "dB" else "m"
+    measure = "the transmissibility" if unit == "dB" else "the pose"
+    if run["step"] == "accuracy-driven":
+        return [f"Step: dt = {run['dt']:g} s, accuracy-driven: estimated error "
+                f"{run['step_error_' + key]:.2g} {unit} on {measure} (tolerance "
+                f"{run['step_tolerance_' + key]:g} {unit}, reference dt "
+                f"{run['step_reference_dt']:.3g} s, {run['step_probe_duration']:g} s probe)"]
+    return [f"Step: dt = {run['dt']:g} s, the file's: {run['step_reason']}"]

@@ -25,15 +25,16 @@ turned into a length by the platform's size ``r`` (the top joints' RMS distance 
 centroid), so a rotation per translation counts as ``|T| r`` and a translation per
 rotation as ``|T| / r``.
 
-**Integration step.** Where ``dt`` is not given, each run's step is chosen by the method of
-:func:`qzs.engine.accuracy.choose_step` (docs/model.md §7) applied to the hexapod: the
-probe of :func:`~qzs.engine.accuracy.probe_excitation`, steps halved from the largest
-stable one that divides the output period down to the set-up's ``dt``, the excited axis's
-diagonal entry compared between successive steps over its trusted bins, the error
-extrapolated with the observed ratio (capped at the scheme's order), a safety factor of 2
-against the tolerance ``ACCURACY["tolerance_db"]``. Where no step coarser than the set-up's
-meets it (stick-slip whose pattern changes with the step, so that the differences do not
-shrink), the run takes the set-up's ``dt`` and its record says why.
+**Integration step.** Where ``dt`` is not given, each run's step is chosen for a tolerance
+on the run's column of the matrix (``tolerance_db``, default ``ACCURACY["tolerance_db"]``,
+0.01 dB) by :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step` (the single axis's
+method, docs/model.md §7): the probe of :func:`~qzs.engine.accuracy.probe_excitation`,
+steps halved from the largest stable one that divides the output period down to the
+set-up's ``dt``, the column's entries compared between successive steps over their trusted
+bins above the numerical floor, the error extrapolated with the observed ratio (capped at
+the scheme's order), a safety factor of 2. Where no step coarser than the set-up's meets it
+(stick-slip whose pattern changes with the step, so that the differences do not shrink),
+the run takes the set-up's ``dt`` and its record says why.
 
 =============  ================================================================
 ``settings``   default chirp and amplitudes, the numerical floor, the platform's size
@@ -51,11 +52,11 @@ from qzs.workflows.hexapod_transmissibility.result import (HexapodTransmissibili
                                                            transmissibility_record,
                                                            transmissibility_schema,
                                                            transmissibility_summary)
-from qzs.workflows.hexapod_transmissibility.runs import choose_hexapod_step
+from qzs.workflows.hexapod_transmissibility.runs import axis_step
 from qzs.workflows.hexapod_transmissibility.settings import (AMPLITUDE, CHIRP, ESTIMATORS,
                                                              FLOOR_DB, platform_size)
 
 __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "CHIRP",
            "FLOOR_DB", "ESTIMATORS", "transmissibility_summary", "transmissibility_dataset",
-           "transmissibility_record", "choose_hexapod_step", "sweep_trusted_from",
+           "transmissibility_record", "axis_step", "sweep_trusted_from",
            "platform_size", "entry_unit", "transmissibility_schema"]

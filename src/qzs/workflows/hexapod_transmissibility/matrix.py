@@ -23,6 +23,7 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
                              amplitude: float | Mapping[str, float] | None = None,
                              f0: float = CHIRP["f0"], f1: float = CHIRP["f1"],
                              duration: float = CHIRP["duration"], dt: float | None = None,
+                             tolerance_db: float | None = None,
                              sample_rate: float | None = None, solver: str | None = None,
                              fft_length: int | None = None, estimator: str = "h1",
                              floor_db: float = FLOOR_DB, workers: int | None = None,
@@ -55,9 +56,12 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     duration : float
         Sweep time and run length [s]; default 200.
     dt : float, optional
-        Integration step [s]. Default: accuracy-driven per run (module docstring),
-        falling back to the set-up's ``[simulation] dt`` (1e-4 s if it gives none); each
-        run's record says which.
+        A literal integration step [s] for every run. Default: accuracy-driven per run
+        (module docstring), falling back to the set-up's ``[simulation] dt`` (1e-4 s if it
+        gives none); each run's record says which, with the estimated error.
+    tolerance_db : float, optional
+        Tolerance [dB] of the accuracy-driven step on each run's column of the matrix;
+        default ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     sample_rate : float, optional
         Output rate [Hz]; default the set-up's, else 1000.
     solver : {"ode3", "rk4", "euler"}, optional
@@ -93,7 +97,7 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     """
     axes, amplitudes, common, tasks, workers = _plan(
         setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
-        estimator, floor_db, workers, progress)
+        estimator, floor_db, workers, progress, tolerance_db)
     from tqdm.auto import tqdm
 
     _dry_run(tasks[0])

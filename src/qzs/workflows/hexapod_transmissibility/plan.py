@@ -1,4 +1,5 @@
 """Validation and the plan of the runs: axes, amplitudes, step, segments, trusted band."""
+import math
 from types import MappingProxyType
 
 import numpy as np
@@ -61,6 +62,20 @@ def _amplitudes(amplitude, axes):
     return values
 
 
+def _tolerance_db(tolerance_db, dt):
+    """The tolerance [dB] of the accuracy-driven step (None with a given ``dt``)."""
+    if tolerance_db is None:
+        return None if dt is not None else defaults.ACCURACY["tolerance_db"]
+    if dt is not None:
+        raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or `tolerance_db` "
+                             f"({tolerance_db!r} dB, the step chosen to meet it), not both.")
+    value = as_float("tolerance_db", tolerance_db)
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"`tolerance_db` must be a positive, finite tolerance on the "
+                             f"transmissibility [dB] (e.g. 0.01), got {tolerance_db!r}.")
+    return value
+
+
 def _optional_positive(name, value):
     return None if value is None else positive(name, value)
 
@@ -109,7 +124,7 @@ def sweep_trusted_from(f0, f1, duration, fft_length, sample_rate):
 
 
 def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
-          estimator, floor_db, workers, progress):
+          estimator, floor_db, workers, progress, tolerance_db=None):
     """Check every argument; the runs' common settings and one task per axis."""
     from qzs.model.excitation import Chirp
     from qzs.workflows.hexapod import HexapodSetup
@@ -137,6 +152,7 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
     setup_dt = positive("the set-up's [simulation] dt",
                         setup.simulation.get("dt", defaults.SIMULATION["dt"]))
     dt = _optional_positive("dt", dt)
+    tolerance_db = _tolerance_db(tolerance_db, dt)
     from qzs.engine.prepare import steps_per_sample
 
     for name, step in (("dt", dt), ("the set-up's [simulation] dt", setup_dt)):
@@ -183,7 +199,7 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                   base_share_min=defaults.ANALYSIS["base_share_min"], floor_db=floor_db,
                   platform_size=platform_size(setup.geometry),
                   trusted_from=sweep_trusted_from(f0, f1, duration, fft_length, sample_rate),
-                  tolerance_db=defaults.ACCURACY["tolerance_db"], setup_dt=setup_dt,
+                  tolerance_db=tolerance_db, setup_dt=setup_dt,
                   dt=dt, frame="top frame origin (the cube's centre of a cubic geometry)")
     tasks = [dict(axis=axis, excitation=chirps[axis], geometry=setup.geometry,
                   platform=setup.platform, isolator=setup.isolator,

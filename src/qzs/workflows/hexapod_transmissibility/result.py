@@ -66,8 +66,10 @@ class HexapodTransmissibility:
         Per excited axis, the run's largest energy-ledger imbalance divided by its largest
         ``|base work|`` [-] (docs/hexapod.md §9.6).
     runs : mapping
-        Per excited axis, the run's record: ``dt`` [s] and ``step`` (how it was chosen),
-        ``step_error_db`` (the accuracy estimate, if any), ``steps``, ``events``,
+        Per excited axis, the run's record: ``dt`` [s] and ``step`` (how it was chosen:
+        ``"accuracy-driven"``, ``"set-up"`` or ``"given"``), ``step_error_db`` (the
+        estimated error [dB], NaN if none), ``step_reference_dt`` [s], ``step_history``,
+        ``step_reason``, ``steps``, ``events``,
         ``elapsed`` [s], ``locked_fraction`` [-] per leg, ``stop_contacts`` and
         ``stick_events`` per leg, ``stroke_used`` [m] per leg, ``energy_residual`` [J],
         ``base_work_max`` [J], ``n_averages``, ``seconds`` (wall time of the run and its
@@ -77,7 +79,8 @@ class HexapodTransmissibility:
         ``fft_length`` [samples], ``overlap`` [-], ``estimator``, ``coherence_min``,
         ``base_share_min`` [-], ``floor_db`` [dB], ``platform_size`` [m],
         ``trusted_from`` [Hz] (:func:`sweep_trusted_from`), ``tolerance_db`` [dB],
-        ``setup_dt`` [s], ``dt`` [s] (None: chosen per run) and ``frame`` (where the
+        ``setup_dt`` [s], ``dt`` [s] (None: chosen per run for ``tolerance_db``, which is
+        None with a given ``dt``) and ``frame`` (where the
         axes are).
     setup : HexapodSetup
         The platform simulated.
@@ -258,10 +261,53 @@ def transmissibility_summary(result):
     for note in result.linear_notes:
         lines.append(f"  note: {note}")
     for axis in result.excited_axes:
-        r = result.runs[axis]
-        if r["step"] != "given":
-            lines.append(f"  step of the {axis} run: {r['step']} ({r['step_reason']})")
+        lines.append(f"  step of the {axis} run: {step_text(result.runs[axis], s)}")
     return "\n".join(lines)
+
+
+def step_text(run: Mapping[str, Any], settings: Mapping[str, Any]) -> str:
+    """One run's step in words: the step, how it was chosen, its estimated error.
+
+    Parameters
+    ----------
+    run : mapping
+        The run's record (:attr:`HexapodTransmissibility.runs`).
+    settings : mapping
+        The matrix's settings (``tolerance_db`` [dB]).
+
+    Returns
+    -------
+    str
+    """
+    if run["step"] == "given":
+        return f"dt = {run['dt']:g} s, given (no error estimate)"
+    tolerance = settings["tolerance_db"]
+    if run["step"] == "accuracy-driven":
+        return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
+                f"{run['step_error_db']:.2g} dB (tolerance {tolerance:g} dB, reference dt "
+                f"{run['step_reference_dt']:.3g} s)")
+    return f"dt = {run['dt']:g} s, the set-up's: {run['step_reason']}"
+
+
+def run_steps(result: HexapodTransmissibility) -> dict[str, dict[str, Any]]:
+    """Each run's step as data (the ``steps`` of :func:`transmissibility_record`).
+
+    Parameters
+    ----------
+    result : HexapodTransmissibility
+        The matrix.
+
+    Returns
+    -------
+    dict
+        Per excited axis: ``dt`` [s], ``step`` (how chosen), ``error_db`` (the estimated
+        error [dB], NaN if none), ``tolerance_db`` [dB] (None with a given ``dt``),
+        ``reference_dt`` [s], ``reason``.
+    """
+    return {axis: {"dt": run["dt"], "step": run["step"], "error_db": run["step_error_db"],
+                   "tolerance_db": result.settings["tolerance_db"],
+                   "reference_dt": run["step_reference_dt"], "reason": run["step_reason"]}
+            for axis, run in result.runs.items()}
 
 
 def transmissibility_record(result: HexapodTransmissibility) -> dict[str, Any]:
@@ -276,7 +322,9 @@ def transmissibility_record(result: HexapodTransmissibility) -> dict[str, Any]:
     -------
     dict
         ``summary`` (text), ``excited_axes``, ``amplitude`` [m or rad], ``settings``,
-        ``runs`` (per axis: ``dt`` [s], ``step``, ledger, legs), ``energy_residual`` [-],
+        ``runs`` (per axis: ``dt`` [s], ``step``, ledger, legs), ``steps`` (per axis: ``dt``
+        [s], ``step`` (how chosen), ``error_db`` (estimated error [dB], NaN if none),
+        ``tolerance_db`` [dB], ``reference_dt`` [s], ``reason``), ``energy_residual`` [-],
         ``linear_stable``, ``linear_natural_frequencies`` [Hz], ``trusted_bins`` (count
         per entry ``"output/input"`` of the excited columns), ``source`` (the set-up's
         file).
@@ -285,6 +333,7 @@ def transmissibility_record(result: HexapodTransmissibility) -> dict[str, Any]:
             "excited_axes": list(result.excited_axes), "amplitude": dict(result.amplitude),
             "settings": dict(result.settings),
             "runs": {axis: dict(run) for axis, run in result.runs.items()},
+            "steps": run_steps(result),
             "energy_residual": dict(result.energy_residual),
             "linear_stable": result.linear_stable,
             "linear_natural_frequencies": result.linear_natural_frequencies,
@@ -397,7 +446,7 @@ def transmissibility_dataset(result):
             attrs[f"settings.{key}_units"] = units[key]
     run_units = {"dt": "s", "elapsed": "s", "seconds": "s", "energy_residual": "J",
                  "base_work_max": "J", "stroke_used": "m", "stroke_half": "m",
-                 "step_error_db": "dB", "locked_fraction": "1"}
+                 "step_error_db": "dB", "step_reference_dt": "s", "locked_fraction": "1"}
     for axis, record in result.runs.items():
         for key, value in record.items():
             if key == "step_history":

@@ -4,10 +4,9 @@ import time
 
 import numpy as np
 
-from qzs._format import decibels
 from qzs.defaults import AXES
-from qzs.errors import ParameterError
-from qzs.workflows.hexapod_transmissibility.plan import _control, _default_fft_length, _stable
+from qzs.engine.accuracy import SAFETY
+from qzs.workflows.hexapod_transmissibility.plan import _control
 
 
 # ---------------------------------------------------------------- one run
@@ -35,8 +34,12 @@ def _simulate(task, excitation, dt, duration):
                             solver=task["solver"], **_control(task))
 
 
-def choose_hexapod_step(task):
-    """The accuracy-driven step of one run (see the module docstring), or the set-up's.
+def axis_step(task):
+    """The step of one run: accuracy-driven (see the module docstring), or the set-up's.
+
+    :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step` on the run's chirp, the driven
+    axis's transmissibility against ``task["tolerance_db"]``, halving down to the set-up's
+    ``dt`` and falling back to it where no coarser step meets the tolerance.
 
     Parameters
     ----------
@@ -49,72 +52,28 @@ def choose_hexapod_step(task):
         The step [s].
     record : dict
         ``step`` (``"accuracy-driven"`` or ``"set-up"``), ``step_error_db`` (the
-        estimate at the chosen step, NaN for the set-up's), ``step_history``
-        (``(dt, difference to the next finer step [dB])`` per step tried) and
-        ``step_reason``.
+        estimate at the chosen step [dB], NaN for the set-up's), ``step_reference_dt`` (the
+        finest step of the probe [s]), ``step_history`` (``(dt [s], difference to the next
+        finer step [dB])`` per step compared) and ``step_reason``.
     """
-    from qzs.engine.accuracy import SAFETY, admissible_step, halving_search, probe_excitation
-    from qzs.engine.stability import SOLVERS
+    from qzs.engine.hexapod.accuracy import choose_hexapod_step
 
-    excitation = task["excitation"]
-    rate, solver = task["sample_rate"], task["solver"]
-    order = SOLVERS[solver][1]
-    band = (min(1.0, 0.5 * task["f1"]) if task["f0"] == 0 else task["f0"], task["f1"])
-    probe, duration = probe_excitation(excitation, band)
-    finest = task["setup_dt"]
-    try:
-        dt0, _ = admissible_step(rate, task["controller"].controller_rate,
-                                 _stable_from_task(task))
-    except ParameterError:
-        dt0 = finest
-    candidates = [dt0 / 2 ** j for j in range(12) if dt0 / 2 ** j >= finest * (1 - 1e-9)]
-    j_axis = AXES.index(task["axis"])
-    probe_task = dict(task, fft_length=_default_fft_length(int(round(duration * rate)) + 1))
-    estimates = {}
-
-    def estimate(j):
-        if j not in estimates:
-            run = _simulate(task, probe, candidates[j], duration)
-            estimates[j] = _estimate(run, task["axis"], probe_task, (j_axis,))[j_axis]
-        return estimates[j]
-
-    def difference(j):
-        a, b = estimate(j), estimate(j + 1)
-        keep = ((a.frequency >= band[0]) & (a.frequency <= band[1]) & a.trusted & b.trusted
-                & (a.magnitude > 0) & (b.magnitude > 0))
-        if not keep.any():
-            return math.nan
-        return float(np.max(np.abs(decibels(a.magnitude[keep] / b.magnitude[keep]))))
-
-    chosen, searched = (None, []) if len(candidates) < 3 else halving_search(
-        difference, order, task["tolerance_db"], dt0, len(candidates) - 1, SAFETY)
-    history = tuple((dt, d) for dt, d, _ in searched)
-    if chosen is not None:
-        error = searched[chosen][2]
-        return candidates[chosen], dict(
-            step="accuracy-driven", step_error_db=error, step_history=history,
-            step_reason=f"estimated error {error:.3g} dB <= {task['tolerance_db']:g} dB / "
-                        f"{SAFETY:g} on a {duration:g} s probe")
-    if len(candidates) < 3:
-        reason = (f"fewer than three steps between the largest stable one and the set-up's "
-                  f"({finest:g} s) to compare")
-    elif len(searched) < len(candidates) - 2 and not np.isfinite(difference(len(searched))):
-        reason = "no bin of the probe's band is trusted in both runs"
-    else:
-        shown = ", ".join(f"{d:.3g}" for _, d in history)
-        reason = (f"no step coarser than the set-up's met {task['tolerance_db']:g} dB: the "
-                  f"differences between successive halvings ({shown} dB) do not shrink as the "
-                  "scheme's order predicts (the stick-slip pattern changes with the step)")
-    return finest, dict(step="set-up", step_error_db=math.nan, step_history=history,
-                        step_reason=reason)
-
-
-def _stable_from_task(task):
-    from qzs.workflows.hexapod import HexapodSetup
-
-    setup = HexapodSetup(geometry=task["geometry"], platform=task["platform"],
-                         isolator=task["isolator"], controller=task["controller"])
-    return _stable(setup, task["controller"], task["solver"])
+    f0, f1 = task["f0"], task["f1"]
+    choice = choose_hexapod_step(
+        task["geometry"], task["platform"], task["isolator"], task["controller"],
+        excitation={task["axis"]: task["excitation"]}, tolerance_db=task["tolerance_db"],
+        solver=task["solver"], sample_rate=task["sample_rate"],
+        band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1), finest=task["setup_dt"],
+        fallback=task["setup_dt"], **_control(task))
+    history = tuple((dt, d) for dt, d, _ in choice.history)
+    record = dict(step_error_db=choice.error, step_reference_dt=choice.reference_dt,
+                  step_history=history)
+    if math.isnan(choice.error):
+        return choice.dt, dict(step="set-up", step_reason=choice.notes[-1], **record)
+    return choice.dt, dict(
+        step="accuracy-driven", step_reason=(
+            f"estimated error {choice.error:.3g} dB <= {task['tolerance_db']:g} dB / "
+            f"{SAFETY:g} on a {choice.probe_duration:g} s probe"), **record)
 
 
 def run_axis(task):
@@ -134,10 +93,11 @@ def run_axis(task):
     """
     start = time.perf_counter()
     if task["dt"] is not None:
-        dt, record = task["dt"], dict(step="given", step_error_db=math.nan, step_history=(),
+        dt, record = task["dt"], dict(step="given", step_error_db=math.nan,
+                                      step_reference_dt=math.nan, step_history=(),
                                       step_reason="given by the caller")
     else:
-        dt, record = choose_hexapod_step(task)
+        dt, record = axis_step(task)
     result = _simulate(task, task["excitation"], dt, task["duration"])
     estimates = _estimate(result, task["axis"], task)
     first = estimates[0]

@@ -3,7 +3,8 @@ from types import MappingProxyType
 
 import numpy as np
 
-
+from qzs.defaults import HEXAPOD
+from qzs.model.hexapod import platform_size
 
 #: Default chirp amplitude per base axis: 2 mm in translation [m], 0.01 rad in rotation
 #: [rad] (1.2 mm at the top joints of the 0.15 m cube).
@@ -15,33 +16,11 @@ AMPLITUDE = MappingProxyType({"x": 0.002, "y": 0.002, "z": 0.002,
 CHIRP = MappingProxyType({"f0": 0.0, "f1": 20.0, "duration": 200.0})
 #: Numerical floor of a trusted entry [dB]: the dimensionless response relative to the
 #: base motion (see the module docstring).
-FLOOR_DB = -100.0
+FLOOR_DB = HEXAPOD["floor_db"]
 #: Welch estimators with a phase (the matrix is complex).
 ESTIMATORS = ("h1", "h2")
 #: Welch segments a run averages at least when ``fft_length`` is not given.
 MIN_SEGMENTS = 8
-
-
-def platform_size(geometry):
-    """The length [m] that makes a rotation comparable with a translation.
-
-    The top joints' RMS distance from their centroid (what :class:`~qzs.model.hexapod.
-    HexapodGeometry` scales its Jacobian's rotation columns by), or the mean leg length
-    if the joints coincide.
-
-    Parameters
-    ----------
-    geometry : HexapodGeometry
-        The platform.
-
-    Returns
-    -------
-    float
-        [m].
-    """
-    joints = np.asarray(geometry.top_joints, dtype=float)
-    spread = float(np.sqrt(np.mean(np.sum((joints - joints.mean(axis=0)) ** 2, axis=1))))
-    return spread if spread > 0 else float(np.mean(geometry.home_lengths))
 
 
 def _scale(size):
