@@ -421,7 +421,7 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
                               files=MappingProxyType(files))
 
 
-def study_steps(study):
+def study_steps(study: HexapodStudyResult) -> dict[str, dict[str, dict[str, Any]]]:
     """Each run's step as data: ``{case: {axis: {dt, step, error_db, tolerance_db,
     reference_dt, reason}}}`` (``qzs hexapod study --json``).
 

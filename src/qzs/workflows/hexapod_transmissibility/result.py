@@ -16,6 +16,8 @@ from qzs.errors import ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import xarray as xr
     from matplotlib.figure import Figure
 
