@@ -1,5 +1,6 @@
 """``qzs experiment``: an experiment log beside the matching simulation."""
-from qzs.cli.common import EPILOG, add_json_option, emit, integer_at_least
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, emit,
+                             integer_at_least)
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parser", "run"]
@@ -42,6 +43,7 @@ def add_parser(subparsers):
                         help="model parameters for the simulation (see `qzs params --toml`)")
     parser.add_argument("--resample", action="store_true",
                         help="resample a non-uniform time base onto a uniform grid")
+    add_frequency_axis_option(parser)
     add_json_option(parser)
     return parser
 
@@ -65,7 +67,8 @@ def run(args):
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,
                                    n_averages=args.averages, config=args.config,
                                    resample=args.resample,
-                                   simulate_match=not args.no_simulation)
+                                   simulate_match=not args.no_simulation,
+                                   frequency_scale=args.frequency_axis)
     text = (f"{result.summary()}\nwrote {paths['report']}, {paths['figure'].name} (+ .svg) "
             f"and {paths['table'].name}")
     emit(args, text, {**result.to_record(),

@@ -65,7 +65,7 @@ class TransmissibilityFit:
     n_simulations: int
     elapsed: float
 
-    def plot(self, path=None, title=""):
+    def plot(self, path=None, title="", frequency_scale=None):
         """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
 
         Parameters
@@ -74,6 +74,8 @@ class TransmissibilityFit:
             Write the figure there (a .png also as .svg).
         title : str
             Figure title.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -81,7 +83,8 @@ class TransmissibilityFit:
         """
         from qzs.viz.identify import plot_transmissibility_fit
 
-        return plot_transmissibility_fit(self, path=path, title=title)
+        return plot_transmissibility_fit(self, path=path, title=title,
+                                         frequency_scale=frequency_scale)
 
 
 def _free_parameters(free, isolator, controller, initial):

@@ -42,6 +42,7 @@ from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.excitation import Chirp
+from qzs.viz.figures import check_frequency_scale
 
 __all__ = ["ExperimentResult", "process_experiment", "experiment_metrics", "infer_chirp",
            "run_experiment", "experiment_schema"]
@@ -200,7 +201,7 @@ class ExperimentResult:
             return float("nan")
         return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
-    def plot(self, path=None, title=None):
+    def plot(self, path=None, title=None, frequency_scale=None):
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
 
         Parameters
@@ -209,6 +210,8 @@ class ExperimentResult:
             Write the figure there (a .png also as .svg).
         title : str, optional
             Figure title; default the log's file name.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -216,7 +219,7 @@ class ExperimentResult:
         """
         from qzs.viz.experiment import plot_experiment
 
-        return plot_experiment(self, path=path, title=title)
+        return plot_experiment(self, path=path, title=title, frequency_scale=frequency_scale)
 
     def to_xarray(self):
         """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag
@@ -286,13 +289,16 @@ class ExperimentResult:
             "discrepancy_db": self.discrepancy_db(),
             "simulation_seconds": self.simulation_seconds, "notes": list(self.notes)}
 
-    def write_report(self, folder):
+    def write_report(self, folder, frequency_scale=None):
         """Write ``transmissibility.png`` (+ .svg), ``transmissibility.csv`` and ``report.md``.
 
         Parameters
         ----------
         folder : str or Path
             Output folder, created if missing.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the figure; default ``qzs.defaults.FIGURES["frequency_scale"]``
+            (log).
 
         Returns
         -------
@@ -305,7 +311,7 @@ class ExperimentResult:
         folder.mkdir(parents=True, exist_ok=True)
         paths = {"figure": folder / "transmissibility.png",
                  "table": folder / "transmissibility.csv", "report": folder / "report.md"}
-        plt.close(self.plot(path=paths["figure"]))
+        plt.close(self.plot(path=paths["figure"], frequency_scale=frequency_scale))
         data = self.to_xarray()
         names = [n for n in ("experiment", "simulation", "coherence", "trusted") if n in data]
         with atomic_path(paths["table"]) as tmp:
@@ -549,7 +555,7 @@ def _simulate_like(recording, kind, excitation, isolator, controller, corner, we
 
 
 def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, config=None,
-                   resample=False, simulate_match=True):
+                   resample=False, simulate_match=True, frequency_scale=None):
     """Read a log, process it (:func:`process_experiment`) and write its report (``qzs experiment``).
 
     The channel map's ``[experiment]`` table gives the high-pass corner [Hz], the chirp
@@ -575,6 +581,9 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
         Resample a non-uniform time base onto a uniform grid.
     simulate_match : bool
         Simulate the same chirp and process it the same way.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figure; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -592,6 +601,8 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
     """
     check_output_path(out, argument="out", suffixes=None, directory=True,
                       estimated_bytes=REPORT_BYTES)
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale)
     channel_map = load_channel_map(channel_map)
     settings = dict(channel_map.experiment)
     welch = {}
@@ -621,4 +632,4 @@ def run_experiment(log, channel_map, *, out, fft_length=None, n_averages=None, c
         n_averages=welch.get("n_averages", EXPERIMENT_AVERAGES),
         isolator=isolator, controller=controller, simulate_match=simulate_match,
         excitation=excitation)
-    return result, result.write_report(out)
+    return result, result.write_report(out, frequency_scale=frequency_scale)

@@ -541,7 +541,8 @@ def linear_text(setup, model, record):
     return "\n".join(lines)
 
 
-def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50.0), points=400):
+def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50.0), points=400,
+                                 frequency_scale=None):
     """Write the linear model's 6x6 transmissibility grid (:mod:`qzs.viz.hexapod_matrix`).
 
     Parameters
@@ -556,6 +557,9 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
         Band drawn [Hz], log-spaced.
     points : int
         Frequencies drawn.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -571,7 +575,7 @@ def plot_linear_transmissibility(setup, model, out, *, frequency_range=(0.05, 50
     frequency = np.geomspace(*frequency_range, points)
     stability = "" if model.stable else " (linearly UNSTABLE: see the notes)"
     figure = plot_transmissibility_matrix(
-        frequency, linear=model, out=out,
+        frequency, linear=model, out=out, frequency_scale=frequency_scale,
         title=f"Linear transmissibility of the {setup.kind} hexapod, platform "
               f"{setup.platform.mass:.3g} kg{stability}")
     plt.close(figure)

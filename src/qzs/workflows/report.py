@@ -29,6 +29,7 @@ from qzs.iotools.files import atomic_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
 from qzs.model.registry import PARAMETERS, format_value, unit_of, update_parameters
+from qzs.viz.figures import check_frequency_scale
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.studies import CLAIMS as STATEMENTS
@@ -361,8 +362,11 @@ def _curves(result):
                  coherence=c.coherence, linear=c.linear.get("magnitude")) for c in cases]
 
 
-def _figures(result, folder):
-    """Draw a study's views; returns ``[(figure name, png path, caption notes)]``."""
+def _figures(result, folder, frequency_scale=None):
+    """Draw a study's views; returns ``[(figure name, png path, caption notes)]``.
+
+    ``frequency_scale`` (``--frequency-axis``) overrides the views' own; else a view's
+    ``frequency_scale`` or the default (log) is used."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -389,7 +393,8 @@ def _figures(result, folder):
         path = folder / f"{view['figure']}.png"
         options = {} if coherence_min is None else {"coherence_min": coherence_min}
         fig = plot_transmissibility(curves, frequency_range=span,
-                                    scale=view.get("frequency_scale", "linear"),
+                                    frequency_scale=frequency_scale or view.get(
+                                        "frequency_scale"),
                                     title=study.title, path=path, untrusted_below=untrusted,
                                     **options)
         plt.close(fig)
@@ -450,25 +455,26 @@ def _settings(result):
     return {k: v[0] if len(v) == 1 else v for k, v in out.items()}
 
 
-def _draw(study_results, folder, workers):
+def _draw(study_results, folder, workers, frequency_scale=None):
     """Every study's figures (:func:`_figures`), in ``workers`` processes if more than one.
 
     Matplotlib holds the GIL, so figures draw in parallel only in processes; about 0.3 s
     a figure, 3 s for the paper's on one core. Returns ``{study name: drawn}``.
     """
     if workers <= 1:
-        return {r.study.name: _figures(r, folder) for r in study_results}
+        return {r.study.name: _figures(r, folder, frequency_scale) for r in study_results}
     from concurrent.futures import ProcessPoolExecutor
 
     # the studies with most views first, so that no process is left with two at the end
     order = sorted(study_results, key=lambda r: -len(r.study.views or [None]))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        drawn = {r.study.name: pool.submit(_figures, r, folder) for r in order}
+        drawn = {r.study.name: pool.submit(_figures, r, folder, frequency_scale)
+                 for r in order}
         return {r.study.name: drawn[r.study.name].result() for r in study_results}
 
 
 def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None,
-                        workers=None):
+                        workers=None, frequency_scale=None):
     """Write figures, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
 
     Parameters
@@ -483,6 +489,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         Wall time of the runs [s], recorded in the metrics and the report.
     workers : int, optional
         Processes drawing the figures; default all cores. 1 draws them in-process.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of every figure; default each view's own, else
+        ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -495,9 +504,11 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         ``workers`` not a positive integer.
     """
     workers = worker_count(workers, len(study_results))  # checked before anything is written
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    figures = _draw(study_results, folder, workers)
+    figures = _draw(study_results, folder, workers, frequency_scale)
     verdicts = decide_claims(study_results)
     rows = _metric_rows(study_results)
 
@@ -710,7 +721,7 @@ def _case_table(result):
 
 
 def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=None,
-              progress=True, argument="folder"):
+              progress=True, argument="folder", frequency_scale=None):
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
     Parameters
@@ -728,6 +739,9 @@ def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=
         Show a progress bar over cases.
     argument : str
         How the caller names ``folder`` in messages (``"--out"`` on the command line).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of every figure (``--frequency-axis``); default each view's own,
+        else ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -750,11 +764,13 @@ def run_paper(definitions=None, folder="results/paper", *, quick=False, workers=
 
     check_output_path(folder, argument=argument, suffixes=None, directory=True,
                       estimated_bytes=PAPER_BYTES)
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale, argument="frequency_scale")
     paths = shipped_studies() if definitions is None else definitions
     studies = [load_study(p) for p in paths]
     start = time.perf_counter()
     results = run_studies(studies, quick=quick, workers=workers, progress=progress)
     wall = time.perf_counter() - start
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
-                                   workers=workers)
+                                   workers=workers, frequency_scale=frequency_scale)
     return results, verdicts, wall

@@ -34,7 +34,7 @@ from qzs.analysis.linear import linearize
 from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
                                    transmissibility_metrics)
 from qzs.analysis.statistics import run_statistics
-from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
+from qzs.defaults import ANALYSIS, FREQUENCY_SCALES, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
 from qzs.errors import ParameterError
 from qzs.identify.spring import fit_spring
@@ -90,7 +90,7 @@ class Study:
         Ids of the paper's claims its cases decide (keys of :data:`CLAIMS`).
     views : tuple of dict
         Figures to draw: ``figure`` (file stem), ``frequency_range`` [Hz] and
-        optionally ``frequency_scale``.
+        optionally ``frequency_scale`` (``"log"``, the default, or ``"linear"``).
     defaults : dict
         Parameter overrides shared by every case (``[defaults]``).
     excitation : dict
@@ -258,6 +258,12 @@ def load_study(path):
             raise ParameterError(f"{str(path)!r}: unknown claim id {claim!r} in [study] claims; "
                                  f"known ids are {sorted(CLAIMS)}.")
     views = tuple(head.get("view", ()))
+    for view in views:
+        scale = view.get("frequency_scale")
+        if scale is not None and scale not in FREQUENCY_SCALES:
+            raise ParameterError(f"{str(path)!r}: [[study.view]] {view.get('figure')!r} has "
+                                 f"frequency_scale = {scale!r}; use one of "
+                                 f"{', '.join(FREQUENCY_SCALES)} or leave it out (log).")
     options = {**document.get("spring", {}), **document.get("processing", {})}
     return Study(name=head["name"], title=head.get("title", head["name"]), kind=kind,
                  cases=cases, claims=tuple(claims), views=views,

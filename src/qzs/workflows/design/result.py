@@ -82,8 +82,14 @@ class DesignResult:
         """
         return design_text(self)
 
-    def plot(self):
+    def plot(self, frequency_scale=None):
         """Draw every figure of the design.
+
+        Parameters
+        ----------
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the transmissibility figure; default
+            ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -92,9 +98,9 @@ class DesignResult:
         """
         from qzs.viz.design import plot_design
 
-        return plot_design(self)
+        return plot_design(self, frequency_scale=frequency_scale)
 
-    def save(self, folder):
+    def save(self, folder, frequency_scale=None):
         """Write ``report.html``, ``design.json`` and the figures (PNG and SVG) into ``folder``.
 
         Each file is written atomically (a temporary file renamed onto it).
@@ -103,6 +109,9 @@ class DesignResult:
         ----------
         folder : str or Path
             The output folder, created if missing.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the transmissibility figure; default
+            ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -118,7 +127,7 @@ class DesignResult:
         folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
         folder.mkdir(parents=True, exist_ok=True)
         written = {}
-        for name, figure in plot_design(self).items():
+        for name, figure in plot_design(self, frequency_scale=frequency_scale).items():
             path = folder / f"{name}.png"
             save_figure(figure, path, also_svg=True)
             plt.close(figure)

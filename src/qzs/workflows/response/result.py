@@ -377,7 +377,7 @@ class SteadyStateResponse:
         """
         return response_dataset(self)
 
-    def plot(self, path=None, title=None):
+    def plot(self, path=None, title=None, frequency_scale=None):
         """The figure (:func:`qzs.viz.response.plot_response`).
 
         Parameters
@@ -386,6 +386,8 @@ class SteadyStateResponse:
             Write the figure there (format from the extension).
         title : str, optional
             Figure title.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -393,7 +395,7 @@ class SteadyStateResponse:
         """
         from qzs.viz.response import plot_response
 
-        return plot_response(self, path=path, title=title)
+        return plot_response(self, path=path, title=title, frequency_scale=frequency_scale)
 
     def save(self, path):
         """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point) or
