@@ -107,6 +107,15 @@ def _label(name):
     return labels[name]
 
 
+def _legend_outside(plot, place, **properties):
+    """Move the legend the glyphs made out of ``plot``'s frame to its ``place`` side
+    (``"below"``, ``"right"``): it never covers a curve."""
+    legend = plot.legend[0]
+    plot.center.remove(legend)
+    legend.update(border_line_alpha=0, location="top_left", **properties)
+    plot.add_layout(legend, place)
+
+
 def _shown(name, value):
     """A setting's registry value as its widget shows it (:data:`DISPLAY_UNITS`)."""
     return value * DISPLAY_UNITS[name][1] if name in DISPLAY_UNITS else value
@@ -264,9 +273,6 @@ class TuningPage:
                        x_axis_label="frequency [Hz]", y_axis_label="transmissibility [dB]")
         trans.xaxis.ticker = LogTicker(mantissas=[1, 2, 5])
         trans.xaxis.formatter = NumeralTickFormatter(format="0.[00]")
-        trans.add_layout(Legend(label_text_font_size="9pt", orientation="horizontal",
-                                name="qzs-transmissibility-legend", border_line_alpha=0),
-                         "below")
         trans.multi_line("xs", "ys", source=source["pinned"], color="color", line_width=1.5,
                          alpha=0.8, legend_field="label")
         trans.line("x", "y", source=source["transmissibility"], color="#1f77b4",
@@ -277,19 +283,25 @@ class TuningPage:
                    line_dash="dashed", legend_label="linear model")
         trans.add_layout(Span(location=0.0, dimension="width", line_color="#999999",
                               line_width=1))
+        # one item a line: the pins' labels are long
+        _legend_outside(trans, "below", name="qzs-transmissibility-legend",
+                        label_text_font_size="9pt", orientation="vertical", spacing=0,
+                        padding=4)
 
         def timeplot(title, label, **kw):
             return figure(frame_height=170, sizing_mode="stretch_width", min_width=250,
                           tools=tools, title=title, x_axis_label="time [s]",
                           y_axis_label=label, **kw)
 
-        response = timeplot("Response to the sine", "displacement from rest [mm]")
-        response.add_layout(Legend(label_text_font_size="8pt", orientation="horizontal",
-                                   name="qzs-response-legend", border_line_alpha=0,
-                                   padding=0, margin=0), "above")
+        response = timeplot("Response to the sine", "displacement from rest [mm]",
+                            name="qzs-response-plot")
         response.line("x", "y", source=source["base"], color="#888888", legend_label="base y")
         response.line("x", "y", source=source["payload"], color="#1f77b4",
                       legend_label="payload x")
+        # beside the frame, so that the three time plots keep one height
+        _legend_outside(response, "right", name="qzs-response-legend",
+                        label_text_font_size="8pt", orientation="vertical", padding=2,
+                        margin=2, glyph_width=14, label_standoff=3)
         stroke = timeplot("Stroke used (red: the stops)", "relative position z [mm]",
                           x_range=response.x_range)
         stroke.line("x", "y", source=source["relative_position"], color="#1f77b4")
@@ -303,7 +315,7 @@ class TuningPage:
         motor.line("x", "y", source=source["motor_force"], color="#1f77b4")
         for column in ("low", "high"):
             motor.line("x", column, source=source["limits"], line_width=2, color="#d62728")
-        locked = figure(frame_height=300, width=260, tools="save,hover", title="Locked share",
+        locked = figure(frame_height=300, width=300, tools="save,hover", title="Locked share",
                         x_range=FactorRange(factors=self._empty("locked")["run"]),
                         y_range=(0, 100), x_axis_label="run",
                         y_axis_label="time locked (stuck or on a stop) [%]")
