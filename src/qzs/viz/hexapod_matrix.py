@@ -10,7 +10,8 @@ import numpy as np
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs._format import decibels
 from qzs.defaults import AXES, FIGURES
-from qzs.viz.figures import check_frequency_scale, frequency_axis, frequency_limits, save_figure
+from qzs.viz.figures import (check_frequency_scale, frequency_axis, frequency_limits, nice_floor,
+                             save_figure)
 
 __all__ = ["plot_transmissibility_matrix", "AXES"]
 
@@ -98,6 +99,8 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
     positive = frequency > 0
     low, high = frequency_limits(frequency_range or (0.0, frequency[positive].max()),
                                  frequency[positive], scale)
+    if scale == "log":
+        low = nice_floor(low)  # small panels label the decades only: let 0.1 Hz be one
     shown = positive & (frequency >= low) & (frequency <= high)
 
     fig, axes = plt.subplots(6, 6, sharex=True, figsize=(15, 12.5), constrained_layout=True)
