@@ -83,7 +83,8 @@ def plot_experiment(result, *, path=None, title=None, frequency_scale=None):
         bottom.axhline(coherence_min, color="k", lw=0.8, ls=":")
     top.axhline(0.0, color="k", lw=0.6)
     top.set_ylabel("transmissibility [dB]\nsqrt(S_payload/S_base)")
-    top.legend(fontsize="small")
+    fig.legend(*top.get_legend_handles_labels(), fontsize="small", loc="outside lower center",
+               ncol=2)  # below the panels: never over a curve
     bottom.set_ylim(0, 1.05)
     bottom.set_ylabel("coherence [-]")
     bottom.set_xlabel("frequency [Hz]")
