@@ -83,9 +83,14 @@ def measure(moves=8, idle_wait=10.0, screenshot=None):
     return results
 
 
+#: Width of the README's screenshot [px]: a common laptop window, where the page must fit.
+SCREENSHOT_WIDTH = 1280
+
+
 def _screenshot(page, path):
     from qzs.app import browser
 
+    page.set_viewport_size({"width": SCREENSHOT_WIDTH, "height": 1000})
     page.get_by_text("Reset to paper", exact=True).click()
     page.wait_for_timeout(2000)
     page.get_by_text("Pin curve", exact=True).click()

@@ -69,6 +69,14 @@ def test_the_json_list_is_every_subcommand_with_json():
                               f"in the parser, not on the page: {sorted(having - listed)}")
 
 
+def test_the_frequency_axis_list_is_every_subcommand_that_draws_frequency():
+    text = bullet("`--frequency-axis` (on ")
+    listed = set(re.findall(r"`([a-z][a-z -]*)`", text.split(")", 1)[0]))
+    having = {name for name, parser in commands() if "--frequency-axis" in options(parser)}
+    assert listed == having, (f"on the page, not in the parser: {sorted(listed - having)}; "
+                              f"in the parser, not on the page: {sorted(having - listed)}")
+
+
 # ---------------------------------------------------------------- output paths
 #: The arguments each subcommand needs besides its output path, and a valid name for each
 #: output option (the check under test is the folder's, not the extension's).

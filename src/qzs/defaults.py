@@ -12,7 +12,8 @@ from types import MappingProxyType
 from typing import Any
 
 __all__ = ["SIMULATION", "ANALYSIS", "REPORTED_FREQUENCIES", "ACCURACY", "EXCITATION",
-           "HEXAPOD", "AXES", "AXIS_UNITS", "AXIS_RATE_UNITS", "FIGURES"]
+           "HEXAPOD", "AXES", "AXIS_UNITS", "AXIS_RATE_UNITS", "FIGURES",
+           "FREQUENCY_SCALES"]
 
 #: Integration settings: the paper's (Section 3): Simulink's ode3 at dt = 1e-4 s [s],
 #: output at 1 kHz [Hz].
@@ -66,5 +67,11 @@ AXIS_UNITS = ("m", "m", "m", "rad", "rad", "rad")
 AXIS_RATE_UNITS = ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s")
 
 #: Figures: the amplitude ratio [-] drawn for 0 on a dB axis (-240 dB), so that a zero
-#: magnitude stays on the plot.
-FIGURES: Mapping[str, Any] = MappingProxyType({"magnitude_floor": 1e-12})
+#: magnitude stays on the plot; the scale of every frequency axis (``"log"``: the
+#: resonances and stiction features below 2.5 Hz and the roll-off to 20 Hz span
+#: decades; ``"linear"`` on request), and the lowest frequency [Hz] a log axis shows when
+#: the data give none (0 Hz cannot be drawn on it).
+FIGURES: Mapping[str, Any] = MappingProxyType({"magnitude_floor": 1e-12, "frequency_scale": "log",
+                                                  "frequency_floor": 0.1})
+#: The scales a frequency axis may take (``frequency_scale=``, ``--frequency-axis``).
+FREQUENCY_SCALES = ("log", "linear")

@@ -128,3 +128,46 @@ def test_platform_tab_shows_geometry_and_grid(page):
     assert page.locator("img[src^='data:image/png']").count() >= 1
     browser.type_value(page, "platform.pi_kp", "50")  # the paper's gain: unstable
     page.get_by_text("statically UNSTABLE").first.wait_for(timeout=60_000)
+
+
+def overlaps(first, second):
+    """Whether two ``(left, top, right, bottom)`` boxes share any area."""
+    return (first[0] < second[2] and second[0] < first[2]
+            and first[1] < second[3] and second[1] < first[3])
+
+
+@pytest.mark.parametrize("width", [1280, 1920])
+def test_page_fits_the_window_and_no_legend_covers_data(context, server, width):
+    """At 1280 px (and 1920) nothing is clipped or scrolled sideways, on either tab, and
+    the legends of the transmissibility and the sine response lie outside their frames
+    (the data region), with a pinned curve's long label too."""
+    page = browser.open_page(context, server)
+    try:
+        page.set_viewport_size({"width": width, "height": 900})
+        page.wait_for_timeout(1000)  # the plots follow the window's width
+        page.get_by_text("Pin curve", exact=True).click()
+        page.wait_for_function("() => Bokeh.documents[0].get_model_by_name('qzs-pinned')"
+                               ".data.xs.length === 1", timeout=30_000)
+        page.wait_for_timeout(500)
+        assert browser.horizontal_overflow(page) <= 0
+        assert page.evaluate("() => document.documentElement.scrollWidth") <= width
+        for name in ("qzs-transmissibility-plot", "qzs-response-plot"):
+            frame, legend = browser.plot_boxes(page, name)
+            assert legend is not None, name
+            assert legend[2] > legend[0] and legend[3] > legend[1], (name, legend)
+            assert not overlaps(frame, legend), (name, frame, legend)
+        page.get_by_text("Six-axis platform", exact=True).click()
+        page.get_by_text("statically stable").first.wait_for(timeout=120_000)
+        page.wait_for_timeout(500)
+        assert browser.horizontal_overflow(page) <= 0
+    finally:
+        page.close()
+
+
+def test_transmissibility_axis_is_logarithmic_with_positive_frequencies(page):
+    """The page draws frequency on a log axis, as every figure of qzs: no bin at 0 Hz."""
+    scale = page.evaluate("() => Bokeh.documents[0].get_model_by_name("
+                          "'qzs-transmissibility-plot').x_scale.type")
+    assert scale == "LogScale"
+    for key in ("transmissibility", "linear"):
+        assert min(browser.source_data(page, key)["x"]) > 0

@@ -149,3 +149,38 @@ def test_png_download_is_a_png(page):
     page.reset()
     data = page._png_file()
     assert isinstance(data, io.BytesIO) and data.getvalue()[:4] == b"\x89PNG"
+
+
+def test_displacements_are_in_mm_in_the_controls_as_in_the_plots(page):
+    """One unit for displacements on the page: the amplitude's control shows mm (its label
+    says so), the request it makes stays SI (m), and the plots are in mm."""
+    page.reset()
+    widget = page.widgets["excitation.amplitude"]
+    assert label(widget).endswith("[mm]")
+    assert widget.value == pytest.approx(1e3 * page_request().amplitude)
+    request = set_value(page, "excitation.amplitude", 4.0)
+    assert request.amplitude == pytest.approx(0.004)
+    assert page.plots["response"].yaxis[0].axis_label.endswith("[mm]")
+    assert page.plots["stroke"].yaxis[0].axis_label.endswith("[mm]")
+    page.reset()
+    assert page.values()["excitation.amplitude"] == pytest.approx(page_request().amplitude)
+
+
+def test_frequency_axis_is_log_and_legends_lie_outside_the_frames(page):
+    """The transmissibility's frequency axis is logarithmic, starting at the lowest bin
+    drawn (no 0 Hz bin on it); its legend and the sine response's lie beside the frame,
+    never in it (Bokeh's ``center`` holds what is drawn over the data)."""
+    from bokeh.models import Legend, LogScale
+
+    page.reset()
+    trans = page.plots["transmissibility"]
+    assert isinstance(trans.x_scale, LogScale)
+    for key in ("transmissibility", "linear"):
+        assert np.min(page.sources[key].data["x"]) > 0
+    lowest = min(np.min(page.sources[key].data["x"]) for key in ("transmissibility", "linear"))
+    assert 0 < trans.x_range.start <= lowest
+    assert trans.x_range.end == pytest.approx(max(page.data.request.band))
+    for name, side in (("transmissibility", "below"), ("response", "right")):
+        plot = page.plots[name]
+        assert not [r for r in plot.center if isinstance(r, Legend)], name
+        assert [r for r in getattr(plot, side) if isinstance(r, Legend)], name

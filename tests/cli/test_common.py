@@ -87,3 +87,15 @@ def test_the_out_of_memory_hint_names_the_commands_own_options(monkeypatch, caps
         assert word in err, (word, err)
     for word in foreign:
         assert word not in err, (word, err)
+
+
+def test_the_frequency_axis_option_takes_log_or_linear_and_defaults_to_the_setting(capsys):
+    from qzs.cli.common import add_frequency_axis_option
+
+    parser = argparse.ArgumentParser()
+    add_frequency_axis_option(parser)
+    assert parser.parse_args([]).frequency_axis is None   # FIGURES["frequency_scale"], log
+    assert parser.parse_args(["--frequency-axis", "linear"]).frequency_axis == "linear"
+    with pytest.raises(SystemExit) as stop:
+        parser.parse_args(["--frequency-axis", "semilog"])
+    assert stop.value.code == 2 and "invalid choice: 'semilog'" in capsys.readouterr().err

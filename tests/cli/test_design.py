@@ -17,8 +17,9 @@ class FakeResult:
     def __init__(self):
         self.saved_to = None
 
-    def save(self, folder):
+    def save(self, folder, frequency_scale=None):
         self.saved_to = folder
+        self.frequency_scale = frequency_scale
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "report.html").write_text("<html></html>")
         return {"report": folder / "report.html", "json": folder / "design.json"}
@@ -42,12 +43,14 @@ def test_cli_forwards_the_options_writes_the_report_and_prints_json(monkeypatch,
     out = tmp_path / "design"
     code = main(["design", "--out", str(out), "--json", "--quiet", "--stiction-range", "8,12",
                  "--mass-range", "6.4,6.4", "--force-steps", "2", "--cost", "peak",
-                 "--delay", "0.001", "--set", "pi_kp=60", "--quick"])
+                 "--delay", "0.001", "--set", "pi_kp=60", "--quick", "--frequency-axis",
+                 "linear"])
     assert code == 0
     record = json.loads(capsys.readouterr().out)
     assert record["gains"] == {"pi_kp": 123.0, "pi_ki": 49.2, "damping_gain": None}
     assert record["outputs"]["report"] == str(out / "report.html")
     assert result.saved_to == out and (out / "report.html").exists()
+    assert result.frequency_scale == "linear"
     assert seen["stiction_range"] == (8.0, 12.0) and seen["mass_range"] == (6.4, 6.4)
     assert seen["force_steps"] == (2.0,) and seen["band"] == (1.0, 20.0)
     assert seen["cost"] == "peak" and seen["delay"] == 0.001 and seen["quick"] is True

@@ -23,14 +23,15 @@ def test_options_reach_the_workflow_under_their_api_names(tmp_path, monkeypatch,
     out = tmp_path / "out"
     assert main(["experiment", "log.csv", "--map", "map.toml", "--out", str(out),
                  "--fft-length", "1024", "--averages", "7", "--no-simulation", "--resample",
-                 "--config", "p.toml"]) == 0
+                 "--config", "p.toml", "--frequency-axis", "linear"]) == 0
     assert seen == {"log": "log.csv", "channel_map": "map.toml", "out": str(out),
                     "fft_length": 1024, "n_averages": 7, "config": "p.toml", "resample": True,
-                    "simulate_match": False}
+                    "simulate_match": False, "frequency_scale": "linear"}
     assert "measured" in capsys.readouterr().out
     assert main(["experiment", "log.csv", "--map", "map.toml", "--out", str(out),
                  "--json"]) == 0
     assert seen["fft_length"] is None and seen["simulate_match"] is True
+    assert seen["frequency_scale"] is None   # the default axis, log
     assert '"files": {"report": "' in capsys.readouterr().out
 
 

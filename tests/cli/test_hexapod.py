@@ -271,3 +271,21 @@ def test_centralised_option_equals_the_per_leg_loops_at_the_cube_centre(tmp_path
     path.write_text("[geometry]\nkind = 'cubic'\ncube_edge = 0.15\n[cartesian]\n")
     assert main(["hexapod", "linear", "--config", str(path), "--centralised"]) == 2
     assert "[cartesian]" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("given, scale", [([], "log"), (["--frequency-axis", "linear"], "linear")])
+def test_linear_plot_takes_the_frequency_axis_asked_for(tmp_path, monkeypatch, given, scale):
+    """--frequency-axis reaches the grid: log by default, linear on request."""
+    import qzs.viz.hexapod_matrix as module
+
+    drawn = []
+    original = module.plot_transmissibility_matrix
+
+    def spy(*args, **kwargs):
+        figure = original(*args, **kwargs)
+        drawn.append({ax.get_xscale() for ax in figure.axes})
+        return figure
+
+    monkeypatch.setattr(module, "plot_transmissibility_matrix", spy)
+    assert main(["hexapod", "linear", "--plot", str(tmp_path / "grid.png"), *given]) == 0
+    assert drawn == [{scale}]

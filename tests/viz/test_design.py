@@ -27,3 +27,22 @@ def test_the_static_design_draws_the_force_the_payload_needs():
     assert design.get_xdata()[0] == pytest.approx(isolator.mass, rel=1e-14)
     assert design.get_ydata()[0] == pytest.approx(isolator.mass * isolator.gravity - lifted,
                                                   rel=1e-12)
+
+
+@pytest.mark.parametrize("scale", [None, "linear"])
+def test_the_damping_search_draws_frequency_log_by_default(frequency_axes, scale):
+    """The damping search's transmissibility panel: a log frequency axis from the lowest
+    trusted bin (0 Hz dropped), linear on request; the gain panel keeps its own axis."""
+    from qzs.viz.design import plot_damping_search
+
+    frequency = np.linspace(0.0, 20.0, 81)
+    magnitude = 1.0 / np.abs(1.0 - (frequency / 2.0) ** 2 + 0.4j * frequency / 2.0)
+    trusted = frequency >= 0.5
+    rows = [{"damping_gain": k, "cost": 1.0 / (1 + k), "linear_cost": 1.0 / (1 + k)}
+            for k in (0.0, 10.0, 50.0)]
+    curves = {0.0: (frequency, magnitude, trusted), 10.0: (frequency, 0.9 * magnitude, trusted)}
+    figure = plot_damping_search(rows, curves, 10.0, 100.0, (1.0, 20.0), "rms",
+                                 frequency_scale=scale)
+    frequency_axes(figure.axes[1:], scale or "log")
+    assert figure.axes[1].get_xlim()[0] == pytest.approx(0.0 if scale == "linear" else 0.5)
+    assert figure.axes[1].get_ylabel() == "transmissibility [dB]"

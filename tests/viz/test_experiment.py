@@ -3,6 +3,7 @@ trusted bins within the band, the simulation said to lie on top of it when it do
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from qzs.viz.experiment import plot_experiment
 
@@ -35,3 +36,16 @@ def test_the_measured_curve_is_its_trusted_bins_in_db_within_the_band():
     assert any("on top of the experiment" in label for label in labels)
     np.testing.assert_array_equal(figure.axes[1].lines[0].get_ydata(), measured.coherence[keep])
     assert top.get_title() == "log.csv"
+
+
+@pytest.mark.parametrize("scale", [None, "linear"])
+def test_frequency_is_log_by_default_and_linear_on_request(frequency_axes, scale):
+    magnitude = 1.0 / np.abs(1.0 - (F / 3.0) ** 2 + 0.3j * F / 3.0)
+    measured = estimate(magnitude, (F > 1.0) & (F < 18.0))
+    result = SimpleNamespace(measured=measured, simulated=None, band=(0.0, 20.0),
+                             untrusted_below=1.0,
+                             recording=SimpleNamespace(source="rig/log.csv (map.toml)"))
+    figure = plot_experiment(result, frequency_scale=scale)
+    frequency_axes(figure.axes, scale or "log")
+    low = figure.axes[0].get_xlim()[0]
+    assert low == pytest.approx(0.0 if scale == "linear" else 1.0)   # lowest trusted: 1.25 Hz

@@ -38,3 +38,12 @@ def test_each_panel_is_its_entry_in_db_with_its_unit():
 def test_a_matrix_of_the_wrong_shape_is_refused():
     with pytest.raises(ParameterError, match=r"`simulated` must have shape \(41, 6, 6\)"):
         plot_transmissibility_matrix(F, simulated=np.ones((41, 6, 5)))
+
+
+@pytest.mark.parametrize("scale", [None, "linear"])
+def test_every_panel_has_a_log_frequency_axis_unless_linear_is_asked(frequency_axes, scale):
+    figure = plot_transmissibility_matrix(F, linear=matrix(), frequency_scale=scale)
+    frequency_axes(figure.axes, scale or "log")
+    if scale is None:   # from the lowest positive bin, 0.5 Hz, to the top
+        assert figure.axes[0].get_xlim() == pytest.approx((0.5, 20.0))
+        assert [ax.get_xlabel() for ax in figure.axes[-6:]] == ["frequency [Hz]"] * 6

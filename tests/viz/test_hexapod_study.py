@@ -3,6 +3,7 @@ bins, its linear model only where its loop is stable, the units of a cross-axis 
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from qzs.viz.hexapod_study import plot_study_comparison
 
@@ -35,3 +36,12 @@ def test_each_case_draws_its_trusted_bins_and_a_stable_loops_linear_model():
     assert cross.get_title() == "platform ry per base x: cross-axis response [rad/m]"
     assert diagonal.get_title() == "platform x per base x: transmissibility [-]"
     assert coherence.get_ylabel() == "coherence x/x [-]"
+
+
+@pytest.mark.parametrize("scale", [None, "linear"])
+def test_the_comparison_draws_frequency_log_by_default(frequency_axes, scale):
+    cases = [("PI", case(1.0, 1.0, True))]
+    figure = plot_study_comparison(cases, entries=[[(0, 0)]], frequency_range=(0.1, 20.0),
+                                   frequency_scale=scale)
+    frequency_axes(figure.axes, scale or "log")
+    assert figure.axes[0].get_xlim() == pytest.approx((0.1, 20.0))

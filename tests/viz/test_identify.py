@@ -17,3 +17,16 @@ def test_the_spring_fit_draws_the_measured_points_and_the_fitted_tanh():
     np.testing.assert_allclose(fit.get_ydata(), -60.5 * np.tanh(34.0 * x), rtol=1e-12)
     assert fit.get_label() == "fit: a = 60.50 N, b = 34.00 1/m"
     assert figure.axes[0].get_xlabel() == "relative position z [mm]"
+
+
+def test_the_transmissibility_fit_draws_frequency_on_a_log_axis(frequency_axes):
+    from types import SimpleNamespace
+
+    from qzs.viz.identify import plot_transmissibility_fit
+
+    frequency = np.linspace(0.0, 10.0, 41)
+    measured = 1.0 / np.abs(1.0 - (frequency / 2.0) ** 2 + 0.4j * frequency / 2.0)
+    fit = SimpleNamespace(frequency=frequency, measured=measured, fitted=1.01 * measured,
+                          parameters={"stiction_force": 10.0})
+    frequency_axes(plot_transmissibility_fit(fit).axes, "log")
+    frequency_axes(plot_transmissibility_fit(fit, frequency_scale="linear").axes, "linear")

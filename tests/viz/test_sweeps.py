@@ -95,3 +95,12 @@ def test_plot_command_writes_the_default_figures(grid_store, monkeypatch, tmp_pa
                         "grid-stop_contacts-pi_kp-stiction_force.png")):
         assert run_sweep_plot_command(parser.parse_args(argv)) == 0
         assert (tmp_path / name).exists() and f"wrote {name}" in capsys.readouterr().out
+
+
+def test_the_band_draws_frequency_log_by_default_and_linear_on_request(monte_carlo_store,
+                                                                       frequency_axes):
+    from qzs.workflows.sweeps import open_sweep
+
+    data = open_sweep(monte_carlo_store)
+    frequency_axes(plot_transmissibility_band(data).axes, "log")
+    frequency_axes(plot_transmissibility_band(data, frequency_scale="linear").axes, "linear")

@@ -1,6 +1,7 @@
 """Transmissibility curves in dB (qzs.viz.transmissibility): which curves coincide, from which
 frequency on, and a drawn curve that is 20 log10 of its magnitude on its trusted bins only."""
 import numpy as np
+import pytest
 
 from qzs.viz.transmissibility import coinciding, plot_transmissibility
 
@@ -35,3 +36,29 @@ def test_the_solid_curve_is_the_trusted_bins_in_db():
     expected = np.where(trusted, 20 * np.log10(magnitude), np.nan)[keep]
     np.testing.assert_allclose(y, expected, rtol=1e-14)
     assert np.isnan(y[~trusted[keep]]).all()
+
+
+@pytest.mark.parametrize("scale", [None, "log", "linear"])
+def test_frequency_is_log_by_default_and_linear_on_request(frequency_axes, scale):
+    """Log by default (qzs.defaults.FIGURES), from the lowest trusted or linearised bin
+    rounded down to 1-2-5; the 0 Hz bin dropped, with no warning; linear when asked."""
+    import warnings
+
+    import matplotlib.pyplot as plt
+
+    magnitude = 1.0 / np.abs(1.0 - (F / 4.0) ** 2 + 0.2j * F / 4.0)
+    curves = [curve("model", magnitude, trusted=F > 2.0, coherence=np.full(F.shape, 0.95))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        figure = plot_transmissibility(curves, frequency_range=(0.0, 20.0),
+                                       frequency_scale=scale)
+        figure.canvas.draw()
+    frequency_axes(figure.axes, scale or "log")
+    assert figure.axes[0].get_xlim() == pytest.approx((0.0 if scale == "linear" else 2.0, 20.0))
+    assert figure.axes[0].get_ylabel().startswith("transmissibility [dB]")
+    assert figure.axes[1].get_ylabel() == "coherence [-]"
+    # a linearised curve is exact at every bin: the log axis starts at its lowest one
+    curves[0]["linear"] = magnitude
+    figure = plot_transmissibility(curves, frequency_range=(0.0, 20.0))
+    assert figure.axes[0].get_xlim()[0] == pytest.approx(0.2)   # F[1] = 0.25 Hz
+    plt.close("all")

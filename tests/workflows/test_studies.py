@@ -21,6 +21,13 @@ def test_every_shipped_study_loads_and_names_known_claims():
     assert set(CLAIMS) == {c for s in studies for c in s.claims}
 
 
+def test_the_shipped_views_take_the_default_frequency_axis():
+    """The paper's figures draw frequency as every figure does (log): no view asks for
+    another scale; ``--frequency-axis linear`` gives the paper's own axes."""
+    for path in shipped_studies():
+        assert all("frequency_scale" not in view for view in load_study(path).views)
+
+
 def test_shipped_name_resolves():
     assert load_study("stiction").name == "stiction"
 
@@ -35,6 +42,9 @@ def test_shipped_name_resolves():
     ("[study]\nname='x'\nkind='transmissibility'\n[[case]]\nlabel='a'\n[analysis]\nfft=3\n",
      r"unknown key\(s\) \['fft'\] in \[analysis\]"),
     ("[stuff]\n", r"unknown table\(s\) \['stuff'\]"),
+    ("[study]\nname='x'\nkind='transmissibility'\n[[study.view]]\nfigure='f'\n"
+     "frequency_range=[0.0, 20.0]\nfrequency_scale='semilog'\n[[case]]\nlabel='a'\n",
+     r"'f' has frequency_scale = 'semilog'; use one of log, linear"),
 ])
 def test_bad_study_files(tmp_path, text, match):
     path = tmp_path / "s.toml"

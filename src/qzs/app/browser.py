@@ -20,7 +20,7 @@ from pathlib import Path
 
 __all__ = ["CHROMIUM", "CHROMIUM_ARGS", "INSTALL_HINT", "find_chromium", "free_port",
            "start_server", "launch", "open_page", "source_data", "drag_slider", "type_value",
-           "wait_until_changed", "download"]
+           "wait_until_changed", "download", "horizontal_overflow", "plot_boxes"]
 
 #: Debian's Chromium.
 CHROMIUM = "/usr/bin/chromium"
@@ -213,6 +213,50 @@ def source_data(page, key):
         " for (const [k, v] of Object.entries(m.data)) out[k] = Array.from(v, (x) =>"
         " (x && x.length !== undefined && typeof x !== 'string') ? Array.from(x) : x);"
         " return out; }", SOURCE_NAMES[key])
+
+
+def horizontal_overflow(page):
+    """How far the page is wider than the window [px] (0: nothing clipped or scrolled).
+
+    Parameters
+    ----------
+    page : playwright.sync_api.Page
+        The loaded page.
+
+    Returns
+    -------
+    int
+        ``document.documentElement.scrollWidth`` minus the window's inner width.
+    """
+    return page.evaluate("() => document.documentElement.scrollWidth - window.innerWidth")
+
+
+def plot_boxes(page, name):
+    """Where a Bokeh plot's frame (the data region) and its legend are drawn.
+
+    Parameters
+    ----------
+    page : playwright.sync_api.Page
+        The loaded page.
+    name : str
+        The plot's Bokeh ``name`` (``qzs-transmissibility-plot``, ``qzs-response-plot``).
+
+    Returns
+    -------
+    frame, legend : tuple of float
+        ``(left, top, right, bottom)`` in the plot's canvas [px]; ``legend`` is None for a
+        plot without one.
+    """
+    return page.evaluate("""(name) => {
+      const model = Bokeh.documents[0].get_model_by_name(name);
+      let view = null;
+      for (const root of Bokeh.index) { view = root.owner.find_one(model); if (view) break; }
+      const box = (b) => [b.left, b.top, b.right, b.bottom];
+      const legend = [...model.center, ...model.above, ...model.below, ...model.left,
+                      ...model.right].find((r) => r.type === "Legend");
+      return [box(view.frame.bbox),
+              legend === undefined ? null : box(view.owner.find_one(legend).bbox)];
+    }""", name)
 
 
 def wait_until_changed(page, old_y, key="transmissibility", timeout=30.0):

@@ -83,7 +83,7 @@ SINE_STATE_TOLERANCE = 1e-3
 WELCH_SEGMENTS = 24
 #: Points each time trace sends to the browser at most (a min/max envelope beyond).
 TRACE_POINTS = 4000
-#: Frequencies of the linear model's curve [-].
+#: Frequencies of the linear model's curve, log-spaced over the band [-].
 LINEAR_POINTS = 400
 
 
@@ -443,7 +443,7 @@ def _linear_curve(request):
     if request.excitation == "stepped" and low == 0.0:
         low = high / request.frequency_count
     low = max(low, high / LINEAR_POINTS)
-    frequency = np.linspace(low, high, LINEAR_POINTS)
+    frequency = np.geomspace(low, high, LINEAR_POINTS)  # even on the page's log axis
     return frequency, decibels(linearize(request.isolator, request.controller)
                                .transmissibility(frequency))
 

@@ -9,6 +9,8 @@ import io
 
 import numpy as np
 
+from qzs.viz.figures import drawn, frequency_axis
+
 __all__ = ["page_figure", "figure_png", "PIN_COLORS", "describe_request"]
 
 #: Colours of pinned curves, in pin order (matplotlib's tab10 after its first two).
@@ -66,19 +68,24 @@ def page_figure(data, pinned=()):
     request = data.request
 
     for (label, frequency, magnitude_db), color in zip(pinned, PIN_COLORS):
-        axes_t.plot(frequency, magnitude_db, color=color, lw=1.0, alpha=0.8,
-                    label=f"pinned: {label}")
+        keep = drawn(frequency)
+        axes_t.plot(np.asarray(frequency)[keep], np.asarray(magnitude_db)[keep], color=color,
+                    lw=1.0, alpha=0.8, label=f"pinned: {label}")
     kind = "chirp (trusted bins)" if request.excitation == "chirp" else "stepped sine"
-    axes_t.plot(data.frequency, data.transmissibility_db, color="#1f77b4", lw=1.6,
+    shown, linear = drawn(data.frequency), drawn(data.linear_frequency)
+    axes_t.plot(data.frequency[shown], data.transmissibility_db[shown], color="#1f77b4", lw=1.6,
                 marker="o" if request.excitation == "stepped" else None, ms=4,
                 label=f"simulated, {kind}")
-    axes_t.plot(data.linear_frequency, data.linear_db, color="#ff7f0e", lw=1.2, ls="--",
-                label="linear model")
+    axes_t.plot(data.linear_frequency[linear], data.linear_db[linear], color="#ff7f0e", lw=1.2,
+                ls="--", label="linear model")
     axes_t.axhline(0.0, color="0.6", lw=0.6)
-    axes_t.set(xlabel="frequency [Hz]", ylabel="transmissibility [dB]",
+    frequency_axis(axes_t, (min(request.band), max(request.band)),
+                   np.concatenate([data.frequency[shown], data.linear_frequency[linear]]),
+                   label="frequency [Hz]")
+    axes_t.set(ylabel="transmissibility [dB]",
                title="Transmissibility, payload over base acceleration")
-    axes_t.legend(fontsize=8, loc="upper right")
-    axes_t.grid(alpha=0.3)
+    axes_t.legend(fontsize=8, loc="best")
+    axes_t.grid(alpha=0.3, which="both")
 
     shares = [100 * data.locked_share["sine"], 100 * data.locked_share["excitation"]]
     names = [f"{request.sine_frequency:g} Hz sine",
@@ -95,7 +102,8 @@ def page_figure(data, pinned=()):
     axes_x.set(xlabel="time [s]", ylabel="displacement from rest [mm]",
                title=f"Response to a {request.sine_frequency:g} Hz, "
                      f"{request.amplitude * _MM:g} mm sine")
-    axes_x.legend(fontsize=8, loc="upper left")
+    axes_x.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncols=2,
+                  frameon=False)  # below the axes: the traces fill the whole frame
 
     time_, z = data.traces["relative_position"]
     axes_z.plot(time_, z * _MM, color="#1f77b4", lw=1.0, label="relative position z")

@@ -18,7 +18,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColumnDataSource, FactorRange, Legend, Span
+from bokeh.models import (ColumnDataSource, FactorRange, Legend, LogTicker, NumeralTickFormatter,
+                          Range1d, Span)
 from bokeh.plotting import figure
 
 from qzs._format import markdown_table, number
@@ -29,9 +30,10 @@ from qzs.app.platform import PLATFORM_PARAMETERS, compute_platform
 from qzs.app.updates import LatestOnly
 from qzs.errors import DataError, ParameterError, SimulationError
 from qzs.model.registry import PARAMETERS, parameter_info
+from qzs.viz.figures import frequency_limits
 
 __all__ = ["TuningPage", "PlatformTab", "build_page", "css_class", "SLIDERS", "SOURCE_NAMES",
-           "EXECUTOR"]
+           "EXECUTOR", "DISPLAY_UNITS"]
 
 LOG = logging.getLogger("qzs.app")
 
@@ -39,8 +41,15 @@ LOG = logging.getLogger("qzs.app")
 #: at a time, so that the machine's cores serve the kernels and the event loop stays free.
 EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="qzs-app")
 
-#: Slider ranges of the page (start, end, step) in the registry's units; typed values may
-#: leave them (the API's validation decides), except where :data:`LIMITS` bounds a size.
+#: Settings the page shows in another unit than the registry's SI one: name -> (unit,
+#: factor from the registry's unit). Displacements are in mm on the whole page, controls
+#: and plots alike: the paper quotes them in mm (a 10 mm chirp, strokes of tens of mm), and
+#: 10 reads better than 0.0100 m. Everything else keeps the registry's unit; the request,
+#: the TOML export and the API stay SI.
+DISPLAY_UNITS = {"excitation.amplitude": ("mm", 1e3)}
+#: Slider ranges of the page (start, end, step) in the units the labels show (the
+#: registry's, or :data:`DISPLAY_UNITS`); typed values may leave them (the API's validation
+#: decides), except where :data:`LIMITS` bounds a size.
 SLIDERS = {
     "stiction_force": (0.0, 40.0, 0.5),
     "coulomb_force": (0.0, 20.0, 0.25),
@@ -53,7 +62,7 @@ SLIDERS = {
     "pi_ki": (0.0, 200.0, 1.0),
     "damping_gain": (0.0, 500.0, 5.0),
     "velocity_highpass": (0.0, 10.0, 0.1),
-    "excitation.amplitude": (0.0, 0.05, 0.0005),
+    "excitation.amplitude": (0.0, 50.0, 0.5),
     "excitation.duration": (*LIMITS["excitation.duration"][:2], 10.0),
     "band": (0.0, LIMITS["excitation.f1"][1], 0.1),
     "frequency_count": (*LIMITS["frequency_count"][:2], 1),
@@ -85,7 +94,7 @@ def _label(name):
         return f"{info.doc} [{info.unit}]"
     labels = {
         "excitation.amplitude": f"base displacement amplitude "
-                                f"[{parameter_info('excitation.amplitude', 'chirp').unit}]",
+                                f"[{DISPLAY_UNITS['excitation.amplitude'][0]}]",
         "excitation.duration": f"chirp {parameter_info('excitation.duration', 'chirp').doc} "
                                f"[{parameter_info('excitation.duration', 'chirp').unit}]",
         "band": f"band f0-f1 [{parameter_info('excitation.f0', 'chirp').unit}]",
@@ -96,6 +105,25 @@ def _label(name):
         "sample_rate": f"output sample rate [{LIMITS['sample_rate'][2]}]",
     }
     return labels[name]
+
+
+def _legend_outside(plot, place, **properties):
+    """Move the legend the glyphs made out of ``plot``'s frame to its ``place`` side
+    (``"below"``, ``"right"``): it never covers a curve."""
+    legend = plot.legend[0]
+    plot.center.remove(legend)
+    legend.update(border_line_alpha=0, location="top_left", **properties)
+    plot.add_layout(legend, place)
+
+
+def _shown(name, value):
+    """A setting's registry value as its widget shows it (:data:`DISPLAY_UNITS`)."""
+    return value * DISPLAY_UNITS[name][1] if name in DISPLAY_UNITS else value
+
+
+def _registry(name, value):
+    """A widget's value in the registry's unit (:data:`DISPLAY_UNITS`)."""
+    return value / DISPLAY_UNITS[name][1] if name in DISPLAY_UNITS else value
 
 
 def _named(cls, label, *, style=None, **params):
@@ -192,8 +220,7 @@ class TuningPage:
             start, end, step = SLIDERS[name]
             widgets[name] = _named(
                 pn.widgets.EditableFloatSlider, _label(name), start=start, end=end, step=step,
-                value=float(values[name]), width=_WIDGET_WIDTH,
-                format="0.0000" if name == "excitation.amplitude" else None)
+                value=_shown(name, float(values[name])), width=_WIDGET_WIDTH)
         start, end, step = SLIDERS["band"]
         widgets["band"] = _named(
             pn.widgets.EditableRangeSlider, _label("band"), start=start, end=end, step=step,
@@ -217,7 +244,7 @@ class TuningPage:
             if name == "band":
                 values["excitation.f0"], values["excitation.f1"] = widget.value
             else:
-                values[name] = widget.value
+                values[name] = _registry(name, widget.value)
         return values
 
     # ------------------------------------------------------------ plots
@@ -236,12 +263,16 @@ class TuningPage:
     def _make_plots(self):
         source = self.sources
         tools = "pan,wheel_zoom,box_zoom,reset,save,hover"
-        trans = figure(height=380, width=760, tools=tools, name="qzs-transmissibility-plot",
-                       title="Transmissibility: payload over base acceleration (trusted bins "
-                             "only; dashed: linear model)",
+        # the frequency axis as every figure of qzs draws it (qzs.viz.figures.frequency_axis):
+        # log, 1-2-5 ticks labelled as plain numbers; the legend below the frame, never on
+        # the curves; the frame's height fixed, the width following the window
+        trans = figure(frame_height=300, sizing_mode="stretch_width", min_width=420,
+                       tools=tools, name="qzs-transmissibility-plot", x_axis_type="log",
+                       x_range=Range1d(0.1, 20.0),
+                       title="Transmissibility, payload over base acceleration (trusted bins)",
                        x_axis_label="frequency [Hz]", y_axis_label="transmissibility [dB]")
-        trans.add_layout(Legend(location="top_right", label_text_font_size="9pt",
-                                background_fill_alpha=0.7))
+        trans.xaxis.ticker = LogTicker(mantissas=[1, 2, 5])
+        trans.xaxis.formatter = NumeralTickFormatter(format="0.[00]")
         trans.multi_line("xs", "ys", source=source["pinned"], color="color", line_width=1.5,
                          alpha=0.8, legend_field="label")
         trans.line("x", "y", source=source["transmissibility"], color="#1f77b4",
@@ -252,20 +283,25 @@ class TuningPage:
                    line_dash="dashed", legend_label="linear model")
         trans.add_layout(Span(location=0.0, dimension="width", line_color="#999999",
                               line_width=1))
+        # one item a line: the pins' labels are long
+        _legend_outside(trans, "below", name="qzs-transmissibility-legend",
+                        label_text_font_size="9pt", orientation="vertical", spacing=0,
+                        padding=4)
 
         def timeplot(title, label, **kw):
-            return figure(height=250, width=380, tools=tools, title=title,
-                          x_axis_label="time [s]", y_axis_label=label, **kw)
+            return figure(frame_height=170, sizing_mode="stretch_width", min_width=250,
+                          tools=tools, title=title, x_axis_label="time [s]",
+                          y_axis_label=label, **kw)
 
-        response = timeplot("Response to the sine", "displacement from rest [mm]")
+        response = timeplot("Response to the sine", "displacement from rest [mm]",
+                            name="qzs-response-plot")
         response.line("x", "y", source=source["base"], color="#888888", legend_label="base y")
         response.line("x", "y", source=source["payload"], color="#1f77b4",
                       legend_label="payload x")
-        response.legend.location = "top_left"
-        response.legend.orientation = "horizontal"
-        response.legend.background_fill_alpha = 0.7
-        response.legend.label_text_font_size = "8pt"
-        response.y_range.range_padding = 0.45  # room for the legend above the traces
+        # beside the frame, so that the three time plots keep one height
+        _legend_outside(response, "right", name="qzs-response-legend",
+                        label_text_font_size="8pt", orientation="vertical", padding=2,
+                        margin=2, glyph_width=14, label_standoff=3)
         stroke = timeplot("Stroke used (red: the stops)", "relative position z [mm]",
                           x_range=response.x_range)
         stroke.line("x", "y", source=source["relative_position"], color="#1f77b4")
@@ -279,7 +315,7 @@ class TuningPage:
         motor.line("x", "y", source=source["motor_force"], color="#1f77b4")
         for column in ("low", "high"):
             motor.line("x", column, source=source["limits"], line_width=2, color="#d62728")
-        locked = figure(height=380, width=300, tools="save,hover", title="Locked share",
+        locked = figure(frame_height=300, width=300, tools="save,hover", title="Locked share",
                         x_range=FactorRange(factors=self._empty("locked")["run"]),
                         y_range=(0, 100), x_axis_label="run",
                         y_axis_label="time locked (stuck or on a stop) [%]")
@@ -317,14 +353,16 @@ class TuningPage:
         buttons = pn.Column(pn.Row(self.pin_button, self.clear_button, self.reset_button),
                             pn.Row(self.toml_download, self.png_download))
         p = self.plots
+        wide = {"sizing_mode": "stretch_width"}  # the plots share what the sidebar leaves
         main = pn.Column(
             buttons, self.summary,
-            pn.Row(pn.pane.Bokeh(p["transmissibility"]), pn.pane.Bokeh(p["locked"])),
-            pn.Row(pn.pane.Bokeh(p["response"]), pn.pane.Bokeh(p["stroke"]),
-                   pn.pane.Bokeh(p["motor"])))
+            pn.Row(pn.pane.Bokeh(p["transmissibility"], **wide), pn.pane.Bokeh(p["locked"]),
+                   **wide),
+            pn.Row(pn.pane.Bokeh(p["response"], **wide), pn.pane.Bokeh(p["stroke"], **wide),
+                   pn.pane.Bokeh(p["motor"], **wide), **wide), **wide)
         for plot in p.values():
             plot.toolbar.logo = None
-        return pn.Row(pn.Column(*sidebar, width=_WIDGET_WIDTH + 30), main)
+        return pn.Row(pn.Column(*sidebar, width=_WIDGET_WIDTH + 30), main, **wide)
 
     # ------------------------------------------------------------ updates
     def _schedule(self, callback):
@@ -391,8 +429,17 @@ class TuningPage:
 
     def _draw(self, data):
         source, request = self.sources, data.request
-        source["transmissibility"].data = {"x": data.frequency, "y": data.transmissibility_db}
-        source["linear"].data = {"x": data.linear_frequency, "y": data.linear_db}
+        # a log axis draws no bin at or below 0 Hz (the chirp's trusted bins and the
+        # linear curve have none; the mask keeps it so)
+        shown, linear = data.frequency > 0, data.linear_frequency > 0
+        source["transmissibility"].data = {"x": data.frequency[shown],
+                                           "y": data.transmissibility_db[shown]}
+        source["linear"].data = {"x": data.linear_frequency[linear],
+                                 "y": data.linear_db[linear]}
+        low, high = frequency_limits(
+            (min(request.band), max(request.band)),
+            np.concatenate([data.frequency[shown], data.linear_frequency[linear]]))
+        self.plots["transmissibility"].x_range.update(start=low, end=high)
         for key, trace in (("base", "base_displacement"), ("payload", "payload_displacement"),
                            ("relative_position", "relative_position")):
             time_, values = data.traces[trace]
@@ -444,9 +491,10 @@ class TuningPage:
             return
         if len(self.pins) >= len(PIN_COLORS):
             self.pins.pop(0)
+        shown = np.asarray(self.data.frequency) > 0  # a log axis draws no 0 Hz bin
         self.pins.append((describe_request(self.data.request).split(";")[0],
-                          np.asarray(self.data.frequency), np.asarray(
-                              self.data.transmissibility_db)))
+                          np.asarray(self.data.frequency)[shown],
+                          np.asarray(self.data.transmissibility_db)[shown]))
         self._draw_pins()
 
     def clear_pins(self):
@@ -469,7 +517,7 @@ class TuningPage:
                 if name == "band":
                     widget.value = (values["excitation.f0"], values["excitation.f1"])
                 else:
-                    widget.value = values[name]
+                    widget.value = _shown(name, values[name])
         finally:
             self._resetting = False
         self.request_update()
@@ -523,13 +571,14 @@ class PlatformTab:
         self.spinner = pn.indicators.LoadingSpinner(value=False, size=22, margin=(5, 5))
         self.status = pn.pane.Markdown("computed when this tab is first shown", margin=(0, 5))
         self.alert = pn.pane.Alert("", alert_type="danger", visible=False, width=_WIDGET_WIDTH)
-        self.modes = pn.pane.Markdown("", sizing_mode="stretch_width")
-        self.grid = pn.pane.PNG(None, width=1000)
+        self.modes = pn.pane.Markdown("", sizing_mode="stretch_width", min_width=220)
+        # the 6x6 grid follows the window's width (at most its drawn 1000 px)
+        self.grid = pn.pane.PNG(None, sizing_mode="scale_width", max_width=1000)
         self.source = ColumnDataSource(name=SOURCE_NAMES["platform_legs"], data={
             "x0": [], "y0": [], "z0": [], "x1": [], "y1": [], "z1": []})
         views = []
         for title, (a, b) in (("Top view", ("x", "y")), ("Side view", ("x", "z"))):
-            view = figure(height=320, width=330, title=f"{title} at home",
+            view = figure(height=300, width=300, title=f"{title} at home",
                           x_axis_label=f"{a} [mm]", y_axis_label=f"{b} [mm]",
                           tools="pan,wheel_zoom,reset,save", match_aspect=True)
             view.segment(f"{a}0", f"{b}0", f"{a}1", f"{b}1", source=self.source,
@@ -552,7 +601,9 @@ class PlatformTab:
             pn.Row(self.spinner, self.status), self.alert, *self.widgets.values(),
             width=_WIDGET_WIDTH + 30)
         self.layout = pn.Row(sidebar, pn.Column(pn.Row(*[pn.pane.Bokeh(v) for v in views],
-                                                       self.modes), self.grid))
+                                                       self.modes, sizing_mode="stretch_width"),
+                                                self.grid, sizing_mode="stretch_width"),
+                             sizing_mode="stretch_width")
 
     def values(self):
         """The tab's leg settings (registry names -> SI values)."""
@@ -603,7 +654,7 @@ def build_page():
     page = TuningPage()
     platform = PlatformTab(schedule=page._schedule)
     tabs = pn.Tabs(("Single axis", page.layout), ("Six-axis platform", platform.layout),
-                   dynamic=False)
+                   dynamic=False, sizing_mode="stretch_width")
 
     def shown(event):
         if event.new == 1 and platform.data is None and not platform.updates.running:

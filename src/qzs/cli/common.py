@@ -20,6 +20,7 @@ import json
 import sys
 
 from qzs._format import json_ready
+from qzs.defaults import FIGURES, FREQUENCY_SCALES
 from qzs.errors import (DataError, FitError, MissingDependencyError, ParameterError,
                         SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
@@ -27,7 +28,8 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
-__all__ = ["settings", "parameters", "add_set_option", "add_json_option", "emit", "jsonable",
+__all__ = ["settings", "parameters", "add_set_option", "add_json_option",
+           "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
            "MEMORY_HINTS", "MEMORY_HINT"]
 
@@ -81,6 +83,21 @@ def add_json_option(parser):
     parser.add_argument("--json", action="store_true",
                         help="print the summary as one JSON object (NaN and inf as null) "
                              "instead of text")
+
+
+def add_frequency_axis_option(parser):
+    """Add ``--frequency-axis {log,linear}`` to ``parser``: the scale of its figures'
+    frequency axes (``args.frequency_axis``; None: ``qzs.defaults.FIGURES``, log).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser; its handler passes ``frequency_scale=args.frequency_axis``.
+    """
+    parser.add_argument("--frequency-axis", choices=FREQUENCY_SCALES, default=None,
+                        help=f"frequency axis of the figures (default "
+                             f"{FIGURES['frequency_scale']}: the features below 2.5 Hz and "
+                             f"the roll-off to 20 Hz span decades)")
 
 
 def emit(args, text, record):

@@ -1,7 +1,8 @@
 """``qzs design``: PI and damping gains from the isolator and its disturbance (docs/design.md)."""
 import math
 
-from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, add_set_option,
+                             emit, parameters)
 from qzs.errors import ParameterError
 
 __all__ = ["add_parser", "run", "parse_pair", "parse_list"]
@@ -128,6 +129,7 @@ def add_parser(subparsers):
     cmd.add_argument("--workers", metavar="N", type=int,
                      help="threads (default: all cores)")
     cmd.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_frequency_axis_option(cmd)
     add_json_option(cmd)
     return cmd
 
@@ -168,7 +170,7 @@ def run(args):
         stiction_range=stiction, mass_range=mass, force_steps=steps, band=band, cost=args.cost,
         controller_rate=args.controller_rate, delay=args.delay, quick=args.quick,
         damping_gain_max=args.damping_max, workers=args.workers, progress=not args.quiet)
-    written = result.save(folder)
+    written = result.save(folder, frequency_scale=args.frequency_axis)
     record = result.to_dict()
     record["outputs"] = {name: str(path) for name, path in written.items()}
     emit(args, result.summary() + f"\n  wrote            {written['report']}", record)

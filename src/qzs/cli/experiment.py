@@ -6,7 +6,8 @@ ends the command, as ``--help`` does (LOG and ``--map`` are not needed then).
 import argparse
 from pathlib import Path
 
-from qzs.cli.common import EPILOG, add_json_option, emit, integer_at_least, run_handler
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, emit,
+                             integer_at_least, run_handler)
 from qzs.errors import OutputPathError
 from qzs.iotools.paths import check_output_path
 
@@ -53,6 +54,7 @@ def add_parser(subparsers):
                         help="model parameters for the simulation (see `qzs params --toml`)")
     parser.add_argument("--resample", action="store_true",
                         help="resample a non-uniform time base onto a uniform grid")
+    add_frequency_axis_option(parser)
     add_json_option(parser)
     return parser
 
@@ -103,7 +105,8 @@ def run(args):
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,
                                    n_averages=args.averages, config=args.config,
                                    resample=args.resample,
-                                   simulate_match=not args.no_simulation)
+                                   simulate_match=not args.no_simulation,
+                                   frequency_scale=args.frequency_axis)
     text = (f"{result.summary()}\nwrote {paths['report']}, {paths['figure'].name} (+ .svg) "
             f"and {paths['table'].name}")
     emit(args, text, {**result.to_record(),

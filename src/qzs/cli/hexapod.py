@@ -1,5 +1,6 @@
 """``qzs hexapod``: the six-axis platform of six isolator legs (docs/hexapod.md)."""
-from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, settings
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, add_set_option,
+                             emit, settings)
 from qzs.defaults import ACCURACY, AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.workflows.hexapod import SHIPPED_DEFAULT
@@ -81,6 +82,7 @@ def add_parser(subparsers):
                         help="leave out the geometric stiffness of the static leg forces")
     linear.add_argument("--plot", metavar="FILE.png",
                         help="draw the 6x6 transmissibility of the linear model (0.05-50 Hz)")
+    add_frequency_axis_option(linear)
     add_json_option(linear)
     linear.set_defaults(handler=run_linear)
     simulate = sub.add_parser(
@@ -155,6 +157,7 @@ def add_parser(subparsers):
                         help="folder for transmissibility.png and transmissibility.nc "
                              "(default results/hexapod_transmissibility)")
     matrix.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_frequency_axis_option(matrix)
     add_json_option(matrix)
     matrix.set_defaults(handler=run_transmissibility)
     study = sub.add_parser(
@@ -171,6 +174,7 @@ def add_parser(subparsers):
     study.add_argument("--workers", type=int, metavar="N",
                        help="parallel runs per case (default: all cores)")
     study.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_frequency_axis_option(study)
     add_json_option(study)
     study.set_defaults(handler=run_study)
     for command in sub.choices.values():
@@ -257,7 +261,8 @@ def run_linear(args):
     if args.plot:
         from qzs.workflows.hexapod import plot_linear_transmissibility
 
-        record["plot"] = str(plot_linear_transmissibility(setup, model, args.plot))
+        record["plot"] = str(plot_linear_transmissibility(
+            setup, model, args.plot, frequency_scale=args.frequency_axis))
         text += f"\n  wrote {args.plot}"
     emit(args, text, record)
     return 0
@@ -379,7 +384,7 @@ def run_transmissibility(args):
     data = folder / "transmissibility.nc"
     import matplotlib.pyplot as plt
 
-    plt.close(result.plot(out=figure))
+    plt.close(result.plot(out=figure, frequency_scale=args.frequency_axis))
     result.save(data)
     text = result.summary() + f"\n  wrote {figure} and {data}"
     record = {**transmissibility_record(result), "figure": str(figure), "netcdf": str(data)}
@@ -406,7 +411,8 @@ def run_study(args):
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
     result = run_hexapod_study(args.out, quick=args.quick, dt=args.dt,
                                tolerance_db=args.tolerance, workers=args.workers,
-                               progress=not args.quiet and not args.json)
+                               progress=not args.quiet and not args.json,
+                               frequency_scale=args.frequency_axis)
     record = {"quick": result.quick, "wall_seconds": result.wall_seconds,
               "steps": study_steps(result),
               "rows": list(result.rows), "findings": list(result.findings),

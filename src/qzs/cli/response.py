@@ -3,7 +3,8 @@
 It parses and delegates to :func:`qzs.workflows.response.steady_state_response`
 (docs/response.md); ``--json`` prints the list of points, one record each.
 """
-from qzs.cli.common import add_set_option, emit, integer_at_least, parameters
+from qzs.cli.common import (add_frequency_axis_option, add_set_option, emit, integer_at_least,
+                             parameters)
 from qzs.defaults import EXCITATION
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
@@ -91,6 +92,7 @@ def add_parser(subparsers):
     parser.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
                         help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_frequency_axis_option(parser)
     parser.add_argument("--json", action="store_true",
                         help="print the points as a JSON list of records (frequency [Hz], "
                              "transmissibility [-], direction, ...; NaN as null) instead of "
@@ -231,7 +233,7 @@ def run(args):
     if plot is not None:
         import matplotlib.pyplot as plt
 
-        plt.close(response.plot(path=plot))
+        plt.close(response.plot(path=plot, frequency_scale=args.frequency_axis))
         files["plot"] = plot
     text = response.summary() + "".join(f"\n  wrote            {p}" for p in files.values())
     if args.json:

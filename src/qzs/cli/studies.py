@@ -1,7 +1,7 @@
 """``qzs paper`` and ``qzs study``: the paper's studies, their figures, metrics and report."""
 from pathlib import Path
 
-from qzs.cli.common import add_json_option, emit
+from qzs.cli.common import add_frequency_axis_option, add_json_option, emit
 from qzs.errors import ParameterError
 
 __all__ = ["add_parsers", "run"]
@@ -37,6 +37,7 @@ def add_parsers(subparsers):
         cmd.add_argument("--workers", type=int, metavar="N",
                          help="worker processes (default: all cores)")
         cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+        add_frequency_axis_option(cmd)
         add_json_option(cmd)
 
 
@@ -62,7 +63,8 @@ def run(args):
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
                                         workers=args.workers, progress=not args.quiet,
                                         argument="--out", dt=args.dt,
-                                        tolerance_db=args.tolerance)
+                                        tolerance_db=args.tolerance,
+                                        frequency_scale=args.frequency_axis)
     lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"
              for result in results]
     lines.append(f"{'total':<12}    wall {wall:7.1f} s")

@@ -72,7 +72,8 @@ class TransmissibilityFit:
     n_simulations: int
     elapsed: float
 
-    def plot(self, path: str | Path | None = None, title: str = "") -> "Figure":
+    def plot(self, path: str | Path | None = None, title: str = "",
+             frequency_scale: str | None = None) -> "Figure":
         """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
 
         Parameters
@@ -81,6 +82,8 @@ class TransmissibilityFit:
             Write the figure there (a .png also as .svg).
         title : str
             Figure title.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -88,7 +91,8 @@ class TransmissibilityFit:
         """
         from qzs.viz.identify import plot_transmissibility_fit
 
-        return plot_transmissibility_fit(self, path=path, title=title)
+        return plot_transmissibility_fit(self, path=path, title=title,
+                                         frequency_scale=frequency_scale)
 
 
 def _free_parameters(free, isolator, controller, initial):

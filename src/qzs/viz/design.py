@@ -10,7 +10,7 @@ import numpy as np
 
 from qzs._format import decibels
 from qzs.defaults import FIGURES
-from qzs.viz.figures import new_figure
+from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure
 
 __all__ = ["plot_design", "plot_static_design", "plot_pi_search", "plot_hunting",
            "plot_damping_search", "plot_margins", "plot_damping_effect"]
@@ -215,7 +215,7 @@ def plot_hunting(locus, traces, rows):
     return fig
 
 
-def plot_damping_search(rows, curves, chosen, bound, band, cost):
+def plot_damping_search(rows, curves, chosen, bound, band, cost, frequency_scale=None):
     """Cost against the damping gain, and transmissibility without and with the chosen gain.
 
     Parameters
@@ -232,11 +232,14 @@ def plot_damping_search(rows, curves, chosen, bound, band, cost):
         The cost's band [Hz, Hz].
     cost : str
         ``"rms"`` or ``"peak"``.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
+    scale = check_frequency_scale(frequency_scale)
     fig, axes = new_figure(2, height=3.3, sharex=False)
     ax = axes[0]
     gains = np.array([r["damping_gain"] for r in rows], dtype=float)
@@ -258,25 +261,28 @@ def plot_damping_search(rows, curves, chosen, bound, band, cost):
     ax.grid(alpha=0.3, which="both")
     ax = axes[1]
     shown = [k for k in (0.0, chosen) if k in curves]
-    levels = []
+    levels, lowest = [], []
     for gain, color in zip(shown, ("tab:gray", "tab:green")):
         frequency, magnitude, trusted = curves[gain]
+        frequency = np.asarray(frequency, dtype=float)
         trusted = np.asarray(trusted, bool) & (frequency > 0)
+        keep = drawn(frequency, scale)
         db = decibels(magnitude, FIGURES["magnitude_floor"])
         solid = np.where(trusted, db, np.nan)
-        ax.plot(frequency, db, color=color, alpha=0.25, lw=0.8)
-        ax.plot(frequency, solid, color=color, lw=1.3, label=f"Kd = {gain:g} N*s/m")
+        ax.plot(frequency[keep], db[keep], color=color, alpha=0.25, lw=0.8)
+        ax.plot(frequency[keep], solid[keep], color=color, lw=1.3, label=f"Kd = {gain:g} N*s/m")
         inside = trusted & (frequency >= band[0]) & (frequency <= band[1])
         levels.extend(db[inside])
+        lowest.append(frequency[trusted])
     if levels:
         ax.set_ylim(min(levels) - 6, max(levels) + 6)
-    ax.axvspan(*band, color="tab:blue", alpha=0.06, label="cost band")
-    ax.set_xlim(0, band[1] * 1.05)
-    ax.set_xlabel("frequency [Hz]")
+    low, _ = frequency_axis(ax, (0.0, band[1] * 1.05), np.concatenate(lowest or [[]]),
+                            frequency_scale=scale, label="frequency [Hz]")
+    ax.axvspan(max(band[0], low), band[1], color="tab:blue", alpha=0.06, label="cost band")
     ax.set_ylabel("transmissibility [dB]")
     ax.set_title("Simulated transmissibility (faint: untrusted bins)")
     ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
+    ax.grid(alpha=0.3, which="both")
     return fig
 
 
@@ -423,13 +429,15 @@ def plot_damping_effect(rows, delay_rows):
     return fig
 
 
-def plot_design(result):
+def plot_design(result, frequency_scale=None):
     """Every figure of a design.
 
     Parameters
     ----------
     result : DesignResult
         The design (:func:`qzs.workflows.design.driver.design_controller`).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the transmissibility figure; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -455,7 +463,8 @@ def plot_design(result):
         figures["damping"] = plot_damping_search(result.damping["rows"],
                                                  result.series.get("damping_curves", {}),
                                                  result.damping["chosen"],
-                                                 result.damping["bound"], s["band"], s["cost"])
+                                                 result.damping["bound"], s["band"], s["cost"],
+                                                 frequency_scale=frequency_scale)
     figures["margins"] = plot_margins(result.margins["table"], result.margins["required_rate"],
                                       s["gain_margin_min"], s["phase_margin_min"], s["delay"],
                                       result.margins.get("by_delay", ()))

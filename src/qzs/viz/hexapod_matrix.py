@@ -10,7 +10,8 @@ import numpy as np
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs._format import decibels
 from qzs.defaults import AXES, FIGURES
-from qzs.viz.figures import save_figure
+from qzs.viz.figures import (check_frequency_scale, frequency_axis, frequency_limits, nice_floor,
+                             save_figure)
 
 __all__ = ["plot_transmissibility_matrix", "AXES"]
 
@@ -19,7 +20,8 @@ _FLOOR = FIGURES["magnitude_floor"]
 
 def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trusted=None,
                                  frequency_range=None, floor_db=-80.0, title=None, out=None,
-                                 excited=None, linear_label=None, untrusted_below=None):
+                                 excited=None, linear_label=None, untrusted_below=None,
+                                 frequency_scale=None):
     """Draw the 6x6 transmissibility matrix; optionally write it.
 
     Parameters
@@ -51,6 +53,8 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
     untrusted_below : float, optional
         Shade the band below this frequency [Hz] grey: untrusted in every entry (e.g. a
         chirp's start).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -91,8 +95,12 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
     if excited.shape != (6,):
         raise ParameterError(f"`excited` must be six flags, one per base axis, got shape "
                              f"{excited.shape}.")
+    scale = check_frequency_scale(frequency_scale)
     positive = frequency > 0
-    low, high = frequency_range or (frequency[positive].min(), frequency[positive].max())
+    low, high = frequency_limits(frequency_range or (0.0, frequency[positive].max()),
+                                 frequency[positive], scale)
+    if scale == "log":
+        low = nice_floor(low)  # small panels label the decades only: let 0.1 Hz be one
     shown = positive & (frequency >= low) & (frequency <= high)
 
     fig, axes = plt.subplots(6, 6, sharex=True, figsize=(15, 12.5), constrained_layout=True)
@@ -132,8 +140,7 @@ def plot_transmissibility_matrix(frequency, *, linear=None, simulated=None, trus
                 ax.text(0.5, 0.5, "no trusted bin" if faint else f"< {floor_db:g} dB",
                         transform=ax.transAxes, ha="center", va="center", color="0.5",
                         fontsize=8)
-            ax.set_xscale("log")
-            ax.set_xlim(low, high)
+            frequency_axis(ax, (low, high), frequency_scale=scale, decades_only=True)
             ax.set_ylim(floor_db, top)
             if untrusted_below is not None and untrusted_below > low and excited[j]:
                 ax.axvspan(low, untrusted_below, color="0.92", zorder=0, lw=0)

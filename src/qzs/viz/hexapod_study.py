@@ -12,7 +12,7 @@ import numpy as np
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs._format import decibels
 from qzs.defaults import AXES, FIGURES
-from qzs.viz.figures import save_figure
+from qzs.viz.figures import check_frequency_scale, frequency_axis, frequency_limits, save_figure
 
 __all__ = ["plot_study_comparison", "AXES"]
 
@@ -20,7 +20,7 @@ _FLOOR = FIGURES["magnitude_floor"]
 
 
 def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=(0.1, 20.0),
-                          untrusted_below=None, title=None, out=None):
+                          untrusted_below=None, title=None, out=None, frequency_scale=None):
     """Draw chosen entries of several simulated matrices, one column per excited axis.
 
     Parameters
@@ -42,6 +42,8 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
         Figure title.
     out : str or Path, optional
         Write the figure there (atomically; a .png also as .svg).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -55,7 +57,9 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
     fig, axes = plt.subplots(rows, columns, sharex=True, figsize=(6.2 * columns, 2.7 * rows),
                              constrained_layout=True, squeeze=False,
                              gridspec_kw={"height_ratios": [1.0] * (rows - 1) + [0.6]})
-    low, high = frequency_range
+    scale = check_frequency_scale(frequency_scale)
+    low, high = frequency_limits(frequency_range,
+                                 np.concatenate([r.frequency for _, r in cases]), scale)
     for c, column in enumerate(entries):
         for r, (i, j) in enumerate(column):
             ax = axes[r, c]
@@ -81,8 +85,7 @@ def plot_study_comparison(cases, *, entries, coherence_min=0.9, frequency_range=
             top = 10 * np.ceil(np.nanmax(shown) / 10 + 0.05)
             bottom = max(10 * np.floor(np.nanmin(shown) / 10 - 0.05), top - 80)
             ax.set_ylim(bottom, top)
-            ax.set_xscale("log")
-            ax.set_xlim(low, high)
+            frequency_axis(ax, (low, high), frequency_scale=scale)
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
             kind = "transmissibility" if i == j else "cross-axis response"
             unit = entry_unit(i, j, dimensionless="-")

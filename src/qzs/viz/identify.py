@@ -88,7 +88,7 @@ def plot_friction_fit(fit, *, path=None, title=""):
     return fig
 
 
-def plot_transmissibility_fit(fit, *, path=None, title=""):
+def plot_transmissibility_fit(fit, *, path=None, title="", frequency_scale=None):
     """Measured and fitted transmissibility curves of a :class:`~qzs.identify.TransmissibilityFit`.
 
     Parameters
@@ -99,6 +99,8 @@ def plot_transmissibility_fit(fit, *, path=None, title=""):
         Write the figure there (a .png also as .svg).
     title : str
         Figure title.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -109,4 +111,4 @@ def plot_transmissibility_fit(fit, *, path=None, title=""):
               {"label": f"fitted model ({fitted})", "frequency": fit.frequency,
                "magnitude": fit.fitted}]
     return plot_transmissibility(curves, frequency_range=(0.0, float(fit.frequency[-1])),
-                                 title=title, path=path)
+                                 frequency_scale=frequency_scale, title=title, path=path)

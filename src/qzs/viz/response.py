@@ -9,7 +9,7 @@ import numpy as np
 
 from qzs._format import decibels
 from qzs.defaults import FIGURES
-from qzs.viz.figures import new_figure, save_figure
+from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure, save_figure
 
 __all__ = ["plot_response"]
 
@@ -44,7 +44,7 @@ def _draw_balance(axes, curve, values, scale=1.0):
             labelled.add(label)
 
 
-def plot_response(response, path=None, title=None):
+def plot_response(response, path=None, title=None, frequency_scale=None):
     """Draw a :class:`~qzs.workflows.response.result.SteadyStateResponse`.
 
     Parameters
@@ -55,6 +55,8 @@ def plot_response(response, path=None, title=None):
         Write the figure there (format from the extension; a .png also as .svg).
     title : str, optional
         Figure title; default names the amplitude and the step.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -62,15 +64,17 @@ def plot_response(response, path=None, title=None):
     """
     fig, (ax_t, ax_z, ax_l) = new_figure(3, height=2.4, height_ratios=(1.6, 1.0, 0.7))
     f_all = response.frequencies
-    log = f_all.size > 1 and f_all[-1] / f_all[0] >= 10
+    scale = check_frequency_scale(frequency_scale)
     curve = response.balance
     if response.linear:
-        ax_t.plot(response.linear["frequency"],
-                  decibels(response.linear["transmissibility"], _FLOOR), color="0.45", ls=":",
+        keep = drawn(response.linear["frequency"], scale)
+        ax_t.plot(np.asarray(response.linear["frequency"])[keep],
+                  decibels(np.asarray(response.linear["transmissibility"])[keep], _FLOOR),
+                  color="0.45", ls=":",
                   lw=1.2, label="linearised loop (no friction)", zorder=1)
     if response.chirp is not None:
         est = response.chirp
-        keep = (est.frequency >= f_all[0]) & (est.frequency <= f_all[-1])
+        keep = (est.frequency >= f_all[0]) & (est.frequency <= f_all[-1]) & (est.frequency > 0)
         trusted = est.trusted & keep
         ax_t.plot(est.frequency[keep], decibels(est.magnitude[keep], _FLOOR), color="C2",
                   lw=0.6, alpha=0.25, zorder=1)
@@ -135,13 +139,11 @@ def plot_response(response, path=None, title=None):
     ax_l.set_xlabel("frequency [Hz]")
     for ax in (ax_t, ax_z, ax_l):
         ax.grid(True, which="both", alpha=0.25)
-        if log:
-            ax.set_xscale("log")
-    if log:
-        ax_t.set_xlim(f_all[0] * 0.95, f_all[-1] * 1.05)
+    if scale == "log":
+        frequency_axis(ax_t, (f_all[0] * 0.95, f_all[-1] * 1.05), frequency_scale=scale)
     else:
         pad = 0.02 * np.ptp(f_all) if f_all.size > 1 else 0.1 * f_all[0]
-        ax_t.set_xlim(f_all[0] - pad, f_all[-1] + pad)
+        frequency_axis(ax_t, (f_all[0] - pad, f_all[-1] + pad), frequency_scale=scale)
     handles, labels = [], []
     for ax in (ax_t,):
         h, lab = ax.get_legend_handles_labels()

@@ -10,7 +10,7 @@ import json
 import numpy as np
 
 from qzs.errors import ParameterError
-from qzs.viz.figures import new_figure, save_figure
+from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure, save_figure
 
 __all__ = ["plot_metric", "plot_transmissibility_band", "scalar_outputs", "varied_parameters",
            "figure_suffixes", "REDUCTIONS", "FIGURE_BYTES"]
@@ -200,7 +200,7 @@ def _line(ax, frame, levels, reduce):
 
 
 def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), path=None,
-                               frequency_scale="log"):
+                               frequency_scale=None):
     """Median transmissibility and its percentile band over the cases of a sweep.
 
     Parameters
@@ -213,8 +213,8 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
         Lower and upper percentiles of the band [%].
     path : str or Path, optional
         Write the figure there.
-    frequency_scale : {"log", "linear"}
-        Frequency axis scale.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis scale; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -235,6 +235,9 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
             raise ParameterError(f"{by!r} has {len(distinct)} levels among the cases; "
                                  "the band plot takes at most 8 (choose a grid parameter).")
         levels = [(v, ok & (values == v)) for v in sorted(distinct)]
+    scale = check_frequency_scale(frequency_scale)
+    keep = drawn(frequency, scale)
+    frequency, curves = frequency[keep], curves[..., keep]
     fig, (ax,) = new_figure(1, height=4.2)
     for k, (value, mask) in enumerate(levels):
         chosen = curves[mask]
@@ -249,9 +252,9 @@ def plot_transmissibility_band(dataset, *, by=None, percentiles=(5.0, 95.0), pat
                         label=f"{percentiles[0]:g}-{percentiles[1]:g} % of the cases"
                         if k == 0 else "_nolegend_")
     ax.set_yscale("log")
-    ax.set_xscale(frequency_scale)
+    frequency_axis(ax, (0.0, float(frequency.max())), frequency, frequency_scale=scale,
+                   label="frequency [Hz]")
     ax.axhline(1.0, color="0.5", lw=0.8)
-    ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(_Y_LABEL)
     ax.set_title(_title(dataset, left_out))
     ax.grid(True, which="both", alpha=0.3)

@@ -10,7 +10,7 @@ import numpy as np
 
 from qzs._format import decibels
 from qzs.defaults import ANALYSIS, FIGURES
-from qzs.viz.figures import new_figure, save_figure
+from qzs.viz.figures import check_frequency_scale, frequency_axis, new_figure, save_figure
 
 __all__ = ["plot_transmissibility", "coinciding", "overlap_notes"]
 
@@ -131,9 +131,8 @@ def _ylimits(curves, frequency_range):
         f = np.asarray(curve["frequency"], dtype=float)
         keep = _trusted(curve) & _in_range(f, frequency_range)
         values.append(decibels(np.asarray(curve["magnitude"])[keep], _FLOOR))
-        if curve.get("linear") is not None and keep.any():
-            lowest = f[keep][0]
-            band = _in_range(f, frequency_range) & (f >= lowest)
+        if curve.get("linear") is not None:
+            band = _in_range(f, frequency_range)
             values.append(decibels(np.asarray(curve["linear"])[band], _FLOOR))
     values = np.concatenate(values) if values else np.array([])
     values = values[np.isfinite(values) & (values > decibels(_FLOOR))]
@@ -144,7 +143,7 @@ def _ylimits(curves, frequency_range):
     return low - pad, high + pad
 
 
-def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear", title="",
+def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), frequency_scale=None, title="",
                           path=None, untrusted_below=None, estimator="sqrt(S_payload/S_base)",
                           coherence_min=ANALYSIS["coherence_min"]):
     """Transmissibility curves in dB against frequency, and their coherence below.
@@ -161,9 +160,10 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
         (magnitude-squared, per bin), ``linear`` (the linearised model's magnitude on the
         same frequencies, drawn dashed in the same colour) and ``style`` (matplotlib kwargs).
     frequency_range : (float, float)
-        Axis limits [Hz].
-    scale : {"linear", "log"}
-        Frequency axis scale.
+        Axis limits [Hz]; a log axis starting at 0 starts at the lowest trusted bin
+        instead (:func:`qzs.viz.figures.frequency_limits`).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis scale; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
     title : str
         Figure title.
     path : str or Path, optional
@@ -181,6 +181,7 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
     """
     from matplotlib.lines import Line2D
 
+    scale = check_frequency_scale(frequency_scale)
     with_coherence = any(c.get("coherence") is not None for c in curves)
     if with_coherence:
         fig, (ax, cax) = new_figure(2, height=2.9, width=10.0, height_ratios=(3, 1))
@@ -226,20 +227,24 @@ def plot_transmissibility(curves, *, frequency_range=(0.0, 20.0), scale="linear"
     handles.append(Line2D([], [], color="0.45", lw=1.0, alpha=0.45,
                           label=f"faint: untrusted (coherence < {coherence_min:g} or no base power)"))
     axes = [ax] if cax is None else [ax, cax]
+    # a log axis starts at the lowest bin read: a trusted one, or the linearised model's
+    # (exact at every bin, it shows the resonance the chirp cannot reach)
+    shown = [np.asarray(c["frequency"], dtype=float)[_trusted(c)] for c in curves]
+    shown += [np.asarray(c["frequency"], dtype=float) for c in curves
+              if c.get("linear") is not None]
+    low, high = frequency_axis(ax, frequency_range, np.concatenate(shown or [[]]),
+                               frequency_scale=scale)
     if untrusted_below:
         for a in axes:
-            span = a.axvspan(frequency_range[0], untrusted_below, color="0.88", zorder=0,
+            span = a.axvspan(low, untrusted_below, color="0.88", zorder=0,
                              label=f"below {untrusted_below:g} Hz: untrusted after the high-pass")
         handles.append(span)
     ax.axhline(0.0, color="k", lw=0.6)
-    limits = _ylimits(curves, frequency_range)
+    limits = _ylimits(curves, (low, high))
     if limits is not None:
         ax.set_ylim(*limits)
     for a in axes:
-        a.set_xscale(scale)
         a.grid(True, which="both", alpha=0.3)
-    low = frequency_range[0] if scale == "linear" else max(frequency_range[0], 0.01)
-    ax.set_xlim(low, frequency_range[1])
     ax.set_ylabel(f"transmissibility [dB]\n{estimator}")
     longest = max(len(h.get_label()) for h in handles)
     for h in handles:

@@ -44,6 +44,7 @@ from qzs.iotools.readers import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.excitation import Chirp
+from qzs.viz.figures import check_frequency_scale
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -210,7 +211,8 @@ class ExperimentResult:
             return float("nan")
         return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
-    def plot(self, path: str | Path | None = None, title: str | None = None) -> Figure:
+    def plot(self, path: str | Path | None = None, title: str | None = None,
+             frequency_scale: str | None = None) -> Figure:
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
 
         Parameters
@@ -219,6 +221,8 @@ class ExperimentResult:
             Write the figure there (a .png also as .svg).
         title : str, optional
             Figure title; default the log's file name.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -226,7 +230,7 @@ class ExperimentResult:
         """
         from qzs.viz.experiment import plot_experiment
 
-        return plot_experiment(self, path=path, title=title)
+        return plot_experiment(self, path=path, title=title, frequency_scale=frequency_scale)
 
     def to_xarray(self) -> xr.Dataset:
         """Both curves on coordinate ``frequency`` [Hz] over the band, with a ``trusted`` flag
@@ -296,13 +300,17 @@ class ExperimentResult:
             "discrepancy_db": self.discrepancy_db(),
             "simulation_seconds": self.simulation_seconds, "notes": list(self.notes)}
 
-    def write_report(self, folder: str | Path) -> dict[str, Path]:
+    def write_report(self, folder: str | Path,
+                     frequency_scale: str | None = None) -> dict[str, Path]:
         """Write ``transmissibility.png`` (+ .svg), ``transmissibility.csv`` and ``report.md``.
 
         Parameters
         ----------
         folder : str or Path
             Output folder, created if missing.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the figure; default ``qzs.defaults.FIGURES["frequency_scale"]``
+            (log).
 
         Returns
         -------
@@ -315,7 +323,7 @@ class ExperimentResult:
         folder.mkdir(parents=True, exist_ok=True)
         paths = {"figure": folder / "transmissibility.png",
                  "table": folder / "transmissibility.csv", "report": folder / "report.md"}
-        plt.close(self.plot(path=paths["figure"]))
+        plt.close(self.plot(path=paths["figure"], frequency_scale=frequency_scale))
         write_dataset(self.to_xarray(), paths["table"])  # a units row under the names
         with atomic_path(paths["report"]) as tmp:
             Path(tmp).write_text(_markdown(self, paths["figure"].name), encoding="utf-8")
@@ -555,7 +563,8 @@ def _simulate_like(recording, kind, excitation, isolator, controller, corner, we
 def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
                    fft_length: int | None = None, n_averages: int | None = None,
                    config: str | Path | None = None, resample: bool = False,
-                   simulate_match: bool = True) -> tuple[ExperimentResult, dict[str, Path]]:
+                   simulate_match: bool = True,
+                   frequency_scale: str | None = None) -> tuple[ExperimentResult, dict[str, Path]]:
     """Read a log, process it (:func:`process_experiment`) and write its report (``qzs experiment``).
 
     The channel map's ``[experiment]`` table gives the high-pass corner [Hz], the chirp
@@ -581,6 +590,9 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
         Resample a non-uniform time base onto a uniform grid.
     simulate_match : bool
         Simulate the same chirp and process it the same way.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figure; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -598,6 +610,8 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
     """
     check_output_path(out, argument="out", suffixes=None, directory=True,
                       estimated_bytes=REPORT_BYTES)
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale)
     channel_map = load_channel_map(channel_map)
     settings = dict(channel_map.experiment)
     welch = {}
@@ -628,4 +642,4 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
         n_averages=welch.get("n_averages", EXPERIMENT_AVERAGES),
         isolator=isolator, controller=controller, simulate_match=simulate_match,
         excitation=excitation)
-    return result, result.write_report(out)
+    return result, result.write_report(out, frequency_scale=frequency_scale)

@@ -564,7 +564,7 @@ def linear_text(setup: HexapodSetup, model: HexapodLinearModel,
 def plot_linear_transmissibility(setup: HexapodSetup, model: HexapodLinearModel,
                                  out: str | Path, *,
                                  frequency_range: tuple[float, float] = (0.05, 50.0),
-                                 points: int = 400) -> Path:
+                                 points: int = 400, frequency_scale: str | None = None) -> Path:
     """Write the linear model's 6x6 transmissibility grid (:mod:`qzs.viz.hexapod_matrix`).
 
     Parameters
@@ -579,6 +579,9 @@ def plot_linear_transmissibility(setup: HexapodSetup, model: HexapodLinearModel,
         Band drawn [Hz], log-spaced.
     points : int
         Frequencies drawn.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -594,7 +597,7 @@ def plot_linear_transmissibility(setup: HexapodSetup, model: HexapodLinearModel,
     frequency = np.geomspace(*frequency_range, points)
     stability = "" if model.stable else " (linearly UNSTABLE: see the notes)"
     figure = plot_transmissibility_matrix(
-        frequency, linear=model, out=out,
+        frequency, linear=model, out=out, frequency_scale=frequency_scale,
         title=f"Linear transmissibility of the {setup.kind} hexapod, platform "
               f"{setup.platform.mass:.3g} kg{stability}")
     plt.close(figure)

@@ -46,6 +46,7 @@ from qzs.analysis.spectral import transmissibility_metrics
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
+from qzs.viz.figures import check_frequency_scale
 from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
 from qzs.workflows.hexapod_transmissibility.result import step_text
@@ -123,19 +124,21 @@ class HexapodStudyResult:
         """
         return _summary_text(self)
 
-    def plot(self, out: str | Path | None = None) -> "Figure":
+    def plot(self, out: str | Path | None = None, frequency_scale: str | None = None) -> "Figure":
         """The comparison figure of the cases (:func:`comparison_figure`).
 
         Parameters
         ----------
         out : str or Path, optional
             Write the figure there.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
         matplotlib.figure.Figure
         """
-        return comparison_figure(self.cases, out=out)
+        return comparison_figure(self.cases, out=out, frequency_scale=frequency_scale)
 
 
 # ---------------------------------------------------------------- metrics
@@ -367,7 +370,8 @@ def _findings(cases, rows):
 # ---------------------------------------------------------------- the run
 def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bool = False,
                       dt: float | None = None, tolerance_db: float | None = None,
-                      workers: int | None = None, progress: bool = True) -> HexapodStudyResult:
+                      workers: int | None = None, progress: bool = True,
+                      frequency_scale: str | None = None) -> HexapodStudyResult:
     """Run the shipped hexapod study and write its report (``qzs hexapod study``).
 
     Parameters
@@ -386,6 +390,9 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
         Processes per case (one per excited axis); default the machine's cores.
     progress : bool
         Show progress bars over each case's runs.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -400,6 +407,8 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     from qzs.iotools.paths import check_output_path
 
     check_output_path(folder, argument="folder", suffixes=None, directory=True)
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale)
     settings = RUNS["quick" if quick else "full"]
     setups = {label: load_hexapod(SHIPPED_DEFAULT, overrides)
               for label, (_, overrides) in CASES.items()}
@@ -415,7 +424,8 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     rows = tuple(_metrics_row(label, result, axis) for label, result in cases.items()
                  for axis in STUDY_AXES)
     findings = _findings(cases, rows)
-    files = write_study_outputs(cases, rows, findings, folder, quick=quick, wall_seconds=wall)
+    files = write_study_outputs(cases, rows, findings, folder, quick=quick, wall_seconds=wall,
+                                frequency_scale=frequency_scale)
     return HexapodStudyResult(cases=MappingProxyType(cases), rows=rows, findings=findings,
                               quick=quick, wall_seconds=wall, folder=Path(folder),
                               files=MappingProxyType(files))
@@ -447,7 +457,7 @@ def _slug(label):
     return label.lower().replace(" ", "_")
 
 
-def comparison_figure(cases, out=None):
+def comparison_figure(cases, out=None, frequency_scale=None):
     """The study's comparison figure: the direct and coupled entries of every case.
 
     Parameters
@@ -457,6 +467,9 @@ def comparison_figure(cases, out=None):
         (:attr:`HexapodStudyResult.cases`), the first the reference (PI).
     out : str or Path, optional
         Write the figure there (PNG and SVG beside it).
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -491,11 +504,12 @@ def comparison_figure(cases, out=None):
                f"{settings['duration']:g} s each\n"
                "solid: trusted bins; faint: untrusted; dashed: linear model (stable loops "
                "only); grey: the sweep's start, untrusted"),
-        out=out)
+        out=out, frequency_scale=frequency_scale)
     return figure
 
 
-def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seconds=None):
+def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seconds=None,
+                        frequency_scale=None):
     """Write the figures, matrices, ``metrics.csv``, ``metrics.json`` and ``report.md``.
 
     Parameters
@@ -512,6 +526,9 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
         Whether the runs were the quick ones.
     wall_seconds : float, optional
         Wall time of the runs [s].
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
+        (log).
 
     Returns
     -------
@@ -525,11 +542,12 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
     files = {}
     for label, result in cases.items():
         name = f"hexapod_matrix_{_slug(label)}"
-        figure = result.plot(out=folder / f"{name}.png")
+        figure = result.plot(out=folder / f"{name}.png", frequency_scale=frequency_scale)
         plt.close(figure)
         files[f"{name}.png"] = folder / f"{name}.png"
         files[f"{name}.nc"] = result.save(folder / f"{name}.nc")
-    plt.close(comparison_figure(cases, out=folder / f"{_FIGURE_COMPARISON}.png"))
+    plt.close(comparison_figure(cases, out=folder / f"{_FIGURE_COMPARISON}.png",
+                                frequency_scale=frequency_scale))
     files[f"{_FIGURE_COMPARISON}.png"] = folder / f"{_FIGURE_COMPARISON}.png"
     files[f"{_FIGURE_COMPARISON}.svg"] = folder / f"{_FIGURE_COMPARISON}.svg"
 

@@ -37,6 +37,7 @@ from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
 from qzs.model.registry import PARAMETERS, format_value, unit_of, update_parameters
+from qzs.viz.figures import check_frequency_scale
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
@@ -468,8 +469,11 @@ def curves_of(result, *, quick=False):
     return curves_dataset(_curves(result), attrs)
 
 
-def _figures(result, folder):
-    """Draw a study's views; returns ``[(figure name, png path, caption notes)]``."""
+def _figures(result, folder, frequency_scale=None):
+    """Draw a study's views; returns ``[(figure name, png path, caption notes)]``.
+
+    ``frequency_scale`` (``--frequency-axis``) overrides the views' own; else a view's
+    ``frequency_scale`` or the default (log) is used."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -496,7 +500,8 @@ def _figures(result, folder):
         path = folder / f"{view['figure']}.png"
         options = {} if coherence_min is None else {"coherence_min": coherence_min}
         fig = plot_transmissibility(curves, frequency_range=span,
-                                    scale=view.get("frequency_scale", "linear"),
+                                    frequency_scale=frequency_scale or view.get(
+                                        "frequency_scale"),
                                     title=study.title, path=path, untrusted_below=untrusted,
                                     **options)
         plt.close(fig)
@@ -607,25 +612,26 @@ def _settings(result):
     return {k: v[0] if len(v) == 1 else v for k, v in out.items()}
 
 
-def _draw(study_results, folder, workers):
+def _draw(study_results, folder, workers, frequency_scale=None):
     """Every study's figures (:func:`_figures`), in ``workers`` processes if more than one.
 
     Matplotlib holds the GIL, so figures draw in parallel only in processes; about 0.3 s
     a figure, 3 s for the paper's on one core. Returns ``{study name: drawn}``.
     """
     if workers <= 1:
-        return {r.study.name: _figures(r, folder) for r in study_results}
+        return {r.study.name: _figures(r, folder, frequency_scale) for r in study_results}
     from concurrent.futures import ProcessPoolExecutor
 
     # the studies with most views first, so that no process is left with two at the end
     order = sorted(study_results, key=lambda r: -len(r.study.views or [None]))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        drawn = {r.study.name: pool.submit(_figures, r, folder) for r in order}
+        drawn = {r.study.name: pool.submit(_figures, r, folder, frequency_scale)
+                 for r in order}
         return {r.study.name: drawn[r.study.name].result() for r in study_results}
 
 
 def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None,
-                        workers=None):
+                        workers=None, frequency_scale=None):
     """Write figures, curves, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
 
     The curves of each transmissibility study go to ``<study>_curves.nc`` and
@@ -644,6 +650,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         Wall time of the runs [s], recorded in the metrics and the report.
     workers : int, optional
         Processes drawing the figures; default all cores. 1 draws them in-process.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of every figure; default each view's own, else
+        ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -656,9 +665,11 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         ``workers`` not a positive integer.
     """
     workers = worker_count(workers, len(study_results))  # checked before anything is written
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    figures = _draw(study_results, folder, workers)
+    figures = _draw(study_results, folder, workers, frequency_scale)
     verdicts = decide_claims(study_results)
     rows = _metric_rows(study_results)
 
@@ -893,7 +904,9 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
               folder: str | Path = "results/paper", *, quick: bool = False,
               workers: int | None = None, progress: bool = True,
               argument: str = "folder", dt: float | None = None,
-              tolerance_db: float | None = None) -> tuple[list[StudyResult], list[Verdict], float]:
+              tolerance_db: float | None = None,
+              frequency_scale: str | None = None
+              ) -> tuple[list[StudyResult], list[Verdict], float]:
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
     Parameters
@@ -917,6 +930,9 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     tolerance_db : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets; default
         :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of every figure (``--frequency-axis``); default each view's own,
+        else ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
     Returns
     -------
@@ -939,6 +955,8 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
 
     check_output_path(folder, argument=argument, suffixes=None, directory=True,
                       estimated_bytes=PAPER_BYTES)
+    if frequency_scale is not None:
+        check_frequency_scale(frequency_scale, argument="frequency_scale")
     paths = shipped_studies() if definitions is None else definitions
     studies = [load_study(p) for p in paths]
     start = time.perf_counter()
@@ -946,5 +964,5 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
                           tolerance_db=tolerance_db)
     wall = time.perf_counter() - start
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
-                                   workers=workers)
+                                   workers=workers, frequency_scale=frequency_scale)
     return results, verdicts, wall

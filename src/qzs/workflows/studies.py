@@ -41,7 +41,7 @@ from qzs.analysis.linear import linearize
 from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
                                    transmissibility_metrics)
 from qzs.analysis.statistics import run_statistics
-from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
+from qzs.defaults import ACCURACY, ANALYSIS, FREQUENCY_SCALES, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
 from qzs.errors import ParameterError, ToleranceNotMetError
 from qzs.identify.spring import fit_spring
@@ -108,7 +108,7 @@ class Study:
         Ids of the paper's claims its cases decide (keys of :data:`CLAIMS`).
     views : tuple of dict
         Figures to draw: ``figure`` (file stem), ``frequency_range`` [Hz] and
-        optionally ``frequency_scale``.
+        optionally ``frequency_scale`` (``"log"``, the default, or ``"linear"``).
     defaults : dict
         Parameter overrides shared by every case (``[defaults]``).
     excitation : dict
@@ -290,6 +290,12 @@ def load_study(path):
             raise ParameterError(f"{str(path)!r}: unknown claim id {claim!r} in [study] claims; "
                                  f"known ids are {sorted(CLAIMS)}.")
     views = tuple(head.get("view", ()))
+    for view in views:
+        scale = view.get("frequency_scale")
+        if scale is not None and scale not in FREQUENCY_SCALES:
+            raise ParameterError(f"{str(path)!r}: [[study.view]] {view.get('figure')!r} has "
+                                 f"frequency_scale = {scale!r}; use one of "
+                                 f"{', '.join(FREQUENCY_SCALES)} or leave it out (log).")
     options = {**document.get("spring", {}), **document.get("processing", {})}
     return Study(name=head["name"], title=head.get("title", head["name"]), kind=kind,
                  cases=cases, claims=tuple(claims), views=views,

@@ -95,8 +95,14 @@ class DesignResult:
         """
         return design_text(self)
 
-    def plot(self) -> dict[str, Figure]:
+    def plot(self, frequency_scale: str | None = None) -> dict[str, Figure]:
         """Draw every figure of the design.
+
+        Parameters
+        ----------
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the transmissibility figure; default
+            ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -105,7 +111,7 @@ class DesignResult:
         """
         from qzs.viz.design import plot_design
 
-        return plot_design(self)
+        return plot_design(self, frequency_scale=frequency_scale)
 
     def curves(self) -> xr.Dataset | None:
         """The damping search's transmissibility curves as a dataset, one case per gain tried.
@@ -140,7 +146,8 @@ class DesignResult:
             attrs.update({"band": np.asarray(band, dtype=float), "band_units": "Hz"})
         return curves_dataset(curves, attrs)
 
-    def save(self, folder: str | Path) -> dict[str, Path]:
+    def save(self, folder: str | Path,
+             frequency_scale: str | None = None) -> dict[str, Path]:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
         search's curves (``damping_curves.nc`` and ``.csv``, :meth:`curves`) into ``folder``.
 
@@ -150,6 +157,9 @@ class DesignResult:
         ----------
         folder : str or Path
             The output folder, created if missing.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis of the transmissibility figure; default
+            ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -166,7 +176,7 @@ class DesignResult:
         folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
         folder.mkdir(parents=True, exist_ok=True)
         written = {}
-        for name, figure in plot_design(self).items():
+        for name, figure in plot_design(self, frequency_scale=frequency_scale).items():
             path = folder / f"{name}.png"
             save_figure(figure, path, also_svg=True)
             plt.close(figure)

@@ -126,7 +126,8 @@ class HexapodTransmissibility:
         """
         return transmissibility_dataset(self)
 
-    def plot(self, out: str | Path | None = None, *, title: str | None = None) -> Figure:
+    def plot(self, out: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> Figure:
         """The 6x6 grid with the linear model dashed (:func:`qzs.viz.hexapod_matrix.
         plot_transmissibility_matrix`); columns not excited are left empty.
 
@@ -136,6 +137,8 @@ class HexapodTransmissibility:
             Write the figure there (atomically; format from the suffix).
         title : str, optional
             Figure title; default one naming the platform and the run settings.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -148,7 +151,7 @@ class HexapodTransmissibility:
             trusted=self.trusted, excited=self.excited, frequency_range=_plot_range(self),
             title=title or default_title(self), out=out,
             linear_label=None if self.linear_stable else "linear model (UNSTABLE loop)",
-            untrusted_below=self.settings["trusted_from"])
+            untrusted_below=self.settings["trusted_from"], frequency_scale=frequency_scale)
 
     def save(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` as NetCDF (h5netcdf), atomically.

@@ -393,7 +393,8 @@ class SteadyStateResponse:
         """
         return response_dataset(self)
 
-    def plot(self, path: str | Path | None = None, title: str | None = None) -> Figure:
+    def plot(self, path: str | Path | None = None, title: str | None = None,
+             frequency_scale: str | None = None) -> Figure:
         """The figure (:func:`qzs.viz.response.plot_response`).
 
         Parameters
@@ -402,6 +403,8 @@ class SteadyStateResponse:
             Write the figure there (format from the extension).
         title : str, optional
             Figure title.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
@@ -409,7 +412,7 @@ class SteadyStateResponse:
         """
         from qzs.viz.response import plot_response
 
-        return plot_response(self, path=path, title=title)
+        return plot_response(self, path=path, title=title, frequency_scale=frequency_scale)
 
     def save(self, path: str | Path) -> Path:
         """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point),
