@@ -15,6 +15,7 @@
 ``accuracy``     :func:`choose_step`, the largest step meeting a tolerance
 ``driver``       the one run loop: plan, chunks, memory guard, preview, progress, signals
 ``periodic``     :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
+``compiling``    :func:`~qzs.engine.compiling.compile_notice`: say so while kernels compile
 ``hexapod``      subpackage: :func:`simulate_hexapod`, six isolator legs under a rigid platform
 ===============  ==================================================================
 """
