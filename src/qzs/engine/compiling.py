@@ -7,7 +7,7 @@ disk; later runs load it in well under a second. :func:`compile_notice` listens 
 compile events (``numba:compile``, sent only when a kernel really compiles, never when it is
 loaded from the cache): the first compile of a qzs kernel prints, at once, ::
 
-    qzs: compiling the kernels once (about 15 s; later runs start in about 1 s):
+    qzs: compiling the kernels once (about 15 s; later runs start in about 1 s): 1 2 3 s
 
 and while any kernel compiles the seconds since then follow, one a second: at the end of
 that line (`` 1 2 3 ...``, the line ends with the compile), or, while a progress bar is
@@ -140,6 +140,7 @@ class _Notice:
         self.cold = []  # the entry kernels that were to compile
         self.about = None  # the estimate of the whole, rescaled as kernels finish
         self.line_open = False  # our own line, ticks appended, not yet ended
+        self.ticked = False  # a tick was written on it
         self.bars = []  # the progress bars whose postfix shows the seconds
         self.wake = threading.Event()
         self.stopped = False
@@ -180,18 +181,16 @@ class _Notice:
             notice = NOTICE.format(seconds=self.seconds)
             bars = _progress_bars(self.stream)
             if bars or not self.ticking:
-                self._write_above(bars, notice + ("" if not self.ticking else ":") + "\n")
+                self._write_above(bars, notice + "\n")
             else:
-                self._write(notice + ":")
+                self._write(notice)
                 self.line_open = True
         self.wake.set()
 
     def _burst_ends(self):
         self.wake.clear()
         self._rescale()
-        if self.line_open:
-            self._write(" s\n")
-            self.line_open = False
+        self._end_line()
         for bar in self.bars:
             try:
                 bar.set_postfix_str("", refresh=True)
@@ -211,6 +210,12 @@ class _Notice:
             rest = sum(COMPILE_SECONDS.get(name, 5.0) for name in self.cold if name not in done)
             self.about = max(self.seconds, int(elapsed + rest * elapsed / expected + 0.5))
 
+    def _end_line(self):
+        """End our own line: with the unit after the seconds, if any were written."""
+        if self.line_open:
+            self._write(" s\n" if self.ticked else "\n")
+            self.line_open = self.ticked = False
+
     def _write_above(self, bars, text):
         """``text`` above the progress bars: clear them, write, draw them again."""
         for bar in bars:
@@ -227,18 +232,17 @@ class _Notice:
             seconds = int(time.perf_counter() - self.first + 0.5)
             bars = _progress_bars(self.stream)
             if bars:
-                if self.line_open:
-                    self._write(" s\n")
-                    self.line_open = False
+                self._end_line()
                 for bar in bars:
                     bar.set_postfix_str(f"compiling the kernels once, {seconds} s of about "
                                         f"{max(self.about, seconds)}", refresh=True)
                 self.bars = bars
             else:
                 if not self.line_open:
-                    self._write("qzs: compiling:")
+                    self._write("qzs: compiling")
                     self.line_open = True
-                self._write(f" {seconds}")
+                self._write(f"{'' if self.ticked else ':'} {seconds}")
+                self.ticked = True
 
     def run(self):
         """The ticker thread: :meth:`tick` every :data:`TICK` seconds while compiling."""
@@ -259,9 +263,7 @@ class _Notice:
         with self.lock:
             self.stopped = True
             self.wake.set()
-            if self.line_open:
-                self._write(" s\n")
-                self.line_open = False
+            self._end_line()
 
 
 @contextmanager
