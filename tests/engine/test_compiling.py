@@ -163,7 +163,8 @@ def _timed_stderr(argv, env, timeout):
 
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
-    stdout, _ = process.communicate(timeout=timeout)
+    stdout = process.stdout.read()  # stderr is the reader's alone (communicate would read it)
+    process.wait(timeout=timeout)
     reader.join(timeout=5)
     assert process.returncode == 0, b"".join(c for _, c in chunks).decode()
     return chunks, stdout, time.perf_counter() - start
@@ -192,12 +193,13 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     assert first <= startup + 4.0, (first, startup)
     notice_at = next(t for t, c in chunks if b"compiling the kernels once" in c)
     assert notice_at == first  # nothing else came before it
-    # until the last sign of compiling, no gap longer than the bound
+    # until the last sign of compiling, no gap longer than the bound: the ticker writes every
+    # second; a busy machine starves it now and then, as much as it slows the start-up
     last = max(t for t, c in chunks if b"compiling" in c or c.strip(b" s\n").isdigit())
-    times = [t for t, _ in chunks if t <= last]
-    gaps = [b - a for a, b in zip(times, times[1:])]
-    assert max(gaps, default=0.0) <= 4.0, gaps
-    assert len(times) >= 5  # it compiled for seconds, and said so more than once
+    told = [(t, c) for t, c in chunks if t <= last]
+    assert len(told) >= 5  # it compiled for seconds, and said so more than once
+    gap, where = max((b[0] - a[0], (a, b)) for a, b in zip(told, told[1:]))
+    assert gap <= max(4.0, 2.0 * startup), (gap, startup, where)
 
     # the same cache again: everything is loaded, nothing is said about compiling
     chunks, stdout, _ = _timed_stderr(argv, env, timeout=300)
