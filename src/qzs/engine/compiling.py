@@ -41,15 +41,16 @@ ENTRY_KERNELS = {
                 "qzs.engine.hexapod.stepping._run"),
 }
 #: Wall seconds each entry kernel takes to compile on a quiet 2-core VM (with what it calls
-#: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled), measured as CPU
-#: seconds on a busy one and scaled by the C reference run of benchmarks/c_reference (2.5 s
-#: when quiet) measured beside it; see benchmarks/README.md.
+#: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled): CPU seconds
+#: measured on a busy one, scaled by a run of the C reference model (benchmarks/c_reference,
+#: 2.5 s when quiet) measured beside it (benchmarks/README.md, "Cold start"); the batch
+#: kernel's from CONTRIBUTING.md's earlier figure.
 COMPILE_SECONDS = {
-    "qzs.engine.base_motion._series": 0.5, "qzs.engine.kernels.hold_force": 1.0,
-    "qzs.engine.kernels.evaluate": 1.5, "qzs.engine.lanes.run_single": 8.5,
-    "qzs.engine.lanes.run_lanes": 20.0,
-    "qzs.engine.hexapod.dynamics._rest_frame": 0.2, "qzs.engine.hexapod.dynamics._evaluate": 8.0,
-    "qzs.engine.hexapod.stepping._start": 3.5, "qzs.engine.hexapod.stepping._run": 5.0,
+    "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
+    "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
+    "qzs.engine.lanes.run_lanes": 30.0,
+    "qzs.engine.hexapod.dynamics._rest_frame": 0.2, "qzs.engine.hexapod.dynamics._evaluate": 9.0,
+    "qzs.engine.hexapod.stepping._start": 4.0, "qzs.engine.hexapod.stepping._run": 6.0,
 }
 #: The notice, with the estimate in whole seconds.
 NOTICE = "qzs: compiling the kernels once (about {seconds} s; later runs start in about 1 s)"
