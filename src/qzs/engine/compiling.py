@@ -109,7 +109,7 @@ def estimate(kernels):
     Returns
     -------
     int
-        The sum of :data:`COMPILE_SECONDS`, at least 5, to the next multiple of 5 above 10 s.
+        The sum of :data:`COMPILE_SECONDS`, at least 5, to the nearest multiple of 5 above 10 s.
     """
     seconds = sum(COMPILE_SECONDS.get(name, 5.0) for name in kernels)
     if seconds <= 10.0:
