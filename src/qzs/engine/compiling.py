@@ -41,10 +41,10 @@ ENTRY_KERNELS = {
                 "qzs.engine.hexapod.stepping._run"),
 }
 #: Wall seconds each entry kernel takes to compile on a quiet 2-core VM (with what it calls
-#: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled): CPU seconds
-#: measured on a busy one, scaled by a run of the C reference model (benchmarks/c_reference,
-#: 2.5 s when quiet) measured beside it (benchmarks/README.md, "Cold start"); the batch
-#: kernel's from CONTRIBUTING.md's earlier figure.
+#: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled): their compile CPU
+#: seconds (numba's compile events) scaled to the cold commands measured on 2026-11-26
+#: (benchmarks/README.md, "Cold start"); the batch kernel's from CONTRIBUTING.md's earlier
+#: figure.
 COMPILE_SECONDS = {
     "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
     "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
