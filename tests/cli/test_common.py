@@ -99,3 +99,57 @@ def test_the_frequency_axis_option_takes_log_or_linear_and_defaults_to_the_setti
     with pytest.raises(SystemExit) as stop:
         parser.parse_args(["--frequency-axis", "semilog"])
     assert stop.value.code == 2 and "invalid choice: 'semilog'" in capsys.readouterr().err
+
+
+def _fake_compile(module="qzs.engine.fake"):
+    """numba's compile events, as a kernel of ``module`` compiling would send them."""
+    from numba.core import event
+
+    def kernel():
+        pass
+
+    kernel.__module__ = module
+    data = {"dispatcher": argparse.Namespace(py_func=kernel)}
+    event.start_event("numba:compile", data=data)
+    event.end_event("numba:compile", data=data)
+
+
+def test_every_command_that_runs_kernels_names_real_families_and_real_commands():
+    from qzs.cli import build_parser
+    from qzs.cli.common import KERNEL_FAMILIES
+    from qzs.engine.compiling import ENTRY_KERNELS
+
+    commands = build_parser()._subparsers._group_actions[0].choices
+    for name, families in KERNEL_FAMILIES.items():
+        command, _, sub = name.partition(" ")
+        assert command in commands, name
+        if sub:
+            assert sub in commands[command]._subparsers._group_actions[0].choices, name
+        assert families and set(families) <= set(ENTRY_KERNELS), name
+    for command in ("simulate", "paper", "study", "sweep", "response", "design", "experiment",
+                    "app"):
+        assert command in KERNEL_FAMILIES, command
+
+
+@pytest.mark.parametrize("namespace, said", [
+    (dict(command="simulate", quiet=False, json=False), "ticking"),
+    (dict(command="simulate", quiet=True, json=False), "line"),
+    (dict(command="hexapod", hexapod_command="simulate", json=True, quiet=False), "line"),
+    (dict(command="hexapod", hexapod_command="linear"), "nothing"),  # runs no kernel
+    (dict(command="params"), "nothing"),
+])
+def test_a_compile_inside_a_command_is_said_on_stderr_only(capsys, namespace, said):
+    def handler(args):
+        _fake_compile()
+        print("result")
+        return 0
+
+    assert run_handler(handler, argparse.Namespace(**namespace)) == 0
+    out, err = capsys.readouterr()
+    assert out == "result\n"  # stdout is the command's alone (--json stays one JSON object)
+    if said == "nothing":
+        assert err == ""
+    else:
+        assert err.startswith("qzs: compiling the kernels once (about ")
+        assert err.count("\n") == 1
+        assert err.endswith("s)\n")  # no seconds: the compile took none

@@ -158,8 +158,8 @@ def warm_up(stream=None):
 
     stream = stream or sys.stderr
     start = time.perf_counter()
-    print("qzs app: warming the kernels (the first time they compile, about a minute; "
-          "later a few seconds) ...", file=stream, flush=True)
+    print("qzs app: warming the kernels (a few seconds; the first time they compile, and "
+          "`qzs: compiling the kernels once` says so) ...", file=stream, flush=True)
     data = compute_page(page_request())
     compute_page(page_request({"excitation.kind": "stepped", "frequency_count": 2}))
     figure_png(data)

@@ -31,7 +31,7 @@ from qzs.model.registry import update_parameters
 __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
-           "MEMORY_HINTS", "MEMORY_HINT"]
+           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
 
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
@@ -53,6 +53,16 @@ MEMORY_HINTS = {
     "paper": "choose fewer --workers, or --quick",
     "study": "choose fewer --workers, or --quick",
     "design": "choose fewer --workers, or --quick",
+}
+#: The kernel families (:data:`qzs.engine.compiling.ENTRY_KERNELS`) each subcommand runs
+#: (``hexapod <sub>`` for the six-axis ones): a first run on an empty kernel cache says that
+#: they compile, and about how long it takes. A subcommand not listed runs no kernel.
+KERNEL_FAMILIES = {
+    "simulate": ("single",), "experiment": ("single",), "response": ("single",),
+    "app": ("single",), "sweep": ("single", "batch"), "design": ("single", "batch"),
+    "paper": ("single", "batch"), "study": ("single", "batch"),
+    "hexapod simulate": ("hexapod",), "hexapod transmissibility": ("hexapod",),
+    "hexapod study": ("hexapod",),
 }
 #: What to do after running out of memory in any other subcommand.
 MEMORY_HINT = "close other programs, or ask for less (a shorter run, fewer cases)"
@@ -239,7 +249,10 @@ def run_handler(handler, args):
     """Run a subcommand's handler and map its outcome to the exit code (:data:`EXIT_CODES`).
 
     Every error ends as one line ``qzs: error: ...`` on stderr, never a traceback;
-    which exit code follows from the error's class, never from its message.
+    which exit code follows from the error's class, never from its message. When the
+    handler compiles kernels (a first run on an empty cache), a notice on stderr says so at
+    once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
+    with ``--quiet`` or ``--json`` the notice alone).
 
     Parameters
     ----------
@@ -259,7 +272,14 @@ def run_handler(handler, args):
         ``BrokenPipeError`` is left to :func:`qzs.cli.main` (141).
     """
     try:
-        return handler(args)
+        families = kernel_families(args)
+        if not families:
+            return handler(args)
+        from qzs.engine.compiling import compile_notice
+
+        quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
+        with compile_notice(families, ticking=not quiet):
+            return handler(args)
     except (SimulationError, FitError, WriteError) as error:  # WriteError before DataError
         return _fail(error, 1)
     except (ParameterError, DataError, MissingDependencyError) as error:
@@ -280,6 +300,31 @@ def run_handler(handler, args):
                      f"{memory_hint(args)}", 1)
 
 
+def _command(args):
+    """``args.command``, or ``hexapod <sub>`` for the six-axis subcommands."""
+    command = getattr(args, "command", None)
+    if command == "hexapod":
+        command = f"hexapod {getattr(args, 'hexapod_command', '')}"
+    return command
+
+
+def kernel_families(args):
+    """The kernel families the command ``args`` describe runs (:data:`KERNEL_FAMILIES`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace or None
+        The parsed arguments (``command``, and ``hexapod_command`` for ``qzs hexapod``).
+
+    Returns
+    -------
+    tuple of str
+        Keys of :data:`qzs.engine.compiling.ENTRY_KERNELS`; empty for a command that runs
+        no kernel.
+    """
+    return KERNEL_FAMILIES.get(_command(args), ())
+
+
 def memory_hint(args):
     """What to do after running out of memory in the command ``args`` describe.
 
@@ -294,10 +339,7 @@ def memory_hint(args):
         The options of that command that make it take less memory (:data:`MEMORY_HINTS`),
         else :data:`MEMORY_HINT`.
     """
-    command = getattr(args, "command", None)
-    if command == "hexapod":
-        command = f"hexapod {getattr(args, 'hexapod_command', '')}"
-    return MEMORY_HINTS.get(command, MEMORY_HINT)
+    return MEMORY_HINTS.get(_command(args), MEMORY_HINT)
 
 
 def _fail(error, code):

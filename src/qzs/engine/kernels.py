@@ -242,7 +242,7 @@ def _mechanical_energy(t, s, mode, P, E, table):
     return e[0] + e[1] + e[2] + e[3]
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _with(s, index, value):
     """Copy of state tuple ``s`` with entry ``index`` replaced by ``value``."""
     return (value if index == 0 else s[0], value if index == 1 else s[1],
@@ -251,7 +251,7 @@ def _with(s, index, value):
             value if index == 6 else s[6], value if index == 7 else s[7])
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _book_impulse(t, s, ledger, E, table, P):
     """Set v to exactly 0 and book the impulse that does it (closes the energy ledger).
 
@@ -275,7 +275,7 @@ def _settle(t, s, direction, held, P, E, table):
     crossing is located to round-off, so the impulse booked for it is negligible.
     """
     s = _book_impulse(t, s, S_D_FRICTION, E, table, P)
-    f_hold = rhs_at(t, s, MODE_STICK, 0.0, held, P, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, P, E, table)[1][F_HOLD]
     if abs(f_hold) <= P[P_FS]:
         return s, MODE_STICK, direction
     return s, MODE_SLIP, release_direction(MODE_STICK, f_hold)
@@ -290,11 +290,11 @@ def _hit_wall(t, s, low, held, P, E, table):
     ``(state, mode, direction)``.
     """
     s = _book_impulse(t, s, S_D_STOP, E, table, P)
-    before = _mechanical_energy(t, s, MODE_SLIP, P, E, table)
+    slip = np.int64(MODE_SLIP)
+    before = _mechanical_energy(t, s, slip, P, E, table)
     s = _with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH])
     # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
-    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, MODE_SLIP, P, E,
-                                                                    table))
+    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, slip, P, E, table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
     f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
     if hold_margin(mode, f_hold, P[P_FS]) < 0.0:
@@ -529,7 +529,7 @@ def evaluate(t, state, flags, p, ex, table, row, row_flags):
     s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
     held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
     E = excitation_tuple(ex)
-    phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, True)
+    phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, np.bool_(True))
     record(t, s, flags[I_MODE], flags[I_DIRECTION], held, params_tuple(p), E, table, row,
            row_flags, phase, sin0, cos0)
 
@@ -539,4 +539,5 @@ def hold_force(t, state, p, ex, table):
     """Force friction must supply to keep the payload stuck at ``state`` [N], and the forces."""
     s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
     held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
-    return rhs_at(t, s, MODE_STICK, 0.0, held, params_tuple(p), excitation_tuple(ex), table)[1]
+    return rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, params_tuple(p), excitation_tuple(ex),
+                  table)[1]

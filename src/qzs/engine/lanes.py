@@ -306,7 +306,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         L[_at(R_FAILED, c)] = 1.0
     step = step0
     row = row0
-    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
+    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, np.bool_(True))
     for _ in range(n_steps):
         t = step * h
         if sampled:
@@ -394,7 +394,7 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
     status = K.STATUS_OK
     row = row0
     margin = state[K.A_MARGIN]
-    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, True)
+    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, np.bool_(True))
     for _ in range(n_steps):
         t = step * h
         if control_steps > 0 and step % control_steps == 0:

@@ -33,6 +33,7 @@ measurements):
   side and the update as function arguments compiled to the same machine code for the event
   paths but cost compile time (see docs/model.md §9).
 """
+import numpy as np
 from numba import njit
 
 from qzs.engine.arithmetic import JIT as _JIT
@@ -239,7 +240,7 @@ def locate(trial, data, g0, g1, h, state):
     lo, hi = 0.0, h
     g_lo, g_hi = g0, g1
     at = h * g0 / (g0 - g1)
-    side = 0
+    side = np.int64(0)  # not a literal: illinois_step compiles once, for int64
     for _ in range(LOCATE_ITERATIONS):
         g, state = trial(at, data)
         done, at, lo, hi, g_lo, g_hi, side = illinois_step(at, g, g0, h, lo, hi, g_lo, g_hi,

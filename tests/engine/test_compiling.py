@@ -1,0 +1,207 @@
+"""The compile notice: said at once when a qzs kernel compiles, seconds while it does, else nothing."""
+import io
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba.core import event
+from numba.core.registry import CPUDispatcher
+
+from qzs.engine import compiling
+from qzs.engine.compiling import (COMPILE_SECONDS, ENTRY_KERNELS, compile_notice, cold_kernels,
+                                  estimate)
+
+SOURCE = Path(__file__).resolve().parents[2] / "src"
+
+
+class _Kernel:
+    """Stands for a numba dispatcher in a compile event: only its function's module counts."""
+
+    def __init__(self, module):
+        def kernel():
+            pass
+
+        kernel.__module__ = module
+        self.py_func = kernel
+
+
+def _compile(module, seconds, nested=()):
+    """Send numba's compile events as a compile of ``seconds`` would (``nested`` inside it)."""
+    data = {"dispatcher": _Kernel(module)}
+    event.start_event("numba:compile", data=data)
+    for inner in nested:
+        _compile(inner, 0.0)
+    time.sleep(seconds)
+    event.end_event("numba:compile", data=data)
+
+
+@pytest.fixture
+def fast_ticks(monkeypatch):
+    monkeypatch.setattr(compiling, "TICK", 0.1)
+
+
+def test_every_entry_kernel_is_a_cached_numba_kernel_with_an_estimate():
+    for family, names in ENTRY_KERNELS.items():
+        assert names, family
+        for name in names:
+            kernel = compiling._dispatcher(name)
+            assert isinstance(kernel, CPUDispatcher), name
+            assert kernel.targetoptions.get("cache") or kernel._cache is not None, name
+            assert 0.0 < COMPILE_SECONDS[name] < 60.0, name
+    assert set(COMPILE_SECONDS) == {n for names in ENTRY_KERNELS.values() for n in names}
+
+
+def test_the_estimate_is_the_sum_rounded_as_said():
+    assert estimate([]) == 5  # a kernel outside the table: still some seconds
+    assert estimate(["qzs.engine.lanes.run_single"]) == round(COMPILE_SECONDS[
+        "qzs.engine.lanes.run_single"])
+    total = sum(COMPILE_SECONDS[n] for n in ENTRY_KERNELS["single"])
+    assert estimate(ENTRY_KERNELS["single"]) % 5 == 0
+    assert abs(estimate(ENTRY_KERNELS["single"]) - total) <= 2.5
+
+
+def test_on_an_empty_cache_every_entry_kernel_is_cold_and_none_compiles(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=str(SOURCE))
+    probe = ("from qzs.engine.compiling import cold_kernels, ENTRY_KERNELS\n"
+             "from qzs.engine import lanes\n"
+             "print(cold_kernels(['single', 'hexapod']) == [*ENTRY_KERNELS['single'], "
+             "*ENTRY_KERNELS['hexapod']], cold_kernels([]), len(lanes.run_single.overloads))")
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                         text=True, check=True, timeout=120)
+    assert out.stdout.split() == ["True", "[]", "0"]
+
+
+def test_a_kernel_loaded_in_this_process_is_not_cold():
+    from qzs.engine import kernels as K
+
+    K.params_tuple(np.zeros(K.N_PARAMS))  # compiles (or loads) it here
+    assert compiling._dispatcher("qzs.engine.kernels.params_tuple").overloads
+    ENTRY_KERNELS_WITH = {"probe": ("qzs.engine.kernels.params_tuple",)}
+    original = dict(ENTRY_KERNELS)
+    try:
+        ENTRY_KERNELS.update(ENTRY_KERNELS_WITH)
+        assert cold_kernels(["probe"]) == []
+    finally:
+        ENTRY_KERNELS.clear()
+        ENTRY_KERNELS.update(original)
+
+
+def test_a_qzs_compile_is_announced_at_once_and_counted_until_it_ends(fast_ticks):
+    stream = io.StringIO()
+    with compile_notice(["single"], stream=stream):
+        start = time.perf_counter()
+        seen = []
+        thread = threading.Thread(target=_compile, args=("qzs.engine.fake", 0.55,
+                                                          ["numba.cpython.fake"]))
+        thread.start()
+        while thread.is_alive():
+            seen.append((time.perf_counter() - start, stream.getvalue()))
+            time.sleep(0.01)
+        thread.join()
+    text = stream.getvalue()
+    assert text.startswith("qzs: compiling the kernels once (about ")
+    assert "later runs start in about 1 s)" in text
+    first = next(t for t, shown in seen if shown)
+    assert first < 0.1  # at once, not when the compile ends
+    ticks = text.split(":", 2)[-1].split()
+    assert len(ticks) >= 4 and ticks[-1] == "s"  # a sign of life every TICK, then the unit
+    assert text.endswith(" s\n") and text.count("\n") == 1
+
+
+def test_a_compile_outside_qzs_or_no_compile_says_nothing(fast_ticks):
+    stream = io.StringIO()
+    with compile_notice(["single"], stream=stream):
+        _compile("numba.np.fake", 0.3)
+        time.sleep(0.3)
+    assert stream.getvalue() == ""
+
+
+def test_without_ticking_only_the_notice_line(fast_ticks):
+    stream = io.StringIO()
+    with compile_notice(["single"], stream=stream, ticking=False):
+        _compile("qzs.engine.fake", 0.4)
+        _compile("qzs.engine.fake", 0.3)  # a second compile: the notice is said once
+    assert stream.getvalue().count("\n") == 1
+    assert stream.getvalue().startswith("qzs: compiling the kernels once (about ")
+    assert stream.getvalue().endswith("s)\n")
+
+
+def test_under_a_progress_bar_the_seconds_go_into_its_postfix(fast_ticks):
+    from tqdm.std import tqdm
+
+    stream = io.StringIO()
+    with compile_notice(["single"], stream=stream):
+        bar = tqdm(total=10, file=stream, desc="simulating", mininterval=0)
+        try:
+            _compile("qzs.engine.fake", 0.5)
+            assert bar.postfix in (None, "")  # the bar is the caller's again
+        finally:
+            bar.close()
+    text = stream.getvalue()
+    assert "qzs: compiling the kernels once (about " in text
+    assert "compiling the kernels once, " in text.split("\n", 1)[1]  # in the bar's line
+    assert text.count("qzs: compiling") == 1  # the notice, no own line fighting with the bar
+
+
+def _timed_stderr(argv, env, timeout):
+    """Run ``argv``; return ``[(seconds since start, bytes)]`` of its stderr, and stdout."""
+    start = time.perf_counter()
+    process = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    chunks = []
+
+    def read():
+        while True:
+            chunk = os.read(process.stderr.fileno(), 4096)
+            if not chunk:
+                return
+            chunks.append((time.perf_counter() - start, chunk))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    stdout = process.stdout.read()  # stderr is the reader's alone (communicate would read it)
+    process.wait(timeout=timeout)
+    reader.join(timeout=5)
+    assert process.returncode == 0, b"".join(c for _, c in chunks).decode()
+    return chunks, stdout, time.perf_counter() - start
+
+
+@pytest.mark.slow
+def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path):
+    """A cold ``qzs simulate``: the notice within seconds, then no silence over a few seconds.
+
+    The bounds are generous for a busy 2-core machine (the ticker writes every second) and
+    still fail when the compile is silent: it takes 10-20 s on a quiet machine.
+    """
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(SOURCE))
+    env.pop("NUMBA_DISABLE_JIT", None)
+    # the same moment's start-up without any kernel: how long a warm run stays silent anyway
+    started = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "import qzs.cli, qzs.engine.simulate"], env=env,
+                   check=True, timeout=120)
+    startup = time.perf_counter() - started
+    argv = [sys.executable, "-m", "qzs", "simulate", "--duration", "0.2", "--plot", "none"]
+    chunks, stdout, _ = _timed_stderr(argv, env, timeout=900)
+    assert b"qzs simulation" in stdout
+    text = b"".join(c for _, c in chunks).decode()
+    assert "qzs: compiling the kernels once (about " in text
+    first = chunks[0][0]
+    assert first <= startup + 4.0, (first, startup)
+    notice_at = next(t for t, c in chunks if b"compiling the kernels once" in c)
+    assert notice_at == first  # nothing else came before it
+    # until the last sign of compiling, no gap longer than the bound: the ticker writes every
+    # second; a busy machine starves it now and then, as much as it slows the start-up
+    last = max(t for t, c in chunks if b"compiling" in c or c.strip(b" s\n").isdigit())
+    told = [(t, c) for t, c in chunks if t <= last]
+    assert len(told) >= 5  # it compiled for seconds, and said so more than once
+    gap, where = max((b[0] - a[0], (a, b)) for a, b in zip(told, told[1:]))
+    assert gap <= max(4.0, 2.0 * startup), (gap, startup, where)
+
+    # the same cache again: everything is loaded, nothing is said about compiling
+    chunks, stdout, _ = _timed_stderr(argv, env, timeout=300)
+    assert b"qzs simulation" in stdout
+    assert b"compiling" not in b"".join(c for _, c in chunks)
