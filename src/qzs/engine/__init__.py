@@ -1,6 +1,26 @@
 """The engine: numba kernels, the single and lockstep drivers, and the runs built on them.
 
-==================  ==========================================================="""
+==================  ==================================================================
+``arithmetic``      own exp/tanh and explicit fused multiply-adds (no fast-math)
+``laws``            the force laws, written once as numba functions
+``base_motion``     the excitation kernels
+``stickslip``       the stick-slip decisions and event location, once for every kernel
+``kernels``         right-hand side, Runge-Kutta steps, stick-slip events (one case)
+``lanes``           the drivers: one case, or many in lockstep
+``stability``       the solvers and their linear stability limit
+``prepare``         validation and packing shared by single and batch runs
+``simulate``        :func:`simulate`, the validated single run
+``batch``           :func:`simulate_batch`, many parameter sets at once
+``results``         :class:`SimulationResult`
+``accuracy``        :func:`choose_step`, the largest step meeting a tolerance
+``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
+``step_cache``      the step choices kept on disk, keyed by their inputs and the code
+``driver``          the one run loop: plan, chunks, memory guard, preview, progress, signals
+``periodic``        :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
+``compiling``       :func:`~qzs.engine.compiling.compile_notice`: say so while kernels compile
+``hexapod``         subpackage: :func:`simulate_hexapod`, six isolator legs under a rigid platform
+==================  ==================================================================
+"""
 from qzs._lazy import lazy_exports
 
 _EXPORTS = {
