@@ -45,7 +45,7 @@ def _add_step_options(parser):
                            "run's step chosen for --tolerance, else the file's dt)")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="tolerance of each run's step on its column of the matrix [dB] (default "
-                           f"{ACCURACY['tolerance_db']:g}, docs/hexapod.md §10.3)")
+                           f"{ACCURACY['tolerance_db']:g}, `qzs docs hexapod` §10.3)")
 
 
 def add_parser(subparsers):
@@ -110,8 +110,8 @@ def add_parser(subparsers):
     step = simulate.add_mutually_exclusive_group()
     step.add_argument("--dt", type=float, metavar="S",
                       help="a literal integration step [s] (default: the step chosen for "
-                           "the tolerance, halving down to the file's dt, docs/hexapod.md "
-                           "§10.3)")
+                           "the tolerance, halving down to the file's dt, `qzs docs "
+                           "hexapod` §10.3)")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="tolerance on the driven axis's transmissibility column [dB] (the "
                            f"default measure for a chirp along one axis; default "

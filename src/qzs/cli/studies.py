@@ -31,7 +31,7 @@ def add_parsers(subparsers):
         step.add_argument("--tolerance", type=float, metavar="DB",
                           help="choose one step per batch of cases, the largest keeping every "
                                "case's transmissibility within DB [dB] (default 0.01; "
-                               "docs/model.md §7); a study file's [simulation] dt is kept")
+                               "`qzs docs model` §7); a study file's [simulation] dt is kept")
         cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
                          help=f"output folder (default results/{name})")
         cmd.add_argument("--workers", type=int, metavar="N",
