@@ -74,6 +74,13 @@ def test_the_curve_files_redraw_the_figures_data(damping_study, drawn, tmp_path)
             np.testing.assert_array_equal(row["trusted"].values.astype(bool), curve["trusted"])
         # the parameters of the case, its default where the case does not set one
         assert float(from_nc["pi_kp"][i]) == curve["parameters"]["pi_kp"]
+    # the MATLAB file: the NetCDF's variables, (case, frequency) as MATLAB reads them
+    import scipy.io
+
+    from_mat = scipy.io.loadmat(tmp_path / "damping_curves.mat")
+    np.testing.assert_array_equal(from_mat["magnitude"], from_nc["magnitude"].values)
+    np.testing.assert_array_equal(from_mat["frequency"][:, 0], from_nc["frequency"].values)
+    assert from_mat["units"]["magnitude"][0, 0][0] == from_nc["magnitude"].attrs["units"]
     assert list(from_nc["damping_gain"].values) == [0.0, 50.0, 100.0]
     assert list(from_nc["pi_kp"].values)[1] == 60.0
     # the units: the schema's, the registry's for parameters, in both files
@@ -116,7 +123,7 @@ def test_a_curve_without_phase_or_coherence_is_nan_there(tmp_path):
     data = curves_dataset([{"label": "a", "frequency": [1.0, 2.0], "magnitude": [1.0, 0.5]}])
     assert np.isnan(data["phase"].values).all() and data["trusted"].values.all()
     paths = write_curves(data, tmp_path, "toy")
-    assert [p.name for p in paths] == ["toy_curves.nc", "toy_curves.csv"]
+    assert [p.name for p in paths] == ["toy_curves.nc", "toy_curves.csv", "toy_curves.mat"]
     xr.testing.assert_identical(xr.load_dataset(paths[0]).load(), write_dataset(
         data, tmp_path / "again.nc") and xr.load_dataset(tmp_path / "again.nc"))
 
@@ -149,7 +156,7 @@ def test_the_spring_data_holds_the_points_and_the_fitted_law(tmp_path):
     np.testing.assert_allclose(data["fitted_force"].values, -60.0 * np.tanh(80.0 * z),
                                rtol=1e-12)
     assert data["displacement"].attrs["units"] == "m" and data.attrs["spring_shape_units"] == "1/m"
-    nc, csv = write_curves(data, tmp_path, "spring")
+    nc, csv, _ = write_curves(data, tmp_path, "spring")
     table = pd.read_csv(csv, comment="#", header=[0, 1])
     assert list(table.columns) == [("displacement", "m"), ("force", "N"), ("fitted_force", "N")]
     xr.testing.assert_identical(xr.load_dataset(nc), data)

@@ -297,7 +297,7 @@ def test_study_cli_prints_json(tmp_path, capsys):
     outputs = record["outputs"]
     assert outputs["report"] == str(out / "report.html")
     assert str(out / "tiny.png") in outputs["figures"] and str(out / "tiny.svg") in outputs["figures"]
-    assert outputs["curves"] == [str(out / "tiny_curves.nc"), str(out / "tiny_curves.csv")]
+    assert outputs["curves"] == [str(out / f"tiny_curves{suffix}") for suffix in (".nc", ".csv", ".mat")]
     for path in (outputs["report"], outputs["metrics_json"], outputs["metrics_csv"],
                  *outputs["figures"], *outputs["curves"]):
         assert (tmp_path / path).exists() or __import__("pathlib").Path(path).exists()

@@ -534,20 +534,22 @@ def _csv_head(attrs, names, units):
 
 
 def write_dataset(dataset, path):
-    """Write a dataset built from a schema (``to_dataset``) to NetCDF or CSV, atomically.
+    """Write a dataset built from a schema (``to_dataset``) to NetCDF, CSV or MATLAB, atomically.
 
     ``.nc``: the dataset as it is (CF-1.10, h5netcdf). ``.csv``: one row per point of its
     dimensions (long format: a curve of each case one row per frequency), the
     coordinates first, then the data variables, laid out as :data:`CSV_LAYOUT` says (a
     row of names, a row of units from the variables' ``units``), the global attributes as
     ``# key = value [unit]`` header lines, numbers at the ``%.10g`` format, flags 0/1.
+    ``.mat``: the NetCDF's variables under the same names, units and attributes in
+    structs (:func:`qzs.iotools.matfile.write_mat`).
 
     Parameters
     ----------
     dataset : xarray.Dataset
         The data, with CF attributes (:func:`qzs.iotools.schema.to_dataset`).
     path : str or Path
-        Target file, ``.nc`` or ``.csv``; its folder is created if missing.
+        Target file, ``.nc``, ``.csv`` or ``.mat``; its folder is created if missing.
 
     Returns
     -------
@@ -562,7 +564,11 @@ def write_dataset(dataset, path):
         Writing failed (disk full, permissions); nothing is left behind.
     """
     path = Path(path)
-    suffix = _suffix(path, (".nc", ".csv"), "a dataset")
+    suffix = _suffix(path, (".nc", ".csv", ".mat"), "a dataset")
+    if suffix == ".mat":
+        from qzs.iotools.matfile import write_mat
+
+        return write_mat(dataset, path)
     try:
         with atomic_path(path) as tmp:
             if suffix == ".nc":

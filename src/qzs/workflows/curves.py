@@ -29,7 +29,7 @@ __all__ = ["curves_schema", "curves_dataset", "spring_schema", "spring_dataset",
            "CURVE_SUFFIXES"]
 
 #: The files :func:`write_curves` writes, by suffix.
-CURVE_SUFFIXES = (".nc", ".csv")
+CURVE_SUFFIXES = (".nc", ".csv", ".mat")
 _ON = ("case", "frequency")
 
 

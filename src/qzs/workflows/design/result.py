@@ -149,7 +149,8 @@ class DesignResult:
     def save(self, folder: str | Path,
              frequency_scale: str | None = None) -> dict[str, Path]:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
-        search's curves (``damping_curves.nc`` and ``.csv``, :meth:`curves`) into ``folder``.
+        search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
+        ``folder``.
 
         Each file is written atomically (a temporary file renamed onto it).
 
@@ -183,7 +184,8 @@ class DesignResult:
             written[name] = path
         curves = self.curves()
         if curves is not None:
-            written["curves_nc"], written["curves_csv"] = write_curves(curves, folder, "damping")
+            for path in write_curves(curves, folder, "damping"):
+                written[f"curves_{path.suffix.lstrip('.')}"] = path
         record = self.to_dict()
         with atomic_path(folder / "design.json") as tmp:
             tmp.write_text(json_text(record), encoding="utf-8")
