@@ -72,7 +72,7 @@ def run(args):
     lines.extend(f"  [{verdict.label}] {verdict.statement} ({verdict.study})\n"
                  f"      {verdict.evidence}" for verdict in verdicts)
     lines.append(f"wrote {Path(args.out) / 'report.html'}, metrics.json, metrics.csv, figures and "
-                 "their curves (<study>_curves.nc, .csv)")
+                 "their curves (<study>_curves.nc, .csv, .mat)")
     emit(args, "\n".join(lines),
          paper_summary(results, verdicts, args.out, quick=args.quick, wall_seconds=wall))
     return 0
