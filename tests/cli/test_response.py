@@ -67,3 +67,38 @@ def test_a_range_of_1e8_frequencies_fails_before_making_any():
         parse_frequencies(None, "0.5,20,100000000")
     assert time.perf_counter() - began < 0.5
     assert len(parse_frequencies(None, f"0.5,20,{MAX_FREQUENCIES}")) == MAX_FREQUENCIES
+
+
+def test_the_curve_is_written_beside_its_figure_with_a_units_row(tmp_path, capsys):
+    """The figure's data beside it (.nc, .csv with its units row, .mat), the same points."""
+    import numpy as np
+    import pandas as pd
+    import scipy.io
+    import xarray as xr
+
+    from qzs.cli import main
+
+    plot = tmp_path / "resp.png"
+    assert main(["response", "--frequencies", "3,6", "--direction", "up", "--dt", "1e-3",
+                 "--no-harmonic-balance", "--plot", str(plot), "--quiet"]) == 0
+    assert "resp.csv" in capsys.readouterr().out
+    netcdf = xr.load_dataset(tmp_path / "resp.nc")
+    table = pd.read_csv(tmp_path / "resp.csv", comment="#", header=[0, 1])
+    units = dict(table.columns)
+    assert units["frequency"] == "Hz" and units["transmissibility"] == "1"
+    assert units["phase"] == "rad" and units["relative_amplitude"] == "m"
+    np.testing.assert_allclose(table[("transmissibility", "1")].values,
+                               netcdf["transmissibility"].values.ravel(), rtol=1e-9)
+    mat = scipy.io.loadmat(tmp_path / "resp.mat")
+    np.testing.assert_array_equal(mat["frequency"].ravel(), netcdf["frequency"].values)
+
+
+def test_a_curve_file_beside_the_figure_that_cannot_be_written_fails_before_any_run(tmp_path,
+                                                                                     capsys):
+    from qzs.cli import main
+
+    (tmp_path / "resp.nc").mkdir()  # a folder where the curve file would go
+    assert main(["response", "--frequencies", "3", "--plot", str(tmp_path / "resp.png"),
+                 "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "--plot" in err and "resp.nc" in err

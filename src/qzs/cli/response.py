@@ -3,6 +3,8 @@
 It parses and delegates to :func:`qzs.workflows.response.steady_state_response`
 (docs/response.md); ``--json`` prints the list of points, one record each.
 """
+from pathlib import Path
+
 from qzs.cli.common import (add_frequency_axis_option, add_set_option, emit, integer_at_least,
                              parameters)
 from qzs.defaults import EXCITATION
@@ -90,7 +92,8 @@ def add_parser(subparsers):
     parser.add_argument("--out", metavar="FILE",
                         help="write the response to FILE (.nc, .csv, .json or .mat)")
     parser.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
-                        help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip)")
+                        help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip); "
+                             "its curve is written beside it as .nc, .csv and .mat")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_frequency_axis_option(parser)
     parser.add_argument("--json", action="store_true",
@@ -193,6 +196,7 @@ def run(args):
     """
     import sys
 
+    from qzs.workflows.curves import CURVE_SUFFIXES
     from qzs.workflows.response import RESPONSE_SUFFIXES, steady_state_response
 
     frequencies = parse_frequencies(args.frequencies, args.range, args.spacing)
@@ -202,8 +206,12 @@ def run(args):
     if amplitude is None:
         amplitude = config["excitation"].get("amplitude", EXCITATION["amplitude"])
     plot = None if args.plot.lower() == "none" else args.plot
+    beside = []  # the curve as data beside its figure: NetCDF, CSV and MATLAB
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+        beside = [Path(plot).with_suffix(suffix) for suffix in CURVE_SUFFIXES]
+        for path in beside:
+            check_output_path(path, argument="--plot", suffixes=RESPONSE_SUFFIXES)
     if args.out:
         check_output_path(args.out, argument="--out", suffixes=RESPONSE_SUFFIXES)
     options = {}
@@ -235,6 +243,9 @@ def run(args):
 
         plt.close(response.plot(path=plot, frequency_scale=args.frequency_axis))
         files["plot"] = plot
+        for path in beside:
+            response.save(path)
+            files[f"curve{path.suffix}"] = str(path)
     text = response.summary() + "".join(f"\n  wrote            {p}" for p in files.values())
     if args.json:
         for note in response.notes:

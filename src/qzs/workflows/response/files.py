@@ -215,7 +215,11 @@ def _json_safe(value):
 
 
 def _csv(response):
-    """The points as CSV: ``# key = value [unit]`` lines, a header, one row per point."""
+    """The points as CSV: ``# key = value [unit]`` lines, a row of names, a row of their
+    units (:data:`qzs.iotools.writer.CSV_LAYOUT`, the units of the NetCDF's variables), one
+    row per point."""
+    from qzs.iotools.writer import CSV_LAYOUT
+
     attrs = _parameter_attributes(response.isolator, response.controller)
     lines = [f"# amplitude = {response.amplitude!r} [m]", f"# dt = {response.dt!r} [s]",
              f"# solver = {response.solver}"]
@@ -226,7 +230,14 @@ def _csv(response):
              + [f"harmonic_{k}" for k in range(2, 2 + n_harm)]
              + [n for n in records[0] if n not in ("direction", "frequency", "transmissibility",
                                                   "phase", "harmonics")] if records else [])
+    dataset = response.to_xarray()
+    units = [dataset[name.split("_")[0] + "s" if name.startswith("harmonic_") else name]
+             .attrs.get("units", "") if (name.startswith("harmonic_") or name in dataset)
+             else "" for name in names]
+    header = len(lines) + 2  # the names' line, after the layout line
+    lines.append(f"# {CSV_LAYOUT.format(names=header, units=header + 1, data=header + 2)}")
     lines.append(",".join(names))
+    lines.append(",".join(units))
     for record in records:
         row = []
         for name in names:
