@@ -150,7 +150,9 @@ def _step_record(choice, settings):
     """The step as the JSON record gives it: literal, or chosen with its tolerance and error."""
     if choice is None:
         return {"dt": settings["dt"], "chosen": False}
-    unit = {"transmissibility_db": "dB", "state_m": "m"}[choice.measure]
+    from qzs.engine.accuracy import MEASURE_UNITS
+
+    unit = MEASURE_UNITS[choice.measure]
     return {"dt": choice.dt, "chosen": True, "measure": choice.measure, "unit": unit,
             "tolerance": choice.tolerance, "error": choice.error, "met": choice.met,
             "reference_dt": choice.reference_dt, "cached": choice.cached,

@@ -25,7 +25,7 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "choose_step_or_finest", "default_tolerance",
            "probe_excitation", "step_error", "halving_search", "admissible_step",
-           "step_run_entries", "estimate_difference_db"]
+           "step_run_entries", "estimate_difference_db", "MEASURE_UNITS"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -44,7 +44,8 @@ PROBE_SEGMENTS = 8
 #: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
 #: of times longer (:class:`~qzs.errors.ControllerRateError`).
 RATE_REFINEMENT_MAX = 32
-_MEASURES = {"transmissibility_db": "dB", "state_m": "m"}
+#: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
+MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
 #: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
 ADMISSIBLE_REFINEMENT = 1_000_000
 
@@ -118,7 +119,7 @@ class StepChoice:
         -------
         str
         """
-        unit = _MEASURES[self.measure]
+        unit = MEASURE_UNITS[self.measure]
         if not self.met:
             return "\n".join([f"dt = {self.dt:.6g} s ({self.solver}): no step tried meets the "
                               f"tolerance {self.tolerance:g} {unit}"]
@@ -229,7 +230,7 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
     float
         The difference, in [dB] or [m]; ``nan`` if no bin of the band is trusted in both.
     """
-    _choice("measure", measure, tuple(_MEASURES))
+    _choice("measure", measure, tuple(MEASURE_UNITS))
     if measure == "state_m":
         return float(np.max(np.abs(coarse.relative_position - fine.relative_position)))
 
@@ -544,7 +545,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         if bar is not None:
             bar.close()
     if chosen is None:
-        raise ToleranceNotMetError(tolerance, _MEASURES[measure], dt0 / 2 ** (max_halvings - 1),
+        raise ToleranceNotMetError(tolerance, MEASURE_UNITS[measure], dt0 / 2 ** (max_halvings - 1),
                                    min(h[2] for h in history), safety)
     j = chosen
     notes += _order_notes(differences[j], differences[j + 1], order)
@@ -583,7 +584,7 @@ def _from_record(record, probe, duration):
         choice = StepChoice(probe=probe, cached=True, **values)
     except (KeyError, TypeError, ValueError, IndexError):
         return None
-    if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in _MEASURES
+    if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in MEASURE_UNITS
             and math.isclose(choice.probe_duration, duration)):
         return None
     return choice
@@ -641,28 +642,22 @@ def choose_step_or_finest(excitation=None, isolator=None, controller=None, **opt
         excitation = run_inputs(excitation, isolator, controller)[0]
         measure, tolerance = _tolerance(options.get("tolerance_db"),
                                         options.get("tolerance_state"))
-        sample_rate = float(options.get("sample_rate", defaults.SIMULATION["sample_rate"]))
+        solver = options.get("solver", defaults.SIMULATION["solver"])
+        _, sample_rate, band, probe, duration = _probe_settings(
+            excitation, measure, solver,
+            options.get("sample_rate", defaults.SIMULATION["sample_rate"]), options.get("band"),
+            options.get("probe_duration"), options.get("fft_length"),
+            options.get("safety", SAFETY), options.get("max_halvings", MAX_HALVINGS))
         dt = min(defaults.SIMULATION["dt"], error.smallest_step)
         note = (f"no step down to {error.smallest_step:.3g} s met {tolerance:g} {error.unit} "
                 f"(smallest estimate {error.smallest_error:.3g} {error.unit}: stick-slip or stop "
                 f"contacts redraw the response at every step); running at dt = {dt:.3g} s, "
                 "whose error is not estimated")
-        band = None
-        if measure == "transmissibility_db":
-            band = _band(options.get("band"), excitation, sample_rate)
-        probe, duration = probe_excitation(
-            excitation, band or _frequency_range(excitation, sample_rate),
-            options.get("probe_duration"))
         return StepChoice(dt=dt, error=math.nan, measure=measure, tolerance=tolerance,
                           reference_dt=error.smallest_step, stability_limit=math.nan,
-                          sample_rate=sample_rate,
-                          solver=options.get("solver", defaults.SIMULATION["solver"]),
-                          probe=probe, probe_duration=float(duration), band=band, history=(),
+                          sample_rate=sample_rate, solver=solver, probe=probe,
+                          probe_duration=float(duration), band=band, history=(),
                           notes=(note,), met=False)
-
-
-#: Suffix of the run entries of a chosen step, by measure (their unit: dB or m).
-_RUN_SUFFIX = {"transmissibility_db": "db", "state_m": "m"}
 
 
 def step_run_entries(choice):
@@ -681,7 +676,7 @@ def step_run_entries(choice):
         :attr:`SimulationResult.run <qzs.engine.results.SimulationResult.run>` and the
         file's ``run.*`` attributes.
     """
-    suffix = _RUN_SUFFIX[choice.measure]
+    suffix = MEASURE_UNITS[choice.measure].lower()
     return {f"step_tolerance_{suffix}": float(choice.tolerance),
             f"step_error_{suffix}": float(choice.error)}
 

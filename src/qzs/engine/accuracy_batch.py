@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import (_MEASURES, SAFETY, StepChoice, _bound_notes, _estimate,
+from qzs.engine.accuracy import (MEASURE_UNITS, SAFETY, StepChoice, _bound_notes, _estimate,
                                  _order_notes, _probe_settings, _tolerance, admissible_step,
                                  step_error)
 from qzs.errors import ParameterError, ToleranceNotMetError
@@ -261,7 +261,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     finally:
         if bar is not None:
             bar.close()
-    unit = _MEASURES[measure]
+    unit = MEASURE_UNITS[measure]
     if not met:
         raise ToleranceNotMetError(tolerance, unit, dt0 / 2 ** (max_halvings - 1),
                                    min(best.values(), default=math.inf), safety)

@@ -804,15 +804,12 @@ def step_record(choice):
         and the tolerance: the names of :mod:`qzs.engine.accuracy`'s run entries),
         ``step_reference_dt`` [s], ``step_probe_duration`` [s] and ``step_reason``.
     """
-    import math
+    from qzs.engine.accuracy import MEASURE_UNITS, step_run_entries
 
-    suffix = "db" if choice.measure == "transmissibility_db" else "m"
-    unit = "dB" if suffix == "db" else "m"
-    met = not math.isnan(choice.error)
+    unit = MEASURE_UNITS[choice.measure]
     reason = (f"estimated error {choice.error:.2g} {unit} <= {choice.tolerance:g} {unit} / "
-              f"safety on a {choice.probe_duration:g} s probe" if met else choice.notes[-1])
-    return {"step": "accuracy-driven" if met else "set-up",
-            f"step_error_{suffix}": float(choice.error),
-            f"step_tolerance_{suffix}": choice.tolerance,
+              f"safety on a {choice.probe_duration:g} s probe" if choice.met
+              else choice.notes[-1])
+    return {"step": "accuracy-driven" if choice.met else "set-up", **step_run_entries(choice),
             "step_reference_dt": choice.reference_dt,
             "step_probe_duration": choice.probe_duration, "step_reason": reason}

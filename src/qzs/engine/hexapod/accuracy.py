@@ -35,15 +35,13 @@ import numpy as np
 
 from qzs import _validation, defaults
 from qzs._validation import choice as _choice
-from qzs.engine.accuracy import (MAX_HALVINGS, PROBE_DURATION, SAFETY, StepChoice, _band,
-                                 _frequency_range, _probe_fft_length, _tolerance,
-                                 admissible_step, estimate_difference_db, halving_search,
-                                 probe_excitation)
+from qzs.engine.accuracy import (MAX_HALVINGS, MEASURE_UNITS, PROBE_DURATION, SAFETY,
+                                 StepChoice, _band, _frequency_range, _probe_fft_length,
+                                 _tolerance, admissible_step, estimate_difference_db,
+                                 halving_search, probe_excitation)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 __all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error"]
-
-_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
 
 
 def hexapod_probe(excitation, band=None, probe_duration=None, duration=None,
@@ -129,7 +127,7 @@ def hexapod_step_error(coarse, fine, measure, *, axis=None, band=None, fft_lengt
     """
     from qzs.model.hexapod import platform_size
 
-    _choice("measure", measure, tuple(_UNITS))
+    _choice("measure", measure, tuple(MEASURE_UNITS))
     size = platform_size(coarse.geometry) if size is None else size
     scale = np.array([1.0, 1.0, 1.0, size, size, size])
     if measure == "state_m":
@@ -301,7 +299,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     finally:
         if bar is not None:
             bar.close()
-    unit = _UNITS[measure]
+    unit = MEASURE_UNITS[measure]
     common = dict(measure=measure, tolerance=tolerance, stability_limit=float(limit),
                   sample_rate=sample_rate, solver=solver, probe=probe,
                   probe_duration=float(length), band=band, history=tuple(history))
