@@ -29,16 +29,17 @@ from pathlib import Path
 
 import numpy as np
 
+from qzs.engine.arithmetic import _KERNEL_SOURCES
+
 __all__ = ["CACHE_ENV", "cache_folder", "cache_key", "load", "store"]
 
 #: Environment variable naming the folder of qzs's caches (the step choices go to ``steps/``).
 CACHE_ENV = "QZS_CACHE_DIR"
-#: The sources (below ``src/qzs``) a step choice depends on, besides the kernels numba caches.
-_SOURCES = ("engine/arithmetic.py", "engine/laws.py", "engine/stickslip.py",
-            "engine/base_motion.py", "engine/kernels.py", "engine/lanes.py",
-            "engine/prepare.py", "engine/simulate.py", "engine/stability.py",
-            "engine/accuracy.py", "engine/driver.py", "model/excitation.py",
-            "model/isolator.py", "model/controller.py", "analysis/spectral.py")
+#: The sources (below ``src/qzs``) a step choice depends on: the kernels' (whose fingerprint
+#: also guards numba's cache, :mod:`qzs.engine.arithmetic`) and the Python around them.
+_SOURCES = (*_KERNEL_SOURCES, "engine/prepare.py", "engine/simulate.py", "engine/stability.py",
+            "engine/accuracy.py", "engine/driver.py", "model/isolator.py",
+            "model/controller.py", "analysis/spectral.py")
 #: Version of the record's layout; a record of another version is ignored.
 _FORMAT = 1
 
