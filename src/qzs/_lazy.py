@@ -55,7 +55,9 @@ def import_in_background(*modules):
     Returns
     -------
     threading.Thread
-        The started thread (joining it is never needed).
+        The started thread. Join it before ending where other code may look the module up
+        in ``sys.modules`` rather than import it (it would find it half imported); an
+        ``import`` waits by itself.
     """
     def load():
         for name in modules:

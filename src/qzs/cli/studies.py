@@ -2,6 +2,7 @@
 from pathlib import Path
 
 from qzs.cli.common import add_frequency_axis_option, add_json_option, emit
+from qzs.defaults import ACCURACY
 from qzs.errors import ParameterError
 
 __all__ = ["add_parsers", "run"]
@@ -30,8 +31,9 @@ def add_parsers(subparsers):
                                "1e-4); default chosen for --tolerance")
         step.add_argument("--tolerance", type=float, metavar="DB",
                           help="choose one step per batch of cases, the largest keeping every "
-                               "case's transmissibility within DB [dB] (default 0.01; "
-                               "`qzs docs model` §7); a study file's [simulation] dt is kept")
+                               "case's transmissibility within DB [dB] (default "
+                               f"{ACCURACY['tolerance_db']:g}; `qzs docs model` §7); a study "
+                               "file's [simulation] dt is kept")
         cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
                          help=f"output folder (default results/{name})")
         cmd.add_argument("--workers", type=int, metavar="N",
