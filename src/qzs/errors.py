@@ -13,7 +13,7 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
            "ControllerRateError", "CountLimitError", "InvalidCasesError",
-           "SchedulerError", "AddressError", "Terminated",
+           "SchedulerError", "AddressError", "ProblemError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -151,6 +151,35 @@ class CountLimitError(ParameterError):
 
     def __reduce__(self):
         return type(self), (self.name, self.count, self.limit, self.items, self.fix)
+
+
+class ProblemError(ParameterError):
+    """A design problem file is invalid; raised before any design is evaluated.
+
+    Attributes
+    ----------
+    table : str
+        The table (``variables``, ``objectives[0]``, ``uncertain.mass``).
+    key : str
+        The key or parameter in it ('' for the table as a whole).
+    value : object
+        The value given.
+    fix : str
+        What is wrong and what to do.
+    source : str
+        The file (or "problem definition"); '' until known.
+    """
+
+    def __init__(self, table, key, value, fix, source=""):
+        self.table, self.key, self.value = str(table), str(key), value
+        self.fix, self.source = str(fix), str(source)
+        where = f"[{self.table}]" + (f" {self.key}" if self.key else "")
+        shown = f" = {self.value!r}" if self.value not in (None, "") else ""
+        prefix = f"{self.source}: " if self.source else ""
+        super().__init__(f"{prefix}{where}{shown}: {self.fix}.")
+
+    def __reduce__(self):
+        return type(self), (self.table, self.key, self.value, self.fix, self.source)
 
 
 class SchedulerError(ParameterError):

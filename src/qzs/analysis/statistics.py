@@ -6,7 +6,7 @@ summary.
 """
 import numpy as np
 
-__all__ = ["RunStatistics", "run_statistics", "STATISTICS", "SummaryStatistics",
+__all__ = ["RunStatistics", "run_statistics", "STATISTICS", "SATURATION", "SummaryStatistics",
            "SUMMARY_STATISTICS"]
 
 #: Statistics of a run: name -> (unit, description).
@@ -18,6 +18,10 @@ STATISTICS = {
     "locked_fraction": ("1", "fraction of samples locked"),
 }
 
+#: The statistic :class:`RunStatistics` adds where it knows the motor's limits.
+SATURATION = {"saturated_fraction": ("1", "fraction of samples where the loops ask for the "
+                                          "motor's limit or more")}
+
 
 class RunStatistics:
     """Statistics of ``n_cases`` runs, fed with consecutive blocks of samples.
@@ -27,11 +31,19 @@ class RunStatistics:
     stop_centers : array_like, shape (n_cases,)
         Centre of each case's stroke in relative position [m]: the peak stroke is
         measured from it.
+    force_limits : array_like, shape (n_cases,), optional
+        Each case's motor force limit [N]. Given, :meth:`result` adds
+        ``saturated_fraction`` (:data:`SATURATION`): the share of samples whose motor
+        force sits at the limit, which is where the loops ask for the limit or more (the
+        motor force is the loops' demand clipped to it).
     """
 
-    def __init__(self, stop_centers):
+    def __init__(self, stop_centers, force_limits=None):
         self.centers = np.atleast_1d(np.asarray(stop_centers, dtype=float))
         n = self.centers.size
+        self.limits = (None if force_limits is None
+                       else np.broadcast_to(np.asarray(force_limits, dtype=float), (n,)))
+        self.saturated = np.zeros(n)
         self.z_min = np.full(n, np.inf)
         self.z_max = np.full(n, -np.inf)
         self.peak = np.zeros(n)
@@ -63,13 +75,19 @@ class RunStatistics:
         self.force_squares[cases] += (motor_force ** 2).sum(axis=1)
         self.locked[cases] += locked.sum(axis=1)
         self.counted[cases] += z.shape[1]
+        if self.limits is not None:
+            at_limit = np.abs(motor_force) >= self.limits[cases, None] * (1.0 - 1e-9)
+            self.saturated[cases] += at_limit.sum(axis=1)
 
     def result(self):
         """The statistics so far: name (see :data:`STATISTICS`) -> array of shape (n_cases,)."""
         counted = np.maximum(self.counted, 1)
-        return {"z_min": self.z_min, "z_max": self.z_max, "peak_stroke": self.peak,
-                "motor_force_rms": np.sqrt(self.force_squares / counted),
-                "locked_fraction": self.locked / counted}
+        result = {"z_min": self.z_min, "z_max": self.z_max, "peak_stroke": self.peak,
+                  "motor_force_rms": np.sqrt(self.force_squares / counted),
+                  "locked_fraction": self.locked / counted}
+        if self.limits is not None:
+            result["saturated_fraction"] = self.saturated / counted
+        return result
 
 
 def run_statistics(relative_position, motor_force, locked, stop_center):
@@ -178,8 +196,7 @@ SUMMARY_STATISTICS = {
     "z_mean": ("m", "mean relative position"),
     "z_final": ("m", "last relative position"),
     "contact_fraction": ("1", "fraction of samples in contact with a stop"),
-    "saturated_fraction": ("1", "fraction of samples where the loops ask for the motor's "
-                                "limit or more"),
+    **SATURATION,
     "motor_force_peak": ("N", "largest |motor force|"),
     "energy_residual_max": ("J", "largest |energy-ledger residual|"),
     "base_work_max": ("J", "largest |work done by the base|"),

@@ -20,7 +20,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs._validation import worker_count
-from qzs.analysis.statistics import STATISTICS, RunStatistics
+from qzs.analysis.statistics import SATURATION, STATISTICS, RunStatistics
 from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
@@ -43,6 +43,7 @@ __all__ = ["BatchResult", "simulate_batch", "batch_schema", "STATS"]
 STATS = {
     "stop_contacts": ("1", "number of hard-stop contacts"),
     **STATISTICS,
+    **SATURATION,
     "stick_events": ("1", "number of stick events"),
     "steps": ("1", "integration steps done"),
 }
@@ -321,7 +322,8 @@ class _Lanes(driver.Stepper):
         self.out = np.empty((n, min(plan.samples, plan.chunk_samples), K.N_CHANNELS))
         self.out_flags = np.zeros((n, self.out.shape[1], 2), dtype=np.bool_)
         self.statistics = RunStatistics(0.5 * (self.params[:, K.P_Z_LOW]
-                                               + self.params[:, K.P_Z_HIGH]))
+                                               + self.params[:, K.P_Z_HIGH]),
+                                        force_limits=self.params[:, K.P_FMAX])
         self.bounds = np.linspace(0, n, workers + 1).astype(int)
         self.pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
         self.done = 0  # steps done

@@ -315,7 +315,7 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
     """
     out = definition.outputs
     spectral = bool(out["transmissibility"] or out["coherence"] or out["metrics"]
-                    or out["bands"])
+                    or out["bands"] or out["rms_bands"])
     channels = (["base_acceleration", "payload_acceleration"] if spectral else []) + [
         c for c in out["time_series"] if not spectral or c not in (
             "base_acceleration", "payload_acceleration")]
@@ -371,6 +371,10 @@ def _reduce(definition, base, payload, arrays, i):
         inside = band_mask(f, lo, hi, trusted=estimate.trusted)
         arrays[f"mean_transmissibility_{label}"][i] = (magnitude[inside].mean() if inside.any()
                                                        else np.nan)
+    for label, (lo, hi) in out["rms_bands"].items():
+        inside = band_mask(f, lo, hi, trusted=estimate.trusted)
+        arrays[f"rms_transmissibility_{label}"][i] = (
+            np.sqrt(np.mean(magnitude[inside] ** 2)) if inside.any() else np.nan)
     if out["metrics"]:
         metrics = transmissibility_metrics(f[keep], magnitude[keep],
                                            trusted=estimate.trusted[keep],

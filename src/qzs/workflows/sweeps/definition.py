@@ -60,7 +60,8 @@ SIMULATION_DEFAULTS = {"dt": None, "solver": SIMULATION["solver"],
                        "tolerance_db": ACCURACY["tolerance_db"]}
 #: Folder of the shipped sweep files, inside the package.
 SHIPPED = "workflows/sweep_files"
-OUTPUT_KEYS = ("stats", "metrics", "transmissibility", "coherence", "time_series", "bands")
+OUTPUT_KEYS = ("stats", "metrics", "transmissibility", "coherence", "time_series", "bands",
+               "rms_bands")
 METRICS = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",
            "rolloff_db_per_decade")
 _FORMAT = "qzs-sweep-1"
@@ -447,7 +448,7 @@ def _outputs(table, analysis):
     metrics = list(METRICS) + [f"transmissibility_at_{f:g}_hz"
                                for f in analysis["at_frequencies"]]
     outputs = {"stats": list(STATS), "metrics": metrics, "transmissibility": True,
-               "coherence": False, "time_series": [], "bands": {}, **given}
+               "coherence": False, "time_series": [], "bands": {}, "rms_bands": {}, **given}
     for key, valid in (("stats", list(STATS)), ("metrics", metrics),
                        ("time_series", [c for c in CHANNELS if c != "time"])):
         chosen = outputs[key]
@@ -461,24 +462,26 @@ def _outputs(table, analysis):
         if not isinstance(outputs[key], bool):
             raise ParameterError(f"`outputs.{key}` must be true or false, got "
                                  f"{outputs[key]!r}.")
-    bands = outputs["bands"]
-    if not isinstance(bands, dict):
-        raise ParameterError(f"`outputs.bands` must be a table name = [low, high], got "
-                             f"{bands!r}.")
     resolution = analysis["sample_rate"] / analysis["fft_length"]
     f = np.fft.rfftfreq(analysis["fft_length"], 1.0 / analysis["sample_rate"])
-    for label, edges in bands.items():
-        if not label.isidentifier():
-            raise ParameterError(f"band name {label!r} must be a plain identifier (letters, "
-                                 "digits, underscore).")
-        if (not isinstance(edges, list) or len(edges) != 2
-                or not 0 <= finite_real(f"bands.{label}", edges[0])
-                < finite_real(f"bands.{label}", edges[1])):
-            raise ParameterError(f"band {label!r} must be [low, high] with 0 <= low < high "
-                                 f"[Hz], got {edges!r}.")
-        if not np.any((f > 0) & (f >= edges[0]) & (f <= edges[1])):
-            raise ParameterError(f"band {label!r} {edges} Hz holds no frequency bin (resolution "
-                                 f"{resolution:.3g} Hz); widen it or raise `fft_length`.")
+    for key in ("bands", "rms_bands"):
+        bands = outputs[key]
+        if not isinstance(bands, dict):
+            raise ParameterError(f"`outputs.{key}` must be a table name = [low, high], got "
+                                 f"{bands!r}.")
+        for label, edges in bands.items():
+            if not label.isidentifier():
+                raise ParameterError(f"band name {label!r} must be a plain identifier "
+                                     "(letters, digits, underscore).")
+            if (not isinstance(edges, list) or len(edges) != 2
+                    or not 0 <= finite_real(f"{key}.{label}", edges[0])
+                    < finite_real(f"{key}.{label}", edges[1])):
+                raise ParameterError(f"band {label!r} must be [low, high] with 0 <= low < "
+                                     f"high [Hz], got {edges!r}.")
+            if not np.any((f > 0) & (f >= edges[0]) & (f <= edges[1])):
+                raise ParameterError(f"band {label!r} {edges} Hz holds no frequency bin "
+                                     f"(resolution {resolution:.3g} Hz); widen it or raise "
+                                     "`fft_length`.")
     return outputs
 
 

@@ -96,7 +96,8 @@ def schema(definition, n_time):
                                            "(not run or invalid, see status)"})
         else:
             variables[name] = (("case",), np.float64, np.nan, {"units": unit, "long_name": doc})
-    spectral = out["transmissibility"] or out["coherence"] or out["metrics"] or out["bands"]
+    spectral = (out["transmissibility"] or out["coherence"] or out["metrics"] or out["bands"]
+                or out["rms_bands"])
     if spectral:
         variables["n_averages"] = (("case",), np.int32, 0,
                                    {"long_name": "Welch segments averaged"})
@@ -109,6 +110,12 @@ def schema(definition, n_time):
             ("case",), np.float64, np.nan,
             {"units": "1", "band": [low, high],
              "long_name": f"mean transmissibility {low:g}-{high:g} Hz, amplitude ratio "
+                          "sqrt(S_payload/S_base)"})
+    for label, (low, high) in out["rms_bands"].items():
+        variables[f"rms_transmissibility_{label}"] = (
+            ("case",), np.float64, np.nan,
+            {"units": "1", "band": [low, high],
+             "long_name": f"RMS transmissibility {low:g}-{high:g} Hz, amplitude ratio "
                           "sqrt(S_payload/S_base)"})
     if out["transmissibility"]:
         variables["transmissibility"] = (("case", "frequency"), np.float64, np.nan,

@@ -1,0 +1,25 @@
+"""The design space: multi-objective optimisation, robust design and global sensitivity.
+
+A problem file (:mod:`.problem`) names the decision variables (registry parameters with
+bounds), the uncertain parameters (distributions), and the objectives and constraints
+(metrics of a run or of the linear analysis, :mod:`.metrics`). ``qzs optimize`` searches
+it with pymoo's NSGA-II, one lockstep batch per generation (:mod:`.optimizer`), keeping
+every evaluated design in a resumable Zarr store (:mod:`.store`); ``qzs sensitivity``
+ranks the parameters by Sobol or Morris indices (:mod:`.sensitivity`). The guide is
+``qzs docs design-space``.
+
+===============  ================================================================
+``problem``      problem files: variables, uncertainty, objectives, constraints
+``metrics``      the metrics, and a population evaluated in lockstep batches
+``optimizer``    NSGA-II over the problem, generation by generation (pymoo)
+``store``        the Zarr store of every evaluated design: resume, replay
+``result``       the Pareto set: files, figure, chosen design, report
+``sensitivity``  Sobol and Morris indices of the metrics (SALib)
+===============  ================================================================
+"""
+from qzs.workflows.design_space.metrics import METRICS, Evaluation, evaluate
+from qzs.workflows.design_space.problem import (DesignProblem, Goal, Uncertainty, Variable,
+                                                load_problem, shipped_problems)
+
+__all__ = ["load_problem", "shipped_problems", "DesignProblem", "Variable", "Uncertainty",
+           "Goal", "METRICS", "Evaluation", "evaluate"]

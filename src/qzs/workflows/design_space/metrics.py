@@ -1,0 +1,357 @@
+"""What a design is judged by: the metrics, and a population's evaluation in lockstep.
+
+A metric is a number per simulated case: a statistic of the run (peak stroke, RMS motor
+force, saturated and locked shares), a number of the transmissibility estimate (RMS or
+mean over a band, the value at a frequency, the isolation onset; trusted bins only,
+docs/model.md §10), or a number of the linear analysis at the setpoint, which needs no
+simulation (hunting amplitude at rest, stability margins, the linear transmissibility).
+
+:func:`evaluate` runs a population: every design crossed with every Monte Carlo draw
+(common random numbers), in batches through
+:func:`qzs.workflows.sweeps.backends.run_batch`, the task of every sweep, so a design
+gives exactly the numbers of a sweep's case and of :func:`qzs.simulate`. Cases that share
+their excitation and step run as one lockstep batch of the lane kernel.
+"""
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qzs.analysis.statistics import STATISTICS as RUN_STATISTICS
+from qzs.engine.batch import STATS
+
+__all__ = ["MetricDefinition", "METRICS", "STATISTICS", "metric_column", "sweep_outputs",
+           "Evaluation", "evaluate", "case_settings"]
+
+#: How the Monte Carlo draws of a design combine.
+STATISTICS = ("mean", "worst", "quantile")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MetricDefinition:
+    """One metric a goal can name.
+
+    Attributes
+    ----------
+    name : str
+        The metric's name in problem files.
+    units : str
+        Its unit.
+    description : str
+        One line.
+    source : {"run", "spectrum", "linear"}
+        A statistic of the simulated run, a number of its transmissibility estimate, or of
+        the linear analysis (no simulation).
+    options : tuple of str
+        Keys a goal gives with it: ``frequency`` [Hz] or ``band`` [Hz].
+    lowest, highest : float or None
+        Bounds the metric can never pass (a constraint beyond them is infeasible).
+    """
+
+    name: str
+    units: str
+    description: str
+    source: str
+    options: tuple = ()
+    lowest: float | None = None
+    highest: float | None = None
+
+
+def _run(name, lowest=0.0, highest=None):
+    unit, doc = STATS[name]
+    return MetricDefinition(name=name, units=unit, description=doc, source="run",
+                            lowest=lowest, highest=highest)
+
+
+#: Metrics by name.
+METRICS = {m.name: m for m in (
+    MetricDefinition(name="rms_transmissibility", units="1", source="spectrum",
+                     options=("band",), lowest=0.0,
+                     description="RMS transmissibility (amplitude ratio) over `band` "
+                                 "(default the analysis band), trusted bins"),
+    MetricDefinition(name="mean_transmissibility", units="1", source="spectrum",
+                     options=("band",), lowest=0.0,
+                     description="mean transmissibility (amplitude ratio) over `band`, "
+                                 "trusted bins"),
+    MetricDefinition(name="transmissibility_at", units="1", source="spectrum",
+                     options=("frequency",), lowest=0.0,
+                     description="transmissibility (amplitude ratio) at `frequency`, "
+                                 "interpolated between trusted bins"),
+    MetricDefinition(name="resonance_peak", units="1", source="spectrum", lowest=0.0,
+                     description="largest transmissibility in the analysis band"),
+    MetricDefinition(name="resonance_frequency", units="Hz", source="spectrum", lowest=0.0,
+                     description="frequency of the largest transmissibility"),
+    MetricDefinition(name="isolation_onset", units="Hz", source="spectrum", lowest=0.0,
+                     description="lowest frequency above which the transmissibility stays "
+                                 "below 1"),
+    MetricDefinition(name="minus_3db_frequency", units="Hz", source="spectrum", lowest=0.0,
+                     description="frequency where the transmissibility falls below -3 dB"),
+    _run("peak_stroke"),
+    _run("motor_force_rms"),
+    _run("saturated_fraction", highest=1.0),
+    _run("locked_fraction", highest=1.0),
+    _run("stop_contacts"),
+    _run("stick_events"),
+    MetricDefinition(name="hunting_amplitude", units="m", source="linear", lowest=0.0,
+                     description="predicted plateau of the stick-slip limit cycle at rest "
+                                 "(describing function; 0 where the loop does not hunt)"),
+    MetricDefinition(name="gain_margin", units="dB", source="linear",
+                     description="gain margin of the control loop at the setpoint"),
+    MetricDefinition(name="phase_margin", units="deg", source="linear",
+                     description="phase margin of the control loop at the setpoint (inf "
+                                 "where |L| never crosses 1)"),
+    MetricDefinition(name="linear_transmissibility_at", units="1", source="linear",
+                     options=("frequency",), lowest=0.0,
+                     description="transmissibility of the linearised loop at `frequency` "
+                                 "(no friction, no stops)"),
+)}
+assert set(RUN_STATISTICS) <= set(STATS)
+
+
+def _band_label(band):
+    return f"{band[0]:g}_to_{band[1]:g}_hz".replace(".", "p")
+
+
+def metric_column(metric, options):
+    """The name of a metric with its options, as evaluated and stored.
+
+    Parameters
+    ----------
+    metric : str
+        A name of :data:`METRICS`.
+    options : dict
+        ``frequency`` [Hz] or ``band`` [Hz], as the metric takes.
+
+    Returns
+    -------
+    str
+        ``transmissibility_at_12_hz``, ``rms_transmissibility_1_to_3_hz``, or ``metric``.
+    """
+    if "frequency" in options:
+        return f"{metric}_{options['frequency']:g}_hz"
+    if "band" in options:
+        return f"{metric}_{_band_label(options['band'])}"
+    return metric
+
+
+def sweep_outputs(goals, analysis):
+    """What the sweep behind a problem records for these goals.
+
+    Parameters
+    ----------
+    goals : sequence of Goal
+        The problem's objectives and constraints.
+    analysis : dict
+        The resolved analysis settings.
+
+    Returns
+    -------
+    analysis : dict
+        ``at_frequencies`` [Hz] the goals need.
+    outputs : dict
+        The sweep's ``[outputs]`` table (no curve).
+    """
+    stats, metrics, bands, rms, at = [], [], {}, {}, []
+    for goal in goals:
+        source = METRICS[goal.metric].source
+        if source == "run":
+            stats.append(goal.metric)
+        elif goal.metric == "transmissibility_at":
+            at.append(goal.options["frequency"])
+            metrics.append(goal.column)
+        elif goal.metric in ("rms_transmissibility", "mean_transmissibility"):
+            table = rms if goal.metric.startswith("rms") else bands
+            table[_band_label(goal.options["band"])] = goal.options["band"]
+        elif source == "spectrum":
+            metrics.append(goal.metric)
+    outputs = {"stats": list(dict.fromkeys(stats)), "metrics": list(dict.fromkeys(metrics)),
+               "transmissibility": False, "coherence": False, "bands": bands,
+               "rms_bands": rms}
+    return {"at_frequencies": list(dict.fromkeys(at))}, outputs
+
+
+def _sweep_name(goal):
+    """The sweep variable holding a goal's metric."""
+    if goal.metric == "rms_transmissibility":
+        return f"rms_transmissibility_{_band_label(goal.options['band'])}"
+    if goal.metric == "mean_transmissibility":
+        return f"mean_transmissibility_{_band_label(goal.options['band'])}"
+    return goal.column
+
+
+@dataclass(frozen=True, kw_only=True)
+class Evaluation:
+    """The metrics of a population, every design under every draw.
+
+    Attributes
+    ----------
+    designs : ndarray, shape (n_designs, n_variables)
+        The decision variables [their units].
+    values : dict of str to ndarray, shape (n_designs, n_samples)
+        Metric column -> its value per design and draw [the metric's unit]; NaN where the
+        run failed or the metric is undefined.
+    status : ndarray of int8, shape (n_designs, n_samples)
+        Sweep status per case (1 ok; see :data:`qzs.workflows.sweeps.store.STATUS`).
+    messages : list of list of str
+        Why a case failed ('' if ok).
+    steps : int
+        Integration steps done.
+    elapsed : float
+        Wall time [s].
+    """
+
+    designs: np.ndarray
+    values: dict
+    status: np.ndarray
+    messages: list = field(repr=False)
+    steps: int = 0
+    elapsed: float = 0.0
+
+    def goal_values(self, goals):
+        """Each goal's value per design: the draws combined by its statistic.
+
+        Returns
+        -------
+        ndarray, shape (n_designs, n_goals)
+            [each goal's unit]; NaN where a draw's value is undefined.
+        """
+        return np.column_stack([goal.aggregate(self.values[goal.column]) for goal in goals]) \
+            if goals else np.empty((len(self.designs), 0))
+
+
+def case_settings(problem, designs):
+    """One dict of parameter values per case: each design crossed with each draw.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    designs : ndarray, shape (n_designs, n_variables)
+        The decision variables [their units].
+
+    Returns
+    -------
+    list of dict
+        Design-major, draws fastest: case ``i * samples + k`` is design ``i`` under draw
+        ``k``.
+    """
+    draws = problem.draws()
+    names = [v.name for v in problem.variables]
+    settings = []
+    for row in np.asarray(designs, dtype=float):
+        design = dict(zip(names, row.tolist()))
+        for k in range(problem.samples):
+            settings.append({**design, **{name: float(v[k]) for name, v in draws.items()}})
+    return settings
+
+
+def _linear(problem, settings, columns, values, status, messages):
+    """The linear metrics of each case (python-control; no simulation)."""
+    from qzs.analysis.control_design.hunting import predict_hunting
+    from qzs.analysis.control_design.stability_margins import loop_margins
+    from qzs.analysis.linear import linear_transmissibility
+    from qzs.errors import ParameterError
+    from qzs.workflows.sweeps.backends import build_case
+
+    goals = {g.column: g for g in problem.goals if METRICS[g.metric].source == "linear"}
+    for c, case in enumerate(settings):
+        try:
+            isolator, controller, _, _ = build_case(problem.sweep, case)
+        except (ParameterError, TypeError) as error:
+            status[c], messages[c] = 2, str(error)
+            continue
+        margins = None
+        for column, goal in goals.items():
+            if goal.metric == "hunting_amplitude":
+                prediction = predict_hunting(isolator, controller)
+                value = prediction.amplitude if prediction.hunts else 0.0
+            elif goal.metric in ("gain_margin", "phase_margin"):
+                if margins is None:
+                    margins = loop_margins(isolator, controller)
+                value = getattr(margins, goal.metric)
+                if goal.metric == "phase_margin" and math.isnan(value) and margins.stable:
+                    value = math.inf  # |L| < 1 everywhere: no crossover to lose
+            else:
+                value = abs(complex(linear_transmissibility(goal.options["frequency"],
+                                                            isolator, controller)))
+            values[column][c] = value
+
+
+def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
+             progress=None):
+    """Evaluate designs: every design under every draw, in lockstep batches.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem; its ``sweep`` must have its step fixed (``simulation["dt"]``) when
+        any goal needs a simulation.
+    designs : array_like, shape (n_designs, n_variables)
+        The decision variables [their units], in the order of ``problem.variables``.
+    client : distributed.Client, optional
+        Run the batches on this Dask cluster (results are the same).
+    threads : int, optional
+        Threads per batch; default all cores locally, 1 on a cluster.
+    batch_size : int, optional
+        Cases per batch; default all of them locally (one lockstep batch), about two
+        batches per worker thread on a cluster.
+    progress : callable, optional
+        Called with the number of cases each finished batch held.
+
+    Returns
+    -------
+    Evaluation
+    """
+    from qzs.workflows.sweeps.backends import _dask, _local, run_batch  # noqa: F401
+
+    began = time.perf_counter()
+    designs = np.atleast_2d(np.asarray(designs, dtype=float))
+    n, samples = designs.shape[0], problem.samples
+    settings = case_settings(problem, designs)
+    total = len(settings)
+    columns = problem.columns
+    values = {column: np.full(total, np.nan) for column in columns}
+    status = np.ones(total, dtype=np.int8)
+    messages = [""] * total
+    steps = 0
+    simulated = [g for g in problem.goals if METRICS[g.metric].source != "linear"]
+    if simulated:
+        definition = problem.sweep
+        if definition.simulation["dt"] is None:
+            raise ValueError("the problem's step is not fixed yet: choose it first "
+                             "(qzs.workflows.design_space.optimizer.fix_step)")
+        if batch_size is None:
+            batch_size = total if client is None else max(
+                1, -(-total // (2 * sum(client.nthreads().values()))))
+        batches = [(a, min(a + batch_size, total)) for a in range(0, total, batch_size)]
+        if client is not None:
+            results = _dask(client, definition, batches, settings, 0,
+                            1 if threads is None else threads)
+        else:
+            results = _local(definition, batches, settings, 0, threads)
+        try:
+            for result in results:
+                start, arrays = result["start"], result["arrays"]
+                stop = start + len(arrays["status"])
+                status[start:stop] = arrays["status"]
+                messages[start:stop] = [str(m) for m in arrays["message"]]
+                for goal in simulated:
+                    column = np.asarray(arrays[_sweep_name(goal)], dtype=float)
+                    values[goal.column][start:stop] = column
+                steps += int(result["steps"])
+                if progress is not None:
+                    progress(stop - start)
+        finally:
+            results.close()
+        for column in values:  # a failed case defines no metric
+            values[column][status != 1] = np.nan
+    if any(METRICS[g.metric].source == "linear" for g in problem.goals):
+        _linear(problem, settings, columns, values, status, messages)
+        if not simulated and progress is not None:
+            progress(total)
+    return Evaluation(designs=designs,
+                      values={c: v.reshape(n, samples) for c, v in values.items()},
+                      status=status.reshape(n, samples),
+                      messages=[messages[i * samples:(i + 1) * samples] for i in range(n)],
+                      steps=steps, elapsed=time.perf_counter() - began)

@@ -1,0 +1,664 @@
+"""Design problems: decision variables, uncertain parameters, objectives and constraints.
+
+A problem file (TOML) says what a designer may change, what is uncertain, and what
+is wanted::
+
+    [problem]
+    name = "isolation_vs_effort"
+    title = "Transmissibility at 12 Hz against motor effort, any stiction 5-15 N"
+
+    [variables]                  # registry parameters (qzs params) with bounds
+    damping_gain = { low = 0.0, high = 300.0 }
+    pi_kp = { low = 1.0, high = 1000.0, scale = "log" }    # searched on log10
+    # integer = true rounds a variable to whole numbers
+
+    [parameters]                 # held fixed (registry names)
+    [excitation]                 # as in a sweep file: kind, amplitude, f0, f1, duration
+
+    [uncertain]                  # robust design: a distribution per parameter, or a list
+    stiction_force = { distribution = "uniform", low = 5.0, high = 15.0 }
+    mass = { values = [6.2, 6.4, 6.6] }
+
+    [robust]
+    samples = 8                  # Monte Carlo draws, the same for every design
+    seed = 1
+    method = "lhs"               # or "random"
+
+    [[objectives]]
+    metric = "transmissibility_at"
+    frequency = 12.0             # [Hz]
+    statistic = "mean"           # mean (default), worst, quantile (with quantile = 0.9)
+    # sense = "maximize" for a metric wanted large
+
+    [[constraints]]
+    metric = "peak_stroke"
+    max = 0.020                  # [m]; or min = ...
+    statistic = "worst"
+
+    [optimizer]                  # qzs optimize: pymoo's NSGA-II
+    population = 64
+    generations = 20
+    seed = 1
+
+    [sensitivity]                # qzs sensitivity: SALib
+    method = "sobol"             # or "morris"
+    samples = 256
+
+    [simulation]                 # as in a sweep file: solver, dt or tolerance_db
+    [analysis]                   # as in a sweep file: sample_rate, fft_length, band, ...
+
+Metrics are those of :data:`qzs.workflows.design_space.metrics.METRICS`. Every
+mistake is reported before any run, as a :class:`~qzs.errors.ProblemError` naming
+the table, the key, the value and the fix.
+"""
+import hashlib
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from qzs._validation import read_toml
+from qzs.errors import CountLimitError, ParameterError, ProblemError
+from qzs.iotools.shipped import resolve_shipped, shipped_files
+from qzs.model.registry import PARAMETERS
+from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_column
+from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
+                                             _distribution, _frozen, load_sweep)
+
+__all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem",
+           "shipped_problems", "TABLES", "MAX_SAMPLES"]
+
+TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
+          "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis")
+#: Folder of the shipped problem files, inside the package.
+SHIPPED = "workflows/problem_files"
+#: Most Monte Carlo draws per design: each is a simulation of every design.
+MAX_SAMPLES = 1024
+_FORMAT = "qzs-problem-1"
+SCALES = ("linear", "log")
+SENSES = ("minimize", "maximize")
+OPTIMIZER_DEFAULTS = {"algorithm": "nsga2", "population": 64, "generations": 20, "seed": 1}
+ALGORITHMS = ("nsga2",)
+SENSITIVITY_DEFAULTS = {"method": "sobol", "samples": 256, "seed": 1, "confidence": 0.95,
+                        "trajectories": 20, "levels": 4, "metrics": None}
+SENSITIVITY_METHODS = ("sobol", "morris")
+ROBUST_DEFAULTS = {"samples": 1, "seed": 1, "method": "lhs"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Variable:
+    """A decision variable: a registry parameter searched between bounds.
+
+    Attributes
+    ----------
+    name : str
+        Registry name (``pi_kp``) or ``excitation.<name>``.
+    low, high : float
+        Bounds [the parameter's unit].
+    scale : {"linear", "log"}
+        ``log``: searched and sampled on ``log10`` (both bounds positive).
+    integer : bool
+        Rounded to whole numbers.
+    units : str
+        The parameter's unit (from the registry).
+    """
+
+    name: str
+    low: float
+    high: float
+    scale: str = "linear"
+    integer: bool = False
+    units: str = ""
+
+    def to_unit(self, values):
+        """Map values of the search space (``log10`` for a log scale) to the parameter."""
+        values = np.asarray(values, dtype=float)
+        out = 10.0 ** values if self.scale == "log" else values
+        return np.round(out) if self.integer else out
+
+    @property
+    def search_bounds(self) -> tuple[float, float]:
+        """Bounds in the search space (``log10`` of them for a log scale)."""
+        if self.scale == "log":
+            return math.log10(self.low), math.log10(self.high)
+        return self.low, self.high
+
+
+@dataclass(frozen=True, kw_only=True)
+class Uncertainty:
+    """An uncertain parameter: a distribution, or a list of equally likely values.
+
+    Attributes
+    ----------
+    name : str
+        Registry name.
+    distribution : str
+        ``uniform``, ``normal``, ``lognormal``, ``loguniform`` or ``values``.
+    settings : dict
+        Its keys (``low``/``high``, ``mean``/``std``, ``median``/``sigma`` [the parameter's
+        unit; ``sigma`` of ``ln``], or ``values``).
+    units : str
+        The parameter's unit.
+    """
+
+    name: str
+    distribution: str
+    settings: dict
+    units: str = ""
+
+    def quantile(self, u):
+        """The parameter at probabilities ``u`` in (0, 1): inverse CDF."""
+        u = np.asarray(u, dtype=float)
+        if self.distribution == "values":
+            values = np.asarray(self.settings["values"], dtype=float)
+            return values[np.minimum((u * values.size).astype(int), values.size - 1)]
+        return _frozen(self.distribution, self.settings).ppf(u)
+
+    @property
+    def nominal(self) -> float:
+        """The median: the value a design is probed at when one value is needed."""
+        return float(self.quantile(0.5))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Goal:
+    """An objective or a constraint on one metric.
+
+    Attributes
+    ----------
+    metric : str
+        A name of :data:`~qzs.workflows.design_space.metrics.METRICS`.
+    column : str
+        The metric with its options, as evaluated (``transmissibility_at_12_hz``).
+    options : dict
+        The metric's options (``frequency`` [Hz], ``band`` [Hz]).
+    statistic : {"mean", "worst", "quantile"}
+        How the Monte Carlo draws of a design combine.
+    quantile : float or None
+        The probability of ``statistic = "quantile"``.
+    sense : {"minimize", "maximize"}
+        Objectives: which way is better. Constraints: ``minimize`` for an upper bound.
+    bound : float or None
+        Constraints: the bound [the metric's unit]; None for an objective.
+    units : str
+        The metric's unit.
+    """
+
+    metric: str
+    column: str
+    options: dict
+    statistic: str = "mean"
+    quantile: float | None = None
+    sense: str = "minimize"
+    bound: float | None = None
+    units: str = ""
+
+    @property
+    def label(self) -> str:
+        """Name of the goal's value: the column and its statistic (``peak_stroke_worst``)."""
+        if self.statistic == "quantile":
+            return f"{self.column}_q{self.quantile:g}"
+        return self.column if self.statistic == "mean" else f"{self.column}_{self.statistic}"
+
+    def describe(self) -> str:
+        """One line for people: ``peak_stroke (worst) <= 0.02 m``."""
+        stat = (f"quantile {self.quantile:g}" if self.statistic == "quantile"
+                else self.statistic)
+        if self.bound is None:
+            return f"{self.sense} {self.column} ({stat}) [{self.units}]"
+        op = "<=" if self.sense == "minimize" else ">="
+        return f"{self.column} ({stat}) {op} {self.bound:g} {self.units}"
+
+    def aggregate(self, values):
+        """Combine the draws of each design (last axis) into one number per design.
+
+        NaN draws (a metric the run does not define) make the design's value NaN.
+        """
+        values = np.asarray(values, dtype=float)
+        if self.statistic == "mean":
+            return values.mean(axis=-1)
+        if self.statistic == "worst":
+            return values.max(axis=-1) if self.sense == "minimize" else values.min(axis=-1)
+        q = self.quantile if self.sense == "minimize" else 1.0 - self.quantile
+        return np.quantile(values, q, axis=-1)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DesignProblem:
+    """A validated design problem (the TOML layout is in :mod:`.problem`).
+
+    Attributes
+    ----------
+    name, title : str
+        Short name (default store ``<name>.zarr``) and title.
+    variables : tuple of Variable
+        What is searched.
+    uncertain : tuple of Uncertainty
+        What is uncertain.
+    samples : int
+        Monte Carlo draws per design (1 without uncertainty).
+    seed : int
+        Seed of the draws (common random numbers: one set for every design).
+    sampling : {"lhs", "random"}
+        How the draws are made.
+    objectives, constraints : tuple of Goal
+        What is minimised (or maximised) and what is bounded.
+    optimizer, sensitivity : dict
+        Resolved ``[optimizer]`` and ``[sensitivity]`` settings.
+    sweep : SweepDefinition
+        The evaluation as a sweep: fixed parameters, excitation, simulation, analysis
+        and the outputs the metrics need (:func:`qzs.workflows.sweeps.backends.run_batch`
+        runs it).
+    document : dict
+        The parsed TOML file; its hash identifies the problem in a store.
+    source : str
+        Where it was read from.
+    """
+
+    name: str
+    title: str
+    variables: tuple
+    uncertain: tuple
+    samples: int
+    seed: int
+    sampling: str
+    objectives: tuple
+    constraints: tuple
+    optimizer: dict
+    sensitivity: dict
+    sweep: SweepDefinition = field(repr=False)
+    document: dict = field(repr=False)
+    source: str = ""
+
+    @property
+    def goals(self) -> tuple:
+        """Objectives, then constraints."""
+        return (*self.objectives, *self.constraints)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """Every metric column the goals need, in order, each once."""
+        return tuple(dict.fromkeys(goal.column for goal in self.goals))
+
+    @property
+    def hash(self) -> str:
+        """SHA-256 of the canonical problem document (what a store must match to resume)."""
+        text = json.dumps({"format": _FORMAT, "document": self.document}, sort_keys=True,
+                          default=str)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def draws(self):
+        """The Monte Carlo draws: uncertain name -> ndarray of shape (samples,).
+
+        The same for every design and every call (common random numbers), from ``seed``.
+        """
+        if not self.uncertain:
+            return {}
+        from scipy.stats import qmc
+
+        rng = np.random.default_rng(self.seed)
+        d = len(self.uncertain)
+        if self.sampling == "lhs":
+            u = qmc.LatinHypercube(d=d, rng=rng).random(self.samples)
+        else:
+            u = rng.random((self.samples, d))
+        u = np.clip(u, 1e-12, 1 - 1e-12)
+        return {p.name: p.quantile(u[:, j]) for j, p in enumerate(self.uncertain)}
+
+
+# ---------------------------------------------------------------- loading and validation
+def shipped_problems():
+    """Paths of the problem files shipped with qzs."""
+    return shipped_files(SHIPPED)
+
+
+def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
+    """Read and validate a design problem.
+
+    Parameters
+    ----------
+    source : str, Path or dict
+        A TOML file, the name of a shipped problem (``"isolation_vs_effort"``), or an
+        already parsed document.
+
+    Returns
+    -------
+    DesignProblem
+
+    Raises
+    ------
+    ProblemError
+        An unknown table, key, parameter or metric, empty bounds, a bad distribution or
+        statistic, no objective, or a constraint set no design can meet (its ``table``,
+        ``key``, ``value`` and ``fix`` attributes say which and what to do).
+    """
+    if isinstance(source, Mapping):
+        document, where, stem = dict(source), "problem definition", "problem"
+    else:
+        try:
+            path = resolve_shipped(source, SHIPPED, "problem", "problems")
+            document = read_toml(path, "problem file")
+        except ProblemError:
+            raise
+        except ParameterError as error:
+            raise ProblemError("file", "", source, str(error)) from None
+        where, stem = repr(str(path)), path.stem
+    return _problem(document, where, stem)
+
+
+def _fail(table, key, value, fix):
+    raise ProblemError(table, key, value, fix)
+
+
+def _table(document, name, kind=dict):
+    value = document.get(name, kind())
+    if not isinstance(value, kind):
+        shape = "table" if kind is dict else f"list of tables [[{name}]]"
+        _fail(name, "", value, f"[{name}] must be a {shape}")
+    return value
+
+
+def _known(table, name, allowed):
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        _fail(name, unknown[0], table[unknown[0]],
+              f"unknown key in [{name}]; allowed are: {', '.join(allowed)}")
+
+
+def _parameter_name(table, name, kind):
+    excitation = [f"excitation.{k}" for k in EXCITATION_PARAMETERS[kind]]
+    if name not in PARAMETERS and name not in excitation:
+        close = [p for p in (*PARAMETERS, *excitation) if p.split("_")[0] in name]
+        hint = f" (did you mean {', '.join(close[:4])}?)" if close else ""
+        _fail(table, name, name, f"not a parameter{hint}; `qzs params` lists them: "
+                                 f"{', '.join(sorted(PARAMETERS))}")
+    return PARAMETERS[name].unit if name in PARAMETERS else "-"
+
+
+def _number(table, key, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        _fail(table, key, value, "must be a finite number")
+    return float(value)
+
+
+def _variables(document, kind):
+    table = _table(document, "variables")
+    if not table:
+        _fail("variables", "", {}, "a problem needs at least one decision variable: add "
+                                   "[variables] with e.g. pi_kp = { low = 1.0, high = 1000.0 }")
+    variables = []
+    for name, spec in table.items():
+        units = _parameter_name("variables", name, kind)
+        where = f"variables.{name}"
+        if not isinstance(spec, dict):
+            _fail("variables", name, spec, "must be a table { low = ..., high = ... } "
+                                           "[the parameter's unit]")
+        _known(spec, where, ("low", "high", "scale", "integer"))
+        if "low" not in spec or "high" not in spec:
+            _fail("variables", name, spec, "needs both `low` and `high`")
+        low, high = _number(where, "low", spec["low"]), _number(where, "high", spec["high"])
+        if not low < high:
+            _fail("variables", name, [low, high], "empty bounds: `low` must be below `high`")
+        scale = spec.get("scale", "linear")
+        if scale not in SCALES:
+            _fail(where, "scale", scale, f"must be one of {SCALES}")
+        if scale == "log" and low <= 0:
+            _fail(where, "low", low, "a log scale needs `low` > 0; use scale = \"linear\" to "
+                                     "include zero")
+        integer = spec.get("integer", False)
+        if not isinstance(integer, bool):
+            _fail(where, "integer", integer, "must be true or false")
+        if integer and math.ceil(low) > math.floor(high):
+            _fail("variables", name, [low, high], "holds no whole number; widen the bounds")
+        variables.append(Variable(name=name, low=low, high=high, scale=scale, integer=integer,
+                                  units=units))
+    return tuple(variables)
+
+
+def _uncertain(document, kind, variables):
+    table = _table(document, "uncertain")
+    uncertain = []
+    for name, spec in table.items():
+        units = _parameter_name("uncertain", name, kind)
+        if name in variables:
+            _fail("uncertain", name, spec, "is also a decision variable; a parameter is either "
+                                           "searched or uncertain")
+        if isinstance(spec, dict) and "values" in spec:
+            _known(spec, f"uncertain.{name}", ("values",))
+            values = spec["values"]
+            if not isinstance(values, list) or not values:
+                _fail(f"uncertain.{name}", "values", values, "must be a non-empty list")
+            values = [_number(f"uncertain.{name}", "values", v) for v in values]
+            uncertain.append(Uncertainty(name=name, distribution="values",
+                                         settings={"values": values}, units=units))
+            continue
+        try:
+            distribution, settings = _distribution(name, spec)
+        except ParameterError as error:
+            allowed = ", ".join(DISTRIBUTIONS) + ", or { values = [...] }"
+            raise ProblemError("uncertain", name, spec, f"{error} (distributions: {allowed})") \
+                from None
+        uncertain.append(Uncertainty(name=name, distribution=distribution, settings=settings,
+                                     units=units))
+    return tuple(uncertain)
+
+
+def _goal(table, index, spec, constraint, analysis):
+    where = f"{table}[{index}]"
+    if not isinstance(spec, dict):
+        _fail(table, str(index), spec, "each entry must be a table with a `metric`")
+    allowed = ["metric", "statistic", "quantile", "frequency", "band"]
+    allowed += ["max", "min"] if constraint else ["sense"]
+    _known(spec, where, allowed)
+    metric = spec.get("metric")
+    if metric not in METRICS:
+        _fail(where, "metric", metric, "not a metric; metrics are: " + ", ".join(METRICS))
+    definition = METRICS[metric]
+    options = {}
+    for option in ("frequency", "band"):
+        if option in spec and option not in definition.options:
+            _fail(where, option, spec[option], f"metric {metric!r} takes no `{option}`")
+    if "frequency" in definition.options:
+        if "frequency" not in spec:
+            _fail(where, "frequency", None, f"metric {metric!r} needs `frequency` [Hz]")
+        frequency = _number(where, "frequency", spec["frequency"])
+        low, high = analysis["band"]
+        if not low < frequency <= high:
+            _fail(where, "frequency", frequency, f"must lie in the analysis band "
+                                                 f"{low:g}-{high:g} Hz ([analysis] band)")
+        options["frequency"] = frequency
+    if "band" in definition.options:
+        band = spec.get("band", list(analysis["band"]))
+        if (not isinstance(band, list) or len(band) != 2
+                or not 0 <= _number(where, "band", band[0]) < _number(where, "band", band[1])):
+            _fail(where, "band", band, "must be [low, high] with 0 <= low < high [Hz]")
+        options["band"] = [float(band[0]), float(band[1])]
+    statistic = spec.get("statistic", "mean")
+    if statistic not in STATISTICS:
+        _fail(where, "statistic", statistic, f"must be one of {STATISTICS}")
+    quantile = None
+    if statistic == "quantile":
+        if "quantile" not in spec:
+            _fail(where, "quantile", None, "statistic \"quantile\" needs `quantile` in (0, 1)")
+        quantile = _number(where, "quantile", spec["quantile"])
+        if not 0 < quantile < 1:
+            _fail(where, "quantile", quantile, "must lie strictly between 0 and 1")
+    elif "quantile" in spec:
+        _fail(where, "quantile", spec["quantile"], "applies to statistic = \"quantile\" only")
+    bound = None
+    if constraint:
+        if ("max" in spec) == ("min" in spec):
+            _fail(where, "max", spec.get("max"), "a constraint needs exactly one of `max` "
+                                                 "(an upper bound) or `min` (a lower bound)")
+        sense = "minimize" if "max" in spec else "maximize"
+        bound = _number(where, "max" if "max" in spec else "min", spec.get("max", spec.get("min")))
+    else:
+        sense = spec.get("sense", "minimize")
+        if sense not in SENSES:
+            _fail(where, "sense", sense, f"must be one of {SENSES}")
+    return Goal(metric=metric, column=metric_column(metric, options), options=options,
+                statistic=statistic, quantile=quantile, sense=sense, bound=bound,
+                units=definition.units)
+
+
+def _settings(document, name, defaults):
+    table = _table(document, name)
+    _known(table, name, tuple(defaults))
+    return {**defaults, **table}
+
+
+def _positive_int(table, key, value, limit=None):
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        _fail(table, key, value, "must be a whole number >= 1")
+    if limit is not None and value > limit:
+        raise CountLimitError(f"[{table}] {key}", value, limit, "draws" if key == "samples"
+                              else key, "use fewer")
+    return value
+
+
+def _infeasible(constraints):
+    """Pairs of bounds on one statistic of one metric that no value meets."""
+    for i, a in enumerate(constraints):
+        for b in constraints[i + 1:]:
+            if (a.label == b.label and a.sense != b.sense):
+                upper, lower = (a, b) if a.sense == "minimize" else (b, a)
+                if upper.bound < lower.bound:
+                    _fail("constraints", upper.column, [lower.bound, upper.bound],
+                          f"no design can meet both `min = {lower.bound:g}` and "
+                          f"`max = {upper.bound:g}` on {upper.label}: the set is infeasible")
+    for goal in constraints:
+        floor = METRICS[goal.metric].lowest
+        if goal.sense == "minimize" and floor is not None and goal.bound < floor:
+            _fail("constraints", goal.column, goal.bound,
+                  f"{goal.metric} is never below {floor:g} {goal.units}: no design meets "
+                  f"`max = {goal.bound:g}`")
+        top = METRICS[goal.metric].highest
+        if goal.sense == "maximize" and top is not None and goal.bound > top:
+            _fail("constraints", goal.column, goal.bound,
+                  f"{goal.metric} is never above {top:g} {goal.units}: no design meets "
+                  f"`min = {goal.bound:g}`")
+
+
+def _problem(document, where, stem):
+    try:
+        _known(document, "top level", TABLES)
+        head = _table(document, "problem")
+        _known(head, "problem", ("name", "title", "description"))
+        name = str(head.get("name", stem))
+        excitation = _table(document, "excitation")
+        kind = excitation.get("kind", "chirp")
+        if kind not in EXCITATION_PARAMETERS:
+            _fail("excitation", "kind", kind, f"must be one of {tuple(EXCITATION_PARAMETERS)}")
+        variables = _variables(document, kind)
+        names = [v.name for v in variables]
+        uncertain = _uncertain(document, kind, names)
+        fixed = _table(document, "parameters")
+        for key in fixed:
+            if key in names or key in [u.name for u in uncertain]:
+                _fail("parameters", key, fixed[key], "is also searched or uncertain; remove it "
+                                                     "from [parameters]")
+        robust = _settings(document, "robust", ROBUST_DEFAULTS)
+        if uncertain:
+            samples = _positive_int("robust", "samples", robust["samples"], MAX_SAMPLES)
+        else:
+            if "samples" in _table(document, "robust"):
+                _fail("robust", "samples", robust["samples"], "draws apply to [uncertain] "
+                                                              "parameters; there are none")
+            samples = 1
+        if robust["method"] not in ("lhs", "random"):
+            _fail("robust", "method", robust["method"], "must be \"lhs\" or \"random\"")
+        if isinstance(robust["seed"], bool) or not isinstance(robust["seed"], int) \
+                or robust["seed"] < 0:
+            _fail("robust", "seed", robust["seed"], "must be a whole number >= 0")
+        base = _sweep(document, name, variables, uncertain)
+        objectives = tuple(_goal("objectives", i, spec, False, base.analysis)
+                           for i, spec in enumerate(_table(document, "objectives", list)))
+        if not objectives:
+            _fail("objectives", "", [], "a problem needs at least one objective: add "
+                                        "[[objectives]] with metric = \"...\"")
+        constraints = tuple(_goal("constraints", i, spec, True, base.analysis)
+                            for i, spec in enumerate(_table(document, "constraints", list)))
+        sweep = _sweep(document, name, variables, uncertain, (*objectives, *constraints))
+        _infeasible(constraints)
+        if not uncertain:
+            for goal in (*objectives, *constraints):
+                if goal.statistic != "mean":
+                    _fail("objectives" if goal.bound is None else "constraints", goal.column,
+                          goal.statistic, "a statistic over draws needs [uncertain] "
+                                          "parameters; leave `statistic` out")
+        optimizer = _settings(document, "optimizer", OPTIMIZER_DEFAULTS)
+        if optimizer["algorithm"] not in ALGORITHMS:
+            _fail("optimizer", "algorithm", optimizer["algorithm"], f"must be one of {ALGORITHMS}"
+                                                                    " (pymoo's NSGA-II)")
+        for key in ("population", "generations"):
+            _positive_int("optimizer", key, optimizer[key], 100_000)
+        if optimizer["population"] < 4:
+            _fail("optimizer", "population", optimizer["population"], "NSGA-II needs at least "
+                                                                      "4 designs per generation")
+        if isinstance(optimizer["seed"], bool) or not isinstance(optimizer["seed"], int):
+            _fail("optimizer", "seed", optimizer["seed"], "must be a whole number")
+        sensitivity = _sensitivity(document, objectives, constraints)
+    except ProblemError as error:
+        if error.source:
+            raise
+        raise ProblemError(error.table, error.key, error.value, error.fix, source=where) \
+            from None
+    return DesignProblem(name=name, title=str(head.get("title", name)), variables=variables,
+                         uncertain=uncertain, samples=samples, seed=int(robust["seed"]),
+                         sampling=robust["method"], objectives=objectives,
+                         constraints=constraints, optimizer=optimizer, sensitivity=sensitivity,
+                         sweep=sweep, document=document, source=where)
+
+
+def _sensitivity(document, objectives, constraints):
+    settings = _settings(document, "sensitivity", SENSITIVITY_DEFAULTS)
+    if settings["method"] not in SENSITIVITY_METHODS:
+        _fail("sensitivity", "method", settings["method"],
+              f"must be one of {SENSITIVITY_METHODS} (SALib's Saltelli/Sobol or Morris)")
+    for key in ("samples", "trajectories", "levels"):
+        _positive_int("sensitivity", key, settings[key], 1_000_000)
+    if not 0 < _number("sensitivity", "confidence", settings["confidence"]) < 1:
+        _fail("sensitivity", "confidence", settings["confidence"], "must lie in (0, 1)")
+    columns = [g.column for g in (*objectives, *constraints)]
+    chosen = settings["metrics"]
+    if chosen is None:
+        settings["metrics"] = list(dict.fromkeys(columns))
+    elif not isinstance(chosen, list) or not chosen or any(c not in columns for c in chosen):
+        _fail("sensitivity", "metrics", chosen, "must list metric columns of the objectives "
+                                                f"or constraints: {', '.join(columns)}")
+    return settings
+
+
+def _sweep(document, name, variables, uncertain, goals=None):
+    """The problem's evaluation as a sweep: everything but what is searched or drawn.
+
+    Without ``goals``, the sweep that resolves the analysis settings the goals are checked
+    against; with them, the one that records what they need.
+    """
+    from qzs.workflows.design_space.metrics import sweep_outputs
+
+    grid = {v.name: [v.low, v.high] for v in variables}
+    grid.update({u.name: [u.nominal] for u in uncertain})
+    analysis = dict(_table(document, "analysis"))
+    sweep = {"sweep": {"name": name}, "parameters": _table(document, "parameters"),
+             "excitation": _table(document, "excitation"), "grid": grid,
+             "simulation": _table(document, "simulation"), "analysis": analysis,
+             "outputs": {"transmissibility": False}}
+    if goals is not None:
+        resolved = load_sweep(sweep).analysis
+        extra, outputs = sweep_outputs(goals, resolved)
+        sweep["analysis"] = {**analysis, **extra}
+        if "band" not in analysis:
+            sweep["analysis"]["band"] = resolved["band"]
+        sweep["outputs"] = outputs
+    try:
+        return load_sweep(sweep)
+    except CountLimitError:
+        raise
+    except ParameterError as error:
+        raise ProblemError("parameters, excitation, simulation or analysis", "", "",
+                           str(error).removeprefix("sweep definition: ")) from None
