@@ -172,7 +172,7 @@ class ProblemError(ParameterError):
 
     def __init__(self, table, key, value, fix, source=""):
         self.table, self.key, self.value = str(table), str(key), value
-        self.fix, self.source = str(fix), str(source)
+        self.fix, self.source = str(fix).rstrip("."), str(source)
         where = f"[{self.table}]" + (f" {self.key}" if self.key else "")
         shown = f" = {self.value!r}" if self.value not in (None, "") else ""
         prefix = f"{self.source}: " if self.source else ""

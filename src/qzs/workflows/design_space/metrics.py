@@ -47,6 +47,8 @@ class MetricDefinition:
         Keys a goal gives with it: ``frequency`` [Hz] or ``band`` [Hz].
     lowest, highest : float or None
         Bounds the metric can never pass (a constraint beyond them is infeasible).
+    label : str
+        A short name for axes and tables ('' : the name with spaces).
     """
 
     name: str
@@ -56,25 +58,38 @@ class MetricDefinition:
     options: tuple = ()
     lowest: float | None = None
     highest: float | None = None
+    label: str = ""
+
+    def title(self, options):
+        """The metric with its options for people: ``RMS transmissibility 1-5 Hz``."""
+        text = self.label or self.name.replace("_", " ")
+        if "frequency" in options:
+            return f"{text} {options['frequency']:g} Hz"
+        if "band" in options:
+            return f"{text} {options['band'][0]:g}-{options['band'][1]:g} Hz"
+        return text
 
 
 def _run(name, lowest=0.0, highest=None):
     unit, doc = STATS[name]
     return MetricDefinition(name=name, units=unit, description=doc, source="run",
-                            lowest=lowest, highest=highest)
+                            lowest=lowest, highest=highest, label=doc)
 
 
 #: Metrics by name.
 METRICS = {m.name: m for m in (
-    MetricDefinition(name="rms_transmissibility", units="1", source="spectrum",
+    MetricDefinition(name="rms_transmissibility", units="1", label="RMS transmissibility",
+                     source="spectrum",
                      options=("band",), lowest=0.0,
                      description="RMS transmissibility (amplitude ratio) over `band` "
                                  "(default the analysis band), trusted bins"),
-    MetricDefinition(name="mean_transmissibility", units="1", source="spectrum",
+    MetricDefinition(name="mean_transmissibility", units="1", label="mean transmissibility",
+                     source="spectrum",
                      options=("band",), lowest=0.0,
                      description="mean transmissibility (amplitude ratio) over `band`, "
                                  "trusted bins"),
-    MetricDefinition(name="transmissibility_at", units="1", source="spectrum",
+    MetricDefinition(name="transmissibility_at", units="1", label="transmissibility at",
+                     source="spectrum",
                      options=("frequency",), lowest=0.0,
                      description="transmissibility (amplitude ratio) at `frequency`, "
                                  "interpolated between trusted bins"),
@@ -101,7 +116,8 @@ METRICS = {m.name: m for m in (
     MetricDefinition(name="phase_margin", units="deg", source="linear",
                      description="phase margin of the control loop at the setpoint (inf "
                                  "where |L| never crosses 1)"),
-    MetricDefinition(name="linear_transmissibility_at", units="1", source="linear",
+    MetricDefinition(name="linear_transmissibility_at", units="1", label="linear transmissibility at",
+                     source="linear",
                      options=("frequency",), lowest=0.0,
                      description="transmissibility of the linearised loop at `frequency` "
                                  "(no friction, no stops)"),
@@ -110,7 +126,7 @@ assert set(RUN_STATISTICS) <= set(STATS)
 
 
 def _band_label(band):
-    return f"{band[0]:g}_to_{band[1]:g}_hz".replace(".", "p")
+    return f"from_{band[0]:g}_to_{band[1]:g}_hz".replace(".", "p")
 
 
 def metric_column(metric, options):
@@ -126,7 +142,7 @@ def metric_column(metric, options):
     Returns
     -------
     str
-        ``transmissibility_at_12_hz``, ``rms_transmissibility_1_to_3_hz``, or ``metric``.
+        ``transmissibility_at_12_hz``, ``rms_transmissibility_from_1_to_3_hz``, or ``metric``.
     """
     if "frequency" in options:
         return f"{metric}_{options['frequency']:g}_hz"

@@ -186,6 +186,8 @@ class Goal:
         Constraints: the bound [the metric's unit]; None for an objective.
     units : str
         The metric's unit.
+    title : str
+        The metric with its options for people (``transmissibility at 12 Hz``).
     """
 
     metric: str
@@ -196,6 +198,7 @@ class Goal:
     sense: str = "minimize"
     bound: float | None = None
     units: str = ""
+    title: str = ""
 
     @property
     def label(self) -> str:
@@ -205,13 +208,16 @@ class Goal:
         return self.column if self.statistic == "mean" else f"{self.column}_{self.statistic}"
 
     def describe(self) -> str:
-        """One line for people: ``peak_stroke (worst) <= 0.02 m``."""
-        stat = (f"quantile {self.quantile:g}" if self.statistic == "quantile"
-                else self.statistic)
+        """One line for people: ``peak_stroke (worst case) <= 0.02 m``.
+
+        The mean over the draws, or the one value without draws, is not named.
+        """
+        stat = (f" (quantile {self.quantile:g})" if self.statistic == "quantile"
+                else {"mean": "", "worst": " (worst case)"}[self.statistic])
         if self.bound is None:
-            return f"{self.sense} {self.column} ({stat}) [{self.units}]"
+            return f"{self.sense} {self.column}{stat} [{self.units}]"
         op = "<=" if self.sense == "minimize" else ">="
-        return f"{self.column} ({stat}) {op} {self.bound:g} {self.units}"
+        return f"{self.column}{stat} {op} {self.bound:g} {self.units}"
 
     def aggregate(self, values):
         """Combine the draws of each design (last axis) into one number per design.
@@ -502,7 +508,7 @@ def _goal(table, index, spec, constraint, analysis):
             _fail(where, "sense", sense, f"must be one of {SENSES}")
     return Goal(metric=metric, column=metric_column(metric, options), options=options,
                 statistic=statistic, quantile=quantile, sense=sense, bound=bound,
-                units=definition.units)
+                units=definition.units, title=definition.title(options))
 
 
 def _settings(document, name, defaults):

@@ -1,0 +1,253 @@
+"""NSGA-II over a design problem, one lockstep batch per generation (pymoo).
+
+Why pymoo: its NSGA-II asks for a whole generation at once and is told the results
+(``ask``/``tell``), which is exactly one lockstep batch of the lane kernel per
+generation; it handles inequality constraints by constrained domination (a feasible
+design beats an infeasible one, infeasible ones rank by their total violation) without
+penalty weights; and its random state is one seeded generator, so a run is repeatable.
+Optuna's multi-objective samplers work trial by trial around a database and would
+serialise what the lane kernel does at once.
+
+Resuming replays: the algorithm is started again from its seed and asked for the same
+generations; a generation the store already holds is answered from the store (after
+checking, bit for bit, that the optimiser asked for the same designs), the rest are
+evaluated. So an interrupted and resumed run ends with exactly the designs, Pareto set
+and chosen design of an uninterrupted one.
+"""
+import dataclasses
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from qzs._optional import require
+from qzs.errors import OutputPathError
+from qzs.workflows.design_space.metrics import METRICS, evaluate
+from qzs.workflows.design_space.problem import DesignProblem, load_problem
+from qzs.workflows.design_space.store import DesignStore, check
+
+__all__ = ["optimize", "fix_step", "objective_matrix", "probe_designs"]
+
+
+def probe_designs(problem):
+    """Designs the step is chosen on: the lower corner, the centre and the upper corner.
+
+    Returns
+    -------
+    ndarray, shape (3, n_variables)
+        [the variables' units].
+    """
+    low = np.array([v.search_bounds[0] for v in problem.variables])
+    high = np.array([v.search_bounds[1] for v in problem.variables])
+    points = np.vstack([low, 0.5 * (low + high), high])
+    return np.column_stack([v.to_unit(points[:, j]) for j, v in enumerate(problem.variables)])
+
+
+def fix_step(problem, *, progress=False):
+    """The problem with its integration step fixed.
+
+    A problem whose ``[simulation]`` gives no ``dt`` runs at the step chosen for its
+    ``tolerance_db`` on :func:`probe_designs` (each at the uncertain parameters' medians),
+    by :func:`qzs.workflows.sweeps.backends.choose_sweep_step`, the sweeps' choice. A
+    problem of linear metrics only needs no step.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    progress : bool
+        Show the probes' progress.
+
+    Returns
+    -------
+    DesignProblem
+        With ``sweep.simulation["dt"]`` set (and ``step_note`` saying how).
+    """
+    from qzs.workflows.sweeps.backends import choose_sweep_step
+
+    if problem.sweep.simulation["dt"] is not None or all(
+            METRICS[g.metric].source == "linear" for g in problem.goals):
+        return problem
+    nominal = {u.name: u.nominal for u in problem.uncertain}
+    names = [v.name for v in problem.variables]
+    settings = [{**dict(zip(names, row.tolist())), **nominal} for row in probe_designs(problem)]
+    sweep, _ = choose_sweep_step(problem.sweep, settings, progress=progress)
+    return dataclasses.replace(problem, sweep=sweep)
+
+
+def objective_matrix(problem, goal_values):
+    """What the optimiser minimises and what it keeps <= 0.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    goal_values : ndarray, shape (n_designs, n_goals)
+        :meth:`~qzs.workflows.design_space.metrics.Evaluation.goal_values` of
+        ``problem.goals``.
+
+    Returns
+    -------
+    F : ndarray, shape (n_designs, n_objectives)
+        The objectives, negated where maximised. An undefined objective (NaN) takes the
+        worst defined value of its column.
+    G : ndarray, shape (n_designs, n_constraints + 1)
+        Each constraint as ``value - max`` or ``min - value`` [its unit]; the last column
+        is 1 for a design with any undefined goal (a failed run, a metric its trusted bins
+        do not define) and -1 otherwise, so such a design is infeasible.
+    """
+    goal_values = np.asarray(goal_values, dtype=float)
+    n_obj = len(problem.objectives)
+    sign = np.array([-1.0 if g.sense == "maximize" else 1.0 for g in problem.objectives])
+    F = goal_values[:, :n_obj] * sign
+    for j in range(n_obj):
+        bad = ~np.isfinite(F[:, j])
+        if bad.any():
+            F[bad, j] = np.max(F[~bad, j]) if (~bad).any() else 0.0
+    G = np.empty((len(goal_values), len(problem.constraints) + 1))
+    for j, goal in enumerate(problem.constraints):
+        value = goal_values[:, n_obj + j]
+        G[:, j] = value - goal.bound if goal.sense == "minimize" else goal.bound - value
+    G[:, :-1] = np.where(np.isnan(G[:, :-1]), 0.0, G[:, :-1])
+    G[:, -1] = np.where(np.isnan(goal_values).any(axis=1), 1.0, -1.0)
+    return F, G
+
+
+def _algorithm(problem, population):
+    require("pymoo", "qzs optimize (multi-objective search)")
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.core.problem import Problem
+
+    bounds = np.array([v.search_bounds for v in problem.variables])
+    search = Problem(n_var=len(problem.variables), n_obj=len(problem.objectives),
+                     n_ieq_constr=len(problem.constraints) + 1, xl=bounds[:, 0],
+                     xu=bounds[:, 1])
+    algorithm = NSGA2(pop_size=population, eliminate_duplicates=True)
+    return algorithm, search
+
+
+def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
+             store: str | Path | None = None, *, resume: bool = False,
+             overwrite: bool = False, generations: int | None = None,
+             population: int | None = None, scheduler: Any = None,
+             workers: int | None = None, threads: int | None = None,
+             progress: bool = True) -> "OptimizationResult":
+    """Search a design problem with NSGA-II; every generation is one lockstep batch.
+
+    Parameters
+    ----------
+    problem : DesignProblem, str, Path or dict
+        The problem, a TOML file, a shipped problem's name or a parsed document.
+    store : str or Path, optional
+        Zarr store (``*.zarr``) keeping every evaluated design; default
+        ``<problem name>.zarr``. An interrupted run keeps its complete generations.
+    resume : bool
+        Continue the store: stored generations are replayed, the rest evaluated; the
+        result is bit-identical to an uninterrupted run.
+    overwrite : bool
+        Replace an existing store.
+    generations, population : int, optional
+        Override ``[optimizer]``'s generations and designs per generation.
+    scheduler : str or distributed.Client, optional
+        Evaluate each generation on this Dask cluster (same results).
+    workers : int, optional
+        Start a local Dask cluster of this many single-threaded worker processes.
+    threads : int, optional
+        Threads per batch; default all cores locally, 1 on a cluster.
+    progress : bool
+        Show a progress bar over the designs.
+
+    Returns
+    -------
+    OptimizationResult
+
+    Raises
+    ------
+    ProblemError
+        An invalid problem (before any run).
+    OutputPathError
+        The store cannot be written, exists without ``resume``/``overwrite``, or holds
+        another problem's designs.
+    """
+    from tqdm.auto import tqdm
+
+    from qzs.workflows.design_space.problem import _positive_int
+    from qzs.workflows.design_space.result import OptimizationResult
+    from qzs.workflows.sweeps.backends import _client, _is_client
+
+    if not isinstance(problem, DesignProblem):
+        problem = load_problem(problem)
+    settings = dict(problem.optimizer)
+    if generations is not None:
+        settings["generations"] = _positive_int("optimizer", "generations", generations,
+                                                100_000)
+    if population is not None:
+        settings["population"] = _positive_int("optimizer", "population", population, 100_000)
+    problem = dataclasses.replace(problem, optimizer=settings)
+    store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
+    check(store, resume=resume, overwrite=overwrite)
+    require("pymoo", "qzs optimize (multi-objective search)")
+    client = cluster = None
+    began = time.perf_counter()
+    bar = None
+    evaluated_now = steps = 0
+    try:
+        if scheduler is not None or workers is not None:
+            client, cluster = _client(scheduler, workers)
+        opened = DesignStore(store, problem, resume=resume, overwrite=overwrite)
+        if opened.step is not None:
+            sweep = problem.sweep
+            problem = dataclasses.replace(problem, sweep=dataclasses.replace(
+                sweep, simulation={**sweep.simulation, "dt": opened.step[0],
+                                   "step_note": opened.step[1]}))
+        else:
+            problem = fix_step(problem, progress=progress)
+            dt = problem.sweep.simulation["dt"]
+            if dt is not None:
+                opened.set_step(dt, problem.sweep.simulation.get("step_note", ""))
+        algorithm, search = _algorithm(problem, settings["population"])
+        from pymoo.core.evaluator import Evaluator
+        from pymoo.problems.static import StaticProblem
+
+        algorithm.setup(search, termination=("n_gen", settings["generations"]),
+                        seed=settings["seed"], verbose=False)
+        per_generation = settings["population"] * problem.samples
+        bar = tqdm(total=settings["generations"] * per_generation, unit="case",
+                   desc=problem.name, disable=not progress, dynamic_ncols=True)
+        stored = opened.generations
+        for generation in range(settings["generations"]):
+            population_ = algorithm.ask()
+            X = population_.get("X")
+            if generation < stored:
+                position, values, status = opened.generation_rows(generation)
+                if position.shape != X.shape or not np.array_equal(position, X):
+                    raise OutputPathError("store", store, "holds designs the optimiser does "
+                                          f"not ask for again (generation {generation}); it "
+                                          "was written by another qzs or pymoo version. "
+                                          "Start again with --overwrite")
+                goal_values = np.column_stack([g.aggregate(values[g.column])
+                                               for g in problem.goals])
+                bar.update(len(X) * problem.samples)
+            else:
+                designs = np.column_stack([v.to_unit(X[:, j])
+                                           for j, v in enumerate(problem.variables)])
+                evaluation = evaluate(problem, designs, client=client, threads=threads,
+                                      progress=bar.update)
+                opened.append(generation, X, evaluation)
+                goal_values = evaluation.goal_values(problem.goals)
+                evaluated_now += len(X)
+                steps += evaluation.steps
+            F, G = objective_matrix(problem, goal_values)
+            Evaluator().eval(StaticProblem(search, F=F, G=G), population_)
+            algorithm.tell(infills=population_)
+    finally:
+        if bar is not None:
+            bar.close()
+        if client is not None and not _is_client(scheduler):
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    return OptimizationResult.from_store(opened, problem, wall=time.perf_counter() - began,
+                                         evaluated=evaluated_now, steps=steps)

@@ -1,0 +1,357 @@
+"""The result of ``qzs optimize``: every evaluated design, the Pareto set, the chosen design.
+
+:class:`OptimizationResult` holds the store's designs and derives the rest: which
+designs meet every constraint, the Pareto set among those (non-dominated in the
+objectives), and the chosen design, the member of the Pareto set nearest the ideal
+point once each objective is scaled to the front's range (a compromise; with one
+objective, the best feasible design). It only delegates: ``.to_xarray()`` and
+``.save()`` to the file layer, ``.plot()`` to :mod:`qzs.viz.design_space`.
+"""
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from qzs._version import __version__
+from qzs.errors import ParameterError
+
+__all__ = ["OptimizationResult", "pareto_front"]
+
+
+def pareto_front(F):
+    """Indices of the non-dominated rows of ``F`` (minimised), each distinct row once.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n_objectives)
+
+    Returns
+    -------
+    ndarray of int
+        Sorted indices.
+    """
+    F = np.asarray(F, dtype=float)
+    if F.size == 0:
+        return np.zeros(0, dtype=int)
+    _, first = np.unique(F, axis=0, return_index=True)
+    keep = []
+    for i in np.sort(first):
+        dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
+        if not dominated.any():
+            keep.append(i)
+    return np.asarray(keep, dtype=int)
+
+
+@dataclass(frozen=True, kw_only=True)
+class OptimizationResult:
+    """What ``qzs optimize`` found.
+
+    Attributes
+    ----------
+    problem : DesignProblem
+        The problem (its step fixed).
+    designs : ndarray, shape (n, n_variables)
+        Every evaluated design [the variables' units].
+    generation : ndarray of int, shape (n,)
+        The generation that evaluated it.
+    values : dict of str to ndarray, shape (n, n_samples)
+        Metric column -> value per design and draw [its unit].
+    status : ndarray of int8, shape (n, n_samples)
+        Sweep status per case (1 ok).
+    goal_values : ndarray, shape (n, n_goals)
+        Each objective and constraint per design, its draws combined [its unit].
+    feasible : ndarray of bool, shape (n,)
+        Every constraint met and every goal defined.
+    pareto : ndarray of int
+        Indices of the Pareto set among the feasible designs.
+    messages : dict of int to str
+        Why a design's run failed.
+    store : Path
+        The store.
+    wall : float
+        Wall time of this call [s].
+    evaluated : int
+        Designs evaluated by this call (the others came from the store).
+    steps : int
+        Integration steps of this call.
+    """
+
+    problem: object = field(repr=False)
+    designs: np.ndarray
+    generation: np.ndarray
+    values: dict = field(repr=False)
+    status: np.ndarray = field(repr=False)
+    goal_values: np.ndarray
+    feasible: np.ndarray
+    pareto: np.ndarray
+    messages: dict = field(repr=False, default_factory=dict)
+    store: Path | None = None
+    wall: float = 0.0
+    evaluated: int = 0
+    steps: int = 0
+
+    @classmethod
+    def from_store(cls, store, problem, *, wall=0.0, evaluated=0, steps=0):
+        """The result of every design a :class:`~.store.DesignStore` holds."""
+        from qzs.workflows.design_space.optimizer import objective_matrix
+
+        data = store.read()
+        goal_values = (np.column_stack([g.aggregate(data["values"][g.column])
+                                        for g in problem.goals])
+                       if len(data["generation"]) else np.empty((0, len(problem.goals))))
+        F, G = objective_matrix(problem, goal_values)
+        feasible = np.all(G <= 0.0, axis=1)
+        members = np.flatnonzero(feasible)
+        pareto = members[pareto_front(F[members])] if members.size else members
+        return cls(problem=problem, designs=data["design_variables"],
+                   generation=data["generation"], values=data["values"],
+                   status=data["status"], goal_values=goal_values, feasible=feasible,
+                   pareto=pareto, messages=data["messages"], store=store.path, wall=wall,
+                   evaluated=evaluated, steps=steps)
+
+    # ------------------------------------------------------------ derived
+    @property
+    def step(self) -> float | None:
+        """The integration step [s] (None for a problem of linear metrics only)."""
+        return self.problem.sweep.simulation["dt"]
+
+    @property
+    def chosen(self) -> int | None:
+        """Index of the chosen design: the Pareto member nearest the ideal point.
+
+        Each objective is scaled to the Pareto set's range (0 best, 1 worst); the member
+        with the smallest Euclidean distance to the origin is chosen. None if no design
+        is feasible.
+        """
+        if self.pareto.size == 0:
+            return None
+        n_obj = len(self.problem.objectives)
+        sign = np.array([-1.0 if g.sense == "maximize" else 1.0 for g in self.problem.objectives])
+        F = self.goal_values[self.pareto, :n_obj] * sign
+        span = F.max(axis=0) - F.min(axis=0)
+        scaled = (F - F.min(axis=0)) / np.where(span > 0, span, 1.0)
+        return int(self.pareto[np.argmin(np.sqrt((scaled ** 2).sum(axis=1)))])
+
+    def design(self, index=None) -> dict:
+        """A design's variables by name [their units] (default the chosen design)."""
+        index = self._index(index)
+        return {v.name: float(self.designs[index, j])
+                for j, v in enumerate(self.problem.variables)}
+
+    def _index(self, index):
+        if index is None:
+            index = self.chosen
+            if index is None:
+                raise ParameterError("no design meets every constraint, so none is chosen; "
+                                     "relax the constraints or widen the bounds, or give "
+                                     "`index` to pick one of the designs anyway.")
+        index = int(index)
+        if not 0 <= index < len(self.designs):
+            raise ParameterError(f"`index` must be a design index in 0..{len(self.designs) - 1},"
+                                 f" got {index}.")
+        return index
+
+    # ------------------------------------------------------------ files
+    def to_xarray(self, *, pareto_only=False):
+        """The designs as an ``xarray.Dataset`` on a ``design`` dimension, with units.
+
+        Parameters
+        ----------
+        pareto_only : bool
+            Only the Pareto set.
+
+        Returns
+        -------
+        xarray.Dataset
+            The variables [their units], each goal's value (draws combined), ``feasible``,
+            ``pareto`` and ``generation``; the problem and the step as attributes.
+        """
+        import xarray as xr
+
+        p = self.problem
+        rows = self.pareto if pareto_only else np.arange(len(self.designs))
+        chosen = self.chosen
+        data = {}
+        for j, v in enumerate(p.variables):
+            data[v.name] = ("design", self.designs[rows, j],
+                            {"units": v.units, "long_name": f"decision variable {v.name}",
+                             "valid_min": v.low, "valid_max": v.high, "scale": v.scale})
+        for j, goal in enumerate(p.goals):
+            role = "objective" if goal.bound is None else "constraint"
+            attrs = {"units": goal.units, "long_name": f"{role}: {goal.describe()}",
+                     "metric": goal.metric, "statistic": goal.statistic}
+            if goal.bound is not None:
+                attrs["bound"] = goal.bound
+            data[goal.label] = ("design", self.goal_values[rows, j], attrs)
+        in_pareto = np.isin(rows, self.pareto)
+        data["feasible"] = ("design", self.feasible[rows].astype(np.int8),
+                            {"units": "1", "long_name": "every constraint met (1) or not (0)"})
+        data["pareto"] = ("design", in_pareto.astype(np.int8),
+                          {"units": "1", "long_name": "in the Pareto set (1) or not (0)"})
+        data["chosen"] = ("design", (rows == chosen).astype(np.int8),
+                          {"units": "1", "long_name": "the chosen design (1)"})
+        data["generation"] = ("design", self.generation[rows].astype(np.int32),
+                              {"units": "1", "long_name": "generation that evaluated it"})
+        attrs = {"title": f"qzs optimize: {p.title}", "problem": p.name,
+                 "objectives": "; ".join(g.describe() for g in p.objectives),
+                 "constraints": "; ".join(g.describe() for g in p.constraints) or "none",
+                 "uncertain": "; ".join(f"{u.name} {u.distribution} {u.settings} [{u.units}]"
+                                        for u in p.uncertain) or "none",
+                 "monte_carlo_samples": p.samples, "evaluated_designs": len(self.designs),
+                 "algorithm": "NSGA-II (pymoo)", "population": p.optimizer["population"],
+                 "generations": p.optimizer["generations"], "seed": p.optimizer["seed"],
+                 "qzs_version": __version__, "Conventions": "CF-1.10"}
+        if self.step is not None:
+            attrs["dt"] = self.step
+            attrs["step_note"] = p.sweep.simulation.get("step_note", "")
+        return xr.Dataset(data, coords={"design": ("design", rows.astype(np.int64),
+                                                   {"long_name": "index of the evaluated "
+                                                                 "design in the store"})},
+                          attrs=attrs)
+
+    def save(self, path, *, pareto_only=True):
+        """Write the Pareto set (or every design) to NetCDF, CSV or MATLAB, atomically.
+
+        Parameters
+        ----------
+        path : str or Path
+            ``.nc``, ``.csv`` (with a units row) or ``.mat``.
+        pareto_only : bool
+            Only the Pareto set (default), or every evaluated design.
+
+        Returns
+        -------
+        Path
+        """
+        from qzs.iotools.writer import write_dataset
+
+        return write_dataset(self.to_xarray(pareto_only=pareto_only), path)
+
+    def config_text(self, index=None):
+        """The chosen design (or design ``index``) as a run configuration's TOML text.
+
+        Uncertain parameters take their medians; the excitation and step are the
+        problem's. ``qzs simulate --config FILE`` runs it.
+        """
+        from qzs.iotools.config import config_text
+        from qzs.workflows.sweeps.backends import build_case
+
+        index = self._index(index)
+        p = self.problem
+        case = {**self.design(index), **{u.name: u.nominal for u in p.uncertain}}
+        isolator, controller, (_, duration), _ = build_case(p.sweep, case)
+        excitation = {"kind": p.sweep.excitation_kind, **p.sweep.excitation}
+        excitation.update({k.split(".", 1)[1]: v for k, v in case.items()
+                           if k.startswith("excitation.")})
+        excitation.setdefault("duration", duration)
+        simulation = {"solver": p.sweep.simulation["solver"],
+                      "sample_rate": p.sweep.analysis["sample_rate"]}
+        if self.step is not None:
+            simulation["dt"] = self.step
+        values = ", ".join(f"{g.label} = {self.goal_values[index, j]:.4g} {g.units}"
+                           for j, g in enumerate(p.goals))
+        return config_text(isolator, controller, excitation, simulation,
+                           note=f"design {index} of `qzs optimize` {p.name!r}: {values}")
+
+    def write_config(self, path, index=None):
+        """Write :meth:`config_text` to ``path`` (TOML), atomically; returns the path."""
+        from qzs.iotools.files import atomic_path
+
+        text = self.config_text(index)
+        with atomic_path(Path(path)) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+        return Path(path)
+
+    def plot(self, ax=None, **kwargs):
+        """The Pareto figure (:func:`qzs.viz.design_space.plot_pareto`)."""
+        from qzs.viz.design_space import plot_pareto
+
+        return plot_pareto(self, ax=ax, **kwargs)
+
+    # ------------------------------------------------------------ text
+    def summary(self) -> str:
+        """A few lines: evaluations, feasible designs, the Pareto set and the chosen design."""
+        p = self.problem
+        lines = [f"{p.name}: {len(self.designs)} designs evaluated in "
+                 f"{int(self.generation.max()) + 1 if len(self.generation) else 0} generations "
+                 f"({self.evaluated} now, {self.wall:.1f} s), x {p.samples} draws each",
+                 f"  feasible {int(self.feasible.sum())}, Pareto set {self.pareto.size}"]
+        if self.step is not None:
+            lines.append(f"  step dt = {self.step:g} s")
+        chosen = self.chosen
+        if chosen is None:
+            lines.append("  no design meets every constraint: nothing chosen")
+        else:
+            design = ", ".join(f"{v.name} = {self.designs[chosen, j]:.4g} {v.units}"
+                               for j, v in enumerate(p.variables))
+            goals = ", ".join(f"{g.label} = {_fmt(self.goal_values[chosen, j])} {g.units}"
+                              for j, g in enumerate(p.goals))
+            lines += [f"  chosen design {chosen}: {design}", f"    {goals}"]
+        return "\n".join(lines)
+
+    def report(self) -> str:
+        """A Markdown report: the problem, the search, the Pareto set, the chosen design."""
+        p = self.problem
+        out = [f"# Design search: {p.title}", "",
+               f"Problem `{p.name}` ({p.source}); qzs {__version__}; NSGA-II (pymoo), "
+               f"{p.optimizer['population']} designs per generation, "
+               f"{p.optimizer['generations']} generations, seed {p.optimizer['seed']}.", "",
+               "## Decision variables", "", "| variable | low | high | scale | unit |",
+               "|---|---|---|---|---|"]
+        out += [f"| {v.name} | {v.low:g} | {v.high:g} | {v.scale}"
+                f"{' (integer)' if v.integer else ''} | {v.units} |" for v in p.variables]
+        out += ["", "## Goals", ""]
+        out += [f"- objective: {g.describe()}" for g in p.objectives]
+        out += [f"- constraint: {g.describe()}" for g in p.constraints]
+        if p.uncertain:
+            out += ["", f"## Uncertainty ({p.samples} draws, {p.sampling}, seed {p.seed}, the "
+                        "same draws for every design)", ""]
+            out += [f"- {u.name} [{u.units}]: {u.distribution} {u.settings}"
+                    for u in p.uncertain]
+        out += ["", "## Search", "",
+                f"- {len(self.designs)} designs evaluated ({self.evaluated} by this call, the "
+                f"rest read from the store), {int(self.feasible.sum())} feasible, "
+                f"{self.pareto.size} in the Pareto set.",
+                f"- Integration step: {self._step_text()}."]
+        failed = int(np.count_nonzero(self.status != 1))
+        if failed:
+            out.append(f"- {failed} runs failed or were invalid; their designs count as "
+                       "infeasible (first reasons: " + "; ".join(
+                           f"design {k}: {v}" for k, v in list(self.messages.items())[:3]) + ").")
+        out += ["", "## Pareto set", ""]
+        if self.pareto.size:
+            labels = [v.name for v in p.variables] + [g.label for g in p.goals]
+            units = [v.units for v in p.variables] + [g.units for g in p.goals]
+            out += ["| design | " + " | ".join(f"{l} [{u}]" for l, u in zip(labels, units))
+                    + " |", "|---" * (len(labels) + 1) + "|"]
+            order = self.pareto[np.argsort(self.goal_values[self.pareto, 0])]
+            for i in order:
+                row = [*self.designs[i], *self.goal_values[i]]
+                mark = " (chosen)" if i == self.chosen else ""
+                out.append(f"| {i}{mark} | " + " | ".join(_fmt(x) for x in row) + " |")
+        else:
+            out.append("No design meets every constraint. Relax the constraints or widen the "
+                       "bounds; `feasible` in the designs file shows how close each came.")
+        out += ["", "## Chosen design", ""]
+        chosen = self.chosen
+        if chosen is None:
+            out.append("None (no feasible design).")
+        else:
+            out.append("The Pareto member nearest the ideal point, each objective scaled to "
+                       "the front's range: " + ", ".join(
+                           f"{k} = {_fmt(v)}" for k, v in self.design(chosen).items()) + ".")
+        return "\n".join(out) + "\n"
+
+    def _step_text(self):
+        if self.step is None:
+            return "none (linear metrics only)"
+        note = self.problem.sweep.simulation.get("step_note")
+        return f"dt = {self.step:g} s" + (f" ({note})" if note else "")
+
+
+def _fmt(value):
+    value = float(value)
+    if math.isnan(value):
+        return "undefined"
+    return f"{value:.4g}"
