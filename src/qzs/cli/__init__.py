@@ -12,6 +12,8 @@
     qzs sweep-export STORE [--out FILE.mat]
     qzs response [--frequencies F1,F2,... | --range F0,F1,N] [--direction up|down|both] [--json]
     qzs design [--config FILE.toml] [--set NAME=VALUE] [--stiction-range LOW,HIGH] [--quick]
+    qzs optimize FILE.toml [--out DIR] [--resume] [--workers N | --scheduler ADDRESS]
+    qzs sensitivity FILE.toml [--method sobol|morris] [--samples N] [--out DIR]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
     qzs docs [TOPIC [SECTION]]
     qzs completion bash|zsh
@@ -19,20 +21,21 @@
 Every subcommand hands its parsed arguments to a function of the layers below; one module
 per subcommand (or pair of subcommands), and what they share:
 
-==============  =======================================================================
-``common``      ``--set`` pairs, parameter loading, ``--json``, the exit codes
-``simulate``    ``qzs simulate``: one run, its summary, figure and time series
-``params``      ``qzs params``: every parameter with its value and unit
-``studies``     ``qzs paper`` and ``qzs study``: the paper's studies and report
-``experiment``  ``qzs experiment``: an experiment log beside the matching simulation
-``sweep``       ``qzs sweep``, ``sweep-plot``, ``sweep-export``: Zarr store, figures, .mat
-``response``    ``qzs response``: the steady-state response by stepped-sine simulation
-``design``      ``qzs design``: PI and damping gains from the isolator and its disturbance
-``hexapod``     ``qzs hexapod``: the six-axis platform of six isolator legs
-``app``         ``qzs app``: the interactive tuning page in the browser
-``docs``        ``qzs docs``: the model and workflow pages shipped inside the package
-``completion``  ``qzs completion``: bash and zsh completion scripts from the parser
-==============  =======================================================================
+================  =======================================================================
+``common``        ``--set`` pairs, parameter loading, ``--json``, the exit codes
+``simulate``      ``qzs simulate``: one run, its summary, figure and time series
+``params``        ``qzs params``: every parameter with its value and unit
+``studies``       ``qzs paper`` and ``qzs study``: the paper's studies and report
+``experiment``    ``qzs experiment``: an experiment log beside the matching simulation
+``sweep``         ``qzs sweep``, ``sweep-plot``, ``sweep-export``: Zarr store, figures, .mat
+``response``      ``qzs response``: the steady-state response by stepped-sine simulation
+``design``        ``qzs design``: PI and damping gains from the isolator and its disturbance
+``design_space``  ``qzs optimize``, ``qzs sensitivity``: Pareto search and Sobol/Morris indices
+``hexapod``       ``qzs hexapod``: the six-axis platform of six isolator legs
+``app``           ``qzs app``: the interactive tuning page in the browser
+``docs``          ``qzs docs``: the model and workflow pages shipped inside the package
+``completion``    ``qzs completion``: bash and zsh completion scripts from the parser
+================  =======================================================================
 
 Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0 success,
 1 a failed run, 2 bad input or usage (one line on stderr, never a traceback), 130 Ctrl-C,
@@ -47,8 +50,8 @@ import signal
 import sys
 
 from qzs._version import __version__
-from qzs.cli import (app, completion, design, docs, experiment, hexapod, params, response,
-                     simulate, studies, sweep)
+from qzs.cli import (app, completion, design, design_space, docs, experiment, hexapod, params,
+                     response, simulate, studies, sweep)
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -59,7 +62,9 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
             "sweep-export": sweep.run_export_command,
             "hexapod": hexapod.run, "response": response.run,
-            "design": design.run, "app": app.run, "docs": docs.run,
+            "design": design.run, "optimize": design_space.run_optimize_command,
+            "sensitivity": design_space.run_sensitivity_command,
+            "app": app.run, "docs": docs.run,
             "completion": completion.run}
 
 
@@ -91,6 +96,7 @@ def build_parser():
     studies.add_parsers(sub)
     experiment.add_parser(sub)
     sweep.add_parsers(sub)
+    design_space.add_parsers(sub)
     params.add_parser(sub)
     hexapod.add_parser(sub)
     design.add_parser(sub)

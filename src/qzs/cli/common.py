@@ -60,6 +60,7 @@ MEMORY_HINTS = {
 KERNEL_FAMILIES = {
     "simulate": ("single",), "experiment": ("single",), "response": ("single",),
     "app": ("single",), "sweep": ("single", "batch"), "design": ("single", "batch"),
+    "optimize": ("single", "batch"), "sensitivity": ("single", "batch"),
     "paper": ("single", "batch"), "study": ("single", "batch"),
     "hexapod simulate": ("hexapod",), "hexapod transmissibility": ("hexapod",),
     "hexapod study": ("hexapod",),

@@ -18,8 +18,11 @@ ranks the parameters by Sobol or Morris indices (:mod:`.sensitivity`). The guide
 ===============  ================================================================
 """
 from qzs.workflows.design_space.metrics import METRICS, Evaluation, evaluate
+from qzs.workflows.design_space.optimizer import optimize
 from qzs.workflows.design_space.problem import (DesignProblem, Goal, Uncertainty, Variable,
-                                                load_problem, shipped_problems)
+                                                load_problem, plan_text, shipped_problems)
+from qzs.workflows.design_space.result import OptimizationResult, write_files
 
-__all__ = ["load_problem", "shipped_problems", "DesignProblem", "Variable", "Uncertainty",
-           "Goal", "METRICS", "Evaluation", "evaluate"]
+__all__ = ["optimize", "load_problem", "shipped_problems", "plan_text", "DesignProblem",
+           "Variable", "Uncertainty", "Goal", "METRICS", "Evaluation", "evaluate",
+           "OptimizationResult", "write_files"]

@@ -69,7 +69,7 @@ from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_colum
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
                                              _distribution, _frozen, load_sweep)
 
-__all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem",
+__all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "plan_text",
            "shipped_problems", "TABLES", "MAX_SAMPLES"]
 
 TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
@@ -668,3 +668,38 @@ def _sweep(document, name, variables, uncertain, goals=None):
     except ParameterError as error:
         raise ProblemError("parameters, excitation, simulation or analysis", "", "",
                            str(error).removeprefix("sweep definition: ")) from None
+
+
+def plan_text(problem: DesignProblem) -> str:
+    """What a search will evaluate: variables, uncertainty, goals, cases and steps.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+
+    Returns
+    -------
+    str
+        A few lines of text (``qzs optimize --dry-run``).
+    """
+    o, a, s = problem.optimizer, problem.sweep.analysis, problem.sweep.simulation
+    per_generation = o["population"] * problem.samples
+    lines = [f"problem {problem.name!r}: {problem.title}",
+             f"  NSGA-II: {o['population']} designs x {o['generations']} generations, seed "
+             f"{o['seed']}; {problem.samples} draw(s) per design -> {per_generation} cases "
+             "per generation, one lockstep batch each",
+             f"  {problem.sweep.excitation_kind} excitation, {a['duration']:g} s per case, "
+             f"{a['sample_rate']:g} Hz output"]
+    lines += [f"  variable  {v.name:<22} {v.low:g} .. {v.high:g} {v.units} ({v.scale}"
+              f"{', integer' if v.integer else ''})" for v in problem.variables]
+    lines += [f"  uncertain {u.name:<22} {u.distribution} {u.settings} {u.units}"
+              for u in problem.uncertain]
+    lines += [f"  objective {g.describe()}" for g in problem.objectives]
+    lines += [f"  constraint {g.describe()}" for g in problem.constraints]
+    if s["dt"] is not None:
+        steps = o["generations"] * per_generation * a["duration"] / s["dt"]
+        lines.append(f"  dt = {s['dt']:g} s: about {steps:.3g} integration steps in all")
+    else:
+        lines.append(f"  dt chosen before the first generation for {s['tolerance_db']:g} dB")
+    return "\n".join(lines)

@@ -16,7 +16,7 @@ import numpy as np
 from qzs._version import __version__
 from qzs.errors import ParameterError
 
-__all__ = ["OptimizationResult", "pareto_front"]
+__all__ = ["OptimizationResult", "pareto_front", "write_files", "OUTPUT_FILES"]
 
 
 def pareto_front(F):
@@ -355,3 +355,48 @@ def _fmt(value):
     if math.isnan(value):
         return "undefined"
     return f"{value:.4g}"
+
+
+#: What :func:`write_files` writes into its folder, beside the store.
+OUTPUT_FILES = ("pareto.nc", "pareto.csv", "pareto.mat", "designs.nc", "pareto.png",
+                "chosen.toml", "report.md")
+
+
+def write_files(result, folder):
+    """Write a search's outputs into ``folder``, each file atomically.
+
+    ``pareto.nc``/``.csv``/``.mat`` (the Pareto set with units), ``designs.nc`` (every
+    evaluated design, with ``feasible``, ``pareto`` and ``chosen`` flags), ``pareto.png``
+    (:func:`qzs.viz.design_space.plot_pareto`), ``chosen.toml`` (the chosen design as a run
+    configuration ``qzs simulate --config`` reads; left out if no design is feasible) and
+    ``report.md``.
+
+    Parameters
+    ----------
+    result : OptimizationResult
+        The search.
+    folder : str or Path
+        Where to write; created if missing.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    import matplotlib.pyplot as plt
+
+    from qzs.iotools.files import atomic_path
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [result.save(folder / name) for name in ("pareto.nc", "pareto.csv", "pareto.mat")]
+    written.append(result.save(folder / "designs.nc", pareto_only=False))
+    figure = result.plot(path=folder / "pareto.png")
+    plt.close(figure)
+    written.append(folder / "pareto.png")
+    if result.chosen is not None:
+        written.append(result.write_config(folder / "chosen.toml"))
+    with atomic_path(folder / "report.md") as tmp:
+        Path(tmp).write_text(result.report(), encoding="utf-8")
+    written.append(folder / "report.md")
+    return written

@@ -25,7 +25,7 @@ from qzs._version import __version__
 from qzs.errors import OutputPathError, ParameterError
 from qzs.iotools.paths import check_output_path
 
-__all__ = ["DesignStore", "STORE_SUFFIX", "FORMAT"]
+__all__ = ["DesignStore", "STORE_SUFFIX", "FORMAT", "check", "stored_generations"]
 
 STORE_SUFFIX = ".zarr"
 FORMAT = "qzs-design-store-1"
@@ -228,3 +228,23 @@ def check(path, *, resume=False, overwrite=False, argument="store"):
     if path.exists() and not resume and not overwrite:
         raise OutputPathError(argument, path, "exists; pass --resume to continue it, "
                               "--overwrite to replace it, or choose another name")
+
+
+def stored_generations(path):
+    """Complete generations in a design store (0 if there is none at ``path``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+
+    Returns
+    -------
+    int
+    """
+    import zarr
+
+    try:
+        return int(zarr.open_group(str(path), mode="r").attrs.get("generations_done", 0))
+    except Exception:  # noqa: BLE001 - no store, or not a Zarr group: nothing kept
+        return 0

@@ -1,0 +1,174 @@
+"""``qzs optimize`` and ``qzs sensitivity``: the design space of a problem file."""
+import sys
+from pathlib import Path
+
+from qzs.cli.common import EPILOG
+from qzs.errors import ParameterError, Terminated
+from qzs.iotools.paths import check_output_path
+
+__all__ = ["add_parsers", "run_optimize_command", "run_sensitivity_command"]
+
+_PROBLEM_HELP = ("design problem file (TOML), or a shipped problem name (e.g. "
+                 "isolation_vs_effort); `qzs docs design-space` describes the layout")
+
+
+def _execution(cmd):
+    where = cmd.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="evaluate on an existing Dask cluster (e.g. tcp://host:8786)")
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="start a local Dask cluster of N worker processes")
+    cmd.add_argument("--threads", type=int, metavar="N",
+                     help="threads per batch (default: all cores locally, 1 on Dask)")
+    cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def add_parsers(subparsers):
+    """Add ``optimize`` and ``sensitivity`` to a sub-parser collection.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        What ``ArgumentParser.add_subparsers`` returned.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``optimize`` parser.
+    """
+    cmd = subparsers.add_parser(
+        "optimize", help="search a design problem for its Pareto set (NSGA-II)",
+        description="Search the decision variables of a problem file for the designs that "
+                    "best trade its objectives under its constraints (pymoo's NSGA-II; each "
+                    "generation one lockstep batch), robust to its uncertain parameters. "
+                    "Writes the store of every evaluated design, the Pareto set (.nc, .csv, "
+                    ".mat), its figure, the chosen design as a run configuration "
+                    "(chosen.toml, for qzs simulate --config) and a report.",
+        epilog="The problem is checked before any run (unknown parameter or metric, empty "
+               "bounds, infeasible constraints), and so is --out. Ctrl-C (130) and SIGTERM "
+               "(143) keep every complete generation; --resume replays them and continues, "
+               "with the same result as an uninterrupted run. " + EPILOG)
+    cmd.add_argument("problem", metavar="FILE.toml", help=_PROBLEM_HELP)
+    cmd.add_argument("--out", metavar="DIR",
+                     help="output folder (default the problem's name); the store is "
+                          "DIR/NAME.zarr")
+    cmd.add_argument("--resume", action="store_true",
+                     help="continue an interrupted search in --out (same problem file)")
+    cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")
+    cmd.add_argument("--generations", type=int, metavar="N",
+                     help="generations (default the file's [optimizer] generations)")
+    cmd.add_argument("--population", type=int, metavar="N",
+                     help="designs per generation (default the file's [optimizer] population)")
+    cmd.add_argument("--dry-run", action="store_true",
+                     help="print the problem and the work, run nothing")
+    _execution(cmd)
+
+    sens = subparsers.add_parser(
+        "sensitivity", help="global sensitivity of a problem's metrics (Sobol or Morris)",
+        description="Rank the decision variables and uncertain parameters of a problem file "
+                    "by their influence on its metrics: Sobol first and total indices with "
+                    "confidence intervals (SALib, Saltelli sampling), or Morris screening "
+                    "for many parameters. Writes the indices (.nc, .csv, .mat) and a bar "
+                    "chart with intervals.",
+        epilog="The problem and --out are checked before any run. " + EPILOG)
+    sens.add_argument("problem", metavar="FILE.toml", help=_PROBLEM_HELP)
+    sens.add_argument("--out", metavar="DIR",
+                      help="output folder (default NAME-sensitivity)")
+    sens.add_argument("--method", choices=("sobol", "morris"),
+                      help="default the file's [sensitivity] method")
+    sens.add_argument("--samples", type=int, metavar="N",
+                      help="Sobol: base samples, a power of 2 (N x (d + 2) runs); Morris: "
+                           "trajectories (N x (d + 1) runs); default the file's")
+    sens.add_argument("--seed", type=int, metavar="N", help="default the file's")
+    _execution(sens)
+    return cmd
+
+
+def _check_counts(args):
+    for option in ("workers", "threads", "generations", "population", "samples"):
+        value = getattr(args, option, None)
+        if value is not None and value < 1:
+            raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
+
+
+def _stopped(stop, store, command):
+    what, code = (("interrupted", 130) if isinstance(stop, KeyboardInterrupt)
+                  else ("terminated", stop.exit_code))
+    print(f"qzs: {what}; {command}", file=sys.stderr)
+    return code
+
+
+def run_optimize_command(args):
+    """Run ``qzs optimize`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs optimize`` arguments.
+
+    Returns
+    -------
+    int
+        0, or 130 if Ctrl-C interrupted the search, 143 if SIGTERM ended it (its complete
+        generations stay in the store either way).
+    """
+    from qzs.workflows.design_space import load_problem, optimize, plan_text, write_files
+    from qzs.workflows.design_space.store import check, stored_generations
+
+    _check_counts(args)
+    problem = load_problem(args.problem)
+    if args.dry_run:
+        print(plan_text(problem))
+        return 0
+    folder = Path(args.out) if args.out else Path(problem.name)
+    check_output_path(folder, argument="--out", suffixes=None, directory=True)
+    store = folder / f"{problem.name}.zarr"
+    check(store, resume=args.resume, overwrite=args.overwrite, argument="--out")
+    try:
+        result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
+                          generations=args.generations, population=args.population,
+                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
+                          progress=not args.quiet)
+    except (KeyboardInterrupt, Terminated) as stop:
+        return _stopped(stop, store, f"{stored_generations(store)} complete generation(s) are "
+                                     f"kept in {store}. Continue with: qzs optimize "
+                                     f"{args.problem} --out {folder} --resume")
+    written = write_files(result, folder)
+    print(result.summary())
+    print(f"  wrote            {store}")
+    for path in written:
+        print(f"  wrote            {path}")
+    return 0
+
+
+def run_sensitivity_command(args):
+    """Run ``qzs sensitivity`` from parsed arguments; returns the exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``qzs sensitivity`` arguments.
+
+    Returns
+    -------
+    int
+        0, or 130 if Ctrl-C interrupted it, 143 if SIGTERM ended it.
+    """
+    from qzs.workflows.design_space import load_problem, sensitivity
+
+    _check_counts(args)
+    problem = load_problem(args.problem)
+    folder = Path(args.out) if args.out else Path(f"{problem.name}-sensitivity")
+    check_output_path(folder, argument="--out", suffixes=None, directory=True)
+    try:
+        result = sensitivity(problem, method=args.method, samples=args.samples, seed=args.seed,
+                             scheduler=args.scheduler, workers=args.workers,
+                             threads=args.threads, progress=not args.quiet)
+    except (KeyboardInterrupt, Terminated) as stop:
+        return _stopped(stop, None, "nothing is written (a sensitivity run is not resumable; "
+                                    "fewer --samples make it shorter)")
+    written = result.write_files(folder)
+    print(result.summary())
+    for path in written:
+        print(f"  wrote            {path}")
+    return 0
