@@ -1,0 +1,82 @@
+"""``qzs optimize`` and ``qzs sensitivity`` (qzs.cli.design_space): files written, plans
+printed, bad input refused with one line and exit 2, Ctrl-C keeping the generations."""
+import pytest
+import tomli_w
+
+from qzs.cli import main
+
+pytest.importorskip("pymoo")
+
+PROBLEM = {
+    "problem": {"name": "cli"},
+    "variables": {"viscous_damping": {"low": 10.0, "high": 500.0},
+                  "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
+    "parameters": {"damping_gain": 0.0},
+    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
+                   {"metric": "linear_transmissibility_at", "frequency": 12.0}],
+    "optimizer": {"population": 8, "generations": 2, "seed": 1},
+}
+
+
+@pytest.fixture
+def problem_file(tmp_path):
+    path = tmp_path / "cli.toml"
+    path.write_text(tomli_w.dumps(PROBLEM))
+    return path
+
+
+def test_optimize_writes_the_store_and_every_result_file(problem_file, tmp_path, capsys):
+    from qzs.workflows.design_space.result import OUTPUT_FILES
+
+    out = tmp_path / "out"
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert "16 designs evaluated in 2 generations" in printed
+    assert sorted(p.name for p in out.iterdir()) == sorted([*OUTPUT_FILES, "cli.zarr"])
+    # again: the store is in the way, and --resume continues it with nothing to evaluate
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet"]) == 2
+    assert "--resume" in capsys.readouterr().err
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet", "--resume",
+                 "--generations", "3"]) == 0
+    assert "24 designs evaluated in 3 generations (8 now" in capsys.readouterr().out
+
+
+def test_a_dry_run_prints_the_plan_and_writes_nothing(problem_file, tmp_path, capsys):
+    assert main(["optimize", str(problem_file), "--dry-run", "--out", str(tmp_path / "o")]) == 0
+    assert "8 designs x 2 generations" in capsys.readouterr().out
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_bad_problem_file_is_one_line_and_exit_2(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    bad = dict(PROBLEM, variables={"pi_kpp": {"low": 1.0, "high": 2.0}})
+    path.write_text(tomli_w.dumps(bad))
+    assert main(["optimize", str(path), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "[variables] pi_kpp" in err and "not a parameter" in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("option", ["--workers", "--generations", "--population"])
+def test_counts_below_one_are_refused(problem_file, option, capsys):
+    assert main(["optimize", str(problem_file), option, "0"]) == 2
+    assert f"`{option}` must be >= 1, got 0" in capsys.readouterr().err
+
+
+def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_file, tmp_path,
+                                                                      capsys, monkeypatch):
+    from qzs.workflows.design_space import metrics, optimizer
+
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(None)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return metrics.evaluate(*args, **kwargs)
+
+    monkeypatch.setattr(optimizer, "evaluate", interrupted)
+    out = tmp_path / "out"
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert "1 complete generation(s) are kept" in err and "--resume" in err

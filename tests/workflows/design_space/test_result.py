@@ -1,0 +1,107 @@
+"""The search's result (qzs.workflows.design_space.result): the chosen design, the files a
+user takes elsewhere (NetCDF, CSV with units, MATLAB), the run configuration and the report."""
+import copy
+
+import numpy as np
+import pytest
+
+from qzs.errors import ParameterError
+from qzs.workflows.design_space.optimizer import optimize
+from qzs.workflows.design_space.result import OUTPUT_FILES, write_files
+
+pytest.importorskip("pymoo")
+
+LINEAR = {
+    "problem": {"name": "linear", "title": "linear trade-off"},
+    "variables": {"damping_gain": {"low": 0.0, "high": 300.0},
+                  "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
+    # a stiffer position loop hunts less but isolates less at 1 Hz: a real trade-off
+    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
+                   {"metric": "hunting_amplitude"}],
+    "constraints": [{"metric": "linear_transmissibility_at", "frequency": 5.0, "max": 0.9}],
+    "optimizer": {"population": 8, "generations": 3, "seed": 4},
+}
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    return optimize(LINEAR, tmp_path_factory.mktemp("r") / "linear.zarr", progress=False)
+
+
+def test_the_chosen_design_is_the_pareto_member_nearest_the_ideal_point(result):
+    F = result.goal_values[result.pareto, :2]
+    scaled = (F - F.min(axis=0)) / (F.max(axis=0) - F.min(axis=0))
+    distance = np.hypot(*scaled.T)
+    assert result.chosen == result.pareto[np.argmin(distance)]
+    assert set(result.design()) == {"damping_gain", "pi_kp"}
+
+
+def test_the_pareto_set_files_carry_units_and_read_back_equal(result, tmp_path):
+    import scipy.io
+    import xarray as xr
+
+
+    result.save(tmp_path / "p.nc")
+    data = xr.open_dataset(tmp_path / "p.nc", engine="h5netcdf").load()
+    assert data.sizes["design"] == result.pareto.size
+    assert data["pi_kp"].attrs["units"] == "N/m"
+    assert data["damping_gain"].attrs["units"] == "N*s/m"
+    assert np.array_equal(data["pi_kp"].values, result.designs[result.pareto, 1])
+    assert data["linear_transmissibility_at_5_hz"].attrs["bound"] == 0.9
+    assert data["pareto"].values.all() and data["chosen"].values.sum() == 1
+    result.save(tmp_path / "p.mat")
+    mat = scipy.io.loadmat(tmp_path / "p.mat", squeeze_me=True)
+    assert np.array_equal(mat["pi_kp"], result.designs[result.pareto, 1])
+    result.save(tmp_path / "p.csv")
+    lines = (tmp_path / "p.csv").read_text().splitlines()
+    body = [line for line in lines if not line.startswith("#")]
+    names, units = body[0].split(","), body[1].split(",")
+    assert units[names.index("pi_kp")] == "N/m"
+    rows = np.array([line.split(",") for line in body[2:]])
+    assert np.allclose(rows[:, names.index("pi_kp")].astype(float),
+                       result.designs[result.pareto, 1], rtol=1e-9)
+    every = result.to_xarray()
+    assert every.sizes["design"] == len(result.designs)
+    assert int(every["pareto"].sum()) == result.pareto.size
+
+
+def test_the_chosen_design_is_a_run_configuration_qzs_simulate_reads(result, tmp_path):
+    from qzs.iotools.config import load_config
+
+    path = result.write_config(tmp_path / "chosen.toml")
+    config = load_config(path)
+    design = result.design()
+    assert config["controller"].damping_gain == design["damping_gain"]
+    assert config["controller"].pi_kp == design["pi_kp"]
+    assert config["excitation"]["kind"] == "chirp"
+    other = result.pareto[0] if result.pareto[0] != result.chosen else result.pareto[1]
+    assert load_config(result.write_config(tmp_path / "other.toml", other))[
+        "controller"].pi_kp == result.designs[other, 1]
+    with pytest.raises(ParameterError, match="`index` must be a design index"):
+        result.config_text(10 ** 6)
+
+
+def test_no_feasible_design_chooses_nothing_and_says_so(tmp_path):
+    document = copy.deepcopy(LINEAR)
+    document["constraints"] = [{"metric": "linear_transmissibility_at", "frequency": 5.0,
+                                "max": 1e-6}]
+    result = optimize(document, tmp_path / "none.zarr", generations=1, progress=False)
+    assert result.pareto.size == 0 and result.chosen is None
+    with pytest.raises(ParameterError, match="no design meets every constraint"):
+        result.config_text()
+    assert "No design meets every constraint" in result.report()
+    written = write_files(result, tmp_path / "out")
+    assert not (tmp_path / "out" / "chosen.toml").exists()
+    assert len(written) == len(OUTPUT_FILES) - 1
+
+
+def test_the_report_and_files_name_every_goal_with_its_unit(result, tmp_path):
+    report = result.report()
+    assert "| pi_kp | 1 | 1000 | log | N/m |" in report
+    assert "linear_transmissibility_at_5_hz <= 0.9 1" in report
+    assert "(chosen)" in report
+    written = write_files(result, tmp_path / "out")
+    assert sorted(p.name for p in written) == sorted(OUTPUT_FILES)
+    assert not [p for p in (tmp_path / "out").iterdir() if p.name.startswith(".")]
+    summary = result.summary()
+    assert f"Pareto set {result.pareto.size}" in summary
