@@ -52,7 +52,8 @@ def complete(script, words, cwd):
     (["qzs", "simulate", "--to"], ["--tolerance", "--tolerance-state"]),
     (["qzs", "simulate", "--solver", ""], ["ode3", "rk4", "euler"]),
     (["qzs", "simulate", "--solver", "rk4", "--dur"], ["--duration"]),
-    (["qzs", "s"], ["simulate", "study", "sweep", "sweep-plot", "sweep-export"]),
+    (["qzs", "s"], ["simulate", "study", "sweep", "sweep-plot", "sweep-export",
+                    "sensitivity"]),
     (["qzs", "hexapod", ""], ["linear", "simulate", "transmissibility", "study"]),
     (["qzs", "hexapod", "simulate", "--axis", "r"], ["rx", "ry", "rz"]),
     (["qzs", "hexapod", "--config", "x.toml", "st"], ["study"]),   # skips an option's value

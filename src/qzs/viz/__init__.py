@@ -8,6 +8,7 @@
 ``experiment``        a measured log beside its simulation
 ``sweeps``            sweep stores: metrics against parameters, transmissibility bands
 ``design``            a controller design's figures (``qzs design``)
+``design_space``      a design search's Pareto front (``qzs optimize``)
 ``response``          the steady-state response: branches, harmonic balance, chirp
 ``hexapod``           a hexapod run: platform pose, leg strokes, motor forces
 ``hexapod_matrix``    the six-axis platform's 6x6 transmissibility as a grid

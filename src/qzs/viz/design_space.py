@@ -15,7 +15,17 @@ __all__ = ["plot_pareto", "goal_label"]
 
 
 def goal_label(goal):
-    """An axis label: the goal, its statistic and its unit (``peak_stroke, worst [m]``)."""
+    """An axis label: the goal, its statistic and its unit (``peak stroke, worst case [m]``).
+
+    Parameters
+    ----------
+    goal : Goal
+        An objective or constraint of a design problem.
+
+    Returns
+    -------
+    str
+    """
     stat = (f", quantile {goal.quantile:g}" if goal.statistic == "quantile"
             else {"mean": "", "worst": ", worst case"}[goal.statistic])
     return f"{goal.title}{stat} [{goal.units}]"

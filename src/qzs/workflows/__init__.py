@@ -13,6 +13,8 @@
                               or on Dask
 ``design``                    ``qzs design``: PI and damping gains searched by simulation,
                               with the evidence
+``design_space``              ``qzs optimize`` and ``qzs sensitivity``: Pareto search (NSGA-II),
+                              robust design, Sobol and Morris indices
 ``response``                  steady-state frequency response: stepped-sine sweeps up and
                               down, beside the harmonic balance and the paper's chirp estimate
 ``hexapod``                   six-axis set-ups: hexapod files (``hexapod_files/``), defaults,

@@ -7,10 +7,9 @@ import pytest
 
 from qzs.errors import OutputPathError, ProblemError
 from qzs.workflows.design_space import metrics
-from qzs.workflows.design_space.optimizer import (fix_step, objective_matrix, optimize,
-                                                  probe_designs)
+from qzs.workflows.design_space.optimizer import fix_step, optimize, probe_designs
 from qzs.workflows.design_space.problem import load_problem
-from qzs.workflows.design_space.result import pareto_front
+from qzs.workflows.design_space.result import objective_matrix, pareto_front
 
 pytest.importorskip("pymoo")
 

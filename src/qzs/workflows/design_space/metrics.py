@@ -61,7 +61,17 @@ class MetricDefinition:
     label: str = ""
 
     def title(self, options):
-        """The metric with its options for people: ``RMS transmissibility 1-5 Hz``."""
+        """The metric with its options for people: ``RMS transmissibility 1-5 Hz``.
+
+        Parameters
+        ----------
+        options : dict
+            The goal's ``frequency`` [Hz] or ``band`` [Hz], as the metric takes.
+
+        Returns
+        -------
+        str
+        """
         text = self.label or self.name.replace("_", " ")
         if "frequency" in options:
             return f"{text} {options['frequency']:g} Hz"
@@ -226,6 +236,11 @@ class Evaluation:
 
     def goal_values(self, goals):
         """Each goal's value per design: the draws combined by its statistic.
+
+        Parameters
+        ----------
+        goals : sequence of Goal
+            The goals, in the order of the columns returned.
 
         Returns
         -------

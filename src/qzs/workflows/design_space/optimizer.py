@@ -26,13 +26,22 @@ from qzs._optional import require
 from qzs.errors import OutputPathError
 from qzs.workflows.design_space.metrics import METRICS, evaluate
 from qzs.workflows.design_space.problem import DesignProblem, load_problem
+from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check
 
-__all__ = ["optimize", "fix_step", "objective_matrix", "probe_designs"]
+__all__ = ["optimize", "fix_step", "probe_designs"]
 
 
 def probe_designs(problem):
     """Designs the step is chosen on: the lower corner, the centre and the upper corner.
+
+    The centre is the middle of the search space (the geometric mean of a log-scale
+    variable's bounds).
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
 
     Returns
     -------
@@ -77,44 +86,6 @@ def fix_step(problem, *, progress=False):
     return dataclasses.replace(problem, sweep=sweep)
 
 
-def objective_matrix(problem, goal_values):
-    """What the optimiser minimises and what it keeps <= 0.
-
-    Parameters
-    ----------
-    problem : DesignProblem
-        The problem.
-    goal_values : ndarray, shape (n_designs, n_goals)
-        :meth:`~qzs.workflows.design_space.metrics.Evaluation.goal_values` of
-        ``problem.goals``.
-
-    Returns
-    -------
-    F : ndarray, shape (n_designs, n_objectives)
-        The objectives, negated where maximised. An undefined objective (NaN) takes the
-        worst defined value of its column.
-    G : ndarray, shape (n_designs, n_constraints + 1)
-        Each constraint as ``value - max`` or ``min - value`` [its unit]; the last column
-        is 1 for a design with any undefined goal (a failed run, a metric its trusted bins
-        do not define) and -1 otherwise, so such a design is infeasible.
-    """
-    goal_values = np.asarray(goal_values, dtype=float)
-    n_obj = len(problem.objectives)
-    sign = np.array([-1.0 if g.sense == "maximize" else 1.0 for g in problem.objectives])
-    F = goal_values[:, :n_obj] * sign
-    for j in range(n_obj):
-        bad = ~np.isfinite(F[:, j])
-        if bad.any():
-            F[bad, j] = np.max(F[~bad, j]) if (~bad).any() else 0.0
-    G = np.empty((len(goal_values), len(problem.constraints) + 1))
-    for j, goal in enumerate(problem.constraints):
-        value = goal_values[:, n_obj + j]
-        G[:, j] = value - goal.bound if goal.sense == "minimize" else goal.bound - value
-    G[:, :-1] = np.where(np.isnan(G[:, :-1]), 0.0, G[:, :-1])
-    G[:, -1] = np.where(np.isnan(goal_values).any(axis=1), 1.0, -1.0)
-    return F, G
-
-
 def _algorithm(problem, population):
     require("pymoo", "qzs optimize (multi-objective search)")
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -133,7 +104,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
              overwrite: bool = False, generations: int | None = None,
              population: int | None = None, scheduler: Any = None,
              workers: int | None = None, threads: int | None = None,
-             progress: bool = True) -> "OptimizationResult":
+             progress: bool = True) -> OptimizationResult:
     """Search a design problem with NSGA-II; every generation is one lockstep batch.
 
     Parameters
@@ -174,7 +145,6 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     from tqdm.auto import tqdm
 
     from qzs.workflows.design_space.problem import _positive_int
-    from qzs.workflows.design_space.result import OptimizationResult
     from qzs.workflows.sweeps.backends import _client, _is_client
 
     if not isinstance(problem, DesignProblem):

@@ -97,8 +97,10 @@ class Variable:
     ----------
     name : str
         Registry name (``pi_kp``) or ``excitation.<name>``.
-    low, high : float
-        Bounds [the parameter's unit].
+    low : float
+        Lower bound, in the parameter's unit (``[N/m]`` for ``pi_kp``).
+    high : float
+        Upper bound, in the parameter's unit (``[N/m]`` for ``pi_kp``).
     scale : {"linear", "log"}
         ``log``: searched and sampled on ``log10`` (both bounds positive).
     integer : bool
@@ -115,7 +117,18 @@ class Variable:
     units: str = ""
 
     def to_unit(self, values):
-        """Map values of the search space (``log10`` for a log scale) to the parameter."""
+        """Map values of the search space (``log10`` for a log scale) to the parameter.
+
+        Parameters
+        ----------
+        values : array_like
+            Positions in the search space.
+
+        Returns
+        -------
+        ndarray
+            The parameter's values [its unit], rounded for an integer variable.
+        """
         values = np.asarray(values, dtype=float)
         out = 10.0 ** values if self.scale == "log" else values
         return np.round(out) if self.integer else out
@@ -151,7 +164,18 @@ class Uncertainty:
     units: str = ""
 
     def quantile(self, u):
-        """The parameter at probabilities ``u`` in (0, 1): inverse CDF."""
+        """The parameter at probabilities ``u``: the inverse CDF.
+
+        Parameters
+        ----------
+        u : array_like
+            Probabilities in (0, 1).
+
+        Returns
+        -------
+        ndarray
+            The parameter's values [its unit].
+        """
         u = np.asarray(u, dtype=float)
         if self.distribution == "values":
             values = np.asarray(self.settings["values"], dtype=float)
@@ -223,6 +247,18 @@ class Goal:
         """Combine the draws of each design (last axis) into one number per design.
 
         NaN draws (a metric the run does not define) make the design's value NaN.
+
+        Parameters
+        ----------
+        values : array_like, shape (..., n_samples)
+            The metric per draw [its unit].
+
+        Returns
+        -------
+        ndarray, shape (...)
+            ``mean``: the mean; ``worst``: the largest for a minimised goal (or an upper
+            bound), the smallest otherwise; ``quantile``: the quantile ``q`` on the bad
+            side (``1 - q`` for a maximised goal).
         """
         values = np.asarray(values, dtype=float)
         if self.statistic == "mean":

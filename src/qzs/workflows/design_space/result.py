@@ -15,8 +15,10 @@ import numpy as np
 
 from qzs._version import __version__
 from qzs.errors import ParameterError
+from qzs.workflows.design_space.problem import DesignProblem
 
-__all__ = ["OptimizationResult", "pareto_front", "write_files", "OUTPUT_FILES"]
+__all__ = ["OptimizationResult", "objective_matrix", "pareto_front", "write_files",
+           "OUTPUT_FILES"]
 
 
 def pareto_front(F):
@@ -25,6 +27,7 @@ def pareto_front(F):
     Parameters
     ----------
     F : array_like, shape (n, n_objectives)
+        The objectives of ``n`` designs, each minimised.
 
     Returns
     -------
@@ -41,6 +44,44 @@ def pareto_front(F):
         if not dominated.any():
             keep.append(i)
     return np.asarray(keep, dtype=int)
+
+
+def objective_matrix(problem, goal_values):
+    """What the optimiser minimises and what it keeps <= 0.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    goal_values : ndarray, shape (n_designs, n_goals)
+        :meth:`~qzs.workflows.design_space.metrics.Evaluation.goal_values` of
+        ``problem.goals``.
+
+    Returns
+    -------
+    F : ndarray, shape (n_designs, n_objectives)
+        The objectives, negated where maximised. An undefined objective (NaN) takes the
+        worst defined value of its column.
+    G : ndarray, shape (n_designs, n_constraints + 1)
+        Each constraint as ``value - max`` or ``min - value`` [its unit]; the last column
+        is 1 for a design with any undefined goal (a failed run, a metric its trusted bins
+        do not define) and -1 otherwise, so such a design is infeasible.
+    """
+    goal_values = np.asarray(goal_values, dtype=float)
+    n_obj = len(problem.objectives)
+    sign = np.array([-1.0 if g.sense == "maximize" else 1.0 for g in problem.objectives])
+    F = goal_values[:, :n_obj] * sign
+    for j in range(n_obj):
+        bad = ~np.isfinite(F[:, j])
+        if bad.any():
+            F[bad, j] = np.max(F[~bad, j]) if (~bad).any() else 0.0
+    G = np.empty((len(goal_values), len(problem.constraints) + 1))
+    for j, goal in enumerate(problem.constraints):
+        value = goal_values[:, n_obj + j]
+        G[:, j] = value - goal.bound if goal.sense == "minimize" else goal.bound - value
+    G[:, :-1] = np.where(np.isnan(G[:, :-1]), 0.0, G[:, :-1])
+    G[:, -1] = np.where(np.isnan(goal_values).any(axis=1), 1.0, -1.0)
+    return F, G
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -77,7 +118,7 @@ class OptimizationResult:
         Integration steps of this call.
     """
 
-    problem: object = field(repr=False)
+    problem: DesignProblem = field(repr=False)
     designs: np.ndarray
     generation: np.ndarray
     values: dict = field(repr=False)
@@ -93,9 +134,25 @@ class OptimizationResult:
 
     @classmethod
     def from_store(cls, store, problem, *, wall=0.0, evaluated=0, steps=0):
-        """The result of every design a :class:`~.store.DesignStore` holds."""
-        from qzs.workflows.design_space.optimizer import objective_matrix
+        """The result of every design a :class:`~.store.DesignStore` holds.
 
+        Parameters
+        ----------
+        store : DesignStore
+            The store.
+        problem : DesignProblem
+            Its problem, with the step fixed.
+        wall : float
+            Wall time of the search [s].
+        evaluated : int
+            Designs the search evaluated (the others were read from the store).
+        steps : int
+            Integration steps of the search.
+
+        Returns
+        -------
+        OptimizationResult
+        """
         data = store.read()
         goal_values = (np.column_stack([g.aggregate(data["values"][g.column])
                                         for g in problem.goals])
@@ -134,7 +191,18 @@ class OptimizationResult:
         return int(self.pareto[np.argmin(np.sqrt((scaled ** 2).sum(axis=1)))])
 
     def design(self, index=None) -> dict:
-        """A design's variables by name [their units] (default the chosen design)."""
+        """A design's variables by name.
+
+        Parameters
+        ----------
+        index : int, optional
+            The design's index; default the chosen design.
+
+        Returns
+        -------
+        dict of str to float
+            Variable -> value [its unit].
+        """
         index = self._index(index)
         return {v.name: float(self.designs[index, j])
                 for j, v in enumerate(self.problem.variables)}
@@ -233,6 +301,15 @@ class OptimizationResult:
 
         Uncertain parameters take their medians; the excitation and step are the
         problem's. ``qzs simulate --config FILE`` runs it.
+
+        Parameters
+        ----------
+        index : int, optional
+            The design's index; default the chosen design.
+
+        Returns
+        -------
+        str
         """
         from qzs.iotools.config import config_text
         from qzs.workflows.sweeps.backends import build_case
@@ -255,7 +332,19 @@ class OptimizationResult:
                            note=f"design {index} of `qzs optimize` {p.name!r}: {values}")
 
     def write_config(self, path, index=None):
-        """Write :meth:`config_text` to ``path`` (TOML), atomically; returns the path."""
+        """Write :meth:`config_text` to a TOML file, atomically.
+
+        Parameters
+        ----------
+        path : str or Path
+            The file.
+        index : int, optional
+            The design's index; default the chosen design.
+
+        Returns
+        -------
+        Path
+        """
         from qzs.iotools.files import atomic_path
 
         text = self.config_text(index)
@@ -264,7 +353,19 @@ class OptimizationResult:
         return Path(path)
 
     def plot(self, ax=None, **kwargs):
-        """The Pareto figure (:func:`qzs.viz.design_space.plot_pareto`)."""
+        """The Pareto figure (:func:`qzs.viz.design_space.plot_pareto`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Draw into this axes (two objectives only).
+        **kwargs
+            ``path`` and ``title``, as :func:`~qzs.viz.design_space.plot_pareto` takes them.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from qzs.viz.design_space import plot_pareto
 
         return plot_pareto(self, ax=ax, **kwargs)

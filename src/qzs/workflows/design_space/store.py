@@ -138,11 +138,24 @@ class DesignStore:
         return (attrs["dt"], attrs.get("step_note", "")) if "dt" in attrs else None
 
     def set_step(self, dt, note):
-        """Record the integration step [s] every generation uses."""
+        """Record the integration step every generation uses.
+
+        Parameters
+        ----------
+        dt : float
+            The step [s].
+        note : str
+            How it was chosen.
+        """
         self.group.attrs.update({"dt": float(dt), "step_note": str(note)})
 
     def generation_rows(self, generation):
         """The stored rows of one complete generation.
+
+        Parameters
+        ----------
+        generation : int
+            The generation's number (0 first).
 
         Returns
         -------
