@@ -20,6 +20,7 @@ ranks the parameters by Sobol or Morris indices (:mod:`.sensitivity`). The guide
 from qzs.workflows.design_space.metrics import METRICS, Evaluation, evaluate
 from qzs.workflows.design_space.problem import (DesignProblem, Goal, Uncertainty, Variable,
                                                 load_problem, shipped_problems)
+from qzs.workflows.design_space.sensitivity import SensitivityResult, sensitivity
 
 __all__ = ["load_problem", "shipped_problems", "DesignProblem", "Variable", "Uncertainty",
-           "Goal", "METRICS", "Evaluation", "evaluate"]
+           "Goal", "METRICS", "Evaluation", "evaluate", "sensitivity", "SensitivityResult"]
