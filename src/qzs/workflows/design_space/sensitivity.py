@@ -593,7 +593,7 @@ def parameter_ranking(result: SensitivityResult, metric: str | None = None) -> t
     if result.reasons[i]:
         raise ParameterError(f"the indices of {result.metrics[i]!r} are undefined: "
                              f"{result.reasons[i]}; no ranking.")
-    key = result.total_order if result.method == "sobol" else result.mu_star
+    key = result.indices["total_order" if result.method == "sobol" else "mu_star"]
     order = np.argsort(-key[i], kind="stable")
     return tuple(result.parameters[j] for j in order)
 
@@ -624,6 +624,7 @@ def sensitivity_summary(result: SensitivityResult) -> str:
                 f"{result.levels} levels, {result.evaluations} cases, {level} intervals")
         columns = f"{'parameter':<32} {'mu*':>10} {'+-':>9} {'sigma':>10} {'mu':>10}"
     lines = [head]
+    indices, intervals = result.indices, result.intervals
     if result.failed:
         lines.append(f"{result.failed} of {result.evaluations} cases failed")
     for i, metric in enumerate(result.metrics):
@@ -638,15 +639,15 @@ def sensitivity_summary(result: SensitivityResult) -> str:
             label = _label(name, result.parameter_units[j])
             if result.parameter_kinds[j] == "uncertain":
                 label += " ~"
+            half = {name: np.diff(interval[i, j])[0] / 2 for name, interval in intervals.items()}
             if result.method == "sobol":
-                s1, st = result.first_order[i, j], result.total_order[i, j]
-                c1 = np.diff(result.first_order_interval[i, j])[0] / 2
-                ct = np.diff(result.total_order_interval[i, j])[0] / 2
-                lines.append(f"  {label:<32} {s1:8.3f} {c1:7.3f} {st:8.3f} {ct:7.3f}")
+                s1, st = indices["first_order"][i, j], indices["total_order"][i, j]
+                lines.append(f"  {label:<32} {s1:8.3f} {half['first_order']:7.3f} {st:8.3f} "
+                             f"{half['total_order']:7.3f}")
             else:
-                ms, sg, mu = result.mu_star[i, j], result.sigma[i, j], result.mu[i, j]
-                cm = np.diff(result.mu_star_interval[i, j])[0] / 2
-                lines.append(f"  {label:<32} {ms:10.4g} {cm:9.3g} {sg:10.4g} {mu:10.4g}")
+                ms, sg, mu = (indices[name][i, j] for name in ("mu_star", "sigma", "mu"))
+                lines.append(f"  {label:<32} {ms:10.4g} {half['mu_star']:9.3g} {sg:10.4g} "
+                             f"{mu:10.4g}")
     if "uncertain" in result.parameter_kinds:
         lines += ["", "~ uncertain parameter (sampled from its distribution)"]
     return "\n".join(lines)
@@ -672,9 +673,9 @@ def sensitivity_schema(result: SensitivityResult) -> Schema:
                  long_name="metric column of the problem's goals"),
         Variable(name="parameter", dims=("parameter",), dtype="str",
                  long_name="registry parameter"),
-        Variable(name="metric_units", dims=("metric",), dtype="str",
+        Variable(name="metric_unit", dims=("metric",), dtype="str",
                  long_name="unit of the metric"),
-        Variable(name="parameter_units", dims=("parameter",), dtype="str",
+        Variable(name="parameter_unit", dims=("parameter",), dtype="str",
                  long_name="unit of the parameter"),
         Variable(name="parameter_kind", dims=("parameter",), dtype="str",
                  long_name="variable (uniform between its bounds) or uncertain (from "
@@ -684,7 +685,7 @@ def sensitivity_schema(result: SensitivityResult) -> Schema:
     for name in _INDICES[result.method]:
         doc, unit = INDICES[name]
         note = {} if unit or common else {"comment": "in the unit of each metric "
-                                                     "(metric_units)"}
+                                                     "(metric_unit)"}
         unit = unit or common
         variables.append(Variable(name=name, dims=on, units=unit, long_name=doc,
                                   attributes=note))
@@ -722,8 +723,8 @@ def sensitivity_dataset(result: SensitivityResult) -> xr.Dataset:
     from qzs._version import __version__
 
     values = {"metric": list(result.metrics), "parameter": list(result.parameters),
-              "metric_units": list(result.metric_units),
-              "parameter_units": list(result.parameter_units),
+              "metric_unit": list(result.metric_units),
+              "parameter_unit": list(result.parameter_units),
               "parameter_kind": list(result.parameter_kinds), "reason": list(result.reasons)}
     for name in _INDICES[result.method]:
         values[name] = getattr(result, name)
