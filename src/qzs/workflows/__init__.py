@@ -19,5 +19,7 @@
                               the reports behind ``qzs hexapod``
 ``hexapod_transmissibility``  the simulated 6x6 transmissibility of a platform, chirp per axis
 ``hexapod_study``             ``qzs hexapod study``: six paper legs with and without PI
+``design_space``              ``qzs optimize`` and ``qzs sensitivity``: problem files, NSGA-II,
+                              robust design, Sobol and Morris indices
 ============================  ================================================================
 """
