@@ -13,6 +13,7 @@
 ``hexapod``           a hexapod run: platform pose, leg strokes, motor forces
 ``hexapod_matrix``    the six-axis platform's 6x6 transmissibility as a grid
 ``hexapod_study``     the hexapod study's cases side by side
+``sensitivity``       Sobol and Morris indices as bars with their intervals
 ====================  ================================================================
 """
 from qzs.viz.figures import envelope, new_figure, save_figure

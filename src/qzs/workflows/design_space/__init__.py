@@ -22,7 +22,8 @@ from qzs.workflows.design_space.optimizer import optimize
 from qzs.workflows.design_space.problem import (DesignProblem, Goal, Uncertainty, Variable,
                                                 load_problem, plan_text, shipped_problems)
 from qzs.workflows.design_space.result import OptimizationResult, write_files
+from qzs.workflows.design_space.sensitivity import SensitivityResult, sensitivity
 
-__all__ = ["optimize", "load_problem", "shipped_problems", "plan_text", "DesignProblem",
-           "Variable", "Uncertainty", "Goal", "METRICS", "Evaluation", "evaluate",
-           "OptimizationResult", "write_files"]
+__all__ = ["optimize", "sensitivity", "load_problem", "shipped_problems", "plan_text",
+           "DesignProblem", "Variable", "Uncertainty", "Goal", "METRICS", "Evaluation",
+           "evaluate", "OptimizationResult", "SensitivityResult", "write_files"]

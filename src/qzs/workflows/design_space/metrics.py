@@ -11,6 +11,8 @@ simulation (hunting amplitude at rest, stability margins, the linear transmissib
 :func:`qzs.workflows.sweeps.backends.run_batch`, the task of every sweep, so a design
 gives exactly the numbers of a sweep's case and of :func:`qzs.simulate`. Cases that share
 their excitation and step run as one lockstep batch of the lane kernel.
+:func:`evaluate_cases` is that path for any list of cases (a sensitivity analysis sets
+variables and uncertain parameters together, so it cannot cross designs with draws).
 """
 import math
 import time
@@ -22,7 +24,7 @@ from qzs.analysis.statistics import STATISTICS as RUN_STATISTICS
 from qzs.engine.batch import STATS
 
 __all__ = ["MetricDefinition", "METRICS", "STATISTICS", "metric_column", "sweep_outputs",
-           "Evaluation", "evaluate", "case_settings"]
+           "Evaluation", "evaluate", "evaluate_cases", "case_settings"]
 
 #: How the Monte Carlo draws of a design combine.
 STATISTICS = ("mean", "worst", "quantile")
@@ -277,16 +279,23 @@ def case_settings(problem, designs):
     return settings
 
 
-def _linear(problem, settings, columns, values, status, messages):
-    """The linear metrics of each case (python-control; no simulation)."""
+def _linear(problem, settings, goals, values, status, messages, progress=None):
+    """The linear metrics ``goals`` of each case (python-control; no simulation).
+
+    ``progress`` is called with the number of cases done, about every hundredth of them.
+    """
     from qzs.analysis.control_design.hunting import predict_hunting
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
     from qzs.errors import ParameterError
     from qzs.workflows.sweeps.backends import build_case
 
-    goals = {g.column: g for g in problem.goals if METRICS[g.metric].source == "linear"}
+    goals = {g.column: g for g in goals}
+    every, done = max(1, len(settings) // 100), 0
     for c, case in enumerate(settings):
+        if progress is not None and c and c % every == 0:
+            progress(c - done)
+            done = c
         try:
             isolator, controller, _, _ = build_case(problem.sweep, case)
         except (ParameterError, TypeError) as error:
@@ -307,19 +316,29 @@ def _linear(problem, settings, columns, values, status, messages):
                 value = abs(complex(linear_transmissibility(goal.options["frequency"],
                                                             isolator, controller)))
             values[column][c] = value
+    if progress is not None:
+        progress(len(settings) - done)
 
 
-def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
-             progress=None):
-    """Evaluate designs: every design under every draw, in lockstep batches.
+def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None,
+                   batch_size=None, progress=None):
+    """Evaluate cases, each a dict of parameter values, in lockstep batches.
+
+    The one path of every evaluation: :func:`evaluate` crosses designs with draws into
+    cases, a sensitivity analysis samples variables and uncertain parameters together;
+    each case runs through :func:`qzs.workflows.sweeps.backends.run_batch` with
+    ``problem.sweep`` (simulated metrics) or the linear analysis (linear metrics).
 
     Parameters
     ----------
     problem : DesignProblem
-        The problem; its ``sweep`` must have its step fixed (``simulation["dt"]``) when
-        any goal needs a simulation.
-    designs : array_like, shape (n_designs, n_variables)
-        The decision variables [their units], in the order of ``problem.variables``.
+        The problem; its ``sweep`` must have its step fixed (``simulation["dt"]``) when a
+        metric of ``columns`` needs a simulation.
+    settings : list of dict
+        One dict per case: parameter name -> value [the parameter's unit].
+    columns : sequence of str, optional
+        The metric columns wanted; default every column of the problem's goals. No
+        simulation runs when none of them needs one.
     client : distributed.Client, optional
         Run the batches on this Dask cluster (results are the same).
     threads : int, optional
@@ -332,22 +351,32 @@ def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
 
     Returns
     -------
-    Evaluation
+    values : dict of str to ndarray, shape (n_cases,)
+        Metric column -> its value per case [the metric's unit]; NaN where the run failed
+        or the metric is undefined.
+    status : ndarray of int8, shape (n_cases,)
+        Sweep status per case (1 ok; see :data:`qzs.workflows.sweeps.store.STATUS`).
+    messages : list of str
+        Why a case failed ('' if ok).
+    steps : int
+        Integration steps done.
+
+    Raises
+    ------
+    ValueError
+        A simulated metric is wanted and the problem's step is not fixed yet.
     """
     from qzs.workflows.sweeps.backends import _dask, _local, run_batch  # noqa: F401
 
-    began = time.perf_counter()
-    designs = np.atleast_2d(np.asarray(designs, dtype=float))
-    n, samples = designs.shape[0], problem.samples
-    settings = case_settings(problem, designs)
     total = len(settings)
-    columns = problem.columns
+    columns = problem.columns if columns is None else tuple(columns)
+    goals = [g for g in problem.goals if g.column in columns]
     values = {column: np.full(total, np.nan) for column in columns}
     status = np.ones(total, dtype=np.int8)
     messages = [""] * total
     steps = 0
-    simulated = [g for g in problem.goals if METRICS[g.metric].source != "linear"]
-    if simulated:
+    simulated = [g for g in goals if METRICS[g.metric].source != "linear"]
+    if simulated and total:
         definition = problem.sweep
         if definition.simulation["dt"] is None:
             raise ValueError("the problem's step is not fixed yet: choose it first "
@@ -377,10 +406,45 @@ def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
             results.close()
         for column in values:  # a failed case defines no metric
             values[column][status != 1] = np.nan
-    if any(METRICS[g.metric].source == "linear" for g in problem.goals):
-        _linear(problem, settings, columns, values, status, messages)
-        if not simulated and progress is not None:
-            progress(total)
+    linear = [g for g in goals if METRICS[g.metric].source == "linear"]
+    if linear:
+        _linear(problem, settings, linear, values, status, messages,
+                None if simulated else progress)
+    return values, status, messages, steps
+
+
+def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
+             progress=None):
+    """Evaluate designs: every design under every draw, in lockstep batches.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem; its ``sweep`` must have its step fixed (``simulation["dt"]``) when
+        any goal needs a simulation.
+    designs : array_like, shape (n_designs, n_variables)
+        The decision variables [their units], in the order of ``problem.variables``.
+    client : distributed.Client, optional
+        Run the batches on this Dask cluster (results are the same).
+    threads : int, optional
+        Threads per batch; default all cores locally, 1 on a cluster.
+    batch_size : int, optional
+        Cases per batch; default all of them locally (one lockstep batch), about two
+        batches per worker thread on a cluster.
+    progress : callable, optional
+        Called with the number of cases each finished batch held.
+
+    Returns
+    -------
+    Evaluation
+    """
+    began = time.perf_counter()
+    designs = np.atleast_2d(np.asarray(designs, dtype=float))
+    n, samples = designs.shape[0], problem.samples
+    settings = case_settings(problem, designs)
+    values, status, messages, steps = evaluate_cases(
+        problem, settings, client=client, threads=threads, batch_size=batch_size,
+        progress=progress)
     return Evaluation(designs=designs,
                       values={c: v.reshape(n, samples) for c, v in values.items()},
                       status=status.reshape(n, samples),
