@@ -80,3 +80,22 @@ def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_fi
     assert main(["optimize", str(problem_file), "--out", str(out), "--quiet"]) == 130
     err = capsys.readouterr().err
     assert "1 complete generation(s) are kept" in err and "--resume" in err
+
+
+def test_sensitivity_writes_the_indices_and_their_figure(problem_file, tmp_path, capsys):
+    out = tmp_path / "sens"
+    assert main(["sensitivity", str(problem_file), "--method", "morris", "--samples", "4",
+                 "--out", str(out), "--quiet"]) == 0
+    from qzs.workflows.design_space.sensitivity import SENSITIVITY_FILES
+
+    assert sorted(p.name for p in out.iterdir()) == sorted(SENSITIVITY_FILES)
+    printed = capsys.readouterr().out
+    assert "viscous_damping" in printed and "pi_kp" in printed
+
+
+def test_sensitivity_refuses_a_base_count_that_is_not_a_power_of_two(problem_file, tmp_path,
+                                                                      capsys):
+    assert main(["sensitivity", str(problem_file), "--samples", "100",
+                 "--out", str(tmp_path / "s")]) == 2
+    assert "power of two" in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()

@@ -154,20 +154,21 @@ def run_sensitivity_command(args):
     int
         0, or 130 if Ctrl-C interrupted it, 143 if SIGTERM ended it.
     """
-    from qzs.workflows.design_space import load_problem, sensitivity
+    from qzs.workflows.design_space import load_problem
+    from qzs.workflows.design_space.sensitivity import run_sensitivity
 
     _check_counts(args)
     problem = load_problem(args.problem)
     folder = Path(args.out) if args.out else Path(f"{problem.name}-sensitivity")
     check_output_path(folder, argument="--out", suffixes=None, directory=True)
     try:
-        result = sensitivity(problem, method=args.method, samples=args.samples, seed=args.seed,
-                             scheduler=args.scheduler, workers=args.workers,
-                             threads=args.threads, progress=not args.quiet)
+        result, written = run_sensitivity(problem, folder, method=args.method,
+                                          samples=args.samples, seed=args.seed,
+                                          scheduler=args.scheduler, workers=args.workers,
+                                          threads=args.threads, progress=not args.quiet)
     except (KeyboardInterrupt, Terminated) as stop:
         return _stopped(stop, None, "nothing is written (a sensitivity run is not resumable; "
                                     "fewer --samples make it shorter)")
-    written = result.write_files(folder)
     print(result.summary())
     for path in written:
         print(f"  wrote            {path}")

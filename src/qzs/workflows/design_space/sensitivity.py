@@ -63,7 +63,7 @@ if TYPE_CHECKING:
 
 __all__ = ["sensitivity", "SensitivityResult", "sensitivity_dataset", "sensitivity_summary",
            "sensitivity_schema", "parameter_ranking", "SENSITIVITY_SUFFIXES",
-           "NUM_RESAMPLES", "INDICES"]
+           "NUM_RESAMPLES", "INDICES", "run_sensitivity", "SENSITIVITY_FILES"]
 
 #: The files :meth:`SensitivityResult.save` writes, by suffix.
 SENSITIVITY_SUFFIXES = (".nc", ".csv", ".mat")
@@ -747,3 +747,66 @@ def sensitivity_dataset(result: SensitivityResult) -> xr.Dataset:
     if result.settings.get("dt") is not None:
         attrs["dt_units"] = "s"
     return to_dataset(sensitivity_schema(result), values, attrs)
+
+
+#: What :func:`run_sensitivity` writes into its folder.
+SENSITIVITY_FILES = ("sensitivity.nc", "sensitivity.csv", "sensitivity.mat", "sensitivity.png",
+                     "sensitivity.txt")
+
+
+def run_sensitivity(problem: DesignProblem | str | Path | Mapping[str, Any],
+                    folder: str | Path, *, method: str | None = None,
+                    samples: int | None = None, seed: int | None = None,
+                    scheduler: Any = None, workers: int | None = None,
+                    threads: int | None = None,
+                    progress: bool = True) -> tuple[SensitivityResult, list[Path]]:
+    """Run :func:`sensitivity` (locally or on Dask) and write its files into ``folder``.
+
+    Parameters
+    ----------
+    problem : DesignProblem, str, Path or dict
+        The problem, a TOML file, a shipped problem's name or a parsed document.
+    folder : str or Path
+        Where :data:`SENSITIVITY_FILES` go (created if missing; each file atomic).
+    method, samples, seed : optional
+        As :func:`sensitivity` takes them.
+    scheduler : str or distributed.Client, optional
+        Evaluate on this Dask cluster.
+    workers : int, optional
+        Start a local Dask cluster of this many single-threaded worker processes.
+    threads : int, optional
+        Threads per batch.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    result : SensitivityResult
+    written : list of Path
+    """
+    import matplotlib.pyplot as plt
+
+    from qzs.iotools.files import atomic_path
+    from qzs.workflows.sweeps.backends import _client, _is_client
+
+    client = cluster = None
+    try:
+        if scheduler is not None or workers is not None:
+            client, cluster = _client(scheduler, workers)
+        result = sensitivity(problem, method=method, samples=samples, seed=seed, client=client,
+                             threads=threads, progress=progress)
+    finally:
+        if client is not None and not _is_client(scheduler):
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [result.save(folder / name) for name in SENSITIVITY_FILES[:3]]
+    figure = result.plot(folder / "sensitivity.png")
+    plt.close(figure)
+    written.append(folder / "sensitivity.png")
+    with atomic_path(folder / "sensitivity.txt") as tmp:
+        Path(tmp).write_text(result.summary() + "\n", encoding="utf-8")
+    written.append(folder / "sensitivity.txt")
+    return result, written
