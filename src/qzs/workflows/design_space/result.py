@@ -463,7 +463,7 @@ OUTPUT_FILES = ("pareto.nc", "pareto.csv", "pareto.mat", "designs.nc", "pareto.p
                 "chosen.toml", "report.md")
 
 
-def write_files(result, folder):
+def write_files(result: OptimizationResult, folder: str | Path) -> list[Path]:
     """Write a search's outputs into ``folder``, each file atomically.
 
     ``pareto.nc``/``.csv``/``.mat`` (the Pareto set with units), ``designs.nc`` (every

@@ -213,7 +213,8 @@ class DesignStore:
                                  "messages": messages})
 
 
-def check(path, *, resume=False, overwrite=False, argument="store"):
+def check(path: str | Path, *, resume: bool = False, overwrite: bool = False,
+          argument: str = "store") -> None:
     """Check a store path before any work: name, folder, and resume/overwrite.
 
     Parameters
@@ -243,7 +244,7 @@ def check(path, *, resume=False, overwrite=False, argument="store"):
                               "--overwrite to replace it, or choose another name")
 
 
-def stored_generations(path):
+def stored_generations(path: str | Path) -> int:
     """Complete generations in a design store (0 if there is none at ``path``).
 
     Parameters
@@ -258,6 +259,7 @@ def stored_generations(path):
     import zarr
 
     try:
-        return int(zarr.open_group(str(path), mode="r").attrs.get("generations_done", 0))
+        done = zarr.open_group(str(path), mode="r").attrs.get("generations_done", 0)
+        return done if isinstance(done, int) else 0
     except Exception:  # noqa: BLE001 - no store, or not a Zarr group: nothing kept
         return 0
