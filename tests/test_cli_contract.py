@@ -90,7 +90,8 @@ ARGV = {"simulate": ["simulate"], "params": ["params"], "paper": ["paper"],
         "sweep-export": ["sweep-export", "s.zarr"],
         "hexapod": ["hexapod", "linear"], "response": ["response"],
         "design": ["design"], "app": ["app", "--no-browser"], "docs": ["docs"],
-        "completion": ["completion", "bash"]}
+        "completion": ["completion", "bash"], "optimize": ["optimize", "p.toml"],
+        "sensitivity": ["sensitivity", "p.toml"]}
 
 
 def test_every_subcommand_has_the_same_exit_codes(monkeypatch, capsys):

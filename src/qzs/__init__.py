@@ -34,7 +34,7 @@ from qzs.engine.results import SimulationResult
 from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
-                        MissingDependencyError, OutputPathError, ParameterError,
+                        MissingDependencyError, OutputPathError, ParameterError, ProblemError,
                         ResultTooLargeError, SimulationError, SizeLimitError, StabilityError,
                         ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
@@ -63,6 +63,11 @@ _LAZY = {
     "DesignResult": "qzs.workflows.design.result",
     "hexapod_transmissibility": "qzs.workflows.hexapod_transmissibility",
     "HexapodTransmissibility": "qzs.workflows.hexapod_transmissibility",
+    "optimize": "qzs.workflows.design_space.optimizer",
+    "sensitivity": "qzs.workflows.design_space.sensitivity",
+    "load_problem": "qzs.workflows.design_space.problem",
+    "OptimizationResult": "qzs.workflows.design_space.result",
+    "SensitivityResult": "qzs.workflows.design_space.sensitivity",
 }
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
@@ -78,6 +83,10 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.iotools.readers import load_channel_map, read_recording
     from qzs.workflows.design.driver import design_controller
     from qzs.workflows.design.result import DesignResult
+    from qzs.workflows.design_space.optimizer import optimize
+    from qzs.workflows.design_space.problem import load_problem
+    from qzs.workflows.design_space.result import OptimizationResult
+    from qzs.workflows.design_space.sensitivity import SensitivityResult, sensitivity
     from qzs.workflows.hexapod_transmissibility import (HexapodTransmissibility,
                                                         hexapod_transmissibility)
     from qzs.workflows.response.result import SteadyStateResponse
@@ -94,7 +103,7 @@ __all__ = [
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
-    "ToleranceNotMetError", "SizeLimitError",
+    "ToleranceNotMetError", "SizeLimitError", "ProblemError",
     "DataWarning", "FitWarning",
     *_LAZY,
 ]

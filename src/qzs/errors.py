@@ -170,7 +170,7 @@ class ProblemError(ParameterError):
         The file (or "problem definition"); '' until known.
     """
 
-    def __init__(self, table, key, value, fix, source=""):
+    def __init__(self, table: str, key: str, value: object, fix: str, source: str = "") -> None:
         self.table, self.key, self.value = str(table), str(key), value
         self.fix, self.source = str(fix).rstrip("."), str(source)
         where = f"[{self.table}]" + (f" {self.key}" if self.key else "")

@@ -7,15 +7,25 @@ point once each objective is scaled to the front's range (a compromise; with one
 objective, the best feasible design). It only delegates: ``.to_xarray()`` and
 ``.save()`` to the file layer, ``.plot()`` to :mod:`qzs.viz.design_space`.
 """
+from __future__ import annotations
+
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from qzs._version import __version__
 from qzs.errors import ParameterError
 from qzs.workflows.design_space.problem import DesignProblem
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from qzs.workflows.design_space.store import DesignStore
 
 __all__ = ["OptimizationResult", "objective_matrix", "pareto_front", "write_files",
            "OUTPUT_FILES"]
@@ -133,7 +143,8 @@ class OptimizationResult:
     steps: int = 0
 
     @classmethod
-    def from_store(cls, store, problem, *, wall=0.0, evaluated=0, steps=0):
+    def from_store(cls, store: DesignStore, problem: DesignProblem, *, wall: float = 0.0,
+                   evaluated: int = 0, steps: int = 0) -> OptimizationResult:
         """The result of every design a :class:`~.store.DesignStore` holds.
 
         Parameters
@@ -190,7 +201,7 @@ class OptimizationResult:
         scaled = (F - F.min(axis=0)) / np.where(span > 0, span, 1.0)
         return int(self.pareto[np.argmin(np.sqrt((scaled ** 2).sum(axis=1)))])
 
-    def design(self, index=None) -> dict:
+    def design(self, index: int | None = None) -> dict[str, float]:
         """A design's variables by name.
 
         Parameters
@@ -221,7 +232,7 @@ class OptimizationResult:
         return index
 
     # ------------------------------------------------------------ files
-    def to_xarray(self, *, pareto_only=False):
+    def to_xarray(self, *, pareto_only: bool = False) -> xr.Dataset:
         """The designs as an ``xarray.Dataset`` on a ``design`` dimension, with units.
 
         Parameters
@@ -278,7 +289,7 @@ class OptimizationResult:
                                                                  "design in the store"})},
                           attrs=attrs)
 
-    def save(self, path, *, pareto_only=True):
+    def save(self, path: str | Path, *, pareto_only: bool = True) -> Path:
         """Write the Pareto set (or every design) to NetCDF, CSV or MATLAB, atomically.
 
         Parameters
@@ -296,7 +307,7 @@ class OptimizationResult:
 
         return write_dataset(self.to_xarray(pareto_only=pareto_only), path)
 
-    def config_text(self, index=None):
+    def config_text(self, index: int | None = None) -> str:
         """The chosen design (or design ``index``) as a run configuration's TOML text.
 
         Uncertain parameters take their medians; the excitation and step are the
@@ -331,7 +342,7 @@ class OptimizationResult:
         return config_text(isolator, controller, excitation, simulation,
                            note=f"design {index} of `qzs optimize` {p.name!r}: {values}")
 
-    def write_config(self, path, index=None):
+    def write_config(self, path: str | Path, index: int | None = None) -> Path:
         """Write :meth:`config_text` to a TOML file, atomically.
 
         Parameters
@@ -352,7 +363,7 @@ class OptimizationResult:
             Path(tmp).write_text(text, encoding="utf-8")
         return Path(path)
 
-    def plot(self, ax=None, **kwargs):
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Figure:
         """The Pareto figure (:func:`qzs.viz.design_space.plot_pareto`).
 
         Parameters
