@@ -288,16 +288,21 @@ def _linear(problem, settings, goals, values, status, messages, progress=None):
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
     from qzs.errors import ParameterError
-    from qzs.workflows.sweeps.backends import build_case
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
+    from qzs.model.registry import update_parameters
 
     goals = {g.column: g for g in goals}
+    fixed = problem.sweep.parameters
     every, done = max(1, len(settings) // 100), 0
     for c, case in enumerate(settings):
         if progress is not None and c and c % every == 0:
             progress(c - done)
             done = c
-        try:
-            isolator, controller, _, _ = build_case(problem.sweep, case)
+        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
+        try:  # the model only: the linear analysis needs no excitation
+            isolator, controller = update_parameters(IsolatorParameters(),
+                                                     ControllerParameters(), {**fixed, **model})
         except (ParameterError, TypeError) as error:
             status[c], messages[c] = 2, str(error)
             continue
