@@ -27,7 +27,10 @@ the target, PASS/FAIL:
 7. the lane kernel against JAX on the same (regularised) model, 1024 cases, one and two cores
    (``bench_jax.py``; needs jax, the ``bench`` extra, never installed by this script);
 8. (issue 11) a sweep on a Dask cluster of fresh worker processes at its local speed;
-9. (issue 14) the tuning page: a slider's release to the redrawn transmissibility within 1 s.
+9. (issue 14) the tuning page: a slider's release to the redrawn transmissibility within 1 s;
+11. the design-space search: ``qzs optimize``'s Pareto front within 1 % (multiplicative epsilon,
+    each objective) of a 10 000-design ``qzs sweep`` grid's, at under a tenth of its evaluations
+    (``bench_design_space.py``; seed 1 with ``--quick``, seeds 1-3 otherwise).
 
 The C baseline is ``benchmarks/c_reference/isolator.c``, compiled here with gcc (flags in
 ``c_reference/reference.py``) into a cache folder outside the repository and run in this
@@ -74,7 +77,7 @@ TARGET_CHOICE = 0.3       # the step choice of the paper's chirp [s]
 TARGET_STARTUP = 0.6      # start-up to the first step [s]
 TOLERANCE_DB = 0.01       # the default tolerance of the accuracy-driven step
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 11)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -652,6 +655,18 @@ def target_app(table, args):
               f"{median * 1e3:.0f} ms", f"{computed * 1e3:.0f} ms", "-", "-", "info")
 
 
+# --------------------------------------------------------------------------- 11. design space
+
+def target_design_space(table, args):
+    import bench_design_space
+
+    out = bench_design_space.measure(seeds=(1,) if args.quick else (1, 2, 3),
+                                     idle_wait=args.idle_wait)
+    table.note_runs([out["grid"], *out["runs"]])
+    for what, value, baseline, ratio, goal, verdict in bench_design_space.verdicts(out):
+        table.add("11i" if verdict == "info" else 11, what, value, baseline, ratio, goal, verdict)
+
+
 # --------------------------------------------------------------------------- main
 
 def main(argv=None):
@@ -718,6 +733,8 @@ def main(argv=None):
         (7, "7. lane kernel vs JAX", lambda: target_jax(table, args), False, 7 in only),
         (8, "8. clusters (issue 11)", lambda: target_cluster(table, args), False, 8 in only),
         (9, "9. the tuning page (issue 14)", lambda: target_app(table, args), False, 9 in only),
+        (11, "11. the design-space search against a grid",
+         lambda: target_design_space(table, args), False, 11 in only),
     ]
     for number, title, fn, needs_c, wanted in steps_targets:
         if not wanted:
