@@ -216,3 +216,25 @@ def test_an_integer_variable_takes_whole_numbers_only(tmp_path):
     assert np.array_equal(rates, np.round(rates)) and rates.min() >= 200 and rates.max() <= 2000
     # a sampled controller loses phase as its rate falls: the margin is a real objective
     assert np.ptp(result.goal_values[:, 1]) > 0
+
+
+def test_a_log_scale_objective_is_compared_in_ratios_and_must_stay_positive():
+    document = copy.deepcopy(LINEAR)
+    document["objectives"][0]["scale"] = "log"
+    problem = load_problem(document)
+    F, G = objective_matrix(problem, np.array([[0.1, 0.5, 0.0], [1e-3, 0.5, 0.0],
+                                               [0.0, 0.5, 0.0]]))
+    assert F[:2, 0] == pytest.approx([-1.0, -3.0])
+    assert G[:, -1].tolist() == [-1.0, -1.0, 1.0]  # log10(0): undefined, so infeasible
+    document["objectives"][0] = {"metric": "gain_margin", "scale": "log"}
+    with pytest.raises(ProblemError, match="stays positive"):
+        load_problem(document)
+
+
+def test_the_seed_can_be_given_to_the_call_and_changes_the_search(tmp_path):
+    one = optimize(LINEAR, tmp_path / "a.zarr", generations=1, progress=False)
+    other = optimize(LINEAR, tmp_path / "b.zarr", generations=1, seed=99, progress=False)
+    assert other.problem.optimizer["seed"] == 99
+    assert not np.array_equal(one.designs, other.designs)
+    with pytest.raises(ProblemError, match="whole number"):
+        optimize(LINEAR, tmp_path / "c.zarr", seed=1.5, progress=False)

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from qzs._optional import require
-from qzs.errors import OutputPathError
+from qzs.errors import OutputPathError, ProblemError
 from qzs.workflows.design_space.metrics import METRICS, evaluate
 from qzs.workflows.design_space.problem import DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
@@ -102,7 +102,8 @@ def _algorithm(problem, population):
 def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
              store: str | Path | None = None, *, resume: bool = False,
              overwrite: bool = False, generations: int | None = None,
-             population: int | None = None, scheduler: Any = None,
+             population: int | None = None, seed: int | None = None,
+             scheduler: Any = None,
              workers: int | None = None, threads: int | None = None,
              progress: bool = True) -> OptimizationResult:
     """Search a design problem with NSGA-II; every generation is one lockstep batch.
@@ -121,6 +122,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         Replace an existing store.
     generations, population : int, optional
         Override ``[optimizer]``'s generations and designs per generation.
+    seed : int, optional
+        Override ``[optimizer]``'s seed.
     scheduler : str or distributed.Client, optional
         Evaluate each generation on this Dask cluster (same results).
     workers : int, optional
@@ -155,6 +158,10 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
                                                 100_000)
     if population is not None:
         settings["population"] = _positive_int("optimizer", "population", population, 100_000)
+    if seed is not None:
+        if isinstance(seed, bool) or not isinstance(seed, int):
+            raise ProblemError("optimizer", "seed", seed, "must be a whole number")
+        settings["seed"] = seed
     problem = dataclasses.replace(problem, optimizer=settings)
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)

@@ -212,6 +212,10 @@ class Goal:
         The metric's unit.
     title : str
         The metric with its options for people (``transmissibility at 12 Hz``).
+    scale : {"linear", "log"}
+        Objectives: ``log`` makes the optimiser compare ``log10`` of the value, so that its
+        crowding spreads the Pareto set evenly in ratios (the set itself is the same; the
+        metric must stay positive, a value <= 0 counts as undefined).
     """
 
     metric: str
@@ -223,6 +227,7 @@ class Goal:
     bound: float | None = None
     units: str = ""
     title: str = ""
+    scale: str = "linear"
 
     @property
     def label(self) -> str:
@@ -494,7 +499,7 @@ def _goal(table, index, spec, constraint, analysis):
     if not isinstance(spec, dict):
         _fail(table, str(index), spec, "each entry must be a table with a `metric`")
     allowed = ["metric", "statistic", "quantile", "frequency", "band"]
-    allowed += ["max", "min"] if constraint else ["sense"]
+    allowed += ["max", "min"] if constraint else ["sense", "scale"]
     _known(spec, where, allowed)
     metric = spec.get("metric")
     if metric not in METRICS:
@@ -542,9 +547,16 @@ def _goal(table, index, spec, constraint, analysis):
         sense = spec.get("sense", "minimize")
         if sense not in SENSES:
             _fail(where, "sense", sense, f"must be one of {SENSES}")
+        scale = spec.get("scale", "linear")
+        if scale not in SCALES:
+            _fail(where, "scale", scale, f"must be one of {SCALES}")
+        if scale == "log" and definition.lowest is None:
+            _fail(where, "scale", scale, f"{metric!r} can be negative; a log scale needs a "
+                                         "metric that stays positive")
     return Goal(metric=metric, column=metric_column(metric, options), options=options,
                 statistic=statistic, quantile=quantile, sense=sense, bound=bound,
-                units=definition.units, title=definition.title(options))
+                units=definition.units, title=definition.title(options),
+                scale="linear" if constraint else scale)
 
 
 def _settings(document, name, defaults):

@@ -70,8 +70,9 @@ def objective_matrix(problem, goal_values):
     Returns
     -------
     F : ndarray, shape (n_designs, n_objectives)
-        The objectives, negated where maximised. An undefined objective (NaN) takes the
-        worst defined value of its column.
+        The objectives (``log10`` of those on a log scale), negated where maximised. An
+        undefined objective (NaN, or a value <= 0 on a log scale) takes the worst defined
+        value of its column.
     G : ndarray, shape (n_designs, n_constraints + 1)
         Each constraint as ``value - max`` or ``min - value`` [its unit]; the last column
         is 1 for a design with any undefined goal (a failed run, a metric its trusted bins
@@ -80,7 +81,13 @@ def objective_matrix(problem, goal_values):
     goal_values = np.asarray(goal_values, dtype=float)
     n_obj = len(problem.objectives)
     sign = np.array([-1.0 if g.sense == "maximize" else 1.0 for g in problem.objectives])
-    F = goal_values[:, :n_obj] * sign
+    F = goal_values[:, :n_obj].copy()
+    for j, goal in enumerate(problem.objectives):
+        if goal.scale == "log":
+            with np.errstate(divide="ignore", invalid="ignore"):
+                F[:, j] = np.where(F[:, j] > 0, np.log10(np.abs(F[:, j])), np.nan)
+    undefined = np.isnan(F).any(axis=1)
+    F *= sign
     for j in range(n_obj):
         bad = ~np.isfinite(F[:, j])
         if bad.any():
@@ -90,7 +97,7 @@ def objective_matrix(problem, goal_values):
         value = goal_values[:, n_obj + j]
         G[:, j] = value - goal.bound if goal.sense == "minimize" else goal.bound - value
     G[:, :-1] = np.where(np.isnan(G[:, :-1]), 0.0, G[:, :-1])
-    G[:, -1] = np.where(np.isnan(goal_values).any(axis=1), 1.0, -1.0)
+    G[:, -1] = np.where(np.isnan(goal_values).any(axis=1) | undefined, 1.0, -1.0)
     return F, G
 
 
