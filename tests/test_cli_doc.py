@@ -96,6 +96,8 @@ NEEDS = {
     "hexapod study": ["--quick"],
     "design": ["--quick"],
     "response": [],
+    "optimize": ["isolation_vs_effort"],
+    "sensitivity": ["isolation_vs_effort"],
 }
 NAMES = {"--toml": "p.toml", "--plot": "figure.png", "sweep --out": "store.zarr",
          "simulate --out": "run.nc", "hexapod simulate --out": "run.nc",

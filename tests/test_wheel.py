@@ -104,6 +104,7 @@ def test_every_package_data_file_is_in_the_wheel(built):
     assert any(name.startswith("qzs/workflows/study_files/") for name in expected)
     assert any(name.startswith("qzs/workflows/sweep_files/") for name in expected)
     assert any(name.startswith("qzs/workflows/hexapod_files/") for name in expected)
+    assert any(name.startswith("qzs/workflows/problem_files/") for name in expected)
     missing = [name for name in expected if name not in names]
     assert not missing, f"{wheel.name} lacks {missing}"
 

@@ -31,7 +31,8 @@ SUBPACKAGES = {
     "engine": "kernels, single and lockstep runs, results",
     "identify": "spring, friction and transmissibility fits",
     "viz": "every figure",
-    "workflows": "the paper's studies, experiments, sweeps, response, design, six axes",
+    "workflows": "the paper's studies, experiments, sweeps, response, design, the design space, "
+                 "six axes",
 }
 #: Top-level modules of the base layer whose public classes are documented on api/qzs.rst.
 BASE_MODULES = ("qzs.errors",)

@@ -30,6 +30,7 @@ TOPICS = {
     "response": "response.md",
     "design": "design.md",
     "sweeps": "sweeps.md",
+    "design-space": "design-space.md",
     "app": "app.md",
     "getting-started": "getting-started.md",
     "workflows/command-line": "workflows/command-line.md",
