@@ -173,8 +173,11 @@ class ProblemError(ParameterError):
     def __init__(self, table: str, key: str, value: object, fix: str, source: str = "") -> None:
         self.table, self.key, self.value = str(table), str(key), value
         self.fix, self.source = str(fix).rstrip("."), str(source)
-        where = f"[{self.table}]" + (f" {self.key}" if self.key else "")
-        shown = f" = {self.value!r}" if self.value not in (None, "") else ""
+        table = self.table if "[" in self.table else f"[{self.table}]"  # objectives[0]
+        where = table + (f" {self.key}" if self.key else "")
+        value = self.value
+        empty = value is None or (isinstance(value, (str, list, dict)) and not value)
+        shown = "" if empty or (isinstance(value, str) and value == self.key) else f" = {value!r}"
         prefix = f"{self.source}: " if self.source else ""
         super().__init__(f"{prefix}{where}{shown}: {self.fix}.")
 

@@ -144,3 +144,29 @@ def test_every_metric_has_a_unit_and_a_known_source():
     for metric in METRICS.values():
         assert metric.units and metric.source in ("run", "spectrum", "linear")
         assert metric.description
+
+
+def test_an_unstable_loop_has_no_margin_and_a_hunting_check_skips_the_friction_law():
+    from qzs.analysis.control_design.hunting import predict_hunting
+    from qzs.analysis.control_design.stability_margins import loop_margins
+
+    document = copy.deepcopy(SHORT)
+    document["simulation"] = {}
+    document["variables"] = {"pi_ki": {"low": 1.0, "high": 1e6, "scale": "log"}}
+    document["objectives"] = [{"metric": "phase_margin", "sense": "maximize"},
+                              {"metric": "gain_margin", "sense": "maximize"}]
+    document["constraints"] = []
+    problem = load_problem(document)
+    stiff = qzs.ControllerParameters(pi_ki=1e6)
+    assert not loop_margins(qzs.IsolatorParameters(), stiff).stable  # the case checked
+    evaluation = evaluate(problem, np.array([[20.0], [1e6]]))
+    assert not np.isnan(evaluation.values["gain_margin"][0, 0])  # stable: inf or a number
+    # the margin routine gives the unstable loop 92 dB and 73 deg: angles, not margins
+    assert np.isnan(evaluation.values["phase_margin"][1, 0])
+    assert np.isnan(evaluation.values["gain_margin"][1, 0])
+    full = predict_hunting(qzs.IsolatorParameters(), qzs.ControllerParameters())
+    quick = predict_hunting(qzs.IsolatorParameters(), qzs.ControllerParameters(),
+                            memoryless=False)
+    assert (quick.hunts, quick.amplitude) == (full.hunts, full.amplitude)
+    assert quick.friction_intersections == () and "memoryless" in quick.reasons[
+        "friction_intersections"]

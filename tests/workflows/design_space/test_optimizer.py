@@ -215,7 +215,8 @@ def test_an_integer_variable_takes_whole_numbers_only(tmp_path):
     rates = result.designs[:, 2]
     assert np.array_equal(rates, np.round(rates)) and rates.min() >= 200 and rates.max() <= 2000
     # a sampled controller loses phase as its rate falls: the margin is a real objective
-    assert np.ptp(result.goal_values[:, 1]) > 0
+    margins = result.goal_values[:, 1]  # NaN where the sampled loop is unstable
+    assert np.nanmax(margins) > np.nanmin(margins)
 
 
 def test_a_log_scale_objective_is_compared_in_ratios_and_must_stay_positive():

@@ -153,7 +153,8 @@ def test_a_bad_problem_is_refused_naming_table_key_value_and_fix(what, tables, t
     assert (error.table, error.key) == (table, key)
     assert fix in error.fix
     assert error.source == "problem definition"
-    assert str(error).startswith(f"problem definition: [{table}]")
+    shown = table if "[" in table else f"[{table}]"
+    assert str(error).startswith(f"problem definition: {shown}")
 
 
 def test_too_many_draws_are_refused_before_any_draw():

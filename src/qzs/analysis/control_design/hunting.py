@@ -282,7 +282,8 @@ def hunting_stiffness(isolator=None, controller=None, half_width=None):
     return high
 
 
-def predict_hunting(isolator=None, controller=None, relative_position=None):
+def predict_hunting(isolator=None, controller=None, relative_position=None, *,
+                    memoryless=True):
     """Describing-function prediction of hunting at rest (python-control).
 
     Two analyses (see the module's text): the memoryless friction law in the velocity loop
@@ -299,6 +300,10 @@ def predict_hunting(isolator=None, controller=None, relative_position=None):
         PI and damping loops; defaults if omitted.
     relative_position : float, optional
         Operating point z [m]; default the setpoint.
+    memoryless : bool
+        Also intersect the memoryless friction law with the velocity loop (about three
+        quarters of the time); False leaves ``friction_intersections`` empty, with a
+        reason, and changes nothing else (the design search's ``hunting_amplitude``).
 
     Returns
     -------
@@ -309,7 +314,11 @@ def predict_hunting(isolator=None, controller=None, relative_position=None):
     m, cv, k, kp, ki, kd, w = numbers
     k_total = k + kp
     reasons = {}
-    friction = _memoryless_intersections(isolator, numbers)
+    if memoryless:
+        friction = _memoryless_intersections(isolator, numbers)
+    else:
+        friction = []
+        reasons["friction_intersections"] = "not computed (memoryless=False)"
     jump = slip_jump(isolator, controller, relative_position)[0]
     d = 0.5 * jump
     h = isolator.stiction_force - d

@@ -124,10 +124,12 @@ METRICS = {m.name: m for m in (
                      description="predicted plateau of the stick-slip limit cycle at rest "
                                  "(describing function; 0 where the loop does not hunt)"),
     MetricDefinition(name="gain_margin", units="dB", source="linear",
-                     description="gain margin of the control loop at the setpoint"),
+                     description="gain margin of the control loop at the setpoint "
+                                 "(undefined where the closed loop is unstable)"),
     MetricDefinition(name="phase_margin", units="deg", source="linear",
                      description="phase margin of the control loop at the setpoint (inf "
-                                 "where |L| never crosses 1)"),
+                                 "where |L| never crosses 1; undefined where the closed "
+                                 "loop is unstable)"),
     MetricDefinition(name="linear_transmissibility_at", units="1", label="linear transmissibility at",
                      source="linear",
                      options=("frequency",), lowest=0.0,
@@ -309,13 +311,15 @@ def _linear(problem, settings, goals, values, status, messages, progress=None):
         margins = None
         for column, goal in goals.items():
             if goal.metric == "hunting_amplitude":
-                prediction = predict_hunting(isolator, controller)
+                prediction = predict_hunting(isolator, controller, memoryless=False)
                 value = prediction.amplitude if prediction.hunts else 0.0
             elif goal.metric in ("gain_margin", "phase_margin"):
                 if margins is None:
                     margins = loop_margins(isolator, controller)
                 value = getattr(margins, goal.metric)
-                if goal.metric == "phase_margin" and math.isnan(value) and margins.stable:
+                if not margins.stable:
+                    value = math.nan  # an unstable loop has no margin: undefined, infeasible
+                elif goal.metric == "phase_margin" and math.isnan(value):
                     value = math.inf  # |L| < 1 everywhere: no crossover to lose
             else:
                 value = abs(complex(linear_transmissibility(goal.options["frequency"],

@@ -246,7 +246,7 @@ class Goal:
         if self.bound is None:
             return f"{self.sense} {self.column}{stat} [{self.units}]"
         op = "<=" if self.sense == "minimize" else ">="
-        return f"{self.column}{stat} {op} {self.bound:g} {self.units}"
+        return f"{self.column}{stat} {op} {self.bound:g}{_unit(self.units)}"
 
     def aggregate(self, values):
         """Combine the draws of each design (last axis) into one number per design.
@@ -395,6 +395,11 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
             raise ProblemError("file", "", source, str(error)) from None
         where, stem = repr(str(path)), path.stem
     return _problem(document, where, stem)
+
+
+def _unit(units):
+    """`` m`` for a unit after a number; nothing for a ratio (``1``)."""
+    return "" if units in ("", "1") else f" {units}"
 
 
 def _fail(table, key, value, fix):
@@ -588,13 +593,13 @@ def _infeasible(constraints):
         floor = METRICS[goal.metric].lowest
         if goal.sense == "minimize" and floor is not None and goal.bound < floor:
             _fail("constraints", goal.column, goal.bound,
-                  f"{goal.metric} is never below {floor:g} {goal.units}: no design meets "
-                  f"`max = {goal.bound:g}`")
+                  f"{goal.metric} is never below {floor:g}{_unit(goal.units)}: no design "
+                  f"meets `max = {goal.bound:g}`")
         top = METRICS[goal.metric].highest
         if goal.sense == "maximize" and top is not None and goal.bound > top:
             _fail("constraints", goal.column, goal.bound,
-                  f"{goal.metric} is never above {top:g} {goal.units}: no design meets "
-                  f"`min = {goal.bound:g}`")
+                  f"{goal.metric} is never above {top:g}{_unit(goal.units)}: no design "
+                  f"meets `min = {goal.bound:g}`")
 
 
 def _problem(document, where, stem):

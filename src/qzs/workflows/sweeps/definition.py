@@ -389,9 +389,10 @@ def _distribution(name, spec):
     missing = [k for k in required if k not in keys]
     extra = sorted(set(keys) - set(required) - set(optional))
     if missing or extra:
-        raise ParameterError(f"distribution {kind!r} of {name!r} takes keys "
-                             f"{list(required)} (optional {list(optional)}); missing "
-                             f"{missing}, unknown {extra}.")
+        takes = f"{list(required)}" + (f" (optional {list(optional)})" if optional else "")
+        wrong = "; ".join(part for part in (f"missing {missing}" if missing else "",
+                                            f"unknown {extra}" if extra else "") if part)
+        raise ParameterError(f"distribution {kind!r} of {name!r} takes keys {takes}; {wrong}.")
     values = {k: finite_real(f"{name}.{k}", v) for k, v in keys.items()}
     for key in ("std", "sigma", "median"):
         if key in values and values[key] <= 0:
