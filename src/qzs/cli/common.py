@@ -29,6 +29,7 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
 __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
+           "add_execution_options", "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
            "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
@@ -109,6 +110,51 @@ def add_frequency_axis_option(parser):
                         help=f"frequency axis of the figures (default "
                              f"{FIGURES['frequency_scale']}: the features below 2.5 Hz and "
                              f"the roll-off to 20 Hz span decades)")
+
+
+def add_execution_options(parser, verb="run"):
+    """Add ``--scheduler`` | ``--workers``, ``--threads`` and ``--quiet`` (Dask or local).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    verb : str
+        What the cases do there (``run``, ``evaluate``), for the help texts.
+    """
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help=f"{verb} on an existing Dask cluster (e.g. tcp://host:8786)")
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="start a local Dask cluster of N worker processes")
+    parser.add_argument("--threads", type=int, metavar="N",
+                        help="threads per batch (default: all cores locally, 1 on Dask)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def stopped(stop, what_is_kept):
+    """Say on stderr what an interrupted or terminated run kept; return its exit code.
+
+    Parameters
+    ----------
+    stop : KeyboardInterrupt or Terminated
+        What ended the run.
+    what_is_kept : str
+        What stays and how to continue.
+
+    Returns
+    -------
+    int
+        130 for Ctrl-C, the signal's code (143) for SIGTERM.
+    """
+    import sys
+
+    from qzs.errors import Terminated
+
+    what, code = (("terminated", stop.exit_code) if isinstance(stop, Terminated)
+                  else ("interrupted", 130))
+    print(f"qzs: {what}; {what_is_kept}", file=sys.stderr)
+    return code
 
 
 def emit(args, text, record):

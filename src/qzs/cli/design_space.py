@@ -1,8 +1,7 @@
 """``qzs optimize`` and ``qzs sensitivity``: the design space of a problem file."""
-import sys
 from pathlib import Path
 
-from qzs.cli.common import EPILOG
+from qzs.cli.common import EPILOG, add_execution_options, stopped
 from qzs.errors import ParameterError, Terminated
 from qzs.iotools.paths import check_output_path
 
@@ -10,17 +9,6 @@ __all__ = ["add_parsers", "run_optimize_command", "run_sensitivity_command"]
 
 _PROBLEM_HELP = ("design problem file (TOML), or a shipped problem name (e.g. "
                  "isolation_vs_effort); `qzs docs design-space` describes the layout")
-
-
-def _execution(cmd):
-    where = cmd.add_mutually_exclusive_group()
-    where.add_argument("--scheduler", metavar="ADDRESS",
-                       help="evaluate on an existing Dask cluster (e.g. tcp://host:8786)")
-    where.add_argument("--workers", type=int, metavar="N",
-                       help="start a local Dask cluster of N worker processes")
-    cmd.add_argument("--threads", type=int, metavar="N",
-                     help="threads per batch (default: all cores locally, 1 on Dask)")
-    cmd.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def add_parsers(subparsers):
@@ -61,7 +49,7 @@ def add_parsers(subparsers):
                      help="designs per generation (default the file's [optimizer] population)")
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the problem and the work, run nothing")
-    _execution(cmd)
+    add_execution_options(cmd, "evaluate")
 
     sens = subparsers.add_parser(
         "sensitivity", help="global sensitivity of a problem's metrics (Sobol or Morris)",
@@ -80,7 +68,7 @@ def add_parsers(subparsers):
                       help="Sobol: base samples, a power of 2 (N x (d + 2) runs); Morris: "
                            "trajectories (N x (d + 1) runs); default the file's")
     sens.add_argument("--seed", type=int, metavar="N", help="default the file's")
-    _execution(sens)
+    add_execution_options(sens, "evaluate")
     return cmd
 
 
@@ -89,13 +77,6 @@ def _check_counts(args):
         value = getattr(args, option, None)
         if value is not None and value < 1:
             raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
-
-
-def _stopped(stop, store, command):
-    what, code = (("interrupted", 130) if isinstance(stop, KeyboardInterrupt)
-                  else ("terminated", stop.exit_code))
-    print(f"qzs: {what}; {command}", file=sys.stderr)
-    return code
 
 
 def run_optimize_command(args):
@@ -130,9 +111,9 @@ def run_optimize_command(args):
                           scheduler=args.scheduler, workers=args.workers, threads=args.threads,
                           progress=not args.quiet)
     except (KeyboardInterrupt, Terminated) as stop:
-        return _stopped(stop, store, f"{stored_generations(store)} complete generation(s) are "
-                                     f"kept in {store}. Continue with: qzs optimize "
-                                     f"{args.problem} --out {folder} --resume")
+        return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept in "
+                             f"{store}. Continue with: qzs optimize {args.problem} --out "
+                             f"{folder} --resume")
     written = write_files(result, folder)
     print(result.summary())
     print(f"  wrote            {store}")
@@ -167,8 +148,8 @@ def run_sensitivity_command(args):
                                           scheduler=args.scheduler, workers=args.workers,
                                           threads=args.threads, progress=not args.quiet)
     except (KeyboardInterrupt, Terminated) as stop:
-        return _stopped(stop, None, "nothing is written (a sensitivity run is not resumable; "
-                                    "fewer --samples make it shorter)")
+        return stopped(stop, "nothing is written (a sensitivity run is not resumable; fewer "
+                             "--samples make it shorter)")
     print(result.summary())
     for path in written:
         print(f"  wrote            {path}")

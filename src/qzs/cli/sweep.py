@@ -1,9 +1,8 @@
 """``qzs sweep``, ``qzs sweep-plot`` and ``qzs sweep-export``: parameter sweeps into a Zarr
 store, their figures, and the store as a MATLAB file."""
-import sys
 from pathlib import Path
 
-from qzs.cli.common import EPILOG
+from qzs.cli.common import EPILOG, add_execution_options, stopped
 from qzs.errors import ParameterError, Terminated
 from qzs.iotools.paths import check_output_path
 from qzs.viz.sweeps import FIGURE_BYTES, REDUCTIONS, figure_suffixes
@@ -43,16 +42,9 @@ def add_parsers(subparsers):
     cmd.add_argument("--resume", action="store_true",
                      help="continue an interrupted sweep in --out (same sweep file)")
     cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")
-    where = cmd.add_mutually_exclusive_group()
-    where.add_argument("--scheduler", metavar="ADDRESS",
-                       help="run on an existing Dask cluster (e.g. tcp://host:8786)")
-    where.add_argument("--workers", type=int, metavar="N",
-                       help="start a local Dask cluster of N worker processes")
-    cmd.add_argument("--threads", type=int, metavar="N",
-                     help="threads per batch (default: all cores locally, 1 on Dask)")
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the cases and the work, run nothing")
-    cmd.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_execution_options(cmd)
 
     plot = subparsers.add_parser(
         "sweep-plot", help="figures of a sweep store",
@@ -119,12 +111,9 @@ def run_sweep_command(args):
                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
                          progress=not args.quiet)
     except (KeyboardInterrupt, Terminated) as stop:
-        what, code = (("interrupted", 130) if isinstance(stop, KeyboardInterrupt)
-                      else ("terminated", stop.exit_code))
-        print(f"qzs: {what}; {stored_count(store)} of {definition.n_cases} cases are "
-              f"stored in {store}. Continue with: qzs sweep {args.definition} --out {store} "
-              "--resume", file=sys.stderr)
-        return code
+        return stopped(stop, f"{stored_count(store)} of {definition.n_cases} cases are stored "
+                             f"in {store}. Continue with: qzs sweep {args.definition} --out "
+                             f"{store} --resume")
     print(summary_text(open_sweep(store), report))
     print(f"  wrote            {store}")
     return 0

@@ -148,7 +148,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     from tqdm.auto import tqdm
 
     from qzs.workflows.design_space.problem import _positive_int
-    from qzs.workflows.sweeps.backends import _client, _is_client
+    from qzs.workflows.sweeps.backends import dask_client
 
     if not isinstance(problem, DesignProblem):
         problem = load_problem(problem)
@@ -166,13 +166,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)
     require("pymoo", "qzs optimize (multi-objective search)")
-    client = cluster = None
     began = time.perf_counter()
-    bar = None
-    evaluated_now = steps = 0
-    try:
-        if scheduler is not None or workers is not None:
-            client, cluster = _client(scheduler, workers)
+    with dask_client(scheduler, workers) as client:  # before the store or any probe
         opened = DesignStore(store, problem, resume=resume, overwrite=overwrite)
         if opened.step is not None:
             sweep = problem.sweep
@@ -184,47 +179,58 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
             dt = problem.sweep.simulation["dt"]
             if dt is not None:
                 opened.set_step(dt, problem.sweep.simulation.get("step_note", ""))
-        algorithm, search = _algorithm(problem, settings["population"])
-        from pymoo.core.evaluator import Evaluator
-        from pymoo.problems.static import StaticProblem
-
-        algorithm.setup(search, termination=("n_gen", settings["generations"]),
-                        seed=settings["seed"], verbose=False)
-        per_generation = settings["population"] * problem.samples
-        bar = tqdm(total=settings["generations"] * per_generation, unit="case",
-                   desc=problem.name, disable=not progress, dynamic_ncols=True)
-        stored = opened.generations
-        for generation in range(settings["generations"]):
-            population_ = algorithm.ask()
-            X = population_.get("X")
-            if generation < stored:
-                position, values, status = opened.generation_rows(generation)
-                if position.shape != X.shape or not np.array_equal(position, X):
-                    raise OutputPathError("store", store, "holds designs the optimiser does "
-                                          f"not ask for again (generation {generation}); it "
-                                          "was written by another qzs or pymoo version. "
-                                          "Start again with --overwrite")
-                goal_values = np.column_stack([g.aggregate(values[g.column])
-                                               for g in problem.goals])
-                bar.update(len(X) * problem.samples)
-            else:
-                designs = np.column_stack([v.to_unit(X[:, j])
-                                           for j, v in enumerate(problem.variables)])
-                evaluation = evaluate(problem, designs, client=client, threads=threads,
-                                      progress=bar.update)
-                opened.append(generation, X, evaluation)
-                goal_values = evaluation.goal_values(problem.goals)
-                evaluated_now += len(X)
-                steps += evaluation.steps
-            F, G = objective_matrix(problem, goal_values)
-            Evaluator().eval(StaticProblem(search, F=F, G=G), population_)
-            algorithm.tell(infills=population_)
-    finally:
-        if bar is not None:
-            bar.close()
-        if client is not None and not _is_client(scheduler):
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        total = settings["generations"] * settings["population"] * problem.samples
+        with tqdm(total=total, unit="case", desc=problem.name, disable=not progress,
+                  dynamic_ncols=True) as bar:
+            evaluated_now, steps = _generations(problem, opened, client, threads, bar)
     return OptimizationResult.from_store(opened, problem, wall=time.perf_counter() - began,
                                          evaluated=evaluated_now, steps=steps)
+
+
+def _generations(problem, opened, client, threads, bar):
+    """Ask NSGA-II for every generation and tell it the designs' objectives.
+
+    A generation the store holds is answered from it (after checking bit for bit that
+    the same designs were asked for); the others are evaluated and stored.
+
+    Returns
+    -------
+    evaluated : int
+        Designs evaluated now.
+    steps : int
+        Their integration steps.
+    """
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.problems.static import StaticProblem
+
+    settings = problem.optimizer
+    algorithm, search = _algorithm(problem, settings["population"])
+    algorithm.setup(search, termination=("n_gen", settings["generations"]),
+                    seed=settings["seed"], verbose=False)
+    evaluated = steps = 0
+    for generation in range(settings["generations"]):
+        asked = algorithm.ask()
+        X = asked.get("X")
+        if generation < opened.generations:
+            position, values, _ = opened.generation_rows(generation)
+            if position.shape != X.shape or not np.array_equal(position, X):
+                raise OutputPathError("store", opened.path, "holds designs the optimiser does "
+                                      f"not ask for again (generation {generation}); it was "
+                                      "written by another qzs or pymoo version. Start again "
+                                      "with --overwrite")
+            goal_values = np.column_stack([g.aggregate(values[g.column])
+                                           for g in problem.goals])
+            bar.update(len(X) * problem.samples)
+        else:
+            designs = np.column_stack([v.to_unit(X[:, j])
+                                       for j, v in enumerate(problem.variables)])
+            evaluation = evaluate(problem, designs, client=client, threads=threads,
+                                  progress=bar.update)
+            opened.append(generation, X, evaluation)
+            goal_values = evaluation.goal_values(problem.goals)
+            evaluated += len(X)
+            steps += evaluation.steps
+        F, G = objective_matrix(problem, goal_values)
+        Evaluator().eval(StaticProblem(search, F=F, G=G), asked)
+        algorithm.tell(infills=asked)
+    return evaluated, steps

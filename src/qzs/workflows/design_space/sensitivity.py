@@ -787,19 +787,11 @@ def run_sensitivity(problem: DesignProblem | str | Path | Mapping[str, Any],
     import matplotlib.pyplot as plt
 
     from qzs.iotools.files import atomic_path
-    from qzs.workflows.sweeps.backends import _client, _is_client
+    from qzs.workflows.sweeps.backends import dask_client
 
-    client = cluster = None
-    try:
-        if scheduler is not None or workers is not None:
-            client, cluster = _client(scheduler, workers)
+    with dask_client(scheduler, workers) as client:
         result = sensitivity(problem, method=method, samples=samples, seed=seed, client=client,
                              threads=threads, progress=progress)
-    finally:
-        if client is not None and not _is_client(scheduler):
-            client.close()
-        if cluster is not None:
-            cluster.close()
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = [result.save(folder / name) for name in SENSITIVITY_FILES[:3]]

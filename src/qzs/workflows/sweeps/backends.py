@@ -8,6 +8,7 @@ the cases have excitations of their own) and reduces every case to the outputs
 the sweep keeps. A case with invalid parameters, a diverged simulation or a failed
 analysis is recorded with its status and message; the others go on.
 """
+import contextlib
 import os
 import threading
 import time
@@ -36,7 +37,7 @@ from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID
                                         write_batch)
 
 __all__ = ["run_batch", "execute", "case_settings", "check_store_path", "build_case",
-           "check_cases", "choose_sweep_step", "STORE_SUFFIX"]
+           "check_cases", "choose_sweep_step", "dask_client", "STORE_SUFFIX"]
 
 #: The extension of a sweep store: a Zarr folder, not a NetCDF file (``--out store.nc``
 #: would make a folder named like a file of another format).
@@ -433,6 +434,42 @@ def _client(scheduler, workers):
     return Client(cluster), cluster
 
 
+@contextlib.contextmanager
+def dask_client(scheduler=None, workers=None):
+    """The Dask client a run uses, or None to run locally; what it starts, it closes.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client, optional
+        A scheduler's address (connected to, and the connection closed on exit) or a
+        client (used as it is, left open).
+    workers : int, optional
+        Start a local cluster of this many single-threaded worker processes (closed on
+        exit).
+
+    Yields
+    ------
+    distributed.Client or None
+        None when neither is given.
+
+    Raises
+    ------
+    SchedulerError
+        Nothing answers at ``scheduler`` (at once, before any work).
+    """
+    if scheduler is None and workers is None:
+        yield None
+        return
+    client, cluster = _client(scheduler, workers)
+    try:
+        yield client
+    finally:
+        if not _is_client(scheduler):
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+
 def _connect(client_class, address):
     """A client of the scheduler at ``address``, saying on stderr what it waits for."""
     import sys
@@ -512,51 +549,46 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
     if definition.simulation["dt"] is None:  # sized at the output period until dt is chosen
         _check_store(definition, store, _n_time(definition, settings), argument="store",
                      resume=resume, overwrite=overwrite)
-    client = cluster = None
     report = {"cases": 0, "failed": 0, "steps": 0, "wall": 0.0}
     began = time.perf_counter()
     bar = results = None
-    try:
-        if scheduler is not None or workers is not None:  # before any probe or store
-            client, cluster = _client(scheduler, workers)
-        definition, _ = choose_sweep_step(definition, settings)
-        n_time = _n_time(definition, settings)
-        _check_store(definition, store, n_time, argument="store", resume=resume,
-                     overwrite=overwrite)
-        done = prepare_store(store, definition, columns, n_time, resume=resume,
-                             overwrite=overwrite)
-        size = definition.batch_size
-        batches = [(a, min(a + size, definition.n_cases))
-                   for a in range(0, definition.n_cases, size) if not done[a:a + size].all()]
-        if client is not None:
-            results = _dask(client, definition, batches, settings, n_time,
-                            1 if threads is None else threads)
-        else:
-            results = _local(definition, batches, settings, n_time, threads)
-        failed = _stored_failures(store) if done.any() else 0
-        bar = tqdm(total=definition.n_cases, initial=int(done.sum()), unit="case",
-                   desc=definition.name, disable=not progress, dynamic_ncols=True,
-                   postfix={"failed": failed})
-        for result in results:
-            write_batch(store, definition, result["start"], result["arrays"], n_time)
-            n = len(result["arrays"]["status"])
-            new_failures = int(np.count_nonzero(result["arrays"]["status"] > OK))
-            report["cases"] += n
-            report["failed"] += new_failures
-            report["steps"] += result["steps"]
-            failed += new_failures
-            bar.update(n)
-            bar.set_postfix(failed=failed, refresh=False)
-    finally:
-        if bar is not None:
-            bar.close()
-        if results is not None:
-            results.close()
-        if client is not None and not _is_client(scheduler):
-            client.close()
-        if cluster is not None:
-            cluster.close()
-        report["wall"] = time.perf_counter() - began
+    with dask_client(scheduler, workers) as client:  # before any probe or store
+        try:
+            definition, _ = choose_sweep_step(definition, settings)
+            n_time = _n_time(definition, settings)
+            _check_store(definition, store, n_time, argument="store", resume=resume,
+                         overwrite=overwrite)
+            done = prepare_store(store, definition, columns, n_time, resume=resume,
+                                 overwrite=overwrite)
+            size = definition.batch_size
+            batches = [(a, min(a + size, definition.n_cases))
+                       for a in range(0, definition.n_cases, size)
+                       if not done[a:a + size].all()]
+            if client is not None:
+                results = _dask(client, definition, batches, settings, n_time,
+                                1 if threads is None else threads)
+            else:
+                results = _local(definition, batches, settings, n_time, threads)
+            failed = _stored_failures(store) if done.any() else 0
+            bar = tqdm(total=definition.n_cases, initial=int(done.sum()), unit="case",
+                       desc=definition.name, disable=not progress, dynamic_ncols=True,
+                       postfix={"failed": failed})
+            for result in results:
+                write_batch(store, definition, result["start"], result["arrays"], n_time)
+                n = len(result["arrays"]["status"])
+                new_failures = int(np.count_nonzero(result["arrays"]["status"] > OK))
+                report["cases"] += n
+                report["failed"] += new_failures
+                report["steps"] += result["steps"]
+                failed += new_failures
+                bar.update(n)
+                bar.set_postfix(failed=failed, refresh=False)
+        finally:
+            if bar is not None:
+                bar.close()
+            if results is not None:
+                results.close()
+            report["wall"] = time.perf_counter() - began
     return report
 
 
