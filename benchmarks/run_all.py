@@ -30,7 +30,9 @@ the target, PASS/FAIL:
 9. (issue 14) the tuning page: a slider's release to the redrawn transmissibility within 1 s;
 11. the design-space search: ``qzs optimize``'s Pareto front within 1 % (multiplicative epsilon,
     each objective) of a 10 000-design ``qzs sweep`` grid's, at under a tenth of its evaluations
-    (``bench_design_space.py``; seed 1 with ``--quick``, seeds 1-3 otherwise).
+    (``bench_design_space.py``), judged on its ``isolation`` problem (8-16 Hz); seed 1 with
+    ``--quick``, seeds 1-3 otherwise, and then also its ``stick-slip`` problem (1-5 Hz, the
+    hard case), reported as 11s rows that are not the target's verdict.
 
 The C baseline is ``benchmarks/c_reference/isolator.c``, compiled here with gcc (flags in
 ``c_reference/reference.py``) into a cache folder outside the repository and run in this
@@ -658,13 +660,22 @@ def target_app(table, args):
 # --------------------------------------------------------------------------- 11. design space
 
 def target_design_space(table, args):
+    """Target 11 on the isolation problem; the stick-slip one (full runs only) as 11s rows."""
     import bench_design_space
 
-    out = bench_design_space.measure(seeds=(1,) if args.quick else (1, 2, 3),
-                                     idle_wait=args.idle_wait)
-    table.note_runs([out["grid"], *out["runs"]])
-    for what, value, baseline, ratio, goal, verdict in bench_design_space.verdicts(out):
-        table.add("11i" if verdict == "info" else 11, what, value, baseline, ratio, goal, verdict)
+    primary = bench_design_space.PRIMARY
+    names = [primary] if args.quick else list(bench_design_space.PROBLEMS)
+    for name in names:
+        out = bench_design_space.measure(name, seeds=(1,) if args.quick else (1, 2, 3),
+                                         idle_wait=args.idle_wait)
+        table.note_runs([out["grid"], *out["runs"]])
+        for what, value, baseline, ratio, goal, verdict in bench_design_space.verdicts(out):
+            if name == primary:
+                table.add("11i" if verdict == "info" else 11, what, value, baseline, ratio, goal,
+                          verdict)
+            else:  # reported, not the target's verdict
+                table.add("11s", what, value, baseline, ratio, goal,
+                          verdict if verdict == "info" else f"{verdict} (info)")
 
 
 # --------------------------------------------------------------------------- main
