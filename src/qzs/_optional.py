@@ -11,6 +11,8 @@ OPTIONAL = {
     "zarr": ("zarr", "cluster"),
     "panel": ("panel", "app"),
     "bokeh": ("bokeh", "app"),
+    "pymoo": ("pymoo", "design"),
+    "SALib": ("SALib", "design"),
 }
 
 

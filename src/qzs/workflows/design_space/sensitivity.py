@@ -50,6 +50,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from qzs._optional import require
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.workflows.design_space.metrics import METRICS, evaluate_cases
@@ -323,6 +324,7 @@ def sensitivity(problem: DesignProblem | str | Path | Mapping[str, Any], *,
     began = time.perf_counter()
     if not isinstance(problem, DesignProblem):
         problem = load_problem(problem)
+    require("SALib", "qzs sensitivity (Sobol and Morris indices)")
     plan = _plan(problem, method, samples, seed, metrics, evaluate)
     names, units, kinds = _parameters(problem)
     salib = _salib_problem(problem, plan)
