@@ -56,6 +56,12 @@ _ROWS_PER_CHUNK = 1_000_000
 #: The channels the statistics read (:meth:`_Lanes.absorb`), recorded whatever is kept; the
 #: kernel computes and stores no other channel (the flags it always records).
 _STATISTICS_COLUMNS = (K.C_Z, K.C_F_MOTOR)
+#: Samples (cases x rows) whose statistics are taken at once. Over a whole chunk (4 MB per
+#: temporary at 128 cases x 3906 rows) numpy's temporaries were mapped fresh from the system
+#: at every call (glibc unmaps or trims large blocks when they are freed) and their first
+#: touch cost this VM more than the arithmetic: 12.8 ns a sample, against 3.0 ns in groups
+#: of 2**17 samples (1 MB temporaries, reused from the heap).
+_GROUP_SAMPLES = 1 << 17
 
 
 @dataclass
@@ -350,16 +356,24 @@ class _Lanes(driver.Stepper):
             self.pool.shutdown()
 
     def absorb(self, rows, start_row, first_row, a=0, b=None):
-        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics."""
-        cases = slice(a, b)
-        block = self.out[cases, first_row:first_row + rows]
-        marks = self.out_flags[cases, first_row:first_row + rows]
-        for name, col in self.values:
-            self.kept[name][cases, start_row:start_row + rows] = block[:, :, col]
-        for name, col in self.flag_columns:
-            self.kept[name][cases, start_row:start_row + rows] = marks[:, :, col]
-        self.statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
-                            marks[:, :, K.O_LOCKED], cases)
+        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics.
+
+        A group of cases at a time (:data:`_GROUP_SAMPLES`): the statistics are per case, so
+        the grouping changes no bit, and their numpy temporaries stay small enough to be
+        reused from the heap and to stay in cache.
+        """
+        b = len(self.status) if b is None else b
+        group = max(1, _GROUP_SAMPLES // max(rows, 1))
+        for g in range(a, b, group):
+            cases = slice(g, min(g + group, b))
+            block = self.out[cases, first_row:first_row + rows]
+            marks = self.out_flags[cases, first_row:first_row + rows]
+            for name, col in self.values:
+                self.kept[name][cases, start_row:start_row + rows] = block[:, :, col]
+            for name, col in self.flag_columns:
+                self.kept[name][cases, start_row:start_row + rows] = marks[:, :, col]
+            self.statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
+                                marks[:, :, K.O_LOCKED], cases)
 
     def _kernel(self, steps, a, b):
         """Advance cases ``a..b-1`` by ``steps`` steps from step ``self.done``."""
