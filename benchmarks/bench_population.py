@@ -90,7 +90,7 @@ def timed(label, function, idle_wait, runs):
     start = time.perf_counter()
     result = function()
     wall = time.perf_counter() - start
-    runs.append(busy)
+    runs.append(dict(seconds=wall, busy=busy))
     log(f"  {label}: {wall:.3f} s{_busy_note(busy)}")
     return wall, result
 
@@ -156,6 +156,28 @@ def measure(dt, duration, repeats, idle_wait, cores, runs):
     return best
 
 
+def verdicts(results):
+    """Rows ``(what, qzs, baseline, ratio, target, verdict)`` of :func:`measure`'s results
+    (by step): the verdict at dt = 1e-3 s, information rows beside it."""
+    rows = []
+    for dt, b in results.items():
+        ratio = b["call"] / b["single"]
+        target = abs(dt - 1e-3) < 1e-12
+        rows.append((f"{DESIGNS} designs in one lockstep batch, dt = {dt:g} s: simulate_batch "
+                     "/ one qzs.simulate", f"{b['call']:.2f} s", f"{b['single'] * 1e3:.0f} ms",
+                     f"{ratio:.1f}x", f"<= {TARGET:g}x" if target else "-",
+                     ("PASS" if ratio <= TARGET else "FAIL") if target else "info"))
+        rows.append((f"  kernel alone ({b['ns 1']:.0f} ns per lane-step on 1 core, "
+                     f"{b['ns 2']:.0f} per core on 2)", f"{b['kernel']:.2f} s",
+                     f"{b['single kernel'] * 1e3:.0f} ms", f"{b['kernel'] / b['single']:.1f}x",
+                     "-", "info"))
+        single = b["single"] + b["single analysis"]
+        rows.append(("  evaluated: + a transmissibility per case, / one run + its own",
+                     f"{b['evaluation']:.2f} s", f"{single * 1e3:.0f} ms",
+                     f"{b['evaluation'] / single:.1f}x", "-", "info"))
+    return rows
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="60 s chirp, best of 2")
@@ -176,7 +198,7 @@ def main(argv=None):
     results = {}
     for dt in (float(x) for x in args.dt.split(",")):
         results[dt] = measure(dt, duration, repeats, args.idle_wait, cores, runs)
-    noisy = sum(1 for busy in runs if busy is not None and busy > 0.3)
+    noisy = sum(1 for run in runs if run["busy"] is not None and run["busy"] > 0.3)
     log("")
     if noisy:
         log(f"WARNING: {noisy} of {len(runs)} timed runs started while other processes kept "
@@ -197,13 +219,8 @@ def main(argv=None):
         "integration (BatchResult.elapsed, 2 cores); batch: the whole simulate_batch call; "
         "+ T all: and the 256 transmissibility estimates; ns/ls: ns per lane and step of the "
         "kernel per core, on 1 and 2 cores.")
-    for dt, b in results.items():
-        ratio = b["call"] / b["single"]
-        verdict = ("PASS" if ratio <= TARGET else "FAIL") if abs(dt - 1e-3) < 1e-12 else "info"
-        log(f"population of {DESIGNS} / one single run, dt = {dt:g} s: {ratio:.1f}x, target "
-            f"<= {TARGET:g}x: {verdict} (kernel alone {b['kernel'] / b['single']:.1f}x; "
-            f"evaluated with its analysis {b['evaluation'] / (b['single'] + b['single analysis']):.1f}x"
-            " of a single run with its own)")
+    for what, value, baseline, ratio, goal, verdict in verdicts(results):
+        log(f"{what}: {value} against {baseline}: {ratio}, target {goal}: {verdict}")
     log(f"load average at end: {_load()}")
     return results
 
