@@ -24,6 +24,7 @@ import argparse
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -254,6 +255,8 @@ def paper(folder):
             return {k: clean(v) for k, v in value.items() if k not in drop}
         if isinstance(value, list):
             return [clean(v) for v in value]
+        if isinstance(value, str):  # the step's statement quotes the seconds its choice took
+            return re.sub(r"[0-9.]+ s to choose", "(time) to choose", value)
         return value
 
     text = json.dumps(clean(metrics), sort_keys=True)
