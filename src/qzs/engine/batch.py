@@ -48,7 +48,7 @@ STATS = {
     "steps": ("1", "integration steps done"),
 }
 _COUNTS = ("stop_contacts", "stick_events", "steps")  # statistics stored as int64
-#: Output rows held at once, over all cases (~190 MB of the kernel's 24 channels): the kernel
+#: Output rows held at once, over all cases (8 MB per channel the kernel records): the kernel
 #: writes them, each chunk's kept channels and statistics are taken out. A buffer of 4e6 rows
 #: (770 MB) cost `qzs paper` about 0.9 s of first touch in a fresh process (17.2-17.5 s against
 #: 16.0-16.5 s with 1e6 rows; 2.5e5 rows gave the same as 1e6).

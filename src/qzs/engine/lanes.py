@@ -12,6 +12,10 @@ per case) and each step is two passes over the lanes:
 2. for the flagged lanes only, the full event-locating step of
    :func:`qzs.engine.kernels.grid_step`.
 
+At an output sample, one more vectorised pass computes the channels of every lane
+(:func:`_sample_lanes`, the operations of :func:`qzs.engine.kernels.record`), and only the
+channels the caller asks for are stored (:func:`_keep`).
+
 No fast-math is used (see :mod:`qzs.engine.kernels`): a lane computes the same bits
 in a vector register as in scalar code, and pass 1 takes the same operations in
 the same order as :func:`qzs.engine.kernels.grid_step` does for an ordinary step. So
