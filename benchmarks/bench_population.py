@@ -107,6 +107,7 @@ def measure(dt, duration, repeats, idle_wait, cores, runs):
     simulate_batch(cases[:16], warm, channels=CHANNELS, workers=cores, **options)
     simulate_batch(cases[:16], warm, channels=CHANNELS, workers=1, **options)
     qzs.simulate(warm, *cases[0], **options)
+    analyse(*np.random.default_rng(0).normal(size=(2, FFT_LENGTH)))  # scipy.signal imported
     isolator, controller = cases[0]
     best = {}
 
