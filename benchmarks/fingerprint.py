@@ -24,6 +24,7 @@ import argparse
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -108,6 +109,32 @@ def batch():
                             channels=channels, workers=2)
     line("batch/channels", result.time, *[result.channels[c] for c in channels])
     line("batch/stats", *[result.stats[k] for k in sorted(result.stats)], result.status)
+
+
+def population():
+    """A design population as the optimiser runs it: 256 lanes, many chunks, both steps."""
+    from qzs import Chirp, ControllerParameters, IsolatorParameters, simulate_batch
+
+    rng = np.random.default_rng(26)
+    n = 256
+    kp, ki = np.exp(rng.uniform(np.log(2.0), np.log(1000.0), n)), rng.uniform(0.0, 20.0, n)
+    kd, fs = rng.uniform(0.0, 100.0, n), rng.uniform(5.0, 15.0, n)
+    cases = [(IsolatorParameters(stiction_force=float(fs[i]),
+                                 stop_model=("compliant", "plastic")[i % 7 == 3]),
+              ControllerParameters(pi_kp=float(kp[i]), pi_ki=float(ki[i]),
+                                   damping_gain=float(kd[i]),
+                                   controller_rate=(0.0, 1000.0)[i % 11 == 5]))
+             for i in range(n)]
+    channels = ("base_acceleration", "payload_acceleration", "relative_position", "locked",
+                "stop_contact", "friction_force", "spring_energy")
+    for dt, duration in ((1e-3, 40.0), (1e-4, 6.0)):
+        result = simulate_batch(cases, Chirp(duration=duration, amplitude=0.03), dt=dt,
+                                sample_rate=1e3, channels=channels, workers=2)
+        line(f"population/dt={dt:g}/channels", result.time,
+             *[result.channels[c] for c in channels])
+        line(f"population/dt={dt:g}/stats", *[result.stats[k] for k in sorted(result.stats)],
+             result.status, show=(int(result.stats["stick_events"].sum()),
+                                  int(result.stats["stop_contacts"].sum())))
 
 
 def hexapod():
@@ -228,6 +255,8 @@ def paper(folder):
             return {k: clean(v) for k, v in value.items() if k not in drop}
         if isinstance(value, list):
             return [clean(v) for v in value]
+        if isinstance(value, str):  # the step's statement quotes the seconds its choice took
+            return re.sub(r"[0-9.]+ s to choose", "(time) to choose", value)
         return value
 
     text = json.dumps(clean(metrics), sort_keys=True)
@@ -240,7 +269,8 @@ def main():
     parser.add_argument("--skip-paper", action="store_true")
     parser.add_argument("--only", default="", help="comma-separated parts to run")
     args = parser.parse_args()
-    parts = dict(single=single_runs, batch=batch, hexapod=hexapod, response=response,
+    parts = dict(single=single_runs, batch=batch, population=population, hexapod=hexapod,
+                 response=response,
                  balance=balance)
     with tempfile.TemporaryDirectory() as folder:
         parts["streamed"] = lambda: streamed_run(folder)

@@ -28,6 +28,8 @@ the target, PASS/FAIL:
    (``bench_jax.py``; needs jax, the ``bench`` extra, never installed by this script);
 8. (issue 11) a sweep on a Dask cluster of fresh worker processes at its local speed;
 9. (issue 14) the tuning page: a slider's release to the redrawn transmissibility within 1 s;
+10. (issue 26) a population of 256 designs in one lockstep batch on 2 cores within 16 single
+    runs at the same step, dt = 1e-3 s (``bench_population.py``; dt = 1e-4 s as information).
 11. the design-space search: ``qzs optimize``'s Pareto front within 1 % (multiplicative epsilon,
     each objective) of a 10 000-design ``qzs sweep`` grid's, at under a tenth of its evaluations
     (``bench_design_space.py``), judged on its ``isolation`` problem (8-16 Hz); seed 1 with
@@ -79,7 +81,7 @@ TARGET_CHOICE = 0.3       # the step choice of the paper's chirp [s]
 TARGET_STARTUP = 0.6      # start-up to the first step [s]
 TOLERANCE_DB = 0.01       # the default tolerance of the accuracy-driven step
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 11)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -657,6 +659,25 @@ def target_app(table, args):
               f"{median * 1e3:.0f} ms", f"{computed * 1e3:.0f} ms", "-", "-", "info")
 
 
+# --------------------------------------------------------------------------- 10. populations
+
+def target_population(table, args):
+    """Target 10: 256 designs in one lockstep batch against one single run (issue 26)."""
+    import bench_population
+
+    duration = 60.0 if args.quick else 131.072
+    cores = min(2, os.cpu_count() or 1)
+    results, runs = {}, []
+    for dt in (1e-3, 1e-4):
+        results[dt] = bench_population.measure(dt, duration, args.repeats, args.idle_wait,
+                                               cores, runs)
+    table.note_runs(runs)
+    for what, value, baseline, ratio, goal, verdict in bench_population.verdicts(results):
+        info = verdict == "info"
+        verdict = verdict + ("*" if args.quick and not info else "")
+        table.add("10i" if info else 10, what, value, baseline, ratio, goal, verdict)
+
+
 # --------------------------------------------------------------------------- 11. design space
 
 def target_design_space(table, args):
@@ -744,6 +765,8 @@ def main(argv=None):
         (7, "7. lane kernel vs JAX", lambda: target_jax(table, args), False, 7 in only),
         (8, "8. clusters (issue 11)", lambda: target_cluster(table, args), False, 8 in only),
         (9, "9. the tuning page (issue 14)", lambda: target_app(table, args), False, 9 in only),
+        (10, "10. a design population in one lockstep batch (issue 26)",
+         lambda: target_population(table, args), False, 10 in only),
         (11, "11. the design-space search against a grid",
          lambda: target_design_space(table, args), False, 11 in only),
     ]

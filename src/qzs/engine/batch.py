@@ -48,11 +48,20 @@ STATS = {
     "steps": ("1", "integration steps done"),
 }
 _COUNTS = ("stop_contacts", "stick_events", "steps")  # statistics stored as int64
-#: Output rows held at once, over all cases (~190 MB of the kernel's 24 channels): the kernel
+#: Output rows held at once, over all cases (8 MB per channel the kernel records): the kernel
 #: writes them, each chunk's kept channels and statistics are taken out. A buffer of 4e6 rows
 #: (770 MB) cost `qzs paper` about 0.9 s of first touch in a fresh process (17.2-17.5 s against
 #: 16.0-16.5 s with 1e6 rows; 2.5e5 rows gave the same as 1e6).
 _ROWS_PER_CHUNK = 1_000_000
+#: The channels the statistics read (:meth:`_Lanes.absorb`), recorded whatever is kept; the
+#: kernel computes and stores no other channel (the flags it always records).
+_STATISTICS_COLUMNS = (K.C_Z, K.C_F_MOTOR)
+#: Samples (cases x rows) whose statistics are taken at once. Over a whole chunk (4 MB per
+#: temporary at 128 cases x 3906 rows) numpy's temporaries were mapped fresh from the system
+#: at every call (glibc unmaps or trims large blocks when they are freed) and their first
+#: touch cost this VM more than the arithmetic: 12.8 ns a sample, against 3.0 ns in groups
+#: of 2**17 samples (1 MB temporaries, reused from the heap).
+_GROUP_SAMPLES = 1 << 17
 
 
 @dataclass
@@ -256,9 +265,11 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
                         remedy="keep fewer `channels`, lower the `sample_rate`, or run the cases "
                                "in several batches")
     lanes = _Lanes(prepared, channels, workers, plan)
+    sample, marks = np.empty(K.N_CHANNELS), np.zeros(2, dtype=np.bool_)
     for c in range(n):
-        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], ex, table,
-                   lanes.out[c, 0], lanes.out_flags[c, 0])
+        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], ex, table, sample,
+                   marks)
+        lanes.out[c, 0], lanes.out_flags[c, 0] = sample, marks
     lanes.absorb(1, 0, 0)
     recorder = _Rows()
     recorder.rows = 1
@@ -302,6 +313,10 @@ class _Lanes(driver.Stepper):
     the statistics do not wait for the slowest share). A share of one case runs the
     one-case kernel (the same numbers, without the lanes' bookkeeping). A case that
     diverges keeps what it finished; the rest of its rows are NaN.
+
+    The chunk buffer is channel-major, ``(channel, case, row)``, and only the channels kept
+    and those the statistics read (:data:`_STATISTICS_COLUMNS`) are computed and written;
+    ``out`` and ``out_flags`` are its views as ``(case, row, channel)``.
     """
 
     def __init__(self, prepared, channels, workers, plan):
@@ -319,8 +334,14 @@ class _Lanes(driver.Stepper):
                          else np.zeros((n, plan.samples), dtype=bool)) for c in channels}
         self.values = [(c, CHANNELS[c][0]) for c in channels if c in CHANNELS]
         self.flag_columns = [(c, FLAGS[c][0]) for c in channels if c in FLAGS]
-        self.out = np.empty((n, min(plan.samples, plan.chunk_samples), K.N_CHANNELS))
-        self.out_flags = np.zeros((n, self.out.shape[1], 2), dtype=np.bool_)
+        self.columns = np.array(sorted({col for _, col in self.values}
+                                       | set(_STATISTICS_COLUMNS)), dtype=np.int64)
+        rows = min(plan.samples, plan.chunk_samples)
+        self.buffer = np.empty((K.N_CHANNELS, n, rows))  # the channels not kept: never touched
+        self.flag_buffer = np.zeros((2, n, rows), dtype=np.bool_)
+        self.out = np.moveaxis(self.buffer, 0, -1)
+        self.out_flags = np.moveaxis(self.flag_buffer, 0, -1)
+        self.single = {}  # case -> the one-case kernel's row-major buffers
         self.statistics = RunStatistics(0.5 * (self.params[:, K.P_Z_LOW]
                                                + self.params[:, K.P_Z_HIGH]),
                                         force_limits=self.params[:, K.P_FMAX])
@@ -335,31 +356,46 @@ class _Lanes(driver.Stepper):
             self.pool.shutdown()
 
     def absorb(self, rows, start_row, first_row, a=0, b=None):
-        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics."""
-        cases = slice(a, b)
-        block = self.out[cases, first_row:first_row + rows]
-        marks = self.out_flags[cases, first_row:first_row + rows]
-        for name, col in self.values:
-            self.kept[name][cases, start_row:start_row + rows] = block[:, :, col]
-        for name, col in self.flag_columns:
-            self.kept[name][cases, start_row:start_row + rows] = marks[:, :, col]
-        self.statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
-                            marks[:, :, K.O_LOCKED], cases)
+        """Rows ``first_row..`` of cases ``a..b-1`` into the kept channels and statistics.
+
+        A group of cases at a time (:data:`_GROUP_SAMPLES`): the statistics are per case, so
+        the grouping changes no bit, and their numpy temporaries stay small enough to be
+        reused from the heap and to stay in cache.
+        """
+        b = len(self.status) if b is None else b
+        group = max(1, _GROUP_SAMPLES // max(rows, 1))
+        for g in range(a, b, group):
+            cases = slice(g, min(g + group, b))
+            block = self.out[cases, first_row:first_row + rows]
+            marks = self.out_flags[cases, first_row:first_row + rows]
+            for name, col in self.values:
+                self.kept[name][cases, start_row:start_row + rows] = block[:, :, col]
+            for name, col in self.flag_columns:
+                self.kept[name][cases, start_row:start_row + rows] = marks[:, :, col]
+            self.statistics.add(block[:, :, K.C_Z], block[:, :, K.C_F_MOTOR],
+                                marks[:, :, K.O_LOCKED], cases)
 
     def _kernel(self, steps, a, b):
         """Advance cases ``a..b-1`` by ``steps`` steps from step ``self.done``."""
         if b - a == 1:  # the one-case kernel: the same numbers, without lane bookkeeping
             if self.status[a] == K.STATUS_OK:
+                if a not in self.single:
+                    self.single[a] = (np.empty((self.buffer.shape[2], K.N_CHANNELS)),
+                                      np.zeros((self.buffer.shape[2], 2), dtype=np.bool_))
+                data, marks = self.single[a]
                 self.status[a], self.written[a] = _lanes.run_single(
                     self.solver, steps, self.decimation, self.states[a], self.flags[a],
-                    self.params[a], self.ex, self.table, self.out[a], self.out_flags[a], 0)
+                    self.params[a], self.ex, self.table, data, marks, 0)
+                written = self.written[a]
+                self.buffer[self.columns, a, :written] = data[:written, self.columns].T
+                self.flag_buffer[:, a, :written] = marks[:written].T
             return
         for first in range(a, b, _lanes.MAX_LANES):
             last = min(first + _lanes.MAX_LANES, b)
             code = _lanes.run_lanes(self.solver, self.done, steps, self.decimation,
                                     self.states[first:last], self.flags[first:last],
                                     self.params[first:last], self.ex, self.table,
-                                    self.out[first:last], self.out_flags[first:last], 0,
+                                    self.columns, self.buffer, self.flag_buffer, first, 0,
                                     self.status[first:last], self.written[first:last])
             if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long
                 raise RuntimeError(f"the batch kernel refused {last - first} cases (at most "

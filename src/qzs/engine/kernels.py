@@ -367,7 +367,7 @@ def _any_event(s, s1, mode, direction, margin1, P):
 
 
 @njit(**_JIT)
-def _rk(solver, t, h, s, mode, direction, held, P, E, table):
+def _rk(solver, t, h, s, k0, mode, direction, held, P, E, table):
     """The Runge-Kutta step of :func:`rk_step` for the event path, stage by stage.
 
     The same tableau and fused updates, in the same order; each stage calls the
@@ -375,13 +375,15 @@ def _rk(solver, t, h, s, mode, direction, held, P, E, table):
     rather than rotating it from a nearby phase. Single runs and batches both take this
     path for the part of a step around an event, so they stay identical; compiling
     :func:`rk_step`'s inlined stages a second time here took about 70 s of a cold start
-    (docs/model.md §9).
+    (docs/model.md §9). ``k0`` is the first stage's rate, ``rhs_at(t, s, ...)[0]``: every
+    trial step of an event's location starts from the same ``t`` and ``s``, so
+    :func:`_locate` evaluates it once for all of them.
     """
-    result, k = s, s
-    for stage in range(n_stages(solver)):
+    result = _axpy(s, tableau(solver, h, 0)[2], k0)
+    k = k0
+    for stage in range(1, n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
-        k = rhs_at(t + offset, s if stage == 0 else _axpy(s, a, k), mode, direction, held, P,
-                   E, table)[0]
+        k = rhs_at(t + offset, _axpy(s, a, k), mode, direction, held, P, E, table)[0]
         result = _axpy(result, weight, k)
     return result
 
@@ -390,11 +392,12 @@ def _rk(solver, t, h, s, mode, direction, held, P, E, table):
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s] and its event value.
 
-    ``data`` is ``(solver, event, t, s, mode, direction, held, P, E, table)``, the step's
-    start; returns ``(event value, state)`` at ``t + at`` (:func:`_rk`, :func:`_event_value`).
+    ``data`` is ``(solver, event, t, s, k0, mode, direction, held, P, E, table)``, the
+    step's start and its first stage's rate; returns ``(event value, state)`` at ``t + at``
+    (:func:`_rk`, :func:`_event_value`).
     """
-    solver, event, t, s, mode, direction, held, P, E, table = data
-    state = _rk(solver, t, at, s, mode, float(direction), held, P, E, table)
+    solver, event, t, s, k0, mode, direction, held, P, E, table = data
+    state = _rk(solver, t, at, s, k0, mode, float(direction), held, P, E, table)
     return _event_value(event, t + at, state, mode, direction, held, P, E, table), state
 
 
@@ -403,10 +406,14 @@ def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table):
     """Event ``event`` located in ``[t, t + h]`` (:func:`qzs.engine.stickslip.locate`).
 
     Returns ``(time from t, state there)``: at most 6 Runge-Kutta steps from ``t`` (each an
-    :func:`_event_trial`), the event function then zero to round-off.
+    :func:`_event_trial`, all sharing their first stage), the event function then zero to
+    round-off.
     """
-    return locate(_event_trial, (solver, event, t, s, mode, direction, held, P, E, table), g0,
-                  g1, h, s)
+    k0 = s
+    if g0 > 0.0:  # else no trial is made
+        k0 = rhs_at(t, s, mode, float(direction), held, P, E, table)[0]
+    return locate(_event_trial, (solver, event, t, s, k0, mode, direction, held, P, E, table),
+                  g0, g1, h, s)
 
 
 @njit(**_JIT)
@@ -460,7 +467,8 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     rest = h - at
     s1 = s_event
     if rest > 0.0:
-        s1 = _rk(solver, t_event, rest, s_event, mode, float(direction), held, P, E, table)
+        k0 = rhs_at(t_event, s_event, mode, float(direction), held, P, E, table)[0]
+        s1 = _rk(solver, t_event, rest, s_event, k0, mode, float(direction), held, P, E, table)
     if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
         if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
             s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, E,

@@ -12,6 +12,10 @@ per case) and each step is two passes over the lanes:
 2. for the flagged lanes only, the full event-locating step of
    :func:`qzs.engine.kernels.grid_step`.
 
+At an output sample, one more vectorised pass computes the channels of every lane
+(:func:`_sample_lanes`, the operations of :func:`qzs.engine.kernels.record`), and only the
+channels the caller asks for are stored (:func:`_keep`).
+
 No fast-math is used (see :mod:`qzs.engine.kernels`): a lane computes the same bits
 in a vector register as in scalar code, and pass 1 takes the same operations in
 the same order as :func:`qzs.engine.kernels.grid_step` does for an ordinary step. So
@@ -35,6 +39,9 @@ N_ROWS = K.N_STATE + 6
 # Rows of the per-step scratch array: the running weighted sum, the stage input, the flag.
 T_SUM, T_INPUT, T_FLAGGED = 0, K.N_ODE, K.N_ODE + 4
 N_SCRATCH = K.N_ODE + 5
+# Rows of a sample's scratch array: the output channels (``K.C_*``), then the two flags.
+Q_LOCKED, Q_CONTACT = K.N_CHANNELS + K.O_LOCKED, K.N_CHANNELS + K.O_CONTACT
+N_RECORD = K.N_CHANNELS + 2
 #: Most lanes per call. Lane arrays are flat, row ``i`` of lane ``c`` at ``i * W + c``
 #: with the row stride ``W`` a compile-time constant: LLVM then sees that the rows of
 #: an array cannot overlap and vectorises the lane loops with two overlap checks. ``W``
@@ -227,6 +234,85 @@ def _finish_any(n, b_end, L, T, PP):
     return _finish_lanes(False, n, b_end, L, T, PP)
 
 
+@njit(**_JIT, inline="always")
+def _sample_lanes(exact, n, t, base, L, PP, Q):
+    """The output channels of every lane at a sample, but the energies, into ``Q``.
+
+    What :func:`qzs.engine.kernels.record` computes, with the same operations in the same
+    order (the right-hand side's forces at the state), lane by lane in a loop LLVM
+    vectorises; the caller keeps the channels it wants (:func:`_keep`).
+    """
+    for c in range(n):
+        s = _state(L, c)
+        mode = int(L[_at(R_MODE, c)])
+        P = _params(PP, c, exact)
+        force = K.rhs(base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)], _held(L, c),
+                      P)[1]
+        v = s[K.S_V] if mode == K.MODE_SLIP else 0.0
+        Q[_at(K.C_TIME, c)] = t
+        Q[_at(K.C_BASE_Y, c)] = force[K.F_Y]
+        Q[_at(K.C_BASE_YD, c)] = force[K.F_YD]
+        Q[_at(K.C_BASE_YDD, c)] = force[K.F_YDD]
+        Q[_at(K.C_X, c)] = force[K.F_Y] + s[K.S_Z]
+        Q[_at(K.C_XD, c)] = force[K.F_YD] + v
+        Q[_at(K.C_XDD, c)] = force[K.F_XDD]
+        Q[_at(K.C_Z, c)] = s[K.S_Z]
+        Q[_at(K.C_V, c)] = v
+        Q[_at(K.C_F_SPRING, c)] = force[K.F_SPRING]
+        Q[_at(K.C_F_FRICTION, c)] = force[K.F_FRICTION]
+        Q[_at(K.C_F_STOP, c)] = force[K.F_STOP]
+        Q[_at(K.C_F_MOTOR, c)] = force[K.F_MOTOR]
+        Q[_at(K.C_F_PI, c)] = force[K.F_PI]
+        Q[_at(K.C_F_DAMP, c)] = force[K.F_DAMP]
+        Q[_at(K.C_V_MEASURED, c)] = force[K.F_V_MEASURED]
+        Q[_at(K.C_W_BASE, c)] = s[K.S_W_BASE]
+        Q[_at(K.C_D_FRICTION, c)] = s[K.S_D_FRICTION]
+        Q[_at(K.C_W_MOTOR, c)] = s[K.S_W_MOTOR]
+        Q[_at(K.C_D_STOP, c)] = s[K.S_D_STOP]
+        Q[_at(Q_LOCKED, c)] = 1.0 if mode != K.MODE_SLIP else 0.0
+        Q[_at(Q_CONTACT, c)] = 1.0 if K._in_contact(s, mode, P) else 0.0
+
+
+@njit(**_JIT)
+def _sample_exact(n, t, base, L, PP, Q):
+    _sample_lanes(True, n, t, base, L, PP, Q)
+
+
+@njit(**_JIT)
+def _sample_any(n, t, base, L, PP, Q):
+    _sample_lanes(False, n, t, base, L, PP, Q)
+
+
+@njit(**_JIT)
+def _keep(exact, n, t, base, L, PP, Q, columns, energies, out, out_flags, lane0, row):
+    """Record a sample: the channels ``columns`` and both flags of every lane that has not
+    failed, to ``out[column, lane0 + c, row]`` and ``out_flags[flag, lane0 + c, row]``.
+
+    The same numbers as :func:`qzs.engine.kernels.record`: the channels from one vectorised
+    pass (:func:`_sample_lanes`), the energies (libm's ``exp`` and ``log1p``) lane by lane
+    and only when ``energies`` (a column asks for them).
+    """
+    if exact:
+        _sample_exact(n, t, base, L, PP, Q)
+    else:
+        _sample_any(n, t, base, L, PP, Q)
+    if energies:
+        for c in range(n):
+            if L[_at(R_FAILED, c)] == 0.0:
+                (Q[_at(K.C_E_KINETIC, c)], Q[_at(K.C_E_SPRING, c)], Q[_at(K.C_E_GRAVITY, c)],
+                 Q[_at(K.C_E_STOP, c)]) = K.energies(base[0], base[1], _state(L, c),
+                                                      int(L[_at(R_MODE, c)]), _params(PP, c))
+    for k in range(columns.size):
+        column = columns[k]
+        for c in range(n):
+            if L[_at(R_FAILED, c)] == 0.0:
+                out[column, lane0 + c, row] = Q[_at(column, c)]
+    for c in range(n):
+        if L[_at(R_FAILED, c)] == 0.0:
+            out_flags[K.O_LOCKED, lane0 + c, row] = Q[_at(Q_LOCKED, c)] != 0.0
+            out_flags[K.O_CONTACT, lane0 + c, row] = Q[_at(Q_CONTACT, c)] != 0.0
+
+
 @njit(**_JIT)
 def _vector_pass(exact, slipping, solver, n, h, L, T, PP, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
@@ -255,13 +341,15 @@ def _vector_pass(exact, slipping, solver, n, h, L, T, PP, bases, b_end):
 
 
 @njit(**_JIT, nogil=True)
-def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, table, out,
-              out_flags, row0, status, rows):
+def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, table, columns,
+              out, out_flags, lane0, row0, status, rows):
     """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
 
-    Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
-    (``K.N_PARAMS``), ``out`` and ``out_flags`` (rows from ``row0``) is case ``c``;
-    the excitation ``ex, table`` is shared. ``states`` and ``flags`` carry the
+    Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``) and ``params``
+    (``K.N_PARAMS``) is case ``c``; the excitation ``ex, table`` is shared. A sample of case
+    ``c`` goes to ``out[column, lane0 + c, row]`` for each channel of ``columns`` (``K.C_*``;
+    the other channels are not computed, but the energies only if asked) and to
+    ``out_flags[flag, lane0 + c, row]`` for both flags (``K.O_*``), rows from ``row0``. ``states`` and ``flags`` carry the
     cases between calls. A case whose ``status`` is not ``K.STATUS_OK`` is left
     alone; one that diverges (non-finite, beyond 100 strokes or 1e4 m/s) gets
     ``K.STATUS_DIVERGED``, keeps its last finite state and, in ``flags[c,
@@ -276,6 +364,10 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
     PP = np.zeros(K.N_PARAMS * W)
     L = np.zeros(N_ROWS * W)
     T = np.zeros(N_SCRATCH * W)
+    Q = np.zeros(N_RECORD * W)
+    energies = False
+    for k in range(columns.size):
+        energies = energies or columns[k] >= K.C_E_KINETIC
     failed_step = np.full(n, -1, dtype=np.int64)
     sampled = False
     for c in range(n):
@@ -345,11 +437,9 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
                                           step % K.PHASE_PERIOD == 0)
         if step % decimation == 0:
-            for c in range(n):
-                if L[_at(R_FAILED, c)] == 0.0:
-                    K.record(step * h, _state(L, c), int(L[_at(R_MODE, c)]),
-                             int(L[_at(R_DIRECTION, c)]), _held(L, c), _params(PP, c), E,
-                             table, out[c, row], out_flags[c, row], phase, sin0, cos0)
+            base = base_motion_near(step * h, phase, sin0, cos0, E, table)
+            _keep(exact, lanes, step * h, base, L, PP, Q, columns, energies, out, out_flags,
+                  lane0, row)
             row += 1
 
     for c in range(n):

@@ -1,0 +1,236 @@
+#!/usr/bin/env python
+"""A design population in one lockstep batch against one design's single run (issue 26).
+
+    .venv/bin/python benchmarks/bench_population.py            # 131 s chirp, dt 1e-3 and 1e-4
+    .venv/bin/python benchmarks/bench_population.py --quick    # 60 s chirp, best of 2
+    .venv/bin/python benchmarks/bench_population.py --dt 1e-3 --repeats 5 --idle-wait 60
+
+What the design-space optimiser does with each generation: 256 designs (PI gains
+``pi_kp`` 2-1000 N/m log-uniform and ``pi_ki`` 0-20 N/(m*s), active damping
+``damping_gain`` 0-100 N*s/m, stiction 5-15 N, the ranges of the shipped sweep and of
+``qzs params``; drawn at random, seed 26) simulated as ONE lockstep batch,
+``simulate_batch(cases, chirp, dt=dt, sample_rate=1000, channels=("base_acceleration",
+"payload_acceleration"), workers=2)``, then a transmissibility estimate per case
+(``qzs.analysis.spectral.transmissibility``, the sweeps' 16384-point Welch segments) and
+the batch statistics. The excitation is the paper's chirp (10 mm, 0-20 Hz) shortened to
+131.072 s (60 s with ``--quick``); the steps are dt = 1e-3 s (what qzs chooses for the
+paper's run) and the paper's 1e-4 s, output at 1 kHz.
+
+The baseline, measured in the same process and the same rounds: one design's single run,
+``qzs.simulate(chirp, isolator, controller, dt=dt, sample_rate=1000)`` (its 24 channels at
+1 kHz and its summary, as a user gets it). Kernels come from numba's cache (one untimed
+warm-up call of each first). Per dt it prints:
+
+- the single run's wall time, and the same with its transmissibility estimate;
+- the population: the kernel's integration (``BatchResult.elapsed``), the whole
+  ``simulate_batch`` call (the 256 cases validated and set up, the channels kept, the
+  statistics), and the evaluation end to end (that call, then the 256 transmissibility
+  estimates and the band means read from them);
+- ns per lane and step of the kernel on 1 core (``workers=1``) and on 2
+  (``elapsed * cores / lane-steps``);
+- the ratios against the single run. Target (issue 26): the population's ``simulate_batch``
+  call within **16x** one single run at dt = 1e-3 s, on 2 cores (the verdict; dt = 1e-4 s is
+  reported for information). The evaluation with its analysis, against a single run with
+  its own, is an information row.
+
+Every timing is the best of N (``--repeats``), each run started after waiting up to
+``--idle-wait`` s for the machine to go quiet (the helpers of ``bench_simulate.py``); the log
+lists the load other processes put on the machine before each run. Exits 0: a benchmark
+reports, it does not fail CI.
+"""
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+
+TARGET = 16.0             # population / single run, at dt = 1e-3 s on 2 cores
+DESIGNS = 256
+SAMPLE_RATE = 1000.0
+FFT_LENGTH = 16384        # the sweeps' Welch segments (sweep_files/pi_vs_stiction.toml)
+BAND = (1.0, 20.0)        # [Hz] the band mean the evaluation reads
+CHANNELS = ("base_acceleration", "payload_acceleration")
+
+log = lambda msg="": print(msg, flush=True)  # noqa: E731
+
+
+def designs(n, seed=26):
+    """``n`` random designs: (IsolatorParameters, ControllerParameters) pairs."""
+    import qzs
+
+    rng = np.random.default_rng(seed)
+    kp = np.exp(rng.uniform(np.log(2.0), np.log(1000.0), n))
+    ki = rng.uniform(0.0, 20.0, n)
+    kd = rng.uniform(0.0, 100.0, n)
+    fs = rng.uniform(5.0, 15.0, n)
+    return [(qzs.IsolatorParameters(stiction_force=float(fs[i])),
+             qzs.ControllerParameters(pi_kp=float(kp[i]), pi_ki=float(ki[i]),
+                                      damping_gain=float(kd[i]))) for i in range(n)]
+
+
+def analyse(base, payload):
+    """One case's evaluation after its run: the transmissibility and its band mean."""
+    from qzs.analysis.spectral import transmissibility
+
+    estimate = transmissibility(base, payload, SAMPLE_RATE, fft_length=FFT_LENGTH)
+    f = estimate.frequency
+    inside = (f >= BAND[0]) & (f <= BAND[1]) & estimate.trusted
+    return float(estimate.magnitude[inside].mean()) if inside.any() else np.nan
+
+
+def timed(label, function, idle_wait, runs):
+    """Run ``function`` after an idle wait; log and keep its wall time [s] and result."""
+    busy = wait_for_idle(idle_wait)
+    start = time.perf_counter()
+    result = function()
+    wall = time.perf_counter() - start
+    runs.append(dict(seconds=wall, busy=busy))
+    log(f"  {label}: {wall:.3f} s{_busy_note(busy)}")
+    return wall, result
+
+
+def measure(dt, duration, repeats, idle_wait, cores, runs):
+    """Best-of-``repeats`` figures of the single run and the population at step ``dt``."""
+    import qzs
+    from qzs.engine.batch import simulate_batch
+
+    cases = designs(DESIGNS)
+    excitation = qzs.Chirp(duration=duration)
+    warm = qzs.Chirp(duration=1.0)
+    options = dict(dt=dt, sample_rate=SAMPLE_RATE)
+    simulate_batch(cases[:16], warm, channels=CHANNELS, workers=cores, **options)
+    simulate_batch(cases[:16], warm, channels=CHANNELS, workers=1, **options)
+    qzs.simulate(warm, *cases[0], **options)
+    analyse(*np.random.default_rng(0).normal(size=(2, FFT_LENGTH)))  # scipy.signal imported
+    isolator, controller = cases[0]
+    best = {}
+
+    def keep(name, value):
+        best[name] = min(best.get(name, np.inf), value)
+
+    for round_ in range(repeats):
+        log(f" round {round_ + 1}/{repeats}, dt = {dt:g} s")
+        wall, single = timed("single run (qzs.simulate)",
+                             lambda: qzs.simulate(excitation, isolator, controller, **options),
+                             idle_wait, runs)
+        keep("single", wall)
+        keep("single kernel", single.run["elapsed"])
+        start = time.perf_counter()
+        analyse(single.base_acceleration, single.payload_acceleration)
+        keep("single analysis", time.perf_counter() - start)
+        del single
+
+        def population():
+            start = time.perf_counter()
+            batch = simulate_batch(cases, excitation, channels=CHANNELS, workers=cores,
+                                   **options)
+            called = time.perf_counter() - start
+            means = [analyse(batch.channels["base_acceleration"][c],
+                             batch.channels["payload_acceleration"][c])
+                     if batch.status[c] == 0 else np.nan for c in range(len(cases))]
+            return batch, called, means
+        wall, (batch, called, means) = timed(f"population of {DESIGNS}, {cores} cores, "
+                                             "evaluated end to end", population, idle_wait,
+                                             runs)
+        lane_steps = float(batch.stats["steps"].sum())
+        log(f"    kernel {batch.elapsed:.3f} s ({batch.elapsed * cores / lane_steps * 1e9:.1f} "
+            f"ns per lane-step and core), simulate_batch {called:.3f} s, analysis "
+            f"{wall - called:.3f} s; {int(batch.status.sum())} failed, "
+            f"{np.isnan(means).sum()} without a band mean")
+        keep("kernel", batch.elapsed)
+        keep("call", called)
+        keep("evaluation", wall)
+        keep("analysis", wall - called)
+        keep("ns 2", batch.elapsed * cores / lane_steps * 1e9)
+        del batch
+        _, one = timed(f"population of {DESIGNS}, 1 core (kernel only)",
+                       lambda: simulate_batch(cases, excitation, channels=CHANNELS, workers=1,
+                                              **options), idle_wait, runs)
+        keep("ns 1", one.elapsed / float(one.stats["steps"].sum()) * 1e9)
+        del one
+    return best
+
+
+def verdicts(results):
+    """Rows ``(what, qzs, baseline, ratio, target, verdict)`` of :func:`measure`'s results
+    (by step): the verdict at dt = 1e-3 s, information rows beside it."""
+    rows = []
+    for dt, b in results.items():
+        ratio = b["call"] / b["single"]
+        target = abs(dt - 1e-3) < 1e-12
+        rows.append((f"{DESIGNS} designs in one lockstep batch, dt = {dt:g} s: simulate_batch "
+                     "/ one qzs.simulate", f"{b['call']:.2f} s", f"{b['single'] * 1e3:.0f} ms",
+                     f"{ratio:.1f}x", f"<= {TARGET:g}x" if target else "-",
+                     ("PASS" if ratio <= TARGET else "FAIL") if target else "info"))
+        rows.append((f"  kernel alone ({b['ns 1']:.0f} ns per lane-step on 1 core, "
+                     f"{b['ns 2']:.0f} per core on 2)", f"{b['kernel']:.2f} s",
+                     f"{b['single kernel'] * 1e3:.0f} ms", f"{b['kernel'] / b['single']:.1f}x",
+                     "-", "info"))
+        single = b["single"] + b["single analysis"]
+        rows.append(("  evaluated: + a transmissibility per case, / one run + its own",
+                     f"{b['evaluation']:.2f} s", f"{single * 1e3:.0f} ms",
+                     f"{b['evaluation'] / single:.1f}x", "-", "info"))
+    return rows
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="60 s chirp, best of 2")
+    parser.add_argument("--dt", default="1e-3,1e-4", help="steps [s], comma-separated")
+    parser.add_argument("--duration", type=float, default=None,
+                        help="simulated time [s] (default 131.072, 60 with --quick)")
+    parser.add_argument("--repeats", type=int, default=None, help="best-of-N (3; 2 quick)")
+    parser.add_argument("--idle-wait", type=float, default=20.0, metavar="S",
+                        help="wait up to S s before each timed run for the machine to go quiet")
+    args = parser.parse_args(argv)
+    duration = args.duration or (60.0 if args.quick else 131.072)
+    repeats = args.repeats or (2 if args.quick else 3)
+    cores = min(2, os.cpu_count() or 1)
+    log(f"# bench_population: {DESIGNS} designs, {duration:g} s chirp, best of {repeats}")
+    for key, value in machine_info():
+        log(f"  {key:13s} {value}")
+    runs = []
+    results = {}
+    for dt in (float(x) for x in args.dt.split(",")):
+        results[dt] = measure(dt, duration, repeats, args.idle_wait, cores, runs)
+    noisy = sum(1 for run in runs if run["busy"] is not None and run["busy"] > 0.3)
+    log("")
+    if noisy:
+        log(f"WARNING: {noisy} of {len(runs)} timed runs started while other processes kept "
+            "more than 0.3 CPUs busy: the figures are noisy. Rerun on a quiet machine.")
+    log(f"RESULTS ({DESIGNS} designs, {duration:g} s chirp at 1 kHz output, best of {repeats}; "
+        f"{cores} cores)")
+    header = (f"{'dt':>7} {'single':>8} {'+ T':>8} {'kernel':>8} {'batch':>8} {'+ T all':>8} "
+              f"{'ns/ls 1c':>9} {'ns/ls 2c':>9} {'batch/single':>13} {'eval/(single+T)':>16}")
+    log(header)
+    log("-" * len(header))
+    for dt, b in results.items():
+        single_t = b["single"] + b["single analysis"]
+        log(f"{dt:>7g} {b['single']:>7.3f}s {single_t:>7.3f}s {b['kernel']:>7.3f}s "
+            f"{b['call']:>7.3f}s {b['evaluation']:>7.3f}s {b['ns 1']:>9.1f} {b['ns 2']:>9.1f} "
+            f"{b['call'] / b['single']:>12.1f}x {b['evaluation'] / single_t:>15.1f}x")
+    log("")
+    log("single: qzs.simulate wall; + T: and its transmissibility; kernel: the population's "
+        "integration (BatchResult.elapsed, 2 cores); batch: the whole simulate_batch call; "
+        "+ T all: and the 256 transmissibility estimates; ns/ls: ns per lane and step of the "
+        "kernel per core, on 1 and 2 cores.")
+    for what, value, baseline, ratio, goal, verdict in verdicts(results):
+        log(f"{what}: {value} against {baseline}: {ratio}, target {goal}: {verdict}")
+    log(f"load average at end: {_load()}")
+    return results
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except Exception:  # a benchmark reports; it never fails the caller
+        import traceback
+
+        traceback.print_exc()
+    sys.exit(0)
