@@ -48,6 +48,7 @@ import os
 import re
 import signal
 import sys
+import threading
 
 from qzs._version import __version__
 from qzs.cli import (app, completion, design, design_space, docs, experiment, hexapod, params,
@@ -149,8 +150,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         return 130
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        _restore_sigterm(previous)
 
 
 def _flush_stdout():
@@ -180,6 +180,12 @@ def _catch_sigterm():
     default action). Child processes forked later (worker pools) inherit the handler;
     there it restores the default action and re-sends the signal, so that a pool can
     still stop its workers.
+
+    A handler that runs inside a weakref callback or a ``__del__`` raises where Python
+    ignores exceptions (it prints "Exception ignored in" and goes on): the
+    :func:`sys.unraisablehook` installed here sees that :class:`Terminated`, arms the
+    handler again and sends the signal once more, so that it raises at the next
+    instruction outside (the run would otherwise finish and exit 0).
     """
     pid = os.getpid()
 
@@ -188,12 +194,55 @@ def _catch_sigterm():
         if os.getpid() != pid:
             os.kill(os.getpid(), signum)
             return
+        inside = frame
+        while inside is not None:  # still in the hook: a raise would be ignored again
+            if inside.f_code is redeliver.__code__:
+                _send_later(signum)
+                return
+            inside = inside.f_back
         raise Terminated(signum)
 
+    def _send_later(signum):
+        """Arm the handler and send the signal again in 10 ms, after the hook returned."""
+        signal.signal(signum, handler)
+        timer = threading.Timer(0.01, os.kill, args=(pid, signum))
+        timer.daemon = True
+        redeliver.timers.append(timer)
+        timer.start()
+
+    def redeliver(unraisable):
+        error = unraisable.exc_value
+        if isinstance(error, Terminated) and os.getpid() == pid:
+            _send_later(error.signum)
+            return
+        chained(unraisable)
+
     try:
-        return signal.signal(signal.SIGTERM, handler)
+        previous = signal.signal(signal.SIGTERM, handler)
     except ValueError:  # not the main thread
         return None
+    chained = sys.unraisablehook
+    redeliver.chained, redeliver.timers = chained, []
+    sys.unraisablehook = redeliver
+    return previous
+
+
+def _restore_sigterm(previous):
+    """Undo :func:`_catch_sigterm`: its SIGTERM handler and its unraisable hook.
+
+    Parameters
+    ----------
+    previous : handler or None
+        What :func:`_catch_sigterm` returned (None: it set nothing).
+    """
+    if previous is None:
+        return
+    signal.signal(signal.SIGTERM, previous)
+    chained = getattr(sys.unraisablehook, "chained", None)
+    if chained is not None:
+        for timer in sys.unraisablehook.timers:  # a signal not yet sent again stays unsent
+            timer.cancel()
+        sys.unraisablehook = chained
 
 
 if __name__ == "__main__":  # pragma: no cover
