@@ -172,7 +172,6 @@ def run_grid(grid_path, store, idle_wait):
 
 def read_grid(store, problem):
     """The grid's designs [their units] and objective values, one row per case."""
-    from qzs.workflows.design_space.metrics import _sweep_name
     from qzs.workflows.sweeps import open_sweep
 
     ds = open_sweep(store)
@@ -180,7 +179,7 @@ def read_grid(store, problem):
     if (status != 1).any():
         raise RuntimeError(f"{int((status != 1).sum())} grid cases did not end ok")
     X = np.column_stack([ds[v.name].values for v in problem.variables])
-    F = np.column_stack([ds[_sweep_name(g)].values for g in problem.objectives])
+    F = np.column_stack([ds[g.column].values for g in problem.objectives])
     return X, F
 
 

@@ -24,7 +24,7 @@ from qzs.analysis.statistics import STATISTICS as RUN_STATISTICS
 from qzs.engine.batch import STATS
 
 __all__ = ["MetricDefinition", "METRICS", "STATISTICS", "metric_column", "sweep_outputs",
-           "Evaluation", "evaluate", "evaluate_cases", "case_settings"]
+           "Evaluation", "evaluate", "evaluate_cases", "case_settings", "goal_values"]
 
 #: How the Monte Carlo draws of a design combine.
 STATISTICS = ("mean", "worst", "quantile")
@@ -201,13 +201,25 @@ def sweep_outputs(goals, analysis):
     return {"at_frequencies": list(dict.fromkeys(at))}, outputs
 
 
-def _sweep_name(goal):
-    """The sweep variable holding a goal's metric."""
-    if goal.metric == "rms_transmissibility":
-        return f"rms_transmissibility_{_band_label(goal.options['band'])}"
-    if goal.metric == "mean_transmissibility":
-        return f"mean_transmissibility_{_band_label(goal.options['band'])}"
-    return goal.column
+def goal_values(goals, values, n_designs):
+    """Each goal's value per design: its column's draws combined by its statistic.
+
+    Parameters
+    ----------
+    goals : sequence of Goal
+        The goals, in the order of the columns returned.
+    values : mapping of str to ndarray, shape (n_designs, n_samples)
+        Metric column -> value per design and draw [the metric's unit].
+    n_designs : int
+        Designs (the shape when there is no goal).
+
+    Returns
+    -------
+    ndarray, shape (n_designs, n_goals)
+        [each goal's unit]; NaN where a draw's value is undefined.
+    """
+    columns = [goal.aggregate(values[goal.column]) for goal in goals]
+    return np.column_stack(columns) if columns else np.empty((n_designs, 0))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -251,8 +263,7 @@ class Evaluation:
         ndarray, shape (n_designs, n_goals)
             [each goal's unit]; NaN where a draw's value is undefined.
         """
-        return np.column_stack([goal.aggregate(self.values[goal.column]) for goal in goals]) \
-            if goals else np.empty((len(self.designs), 0))
+        return goal_values(goals, self.values, len(self.designs))
 
 
 def case_settings(problem, designs):
@@ -290,21 +301,16 @@ def _linear(problem, settings, goals, values, status, messages, progress=None):
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
     from qzs.errors import ParameterError
-    from qzs.model.controller import ControllerParameters
-    from qzs.model.isolator import IsolatorParameters
-    from qzs.model.registry import update_parameters
+    from qzs.workflows.sweeps.backends import build_model
 
     goals = {g.column: g for g in goals}
-    fixed = problem.sweep.parameters
     every, done = max(1, len(settings) // 100), 0
     for c, case in enumerate(settings):
         if progress is not None and c and c % every == 0:
             progress(c - done)
             done = c
-        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
         try:  # the model only: the linear analysis needs no excitation
-            isolator, controller = update_parameters(IsolatorParameters(),
-                                                     ControllerParameters(), {**fixed, **model})
+            isolator, controller = build_model(problem.sweep, case)
         except (ParameterError, TypeError) as error:
             status[c], messages[c] = 2, str(error)
             continue
@@ -375,7 +381,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
     ValueError
         A simulated metric is wanted and the problem's step is not fixed yet.
     """
-    from qzs.workflows.sweeps.backends import _dask, _local, run_batch  # noqa: F401
+    from qzs.workflows.sweeps.backends import _dask, _local
 
     total = len(settings)
     columns = problem.columns if columns is None else tuple(columns)
@@ -406,8 +412,9 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
                 status[start:stop] = arrays["status"]
                 messages[start:stop] = [str(m) for m in arrays["message"]]
                 for goal in simulated:
-                    column = np.asarray(arrays[_sweep_name(goal)], dtype=float)
-                    values[goal.column][start:stop] = column
+                    # the sweep stores each metric under the goal's column name
+                    values[goal.column][start:stop] = np.asarray(arrays[goal.column],
+                                                                 dtype=float)
                 steps += int(result["steps"])
                 if progress is not None:
                     progress(stop - start)

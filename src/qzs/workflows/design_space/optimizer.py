@@ -24,7 +24,7 @@ import numpy as np
 
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
-from qzs.workflows.design_space.metrics import METRICS, evaluate
+from qzs.workflows.design_space.metrics import METRICS, evaluate, goal_values
 from qzs.workflows.design_space.problem import DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check
@@ -218,8 +218,7 @@ def _generations(problem, opened, client, threads, bar):
                                       f"not ask for again (generation {generation}); it was "
                                       "written by another qzs or pymoo version. Start again "
                                       "with --overwrite")
-            goal_values = np.column_stack([g.aggregate(values[g.column])
-                                           for g in problem.goals])
+            aggregated = goal_values(problem.goals, values, len(X))
             bar.update(len(X) * problem.samples)
         else:
             designs = np.column_stack([v.to_unit(X[:, j])
@@ -227,10 +226,10 @@ def _generations(problem, opened, client, threads, bar):
             evaluation = evaluate(problem, designs, client=client, threads=threads,
                                   progress=bar.update)
             opened.append(generation, X, evaluation)
-            goal_values = evaluation.goal_values(problem.goals)
+            aggregated = evaluation.goal_values(problem.goals)
             evaluated += len(X)
             steps += evaluation.steps
-        F, G = objective_matrix(problem, goal_values)
+        F, G = objective_matrix(problem, aggregated)
         Evaluator().eval(StaticProblem(search, F=F, G=G), asked)
         algorithm.tell(infills=asked)
     return evaluated, steps

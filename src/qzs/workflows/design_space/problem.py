@@ -67,7 +67,7 @@ from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.registry import PARAMETERS
 from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_column
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
-                                             _distribution, _frozen, load_sweep)
+                                             _distribution, _frozen, load_sweep, unit_draws)
 
 __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "plan_text",
            "shipped_problems", "TABLES", "MAX_SAMPLES"]
@@ -345,15 +345,7 @@ class DesignProblem:
         """
         if not self.uncertain:
             return {}
-        from scipy.stats import qmc
-
-        rng = np.random.default_rng(self.seed)
-        d = len(self.uncertain)
-        if self.sampling == "lhs":
-            u = qmc.LatinHypercube(d=d, rng=rng).random(self.samples)
-        else:
-            u = rng.random((self.samples, d))
-        u = np.clip(u, 1e-12, 1 - 1e-12)
+        u = unit_draws(len(self.uncertain), self.samples, self.sampling, self.seed)
         return {p.name: p.quantile(u[:, j]) for j, p in enumerate(self.uncertain)}
 
 
@@ -641,7 +633,8 @@ def _problem(document, where, stem):
                                         "[[objectives]] with metric = \"...\"")
         constraints = tuple(_goal("constraints", i, spec, True, base.analysis)
                             for i, spec in enumerate(_table(document, "constraints", list)))
-        sweep = _sweep(document, name, variables, uncertain, (*objectives, *constraints))
+        sweep = _sweep(document, name, variables, uncertain, (*objectives, *constraints),
+                       base.analysis)
         _infeasible(constraints)
         if not uncertain:
             for goal in (*objectives, *constraints):
@@ -692,11 +685,12 @@ def _sensitivity(document, objectives, constraints):
     return settings
 
 
-def _sweep(document, name, variables, uncertain, goals=None):
+def _sweep(document, name, variables, uncertain, goals=None, resolved=None):
     """The problem's evaluation as a sweep: everything but what is searched or drawn.
 
     Without ``goals``, the sweep that resolves the analysis settings the goals are checked
-    against; with them, the one that records what they need.
+    against; with them and that sweep's ``resolved`` analysis, the one that records what
+    they need.
     """
     from qzs.workflows.design_space.metrics import sweep_outputs
 
@@ -708,7 +702,6 @@ def _sweep(document, name, variables, uncertain, goals=None):
              "simulation": _table(document, "simulation"), "analysis": analysis,
              "outputs": {"transmissibility": False}}
     if goals is not None:
-        resolved = load_sweep(sweep).analysis
         extra, outputs = sweep_outputs(goals, resolved)
         sweep["analysis"] = {**analysis, **extra}
         if "band" not in analysis:

@@ -18,6 +18,7 @@ import numpy as np
 
 from qzs._version import __version__
 from qzs.errors import ParameterError
+from qzs.workflows.design_space.metrics import goal_values
 from qzs.workflows.design_space.problem import DesignProblem
 
 if TYPE_CHECKING:
@@ -172,16 +173,14 @@ class OptimizationResult:
         OptimizationResult
         """
         data = store.read()
-        goal_values = (np.column_stack([g.aggregate(data["values"][g.column])
-                                        for g in problem.goals])
-                       if len(data["generation"]) else np.empty((0, len(problem.goals))))
-        F, G = objective_matrix(problem, goal_values)
+        values = goal_values(problem.goals, data["values"], len(data["generation"]))
+        F, G = objective_matrix(problem, values)
         feasible = np.all(G <= 0.0, axis=1)
         members = np.flatnonzero(feasible)
         pareto = members[pareto_front(F[members])] if members.size else members
         return cls(problem=problem, designs=data["design_variables"],
                    generation=data["generation"], values=data["values"],
-                   status=data["status"], goal_values=goal_values, feasible=feasible,
+                   status=data["status"], goal_values=values, feasible=feasible,
                    pareto=pareto, messages=data["messages"], store=store.path, wall=wall,
                    evaluated=evaluated, steps=steps)
 

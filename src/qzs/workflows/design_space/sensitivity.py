@@ -34,13 +34,14 @@ the ends, at probability 0 and 1, are infinite for an unbounded distribution).
 Each sample point is one case ``{name: value}``, evaluated by
 :func:`qzs.workflows.design_space.metrics.evaluate_cases`, the path of every design of an
 optimisation: simulated metrics through the sweep batch task (the step chosen first for
-the problem's ``tolerance_db`` if ``[simulation]`` gives no ``dt``), linear metrics by the
+the problem's ``tolerance_db`` if ``[simulation]`` gives no ``dt``, by the optimiser's
+:func:`~qzs.workflows.design_space.optimizer.fix_step`, so both integrate a problem at
+one step), linear metrics by the
 linear analysis. A case whose metric is undefined (a failed run) leaves that metric's
 indices undefined: they are NaN, with the reason in :attr:`SensitivityResult.reasons`.
 """
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -473,11 +474,11 @@ def _evaluate(problem, settings, plan, evaluate, client, threads, progress):
             values = _check_returned(returned, metrics, n)
             bar.update(n)
             return values, [""] * n, definition
-        if plan["simulated"] and definition.simulation["dt"] is None:
-            from qzs.workflows.sweeps.backends import choose_sweep_step
+        if plan["simulated"]:  # the step the optimiser would integrate this problem at
+            from qzs.workflows.design_space.optimizer import fix_step
 
-            definition, _ = choose_sweep_step(definition, settings)
-            problem = dataclasses.replace(problem, sweep=definition)
+            problem = fix_step(problem)
+            definition = problem.sweep
         batch_size = (None if client is not None
                       else max(definition.batch_size, -(-n // 50)))
         values, _, messages, _ = evaluate_cases(problem, settings, columns=metrics,

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs._version import __version__
-from qzs.errors import OutputPathError, ParameterError
+from qzs.errors import OutputPathError
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["DesignStore", "STORE_SUFFIX", "FORMAT", "check", "stored_generations"]
@@ -231,13 +231,10 @@ def check(path: str | Path, *, resume: bool = False, overwrite: bool = False,
     OutputPathError, ParameterError
         As :class:`DesignStore`.
     """
-    if resume and overwrite:
-        raise ParameterError("`resume` (--resume) continues the store and `overwrite` "
-                             "(--overwrite) replaces it: give one of them, not both.")
+    from qzs.workflows.sweeps.backends import check_resume
+
+    check_resume(path, argument, resume, overwrite, work="the search")
     path = Path(path)
-    if resume and not path.exists():
-        raise OutputPathError(argument, path, "does not exist, so there is nothing to resume; "
-                              "check the name, or leave out --resume to start")
     check_output_path(path, argument=argument, suffixes=(STORE_SUFFIX,), directory=True)
     if path.exists() and not resume and not overwrite:
         raise OutputPathError(argument, path, "exists; pass --resume to continue it, "

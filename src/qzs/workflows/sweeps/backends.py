@@ -37,7 +37,8 @@ from qzs.workflows.sweeps.store import (ANALYSIS_FAILED, COUNTS, FAILED, INVALID
                                         write_batch)
 
 __all__ = ["run_batch", "execute", "case_settings", "check_store_path", "build_case",
-           "check_cases", "choose_sweep_step", "dask_client", "STORE_SUFFIX"]
+           "build_model",
+           "check_cases", "check_resume", "choose_sweep_step", "dask_client", "STORE_SUFFIX"]
 
 #: The extension of a sweep store: a Zarr folder, not a NetCDF file (``--out store.nc``
 #: would make a folder named like a file of another format).
@@ -86,6 +87,31 @@ def _empty(definition, n, n_time):
     return arrays
 
 
+def build_model(definition, case):
+    """A case's model parameters: the sweep's fixed ones with the case's varied ones.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    case : dict
+        The case's varied parameters (``excitation.<name>`` entries are left out).
+
+    Returns
+    -------
+    isolator : IsolatorParameters
+    controller : ControllerParameters
+
+    Raises
+    ------
+    ParameterError
+        Invalid parameter values.
+    """
+    model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
+    return update_parameters(IsolatorParameters(), ControllerParameters(),
+                             {**definition.parameters, **model})
+
+
 def build_case(definition, case):
     """A case's parameters and excitation.
 
@@ -111,12 +137,10 @@ def build_case(definition, case):
     ParameterError
         Invalid parameter values.
     """
-    model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
     excitation = {**definition.excitation,
                   **{k.split(".", 1)[1]: v for k, v in case.items()
                      if k.startswith("excitation.")}}
-    isolator, controller = update_parameters(
-        IsolatorParameters(), ControllerParameters(), {**definition.parameters, **model})
+    isolator, controller = build_model(definition, case)
     built = case_excitation(definition.excitation_kind, excitation, definition.analysis)
     return isolator, controller, built, tuple(sorted(excitation.items()))
 
@@ -143,12 +167,10 @@ def check_cases(definition, settings):
         and reasons.
     """
     invalid, excitations = [], {}
-    isolator, controller = IsolatorParameters(), ControllerParameters()
     for i, case in enumerate(settings):
-        model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
         varied = {k.split(".", 1)[1]: v for k, v in case.items() if k.startswith("excitation.")}
         try:
-            update_parameters(isolator, controller, {**definition.parameters, **model})
+            build_model(definition, case)
             key = tuple(sorted(varied.items()))
             if key not in excitations:
                 try:
@@ -542,7 +564,7 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
     """
     from tqdm.auto import tqdm
 
-    _check_resume(store, "store", resume, overwrite)
+    check_resume(store, "store", resume, overwrite)
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
     check_cases(definition, settings)
@@ -634,21 +656,40 @@ def check_store_path(definition: SweepDefinition, store: str | Path, *,
     ParameterError
         Both ``resume`` and ``overwrite``.
     """
-    _check_resume(store, argument, resume, overwrite)
+    check_resume(store, argument, resume, overwrite)
     settings = case_settings(definition, sample_cases(definition))
     _check_store(definition, store, _n_time(definition, settings), argument=argument,
                  resume=resume, overwrite=overwrite)
 
 
-def _check_resume(store, argument, resume, overwrite):
-    """``resume`` and ``overwrite`` together, or ``resume`` of no store, are errors."""
+def check_resume(store, argument, resume, overwrite, work="the sweep"):
+    """``resume`` and ``overwrite`` together, or ``resume`` of no store, are errors.
+
+    Parameters
+    ----------
+    store : str or Path
+        The store (a sweep's or a design search's).
+    argument : str
+        How the caller names it (``"--out"``, ``"store"``).
+    resume, overwrite : bool
+        What was asked for.
+    work : str
+        What leaving out ``resume`` starts, for the message.
+
+    Raises
+    ------
+    ParameterError
+        Both ``resume`` and ``overwrite``.
+    OutputPathError
+        ``resume`` of a store that does not exist.
+    """
     if resume and overwrite:
         raise ParameterError("`resume` (--resume) continues the store and `overwrite` "
                              "(--overwrite) replaces it: give one of them, not both.")
     if resume and not Path(store).exists():
         raise OutputPathError(argument, store, "does not exist, so there is nothing to resume; "
-                              "check the name, or leave out `resume` (--resume) to start the "
-                              "sweep")
+                              f"check the name, or leave out `resume` (--resume) to start "
+                              f"{work}")
 
 
 def _check_store(definition, store, n_time, *, argument, resume, overwrite):

@@ -31,7 +31,8 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model import registry
 from qzs.model.registry import PARAMETERS, update_parameters
 
-__all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "shipped_sweeps",
+__all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "unit_draws",
+           "shipped_sweeps",
            "plan_text", "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS", "MAX_CASES"]
 
 METHODS = ("grid", "random", "lhs")
@@ -522,20 +523,42 @@ def draw_samples(distributions, n, method="lhs", seed=None):
     -------
     dict of str to ndarray, shape (n,)
     """
+    u = unit_draws(len(distributions), n, method, seed)
+    return {name: _frozen(kind, p).ppf(u[:, j])
+            for j, (name, (kind, p)) in enumerate(distributions.items())}
+
+
+def unit_draws(dimensions, n, method="lhs", seed=None):
+    """``n`` points of the unit hypercube, the probabilities inverse CDFs turn into draws.
+
+    Parameters
+    ----------
+    dimensions : int
+        Parameters drawn.
+    n : int
+        Number of samples.
+    method : {"random", "lhs"}
+        Independent uniform draws, or a Latin hypercube (``scipy.stats.qmc``).
+    seed : int, optional
+        Seed of ``numpy.random.default_rng``; the same seed gives the same points.
+
+    Returns
+    -------
+    ndarray, shape (n, dimensions)
+        In ``[1e-12, 1 - 1e-12]``, so that unbounded inverse CDFs stay finite.
+    """
     from scipy.stats import qmc
 
     rng = np.random.default_rng(seed)
     if method == "lhs":
         try:
-            sampler = qmc.LatinHypercube(d=len(distributions), rng=rng)
+            sampler = qmc.LatinHypercube(d=dimensions, rng=rng)
         except TypeError:  # scipy < 1.15 names it `seed`
-            sampler = qmc.LatinHypercube(d=len(distributions), seed=rng)
+            sampler = qmc.LatinHypercube(d=dimensions, seed=rng)
         u = sampler.random(n)
     else:
-        u = rng.random((n, len(distributions)))
-    u = np.clip(u, 1e-12, 1 - 1e-12)  # keep unbounded inverse CDFs finite
-    return {name: _frozen(kind, p).ppf(u[:, j])
-            for j, (name, (kind, p)) in enumerate(distributions.items())}
+        u = rng.random((n, dimensions))
+    return np.clip(u, 1e-12, 1 - 1e-12)
 
 
 def sample_cases(definition):
