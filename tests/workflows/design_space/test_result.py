@@ -105,3 +105,11 @@ def test_the_report_and_files_name_every_goal_with_its_unit(result, tmp_path):
     assert not [p for p in (tmp_path / "out").iterdir() if p.name.startswith(".")]
     summary = result.summary()
     assert f"Pareto set {result.pareto.size}" in summary
+
+
+def test_the_report_states_the_chosen_design_with_units(result):
+    line = result.report().split("## Chosen design")[1]
+    design = result.design()
+    assert f"Design {result.chosen}," in line
+    assert f"pi_kp = {design['pi_kp']:.4g} N/m" in line
+    assert "hunting_amplitude = " in line and " m" in line

@@ -19,7 +19,7 @@ import numpy as np
 from qzs._version import __version__
 from qzs.errors import ParameterError
 from qzs.workflows.design_space.metrics import goal_values
-from qzs.workflows.design_space.problem import DesignProblem
+from qzs.workflows.design_space.problem import DesignProblem, _unit
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -456,9 +456,13 @@ class OptimizationResult:
         if chosen is None:
             out.append("None (no feasible design).")
         else:
-            out.append("The Pareto member nearest the ideal point, each objective scaled to "
-                       "the front's range: " + ", ".join(
-                           f"{k} = {_fmt(v)}" for k, v in self.design(chosen).items()) + ".")
+            units = {v.name: v.units for v in p.variables}
+            out.append(f"Design {chosen}, the Pareto member nearest the ideal point, each "
+                       "objective scaled to the front's range: " + ", ".join(
+                           f"{k} = {_fmt(v)} {units[k]}" for k, v in self.design(chosen).items())
+                       + "; " + ", ".join(f"{g.label} = {_fmt(self.goal_values[chosen, j])}"
+                                          f"{_unit(g.units)}" for j, g in enumerate(p.goals))
+                       + ". `chosen.toml` holds it as a run configuration.")
         return "\n".join(out) + "\n"
 
     def _step_text(self):
