@@ -44,6 +44,8 @@ from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialS
 # Loaded on first use, so that ``import qzs`` stays lean (PEP 562).
 _LAZY = {
     "simulate_batch": "qzs.engine.batch", "BatchResult": "qzs.engine.batch",
+    "resolve": "qzs.engine.run_spec", "ResolvedRun": "qzs.engine.run_spec",
+    "StepChoice": "qzs.engine.step_search",
     "transmissibility": "qzs.analysis.spectral",
     "TransmissibilityEstimate": "qzs.analysis.spectral",
     "transmissibility_metrics": "qzs.analysis.spectral",
@@ -78,6 +80,8 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
     from qzs.engine.results import read_result
+    from qzs.engine.run_spec import ResolvedRun, resolve
+    from qzs.engine.step_search import StepChoice
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
     from qzs.iotools.readers import load_channel_map, read_recording

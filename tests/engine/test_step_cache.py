@@ -17,7 +17,7 @@ import pytest
 
 from qzs import Chirp, DisplacementRecord, IsolatorParameters
 from qzs.engine import step_cache
-from qzs.engine.accuracy import choose_step, choose_step_or_finest
+from qzs.engine.accuracy import choose_step
 
 PROBE = 12.0
 CHIRP = Chirp(duration=100.0, f1=5.0)
@@ -104,11 +104,14 @@ def test_records_keep_infinite_and_missing_numbers(cache):
 
 
 def test_without_a_step_meeting_the_tolerance_the_fallback_says_so():
-    """choose_step_or_finest: the finer of the paper's step and the finest tried, met False,
+    """The one fallback (fallback=True): the paper's step, or the caller's finest, met False,
     no error estimate, and a note with the smallest estimate."""
-    choice = choose_step_or_finest(CHIRP, tolerance_state=1e-15, probe_duration=PROBE,
-                                   max_halvings=2)
+    choice = choose_step(CHIRP, tolerance_state=1e-15, probe_duration=PROBE, max_halvings=2,
+                         fallback=True)
     assert not choice.met and math.isnan(choice.error)
-    assert choice.dt == min(1e-4, choice.reference_dt)
-    assert "no step down to" in choice.notes[0] and "not estimated" in choice.notes[0]
+    assert choice.dt == 1e-4
+    finer = choose_step(CHIRP, tolerance_state=1e-15, probe_duration=PROBE, max_halvings=2,
+                        fallback=True, finest=2.5e-4)
+    assert finer.dt == 2.5e-4 and not finer.met
+    assert "no step down to" in choice.notes[-1] and "not estimated" in choice.notes[-1]
     assert "no step tried meets" in choice.summary()

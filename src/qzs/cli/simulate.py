@@ -10,6 +10,7 @@ from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parame
 from qzs.defaults import ACCURACY, EXCITATION
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
+from qzs.iotools.files import RESULT_SUFFIXES
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, Sine, build_excitation
 
 __all__ = ["add_parser", "run"]
@@ -124,41 +125,6 @@ def _excitation(args, table, source):
     return build_excitation(kind, options, names=names)
 
 
-def _choose_step(args, excitation, config, settings):
-    """The step of a run given no literal ``--dt``: the largest meeting the tolerance asked
-    for (``--tolerance``, ``--tolerance-state``) or the default one, from the step cache
-    when the same choice was made before (docs/model.md §7)."""
-    from qzs.engine.accuracy import choose_step_or_finest, default_tolerance
-
-    if args.tolerance is not None:
-        tolerance = {"tolerance_db": args.tolerance}
-    elif args.tolerance_state is not None:
-        tolerance = {"tolerance_state": args.tolerance_state}
-    else:
-        tolerance = default_tolerance(excitation)
-    if "tolerance_db" in tolerance and isinstance(excitation, Sine):
-        raise ParameterError(
-            f"--tolerance {args.tolerance:g} is on the transmissibility [dB], which a sine "
-            "has no band to estimate; give --tolerance-state M [m] or a literal --dt.")
-    return choose_step_or_finest(
-        excitation, config["isolator"], config["controller"], **tolerance,
-        **{k: settings[k] for k in ("solver", "sample_rate") if k in settings},
-        progress=not args.quiet and not args.json, cache=True)
-
-
-def _step_record(choice, settings):
-    """The step as the JSON record gives it: literal, or chosen with its tolerance and error."""
-    if choice is None:
-        return {"dt": settings["dt"], "chosen": False}
-    from qzs.engine.accuracy import MEASURE_UNITS
-
-    unit = MEASURE_UNITS[choice.measure]
-    return {"dt": choice.dt, "chosen": True, "measure": choice.measure, "unit": unit,
-            "tolerance": choice.tolerance, "error": choice.error, "met": choice.met,
-            "reference_dt": choice.reference_dt, "cached": choice.cached,
-            "notes": list(choice.notes)}
-
-
 def run(args):
     """Run ``qzs simulate`` from parsed arguments; returns the exit code (130 if interrupted).
 
@@ -174,8 +140,7 @@ def run(args):
     """
     import sys
 
-    from qzs.engine.accuracy import step_run_entries
-    from qzs.engine.simulate import simulate
+    from qzs.engine.run_spec import resolve
     from qzs.workflows.run import simulate_to_file
 
     config = parameters(args)
@@ -185,30 +150,35 @@ def run(args):
         value = getattr(args, key)
         if value is not None:
             settings[key] = value
+    if args.tolerance is not None or args.tolerance_state is not None:
+        settings.pop("dt", None)  # a tolerance on the command line replaces the file's dt
+    if args.tolerance is not None and isinstance(excitation, Sine):
+        raise ParameterError(
+            f"--tolerance {args.tolerance:g} is on the transmissibility [dB], which a sine "
+            "has no band to estimate; give --tolerance-state M [m] or a literal --dt.")
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
-    choice = None
-    if "dt" not in settings or args.tolerance is not None or args.tolerance_state is not None:
-        choice = _choose_step(args, excitation, config, settings)
-        settings["dt"] = choice.dt
     plot = None if args.plot.lower() == "none" else args.plot
     if plot is not None:
         check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
-    common = dict(progress=not args.quiet and not args.json, interruptible=True)
-    entries = {} if choice is None else step_run_entries(choice)
+    if args.out:
+        check_output_path(args.out, argument="--out", suffixes=RESULT_SUFFIXES)
+    show = not args.quiet and not args.json
+    resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
+                       tolerance=args.tolerance, tolerance_state=args.tolerance_state,
+                       step="chosen", progress=show)
+    for note in resolved.notes:
+        print(f"qzs: {note}", file=sys.stderr)
+    common = dict(progress=show, interruptible=True)
     # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
     # returning, so that no import is left half done (an error in the run ends it too)
     loading = import_in_background("matplotlib.pyplot", "qzs.viz.simulation") if plot else None
     try:
         if args.out:
-            result = simulate_to_file(args.out, excitation, config["isolator"],
-                                      config["controller"], **settings, **common,
-                                      argument="--out", run_entries=entries)
+            result = simulate_to_file(args.out, resolved=resolved, **common, argument="--out")
         else:
-            result = simulate(excitation, config["isolator"], config["controller"],
-                              **settings, **common)
-            result.run.update(entries)
+            result = resolved.simulate(**common)
     finally:
         if loading is not None:
             loading.join()
@@ -218,10 +188,10 @@ def run(args):
     if plot is not None:
         result.plot(path=plot)
         files["plot"] = plot
-    notes = "" if choice is None else "".join(f"\n                   note: {note}"
-                                              for note in choice.notes)
+    step = resolved.step
+    notes = "".join(f"\n                   note: {note}" for note in step.notes)
     text = (result.summary() + notes
             + "".join(f"\n  wrote            {p}" for p in files.values()))
-    record = {**summary_record(result), "files": files, "step": _step_record(choice, settings)}
+    record = {**summary_record(result), "files": files, "step": step.to_dict()}
     emit(args, text, record)
     return 0 if result.completed else 130

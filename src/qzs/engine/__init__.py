@@ -12,8 +12,10 @@
 ``simulate``        :func:`simulate`, the validated single run
 ``batch``           :func:`simulate_batch`, many parameter sets at once
 ``results``         :class:`SimulationResult`
-``accuracy``        :func:`choose_step`, the largest step meeting a tolerance
+``step_search``     the one step search, its fallback and its record (:class:`StepChoice`)
+``accuracy``        :func:`choose_step`, the step of one axis: its probe and measures
 ``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
+``run_spec``        :func:`resolve`, a run resolved once: inputs, duration, step and record
 ``step_cache``      the step choices kept on disk, keyed by their inputs and the code
 ``driver``          the one run loop: plan, chunks, memory guard, preview, progress, signals
 ``periodic``        :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
@@ -30,7 +32,8 @@ _EXPORTS = {
     "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",
-    "choose_step": "qzs.engine.accuracy", "StepChoice": "qzs.engine.accuracy",
+    "choose_step": "qzs.engine.accuracy", "StepChoice": "qzs.engine.step_search",
+    "resolve": "qzs.engine.run_spec", "ResolvedRun": "qzs.engine.run_spec",
     "simulate_hexapod": "qzs.engine.hexapod.simulate",
     "HexapodResult": "qzs.engine.hexapod.result",
 }

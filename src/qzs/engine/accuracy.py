@@ -12,7 +12,6 @@ step halving on a short representative stretch of the excitation (the *probe*):
 (0.001, 0.0004...)
 """
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -20,120 +19,30 @@ from qzs import _validation, defaults
 from qzs._format import decibels
 from qzs._lazy import import_in_background
 from qzs._validation import choice as _choice
-from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
+from qzs.engine.step_search import (ADMISSIBLE_REFINEMENT, MAX_HALVINGS, MEASURE_UNITS,
+                                    RATE_REFINEMENT_MAX, SAFETY, StepChoice, admissible_step,
+                                    bound_notes, halving_search, search_step,
+                                    tolerance_measure)
+from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
-__all__ = ["StepChoice", "choose_step", "choose_step_or_finest", "default_tolerance",
-           "probe_excitation", "step_error", "halving_search", "admissible_step",
-           "step_run_entries", "estimate_difference_db", "MEASURE_UNITS"]
+__all__ = ["StepChoice", "choose_step", "default_tolerance", "probe_excitation", "step_error",
+           "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
+           "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
+           "probe_settings"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
-#: Halvings below the largest admissible step tried at most before giving up.
-MAX_HALVINGS = 8
 #: A chirp's probe sweeps this far beyond the band's top [-], so no bin of the band lies on
 #: the sweep's end (on a short probe the last segment alone holds those bins: 0.009 dB there
 #: against 0.001 dB inside the band at dt = 1 ms on a 60 s probe of the paper's chirp).
 OVERSHOOT = 1.1
-#: Factor between the estimated error and the tolerance (see :func:`choose_step`).
-SAFETY = 2.0
 #: Welch segments the probe's transmissibility averages at least.
 PROBE_SEGMENTS = 8
-#: A sampled controller may make the step at most this much finer than the largest stable
-#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
-#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
-#: of times longer (:class:`~qzs.errors.ControllerRateError`).
-RATE_REFINEMENT_MAX = 32
-#: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
-MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
-#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
-ADMISSIBLE_REFINEMENT = 1_000_000
-
-
-@dataclass(frozen=True)
-class StepChoice:
-    """The outcome of :func:`choose_step`.
-
-    Attributes
-    ----------
-    dt : float
-        The chosen integration step [s]: the largest candidate meeting the tolerance.
-    error : float
-        Estimated error of a run at ``dt`` in the requested measure ([dB] or [m]).
-    measure : str
-        ``"transmissibility_db"`` (max ``|20 log10(T_dt/T_ref)|`` over the trusted bins of
-        ``band``) or ``"state_m"`` (max ``|z_dt - z_ref|`` over the output samples).
-    tolerance : float
-        The tolerance asked for, in the unit of ``measure``.
-    reference_dt : float
-        The finest step integrated on the probe [s] (the estimate's reference).
-    stability_limit : float
-        The solver's largest stable step for this model [s].
-    sample_rate : float
-        Output rate [Hz]; ``dt`` divides its period.
-    solver : str
-        The integrator.
-    probe : object
-        The excitation integrated to choose the step.
-    probe_duration : float
-        Length of the probe [s].
-    band : tuple of float
-        Frequency band [Hz] of the transmissibility measure (None for the state).
-    history : tuple
-        ``(dt, difference to the next finer step, estimated error)`` per step tried,
-        coarsest first; the difference and estimate are in the unit of ``measure``.
-    notes : tuple of str
-        What the caller should know (the limit that bound the step, caveats).
-    met : bool
-        Whether ``dt`` meets the tolerance; False only for the fallback of
-        :func:`choose_step_or_finest` (``error`` is then NaN: no estimate holds for it).
-    cached : bool
-        Whether the choice was read from the step cache (:mod:`qzs.engine.step_cache`).
-    """
-
-    dt: float
-    error: float
-    measure: str
-    tolerance: float
-    reference_dt: float
-    stability_limit: float
-    sample_rate: float
-    solver: str
-    probe: object
-    probe_duration: float
-    band: tuple
-    history: tuple
-    notes: tuple
-    met: bool = True
-    cached: bool = False
-
-    @property
-    def steps_per_sample(self):
-        """Integration steps per output sample [-]."""
-        return int(round(1.0 / (self.sample_rate * self.dt)))
-
-    def summary(self):
-        """One paragraph for people: the step, its error and why.
-
-        Returns
-        -------
-        str
-        """
-        unit = MEASURE_UNITS[self.measure]
-        if not self.met:
-            return "\n".join([f"dt = {self.dt:.6g} s ({self.solver}): no step tried meets the "
-                              f"tolerance {self.tolerance:g} {unit}"]
-                             + [f"  note: {note}" for note in self.notes])
-        lines = [f"dt = {self.dt:.6g} s ({self.solver}, {self.steps_per_sample} step(s) per "
-                 f"{self.sample_rate:g} Hz sample): estimated error {self.error:.3g} {unit} "
-                 f"(tolerance {self.tolerance:g} {unit}, reference dt = {self.reference_dt:.3g} s, "
-                 f"probe {self.probe_duration:g} s, stability limit {self.stability_limit:.3g} s)"]
-        lines += [f"  note: {note}" for note in self.notes]
-        return "\n".join(lines)
 
 
 # ---------------------------------------------------------------- the probe
-def _frequency_range(excitation, sample_rate):
+def frequency_range(excitation, sample_rate):
     """Lowest and highest frequency [Hz] the excitation holds."""
     if isinstance(excitation, Chirp):
         return min(excitation.f0, excitation.f1), max(excitation.f0, excitation.f1)
@@ -198,8 +107,38 @@ def probe_excitation(excitation, band, probe_duration=None):
     return excitation, duration
 
 
+def excitation_over(excitation, duration):
+    """The excitation a run of ``duration`` seconds covers: what its step is chosen for.
+
+    A run shorter than its chirp sees only the start of the sweep: the first 60 s of the
+    paper's 0-20 Hz, 2000 s chirp hold 0-0.6 Hz. The chirp it covers is the same sweep law
+    ended there (``f1`` the frequency reached at ``duration``, the same sweep rate), so the
+    step search probes the band the run holds, not the whole sweep's. Every other excitation
+    (a sine, a random excitation, a record, a run as long as its chirp or longer) is its own.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+    duration : float or None
+        The simulated time [s] (None: the excitation's length).
+
+    Returns
+    -------
+    Chirp, Sine, RandomExcitation or DisplacementRecord
+    """
+    if (not isinstance(excitation, Chirp) or duration is None
+            or duration >= excitation.duration):
+        return excitation
+    import dataclasses
+
+    return dataclasses.replace(excitation, f1=float(excitation.frequency_at(duration)),
+                               duration=float(duration),
+                               fade_in=min(excitation.fade_in, float(duration)))
+
+
 # ---------------------------------------------------------------- the measures
-def _probe_fft_length(n_samples, sample_rate, band, fft_length):
+def probe_fft_length(n_samples, sample_rate, band, fft_length):
     if fft_length is not None:
         return int(fft_length)
     # a power of two with at least PROBE_SEGMENTS half-overlapping segments in the probe
@@ -235,7 +174,7 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
         return float(np.max(np.abs(coarse.relative_position - fine.relative_position)))
 
     rate = coarse.run["sample_rate"]
-    length = _probe_fft_length(coarse.relative_position.size, rate, band, fft_length)
+    length = probe_fft_length(coarse.relative_position.size, rate, band, fft_length)
     a, b = (_probe_transmissibility(run, rate, length) for run in (coarse, fine))
     return estimate_difference_db(a, b, band)
 
@@ -272,21 +211,8 @@ def estimate_difference_db(coarse, fine, band, keep=None):
 
 
 # ---------------------------------------------------------------- validation
-def _tolerance(tolerance_db, tolerance_state):
-    given = [(name, value) for name, value in (("tolerance_db", tolerance_db),
-                                               ("tolerance_state", tolerance_state))
-             if value is not None]
-    if len(given) != 1:
-        raise ParameterError(
-            "give exactly one of `tolerance_db` (transmissibility, dB) and `tolerance_state` "
-            f"(relative position, m); got {' and '.join(n for n, _ in given) or 'neither'}.")
-    name, value = given[0]
-    measure = "transmissibility_db" if name == "tolerance_db" else "state_m"
-    return measure, _validation.positive_real(name, value)
-
-
-def _band(band, excitation, sample_rate):
-    lowest, highest = _frequency_range(excitation, sample_rate)
+def check_band(band, excitation, sample_rate):
+    lowest, highest = frequency_range(excitation, sample_rate)
     if band is None:
         low, high = lowest, highest
         if isinstance(excitation, Chirp) and low == 0.0:
@@ -310,104 +236,11 @@ def _band(band, excitation, sample_rate):
     return (low, high)
 
 
-def admissible_step(sample_rate, controller_rate, stable):
-    """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
-    divides the controller's period too.
-
-    Parameters
-    ----------
-    sample_rate : float
-        Output rate [Hz]; the step divides its period.
-    controller_rate : float
-        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
-    stable : callable
-        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
-
-    Returns
-    -------
-    dt : float
-        The step [s].
-    k : int
-        Steps per output sample [-].
-
-    Raises
-    ------
-    ControllerRateError
-        The controller's period is a whole number of steps only at a step more than
-        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
-    """
-    from qzs.engine.prepare import steps_per_sample
-
-    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
-                  if stable(1.0 / (sample_rate * k))), None)
-    if first is None:
-        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
-                             "is stable; check the model's stiffness and the `sample_rate`.")
-    if controller_rate <= 0:
-        return 1.0 / (sample_rate * first), first
-    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
-        dt = 1.0 / (sample_rate * k)
-        if not stable(dt):
-            continue
-        try:
-            steps_per_sample(controller_rate, dt, "controller_rate")
-        except ParameterError:
-            continue
-        return dt, k
-    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
-    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
-    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
-                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
-                              suggestions=sorted(near))
-
-
-# ---------------------------------------------------------------- the search
-def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFETY):
-    """Richardson-style search over ``dt_j = dt0 / 2**j``: the coarsest step that meets a
-    tolerance (the method of :func:`choose_step`, for any model and any measure).
-
-    Parameters
-    ----------
-    difference : callable
-        ``difference(j)``: the measured difference between the runs at ``dt_j`` and
-        ``dt_{j+1}`` (in the tolerance's unit; NaN: no measure, the search stops).
-    order : int
-        The scheme's order of accuracy [-]; the observed ratio ``d_j/d_{j+1}`` is capped at
-        ``2**order``.
-    tolerance : float
-        What the error estimate times ``safety`` must not exceed (its unit).
-    dt0 : float
-        The coarsest candidate [s].
-    max_halvings : int
-        Candidates ``dt_0 .. dt_{max_halvings}`` [-].
-    safety : float
-        Factor [-] between the estimate and the tolerance.
-
-    Returns
-    -------
-    chosen : int or None
-        ``j`` of the chosen step, None if no candidate met the tolerance.
-    history : list of tuple
-        ``(dt_j [s], d_j, estimate_j)`` per candidate compared; the estimate is
-        ``d_j r/(r - 1)``, 0 where ``d_j = 0`` and inf where the differences do not shrink.
-    """
-    history = []
-    for j in range(max_halvings - 1):
-        d, d_next = difference(j), difference(j + 1)
-        if not (np.isfinite(d) and np.isfinite(d_next)):
-            break
-        estimate = _estimate(d, d_next, order)
-        history.append((dt0 / 2 ** j, d, estimate))
-        if safety * estimate <= tolerance:
-            return j, history
-    return None, history
-
-
 def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db=None,
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS,
-                safety=SAFETY, progress=False, cache=False):
+                safety=SAFETY, finest=None, fallback=False, progress=False, cache=False):
     """The largest fixed step whose error stays within a tolerance (docs/model.md §7).
 
     Candidates are ``dt_j = dt_0 / 2**j`` with ``dt_0 = 1/(sample_rate*k)`` the largest
@@ -455,6 +288,13 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Factor [-] (>= 1) between the estimate and the tolerance; default 2: the probe's
         Welch bins are coarser than a long run's, and the maximum over the finer bins of
         the paper's 2000 s run was 1.9 times the probe's (docs/model.md §7).
+    finest : float, optional
+        The finest candidate [s]: halvings stop above it; the fallback step too.
+    fallback : bool
+        Where no candidate meets the tolerance (or no bin of the band is trusted on the
+        probe), return the fallback of :func:`~qzs.engine.step_search.search_step` (``finest``,
+        default the paper's step; ``met`` False, ``error`` NaN, a note why) instead of
+        raising: what a run that must go on asks for.
     progress : bool
         Show a progress bar over the probe runs.
     cache : bool
@@ -476,9 +316,9 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import largest_stable_step, stability_test
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    order, sample_rate, band, probe, duration = _probe_settings(
+    order, sample_rate, band, probe, duration = probe_settings(
         excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
         max_halvings)
 
@@ -490,7 +330,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
             excitation=excitation, isolator=isolator, controller=controller,
             initial_state=initial_state, measure=measure, tolerance=tolerance, solver=solver,
             sample_rate=sample_rate, band=band, probe_duration=probe_duration,
-            fft_length=fft_length, max_halvings=max_halvings, safety=safety)
+            fft_length=fft_length, max_halvings=max_halvings, safety=safety,
+            **({"finest": finest, "fallback": True} if fallback else {}))
         hit = _from_record(step_cache.load(key), probe, duration)
         if hit is not None:
             return hit
@@ -507,53 +348,20 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
     dt0, k0 = admissible_step(sample_rate, controller.controller_rate,
                               lambda dt: dt <= resolving and stable(dt))
-    notes = _bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
-                         probe is not excitation)
 
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
+    def run(dt, cases):
+        return [simulate(probe, isolator, controller, duration=duration, dt=dt,
+                         sample_rate=sample_rate, solver=solver, initial_state=initial_state)]
 
-        bar = tqdm(total=max_halvings + 1, unit="run", desc="choosing dt", leave=False)
-    runs = {}
-
-    def run(j):
-        if j not in runs:
-            runs[j] = simulate(probe, isolator, controller, duration=duration, dt=dt0 / 2 ** j,
-                               sample_rate=sample_rate, solver=solver,
-                               initial_state=initial_state)
-            if bar is not None:
-                bar.update(1)
-        return runs[j]
-
-    differences = {}
-
-    def difference(j):
-        if j not in differences:
-            differences[j] = step_error(run(j), run(j + 1), measure, band=band,
-                                        fft_length=fft_length)
-            if measure == "transmissibility_db" and np.isnan(differences[j]):
-                raise ParameterError(
-                    f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
-                    f"{duration:g} s probe; lengthen `probe_duration` or narrow the band.")
-        return differences[j]
-
-    try:
-        chosen, history = halving_search(difference, order, tolerance, dt0, max_halvings,
-                                         safety)
-    finally:
-        if bar is not None:
-            bar.close()
-    if chosen is None:
-        raise ToleranceNotMetError(tolerance, MEASURE_UNITS[measure], dt0 / 2 ** (max_halvings - 1),
-                                   min(h[2] for h in history), safety)
-    j = chosen
-    notes += _order_notes(differences[j], differences[j + 1], order)
-    choice = StepChoice(dt=dt0 / 2 ** j, error=float(history[-1][2]), measure=measure,
-                        tolerance=tolerance, reference_dt=dt0 / 2 ** (j + 2),
-                        stability_limit=float(limit), sample_rate=sample_rate, solver=solver,
-                        probe=probe, probe_duration=float(duration), band=band,
-                        history=tuple(history), notes=tuple(notes))
+    choice = search_step(
+        run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
+                                                         fft_length=fft_length),
+        dt0=dt0, order=order, measure=measure, tolerance=tolerance, sample_rate=sample_rate,
+        solver=solver, probe=probe, probe_duration=duration, band=band,
+        notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
+                          probe is not excitation),
+        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
+        fallback=fallback, progress=progress)
     if key is not None:
         from qzs.engine import step_cache
 
@@ -563,7 +371,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
 
 #: The fields of a :class:`StepChoice` a cache record keeps (the probe is made again).
 _RECORD_FIELDS = ("dt", "error", "measure", "tolerance", "reference_dt", "stability_limit",
-                  "sample_rate", "solver", "probe_duration", "band", "history", "notes")
+                  "sample_rate", "solver", "probe_duration", "band", "history", "notes", "met")
 
 
 def _to_record(choice):
@@ -614,88 +422,9 @@ def default_tolerance(excitation):
     return {"tolerance_db": float(defaults.ACCURACY["tolerance_db"])}
 
 
-def choose_step_or_finest(excitation=None, isolator=None, controller=None, **options):
-    """:func:`choose_step`, or, where no step tried meets the tolerance, a fallback that says so.
-
-    Stick-slip and stop contacts can redraw a response at every step, so that the
-    differences between steps stop shrinking; a command must still run. The fallback is
-    the finer of the paper's step (``defaults.SIMULATION["dt"]``) and the finest step
-    tried, with ``met`` False, ``error`` NaN (no estimate holds for it) and a note giving
-    the smallest estimate found.
-
-    Parameters
-    ----------
-    excitation, isolator, controller
-        As for :func:`choose_step`.
-    **options
-        Every keyword of :func:`choose_step`.
-
-    Returns
-    -------
-    StepChoice
-    """
-    try:
-        return choose_step(excitation, isolator, controller, **options)
-    except ToleranceNotMetError as error:
-        from qzs.engine.prepare import run_inputs
-
-        excitation = run_inputs(excitation, isolator, controller)[0]
-        measure, tolerance = _tolerance(options.get("tolerance_db"),
-                                        options.get("tolerance_state"))
-        solver = options.get("solver", defaults.SIMULATION["solver"])
-        _, sample_rate, band, probe, duration = _probe_settings(
-            excitation, measure, solver,
-            options.get("sample_rate", defaults.SIMULATION["sample_rate"]), options.get("band"),
-            options.get("probe_duration"), options.get("fft_length"),
-            options.get("safety", SAFETY), options.get("max_halvings", MAX_HALVINGS))
-        dt = min(defaults.SIMULATION["dt"], error.smallest_step)
-        note = (f"no step down to {error.smallest_step:.3g} s met {tolerance:g} {error.unit} "
-                f"(smallest estimate {error.smallest_error:.3g} {error.unit}: stick-slip or stop "
-                f"contacts redraw the response at every step); running at dt = {dt:.3g} s, "
-                "whose error is not estimated")
-        return StepChoice(dt=dt, error=math.nan, measure=measure, tolerance=tolerance,
-                          reference_dt=error.smallest_step, stability_limit=math.nan,
-                          sample_rate=sample_rate, solver=solver, probe=probe,
-                          probe_duration=float(duration), band=band, history=(),
-                          notes=(note,), met=False)
-
-
-def step_run_entries(choice):
-    """What a run records of its chosen step: tolerance and estimated error, in units.
-
-    Parameters
-    ----------
-    choice : StepChoice
-        The step the run was made at.
-
-    Returns
-    -------
-    dict
-        ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the state
-        measure; the error NaN where no step met the tolerance), for
-        :attr:`SimulationResult.run <qzs.engine.results.SimulationResult.run>` and the
-        file's ``run.*`` attributes.
-    """
-    suffix = MEASURE_UNITS[choice.measure].lower()
-    return {f"step_tolerance_{suffix}": float(choice.tolerance),
-            f"step_error_{suffix}": float(choice.error)}
-
-
 # ---------------------------------------------------------------- shared by the searches
 
-def _estimate(d, d_next, order):
-    """The Richardson estimate of the error of ``dt_j`` from ``d_j`` and ``d_{j+1}``
-    (:func:`halving_search`): 0 where ``d_j = 0``, inf where the differences do not shrink."""
-    ratio = d / d_next if d_next > 0 else math.inf
-    if d == 0.0:
-        return 0.0
-    if ratio <= 1.0:  # not converging yet: no estimate
-        return math.inf
-    r = min(ratio, 2.0 ** order)
-    return d * r / (r - 1)
-
-
-def _probe_settings(excitation, measure, solver, sample_rate, band, probe_duration, fft_length,
+def probe_settings(excitation, measure, solver, sample_rate, band, probe_duration, fft_length,
                     safety, max_halvings):
     """Check a step search's settings; ``(order, sample_rate, band, probe, probe duration)``."""
     from qzs.engine.stability import SOLVERS
@@ -706,9 +435,9 @@ def _probe_settings(excitation, measure, solver, sample_rate, band, probe_durati
         _validation.positive_real("probe_duration", probe_duration)
     _validation.real("safety", safety, minimum=1.0)
     _validation.integer("max_halvings", max_halvings, 2)
-    band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
+    band = check_band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
     probe, duration = probe_excitation(
-        excitation, band or _frequency_range(excitation, sample_rate), probe_duration)
+        excitation, band or frequency_range(excitation, sample_rate), probe_duration)
     # a whole number of output periods: every candidate step then records the same samples
     # (a sine's probe of 40 periods need not be; its runs at dt and dt/2 differed by one)
     duration = math.floor(duration * sample_rate * (1 + 1e-12)) / sample_rate
@@ -722,38 +451,6 @@ def _probe_settings(excitation, measure, solver, sample_rate, band, probe_durati
             raise ParameterError(f"`fft_length` must be an integer in [8, {n}] (the probe's "
                                  f"samples), got {fft_length!r}.")
     return order, sample_rate, band, probe, duration
-
-
-def _bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
-    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people."""
-    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
-
-    notes = []
-    if k0 == 1:
-        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
-                     f"(a lower sample_rate would allow larger steps; stability allows "
-                     f"{limit:.3g} s)")
-    elif resolving < limit:
-        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
-                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
-                     f"of its highest frequency (stability allows {limit:.3g} s)")
-    else:
-        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
-                     f"<= {limit:.3g} s")
-    if measure == "state_m" and shortened:
-        notes.append("the state error is measured on a shortened chirp; on the full sweep "
-                     "phase errors accumulate over a longer time")
-    return notes
-
-
-def _order_notes(d, d_next, order):
-    """A note when the observed order of the chosen step lies below the scheme's."""
-    if d > 0 and d_next > 0:
-        observed = math.log2(d / d_next)
-        if observed < order - 0.5:
-            return [f"observed order {observed:.2f} below the scheme's {order} (stick-slip "
-                    "events lower it): the estimate extrapolates with the observed ratio"]
-    return []
 
 
 def _probe_transmissibility(run, rate, fft_length):

@@ -5,77 +5,26 @@ measure, candidates and Richardson estimate) with every case probed at once, eac
 one lockstep batch of the cases still searched; the paper's studies and sweeps take their
 step from it.
 """
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import (MEASURE_UNITS, SAFETY, StepChoice, _bound_notes, _estimate,
-                                 _order_notes, _probe_settings, _tolerance, admissible_step,
-                                 step_error)
-from qzs.errors import ParameterError, ToleranceNotMetError
+from qzs.engine.accuracy import probe_settings, step_error
+from qzs.engine.step_search import (SAFETY, StepChoice, admissible_step, bound_notes,
+                                    search_step, tolerance_measure)
+from qzs.errors import ParameterError
 
 __all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step"]
+
+#: The record of a batch's step: the one record, :class:`~qzs.engine.step_search.StepChoice`
+#: (its ``case_errors``, ``case_steps`` and ``unmet`` filled in).
+BatchStepChoice = StepChoice
 
 #: Halvings :func:`choose_batch_step` tries at most by default: candidates down to
 #: ``dt_0/8`` (125 us at a 1 kHz output, about the paper's 1e-4 s), compared with runs down
 #: to ``dt_0/32``. A case no candidate meets is reported, and the step comes from the others.
 BATCH_MAX_HALVINGS = 5
-
-
-@dataclass(frozen=True)
-class BatchStepChoice(StepChoice):
-    """The outcome of :func:`choose_batch_step`: one step for every case of a lockstep batch.
-
-    Attributes
-    ----------
-    dt : float
-        The chosen step [s]: the finest of the cases' coarsest steps meeting the tolerance.
-    error : float
-        The largest estimated error over the cases that met the tolerance ([dB] or [m]).
-    measure : str
-        As for :class:`StepChoice`.
-    tolerance : float
-        The tolerance asked for, in the unit of ``measure``.
-    reference_dt : float
-        The finest step integrated on the probe for the case(s) that set ``dt`` [s].
-    stability_limit : float
-        The smallest over the cases of the solver's largest stable step [s].
-    sample_rate : float
-        Output rate [Hz]; ``dt`` divides its period.
-    solver : str
-        The integrator.
-    probe : object
-        The excitation integrated to choose the step.
-    probe_duration : float
-        Length of the probe [s].
-    band : tuple of float
-        Frequency band [Hz] of the transmissibility measure (None for the state).
-    history : tuple
-        ``(dt, difference, estimate)`` per step tried, the largest difference and estimate
-        over the cases still searched at that step.
-    notes : tuple of str
-        What the caller should know (the limit that bound the step, the unmet cases).
-    case_errors : tuple of float
-        Each case's estimated error at the coarsest step that met the tolerance for it
-        (``dt`` is that step or finer), in the unit of ``measure``; inf for a case no
-        candidate met, NaN for one without a trusted bin in the band on the probe.
-    case_steps : tuple of float
-        That coarsest step [s] per case (NaN: none).
-    unmet : tuple of int
-        Indices of the cases no candidate met, or without a trusted bin: ``dt`` comes from
-        the others, and their response depends on the step (see ``notes``).
-    met : bool
-        True: a batch choice always meets the tolerance for the cases that set it (none
-        meeting it raises :class:`~qzs.errors.ToleranceNotMetError`).
-    cached : bool
-        False: batch choices are not kept in the step cache.
-    """
-
-    case_errors: tuple = ()
-    case_steps: tuple = ()
-    unmet: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -93,7 +42,8 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
                       solver=defaults.SIMULATION["solver"],
                       sample_rate=defaults.SIMULATION["sample_rate"], band=None,
                       probe_duration=None, fft_length=None, max_halvings=BATCH_MAX_HALVINGS,
-                      safety=SAFETY, workers=None, progress=False, labels=None):
+                      safety=SAFETY, finest=None, fallback=False, workers=None, progress=False,
+                      labels=None):
     """One step for many cases sharing an excitation: the coarsest meeting the tolerance
     for every case (docs/model.md §7).
 
@@ -135,6 +85,11 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         Halvings of ``dt_0`` tried at most [-] (default :data:`BATCH_MAX_HALVINGS`).
     safety : float
         Factor [-] (>= 1) between the estimate and the tolerance, as for :func:`choose_step`.
+    finest : float, optional
+        The finest candidate [s]; the fallback step too.
+    fallback : bool
+        Where no candidate meets the tolerance for any case, return the one fallback of
+        :func:`~qzs.engine.step_search.search_step` instead of raising.
     workers : int, optional
         Threads of the batch kernel; default all cores.
     progress : bool
@@ -161,12 +116,12 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     from qzs.engine.stability import largest_stable_step, stability_test
     from qzs.errors import SimulationError
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     cases = [run_inputs(None, *pair)[1:] for pair in cases]
     if not cases:
         raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
     excitation = run_inputs(excitation)[0]
-    order, sample_rate, band, probe, duration = _probe_settings(
+    order, sample_rate, band, probe, duration = probe_settings(
         excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
         max_halvings)
 
@@ -192,103 +147,28 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         dt0, k0 = admissible_step(sample_rate, rates[0], stable)
     else:
         dt0, k0 = admissible_step(sample_rate, 0.0, lambda dt: stable(dt) and divides(dt))
-    notes = _bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
-                         probe is not excitation)
-
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=max_halvings + 1, unit="batch", desc="choosing dt", leave=False)
-    runs = {}
-
-    def run(j, members):
-        kept = runs.setdefault(j, {})
-        missing = [c for c in members if c not in kept]
-        if not missing:
-            return
-        batch = simulate_batch([cases[c] for c in missing], probe, duration=duration,
-                               dt=dt0 / 2 ** j, sample_rate=sample_rate, solver=solver,
-                               channels=("base_acceleration", "payload_acceleration",
-                                         "relative_position"), workers=workers)
-        for row, c in enumerate(missing):
-            if batch.messages[row]:
-                raise SimulationError(f"{labels[c]} diverged on the {duration:g} s probe at "
-                                      f"dt = {dt0 / 2 ** j:.3g} s: {batch.messages[row]}")
-            kept[c] = _ProbeRun(**{name: batch.channels[name][row] for name in
-                                   ("base_acceleration", "payload_acceleration",
-                                    "relative_position")},
-                                run={"sample_rate": sample_rate})
-        if bar is not None:
-            bar.update(1)
-
-    differences = {}
-
-    def difference(j, c):
-        if (j, c) not in differences:
-            differences[j, c] = step_error(runs[j][c], runs[j + 1][c], measure, band=band,
-                                           fft_length=fft_length)
-        return differences[j, c]
-
     n = len(cases)
     labels = [f"case {c}" for c in range(n)] if labels is None else [str(x) for x in labels]
-    if len(labels) != n:
-        raise ParameterError(f"`labels` must name each of the {n} cases, got {len(labels)}.")
-    searched, met, best, history, untrusted, hopeless = list(range(n)), {}, {}, [], [], []
-    try:
-        for j in range(max_halvings - 1):
-            if not searched:
-                break
-            for level in (j, j + 1, j + 2):
-                run(level, searched)
-            pairs = {c: (difference(j, c), difference(j + 1, c)) for c in searched}
-            untrusted += [c for c, (d, d_next) in pairs.items()
-                          if not (np.isfinite(d) and np.isfinite(d_next))]
-            estimates = {c: _estimate(d, d_next, order) for c, (d, d_next) in pairs.items()
-                         if c not in untrusted}
-            if estimates:
-                history.append((dt0 / 2 ** j, max(pairs[c][0] for c in estimates),
-                                max(estimates.values())))
-            left = max_halvings - 2 - j  # candidates finer than dt_j still to compare
-            for c, estimate in estimates.items():
-                best[c] = min(best.get(c, math.inf), estimate)
-                if safety * estimate <= tolerance:
-                    met[c] = (j, estimate)
-                elif safety * estimate > tolerance * 2.0 ** (order * left):
-                    hopeless.append(c)  # even at the scheme's order no candidate left meets it
-            searched = [c for c in searched
-                        if c not in met and c not in untrusted and c not in hopeless]
-    finally:
-        if bar is not None:
-            bar.close()
-    unit = MEASURE_UNITS[measure]
-    if not met:
-        raise ToleranceNotMetError(tolerance, unit, dt0 / 2 ** (max_halvings - 1),
-                                   min(best.values(), default=math.inf), safety)
-    j = max(level for level, _ in met.values())
-    deciding = min(c for c, (level, _) in met.items() if level == j)
-    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
-    unmet = tuple(sorted(set(range(n)) - set(met)))
-    failed = sorted(searched + hopeless)
-    if failed:
-        notes.append(
-            f"{'; '.join(labels[c] for c in failed)}: no step down to "
-            f"{dt0 / 2 ** (max_halvings - 2):.3g} s meets {tolerance:g} {unit} (best estimate "
-            + ", ".join(f"{best.get(c, math.inf):.2g} {unit}" for c in failed)
-            + "; an estimate that even the scheme's order could not bring within the tolerance "
-            "by the finest candidate ends the search early): their response depends on the step "
-            "(stop contacts or a stick-slip pattern each refinement redraws); the step is the "
-            "other cases'")
-    if untrusted:
-        notes.append(f"{'; '.join(labels[c] for c in sorted(set(untrusted)))}: no bin of "
-                     f"the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the {duration:g} s "
-                     "probe, so no error is measured; the step is the other cases'")
-    case_errors = tuple(float(met[c][1]) if c in met else
-                        (math.nan if c in untrusted else math.inf) for c in range(n))
-    case_steps = tuple(dt0 / 2 ** met[c][0] if c in met else math.nan for c in range(n))
-    return BatchStepChoice(
-        dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())), measure=measure,
-        tolerance=tolerance, reference_dt=dt0 / 2 ** (j + 2), stability_limit=float(limit),
-        sample_rate=sample_rate, solver=solver, probe=probe, probe_duration=float(duration),
-        band=band, history=tuple(history), notes=tuple(notes), case_errors=case_errors,
-        case_steps=case_steps, unmet=unmet)
+    names = ("base_acceleration", "payload_acceleration", "relative_position")
+
+    def run(dt, members):
+        batch = simulate_batch([cases[c] for c in members], probe, duration=duration, dt=dt,
+                               sample_rate=sample_rate, solver=solver, channels=names,
+                               workers=workers)
+        for row, c in enumerate(members):
+            if batch.messages[row]:
+                raise SimulationError(f"{labels[c]} diverged on the {duration:g} s probe at "
+                                      f"dt = {dt:.3g} s: {batch.messages[row]}")
+        return [_ProbeRun(**{name: batch.channels[name][row] for name in names},
+                          run={"sample_rate": sample_rate}) for row in range(len(members))]
+
+    return search_step(
+        run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
+                                                         fft_length=fft_length),
+        cases=n, dt0=dt0, order=order, measure=measure, tolerance=tolerance,
+        sample_rate=sample_rate, solver=solver, probe=probe, probe_duration=duration,
+        band=band, notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
+                                     probe is not excitation),
+        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
+        fallback=fallback, give_up_early=True, labels=labels, progress=progress,
+        unit_name="batch")

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from qzs.model.excitation import Excitation
     from qzs.model.isolator import InitialState, IsolatorParameters
 
-__all__ = ["simulate", "result_bytes", "SingleAxis"]
+__all__ = ["simulate", "run_resolved", "result_bytes", "SingleAxis"]
 
 #: Bytes one output sample takes in memory: every channel as float64, the flags as bool.
 BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
@@ -31,7 +31,8 @@ BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
 
 def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters | None = None,
              controller: ControllerParameters | None = None, *, duration: float | None = None,
-             dt: float = defaults.SIMULATION["dt"],
+             dt: float | None = None, tolerance: float | None = None,
+             tolerance_state: float | None = None,
              sample_rate: float = defaults.SIMULATION["sample_rate"],
              solver: str = defaults.SIMULATION["solver"],
              initial_state: InitialState | None = None, progress: bool = False,
@@ -49,8 +50,17 @@ def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters 
         PI and damping loops; defaults of docs/model.md §11 if omitted.
     duration : float, optional
         Simulated time [s]; default the excitation's length (required for a sine).
-    dt : float
-        Integration step [s]; default 1e-4 (the paper's 2e7 steps for 2000 s).
+    dt : float, optional
+        A literal integration step [s] (the paper's: 1e-4, its 2e7 steps for 2000 s).
+    tolerance : float, optional
+        Choose the largest step whose transmissibility stays within this many [dB] of a
+        finer one over the band the run covers (docs/model.md §7).
+    tolerance_state : float, optional
+        Choose the largest step whose relative position stays within this many [m] of a
+        finer one. Give at most one of ``dt``, ``tolerance`` and ``tolerance_state``; given
+        none, the paper's literal ``dt`` = 1e-4 s (``qzs simulate`` and the page choose
+        the step for ``qzs.defaults.ACCURACY`` instead: ``tolerance=0.01`` here gives their
+        step and numbers; :func:`qzs.engine.run_spec.resolve`); ``result.step`` says how.
     sample_rate : float
         Output sample rate [Hz]; ``1/dt`` must be a whole multiple of it. Output
         is decimated while integrating, so memory grows with the output only.
@@ -87,8 +97,37 @@ def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters 
     SimulationError
         The state diverged or became non-finite (the message names time and state).
     """
-    run = prepare_run(excitation, isolator, controller, duration=duration, dt=dt,
-                      sample_rate=sample_rate, solver=solver, initial_state=initial_state)
+    from qzs.engine.run_spec import resolve
+
+    return run_resolved(resolve(excitation, isolator, controller, duration=duration, dt=dt,
+                                tolerance=tolerance, tolerance_state=tolerance_state,
+                                sample_rate=sample_rate, solver=solver,
+                                initial_state=initial_state, progress=progress),
+                        progress=progress, interruptible=interruptible, sink=sink)
+
+
+def run_resolved(resolved, *, progress=False, interruptible=False, sink=None):
+    """Integrate a resolved run (:func:`qzs.engine.run_spec.resolve`): the one single-axis run.
+
+    Parameters
+    ----------
+    resolved : ResolvedRun
+        The run, its step chosen.
+    progress : bool
+        Show a progress bar.
+    interruptible : bool
+        Ctrl-C ends the run early and returns what was simulated.
+    sink : callable, optional
+        As for :func:`simulate`.
+
+    Returns
+    -------
+    SimulationResult
+        Its ``run`` holds the step record's entries (``step_*``,
+        :meth:`~qzs.engine.step_search.StepChoice.attributes`) and its ``step`` the record.
+    """
+    run = prepare_run(**resolved.arguments())
+    solver = resolved.solver
     plan = driver.plan_run(run.duration, run.dt, run.decimation)
     p = run.params
     statistics = SummaryStatistics(0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]),
@@ -110,9 +149,12 @@ def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters 
                 stick_events=int(flags[K.I_N_STICKS]), stop_low=float(p[K.P_Z_LOW]),
                 stop_high=float(p[K.P_Z_HIGH]), samples=recorder.rows,
                 preview_every=recorder.every)
+    info.update(resolved.step.attributes())
     data, data_flags = recorder.result()
-    return SimulationResult(data, data_flags, isolator=run.isolator, controller=run.controller,
-                            excitation=run.excitation, run=info, statistics=statistics.result())
+    result = SimulationResult(data, data_flags, isolator=run.isolator, controller=run.controller,
+                              excitation=run.excitation, run=info, statistics=statistics.result())
+    result.step = resolved.step
+    return result
 
 
 class SingleAxis(driver.Stepper):

@@ -6,14 +6,12 @@
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from qzs import defaults
-from qzs.engine.prepare import run_inputs
+from qzs.engine.run_spec import ResolvedRun, resolve
 from qzs.engine.results import ResultWriter, estimated_size
-from qzs.engine.simulate import simulate
 from qzs.iotools.files import RESULT_SUFFIXES as _FORMATS
 from qzs.iotools.paths import check_output_path
 
@@ -32,12 +30,13 @@ RESULT_SUFFIXES = tuple(_FORMATS)
 def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
                      isolator: IsolatorParameters | None = None,
                      controller: ControllerParameters | None = None, *,
-                     duration: float | None = None, dt: float = defaults.SIMULATION["dt"],
+                     duration: float | None = None, dt: float | None = None,
+                     tolerance: float | None = None, tolerance_state: float | None = None,
                      sample_rate: float = defaults.SIMULATION["sample_rate"],
                      solver: str = defaults.SIMULATION["solver"],
                      initial_state: InitialState | None = None, progress: bool = False,
                      interruptible: bool = False, argument: str = "path",
-                     run_entries: Mapping[str, Any] | None = None) -> SimulationResult:
+                     resolved: ResolvedRun | None = None) -> SimulationResult:
     """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are
@@ -59,8 +58,9 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
         PI and damping loops; defaults if omitted.
     duration : float, optional
         Simulated time [s]; default the excitation's length.
-    dt : float
-        Integration step [s].
+    dt, tolerance, tolerance_state : float, optional
+        A literal step [s], or the tolerance [dB] or [m] it is chosen for, as for
+        :func:`qzs.simulate` (none: the default accuracy).
     sample_rate : float
         Output sample rate [Hz].
     solver : {"ode3", "rk4", "euler"}
@@ -73,9 +73,10 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
         Ctrl-C ends the run early and writes what was simulated.
     argument : str
         How the caller names ``path`` in messages (``"--out"`` on the command line).
-    run_entries : dict, optional
-        More entries of ``result.run`` (and of the file's ``run.*`` attributes), such as a
-        chosen step's tolerance and error (:func:`qzs.engine.accuracy.step_run_entries`).
+    resolved : ResolvedRun, optional
+        The run already resolved (:func:`qzs.engine.run_spec.resolve`); then the run's
+        other arguments are not given. Its step record goes into the file's ``run.step_*``
+        attributes.
 
     Returns
     -------
@@ -88,19 +89,23 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
     OutputPathError
         The path cannot be written (extension, folder, permissions, free space).
     """
-    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    length = duration if duration is not None else excitation.duration
+    # the path first (its extension, folder and permissions), before the step is chosen
+    check_output_path(path, argument=argument, suffixes=RESULT_SUFFIXES)
+    if resolved is None:
+        resolved = resolve(excitation, isolator, controller, duration=duration, dt=dt,
+                           tolerance=tolerance, tolerance_state=tolerance_state,
+                           sample_rate=sample_rate, solver=solver, initial_state=initial_state,
+                           progress=progress)
     size = None
     known = Path(path).suffix.lower() in RESULT_SUFFIXES  # else check_output_path names them
-    if known and length is not None and length > 0 and sample_rate > 0:
-        size = estimated_size(int(round(length * sample_rate)) + 1, Path(path).suffix)
+    if known:
+        size = estimated_size(int(round(resolved.duration * resolved.sample_rate)) + 1,
+                              Path(path).suffix)
     check_output_path(path, argument=argument, suffixes=RESULT_SUFFIXES, estimated_bytes=size)
-    with ResultWriter(path, isolator=isolator, controller=controller,
-                      excitation=excitation) as writer:
-        result = simulate(excitation, isolator, controller, duration=duration, dt=dt,
-                          sample_rate=sample_rate, solver=solver, initial_state=initial_state,
-                          progress=progress, interruptible=interruptible, sink=writer.append)
-        result.run.update(run_entries or {})
+    with ResultWriter(path, isolator=resolved.isolator, controller=resolved.controller,
+                      excitation=resolved.excitation) as writer:
+        result = resolved.simulate(progress=progress, interruptible=interruptible,
+                                   sink=writer.append)
         # the file holds every sample: the in-memory preview's stride is no property of it
         writer.finish({k: v for k, v in result.run.items() if k != "preview_every"})
     return result

@@ -113,10 +113,10 @@ def test_a_tolerance_no_step_meets_is_an_error_or_the_fallback_with_the_reason(s
                    duration=1.0, tolerance_state=1e-30, finest=2.5e-4)
     with pytest.raises(ToleranceNotMetError, match="1e-30 m"):
         choose_hexapod_step(geometry, platform, controller=STABLE, **options)
-    choice = choose_hexapod_step(geometry, platform, controller=STABLE, fallback=2.5e-4,
+    choice = choose_hexapod_step(geometry, platform, controller=STABLE, fallback=True,
                                  **options)
-    assert choice.dt == 2.5e-4 and math.isnan(choice.error)
-    assert "taking 0.00025 s" in choice.notes[-1]
+    assert choice.dt == 2.5e-4 and math.isnan(choice.error) and not choice.met
+    assert "running at dt = 0.00025 s" in choice.notes[-1]
     assert [h[0] for h in choice.history] == [2e-3, 1e-3]  # down to the finest, 2.5e-4 s
 
 

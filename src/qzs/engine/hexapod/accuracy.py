@@ -35,10 +35,11 @@ import numpy as np
 
 from qzs import _validation, defaults
 from qzs._validation import choice as _choice
-from qzs.engine.accuracy import (MAX_HALVINGS, MEASURE_UNITS, PROBE_DURATION, SAFETY,
-                                 StepChoice, _band, _frequency_range, _probe_fft_length,
-                                 _tolerance, admissible_step, estimate_difference_db,
-                                 halving_search, probe_excitation)
+from qzs.engine.accuracy import (PROBE_DURATION, check_band, estimate_difference_db,
+                                 frequency_range, probe_excitation, probe_fft_length)
+from qzs.engine.step_search import (MAX_HALVINGS, MEASURE_UNITS, SAFETY, admissible_step,
+                                    bound_notes,
+                                    search_step, tolerance_measure)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 __all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error"]
@@ -83,7 +84,7 @@ def hexapod_probe(excitation, band=None, probe_duration=None, duration=None,
     probes, lengths, limits = {}, [], []
     for axis, value in excitation.items():
         probe, length = probe_excitation(
-            value, band or _frequency_range(value, sample_rate), probe_duration)
+            value, band or frequency_range(value, sample_rate), probe_duration)
         probes[axis] = probe
         lengths.append(length)
         if probe.duration is not None:
@@ -136,7 +137,7 @@ def hexapod_step_error(coarse, fine, measure, *, axis=None, band=None, fft_lengt
 
     j = defaults.AXES.index(axis)
     rate = coarse.run["sample_rate"]
-    length = _probe_fft_length(coarse["platform_pose"].shape[0], rate, band, fft_length)
+    length = probe_fft_length(coarse["platform_pose"].shape[0], rate, band, fft_length)
     floor = 10 ** (floor_db / 20)
     differences = []
     for i in range(6):
@@ -153,7 +154,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
                         tolerance_db=None, tolerance_state=None,
                         solver=defaults.SIMULATION["solver"],
                         sample_rate=defaults.SIMULATION["sample_rate"], band=None,
-                        duration=None, finest=None, fallback=None, probe_duration=None,
+                        duration=None, finest=None, fallback=False, probe_duration=None,
                         cartesian=None, max_halvings=MAX_HALVINGS, safety=SAFETY,
                         progress=False):
     """The largest fixed step of a six-axis run whose error stays within a tolerance.
@@ -192,9 +193,11 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     finest : float, optional
         The finest candidate [s]: halvings stop above it (default :data:`~qzs.engine.
         accuracy.MAX_HALVINGS` halvings).
-    fallback : float, optional
-        The step [s] taken when no candidate meets the tolerance (its ``error`` is then
-        ``nan`` and a note says why); default: :class:`~qzs.errors.ToleranceNotMetError`.
+    fallback : bool
+        Where no candidate meets the tolerance, return the one fallback of
+        :func:`~qzs.engine.step_search.search_step` (``finest``, default the paper's step;
+        ``error`` NaN and a note why) instead of raising
+        :class:`~qzs.errors.ToleranceNotMetError`.
     probe_duration : float, optional
         Length of the probe [s]; default 60 s (a sine: its fade-in and 40 periods).
     cartesian : CartesianController, optional
@@ -229,14 +232,14 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     from qzs.model.hexapod import platform_size
     from qzs.model.isolator import IsolatorParameters
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     moving = _excitations(excitation)
     if not moving:
         raise ParameterError("`excitation` moves no base axis: there is nothing to choose a "
                              "step for; give e.g. excitation={'z': Chirp(duration=20.0)}.")
     _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
     sample_rate = _validation.positive_real("sample_rate", sample_rate)
-    for name, value in (("duration", duration), ("finest", finest), ("fallback", fallback),
+    for name, value in (("duration", duration), ("finest", finest),
                         ("probe_duration", probe_duration)):
         if value is not None:
             _validation.positive_real(name, value)
@@ -250,7 +253,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
                 f"base moving along one axis; it moves along {sorted(moving)}. Give "
                 "`tolerance_state` [m] (the pose) instead, or excite one axis.")
         axis, = moving
-        band = _band(band, moving[axis], sample_rate)
+        band = check_band(band, moving[axis], sample_rate)
     isolators = _per_leg("isolator", IsolatorParameters() if isolator is None else isolator,
                          IsolatorParameters)
     controllers = _per_leg("controller",
@@ -262,69 +265,18 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     resolving = min(resolving_step(value, length) for value in probe.values())
     dt0, k0 = admissible_step(sample_rate, controllers[0].controller_rate,
                               lambda dt: dt <= resolving and stable(dt))
-    if finest is not None:
-        count = sum(1 for j in range(64) if dt0 / 2 ** j >= finest * (1 - 1e-9))
-        max_halvings = min(max_halvings, count - 1)
-    notes = [f"dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s: the largest step that divides "
-             f"the output period, is stable (<= {limit:.3g} s) and resolves the base motion"]
     size = platform_size(geometry)
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
 
-        bar = tqdm(total=max_halvings + 1, unit="run", desc="choosing dt", leave=False)
-    runs, differences = {}, {}
+    def run(dt, cases):
+        return [simulate_hexapod(geometry, platform, isolators, controllers, excitation=probe,
+                                 duration=length, dt=dt, sample_rate=sample_rate, solver=solver,
+                                 cartesian=cartesian)]
 
-    def run(j):
-        if j not in runs:
-            runs[j] = simulate_hexapod(geometry, platform, isolators, controllers,
-                                       excitation=probe, duration=length, dt=dt0 / 2 ** j,
-                                       sample_rate=sample_rate, solver=solver,
-                                       cartesian=cartesian)
-            if bar is not None:
-                bar.update(1)
-        return runs[j]
-
-    def difference(j):
-        if j not in differences:
-            differences[j] = hexapod_step_error(run(j), run(j + 1), measure, axis=axis,
-                                                band=band, size=size)
-            if j > 0:
-                runs.pop(j - 1, None)  # a six-axis run holds 99 channels: keep two
-        return differences[j]
-
-    try:
-        chosen, history = (None, []) if max_halvings < 2 else halving_search(
-            difference, order, tolerance, dt0, max_halvings, safety)
-    finally:
-        if bar is not None:
-            bar.close()
-    unit = MEASURE_UNITS[measure]
-    common = dict(measure=measure, tolerance=tolerance, stability_limit=float(limit),
-                  sample_rate=sample_rate, solver=solver, probe=probe,
-                  probe_duration=float(length), band=band, history=tuple(history))
-    if chosen is None:
-        untrusted = any(math.isnan(d) for d in differences.values())
-        if untrusted:
-            reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted in both "
-                      f"runs of the {length:g} s probe")
-            if fallback is None:
-                raise ParameterError(reason + "; lengthen `probe_duration` or narrow the band.")
-        elif history:
-            shown = ", ".join(f"{d:.3g}" for _, d, _ in history)
-            reason = (f"no step down to {dt0 / 2 ** max_halvings:.3g} s met {tolerance:g} "
-                      f"{unit} (with safety {safety:g}): the differences between successive "
-                      f"halvings ({shown} {unit}) do not shrink as the scheme's order predicts "
-                      "(a stick-slip pattern that each refinement redraws)")
-        else:
-            reason = (f"fewer than three candidate steps between {dt0:.3g} s and the finest, "
-                      f"{finest:.3g} s, to compare")
-        if fallback is None:
-            best = min((h[2] for h in history), default=math.inf)
-            raise ToleranceNotMetError(tolerance, unit, dt0 / 2 ** max_halvings, best, safety)
-        return StepChoice(dt=float(fallback), error=math.nan,
-                          reference_dt=dt0 / 2 ** max_halvings,
-                          notes=tuple(notes + [reason + f"; taking {fallback:g} s"]), met=False,
-                          **common)
-    return StepChoice(dt=dt0 / 2 ** chosen, error=float(history[-1][2]),
-                      reference_dt=dt0 / 2 ** (chosen + 2), notes=tuple(notes), **common)
+    return search_step(
+        run=run, compare=lambda coarse, fine: hexapod_step_error(
+            coarse, fine, measure, axis=axis, band=band, size=size),
+        dt0=dt0, order=order, measure=measure, tolerance=tolerance, sample_rate=sample_rate,
+        solver=solver, probe=probe, probe_duration=length, band=band,
+        notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure, True),
+        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
+        fallback=fallback, progress=progress)

@@ -1,0 +1,225 @@
+"""A run resolved once: inputs validated, defaults and duration put in, the step chosen, its record made.
+
+Every single-axis run of qzs goes through :func:`resolve`: :func:`qzs.simulate`, the
+streaming writer (:func:`qzs.workflows.run.simulate_to_file`), ``qzs simulate`` and the
+tuning page. It is the one place where a run's defaults are decided (docs/model.md §7,
+"one step decision"): a literal ``dt``, or the largest step meeting a tolerance over the band
+the run covers (``tolerance`` [dB] on the transmissibility, ``tolerance_state`` [m] on the
+relative position); given neither, ``step`` says which (the Python functions: the paper's
+literal step; the commands and the page: the default accuracy), so that the API, the command
+line and the page give the same step and the same numbers for the same inputs.
+Values flow down only: what a caller needs of the step (its record, its notes) is in the
+:class:`ResolvedRun`, never asked again.
+
+>>> import qzs
+>>> run = qzs.resolve(qzs.Chirp(duration=60.0, f1=5.0), tolerance=0.01)  # doctest: +SKIP
+>>> run.step.line()  # doctest: +SKIP
+'0.001 s (chosen for 0.01 dB, estimated error 0.0011 dB)'
+>>> result = run.simulate()  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from qzs import _validation, defaults
+from qzs.errors import ParameterError
+
+__all__ = ["ResolvedRun", "resolve", "MAX_SAMPLES"]
+
+#: Output samples a run may ask for at most [-] (past this, counts lose their integers).
+MAX_SAMPLES = 1e15
+
+
+@dataclass(frozen=True, kw_only=True)
+class ResolvedRun:
+    """A single-axis run with every input resolved: what :func:`resolve` returns.
+
+    Attributes
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        Base motion.
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        PI and damping loops.
+    initial_state : InitialState or None
+        The initial state (None: at rest at the setpoint).
+    duration : float
+        Simulated time [s].
+    dt : float
+        Integration step [s].
+    sample_rate : float
+        Output rate [Hz].
+    solver : str
+        The integrator.
+    step : StepChoice
+        How ``dt`` was chosen, or that it was given (:class:`~qzs.engine.step_search.StepChoice`):
+        the one record the console, JSON, files and reports show.
+    notes : tuple of str
+        Defaults put in that a person should hear of (a sine's duration).
+    """
+
+    excitation: Any
+    isolator: Any
+    controller: Any
+    initial_state: Any
+    duration: float
+    dt: float
+    sample_rate: float
+    solver: str
+    step: Any
+    notes: tuple = ()
+
+    def arguments(self):
+        """The keywords of the run for :func:`qzs.engine.simulate.simulate` and its kin.
+
+        Returns
+        -------
+        dict
+            ``excitation``, ``isolator``, ``controller``, ``duration`` [s], ``dt`` [s],
+            ``sample_rate`` [Hz], ``solver`` and ``initial_state``.
+        """
+        return dict(excitation=self.excitation, isolator=self.isolator,
+                    controller=self.controller, duration=self.duration, dt=self.dt,
+                    sample_rate=self.sample_rate, solver=self.solver,
+                    initial_state=self.initial_state)
+
+    def simulate(self, *, progress=False, interruptible=False, sink=None):
+        """Integrate the run (:func:`qzs.engine.simulate.run_resolved`).
+
+        Parameters
+        ----------
+        progress : bool
+            Show a progress bar.
+        interruptible : bool
+            Ctrl-C ends the run early and returns what was simulated.
+        sink : callable, optional
+            As for :func:`qzs.simulate`.
+
+        Returns
+        -------
+        SimulationResult
+        """
+        from qzs.engine.simulate import run_resolved
+
+        return run_resolved(self, progress=progress, interruptible=interruptible, sink=sink)
+
+
+def resolve(excitation=None, isolator=None, controller=None, *, duration=None, dt=None,
+            tolerance=None, tolerance_state=None,
+            sample_rate=defaults.SIMULATION["sample_rate"],
+            solver=defaults.SIMULATION["solver"], initial_state=None, step="literal",
+            progress=False, cache=True):
+    """Resolve a single-axis run once: validate, put in defaults, choose the step.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
+        Base motion; default the paper's 10 mm, 0-20 Hz, 2000 s chirp.
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        PI and damping loops; defaults if omitted.
+    duration : float, optional
+        Simulated time [s]; default the excitation's length (required for a sine).
+    dt : float, optional
+        A literal integration step [s] (the paper's: 1e-4). Give it or a tolerance, not
+        both.
+    tolerance : float, optional
+        Choose the largest step whose transmissibility stays within this many [dB] of a
+        finer one over the band the run covers (docs/model.md §7).
+    tolerance_state : float, optional
+        Choose the largest step whose relative position stays within this many [m] of a
+        finer one.
+    sample_rate : float
+        Output rate [Hz].
+    solver : {"ode3", "rk4", "euler"}
+        Fixed-step integrator.
+    initial_state : InitialState, optional
+        Default: at rest at the setpoint.
+    step : {"literal", "chosen"}
+        The step given neither a ``dt`` nor a tolerance (docs/model.md §7, the one step
+        decision): ``"literal"``, the paper's ``defaults.SIMULATION["dt"]`` (the Python
+        functions': a script's numbers never depend on a search or a cache), or
+        ``"chosen"``, the largest step meeting ``defaults.ACCURACY`` (the transmissibility
+        within 0.01 dB; a sine's relative position within 1e-5 m), as the commands and the
+        page ask. Either way the same inputs give the same step everywhere.
+    progress : bool
+        Show a progress bar while the step is chosen.
+    cache : bool
+        Read the step from, and keep it in, the step cache on disk
+        (:mod:`qzs.engine.step_cache`): a repeated question skips the probe, with the same
+        answer.
+
+    Returns
+    -------
+    ResolvedRun
+
+    Raises
+    ------
+    ParameterError
+        An invalid input (named with its value and the fix), both a ``dt`` and a
+        tolerance, a transmissibility tolerance for a sine; as :func:`qzs.simulate`.
+    """
+    from qzs.engine.accuracy import (choose_step, default_tolerance, excitation_over,
+                                     probe_excitation)
+    from qzs.engine.prepare import run_inputs
+    from qzs.engine.step_search import StepChoice
+    from qzs.model.excitation import Sine
+
+    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
+    notes = []
+    _validation.choice("step", step, ("literal", "chosen"))
+    if duration is None:
+        duration = excitation.duration
+        if duration is None:
+            raise ParameterError("`duration` is required for a sine excitation, got None.")
+    duration = _validation.positive("duration", duration)
+    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
+        raise ParameterError(
+            f"`duration` ({duration!r} s) exceeds the excitation's length "
+            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    sample_rate = _validation.positive("sample_rate", sample_rate)
+    if not duration * sample_rate <= MAX_SAMPLES:
+        raise ParameterError(
+            f"`duration` ({duration!r} s) at `sample_rate` {sample_rate:g} Hz asks for "
+            f"{duration * sample_rate:.3g} output samples, more than any run can hold "
+            f"({MAX_SAMPLES:.0e}); shorten the run or lower the rate.")
+    given = [name for name, value in (("dt", dt), ("tolerance", tolerance),
+                                      ("tolerance_state", tolerance_state)) if value is not None]
+    if len(given) > 1:
+        raise ParameterError(f"give one of `dt`, `tolerance` and `tolerance_state`, got "
+                             f"{' and '.join(f'`{n}`' for n in given)}; a literal step has no "
+                             "tolerance to meet.")
+    if dt is None and not given and step == "literal":
+        dt = defaults.SIMULATION["dt"]
+    if dt is not None:
+        choice = StepChoice.literal(_validation.positive("dt", dt), sample_rate=sample_rate,
+                                    solver=solver)
+    else:
+        if tolerance is not None:
+            if isinstance(excitation, Sine):
+                raise ParameterError(
+                    f"`tolerance` ({tolerance!r} dB) is on the transmissibility, which a sine "
+                    "has no band to estimate; give `tolerance_state` [m] or a literal `dt`.")
+            asked = {"tolerance_db": tolerance}
+        elif tolerance_state is not None:
+            asked = {"tolerance_state": tolerance_state}
+        else:
+            asked = default_tolerance(excitation)
+        covered = excitation_over(excitation, duration)
+        probe_duration = None
+        if not math.isclose(duration, covered.duration or math.inf):
+            # a stationary excitation's probe is its start: never longer than the run
+            default = probe_excitation(covered, (0.0, 0.0))[1]
+            probe_duration = duration if duration < default else None
+        choice = choose_step(covered, isolator, controller, **asked, solver=solver,
+                           sample_rate=sample_rate, probe_duration=probe_duration,
+                           initial_state=initial_state, fallback=True, progress=progress,
+                           cache=cache)
+    return ResolvedRun(excitation=excitation, isolator=isolator, controller=controller,
+                       initial_state=initial_state, duration=duration, dt=choice.dt,
+                       sample_rate=sample_rate, solver=solver, step=choice, notes=tuple(notes))
+

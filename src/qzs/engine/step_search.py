@@ -1,0 +1,632 @@
+"""The one step search: the largest fixed step meeting a tolerance, for any model (docs/model.md §7).
+
+Every accuracy-driven step of qzs comes from :func:`search_step`: one axis
+(:func:`qzs.engine.accuracy.choose_step`), a lockstep batch of cases
+(:func:`qzs.engine.accuracy_batch.choose_batch_step`) and the six-leg platform
+(:func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`) give it only what differs: how to
+integrate a candidate step on the probe, and how to measure the difference of two runs. The
+halving, its memo, its progress bar, the Richardson estimate, the one fallback policy and the
+one record (:class:`StepChoice`) are written here once.
+
+The method: candidates ``dt_j = dt_0 / 2**j`` from the largest admissible step ``dt_0``
+(:func:`admissible_step`); each is integrated on the probe and compared with the next finer
+one: the difference ``d_j`` is measured, and the observed ratio ``r_j = d_j/d_{j+1}``
+(``2**order`` in the asymptotic range; stick-slip events lower it), capped at ``2**order``,
+extrapolates the error of ``dt_j`` as ``d_j r_j/(r_j - 1)``. The chosen step is the coarsest
+whose estimate times the safety factor meets the tolerance; for several cases, the finest of
+the cases' chosen steps.
+
+The fallback (one policy, docs/model.md §7): where no candidate meets the tolerance (the
+differences do not shrink: stop contacts or a stick-slip pattern each refinement redraws),
+or no bin of the band is trusted on the probe, a caller that must run anyway gets the
+``finest`` step it allows (default the paper's ``defaults.SIMULATION["dt"]``), with ``met``
+False, ``error`` NaN (no estimate holds for it) and a note that says why.
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from qzs import _validation, defaults
+from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
+
+__all__ = ["StepChoice", "search_step", "halving_search", "admissible_step", "tolerance_measure",
+           "bound_notes", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
+           "ADMISSIBLE_REFINEMENT"]
+
+#: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
+MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
+#: Factor between the estimated error and the tolerance (docs/model.md §7).
+SAFETY = 2.0
+#: Halvings below the largest admissible step tried at most before giving up.
+MAX_HALVINGS = 8
+#: A sampled controller may make the step at most this much finer than the largest stable
+#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
+#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
+#: of times longer (:class:`~qzs.errors.ControllerRateError`).
+RATE_REFINEMENT_MAX = 32
+#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
+ADMISSIBLE_REFINEMENT = 1_000_000
+
+
+@dataclass(frozen=True, kw_only=True)
+class StepChoice:
+    """The step of a run and how it was chosen: the one step record of qzs.
+
+    The console (:meth:`summary`), the JSON record (:meth:`to_dict`), the file attributes
+    (:meth:`attributes`, the ``run.step_*`` entries of NetCDF and MAT files) and the reports
+    all show this record. A literal step (:meth:`literal`) is a record too, with ``chosen``
+    False.
+
+    Attributes
+    ----------
+    dt : float
+        The integration step [s].
+    error : float
+        Estimated error of a run at ``dt`` in the requested measure ([dB] or [m]); NaN for
+        a literal step and for the fallback (no estimate holds for it).
+    measure : str
+        ``"transmissibility_db"`` (max ``|20 log10(T_dt/T_ref)|`` over the trusted bins of
+        ``band``) or ``"state_m"`` (max ``|z_dt - z_ref|`` over the output samples); empty
+        for a literal step.
+    tolerance : float
+        The tolerance asked for, in the unit of ``measure`` (NaN for a literal step).
+    reference_dt : float
+        The finest step integrated on the probe [s] (the estimate's reference).
+    stability_limit : float
+        The solver's largest stable step for this model [s].
+    sample_rate : float
+        Output rate [Hz]; ``dt`` divides its period.
+    solver : str
+        The integrator.
+    probe : object
+        The excitation integrated to choose the step (None for a literal step).
+    probe_duration : float
+        Length of the probe [s].
+    band : tuple of float
+        Frequency band [Hz] of the transmissibility measure (None for the state).
+    history : tuple
+        ``(dt, difference to the next finer step, estimated error)`` per step tried,
+        coarsest first, in the unit of ``measure``; for several cases the largest over the
+        cases still searched.
+    notes : tuple of str
+        What the caller should know (the limit that bound the step, caveats, the fallback).
+    met : bool
+        Whether ``dt`` meets the tolerance; False for the fallback.
+    cached : bool
+        Whether the choice was read from the step cache (:mod:`qzs.engine.step_cache`).
+    chosen : bool
+        False for a literal step (:meth:`literal`).
+    case_errors : tuple of float
+        Several cases: each case's estimated error at the coarsest step that met the
+        tolerance for it (inf: none did; NaN: no trusted bin on the probe).
+    case_steps : tuple of float
+        Several cases: that coarsest step [s] per case (NaN: none).
+    unmet : tuple of int
+        Several cases: those no candidate met, or without a trusted bin; ``dt`` comes from
+        the others.
+    """
+
+    dt: float
+    error: float
+    measure: str
+    tolerance: float
+    reference_dt: float
+    stability_limit: float
+    sample_rate: float
+    solver: str
+    probe: object
+    probe_duration: float
+    band: tuple
+    history: tuple
+    notes: tuple
+    met: bool = True
+    cached: bool = False
+    chosen: bool = True
+    case_errors: tuple = ()
+    case_steps: tuple = ()
+    unmet: tuple = ()
+
+    @classmethod
+    def literal(cls, dt, *, sample_rate=defaults.SIMULATION["sample_rate"],
+                solver=defaults.SIMULATION["solver"]):
+        """The record of a step given literally (``dt`` [s]): nothing chosen, no estimate.
+
+        Parameters
+        ----------
+        dt : float
+            The step [s].
+        sample_rate : float
+            Output rate [Hz].
+        solver : str
+            The integrator.
+
+        Returns
+        -------
+        StepChoice
+        """
+        return cls(dt=float(dt), error=math.nan, measure="", tolerance=math.nan,
+                   reference_dt=math.nan, stability_limit=math.nan,
+                   sample_rate=float(sample_rate), solver=str(solver), probe=None,
+                   probe_duration=math.nan, band=None, history=(), notes=(), met=True,
+                   chosen=False)
+
+    @property
+    def unit(self):
+        """The unit of ``error`` and ``tolerance``: ``"dB"``, ``"m"`` or ``""`` (literal)."""
+        return MEASURE_UNITS.get(self.measure, "")
+
+    @property
+    def steps_per_sample(self):
+        """Integration steps per output sample [-]."""
+        return int(round(1.0 / (self.sample_rate * self.dt)))
+
+    def summary(self):
+        """One paragraph for people: the step, its error and why (the console's form).
+
+        Returns
+        -------
+        str
+        """
+        if not self.chosen:
+            return f"dt = {self.dt:.6g} s ({self.solver}): given literally; its error is not estimated"
+        unit = self.unit
+        if not self.met:
+            return "\n".join([f"dt = {self.dt:.6g} s ({self.solver}): no step tried meets the "
+                              f"tolerance {self.tolerance:g} {unit}"]
+                             + [f"  note: {note}" for note in self.notes])
+        lines = [f"dt = {self.dt:.6g} s ({self.solver}, {self.steps_per_sample} step(s) per "
+                 f"{self.sample_rate:g} Hz sample): estimated error {self.error:.3g} {unit} "
+                 f"(tolerance {self.tolerance:g} {unit}, reference dt = {self.reference_dt:.3g} s, "
+                 f"probe {self.probe_duration:g} s, stability limit {self.stability_limit:.3g} s)"
+                 + (", from the step cache" if self.cached else "")]
+        lines += [f"  note: {note}" for note in self.notes]
+        return "\n".join(lines)
+
+    def line(self):
+        """The step in one line, as summaries and reports quote it.
+
+        Returns
+        -------
+        str
+        """
+        if not self.chosen:
+            return f"{self.dt:.6g} s (given)"
+        if not self.met:
+            return (f"{self.dt:.6g} s (no step tried met {self.tolerance:g} {self.unit}; "
+                    "error not estimated)")
+        return (f"{self.dt:.6g} s (chosen for {self.tolerance:g} {self.unit}, estimated error "
+                f"{self.error:.2g} {self.unit})")
+
+    def to_dict(self):
+        """The record as JSON gives it (``qzs ... --json``'s ``step``).
+
+        Returns
+        -------
+        dict
+            ``dt`` [s], ``chosen``; for a chosen step also ``measure``, ``unit``,
+            ``tolerance`` and ``error`` (in ``unit``), ``met``, ``reference_dt`` [s],
+            ``cached``, ``band`` [Hz] and ``notes``.
+        """
+        if not self.chosen:
+            return {"dt": self.dt, "chosen": False}
+        record = {"dt": self.dt, "chosen": True, "measure": self.measure, "unit": self.unit,
+                  "tolerance": self.tolerance, "error": self.error, "met": self.met,
+                  "reference_dt": self.reference_dt, "cached": self.cached,
+                  "band": None if self.band is None else list(self.band),
+                  "notes": list(self.notes)}
+        if self.case_steps:
+            record.update(case_steps=list(self.case_steps), case_errors=list(self.case_errors),
+                          unmet=list(self.unmet))
+        return record
+
+    def attributes(self):
+        """The record as a run's file attributes give it (``run.step_*``).
+
+        Returns
+        -------
+        dict
+            Nothing for a literal step (``run.dt`` says it all); for a chosen one
+            ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the state
+            measure; the error NaN where no step met the tolerance), ``step_met`` (1 or 0)
+            and ``step_reference_dt`` [s].
+        """
+        if not self.chosen:
+            return {}
+        suffix = self.unit.lower()
+        return {f"step_tolerance_{suffix}": float(self.tolerance),
+                f"step_error_{suffix}": float(self.error),
+                "step_met": int(bool(self.met)),
+                "step_reference_dt": float(self.reference_dt)}
+
+
+# ---------------------------------------------------------------- shared validation
+def tolerance_measure(tolerance_db, tolerance_state):
+    """The measure and value of exactly one tolerance: ``(measure, tolerance)``.
+
+    Parameters
+    ----------
+    tolerance_db : float or None
+        On the transmissibility [dB].
+    tolerance_state : float or None
+        On the state [m].
+
+    Returns
+    -------
+    measure : str
+        ``"transmissibility_db"`` or ``"state_m"``.
+    tolerance : float
+        The positive tolerance, in the measure's unit.
+
+    Raises
+    ------
+    ParameterError
+        Both, neither, or a tolerance that is not a positive finite number.
+    """
+    given = [(name, value) for name, value in (("tolerance_db", tolerance_db),
+                                               ("tolerance_state", tolerance_state))
+             if value is not None]
+    if len(given) != 1:
+        raise ParameterError(
+            "give exactly one of `tolerance_db` (transmissibility, dB) and `tolerance_state` "
+            f"(relative position, m); got {' and '.join(n for n, _ in given) or 'neither'}.")
+    name, value = given[0]
+    measure = "transmissibility_db" if name == "tolerance_db" else "state_m"
+    return measure, _validation.positive_real(name, value)
+
+
+def admissible_step(sample_rate, controller_rate, stable):
+    """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
+    divides the controller's period too.
+
+    Parameters
+    ----------
+    sample_rate : float
+        Output rate [Hz]; the step divides its period.
+    controller_rate : float
+        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
+    stable : callable
+        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
+
+    Returns
+    -------
+    dt : float
+        The step [s].
+    k : int
+        Steps per output sample [-].
+
+    Raises
+    ------
+    ControllerRateError
+        The controller's period is a whole number of steps only at a step more than
+        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
+    """
+    from qzs.engine.prepare import steps_per_sample
+
+    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
+                  if stable(1.0 / (sample_rate * k))), None)
+    if first is None:
+        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
+                             "is stable; check the model's stiffness and the `sample_rate`.")
+    if controller_rate <= 0:
+        return 1.0 / (sample_rate * first), first
+    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
+        dt = 1.0 / (sample_rate * k)
+        if not stable(dt):
+            continue
+        try:
+            steps_per_sample(controller_rate, dt, "controller_rate")
+        except ParameterError:
+            continue
+        return dt, k
+    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
+    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
+    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
+                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
+                              suggestions=sorted(near))
+
+
+def bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
+    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people.
+
+    Parameters
+    ----------
+    dt0 : float
+        The coarsest candidate [s].
+    k0 : int
+        Its steps per output sample [-].
+    sample_rate : float
+        Output rate [Hz].
+    limit : float
+        The solver's largest stable step [s].
+    resolving : float
+        The largest step that resolves the base motion [s].
+    measure : str
+        The accuracy measure.
+    shortened : bool
+        Whether the probe is a shortened stand-in for the run's excitation.
+
+    Returns
+    -------
+    list of str
+    """
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
+
+    notes = []
+    if k0 == 1:
+        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
+                     f"(a lower sample_rate would allow larger steps; stability allows "
+                     f"{limit:.3g} s)")
+    elif resolving < limit:
+        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
+                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
+                     f"of its highest frequency (stability allows {limit:.3g} s)")
+    else:
+        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
+                     f"<= {limit:.3g} s")
+    if measure == "state_m" and shortened:
+        notes.append("the state error is measured on a shortened chirp; on the full sweep "
+                     "phase errors accumulate over a longer time")
+    return notes
+
+
+# ---------------------------------------------------------------- the search
+def _estimate(d, d_next, order):
+    """The Richardson estimate of the error of ``dt_j`` from ``d_j`` and ``d_{j+1}``:
+    0 where ``d_j = 0``, inf where the differences do not shrink."""
+    ratio = d / d_next if d_next > 0 else math.inf
+    if d == 0.0:
+        return 0.0
+    if ratio <= 1.0:  # not converging yet: no estimate
+        return math.inf
+    r = min(ratio, 2.0 ** order)
+    return d * r / (r - 1)
+
+
+def _order_notes(d, d_next, order):
+    """A note when the observed order of the chosen step lies below the scheme's."""
+    if d > 0 and d_next > 0:
+        observed = math.log2(d / d_next)
+        if observed < order - 0.5:
+            return [f"observed order {observed:.2f} below the scheme's {order} (stick-slip "
+                    "events lower it): the estimate extrapolates with the observed ratio"]
+    return []
+
+
+def _loop(difference, n, order, tolerance, dt0, max_halvings, safety, give_up_early,
+          before=None, after=None):
+    """The halving loop over ``n`` cases; returns ``(met, best, history, untrusted, failed)``.
+
+    ``difference(j, c)`` is case ``c``'s difference between ``dt_j`` and ``dt_{j+1}`` (NaN:
+    no measure: the case leaves the search untrusted); ``before(j, cases)`` integrates what
+    the comparisons at ``j`` need, ``after(j)`` frees what no later comparison needs.
+    """
+    searched, met, best, history, untrusted, hopeless = list(range(n)), {}, {}, [], [], []
+    for j in range(max_halvings - 1):
+        if not searched:
+            break
+        if before is not None:
+            before(j, searched)
+        pairs = {c: (difference(j, c), difference(j + 1, c)) for c in searched}
+        untrusted += [c for c, (d, d_next) in pairs.items()
+                      if not (np.isfinite(d) and np.isfinite(d_next))]
+        estimates = {c: _estimate(d, d_next, order) for c, (d, d_next) in pairs.items()
+                     if c not in untrusted}
+        if estimates:
+            history.append((dt0 / 2 ** j, max(pairs[c][0] for c in estimates),
+                            max(estimates.values())))
+        left = max_halvings - 2 - j  # candidates finer than dt_j still to compare
+        for c, estimate in estimates.items():
+            best[c] = min(best.get(c, math.inf), estimate)
+            if safety * estimate <= tolerance:
+                met[c] = (j, estimate)
+            elif give_up_early and safety * estimate > tolerance * 2.0 ** (order * left):
+                hopeless.append(c)  # even at the scheme's order no candidate left meets it
+        searched = [c for c in searched
+                    if c not in met and c not in untrusted and c not in hopeless]
+        if after is not None:
+            after(j)
+    return met, best, history, sorted(set(untrusted)), sorted(searched + hopeless)
+
+
+def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFETY):
+    """The search of :func:`search_step` on one case given its differences directly.
+
+    Parameters
+    ----------
+    difference : callable
+        ``difference(j)``: the measured difference between the runs at ``dt_j`` and
+        ``dt_{j+1}`` (in the tolerance's unit; NaN: no measure, the search stops).
+    order : int
+        The scheme's order of accuracy [-]; the observed ratio ``d_j/d_{j+1}`` is capped at
+        ``2**order``.
+    tolerance : float
+        What the error estimate times ``safety`` must not exceed (its unit).
+    dt0 : float
+        The coarsest candidate [s].
+    max_halvings : int
+        Candidates ``dt_0 .. dt_{max_halvings}`` [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+
+    Returns
+    -------
+    chosen : int or None
+        ``j`` of the chosen step, None if no candidate met the tolerance.
+    history : list of tuple
+        ``(dt_j [s], d_j, estimate_j)`` per candidate compared.
+    """
+    memo = {}
+
+    def measured(j, c):
+        if j not in memo:
+            memo[j] = difference(j)
+        return memo[j]
+
+    met, _, history, _, _ = _loop(measured, 1, order, tolerance, dt0, max_halvings, safety,
+                                  False)
+    return (met[0][0] if met else None), history
+
+
+def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample_rate,
+                solver, probe, probe_duration, band, notes=(), stability_limit,
+                max_halvings=MAX_HALVINGS, safety=SAFETY, finest=None, fallback=False,
+                give_up_early=False, labels=None, progress=False, unit_name="run"):
+    """The coarsest candidate ``dt_0 / 2**j`` whose estimated error meets a tolerance.
+
+    The one search of qzs (module docstring); the callers give what differs.
+
+    Parameters
+    ----------
+    run : callable
+        ``run(dt, cases)``: integrate the probe at step ``dt`` [s] for the listed case
+        indices; returns one run per case, in that order.
+    compare : callable
+        ``compare(coarse, fine)``: the difference of two runs of one case in the measure's
+        unit (NaN: no measure, e.g. no trusted bin in the band).
+    cases : int
+        How many cases share the step [-].
+    dt0 : float
+        The coarsest candidate [s] (:func:`admissible_step`).
+    order : int
+        The scheme's order of accuracy [-].
+    measure : {"transmissibility_db", "state_m"}
+        The accuracy measure.
+    tolerance : float
+        The tolerance, in the measure's unit.
+    sample_rate : float
+        Output rate [Hz].
+    solver : str
+        The integrator.
+    probe : object
+        The excitation integrated (for the record).
+    probe_duration : float
+        Its length [s].
+    band : tuple of float or None
+        The transmissibility measure's band [Hz].
+    notes : sequence of str
+        What bounds ``dt0`` (:func:`bound_notes`).
+    stability_limit : float
+        The largest stable step [s] (for the record).
+    max_halvings : int
+        Halvings of ``dt0`` tried at most [-].
+    safety : float
+        Factor [-] (>= 1) between the estimate and the tolerance.
+    finest : float, optional
+        The finest candidate [s]: halvings stop above it; also the fallback step.
+    fallback : bool
+        Where no candidate meets the tolerance, or no bin of the band is trusted: return
+        the fallback (``finest``, default the paper's step) with ``met`` False instead of
+        raising.
+    give_up_early : bool
+        Let a case leave the search, unmet, as soon as its estimate exceeds the tolerance by
+        more than the scheme's order could close by the finest candidate.
+    labels : sequence of str, optional
+        The cases' names in the notes (default ``case 0``, ...).
+    progress : bool
+        Show a progress bar over the probe runs.
+    unit_name : str
+        What one probe run is called on the bar (``run``, ``batch``).
+
+    Returns
+    -------
+    StepChoice
+
+    Raises
+    ------
+    ToleranceNotMetError
+        No candidate meets the tolerance for any case (without ``fallback``).
+    ParameterError
+        No bin of the band is trusted on the probe for any case (without ``fallback``).
+    """
+    if finest is not None:
+        count = sum(1 for j in range(64) if dt0 / 2 ** j >= finest * (1 - 1e-9))
+        max_halvings = min(max_halvings, count - 1)
+    labels = [f"case {c}" for c in range(cases)] if labels is None else [str(x) for x in labels]
+    if len(labels) != cases:
+        raise ParameterError(f"`labels` must name each of the {cases} cases, got {len(labels)}.")
+    unit = MEASURE_UNITS[measure]
+    notes = list(notes)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False)
+    runs, differences = {}, {}
+
+    def integrate(j, members):
+        kept = runs.setdefault(j, {})
+        missing = [c for c in members if c not in kept]
+        if missing:
+            kept.update(zip(missing, run(dt0 / 2 ** j, missing)))
+            if bar is not None:
+                bar.update(1)
+
+    def before(j, members):
+        for level in (j, j + 1, j + 2):
+            integrate(level, members)
+
+    def difference(j, c):
+        if (j, c) not in differences:
+            differences[j, c] = compare(runs[j][c], runs[j + 1][c])
+        return differences[j, c]
+
+    try:
+        met, best, history, untrusted, failed = _loop(
+            difference, cases, order, tolerance, dt0, max_halvings, safety, give_up_early,
+            before=before, after=lambda j: runs.pop(j, None))
+    finally:
+        if bar is not None:
+            bar.close()
+    record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
+                  sample_rate=float(sample_rate), solver=solver, probe=probe,
+                  probe_duration=float(probe_duration), band=band, history=tuple(history))
+    if not met:
+        finest_tried = dt0 / 2 ** max(max_halvings - 1, 0)
+        if untrusted and len(untrusted) == cases:
+            reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
+                      f"{probe_duration:g} s probe, so no error is measured")
+            if not fallback:
+                raise ParameterError(reason.replace(", so no error is measured", "")
+                                     + "; lengthen `probe_duration` or narrow the band.")
+        else:
+            smallest = min(best.values(), default=math.inf)
+            if not fallback:
+                raise ToleranceNotMetError(tolerance, unit, finest_tried, smallest, safety)
+            reason = (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
+                      f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
+                      "redraw the response at every step)")
+        dt = float(finest if finest is not None else defaults.SIMULATION["dt"])
+        return StepChoice(dt=dt, error=math.nan, reference_dt=finest_tried,
+                          notes=tuple(notes + [f"{reason}; running at dt = {dt:.3g} s, whose "
+                                               "error is not estimated"]), met=False,
+                          case_errors=(math.nan,) * cases if cases > 1 else (),
+                          case_steps=(math.nan,) * cases if cases > 1 else (),
+                          unmet=tuple(range(cases)) if cases > 1 else (), **record)
+    j = max(level for level, _ in met.values())
+    deciding = min(c for c, (level, _) in met.items() if level == j)
+    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
+    if failed:
+        notes.append(
+            f"{'; '.join(labels[c] for c in failed)}: no step down to "
+            f"{dt0 / 2 ** (max_halvings - 2):.3g} s meets {tolerance:g} {unit} (best estimate "
+            + ", ".join(f"{best.get(c, math.inf):.2g} {unit}" for c in failed)
+            + "; an estimate that even the scheme's order could not bring within the tolerance "
+            "by the finest candidate ends the search early): their response depends on the step "
+            "(stop contacts or a stick-slip pattern each refinement redraws); the step is the "
+            "other cases'")
+    if untrusted:
+        notes.append(f"{'; '.join(labels[c] for c in untrusted)}: no bin of "
+                     f"the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
+                     f"{probe_duration:g} s probe, so no error is measured; the step is the "
+                     "other cases'")
+    several = {}
+    if cases > 1:
+        several = dict(
+            case_errors=tuple(float(met[c][1]) if c in met else
+                              (math.nan if c in untrusted else math.inf) for c in range(cases)),
+            case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
+                             for c in range(cases)),
+            unmet=tuple(sorted(set(range(cases)) - set(met))))
+    return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
+                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **several, **record)
