@@ -35,7 +35,7 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, parameter_info, update_parameters
 
 __all__ = ["PageRequest", "PageData", "SizeLimitError", "page_request", "compute_page",
-           "config_text", "choose_page_step", "page_values", "LIMITS", "PAGE_DEFAULTS",
+           "config_text", "resolve_page_run", "page_values", "LIMITS", "PAGE_DEFAULTS",
            "MODEL_PARAMETERS", "EXCITATION_KINDS", "SAMPLE_RATES", "CONTROLLER_RATES",
            "MAX_STEPS", "TRACE_POINTS"]
 
@@ -75,8 +75,6 @@ MAX_STEPS = 10_000_000
 #: Simulated time at most per frequency of a stepped sine [s] (the workflow's default cap,
 #: 30 of the loop's slowest time constants, is 115 s for the paper's loop).
 STEPPED_MAX_TIME = 120.0
-#: Halvings of the largest admissible step the step choice tries at most [-].
-MAX_HALVINGS = 5
 #: Tolerance of the sine run's step: this share of the amplitude in relative position [-].
 SINE_STATE_TOLERANCE = 1e-3
 #: Welch segments a chirp's estimate averages about [-] (half-overlapping).
@@ -287,24 +285,15 @@ def page_request(values=None):
 
 # ---------------------------------------------------------------- the step
 @functools.lru_cache(maxsize=64)
-def _cached_step(excitation, isolator, controller, sample_rate, measure, tolerance):
-    from qzs.engine.accuracy import choose_step_or_finest
-
-    keyword = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}[measure]
-    choice_ = choose_step_or_finest(excitation, isolator, controller, sample_rate=sample_rate,
-                                    max_halvings=MAX_HALVINGS, cache=True,
-                                    **{keyword: tolerance})
-    return choice_.dt, choice_.error, "" if choice_.met else choice_.notes[0]
-
-
-def choose_page_step(excitation, isolator, controller, sample_rate, *, tolerance_db=None,
+def resolve_page_run(excitation, isolator, controller, sample_rate, duration=None,
                      tolerance_state=None):
-    """The integration step of a page run: :func:`qzs.engine.accuracy.choose_step`, cached.
+    """A page run resolved as ``qzs simulate`` resolves it (:func:`qzs.engine.run_spec.resolve`).
 
-    At most :data:`MAX_HALVINGS` halvings are tried; where none meets the tolerance the
-    step falls back to the finer of the paper's 1e-4 s and the finest step tried, with a
-    note. Results are cached per (excitation, parameters, rate): moving a slider back
-    costs no new choice.
+    The step is chosen for the default accuracy (``step="chosen"``), or for
+    ``tolerance_state`` [m] where given (the sine's, relative to its amplitude), with the
+    one fallback and the step cache; so the page gives the step and the numbers that
+    ``qzs simulate`` and ``qzs.simulate(..., tolerance=0.01)`` give for the same inputs.
+    Kept per (excitation, parameters, rate): moving a slider back costs no new choice.
 
     Parameters
     ----------
@@ -316,26 +305,34 @@ def choose_page_step(excitation, isolator, controller, sample_rate, *, tolerance
         PI and damping loops.
     sample_rate : float
         Output rate [Hz].
-    tolerance_db : float, optional
-        Tolerance on the transmissibility [dB].
+    duration : float, optional
+        Simulated time [s] (a sine's; a chirp: its length).
     tolerance_state : float, optional
-        Tolerance on the relative position [m] (give one of the two).
+        Tolerance on the relative position [m].
 
     Returns
     -------
-    dt : float
-        The step [s].
-    error : float
-        Its estimated error, in the tolerance's unit (NaN for the fallback).
-    note : str
-        Empty, or why the fallback was taken.
+    ResolvedRun
     """
-    if (tolerance_db is None) == (tolerance_state is None):
-        raise ParameterError("give exactly one of `tolerance_db` and `tolerance_state`.")
-    measure = "transmissibility_db" if tolerance_db is not None else "state_m"
-    tolerance = tolerance_db if tolerance_db is not None else tolerance_state
-    return _cached_step(excitation, isolator, controller, float(sample_rate), measure,
-                        float(tolerance))
+    from qzs.engine.run_spec import resolve
+
+    return resolve(excitation, isolator, controller, duration=duration,
+                   sample_rate=float(sample_rate), tolerance_state=tolerance_state,
+                   step="chosen")
+
+
+def _step_note(step):
+    """The fallback's reason, for the page's notes (empty where the step met its tolerance)."""
+    return "" if step.met else step.notes[-1]
+
+
+@functools.lru_cache(maxsize=64)
+def _response_step(frequencies, amplitude, isolator, controller, sample_rate):
+    from qzs.workflows.response import response_step
+
+    return response_step(np.asarray(frequencies), amplitude, isolator, controller,
+                         solver=defaults.SIMULATION["solver"],
+                         tolerance_db=defaults.ACCURACY["tolerance_db"], sample_rate=sample_rate)
 
 
 def _check_steps(name, simulated_time, dt):
@@ -450,15 +447,13 @@ def _linear_curve(request):
 
 def _chirp(request):
     from qzs.analysis.spectral import transmissibility
-    from qzs.engine.simulate import simulate
 
     chirp = request.chirp()
-    dt, error, note = choose_page_step(chirp, request.isolator, request.controller,
-                                       request.sample_rate,
-                                       tolerance_db=defaults.ACCURACY["tolerance_db"])
+    resolved = resolve_page_run(chirp, request.isolator, request.controller,
+                                request.sample_rate)
+    dt, error, note = resolved.dt, resolved.step.error, _step_note(resolved.step)
     _check_steps("chirp", chirp.duration, dt)
-    result = simulate(chirp, request.isolator, request.controller, dt=dt,
-                      sample_rate=request.sample_rate)
+    result = resolved.simulate()
     estimate = transmissibility(result.base_acceleration, result.payload_acceleration,
                                 request.sample_rate,
                                 fft_length=welch_length(len(result)))
@@ -484,13 +479,10 @@ def _stepped(request):
 
     frequencies = request.stepped_frequencies()
     low, high = float(frequencies[0]), float(frequencies[-1])
-    # the step the workflow would choose: a chirp over the band (its own probe rule)
-    start = 0.8 * low if low == high else low
-    probe = build_excitation("chirp", {"amplitude": request.amplitude, "f0": start, "f1": high,
-                                       "duration": 60.0, "fade_in": min(2.0 / start, 15.0)})
-    dt, error, note = choose_page_step(probe, request.isolator, request.controller,
-                                       max(request.sample_rate, 20.0 * high),
-                                       tolerance_db=defaults.ACCURACY["tolerance_db"])
+    # the step the workflow chooses (a chirp over the band), at the page's rate
+    step = _response_step(tuple(frequencies), request.amplitude, request.isolator,
+                          request.controller, max(request.sample_rate, 20.0 * high))
+    dt, error, note = step.dt, step.error, _step_note(step)
     max_time = min(settle_time_cap(request.isolator, request.controller), STEPPED_MAX_TIME)
     _check_steps("stepped sine", frequencies.size * max_time, dt)
     response = steady_state_response(frequencies, request.amplitude, request.isolator,
@@ -516,17 +508,16 @@ def _stepped(request):
 
 
 def _sine(request):
-    from qzs.engine.simulate import simulate
     from qzs.viz.figures import envelope
 
     sine = request.sine()
-    dt, _, note = choose_page_step(sine, request.isolator, request.controller,
-                                   request.sample_rate,
-                                   tolerance_state=SINE_STATE_TOLERANCE * max(request.amplitude,
-                                                                              1e-6))
+    resolved = resolve_page_run(sine, request.isolator, request.controller, request.sample_rate,
+                                duration=request.sine_duration,
+                                tolerance_state=SINE_STATE_TOLERANCE * max(request.amplitude,
+                                                                           1e-6))
+    dt, note = resolved.dt, _step_note(resolved.step)
     _check_steps("sine", request.sine_duration, dt)
-    result = simulate(sine, request.isolator, request.controller, duration=request.sine_duration,
-                      dt=dt, sample_rate=request.sample_rate)
+    result = resolved.simulate()
     time_ = result.time
     payload = result.payload_displacement
     traces = {name: envelope(time_, values, TRACE_POINTS) for name, values in (
@@ -542,7 +533,7 @@ def compute_page(request):
 
     The chirp (Welch estimate, trusted bins only) or the stepped sine (settled frequencies
     only), the linear model over the band, and the payload's response to the sine over
-    ``sine_duration``; each run at the step :func:`choose_page_step` picks for the
+    ``sine_duration``; each run at the step :func:`resolve_page_run` picks for the
     transmissibility within ``qzs.defaults.ACCURACY['tolerance_db']`` (the sine: within
     :data:`SINE_STATE_TOLERANCE` of its amplitude in relative position).
 

@@ -30,9 +30,10 @@ from qzs.workflows.response.chirp import chirp_transmissibility
 from qzs.workflows.response.files import RESPONSE_SUFFIXES
 from qzs.workflows.response.frequency import PERIODIC_TOLERANCE, SAMPLES_PER_PERIOD, steps_for
 from qzs.workflows.response.result import ResponsePoint, SteadyStateResponse
-from qzs.workflows.response.sweep import (DIRECTIONS, MAX_PERIODS, settle_time_cap,
-                                          steady_state_response)
+from qzs.workflows.response.sweep import (DIRECTIONS, MAX_PERIODS, response_step,
+                                          settle_time_cap, steady_state_response)
 
 __all__ = ["ResponsePoint", "SteadyStateResponse", "steady_state_response",
            "chirp_transmissibility", "steps_for", "DIRECTIONS", "RESPONSE_SUFFIXES",
-           "SAMPLES_PER_PERIOD", "PERIODIC_TOLERANCE", "MAX_PERIODS", "settle_time_cap"]
+           "SAMPLES_PER_PERIOD", "PERIODIC_TOLERANCE", "MAX_PERIODS", "settle_time_cap",
+           "response_step"]

@@ -325,10 +325,7 @@ class SteadyStateResponse:
             ``settings``, ``step`` (the accuracy choice or None), ``balance`` (the curve or
             None), ``jumps``, ``hysteresis`` [Hz], ``notes``, ``elapsed`` [s].
         """
-        step = None
-        if self.step is not None:
-            step = {"dt": self.step.dt, "error_db": self.step.error,
-                    "tolerance_db": self.step.tolerance, "notes": list(self.step.notes)}
+        step = None if self.step is None else self.step.to_dict()
         return {"points": self.to_records(), "amplitude": self.amplitude, "dt": self.dt,
                 "solver": self.solver, "settings": dict(self.settings), "step": step,
                 "balance": None if self.balance is None else self.balance.to_dict(),

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from qzs import defaults
 from qzs._validation import choice, integer, positive, worker_count
-from qzs.errors import CountLimitError, ParameterError, ToleranceNotMetError
+from qzs.errors import CountLimitError, ParameterError
 from qzs.model.excitation import Chirp
 from qzs.workflows.response.chirp import _run_chirp
 from qzs.workflows.response.frequency import (CONSECUTIVE_PERIODS, MAX_PERIOD_MULTIPLE,
@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from qzs.model.controller import ControllerParameters
     from qzs.model.isolator import IsolatorParameters
 
-__all__ = ["steady_state_response", "settle_time_cap", "DIRECTIONS", "MAX_PERIODS"]
+__all__ = ["steady_state_response", "settle_time_cap", "response_step", "DIRECTIONS",
+           "MAX_PERIODS"]
 
 #: Sweep directions: ``up`` (rising frequency), ``down`` (falling), ``both`` (one of each).
 DIRECTIONS = ("up", "down", "both")
@@ -125,30 +126,52 @@ def settle_time_cap(isolator=None, controller=None):
     return float(np.clip(SETTLE_TIME_CONSTANTS / decay.min(), MIN_TIME, MAX_TIME))
 
 
-def _choose_step(frequencies, amplitude, isolator, controller, solver, tolerance_db, progress):
-    """The accuracy-driven step on a chirp over the band; ``(dt, choice, note)``."""
+def response_step(frequencies, amplitude, isolator, controller, *, solver, tolerance_db,
+                  sample_rate=None, progress=False):
+    """The accuracy-driven step of a stepped-sine response: a chirp over its band.
+
+    The step search (:func:`qzs.engine.accuracy.choose_step`, with the one fallback) on a
+    60 s chirp of the response's amplitude from the lowest frequency (0.8 times it for one
+    frequency) to the highest, at an output rate of at least ``MIN_STEPS_PER_PERIOD`` samples
+    per period of the highest, measured over that band.
+
+    Parameters
+    ----------
+    frequencies : ndarray
+        The response's frequencies [Hz], ascending.
+    amplitude : float
+        Base displacement amplitude [m].
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        PI and damping loops.
+    solver : str
+        The integrator.
+    tolerance_db : float
+        Tolerance on the transmissibility [dB].
+    sample_rate : float, optional
+        The probe's output rate [Hz]; default the larger of the default rate and
+        ``MIN_STEPS_PER_PERIOD`` per period of the highest frequency.
+    progress : bool
+        Show the probe runs' progress.
+
+    Returns
+    -------
+    StepChoice
+        The record (``met`` False, ``error`` NaN and a note for the fallback).
+    """
     from qzs.engine.accuracy import choose_step
 
     low, high = float(frequencies[0]), float(frequencies[-1])
-    rate = max(defaults.SIMULATION["sample_rate"], math.ceil(MIN_STEPS_PER_PERIOD * high))
+    if sample_rate is None:
+        sample_rate = max(defaults.SIMULATION["sample_rate"], math.ceil(MIN_STEPS_PER_PERIOD * high))
     if low == high:
         low = 0.8 * high
     probe = Chirp(amplitude=amplitude, f0=low, f1=high, duration=60.0,
                   fade_in=min(2.0 / low, 15.0))
-    try:
-        step = choose_step(probe, isolator, controller, tolerance_db=tolerance_db,
-                           solver=solver, sample_rate=rate, band=(low, high), progress=progress)
-    except ToleranceNotMetError as error:
-        dt = defaults.SIMULATION["dt"]
-        return dt, None, (f"no step met {tolerance_db:g} dB on the chirp probe ({error}); using "
-                          f"the paper's dt = {dt:g} s")
-    except ParameterError as error:  # the probe's own limits (no trusted bin in the band)
-        dt = min(defaults.SIMULATION["dt"], 1.0 / (MIN_STEPS_PER_PERIOD * high))
-        return dt, None, (f"the step could not be chosen on a chirp probe ({error}); using "
-                          f"dt = {dt:g} s")
-    return step.dt, step, (f"dt <= {step.dt:.3g} s chosen for {tolerance_db:g} dB on a "
-                           f"{low:g}-{high:g} Hz chirp probe (estimated error "
-                           f"{step.error:.2g} dB)")
+    return choose_step(probe, isolator, controller, tolerance_db=tolerance_db, solver=solver,
+                       sample_rate=sample_rate, band=(low, high), fallback=True,
+                       progress=progress, cache=True)
 
 
 def steady_state_response(frequencies: ArrayLike,
@@ -299,9 +322,11 @@ def steady_state_response(frequencies: ArrayLike,
     step = None
     if dt is None:
         tolerance_db = defaults.ACCURACY["tolerance_db"] if tolerance_db is None else tolerance_db
-        dt, step, note = _choose_step(frequencies, amplitude, isolator, controller, solver,
-                                      tolerance_db, progress)
-        notes.append(note)
+        step = response_step(frequencies, amplitude, isolator, controller, solver=solver,
+                             tolerance_db=tolerance_db, progress=progress)
+        dt = step.dt
+        notes.append(f"dt <= {step.line()}, on a {step.probe.f0:g}-{step.probe.f1:g} Hz chirp "
+                     "probe")
     _check_step(dt, frequencies, isolator, controller, solver)
     if max_time is None:
         max_time = settle_time_cap(isolator, controller)

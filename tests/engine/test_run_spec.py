@@ -1,0 +1,97 @@
+"""A run resolved once (qzs.engine.run_spec): the same inputs give the same step and the same
+bits from the API, the command line and the page; the duration reaches the step search.
+
+Properties that fail if the resolution is wrong:
+
+* ``qzs.simulate(..., tolerance=0.01)``, ``qzs simulate --tolerance 0.01 --out`` and the page
+  integrate at one step and give bit-identical series;
+* the step of a run shorter than its chirp is chosen over the band the run covers (a chirp
+  of the same sweep law ended at the frequency the run reaches), not the whole sweep's;
+* a literal step is a record too (nothing chosen, no estimate), and asking for a step two
+  ways, or for more samples than can be counted, is refused before any run.
+"""
+import json
+import math
+
+import numpy as np
+import pytest
+
+import qzs
+from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine
+from qzs.engine.accuracy import excitation_over
+from qzs.errors import ParameterError
+
+CHIRP = Chirp(duration=30.0, f1=5.0)
+
+
+def test_api_command_line_and_page_give_the_same_step_and_bits(tmp_path, capsys):
+    from qzs.app.compute import resolve_page_run
+    from qzs.cli import main
+
+    isolator, controller = IsolatorParameters(), ControllerParameters()
+    api = qzs.simulate(CHIRP, isolator, controller, tolerance=0.01)
+    assert api.step.chosen and api.step.met and api.run["dt"] == api.step.dt
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--excitation-duration", "30", "--f1", "5", "--tolerance", "0.01",
+                 "--out", str(out), "--plot", "none", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["step"]["dt"] == api.step.dt and record["step"]["error"] == api.step.error
+    page = resolve_page_run(CHIRP, isolator, controller, 1000.0).simulate()
+    assert page.step.dt == api.step.dt
+    import xarray as xr
+
+    with xr.open_dataset(out) as data:
+        for name in ("relative_position", "payload_acceleration", "friction_force",
+                     "motor_force"):
+            np.testing.assert_array_equal(data[name].values, api[name])
+            np.testing.assert_array_equal(page[name], api[name])
+    # the command line's default accuracy is the API's tolerance=0.01 (one decision)
+    default = qzs.resolve(CHIRP, step="chosen")
+    assert default.step.tolerance == qzs.defaults.ACCURACY["tolerance_db"]
+    assert default.dt == api.step.dt
+
+
+def test_a_run_shorter_than_its_chirp_chooses_its_step_over_the_band_it_covers():
+    """The paper's 2000 s chirp cut at 60 s covers 0-0.6 Hz: the probe sweeps that band."""
+    covered = excitation_over(Chirp(), 60.0)
+    assert covered.duration == 60.0 and math.isclose(covered.f1, 0.6)
+    t = np.linspace(0.0, 60.0, 601)
+    np.testing.assert_allclose(covered.frequency_at(t), Chirp().frequency_at(t), rtol=1e-12)
+    assert excitation_over(Chirp(), 2000.0) == Chirp()
+    assert excitation_over(Sine(frequency=2.0), 5.0) == Sine(frequency=2.0)
+    run = qzs.resolve(Chirp(), duration=60.0, step="chosen")
+    assert run.step.band[1] == pytest.approx(0.6)  # not the whole sweep's 20 Hz
+    assert run.step.probe.f1 < 1.0 and run.step.probe_duration <= 60.0
+    whole = qzs.resolve(Chirp(duration=200.0, f1=20.0), step="chosen")
+    assert whole.step.band[1] == 20.0
+
+
+def test_a_literal_step_is_a_record_and_the_python_default_is_the_papers_step():
+    run = qzs.resolve(CHIRP)
+    assert run.dt == qzs.defaults.SIMULATION["dt"] and not run.step.chosen
+    assert run.step.attributes() == {} and run.step.to_dict() == {"dt": 1e-4, "chosen": False}
+    result = qzs.simulate(Sine(frequency=2.0), duration=0.5, dt=5e-4)
+    assert result.step.dt == 5e-4 and not result.step.chosen
+
+
+@pytest.mark.parametrize("options, match", [
+    (dict(dt=1e-4, tolerance=0.01), "give one of `dt`, `tolerance`"),
+    (dict(tolerance=0.01, tolerance_state=1e-5), "give one of"),
+    (dict(excitation=Sine(frequency=2.0), duration=1e308), "output samples"),
+    (dict(step="fast"), "`step`"),
+])
+def test_inconsistent_or_impossible_requests_are_refused_before_any_run(options, match,
+                                                                        monkeypatch):
+    import qzs.engine.accuracy as accuracy
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("a step was searched")
+
+    monkeypatch.setattr(accuracy, "choose_step", no_search)
+    with pytest.raises(ParameterError, match=match):
+        qzs.resolve(**{"excitation": Chirp(), **options})
+
+
+def test_a_transmissibility_tolerance_for_a_sine_is_refused():
+    with pytest.raises(ParameterError, match="tolerance_state"):
+        qzs.resolve(Sine(frequency=2.0), duration=1.0, tolerance=0.01)
