@@ -266,7 +266,7 @@ def test_the_chosen_step_is_kept_in_the_file(tmp_path, capsys):
     assert main(["simulate", "--excitation-duration", "30", "--f1", "5",
                  "--sample-rate", "500", "--plot", "none", "--quiet", "--out", str(out)]) == 0
     with xr.open_dataset(out) as data:
-        assert data.attrs["run.step_tolerance_db"] == 0.01 and data.attrs["run.step_met"] == 1
+        assert data.attrs["run.step_tolerance_db"] == 0.01 and data.attrs["run.step"] == "accuracy-driven"
         assert 0 <= data.attrs["run.step_error_db"] <= 0.01
         assert data.attrs["run.dt"] > 1e-4
 

@@ -69,7 +69,8 @@ def test_a_run_shorter_than_its_chirp_chooses_its_step_over_the_band_it_covers()
 def test_a_literal_step_is_a_record_and_the_python_default_is_the_papers_step():
     run = qzs.resolve(CHIRP)
     assert run.dt == qzs.defaults.SIMULATION["dt"] and not run.step.chosen
-    assert run.step.attributes() == {} and run.step.to_dict() == {"dt": 1e-4, "chosen": False}
+    assert run.step.attributes() == {"step": "given"}
+    assert run.step.to_dict() == {"dt": 1e-4, "chosen": False}
     result = qzs.simulate(Sine(frequency=2.0), duration=0.5, dt=5e-4)
     assert result.step.dt == 5e-4 and not result.step.chosen
 

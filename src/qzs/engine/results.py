@@ -81,7 +81,8 @@ RUN_UNITS = {"solver": "-", "dt": "s", "sample_rate": "Hz", "duration": "s", "st
              "elapsed": "s", "completed": "1", "stop_contacts": "1", "stick_events": "1",
              "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1",
              "step_tolerance_db": "dB", "step_error_db": "dB", "step_tolerance_m": "m",
-             "step_error_m": "m"}
+             "step_error_m": "m", "step": "-", "step_reference_dt": "s",
+             "step_probe_duration": "s", "step_reason": "-"}
 #: File formats of a run's result: suffix -> name.
 RESULT_SUFFIXES = files.RESULT_SUFFIXES
 #: Where a run's output rows go in its file: variable -> (block, column) of ``(data, flags)``.

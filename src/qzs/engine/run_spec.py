@@ -26,7 +26,7 @@ from typing import Any
 from qzs import _validation, defaults
 from qzs.errors import ParameterError
 
-__all__ = ["ResolvedRun", "resolve", "MAX_SAMPLES"]
+__all__ = ["ResolvedRun", "resolve", "ResolvedHexapodRun", "resolve_hexapod", "MAX_SAMPLES"]
 
 #: Output samples a run may ask for at most [-] (past this, counts lose their integers).
 MAX_SAMPLES = 1e15
@@ -223,3 +223,133 @@ def resolve(excitation=None, isolator=None, controller=None, *, duration=None, d
                        initial_state=initial_state, duration=duration, dt=choice.dt,
                        sample_rate=sample_rate, solver=solver, step=choice, notes=tuple(notes))
 
+
+
+@dataclass(frozen=True, kw_only=True)
+class ResolvedHexapodRun:
+    """A six-leg platform run with its step resolved: what :func:`resolve_hexapod` returns.
+
+    Attributes
+    ----------
+    excitation : dict
+        Axis name -> excitation.
+    duration : float or None
+        Simulated time [s] (None: the shortest excitation's length).
+    dt : float
+        Integration step [s].
+    sample_rate : float
+        Output rate [Hz].
+    solver : str
+        The integrator.
+    step : StepChoice
+        How ``dt`` was chosen, or that it was given: the one record.
+    """
+
+    excitation: Any
+    duration: Any
+    dt: float
+    sample_rate: float
+    solver: str
+    step: Any
+
+    def arguments(self):
+        """The keywords of :func:`~qzs.engine.hexapod.simulate.simulate_hexapod` it fixes.
+
+        Returns
+        -------
+        dict
+            ``excitation``, ``duration`` [s], ``dt`` [s], ``sample_rate`` [Hz], ``solver``.
+        """
+        return dict(excitation=self.excitation, duration=self.duration, dt=self.dt,
+                    sample_rate=self.sample_rate, solver=self.solver)
+
+
+def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excitation,
+                    duration=None, dt=None, tolerance_db=None, tolerance_state=None,
+                    sample_rate=defaults.SIMULATION["sample_rate"],
+                    solver=defaults.SIMULATION["solver"], cartesian=None, finest=None,
+                    step="literal", progress=False):
+    """Resolve a six-leg platform run once: validate its settings, choose its step.
+
+    The step is literal (``dt``), or the largest meeting a tolerance
+    (:func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`, with the one fallback): the
+    driven axis's transmissibility within ``tolerance_db`` [dB] (one moving axis), or the pose
+    within ``tolerance_state`` [m]; given neither, ``step`` decides as for :func:`resolve`
+    (``"chosen"``: ``defaults.ACCURACY``, the transmissibility for one chirp, else the pose).
+
+    Parameters
+    ----------
+    geometry : HexapodGeometry
+        The platform's joints.
+    platform : PlatformParameters
+        Its mass and inertia.
+    isolator, controller : IsolatorParameters, ControllerParameters or sequences of six
+        The legs.
+    excitation : dict
+        Axis name -> built excitation.
+    duration : float, optional
+        Simulated time [s].
+    dt : float, optional
+        A literal step [s].
+    tolerance_db : float, optional
+        Tolerance [dB] on the driven axis's column of the transmissibility.
+    tolerance_state : float, optional
+        Tolerance [m] on the pose.
+    sample_rate : float
+        Output rate [Hz].
+    solver : str
+        The integrator.
+    cartesian : CartesianController, optional
+        Centralised loops.
+    finest : float, optional
+        The finest candidate of the search and its fallback [s] (default the paper's step).
+    step : {"literal", "chosen"}
+        The step given neither ``dt`` nor a tolerance, as for :func:`resolve`.
+    progress : bool
+        Show the probes' progress.
+
+    Returns
+    -------
+    ResolvedHexapodRun
+
+    Raises
+    ------
+    ParameterError
+        Invalid settings (before any probe), both a ``dt`` and a tolerance.
+    """
+    from qzs.engine.hexapod.accuracy import choose_hexapod_step
+    from qzs.engine.hexapod.prepare import check_hexapod_run
+    from qzs.engine.step_search import StepChoice
+    from qzs.model.excitation import Chirp
+
+    _validation.choice("step", step, ("literal", "chosen"))
+    given = [name for name, value in (("dt", dt), ("tolerance_db", tolerance_db),
+                                      ("tolerance_state", tolerance_state)) if value is not None]
+    if len(given) > 1:
+        raise ParameterError(f"give one of `dt`, `tolerance_db` and `tolerance_state`, got "
+                             f"{' and '.join(f'`{n}`' for n in given)}; a literal step has no "
+                             "tolerance to meet.")
+    finest = defaults.SIMULATION["dt"] if finest is None else finest
+    if dt is None and not given and step == "literal":
+        dt = finest
+    # bad settings fail before any probe (at the finest step, which any choice is above)
+    check_hexapod_run(geometry, platform, isolator, controller, excitation=excitation,
+                      duration=duration, dt=finest if dt is None else dt,
+                      sample_rate=sample_rate, solver=solver, cartesian=cartesian)
+    if dt is not None:
+        choice = StepChoice.literal(dt, sample_rate=sample_rate, solver=solver)
+    else:
+        if tolerance_db is not None:
+            asked = {"tolerance_db": tolerance_db}
+        elif tolerance_state is not None:
+            asked = {"tolerance_state": tolerance_state}
+        elif len(excitation) == 1 and isinstance(next(iter(excitation.values())), Chirp):
+            asked = {"tolerance_db": defaults.ACCURACY["tolerance_db"]}
+        else:
+            asked = {"tolerance_state": defaults.ACCURACY["tolerance_state"]}
+        choice = choose_hexapod_step(geometry, platform, isolator, controller,
+                                     excitation=excitation, **asked, solver=solver,
+                                     sample_rate=sample_rate, duration=duration, finest=finest,
+                                     fallback=True, cartesian=cartesian, progress=progress)
+    return ResolvedHexapodRun(excitation=excitation, duration=duration, dt=choice.dt,
+                              sample_rate=sample_rate, solver=solver, step=choice)

@@ -31,7 +31,7 @@ from qzs import _validation, defaults
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 
 __all__ = ["StepChoice", "search_step", "halving_search", "admissible_step", "tolerance_measure",
-           "bound_notes", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
+           "bound_notes", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
            "ADMISSIBLE_REFINEMENT"]
 
 #: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
@@ -184,19 +184,13 @@ class StepChoice:
         return "\n".join(lines)
 
     def line(self):
-        """The step in one line, as summaries and reports quote it.
+        """The step in one line, as summaries and reports quote it (:func:`record_line`).
 
         Returns
         -------
         str
         """
-        if not self.chosen:
-            return f"{self.dt:.6g} s (given)"
-        if not self.met:
-            return (f"{self.dt:.6g} s (no step tried met {self.tolerance:g} {self.unit}; "
-                    "error not estimated)")
-        return (f"{self.dt:.6g} s (chosen for {self.tolerance:g} {self.unit}, estimated error "
-                f"{self.error:.2g} {self.unit})")
+        return record_line({"dt": self.dt, **self.attributes()})
 
     def to_dict(self):
         """The record as JSON gives it (``qzs ... --json``'s ``step``).
@@ -221,23 +215,66 @@ class StepChoice:
         return record
 
     def attributes(self):
-        """The record as a run's file attributes give it (``run.step_*``).
+        """The record as a run's entries and file attributes give it (``run.step*``).
 
         Returns
         -------
         dict
-            Nothing for a literal step (``run.dt`` says it all); for a chosen one
-            ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the state
-            measure; the error NaN where no step met the tolerance), ``step_met`` (1 or 0)
-            and ``step_reference_dt`` [s].
+            ``step``: ``"given"`` (a literal step: nothing more), ``"accuracy-driven"`` (the
+            step met the tolerance) or ``"fallback"`` (no step tried met it); for the last
+            two also ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the
+            state measure; the error NaN for the fallback), ``step_reference_dt`` [s],
+            ``step_probe_duration`` [s] and ``step_reason`` (why this step, in words).
         """
         if not self.chosen:
-            return {}
+            return {"step": "given"}
         suffix = self.unit.lower()
-        return {f"step_tolerance_{suffix}": float(self.tolerance),
+        if self.met:
+            reason = (f"estimated error {self.error:.2g} {self.unit} <= {self.tolerance:g} "
+                      f"{self.unit} / safety on a {self.probe_duration:g} s probe")
+        else:
+            reason = self.notes[-1] if self.notes else "no step tried met the tolerance"
+        return {"step": "accuracy-driven" if self.met else "fallback",
+                f"step_tolerance_{suffix}": float(self.tolerance),
                 f"step_error_{suffix}": float(self.error),
-                "step_met": int(bool(self.met)),
-                "step_reference_dt": float(self.reference_dt)}
+                "step_reference_dt": float(self.reference_dt),
+                "step_probe_duration": float(self.probe_duration), "step_reason": reason}
+
+
+#: Units of the record's entries (:meth:`StepChoice.attributes`), for files.
+RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB", "step_error_m": "m",
+                "step_tolerance_m": "m", "step_reference_dt": "s", "step_probe_duration": "s",
+                "step_reason": ""}
+
+
+def record_line(run):
+    """How a run's step was chosen, in one line, from its record's entries.
+
+    The one way every summary, report and console line shows a step: from a
+    :class:`StepChoice` (:meth:`StepChoice.line`) or from a run's entries and a file's
+    attributes read back (:meth:`StepChoice.attributes` with ``dt``).
+
+    Parameters
+    ----------
+    run : mapping
+        ``dt`` [s] and the entries of :meth:`StepChoice.attributes` (``step`` missing:
+        given).
+
+    Returns
+    -------
+    str
+    """
+    kind = run.get("step", "given")
+    if kind == "given":
+        return f"dt = {run['dt']:g} s, given (no error estimate)"
+    key = "db" if "step_tolerance_db" in run else "m"
+    unit = MEASURE_UNITS["transmissibility_db" if key == "db" else "state_m"]
+    if kind == "accuracy-driven":
+        return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
+                f"{run['step_error_' + key]:.2g} {unit} (tolerance "
+                f"{run['step_tolerance_' + key]:g} {unit}, reference dt "
+                f"{run['step_reference_dt']:.3g} s, {run['step_probe_duration']:g} s probe)")
+    return f"dt = {run['dt']:g} s, fallback: {run['step_reason']}"
 
 
 # ---------------------------------------------------------------- shared validation

@@ -59,7 +59,7 @@ if TYPE_CHECKING:
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
            "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
-           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised", "step_record"]
+           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised"]
 
 #: Folder of the shipped hexapod files, inside the package.
 SHIPPED = "workflows/hexapod_files"
@@ -632,7 +632,8 @@ def simulate_setup(setup: HexapodSetup, *,
         A literal integration step [s]. Default: the step chosen for a tolerance
         (:func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`), halving down to the
         file's ``[simulation] dt`` (else 1e-4 s) and taking it where no coarser step meets
-        the tolerance; ``result.run`` says which (:func:`step_record`).
+        the tolerance (:func:`qzs.engine.run_spec.resolve_hexapod`); ``result.run`` says
+        which (:meth:`~qzs.engine.step_search.StepChoice.attributes`).
     tolerance_db : float, optional
         Tolerance [dB] on the driven axis's column of the transmissibility (one moving
         axis); the default measure, at ``qzs.defaults.ACCURACY["tolerance_db"]``, for a
@@ -674,6 +675,7 @@ def simulate_setup(setup: HexapodSetup, *,
     """
     from qzs.defaults import SIMULATION
     from qzs.engine.hexapod import simulate_hexapod
+    from qzs.engine.run_spec import resolve_hexapod
     from qzs.model.excitation import build_excitation
 
     tables = {**setup.excitation, **(excitation or {})}
@@ -695,34 +697,30 @@ def simulate_setup(setup: HexapodSetup, *,
     arguments = dict(excitation=built, duration=run.get("duration"),
                      dt=run.get("dt", SIMULATION["dt"]) if dt is None else dt,
                      sample_rate=run.get("sample_rate", SIMULATION["sample_rate"]),
-                     solver=run.get("solver", SIMULATION["solver"]), cartesian=setup.cartesian,
-                     progress=progress, interruptible=interruptible)
-    measure, tolerance = _step_tolerance(built, dt, tolerance_db, tolerance_state)
+                     solver=run.get("solver", SIMULATION["solver"]))
     if out is not None:
         check_out = _out_check(out, argument, arguments, built)
         check_out()
-    step = {"step": "given", "step_reason": "given by the caller"}
-    if measure is not None:  # bad settings fail before any probe
-        from qzs.engine.hexapod.prepare import check_hexapod_run
-
-        check_hexapod_run(setup.geometry, setup.platform, setup.isolator, setup.controller,
-                          **{key: arguments[key] for key in (
-                              "excitation", "duration", "dt", "sample_rate", "solver",
-                              "cartesian")})
-        arguments["dt"], step = _chosen_step(setup, built, arguments, measure, tolerance,
-                                             progress)
+    resolved = resolve_hexapod(setup.geometry, setup.platform, setup.isolator, setup.controller,
+                               excitation=built, duration=arguments["duration"], dt=dt,
+                               tolerance_db=tolerance_db, tolerance_state=tolerance_state,
+                               sample_rate=arguments["sample_rate"], solver=arguments["solver"],
+                               cartesian=setup.cartesian, finest=arguments["dt"], step="chosen",
+                               progress=progress)
+    common = dict(cartesian=setup.cartesian, progress=progress, interruptible=interruptible,
+                  **resolved.arguments())
     if out is None:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                  setup.controller, **arguments)
-        result.run.update(step)
+                                  setup.controller, **common)
+        result.run.update(resolved.step.attributes())
         return result
     from qzs.engine.hexapod.result import HexapodWriter
 
     check_out()  # again: the probes took a while
     with HexapodWriter(out) as writer:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                  setup.controller, sink=writer.append, **arguments)
-        result.run.update(step)
+                                  setup.controller, sink=writer.append, **common)
+        result.run.update(resolved.step.attributes())
         writer.finish(result)
     return result
 
@@ -745,71 +743,3 @@ def _out_check(out, argument, arguments, built):
                                       suffix if suffix in HEXAPOD_SUFFIXES else ".nc")
     return lambda: check_output_path(out, argument=argument, suffixes=HEXAPOD_SUFFIXES,
                                      estimated_bytes=size)
-
-
-def _step_tolerance(built, dt, tolerance_db, tolerance_state):
-    """The step's measure and tolerance (None, None for a literal ``dt``)."""
-    from qzs._validation import positive_real
-    from qzs.defaults import ACCURACY
-    from qzs.model.excitation import Chirp
-
-    given = [name for name, value in (("tolerance_db", tolerance_db),
-                                      ("tolerance_state", tolerance_state)) if value is not None]
-    if dt is not None:
-        if given:
-            raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or "
-                                 f"`{given[0]}` (the step chosen to meet it), not both.")
-        return None, None
-    if len(given) == 2:
-        raise ParameterError("give at most one of `tolerance_db` (the driven axis's "
-                             "transmissibility, dB) and `tolerance_state` (the pose, m).")
-    if tolerance_db is not None:
-        return "transmissibility_db", positive_real("tolerance_db", tolerance_db)
-    if tolerance_state is not None:
-        return "state_m", positive_real("tolerance_state", tolerance_state)
-    if len(built) == 1 and isinstance(next(iter(built.values())), Chirp):
-        return "transmissibility_db", ACCURACY["tolerance_db"]
-    return "state_m", ACCURACY["tolerance_state"]
-
-
-def _chosen_step(setup, built, arguments, measure, tolerance, progress):
-    """The accuracy-driven step of a run and its record (:func:`step_record`)."""
-    from qzs.engine.hexapod.accuracy import choose_hexapod_step
-
-    finest = arguments["dt"]
-    choice = choose_hexapod_step(
-        setup.geometry, setup.platform, setup.isolator, setup.controller, excitation=built,
-        **{("tolerance_db" if measure == "transmissibility_db" else "tolerance_state"):
-           tolerance},
-        solver=arguments["solver"], sample_rate=arguments["sample_rate"],
-        duration=arguments["duration"], finest=finest, fallback=finest,
-        cartesian=setup.cartesian, progress=progress)
-    return choice.dt, step_record(choice)
-
-
-def step_record(choice):
-    """A chosen step as the keys a run's ``run`` dict (and its file) carries.
-
-    Parameters
-    ----------
-    choice : StepChoice
-        :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`'s.
-
-    Returns
-    -------
-    dict
-        ``step`` (``"accuracy-driven"``, or ``"set-up"`` where no coarser step than the
-        file's met the tolerance), ``step_error_db`` and ``step_tolerance_db`` [dB] or
-        ``step_error_m`` and ``step_tolerance_m`` [m] (the estimated error, NaN if none,
-        and the tolerance: the names of :mod:`qzs.engine.accuracy`'s run entries),
-        ``step_reference_dt`` [s], ``step_probe_duration`` [s] and ``step_reason``.
-    """
-    from qzs.engine.accuracy import MEASURE_UNITS, step_run_entries
-
-    unit = MEASURE_UNITS[choice.measure]
-    reason = (f"estimated error {choice.error:.2g} {unit} <= {choice.tolerance:g} {unit} / "
-              f"safety on a {choice.probe_duration:g} s probe" if choice.met
-              else choice.notes[-1])
-    return {"step": "accuracy-driven" if choice.met else "set-up", **step_run_entries(choice),
-            "step_reference_dt": choice.reference_dt,
-            "step_probe_duration": choice.probe_duration, "step_reason": reason}

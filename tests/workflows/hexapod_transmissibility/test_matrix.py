@@ -314,6 +314,6 @@ def test_the_quick_study_writes_its_report_and_states_its_choices(quick_study):
                 assert 0 <= step["error_db"] <= 0.01 / 2 and step["dt"] > 1e-4
                 assert f"dt = {step['dt']:g} s, accuracy-driven" in report
             else:
-                assert step["step"] == "set-up" and step["dt"] == 1e-4
+                assert step["step"] == "fallback" and step["dt"] == 1e-4
                 assert step["error_db"] is None and "do not shrink" in report  # NaN is null
     assert record["steps"]["PI"]["x"]["step"] == "accuracy-driven"

@@ -424,10 +424,10 @@ class HexapodResult:
                     if axis in AXES[3:]:
                         unit = unit.replace("m", "rad") if unit in ("m", "m/s", "m/s^2") else unit
                     meta[f"excitation.{axis}.{field.name}"] = (item, unit)
+        from qzs.engine.step_search import RECORD_UNITS
+
         units = {"dt": "s", "sample_rate": "Hz", "duration": "s", "elapsed": "s", "stops": "m",
-                 "step_error_db": "dB", "step_tolerance_db": "dB", "step_error_m": "m",
-                 "step_tolerance_m": "m", "step_reference_dt": "s", "step_probe_duration": "s",
-                 "step": "-", "step_reason": "-"}
+                 **{key: unit or "-" for key, unit in RECORD_UNITS.items()}}
         for key, value in self.run.items():
             meta[f"run.{key}"] = (value, units.get(key, "1" if key != "solver" else "-"))
         return meta

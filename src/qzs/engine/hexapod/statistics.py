@@ -105,16 +105,6 @@ def _summary_text(result):
 
 def _step_line(run):
     """How the run's step was chosen, where the caller recorded it (``run["step"]``)."""
-    if "step" not in run:
-        return []
-    if run["step"] == "given":
-        return [f"Step: dt = {run['dt']:g} s, given (no error estimate)"]
-    unit = "dB" if "step_tolerance_db" in run else "m"
-    key = "db" if unit == "dB" else "m"
-    measure = "the transmissibility" if unit == "dB" else "the pose"
-    if run["step"] == "accuracy-driven":
-        return [f"Step: dt = {run['dt']:g} s, accuracy-driven: estimated error "
-                f"{run['step_error_' + key]:.2g} {unit} on {measure} (tolerance "
-                f"{run['step_tolerance_' + key]:g} {unit}, reference dt "
-                f"{run['step_reference_dt']:.3g} s, {run['step_probe_duration']:g} s probe)"]
-    return [f"Step: dt = {run['dt']:g} s, the file's: {run['step_reason']}"]
+    from qzs.engine.step_search import record_line
+
+    return [f"Step: {record_line(run)}"] if "step" in run else []

@@ -284,14 +284,9 @@ def step_text(run: Mapping[str, Any], settings: Mapping[str, Any]) -> str:
     -------
     str
     """
-    if run["step"] == "given":
-        return f"dt = {run['dt']:g} s, given (no error estimate)"
-    tolerance = settings["tolerance_db"]
-    if run["step"] == "accuracy-driven":
-        return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
-                f"{run['step_error_db']:.2g} dB (tolerance {tolerance:g} dB, reference dt "
-                f"{run['step_reference_dt']:.3g} s)")
-    return f"dt = {run['dt']:g} s, the set-up's: {run['step_reason']}"
+    from qzs.engine.step_search import record_line
+
+    return record_line(run)
 
 
 def run_steps(result: HexapodTransmissibility) -> dict[str, dict[str, Any]]:
@@ -309,9 +304,11 @@ def run_steps(result: HexapodTransmissibility) -> dict[str, dict[str, Any]]:
         error [dB], NaN if none), ``tolerance_db`` [dB] (None with a given ``dt``),
         ``reference_dt`` [s], ``reason``.
     """
-    return {axis: {"dt": run["dt"], "step": run["step"], "error_db": run["step_error_db"],
+    return {axis: {"dt": run["dt"], "step": run["step"],
+                   "error_db": run.get("step_error_db", math.nan),
                    "tolerance_db": result.settings["tolerance_db"],
-                   "reference_dt": run["step_reference_dt"], "reason": run["step_reason"]}
+                   "reference_dt": run.get("step_reference_dt", math.nan),
+                   "reason": run.get("step_reason", "given by the caller")}
             for axis, run in result.runs.items()}
 
 
@@ -449,9 +446,12 @@ def transmissibility_dataset(result):
         attrs[f"settings.{key}"] = _attribute(value)
         if key in units:
             attrs[f"settings.{key}_units"] = units[key]
+    from qzs.engine.step_search import RECORD_UNITS
+
     run_units = {"dt": "s", "elapsed": "s", "seconds": "s", "energy_residual": "J",
                  "base_work_max": "J", "stroke_used": "m", "stroke_half": "m",
-                 "step_error_db": "dB", "step_reference_dt": "s", "locked_fraction": "1"}
+                 "locked_fraction": "1",
+                 **{key: unit for key, unit in RECORD_UNITS.items() if unit}}
     for axis, record in result.runs.items():
         for key, value in record.items():
             if key == "step_history":

@@ -1,11 +1,10 @@
 """One run per excited base axis: its step, its simulation and its column of estimates."""
-import math
 import time
 
 import numpy as np
 
 from qzs.defaults import AXES
-from qzs.engine.accuracy import SAFETY
+from qzs.engine.step_search import StepChoice
 from qzs.workflows.hexapod_transmissibility.plan import _control
 
 
@@ -39,7 +38,8 @@ def axis_step(task):
 
     :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step` on the run's chirp, the driven
     axis's transmissibility against ``task["tolerance_db"]``, halving down to the set-up's
-    ``dt`` and falling back to it where no coarser step meets the tolerance.
+    ``dt`` and falling back to it where no coarser step meets the tolerance (the one
+    fallback, :mod:`qzs.engine.step_search`).
 
     Parameters
     ----------
@@ -51,10 +51,10 @@ def axis_step(task):
     dt : float
         The step [s].
     record : dict
-        ``step`` (``"accuracy-driven"`` or ``"set-up"``), ``step_error_db`` (the
-        estimate at the chosen step [dB], NaN for the set-up's), ``step_reference_dt`` (the
-        finest step of the probe [s]), ``step_history`` (``(dt [s], difference to the next
-        finer step [dB])`` per step compared) and ``step_reason``.
+        The step record's entries (:meth:`~qzs.engine.step_search.StepChoice.attributes`:
+        ``step``, ``step_error_db``, ``step_tolerance_db``, ``step_reference_dt``,
+        ``step_probe_duration``, ``step_reason``) and ``step_history`` (``(dt [s],
+        difference to the next finer step [dB])`` per step compared).
     """
     from qzs.engine.hexapod.accuracy import choose_hexapod_step
 
@@ -64,16 +64,9 @@ def axis_step(task):
         excitation={task["axis"]: task["excitation"]}, tolerance_db=task["tolerance_db"],
         solver=task["solver"], sample_rate=task["sample_rate"],
         band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1), finest=task["setup_dt"],
-        fallback=task["setup_dt"], **_control(task))
+        fallback=True, **_control(task))
     history = tuple((dt, d) for dt, d, _ in choice.history)
-    record = dict(step_error_db=choice.error, step_reference_dt=choice.reference_dt,
-                  step_history=history)
-    if math.isnan(choice.error):
-        return choice.dt, dict(step="set-up", step_reason=choice.notes[-1], **record)
-    return choice.dt, dict(
-        step="accuracy-driven", step_reason=(
-            f"estimated error {choice.error:.3g} dB <= {task['tolerance_db']:g} dB / "
-            f"{SAFETY:g} on a {choice.probe_duration:g} s probe"), **record)
+    return choice.dt, dict(choice.attributes(), step_history=history)
 
 
 def run_axis(task):
@@ -93,9 +86,8 @@ def run_axis(task):
     """
     start = time.perf_counter()
     if task["dt"] is not None:
-        dt, record = task["dt"], dict(step="given", step_error_db=math.nan,
-                                      step_reference_dt=math.nan, step_history=(),
-                                      step_reason="given by the caller")
+        dt, record = task["dt"], dict(StepChoice.literal(task["dt"]).attributes(),
+                                      step_history=())
     else:
         dt, record = axis_step(task)
     result = _simulate(task, task["excitation"], dt, task["duration"])
