@@ -315,5 +315,5 @@ def test_the_quick_study_writes_its_report_and_states_its_choices(quick_study):
                 assert f"dt = {step['dt']:g} s, accuracy-driven" in report
             else:
                 assert step["step"] == "fallback" and step["dt"] == 1e-4
-                assert step["error_db"] is None and "do not shrink" in report  # NaN is null
+                assert step["error_db"] is None and "redraw the response" in report  # NaN is null
     assert record["steps"]["PI"]["x"]["step"] == "accuracy-driven"
