@@ -6,7 +6,7 @@ import numpy as np
 
 from qzs.defaults import AXES
 from qzs.engine.accuracy import SAFETY
-from qzs.workflows.hexapod_transmissibility.plan import _control
+from qzs.workflows.hexapod.transmissibility.plan import _control
 
 
 # ---------------------------------------------------------------- one run
