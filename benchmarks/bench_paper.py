@@ -13,8 +13,8 @@ import sys
 import tempfile
 import time
 
-from qzs.workflows.report import write_paper_outputs
-from qzs.workflows.studies import load_study, run_studies, shipped_studies
+from qzs.workflows.paper.report import write_paper_outputs
+from qzs.workflows.paper.studies import load_study, run_studies, shipped_studies
 
 TARGET_SECONDS = 180.0
 

@@ -16,7 +16,7 @@ part, the time per frequency and the periods each frequency needed to become per
 One warm-up call first fills numba's on-disk cache so that compile time is left out.
 
 **Study** (``--study``): for each transmissibility case of the paper's shipped studies
-(``src/qzs/workflows/study_files``), the steady state beside the chirp-and-Welch estimate
+(``src/qzs/workflows/paper/study_files``), the steady state beside the chirp-and-Welch estimate
 (:func:`qzs.workflows.response.chirp_transmissibility`: 0 -> 20 Hz at 0.01 Hz/s, 1 kHz,
 32768-point Hann segments), compared by frequency band of the up sweep: *locked* (the
 payload held all period), *stick-slip* (part of it) and *sliding* (never held). Printed: the
@@ -100,7 +100,7 @@ def speed(workers):
 
 
 def _study_cases(names):
-    from qzs.workflows.studies import load_study, shipped_studies
+    from qzs.workflows.paper.studies import load_study, shipped_studies
 
     for path in shipped_studies():
         study = load_study(path)

@@ -134,7 +134,7 @@ def test_experiment_refuses_zero_fft_length_and_averages(tmp_path, capsys, optio
                                                   ("n_averages", 0, "n_averages"),
                                                   ("fft_length", 2.5, "fft_length")])
 def test_run_experiment_refuses_zero_settings(tmp_path, keyword, value, name):
-    from qzs.workflows.experiment import run_experiment
+    from qzs.workflows.experiment.process import run_experiment
 
     with pytest.raises(ParameterError, match=f"`{name}`.*got {value}"):
         run_experiment(DATA / "experiment.csv", DATA / "experiment_map.toml",
@@ -143,7 +143,7 @@ def test_run_experiment_refuses_zero_settings(tmp_path, keyword, value, name):
 
 
 def test_map_experiment_table_with_zero_averages(tmp_path):
-    from qzs.workflows.experiment import run_experiment
+    from qzs.workflows.experiment.process import run_experiment
 
     text = (DATA / "experiment_map.toml").read_text()
     (tmp_path / "map.toml").write_text(text + "\n[experiment]\nn_averages = 0\n"

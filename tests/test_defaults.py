@@ -8,7 +8,7 @@ from qzs import defaults
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_RATE_UNITS, AXIS_UNITS, EXCITATION, HEXAPOD
 from qzs.model.excitation import Chirp, Sine
-from qzs.workflows.hexapod import hexapod_setup
+from qzs.workflows.hexapod.setups import hexapod_setup
 
 SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 

@@ -47,7 +47,7 @@ assert main(["simulate", "--excitation", "sine", "--frequency", "3", "--duration
              "--plot", "none", "--quiet"]) == 0
 assert main(["study", "spring", "--out", {str(tmp_path / "study")!r}, "--workers", "1",
              "--quiet"]) == 0
-import qzs.workflows.report, qzs.workflows.sweeps
+import qzs.workflows.paper.report, qzs.workflows.sweeps
 from qzs.iotools.readers import read_recording
 from qzs.errors import MissingDependencyError
 open({str(tmp_path / "log.mf4")!r}, "wb").write(b"MDF     ")

@@ -43,11 +43,11 @@ RESULT_CLASSES = {
     "qzs.identify": ["SpringFit", "FrictionFit", "TransmissibilityFit"],
     "qzs.iotools.readers": ["Recording", "ChannelMap"],
     "qzs.workflows.response": ["ResponsePoint"],
-    "qzs.workflows.experiment": ["ExperimentResult"],
-    "qzs.workflows.hexapod": ["HexapodSetup"],
-    "qzs.workflows.hexapod_study": ["HexapodStudyResult"],
-    "qzs.workflows.report": ["Verdict"],
-    "qzs.workflows.studies": ["StudyResult"],
+    "qzs.workflows.experiment.process": ["ExperimentResult"],
+    "qzs.workflows.hexapod.setups": ["HexapodSetup"],
+    "qzs.workflows.hexapod.study": ["HexapodStudyResult"],
+    "qzs.workflows.paper.report": ["Verdict"],
+    "qzs.workflows.paper.studies": ["StudyResult"],
     "qzs.workflows.sweeps": ["SweepDefinition"],
 }
 

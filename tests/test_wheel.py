@@ -29,7 +29,7 @@ BUILD_INPUTS = ("pyproject.toml", "README.md", "LICENSE", "src")
 
 def package_data_files():
     """Every file under src/qzs that a ``[tool.setuptools.package-data]`` pattern matches,
-    as a path inside the wheel (``qzs/workflows/study_files/01_spring.toml``)."""
+    as a path inside the wheel (``qzs/workflows/paper/study_files/01_spring.toml``)."""
     patterns = PYPROJECT["tool"]["setuptools"]["package-data"]["qzs"]
     return sorted({f"qzs/{path.relative_to(SOURCE).as_posix()}"
                    for pattern in patterns for path in SOURCE.glob(pattern) if path.is_file()})
@@ -101,10 +101,10 @@ def test_every_package_data_file_is_in_the_wheel(built):
     """The shipped TOML files, any docs pages the package ships: whatever the patterns match."""
     names, wheel, _ = built
     expected = package_data_files()
-    assert any(name.startswith("qzs/workflows/study_files/") for name in expected)
-    assert any(name.startswith("qzs/workflows/sweep_files/") for name in expected)
-    assert any(name.startswith("qzs/workflows/hexapod_files/") for name in expected)
-    assert any(name.startswith("qzs/workflows/problem_files/") for name in expected)
+    assert any(name.startswith("qzs/workflows/paper/study_files/") for name in expected)
+    assert any(name.startswith("qzs/workflows/sweeps/sweep_files/") for name in expected)
+    assert any(name.startswith("qzs/workflows/hexapod/hexapod_files/") for name in expected)
+    assert any(name.startswith("qzs/workflows/design_space/problem_files/") for name in expected)
     missing = [name for name in expected if name not in names]
     assert not missing, f"{wheel.name} lacks {missing}"
 

@@ -8,7 +8,7 @@ case dashed in its colour. It draws every figure of ``qzs paper``; here the pape
 the stiction study, from its quick runs.
 """
 from qzs.viz import plot_transmissibility
-from qzs.workflows.studies import run_study
+from qzs.workflows.paper.studies import run_study
 
 study = run_study("stiction", quick=True, workers=2, progress=False)
 curves = [dict(label=case.label, frequency=case.frequency, magnitude=case.magnitude,

@@ -2,7 +2,7 @@
 An experiment log beside its simulation
 =======================================
 
-:meth:`ExperimentResult.plot <qzs.workflows.experiment.ExperimentResult.plot>` (that is,
+:meth:`ExperimentResult.plot <qzs.workflows.experiment.process.ExperimentResult.plot>` (that is,
 :func:`qzs.viz.experiment.plot_experiment`) draws the transmissibility measured from a rig's
 log beside the simulation of the same chirp, processed the same way, with the coherence and
 the band below 1.5 times the amplifiers' high-pass flagged. The "log" is made by qzs: base and
@@ -15,7 +15,7 @@ import numpy as np
 
 import qzs
 from qzs.analysis.spectral import highpass
-from qzs.workflows.experiment import process_experiment
+from qzs.workflows.experiment.process import process_experiment
 
 folder = Path(tempfile.mkdtemp())
 run = qzs.simulate(qzs.Chirp(duration=120.0), sample_rate=500.0)

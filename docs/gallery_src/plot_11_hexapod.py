@@ -9,7 +9,7 @@ cubic platform of six paper legs (``paper_legs_cubic``), its base shaken sideway
 4 Hz sine.
 """
 import qzs
-from qzs.workflows.hexapod import load_hexapod
+from qzs.workflows.hexapod.setups import load_hexapod
 
 setup = load_hexapod("paper_legs_cubic")
 result = qzs.simulate_hexapod(setup.geometry, setup.platform, setup.isolator, setup.controller,

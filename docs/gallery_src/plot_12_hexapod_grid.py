@@ -7,7 +7,7 @@ transmissibility as a 6x6 grid: each panel one platform axis (row) per base axis
 dB of its unit, the linear model dashed and simulated curves solid on their trusted bins.
 First the linear model of the shipped cubic platform (``qzs hexapod linear --plot``), then
 :meth:`HexapodTransmissibility.plot
-<qzs.workflows.hexapod_transmissibility.HexapodTransmissibility.plot>` with simulated chirps
+<qzs.workflows.hexapod.transmissibility.HexapodTransmissibility.plot>` with simulated chirps
 in ``x`` and ``z`` (``qzs hexapod transmissibility``), short ones here.
 """
 import numpy as np
@@ -15,7 +15,7 @@ import numpy as np
 import qzs
 from qzs.analysis.hexapod_linear import hexapod_linearize
 from qzs.viz.hexapod_matrix import plot_transmissibility_matrix
-from qzs.workflows.hexapod import load_hexapod
+from qzs.workflows.hexapod.setups import load_hexapod
 
 setup = load_hexapod("paper_legs_cubic")
 model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller)

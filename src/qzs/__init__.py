@@ -63,8 +63,8 @@ _LAZY = {
     "SteadyStateResponse": "qzs.workflows.response.result",
     "design_controller": "qzs.workflows.design.driver",
     "DesignResult": "qzs.workflows.design.result",
-    "hexapod_transmissibility": "qzs.workflows.hexapod_transmissibility",
-    "HexapodTransmissibility": "qzs.workflows.hexapod_transmissibility",
+    "hexapod_transmissibility": "qzs.workflows.hexapod.transmissibility",
+    "HexapodTransmissibility": "qzs.workflows.hexapod.transmissibility",
     "optimize": "qzs.workflows.design_space.optimizer",
     "sensitivity": "qzs.workflows.design_space.sensitivity",
     "load_problem": "qzs.workflows.design_space.problem",
@@ -91,7 +91,7 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.workflows.design_space.problem import load_problem
     from qzs.workflows.design_space.result import OptimizationResult
     from qzs.workflows.design_space.sensitivity import SensitivityResult, sensitivity
-    from qzs.workflows.hexapod_transmissibility import (HexapodTransmissibility,
+    from qzs.workflows.hexapod.transmissibility import (HexapodTransmissibility,
                                                         hexapod_transmissibility)
     from qzs.workflows.response.result import SteadyStateResponse
     from qzs.workflows.response.sweep import steady_state_response

@@ -54,7 +54,7 @@ ACCURACY: Mapping[str, Any] = MappingProxyType({"tolerance_db": 0.01, "tolerance
 EXCITATION: Mapping[str, Any] = MappingProxyType({"amplitude": 0.010})
 
 #: Six-axis platform: the edge [m] of the cubic configuration used when none is given
-#: (``qzs hexapod --cubic``, :func:`qzs.workflows.hexapod.hexapod_setup`), and the numerical
+#: (``qzs hexapod --cubic``, :func:`qzs.workflows.hexapod.setups.hexapod_setup`), and the numerical
 #: floor [dB] below which a transmissibility entry is rounding, not a response (relative to
 #: the base motion, rotations as arcs at the platform's size; docs/hexapod.md §10.2).
 HEXAPOD: Mapping[str, Any] = MappingProxyType({"cube_edge": 0.15, "floor_db": -100.0})

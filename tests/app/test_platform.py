@@ -9,7 +9,7 @@ from qzs.errors import ParameterError
 
 def test_platform_tab_is_the_linear_record_of_the_shipped_platform():
     from qzs.app.platform import compute_platform
-    from qzs.workflows.hexapod import SHIPPED_DEFAULT, linear_record, load_hexapod
+    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, linear_record, load_hexapod
 
     data = compute_platform()
     _, record = linear_record(load_hexapod(SHIPPED_DEFAULT))

@@ -5,7 +5,7 @@ from types import SimpleNamespace
 
 import pytest
 
-import qzs.workflows.experiment
+import qzs.workflows.experiment.process
 from qzs.cli import main
 
 
@@ -19,7 +19,7 @@ def test_options_reach_the_workflow_under_their_api_names(tmp_path, monkeypatch,
                  "table": tmp_path / "t.csv"}
         return result, paths
 
-    monkeypatch.setattr(qzs.workflows.experiment, "run_experiment", run_experiment)
+    monkeypatch.setattr(qzs.workflows.experiment.process, "run_experiment", run_experiment)
     out = tmp_path / "out"
     assert main(["experiment", "log.csv", "--map", "map.toml", "--out", str(out),
                  "--fft-length", "1024", "--averages", "7", "--no-simulation", "--resample",
@@ -50,7 +50,7 @@ def test_an_output_folder_that_is_a_file_is_refused_before_reading(tmp_path, cap
 
 def test_write_map_writes_the_template_without_a_log(tmp_path, capsys):
     from qzs.iotools.readers import load_channel_map
-    from qzs.workflows.experiment_map import PLACEHOLDER, channel_map_template
+    from qzs.workflows.experiment.map_template import PLACEHOLDER, channel_map_template
 
     path = tmp_path / "sub" / "map.toml"
     assert main(["experiment", "--write-map", str(path)]) == 0

@@ -9,8 +9,8 @@ from qzs.cli import main
 from qzs.errors import ParameterError
 from qzs.model.hexapod import leg_unit_vectors
 from qzs.model.isolator import IsolatorParameters, spring_force
-from qzs.workflows.hexapod import (default_cube_center_height, hexapod_setup, load_hexapod,
-                                   supported_mass)
+from qzs.workflows.hexapod.setups import (default_cube_center_height, hexapod_setup, load_hexapod,
+                                          supported_mass)
 
 
 def run_json(capsys, *argv):
@@ -85,7 +85,7 @@ def test_every_subcommand_defaults_to_the_shipped_platform(capsys, command):
     `simulate` and `transmissibility` ran the shipped paper_legs_cubic."""
     from qzs.cli import build_parser
     from qzs.cli.hexapod import DEFAULT_SETUP, _setup
-    from qzs.workflows.hexapod import SHIPPED_DEFAULT
+    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT
 
     setup = _setup(build_parser().parse_args(["hexapod", command]))
     shipped = load_hexapod(SHIPPED_DEFAULT)
@@ -97,7 +97,7 @@ def test_every_subcommand_defaults_to_the_shipped_platform(capsys, command):
 
 
 def test_the_default_linear_model_is_the_shipped_platforms_and_stable(capsys):
-    from qzs.workflows.hexapod import SHIPPED_DEFAULT
+    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT
 
     default = run_json(capsys)
     assert default == run_json(capsys, "--config", SHIPPED_DEFAULT)

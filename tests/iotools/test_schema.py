@@ -208,7 +208,7 @@ def test_a_transmissibility_estimate_follows_its_schema():
 
 def test_an_experiment_follows_its_schema():
     from qzs.iotools.readers import read_recording
-    from qzs.workflows.experiment import experiment_schema, process_experiment
+    from qzs.workflows.experiment.process import experiment_schema, process_experiment
 
     recording = read_recording(EXAMPLES / "experiment.csv", EXAMPLES / "experiment_map.toml")
     result = process_experiment(recording, fft_length=8192, simulate_match=False)
@@ -221,7 +221,7 @@ def test_an_experiment_follows_its_schema():
 
 
 def test_the_six_axis_matrix_schema_declares_units_and_flags():
-    from qzs.workflows.hexapod_transmissibility import transmissibility_schema
+    from qzs.workflows.hexapod.transmissibility import transmissibility_schema
 
     schema = transmissibility_schema("h1")
     for variable in schema:

@@ -10,19 +10,19 @@ from qzs.iotools.shipped import resolve_shipped, shipped_files
 SOURCE = Path(__file__).resolve().parents[2] / "src" / "qzs"
 
 
-@pytest.mark.parametrize("folder", ["workflows/study_files", "workflows/sweep_files",
-                                    "workflows/hexapod_files"])
+@pytest.mark.parametrize("folder", ["workflows/paper/study_files", "workflows/sweeps/sweep_files",
+                                    "workflows/hexapod/hexapod_files"])
 def test_the_listing_is_the_folders_toml_files_in_order(folder):
     expected = sorted(p.name for p in (SOURCE / folder).glob("*.toml"))
     assert expected and [p.name for p in shipped_files(folder)] == expected
 
 
 def test_a_shipped_file_is_named_without_its_order_prefix(tmp_path):
-    found = resolve_shipped("stiction", "workflows/study_files", "study", "studies")
+    found = resolve_shipped("stiction", "workflows/paper/study_files", "study", "studies")
     assert found.name == "02_stiction.toml" and found.exists()
     own = tmp_path / "stiction"
     own.write_text("")
-    assert resolve_shipped(own, "workflows/study_files", "study", "studies") == own
+    assert resolve_shipped(own, "workflows/paper/study_files", "study", "studies") == own
     with pytest.raises(ParameterError, match=r"study file not found: 'nope'; shipped studies "
                                              r"are \['damping', 'no_pi', 'pi_gains'"):
-        resolve_shipped("nope", "workflows/study_files", "study", "studies")
+        resolve_shipped("nope", "workflows/paper/study_files", "study", "studies")

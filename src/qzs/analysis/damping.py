@@ -19,7 +19,7 @@ curve's trusted bins, which ``qzs design`` also shows as the change of its cost,
 bins the damped curve does not trust, where the reference is high, count only in the
 reference's cost.)
 
-``qzs paper`` decides the claim from both (:mod:`qzs.workflows.report`) and ``qzs design``
+``qzs paper`` decides the claim from both (:mod:`qzs.workflows.paper.report`) and ``qzs design``
 shows both for every gain it tries (:mod:`qzs.workflows.design`), through
 :func:`damping_change`, so the two reports cannot define them differently.
 

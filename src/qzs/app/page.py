@@ -553,7 +553,7 @@ class PlatformTab:
     """
 
     def __init__(self, *, schedule, executor=None):
-        from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
+        from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
 
         shipped = load_hexapod(SHIPPED_DEFAULT)
         self.data = None

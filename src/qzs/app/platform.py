@@ -1,9 +1,9 @@
 """The six-axis platform's tab of the tuning page, computed without any widget (docs/app.md).
 
 Six of the isolator's legs in the shipped cubic Stewart platform
-(:data:`qzs.workflows.hexapod.SHIPPED_DEFAULT`, docs/hexapod.md), every leg with the
+(:data:`qzs.workflows.hexapod.setups.SHIPPED_DEFAULT`, docs/hexapod.md), every leg with the
 tab's settings: its geometry, its linear analysis
-(:func:`qzs.workflows.hexapod.linear_record`) and the linear 6x6 transmissibility grid
+(:func:`qzs.workflows.hexapod.setups.linear_record`) and the linear 6x6 transmissibility grid
 (:func:`qzs.viz.hexapod_matrix.plot_transmissibility_matrix`), drawn to PNG bytes in
 memory. Nothing here models the platform: it calls those functions.
 """
@@ -81,7 +81,7 @@ def compute_platform(settings=None, dpi=75):
     import matplotlib.pyplot as plt
 
     from qzs.viz.hexapod_matrix import plot_transmissibility_matrix
-    from qzs.workflows.hexapod import AXES, SHIPPED_DEFAULT, linear_record, load_hexapod
+    from qzs.workflows.hexapod.setups import AXES, SHIPPED_DEFAULT, linear_record, load_hexapod
 
     settings = dict(settings or {})
     unknown = sorted(set(settings) - set(PLATFORM_PARAMETERS))

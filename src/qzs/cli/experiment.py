@@ -78,7 +78,7 @@ def _write_map(args):
     if Path(args.write_map).exists():
         raise OutputPathError(args.option, args.write_map, "exists; choose another name (a map "
                               "someone filled in is never replaced)")
-    from qzs.workflows.experiment_map import PLACEHOLDER, write_channel_map_template
+    from qzs.workflows.experiment.map_template import PLACEHOLDER, write_channel_map_template
 
     path = write_channel_map_template(args.write_map)
     print(f'wrote {path}: replace each source = "{PLACEHOLDER}" with the signal\'s name in '
@@ -100,7 +100,8 @@ def run(args):
         The exit code, 0.
     """
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
-    from qzs.workflows.experiment import run_experiment  # scipy and the engine: after the check
+    # scipy and the engine: after the check
+    from qzs.workflows.experiment.process import run_experiment
 
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,
                                    n_averages=args.averages, config=args.config,

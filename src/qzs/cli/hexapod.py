@@ -3,7 +3,7 @@ from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, 
                              emit, settings)
 from qzs.defaults import ACCURACY, AXES, HEXAPOD
 from qzs.errors import ParameterError
-from qzs.workflows.hexapod import SHIPPED_DEFAULT
+from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT
 
 __all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibility",
            "run_study"]
@@ -199,10 +199,10 @@ def run(args):
 
 
 def _setup(args):
-    """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod`): the
+    """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod.setups`): the
     --config file, else a --cubic configuration, else the shipped default
     (:data:`DEFAULT_SETUP`, the same for every subcommand)."""
-    from qzs.workflows.hexapod import centralised
+    from qzs.workflows.hexapod.setups import centralised
 
     setup = _described_setup(args)
     return centralised(setup) if args.centralised else setup
@@ -210,7 +210,8 @@ def _setup(args):
 
 def _described_setup(args):
     from qzs.model.hexapod import cubic_geometry
-    from qzs.workflows.hexapod import default_cube_center_height, hexapod_setup, load_hexapod
+    from qzs.workflows.hexapod.setups import (default_cube_center_height, hexapod_setup,
+                                              load_hexapod)
 
     overrides = settings(args.set)
     cube_options = args.cube_edge is not None or args.cube_center_height is not None
@@ -245,7 +246,7 @@ def run_linear(args):
     int
         0.
     """
-    from qzs.workflows.hexapod import linear_record, linear_text
+    from qzs.workflows.hexapod.setups import linear_record, linear_text
 
     if args.leg_stiffness is not None and not args.leg_stiffness > 0:
         raise ParameterError(f"--leg-stiffness must be a positive stiffness [N/m], got "
@@ -259,7 +260,7 @@ def run_linear(args):
                                   frame=FRAMES[args.frame], include_preload=not args.no_preload)
     text = linear_text(setup, model, record)
     if args.plot:
-        from qzs.workflows.hexapod import plot_linear_transmissibility
+        from qzs.workflows.hexapod.setups import plot_linear_transmissibility
 
         record["plot"] = str(plot_linear_transmissibility(
             setup, model, args.plot, frequency_scale=args.frequency_axis))
@@ -286,7 +287,7 @@ def run_simulate(args):
     """
     from qzs.engine.hexapod.result import HEXAPOD_SUFFIXES
     from qzs.iotools.paths import check_output_path
-    from qzs.workflows.hexapod import simulate_setup
+    from qzs.workflows.hexapod.setups import simulate_setup
 
     given = [name for name in (*_EXCITATION_OPTIONS, "excitation", "excitation_duration")
              if getattr(args, name) is not None]
@@ -367,7 +368,7 @@ def run_transmissibility(args):
     from pathlib import Path
 
     from qzs.iotools.paths import check_output_path
-    from qzs.workflows.hexapod_transmissibility import (CHIRP, hexapod_transmissibility,
+    from qzs.workflows.hexapod.transmissibility import (CHIRP, hexapod_transmissibility,
                                                         transmissibility_record)
 
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
@@ -406,7 +407,7 @@ def run_study(args):
         0.
     """
     from qzs.iotools.paths import check_output_path
-    from qzs.workflows.hexapod_study import run_hexapod_study, study_steps
+    from qzs.workflows.hexapod.study import run_hexapod_study, study_steps
 
     check_output_path(args.out, argument="--out", suffixes=None, directory=True)
     result = run_hexapod_study(args.out, quick=args.quick, dt=args.dt,

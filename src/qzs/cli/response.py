@@ -196,7 +196,7 @@ def run(args):
     """
     import sys
 
-    from qzs.workflows.curves import CURVE_SUFFIXES
+    from qzs.workflows.paper.curves import CURVE_SUFFIXES
     from qzs.workflows.response import RESPONSE_SUFFIXES, steady_state_response
 
     frequencies = parse_frequencies(args.frequencies, args.range, args.spacing)

@@ -56,8 +56,8 @@ def run(args):
     int
         The exit code, 0.
     """
-    from qzs.workflows.report import paper_summary, run_paper
-    from qzs.workflows.report_step import step_statement
+    from qzs.workflows.paper.report import paper_summary, run_paper
+    from qzs.workflows.paper.report_step import step_statement
 
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"--workers must be >= 1, got {args.workers}.")

@@ -13,7 +13,7 @@ def shipped_files(folder):
     Parameters
     ----------
     folder : str
-        Package-relative folder, e.g. ``"workflows/study_files"``.
+        Package-relative folder, e.g. ``"workflows/paper/study_files"``.
     """
     root = resources.files("qzs").joinpath(*folder.split("/"))
     return sorted(Path(str(p)) for p in root.iterdir() if p.name.endswith(".toml"))

@@ -496,7 +496,7 @@ def test_a_recorded_base_motion_replays_through_its_spline(cubic):
 
 def test_regularised_friction_is_refused_by_the_hexapod():
     import qzs
-    from qzs.workflows.hexapod import hexapod_setup
+    from qzs.workflows.hexapod.setups import hexapod_setup
 
     setup = hexapod_setup(settings={"pi_kp": 2000.0, "pi_ki": 800.0})
     with pytest.raises(qzs.ParameterError, match="friction_regularisation"):

@@ -13,7 +13,7 @@ from qzs.engine import driver as driver_module
 from qzs.engine.hexapod import simulate as hexapod_simulate
 from qzs.errors import OutputPathError, ParameterError
 from qzs.engine.hexapod.result import HexapodWriter, estimated_hexapod_size
-from qzs.workflows.hexapod import load_hexapod, simulate_setup
+from qzs.workflows.hexapod.setups import load_hexapod, simulate_setup
 
 #: Longer than one kernel chunk (200,000 steps at dt 1e-4 s), so that chunks join in the file.
 DURATION = 24.0

@@ -39,8 +39,8 @@ def test_both_damping_metrics_are_shown_beside_the_change_of_the_cost(design):
 
 def test_report_and_design_give_the_same_damping_metrics_on_the_same_runs(design):
     """The paper report's damping_changes on the design's own curves gives the design's rows."""
-    from qzs.workflows.report import damping_changes
-    from qzs.workflows.studies import CaseResult, Study, StudyResult
+    from qzs.workflows.paper.report import damping_changes
+    from qzs.workflows.paper.studies import CaseResult, Study, StudyResult
 
     estimates = design.series["damping_estimates"]
     cases = [CaseResult(f"Kd = {kd:g}", {"damping_gain": kd}, e.frequency, e.magnitude,

@@ -131,7 +131,7 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
         plan, N_CHANNELS, N_FLAGS, statistics=statistics.add, sink=sink,
         duration=run.duration, sample_rate=run.sample_rate,
         remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
-               "qzs.workflows.hexapod.simulate_setup(..., out=...)), or lower the "
+               "qzs.workflows.hexapod.setups.simulate_setup(..., out=...)), or lower the "
                "`sample_rate` or the `duration`")
     stepper = _SixLegs(run, recorder.buffers)
     data, marks = recorder.buffers[0]

@@ -10,7 +10,7 @@ import numpy as np
 from qzs._format import json_ready, json_text
 from qzs._version import __version__
 from qzs.iotools.files import atomic_path
-from qzs.workflows.curves import curves_dataset, write_curves
+from qzs.workflows.paper.curves import curves_dataset, write_curves
 from qzs.workflows.design.report import _html, design_text
 
 if TYPE_CHECKING:
@@ -117,7 +117,7 @@ class DesignResult:
         """The damping search's transmissibility curves as a dataset, one case per gain tried.
 
         The curves the ``damping`` figure draws (Kd = 0 and the chosen gain) among them, on
-        ``case`` and ``frequency`` (:func:`qzs.workflows.curves.curves_dataset`), with
+        ``case`` and ``frequency`` (:func:`qzs.workflows.paper.curves.curves_dataset`), with
         ``damping_gain`` [N*s/m], ``pi_kp`` [N/m] and ``pi_ki`` [N/(m*s)] as coordinates.
 
         Returns

@@ -75,7 +75,7 @@ __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "
 TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
           "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis")
 #: Folder of the shipped problem files, inside the package.
-SHIPPED = "workflows/problem_files"
+SHIPPED = "workflows/design_space/problem_files"
 #: Most Monte Carlo draws per design: each is a simulation of every design.
 MAX_SAMPLES = 1024
 _FORMAT = "qzs-problem-1"

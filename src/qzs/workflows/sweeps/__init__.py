@@ -35,7 +35,7 @@ so that batches share one excitation) and the samples (the same draws at every
 grid point: common random numbers). :func:`run_sweep` runs them batch by batch
 through :func:`qzs.engine.batch.simulate_batch`, locally or on a Dask cluster, and
 writes each finished batch to a Zarr store (:mod:`qzs.workflows.sweeps.store`) that an
-interrupted run resumes. Shipped examples: ``qzs/workflows/sweep_files/*.toml``; the
+interrupted run resumes. Shipped examples: ``qzs/workflows/sweeps/sweep_files/*.toml``; the
 guide is ``docs/sweeps.md``.
 
 :func:`run_sweep`, :func:`open_sweep`, :func:`plot_sweep`, :func:`export_sweep` (a store

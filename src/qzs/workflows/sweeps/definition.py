@@ -60,7 +60,7 @@ SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batc
 SIMULATION_DEFAULTS = {"dt": None, "solver": SIMULATION["solver"],
                        "tolerance_db": ACCURACY["tolerance_db"]}
 #: Folder of the shipped sweep files, inside the package.
-SHIPPED = "workflows/sweep_files"
+SHIPPED = "workflows/sweeps/sweep_files"
 OUTPUT_KEYS = ("stats", "metrics", "transmissibility", "coherence", "time_series", "bands",
                "rms_bands")
 METRICS = ("resonance_frequency", "resonance_peak", "isolation_onset", "minus_3db_frequency",

@@ -1,11 +1,11 @@
-"""The hexapod study (qzs.workflows.hexapod_study): its comparison figure draws, per excited
+"""The hexapod study (qzs.workflows.hexapod.study): its comparison figure draws, per excited
 axis, the diagonal and the cross-axis entry the linear model couples most, compared without
 units (a rotation per translation times the platform's size)."""
 from types import SimpleNamespace
 
 import numpy as np
 
-from qzs.workflows.hexapod_study import comparison_figure
+from qzs.workflows.hexapod.study import comparison_figure
 
 F = np.linspace(0.0, 20.0, 81)
 SIZE = 0.1  # [m]

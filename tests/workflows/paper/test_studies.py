@@ -7,8 +7,8 @@ import pytest
 
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
-from qzs.workflows.report import CLAIMS, decide_claims, write_paper_outputs
-from qzs.workflows.studies import load_study, run_studies, shipped_studies
+from qzs.workflows.paper.report import CLAIMS, decide_claims, write_paper_outputs
+from qzs.workflows.paper.studies import load_study, run_studies, shipped_studies
 
 
 def test_every_shipped_study_loads_and_names_known_claims():
@@ -417,7 +417,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
 def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
     """Every case on the stops (no PI): no step meets the tolerance for any; the batch runs
     at the paper's dt = 1e-4 s, and the record and the statement say why."""
-    from qzs.workflows.report_step import step_record
+    from qzs.workflows.paper.report_step import step_record
 
     path = tmp_path / "stops.toml"
     path.write_text("[study]\nname = 'stops'\nkind = 'transmissibility'\n"

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from qzs.model.hexapod import cubic_geometry
-from qzs.workflows.hexapod_transmissibility.settings import _scale, platform_size
+from qzs.workflows.hexapod.transmissibility.settings import _scale, platform_size
 
 
 def test_the_size_is_the_top_joints_rms_distance_from_their_centroid():

@@ -9,13 +9,13 @@ import numpy as np
 
 from qzs._validation import worker_count
 from qzs.defaults import AXES
-from qzs.workflows.hexapod_transmissibility.plan import _dry_run, _plan
-from qzs.workflows.hexapod_transmissibility.result import HexapodTransmissibility
-from qzs.workflows.hexapod_transmissibility.runs import run_axis
-from qzs.workflows.hexapod_transmissibility.settings import CHIRP, FLOOR_DB, _scale
+from qzs.workflows.hexapod.transmissibility.plan import _dry_run, _plan
+from qzs.workflows.hexapod.transmissibility.result import HexapodTransmissibility
+from qzs.workflows.hexapod.transmissibility.runs import run_axis
+from qzs.workflows.hexapod.transmissibility.settings import CHIRP, FLOOR_DB, _scale
 
 if TYPE_CHECKING:
-    from qzs.workflows.hexapod import HexapodSetup
+    from qzs.workflows.hexapod.setups import HexapodSetup
 
 
 # ---------------------------------------------------------------- the matrix
@@ -42,7 +42,7 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     Parameters
     ----------
     setup : HexapodSetup
-        The platform (:func:`qzs.workflows.hexapod.load_hexapod`, ``hexapod_setup``).
+        The platform (:func:`qzs.workflows.hexapod.setups.load_hexapod`, ``hexapod_setup``).
     axes : sequence of str or str
         Base axes to excite (``"x", "y", "z"`` [m], ``"rx", "ry", "rz"`` [rad]), or one
         comma-separated string (``"z,x"``); each is one run. Default all six.

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-    from qzs.workflows.hexapod import HexapodSetup
+    from qzs.workflows.hexapod.setups import HexapodSetup
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)

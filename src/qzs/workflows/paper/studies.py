@@ -4,7 +4,7 @@ A study file has a ``[study]`` table (name, title, kind, claims, views), optiona
 ``[defaults]`` parameter overrides shared by its cases, ``[[case]]`` tables (a
 ``label`` and parameter overrides (names of ``qzs params``)), and optional ``[excitation]``,
 ``[analysis]`` and ``[simulation]`` tables. The shipped files live in
-``qzs/workflows/study_files/*.toml``: copy one, edit it, run it with ``qzs study FILE.toml``.
+``qzs/workflows/paper/study_files/*.toml``: copy one, edit it, run it with ``qzs study FILE.toml``.
 
 Kinds:
 
@@ -56,9 +56,9 @@ __all__ = ["CLAIMS", "Study", "StudyResult", "CaseResult", "load_study", "shippe
 
 KINDS = ("transmissibility", "processing", "spring_characteristic")
 #: Folder of the shipped study files, inside the package.
-SHIPPED = "workflows/study_files"
+SHIPPED = "workflows/paper/study_files"
 #: The paper's claims a study may name in ``[study] claims``, by id: what the paper states
-#: (docs/model.md §13). :data:`qzs.workflows.report.CLAIMS` decides each from the cases of
+#: (docs/model.md §13). :data:`qzs.workflows.paper.report.CLAIMS` decides each from the cases of
 #: the studies that name it.
 CLAIMS = MappingProxyType({
     "resonance_masked": "Passive resonance about 0.08 Hz, masked by stiction.",

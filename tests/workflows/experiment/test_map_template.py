@@ -1,4 +1,4 @@
-"""The channel map template (qzs.workflows.experiment_map): every key the map reader takes,
+"""The channel map template (qzs.workflows.experiment.map_template): every key the map reader takes,
 and, once its placeholders are filled in, a map the real reader reads and a log it opens."""
 import re
 
@@ -7,8 +7,8 @@ import pytest
 
 from qzs.errors import OutputPathError
 from qzs.iotools.readers import EXPERIMENT_KEYS, ROLES, UNITS, load_channel_map, read_recording
-from qzs.workflows.experiment_map import (PLACEHOLDER, channel_map_template,
-                                          write_channel_map_template)
+from qzs.workflows.experiment.map_template import (PLACEHOLDER, channel_map_template,
+                                                   write_channel_map_template)
 
 
 def uncommented(text):

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from qzs.model.hexapod import PlatformParameters, cubic_geometry
-from qzs.workflows.hexapod import hexapod_setup
-from qzs.workflows.hexapod_transmissibility import matrix, plan
+from qzs.workflows.hexapod.setups import hexapod_setup
+from qzs.workflows.hexapod.transmissibility import matrix, plan
 
 
 @pytest.fixture(scope="module")

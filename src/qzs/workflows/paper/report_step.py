@@ -14,13 +14,13 @@ from typing import TYPE_CHECKING, Any
 from qzs.defaults import ACCURACY, SIMULATION
 
 if TYPE_CHECKING:
-    from qzs.workflows.studies import StudyResult
+    from qzs.workflows.paper.studies import StudyResult
 
 __all__ = ["AGREEMENT_TEST", "step_record", "step_statement"]
 
 #: The test that runs a shortened paper at the chosen step and at the paper's own, and
 #: checks every verdict and tabulated number against the criteria of docs/workflows/paper.md.
-AGREEMENT_TEST = "tests/workflows/test_report_step.py"
+AGREEMENT_TEST = "tests/workflows/paper/test_report_step.py"
 
 
 def step_record(study_results: Sequence[StudyResult]) -> dict[str, Any]:

@@ -8,7 +8,7 @@ from qzs import defaults
 from qzs._validation import as_float, choice, integer, positive
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
-from qzs.workflows.hexapod_transmissibility.settings import (AMPLITUDE, ESTIMATORS,
+from qzs.workflows.hexapod.transmissibility.settings import (AMPLITUDE, ESTIMATORS,
                                                              MIN_SEGMENTS, platform_size)
 
 
@@ -127,10 +127,10 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
           estimator, floor_db, workers, progress, tolerance_db=None):
     """Check every argument; the runs' common settings and one task per axis."""
     from qzs.model.excitation import Chirp
-    from qzs.workflows.hexapod import HexapodSetup
+    from qzs.workflows.hexapod.setups import HexapodSetup
 
     if not isinstance(setup, HexapodSetup):
-        raise ParameterError(f"`setup` must be a HexapodSetup (qzs.workflows.hexapod."
+        raise ParameterError(f"`setup` must be a HexapodSetup (qzs.workflows.hexapod.setups."
                              f"load_hexapod or hexapod_setup), got {type(setup).__name__}.")
     axes = _axes(axes)
     amplitudes = _amplitudes(amplitude, axes)

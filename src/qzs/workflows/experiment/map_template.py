@@ -23,7 +23,7 @@ from qzs.iotools.paths import check_output_path
 from qzs.iotools.readers import (EXPERIMENT_KEYS, NAN_POLICIES, ROLES, TIME_UNITS, UNITS,
                                  ChannelMap)
 from qzs.model.excitation import Chirp
-from qzs.workflows.experiment import EXPERIMENT_AVERAGES, SIGNAL_PAIRS, process_experiment
+from qzs.workflows.experiment.process import EXPERIMENT_AVERAGES, SIGNAL_PAIRS, process_experiment
 
 __all__ = ["channel_map_template", "write_channel_map_template", "PLACEHOLDER"]
 

@@ -45,15 +45,15 @@ the run takes the set-up's ``dt`` and its record says why.
 =============  ================================================================
 """
 from qzs.analysis.hexapod_linear import entry_unit
-from qzs.workflows.hexapod_transmissibility.matrix import hexapod_transmissibility
-from qzs.workflows.hexapod_transmissibility.plan import sweep_trusted_from
-from qzs.workflows.hexapod_transmissibility.result import (HexapodTransmissibility,
+from qzs.workflows.hexapod.transmissibility.matrix import hexapod_transmissibility
+from qzs.workflows.hexapod.transmissibility.plan import sweep_trusted_from
+from qzs.workflows.hexapod.transmissibility.result import (HexapodTransmissibility,
                                                            transmissibility_dataset,
                                                            transmissibility_record,
                                                            transmissibility_schema,
                                                            transmissibility_summary)
-from qzs.workflows.hexapod_transmissibility.runs import axis_step
-from qzs.workflows.hexapod_transmissibility.settings import (AMPLITUDE, CHIRP, ESTIMATORS,
+from qzs.workflows.hexapod.transmissibility.runs import axis_step
+from qzs.workflows.hexapod.transmissibility.settings import (AMPLITUDE, CHIRP, ESTIMATORS,
                                                              FLOOR_DB, platform_size)
 
 __all__ = ["HexapodTransmissibility", "hexapod_transmissibility", "AMPLITUDE", "CHIRP",

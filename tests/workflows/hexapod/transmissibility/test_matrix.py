@@ -21,9 +21,9 @@ from qzs.analysis.spectral import transmissibility
 from qzs.cli import main
 from qzs.model.excitation import Chirp
 from qzs.model.hexapod import PlatformParameters, cubic_geometry
-from qzs.workflows.hexapod import hexapod_setup, load_hexapod
+from qzs.workflows.hexapod.setups import hexapod_setup, load_hexapod
 from qzs.defaults import AXES
-from qzs.workflows.hexapod_transmissibility import (HexapodTransmissibility,
+from qzs.workflows.hexapod.transmissibility import (HexapodTransmissibility,
                                                     hexapod_transmissibility)
 
 FRICTIONLESS = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
@@ -159,7 +159,7 @@ def test_coherent_rounding_and_the_sweeps_start_are_untrusted():
     """The two rules beyond the single axis's, on a column built by hand: an entry at 1e-14
     of the base motion with coherence 1 is rounding, not response; bins the chirp crossed
     in the first quarter of the first segment carry a coherence of 1 by construction."""
-    from qzs.workflows.hexapod_transmissibility import matrix, plan
+    from qzs.workflows.hexapod.transmissibility import matrix, plan
 
     setup = setup_with(FRICTIONLESS)
     axes, amplitudes, common, _, _ = plan._plan(

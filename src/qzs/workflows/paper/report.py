@@ -2,7 +2,7 @@
 
 Writes to an output folder: one figure per paper figure (PNG and SVG), the curves behind
 each study's figures as data (``<study>_curves.nc`` and ``<study>_curves.csv``,
-:mod:`qzs.workflows.curves`), ``metrics.json`` and ``metrics.csv`` (per study and case,
+:mod:`qzs.workflows.paper.curves`), ``metrics.json`` and ``metrics.csv`` (per study and case,
 with a units row), and ``report.html``,
 which states how every curve was computed, puts each figure beside the paper's claims
 the study names (docs/model.md §13, "What the paper reports") and says, from the numbers,
@@ -40,11 +40,11 @@ from qzs.model.registry import PARAMETERS, format_value, unit_of, update_paramet
 from qzs.viz.figures import check_frequency_scale
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
-from qzs.workflows.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
-from qzs.workflows.studies import CLAIMS as STATEMENTS
-from qzs.workflows.report_step import step_record, step_statement
-from qzs.workflows.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
-                                   run_studies, shipped_studies)
+from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
+from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
+from qzs.workflows.paper.report_step import step_record, step_statement
+from qzs.workflows.paper.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
+                                         run_studies, shipped_studies)
 
 __all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
            "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper"]
@@ -376,7 +376,7 @@ if set(_DECIDERS) != set(STATEMENTS):  # pragma: no cover - a programming error
     raise RuntimeError(f"claims without a decision: {sorted(set(STATEMENTS) ^ set(_DECIDERS))}")
 
 #: claim id -> (the paper's statement (docs/model.md §13), decision function of a StudyResult).
-#: The ids a study may name are :data:`qzs.workflows.studies.CLAIMS`.
+#: The ids a study may name are :data:`qzs.workflows.paper.studies.CLAIMS`.
 CLAIMS = {claim: (statement, _DECIDERS[claim]) for claim, statement in STATEMENTS.items()}
 
 
@@ -436,12 +436,12 @@ def _curves(result):
 
 
 def curves_of(result, *, quick=False):
-    """A study's curves as a dataset (:func:`qzs.workflows.curves.curves_dataset`).
+    """A study's curves as a dataset (:func:`qzs.workflows.paper.curves.curves_dataset`).
 
     The curves its figures draw, on ``case`` and ``frequency``, with each case's
     parameters as coordinates and the run settings, study and definition as attributes;
     for the spring's characteristic, its points and fitted law
-    (:func:`qzs.workflows.curves.spring_dataset`).
+    (:func:`qzs.workflows.paper.curves.spring_dataset`).
 
     Parameters
     ----------
@@ -563,7 +563,7 @@ def column_unit(name):
     Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
     :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
     ``spring_shape`` from the registry), statistics and run settings from
-    :data:`qzs.workflows.studies.STATS_UNITS` and :data:`~qzs.workflows.studies.RUN_UNITS`.
+    :data:`qzs.workflows.paper.studies.STATS_UNITS` and :data:`~qzs.workflows.paper.studies.RUN_UNITS`.
 
     Parameters
     ----------
@@ -715,7 +715,7 @@ def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdi
         JSON-ready (NaN as None, the reason beside it as ``<metric>_reason``):
         ``qzs_version``, ``quick``, ``wall_seconds``, ``claims`` (claim, study,
         statement, verdict, evidence), ``studies`` (name -> title, seconds, settings,
-        cases with their metrics), ``step`` (:func:`~qzs.workflows.report_step.step_record`), ``outputs`` (report,
+        cases with their metrics), ``step`` (:func:`~qzs.workflows.paper.report_step.step_record`), ``outputs`` (report,
         metrics_json, metrics_csv, figures: PNG and SVG paths, curves: the
         ``<study>_curves.nc`` and ``.csv`` files).
     """
@@ -763,8 +763,8 @@ _CSS = {"reproduced": "reproduced", "not reproduced": "not", "partly reproduced"
         "not decidable": "undecidable"}
 
 #: The run settings a study's section lists: key of :attr:`CaseResult.run
-#: <qzs.workflows.studies.CaseResult>` -> name (units from
-#: :data:`qzs.workflows.studies.RUN_UNITS`).
+#: <qzs.workflows.paper.studies.CaseResult>` -> name (units from
+#: :data:`qzs.workflows.paper.studies.RUN_UNITS`).
 _RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample rate"),
              ("chirp_amplitude", "chirp amplitude"), ("chirp_f0", "chirp from"),
              ("chirp_f1", "chirp to"), ("chirp_duration", "chirp duration"),

@@ -5,7 +5,7 @@ import numpy as np
 
 from qzs.defaults import AXES
 from qzs.engine.step_search import StepChoice
-from qzs.workflows.hexapod_transmissibility.plan import _control
+from qzs.workflows.hexapod.transmissibility.plan import _control
 
 
 # ---------------------------------------------------------------- one run

@@ -1,4 +1,4 @@
-"""Six-axis set-ups (qzs.workflows.hexapod): the payload the MagSprings hold, in closed form for
+"""Six-axis set-ups (qzs.workflows.hexapod.setups): the payload the MagSprings hold, in closed form for
 the cubic configuration, and the shipped platform carrying exactly that."""
 import math
 
@@ -7,8 +7,8 @@ import pytest
 from qzs import ControllerParameters, IsolatorParameters
 from qzs.model.hexapod import cubic_geometry
 from qzs.model.isolator import spring_force
-from qzs.workflows.hexapod import (SHIPPED_DEFAULT, default_cube_center_height, load_hexapod,
-                                   supported_mass)
+from qzs.workflows.hexapod.setups import (SHIPPED_DEFAULT, default_cube_center_height,
+                                          load_hexapod, supported_mass)
 
 
 def test_the_cubic_legs_hold_six_spring_forces_at_the_cube_angle():
@@ -71,7 +71,7 @@ def test_simulate_setup_measures_the_step_by_what_the_run_answers(monkeypatch, e
     the tolerance defaults to ACCURACY's and the choice is what the run's record says."""
     import qzs.engine.hexapod.accuracy as accuracy
     from qzs.defaults import ACCURACY
-    from qzs.workflows.hexapod import simulate_setup
+    from qzs.workflows.hexapod.setups import simulate_setup
 
     seen = {}
 
@@ -99,7 +99,7 @@ def test_simulate_setup_measures_the_step_by_what_the_run_answers(monkeypatch, e
 def test_simulate_setup_refuses_bad_steps_before_any_run(monkeypatch, options, match):
     import qzs.engine.hexapod.simulate as simulate
     from qzs.errors import ParameterError
-    from qzs.workflows.hexapod import simulate_setup
+    from qzs.workflows.hexapod.setups import simulate_setup
 
     def no_run(*args, **kwargs):
         raise AssertionError("a run started")
@@ -110,7 +110,7 @@ def test_simulate_setup_refuses_bad_steps_before_any_run(monkeypatch, options, m
 
 
 def test_a_given_dt_is_literal_and_recorded_as_given():
-    from qzs.workflows.hexapod import simulate_setup
+    from qzs.workflows.hexapod.setups import simulate_setup
 
     result = simulate_setup(load_hexapod(SHIPPED_DEFAULT), duration=0.5, dt=5e-4)
     assert result.run["dt"] == 5e-4 and result.run["steps"] == 1000

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from qzs.workflows.hexapod_transmissibility.runs import _estimate
+from qzs.workflows.hexapod.transmissibility.runs import _estimate
 
 
 def test_a_platform_moving_half_the_base_gives_half_on_every_trusted_bin():

@@ -62,7 +62,7 @@ __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_se
            "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised"]
 
 #: Folder of the shipped hexapod files, inside the package.
-SHIPPED = "workflows/hexapod_files"
+SHIPPED = "workflows/hexapod/hexapod_files"
 #: The shipped file ``qzs hexapod`` uses without --config or --cubic.
 SHIPPED_DEFAULT = "paper_legs_cubic"
 #: Keys of a hexapod file's ``[simulation]`` table.

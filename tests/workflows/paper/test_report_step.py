@@ -26,9 +26,9 @@ import numpy as np
 import pytest
 
 from qzs.defaults import ACCURACY, SIMULATION
-from qzs.workflows.report import decide_claims
-from qzs.workflows.report_step import AGREEMENT_TEST, step_record
-from qzs.workflows.studies import load_study, run_studies, shipped_studies
+from qzs.workflows.paper.report import decide_claims
+from qzs.workflows.paper.report_step import AGREEMENT_TEST, step_record
+from qzs.workflows.paper.studies import load_study, run_studies, shipped_studies
 
 TRANSMISSIBILITY = ("resonance_peak",)
 FREQUENCY = ("resonance_frequency", "isolation_onset", "minus_3db_frequency", "trusted_from",
@@ -158,7 +158,7 @@ def test_every_tabulated_number_agrees_within_its_criterion(both):
 
 def _result(name, **step):
     """A StudyResult of no case, with the step record ``step``."""
-    from qzs.workflows.studies import Study, StudyResult
+    from qzs.workflows.paper.studies import Study, StudyResult
 
     return StudyResult(Study(name=name, title=name, kind="transmissibility", cases=()), [],
                        quick=True, step=step)

@@ -11,9 +11,9 @@ import xarray as xr
 
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import unit_of
-from qzs.workflows import report
-from qzs.workflows.curves import curves_dataset, curves_schema, spring_dataset, write_curves
-from qzs.workflows.studies import CaseResult, Study, StudyResult
+from qzs.workflows.paper import report
+from qzs.workflows.paper.curves import curves_dataset, curves_schema, spring_dataset, write_curves
+from qzs.workflows.paper.studies import CaseResult, Study, StudyResult
 
 FREQUENCY = np.round(np.arange(0.0, 20.0 + 1e-9, 0.25), 10)
 

@@ -1,7 +1,7 @@
 """The plan of the six-axis runs: where a chirp's trusted band starts."""
 import pytest
 
-from qzs.workflows.hexapod_transmissibility.plan import sweep_trusted_from
+from qzs.workflows.hexapod.transmissibility.plan import sweep_trusted_from
 
 
 @pytest.mark.parametrize("f0, f1, duration, fft_length, rate", [

@@ -13,9 +13,9 @@ import pytest
 
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp
-from qzs.workflows.report import CLAIMS, TREND_CLAIMS, decide_claims
-from qzs.workflows.studies import CLAIMS as STATEMENTS
-from qzs.workflows.studies import CaseResult, Study, StudyResult, _locked_below, load_study
+from qzs.workflows.paper.report import CLAIMS, TREND_CLAIMS, decide_claims
+from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
+from qzs.workflows.paper.studies import CaseResult, Study, StudyResult, _locked_below, load_study
 
 FREQUENCY = np.round(np.arange(0.0, 20.0 + 1e-9, 0.05), 10)  # [Hz]
 
@@ -385,7 +385,7 @@ def test_unknown_claim_id_names_the_file_the_id_and_the_known_ids(tmp_path):
 @pytest.mark.parametrize("make", ["file", "read-only"])
 def test_a_bad_output_folder_fails_before_any_study_runs(tmp_path, monkeypatch, make, request):
     """`qzs paper --out <file>` used to fail only after the studies ran (minutes, cold)."""
-    import qzs.workflows.report as report
+    import qzs.workflows.paper.report as report
     from qzs.errors import OutputPathError
 
     monkeypatch.setattr(report, "run_studies",

@@ -4,7 +4,7 @@ The issue's shipped study, in the paper report's style: the platform of the ship
 ``paper_legs_cubic.toml`` (six Table 1 legs in the cubic configuration of edge 0.15 m,
 carrying the 21.48 kg their MagSprings hold at the operating point), its 6x6
 transmissibility from a chirp in z and one in x (:func:`qzs.workflows.
-hexapod_transmissibility.hexapod_transmissibility`), for three position loops:
+hexapod.transmissibility.hexapod_transmissibility`), for three position loops:
 
 ``PI``
     The shipped loop: ``Kp`` = 2000 N/m, ``Ki`` = 800 N/(m*s) per leg.
@@ -47,9 +47,9 @@ from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
 from qzs.viz.figures import check_frequency_scale
-from qzs.workflows.hexapod import SHIPPED_DEFAULT, load_hexapod
-from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility
-from qzs.workflows.hexapod_transmissibility.result import step_text
+from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
+from qzs.workflows.hexapod.transmissibility import hexapod_transmissibility
+from qzs.workflows.hexapod.transmissibility.result import step_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -69,7 +69,7 @@ CASES = MappingProxyType({
 #: Base axes excited, one chirp each.
 STUDY_AXES = ("z", "x")
 #: Chirp length [s] of the full and the quick study; both take the accuracy-driven step of
-#: :mod:`qzs.workflows.hexapod_transmissibility` unless a ``dt`` is given (falling back to
+#: :mod:`qzs.workflows.hexapod.transmissibility` unless a ``dt`` is given (falling back to
 #: the file's 1e-4 s where the probe's differences do not shrink).
 RUNS: Mapping[str, Mapping[str, Any]] = MappingProxyType({
     "full": MappingProxyType({"duration": 400.0}),
@@ -91,7 +91,7 @@ class HexapodStudyResult:
     Attributes
     ----------
     cases : mapping
-        Case label -> :class:`~qzs.workflows.hexapod_transmissibility.
+        Case label -> :class:`~qzs.workflows.hexapod.transmissibility.
         HexapodTransmissibility`.
     rows : tuple of dict
         One metrics row per case and excited axis (the rows of ``metrics.csv``).
@@ -382,7 +382,7 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
         60 s chirps instead of 400 s.
     dt : float, optional
         A literal step [s] for every run; default the accuracy-driven step of each run
-        (:mod:`qzs.workflows.hexapod_transmissibility`).
+        (:mod:`qzs.workflows.hexapod.transmissibility`).
     tolerance_db : float, optional
         Tolerance [dB] of the accuracy-driven step on each run's column; default
         ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
@@ -447,7 +447,7 @@ def study_steps(study: HexapodStudyResult) -> dict[str, dict[str, dict[str, Any]
         none), ``tolerance_db`` [dB] (None with a given ``dt``), ``reference_dt`` [s],
         ``reason``.
     """
-    from qzs.workflows.hexapod_transmissibility.result import run_steps
+    from qzs.workflows.hexapod.transmissibility.result import run_steps
 
     return {label: run_steps(result) for label, result in study.cases.items()}
 
@@ -463,7 +463,7 @@ def comparison_figure(cases, out=None, frequency_scale=None):
     Parameters
     ----------
     cases : mapping
-        Case label -> :class:`~qzs.workflows.hexapod_transmissibility.HexapodTransmissibility`
+        Case label -> :class:`~qzs.workflows.hexapod.transmissibility.HexapodTransmissibility`
         (:attr:`HexapodStudyResult.cases`), the first the reference (PI).
     out : str or Path, optional
         Write the figure there (PNG and SVG beside it).

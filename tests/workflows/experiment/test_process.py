@@ -13,13 +13,13 @@ import pytest
 import qzs
 from qzs.errors import DataError, ParameterError
 from qzs.cli.experiment import add_parser, run
-from qzs.workflows.experiment import infer_chirp, process_experiment
+from qzs.workflows.experiment.process import infer_chirp, process_experiment
 from qzs.analysis.spectral import highpass
 from qzs.errors import DataWarning
 from qzs.iotools.readers import Recording, read_recording
 from qzs.analysis.spectral import transmissibility
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DATA = ROOT / "examples" / "data"
 
 
@@ -241,7 +241,7 @@ def test_experiment_metrics_come_from_trusted_bins_only(example):
     from test_trust import assert_metrics_from_trusted
 
     from qzs.analysis.spectral import band_mask, transmissibility_metrics
-    from qzs.workflows.experiment import experiment_metrics
+    from qzs.workflows.experiment.process import experiment_metrics
 
     measured = example.measured
     keep = band_mask(measured.frequency, 0.0, example.band[1])

@@ -1,0 +1,15 @@
+"""``qzs hexapod``: the six-axis platform's set-ups, its 6x6 transmissibility and its study.
+
+A set-up (:mod:`.setups`) is a hexapod file (``hexapod_files/``) or a cubic configuration
+with defaults; ``qzs hexapod linear`` and ``qzs hexapod simulate`` report on it. The
+simulated 6x6 transmissibility runs one chirp per excited base axis
+(:mod:`.transmissibility`); ``qzs hexapod study`` sets six paper legs with and without PI
+side by side (:mod:`.study`). The model is described in docs/hexapod.md.
+
+=====================  ================================================================
+``setups``             set-ups: hexapod files, defaults, the linear and simulated
+                       reports behind ``qzs hexapod``
+``transmissibility``   the simulated 6x6 transmissibility of a platform, chirp per axis
+``study``              ``qzs hexapod study``: six paper legs with and without PI
+=====================  ================================================================
+"""
