@@ -80,7 +80,7 @@ def test_cli_bad_input_is_exit_2_before_any_work(argv, words, monkeypatch, capsy
     for module, name in [(proportional_search, "simulate"),
                          (proportional_search, "simulate_batch"),
                          (cost, "simulate_batch"), (hunting, "simulate"),
-                         (integration_step, "choose_step")]:
+                         (integration_step, "choose_batch_step")]:
         monkeypatch.setattr(module, name, forbidden)
     assert main(argv + ["--quiet", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err

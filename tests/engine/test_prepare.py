@@ -140,3 +140,14 @@ def test_the_resolution_limit_is_the_step_that_gives_ten_steps_per_period():
     # a record's sample rate bounds its content from above only: not checked
     record = DisplacementRecord(time=np.arange(100) / 1e4, displacement=np.zeros(100))
     assert resolving_step(record) == np.inf
+
+
+@pytest.mark.parametrize("rate, dt, expected", [
+    (1000.0, 1e-3, True), (500.0, 1e-3, True), (1.0 / 3.0, 1e-3, True), (250.0, 1e-4, True),
+    (300.0, 1e-3, False), (2000.0, 1e-3, False), (400.0, 1e-3, False)])
+def test_a_rate_divides_1_over_dt_when_it_is_a_whole_fraction_of_it(rate, dt, expected):
+    from qzs.engine.prepare import divides
+
+    assert divides(rate, dt) is expected
+
+

@@ -112,7 +112,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         A case diverges on the probe.
     """
     from qzs.engine.batch import simulate_batch
-    from qzs.engine.prepare import resolving_step, run_inputs, steps_per_sample
+    from qzs.engine.prepare import divides, resolving_step, run_inputs
     from qzs.engine.stability import largest_stable_step, stability_test
     from qzs.errors import SimulationError
 
@@ -134,19 +134,13 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     def stable(dt):
         return dt <= resolving and all(test(dt) for test in tests)
 
-    def divides(dt):  # several sampled controllers: each period a whole number of steps
-        try:
-            for rate in rates:
-                if rate > 0:
-                    steps_per_sample(rate, dt, "controller_rate")
-        except ParameterError:
-            return False
-        return True
+    def divides_all(dt):  # several sampled controllers: each period a whole number of steps
+        return all(divides(rate, dt) for rate in rates if rate > 0)
 
     if len(rates) == 1:
         dt0, k0 = admissible_step(sample_rate, rates[0], stable)
     else:
-        dt0, k0 = admissible_step(sample_rate, 0.0, lambda dt: stable(dt) and divides(dt))
+        dt0, k0 = admissible_step(sample_rate, 0.0, lambda dt: stable(dt) and divides_all(dt))
     n = len(cases)
     labels = [f"case {c}" for c in range(n)] if labels is None else [str(x) for x in labels]
     names = ("base_acceleration", "payload_acceleration", "relative_position")
@@ -170,5 +164,5 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         band=band, notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
                                      probe is not excitation),
         stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
-        fallback=fallback, give_up_early=True, labels=labels, progress=progress,
+        fallback=fallback, give_up_early=True, labels=labels, per_case=True, progress=progress,
         unit_name="batch")

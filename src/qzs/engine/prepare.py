@@ -15,7 +15,7 @@ from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, S
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample",
+__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample", "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
 
 #: Fewest integration steps per period of the excitation's highest frequency a run is
@@ -89,6 +89,28 @@ def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
             f"`{name}` ({rate!r} Hz) must divide the integration rate 1/dt = {1 / dt:g} Hz into "
             f"a whole number of steps; got {ratio:g} steps. Use e.g. {name}={hint:g}.")
     return steps
+
+
+def divides(rate, dt):
+    """Whether a period of ``rate`` [Hz] is a whole number of steps ``dt`` [s]
+    (:func:`steps_per_sample`'s arithmetic, as a test).
+
+    Parameters
+    ----------
+    rate : float
+        Sample or controller rate [Hz].
+    dt : float
+        Integration step [s].
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        steps_per_sample(rate, dt)
+    except ParameterError:
+        return False
+    return True
 
 
 def resolving_step(excitation, duration=None):

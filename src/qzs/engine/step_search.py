@@ -508,7 +508,8 @@ def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFET
 def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample_rate,
                 solver, probe, probe_duration, band, notes=(), stability_limit,
                 max_halvings=MAX_HALVINGS, safety=SAFETY, finest=None, fallback=False,
-                give_up_early=False, labels=None, progress=False, unit_name="run"):
+                give_up_early=False, labels=None, per_case=False, progress=False,
+                unit_name="run"):
     """The coarsest candidate ``dt_0 / 2**j`` whose estimated error meets a tolerance.
 
     The one search of qzs (module docstring); the callers give what differs.
@@ -560,6 +561,9 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
         more than the scheme's order could close by the finest candidate.
     labels : sequence of str, optional
         The cases' names in the notes (default ``case 0``, ...).
+    per_case : bool
+        Fill the record's ``case_errors``, ``case_steps`` and ``unmet`` even for one case
+        (always for several).
     progress : bool
         Show a progress bar over the probe runs.
     unit_name : str
@@ -615,6 +619,7 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     finally:
         if bar is not None:
             bar.close()
+    several = cases > 1 or per_case
     record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
                   sample_rate=float(sample_rate), solver=solver, probe=probe,
                   probe_duration=float(probe_duration), band=band, history=tuple(history))
@@ -637,9 +642,9 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
         return StepChoice(dt=dt, error=math.nan, reference_dt=finest_tried,
                           notes=tuple(notes + [f"{reason}; running at dt = {dt:.3g} s, whose "
                                                "error is not estimated"]), met=False,
-                          case_errors=(math.nan,) * cases if cases > 1 else (),
-                          case_steps=(math.nan,) * cases if cases > 1 else (),
-                          unmet=tuple(range(cases)) if cases > 1 else (), **record)
+                          case_errors=(math.nan,) * cases if several else (),
+                          case_steps=(math.nan,) * cases if several else (),
+                          unmet=tuple(range(cases)) if several else (), **record)
     j = max(level for level, _ in met.values())
     deciding = min(c for c, (level, _) in met.items() if level == j)
     notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
@@ -657,13 +662,13 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
                      f"the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
                      f"{probe_duration:g} s probe, so no error is measured; the step is the "
                      "other cases'")
-    several = {}
-    if cases > 1:
-        several = dict(
+    entries = {}
+    if several:
+        entries = dict(
             case_errors=tuple(float(met[c][1]) if c in met else
                               (math.nan if c in untrusted else math.inf) for c in range(cases)),
             case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
                              for c in range(cases)),
             unmet=tuple(sorted(set(range(cases)) - set(met))))
     return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
-                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **several, **record)
+                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **entries, **record)

@@ -10,7 +10,7 @@ from qzs.workflows.design import cost
 #: Where the design simulates: (module, name) of every simulating function it calls.
 SIMULATORS = [(proportional_search, "simulate"), (proportional_search, "simulate_batch"),
               (cost, "simulate_batch"), (hunting, "simulate"),
-              (integration_step, "choose_step")]
+              (integration_step, "choose_batch_step")]
 
 
 def forbid_simulation(monkeypatch):

@@ -1,19 +1,12 @@
-"""The design's steps: a controller rate that divides 1/dt, and the PI search's coarser step."""
+"""The design's steps: the PI search's coarser step."""
 import dataclasses
 
 import pytest
 
 from qzs import defaults
 from qzs.engine.stability import stability_test
-from qzs.workflows.design.integration_step import _divides, _stroke_step
+from qzs.workflows.design.integration_step import _stroke_step
 from qzs.workflows.design.settings import KP_GRID, STROKE_STEP_MAX
-
-
-@pytest.mark.parametrize("rate, dt, divides", [
-    (1000.0, 1e-3, True), (500.0, 1e-3, True), (1.0 / 3.0, 1e-3, True), (250.0, 1e-4, True),
-    (300.0, 1e-3, False), (2000.0, 1e-3, False), (400.0, 1e-3, False)])
-def test_a_rate_divides_1_over_dt_when_it_is_a_whole_fraction_of_it(rate, dt, divides):
-    assert _divides(rate, dt) is divides
 
 
 def test_the_stroke_step_is_the_coarsest_stable_output_fraction_up_to_the_limit(design_options):

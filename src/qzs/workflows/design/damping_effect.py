@@ -9,7 +9,7 @@ import math
 
 from qzs._format import decibels
 from qzs.defaults import DAMPING_CLAIM
-from qzs.workflows.design.integration_step import _divides
+from qzs.engine.prepare import divides
 from qzs.workflows.design.settings import DELAYS
 from qzs.workflows.design.cost import _band_grid, _costs, _damping_metrics, _linear_cost
 
@@ -27,7 +27,7 @@ def _why(settings, kp, kd_chosen, damping_rows=(), bar=None):
         if cv != cv0:
             variants.append(("viscous friction", f"{cv:g} N*s/m",
                              dataclasses.replace(base_iso, viscous_damping=cv), base_ctrl))
-    rates = [0.0] + [r for r in (1000.0, 200.0, 100.0, 50.0) if _divides(r, settings.dt)]
+    rates = [0.0] + [r for r in (1000.0, 200.0, 100.0, 50.0) if divides(r, settings.dt)]
     for rate in rates:
         if rate != settings.controller_rate:
             variants.append(("controller rate", "continuous" if rate == 0 else f"{rate:g} Hz",

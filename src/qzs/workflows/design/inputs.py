@@ -14,7 +14,8 @@ from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation
 from qzs.model.registry import model_inputs
 from qzs.workflows.design.cases import DesignCase
-from qzs.workflows.design.integration_step import _choose_dt, _divides, _stroke_step
+from qzs.engine.prepare import divides
+from qzs.workflows.design.integration_step import _stroke_step, choose_dt
 from qzs.workflows.design.settings import COSTS, FFT_LENGTH, QUICK_CHIRP, SAMPLE_RATE, _Settings
 
 
@@ -159,11 +160,11 @@ def _set_steps(settings, dt):
             stiffest = settings.controller_at(settings.controller.pi_kp, settings.damping_gain_max)
             admissible_step(settings.sample_rate, rate, stability_test(
                 settings.isolator, stiffest, defaults.SIMULATION["solver"]))
-        settings.dt, settings.dt_note = _choose_dt(settings, settings.controller.pi_kp)
+        settings.dt, settings.dt_note = choose_dt(settings, settings.controller.pi_kp)
     else:
         settings.dt = real("dt", dt, minimum=0.0, strict=True, fix=" (seconds)")
         settings.dt_note = "given"
-    if rate > 0 and not _divides(rate, settings.dt):
+    if rate > 0 and not divides(rate, settings.dt):
         raise ParameterError(f"`controller_rate` ({rate:g} Hz) must divide 1/dt "
                              f"({1 / settings.dt:g} Hz); choose e.g. {1 / settings.dt:g} Hz or "
                              "a whole fraction of it.")

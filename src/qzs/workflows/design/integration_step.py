@@ -2,14 +2,10 @@
 import dataclasses
 
 from qzs import defaults
-from qzs.engine.accuracy import choose_step
-from qzs.errors import ToleranceNotMetError
+from qzs.engine.accuracy_batch import choose_batch_step
+from qzs.engine.prepare import divides
+from qzs.engine.step_search import MAX_HALVINGS
 from qzs.workflows.design.settings import KP_GRID, STROKE_STEP_MAX
-
-
-def _divides(rate, dt):
-    ratio = 1.0 / (rate * dt)
-    return rate * dt <= 1 + 1e-12 and abs(ratio - round(ratio)) < 1e-6 * ratio
 
 
 def _stroke_step(settings):
@@ -31,32 +27,47 @@ def _stroke_step(settings):
         step = 1.0 / (settings.sample_rate * k)
         if step > STROKE_STEP_MAX or not stable(step):
             continue
-        if settings.controller_rate > 0 and not _divides(settings.controller_rate, step):
+        if settings.controller_rate > 0 and not divides(settings.controller_rate, step):
             continue
         return max(step, settings.dt)
     return settings.dt
 
 
-def _choose_dt(settings, kp_probe):
-    """The accuracy-driven step, chosen on the extreme controllers (docs/model.md decision 26)."""
+def choose_dt(settings, kp_probe):
+    """The accuracy-driven step, chosen on the extreme controllers (docs/model.md decision 26).
+
+    One search (:func:`qzs.engine.accuracy_batch.choose_batch_step`) over the two extreme
+    cases (the most stiction without damping, the most damping), the finest of their
+    steps, with the one fallback where neither meets the tolerance.
+
+    Parameters
+    ----------
+    settings : DesignSettings
+        The design's settings.
+    kp_probe : float
+        The proportional gain of the probed controllers [N/m].
+
+    Returns
+    -------
+    dt : float
+        The step [s].
+    note : str
+        How it was chosen.
+    """
     probes = [(dataclasses.replace(settings.isolator, stiction_force=settings.stiction_range[1]),
                settings.controller_at(kp_probe, 0.0)),
               (settings.isolator, settings.controller_at(kp_probe, settings.damping_gain_max))]
-    steps, notes = [], []
-    for isolator, controller in probes:
-        try:
-            choice = choose_step(settings.excitation, isolator, controller,
-                                 tolerance_db=defaults.ACCURACY["tolerance_db"],
-                                 sample_rate=settings.sample_rate, band=settings.band)
-        except ToleranceNotMetError as error:
-            notes.append(f"Kd = {controller.damping_gain:g} N*s/m: {error}")
-            continue
-        steps.append(choice.dt)
-        notes.append(f"Kd = {controller.damping_gain:g} N*s/m, Fs = {isolator.stiction_force:g} "
-                     f"N: {choice.dt:.3g} s (estimated error {choice.error:.2g} dB)")
-    if not steps:
-        return defaults.SIMULATION["dt"], ("no probed case meets the tolerance; the paper's "
-                                           "step: " + "; ".join(notes))
-    return min(steps), ("accuracy-driven step (tolerance "
-                        f"{defaults.ACCURACY['tolerance_db']:g} dB over the band), the smallest "
-                        "of: " + "; ".join(notes))
+    labels = [f"Kd = {controller.damping_gain:g} N*s/m, Fs = {isolator.stiction_force:g} N"
+              for isolator, controller in probes]
+    choice = choose_batch_step(probes, settings.excitation,
+                               tolerance_db=defaults.ACCURACY["tolerance_db"],
+                               sample_rate=settings.sample_rate, band=settings.band,
+                               max_halvings=MAX_HALVINGS, fallback=True, labels=labels)
+    if not choice.met:
+        return choice.dt, f"no probed case meets the tolerance: {choice.line()}"
+    return choice.dt, ("accuracy-driven step (tolerance "
+                       f"{defaults.ACCURACY['tolerance_db']:g} dB over the band), the smallest "
+                       "of: " + "; ".join(
+                           f"{label}: {step:.3g} s (estimated error {error:.2g} dB)"
+                           for label, step, error in zip(labels, choice.case_steps,
+                                                         choice.case_errors)))

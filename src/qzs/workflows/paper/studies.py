@@ -43,7 +43,7 @@ from qzs.analysis.spectral import (band_mask, highpass, required_duration, trans
 from qzs.analysis.statistics import run_statistics
 from qzs.defaults import ACCURACY, ANALYSIS, FREQUENCY_SCALES, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
-from qzs.errors import ParameterError, ToleranceNotMetError
+from qzs.errors import ParameterError
 from qzs.identify.spring import fit_spring
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
@@ -687,17 +687,15 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
         for task in tasks:
             isolator, controller, _, _ = _case_inputs(task)
             index.setdefault((isolator, controller), []).append(task)
-        try:
-            choice = choose_batch_step(
-                list(index), excitation, tolerance_db=tolerance_db, solver=solver,
-                sample_rate=rate, workers=workers, progress=progress,
-                labels=[members[0]["label"] for members in index.values()])
-        except ToleranceNotMetError as error:  # every case depends on the step: the paper's
-            choice = error
+        # no step meeting the tolerance for any case: the one fallback (the paper's step)
+        choice = choose_batch_step(
+            list(index), excitation, tolerance_db=tolerance_db, solver=solver,
+            sample_rate=rate, fallback=True, workers=workers, progress=progress,
+            labels=[members[0]["label"] for members in index.values()])
         seconds = time.perf_counter() - start
         for c, members in enumerate(index.values()):
             for task in members:
-                task["simulation"]["dt"] = getattr(choice, "dt", SIMULATION["dt"])
+                task["simulation"]["dt"] = choice.dt
                 choices[id(task)] = (choice, c, seconds, group)
     return [_step_record(tasks, choices) for tasks in per_study]
 
@@ -709,9 +707,9 @@ def _step_record(tasks, choices):
         return {}
     first = simulated[0]
     record = {"dt": float(first["simulation"]["dt"]), "source": first["step_source"]}
-    if id(first) in choices and isinstance(choices[id(first)][0], ToleranceNotMetError):
-        error, _, seconds, group = choices[id(first)]
-        record.update(source="fallback", tolerance_db=error.tolerance, notes=[str(error)],
+    if id(first) in choices and not choices[id(first)][0].met:
+        choice, _, seconds, group = choices[id(first)]
+        record.update(source="fallback", tolerance_db=choice.tolerance, notes=[choice.notes[-1]],
                       unmet=[task["label"] for task in simulated], seconds=seconds,
                       group=group)
     elif id(first) in choices:

@@ -26,7 +26,7 @@ from qzs.engine.batch import simulate_batch
 from qzs.engine.prepare import steps_per_sample
 from qzs.defaults import SIMULATION
 from qzs.errors import (CaseError, DataError, DataWarning, InvalidCasesError, OutputPathError,
-                        ParameterError, SchedulerError, ToleranceNotMetError)
+                        ParameterError, SchedulerError)
 from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -234,8 +234,8 @@ def choose_sweep_step(definition, settings, *, progress=False):
     """
     import dataclasses
 
-    from qzs.engine.accuracy import MAX_HALVINGS
     from qzs.engine.accuracy_batch import choose_batch_step
+    from qzs.engine.step_search import MAX_HALVINGS
 
     simulation = definition.simulation
     if simulation["dt"] is not None:
@@ -256,14 +256,13 @@ def choose_sweep_step(definition, settings, *, progress=False):
     choices, unmet = [], []
     for excitation, members in groups.values():  # the probed cases of one excitation at once
         labels = [f"case {i}" for i, _ in members]
-        try:
-            batch = choose_batch_step([pair for _, pair in members], excitation,
-                                      tolerance_db=tolerance, solver=simulation["solver"],
-                                      sample_rate=definition.analysis["sample_rate"],
-                                      max_halvings=MAX_HALVINGS, progress=progress,
-                                      labels=labels)
-        except ToleranceNotMetError as error:
-            unmet.append(f"{', '.join(labels)}: {error}")
+        batch = choose_batch_step([pair for _, pair in members], excitation,
+                                  tolerance_db=tolerance, solver=simulation["solver"],
+                                  sample_rate=definition.analysis["sample_rate"],
+                                  max_halvings=MAX_HALVINGS, fallback=True, progress=progress,
+                                  labels=labels)
+        if not batch.met:  # the one fallback: no case of this excitation sets the step
+            unmet.append(f"{', '.join(labels)}: {batch.notes[-1]}")
             continue
         choices += [(i, dataclasses.replace(batch, dt=batch.case_steps[c],
                                             error=batch.case_errors[c]))
