@@ -107,6 +107,17 @@ class ResolvedRun:
         return run_resolved(self, progress=progress, interruptible=interruptible, sink=sink)
 
 
+def _one_step_request(**asked):
+    """The names of the step requests given (``dt`` or a tolerance); more than one is refused."""
+    given = [name for name, value in asked.items() if value is not None]
+    if len(given) > 1:
+        names = list(asked)
+        raise ParameterError(f"give one of `{names[0]}`, `{names[1]}` and `{names[2]}`, got "
+                             f"{' and '.join(f'`{n}`' for n in given)}; a literal step has no "
+                             "tolerance to meet.")
+    return given
+
+
 def resolve(excitation=None, isolator=None, controller=None, *, duration=None, dt=None,
             tolerance=None, tolerance_state=None,
             sample_rate=defaults.SIMULATION["sample_rate"],
@@ -187,12 +198,7 @@ def resolve(excitation=None, isolator=None, controller=None, *, duration=None, d
             f"`duration` ({duration!r} s) at `sample_rate` {sample_rate:g} Hz asks for "
             f"{duration * sample_rate:.3g} output samples, more than any run can hold "
             f"({MAX_SAMPLES:.0e}); shorten the run or lower the rate.")
-    given = [name for name, value in (("dt", dt), ("tolerance", tolerance),
-                                      ("tolerance_state", tolerance_state)) if value is not None]
-    if len(given) > 1:
-        raise ParameterError(f"give one of `dt`, `tolerance` and `tolerance_state`, got "
-                             f"{' and '.join(f'`{n}`' for n in given)}; a literal step has no "
-                             "tolerance to meet.")
+    given = _one_step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
     if dt is None and not given and step == "literal":
         dt = defaults.SIMULATION["dt"]
     if dt is not None:
@@ -323,12 +329,8 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
     from qzs.model.excitation import Chirp
 
     _validation.choice("step", step, ("literal", "chosen"))
-    given = [name for name, value in (("dt", dt), ("tolerance_db", tolerance_db),
-                                      ("tolerance_state", tolerance_state)) if value is not None]
-    if len(given) > 1:
-        raise ParameterError(f"give one of `dt`, `tolerance_db` and `tolerance_state`, got "
-                             f"{' and '.join(f'`{n}`' for n in given)}; a literal step has no "
-                             "tolerance to meet.")
+    given = _one_step_request(dt=dt, tolerance_db=tolerance_db,
+                              tolerance_state=tolerance_state)
     finest = defaults.SIMULATION["dt"] if finest is None else finest
     if dt is None and not given and step == "literal":
         dt = finest
