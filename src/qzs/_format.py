@@ -18,7 +18,45 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["decibels", "number", "json_ready", "json_text", "csv_text", "html_head",
-           "html_table", "html_figure", "markdown_table", "footnoted"]
+           "html_table", "html_figure", "markdown_table", "footnoted", "step_line",
+           "STEP_RECORD_UNITS"]
+
+#: Units of a step record's entries (:meth:`qzs.engine.step_search.StepChoice.attributes`).
+STEP_RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB",
+                     "step_error_m": "m", "step_tolerance_m": "m", "step_band_low": "Hz",
+                     "step_band_high": "Hz", "step_reference_dt": "s",
+                     "step_probe_duration": "s", "step_reason": ""}
+
+
+def step_line(run):
+    """How a run's step was chosen, in one line, from its step record's entries.
+
+    The one way every summary, report and console line shows a step (docs/model.md §7): from
+    a run's entries or a file's attributes read back (``dt`` and the entries of
+    :meth:`qzs.engine.step_search.StepChoice.attributes`).
+
+    Parameters
+    ----------
+    run : mapping
+        ``dt`` [s] and the step record's entries (``step`` missing: given).
+
+    Returns
+    -------
+    str
+    """
+    kind = run.get("step", "given")
+    if kind == "given":
+        return f"dt = {run['dt']:g} s, given (no error estimate)"
+    key, unit = ("db", "dB") if "step_tolerance_db" in run else ("m", "m")
+    band = ""
+    if "step_band_low" in run:
+        band = f" over {run['step_band_low']:g}-{run['step_band_high']:g} Hz"
+    if kind == "accuracy-driven":
+        return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
+                f"{run['step_error_' + key]:.2g} {unit}{band} (tolerance "
+                f"{run['step_tolerance_' + key]:g} {unit}, reference dt "
+                f"{run['step_reference_dt']:.3g} s, {run['step_probe_duration']:g} s probe)")
+    return f"dt = {run['dt']:g} s, fallback: {run['step_reason']}"
 
 
 def decibels(ratio, floor=None):

@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-import qzs.engine.simulate as simulate_module
+import qzs.engine.single as simulate_module
 from helpers import linear_controller, linear_isolator
 from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine, simulate
 from qzs.engine import StepChoice, choose_step
@@ -129,13 +129,13 @@ def _refuse_to_simulate(*args, **kwargs):
     (dict(tolerance_db=0.1, safety=0.5), "safety"),
 ])
 def test_bad_arguments_raise_before_any_simulation(monkeypatch, kwargs, match):
-    monkeypatch.setattr(simulate_module, "simulate", _refuse_to_simulate)
+    monkeypatch.setattr(simulate_module, "integrate", _refuse_to_simulate)
     with pytest.raises(ParameterError, match=match):
         choose_step(CHIRP, **kwargs)
 
 
 def test_bad_models_and_excitations_are_refused(monkeypatch):
-    monkeypatch.setattr(simulate_module, "simulate", _refuse_to_simulate)
+    monkeypatch.setattr(simulate_module, "integrate", _refuse_to_simulate)
     with pytest.raises(ParameterError, match="excitation"):
         choose_step("chirp", tolerance_db=0.1)
     with pytest.raises(ParameterError, match="isolator"):

@@ -62,8 +62,8 @@ def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch
     def no_run(*args, **kwargs):
         raise AssertionError("a cached choice ran a probe")
 
-    import qzs.engine.simulate as simulate_module
-    monkeypatch.setattr(simulate_module, "simulate", no_run)
+    import qzs.engine.single as simulate_module
+    monkeypatch.setattr(simulate_module, "integrate", no_run)
     again = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
     assert again.cached
     for field in dataclasses.fields(first):

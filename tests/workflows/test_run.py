@@ -13,7 +13,7 @@ import pytest
 
 import qzs
 from qzs import Chirp, Sine, simulate
-from qzs.engine import driver as driver_module, simulate as simulate_module
+from qzs.engine import driver as driver_module, single as simulate_module
 from qzs.errors import ResultTooLargeError
 from qzs.iotools import read_result
 from qzs.workflows.run import simulate_to_file

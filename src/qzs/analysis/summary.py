@@ -119,17 +119,11 @@ def _coverage(result):
 
 def _step_line(run):
     """How the run's step was chosen, as a line (docs/model.md §7); '' for a literal step."""
-    for suffix, unit, what in (("db", "dB", "the transmissibility"),
-                               ("m", "m", "the relative position")):
-        tolerance = run.get(f"step_tolerance_{suffix}")
-        if tolerance is None:
-            continue
-        error = run.get(f"step_error_{suffix}", float("nan"))
-        estimate = (f"estimated error {error:.2g} {unit}" if error == error
-                    else "no step tried met it: error not estimated")
-        return (f"  step             dt = {run['dt']:g} s chosen for {what} within "
-                f"{tolerance:g} {unit}; {estimate}")
-    return ""
+    from qzs._format import step_line
+
+    if run.get("step", "given") == "given":
+        return ""
+    return f"  step             {step_line(run)}"
 
 
 def summary_record(result):

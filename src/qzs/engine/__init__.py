@@ -9,7 +9,8 @@
 ``lanes``           the drivers: one case, or many in lockstep
 ``stability``       the solvers and their linear stability limit
 ``prepare``         validation and packing shared by single and batch runs
-``simulate``        :func:`simulate`, the validated single run
+``single``          :func:`~qzs.engine.single.integrate`, one run at a given step
+``simulate``        :func:`simulate`, a run resolved then integrated
 ``batch``           :func:`simulate_batch`, many parameter sets at once
 ``results``         :class:`SimulationResult`
 ``step_search``     the one step search, its fallback and its record (:class:`StepChoice`)

@@ -313,7 +313,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
     from qzs.engine.prepare import check_resolution, resolving_step, run_inputs
-    from qzs.engine.simulate import simulate
+    from qzs.engine.single import integrate
     from qzs.engine.stability import largest_stable_step, stability_test
 
     measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
@@ -350,8 +350,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
                               lambda dt: dt <= resolving and stable(dt))
 
     def run(dt, cases):
-        return [simulate(probe, isolator, controller, duration=duration, dt=dt,
-                         sample_rate=sample_rate, solver=solver, initial_state=initial_state)]
+        return [integrate(probe, isolator, controller, duration=duration, dt=dt,
+                          sample_rate=sample_rate, solver=solver, initial_state=initial_state)]
 
     choice = search_step(
         run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,

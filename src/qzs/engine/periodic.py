@@ -27,7 +27,7 @@ import numpy as np
 from qzs import defaults
 from qzs.engine import kernels as K
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.simulate import SingleAxis
+from qzs.engine.single import SingleAxis
 from qzs.errors import ParameterError
 
 __all__ = ["PeriodicRun", "CarriedState", "STATE_VARIABLES"]
@@ -176,7 +176,7 @@ class PeriodicRun:
 
     def _advance(self, steps, rows, marks):
         """``steps`` steps from the current state through the single-axis stepper of the run
-        driver (:class:`qzs.engine.simulate.SingleAxis`); True if it diverged."""
+        driver (:class:`qzs.engine.single.SingleAxis`); True if it diverged."""
         self._buffers[0] = (rows, marks)
         self._stepper.advance(steps, 0, 0)
         return self._stepper.diverged

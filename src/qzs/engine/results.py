@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from qzs._format import STEP_RECORD_UNITS
 from qzs.engine import kernels as K
 from qzs.errors import ParameterError
 from qzs.iotools import files
@@ -80,9 +81,7 @@ FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
 RUN_UNITS = {"solver": "-", "dt": "s", "sample_rate": "Hz", "duration": "s", "steps": "1",
              "elapsed": "s", "completed": "1", "stop_contacts": "1", "stick_events": "1",
              "stop_low": "m", "stop_high": "m", "samples": "1", "preview_every": "1",
-             "step_tolerance_db": "dB", "step_error_db": "dB", "step_tolerance_m": "m",
-             "step_error_m": "m", "step": "-", "step_reference_dt": "s",
-             "step_probe_duration": "s", "step_reason": "-"}
+             **{key: unit or "-" for key, unit in STEP_RECORD_UNITS.items()}}
 #: File formats of a run's result: suffix -> name.
 RESULT_SUFFIXES = files.RESULT_SUFFIXES
 #: Where a run's output rows go in its file: variable -> (block, column) of ``(data, flags)``.

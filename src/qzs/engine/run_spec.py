@@ -87,7 +87,7 @@ class ResolvedRun:
                     initial_state=self.initial_state)
 
     def simulate(self, *, progress=False, interruptible=False, sink=None):
-        """Integrate the run (:func:`qzs.engine.simulate.run_resolved`).
+        """Integrate the run (:func:`qzs.engine.single.integrate`).
 
         Parameters
         ----------
@@ -102,9 +102,10 @@ class ResolvedRun:
         -------
         SimulationResult
         """
-        from qzs.engine.simulate import run_resolved
+        from qzs.engine.single import integrate
 
-        return run_resolved(self, progress=progress, interruptible=interruptible, sink=sink)
+        return integrate(**self.arguments(), progress=progress, interruptible=interruptible,
+                         sink=sink, step=self.step)
 
 
 def _one_step_request(**asked):

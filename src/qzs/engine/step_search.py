@@ -28,6 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs import _validation, defaults
+from qzs._format import STEP_RECORD_UNITS as RECORD_UNITS
+from qzs._format import step_line as record_line
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 
 __all__ = ["StepChoice", "search_step", "halving_search", "admissible_step", "tolerance_measure",
@@ -223,7 +225,8 @@ class StepChoice:
             ``step``: ``"given"`` (a literal step: nothing more), ``"accuracy-driven"`` (the
             step met the tolerance) or ``"fallback"`` (no step tried met it); for the last
             two also ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the
-            state measure; the error NaN for the fallback), ``step_reference_dt`` [s],
+            state measure; the error NaN for the fallback), ``step_band_low`` and
+            ``step_band_high`` [Hz] (the transmissibility's band), ``step_reference_dt`` [s],
             ``step_probe_duration`` [s] and ``step_reason`` (why this step, in words).
         """
         if not self.chosen:
@@ -234,47 +237,13 @@ class StepChoice:
                       f"{self.unit} / safety on a {self.probe_duration:g} s probe")
         else:
             reason = self.notes[-1] if self.notes else "no step tried met the tolerance"
+        band = {} if self.band is None else {"step_band_low": float(self.band[0]),
+                                             "step_band_high": float(self.band[1])}
         return {"step": "accuracy-driven" if self.met else "fallback",
-                f"step_tolerance_{suffix}": float(self.tolerance),
+                f"step_tolerance_{suffix}": float(self.tolerance), **band,
                 f"step_error_{suffix}": float(self.error),
                 "step_reference_dt": float(self.reference_dt),
                 "step_probe_duration": float(self.probe_duration), "step_reason": reason}
-
-
-#: Units of the record's entries (:meth:`StepChoice.attributes`), for files.
-RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB", "step_error_m": "m",
-                "step_tolerance_m": "m", "step_reference_dt": "s", "step_probe_duration": "s",
-                "step_reason": ""}
-
-
-def record_line(run):
-    """How a run's step was chosen, in one line, from its record's entries.
-
-    The one way every summary, report and console line shows a step: from a
-    :class:`StepChoice` (:meth:`StepChoice.line`) or from a run's entries and a file's
-    attributes read back (:meth:`StepChoice.attributes` with ``dt``).
-
-    Parameters
-    ----------
-    run : mapping
-        ``dt`` [s] and the entries of :meth:`StepChoice.attributes` (``step`` missing:
-        given).
-
-    Returns
-    -------
-    str
-    """
-    kind = run.get("step", "given")
-    if kind == "given":
-        return f"dt = {run['dt']:g} s, given (no error estimate)"
-    key = "db" if "step_tolerance_db" in run else "m"
-    unit = MEASURE_UNITS["transmissibility_db" if key == "db" else "state_m"]
-    if kind == "accuracy-driven":
-        return (f"dt = {run['dt']:g} s, accuracy-driven: estimated error "
-                f"{run['step_error_' + key]:.2g} {unit} (tolerance "
-                f"{run['step_tolerance_' + key]:g} {unit}, reference dt "
-                f"{run['step_reference_dt']:.3g} s, {run['step_probe_duration']:g} s probe)")
-    return f"dt = {run['dt']:g} s, fallback: {run['step_reason']}"
 
 
 # ---------------------------------------------------------------- shared validation
@@ -592,7 +561,10 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False)
+        # shown after half a second: a cached or quick choice draws nothing, and a first run's
+        # compile notice (qzs.engine.compiling) comes before the bar
+        bar = tqdm(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
+                   delay=0.5)
     runs, differences = {}, {}
 
     def integrate(j, members):
