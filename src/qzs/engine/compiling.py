@@ -218,7 +218,12 @@ class _Notice:
             self.line_open = self.ticked = False
 
     def _write_above(self, bars, text):
-        """``text`` above the progress bars: clear them, write, draw them again."""
+        """``text`` above the progress bars: clear them, write, draw them again (a bar still
+        within its ``delay``, not drawn yet, is left alone: clearing it would write a line of
+        its own before the text)."""
+        now = time.time()  # tqdm's clock
+        bars = [bar for bar in bars
+                if not (getattr(bar, "delay", 0) and now - getattr(bar, "start_t", now) < bar.delay)]
         for bar in bars:
             bar.clear()
         self._write(text)
