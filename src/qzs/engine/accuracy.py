@@ -25,7 +25,8 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "choose_step_or_finest", "default_tolerance",
            "probe_excitation", "step_error", "halving_search", "admissible_step",
-           "step_run_entries", "estimate_difference_db", "MEASURE_UNITS"]
+           "step_run_entries", "estimate_difference_db", "MEASURE_UNITS", "excitation_range",
+           "error_band", "probe_fft_length", "tolerance_measure"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -133,8 +134,21 @@ class StepChoice:
 
 
 # ---------------------------------------------------------------- the probe
-def _frequency_range(excitation, sample_rate):
-    """Lowest and highest frequency [Hz] the excitation holds."""
+def excitation_range(excitation, sample_rate):
+    """Lowest and highest frequency [Hz] the excitation holds.
+
+    Parameters
+    ----------
+    excitation : Excitation
+        A chirp, a sine, a random excitation or a record.
+    sample_rate : float
+        The output's sample rate [Hz]: a record's range ends at its Nyquist frequency.
+
+    Returns
+    -------
+    tuple of float
+        ``(lowest, highest)`` [Hz].
+    """
     if isinstance(excitation, Chirp):
         return min(excitation.f0, excitation.f1), max(excitation.f0, excitation.f1)
     if isinstance(excitation, Sine):
@@ -199,7 +213,26 @@ def probe_excitation(excitation, band, probe_duration=None):
 
 
 # ---------------------------------------------------------------- the measures
-def _probe_fft_length(n_samples, sample_rate, band, fft_length):
+def probe_fft_length(n_samples, sample_rate, band, fft_length):
+    """The FFT length of a probe's transmissibility: given, or the longest power of two
+    that gives the probe :data:`PROBE_SEGMENTS` half-overlapping segments.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples of the probe's output [samples].
+    sample_rate : float
+        The output's sample rate [Hz] (unused: the length depends on the count alone).
+    band : tuple of float
+        The band the error is measured over [Hz] (unused, as ``sample_rate``).
+    fft_length : int or None
+        A length given by the caller, kept as it is [samples].
+
+    Returns
+    -------
+    int
+        The FFT length [samples], at most the analysis default's.
+    """
     if fft_length is not None:
         return int(fft_length)
     # a power of two with at least PROBE_SEGMENTS half-overlapping segments in the probe
@@ -235,7 +268,7 @@ def step_error(coarse, fine, measure, *, band=None, fft_length=None):
         return float(np.max(np.abs(coarse.relative_position - fine.relative_position)))
 
     rate = coarse.run["sample_rate"]
-    length = _probe_fft_length(coarse.relative_position.size, rate, band, fft_length)
+    length = probe_fft_length(coarse.relative_position.size, rate, band, fft_length)
     a, b = (_probe_transmissibility(run, rate, length) for run in (coarse, fine))
     return estimate_difference_db(a, b, band)
 
@@ -272,7 +305,28 @@ def estimate_difference_db(coarse, fine, band, keep=None):
 
 
 # ---------------------------------------------------------------- validation
-def _tolerance(tolerance_db, tolerance_state):
+def tolerance_measure(tolerance_db, tolerance_state):
+    """The measure and the value of the one tolerance given.
+
+    Parameters
+    ----------
+    tolerance_db : float or None
+        On the transmissibility [dB].
+    tolerance_state : float or None
+        On the relative position [m].
+
+    Returns
+    -------
+    measure : str
+        ``"transmissibility_db"`` or ``"state_m"`` (the keys of :data:`MEASURE_UNITS`).
+    tolerance : float
+        Its value, positive and finite [dB or m].
+
+    Raises
+    ------
+    ParameterError
+        Both or neither given, or a value that is not a positive number.
+    """
     given = [(name, value) for name, value in (("tolerance_db", tolerance_db),
                                                ("tolerance_state", tolerance_state))
              if value is not None]
@@ -285,8 +339,31 @@ def _tolerance(tolerance_db, tolerance_state):
     return measure, _validation.positive_real(name, value)
 
 
-def _band(band, excitation, sample_rate):
-    lowest, highest = _frequency_range(excitation, sample_rate)
+def error_band(band, excitation, sample_rate):
+    """The band the transmissibility error is measured over: given and checked, or the
+    excitation's (a chirp from 0 Hz from 1 Hz, where trust begins).
+
+    Parameters
+    ----------
+    band : tuple of float or None
+        ``(low, high)`` [Hz], or None for the excitation's own range.
+    excitation : Excitation
+        The run's excitation.
+    sample_rate : float
+        The output's sample rate [Hz].
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)`` [Hz].
+
+    Raises
+    ------
+    ParameterError
+        Not two frequencies, ``low > high``, above the output's Nyquist frequency, or
+        outside the excitation's frequencies.
+    """
+    lowest, highest = excitation_range(excitation, sample_rate)
     if band is None:
         low, high = lowest, highest
         if isinstance(excitation, Chirp) and low == 0.0:
@@ -476,7 +553,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import largest_stable_step, stability_test
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
     order, sample_rate, band, probe, duration = _probe_settings(
         excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
@@ -640,7 +717,7 @@ def choose_step_or_finest(excitation=None, isolator=None, controller=None, **opt
         from qzs.engine.prepare import run_inputs
 
         excitation = run_inputs(excitation, isolator, controller)[0]
-        measure, tolerance = _tolerance(options.get("tolerance_db"),
+        measure, tolerance = tolerance_measure(options.get("tolerance_db"),
                                         options.get("tolerance_state"))
         solver = options.get("solver", defaults.SIMULATION["solver"])
         _, sample_rate, band, probe, duration = _probe_settings(
@@ -706,9 +783,9 @@ def _probe_settings(excitation, measure, solver, sample_rate, band, probe_durati
         _validation.positive_real("probe_duration", probe_duration)
     _validation.real("safety", safety, minimum=1.0)
     _validation.integer("max_halvings", max_halvings, 2)
-    band = _band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
+    band = error_band(band, excitation, sample_rate) if measure == "transmissibility_db" else None
     probe, duration = probe_excitation(
-        excitation, band or _frequency_range(excitation, sample_rate), probe_duration)
+        excitation, band or excitation_range(excitation, sample_rate), probe_duration)
     # a whole number of output periods: every candidate step then records the same samples
     # (a sine's probe of 40 periods need not be; its runs at dt and dt/2 differed by one)
     duration = math.floor(duration * sample_rate * (1 + 1e-12)) / sample_rate

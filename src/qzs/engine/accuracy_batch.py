@@ -12,7 +12,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs.engine.accuracy import (MEASURE_UNITS, SAFETY, StepChoice, _bound_notes, _estimate,
-                                 _order_notes, _probe_settings, _tolerance, admissible_step,
+                                 _order_notes, _probe_settings, tolerance_measure, admissible_step,
                                  step_error)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
@@ -161,7 +161,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     from qzs.engine.stability import largest_stable_step, stability_test
     from qzs.errors import SimulationError
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     cases = [run_inputs(None, *pair)[1:] for pair in cases]
     if not cases:
         raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")

@@ -36,8 +36,8 @@ import numpy as np
 from qzs import _validation, defaults
 from qzs._validation import choice as _choice
 from qzs.engine.accuracy import (MAX_HALVINGS, MEASURE_UNITS, PROBE_DURATION, SAFETY,
-                                 StepChoice, _band, _frequency_range, _probe_fft_length,
-                                 _tolerance, admissible_step, estimate_difference_db,
+                                 StepChoice, error_band, excitation_range, probe_fft_length,
+                                 tolerance_measure, admissible_step, estimate_difference_db,
                                  halving_search, probe_excitation)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
@@ -83,7 +83,7 @@ def hexapod_probe(excitation, band=None, probe_duration=None, duration=None,
     probes, lengths, limits = {}, [], []
     for axis, value in excitation.items():
         probe, length = probe_excitation(
-            value, band or _frequency_range(value, sample_rate), probe_duration)
+            value, band or excitation_range(value, sample_rate), probe_duration)
         probes[axis] = probe
         lengths.append(length)
         if probe.duration is not None:
@@ -136,7 +136,7 @@ def hexapod_step_error(coarse, fine, measure, *, axis=None, band=None, fft_lengt
 
     j = defaults.AXES.index(axis)
     rate = coarse.run["sample_rate"]
-    length = _probe_fft_length(coarse["platform_pose"].shape[0], rate, band, fft_length)
+    length = probe_fft_length(coarse["platform_pose"].shape[0], rate, band, fft_length)
     floor = 10 ** (floor_db / 20)
     differences = []
     for i in range(6):
@@ -229,7 +229,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     from qzs.model.hexapod import platform_size
     from qzs.model.isolator import IsolatorParameters
 
-    measure, tolerance = _tolerance(tolerance_db, tolerance_state)
+    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
     moving = _excitations(excitation)
     if not moving:
         raise ParameterError("`excitation` moves no base axis: there is nothing to choose a "
@@ -250,7 +250,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
                 f"base moving along one axis; it moves along {sorted(moving)}. Give "
                 "`tolerance_state` [m] (the pose) instead, or excite one axis.")
         axis, = moving
-        band = _band(band, moving[axis], sample_rate)
+        band = error_band(band, moving[axis], sample_rate)
     isolators = _per_leg("isolator", IsolatorParameters() if isolator is None else isolator,
                          IsolatorParameters)
     controllers = _per_leg("controller",
