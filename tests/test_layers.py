@@ -184,6 +184,117 @@ def test_the_checker_sees_a_relative_upward_import():
     assert violations("qzs.model.example", "from ..viz import figures\n")
 
 
+
+# ---------------------------------------------------------------- no private name across packages
+def package_of(module, is_package=False):
+    """The package a module belongs to (a package's ``__init__`` belongs to itself)."""
+    return module if is_package else module.rpartition(".")[0]
+
+
+def private_imports(source, module, is_package=False):
+    """``(line, name, source module)`` of each private name (``_x``, not ``__x__``) a module
+    takes from another package: imported (``from qzs.a.b import _x``, relative or inside a
+    function too), or read off a module imported from another package (``b._x`` after
+    ``from qzs.a import b``). The base layer's private modules (``qzs._validation`` ...,
+    :data:`BASE`) are shared by every layer and are not counted."""
+    own = package_of(module, is_package)
+
+    def private(name):
+        return name.startswith("_") and not name.startswith("__")
+
+    def base_module(name):
+        parts = name.split(".")
+        return len(parts) == 2 and parts[1] in BASE
+
+    found, modules = [], {}
+    tree = ast.parse(source)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:  # relative import: resolve against this module
+                package = module.split(".")
+                package = package if is_package else package[:-1]
+                base = ".".join(package[:len(package) - node.level + 1] + ([base] if base else []))
+            if base.split(".")[0] != "qzs":
+                continue
+            for alias in node.names:
+                candidate = f"{base}.{alias.name}"
+                if _is_module(candidate):  # a module of package `base`
+                    modules[alias.asname or alias.name] = candidate
+                    theirs = base
+                else:  # a name defined in module (or package) `base`
+                    theirs = package_of(base, _is_package(base))
+                if private(alias.name) and theirs != own and not base_module(candidate):
+                    found.append((node.lineno, alias.name, base))
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                if parts[0] != "qzs":
+                    continue
+                if alias.asname:
+                    modules[alias.asname] = alias.name
+                for i, part in enumerate(parts[1:], start=1):
+                    if (private(part) and ".".join(parts[:i]) != own
+                            and not base_module(".".join(parts[:i + 1]))):
+                        found.append((node.lineno, part, ".".join(parts[:i])))
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                and node.value.id in modules and private(node.attr)):
+            target = modules[node.value.id]
+            if package_of(target, _is_package(target)) != own:
+                found.append((node.lineno, node.attr, target))
+    return sorted(set(found))
+
+
+def _is_package(name):
+    return SOURCE.parent.joinpath(*name.split("."), "__init__.py").exists()
+
+
+def test_no_private_name_is_imported_across_packages():
+    """A name with a leading underscore is its package's own: another package that needs it
+    gets it public, with a docstring, or the code moves to where it belongs."""
+    problems = []
+    for module, path in all_modules().items():
+        for line, name, source in private_imports(path.read_text(), module,
+                                                  path.name == "__init__.py"):
+            problems.append(f"src/{module.replace('.', '/')}"
+                            f"{'/__init__' if path.name == '__init__.py' else ''}.py:{line} "
+                            f"takes the private `{name}` of {source}")
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("module, source, names", [
+    # another package's private function, at module level or inside a function
+    ("qzs.workflows.design_space.metrics",
+     "from qzs.workflows.sweeps.batch import _run_group, run_batch\n", ["_run_group"]),
+    ("qzs.workflows.design_space.metrics",
+     "def f():\n    from qzs.workflows.sweeps.batch import _run_group\n", ["_run_group"]),
+    # relative, to a sibling package
+    ("qzs.workflows.design_space.metrics", "from ..sweeps.batch import _run_group\n",
+     ["_run_group"]),
+    # read off a module of another package
+    ("qzs.workflows.design_space.metrics",
+     "from qzs.workflows.sweeps import batch\nbatch._run_group()\n", ["_run_group"]),
+    ("qzs.workflows.design_space.metrics",
+     "import qzs.workflows.sweeps.batch as b\nb._run_group()\n", ["_run_group"]),
+    # a subpackage is another package: private names of its parent's modules are not its
+    ("qzs.engine.hexapod.accuracy", "from qzs.engine.accuracy import _band\n", ["_band"]),
+    # the same package: allowed
+    ("qzs.workflows.sweeps.runner", "from qzs.workflows.sweeps.batch import _run_group\n",
+     []),
+    ("qzs.workflows.sweeps", "from qzs.workflows.sweeps.batch import _run_group\n", []),
+    ("qzs.workflows.sweeps.runner", "from .batch import _run_group\n", []),
+    # public names, dunders and the base layer's private modules: allowed
+    ("qzs.engine.driver", "from qzs.workflows.sweeps.batch import run_batch\n", []),
+    ("qzs.engine.driver", "from qzs._version import __version__\n", []),
+    ("qzs.engine.driver", "from qzs import _validation\n", []),
+    ("qzs.engine.driver", "from qzs._validation import positive\n", []),
+])
+def test_the_checker_sees_a_private_import(module, source, names):
+    """The check itself: a private name taken from another package is reported, else not."""
+    assert [name for _, name, _ in private_imports(source, module, _is_package(module))] == names
+
+
 # ---------------------------------------------------------------- the tests mirror the tree
 TESTS = Path(__file__).resolve().parent
 #: Modules without a test file of their own, with the reason. Only a module whose whole

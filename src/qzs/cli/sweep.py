@@ -92,7 +92,8 @@ def run_sweep_command(args):
         (its stored cases stay either way).
     """
     from qzs.workflows.sweeps import load_sweep, open_sweep, plan_text, stored_count
-    from qzs.workflows.sweeps.backends import check_store_path, execute
+    from qzs.workflows.sweeps.runner import execute
+    from qzs.workflows.sweeps.store_checks import check_store_path
     from qzs.workflows.sweeps.store import summary_text
 
     definition = load_sweep(args.definition)

@@ -83,12 +83,12 @@ def test_linear_metrics_are_the_closed_forms_and_need_no_simulation(monkeypatch)
     from qzs.analysis.control_design.hunting import predict_hunting
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
-    from qzs.workflows.sweeps import backends
+    from qzs.workflows.sweeps import batch
 
     def no_runs(*args, **kwargs):
         raise AssertionError("a linear metric ran a simulation")
 
-    monkeypatch.setattr(backends, "run_batch", no_runs)
+    monkeypatch.setattr(batch, "run_batch", no_runs)
     document = copy.deepcopy(SHORT)
     document["simulation"] = {}  # no step needed, none chosen
     document["objectives"] = [{"metric": "linear_transmissibility_at", "frequency": 3.0},

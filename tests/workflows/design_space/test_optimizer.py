@@ -162,16 +162,16 @@ def test_a_bad_problem_fails_before_any_evaluation(tmp_path, monkeypatch):
 
 
 def test_a_simulated_search_runs_each_generation_as_one_batch(tmp_path, monkeypatch):
-    from qzs.workflows.sweeps import backends
+    from qzs.workflows.sweeps import batch
 
     batches = []
-    run_batch = backends.run_batch
+    run_batch = batch.run_batch
 
     def counted(definition, start, settings, *args, **kwargs):
         batches.append(len(settings))
         return run_batch(definition, start, settings, *args, **kwargs)
 
-    monkeypatch.setattr(backends, "run_batch", counted)
+    monkeypatch.setattr(batch, "run_batch", counted)
     result = optimize(SIMULATED, tmp_path / "sim.zarr", progress=False)
     assert batches == [8 * 2] * 3  # population x draws, once per generation
     assert result.values["motor_force_rms"].shape == (24, 2)

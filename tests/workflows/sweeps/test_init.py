@@ -11,7 +11,7 @@ import xarray as xr
 
 import qzs
 from qzs import ParameterError
-from qzs.workflows.sweeps import backends as sweep_backends
+from qzs.workflows.sweeps import batch as sweep_batch
 from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
 from qzs.cli.sweep import add_parsers, run_sweep_command
 from qzs.workflows.sweeps import load_sweep, run_sweep
@@ -219,7 +219,7 @@ def _count_cases(monkeypatch, interrupt_at=None, exception=SimulatedInterrupt):
     interruption fires once, so a later run through the same patch cannot raise it.
     """
     calls = []
-    original = sweep_backends.simulate_batch
+    original = sweep_batch.simulate_batch
 
     def patched(cases, *args, **kwargs):
         calls.append(len(cases))
@@ -227,20 +227,20 @@ def _count_cases(monkeypatch, interrupt_at=None, exception=SimulatedInterrupt):
             raise exception("interrupted by the test")
         return original(cases, *args, **kwargs)
 
-    monkeypatch.setattr(sweep_backends, "simulate_batch", patched)
+    monkeypatch.setattr(sweep_batch, "simulate_batch", patched)
     return calls
 
 
 def test_resume_after_an_interrupt_gives_the_same_dataset(reference, tmp_path, monkeypatch):
     definition, expected, _ = reference
     store = tmp_path / "resumed.zarr"
-    unpatched = sweep_backends.simulate_batch
+    unpatched = sweep_batch.simulate_batch
     with monkeypatch.context() as patch:
         calls = _count_cases(patch, interrupt_at=2)
         with pytest.raises(SimulatedInterrupt):
             run_sweep(definition, store, progress=False)
         assert calls == [2, 2]
-    assert sweep_backends.simulate_batch is unpatched  # the interrupting patch is gone
+    assert sweep_batch.simulate_batch is unpatched  # the interrupting patch is gone
     partial = load(store)
     assert partial["done"].values.tolist() == [True, True, False, False]
     with pytest.raises(ParameterError, match="exists; pass `resume`"):
@@ -310,7 +310,7 @@ def test_failed_dask_tasks_are_retried(reference, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
     definition, expected, _ = reference
     calls = []
-    run_group = sweep_backends._run_group
+    run_group = sweep_batch._run_group
 
     def flaky(*args, **kwargs):  # every other call fails, so each task fails once
         calls.append(None)
@@ -319,7 +319,7 @@ def test_failed_dask_tasks_are_retried(reference, tmp_path, monkeypatch):
         return run_group(*args, **kwargs)
 
     # an in-process cluster: its worker threads see the patched module
-    monkeypatch.setattr(sweep_backends, "_run_group", flaky)
+    monkeypatch.setattr(sweep_batch, "_run_group", flaky)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:

@@ -8,7 +8,7 @@ simulation (hunting amplitude at rest, stability margins, the linear transmissib
 
 :func:`evaluate` runs a population: every design crossed with every Monte Carlo draw
 (common random numbers), in batches through
-:func:`qzs.workflows.sweeps.backends.run_batch`, the task of every sweep, so a design
+:func:`qzs.workflows.sweeps.batch.run_batch`, the task of every sweep, so a design
 gives exactly the numbers of a sweep's case and of :func:`qzs.simulate`. Cases that share
 their excitation and step run as one lockstep batch of the lane kernel.
 :func:`evaluate_cases` is that path for any list of cases (a sensitivity analysis sets
@@ -301,7 +301,7 @@ def _linear(problem, settings, goals, values, status, messages, progress=None):
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
     from qzs.errors import ParameterError
-    from qzs.workflows.sweeps.backends import build_model
+    from qzs.workflows.sweeps.cases import build_model
 
     goals = {g.column: g for g in goals}
     every, done = max(1, len(settings) // 100), 0
@@ -341,7 +341,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
 
     The one path of every evaluation: :func:`evaluate` crosses designs with draws into
     cases, a sensitivity analysis samples variables and uncertain parameters together;
-    each case runs through :func:`qzs.workflows.sweeps.backends.run_batch` with
+    each case runs through :func:`qzs.workflows.sweeps.batch.run_batch` with
     ``problem.sweep`` (simulated metrics) or the linear analysis (linear metrics).
 
     Parameters
@@ -381,7 +381,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
     ValueError
         A simulated metric is wanted and the problem's step is not fixed yet.
     """
-    from qzs.workflows.sweeps.backends import _dask, _local
+    from qzs.workflows.sweeps.batch import run_local, run_on_dask
 
     total = len(settings)
     columns = problem.columns if columns is None else tuple(columns)
@@ -401,10 +401,10 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
                 1, -(-total // (2 * sum(client.nthreads().values()))))
         batches = [(a, min(a + batch_size, total)) for a in range(0, total, batch_size)]
         if client is not None:
-            results = _dask(client, definition, batches, settings, 0,
+            results = run_on_dask(client, definition, batches, settings, 0,
                             1 if threads is None else threads)
         else:
-            results = _local(definition, batches, settings, 0, threads)
+            results = run_local(definition, batches, settings, 0, threads)
         try:
             for result in results:
                 start, arrays = result["start"], result["arrays"]

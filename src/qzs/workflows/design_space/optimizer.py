@@ -59,7 +59,7 @@ def fix_step(problem, *, progress=False):
 
     A problem whose ``[simulation]`` gives no ``dt`` runs at the step chosen for its
     ``tolerance_db`` on :func:`probe_designs` (each at the uncertain parameters' medians),
-    by :func:`qzs.workflows.sweeps.backends.choose_sweep_step`, the sweeps' choice. A
+    by :func:`qzs.workflows.sweeps.step.choose_sweep_step`, the sweeps' choice. A
     problem of linear metrics only needs no step.
 
     Parameters
@@ -74,7 +74,7 @@ def fix_step(problem, *, progress=False):
     DesignProblem
         With ``sweep.simulation["dt"]`` set (and ``step_note`` saying how).
     """
-    from qzs.workflows.sweeps.backends import choose_sweep_step
+    from qzs.workflows.sweeps.step import choose_sweep_step
 
     if problem.sweep.simulation["dt"] is not None or all(
             METRICS[g.metric].source == "linear" for g in problem.goals):
@@ -148,7 +148,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     from tqdm.auto import tqdm
 
     from qzs.workflows.design_space.problem import _positive_int
-    from qzs.workflows.sweeps.backends import dask_client
+    from qzs.workflows.sweeps.cluster import dask_client
 
     if not isinstance(problem, DesignProblem):
         problem = load_problem(problem)

@@ -67,7 +67,8 @@ from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.registry import PARAMETERS
 from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_column
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
-                                             _distribution, _frozen, load_sweep, unit_draws)
+                                             frozen_distribution, load_sweep, parse_distribution,
+                                             unit_draws)
 
 __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "plan_text",
            "shipped_problems", "TABLES", "MAX_SAMPLES"]
@@ -180,7 +181,7 @@ class Uncertainty:
         if self.distribution == "values":
             values = np.asarray(self.settings["values"], dtype=float)
             return values[np.minimum((u * values.size).astype(int), values.size - 1)]
-        return _frozen(self.distribution, self.settings).ppf(u)
+        return frozen_distribution(self.distribution, self.settings).ppf(u)
 
     @property
     def nominal(self) -> float:
@@ -298,7 +299,7 @@ class DesignProblem:
         Resolved ``[optimizer]`` and ``[sensitivity]`` settings.
     sweep : SweepDefinition
         The evaluation as a sweep: fixed parameters, excitation, simulation, analysis
-        and the outputs the metrics need (:func:`qzs.workflows.sweeps.backends.run_batch`
+        and the outputs the metrics need (:func:`qzs.workflows.sweeps.batch.run_batch`
         runs it).
     document : dict
         The parsed TOML file; its hash identifies the problem in a store.
@@ -481,7 +482,7 @@ def _uncertain(document, kind, variables):
                                          settings={"values": values}, units=units))
             continue
         try:
-            distribution, settings = _distribution(name, spec)
+            distribution, settings = parse_distribution(name, spec)
         except ParameterError as error:
             allowed = ", ".join(DISTRIBUTIONS) + ", or { values = [...] }"
             raise ProblemError("uncertain", name, spec, f"{error} (distributions: {allowed})") \

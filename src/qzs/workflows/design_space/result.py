@@ -329,7 +329,7 @@ class OptimizationResult:
         str
         """
         from qzs.iotools.config import config_text
-        from qzs.workflows.sweeps.backends import build_case
+        from qzs.workflows.sweeps.cases import build_case
 
         index = self._index(index)
         p = self.problem

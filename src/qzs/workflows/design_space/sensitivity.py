@@ -790,7 +790,7 @@ def run_sensitivity(problem: DesignProblem | str | Path | Mapping[str, Any],
     import matplotlib.pyplot as plt
 
     from qzs.iotools.files import atomic_path
-    from qzs.workflows.sweeps.backends import dask_client
+    from qzs.workflows.sweeps.cluster import dask_client
 
     with dask_client(scheduler, workers) as client:
         result = sensitivity(problem, method=method, samples=samples, seed=seed, client=client,

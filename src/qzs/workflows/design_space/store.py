@@ -231,7 +231,7 @@ def check(path: str | Path, *, resume: bool = False, overwrite: bool = False,
     OutputPathError, ParameterError
         As :class:`DesignStore`.
     """
-    from qzs.workflows.sweeps.backends import check_resume
+    from qzs.workflows.sweeps.store_checks import check_resume
 
     check_resume(path, argument, resume, overwrite, work="the search")
     path = Path(path)

@@ -41,11 +41,17 @@ guide is ``docs/sweeps.md``.
 :func:`run_sweep`, :func:`open_sweep`, :func:`plot_sweep`, :func:`export_sweep` (a store
 to a MATLAB file) and :func:`stored_count` are here; figures in :mod:`qzs.viz.sweeps`. The modules:
 
-==============  =================================================================
-``definition``  sweep files: validation, grids, random and Latin-hypercube sampling
-``backends``    the batch task, its reduction, the local and Dask backends
-``store``       the Zarr store: layout, creation, batch writes, resume checks
-==============  =================================================================
+================  =================================================================
+``definition``    sweep files: validation, grids, random and Latin-hypercube sampling
+``cases``         each case's parameters and excitation, invalid cases refused early
+``step``          the integration step chosen for the tolerance on a few cases
+``batch``         the batch task, run in this process or on a Dask cluster
+``reduction``     a case's transmissibility curve, band means and metrics
+``cluster``       the Dask client: given, by address, or a local cluster
+``store``         the Zarr store: layout, creation, batch writes, resume checks
+``store_checks``  the store's name, folder, room and resume, checked before any run
+``runner``        :func:`execute`: a sweep run end to end, batch by batch into the store
+================  =================================================================
 """
 from __future__ import annotations
 
@@ -115,7 +121,7 @@ def run_sweep(definition: SweepDefinition | str | Path | Mapping[str, Any],
     KeyboardInterrupt
         On Ctrl-C, after the batches that finished have been stored.
     """
-    from qzs.workflows.sweeps.backends import execute
+    from qzs.workflows.sweeps.runner import execute
 
     if not isinstance(definition, SweepDefinition):
         definition = load_sweep(definition)

@@ -32,7 +32,7 @@ from qzs.model import registry
 from qzs.model.registry import PARAMETERS, update_parameters
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "unit_draws",
-           "shipped_sweeps",
+           "shipped_sweeps", "parse_distribution", "frozen_distribution",
            "plan_text", "METHODS", "DISTRIBUTIONS", "EXCITATION_PARAMETERS", "MAX_CASES"]
 
 METHODS = ("grid", "random", "lhs")
@@ -56,7 +56,7 @@ TABLES = ("sweep", "parameters", "excitation", "grid", "distributions", "simulat
           "analysis", "outputs")
 SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batch_size")
 #: ``dt`` None: the step is chosen for ``tolerance_db`` before the sweep runs
-#: (:func:`qzs.workflows.sweeps.backends.choose_sweep_step`); a ``dt`` in the file fixes it.
+#: (:func:`qzs.workflows.sweeps.step.choose_sweep_step`); a ``dt`` in the file fixes it.
 SIMULATION_DEFAULTS = {"dt": None, "solver": SIMULATION["solver"],
                        "tolerance_db": ACCURACY["tolerance_db"]}
 #: Folder of the shipped sweep files, inside the package.
@@ -243,7 +243,7 @@ def _definition(document, where, stem):
         raise ParameterError(f"[distributions] must be a table, got {table!r}.")
     for key, spec in table.items():
         _check_name(key, kind)
-        distributions[key] = _distribution(key, spec)
+        distributions[key] = parse_distribution(key, spec)
     for key in (*grid, *distributions):
         fixed = parameters if "." not in key else excitation
         if key.split(".", 1)[-1] in fixed:
@@ -373,7 +373,30 @@ def _grid_values(name, spec):
     return tuple(float(start + i * step) for i in range(count))
 
 
-def _distribution(name, spec):
+def parse_distribution(name, spec):
+    """A distribution table of a sweep or problem file, checked: its kind and its values.
+
+    Parameters
+    ----------
+    name : str
+        The parameter it is of, for the messages.
+    spec : dict
+        The table: ``distribution`` (a name of :data:`DISTRIBUTIONS`; ``log-normal`` is
+        taken for ``lognormal``) and that distribution's keys.
+
+    Returns
+    -------
+    kind : str
+        The distribution's name in :data:`DISTRIBUTIONS`.
+    values : dict of str to float
+        Its keys' values, finite, in the parameter's unit.
+
+    Raises
+    ------
+    ParameterError
+        Not a table, an unknown distribution, missing or unknown keys, a non-positive
+        spread, ``low`` not below ``high``, a loguniform range not above zero.
+    """
     allowed = "; ".join(f"{d} {{{', '.join(r + tuple(f'[{o}]' for o in opt))}}}"
                         for d, (r, opt) in DISTRIBUTIONS.items())
     if not isinstance(spec, dict) or "distribution" not in spec:
@@ -488,7 +511,21 @@ def _outputs(table, analysis):
 
 
 # ---------------------------------------------------------------- sampling
-def _frozen(kind, p):
+def frozen_distribution(kind, p):
+    """The scipy distribution of a checked distribution table (its ``ppf`` draws from it).
+
+    Parameters
+    ----------
+    kind : str
+        The distribution's name in :data:`DISTRIBUTIONS`.
+    p : dict of str to float
+        Its keys' values (:func:`parse_distribution`).
+
+    Returns
+    -------
+    scipy.stats.rv_continuous_frozen
+        A normal with ``low``/``high`` is truncated there.
+    """
     from scipy import stats
 
     if kind == "uniform":
@@ -524,7 +561,7 @@ def draw_samples(distributions, n, method="lhs", seed=None):
     dict of str to ndarray, shape (n,)
     """
     u = unit_draws(len(distributions), n, method, seed)
-    return {name: _frozen(kind, p).ppf(u[:, j])
+    return {name: frozen_distribution(kind, p).ppf(u[:, j])
             for j, (name, (kind, p)) in enumerate(distributions.items())}
 
 

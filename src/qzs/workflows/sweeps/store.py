@@ -369,7 +369,7 @@ def summary_text(dataset: xr.Dataset, report: Mapping[str, Any] | None = None) -
     dataset : xarray.Dataset
         An opened store.
     report : dict, optional
-        What :func:`qzs.workflows.sweeps.backends.execute` returned (cases, steps, wall [s]).
+        What :func:`qzs.workflows.sweeps.runner.execute` returned (cases, steps, wall [s]).
     """
     status = dataset["status"].values
     done = dataset["done"].values

@@ -1,4 +1,4 @@
-"""A sweep's cases (qzs.workflows.sweeps.backends): each grid point becomes the parameters
+"""A sweep's cases (qzs.workflows.sweeps.cases): each grid point becomes the parameters
 and excitation it names, fixed values kept, excitation axes slowest; cases that share an
 excitation share its key (they run in one lockstep batch)."""
 import itertools
@@ -6,7 +6,7 @@ import itertools
 import pytest
 
 from qzs.workflows.sweeps import load_sweep
-from qzs.workflows.sweeps.backends import build_case, case_duration, case_settings
+from qzs.workflows.sweeps.cases import build_case, case_duration, case_settings
 from qzs.workflows.sweeps.definition import sample_cases
 
 DOCUMENT = {"sweep": {"name": "cases", "batch_size": 2},
@@ -40,7 +40,7 @@ def test_invalid_cases_are_named_before_any_case_runs():
     import math
 
     from qzs.errors import CaseError, InvalidCasesError
-    from qzs.workflows.sweeps.backends import check_cases
+    from qzs.workflows.sweeps.cases import check_cases
 
     sweep = load_sweep({"sweep": {"name": "bad"}, "analysis": {"fft_length": 1024,
                                                               "n_averages": 4},
@@ -60,7 +60,7 @@ def test_invalid_cases_are_named_before_any_case_runs():
 
 def test_an_invalid_excitation_value_names_its_cases():
     from qzs.errors import InvalidCasesError
-    from qzs.workflows.sweeps.backends import check_cases
+    from qzs.workflows.sweeps.cases import check_cases
 
     sweep = load_sweep({"sweep": {"name": "bad"}, "analysis": {"fft_length": 1024,
                                                               "n_averages": 4},
@@ -69,21 +69,3 @@ def test_an_invalid_excitation_value_names_its_cases():
         check_cases(sweep, case_settings(sweep, sample_cases(sweep)))
     assert [i for i, _, _ in caught.value.cases] == [2, 3]
     assert "`amplitude` must be non-negative" in caught.value.reason
-
-
-def test_connecting_to_a_scheduler_says_what_it_waits_for(monkeypatch, capsys):
-    """A scheduler that does not answer at once (a filtered port, a slow network): stderr
-    says where it connects and how long it waits, before it waits."""
-    pytest.importorskip("distributed")
-    from qzs.errors import SchedulerError
-    from qzs.workflows.sweeps import backends
-
-    class Silent:  # the client of a scheduler that never answers
-        def __init__(self, address, timeout):
-            assert "connecting to the Dask scheduler at tcp://10.1.2.3:8786" in \
-                capsys.readouterr().err  # said before the wait
-            raise OSError(f"Timed out trying to connect to {address} after {timeout}")
-
-    monkeypatch.setattr(backends, "_probe", lambda address: None)
-    with pytest.raises(SchedulerError, match=r"'tcp://10.1.2.3:8786': Timed out"):
-        backends._connect(Silent, "tcp://10.1.2.3:8786")

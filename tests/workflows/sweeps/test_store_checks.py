@@ -1,0 +1,46 @@
+"""A sweep's store checked before any run (qzs.workflows.sweeps.store_checks): resume and
+overwrite exclude each other, resume needs a store, the name ends in .zarr, an existing
+store needs resume or overwrite; the time series' length is the duration at the output
+rate."""
+import pytest
+
+from qzs.errors import OutputPathError, ParameterError
+from qzs.workflows.sweeps.cases import case_settings
+from qzs.workflows.sweeps.definition import load_sweep, sample_cases
+from qzs.workflows.sweeps.store_checks import check_resume, check_store_path, time_samples
+
+DOCUMENT = {"sweep": {"name": "checks"}, "grid": {"pi_kp": [5.0, 20.0]},
+            "simulation": {"dt": 1e-4},
+            "analysis": {"fft_length": 1024, "n_averages": 4}}
+
+
+def test_resume_and_overwrite(tmp_path):
+    with pytest.raises(ParameterError, match="give one of them, not both"):
+        check_resume(tmp_path / "s.zarr", "--out", True, True)
+    with pytest.raises(OutputPathError, match="nothing to resume") as caught:
+        check_resume(tmp_path / "s.zarr", "--out", True, False, work="the search")
+    assert caught.value.argument == "--out" and "start the search" in str(caught.value)
+    (tmp_path / "s.zarr").mkdir()
+    check_resume(tmp_path / "s.zarr", "--out", True, False)  # a store to resume: fine
+
+
+def test_the_store_path_is_checked_before_any_run(tmp_path):
+    sweep = load_sweep(DOCUMENT)
+    with pytest.raises(OutputPathError, match=r"it must end in \.zarr"):
+        check_store_path(sweep, tmp_path / "s.nc", argument="--out")
+    existing = tmp_path / "s.zarr"
+    existing.mkdir()
+    with pytest.raises(OutputPathError, match="exists; pass `resume`"):
+        check_store_path(sweep, existing)
+    check_store_path(sweep, existing, overwrite=True)
+    check_store_path(sweep, existing, resume=True)
+    check_store_path(sweep, tmp_path / "new.zarr")
+
+
+def test_time_samples_are_the_duration_at_the_output_rate():
+    sweep = load_sweep(DOCUMENT)
+    settings = case_settings(sweep, sample_cases(sweep))
+    assert time_samples(sweep, settings) == 0  # no time series kept
+    kept = load_sweep({**DOCUMENT, "outputs": {"time_series": ["relative_position"]}})
+    duration, rate = kept.analysis["duration"], kept.analysis["sample_rate"]
+    assert time_samples(kept, settings) == int(round(duration * rate)) + 1
