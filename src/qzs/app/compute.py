@@ -284,7 +284,6 @@ def page_request(values=None):
 
 
 # ---------------------------------------------------------------- the step
-@functools.lru_cache(maxsize=64)
 def resolve_page_run(excitation, isolator, controller, sample_rate, duration=None,
                      tolerance_state=None):
     """A page run resolved as ``qzs simulate`` resolves it (:func:`qzs.engine.run_spec.resolve`).
@@ -314,11 +313,16 @@ def resolve_page_run(excitation, isolator, controller, sample_rate, duration=Non
     -------
     ResolvedRun
     """
+    return _resolved(excitation, isolator, controller, float(sample_rate), duration,
+                     tolerance_state)
+
+
+@functools.lru_cache(maxsize=64)
+def _resolved(excitation, isolator, controller, sample_rate, duration, tolerance_state):
     from qzs.engine.run_spec import resolve
 
-    return resolve(excitation, isolator, controller, duration=duration,
-                   sample_rate=float(sample_rate), tolerance_state=tolerance_state,
-                   step="chosen")
+    return resolve(excitation, isolator, controller, duration=duration, sample_rate=sample_rate,
+                   tolerance_state=tolerance_state, step="chosen")
 
 
 def _step_note(step):

@@ -43,7 +43,20 @@ PROBE_SEGMENTS = 8
 
 # ---------------------------------------------------------------- the probe
 def frequency_range(excitation, sample_rate):
-    """Lowest and highest frequency [Hz] the excitation holds."""
+    """Lowest and highest frequency [Hz] the excitation holds.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The excitation.
+    sample_rate : float
+        Output rate [Hz]; a record's content is taken up to its Nyquist frequency.
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)`` [Hz].
+    """
     if isinstance(excitation, Chirp):
         return min(excitation.f0, excitation.f1), max(excitation.f0, excitation.f1)
     if isinstance(excitation, Sine):
@@ -139,6 +152,24 @@ def excitation_over(excitation, duration):
 
 # ---------------------------------------------------------------- the measures
 def probe_fft_length(n_samples, sample_rate, band, fft_length):
+    """The Welch segment length [samples] of a probe's transmissibility.
+
+    Parameters
+    ----------
+    n_samples : int
+        The probe's output samples [-].
+    sample_rate : float
+        Output rate [Hz].
+    band : tuple of float or None
+        The measure's band [Hz] (unused: the length follows the probe).
+    fft_length : int or None
+        A length asked for [samples]; None: a power of two giving at least
+        :data:`PROBE_SEGMENTS` half-overlapping segments, at most the paper's 32768.
+
+    Returns
+    -------
+    int
+    """
     if fft_length is not None:
         return int(fft_length)
     # a power of two with at least PROBE_SEGMENTS half-overlapping segments in the probe
@@ -212,6 +243,29 @@ def estimate_difference_db(coarse, fine, band, keep=None):
 
 # ---------------------------------------------------------------- validation
 def check_band(band, excitation, sample_rate):
+    """The band [Hz] a transmissibility error is measured over, checked.
+
+    Parameters
+    ----------
+    band : tuple of float or None
+        ``(low, high)`` [Hz]; None: the excitation's frequencies (a chirp from 0 Hz: from
+        1 Hz, or half its top if lower).
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The excitation the band must lie in.
+    sample_rate : float
+        Output rate [Hz]; the band must lie below its Nyquist frequency.
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)`` [Hz].
+
+    Raises
+    ------
+    ParameterError
+        Not two finite frequencies with ``0 <= low <= high``, above the Nyquist frequency,
+        or outside the excitation's frequencies.
+    """
     lowest, highest = frequency_range(excitation, sample_rate)
     if band is None:
         low, high = lowest, highest
@@ -425,8 +479,43 @@ def default_tolerance(excitation):
 # ---------------------------------------------------------------- shared by the searches
 
 def probe_settings(excitation, measure, solver, sample_rate, band, probe_duration, fft_length,
-                    safety, max_halvings):
-    """Check a step search's settings; ``(order, sample_rate, band, probe, probe duration)``."""
+                   safety, max_halvings):
+    """Check a step search's settings and make its probe.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+    measure : {"transmissibility_db", "state_m"}
+        The accuracy measure.
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz].
+    band : tuple of float or None
+        The transmissibility measure's band [Hz] (:func:`check_band`).
+    probe_duration : float or None
+        The probe's length [s] (:func:`probe_excitation`).
+    fft_length : int or None
+        Welch segment length [samples].
+    safety : float
+        Factor [-] (>= 1) between the estimate and the tolerance.
+    max_halvings : int
+        Halvings tried at most [-] (>= 2).
+
+    Returns
+    -------
+    order : int
+        The scheme's order [-].
+    sample_rate : float
+        Output rate [Hz].
+    band : tuple of float or None
+        The checked band [Hz] (None for the state measure).
+    probe : object
+        The probe's excitation.
+    duration : float
+        The probe's length [s], a whole number of output periods.
+    """
     from qzs.engine.stability import SOLVERS
 
     _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]

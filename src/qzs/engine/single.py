@@ -32,10 +32,14 @@ def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
 
     Parameters
     ----------
-    excitation, isolator, controller, duration, sample_rate, solver, initial_state
+    excitation, isolator, controller, solver, initial_state
         As for :func:`qzs.simulate`.
+    duration : float, optional
+        Simulated time [s]; default the excitation's length.
     dt : float
         The integration step [s].
+    sample_rate : float
+        Output rate [Hz].
     progress : bool
         Show a progress bar.
     interruptible : bool
