@@ -213,13 +213,15 @@ def test_an_unknown_excitation_kind_in_a_config_is_named(tmp_path, capsys):
 
 
 def test_tolerance_chooses_the_step_the_run_uses(capsys):
-    """`--tolerance DB` runs with the step qzs.engine.accuracy.choose_step finds."""
-    from qzs.engine.accuracy import choose_step
+    """`--tolerance DB` runs with the step qzs.engine.accuracy.choose_step finds for the chirp
+    the run covers (its first 20 s)."""
+    from qzs.engine.accuracy import choose_step, excitation_over
 
     assert main(["simulate", "--excitation-duration", "100", "--duration", "20",
                  "--tolerance", "0.05", "--sample-rate", "500", "--plot", "none", "--json"]) == 0
     record = json.loads(capsys.readouterr().out)
-    expected = choose_step(Chirp(duration=100.0), tolerance_db=0.05, sample_rate=500.0)
+    expected = choose_step(excitation_over(Chirp(duration=100.0), 20.0), tolerance_db=0.05,
+                           sample_rate=500.0)
     assert record["step"]["dt"] == record["run"]["dt"] == expected.dt
     assert record["step"]["chosen"] and record["step"]["unit"] == "dB"
     assert record["step"]["error"] <= 0.05 and record["run"]["step_error_db"] <= 0.05
@@ -231,19 +233,20 @@ def test_without_a_step_the_default_tolerance_chooses_it_and_dt_stays_literal(ca
     """No --dt: the step meeting defaults.ACCURACY (dB for a chirp, metres for a sine), stated
     in the summary and the JSON; --dt is taken as it is."""
     from qzs.defaults import ACCURACY
-    from qzs.engine.accuracy import choose_step
+    from qzs.engine.accuracy import choose_step, excitation_over
 
-    common = ["--excitation-duration", "100", "--duration", "5", "--sample-rate", "500",
+    common = ["--excitation-duration", "100", "--duration", "40", "--sample-rate", "500",
               "--plot", "none"]
     assert main(["simulate", *common, "--json"]) == 0
     record = json.loads(capsys.readouterr().out)
-    expected = choose_step(Chirp(duration=100.0), tolerance_db=ACCURACY["tolerance_db"],
-                           sample_rate=500.0)
+    expected = choose_step(excitation_over(Chirp(duration=100.0), 40.0),
+                           tolerance_db=ACCURACY["tolerance_db"], sample_rate=500.0)
     assert record["run"]["dt"] == expected.dt > 1e-4
     assert record["step"]["tolerance"] == ACCURACY["tolerance_db"]
     assert main(["simulate", *common, "--quiet"]) == 0
-    assert (f"chosen for the transmissibility within {ACCURACY['tolerance_db']:g} dB"
-            in capsys.readouterr().out)
+    text = capsys.readouterr().out
+    assert "accuracy-driven: estimated error" in text
+    assert f"(tolerance {ACCURACY['tolerance_db']:g} dB" in text
     assert main(["simulate", *common, "--dt", "2e-4", "--json"]) == 0
     record = json.loads(capsys.readouterr().out)
     assert record["run"]["dt"] == 2e-4 and record["step"] == {"dt": 2e-4, "chosen": False}
