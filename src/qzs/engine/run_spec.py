@@ -21,10 +21,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from qzs import _validation, defaults
 from qzs.errors import ParameterError
+
+if TYPE_CHECKING:
+    from qzs.engine.results import SimulationResult
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.excitation import Excitation
+    from qzs.model.isolator import InitialState, IsolatorParameters
 
 __all__ = ["ResolvedRun", "resolve", "ResolvedHexapodRun", "resolve_hexapod", "MAX_SAMPLES"]
 
@@ -72,7 +79,7 @@ class ResolvedRun:
     step: Any
     notes: tuple = ()
 
-    def arguments(self):
+    def arguments(self) -> dict[str, Any]:
         """The keywords of the run for :func:`qzs.engine.simulate.simulate` and its kin.
 
         Returns
@@ -86,7 +93,8 @@ class ResolvedRun:
                     sample_rate=self.sample_rate, solver=self.solver,
                     initial_state=self.initial_state)
 
-    def simulate(self, *, progress=False, interruptible=False, sink=None):
+    def simulate(self, *, progress: bool = False, interruptible: bool = False,
+                 sink: Callable[[Any, Any], Any] | None = None) -> SimulationResult:
         """Integrate the run (:func:`qzs.engine.single.integrate`).
 
         Parameters
@@ -119,11 +127,14 @@ def _one_step_request(**asked):
     return given
 
 
-def resolve(excitation=None, isolator=None, controller=None, *, duration=None, dt=None,
-            tolerance=None, tolerance_state=None,
-            sample_rate=defaults.SIMULATION["sample_rate"],
-            solver=defaults.SIMULATION["solver"], initial_state=None, step="literal",
-            progress=False, cache=True):
+def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters | None = None,
+            controller: ControllerParameters | None = None, *, duration: float | None = None,
+            dt: float | None = None, tolerance: float | None = None,
+            tolerance_state: float | None = None,
+            sample_rate: float = defaults.SIMULATION["sample_rate"],
+            solver: str = defaults.SIMULATION["solver"],
+            initial_state: InitialState | None = None, step: str = "literal",
+            progress: bool = False, cache: bool = True) -> ResolvedRun:
     """Resolve a single-axis run once: validate, put in defaults, choose the step.
 
     Parameters
@@ -182,7 +193,7 @@ def resolve(excitation=None, isolator=None, controller=None, *, duration=None, d
     from qzs.model.excitation import Sine
 
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    notes = []
+    notes: list[str] = []
     _validation.choice("step", step, ("literal", "chosen"))
     if duration is None:
         duration = excitation.duration

@@ -22,8 +22,11 @@ or no bin of the band is trusted on the probe, a caller that must run anyway get
 ``finest`` step it allows (default the paper's ``defaults.SIMULATION["dt"]``), with ``met``
 False, ``error`` NaN (no estimate holds for it) and a note that says why.
 """
+from __future__ import annotations
+
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -119,7 +122,7 @@ class StepChoice:
     solver: str
     probe: object
     probe_duration: float
-    band: tuple
+    band: tuple | None
     history: tuple
     notes: tuple
     met: bool = True
@@ -130,8 +133,8 @@ class StepChoice:
     unmet: tuple = ()
 
     @classmethod
-    def literal(cls, dt, *, sample_rate=defaults.SIMULATION["sample_rate"],
-                solver=defaults.SIMULATION["solver"]):
+    def literal(cls, dt: float, *, sample_rate: float = defaults.SIMULATION["sample_rate"],
+                solver: str = defaults.SIMULATION["solver"]) -> StepChoice:
         """The record of a step given literally (``dt`` [s]): nothing chosen, no estimate.
 
         Parameters
@@ -154,16 +157,16 @@ class StepChoice:
                    chosen=False)
 
     @property
-    def unit(self):
+    def unit(self) -> str:
         """The unit of ``error`` and ``tolerance``: ``"dB"``, ``"m"`` or ``""`` (literal)."""
         return MEASURE_UNITS.get(self.measure, "")
 
     @property
-    def steps_per_sample(self):
+    def steps_per_sample(self) -> int:
         """Integration steps per output sample [-]."""
         return int(round(1.0 / (self.sample_rate * self.dt)))
 
-    def summary(self):
+    def summary(self) -> str:
         """One paragraph for people: the step, its error and why (the console's form).
 
         Returns
@@ -185,7 +188,7 @@ class StepChoice:
         lines += [f"  note: {note}" for note in self.notes]
         return "\n".join(lines)
 
-    def line(self):
+    def line(self) -> str:
         """The step in one line, as summaries and reports quote it (:func:`record_line`).
 
         Returns
@@ -194,7 +197,7 @@ class StepChoice:
         """
         return record_line({"dt": self.dt, **self.attributes()})
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The record as JSON gives it (``qzs ... --json``'s ``step``).
 
         Returns
@@ -216,7 +219,7 @@ class StepChoice:
                           unmet=list(self.unmet))
         return record
 
-    def attributes(self):
+    def attributes(self) -> dict[str, Any]:
         """The record as a run's entries and file attributes give it (``run.step*``).
 
         Returns

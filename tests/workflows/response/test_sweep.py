@@ -35,7 +35,8 @@ def test_the_step_is_chosen_for_accuracy_by_default():
     response = steady_state_response([3.0, 6.0], direction="up", harmonic_balance=False,
                                      workers=1)
     assert response.step is not None and response.dt == response.step.dt
-    assert any("chosen for 0.01 dB" in note for note in response.notes)
+    assert any("accuracy-driven" in note and "(tolerance 0.01 dB" in note
+               for note in response.notes)
     for p in response.points:
         assert p.dt <= response.dt and round(1 / (p.frequency * p.dt)) % SAMPLES_PER_PERIOD == 0
 
