@@ -22,6 +22,7 @@ use; the subpackages are the architecture, each importing only from those listed
 ``identify``     spring, friction and transmissibility fits
 ``viz``          every figure
 ``workflows``    studies and report, experiments, sweeps, response, design, hexapod studies
+``export``       the isolator and its controller as C, and as an FMU (FMI 2.0 / 3.0)
 ``app``          the interactive tuning page (``qzs app``; Panel, optional)
 ``cli``          the ``qzs`` command
 ===============  ====================================================================

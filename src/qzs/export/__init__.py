@@ -1,0 +1,12 @@
+"""qzs outside Python: the isolator as C, the controller as C, and an FMU.
+
+One C implementation of the single-axis model (``csrc/``: ``qzs_plant`` the physics,
+``qzs_controller`` the sampled PI + active damping, ``qzs_model`` their closed loop), held
+to the numba kernels bit for bit by the tests, and compiled at run time with the system C
+compiler:
+
+============  =====================================================================
+``csource``   the shipped C sources, the system compiler, compile and load (ctypes)
+``cmodel``    run a case through the C model as :func:`qzs.simulate` would
+============  =====================================================================
+"""
