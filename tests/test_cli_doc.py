@@ -98,11 +98,12 @@ NEEDS = {
     "response": [],
     "optimize": ["isolation_vs_effort"],
     "sensitivity": ["isolation_vs_effort"],
+    "export controller": [],
 }
 NAMES = {"--toml": "p.toml", "--plot": "figure.png", "sweep --out": "store.zarr",
          "simulate --out": "run.nc", "hexapod simulate --out": "run.nc",
          "response --out": "response.nc", "sweep-plot --out": "figure.png",
-         "sweep-export --out": "sweep.mat"}
+         "sweep-export --out": "sweep.mat", "export controller --out": "controller.c"}
 
 
 def promised_options():

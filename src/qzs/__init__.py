@@ -34,10 +34,10 @@ from qzs._version import __version__
 from qzs.engine.results import SimulationResult
 from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
-from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
-                        MissingDependencyError, OutputPathError, ParameterError, ProblemError,
-                        ResultTooLargeError, SimulationError, SizeLimitError, StabilityError,
-                        ToleranceNotMetError)
+from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, ExcitationError,
+                        FitError, FitWarning, MissingDependencyError, OutputPathError,
+                        ParameterError, ProblemError, ResultTooLargeError, SimulationError,
+                        SizeLimitError, StabilityError, ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
                        IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
@@ -69,6 +69,7 @@ _LAZY = {
     "load_problem": "qzs.workflows.design_space.problem",
     "OptimizationResult": "qzs.workflows.design_space.result",
     "SensitivityResult": "qzs.workflows.design_space.sensitivity",
+    "export_controller": "qzs.export.controller",
 }
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
@@ -79,6 +80,7 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
     from qzs.engine.results import read_result
+    from qzs.export.controller import export_controller
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
     from qzs.iotools.readers import load_channel_map, read_recording
@@ -104,7 +106,7 @@ __all__ = [
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
-    "ToleranceNotMetError", "SizeLimitError", "ProblemError",
+    "ToleranceNotMetError", "SizeLimitError", "ProblemError", "CompilerError",
     "DataWarning", "FitWarning",
     *_LAZY,
 ]

@@ -553,21 +553,24 @@ class CompilerError(RuntimeError):
         The compiler asked for (``$CC``, else ``cc``/``gcc``).
     reason : str
         Why: not found on ``PATH``, or the compiler's own messages.
+    fix : str, optional
+        What to do; default: install a compiler or name it in ``CC``.
 
     Attributes
     ----------
-    compiler, reason : str
+    compiler, reason, fix : str
         As given.
     """
 
-    def __init__(self, compiler: str, reason: str) -> None:
-        self.compiler, self.reason = compiler, reason
-        super().__init__(f"the C compiler {compiler!r} {reason}; install one (gcc or clang: "
-                         "e.g. `apt install gcc`, Xcode's command line tools) or name it in "
-                         "the CC environment variable.")
+    def __init__(self, compiler: str, reason: str, fix: str | None = None) -> None:
+        if fix is None:
+            fix = ("install one (gcc or clang: e.g. `apt install gcc`, Xcode's command line "
+                   "tools) or name it in the CC environment variable")
+        self.compiler, self.reason, self.fix = compiler, reason, fix
+        super().__init__(f"the C compiler {compiler!r} {reason}; {fix}.")
 
     def __reduce__(self):
-        return type(self), (self.compiler, self.reason)
+        return type(self), (self.compiler, self.reason, self.fix)
 
 
 class Terminated(BaseException):

@@ -5,8 +5,9 @@ One C implementation of the single-axis model (``csrc/``: ``qzs_plant`` the phys
 to the numba kernels bit for bit by the tests, and compiled at run time with the system C
 compiler:
 
-============  =====================================================================
-``csource``   the shipped C sources, the system compiler, compile and load (ctypes)
-``cmodel``    run a case through the C model as :func:`qzs.simulate` would
-============  =====================================================================
+==============  ===================================================================
+``csource``     the shipped C sources, the system compiler, compile and load (ctypes)
+``cmodel``      run a case through the C model as :func:`qzs.simulate` would
+``controller``  the sampled controller as one dependency-free C file (``qzs export``)
+==============  ===================================================================
 """

@@ -117,7 +117,9 @@ def compile_shared(sources, target, *, flags=CFLAGS, include=(), compiler=None):
         raise CompilerError(compiler, f"could not be run ({error})") from None
     if done.returncode != 0:
         raise CompilerError(compiler, "failed to compile qzs's C sources:\n"
-                            + (done.stderr or done.stdout).strip())
+                            + (done.stderr or done.stdout).strip(),
+                            "report it with the messages above, or try another compiler "
+                            "(the CC environment variable)")
     return Path(target)
 
 
