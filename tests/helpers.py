@@ -1,4 +1,6 @@
 """Named parameter sets and small helpers shared by the simulator tests."""
+import ctypes as _ctypes
+
 import numpy as np
 
 import qzs
@@ -71,3 +73,37 @@ EXPORT_CASES = {
 def export_settings(case):
     """The run settings of a case: :data:`EXPORT_SETTINGS` updated by its own."""
     return {**EXPORT_SETTINGS, **EXPORT_CASES[case][3]}
+
+
+# ---------------------------------------------------------------- the exported controller (ctypes)
+class Parameters(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in (
+        "position_setpoint", "pi_kp", "pi_ki", "damping_gain", "motor_force_max",
+        "period_steps", "step_time")]
+
+
+class Output(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in ("pi", "damping", "motor", "integral_rate")]
+
+
+class Controller(_ctypes.Structure):
+    _fields_ = [("parameters", Parameters), ("integral", _ctypes.c_double), ("output", Output)]
+
+
+def build_controller(tmp_path, source):
+    """Compile an exported controller.c alone, strictly, without libm or include folders;
+    its two functions declared for ctypes."""
+    from qzs.export.csource import compile_shared
+
+    path = tmp_path / "controller.c"
+    path.write_text(source)
+    library = compile_shared([path], tmp_path / "controller.so",
+                             flags=("-O2", "-std=c99", "-pedantic", "-Wall", "-Werror",
+                                    "-ffp-contract=off", "-fPIC"))
+    lib = _ctypes.CDLL(str(library))
+    lib.qzs_controller_init.argtypes = [_ctypes.POINTER(Controller), _ctypes.POINTER(Parameters),
+                                        _ctypes.c_double]
+    lib.qzs_controller_step.argtypes = [_ctypes.POINTER(Controller), _ctypes.c_double,
+                                        _ctypes.c_double]
+    lib.qzs_controller_step.restype = Output
+    return lib

@@ -3,48 +3,20 @@ import ctypes
 
 import numpy as np
 import pytest
+from helpers import Controller, Parameters
+from helpers import build_controller as build
 
 import qzs
 from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
 from qzs.errors import CompilerError, ParameterError
 from qzs.export import controller as exported
-from qzs.export.csource import compile_shared, find_compiler
+from qzs.export.csource import find_compiler
 
 try:
     find_compiler()
 except CompilerError:  # pragma: no cover
     pytest.skip("no C compiler", allow_module_level=True)
-
-
-class Parameters(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in (
-        "position_setpoint", "pi_kp", "pi_ki", "damping_gain", "motor_force_max",
-        "period_steps", "step_time")]
-
-
-class Output(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in ("pi", "damping", "motor", "integral_rate")]
-
-
-class Controller(ctypes.Structure):
-    _fields_ = [("parameters", Parameters), ("integral", ctypes.c_double), ("output", Output)]
-
-
-def build(tmp_path, source):
-    """Compile the exported file alone, strictly, without libm or include folders."""
-    path = tmp_path / "controller.c"
-    path.write_text(source)
-    library = compile_shared([path], tmp_path / "controller.so",
-                             flags=("-O2", "-std=c99", "-pedantic", "-Wall", "-Werror",
-                                    "-ffp-contract=off", "-fPIC"))
-    lib = ctypes.CDLL(str(library))
-    lib.qzs_controller_init.argtypes = [ctypes.POINTER(Controller), ctypes.POINTER(Parameters),
-                                        ctypes.c_double]
-    lib.qzs_controller_step.argtypes = [ctypes.POINTER(Controller), ctypes.c_double,
-                                        ctypes.c_double]
-    lib.qzs_controller_step.restype = Output
-    return lib
 
 
 def test_the_commands_are_the_simulated_controllers_sample_for_sample(tmp_path):
