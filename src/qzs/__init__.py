@@ -70,6 +70,7 @@ _LAZY = {
     "OptimizationResult": "qzs.workflows.design_space.result",
     "SensitivityResult": "qzs.workflows.design_space.sensitivity",
     "export_controller": "qzs.export.controller",
+    "export_fmu": "qzs.export.fmu",
 }
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
@@ -81,6 +82,7 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
     from qzs.engine.results import read_result
     from qzs.export.controller import export_controller
+    from qzs.export.fmu import export_fmu
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
     from qzs.iotools.readers import load_channel_map, read_recording

@@ -45,3 +45,26 @@ def test_usage_and_suffix_errors_exit_2(argv, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(argv) == 2
     assert list(tmp_path.iterdir()) == []
+
+
+def test_export_fmu_writes_a_valid_fmu_of_the_options(tmp_path, capsys):
+    fmpy = pytest.importorskip("fmpy")
+    from fmpy.validation import validate_fmu
+
+    out = tmp_path / "iso.fmu"
+    code = main(["export", "fmu", "--out", str(out), "--fmi", "2", "--mode", "plant",
+                 "--excitation", "sine", "--frequency", "3", "--set", "mass=7",
+                 "--duration", "5"])
+    assert code == 0, capsys.readouterr().err
+    assert validate_fmu(str(out)) == []
+    description = fmpy.read_model_description(str(out))
+    starts = {v.name: v.start for v in description.modelVariables}
+    assert float(starts["isolator.mass"]) == 7.0 and float(starts["excitation.f0"]) == 3.0
+    assert description.fmiVersion == "2.0" and float(description.defaultExperiment.stopTime) == 5
+
+
+def test_export_fmu_refuses_excitation_options_with_inputs(tmp_path, capsys):
+    out = tmp_path / "iso.fmu"
+    code = main(["export", "fmu", "--out", str(out), "--base-motion", "input", "--f0", "1"])
+    assert code == 2 and "--base-motion input" in capsys.readouterr().err
+    assert not out.exists()

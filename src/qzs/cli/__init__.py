@@ -16,6 +16,8 @@
     qzs sensitivity FILE.toml [--method sobol|morris] [--samples N] [--out DIR]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
     qzs export controller [--config FILE.toml] [--set NAME=VALUE ...] [--dt S] [--out FILE.c]
+    qzs export fmu [--out FILE.fmu] [--fmi 3|2] [--mode closed-loop|plant]
+                   [--base-motion internal|input] [--config FILE.toml] [--set NAME=VALUE ...]
     qzs docs [TOPIC [SECTION]]
     qzs completion bash|zsh
 

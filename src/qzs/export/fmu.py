@@ -28,7 +28,9 @@ from qzs.export.fmu_variables import BASE_MOTIONS, MODES, fmu_variables, variabl
 from qzs.export.fmu_xml import build_description, model_description
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
+from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, Sine
+from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["export_fmu", "fmi_headers", "platform_folder", "FMU_SOURCES", "FMI_VERSIONS"]
 
@@ -107,8 +109,9 @@ def _check_choices(fmi_version, mode, base_motion, model_identifier):
                              f"{model_identifier!r}.")
 
 
-def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None, isolator=None,
-               controller=None, *, fmi_version: int = 3, mode: str = "closed-loop",
+def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
+               isolator: IsolatorParameters | None = None,
+               controller: ControllerParameters | None = None, *, fmi_version: int = 3, mode: str = "closed-loop",
                base_motion: str = "internal", dt: float = defaults.SIMULATION["dt"],
                solver: str = defaults.SIMULATION["solver"], duration: float | None = None,
                communication_step: float | None = None, model_identifier: str = "isolator",
