@@ -27,7 +27,8 @@ def test_every_registry_parameter_is_a_parameter_with_its_unit_and_start():
         assert variable.unit == (info.unit if info.unit in UNITS else "")
     assert variables["isolator.mass"].start == 7.5
     assert variables["controller.pi_kp"].start == 77.0
-    assert variables["isolator.stop_model"].start == 1 and variables["isolator.stop_model"].type == "I"
+    assert variables["isolator.stop_model"].start == 1
+    assert variables["isolator.stop_model"].type == "I"
     assert variables["isolator.stop_center"].start == qzs.ControllerParameters().position_setpoint
     assert variables["step_size"].start == 2e-4 and variables["solver"].start == K.SOLVER_RK4
     assert variables["excitation.kind"].start == 2 and variables["excitation.f0"].start == 3.0

@@ -111,7 +111,8 @@ def _check_choices(fmi_version, mode, base_motion, model_identifier):
 
 def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
                isolator: IsolatorParameters | None = None,
-               controller: ControllerParameters | None = None, *, fmi_version: int = 3, mode: str = "closed-loop",
+               controller: ControllerParameters | None = None, *, fmi_version: int = 3,
+               mode: str = "closed-loop",
                base_motion: str = "internal", dt: float = defaults.SIMULATION["dt"],
                solver: str = defaults.SIMULATION["solver"], duration: float | None = None,
                communication_step: float | None = None, model_identifier: str = "isolator",

@@ -12,7 +12,8 @@ void qzs_controller_init(QzsController *controller, const QzsControllerParameter
 QzsControllerOutput qzs_controller_step(QzsController *controller, double z, double v_measured) {
     const QzsControllerParameters *p = &controller->parameters;
     QzsControllerOutput out = qzs_controller_law(p, z, v_measured, controller->integral);
-    controller->integral = controller->integral + out.integral_rate * p->period_steps * p->step_time;
+    controller->integral =
+        controller->integral + out.integral_rate * p->period_steps * p->step_time;
     controller->output = out;
     return out;
 }

@@ -187,7 +187,8 @@ INLINE void rotate(double phase, double phase0, double sin0, double cos0, double
     double d = phase - phase0;
     if (fabs(d) < 0.1) {
         double d2 = d * d;
-        double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0))));
+        double sd =
+            d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0))));
         double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0)));
         *s = sin0 * cd + cos0 * sd;
         *c = cos0 * cd - sin0 * sd;
