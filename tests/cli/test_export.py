@@ -68,3 +68,30 @@ def test_export_fmu_refuses_excitation_options_with_inputs(tmp_path, capsys):
     code = main(["export", "fmu", "--out", str(out), "--base-motion", "input", "--f0", "1"])
     assert code == 2 and "--base-motion input" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
+    """Without --dt the FMU's internal step is the one `qzs simulate` chooses for the same
+    inputs (one resolved run, docs/model.md decision 33), and the description says how."""
+    fmpy = pytest.importorskip("fmpy")
+    import json
+
+    import qzs
+
+    options = ["--excitation-duration", "30", "--f1", "5", "--set", "stiction_force=6"]
+    out = tmp_path / "iso.fmu"
+    assert main(["export", "fmu", "--out", str(out), *options]) == 0
+    description = fmpy.read_model_description(str(out))
+    starts = {v.name: v.start for v in description.modelVariables}
+    capsys.readouterr()
+    assert main(["simulate", *options, "--plot", "none", "--json"]) == 0
+    simulated = json.loads(capsys.readouterr().out)["step"]
+    assert simulated["chosen"] and float(starts["step_size"]) == simulated["dt"]
+    resolved = qzs.resolve(qzs.Chirp(duration=30.0, f1=5.0),
+                           qzs.IsolatorParameters(stiction_force=6.0), step="chosen")
+    assert resolved.dt == simulated["dt"]
+    assert "accuracy-driven" in description.description
+    # a literal --dt stays literal
+    assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4"]) == 0
+    starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
+    assert float(starts["step_size"]) == 2e-4

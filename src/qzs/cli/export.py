@@ -83,9 +83,16 @@ def add_parser(subparsers):
                      help="the internal excitation (default the configuration's, else chirp)")
     for flag, kind, metavar, text in _EXCITATION_FLAGS:
         fmu.add_argument(flag, type=kind, metavar=metavar, help=text)
-    fmu.add_argument("--dt", type=float, metavar="S",
-                     help="internal integration step [s] (default the configuration's, else "
-                          f"{SIMULATION['dt']:g}); communication steps are whole numbers of it")
+    step = fmu.add_mutually_exclusive_group()
+    step.add_argument("--dt", type=float, metavar="S",
+                      help="a literal internal integration step [s] (default the "
+                           "configuration's, else the step `qzs simulate` chooses); "
+                           "communication steps are whole numbers of it")
+    step.add_argument("--tolerance", type=float, metavar="DB",
+                      help="choose the internal step as `qzs simulate --tolerance` does [dB] "
+                           "(default 0.01; a sine: --tolerance-state)")
+    step.add_argument("--tolerance-state", type=float, metavar="M",
+                      help="choose the internal step for the relative position within M [m]")
     fmu.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                      help="integrator (default ode3)")
     fmu.add_argument("--duration", type=float, metavar="S",
@@ -176,7 +183,11 @@ def run_fmu(args):
                              "input (the base motion comes from the FMU's inputs); drop them.")
     path = export_fmu(args.out, excitation, config["isolator"], config["controller"],
                       fmi_version=args.fmi, mode=args.mode, base_motion=args.base_motion,
-                      dt=args.dt if args.dt is not None else settings.get("dt", SIMULATION["dt"]),
+                      dt=args.dt if args.dt is not None else (
+                          None if args.tolerance is not None or args.tolerance_state is not None
+                          else settings.get("dt")),
+                      tolerance=args.tolerance, tolerance_state=args.tolerance_state,
+                      step="chosen",
                       solver=args.solver or settings.get("solver", SIMULATION["solver"]),
                       duration=args.duration if args.duration is not None
                       else settings.get("duration"),

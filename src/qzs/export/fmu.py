@@ -21,6 +21,7 @@ from pathlib import Path
 from qzs import defaults
 from qzs._optional import require
 from qzs.engine.prepare import prepare_run
+from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
 from qzs.errors import ParameterError
 from qzs.export.csource import CFLAGS, compile_shared, source_folder
@@ -113,7 +114,9 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
                isolator: IsolatorParameters | None = None,
                controller: ControllerParameters | None = None, *, fmi_version: int = 3,
                mode: str = "closed-loop",
-               base_motion: str = "internal", dt: float = defaults.SIMULATION["dt"],
+               base_motion: str = "internal", dt: float | None = None,
+               tolerance: float | None = None, tolerance_state: float | None = None,
+               step: str = "literal",
                solver: str = defaults.SIMULATION["solver"], duration: float | None = None,
                communication_step: float | None = None, model_identifier: str = "isolator",
                argument: str = "path") -> Path:
@@ -137,8 +140,17 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
         The PI + damping inside, or the motor force as an input.
     base_motion : {"internal", "input"}
         The excitation inside, or base displacement, velocity and acceleration as inputs.
-    dt : float
-        Internal integration step [s]; a communication step must be a whole number of it.
+    dt : float, optional
+        A literal internal integration step [s]; a communication step must be a whole
+        number of it.
+    tolerance, tolerance_state : float, optional
+        Or the tolerance [dB] or [m] the step is chosen for, on the internal excitation, as
+        :func:`qzs.simulate` chooses it (the run is resolved by :func:`qzs.resolve`, its
+        output rate the communication rate).
+    step : {"literal", "chosen"}
+        The step given neither ``dt`` nor a tolerance, as for :func:`qzs.resolve`: the
+        paper's 1e-4 s, or the default accuracy (``qzs export fmu``'s default, as
+        ``qzs simulate``'s); with base-motion inputs (no excitation to probe) always literal.
     solver : {"ode3", "rk4", "euler"}
         Integrator.
     duration : float, optional
@@ -182,11 +194,17 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
                            else Sine(amplitude=0.0, fade_in=0.0))
     if duration is None:
         duration = probe.duration if probe.duration is not None else 10.0
-    step = communication_step if communication_step is not None else max(1e-3, dt)
+    communication = (communication_step if communication_step is not None
+                     else max(1e-3, dt or 0.0))
     if controller is not None and mode == "plant":
         controller = dataclasses.replace(controller, controller_rate=0.0)
-    run = prepare_run(probe, isolator, controller, duration=duration, dt=dt,
-                      sample_rate=1.0 / step, solver=solver)  # every check qzs.simulate makes
+    # the run resolved as qzs.simulate resolves it: its step literal or chosen, once
+    resolved = resolve(probe, isolator, controller, duration=duration, dt=dt,
+                       tolerance=tolerance, tolerance_state=tolerance_state,
+                       sample_rate=1.0 / communication, solver=solver,
+                       step=step if base_motion == "internal" else "literal")
+    dt, step = resolved.dt, communication
+    run = prepare_run(**resolved.arguments())  # every check qzs.simulate makes
     headers = fmi_headers(fmi_version)
     variables = fmu_variables(isolator=run.isolator, controller=run.controller,
                               excitation_scalars=run.packed[0], dt=dt,
@@ -194,7 +212,8 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
     token = "{" + str(uuid.uuid4()) + "}"
     sources = (*FMU_SOURCES, INTERFACE[fmi_version])
     description = (f"qzs single-axis QZS isolator, {mode}, base motion {base_motion} "
-                   f"({'FMI 3.0' if fmi_version == 3 else 'FMI 2.0'} co-simulation)")
+                   f"({'FMI 3.0' if fmi_version == 3 else 'FMI 2.0'} co-simulation); internal "
+                   f"step {resolved.step.line()}")
     generated = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     with tempfile.TemporaryDirectory(prefix="qzs-fmu-") as folder:
         root = Path(folder)
