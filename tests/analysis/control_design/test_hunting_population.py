@@ -140,3 +140,19 @@ def test_an_empty_population_and_bad_input():
     assert empty.hunts.shape == (0,)
     with pytest.raises(ParameterError, match="controllers"):
         hp.predict_hunting_population([IsolatorParameters()], [])
+
+
+def test_stiff_slips_are_the_scalar_paths_integration(monkeypatch):
+    """A large damping gain on a soft loop, and any slip still going after the step budget,
+    go through the scalar path's LSODA: its numbers, bit for bit."""
+    from qzs.analysis.control_design.hunting import slip_jump
+
+    stiff = [(IsolatorParameters(), ControllerParameters(pi_kp=1.0, damping_gain=4000.0)),
+             (IsolatorParameters(), ControllerParameters(pi_kp=20.0, damping_gain=4000.0))]
+    jump, duration = hp.slip_jumps([c[0] for c in stiff], [c[1] for c in stiff])
+    assert [(j, d) for j, d in zip(jump, duration)] == [slip_jump(*c) for c in stiff]
+    plain = [(IsolatorParameters(), ControllerParameters()),
+             (IsolatorParameters(stiction_force=15.0), ControllerParameters(pi_kp=900.0))]
+    monkeypatch.setattr(hp, "_MAX_STEPS", 5)
+    jump, duration = hp.slip_jumps([c[0] for c in plain], [c[1] for c in plain])
+    assert [(j, d) for j, d in zip(jump, duration)] == [slip_jump(*c) for c in plain]

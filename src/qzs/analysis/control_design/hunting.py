@@ -108,12 +108,16 @@ def slip_jump(isolator=None, controller=None, relative_position=None):
     duration : float
         Length of the slip [s] (NaN if it did not end within the time allowed).
     """
-    from scipy.integrate import solve_ivp
-
     isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
-    fs, fc, cbc = isolator.stiction_force, isolator.coulomb_force, isolator.stribeck_decay
-    k_total = k + kp
+    return _slip(m, cv, k + kp, kd, w, isolator.stiction_force, isolator.coulomb_force,
+                 isolator.stribeck_decay)
+
+
+def _slip(m, cv, k_total, kd, w, fs, fc, cbc):
+    """:func:`slip_jump` of the loop constants: ``(jump [N], duration [s])``, LSODA."""
+    from scipy.integrate import solve_ivp
+
     if fs <= 0 or k_total <= 0:
         return 0.0, math.nan
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs.analysis.control_design.hunting import (RELAY_AMPLITUDE_SPAN, RELAY_FREQUENCIES,
-                                                 SLIP_JUMP_FLOOR)
+                                                 SLIP_JUMP_FLOOR, _slip)
 from qzs.analysis.linear import loop_constants
 from qzs.errors import ParameterError
 from qzs.model.registry import model_inputs
@@ -42,6 +42,12 @@ __all__ = ["PopulationHunting", "predict_hunting_population", "slip_jumps",
 _SLIP_RTOL = 1e-8
 #: Bisection steps refining an intersection's frequency in ``log(w)`` (to round-off) [-].
 _BISECTIONS = 64
+#: Steps side by side after which the designs still slipping are taken for stiff: each is
+#: then integrated alone by the scalar path's LSODA [-].
+_MAX_STEPS = 2000
+#: Stiffness ratio ``(Cv + Kd)^2/(m K)`` (the creep's time scale over the damping's) above
+#: which a design goes to the scalar path's LSODA at once (shipped problem: at most 3400) [-].
+_STIFF = 2e4
 #: scipy's step control (scipy.integrate._ivp.rk): safety factor, least and largest change.
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 
@@ -160,7 +166,9 @@ def _integrate_slips(lanes, constants, jump, duration):
     ``RK45.P``, its step control) with a step of each lane's own, all lanes advanced by one
     numpy evaluation per stage. A lane stops where ``v + 1e-15`` falls through 0 (the
     scalar path's event), located on the step's dense output by bisection; it leaves the
-    integration then, or when it passes its horizon without stopping (no jump).
+    integration then, or when it passes its horizon without stopping (no jump). Lanes still
+    slipping after :data:`_MAX_STEPS` steps are stiff for an explicit method: the scalar
+    path's LSODA integrates each of them.
     """
     from scipy.integrate import RK45
 
@@ -186,7 +194,9 @@ def _integrate_slips(lanes, constants, jump, duration):
     stops = []
     stages = np.empty((b.size + 1, 3, lanes.size))
     with np.errstate(divide="ignore"):
-        while ids.size:
+        for _ in range(_MAX_STEPS):
+            if not ids.size:
+                break
             step = np.minimum(h, horizon - t)
             stages[0, :, :ids.size] = f
             for k in range(1, b.size):
@@ -225,6 +235,8 @@ def _integrate_slips(lanes, constants, jump, duration):
                 ids, y, f, t, h, rejected = (ids[keep], y[:, keep], f[:, keep], t[keep],
                                              h[keep], rejected[keep])
                 params, atol, horizon = params[:, keep], atol[:, keep], horizon[keep]
+    for lane in ids:  # stiff after all: the scalar path's integration
+        jump[lane], duration[lane] = _scalar_slip(constants, lane)
     if stops:
         lane, t0, step = (np.concatenate(x) for x in list(zip(*stops))[:3])
         start = np.concatenate([x[3] for x in stops], axis=1)
@@ -233,6 +245,13 @@ def _integrate_slips(lanes, constants, jump, duration):
         force = start[1] + step * _powers(dense[1], when)
         jump[lane] = np.maximum(0.0, constants["stiction_force"][lane] - force)
         duration[lane] = t0 + when * step
+
+
+def _scalar_slip(constants, lane):
+    """The scalar path's slip (LSODA, implicit where stiff) of one lane: (jump, duration)."""
+    return _slip(*(float(constants[name][lane]) for name in (
+        "mass", "viscous_damping", "k_total", "damping_gain", "highpass", "stiction_force",
+        "coulomb_force", "stribeck_decay")))
 
 
 def _powers(coefficients, share):
@@ -290,9 +309,15 @@ def slip_jumps(isolators, controllers, relative_position=None, *, constants=None
     fs = constants["stiction_force"]
     n = fs.size
     jump, duration = np.zeros(n), np.full(n, np.nan)
-    lanes = np.flatnonzero((fs > 0) & (constants["k_total"] > 0))
+    slipping = (fs > 0) & (constants["k_total"] > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stiffness = ((constants["viscous_damping"] + constants["damping_gain"]) ** 2
+                     / (constants["mass"] * constants["k_total"]))
+    lanes = np.flatnonzero(slipping & (stiffness <= _STIFF))
     if lanes.size:
         _integrate_slips(lanes, constants, jump, duration)
+    for lane in np.flatnonzero(slipping & (stiffness > _STIFF)):
+        jump[lane], duration[lane] = _scalar_slip(constants, lane)
     jump[jump < SLIP_JUMP_FLOOR * fs] = 0.0  # the start kick's own creep: no slip
     return jump, duration
 
