@@ -25,9 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs.analysis.control_design.hunting_population import population_constants
-from qzs.analysis.control_design.stability_margins import (MARGIN_LOWEST,
-                                                           MARGIN_POINTS_PER_DECADE,
-                                                           loop_margins)
+from qzs.analysis.control_design.stability_margins import _margin_grid, loop_margins
 
 #: Designs whose responses are evaluated together [-] (their arrays stay in the cache).
 _CHUNK = 64
@@ -325,9 +323,7 @@ def population_margins(isolators=None, controllers=None, *, constants=None):
     continuous = c["controller_rate"] <= 0
     tops = _grid_top(c)
     for top in np.unique(tops[continuous]):
-        decades = math.log10(top / MARGIN_LOWEST)
-        omega = np.logspace(math.log10(MARGIN_LOWEST), math.log10(top),
-                            int(decades * MARGIN_POINTS_PER_DECADE) + 1)
+        omega = _margin_grid(float(top))  # the scalar path's grid
         group = np.flatnonzero(continuous & (tops == top))
         for start in range(0, group.size, _CHUNK):  # rows a few at a time: in the cache
             rows = group[start:start + _CHUNK]
