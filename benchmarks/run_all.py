@@ -35,6 +35,11 @@ the target, PASS/FAIL:
     (``bench_design_space.py``), judged on its ``isolation`` problem (8-16 Hz); seed 1 with
     ``--quick``, seeds 1-3 otherwise, and then also its ``stick-slip`` problem (1-5 Hz, the
     hard case), reported as 11s rows that are not the target's verdict.
+12. (issue 34, target 2) the hunting prediction of a population (192 designs x 3 stictions of
+    ``isolation_vs_effort``) at most 1 ms per case, against python-control's scalar path;
+13. (issue 34, target 3) the linear metrics of 1536 Sobol cases in at most 1 s, against the
+    scalar path; 13o: ``qzs optimize isolation_vs_effort``, whole process, against the 5 s of
+    issue 34's target 1 (``bench_linear.py``; information, not run with --quick).
 
 The C baseline is qzs's own C model of the isolator (``src/qzs/export/csrc``, the FMU's model,
 held bit for bit to the numba kernels by tests/export/test_cmodel.py), compiled here for this
@@ -83,7 +88,7 @@ TARGET_CHOICE = 0.3       # the step choice of the paper's chirp [s]
 TARGET_STARTUP = 0.6      # start-up to the first step [s]
 TOLERANCE_DB = 0.01       # the default tolerance of the accuracy-driven step
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -706,6 +711,20 @@ def target_design_space(table, args):
                           verdict if verdict == "info" else f"{verdict} (info)")
 
 
+# --------------------------------------------------------------------------- 12, 13. issue 34
+
+def target_linear(table, args):
+    """Targets 12 and 13: hunting and linear metrics of a population (``bench_linear.py``)."""
+    import bench_linear
+
+    runs = []
+    results = bench_linear.measure(args.repeats, args.idle_wait, runs,
+                                   optimize=not args.quick)
+    table.note_runs(runs)
+    for row in bench_linear.verdicts(results):
+        table.add(*row)
+
+
 # --------------------------------------------------------------------------- main
 
 def main(argv=None):
@@ -776,6 +795,8 @@ def main(argv=None):
          lambda: target_population(table, args), False, 10 in only),
         (11, "11. the design-space search against a grid",
          lambda: target_design_space(table, args), False, 11 in only),
+        (12, "12, 13. a population's hunting and linear metrics, vectorised (issue 34)",
+         lambda: target_linear(table, args), False, 12 in only or 13 in only),
     ]
     for number, title, fn, needs_c, wanted in steps_targets:
         if not wanted:
