@@ -35,10 +35,17 @@ the target, PASS/FAIL:
     (``bench_design_space.py``), judged on its ``isolation`` problem (8-16 Hz); seed 1 with
     ``--quick``, seeds 1-3 otherwise, and then also its ``stick-slip`` problem (1-5 Hz, the
     hard case), reported as 11s rows that are not the target's verdict.
+12. (issue 34, target 2) the hunting prediction of a population (192 designs x 3 stictions of
+    ``isolation_vs_effort``) at most 1 ms per case, against python-control's scalar path;
+13. (issue 34, target 3) the linear metrics of 1536 Sobol cases in at most 1 s, against the
+    scalar path; 13o: ``qzs optimize isolation_vs_effort``, whole process, against the 5 s of
+    issue 34's target 1 (``bench_linear.py``; information, not run with --quick).
 
-The C baseline is ``benchmarks/c_reference/isolator.c``, compiled here with gcc (flags in
-``c_reference/reference.py``) into a cache folder outside the repository and run in this
-process through ctypes (the loop only is timed). Every timing is the best of N, each run
+The C baseline is qzs's own C model of the isolator (``src/qzs/export/csrc``, the FMU's model,
+held bit for bit to the numba kernels by tests/export/test_cmodel.py), compiled here for this
+CPU by ``c_reference/reference.py`` into a temporary folder and run in this process through
+ctypes (the loop only is timed); the numba kernel's time on the same prepared run is logged
+beside it. Every timing is the best of N, each run
 started after waiting up to ``--idle-wait`` s for the machine to go quiet (the helpers of
 ``bench_simulate.py``); the log lists the load other processes put on the machine before
 each run. The script always exits 0: it reports, it does not fail CI.
@@ -81,7 +88,7 @@ TARGET_CHOICE = 0.3       # the step choice of the paper's chirp [s]
 TARGET_STARTUP = 0.6      # start-up to the first step [s]
 TOLERANCE_DB = 0.01       # the default tolerance of the accuracy-driven step
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -173,23 +180,28 @@ def c_baseline(duration, repeats, idle_wait, label):
         return r["seconds"], (f"{r['steps']:,} steps, {r['steps'] / r['seconds'] / 1e6:.2f} "
                               f"M steps/s, {r['rows']:,} rows of 24 channels, {r['status']}")
     best, runs = best_of(repeats, label, once, idle_wait)
+    numba = min(reference.numba_seconds(run, out, flags.view(bool)) for _ in range(repeats))
+    log(f"  beside it, the numba kernel (run_single, one call) on the same run: {numba:.3f} s")
     return best, runs
 
 
 def check_agreement():
-    """C vs qzs on a case without events (the test's case): max relative differences."""
+    """C vs qzs on 20 s of the paper's chirp (stick-slip and all): the largest difference of
+    a channel over its range, and how many of the 24 channels are bit-identical."""
     import qzs
 
-    iso = qzs.IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
-    ex = qzs.Sine(amplitude=0.01, frequency=2.0, fade_in=0.0)
-    kw = dict(duration=2.0, dt=DT, sample_rate=1000.0,
-              initial_state=qzs.InitialState(locked=False))
-    q = qzs.simulate(ex, iso, **kw)
-    c = reference.run_reference(ex, iso, **kw)
-    z, v = np.asarray(q.relative_position), np.asarray(q.relative_velocity)
-    dz = np.abs(c["out"][:, 7] - z).max() / np.abs(z).max()
-    dv = np.abs(c["out"][:, 8] - v).max() / np.abs(v).max()
-    return dz, dv
+    ex = qzs.Chirp(amplitude=0.01, f0=0.0, f1=20.0, duration=20.0)
+    kw = dict(duration=20.0, dt=DT, sample_rate=1000.0)
+    q = qzs.simulate(ex, **kw)
+    c = reference.run_reference(ex, **kw)
+    from qzs.engine.results import CHANNELS
+
+    worst, identical = 0.0, 0
+    for name, (column, _, _) in CHANNELS.items():
+        ours = np.asarray(q[name])
+        worst = max(worst, np.abs(c["out"][:, column] - ours).max() / (np.ptp(ours) or 1.0))
+        identical += bool(np.array_equal(c["out"][:, column], ours))
+    return worst, identical
 
 
 # --------------------------------------------------------------------------- 3. the paper
@@ -699,6 +711,20 @@ def target_design_space(table, args):
                           verdict if verdict == "info" else f"{verdict} (info)")
 
 
+# --------------------------------------------------------------------------- 12, 13. issue 34
+
+def target_linear(table, args):
+    """Targets 12 and 13: hunting and linear metrics of a population (``bench_linear.py``)."""
+    import bench_linear
+
+    runs = []
+    results = bench_linear.measure(args.repeats, args.idle_wait, runs,
+                                   optimize=not args.quick)
+    table.note_runs(runs)
+    for row in bench_linear.verdicts(results):
+        table.add(*row)
+
+
 # --------------------------------------------------------------------------- main
 
 def main(argv=None):
@@ -726,13 +752,13 @@ def main(argv=None):
     table = Table()
 
     log("")
-    log("C reference (benchmarks/c_reference/isolator.c)")
+    log("C reference (qzs's C model, src/qzs/export/csrc)")
     try:
         lib = reference.build()
-        log(f"  gcc {' '.join(reference.CFLAGS)} -> {lib.path}")
-        dz, dv = check_agreement()
-        log(f"  agreement with qzs, frictionless 2 Hz sine, 2 s: max |dz| {dz:.2g}, max |dv| "
-            f"{dv:.2g} of their largest values")
+        log(f"  cc {' '.join(reference.CFLAGS)} -> {lib.path}")
+        worst, identical = check_agreement()
+        log(f"  agreement with qzs, the paper's chirp over 20 s: {identical}/24 channels "
+            f"bit-identical, largest difference {worst:.2g} of a channel's range")
         c_full_best, c_runs = c_baseline(2000.0, args.repeats, args.idle_wait,
                                          "C loop, 2000 s chirp")
         c_full = c_full_best["seconds"]
@@ -769,6 +795,8 @@ def main(argv=None):
          lambda: target_population(table, args), False, 10 in only),
         (11, "11. the design-space search against a grid",
          lambda: target_design_space(table, args), False, 11 in only),
+        (12, "12, 13. a population's hunting and linear metrics, vectorised (issue 34)",
+         lambda: target_linear(table, args), False, 12 in only or 13 in only),
     ]
     for number, title, fn, needs_c, wanted in steps_targets:
         if not wanted:
@@ -789,9 +817,9 @@ def main(argv=None):
     table.print(mode, args.idle_wait)
     log("")
     log("Notes: ratios are qzs over (or for speeds, baseline time over qzs time against) a "
-        "baseline timed in this run; i = information row. The C loop does qzs' work per "
-        "ordinary step (same scheme, force laws, 8 states, 24 output channels) but has no "
-        "stick-slip events (see benchmarks/c_reference/isolator.c).")
+        "baseline timed in this run; i = information row. The C loop is qzs's own C model "
+        "(src/qzs/export/csrc): the same scheme, force laws, stick-slip events, stops, "
+        "controller and 24 output channels as the numba kernel, bit for bit.")
     log(f"load average at end: {_load()}")
     return 0
 

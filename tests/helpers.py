@@ -1,6 +1,9 @@
 """Named parameter sets and small helpers shared by the simulator tests."""
+import ctypes as _ctypes
+
 import numpy as np
 
+import qzs
 from qzs import Chirp, ControllerParameters, IsolatorParameters
 
 #: MagSpring shape [1/m] small enough that ``-a*tanh(b*z)`` is linear to ~1e-10 over the
@@ -36,3 +39,72 @@ def linear_controller(**overrides):
 def stick_rises(locked):
     """Number of slip -> locked transitions in a boolean series."""
     return int(np.count_nonzero(np.diff(locked.astype(np.int8)) == 1))
+
+
+EXPORT_PASSIVE = qzs.ControllerParameters(pi_kp=0.0, pi_ki=0.0, damping_gain=0.0)
+EXPORT_SETTINGS = dict(dt=1e-4, sample_rate=1000.0)
+
+#: The cases the C model, the exported controller and the FMU are checked on (issue 33),
+#: name: (excitation, isolator, controller, run settings)
+EXPORT_CASES = {
+    "default": (qzs.Sine(amplitude=0.01, frequency=5.0), None, None, dict(duration=4.0)),
+    "passive": (qzs.Sine(amplitude=0.005, frequency=4.0), None, EXPORT_PASSIVE, dict(duration=4.0)),
+    "plastic stops": (qzs.Sine(amplitude=0.1, frequency=2.0, fade_in=0.5),
+                      qzs.IsolatorParameters(stop_model="plastic"), EXPORT_PASSIVE,
+                      dict(duration=3.0)),
+    "compliant stops": (qzs.Sine(amplitude=0.1, frequency=2.0, fade_in=0.5), None, EXPORT_PASSIVE,
+                        dict(duration=3.0)),
+    "sampled damping": (qzs.Sine(amplitude=0.005, frequency=6.0),
+                        None,
+                        qzs.ControllerParameters(controller_rate=1000.0, damping_gain=300.0),
+                        dict(duration=4.0)),
+    "regularised friction": (qzs.Sine(amplitude=0.005, frequency=5.0),
+                             qzs.IsolatorParameters(friction_regularisation=1e-3), None,
+                             dict(duration=3.0, solver="rk4")),
+    "high stiction": (qzs.Sine(amplitude=0.01, frequency=8.0),
+                      qzs.IsolatorParameters(stiction_force=60.0, coulomb_force=40.0), None,
+                      dict(duration=3.0, solver="euler", dt=2e-5)),
+    "random": (qzs.RandomExcitation(amplitude=0.002, f_high=30.0, duration=5.0, seed=3), None,
+               None, dict(duration=5.0)),
+    "paper chirp shortened": (qzs.Chirp(amplitude=0.01, f0=0.0, f1=20.0, duration=20.0), None,
+                              None, dict(duration=20.0)),
+}
+
+
+def export_settings(case):
+    """The run settings of a case: :data:`EXPORT_SETTINGS` updated by its own."""
+    return {**EXPORT_SETTINGS, **EXPORT_CASES[case][3]}
+
+
+# ---------------------------------------------------------------- the exported controller (ctypes)
+class Parameters(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in (
+        "position_setpoint", "pi_kp", "pi_ki", "damping_gain", "motor_force_max",
+        "period_steps", "step_time")]
+
+
+class Output(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in ("pi", "damping", "motor", "integral_rate")]
+
+
+class Controller(_ctypes.Structure):
+    _fields_ = [("parameters", Parameters), ("integral", _ctypes.c_double), ("output", Output)]
+
+
+def build_controller(tmp_path, source):
+    """Compile an exported controller.c alone, strictly, without libm or include folders;
+    its two functions declared for ctypes."""
+    from qzs.export.csource import compile_shared
+
+    path = tmp_path / "controller.c"
+    path.write_text(source)
+    library = compile_shared([path], tmp_path / "controller.so",
+                             flags=("-O2", "-std=c99", "-pedantic", "-Wall", "-Werror",
+                                    "-ffp-contract=off", "-fPIC"))
+    lib = _ctypes.CDLL(str(library))
+    lib.qzs_controller_init.argtypes = [_ctypes.POINTER(Controller), _ctypes.POINTER(Parameters),
+                                        _ctypes.c_double]
+    lib.qzs_controller_step.argtypes = [_ctypes.POINTER(Controller), _ctypes.c_double,
+                                        _ctypes.c_double]
+    lib.qzs_controller_step.restype = Output
+    return lib

@@ -18,9 +18,9 @@ import pytest
 
 from qzs.cli import HANDLERS, main
 from qzs.cli.common import EXIT_CODES, emit, jsonable, run_handler
-from qzs.errors import (CaseError, DataError, ExcitationError, FitError, MissingDependencyError,
-                        OutputPathError, ParameterError, SimulationError, StabilityError,
-                        Terminated, WriteError)
+from qzs.errors import (CaseError, CompilerError, DataError, ExcitationError, FitError,
+                        MissingDependencyError, OutputPathError, ParameterError,
+                        SimulationError, StabilityError, Terminated, WriteError)
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "examples" / "data"
@@ -44,6 +44,7 @@ def child_env(unbuffered=None):
 @pytest.mark.parametrize("error, code", [
     (SimulationError("diverged at t = 1 s"), 1),
     (FitError("no convergence"), 1),
+    (CompilerError("cc", "was not found on PATH"), 1),
     (CaseError(3, "`mass` must be positive"), 2),   # an invalid case, found before the batch runs
     (OSError(28, "No space left on device", "/full/run.nc"), 1),
     (WriteError("/full/run.nc", "the disk is full"), 1),  # a DataError, but the run ran
@@ -91,7 +92,7 @@ ARGV = {"simulate": ["simulate"], "params": ["params"], "paper": ["paper"],
         "hexapod": ["hexapod", "linear"], "response": ["response"],
         "design": ["design"], "app": ["app", "--no-browser"], "docs": ["docs"],
         "completion": ["completion", "bash"], "optimize": ["optimize", "p.toml"],
-        "sensitivity": ["sensitivity", "p.toml"]}
+        "sensitivity": ["sensitivity", "p.toml"], "export": ["export", "controller"]}
 
 
 def test_every_subcommand_has_the_same_exit_codes(monkeypatch, capsys):

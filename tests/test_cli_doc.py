@@ -98,11 +98,14 @@ NEEDS = {
     "response": [],
     "optimize": ["isolation_vs_effort"],
     "sensitivity": ["isolation_vs_effort"],
+    "export controller": [],
+    "export fmu": [],
 }
 NAMES = {"--toml": "p.toml", "--plot": "figure.png", "sweep --out": "store.zarr",
          "simulate --out": "run.nc", "hexapod simulate --out": "run.nc",
          "response --out": "response.nc", "sweep-plot --out": "figure.png",
-         "sweep-export --out": "sweep.mat"}
+         "sweep-export --out": "sweep.mat", "export controller --out": "controller.c",
+         "export fmu --out": "isolator.fmu"}
 
 
 def promised_options():

@@ -22,7 +22,7 @@ SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 
 #: Layers, lowest first. ``base`` are the top-level modules every layer may use.
 LAYERS = ("base", "model", "iotools", "analysis", "engine", "identify", "viz", "workflows",
-          "app", "cli")
+          "export", "app", "cli")
 #: Top-level modules that are the base layer.
 BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults", "_format"}
 #: The facade (``qzs/__init__.py``, ``qzs/__main__.py``) may import anything; no module imports it.

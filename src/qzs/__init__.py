@@ -22,6 +22,7 @@ use; the subpackages are the architecture, each importing only from those listed
 ``identify``     spring, friction and transmissibility fits
 ``viz``          every figure
 ``workflows``    studies and report, experiments, sweeps, response, design, hexapod studies
+``export``       the isolator and its controller as C, and as an FMU (FMI 2.0 / 3.0)
 ``app``          the interactive tuning page (``qzs app``; Panel, optional)
 ``cli``          the ``qzs`` command
 ===============  ====================================================================
@@ -33,10 +34,10 @@ from qzs._version import __version__
 from qzs.engine.results import SimulationResult
 from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
-from qzs.errors import (CaseError, DataError, DataWarning, ExcitationError, FitError, FitWarning,
-                        MissingDependencyError, OutputPathError, ParameterError, ProblemError,
-                        ResultTooLargeError, SimulationError, SizeLimitError, StabilityError,
-                        ToleranceNotMetError)
+from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, ExcitationError,
+                        FitError, FitWarning, MissingDependencyError, OutputPathError,
+                        ParameterError, ProblemError, ResultTooLargeError, SimulationError,
+                        SizeLimitError, StabilityError, ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
                        IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
@@ -70,6 +71,8 @@ _LAZY = {
     "load_problem": "qzs.workflows.design_space.problem",
     "OptimizationResult": "qzs.workflows.design_space.result",
     "SensitivityResult": "qzs.workflows.design_space.sensitivity",
+    "export_controller": "qzs.export.controller",
+    "export_fmu": "qzs.export.fmu",
 }
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
@@ -82,6 +85,8 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.results import read_result
     from qzs.engine.run_spec import ResolvedRun, resolve
     from qzs.engine.step_search import StepChoice
+    from qzs.export.controller import export_controller
+    from qzs.export.fmu import export_fmu
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
     from qzs.iotools.readers import load_channel_map, read_recording
@@ -107,7 +112,7 @@ __all__ = [
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",
-    "ToleranceNotMetError", "SizeLimitError", "ProblemError",
+    "ToleranceNotMetError", "SizeLimitError", "ProblemError", "CompilerError",
     "DataWarning", "FitWarning",
     *_LAZY,
 ]

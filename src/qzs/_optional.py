@@ -13,6 +13,7 @@ OPTIONAL = {
     "bokeh": ("bokeh", "app"),
     "pymoo": ("pymoo", "design"),
     "SALib": ("SALib", "design"),
+    "fmpy": ("fmpy", "fmu"),
 }
 
 

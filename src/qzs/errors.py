@@ -13,7 +13,7 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
            "ControllerRateError", "CountLimitError", "InvalidCasesError",
-           "SchedulerError", "AddressError", "ProblemError", "Terminated",
+           "SchedulerError", "AddressError", "ProblemError", "CompilerError", "Terminated",
            "DataWarning", "FitWarning"]
 
 
@@ -542,6 +542,35 @@ class MissingDependencyError(ImportError):
 
     def __reduce__(self):
         return type(self), (self.package, self.extra, self.feature)
+
+
+class CompilerError(RuntimeError):
+    """The system C compiler is missing, or failed to build qzs's C sources.
+
+    Parameters
+    ----------
+    compiler : str
+        The compiler asked for (``$CC``, else ``cc``/``gcc``).
+    reason : str
+        Why: not found on ``PATH``, or the compiler's own messages.
+    fix : str, optional
+        What to do; default: install a compiler or name it in ``CC``.
+
+    Attributes
+    ----------
+    compiler, reason, fix : str
+        As given.
+    """
+
+    def __init__(self, compiler: str, reason: str, fix: str | None = None) -> None:
+        if fix is None:
+            fix = ("install one (gcc or clang: e.g. `apt install gcc`, Xcode's command line "
+                   "tools) or name it in the CC environment variable")
+        self.compiler, self.reason, self.fix = compiler, reason, fix
+        super().__init__(f"the C compiler {compiler!r} {reason}; {fix}.")
+
+    def __reduce__(self):
+        return type(self), (self.compiler, self.reason, self.fix)
 
 
 class Terminated(BaseException):

@@ -15,6 +15,9 @@
     qzs optimize FILE.toml [--out DIR] [--resume] [--workers N | --scheduler ADDRESS]
     qzs sensitivity FILE.toml [--method sobol|morris] [--samples N] [--out DIR]
     qzs app [--port N] [--host ADDRESS] [--no-browser]
+    qzs export controller [--config FILE.toml] [--set NAME=VALUE ...] [--dt S] [--out FILE.c]
+    qzs export fmu [--out FILE.fmu] [--fmi 3|2] [--mode closed-loop|plant]
+                   [--base-motion internal|input] [--config FILE.toml] [--set NAME=VALUE ...]
     qzs docs [TOPIC [SECTION]]
     qzs completion bash|zsh
 
@@ -33,6 +36,7 @@ per subcommand (or pair of subcommands), and what they share:
 ``design_space``  ``qzs optimize``, ``qzs sensitivity``: Pareto search and Sobol/Morris indices
 ``hexapod``       ``qzs hexapod``: the six-axis platform of six isolator legs
 ``app``           ``qzs app``: the interactive tuning page in the browser
+``export``        ``qzs export``: the controller as one C file, the isolator as an FMU
 ``docs``          ``qzs docs``: the model and workflow pages shipped inside the package
 ``completion``    ``qzs completion``: bash and zsh completion scripts from the parser
 ================  =======================================================================
@@ -51,8 +55,8 @@ import sys
 import threading
 
 from qzs._version import __version__
-from qzs.cli import (app, completion, design, design_space, docs, experiment, hexapod, params,
-                     response, simulate, studies, sweep)
+from qzs.cli import (app, completion, design, design_space, docs, experiment, export, hexapod,
+                     params, response, simulate, studies, sweep)
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
@@ -65,7 +69,7 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "hexapod": hexapod.run, "response": response.run,
             "design": design.run, "optimize": design_space.run_optimize_command,
             "sensitivity": design_space.run_sensitivity_command,
-            "app": app.run, "docs": docs.run,
+            "app": app.run, "export": export.run, "docs": docs.run,
             "completion": completion.run}
 
 
@@ -103,6 +107,7 @@ def build_parser():
     design.add_parser(sub)
     response.add_parser(sub)
     app.add_parser(sub)
+    export.add_parser(sub)
     docs.add_parser(sub)
     completion.add_parser(sub, parser)
     for command in sub.choices.values():  # every subcommand's help ends with the exit codes

@@ -5,7 +5,8 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
 - 0: success.
 - 1: the run started and failed (:class:`~qzs.errors.SimulationError`,
   :class:`~qzs.errors.FitError`, an I/O error while writing such as a full disk
-  (:class:`~qzs.errors.WriteError`), out of memory).
+  (:class:`~qzs.errors.WriteError`), out of memory, no working C compiler for an export
+  (:class:`~qzs.errors.CompilerError`)).
 - 2: bad input or usage (:class:`~qzs.errors.ParameterError` and its subclasses, such as
   :class:`~qzs.errors.CaseError` for an invalid case of a batch, found before the batch
   runs; :class:`~qzs.errors.DataError`, :class:`~qzs.errors.MissingDependencyError`;
@@ -21,8 +22,8 @@ import sys
 
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
-from qzs.errors import (DataError, FitError, MissingDependencyError, ParameterError,
-                        SimulationError, Terminated, WriteError)
+from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
+                        ParameterError, SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -312,7 +313,8 @@ def run_handler(handler, args):
     -------
     int
         The handler's exit code; 1 after a failed run (:class:`SimulationError`,
-        :class:`FitError`, :class:`WriteError`, an ``OSError`` or ``MemoryError``); 2 after
+        :class:`FitError`, :class:`WriteError`, :class:`CompilerError`, an ``OSError`` or
+        ``MemoryError``); 2 after
         bad input (:class:`ParameterError` and subclasses such as :class:`CaseError`,
         :class:`DataError`, :class:`MissingDependencyError`); 130 after Ctrl-C; 143 after SIGTERM
         (:class:`~qzs.errors.Terminated`, raised by :func:`qzs.cli.main`'s handler).
@@ -327,7 +329,7 @@ def run_handler(handler, args):
         quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
         with compile_notice(families, ticking=not quiet):
             return handler(args)
-    except (SimulationError, FitError, WriteError) as error:  # WriteError before DataError
+    except (SimulationError, FitError, WriteError, CompilerError) as error:  # before DataError
         return _fail(error, 1)
     except (ParameterError, DataError, MissingDependencyError) as error:
         return _fail(error, 2)

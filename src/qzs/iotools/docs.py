@@ -32,6 +32,7 @@ TOPICS = {
     "sweeps": "sweeps.md",
     "design-space": "design-space.md",
     "app": "app.md",
+    "fmu": "fmu.md",
     "getting-started": "getting-started.md",
     "workflows/command-line": "workflows/command-line.md",
     "workflows/simulate": "workflows/simulate.md",

@@ -12,6 +12,8 @@ python-control. Every public name is importable from here
 ``stability_margins``     gain and phase margins, continuous or sampled; the rate a design needs
 ``describing_functions``  the friction law as a memoryless nonlinearity of slip velocity
 ``hunting``               the stick-slip relay in the integral loop: slip jump, hunting prediction
+``hunting_population``    the same prediction for a whole population at once, solved directly
+``linear_population``     transmissibility, stability and margins of a population at once
 ========================  ======================================================================
 
 References

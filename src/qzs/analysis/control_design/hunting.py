@@ -34,10 +34,18 @@ from qzs.analysis.linear import loop_constants
 from qzs.model.registry import model_inputs
 
 __all__ = ["restick_force", "slip_jump", "HuntingPrediction", "integral_loop",
-           "hunting_stiffness", "predict_hunting", "SLIP_JUMP_FLOOR"]
+           "hunting_stiffness", "predict_hunting", "SLIP_JUMP_FLOOR", "RELAY_FREQUENCIES",
+           "RELAY_AMPLITUDE_POINTS", "RELAY_AMPLITUDE_SPAN"]
 
 #: A slip jump below this share of the stiction force is the start kick's creep, not a slip [-].
 SLIP_JUMP_FLOOR = 1e-4
+#: The relay's frequency grid handed to python-control: ``np.logspace(*RELAY_FREQUENCIES)``
+#: [rad/s] (an intersection outside it is no cycle).
+RELAY_FREQUENCIES = (-5, 3, 500)
+#: Amplitudes of the relay's locus: ``h*(1 + logspace(-9, log10(span*(h + 2d)/h), points))``
+#: [N], up to ``h + span*(h + 2d)``.
+RELAY_AMPLITUDE_POINTS = 80
+RELAY_AMPLITUDE_SPAN = 20
 
 
 def restick_force(isolator=None):
@@ -100,12 +108,16 @@ def slip_jump(isolator=None, controller=None, relative_position=None):
     duration : float
         Length of the slip [s] (NaN if it did not end within the time allowed).
     """
-    from scipy.integrate import solve_ivp
-
     isolator, controller = model_inputs(isolator, controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
-    fs, fc, cbc = isolator.stiction_force, isolator.coulomb_force, isolator.stribeck_decay
-    k_total = k + kp
+    return _slip(m, cv, k + kp, kd, w, isolator.stiction_force, isolator.coulomb_force,
+                 isolator.stribeck_decay)
+
+
+def _slip(m, cv, k_total, kd, w, fs, fc, cbc):
+    """:func:`slip_jump` of the loop constants: ``(jump [N], duration [s])``, LSODA."""
+    from scipy.integrate import solve_ivp
+
     if fs <= 0 or k_total <= 0:
         return 0.0, math.nan
 
@@ -405,8 +417,9 @@ def _relay_cycle(isolator, controller, relative_position, numbers, d, h, reasons
     element = control.relay_hysteresis_nonlinearity(d, h)
     g = integral_loop(isolator, controller, relative_position)
     top = h + 2 * d
-    amplitudes = h * (1 + np.logspace(-9, math.log10(20 * top / h), 80))
-    omega = np.logspace(-5, 3, 500)
+    amplitudes = h * (1 + np.logspace(-9, math.log10(RELAY_AMPLITUDE_SPAN * top / h),
+                                      RELAY_AMPLITUDE_POINTS))
+    omega = np.logspace(*RELAY_FREQUENCIES)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         response = control.describing_function_response(g, element, amplitudes, omega=omega)

@@ -293,46 +293,47 @@ def case_settings(problem, designs):
 
 
 def _linear(problem, settings, goals, values, status, messages, progress=None):
-    """The linear metrics ``goals`` of each case (python-control; no simulation).
+    """The linear metrics ``goals`` of every case at once (closed forms; no simulation).
 
-    ``progress`` is called with the number of cases done, about every hundredth of them.
+    One vectorised evaluation of the population (:mod:`~qzs.analysis.control_design.
+    hunting_population`, :mod:`~qzs.analysis.control_design.linear_population`), equal to
+    python-control's numbers to their tests' bounds. ``progress`` is called with the number
+    of cases, once, when they are done.
     """
-    from qzs.analysis.control_design.hunting import predict_hunting
-    from qzs.analysis.control_design.stability_margins import loop_margins
-    from qzs.analysis.linear import linear_transmissibility
+    from qzs.analysis.control_design.hunting_population import (population_constants,
+                                                                predict_hunting_population)
+    from qzs.analysis.control_design.linear_population import (population_margins,
+                                                               population_transmissibility)
     from qzs.errors import ParameterError
     from qzs.workflows.sweeps.cases import build_model
 
-    goals = {g.column: g for g in goals}
-    every, done = max(1, len(settings) // 100), 0
+    built, models = [], []
     for c, case in enumerate(settings):
-        if progress is not None and c and c % every == 0:
-            progress(c - done)
-            done = c
         try:  # the model only: the linear analysis needs no excitation
-            isolator, controller = build_model(problem.sweep, case)
+            models.append(build_model(problem.sweep, case))
+            built.append(c)
         except (ParameterError, TypeError) as error:
             status[c], messages[c] = 2, str(error)
-            continue
-        margins = None
-        for column, goal in goals.items():
-            if goal.metric == "hunting_amplitude":
-                prediction = predict_hunting(isolator, controller, memoryless=False)
-                value = prediction.amplitude if prediction.hunts else 0.0
-            elif goal.metric in ("gain_margin", "phase_margin"):
-                if margins is None:
-                    margins = loop_margins(isolator, controller)
-                value = getattr(margins, goal.metric)
-                if not margins.stable:
-                    value = math.nan  # an unstable loop has no margin: undefined, infeasible
-                elif goal.metric == "phase_margin" and math.isnan(value):
-                    value = math.inf  # |L| < 1 everywhere: no crossover to lose
-            else:
-                value = abs(complex(linear_transmissibility(goal.options["frequency"],
-                                                            isolator, controller)))
-            values[column][c] = value
+    isolators, controllers = [m[0] for m in models], [m[1] for m in models]
+    constants = population_constants(isolators, controllers)
+    margins = hunting = None
+    for goal in goals:
+        if goal.metric == "hunting_amplitude":
+            hunting = hunting or predict_hunting_population(isolators, controllers,
+                                                            constants=constants)
+            value = hunting.hunting_amplitude
+        elif goal.metric in ("gain_margin", "phase_margin"):
+            margins = margins or population_margins(isolators, controllers,
+                                                    constants=constants)
+            value = np.where(margins.stable, getattr(margins, goal.metric), math.nan)
+            if goal.metric == "phase_margin":  # |L| < 1 everywhere: no crossover to lose
+                value = np.where(margins.stable & np.isnan(value), math.inf, value)
+        else:
+            value = population_transmissibility(goal.options["frequency"],
+                                                constants=constants)
+        values[goal.column][built] = value
     if progress is not None:
-        progress(len(settings) - done)
+        progress(len(settings))
 
 
 def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None,

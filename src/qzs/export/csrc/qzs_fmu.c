@@ -1,0 +1,368 @@
+/* qzs: the isolator as an FMU, independent of the FMI version (see qzs_fmu.h). */
+#include "qzs_fmu.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define V(name) (fmu->values[QZS_VR_##name])
+
+void qzs_fmu_log(QzsFmu *fmu, int status, const char *format, ...) {
+    char message[1024];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (fmu->log)
+        fmu->log(fmu->environment, status,
+                 status == QZS_FMU_ERROR ? "logStatusError"
+                                         : (status == QZS_FMU_WARNING ? "logStatusWarning"
+                                                                      : "logEvents"),
+                 message);
+}
+
+void qzs_fmu_reset(QzsFmu *fmu, double start_time) {
+    for (int i = 0; i < QZS_FMU_N_VARIABLES; i++)
+        fmu->values[i] = QZS_FMU_START[i];
+    fmu->initialized = 0;
+    fmu->failed = 0;
+    fmu->start_time = start_time;
+    fmu->time = start_time;
+    fmu->values[QZS_VR_TIME] = start_time;
+    memset(fmu->table, 0, sizeof fmu->table);
+    fmu->has_previous = 0;
+    fmu->previous_time = 0.0;
+    fmu->previous_acceleration = 0.0;
+}
+
+static const char *type_name(char type) {
+    return type == 'F' ? "Float64 (Real)" : (type == 'I' ? "integer" : "Boolean");
+}
+
+static int check_reference(QzsFmu *fmu, unsigned int reference, char type, const char *verb) {
+    if (reference >= QZS_FMU_N_VARIABLES) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "%s: no variable has value reference %u (0 to %d)",
+                    verb, reference, QZS_FMU_N_VARIABLES - 1);
+        return QZS_FMU_ERROR;
+    }
+    if (QZS_FMU_TYPES[reference] != type) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "%s: `%s` (value reference %u) is a %s variable, not %s",
+                    verb, QZS_FMU_NAMES[reference], reference,
+                    type_name(QZS_FMU_TYPES[reference]), type_name(type));
+        return QZS_FMU_ERROR;
+    }
+    return QZS_FMU_OK;
+}
+
+int qzs_fmu_set(QzsFmu *fmu, unsigned int reference, char type, double value) {
+    if (check_reference(fmu, reference, type, "set") != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    const char *name = QZS_FMU_NAMES[reference];
+    char causality = QZS_FMU_CAUSALITY[reference];
+    if (causality != 'p' && causality != 'i') {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "set: `%s` is an %s; only parameters and inputs are set",
+                    name, causality == 'o' ? "output" : "independent variable");
+        return QZS_FMU_ERROR;
+    }
+    if (causality == 'p' && fmu->initialized) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "set: `%s` is a fixed parameter; set it before initialisation ends "
+                    "(or reset the FMU)", name);
+        return QZS_FMU_ERROR;
+    }
+    if (!isfinite(value)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "set: `%s` = %g is not a finite number", name, value);
+        return QZS_FMU_ERROR;
+    }
+    fmu->values[reference] = value;
+    return QZS_FMU_OK;
+}
+
+int qzs_fmu_get(QzsFmu *fmu, unsigned int reference, char type, double *value) {
+    if (check_reference(fmu, reference, type, "get") != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    *value = reference == QZS_VR_TIME ? fmu->time : fmu->values[reference];
+    return QZS_FMU_OK;
+}
+
+/* A parameter outside its range: logged with its value and what it must be. */
+static int refuse(QzsFmu *fmu, const char *name, double value, const char *rule) {
+    qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.17g must be %s; set it so before initialisation "
+                "ends", name, value, rule);
+    return QZS_FMU_ERROR;
+}
+
+#define REQUIRE(name, condition, rule) \
+    if (!(condition)) return refuse(fmu, QZS_FMU_NAMES[QZS_VR_##name], V(name), rule)
+
+static int check_parameters(QzsFmu *fmu) {
+    REQUIRE(ISOLATOR_MASS, V(ISOLATOR_MASS) > 0.0, "positive [kg]");
+    REQUIRE(ISOLATOR_GRAVITY, V(ISOLATOR_GRAVITY) >= 0.0, ">= 0 [m/s^2]");
+    REQUIRE(ISOLATOR_SPRING_FORCE, V(ISOLATOR_SPRING_FORCE) >= 0.0, ">= 0 [N]");
+    REQUIRE(ISOLATOR_SPRING_SHAPE, V(ISOLATOR_SPRING_SHAPE) > 0.0, "positive [1/m]");
+    REQUIRE(ISOLATOR_STICTION_FORCE, V(ISOLATOR_STICTION_FORCE) >= 0.0, ">= 0 [N]");
+    REQUIRE(ISOLATOR_COULOMB_FORCE, V(ISOLATOR_COULOMB_FORCE) >= 0.0 &&
+            V(ISOLATOR_COULOMB_FORCE) <= V(ISOLATOR_STICTION_FORCE),
+            "between 0 and stiction_force [N]");
+    REQUIRE(ISOLATOR_STRIBECK_DECAY, V(ISOLATOR_STRIBECK_DECAY) >= 0.0, ">= 0 [s/m]");
+    REQUIRE(ISOLATOR_VISCOUS_DAMPING, V(ISOLATOR_VISCOUS_DAMPING) >= 0.0, ">= 0 [N*s/m]");
+    REQUIRE(ISOLATOR_FRICTION_REGULARISATION, V(ISOLATOR_FRICTION_REGULARISATION) >= 0.0,
+            ">= 0 [m/s]");
+    REQUIRE(ISOLATOR_STROKE_HALF, V(ISOLATOR_STROKE_HALF) > 0.0, "positive [m]");
+    REQUIRE(ISOLATOR_STOP_STIFFNESS, V(ISOLATOR_STOP_STIFFNESS) > 0.0, "positive [N/m]");
+    REQUIRE(ISOLATOR_STOP_DAMPING, V(ISOLATOR_STOP_DAMPING) >= 0.0, ">= 0 [N*s/m]");
+    REQUIRE(ISOLATOR_STOP_MODEL, V(ISOLATOR_STOP_MODEL) == 0.0 || V(ISOLATOR_STOP_MODEL) == 1.0,
+            "0 (compliant) or 1 (plastic)");
+    REQUIRE(ISOLATOR_FRICTION_REGULARISATION,
+            !(V(ISOLATOR_FRICTION_REGULARISATION) > 0.0 && V(ISOLATOR_STOP_MODEL) == 1.0),
+            "0 with plastic stops (a regularised slip never rests on a stop)");
+    REQUIRE(ISOLATOR_MOTOR_FORCE_MAX, V(ISOLATOR_MOTOR_FORCE_MAX) >= 0.0, ">= 0 [N]");
+    REQUIRE(CONTROLLER_PI_KP, V(CONTROLLER_PI_KP) >= 0.0, ">= 0 [N/m]");
+    REQUIRE(CONTROLLER_PI_KI, V(CONTROLLER_PI_KI) >= 0.0, ">= 0 [N/(m*s)]");
+    REQUIRE(CONTROLLER_DAMPING_GAIN, V(CONTROLLER_DAMPING_GAIN) >= 0.0, ">= 0 [N*s/m]");
+    REQUIRE(CONTROLLER_VELOCITY_HIGHPASS, V(CONTROLLER_VELOCITY_HIGHPASS) >= 0.0, ">= 0 [Hz]");
+    REQUIRE(CONTROLLER_CONTROLLER_RATE, V(CONTROLLER_CONTROLLER_RATE) >= 0.0, ">= 0 [Hz]");
+    REQUIRE(STEP_SIZE, V(STEP_SIZE) > 0.0, "positive [s]");
+    REQUIRE(SOLVER, V(SOLVER) == 0.0 || V(SOLVER) == 1.0 || V(SOLVER) == 2.0,
+            "0 (euler), 1 (ode3) or 2 (rk4)");
+#if !QZS_FMU_BASE_INPUT
+    REQUIRE(EXCITATION_KIND, V(EXCITATION_KIND) == 0.0 || V(EXCITATION_KIND) == 1.0 ||
+            V(EXCITATION_KIND) == 2.0, "0 (linear chirp), 1 (logarithmic chirp) or 2 (sine)");
+    REQUIRE(EXCITATION_F0, V(EXCITATION_F0) >= 0.0 && (V(EXCITATION_KIND) != 1.0 ||
+            V(EXCITATION_F0) > 0.0), ">= 0 [Hz] (positive for a logarithmic chirp)");
+    REQUIRE(EXCITATION_F1, V(EXCITATION_F1) >= 0.0 && (V(EXCITATION_KIND) != 1.0 ||
+            V(EXCITATION_F1) > 0.0), ">= 0 [Hz] (positive for a logarithmic chirp)");
+    REQUIRE(EXCITATION_DURATION, V(EXCITATION_DURATION) > 0.0, "positive [s]");
+    REQUIRE(EXCITATION_FADE_IN, V(EXCITATION_FADE_IN) >= 0.0, ">= 0 [s]");
+#endif
+    return QZS_FMU_OK;
+}
+
+/* The packed parameters, as qzs.engine.prepare._pack_parameters packs them. */
+static int pack_parameters(QzsFmu *fmu, double *P) {
+    memset(P, 0, sizeof(double) * QZS_N_PARAMS);
+    double center = V(ISOLATOR_STOP_CENTER);
+    P[QZS_P_MASS] = V(ISOLATOR_MASS);
+    P[QZS_P_GRAVITY] = V(ISOLATOR_GRAVITY);
+    P[QZS_P_SPRING_A] = V(ISOLATOR_SPRING_FORCE);
+    P[QZS_P_SPRING_B] = V(ISOLATOR_SPRING_SHAPE);
+    P[QZS_P_FS] = V(ISOLATOR_STICTION_FORCE);
+    P[QZS_P_FC] = V(ISOLATOR_COULOMB_FORCE);
+    P[QZS_P_CBC] = V(ISOLATOR_STRIBECK_DECAY);
+    P[QZS_P_CV] = V(ISOLATOR_VISCOUS_DAMPING);
+    P[QZS_P_Z_LOW] = center - V(ISOLATOR_STROKE_HALF);
+    P[QZS_P_Z_HIGH] = center + V(ISOLATOR_STROKE_HALF);
+    P[QZS_P_STOP_K] = V(ISOLATOR_STOP_STIFFNESS);
+    P[QZS_P_STOP_C] = V(ISOLATOR_STOP_DAMPING);
+    P[QZS_P_PLASTIC] = V(ISOLATOR_STOP_MODEL) == 1.0 ? 1.0 : 0.0;
+    P[QZS_P_FMAX] = V(ISOLATOR_MOTOR_FORCE_MAX);
+    P[QZS_P_ZREF] = V(CONTROLLER_POSITION_SETPOINT);
+    P[QZS_P_KP] = V(CONTROLLER_PI_KP);
+    P[QZS_P_KI] = V(CONTROLLER_PI_KI);
+    P[QZS_P_KD] = V(CONTROLLER_DAMPING_GAIN);
+    P[QZS_P_HP_OMEGA] = 2 * 3.141592653589793 * V(CONTROLLER_VELOCITY_HIGHPASS);
+    P[QZS_P_DT] = V(STEP_SIZE);
+    P[QZS_P_VREG] = V(ISOLATOR_FRICTION_REGULARISATION);
+#if QZS_FMU_PLANT_MODE
+    P[QZS_P_CONTROL_STEPS] = 1.0; /* the motor force is held from the input: never sampled */
+#else
+    if (V(CONTROLLER_CONTROLLER_RATE) > 0.0) { /* qzs.engine.prepare.steps_per_sample, "exact" */
+        double ratio = 1.0 / (V(CONTROLLER_CONTROLLER_RATE) * V(STEP_SIZE));
+        double steps = floor(ratio + 0.5);
+        if (steps < 1.0 || fabs(ratio - steps) > 1e-6 * ratio) {
+            qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                        "`controller_rate` = %g Hz must divide the integration rate 1/step_size "
+                        "= %g Hz into a whole number of steps (got %g); e.g. controller_rate = %g",
+                        V(CONTROLLER_CONTROLLER_RATE), 1.0 / V(STEP_SIZE), ratio,
+                        1.0 / ((steps < 1.0 ? 1.0 : steps) * V(STEP_SIZE)));
+            return QZS_FMU_ERROR;
+        }
+        P[QZS_P_CONTROL_STEPS] = steps;
+    }
+#endif
+    return QZS_FMU_OK;
+}
+
+/* The initial state, as qzs.engine.prepare._initial_state makes it by default: at rest at the
+ * setpoint, the high-pass settled, the PI preloaded with the static load, stuck if friction
+ * can hold the payload. */
+static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
+    const QzsPlant *plant = &fmu->run.plant;
+    const double *P = plant->P;
+    memset(state, 0, sizeof(double) * QZS_N_STATE);
+    memset(flags, 0, sizeof(int64_t) * QZS_N_FLAGS);
+    state[QZS_A_MARGIN] = NAN;
+    double z0 = V(CONTROLLER_POSITION_SETPOINT);
+    QzsOde s;
+    for (int j = 0; j < QZS_N_ODE; j++)
+        s.x[j] = 0.0;
+    s.x[QZS_S_Z] = z0;
+    s.x[QZS_S_HP] = qzs_base_motion(plant, 0.0).yd + 0.0;
+    double held[3] = {0.0, 0.0, 0.0};
+#if QZS_FMU_PLANT_MODE
+    held[2] = V(MOTOR_FORCE);
+#endif
+    QzsForces force;
+    qzs_rhs_at(plant, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+    double measured = force.v_measured;
+#if !QZS_FMU_PLANT_MODE
+    if (V(CONTROLLER_PI_KI) > 0.0) {
+        QzsPlant at_rest = *plant; /* the base at rest: qzs.engine.prepare._AT_REST */
+        double rest[QZS_N_EXCITATION] = {QZS_KIND_SINE, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        memcpy(at_rest.E, rest, sizeof rest);
+        qzs_rhs_at(&at_rest, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+        double without_motor = force.hold + force.motor;
+        double f_max = V(ISOLATOR_MOTOR_FORCE_MAX);
+        double needed = without_motor < -f_max ? -f_max : (without_motor > f_max ? f_max
+                                                                                 : without_motor);
+        QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, 0.0);
+        s.x[QZS_S_INT] = (needed - c.pi - c.damping) / V(CONTROLLER_PI_KI);
+    }
+    QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, s.x[QZS_S_INT]);
+    held[0] = c.pi;
+    held[1] = c.damping;
+    held[2] = c.motor;
+#endif
+    qzs_rhs_at(plant, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+    int locked = P[QZS_P_VREG] == 0.0 && fabs(force.hold) <= P[QZS_P_FS];
+    flags[QZS_I_MODE] = locked ? QZS_MODE_STICK : QZS_MODE_SLIP;
+    flags[QZS_I_DIRECTION] = force.hold > 0.0 ? -1 : 1;
+    for (int j = 0; j < QZS_N_ODE; j++)
+        state[j] = s.x[j];
+    state[QZS_A_F_PI] = held[0];
+    state[QZS_A_F_DAMP] = held[1];
+    state[QZS_A_F_MOTOR] = held[2];
+}
+
+/* The outputs: the recorded channels of the run's state at fmu->time. */
+static void update_outputs(QzsFmu *fmu) {
+    double row[QZS_N_CHANNELS];
+    unsigned char row_flags[QZS_N_OUTPUT_FLAGS];
+    QzsRun *run = &fmu->run;
+    qzs_record(&run->plant, fmu->time, &run->s, run->mode, run->direction, run->held, row,
+               row_flags, run->phase);
+    for (int i = 0; i < QZS_FMU_N_VARIABLES; i++) {
+        int channel = QZS_FMU_CHANNEL[i];
+        if (channel >= 100)
+            fmu->values[i] = row_flags[channel - 100] ? 1.0 : 0.0;
+        else if (channel >= 0)
+            fmu->values[i] = row[channel];
+    }
+}
+
+#if QZS_FMU_BASE_INPUT
+/* The base motion over [t0, t1] from the inputs at t0: displacement, velocity and acceleration
+ * as given, the acceleration's slope (the jerk) from the last two acceleration inputs (0 at the
+ * first step); one cubic segment of qzs's tabulated excitation. The acceleration is thus
+ * extrapolated linearly over a step of h: off by at most h^2 max|d4y/dt4| (5/12 h^3 in velocity,
+ * h^4/8 in displacement), and every communication point starts again from the inputs. */
+static void hold_base_inputs(QzsFmu *fmu, double t0, double t1) {
+    double *table = fmu->table; /* 5 rows of 2 columns: times, then c0..c3 */
+    double jerk = 0.0;
+    if (fmu->has_previous && t0 > fmu->previous_time)
+        jerk = (V(BASE_ACCELERATION) - fmu->previous_acceleration) / (t0 - fmu->previous_time);
+    table[0] = t0;
+    table[1] = t1;
+    table[2] = jerk / 6.0;
+    table[4] = 0.5 * V(BASE_ACCELERATION);
+    table[6] = V(BASE_VELOCITY);
+    table[8] = V(BASE_DISPLACEMENT);
+    table[3] = table[5] = table[7] = table[9] = 0.0;
+    fmu->previous_time = t0;
+    fmu->previous_acceleration = V(BASE_ACCELERATION);
+    fmu->has_previous = 1;
+}
+#endif
+
+int qzs_fmu_initialize(QzsFmu *fmu) {
+    if (fmu->initialized)
+        return QZS_FMU_OK;
+    if (fmu->start_time != 0.0) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the start time must be 0 s (qzs runs start at t = 0), "
+                    "got %g s", fmu->start_time);
+        return QZS_FMU_ERROR;
+    }
+    if (check_parameters(fmu) != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    double P[QZS_N_PARAMS];
+    if (pack_parameters(fmu, P) != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    double z0 = V(CONTROLLER_POSITION_SETPOINT);
+    if (!(P[QZS_P_Z_LOW] <= z0 && z0 <= P[QZS_P_Z_HIGH])) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the initial position (position_setpoint = %g m) must "
+                    "lie between the stops [%g, %g] m; move it or the stops (stop_center)", z0,
+                    P[QZS_P_Z_LOW], P[QZS_P_Z_HIGH]);
+        return QZS_FMU_ERROR;
+    }
+    double E[QZS_N_EXCITATION] = {0.0};
+#if QZS_FMU_BASE_INPUT
+    E[QZS_E_KIND] = QZS_KIND_TABLE;
+    hold_base_inputs(fmu, 0.0, V(STEP_SIZE));
+    fmu->has_previous = 0; /* initialisation is no communication point */
+#else
+    E[QZS_E_KIND] = V(EXCITATION_KIND);
+    E[QZS_E_AMPLITUDE] = V(EXCITATION_AMPLITUDE);
+    E[QZS_E_F0] = V(EXCITATION_F0);
+    E[QZS_E_F1] = V(EXCITATION_F1);
+    E[QZS_E_DURATION] = V(EXCITATION_DURATION);
+    E[QZS_E_PHASE] = V(EXCITATION_PHASE);
+    E[QZS_E_FADE] = V(EXCITATION_FADE_IN);
+#endif
+    qzs_plant_init(&fmu->run.plant, P, E, fmu->table, 2);
+    double state[QZS_N_STATE];
+    int64_t flags[QZS_N_FLAGS];
+    initial_state(fmu, state, flags);
+    qzs_run_start(&fmu->run, (int)V(SOLVER), state, flags);
+#if QZS_FMU_PLANT_MODE
+    fmu->run.sampled = 0;
+#endif
+    fmu->initialized = 1;
+    update_outputs(fmu);
+    return QZS_FMU_OK;
+}
+
+int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
+    if (!fmu->initialized) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep before initialisation ended");
+        return QZS_FMU_ERROR;
+    }
+    if (fmu->failed) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep after a failed step; reset or free the FMU");
+        return QZS_FMU_ERROR;
+    }
+    double dt = fmu->run.plant.P[QZS_P_DT];
+    double steps = floor(step / dt + 0.5);
+    if (!(step > 0.0) || steps < 1.0 || fabs(steps * dt - step) > 1e-9 * step) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "the communication step %.17g s is not a whole number of internal steps "
+                    "(step_size = %.17g s: %.17g of them); choose a multiple of step_size",
+                    step, dt, step / dt);
+        return QZS_FMU_ERROR;
+    }
+    if (fabs(current - fmu->time) > 1e-9 * (dt + fabs(current))) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the communication point %.17g s is not the FMU's "
+                    "time %.17g s", current, fmu->time);
+        return QZS_FMU_ERROR;
+    }
+    QzsRun *run = &fmu->run;
+#if QZS_FMU_PLANT_MODE
+    run->held[2] = V(MOTOR_FORCE);
+    run->margin = NAN; /* the held force may have changed: the holding margin too */
+#endif
+#if QZS_FMU_BASE_INPUT
+    hold_base_inputs(fmu, (double)run->step * dt, (double)(run->step + (int64_t)steps) * dt);
+    run->margin = NAN; /* the base motion is a new segment */
+#endif
+    int status = qzs_run_steps(run, (int64_t)steps, 0, NULL, NULL, NULL);
+    fmu->time = (double)run->step * dt;
+    if (status != QZS_STATUS_OK) {
+        fmu->failed = 1;
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the state diverged at t = %.17g s (z = %g m, v = %g "
+                    "m/s); the step is too large for this configuration: lower step_size",
+                    fmu->time, run->s.x[QZS_S_Z], run->s.x[QZS_S_V]);
+        return QZS_FMU_ERROR;
+    }
+    update_outputs(fmu);
+    return QZS_FMU_OK;
+}

@@ -1,0 +1,121 @@
+/* qzs: the closed loop of plant and sampled controller (see qzs_model.h). */
+#include "qzs_model.h"
+
+#include <math.h>
+
+void qzs_run_start(QzsRun *run, int solver, const double *state, const int64_t *flags) {
+    const double *P = run->plant.P;
+    run->solver = solver;
+    run->control_steps = (int64_t)P[QZS_P_CONTROL_STEPS];
+    run->sampled = run->control_steps > 0;
+    qzs_controller_init(&run->controller, &run->plant.control, state[QZS_S_INT]);
+    for (int j = 0; j < QZS_N_ODE; j++)
+        run->s.x[j] = state[j];
+    run->held[0] = state[QZS_A_F_PI];
+    run->held[1] = state[QZS_A_F_DAMP];
+    run->held[2] = state[QZS_A_F_MOTOR];
+    run->margin = state[QZS_A_MARGIN];
+    run->mode = (int)flags[QZS_I_MODE];
+    run->direction = (int)flags[QZS_I_DIRECTION];
+    run->contact = (int)flags[QZS_I_CONTACT];
+    run->step = flags[QZS_I_STEP];
+    run->sticks = flags[QZS_I_N_STICKS];
+    run->contacts = flags[QZS_I_N_CONTACTS];
+    QzsPhase start = {0.0, 0.0, 1.0};
+    run->phase = qzs_advance_phase(&run->plant, (double)run->step * P[QZS_P_DT], start, 1);
+}
+
+int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
+                  unsigned char *out_flags, int64_t *rows) {
+    const QzsPlant *plant = &run->plant;
+    const double *P = plant->P;
+    const double h = P[QZS_P_DT];
+    int status = QZS_STATUS_OK;
+    int64_t row = 0;
+    for (int64_t i = 0; i < n_steps; i++) {
+        double t = (double)run->step * h;
+        if (run->sampled && run->step % run->control_steps == 0) {
+            double z, v_measured;
+            qzs_measure(plant, t, &run->s, run->mode, &z, &v_measured);
+            run->controller.integral = run->s.x[QZS_S_INT];
+            QzsControllerOutput command = qzs_controller_step(&run->controller, z, v_measured);
+            run->held[0] = command.pi;
+            run->held[1] = command.damping;
+            run->held[2] = command.motor;
+            run->s.x[QZS_S_INT] = run->controller.integral;
+            run->margin = NAN;
+        }
+        QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->mode,
+                                     run->direction, run->held, run->margin, run->phase);
+        if (!qzs_finite(plant, &next.s)) {
+            status = QZS_STATUS_DIVERGED;
+            break;
+        }
+        run->s = next.s;
+        run->mode = next.mode;
+        run->direction = next.direction;
+        run->margin = next.margin;
+        run->step += 1;
+        /* rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps */
+        run->phase = qzs_advance_phase(plant, (double)run->step * h, run->phase,
+                                       run->step % QZS_PHASE_PERIOD == 0);
+        run->sticks += next.sticks;
+        run->contacts += next.impacts;
+        int now = qzs_in_contact(plant, &run->s, run->mode);
+        if (now && run->contact == 0 && P[QZS_P_PLASTIC] == 0.0)
+            run->contacts += 1;
+        run->contact = now ? 1 : 0;
+        if (decimation > 0 && run->step % decimation == 0) {
+            qzs_record(plant, (double)run->step * h, &run->s, run->mode, run->direction,
+                       run->held, out + row * QZS_N_CHANNELS,
+                       out_flags + row * QZS_N_OUTPUT_FLAGS, run->phase);
+            row += 1;
+        }
+    }
+    if (rows)
+        *rows = row;
+    return status;
+}
+
+void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags) {
+    for (int j = 0; j < QZS_N_ODE; j++)
+        state[j] = run->s.x[j];
+    state[QZS_A_F_PI] = run->held[0];
+    state[QZS_A_F_DAMP] = run->held[1];
+    state[QZS_A_F_MOTOR] = run->held[2];
+    state[QZS_A_MARGIN] = run->margin;
+    flags[QZS_I_MODE] = run->mode;
+    flags[QZS_I_DIRECTION] = run->direction;
+    flags[QZS_I_CONTACT] = run->contact;
+    flags[QZS_I_STEP] = run->step;
+    flags[QZS_I_N_STICKS] = run->sticks;
+    flags[QZS_I_N_CONTACTS] = run->contacts;
+}
+
+int qzs_model_run(int solver, int64_t n_steps, int64_t decimation, double *state,
+                  int64_t *flags, const double *params, const double *excitation,
+                  const double *table, int64_t table_columns, double *out,
+                  unsigned char *out_flags, int64_t row0, int64_t *rows) {
+    QzsRun run;
+    qzs_plant_init(&run.plant, params, excitation, table, (long)table_columns);
+    qzs_run_start(&run, solver, state, flags);
+    int status = qzs_run_steps(&run, n_steps, decimation, out + row0 * QZS_N_CHANNELS,
+                               out_flags + row0 * QZS_N_OUTPUT_FLAGS, rows);
+    qzs_run_pack(&run, state, flags);
+    return status;
+}
+
+void qzs_model_evaluate(double t, const double *state, const int64_t *flags,
+                        const double *params, const double *excitation, const double *table,
+                        int64_t table_columns, double *row, unsigned char *row_flags) {
+    QzsPlant plant;
+    qzs_plant_init(&plant, params, excitation, table, (long)table_columns);
+    QzsOde s;
+    for (int j = 0; j < QZS_N_ODE; j++)
+        s.x[j] = state[j];
+    double held[3] = {state[QZS_A_F_PI], state[QZS_A_F_DAMP], state[QZS_A_F_MOTOR]};
+    QzsPhase start = {0.0, 0.0, 1.0};
+    QzsPhase phase = qzs_advance_phase(&plant, t, start, 1);
+    qzs_record(&plant, t, &s, (int)flags[QZS_I_MODE], (int)flags[QZS_I_DIRECTION], held, row,
+               row_flags, phase);
+}

@@ -1,0 +1,105 @@
+/* qzs: the single-axis isolator plant in C (docs/model.md §2-§9).
+ *
+ * The physics of qzs's numba kernels (qzs.engine.kernels, laws, stickslip, base_motion,
+ * arithmetic), operation for operation and in the same order, so that the same packed inputs
+ * give the same bits: the force laws, the base motion (chirp, sine, tabulated cubic), the
+ * fixed-step Runge-Kutta schemes (euler, ode3, rk4), the stick-slip events located inside a
+ * step by regula falsi, compliant and plastic stops, the energy ledger and the recorded
+ * channels. Its inputs are packed as qzs packs them (qzs.engine.prepare.prepare_run):
+ * parameters P_*, state S_* and the held controller outputs, excitation E_* and its table.
+ * A change to the kernels that is not made here too fails tests/export/test_cmodel.py.
+ *
+ * Build without fast-math and without implicit contraction (-ffp-contract=off): the fused
+ * multiply-adds are explicit fma() calls, as in the kernels.
+ */
+#ifndef QZS_PLANT_H
+#define QZS_PLANT_H
+
+#include <stdint.h>
+
+#include "qzs_controller.h"
+
+/* packed parameters (qzs.engine.kernels.P_*) */
+enum { QZS_P_MASS, QZS_P_GRAVITY, QZS_P_SPRING_A, QZS_P_SPRING_B, QZS_P_FS, QZS_P_FC,
+       QZS_P_CBC, QZS_P_CV, QZS_P_Z_LOW, QZS_P_Z_HIGH, QZS_P_STOP_K, QZS_P_STOP_C,
+       QZS_P_PLASTIC, QZS_P_FMAX, QZS_P_ZREF, QZS_P_KP, QZS_P_KI, QZS_P_KD, QZS_P_HP_OMEGA,
+       QZS_P_CONTROL_STEPS, QZS_P_DT, QZS_P_VREG, QZS_N_PARAMS };
+/* ODE state (S_*), then the held controller outputs and the holding margin (A_*) */
+enum { QZS_S_Z, QZS_S_V, QZS_S_HP, QZS_S_INT, QZS_S_W_BASE, QZS_S_D_FRICTION, QZS_S_W_MOTOR,
+       QZS_S_D_STOP, QZS_N_ODE, QZS_A_F_PI = QZS_N_ODE, QZS_A_F_DAMP, QZS_A_F_MOTOR,
+       QZS_A_MARGIN, QZS_N_STATE };
+/* integer flags (I_*) */
+enum { QZS_I_MODE, QZS_I_DIRECTION, QZS_I_STEP, QZS_I_CONTACT, QZS_I_N_CONTACTS,
+       QZS_I_N_STICKS, QZS_N_FLAGS };
+/* excitation scalars (qzs.model.excitation.E_*) and kinds */
+enum { QZS_E_KIND, QZS_E_AMPLITUDE, QZS_E_F0, QZS_E_F1, QZS_E_DURATION, QZS_E_PHASE,
+       QZS_E_SPACING, QZS_E_FADE, QZS_N_EXCITATION };
+enum { QZS_KIND_CHIRP_LINEAR, QZS_KIND_CHIRP_LOG, QZS_KIND_SINE, QZS_KIND_TABLE };
+/* output channels (C_*) and flags (O_*) */
+enum { QZS_C_TIME, QZS_C_BASE_Y, QZS_C_BASE_YD, QZS_C_BASE_YDD, QZS_C_X, QZS_C_XD, QZS_C_XDD,
+       QZS_C_Z, QZS_C_V, QZS_C_F_SPRING, QZS_C_F_FRICTION, QZS_C_F_STOP, QZS_C_F_MOTOR,
+       QZS_C_F_PI, QZS_C_F_DAMP, QZS_C_V_MEASURED, QZS_C_W_BASE, QZS_C_D_FRICTION,
+       QZS_C_W_MOTOR, QZS_C_D_STOP, QZS_C_E_KINETIC, QZS_C_E_SPRING, QZS_C_E_GRAVITY,
+       QZS_C_E_STOP, QZS_N_CHANNELS };
+enum { QZS_O_LOCKED, QZS_O_CONTACT, QZS_N_OUTPUT_FLAGS };
+/* modes of the payload: slipping, stuck to the base, resting on the lower / upper plastic stop */
+enum { QZS_MODE_SLIP, QZS_MODE_STICK, QZS_MODE_WALL_LOW, QZS_MODE_WALL_HIGH };
+enum { QZS_SOLVER_EULER, QZS_SOLVER_ODE3, QZS_SOLVER_RK4 };
+enum { QZS_STATUS_OK, QZS_STATUS_DIVERGED };
+/* excitation's sine and cosine computed exactly every this many steps (kernels.PHASE_PERIOD) */
+#define QZS_PHASE_PERIOD 256
+
+/* The ODE state (z, v, high-pass, integral, ledger), by value like the kernels' tuples. */
+typedef struct { double x[QZS_N_ODE]; } QzsOde;
+/* Base displacement [m], velocity [m/s], acceleration [m/s^2]. */
+typedef struct { double y, yd, ydd; } QzsBase;
+/* The force breakdown of the right-hand side (kernels.F_*). */
+typedef struct {
+    double y, yd, ydd, spring, friction, stop, elastic, motor, pi, damp, v_measured, hold, xdd;
+} QzsForces;
+
+/* What does not change during a run: the parameters and the excitation. */
+typedef struct {
+    double P[QZS_N_PARAMS];
+    double E[QZS_N_EXCITATION];
+    const double *table;  /* 5 rows of table_columns (the excitation's piecewise cubic) */
+    long table_columns;
+    QzsControllerParameters control;  /* the controller's part of P */
+} QzsPlant;
+
+/* Where the excitation's sine and cosine were last computed. */
+typedef struct { double phase, sin0, cos0; } QzsPhase;
+
+/* The result of one grid step. */
+typedef struct {
+    QzsOde s;
+    int mode, direction;
+    double margin;
+    int sticks, impacts;
+} QzsStep;
+
+/* Fill the plant from packed parameters, excitation scalars and table (kept by pointer). */
+void qzs_plant_init(QzsPlant *plant, const double *params, const double *excitation,
+                    const double *table, long table_columns);
+/* Base motion at t [s], exact (libm sine). */
+QzsBase qzs_base_motion(const QzsPlant *plant, double t);
+/* Phase and its sine/cosine at t, rotated from `previous` or computed exactly. */
+QzsPhase qzs_advance_phase(const QzsPlant *plant, double t, QzsPhase previous, int exact);
+/* Right-hand side at t (exact base motion): derivatives and forces. */
+void qzs_rhs_at(const QzsPlant *plant, double t, const QzsOde *s, int mode, double direction,
+                const double held[3], QzsOde *deriv, QzsForces *force);
+/* One grid step of length h from t, locating at most one transition inside it. */
+QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, QzsOde s, int mode,
+                      int direction, const double held[3], double margin, QzsPhase phase);
+/* The measured quantities a sampled controller reads at t: z [m] and v_measured [m/s]. */
+void qzs_measure(const QzsPlant *plant, double t, const QzsOde *s, int mode, double *z,
+                 double *v_measured);
+/* The divergence test: finite, within 100 strokes of the stops and below 1e4 m/s. */
+int qzs_finite(const QzsPlant *plant, const QzsOde *s);
+/* Is the payload on or beyond a stop? */
+int qzs_in_contact(const QzsPlant *plant, const QzsOde *s, int mode);
+/* One output sample: channels C_* into row, flags O_* into row_flags. */
+void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, int mode, int direction,
+                const double held[3], double *row, unsigned char *row_flags, QzsPhase phase);
+
+#endif /* QZS_PLANT_H */

@@ -1,0 +1,97 @@
+"""``qzs export``: the command line parses and delegates to qzs.export."""
+import pytest
+
+from qzs.cli import main
+from qzs.errors import CompilerError
+from qzs.export.controller import PARAMETERS_NAME
+
+
+def test_export_controller_writes_the_configurations_controller(tmp_path, capsys):
+    out = tmp_path / "controller.c"
+    code = main(["export", "controller", "--set", "pi_kp=123.5", "--set",
+                 "controller_rate=500", "--dt", "1e-4", "--out", str(out)])
+    assert code == 0, capsys.readouterr().err
+    text = out.read_text()
+    assert f"QzsControllerParameters {PARAMETERS_NAME}" in text
+    assert "    123.5,  /* pi_kp */" in text and "    20.0,  /* period_steps */" in text
+
+
+def test_a_continuous_controller_is_exported_at_one_kilohertz_with_a_note(tmp_path, capsys):
+    out = tmp_path / "controller.c"
+    assert main(["export", "controller", "--out", str(out)]) == 0
+    assert "1000 Hz" in capsys.readouterr().err
+    assert "    10.0,  /* period_steps */" in out.read_text()
+
+
+def test_a_bad_rate_is_refused_before_writing(tmp_path, capsys):
+    out = tmp_path / "controller.c"
+    code = main(["export", "controller", "--set", "controller_rate=333", "--out", str(out)])
+    assert code == 2 and "controller_rate" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_missing_compiler_is_one_line_and_exit_1(monkeypatch, capsys):
+    from qzs.cli.common import run_handler
+
+    def handler(args):
+        raise CompilerError("no-cc", "was not found on PATH")
+    assert run_handler(handler, None) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("qzs: error: the C compiler 'no-cc'") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("argv", [["export"], ["export", "controller", "--out", "x.txt"]])
+def test_usage_and_suffix_errors_exit_2(argv, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_fmu_writes_a_valid_fmu_of_the_options(tmp_path, capsys):
+    fmpy = pytest.importorskip("fmpy")
+    from fmpy.validation import validate_fmu
+
+    out = tmp_path / "iso.fmu"
+    code = main(["export", "fmu", "--out", str(out), "--fmi", "2", "--mode", "plant",
+                 "--excitation", "sine", "--frequency", "3", "--set", "mass=7",
+                 "--duration", "5"])
+    assert code == 0, capsys.readouterr().err
+    assert validate_fmu(str(out)) == []
+    description = fmpy.read_model_description(str(out))
+    starts = {v.name: v.start for v in description.modelVariables}
+    assert float(starts["isolator.mass"]) == 7.0 and float(starts["excitation.f0"]) == 3.0
+    assert description.fmiVersion == "2.0" and float(description.defaultExperiment.stopTime) == 5
+
+
+def test_export_fmu_refuses_excitation_options_with_inputs(tmp_path, capsys):
+    out = tmp_path / "iso.fmu"
+    code = main(["export", "fmu", "--out", str(out), "--base-motion", "input", "--f0", "1"])
+    assert code == 2 and "--base-motion input" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
+    """Without --dt the FMU's internal step is the one `qzs simulate` chooses for the same
+    inputs (one resolved run, docs/model.md decision 33), and the description says how."""
+    fmpy = pytest.importorskip("fmpy")
+    import json
+
+    import qzs
+
+    options = ["--excitation-duration", "30", "--f1", "5", "--set", "stiction_force=6"]
+    out = tmp_path / "iso.fmu"
+    assert main(["export", "fmu", "--out", str(out), *options]) == 0
+    description = fmpy.read_model_description(str(out))
+    starts = {v.name: v.start for v in description.modelVariables}
+    capsys.readouterr()
+    assert main(["simulate", *options, "--plot", "none", "--json"]) == 0
+    simulated = json.loads(capsys.readouterr().out)["step"]
+    assert simulated["chosen"] and float(starts["step_size"]) == simulated["dt"]
+    resolved = qzs.resolve(qzs.Chirp(duration=30.0, f1=5.0),
+                           qzs.IsolatorParameters(stiction_force=6.0), step="chosen")
+    assert resolved.dt == simulated["dt"]
+    assert "accuracy-driven" in description.description
+    # a literal --dt stays literal
+    assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4"]) == 0
+    starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
+    assert float(starts["step_size"]) == 2e-4

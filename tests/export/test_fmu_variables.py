@@ -1,0 +1,98 @@
+"""The FMU's variable table: every registry parameter with its unit and start, the modes'
+inputs and outputs, and the same table as C."""
+import numpy as np
+import pytest
+
+import qzs
+from qzs.engine import kernels as K
+from qzs.errors import CompilerError
+from qzs.export.fmu_variables import UNITS, fmu_variables, variables_header
+from qzs.model.registry import PARAMETERS
+
+EXCITATION = qzs.Sine(amplitude=0.004, frequency=3.0, phase=0.5).pack()[0]
+
+
+def table(mode="closed-loop", base_motion="internal", **isolator):
+    return fmu_variables(isolator=qzs.IsolatorParameters(**isolator),
+                         controller=qzs.ControllerParameters(pi_kp=77.0),
+                         excitation_scalars=EXCITATION, dt=2e-4,
+                         solver_code=K.SOLVER_RK4, mode=mode, base_motion=base_motion)
+
+
+def test_every_registry_parameter_is_a_parameter_with_its_unit_and_start():
+    variables = {v.name: v for v in table(stop_model="plastic", mass=7.5)}
+    for name, info in PARAMETERS.items():
+        variable = variables[f"{info.section}.{name}"]
+        assert variable.causality == "parameter" and variable.description
+        assert variable.unit == (info.unit if info.unit in UNITS else "")
+    assert variables["isolator.mass"].start == 7.5
+    assert variables["controller.pi_kp"].start == 77.0
+    assert variables["isolator.stop_model"].start == 1
+    assert variables["isolator.stop_model"].type == "I"
+    assert variables["isolator.stop_center"].start == qzs.ControllerParameters().position_setpoint
+    assert variables["step_size"].start == 2e-4 and variables["solver"].start == K.SOLVER_RK4
+    assert variables["excitation.kind"].start == 2 and variables["excitation.f0"].start == 3.0
+    assert variables["excitation.phase"].start == 0.5
+
+
+def test_references_are_indices_and_names_unique():
+    for mode in ("closed-loop", "plant"):
+        for base in ("internal", "input"):
+            variables = table(mode, base)
+            assert [v.reference for v in variables] == list(range(len(variables)))
+            assert len({v.name for v in variables}) == len(variables)
+            assert len({v.macro for v in variables}) == len(variables)
+
+
+def test_the_modes_inputs_and_outputs():
+    plant = {v.name: v for v in table("plant", "input")}
+    assert plant["motor_force"].causality == "input"
+    assert "pi_force" not in plant and "damping_force" not in plant
+    assert all(plant[n].causality == "input" for n in ("base_displacement", "base_velocity",
+                                                       "base_acceleration"))
+    assert not any(n.startswith("excitation.") for n in plant)
+    closed = {v.name: v for v in table()}
+    assert closed["motor_force"].causality == "output"
+    assert closed["motor_force"].channel == K.C_F_MOTOR and closed["locked"].channel == 100
+    assert closed["stop_contact"].type == "B"
+
+
+def test_the_si_units_are_consistent():
+    def combine(*terms):
+        out = {}
+        for sign, name in terms:
+            for base, power in UNITS[name].items():
+                out[base] = out.get(base, 0) + sign * power
+        return {k: v for k, v in out.items() if v}
+
+    assert UNITS["N"] == combine((1, "kg"), (1, "m/s^2"))
+    assert UNITS["J"] == combine((1, "N"), (1, "m"))
+    assert UNITS["N*s/m"] == combine((1, "N"), (1, "s"), (-1, "m"))
+    assert UNITS["N/(m*s)"] == combine((1, "N"), (-1, "m"), (-1, "s"))
+    assert UNITS["N/m"] == combine((1, "N"), (-1, "m"))
+
+
+def test_the_header_is_the_table_and_compiles(tmp_path):
+    from qzs.export.csource import compile_shared
+
+    variables = table()
+    header = variables_header(variables, mode="closed-loop", base_motion="internal",
+                              token="{x}")
+    (tmp_path / "qzs_fmu_variables.h").write_text(header)
+    (tmp_path / "check.c").write_text(
+        '#include "qzs_fmu_variables.h"\n'
+        "typedef char n[sizeof QZS_FMU_START / sizeof(double) == QZS_FMU_N_VARIABLES ? 1 : -1];\n"
+        "typedef char t[sizeof QZS_FMU_TYPES - 1 == QZS_FMU_N_VARIABLES ? 1 : -1];\n"
+        "typedef char m[QZS_VR_ISOLATOR_MASS == %d ? 1 : -1];\n"
+        "double qzs_check(void) { return QZS_FMU_START[QZS_VR_STEP_SIZE]; }\n"
+        % next(v.reference for v in variables if v.name == "isolator.mass"))
+    try:
+        compile_shared([tmp_path / "check.c"], tmp_path / "check.so", include=[tmp_path])
+    except CompilerError as error:  # pragma: no cover
+        pytest.skip(str(error))
+    import ctypes
+
+    library = ctypes.CDLL(str(tmp_path / "check.so"))
+    library.qzs_check.restype = ctypes.c_double
+    assert library.qzs_check() == 2e-4
+    assert np.isclose(float(header.count("QZS_VR_")), len(variables) + 0)
