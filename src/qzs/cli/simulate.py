@@ -6,10 +6,10 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
-from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
+from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
+                             figure_path, parameters)
 from qzs.defaults import ACCURACY, EXCITATION
 from qzs.errors import ParameterError
-from qzs.iotools.paths import check_output_path
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, Sine, build_excitation
 
 __all__ = ["add_parser", "run"]
@@ -89,14 +89,10 @@ def add_parser(subparsers):
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                      help="integrator (default ode3)")
-    sim.add_argument("--out", metavar="FILE",
-                     help="stream the time series to FILE (.nc, .csv or .mat for MATLAB) "
-                          "while simulating")
-    sim.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
-                     help=f"figure of the run (.png, .svg or .pdf; default {DEFAULT_PLOT}; "
-                          "'none' to skip)")
-    sim.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_json_option(sim)
+    add_output_options(sim, out=dict(metavar="FILE", help="stream the time series to FILE (.nc, "
+                                                         ".csv or .mat for MATLAB) while "
+                                                         "simulating"),
+                       plot=dict(default=DEFAULT_PLOT, help="figure of the run"))
     return sim
 
 
@@ -192,9 +188,11 @@ def run(args):
     if "dt" not in settings or args.tolerance is not None or args.tolerance_state is not None:
         choice = _choose_step(args, excitation, config, settings)
         settings["dt"] = choice.dt
-    plot = None if args.plot.lower() == "none" else args.plot
+    plot = figure_path(args)
     if plot is not None:
-        check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+        check_output(args, "--plot", plot, suffixes=PLOT_SUFFIXES)
+    if args.out:
+        check_output(args, "--out", args.out, suffixes=None)
     common = dict(progress=not args.quiet and not args.json, interruptible=True)
     entries = {} if choice is None else step_run_entries(choice)
     # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before

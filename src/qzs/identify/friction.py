@@ -108,15 +108,15 @@ class FrictionFit:
         return dataclasses.replace(isolator or IsolatorParameters(),
                                    **{n: getattr(self, n) for n in FRICTION_PARAMETERS[:4]})
 
-    def plot(self, path: str | Path | None = None, title: str = "") -> "Figure":
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
         """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`).
 
         Parameters
         ----------
         path : str or Path, optional
             Write the figure there (a .png also as .svg).
-        title : str
-            Figure title.
+        title : str, optional
+            Figure title; default none.
 
         Returns
         -------
@@ -124,7 +124,7 @@ class FrictionFit:
         """
         from qzs.viz.identify import plot_friction_fit
 
-        return plot_friction_fit(self, path=path, title=title)
+        return plot_friction_fit(self, path=path, title=title or "")
 
 
 def _smoothed_derivatives(time, displacement, window, polyorder, tolerance):

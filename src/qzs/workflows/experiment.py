@@ -211,7 +211,7 @@ class ExperimentResult:
             return float("nan")
         return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
-    def plot(self, path: str | Path | None = None, title: str | None = None,
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> Figure:
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
 
