@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from qzs._validation import strictly_increasing
+from qzs._validation import non_negative_real, positive_real, strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
@@ -244,14 +244,13 @@ def fit_friction(time: ArrayLike, displacement: ArrayLike, force: ArrayLike, *,
                         f"{t.size}, {z.size} and {f.size}.")
     if t.size < 20:
         raise DataError(f"a friction fit needs at least 20 samples, got {t.size}.")
-    threshold = float(exclude_below_velocity)
-    if not threshold >= 0:
-        raise ParameterError(f"`exclude_below_velocity` must be >= 0 [m/s], got {threshold!r}.")
+    threshold = non_negative_real("exclude_below_velocity", exclude_below_velocity,
+                                  fix="a velocity in m/s")
     student_quantile(confidence, 1)  # validates `confidence` before the work
-    if not float(smoothing_window) > 0:
-        raise ParameterError(f"`smoothing_window` must be positive [s], got {smoothing_window!r}.")
-    if mass is not None and not float(mass) > 0:
-        raise ParameterError(f"`mass` must be positive [kg] or None, got {mass!r}.")
+    smoothing_window = positive_real("smoothing_window", smoothing_window,
+                                     fix="a window in s, e.g. 0.02")
+    if mass is not None:
+        mass = positive_real("mass", mass, fix="in kg, or None to leave out the inertia")
     velocity, acceleration, window = _smoothed_derivatives(t, z, float(smoothing_window),
                                                            int(polyorder), tolerance)
     a_s, b_s = _spring_pair(spring)

@@ -531,9 +531,8 @@ def _goal(table, index, spec, constraint, analysis):
     if statistic == "quantile":
         if "quantile" not in spec:
             _fail(where, "quantile", None, "statistic \"quantile\" needs `quantile` in (0, 1)")
-        quantile = _number(where, "quantile", spec["quantile"])
-        if not 0 < quantile < 1:
-            _fail(where, "quantile", quantile, "must lie strictly between 0 and 1")
+        quantile = real("quantile", spec["quantile"], _in(where), minimum=0.0, maximum=1.0,
+                        strict=True)
     elif "quantile" in spec:
         _fail(where, "quantile", spec["quantile"], "applies to statistic = \"quantile\" only")
     bound = None
