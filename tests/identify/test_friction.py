@@ -133,7 +133,8 @@ def test_bad_input():
     (dict(smoothing_window="0.02"), "`smoothing_window` must be a number, got '0.02'"),
     (dict(mass=-1.0), "`mass` must be positive, got -1.0; in kg, or None"),
     (dict(exclude_below_velocity=float("nan")), "`exclude_below_velocity` must be finite"),
-    (dict(exclude_below_velocity=-1e-3), "`exclude_below_velocity` must be non-negative")])
+    (dict(exclude_below_velocity=-1e-3), "`exclude_below_velocity` must be non-negative"),
+    (dict(polyorder=2.0), "`polyorder` must be an integer >= 2, got 2.0")])
 def test_bad_settings_get_the_shared_checks_messages(options, message):
     """Hand-written checks before (text such as "0.02" was taken through float())."""
     time, z, force = instron_test(0)

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from qzs._validation import non_negative_real, positive_real, strictly_increasing
+from qzs._validation import integer, non_negative_real, positive_real, strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
@@ -235,8 +235,7 @@ def fit_friction(time: ArrayLike, displacement: ArrayLike, force: ArrayLike, *,
     """
     if force_sign not in FORCE_SIGNS:
         raise ParameterError(f"`force_sign` must be one of {FORCE_SIGNS}, got {force_sign!r}.")
-    if not isinstance(polyorder, (int, np.integer)) or polyorder < 2:
-        raise ParameterError(f"`polyorder` must be an integer >= 2, got {polyorder!r}.")
+    polyorder = integer("polyorder", polyorder, 2)
     t, z, f = (finite_samples(n, v) for n, v in (("time", time), ("displacement", displacement),
                                           ("force", force)))
     if not t.size == z.size == f.size:

@@ -1,5 +1,4 @@
 """Validation and the plan of the runs: axes, amplitudes, step, segments, trusted band."""
-import math
 from types import MappingProxyType
 
 import numpy as np
@@ -69,11 +68,8 @@ def _tolerance_db(tolerance_db, dt):
     if dt is not None:
         raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or `tolerance_db` "
                              f"({tolerance_db!r} dB, the step chosen to meet it), not both.")
-    value = real("tolerance_db", tolerance_db)
-    if not (math.isfinite(value) and value > 0):
-        raise ParameterError(f"`tolerance_db` must be a positive, finite tolerance on the "
-                             f"transmissibility [dB] (e.g. 0.01), got {tolerance_db!r}.")
-    return value
+    return positive_real("tolerance_db", tolerance_db,
+                         fix="a tolerance on the transmissibility in dB, e.g. 0.01")
 
 
 def _optional_positive(name, value):
