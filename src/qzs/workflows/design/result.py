@@ -170,7 +170,7 @@ class DesignResult:
     def save(self, path: str | Path, *, frequency_scale: str | None = None) -> Path:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
         search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
-        ``folder``.
+        the folder ``path``.
 
         Each file is written atomically (a temporary file renamed onto it).
 
