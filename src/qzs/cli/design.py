@@ -165,7 +165,8 @@ def run(args):
         config["isolator"], config["controller"], excitation=excitation,
         stiction_range=stiction, mass_range=mass, force_steps=steps, band=band, cost=args.cost,
         controller_rate=args.controller_rate, delay=args.delay, quick=args.quick,
-        damping_gain_max=args.damping_max, workers=args.workers, progress=not args.quiet)
+        damping_gain_max=args.damping_max, workers=args.workers,
+        progress=not args.quiet and not args.json)
     written = write_design(result, folder, frequency_scale=args.frequency_axis)
     record = result.to_dict()
     record["outputs"] = {name: str(path) for name, path in written.items()}

@@ -101,7 +101,7 @@ def run_optimize_command(args):
         result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
                           generations=args.generations, population=args.population,
                           scheduler=args.scheduler, workers=args.workers, threads=args.threads,
-                          progress=not args.quiet)
+                          progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept in "
                              f"{store}. Continue with: qzs optimize {args.problem} --out "
@@ -137,7 +137,8 @@ def run_sensitivity_command(args):
         result, written = run_sensitivity(problem, folder, method=args.method,
                                           samples=args.samples, seed=args.seed,
                                           scheduler=args.scheduler, workers=args.workers,
-                                          threads=args.threads, progress=not args.quiet)
+                                          threads=args.threads,
+                                          progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, "nothing is written (a sensitivity run is not resumable; fewer "
                              "--samples make it shorter)")

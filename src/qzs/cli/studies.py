@@ -60,7 +60,8 @@ def run(args):
     check_output(args, "--out", args.out, suffixes=None, directory=True)
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
-                                        workers=args.workers, progress=not args.quiet,
+                                        workers=args.workers,
+                                        progress=not args.quiet and not args.json,
                                         argument="--out", dt=args.dt,
                                         tolerance_db=args.tolerance,
                                         frequency_scale=args.frequency_axis)

@@ -105,7 +105,7 @@ def run_sweep_command(args):
     try:
         report = execute(definition, store, resume=args.resume, overwrite=args.overwrite,
                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
-                         progress=not args.quiet)
+                         progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, f"{stored_count(store)} of {definition.n_cases} cases are stored "
                              f"in {store}. Continue with: qzs sweep {args.definition} --out "
