@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 venv: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/qzs paper --out results/paper
+	$(BIN)/qzs paper --out results/paper --overwrite
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -122,7 +122,7 @@ def test_version_and_help_are_0(capsys):
     assert capsys.readouterr().out.strip() == f"qzs {__version__}"
     assert main(["params", "--help"]) == 0
     out = capsys.readouterr().out
-    assert "exit codes:" in out and "143" in out and "--force" in out
+    assert "exit codes:" in out and "143" in out and "--overwrite" in out
 
 
 def test_help_of_every_subcommand_documents_the_exit_codes(capsys):
@@ -271,16 +271,18 @@ def test_experiment_json(tmp_path, capsys):
     assert Path(record["files"]["report"]).exists()
 
 
-# ---------------------------------------------------------------- params --toml --force
-def test_params_toml_does_not_overwrite_without_force(tmp_path, capsys):
+# ---------------------------------------------------------------- params --toml --overwrite
+def test_params_toml_does_not_overwrite_without_overwrite(tmp_path, capsys):
     path = tmp_path / "mine.toml"
     path.write_text("# my edits\n")
     assert main(["params", "--toml", str(path), "--set", "mass=7"]) == 2
     err = capsys.readouterr().err
-    assert str(path) in err and "--force" in err
+    assert str(path) in err and "--overwrite" in err
     assert path.read_text() == "# my edits\n"
-    assert main(["params", "--toml", str(path), "--set", "mass=7", "--force"]) == 0
+    assert main(["params", "--toml", str(path), "--set", "mass=7", "--overwrite"]) == 0
     assert "mass = 7.0" in path.read_text()
+    assert main(["params", "--toml", str(path), "--set", "mass=8", "--force"]) == 0  # old name
+    assert "mass = 8.0" in path.read_text()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.toml"]
 
 

@@ -1,8 +1,10 @@
 """docs/workflows/command-line.md keeps its promises: read from the page, checked against the parser.
 
-The page promises the exit codes (its table), which subcommands take ``--json`` (its list)
-and that output paths (``--out``, ``--plot``, ``--toml``) are checked before any work starts,
-on every subcommand that has them. Each promise is parsed out of the page's text, so that
+The page promises the exit codes (its table), which subcommands take ``--json`` (its list),
+the output options of every subcommand that writes (its table: ``--out``, ``--plot``, then
+``--json``, ``--quiet`` and ``--overwrite`` on each), one overwrite policy (an existing output
+is refused without ``--overwrite``), and that output paths (``--out``, ``--plot``,
+``--toml``) are checked before any work starts, on every subcommand that has them. Each promise is parsed out of the page's text, so that
 editing the page or the parser without the other fails here. (SIGTERM's cleanup is checked
 in tests/test_cli_contract.py and tests/engine/test_driver.py.)
 """
@@ -153,3 +155,85 @@ def test_every_output_path_is_checked_before_any_work(tmp_path, monkeypatch, cap
     assert err.count("\n") == 1
     assert elapsed < AT_ONCE, f"{argv} took {elapsed:.2f} s to fail"
     assert sorted(os.listdir(tmp_path)) == before
+
+
+# ---------------------------------------------------------------- output options, overwrite
+WRITES = ("--out", "--plot")
+
+
+def output_table():
+    """The page's table: command -> (takes --out, takes --plot)."""
+    rows = re.findall(r"^\s*\| `([a-z][a-z -]*)` \|([^|\n]*)\|([^|\n]*)\|\s*$", page(),
+                      flags=re.MULTILINE)
+    return {name: (bool(out.strip()), bool(plot.strip())) for name, out, plot in rows}
+
+
+def test_the_output_table_is_every_subcommand_that_writes_with_what_it_writes():
+    table = output_table()
+    having = {name: ("--out" in options(parser), "--plot" in options(parser))
+              for name, parser in commands() if set(WRITES) & options(parser)}
+    assert len(table) >= 15
+    assert table == having, ({k: (table.get(k), having.get(k)) for k in set(table) | set(having)
+                              if table.get(k) != having.get(k)})
+
+
+def test_every_subcommand_that_writes_takes_every_output_option_once():
+    """--json, --quiet and --overwrite wherever --out or --plot is, from one declaration."""
+    from qzs.cli.common import OUTPUT_OPTIONS
+
+    assert "`--overwrite`" in bullet("the output options are spelled")
+    for name, parser in commands():
+        if set(WRITES) & options(parser):
+            missing = set(OUTPUT_OPTIONS) - set(WRITES) - options(parser)
+            assert not missing, f"qzs {name} lacks {sorted(missing)}"
+            help_texts = {action.option_strings[0]: action.help for action in parser._actions
+                          if action.option_strings}
+            assert help_texts["--overwrite"].startswith("replace an existing output"), name
+            if "--plot" in help_texts:
+                assert "'none' for no figure" in help_texts["--plot"], name
+
+
+def test_plot_none_draws_no_figure(tmp_path, monkeypatch, capsys):
+    """Refused by `hexapod linear` and `hexapod simulate` before (a file named 'none')."""
+    from qzs.cli.common import figure_path
+
+    monkeypatch.chdir(tmp_path)
+    for command in ("simulate", "response", "hexapod linear", "hexapod simulate"):
+        args = build_parser().parse_args([*command.split(), "--plot", "none"])
+        assert figure_path(args) is None, command
+        assert figure_path(build_parser().parse_args([*command.split(), "--plot", "f.png"])) \
+            == "f.png"
+    assert main(["hexapod", "linear", "--plot", "none", "--json"]) == 0, capsys.readouterr().err
+    assert "plot" not in capsys.readouterr().out and os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("command, option", list(output_cases()),
+                         ids=[f"{c} {o}" for c, o in output_cases()])
+def test_an_existing_output_is_refused_without_overwrite(tmp_path, monkeypatch, capsys, command,
+                                                        option):
+    """One policy: what exists (a file, a folder holding anything) is kept, the message names
+    the option, the path and --overwrite; before any work (the same bound as above)."""
+    monkeypatch.chdir(tmp_path)
+    name = NAMES.get(f"{command} {option}", NAMES.get(option, "out"))
+    path = tmp_path / name
+    folder = name == "out" or name.endswith(".zarr")
+    if folder:
+        path.mkdir()
+        (path / "keep.txt").write_text("mine")
+    else:
+        path.write_text("mine")
+    argv = [*command.split(), *[a.replace("{tmp}", str(tmp_path)) for a in NEEDS[command]],
+            option, str(path)]
+    if "--quiet" in options(dict(commands())[command]):
+        argv.append("--quiet")
+    began = time.perf_counter()
+    code = main(argv)
+    elapsed = time.perf_counter() - began
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.startswith(f"qzs: error: {option} {str(path)!r} exists"), err
+    assert "--overwrite" in err and err.count("\n") == 1
+    assert elapsed < 30 * AT_ONCE, f"{argv} took {elapsed:.2f} s to fail"
+    kept = path / "keep.txt" if folder else path
+    assert kept.read_text() == "mine"
+    assert sorted(os.listdir(tmp_path)) == [name]

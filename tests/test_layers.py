@@ -310,6 +310,7 @@ CROSS_CUTTING = {
     "cli_contract": "exit codes, signals, output paths and --json, the same for every subcommand",
     "cli_doc": "docs/workflows/command-line.md's promises, read from the page, against the parser",
     "bad_inputs": "inputs that used to end in a traceback, through the API and every command",
+    "result_api": "every result class's plot() and save(), one signature",
     "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "
              "and the experiment's tests)",
     "benchmark_reference": "the benchmarks' C reference model against qzs",

@@ -5,36 +5,47 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from qzs._validation import finite_real, integer, interval, optional, positive_real, real
-from qzs.errors import DataError, ParameterError
+from qzs._validation import (Structured, choice, integer, interval, non_negative_real, optional,
+                             positive_real, real)
+from qzs.errors import DataError, ParameterError, ProblemError
 
 NOT_NUMBERS = [True, np.True_, "1.0", None, [1.0], 1 + 2j]
 
 
-@pytest.mark.parametrize("check", [real, finite_real, positive_real])
+@pytest.mark.parametrize("check", [real, positive_real, non_negative_real])
 @pytest.mark.parametrize("value, expected", [(2, 2.0), (0.5, 0.5), (np.float32(0.25), 0.25),
-                                             (np.int64(3), 3.0), (Fraction(1, 4), 0.25)])
+                                             (np.int64(3), 3.0), (Fraction(1, 4), 0.25),
+                                             (np.array(1.5), 1.5)])
 def test_a_positive_real_number_comes_back_as_a_python_float(check, value, expected):
     number = check("x", value)
     assert type(number) is float and number == expected
 
 
-@pytest.mark.parametrize("value", NOT_NUMBERS)
-def test_real_refuses_what_is_not_a_real_number_naming_it_as_given(value):
+@pytest.mark.parametrize("check", [real, positive_real, non_negative_real])
+@pytest.mark.parametrize("value", NOT_NUMBERS + ["1e-4", "2", np.array([1.0])])
+def test_every_check_of_a_real_number_refuses_text_and_non_numbers_alike(check, value):
+    # Before: `positive("dt", "1e-4")` returned 0.0001 where `positive_real` refused it.
     with pytest.raises(ParameterError) as info:
-        real("gain", value, fix="; e.g. 2.0")
-    assert str(info.value) == f"`gain` must be a number, got {value!r}; e.g. 2.0."
+        check("dt", value, fix="e.g. 1e-3 [s]")
+    shown = f"the boolean {value!r}" if isinstance(value, (bool, np.bool_)) else repr(value)
+    assert str(info.value) == f"`dt` must be a number, got {shown}; e.g. 1e-3 [s]."
 
 
-@pytest.mark.parametrize("value, minimum, strict, bound", [
-    (math.nan, None, False, ""), (math.inf, None, False, ""), (-math.inf, 0.0, False, " >= 0"),
-    (-0.5, 0.0, False, " >= 0"), (0.0, 0.0, True, " > 0"), (0.5, 1.0, True, " > 1"),
-    (np.int64(-2), 0.0, False, " >= 0")])
+@pytest.mark.parametrize("value, minimum, maximum, strict, requirement", [
+    (math.nan, None, None, False, "must be finite"),
+    (math.inf, 0.0, None, False, "must be finite"),
+    (-0.5, 0.0, None, False, "must be non-negative"),
+    (0.0, 0.0, None, True, "must be positive"),
+    (0.5, 1.0, None, True, "must be > 1"),
+    (0.5, 1.0, None, False, "must be >= 1"),
+    (2.0, 0.0, 1.0, False, "must lie in [0, 1]"),
+    (1.0, 0.0, 1.0, True, "must lie in (0, 1)"),
+    (np.int64(-2), 0.0, None, False, "must be non-negative")])
 def test_real_refuses_non_finite_values_and_values_out_of_bounds_naming_the_bound(
-        value, minimum, strict, bound):
+        value, minimum, maximum, strict, requirement):
     with pytest.raises(ParameterError) as info:
-        real("gain", value, minimum=minimum, strict=strict)
-    assert str(info.value) == f"`gain` must be a finite number{bound}, got {float(value)!r}."
+        real("gain", value, minimum=minimum, maximum=maximum, strict=strict)
+    assert str(info.value) == f"`gain` {requirement}, got {float(value)!r}."
 
 
 @pytest.mark.parametrize("value, minimum, strict", [(0.0, 0.0, False), (1.0, 1.0, False),
@@ -43,40 +54,49 @@ def test_real_accepts_the_bound_itself_unless_strict(value, minimum, strict):
     assert real("gain", value, minimum=minimum, strict=strict) == value
 
 
-@pytest.mark.parametrize("value", [*NOT_NUMBERS, math.nan, -math.inf, np.float64(math.inf)])
-def test_finite_real_says_finite_number_with_the_value_as_given(value):
-    with pytest.raises(ParameterError) as info:
-        finite_real("dt", value, positive=True)
-    assert str(info.value) == f"`dt` must be a finite number, got {value!r}."
-
-
-@pytest.mark.parametrize("value", [0, -1, 0.0, -2.5, np.int64(0)])
-def test_finite_real_positive_refuses_zero_and_below_with_the_value_as_given(value):
-    assert finite_real("dt", value) == float(value)  # without `positive`, any finite number
-    with pytest.raises(ParameterError) as info:
-        finite_real("dt", value, positive=True)
-    assert str(info.value) == f"`dt` must be positive, got {value!r}."
-
-
-@pytest.mark.parametrize("value", [*NOT_NUMBERS, math.nan, math.inf, 0, -1.0, np.float64(-0.0)])
-def test_positive_real_has_one_message_for_every_refusal(value):
-    with pytest.raises(ParameterError) as info:
+@pytest.mark.parametrize("value", [0, -1.0, np.float64(-0.0), math.inf])
+def test_positive_real_is_real_with_its_bound_message_for_message(value):
+    with pytest.raises(ParameterError) as shorthand:
         positive_real("sample_rate", value)
-    assert str(info.value) == f"`sample_rate` must be a positive finite number, got {value!r}."
+    with pytest.raises(ParameterError) as spelled:
+        real("sample_rate", value, minimum=0.0, strict=True)
+    assert str(shorthand.value) == str(spelled.value)
+    assert str(shorthand.value).startswith("`sample_rate` must be ")
 
 
 def test_the_checks_raise_the_error_class_asked_for():
     for check in (lambda: real("x", "a", error=DataError),
-                  lambda: finite_real("x", math.nan, error=DataError),
-                  lambda: positive_real("x", 0.0, error=DataError)):
+                  lambda: non_negative_real("x", math.nan, error=DataError),
+                  lambda: positive_real("x", 0.0, error=DataError),
+                  lambda: integer("x", 0, 1, DataError),
+                  lambda: choice("x", "c", ("a", "b"), DataError)):
         with pytest.raises(DataError):
             check()
+
+
+def test_a_structured_error_gets_the_name_the_value_and_the_reason_as_attributes():
+    error = Structured(build=lambda key, value, reason: ProblemError("robust", key, value, reason))
+    with pytest.raises(ProblemError) as info:
+        integer("samples", 2.5, 1, error, fix="e.g. 64")
+    assert (info.value.table, info.value.key, info.value.value) == ("robust", "samples", 2.5)
+    assert info.value.fix == "must be an integer >= 1; e.g. 64"
+    with pytest.raises(ProblemError) as info:
+        real("low", "1", error=error)
+    assert (info.value.key, info.value.value, info.value.fix) == ("low", "1", "must be a number")
+
+
+def test_choice_names_the_options_the_value_and_the_fix():
+    assert choice("solver", "rk4", ("rk4", "euler")) == "rk4"
+    with pytest.raises(ParameterError) as info:
+        choice("solver", "rk5", ("rk4", "euler"), fix="see docs/model.md")
+    assert str(info.value) == ("`solver` must be one of 'rk4', 'euler', got 'rk5'; "
+                               "see docs/model.md.")
 
 
 def test_optional_lets_none_through_and_checks_the_rest():
     assert optional(positive_real)("corner", None) is None
     assert optional(positive_real)("corner", 2) == 2.0
-    with pytest.raises(ParameterError, match="`corner` must be a positive finite number"):
+    with pytest.raises(ParameterError, match="`corner` must be positive, got -1.0"):
         optional(positive_real)("corner", -1.0)
 
 
@@ -84,8 +104,11 @@ def test_optional_lets_none_through_and_checks_the_rest():
 def test_integer_refuses_bools_floats_and_values_below_the_minimum(value):
     with pytest.raises(ParameterError) as info:
         integer("jitter_samples", value, 0)
-    assert str(info.value) == f"`jitter_samples` must be an integer >= 0, got {value!r}."
+    shown = "the boolean True" if value is True else repr(value)
+    assert str(info.value) == f"`jitter_samples` must be an integer >= 0, got {shown}."
     assert integer("jitter_samples", np.int64(4), 0) == 4
+    with pytest.raises(ParameterError, match=r"must be an integer in \[1, 8\], got 9"):
+        integer("harmonics", 9, 1, maximum=8)
 
 
 def test_an_interval_is_two_ordered_finite_numbers_above_its_minimum():

@@ -17,8 +17,9 @@ this order:
 The design is the quick one (the ranges' ends, shorter runs, about half a minute).
 """
 import qzs
+from qzs.viz.design import plot_design
 
 design = qzs.design_controller(quick=True, workers=2)
 print(design.summary())
-figures = design.plot()
+figures = plot_design(design)  # every figure; design.plot(figure=...) draws one
 # sphinx_gallery_thumbnail_number = 4

@@ -13,60 +13,138 @@ import numpy as np
 from qzs.errors import ParameterError
 
 
-def as_float(name, value, error=ParameterError):
-    """Return ``value`` as a finite float or raise ``error`` naming ``name``."""
-    if isinstance(value, (bool, np.bool_)):
-        raise error(f"`{name}` must be a number, got the boolean {value!r}.")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise error(f"`{name}` must be a number, got {value!r}.") from None
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class Structured:
+    """An ``error`` for the checks below, for an exception that carries the argument's name,
+    its value and the reason as attributes rather than one message.
+
+    ``Structured(build=build)`` makes the checks call ``build(name, value, reason)`` (the
+    reason is the requirement and the fix: ``"must be positive; e.g. 0.5"``); e.g.
+    ``Structured(build=functools.partial(ProblemError, "variables.mass"))`` in a problem file.
+    """
+
+    build: object
+
+
+def refusal(error, name, value, requirement, fix=""):
+    """The exception saying that ``name`` (given ``value``) ``requirement``, then ``fix``.
+
+    Parameters
+    ----------
+    error : type or Structured
+        An exception class, called with the whole message ``"`name` must be positive, got
+        0.0; fix."``, or a :class:`Structured` builder, called with (name, value, reason).
+    name : str
+        The argument, option or key.
+    value : object
+        The value received, shown with ``repr``.
+    requirement : str
+        What it must be (``"must be positive"``).
+    fix : str
+        What to do (``"e.g. 1e-3 [s]"``); '' for nothing.
+
+    Returns
+    -------
+    Exception
+        To be raised by the caller.
+    """
+    if isinstance(error, Structured):
+        return error.build(name, value, requirement + (f"; {fix}" if fix else ""))
+    shown = f"the boolean {value!r}" if isinstance(value, (bool, np.bool_)) else repr(value)
+    return error(f"`{name}` {requirement}, got {shown}" + (f"; {fix}" if fix else "") + ".")
+
+
+def _real(value):
+    """``value`` as a float if it is a real number (not a bool; a 0-d numeric array counts),
+    else None. Text is not a number: callers that read text parse it first."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return None
+    return float(value)
+
+
+def _bounds(minimum, maximum, strict):
+    """The requirement a bounded number states: "must be positive", "must be >= 1", ..."""
+    if maximum is None:
+        if minimum is None:
+            return "must be finite"
+        if minimum == 0.0:
+            return "must be positive" if strict else "must be non-negative"
+        return f"must be {'>' if strict else '>='} {minimum:g}"
+    low = "-inf" if minimum is None else f"{minimum:g}"
+    opening, closing = ("(" if strict or minimum is None else "["), (")" if strict else "]")
+    return f"must lie in {opening}{low}, {maximum:g}{closing}"
+
+
+def real(name, value, error=ParameterError, *, minimum=None, maximum=None, strict=False,
+         fix=""):
+    """Return ``value`` as a float: a real number (not a bool, not text), finite, within
+    ``minimum`` and ``maximum`` (excluded if ``strict``).
+
+    The one check of a real number; :func:`positive_real` and :func:`non_negative_real` are it
+    with their bound. Messages (value shown as a float once it is a number):
+    ``"`x` must be a number, got 'a'"``, ``"`x` must be finite, got nan"``,
+    ``"`x` must be positive, got 0.0"``, ``"`x` must be non-negative, got -1.0"``,
+    ``"`x` must be >= 1, got 0.5"``, ``"`x` must lie in [0, 1], got 2.0"``, then
+    ``"; fix."``.
+
+    Parameters
+    ----------
+    name : str
+        The argument, option or key, as the user wrote it.
+    value : object
+        The value received.
+    error : type or Structured
+        What to raise (:func:`refusal`).
+    minimum, maximum : float, optional
+        The bounds (None: none).
+    strict : bool
+        Exclude the bounds themselves.
+    fix : str
+        What to do, ending the message ('' for nothing).
+
+    Returns
+    -------
+    float
+    """
+    number = _real(value)
+    if number is None:
+        raise refusal(error, name, value, "must be a number", fix)
     if not math.isfinite(number):
-        raise error(f"`{name}` must be finite, got {number!r}.")
+        raise refusal(error, name, number, "must be finite", fix)
+    if ((minimum is not None and (number < minimum or (strict and number == minimum)))
+            or (maximum is not None and (number > maximum or (strict and number == maximum)))):
+        raise refusal(error, name, number, _bounds(minimum, maximum, strict), fix)
     return number
 
 
-def integer(name, value, minimum, error=ParameterError):
-    """Return ``value`` as an int that must be an integer (not a bool) >= ``minimum``."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
-            or value < minimum:
-        raise error(f"`{name}` must be an integer >= {minimum}, got {value!r}.")
+def positive_real(name, value, error=ParameterError, *, fix=""):
+    """Return ``value`` as a finite float > 0 (:func:`real` with ``minimum=0, strict``)."""
+    return real(name, value, minimum=0.0, strict=True, fix=fix, error=error)
+
+
+def non_negative_real(name, value, error=ParameterError, *, fix=""):
+    """Return ``value`` as a finite float >= 0 (:func:`real` with ``minimum=0``)."""
+    return real(name, value, minimum=0.0, fix=fix, error=error)
+
+
+def integer(name, value, minimum, error=ParameterError, *, maximum=None, fix=""):
+    """Return ``value`` as an int: an integer (not a bool, not a float, not text) with
+    ``minimum <= value <= maximum``; else ``"`x` must be an integer >= 1, got 0.5"``."""
+    whole = (isinstance(value, (int, np.integer))
+             and not isinstance(value, (bool, np.bool_)))
+    if not whole or value < minimum or (maximum is not None and value > maximum):
+        bound = (f"in [{minimum}, {maximum}]" if maximum is not None else f">= {minimum}")
+        raise refusal(error, name, value, f"must be an integer {bound}", fix)
     return int(value)
 
 
 def worker_count(workers, limit=None, error=ParameterError):
     """The workers (threads or processes) to use: ``workers``, an integer >= 1 (not a bool),
     or the machine's core count if it is None; at most ``limit`` (>= 1) if given."""
-    if workers is not None and (isinstance(workers, (bool, np.bool_))
-                                or not isinstance(workers, (int, np.integer)) or workers < 1):
-        raise error(f"`workers` must be a positive integer, got {workers!r}.")
-    count = int(workers) if workers is not None else (os.cpu_count() or 1)
+    count = (os.cpu_count() or 1) if workers is None else integer("workers", workers, 1, error)
     return count if limit is None else max(1, min(count, limit))
-
-
-def _real(value):
-    """``value`` as a float if it is a real number (not a bool), else None."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        return None
-    return float(value)
-
-
-def real(name, value, *, minimum=None, strict=False, fix="", error=ParameterError):
-    """Return ``value`` as a float: a real number (not a bool), finite, at least ``minimum``.
-
-    A number that is not one says ``"`name` must be a number, got 'x'."``; NaN, inf or a
-    value below ``minimum`` (or equal to it if ``strict``) says
-    ``"`name` must be a finite number >= 0, got -1.0."`` (no bound without ``minimum``).
-    ``fix`` ends either message (e.g. ``"; e.g. 0.5"``).
-    """
-    number = _real(value)
-    if number is None:
-        raise error(f"`{name}` must be a number, got {value!r}{fix}.")
-    if not math.isfinite(number) or (minimum is not None and (
-            number < minimum or (strict and number == minimum))):
-        bound = "" if minimum is None else (f" > {minimum:g}" if strict else f" >= {minimum:g}")
-        raise error(f"`{name}` must be a finite number{bound}, got {number!r}{fix}.")
-    return number
 
 
 def interval(name, value, unit, *, minimum=0.0, example=None, error=ParameterError):
@@ -81,61 +159,20 @@ def interval(name, value, unit, *, minimum=0.0, example=None, error=ParameterErr
     try:
         low, high = (float(v) for v in value)
     except (TypeError, ValueError):
-        raise error(f"`{name}` must be two numbers (low, high) in {unit}, got {value!r}; "
-                    f"e.g. {example}.") from None
+        raise refusal(error, name, value, f"must be two numbers (low, high) in {unit}",
+                      f"e.g. {example}") from None
     if not (math.isfinite(low) and math.isfinite(high) and minimum <= low <= high):
-        raise error(f"`{name}` must satisfy {minimum:g} <= low <= high (finite, in {unit}), "
-                    f"got {value!r}; e.g. {example}.")
+        raise refusal(error, name, value, f"must satisfy {minimum:g} <= low <= high (finite, "
+                                          f"in {unit})", f"e.g. {example}")
     return (low, high)
 
 
-def finite_real(name, value, *, positive=False, error=ParameterError):
-    """Return ``value`` as a float: a real number (not a bool), finite, and > 0 if ``positive``.
-
-    Says ``"`name` must be a finite number, got 'x'."`` or, for a finite number that
-    is not positive, ``"`name` must be positive, got 0."`` (the value as given).
-    """
-    number = _real(value)
-    if number is None or not math.isfinite(number):
-        raise error(f"`{name}` must be a finite number, got {value!r}.")
-    if positive and number <= 0.0:
-        raise error(f"`{name}` must be positive, got {value!r}.")
-    return number
-
-
-def positive_real(name, value, error=ParameterError):
-    """Return ``value`` as a float: a real number (not a bool), finite and > 0.
-
-    Every refusal says ``"`name` must be a positive finite number, got 0."`` (the value
-    as given).
-    """
-    number = _real(value)
-    if number is None or not math.isfinite(number) or number <= 0.0:
-        raise error(f"`{name}` must be a positive finite number, got {value!r}.")
-    return number
-
-
-def positive(name, value, error=ParameterError):
-    """Return ``value`` as a float that must be finite and > 0."""
-    number = as_float(name, value, error)
-    if number <= 0.0:
-        raise error(f"`{name}` must be positive, got {number!r}.")
-    return number
-
-
-def non_negative(name, value, error=ParameterError):
-    """Return ``value`` as a float that must be finite and >= 0."""
-    number = as_float(name, value, error)
-    if number < 0.0:
-        raise error(f"`{name}` must be non-negative, got {number!r}.")
-    return number
-
-
-def choice(name, value, options, error=ParameterError):
-    """Return ``value`` if it is one of ``options``."""
+def choice(name, value, options, error=ParameterError, *, fix=""):
+    """Return ``value`` if it is one of ``options``; else ``"`x` must be one of 'a', 'b',
+    got 'c'"``."""
     if value not in options:
         listed = ", ".join(repr(o) for o in options)
-        raise error(f"`{name}` must be one of {listed}; got {value!r}.")
+        raise refusal(error, name, value, f"must be one of {listed}", fix)
     return value
 
 

@@ -123,3 +123,14 @@ def test_a_busy_port_fails_before_the_warm_up(monkeypatch):
             server.serve(port=port, open_browser=False)
         assert server.check_address("127.0.0.1", 0) != port  # 0: any free one
         assert server.choose_port("127.0.0.1", port) != port  # the default's fallback
+
+
+@pytest.mark.parametrize("port", [True, 70000, -1, "8000", 5006.0])
+def test_a_port_that_is_not_one_is_refused_with_the_range(port):
+    from qzs.app import server
+    from qzs.errors import ParameterError
+
+    shown = "the boolean True" if port is True else repr(port)
+    with pytest.raises(ParameterError) as info:
+        server.serve(port=port, open_browser=False)
+    assert str(info.value) == f"`port` must be an integer in [0, 65535], got {shown}; e.g. 5006."

@@ -12,23 +12,26 @@ from qzs.workflows.design import cost
 
 
 class FakeResult:
-    """What the command needs of a DesignResult: ``save``, ``to_dict`` and ``summary``."""
+    """What the command needs of a DesignResult: ``to_dict`` and ``summary`` (its files:
+    :func:`fake_write`)."""
 
     def __init__(self):
         self.saved_to = None
-
-    def save(self, folder, frequency_scale=None):
-        self.saved_to = folder
-        self.frequency_scale = frequency_scale
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / "report.html").write_text("<html></html>")
-        return {"report": folder / "report.html", "json": folder / "design.json"}
 
     def to_dict(self):
         return {"gains": {"pi_kp": 123.0, "pi_ki": 49.2, "damping_gain": float("nan")}}
 
     def summary(self):
         return "qzs design (quick; 1 s)"
+
+
+def fake_write(result, folder, *, frequency_scale=None):
+    """:func:`qzs.workflows.design.result.write_design` of a :class:`FakeResult`."""
+    result.saved_to = folder
+    result.frequency_scale = frequency_scale
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "report.html").write_text("<html></html>")
+    return {"report": folder / "report.html", "json": folder / "design.json"}
 
 
 def test_cli_forwards_the_options_writes_the_report_and_prints_json(monkeypatch, tmp_path,
@@ -40,6 +43,7 @@ def test_cli_forwards_the_options_writes_the_report_and_prints_json(monkeypatch,
         return result
 
     monkeypatch.setattr(D, "design_controller", fake)
+    monkeypatch.setattr(D.result, "write_design", fake_write)
     out = tmp_path / "design"
     code = main(["design", "--out", str(out), "--json", "--quiet", "--stiction-range", "8,12",
                  "--mass-range", "6.4,6.4", "--force-steps", "2", "--cost", "peak",

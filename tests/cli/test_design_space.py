@@ -60,7 +60,7 @@ def test_a_bad_problem_file_is_one_line_and_exit_2(tmp_path, capsys):
 @pytest.mark.parametrize("option", ["--workers", "--generations", "--population"])
 def test_counts_below_one_are_refused(problem_file, option, capsys):
     assert main(["optimize", str(problem_file), option, "0"]) == 2
-    assert f"`{option}` must be >= 1, got 0" in capsys.readouterr().err
+    assert f"argument {option}: must be an integer >= 1, got 0" in capsys.readouterr().err
 
 
 def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_file, tmp_path,

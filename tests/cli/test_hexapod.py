@@ -148,7 +148,7 @@ def test_bad_options_are_usage_errors(capsys):
     assert main(["hexapod", "linear", "--cube-edge", "0.1"]) == 2
     assert "add --cubic" in capsys.readouterr().err
     assert main(["hexapod", "linear", "--cubic", "--cube-edge", "-1"]) == 2
-    assert "--cube-edge must be a positive" in capsys.readouterr().err
+    assert "`--cube-edge` must be positive, got -1.0" in capsys.readouterr().err
     assert main(["hexapod", "linear", "--leg-stiffness", "0"]) == 2
     assert default_cube_center_height(0.3) == pytest.approx(0.3 / (2 * math.sqrt(3)))
 

@@ -29,7 +29,7 @@ def test_a_dry_run_prints_the_cases_and_batches_and_runs_nothing(sweep_file, tmp
 @pytest.mark.parametrize("option", ["--workers", "--threads"])
 def test_fewer_than_one_worker_or_thread_is_refused(sweep_file, option, capsys):
     assert main(["sweep", str(sweep_file), option, "0"]) == 2
-    assert f"`{option}` must be >= 1, got 0" in capsys.readouterr().err
+    assert f"argument {option}: must be an integer >= 1, got 0" in capsys.readouterr().err
 
 
 def test_sweep_export_writes_the_store_as_a_mat_file(tmp_path, capsys):

@@ -68,7 +68,7 @@ def test_a_failing_case_is_recorded_and_the_others_go_on():
     (dict(cases=[]), "at least one"),
     (dict(cases=[(qzs.IsolatorParameters(), "not a controller")]), "case 0: `controller` must be"),
     (dict(dt=0.5), "case 0: .*largest stable step"),
-    (dict(workers=0), "`workers` must be a positive integer"),
+    (dict(workers=0), "`workers` must be an integer >= 1"),
 ])
 def test_bad_arguments(kwargs, match):
     arguments = dict(cases=CASES[:1], excitation=EXCITATION, sample_rate=2.0)

@@ -26,8 +26,8 @@ from qzs import (
 
 # ------------------------------------------------------------------ bad input
 @pytest.mark.parametrize("kwargs, error, match", [
-    (dict(solver="rk45"), ParameterError, r"`solver` must be one of 'euler', 'ode3', 'rk4'; got 'rk45'"),
-    (dict(solver=3), ParameterError, r"`solver` must be one of .*; got 3"),
+    (dict(solver="rk45"), ParameterError, r"`solver` must be one of 'euler', 'ode3', 'rk4', got 'rk45'"),
+    (dict(solver=3), ParameterError, r"`solver` must be one of .*, got 3"),
     (dict(dt=0.0), ParameterError, r"`dt` must be positive, got 0.0"),
     (dict(dt=-1e-4), ParameterError, r"`dt` must be positive, got -0.0001"),
     (dict(dt=float("nan")), ParameterError, r"`dt` must be finite, got nan"),

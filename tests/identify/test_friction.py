@@ -128,6 +128,21 @@ def test_bad_input():
         fit_friction(time, z, force, spring="magspring")
 
 
+@pytest.mark.parametrize("options, message", [
+    (dict(smoothing_window=0.0), "`smoothing_window` must be positive, got 0.0; a window in s"),
+    (dict(smoothing_window="0.02"), "`smoothing_window` must be a number, got '0.02'"),
+    (dict(mass=-1.0), "`mass` must be positive, got -1.0; in kg, or None"),
+    (dict(exclude_below_velocity=float("nan")), "`exclude_below_velocity` must be finite"),
+    (dict(exclude_below_velocity=-1e-3), "`exclude_below_velocity` must be non-negative"),
+    (dict(polyorder=2.0), "`polyorder` must be an integer >= 2, got 2.0")])
+def test_bad_settings_get_the_shared_checks_messages(options, message):
+    """Hand-written checks before (text such as "0.02" was taken through float())."""
+    time, z, force = instron_test(0)
+    with pytest.raises(ParameterError) as info:
+        fit_friction(time, z, force, **options)
+    assert str(info.value).startswith(message)
+
+
 def test_one_direction_cannot_separate_offset():
     time = np.arange(0, 2, 1e-3)
     z = 0.05 * time ** 2  # always moving up

@@ -172,7 +172,7 @@ def test_record_of_a_sine_drives_the_simulator_like_the_sine():
 # ------------------------------------------------------------------ errors
 @pytest.mark.parametrize("factory, match", [
     (lambda: Chirp(f0=0.0, method="logarithmic"), r"logarithmic chirp needs `f0` > 0.*`f0` = 0.0"),
-    (lambda: Chirp(method="exponential"), r"`method` must be one of 'linear', 'logarithmic'; got 'exponential'"),
+    (lambda: Chirp(method="exponential"), r"`method` must be one of 'linear', 'logarithmic', got 'exponential'"),
     (lambda: Chirp(amplitude=-0.01), r"`amplitude` must be non-negative, got -0.01"),
     (lambda: Chirp(duration=0.0), r"`duration` must be positive, got 0.0"),
     (lambda: Chirp(f1=float("nan")), r"`f1` must be finite, got nan"),

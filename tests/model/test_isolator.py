@@ -172,6 +172,7 @@ def test_parameters_are_frozen_keyword_only_and_round_trip_through_dict():
 @pytest.mark.parametrize("name, value, match", [
     ("mass", -1.0, "must be positive, got -1.0"),
     ("mass", 0.0, "must be positive, got 0.0"),
+    ("mass", "2.0", "must be a number, got '2.0'"),  # text was taken as 2.0
     ("mass", float("nan"), "must be finite, got nan"),
     ("gravity", float("inf"), "must be finite, got inf"),
     ("viscous_damping", -0.5, "must be non-negative, got -0.5"),
@@ -180,7 +181,7 @@ def test_parameters_are_frozen_keyword_only_and_round_trip_through_dict():
     ("spring_shape", None, "must be a number, got None"),
     ("stroke_half", [0.08], r"must be a number, got \[0.08\]"),
     ("stop_center", float("nan"), "must be finite, got nan"),
-    ("stop_model", "elastic", "must be one of 'compliant', 'plastic'; got 'elastic'"),
+    ("stop_model", "elastic", "must be one of 'compliant', 'plastic', got 'elastic'"),
     ("friction_regularisation", -1e-3, "must be non-negative, got -0.001"),
     ("friction_regularisation", float("inf"), "must be finite, got inf"),
 ])
@@ -237,5 +238,5 @@ def test_worker_count_defaults_to_the_cores_and_respects_its_limit():
     assert worker_count(5, limit=2) == 2
     assert worker_count(5, limit=0) == 1  # nothing to share out: one worker
     for bad in (0, -1, 1.0, True, np.bool_(True), "2"):
-        with pytest.raises(ParameterError, match="`workers` must be a positive integer"):
+        with pytest.raises(ParameterError, match="`workers` must be an integer >= 1"):
             worker_count(bad)

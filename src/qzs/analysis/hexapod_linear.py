@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qzs._validation import as_float, choice
+from qzs._validation import choice, real
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
@@ -465,7 +465,7 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
         stiffness = np.array([float(spring_stiffness(c.position_setpoint, i))
                               for i, c in zip(isolators, controllers)]) + loop
     elif np.ndim(leg_stiffness) == 0:
-        stiffness = np.full(LEG_COUNT, as_float("leg_stiffness", leg_stiffness))
+        stiffness = np.full(LEG_COUNT, real("leg_stiffness", leg_stiffness))
     else:
         stiffness = np.array(leg_stiffness, dtype=float)
         if stiffness.shape != (LEG_COUNT,) or not np.all(np.isfinite(stiffness)):

@@ -27,7 +27,7 @@ import numpy as np
 
 from qzs import defaults
 from qzs._format import decibels
-from qzs._validation import as_float, choice, integer
+from qzs._validation import choice, integer, real
 from qzs.errors import ParameterError, SizeLimitError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
@@ -153,14 +153,14 @@ class PageRequest:
         except (TypeError, ValueError):
             raise ParameterError(f"`band` must be two frequencies (f0, f1) in Hz, got "
                                  f"{self.band!r}.") from None
-        band = (as_float("excitation.f0", f0), as_float("excitation.f1", f1))
+        band = (real("excitation.f0", f0), real("excitation.f1", f1))
         object.__setattr__(self, "band", band)
         _bounded("excitation.f1", max(band))
         for name, field in (("sine.frequency", "sine_frequency"),
                             ("sine.duration", "sine_duration"),
                             ("excitation.duration", "chirp_duration"),
                             ("sample_rate", "sample_rate")):
-            object.__setattr__(self, field, _bounded(name, as_float(name, getattr(self, field))))
+            object.__setattr__(self, field, _bounded(name, real(name, getattr(self, field))))
         count = integer("frequency_count", self.frequency_count, 1)
         object.__setattr__(self, "frequency_count", _bounded("frequency_count", count))
         choice("sample_rate", self.sample_rate, SAMPLE_RATES)

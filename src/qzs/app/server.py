@@ -16,7 +16,8 @@ import threading
 import time
 
 from qzs._optional import require
-from qzs.errors import AddressError, ParameterError
+from qzs._validation import integer
+from qzs.errors import AddressError
 
 __all__ = ["serve", "warm_up", "choose_port", "check_address", "is_loopback", "DEFAULT_PORT",
            "DEFAULT_HOST"]
@@ -196,9 +197,8 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
         A busy port, or a host that is not this machine's (:func:`check_address`), before
         the warm-up.
     """
-    if port is not None and (isinstance(port, bool) or not isinstance(port, int)
-                             or not 0 <= port <= 65535):
-        raise ParameterError(f"`port` must be an integer in [0, 65535], got {port!r}.")
+    if port is not None:
+        port = integer("port", port, 0, maximum=65535, fix="e.g. 5006")
     port = check_address(host, port)  # a busy port, an address not this machine's: fail now
     require("panel", "the tuning page (qzs app)")
     if is_loopback(host):

@@ -30,11 +30,18 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
 __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
-           "add_execution_options", "stopped",
+           "add_execution_options", "add_output_options", "figure_path", "check_output",
+           "OUTPUT_OPTIONS", "NO_FIGURE", "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
            "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
 
+#: The output options every subcommand that writes takes (:func:`add_output_options`):
+#: ``--out`` and/or ``--plot`` (what it writes), then all of ``--json``, ``--quiet`` and
+#: ``--overwrite``.
+OUTPUT_OPTIONS = ("--out", "--plot", "--json", "--quiet", "--overwrite")
+#: The value of ``--plot`` that draws no figure.
+NO_FIGURE = "none"
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
               130: "interrupted (Ctrl-C)", 141: "output pipe closed by its reader",
@@ -85,17 +92,19 @@ def add_set_option(parser):
                         help="override a parameter by its name (see `qzs params`; repeatable)")
 
 
-def add_json_option(parser):
+def add_json_option(parser, help_text=None):
     """Add ``--json`` to ``parser``: print the summary as one JSON object instead of text.
 
     Parameters
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser; its handler then prints through :func:`emit`.
+    help_text : str, optional
+        The option's help, where the record is not one object.
     """
     parser.add_argument("--json", action="store_true",
-                        help="print the summary as one JSON object (NaN and inf as null) "
-                             "instead of text")
+                        help=help_text or "print the summary as one JSON object (NaN and inf "
+                                          "as null) instead of text")
 
 
 def add_frequency_axis_option(parser):
@@ -113,8 +122,92 @@ def add_frequency_axis_option(parser):
                              f"the roll-off to 20 Hz span decades)")
 
 
+def add_output_options(parser, *, out=None, plot=None, json_help=None):
+    """Add the output options of a subcommand that writes: ``--out`` and/or ``--plot``, then
+    ``--json``, ``--quiet`` and ``--overwrite`` (:data:`OUTPUT_OPTIONS`).
+
+    One policy for every subcommand: an output that exists (a file, or a folder holding
+    anything) is refused before any work, the message naming the path and ``--overwrite``;
+    with ``--overwrite`` it is replaced, atomically (:func:`check_output`). ``--plot none``
+    draws no figure (:func:`figure_path`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    out : dict, optional
+        ``--out``'s ``metavar``, ``help`` and (optional) ``default``; None: no ``--out``.
+    plot : dict, optional
+        ``--plot``'s ``help`` and (optional) ``default`` (None: no figure unless asked);
+        None: no ``--plot``.
+    json_help : str, optional
+        ``--json``'s help, where the record is not one object (:func:`add_json_option`).
+    """
+    if out is not None:
+        parser.add_argument("--out", metavar=out["metavar"], default=out.get("default"),
+                            help=out["help"])
+    if plot is not None:
+        default = plot.get("default")
+        shown = f"default {default}" if default else "default none"
+        parser.add_argument("--plot", metavar="FILE", default=default,
+                            help=f"{plot['help']} (.png, .svg or .pdf; {shown}; "
+                                 f"'{NO_FIGURE}' for no figure)")
+    add_json_option(parser, json_help)
+    parser.add_argument("--quiet", action="store_true",
+                        help="no progress bar (nor the seconds of a first compilation)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing output (without it, one is refused before "
+                             "any work)")
+
+
+def figure_path(args):
+    """``--plot``'s file, or None for no figure (not given, or ``--plot none``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``plot``.
+
+    Returns
+    -------
+    str or None
+    """
+    plot = getattr(args, "plot", None)
+    return None if plot is None or plot.lower() == NO_FIGURE else plot
+
+
+def check_output(args, option, path, *, suffixes, directory=False, estimated_bytes=None):
+    """Check an output path before any work (:func:`qzs.iotools.paths.check_output_path`)
+    under the command line's policy: an existing output needs ``--overwrite``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``args.overwrite`` (absent: False) allows replacing.
+    option : str
+        The option that named the path (``"--out"``), for the message.
+    path : str or Path
+        The file or folder.
+    suffixes : iterable of str or None
+        Allowed extensions (None: any).
+    directory : bool
+        ``path`` is a folder to write into.
+    estimated_bytes : float, optional
+        Expected size [bytes].
+
+    Returns
+    -------
+    Path
+    """
+    from qzs.iotools.paths import check_output_path
+
+    return check_output_path(path, argument=option, suffixes=suffixes, directory=directory,
+                             estimated_bytes=estimated_bytes,
+                             overwrite=getattr(args, "overwrite", False))
+
+
 def add_execution_options(parser, verb="run"):
-    """Add ``--scheduler`` | ``--workers``, ``--threads`` and ``--quiet`` (Dask or local).
+    """Add ``--scheduler`` | ``--workers`` and ``--threads`` (Dask or local).
 
     Parameters
     ----------
@@ -126,11 +219,10 @@ def add_execution_options(parser, verb="run"):
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help=f"{verb} on an existing Dask cluster (e.g. tcp://host:8786)")
-    where.add_argument("--workers", type=int, metavar="N",
+    where.add_argument("--workers", type=integer_at_least(1), metavar="N",
                        help="start a local Dask cluster of N worker processes")
-    parser.add_argument("--threads", type=int, metavar="N",
+    parser.add_argument("--threads", type=integer_at_least(1), metavar="N",
                         help="threads per batch (default: all cores locally, 1 on Dask)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def stopped(stop, what_is_kept):
@@ -229,15 +321,17 @@ def integer_at_least(minimum):
     """
     import argparse
 
+    from qzs._validation import Structured, integer
+
+    usage = Structured(build=lambda name, value, reason:
+                       argparse.ArgumentTypeError(f"{reason}, got {value!r}"))
+
     def parse(text):
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, "
-                                             f"got {text!r}") from None
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"must be an integer >= {minimum}, got {value}")
-        return value
+            value = text
+        return integer("N", value, minimum, usage)
 
     parse.__name__ = f"integer >= {minimum}"
     return parse

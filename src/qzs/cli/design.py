@@ -1,8 +1,8 @@
 """``qzs design``: PI and damping gains from the isolator and its disturbance (docs/design.md)."""
 import math
 
-from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, add_set_option,
-                             emit, parameters)
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_output_options,
+                             add_set_option, check_output, emit, integer_at_least, parameters)
 from qzs.errors import ParameterError
 
 __all__ = ["add_parser", "run", "parse_pair", "parse_list"]
@@ -122,15 +122,13 @@ def add_parser(subparsers):
     cmd.add_argument("--damping-max", metavar="N_S_PER_M", type=float, default=1000.0,
                      help="largest damping gain tried [N*s/m] (default 1000, ten times the "
                           "guide's viscous friction)")
-    cmd.add_argument("--out", metavar="FOLDER", default=DEFAULT_FOLDER,
-                     help=f"output folder (default {DEFAULT_FOLDER})")
     cmd.add_argument("--quick", action="store_true",
                      help="short runs and a coarse search (about a minute)")
-    cmd.add_argument("--workers", metavar="N", type=int,
+    cmd.add_argument("--workers", metavar="N", type=integer_at_least(1),
                      help="threads (default: all cores)")
-    cmd.add_argument("--quiet", action="store_true", help="no progress bars")
     add_frequency_axis_option(cmd)
-    add_json_option(cmd)
+    add_output_options(cmd, out=dict(metavar="FOLDER", default=DEFAULT_FOLDER,
+                                     help=f"output folder (default {DEFAULT_FOLDER})"))
     return cmd
 
 
@@ -147,9 +145,9 @@ def run(args):
     int
         0.
     """
-    from qzs.iotools.paths import check_output_path
     from qzs.model.excitation import build_excitation
     from qzs.workflows.design import design_controller
+    from qzs.workflows.design.result import write_design
 
     config = parameters(args)
     stiction = (None if args.stiction_range is None
@@ -157,20 +155,19 @@ def run(args):
     mass = None if args.mass_range is None else parse_pair("--mass-range", args.mass_range, "kg")
     band = parse_pair("--band", args.band, "Hz")
     steps = parse_list("--force-steps", args.force_steps, "N")
-    if args.workers is not None and args.workers < 1:
-        raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
     excitation = None
     if config["excitation"]:
         options = dict(config["excitation"])
         excitation = build_excitation(options.pop("kind", "chirp"), options)
-    folder = check_output_path(args.out, argument="--out", suffixes=None, directory=True,
-                               estimated_bytes=5e6)
+    folder = check_output(args, "--out", args.out, suffixes=None, directory=True,
+                          estimated_bytes=5e6)
     result = design_controller(
         config["isolator"], config["controller"], excitation=excitation,
         stiction_range=stiction, mass_range=mass, force_steps=steps, band=band, cost=args.cost,
         controller_rate=args.controller_rate, delay=args.delay, quick=args.quick,
-        damping_gain_max=args.damping_max, workers=args.workers, progress=not args.quiet)
-    written = result.save(folder, frequency_scale=args.frequency_axis)
+        damping_gain_max=args.damping_max, workers=args.workers,
+        progress=not args.quiet and not args.json)
+    written = write_design(result, folder, frequency_scale=args.frequency_axis)
     record = result.to_dict()
     record["outputs"] = {name: str(path) for name, path in written.items()}
     emit(args, result.summary() + f"\n  wrote            {written['report']}", record)

@@ -1,8 +1,9 @@
 """``qzs optimize`` and ``qzs sensitivity``: the design space of a problem file."""
 from pathlib import Path
 
-from qzs.cli.common import EPILOG, add_execution_options, stopped
-from qzs.errors import ParameterError, Terminated
+from qzs.cli.common import (EPILOG, add_execution_options, add_output_options, check_output, emit,
+                             integer_at_least, stopped)
+from qzs.errors import Terminated
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parsers", "run_optimize_command", "run_sensitivity_command"]
@@ -37,19 +38,17 @@ def add_parsers(subparsers):
                "(143) keep every complete generation; --resume replays them and continues, "
                "with the same result as an uninterrupted run. " + EPILOG)
     cmd.add_argument("problem", metavar="FILE.toml", help=_PROBLEM_HELP)
-    cmd.add_argument("--out", metavar="DIR",
-                     help="output folder (default the problem's name); the store is "
-                          "DIR/NAME.zarr")
     cmd.add_argument("--resume", action="store_true",
                      help="continue an interrupted search in --out (same problem file)")
-    cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")
-    cmd.add_argument("--generations", type=int, metavar="N",
+    cmd.add_argument("--generations", type=integer_at_least(1), metavar="N",
                      help="generations (default the file's [optimizer] generations)")
-    cmd.add_argument("--population", type=int, metavar="N",
+    cmd.add_argument("--population", type=integer_at_least(1), metavar="N",
                      help="designs per generation (default the file's [optimizer] population)")
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the problem and the work, run nothing")
     add_execution_options(cmd, "evaluate")
+    add_output_options(cmd, out=dict(metavar="DIR", help="output folder (default the problem's "
+                                                         "name); the store is DIR/NAME.zarr"))
 
     sens = subparsers.add_parser(
         "sensitivity", help="global sensitivity of a problem's metrics (Sobol or Morris)",
@@ -60,23 +59,16 @@ def add_parsers(subparsers):
                     "chart with intervals.",
         epilog="The problem and --out are checked before any run. " + EPILOG)
     sens.add_argument("problem", metavar="FILE.toml", help=_PROBLEM_HELP)
-    sens.add_argument("--out", metavar="DIR",
-                      help="output folder (default NAME-sensitivity)")
     sens.add_argument("--method", choices=("sobol", "morris"),
                       help="default the file's [sensitivity] method")
-    sens.add_argument("--samples", type=int, metavar="N",
+    sens.add_argument("--samples", type=integer_at_least(1), metavar="N",
                       help="Sobol: base samples, a power of 2 (N x (d + 2) runs); Morris: "
                            "trajectories (N x (d + 1) runs); default the file's")
     sens.add_argument("--seed", type=int, metavar="N", help="default the file's")
     add_execution_options(sens, "evaluate")
+    add_output_options(sens, out=dict(metavar="DIR", help="output folder (default "
+                                                          "NAME-sensitivity)"))
     return cmd
-
-
-def _check_counts(args):
-    for option in ("workers", "threads", "generations", "population", "samples"):
-        value = getattr(args, option, None)
-        if value is not None and value < 1:
-            raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
 
 
 def run_optimize_command(args):
@@ -96,29 +88,29 @@ def run_optimize_command(args):
     from qzs.workflows.design_space import load_problem, optimize, plan_text, write_files
     from qzs.workflows.design_space.store import check, stored_generations
 
-    _check_counts(args)
     problem = load_problem(args.problem)
     if args.dry_run:
         print(plan_text(problem))
         return 0
     folder = Path(args.out) if args.out else Path(problem.name)
-    check_output_path(folder, argument="--out", suffixes=None, directory=True)
     store = folder / f"{problem.name}.zarr"
+    check_output_path(folder, argument="--out", suffixes=None, directory=True,
+                      overwrite=args.overwrite or args.resume or store.exists())  # see check
     check(store, resume=args.resume, overwrite=args.overwrite, argument="--out")
     try:
         result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
                           generations=args.generations, population=args.population,
                           scheduler=args.scheduler, workers=args.workers, threads=args.threads,
-                          progress=not args.quiet)
+                          progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept in "
                              f"{store}. Continue with: qzs optimize {args.problem} --out "
                              f"{folder} --resume")
     written = write_files(result, folder)
-    print(result.summary())
-    print(f"  wrote            {store}")
-    for path in written:
-        print(f"  wrote            {path}")
+    emit(args, "\n".join([result.summary(), *(f"  wrote            {path}"
+                                              for path in (store, *written))]),
+         {"problem": problem.name, "summary": result.summary(),
+          "files": [str(path) for path in (store, *written)]})
     return 0
 
 
@@ -138,19 +130,19 @@ def run_sensitivity_command(args):
     from qzs.workflows.design_space import load_problem
     from qzs.workflows.design_space.sensitivity import run_sensitivity
 
-    _check_counts(args)
     problem = load_problem(args.problem)
     folder = Path(args.out) if args.out else Path(f"{problem.name}-sensitivity")
-    check_output_path(folder, argument="--out", suffixes=None, directory=True)
+    check_output(args, "--out", folder, suffixes=None, directory=True)
     try:
         result, written = run_sensitivity(problem, folder, method=args.method,
                                           samples=args.samples, seed=args.seed,
                                           scheduler=args.scheduler, workers=args.workers,
-                                          threads=args.threads, progress=not args.quiet)
+                                          threads=args.threads,
+                                          progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, "nothing is written (a sensitivity run is not resumable; fewer "
                              "--samples make it shorter)")
-    print(result.summary())
-    for path in written:
-        print(f"  wrote            {path}")
+    emit(args, "\n".join([result.summary(), *(f"  wrote            {path}" for path in written)]),
+         {"problem": problem.name, "summary": result.summary(),
+          "files": [str(path) for path in written]})
     return 0

@@ -6,8 +6,8 @@ ends the command, as ``--help`` does (LOG and ``--map`` are not needed then).
 import argparse
 from pathlib import Path
 
-from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, emit,
-                             integer_at_least, run_handler)
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_output_options,
+                             check_output, emit, integer_at_least, run_handler)
 from qzs.errors import OutputPathError
 from qzs.iotools.paths import check_output_path
 
@@ -40,8 +40,6 @@ def add_parser(subparsers):
     parser.add_argument("--write-map", metavar="FILE.toml", action=WriteMap,
                         help="write a commented channel map template (every key the map "
                              "reader accepts) to FILE.toml and exit; never replaces a file")
-    parser.add_argument("--out", metavar="DIR", default="qzs-experiment",
-                        help="output folder (default qzs-experiment)")
     parser.add_argument("--no-simulation", action="store_true",
                         help="do not simulate the matching run")
     parser.add_argument("--fft-length", type=integer_at_least(8), metavar="N",
@@ -55,7 +53,8 @@ def add_parser(subparsers):
     parser.add_argument("--resample", action="store_true",
                         help="resample a non-uniform time base onto a uniform grid")
     add_frequency_axis_option(parser)
-    add_json_option(parser)
+    add_output_options(parser, out=dict(metavar="DIR", default="qzs-experiment",
+                                        help="output folder (default qzs-experiment)"))
     return parser
 
 
@@ -99,9 +98,8 @@ def run(args):
     int
         The exit code, 0.
     """
-    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
-    # scipy and the engine: after the check
-    from qzs.workflows.experiment.process import run_experiment
+    check_output(args, "--out", args.out, suffixes=None, directory=True)
+    from qzs.workflows.experiment.process import run_experiment  # scipy and the engine: after the check
 
     result, paths = run_experiment(args.log, args.map, out=args.out, fft_length=args.fft_length,
                                    n_averages=args.averages, config=args.config,

@@ -1,6 +1,7 @@
 """``qzs hexapod``: the six-axis platform of six isolator legs (docs/hexapod.md)."""
-from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_json_option, add_set_option,
-                             emit, settings)
+from qzs._validation import positive_real
+from qzs.cli.common import (EPILOG, add_frequency_axis_option, add_output_options, add_set_option,
+                             check_output, emit, figure_path, integer_at_least, settings)
 from qzs.defaults import ACCURACY, AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT
@@ -80,10 +81,9 @@ def add_parser(subparsers):
                              "of mass; cube-center: a cubic geometry's cube centre)")
     linear.add_argument("--no-preload", action="store_true",
                         help="leave out the geometric stiffness of the static leg forces")
-    linear.add_argument("--plot", metavar="FILE.png",
-                        help="draw the 6x6 transmissibility of the linear model (0.05-50 Hz)")
     add_frequency_axis_option(linear)
-    add_json_option(linear)
+    add_output_options(linear, plot=dict(help="the 6x6 transmissibility of the linear model "
+                                              "(0.05-50 Hz)"))
     linear.set_defaults(handler=run_linear)
     simulate = sub.add_parser(
         "simulate", help="simulate the platform: stick-slip on every leg",
@@ -123,11 +123,9 @@ def add_parser(subparsers):
     simulate.add_argument("--sample-rate", type=float, metavar="HZ", help="output rate [Hz]")
     simulate.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                           help="integrator (default the file's, else ode3)")
-    simulate.add_argument("--out", metavar="FILE",
-                          help="write the run as NetCDF (.nc, CF-1.10) or MATLAB (.mat)")
-    simulate.add_argument("--plot", metavar="FILE.png", help="draw the run")
-    simulate.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_json_option(simulate)
+    add_output_options(simulate, out=dict(metavar="FILE", help="write the run as NetCDF (.nc, "
+                                                              "CF-1.10) or MATLAB (.mat)"),
+                       plot=dict(help="figure of the run"))
     simulate.set_defaults(handler=run_simulate)
     matrix = sub.add_parser(
         "transmissibility", help="the simulated 6x6 transmissibility: one chirp per axis",
@@ -151,14 +149,13 @@ def add_parser(subparsers):
     _add_step_options(matrix)
     matrix.add_argument("--sample-rate", type=float, metavar="HZ",
                         help="output rate [Hz] (default the file's, else 1000)")
-    matrix.add_argument("--workers", type=int, metavar="N",
+    matrix.add_argument("--workers", type=integer_at_least(1), metavar="N",
                         help="parallel runs (default: all cores)")
-    matrix.add_argument("--out", metavar="DIR", default="results/hexapod_transmissibility",
-                        help="folder for transmissibility.png and transmissibility.nc "
-                             "(default results/hexapod_transmissibility)")
-    matrix.add_argument("--quiet", action="store_true", help="no progress bar")
     add_frequency_axis_option(matrix)
-    add_json_option(matrix)
+    add_output_options(matrix, out=dict(metavar="DIR", default="results/hexapod_transmissibility",
+                                        help="folder for transmissibility.png and "
+                                             "transmissibility.nc (default "
+                                             "results/hexapod_transmissibility)"))
     matrix.set_defaults(handler=run_transmissibility)
     study = sub.add_parser(
         "study", help="the shipped study: paper legs, chirps in z and x, with and without PI",
@@ -169,13 +166,11 @@ def add_parser(subparsers):
     study.add_argument("--quick", action="store_true",
                        help="60 s chirps instead of 400 s (well under a minute)")
     _add_step_options(study)
-    study.add_argument("--out", metavar="DIR", default="results/hexapod_study",
-                       help="output folder (default results/hexapod_study)")
-    study.add_argument("--workers", type=int, metavar="N",
+    study.add_argument("--workers", type=integer_at_least(1), metavar="N",
                        help="parallel runs per case (default: all cores)")
-    study.add_argument("--quiet", action="store_true", help="no progress bar")
     add_frequency_axis_option(study)
-    add_json_option(study)
+    add_output_options(study, out=dict(metavar="DIR", default="results/hexapod_study",
+                                       help="output folder (default results/hexapod_study)"))
     study.set_defaults(handler=run_study)
     for command in sub.choices.values():
         command.epilog = EPILOG
@@ -224,8 +219,7 @@ def _described_setup(args):
         return load_hexapod(args.config, overrides)
     if args.cubic:
         edge = HEXAPOD["cube_edge"] if args.cube_edge is None else args.cube_edge
-        if not edge > 0:
-            raise ParameterError(f"--cube-edge must be a positive length [m], got {edge!r}.")
+        positive_real("--cube-edge", edge, fix="a length in m")
         height = (default_cube_center_height(edge) if args.cube_center_height is None
                   else args.cube_center_height)
         geometry = cubic_geometry(cube_edge=edge, cube_center_height=height)
@@ -248,23 +242,21 @@ def run_linear(args):
     """
     from qzs.workflows.hexapod.setups import linear_record, linear_text
 
-    if args.leg_stiffness is not None and not args.leg_stiffness > 0:
-        raise ParameterError(f"--leg-stiffness must be a positive stiffness [N/m], got "
-                             f"{args.leg_stiffness!r}.")
-    if args.plot:
-        from qzs.iotools.paths import check_output_path
-
-        check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
+    if args.leg_stiffness is not None:
+        positive_real("--leg-stiffness", args.leg_stiffness, fix="a stiffness in N/m")
+    plot = figure_path(args)
+    if plot is not None:
+        check_output(args, "--plot", plot, suffixes=(".png", ".svg", ".pdf"))
     setup = _setup(args)
     model, record = linear_record(setup, leg_stiffness=args.leg_stiffness,
                                   frame=FRAMES[args.frame], include_preload=not args.no_preload)
     text = linear_text(setup, model, record)
-    if args.plot:
+    if plot is not None:
         from qzs.workflows.hexapod.setups import plot_linear_transmissibility
 
         record["plot"] = str(plot_linear_transmissibility(
-            setup, model, args.plot, frequency_scale=args.frequency_axis))
-        text += f"\n  wrote {args.plot}"
+            setup, model, plot, frequency_scale=args.frequency_axis))
+        text += f"\n  wrote {plot}"
     emit(args, text, record)
     return 0
 
@@ -286,7 +278,6 @@ def run_simulate(args):
         0.
     """
     from qzs.engine.hexapod.result import HEXAPOD_SUFFIXES
-    from qzs.iotools.paths import check_output_path
     from qzs.workflows.hexapod.setups import simulate_setup
 
     given = [name for name in (*_EXCITATION_OPTIONS, "excitation", "excitation_duration")
@@ -295,9 +286,10 @@ def run_simulate(args):
         raise ParameterError(f"--{given[0].replace('_', '-')} describes the base motion of "
                              "one axis: add --axis (x, y, z, rx, ry or rz).")
     if args.out:
-        check_output_path(args.out, argument="--out", suffixes=HEXAPOD_SUFFIXES)
-    if args.plot:
-        check_output_path(args.plot, argument="--plot", suffixes=(".png", ".svg", ".pdf"))
+        check_output(args, "--out", args.out, suffixes=HEXAPOD_SUFFIXES)
+    plot = figure_path(args)
+    if plot is not None:
+        check_output(args, "--plot", plot, suffixes=(".png", ".svg", ".pdf"))
     setup = _setup(args)
     excitation = None
     if args.axis is not None:
@@ -321,12 +313,12 @@ def run_simulate(args):
     if args.out:
         text += f"\n  wrote            {args.out}"
         record["out"] = args.out
-    if args.plot:
+    if plot is not None:
         import matplotlib.pyplot as plt
 
-        plt.close(result.plot(path=args.plot))
-        text += f"\n  wrote            {args.plot}"
-        record["plot"] = args.plot
+        plt.close(result.plot(path=plot))
+        text += f"\n  wrote            {plot}"
+        record["plot"] = plot
     emit(args, text, record)
     return 0
 
@@ -367,11 +359,10 @@ def run_transmissibility(args):
     """
     from pathlib import Path
 
-    from qzs.iotools.paths import check_output_path
     from qzs.workflows.hexapod.transmissibility import (CHIRP, hexapod_transmissibility,
                                                         transmissibility_record)
 
-    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
+    check_output(args, "--out", args.out, suffixes=None, directory=True)
     setup = _setup(args)
     options = {name: getattr(args, name) for name in ("f0", "f1", "duration")
                if getattr(args, name) is not None}
@@ -385,7 +376,7 @@ def run_transmissibility(args):
     data = folder / "transmissibility.nc"
     import matplotlib.pyplot as plt
 
-    plt.close(result.plot(out=figure, frequency_scale=args.frequency_axis))
+    plt.close(result.plot(path=figure, frequency_scale=args.frequency_axis))
     result.save(data)
     text = result.summary() + f"\n  wrote {figure} and {data}"
     record = {**transmissibility_record(result), "figure": str(figure), "netcdf": str(data)}
@@ -406,10 +397,9 @@ def run_study(args):
     int
         0.
     """
-    from qzs.iotools.paths import check_output_path
     from qzs.workflows.hexapod.study import run_hexapod_study, study_steps
 
-    check_output_path(args.out, argument="--out", suffixes=None, directory=True)
+    check_output(args, "--out", args.out, suffixes=None, directory=True)
     result = run_hexapod_study(args.out, quick=args.quick, dt=args.dt,
                                tolerance_db=args.tolerance, workers=args.workers,
                                progress=not args.quiet and not args.json,

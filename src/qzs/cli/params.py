@@ -1,10 +1,6 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from pathlib import Path
-
-from qzs.cli.common import EPILOG, add_set_option, parameters
-from qzs.errors import OutputPathError
+from qzs.cli.common import EPILOG, add_set_option, check_output, parameters
 from qzs.iotools.config import save_config
-from qzs.iotools.paths import check_output_path
 from qzs.model.registry import format_value, parameter_table
 
 __all__ = ["add_parser", "run"]
@@ -27,10 +23,10 @@ def add_parser(subparsers):
         "params", help="print the default parameters with units",
         description="Print every parameter with its value (the defaults, or --config's, with "
                     "--set applied), unit and description; or write them as a config file.",
-        epilog="--toml never replaces an existing file unless --force is given. " + EPILOG)
+        epilog="--toml never replaces a file without --overwrite. " + EPILOG)
     params.add_argument("--toml", metavar="FILE.toml", help="write them as a config file instead")
-    params.add_argument("--force", action="store_true",
-                        help="let --toml replace an existing file")
+    params.add_argument("--overwrite", "--force", dest="overwrite", action="store_true",
+                        help="let --toml replace an existing file (--force: the old name)")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")
     add_set_option(params)
     return params
@@ -52,15 +48,12 @@ def run(args):
     Raises
     ------
     OutputPathError
-        ``--toml`` names an existing file without ``--force``, or a path that cannot be
+        ``--toml`` names an existing file without ``--overwrite``, or a path that cannot be
         written (checked before anything is written).
     """
     if args.toml:
-        check_output_path(args.toml, argument="--toml", suffixes=(".toml",),
-                          estimated_bytes=64 * 1024)
-        if Path(args.toml).exists() and not getattr(args, "force", False):
-            raise OutputPathError("--toml", args.toml, "exists; pass --force to replace it, "
-                                  "or choose another name")
+        check_output(args, "--toml", args.toml, suffixes=(".toml",),
+                     estimated_bytes=64 * 1024)
     config = parameters(args)
     if args.toml:
         path = save_config(args.toml, config["isolator"], config["controller"])

@@ -5,11 +5,10 @@ It parses and delegates to :func:`qzs.workflows.response.steady_state_response`
 """
 from pathlib import Path
 
-from qzs.cli.common import (add_frequency_axis_option, add_set_option, emit, integer_at_least,
-                             parameters)
+from qzs.cli.common import (add_frequency_axis_option, add_output_options, add_set_option,
+                             check_output, emit, figure_path, integer_at_least, parameters)
 from qzs.defaults import EXCITATION
 from qzs.errors import ParameterError
-from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parser", "run", "parse_frequencies", "DEFAULT_RANGE"]
 
@@ -89,17 +88,14 @@ def add_parser(subparsers):
                              "estimate beside the steady state")
     parser.add_argument("--workers", type=integer_at_least(1), metavar="N",
                         help="processes (default: the sweeps and extra tasks, at most the cores)")
-    parser.add_argument("--out", metavar="FILE",
-                        help="write the response to FILE (.nc, .csv, .json or .mat)")
-    parser.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
-                        help=f"figure (.png, .svg or .pdf; default {DEFAULT_PLOT}; 'none' to skip); "
-                             "its curve is written beside it as .nc, .csv and .mat")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_frequency_axis_option(parser)
-    parser.add_argument("--json", action="store_true",
-                        help="print the points as a JSON list of records (frequency [Hz], "
-                             "transmissibility [-], direction, ...; NaN as null) instead of "
-                             "the table; notes go to stderr")
+    add_output_options(parser, out=dict(metavar="FILE", help="write the response to FILE (.nc, "
+                                                            ".csv, .json or .mat)"),
+                       plot=dict(default=DEFAULT_PLOT, help="figure, its curve written beside "
+                                                            "it as .nc, .csv and .mat"),
+                       json_help="print the points as a JSON list of records (frequency [Hz], "
+                                 "transmissibility [-], direction, ...; NaN as null) instead "
+                                 "of the table; notes go to stderr")
     return parser
 
 
@@ -205,15 +201,15 @@ def run(args):
     amplitude = args.amplitude
     if amplitude is None:
         amplitude = config["excitation"].get("amplitude", EXCITATION["amplitude"])
-    plot = None if args.plot.lower() == "none" else args.plot
+    plot = figure_path(args)
     beside = []  # the curve as data beside its figure: NetCDF, CSV and MATLAB
     if plot is not None:
-        check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+        check_output(args, "--plot", plot, suffixes=PLOT_SUFFIXES)
         beside = [Path(plot).with_suffix(suffix) for suffix in CURVE_SUFFIXES]
         for path in beside:
-            check_output_path(path, argument="--plot", suffixes=RESPONSE_SUFFIXES)
+            check_output(args, "--plot", path, suffixes=RESPONSE_SUFFIXES)
     if args.out:
-        check_output_path(args.out, argument="--out", suffixes=RESPONSE_SUFFIXES)
+        check_output(args, "--out", args.out, suffixes=RESPONSE_SUFFIXES)
     options = {}
     if args.dt is not None:
         options["dt"] = args.dt

@@ -6,10 +6,10 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
-from qzs.cli.common import EPILOG, add_json_option, add_set_option, emit, parameters
+from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
+                             figure_path, parameters)
 from qzs.defaults import ACCURACY, EXCITATION
 from qzs.errors import ParameterError
-from qzs.iotools.paths import check_output_path
 from qzs.iotools.files import RESULT_SUFFIXES
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, Sine, build_excitation
 
@@ -90,14 +90,10 @@ def add_parser(subparsers):
                      help="output rate [Hz] (default 1000)")
     sim.add_argument("--solver", choices=("ode3", "rk4", "euler"),
                      help="integrator (default ode3)")
-    sim.add_argument("--out", metavar="FILE",
-                     help="stream the time series to FILE (.nc, .csv or .mat for MATLAB) "
-                          "while simulating")
-    sim.add_argument("--plot", metavar="FILE", default=DEFAULT_PLOT,
-                     help=f"figure of the run (.png, .svg or .pdf; default {DEFAULT_PLOT}; "
-                          "'none' to skip)")
-    sim.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_json_option(sim)
+    add_output_options(sim, out=dict(metavar="FILE", help="stream the time series to FILE (.nc, "
+                                                         ".csv or .mat for MATLAB) while "
+                                                         "simulating"),
+                       plot=dict(default=DEFAULT_PLOT, help="figure of the run"))
     return sim
 
 
@@ -159,11 +155,11 @@ def run(args):
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
-    plot = None if args.plot.lower() == "none" else args.plot
+    plot = figure_path(args)
     if plot is not None:
-        check_output_path(plot, argument="--plot", suffixes=PLOT_SUFFIXES)
+        check_output(args, "--plot", plot, suffixes=PLOT_SUFFIXES)
     if args.out:
-        check_output_path(args.out, argument="--out", suffixes=RESULT_SUFFIXES)
+        check_output(args, "--out", args.out, suffixes=RESULT_SUFFIXES)
     show = not args.quiet and not args.json
     resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
                        tolerance=args.tolerance, tolerance_state=args.tolerance_state,

@@ -1,9 +1,9 @@
 """``qzs paper`` and ``qzs study``: the paper's studies, their figures, metrics and report."""
 from pathlib import Path
 
-from qzs.cli.common import add_frequency_axis_option, add_json_option, emit
+from qzs.cli.common import (add_frequency_axis_option, add_output_options, check_output, emit,
+                             integer_at_least)
 from qzs.defaults import ACCURACY
-from qzs.errors import ParameterError
 
 __all__ = ["add_parsers", "run"]
 
@@ -34,13 +34,11 @@ def add_parsers(subparsers):
                                "case's transmissibility within DB [dB] (default "
                                f"{ACCURACY['tolerance_db']:g}; `qzs docs model` §7); a study "
                                "file's [simulation] dt is kept")
-        cmd.add_argument("--out", metavar="DIR", default=f"results/{name}",
-                         help=f"output folder (default results/{name})")
-        cmd.add_argument("--workers", type=int, metavar="N",
+        cmd.add_argument("--workers", type=integer_at_least(1), metavar="N",
                          help="worker processes (default: all cores)")
-        cmd.add_argument("--quiet", action="store_true", help="no progress bar")
         add_frequency_axis_option(cmd)
-        add_json_option(cmd)
+        add_output_options(cmd, out=dict(metavar="DIR", default=f"results/{name}",
+                                         help=f"output folder (default results/{name})"))
 
 
 def run(args):
@@ -59,11 +57,11 @@ def run(args):
     from qzs.workflows.paper.report import paper_summary, run_paper
     from qzs.workflows.paper.report_step import step_statement
 
-    if args.workers is not None and args.workers < 1:
-        raise ParameterError(f"--workers must be >= 1, got {args.workers}.")
+    check_output(args, "--out", args.out, suffixes=None, directory=True)
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
-                                        workers=args.workers, progress=not args.quiet,
+                                        workers=args.workers,
+                                        progress=not args.quiet and not args.json,
                                         argument="--out", dt=args.dt,
                                         tolerance_db=args.tolerance,
                                         frequency_scale=args.frequency_axis)

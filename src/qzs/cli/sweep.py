@@ -2,9 +2,9 @@
 store, their figures, and the store as a MATLAB file."""
 from pathlib import Path
 
-from qzs.cli.common import EPILOG, add_execution_options, stopped
-from qzs.errors import ParameterError, Terminated
-from qzs.iotools.paths import check_output_path
+from qzs.cli.common import (EPILOG, add_execution_options, add_output_options, check_output, emit,
+                             stopped)
+from qzs.errors import Terminated
 from qzs.viz.sweeps import FIGURE_BYTES, REDUCTIONS, figure_suffixes
 
 __all__ = ["add_parsers", "run_sweep_command", "run_plot_command", "run_export_command"]
@@ -36,15 +36,14 @@ def add_parsers(subparsers):
                + EPILOG)
     cmd.add_argument("definition", metavar="FILE.toml",
                      help="sweep file, or a shipped sweep name (e.g. pi_vs_stiction)")
-    cmd.add_argument("--out", metavar="STORE.zarr",
-                     help="the Zarr store, a folder whose name ends in .zarr (default "
-                          "NAME.zarr)")
     cmd.add_argument("--resume", action="store_true",
                      help="continue an interrupted sweep in --out (same sweep file)")
-    cmd.add_argument("--overwrite", action="store_true", help="replace an existing store")
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the cases and the work, run nothing")
     add_execution_options(cmd)
+    add_output_options(cmd, out=dict(metavar="STORE.zarr", help="the Zarr store, a folder whose "
+                                                                "name ends in .zarr (default "
+                                                                "NAME.zarr)"))
 
     plot = subparsers.add_parser(
         "sweep-plot", help="figures of a sweep store",
@@ -61,8 +60,9 @@ def add_parsers(subparsers):
                            "default without --y: the band, one per --x level)")
     plot.add_argument("--reduce", choices=REDUCTIONS, default="median",
                       help="combine the cases at one grid point (default median; max = worst)")
-    plot.add_argument("--out", metavar="FILE",
-                      help="figure file, format from its extension (default <sweep>-<...>.png)")
+    add_output_options(plot, out=dict(metavar="FILE", help="figure file, format from its "
+                                                           "extension (default "
+                                                           "<sweep>-<...>.png)"))
 
     export = subparsers.add_parser(
         "sweep-export", help="write a sweep store to a MATLAB file (.mat)",
@@ -72,8 +72,8 @@ def add_parsers(subparsers):
                     "variable exceeds 2 GiB).",
         epilog="The file's name is checked before the store is read. " + EPILOG)
     export.add_argument("store", metavar="STORE.zarr", help="sweep store written by `qzs sweep`")
-    export.add_argument("--out", metavar="FILE.mat",
-                        help="the MATLAB file (default the store's name with .mat)")
+    add_output_options(export, out=dict(metavar="FILE.mat", help="the MATLAB file (default the "
+                                                                 "store's name with .mat)"))
     return cmd
 
 
@@ -98,10 +98,6 @@ def run_sweep_command(args):
 
     definition = load_sweep(args.definition)
     store = Path(args.out) if args.out else Path(f"{definition.name}.zarr")
-    for option in ("workers", "threads"):
-        value = getattr(args, option)
-        if value is not None and value < 1:
-            raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
     if args.dry_run:
         print(plan_text(definition))
         return 0
@@ -110,13 +106,14 @@ def run_sweep_command(args):
     try:
         report = execute(definition, store, resume=args.resume, overwrite=args.overwrite,
                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
-                         progress=not args.quiet)
+                         progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:
         return stopped(stop, f"{stored_count(store)} of {definition.n_cases} cases are stored "
                              f"in {store}. Continue with: qzs sweep {args.definition} --out "
                              f"{store} --resume")
-    print(summary_text(open_sweep(store), report))
-    print(f"  wrote            {store}")
+    emit(args, summary_text(open_sweep(store), report) + f"\n  wrote            {store}",
+         {"sweep": definition.name, "cases": definition.n_cases, "report": report,
+          "files": {"out": str(store)}})
     return 0
 
 
@@ -136,11 +133,11 @@ def run_plot_command(args):
     from qzs.workflows.sweeps import plot_sweep
 
     if args.out is not None:
-        check_output_path(args.out, argument="--out", suffixes=figure_suffixes(),
-                          estimated_bytes=FIGURE_BYTES)
+        check_output(args, "--out", args.out, suffixes=figure_suffixes(),
+                     estimated_bytes=FIGURE_BYTES)
     out = plot_sweep(args.store, metric=args.metric, x=args.x, y=args.y, reduce=args.reduce,
                      out=args.out)
-    print(f"wrote {out}")
+    emit(args, f"wrote {out}", {"files": {"out": str(out)}})
     return 0
 
 
@@ -159,6 +156,8 @@ def run_export_command(args):
     """
     from qzs.workflows.sweeps import export_sweep
 
-    out = export_sweep(args.store, args.out, argument="--out")
-    print(f"wrote {out}")
+    out = Path(args.out) if args.out else Path(args.store).with_suffix(".mat")
+    check_output(args, "--out", out, suffixes=(".mat",))
+    out = export_sweep(args.store, out, argument="--out")
+    emit(args, f"wrote {out}", {"files": {"out": str(out)}})
     return 0

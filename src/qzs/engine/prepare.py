@@ -4,7 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import choice, positive
+from qzs._validation import choice, positive_real
 from qzs.engine import kernels as K
 from qzs.engine.base_motion import base_motion_series
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
@@ -327,13 +327,13 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
     initial_state = InitialState() if initial_state is None else initial_state
     _check_type("initial_state", initial_state, (InitialState,))
     solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
-    dt = positive("dt", dt)
-    sample_rate = positive("sample_rate", sample_rate)
+    dt = positive_real("dt", dt)
+    sample_rate = positive_real("sample_rate", sample_rate)
     if duration is None:
         if excitation.duration is None:
             raise ParameterError("`duration` is required for a sine excitation, got None.")
         duration = excitation.duration
-    duration = positive("duration", duration)
+    duration = positive_real("duration", duration)
     if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
         raise ParameterError(
             f"`duration` ({duration!r} s) exceeds the excitation's length "

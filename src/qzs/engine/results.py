@@ -431,11 +431,23 @@ class SimulationResult:
 
         return summary_text(self)
 
-    def plot(self, **kwargs: Any) -> Figure:
-        """Plot the time series (see :func:`qzs.viz.plot_simulation`)."""
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
+        """Plot the time series (:func:`qzs.viz.simulation.plot_simulation`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there too (format from the suffix).
+        title : str, optional
+            Figure title; default :func:`qzs.analysis.summary.run_title`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from qzs.viz.simulation import plot_simulation
 
-        return plot_simulation(self, **kwargs)
+        return plot_simulation(self, path=path, title=title)
 
     def save(self, path: str | Path) -> Path:
         """Write the run atomically to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).

@@ -199,12 +199,12 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
         duration = excitation.duration
         if duration is None:
             raise ParameterError("`duration` is required for a sine excitation, got None.")
-    duration = _validation.positive("duration", duration)
+    duration = _validation.positive_real("duration", duration)
     if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
         raise ParameterError(
             f"`duration` ({duration!r} s) exceeds the excitation's length "
             f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
-    sample_rate = _validation.positive("sample_rate", sample_rate)
+    sample_rate = _validation.positive_real("sample_rate", sample_rate)
     if not duration * sample_rate <= MAX_SAMPLES:
         raise ParameterError(
             f"`duration` ({duration!r} s) at `sample_rate` {sample_rate:g} Hz asks for "
@@ -214,7 +214,7 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     if dt is None and not given and step == "literal":
         dt = defaults.SIMULATION["dt"]
     if dt is not None:
-        choice = StepChoice.literal(_validation.positive("dt", dt), sample_rate=sample_rate,
+        choice = StepChoice.literal(_validation.positive_real("dt", dt), sample_rate=sample_rate,
                                     solver=solver)
     else:
         if tolerance is not None:

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from qzs._validation import strictly_increasing
+from qzs._validation import integer, non_negative_real, positive_real, strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
@@ -108,15 +108,15 @@ class FrictionFit:
         return dataclasses.replace(isolator or IsolatorParameters(),
                                    **{n: getattr(self, n) for n in FRICTION_PARAMETERS[:4]})
 
-    def plot(self, path: str | Path | None = None, title: str = "") -> "Figure":
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
         """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`).
 
         Parameters
         ----------
         path : str or Path, optional
             Write the figure there (a .png also as .svg).
-        title : str
-            Figure title.
+        title : str, optional
+            Figure title; default none.
 
         Returns
         -------
@@ -124,7 +124,7 @@ class FrictionFit:
         """
         from qzs.viz.identify import plot_friction_fit
 
-        return plot_friction_fit(self, path=path, title=title)
+        return plot_friction_fit(self, path=path, title=title or "")
 
 
 def _smoothed_derivatives(time, displacement, window, polyorder, tolerance):
@@ -235,8 +235,7 @@ def fit_friction(time: ArrayLike, displacement: ArrayLike, force: ArrayLike, *,
     """
     if force_sign not in FORCE_SIGNS:
         raise ParameterError(f"`force_sign` must be one of {FORCE_SIGNS}, got {force_sign!r}.")
-    if not isinstance(polyorder, (int, np.integer)) or polyorder < 2:
-        raise ParameterError(f"`polyorder` must be an integer >= 2, got {polyorder!r}.")
+    polyorder = integer("polyorder", polyorder, 2)
     t, z, f = (finite_samples(n, v) for n, v in (("time", time), ("displacement", displacement),
                                           ("force", force)))
     if not t.size == z.size == f.size:
@@ -244,14 +243,13 @@ def fit_friction(time: ArrayLike, displacement: ArrayLike, force: ArrayLike, *,
                         f"{t.size}, {z.size} and {f.size}.")
     if t.size < 20:
         raise DataError(f"a friction fit needs at least 20 samples, got {t.size}.")
-    threshold = float(exclude_below_velocity)
-    if not threshold >= 0:
-        raise ParameterError(f"`exclude_below_velocity` must be >= 0 [m/s], got {threshold!r}.")
+    threshold = non_negative_real("exclude_below_velocity", exclude_below_velocity,
+                                  fix="a velocity in m/s")
     student_quantile(confidence, 1)  # validates `confidence` before the work
-    if not float(smoothing_window) > 0:
-        raise ParameterError(f"`smoothing_window` must be positive [s], got {smoothing_window!r}.")
-    if mass is not None and not float(mass) > 0:
-        raise ParameterError(f"`mass` must be positive [kg] or None, got {mass!r}.")
+    smoothing_window = positive_real("smoothing_window", smoothing_window,
+                                     fix="a window in s, e.g. 0.02")
+    if mass is not None:
+        mass = positive_real("mass", mass, fix="in kg, or None to leave out the inertia")
     velocity, acceleration, window = _smoothed_derivatives(t, z, float(smoothing_window),
                                                            int(polyorder), tolerance)
     a_s, b_s = _spring_pair(spring)

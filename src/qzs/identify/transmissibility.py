@@ -72,7 +72,7 @@ class TransmissibilityFit:
     n_simulations: int
     elapsed: float
 
-    def plot(self, path: str | Path | None = None, title: str = "",
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> "Figure":
         """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
 
@@ -80,8 +80,8 @@ class TransmissibilityFit:
         ----------
         path : str or Path, optional
             Write the figure there (a .png also as .svg).
-        title : str
-            Figure title.
+        title : str, optional
+            Figure title; default none.
         frequency_scale : {"log", "linear"}, optional
             Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
@@ -91,7 +91,7 @@ class TransmissibilityFit:
         """
         from qzs.viz.identify import plot_transmissibility_fit
 
-        return plot_transmissibility_fit(self, path=path, title=title,
+        return plot_transmissibility_fit(self, path=path, title=title or "",
                                          frequency_scale=frequency_scale)
 
 

@@ -19,7 +19,8 @@ from qzs.errors import OutputPathError
 __all__ = ["check_output_path", "format_bytes"]
 
 
-def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False):
+def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False,
+                      overwrite=True):
     """Check that ``path`` can be written, before the work that produces it starts.
 
     Parameters
@@ -37,6 +38,11 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
         less free space.
     directory : bool
         ``path`` is a folder to write files into (it may exist, as a directory).
+    overwrite : bool
+        May an existing output be replaced? If False, an existing file, or a folder holding
+        anything, is an error naming the path and the flag (``--overwrite`` for an option,
+        ``overwrite=True`` in the API): the command line's policy (``qzs docs
+        command-line``); the API's writers replace, atomically.
 
     Returns
     -------
@@ -48,8 +54,8 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
     OutputPathError
         (a :class:`~qzs.errors.ParameterError`; attributes ``argument``, ``value`` and
         ``reason``) for an unknown extension, a directory where a file must go (or the
-        reverse), a parent that is a file, a folder that is not writable, or too little
-        free space.
+        reverse), a parent that is a file, a folder that is not writable, too little
+        free space, or (without ``overwrite``) an output that exists.
     """
     path = Path(path)
     value = str(path)
@@ -88,6 +94,10 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
             fail(f"needs about {format_bytes(estimated_bytes)} but only {format_bytes(free)} "
                  f"are free on the file system of {str(target)!r}; free some space or "
                  "choose another folder")
+    if not overwrite and path.exists() and (not directory or any(path.iterdir())):
+        flag = "--overwrite" if argument.startswith("--") else "overwrite=True"
+        what, them = ("exists and holds files", "them") if directory else ("exists", "it")
+        fail(f"{what}; pass {flag} to replace {them}, or choose another name")
     return path
 
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from qzs._validation import as_float, non_negative, parameter, validate_fields
+from qzs._validation import non_negative_real, parameter, real, validate_fields
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
 
 __all__ = ["ControllerParameters", "closed_loop_natural_frequency"]
@@ -55,12 +55,12 @@ class ControllerParameters:
 
     def __post_init__(self):
         validate_fields(self, {
-            "position_setpoint": as_float,
-            "pi_kp": non_negative,
-            "pi_ki": non_negative,
-            "damping_gain": non_negative,
-            "velocity_highpass": non_negative,
-            "controller_rate": non_negative,
+            "position_setpoint": real,
+            "pi_kp": non_negative_real,
+            "pi_ki": non_negative_real,
+            "damping_gain": non_negative_real,
+            "velocity_highpass": non_negative_real,
+            "controller_rate": non_negative_real,
         })
 
     def to_dict(self) -> dict[str, Any]:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import (as_float, choice, non_negative, parameter, positive,
+from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
                              strictly_increasing, validate_fields)
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
@@ -54,7 +54,7 @@ def _pack(kind, amplitude=0.0, f0=0.0, f1=0.0, duration=0.0, phase=0.0, spacing=
 
 
 def _fade_rule(name, value):
-    return _excitation_rule(non_negative)(name, value)
+    return _excitation_rule(non_negative_real)(name, value)
 
 
 def _resolve_fade(excitation):
@@ -106,10 +106,10 @@ class Chirp:
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": _excitation_rule(non_negative),
-            "f0": _excitation_rule(non_negative),
-            "f1": _excitation_rule(non_negative),
-            "duration": _excitation_rule(positive),
+            "amplitude": _excitation_rule(non_negative_real),
+            "f0": _excitation_rule(non_negative_real),
+            "f1": _excitation_rule(non_negative_real),
+            "duration": _excitation_rule(positive_real),
             "method": lambda n, v: choice(n, v, ("linear", "logarithmic"),
                                           lambda message: ExcitationError(message, (n,))),
         })
@@ -181,9 +181,9 @@ class Sine:
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": _excitation_rule(non_negative),
-            "frequency": _excitation_rule(non_negative),
-            "phase": _excitation_rule(as_float),
+            "amplitude": _excitation_rule(non_negative_real),
+            "frequency": _excitation_rule(non_negative_real),
+            "phase": _excitation_rule(real),
         })
         _resolve_fade(self)
 
@@ -252,10 +252,10 @@ class RandomExcitation(_Tabulated):
 
     def __post_init__(self):
         validate_fields(self, {
-            "amplitude": _excitation_rule(non_negative),
-            "f_low": _excitation_rule(non_negative),
-            "f_high": _excitation_rule(positive),
-            "duration": _excitation_rule(positive),
+            "amplitude": _excitation_rule(non_negative_real),
+            "f_low": _excitation_rule(non_negative_real),
+            "f_high": _excitation_rule(positive_real),
+            "duration": _excitation_rule(positive_real),
         })
         if self.f_low >= self.f_high:
             raise ExcitationError(

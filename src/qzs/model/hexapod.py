@@ -25,7 +25,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from qzs._validation import as_float, integer, non_negative, parameter, positive, validate_fields
+from qzs._validation import (integer, non_negative_real, parameter, positive_real, real,
+                             validate_fields)
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
 
@@ -79,7 +80,7 @@ def _per_leg(name, value):
     """A float or six floats as a (6,) array."""
     array = np.array(value, dtype=float) if np.ndim(value) else None
     if array is None:
-        return np.full(LEG_COUNT, as_float(name, value))
+        return np.full(LEG_COUNT, real(name, value))
     return _vector_array(name, value, (LEG_COUNT,), "give one number or one per leg")
 
 
@@ -209,7 +210,7 @@ class HexapodGeometry(_ArrayFields):
             object.__setattr__(self, name, _read_only(_vector_array(
                 name, getattr(self, name), shape,
                 "one row (x, y, z) per leg" if shape[0] == LEG_COUNT else "")))
-        validate_fields(self, {"stroke_half": positive})
+        validate_fields(self, {"stroke_half": positive_real})
         vectors = leg_vectors(self)
         lengths = np.linalg.norm(vectors, axis=1)
         scale = max(float(np.max(np.abs(self.base_joints))),
@@ -316,8 +317,8 @@ def cubic_geometry(*, cube_edge, cube_center_height, base_radius=None, top_radiu
     -------
     HexapodGeometry
     """
-    a = positive("cube_edge", cube_edge)
-    height = as_float("cube_center_height", cube_center_height)
+    a = positive_real("cube_edge", cube_edge)
+    height = real("cube_center_height", cube_center_height)
     # cube frame -> base orientation: the diagonal (1, 1, 1) up, lower vertex (1, -1, -1) at 0 deg
     orientation = np.array([[2.0, -1.0, -1.0], [0.0, 1.0, -1.0], [1.0, 1.0, 1.0]])
     orientation /= np.linalg.norm(orientation, axis=1, keepdims=True)
@@ -331,7 +332,7 @@ def cubic_geometry(*, cube_edge, cube_center_height, base_radius=None, top_radiu
     def joints(radius, name, sign, default):
         if radius is None:
             return default
-        r = positive(name, radius)
+        r = positive_real(name, radius)
         closest = a / np.sqrt(2.0)
         if r <= closest:
             raise ParameterError(
@@ -387,9 +388,9 @@ def radial_geometry(*, base_radius, top_radius, base_angle, top_angle, height,
     -------
     HexapodGeometry
     """
-    rb, rt = positive("base_radius", base_radius), positive("top_radius", top_radius)
-    alpha, beta = as_float("base_angle", base_angle), as_float("top_angle", top_angle)
-    h = positive("height", height)
+    rb, rt = positive_real("base_radius", base_radius), positive_real("top_radius", top_radius)
+    alpha, beta = real("base_angle", base_angle), real("top_angle", top_angle)
+    h = positive_real("height", height)
     base, top = [], []
     for leg in range(LEG_COUNT):
         phi = np.deg2rad(120.0) * (leg // 2)
@@ -564,7 +565,7 @@ def forward_kinematics(geometry, lengths, *, guess=None, tolerance=1e-13, max_it
     if np.any(target <= 0):
         raise ParameterError(f"`lengths` must be positive, got {target.tolist()} m.")
     pose = _pose(guess, "guess").copy()
-    tolerance = positive("tolerance", tolerance)
+    tolerance = positive_real("tolerance", tolerance)
     max_iterations = integer("max_iterations", max_iterations, 1)
     residual = inverse_kinematics(geometry, pose) - target
     reason = None
@@ -697,7 +698,7 @@ class PlatformParameters(_ArrayFields):
     gravity: float = parameter(9.81, "m/s^2", "gravitational acceleration g")
 
     def __post_init__(self):
-        validate_fields(self, {"mass": positive, "gravity": non_negative})
+        validate_fields(self, {"mass": positive_real, "gravity": non_negative_real})
         inertia = _vector_array("inertia", self.inertia, (3, 3))
         scale = float(np.max(np.abs(inertia)))
         if not np.allclose(inertia, inertia.T, rtol=0.0, atol=1e-12 * scale):

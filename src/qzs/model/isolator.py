@@ -11,7 +11,8 @@ from typing import Any, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import as_float, choice, non_negative, optional, parameter, positive, validate_fields
+from qzs._validation import (choice, non_negative_real, optional, parameter, positive_real, real,
+                             validate_fields)
 from qzs.errors import ParameterError
 
 __all__ = [
@@ -99,21 +100,21 @@ class IsolatorParameters:
 
     def __post_init__(self):
         validate_fields(self, {
-            "mass": positive,
-            "gravity": non_negative,
-            "spring_force": non_negative,
-            "spring_shape": positive,
-            "stiction_force": non_negative,
-            "coulomb_force": non_negative,
-            "stribeck_decay": non_negative,
-            "viscous_damping": non_negative,
-            "friction_regularisation": non_negative,
-            "stroke_half": positive,
-            "stop_center": optional(as_float),
-            "stop_stiffness": positive,
-            "stop_damping": non_negative,
+            "mass": positive_real,
+            "gravity": non_negative_real,
+            "spring_force": non_negative_real,
+            "spring_shape": positive_real,
+            "stiction_force": non_negative_real,
+            "coulomb_force": non_negative_real,
+            "stribeck_decay": non_negative_real,
+            "viscous_damping": non_negative_real,
+            "friction_regularisation": non_negative_real,
+            "stroke_half": positive_real,
+            "stop_center": optional(real),
+            "stop_stiffness": positive_real,
+            "stop_damping": non_negative_real,
             "stop_model": lambda n, v: choice(n, v, STOP_MODELS),
-            "motor_force_max": non_negative,
+            "motor_force_max": non_negative_real,
         })
         if self.coulomb_force > self.stiction_force:
             raise ParameterError(
@@ -172,9 +173,9 @@ class InitialState:
 
     def __post_init__(self):
         validate_fields(self, {
-            "relative_position": optional(as_float),
-            "relative_velocity": as_float,
-            "pi_integral": optional(as_float),
+            "relative_position": optional(real),
+            "relative_velocity": real,
+            "pi_integral": optional(real),
         })
         if self.locked is not None and not isinstance(self.locked, (bool, np.bool_)):
             raise ParameterError(f"`locked` must be True, False or None, got {self.locked!r}.")

@@ -46,8 +46,8 @@ def test_bad_input_fails_before_any_simulation(monkeypatch, design_options, chan
 
 
 @pytest.mark.parametrize("change, message", [
-    (dict(delay=True), "`delay` must be a number, got True (seconds)."),
-    (dict(dt=0.0), "`dt` must be a finite number > 0, got 0.0 (seconds)."),
+    (dict(delay=True), "`delay` must be a number, got the boolean True; in seconds, e.g. 0.002."),
+    (dict(dt=0.0), "`dt` must be positive, got 0.0; in seconds, e.g. 0.001."),
     (dict(band=(20.0, 1.0)), "`band` must satisfy 0 <= low <= high (finite, in Hz), got "
                              "(20.0, 1.0); e.g. (1, 20)."),
     (dict(mass_range="heavy"), "`mass_range` must be two numbers (low, high) in kg, got "

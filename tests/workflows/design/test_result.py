@@ -4,6 +4,9 @@ import json
 
 import pytest
 
+from qzs.errors import ParameterError
+from qzs.workflows.design.result import write_design
+
 
 def test_to_dict_is_strict_json_and_the_result_is_frozen(design):
     text = json.dumps(design.to_dict(), allow_nan=False)
@@ -13,7 +16,7 @@ def test_to_dict_is_strict_json_and_the_result_is_frozen(design):
 
 
 def test_save_writes_report_json_and_every_figure_atomically(design, tmp_path):
-    written = design.save(tmp_path / "out")
+    written = write_design(design, tmp_path / "out")
     names = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert "report.html" in names and "design.json" in names
     for figure in ("static_design", "pi_search", "hunting", "damping", "margins",
@@ -26,13 +29,28 @@ def test_save_writes_report_json_and_every_figure_atomically(design, tmp_path):
     assert "Why active damping did not help much" in html and "pi_search.png" in html
 
 
+def test_save_returns_the_folder_and_plot_one_named_figure_written_where_asked(design, tmp_path):
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    assert design.save(tmp_path / "out") == tmp_path / "out"
+    figure = design.plot(tmp_path / "margins.png", title="the margins", figure="margins")
+    assert isinstance(figure, Figure) and figure._suptitle.get_text() == "the margins"
+    assert (tmp_path / "margins.png").stat().st_size > 0
+    plt.close(figure)
+    with pytest.raises(ParameterError, match="`figure` must be one of 'static_design'.*"
+                                             "got 'bode'"):
+        design.plot(figure="bode")
+    assert plt.get_fignums() == []  # the figures not returned are closed
+
+
 def test_save_writes_the_damping_curves_the_figure_draws(design, tmp_path):
     """The curves file holds every gain tried; those the figure draws read back exactly."""
     import numpy as np
     import pandas as pd
     import xarray as xr
 
-    written = design.save(tmp_path / "out")
+    written = write_design(design, tmp_path / "out")
     data = xr.load_dataset(written["curves_nc"])
     table = pd.read_csv(written["curves_csv"], comment="#", header=[0, 1])
     assert dict(table.columns)["damping_gain"] == "N*s/m" == data["damping_gain"].attrs["units"]

@@ -142,6 +142,13 @@ BAD = [
      "method", "must be one of"),
     ("an excitation key it does not know", {"excitation": {"frequenz": 3.0}},
      "parameters, excitation, simulation or analysis", "", "frequenz"),
+    # the shared checks of qzs._validation, with the table: text is not a number there either
+    ("a bound given as text", {"variables": {"pi_kp": {"low": "1", "high": 10.0}}},
+     "variables.pi_kp", "low", "must be a number"),
+    ("an infinite bound", {"variables": {"pi_kp": {"low": 1.0, "high": float("inf")}}},
+     "variables.pi_kp", "high", "must be finite"),
+    ("a fractional count of draws", {"robust": {"samples": 2.5}}, "robust", "samples",
+     "must be an integer >= 1"),
 ]
 
 

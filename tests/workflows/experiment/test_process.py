@@ -129,6 +129,11 @@ def test_bad_input():
         process_experiment(noise, fft_length=1024, n_averages=None)
     with pytest.raises(ParameterError, match="must be a qzs.iotools.readers.Recording"):
         process_experiment({"time": [0, 1]})
+    with pytest.raises(ParameterError, match=r"`highpass_corner` must be non-negative, got "
+                                             r"-1.0; in Hz"):
+        process_experiment(recording, highpass_corner=-1.0)
+    with pytest.raises(ParameterError, match="`highpass_corner` must be a number, got '1'"):
+        process_experiment(recording, highpass_corner="1")  # float() took it before
 
 
 def parse(argv):

@@ -92,7 +92,7 @@ def test_simulate_setup_measures_the_step_by_what_the_run_answers(monkeypatch, e
     (dict(dt=1e-3, tolerance_db=0.01), "one of `dt`.*got `dt` and `tolerance_db`"),
     (dict(dt=1e-3, tolerance_state=1e-5), "one of `dt`.*got `dt` and `tolerance_state`"),
     (dict(tolerance_db=0.01, tolerance_state=1e-5), "got `tolerance_db` and `tolerance_state`"),
-    (dict(tolerance_state=-1.0), "`tolerance_state` must be a positive.*-1"),
+    (dict(tolerance_state=-1.0), "`tolerance_state` must be positive, got -1"),
     (dict(tolerance_db=float("inf")), "`tolerance_db`.*inf"),
     (dict(duration=-1.0), "`duration`"),  # the run's own settings, before any probe
 ])

@@ -87,7 +87,7 @@ def test_figures_drawn_in_worker_processes_are_those_drawn_in_process(quick_pape
 @pytest.mark.parametrize("workers", [0, 1.5, True, "2"])
 def test_paper_outputs_refuse_bad_workers_before_writing(quick_paper, tmp_path, workers):
     results, _, _ = quick_paper
-    with pytest.raises(ParameterError, match="`workers` must be a positive integer"):
+    with pytest.raises(ParameterError, match="`workers` must be an integer >= 1"):
         write_paper_outputs(results, tmp_path / "out", workers=workers)
     assert not (tmp_path / "out").exists()
 

@@ -62,6 +62,15 @@ def test_empty_range_is_an_error(spec):
     raises(definition(grid={"pi_kp": spec}), "empty range for 'pi_kp'")
 
 
+def test_a_number_given_as_text_is_refused_as_the_api_and_problem_files_refuse_it():
+    """One check of a real number everywhere (qzs._validation.real): text is not a number."""
+    raises(definition(grid={"pi_kp": {"start": "1", "stop": 2.0, "num": 3}}),
+           "`pi_kp.start` must be a number, got '1'")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"dt": "1e-4"}),
+           "`dt` must be a number, got '1e-4'")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"dt": 0.0}), "`dt` must be positive")
+
+
 def test_malformed_range():
     raises(definition(grid={"pi_kp": {"start": 1.0, "stop": 2.0}}), "one of `num` or `step`")
     raises(definition(grid={"pi_kp": {"start": 0.0, "stop": 2.0, "num": 3, "scale": "log"}}),

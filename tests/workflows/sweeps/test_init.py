@@ -373,8 +373,10 @@ def test_command_runs_prints_and_refuses_reuse(sweep_file, tmp_path, capsys):
     assert "4 of 4 cases stored" in out and "ok 4, invalid 0, failed 0" in out
     with pytest.raises(ParameterError, match="exists"):
         run_sweep_command(parse("sweep", str(sweep_file), "--out", str(store)))
-    with pytest.raises(ParameterError, match="--workers"):
-        run_sweep_command(parse("sweep", str(sweep_file), "--workers", "0"))
+    with pytest.raises(SystemExit) as stop:  # a usage error of the parser (exit 2)
+        parse("sweep", str(sweep_file), "--workers", "0")
+    assert stop.value.code == 2
+    assert "argument --workers: must be an integer >= 1, got 0" in capsys.readouterr().err
 
 
 def test_command_interrupt_exits_130_with_the_resume_hint(sweep_file, tmp_path, capsys,

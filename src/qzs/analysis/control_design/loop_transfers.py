@@ -205,7 +205,7 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
     isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
     rate = real("rate", rate, minimum=0.0, strict=True,
-                 fix="; a sampled loop needs a controller rate in Hz")
+                 fix="a sampled loop needs a controller rate in Hz")
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     period = 1.0 / rate
     plant = discretize_with_delay(*_plant_state_space(m, cv, k, w), period, delay)

@@ -7,7 +7,7 @@ Keller, H. B. (1977). Numerical solution of bifurcation and nonlinear eigenvalue
 """
 import numpy as np
 
-from qzs._validation import integer, positive
+from qzs._validation import integer, positive_real
 from qzs.analysis.harmonic_balance.blas import _single_threaded_blas
 from qzs.analysis.harmonic_balance.curve import _curve
 from qzs.analysis.harmonic_balance.fourier import (DEFAULT_HARMONICS, _basis,
@@ -121,7 +121,7 @@ def _continue(model, low, high, harmonics, time_points, max_points, step):
     omega_scale = 2 * np.pi * high
     scale = _scales(model, 2 * np.pi * high, basis.size)
     span = 1.0 - low / high
-    ds = span / 200 if step is None else positive("step", step)
+    ds = span / 200 if step is None else positive_real("step", step)
     ds_min = span * 1e-7
     frequency_step = span / MAX_POINTS_PER_RANGE  # largest change of omega/omega_top per step
     notes = []

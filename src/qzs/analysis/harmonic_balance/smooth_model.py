@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qzs._validation import non_negative, positive
+from qzs._validation import non_negative_real, positive_real
 from qzs.model.isolator import (friction_force, friction_slope, spring_force,
                                 spring_stiffness)
 from qzs.model.registry import model_inputs
@@ -100,11 +100,11 @@ class SmoothModel:
 
     def __post_init__(self):
         for name in ("mass", "spring_shape", "friction_velocity", "amplitude"):
-            positive(name, getattr(self, name))
+            positive_real(name, getattr(self, name))
         for name in ("gravity", "spring_force", "stiction_force", "coulomb_force",
                      "stribeck_decay", "viscous_damping", "pi_kp", "pi_ki", "damping_gain",
                      "velocity_highpass"):
-            non_negative(name, getattr(self, name))
+            non_negative_real(name, getattr(self, name))
 
     @classmethod
     def from_parameters(cls, isolator=None, controller=None, *, amplitude,

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qzs._validation import positive
+from qzs._validation import positive_real
 from qzs.analysis.harmonic_balance.blas import _single_threaded_blas
 from qzs.analysis.harmonic_balance.fourier import (DEFAULT_HARMONICS, _basis, _check_settings,
                                                    _default_time_points)
@@ -245,7 +245,7 @@ def periodic_response(frequency, model, *, harmonics=DEFAULT_HARMONICS, time_poi
     HarmonicBalanceSolution
         ``converged`` says whether Newton met its tolerance.
     """
-    frequency = positive("frequency", frequency)
+    frequency = positive_real("frequency", frequency)
     if not isinstance(model, SmoothModel):
         raise ParameterError(f"`model` must be a SmoothModel, got {type(model).__name__}.")
     harmonics, time_points = _check_settings(harmonics, time_points)

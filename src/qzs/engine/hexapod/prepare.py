@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import choice, positive
+from qzs._validation import choice, positive_real
 from qzs.engine import driver
 from qzs.engine.hexapod.dynamics import _evaluate, _rest_frame
 from qzs.engine.hexapod.layout import (
@@ -237,14 +237,14 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
                 "`duration` is required when no excitation defines one (a Sine has no length; "
                 "without excitation there is none); pass e.g. duration=10.0 [s].")
         duration = min(lengths)
-    duration = positive("duration", duration)
+    duration = positive_real("duration", duration)
     for axis, value in moving.items():
         if value.duration is not None and duration > value.duration * (1 + 1e-12):
             raise ParameterError(
                 f"`duration` ({duration!r} s) exceeds the length of `excitation[{axis!r}]` "
                 f"({value.duration!r} s); shorten the run or lengthen that excitation.")
-    dt = positive("dt", dt)
-    sample_rate = positive("sample_rate", sample_rate)
+    dt = positive_real("dt", dt)
+    sample_rate = positive_real("sample_rate", sample_rate)
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
     decimation = steps_per_sample(sample_rate, dt, "sample_rate")

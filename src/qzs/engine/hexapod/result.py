@@ -488,13 +488,15 @@ class HexapodResult:
         """
         return save_hexapod_result(self, path)
 
-    def plot(self, **kwargs: Any) -> Figure:
-        """Plot the run (see :func:`qzs.viz.hexapod.plot_hexapod`).
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
+        """Plot the run (:func:`qzs.viz.hexapod.plot_hexapod`).
 
         Parameters
         ----------
-        **kwargs
-            Passed to :func:`qzs.viz.hexapod.plot_hexapod` (``path``, ``title``).
+        path : str or Path, optional
+            Write the figure there too (format from the suffix).
+        title : str, optional
+            Figure title; default one naming the run.
 
         Returns
         -------
@@ -502,4 +504,4 @@ class HexapodResult:
         """
         from qzs.viz.hexapod import plot_hexapod
 
-        return plot_hexapod(self, **kwargs)
+        return plot_hexapod(self, path=path, title=title)

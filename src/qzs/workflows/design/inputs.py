@@ -42,8 +42,8 @@ def _design_settings(isolator, controller, *, excitation, stiction_range, mass_r
     if cost not in COSTS:
         raise ParameterError(f"`cost` must be one of {', '.join(COSTS)}, got {cost!r}.")
     rate = controller.controller_rate if controller_rate is None else real(
-        "controller_rate", controller_rate, minimum=0.0, fix=" (Hz; 0 for continuous)")
-    delay = real("delay", delay, minimum=0.0, fix=" (seconds)")
+        "controller_rate", controller_rate, minimum=0.0, fix="in Hz; 0 for continuous")
+    delay = real("delay", delay, minimum=0.0, fix="in seconds, e.g. 0.002")
     damping_gain_max = real("damping_gain_max", damping_gain_max, minimum=0.0, strict=True)
     gain_margin_min = real("gain_margin_min", gain_margin_min, minimum=0.0)
     phase_margin_min = real("phase_margin_min", phase_margin_min, minimum=0.0)
@@ -162,7 +162,7 @@ def _set_steps(settings, dt):
                 settings.isolator, stiffest, defaults.SIMULATION["solver"]))
         settings.dt, settings.dt_note = choose_dt(settings, settings.controller.pi_kp)
     else:
-        settings.dt = real("dt", dt, minimum=0.0, strict=True, fix=" (seconds)")
+        settings.dt = real("dt", dt, minimum=0.0, strict=True, fix="in seconds, e.g. 0.001")
         settings.dt_note = "given"
     if rate > 0 and not divides(rate, settings.dt):
         raise ParameterError(f"`controller_rate` ({rate:g} Hz) must divide 1/dt "

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
 
     from qzs.analysis.control_design import RouthHurwitz, StaticDesign
 
-__all__ = ["DesignResult"]
+__all__ = ["DesignResult", "write_design"]
 
 
 @dataclass(frozen=True)
@@ -95,23 +95,44 @@ class DesignResult:
         """
         return design_text(self)
 
-    def plot(self, frequency_scale: str | None = None) -> dict[str, Figure]:
-        """Draw every figure of the design.
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             figure: str = "static_design", frequency_scale: str | None = None) -> Figure:
+        """Draw one figure of the design (:func:`qzs.viz.design.plot_design` draws them all;
+        :meth:`save` writes them all).
 
         Parameters
         ----------
+        path : str or Path, optional
+            Write the figure there too (format from the suffix).
+        title : str, optional
+            Figure title; default the figure's own.
+        figure : str
+            Which: ``static_design``, ``pi_search``, ``hunting``, ``damping``, ``margins`` or
+            ``damping_effect`` (``pi_search`` and ``damping`` when that search ran).
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
         Returns
         -------
-        dict of str to matplotlib.figure.Figure
-            Figure name -> figure.
+        matplotlib.figure.Figure
         """
-        from qzs.viz.design import plot_design
+        import matplotlib.pyplot as plt
 
-        return plot_design(self, frequency_scale=frequency_scale)
+        from qzs._validation import choice
+        from qzs.viz.design import plot_design
+        from qzs.viz.figures import save_figure
+
+        figures = plot_design(self, frequency_scale=frequency_scale)
+        for name, other in figures.items():
+            if name != figure:
+                plt.close(other)
+        chosen = figures[choice("figure", figure, tuple(figures))]
+        if title is not None:
+            chosen.suptitle(title)
+        if path is not None:
+            save_figure(chosen, path)
+        return chosen
 
     def curves(self) -> xr.Dataset | None:
         """The damping search's transmissibility curves as a dataset, one case per gain tried.
@@ -146,17 +167,16 @@ class DesignResult:
             attrs.update({"band": np.asarray(band, dtype=float), "band_units": "Hz"})
         return curves_dataset(curves, attrs)
 
-    def save(self, folder: str | Path,
-             frequency_scale: str | None = None) -> dict[str, Path]:
+    def save(self, path: str | Path, *, frequency_scale: str | None = None) -> Path:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
         search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
-        ``folder``.
+        the folder ``path``.
 
         Each file is written atomically (a temporary file renamed onto it).
 
         Parameters
         ----------
-        folder : str or Path
+        path : str or Path
             The output folder, created if missing.
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
@@ -164,34 +184,55 @@ class DesignResult:
 
         Returns
         -------
-        dict of str to Path
-            ``report``, ``json``, one entry per figure (its PNG) and ``curves_nc``,
-            ``curves_csv`` (when the damping search simulated).
+        Path
+            The folder (:func:`write_design` says which file is which).
         """
-        import matplotlib.pyplot as plt
+        return write_design(self, path, frequency_scale=frequency_scale)["report"].parent
 
-        from qzs.iotools.paths import check_output_path
-        from qzs.viz.design import plot_design
-        from qzs.viz.figures import save_figure
 
-        folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = {}
-        for name, figure in plot_design(self, frequency_scale=frequency_scale).items():
-            path = folder / f"{name}.png"
-            save_figure(figure, path, also_svg=True)
-            plt.close(figure)
-            written[name] = path
-        curves = self.curves()
-        if curves is not None:
-            for path in write_curves(curves, folder, "damping"):
-                written[f"curves_{path.suffix.lstrip('.')}"] = path
-        record = self.to_dict()
-        with atomic_path(folder / "design.json") as tmp:
-            tmp.write_text(json_text(record), encoding="utf-8")
-        written["json"] = folder / "design.json"
-        with atomic_path(folder / "report.html") as tmp:
-            tmp.write_text(_html(self, record, written), encoding="utf-8")
-        written["report"] = folder / "report.html"
-        return written
+def write_design(result: DesignResult, folder: str | Path, *,
+                 frequency_scale: str | None = None) -> dict[str, Path]:
+    """Write what :meth:`DesignResult.save` writes; return each file by its role.
 
+    Parameters
+    ----------
+    result : DesignResult
+        The design.
+    folder : str or Path
+        The output folder, created if missing.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the transmissibility figure; default
+        ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+    Returns
+    -------
+    dict of str to Path
+        ``report``, ``json``, one entry per figure (its PNG) and ``curves_nc``,
+        ``curves_csv`` (when the damping search simulated).
+    """
+    import matplotlib.pyplot as plt
+
+    from qzs.iotools.paths import check_output_path
+    from qzs.viz.design import plot_design
+    from qzs.viz.figures import save_figure
+
+    folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = {}
+    for name, figure in plot_design(result, frequency_scale=frequency_scale).items():
+        path = folder / f"{name}.png"
+        save_figure(figure, path, also_svg=True)
+        plt.close(figure)
+        written[name] = path
+    curves = result.curves()
+    if curves is not None:
+        for path in write_curves(curves, folder, "damping"):
+            written[f"curves_{path.suffix.lstrip('.')}"] = path
+    record = result.to_dict()
+    with atomic_path(folder / "design.json") as tmp:
+        tmp.write_text(json_text(record), encoding="utf-8")
+    written["json"] = folder / "design.json"
+    with atomic_path(folder / "report.html") as tmp:
+        tmp.write_text(_html(result, record, written), encoding="utf-8")
+    written["report"] = folder / "report.html"
+    return written

@@ -61,7 +61,7 @@ from typing import Any
 
 import numpy as np
 
-from qzs._validation import read_toml
+from qzs._validation import Structured, integer, read_toml, real
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.registry import PARAMETERS
@@ -424,10 +424,13 @@ def _parameter_name(table, name, kind):
     return PARAMETERS[name].unit if name in PARAMETERS else "-"
 
 
+def _in(table):
+    """The checks' ``error`` for a key of ``table``: a :class:`ProblemError` naming both."""
+    return Structured(build=lambda key, value, reason: ProblemError(table, key, value, reason))
+
+
 def _number(table, key, value):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        _fail(table, key, value, "must be a finite number")
-    return float(value)
+    return real(key, value, error=_in(table))
 
 
 def _variables(document, kind):
@@ -529,9 +532,8 @@ def _goal(table, index, spec, constraint, analysis):
     if statistic == "quantile":
         if "quantile" not in spec:
             _fail(where, "quantile", None, "statistic \"quantile\" needs `quantile` in (0, 1)")
-        quantile = _number(where, "quantile", spec["quantile"])
-        if not 0 < quantile < 1:
-            _fail(where, "quantile", quantile, "must lie strictly between 0 and 1")
+        quantile = real("quantile", spec["quantile"], _in(where), minimum=0.0, maximum=1.0,
+                        strict=True)
     elif "quantile" in spec:
         _fail(where, "quantile", spec["quantile"], "applies to statistic = \"quantile\" only")
     bound = None
@@ -564,8 +566,7 @@ def _settings(document, name, defaults):
 
 
 def _positive_int(table, key, value, limit=None):
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        _fail(table, key, value, "must be a whole number >= 1")
+    integer(key, value, 1, _in(table))
     if limit is not None and value > limit:
         raise CountLimitError(f"[{table}] {key}", value, limit, "draws" if key == "samples"
                               else key, "use fewer")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -369,15 +369,18 @@ class OptimizationResult:
             Path(tmp).write_text(text, encoding="utf-8")
         return Path(path)
 
-    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Figure:
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             ax: Axes | None = None) -> Figure:
         """The Pareto figure (:func:`qzs.viz.design_space.plot_pareto`).
 
         Parameters
         ----------
+        path : str or Path, optional
+            Write the figure there too (format from the suffix).
+        title : str, optional
+            Figure title; default the problem's.
         ax : matplotlib.axes.Axes, optional
             Draw into this axes (two objectives only).
-        **kwargs
-            ``path`` and ``title``, as :func:`~qzs.viz.design_space.plot_pareto` takes them.
 
         Returns
         -------
@@ -385,7 +388,7 @@ class OptimizationResult:
         """
         from qzs.viz.design_space import plot_pareto
 
-        return plot_pareto(self, ax=ax, **kwargs)
+        return plot_pareto(self, ax=ax, path=path, title=title)
 
     # ------------------------------------------------------------ text
     def summary(self) -> str:

@@ -35,7 +35,7 @@ from qzs.analysis.spectral import (band_mask, highpass, required_samples, transm
 from qzs.defaults import ANALYSIS
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
-from qzs._validation import integer
+from qzs._validation import integer, non_negative_real
 from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
@@ -211,7 +211,7 @@ class ExperimentResult:
             return float("nan")
         return float(np.median(np.abs(decibels(measured[trusted] / simulated[trusted]))))
 
-    def plot(self, path: str | Path | None = None, title: str | None = None,
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> Figure:
         """The two curves and the coherence (:func:`qzs.viz.experiment.plot_experiment`).
 
@@ -470,9 +470,7 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
     if not isinstance(recording, Recording):
         raise ParameterError(f"`recording` must be a qzs.iotools.readers.Recording, got "
                              f"{type(recording).__name__}; read the log with read_recording.")
-    corner = float(highpass_corner or 0.0)
-    if corner < 0:
-        raise ParameterError(f"`highpass_corner` must be >= 0 [Hz], got {highpass_corner!r}.")
+    corner = non_negative_real("highpass_corner", highpass_corner or 0.0, fix="in Hz")
     fft_length = _welch_setting("fft_length", fft_length, MIN_FFT_LENGTH)
     if n_averages is not None:
         n_averages = _welch_setting("n_averages", n_averages, 1)

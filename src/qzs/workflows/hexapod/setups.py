@@ -218,7 +218,7 @@ def _numbers(table, section, where):
     for key, unit in _SCALAR_UNITS.items():
         if key in checked:
             checked[key] = real(f"[{section}] {key}", checked[key],
-                                fix=f"; give a number in {unit}, e.g. {key} = "
+                                fix=f"give a number in {unit}, e.g. {key} = "
                                     f"{_EXAMPLES.get(key, 0.1)}",
                                 error=lambda message: ParameterError(where + message))
     return checked

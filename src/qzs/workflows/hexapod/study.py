@@ -124,13 +124,16 @@ class HexapodStudyResult:
         """
         return _summary_text(self)
 
-    def plot(self, out: str | Path | None = None, frequency_scale: str | None = None) -> "Figure":
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
         """The comparison figure of the cases (:func:`comparison_figure`).
 
         Parameters
         ----------
-        out : str or Path, optional
+        path : str or Path, optional
             Write the figure there.
+        title : str, optional
+            Figure title; default one naming the platform, the chirps and the line styles.
         frequency_scale : {"log", "linear"}, optional
             Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
 
@@ -138,7 +141,8 @@ class HexapodStudyResult:
         -------
         matplotlib.figure.Figure
         """
-        return comparison_figure(self.cases, out=out, frequency_scale=frequency_scale)
+        return comparison_figure(self.cases, out=path, frequency_scale=frequency_scale,
+                                 title=title)
 
 
 # ---------------------------------------------------------------- metrics
@@ -457,7 +461,7 @@ def _slug(label):
     return label.lower().replace(" ", "_")
 
 
-def comparison_figure(cases, out=None, frequency_scale=None):
+def comparison_figure(cases, out=None, frequency_scale=None, title=None):
     """The study's comparison figure: the direct and coupled entries of every case.
 
     Parameters
@@ -470,6 +474,8 @@ def comparison_figure(cases, out=None, frequency_scale=None):
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
         (log).
+    title : str, optional
+        Figure title; default one naming the platform, the chirps and the line styles.
 
     Returns
     -------
@@ -499,7 +505,7 @@ def comparison_figure(cases, out=None, frequency_scale=None):
         list(cases.items()), entries=entries, coherence_min=settings["coherence_min"],
         frequency_range=(max(0.1, float(first.frequency[1])), settings["f1"]),
         untrusted_below=settings["trusted_from"],
-        title=(f"Six paper legs, cubic platform {first.setup.platform.mass:.4g} kg: "
+        title=title or (f"Six paper legs, cubic platform {first.setup.platform.mass:.4g} kg: "
                f"chirps of {first.amplitude['z'] * 1e3:g} mm in z and x, "
                f"{settings['duration']:g} s each\n"
                "solid: trusted bins; faint: untrusted; dashed: linear model (stable loops "
@@ -542,7 +548,7 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
     files = {}
     for label, result in cases.items():
         name = f"hexapod_matrix_{_slug(label)}"
-        figure = result.plot(out=folder / f"{name}.png", frequency_scale=frequency_scale)
+        figure = result.plot(path=folder / f"{name}.png", frequency_scale=frequency_scale)
         plt.close(figure)
         files[f"{name}.png"] = folder / f"{name}.png"
         files[f"{name}.nc"] = result.save(folder / f"{name}.nc")

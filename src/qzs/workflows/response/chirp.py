@@ -2,7 +2,7 @@
 (docs/response.md §7), set beside the steady state by ``compare_chirp``.
 """
 from qzs import defaults
-from qzs._validation import positive
+from qzs._validation import positive_real
 from qzs.model.excitation import Chirp
 
 __all__ = ["chirp_transmissibility", "PAPER_SWEEP_RATE"]
@@ -51,7 +51,7 @@ def chirp_transmissibility(amplitude=defaults.EXCITATION["amplitude"], isolator=
     from qzs.analysis.spectral import transmissibility
     from qzs.engine.simulate import simulate
 
-    top = max(20.0, positive("top", top))
+    top = max(20.0, positive_real("top", top))
     rate = defaults.ANALYSIS["sample_rate"]
     chirp = Chirp(amplitude=amplitude, f0=0.0, f1=top, duration=top / PAPER_SWEEP_RATE)
     result = simulate(chirp, isolator, controller, dt=dt, sample_rate=rate, solver=solver)

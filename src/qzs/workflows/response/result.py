@@ -390,7 +390,7 @@ class SteadyStateResponse:
         """
         return response_dataset(self)
 
-    def plot(self, path: str | Path | None = None, title: str | None = None,
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> Figure:
         """The figure (:func:`qzs.viz.response.plot_response`).
 

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from qzs import defaults
-from qzs._validation import choice, integer, positive, worker_count
+from qzs._validation import choice, integer, positive_real, worker_count
 from qzs.errors import CountLimitError, ParameterError
 from qzs.model.excitation import Chirp
 from qzs.workflows.response.chirp import _run_chirp
@@ -278,7 +278,7 @@ def steady_state_response(frequencies: ArrayLike,
     from qzs.analysis.linear import linearize
     from qzs.engine.prepare import run_inputs
 
-    amplitude = positive("amplitude", amplitude)
+    amplitude = positive_real("amplitude", amplitude)
     _, isolator, controller = run_inputs(None, isolator, controller)
     direction = choice("direction", direction, DIRECTIONS)
     from qzs.engine.stability import SOLVERS
@@ -288,16 +288,16 @@ def steady_state_response(frequencies: ArrayLike,
         raise ParameterError("give `dt` (a fixed largest step) or `tolerance_db` (the step "
                              "chosen for an accuracy), not both.")
     if tolerance_db is not None:
-        tolerance_db = positive("tolerance_db", tolerance_db)
+        tolerance_db = positive_real("tolerance_db", tolerance_db)
     if dt is not None:
-        dt = positive("dt", dt)
-    periodic_tolerance = positive("periodic_tolerance", periodic_tolerance)
+        dt = positive_real("dt", dt)
+    periodic_tolerance = positive_real("periodic_tolerance", periodic_tolerance)
     if periodic_tolerance >= 0.1:
         raise ParameterError(f"`periodic_tolerance` must be below 0.1, got "
                              f"{periodic_tolerance!r}; 1e-6 is the default.")
     max_periods = integer("max_periods", max_periods, CONSECUTIVE_PERIODS + MAX_PERIOD_MULTIPLE + 1)
     if max_time is not None:
-        max_time = positive("max_time", max_time)
+        max_time = positive_real("max_time", max_time)
     fade_in = float(fade_in)
     if not math.isfinite(fade_in) or fade_in < 0:
         raise ParameterError(f"`fade_in` must be a non-negative number of seconds, got "
@@ -306,7 +306,7 @@ def steady_state_response(frequencies: ArrayLike,
     if harmonics > SAMPLES_PER_PERIOD // 4:
         raise ParameterError(f"`harmonics` must be at most {SAMPLES_PER_PERIOD // 4} (the "
                              f"{SAMPLES_PER_PERIOD} samples per period), got {harmonics}.")
-    friction_velocity = hb.FRICTION_VELOCITY if friction_velocity is None else positive(
+    friction_velocity = hb.FRICTION_VELOCITY if friction_velocity is None else positive_real(
         "friction_velocity", friction_velocity)
     balance_harmonics = hb.DEFAULT_HARMONICS if balance_harmonics is None else integer(
         "balance_harmonics", balance_harmonics, 1)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 import numpy as np
 
-from qzs._validation import finite_real, integer, known_keys, read_toml
+from qzs._validation import integer, known_keys, positive_real, read_toml, real
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
@@ -285,11 +285,10 @@ def _definition(document, where, stem):
         raise ParameterError("give either `dt` (a fixed step [s]) or `tolerance_db` (the "
                              "accuracy the step is chosen for [dB]) in [simulation], not both.")
     if "dt" in given:
-        simulation["dt"] = finite_real("dt", simulation["dt"], positive=True)
+        simulation["dt"] = positive_real("dt", simulation["dt"])
         simulation["tolerance_db"] = None
     else:
-        simulation["tolerance_db"] = finite_real("tolerance_db", simulation["tolerance_db"],
-                                                 positive=True)
+        simulation["tolerance_db"] = positive_real("tolerance_db", simulation["tolerance_db"])
     analysis = _analysis(document.get("analysis", {}), simulation["dt"])
     top = excitation.get("f1")
     if (kind != "sine" and "band" not in document.get("analysis", {})
@@ -341,8 +340,8 @@ def _grid_values(name, spec):
     if "start" not in spec or "stop" not in spec or ("num" in spec) == ("step" in spec):
         raise ParameterError(f"range {name!r} needs `start`, `stop` and one of `num` or "
                              f"`step`, got {spec!r}.")
-    start = finite_real(f"{name}.start", spec["start"])
-    stop = finite_real(f"{name}.stop", spec["stop"])
+    start = real(f"{name}.start", spec["start"])
+    stop = real(f"{name}.stop", spec["stop"])
     scale = spec.get("scale", "linear")
     if scale not in ("linear", "log"):
         raise ParameterError(f"`{name}.scale` must be 'linear' or 'log', got {scale!r}.")
@@ -359,7 +358,7 @@ def _grid_values(name, spec):
                                      f"`stop` > 0, got {start!r} and {stop!r}.")
             return tuple(float(v) for v in np.geomspace(start, stop, int(num)))
         return tuple(float(v) for v in np.linspace(start, stop, int(num)))
-    step = finite_real(f"{name}.step", spec["step"], positive=True)
+    step = positive_real(f"{name}.step", spec["step"])
     if scale == "log":
         raise ParameterError(f"range {name!r}: `step` is for linear ranges; use `num` with "
                              "scale = 'log'.")
@@ -417,7 +416,7 @@ def parse_distribution(name, spec):
         wrong = "; ".join(part for part in (f"missing {missing}" if missing else "",
                                             f"unknown {extra}" if extra else "") if part)
         raise ParameterError(f"distribution {kind!r} of {name!r} takes keys {takes}; {wrong}.")
-    values = {k: finite_real(f"{name}.{k}", v) for k, v in keys.items()}
+    values = {k: real(f"{name}.{k}", v) for k, v in keys.items()}
     for key in ("std", "sigma", "median"):
         if key in values and values[key] <= 0:
             raise ParameterError(f"`{name}.{key}` must be positive, got {values[key]!r}.")
@@ -435,16 +434,15 @@ def _analysis(table, dt):
     analysis = {**_analysis_defaults(), **given}
     if "duration" in given and "n_averages" in given:
         raise ParameterError("give either `n_averages` or `duration` in [analysis], not both.")
-    rate = analysis["sample_rate"] = finite_real("sample_rate", analysis["sample_rate"],
-                                                 positive=True)
+    rate = analysis["sample_rate"] = positive_real("sample_rate", analysis["sample_rate"])
     ratio = 1.0 / (rate * dt) if dt is not None else 1.0  # a chosen step divides it
     if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
         raise ParameterError(f"`sample_rate` ({rate!r} Hz) must divide the integration rate "
                              f"1/dt = {1 / dt:g} Hz into a whole number of steps.")
     fft_length = analysis["fft_length"] = integer("fft_length", analysis["fft_length"], 8)
-    overlap = analysis["overlap"] = finite_real("overlap", analysis["overlap"])
+    overlap = analysis["overlap"] = real("overlap", analysis["overlap"])
     if "duration" in given:
-        analysis["duration"] = finite_real("duration", given["duration"], positive=True)
+        analysis["duration"] = positive_real("duration", given["duration"])
         samples = int(analysis["duration"] * rate)
         analysis["n_averages"] = welch_average_count(samples, fft_length, overlap)
         if analysis["n_averages"] < 1:
@@ -456,7 +454,7 @@ def _analysis(table, dt):
                                                  overlap)
     band = analysis["band"]
     if (not isinstance(band, list) or len(band) != 2
-            or not 0 <= finite_real("band", band[0]) < finite_real("band", band[1])):
+            or not 0 <= real("band", band[0]) < real("band", band[1])):
         raise ParameterError(f"`band` must be [low, high] with 0 <= low < high [Hz], got "
                              f"{band!r}.")
     analysis["band"] = [float(band[0]), float(min(band[1], rate / 2))]
@@ -464,7 +462,7 @@ def _analysis(table, dt):
     if not isinstance(spots, list):
         raise ParameterError(f"`at_frequencies` must be a list of frequencies [Hz], got "
                              f"{spots!r}.")
-    analysis["at_frequencies"] = [finite_real("at_frequencies", f, positive=True) for f in spots]
+    analysis["at_frequencies"] = [positive_real("at_frequencies", f) for f in spots]
     return analysis
 
 
@@ -499,8 +497,8 @@ def _outputs(table, analysis):
                 raise ParameterError(f"band name {label!r} must be a plain identifier "
                                      "(letters, digits, underscore).")
             if (not isinstance(edges, list) or len(edges) != 2
-                    or not 0 <= finite_real(f"{key}.{label}", edges[0])
-                    < finite_real(f"{key}.{label}", edges[1])):
+                    or not 0 <= real(f"{key}.{label}", edges[0])
+                    < real(f"{key}.{label}", edges[1])):
                 raise ParameterError(f"band {label!r} must be [low, high] with 0 <= low < "
                                      f"high [Hz], got {edges!r}.")
             if not np.any((f > 0) & (f >= edges[0]) & (f <= edges[1])):

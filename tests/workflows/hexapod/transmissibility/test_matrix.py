@@ -265,7 +265,8 @@ def test_the_command_writes_the_grid_and_the_matrix(tmp_path, capsys):
     assert record["source"].endswith("paper_legs_cubic.toml")
     assert main(["hexapod", "transmissibility", "--dt", "1e-3", "--tolerance", "0.01",
                  "--out", str(out)]) == 2  # a literal step or a tolerance, not both
-    assert main(["hexapod", "transmissibility", "--axes", "z,q", "--out", str(out)]) == 2
+    assert main(["hexapod", "transmissibility", "--axes", "z,q", "--out", str(out),
+                 "--overwrite"]) == 2
     assert "`axes`" in capsys.readouterr().err
     assert main(["hexapod", "transmissibility", "--amplitude", "z=big", "--out",
                  str(out)]) == 2

@@ -1,11 +1,10 @@
 """Validation and the plan of the runs: axes, amplitudes, step, segments, trusted band."""
-import math
 from types import MappingProxyType
 
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import as_float, choice, integer, positive
+from qzs._validation import choice, integer, positive_real, real
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
 from qzs.workflows.hexapod.transmissibility.settings import (AMPLITUDE, ESTIMATORS,
@@ -54,7 +53,7 @@ def _amplitudes(amplitude, axes):
         given = dict.fromkeys(axes, amplitude)
     for axis, value in given.items():
         unit = AXIS_UNITS[AXES.index(axis)]
-        number = as_float(f"amplitude[{axis!r}]", value)
+        number = real(f"amplitude[{axis!r}]", value)
         if not number > 0:
             raise ParameterError(f"`amplitude[{axis!r}]` must be a positive amplitude [{unit}], "
                                  f"got {value!r}.")
@@ -69,15 +68,12 @@ def _tolerance_db(tolerance_db, dt):
     if dt is not None:
         raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or `tolerance_db` "
                              f"({tolerance_db!r} dB, the step chosen to meet it), not both.")
-    value = as_float("tolerance_db", tolerance_db)
-    if not (math.isfinite(value) and value > 0):
-        raise ParameterError(f"`tolerance_db` must be a positive, finite tolerance on the "
-                             f"transmissibility [dB] (e.g. 0.01), got {tolerance_db!r}.")
-    return value
+    return positive_real("tolerance_db", tolerance_db,
+                         fix="a tolerance on the transmissibility in dB, e.g. 0.01")
 
 
 def _optional_positive(name, value):
-    return None if value is None else positive(name, value)
+    return None if value is None else positive_real(name, value)
 
 
 def _stable(setup, controller, solver):
@@ -134,13 +130,13 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                              f"load_hexapod or hexapod_setup), got {type(setup).__name__}.")
     axes = _axes(axes)
     amplitudes = _amplitudes(amplitude, axes)
-    f0 = as_float("f0", f0)
-    f1 = as_float("f1", f1)
+    f0 = real("f0", f0)
+    f1 = real("f1", f1)
     if not 0 <= f0 < f1:
         raise ParameterError(f"the chirp must rise: 0 <= `f0` < `f1` [Hz], got f0={f0!r}, "
                              f"f1={f1!r}.")
-    duration = positive("duration", duration)
-    sample_rate = positive("sample_rate", sample_rate if sample_rate is not None else
+    duration = positive_real("duration", duration)
+    sample_rate = positive_real("sample_rate", sample_rate if sample_rate is not None else
                            setup.simulation.get("sample_rate",
                                                 defaults.SIMULATION["sample_rate"]))
     if f1 >= 0.5 * sample_rate:
@@ -149,7 +145,7 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
     solver = choice("solver", solver if solver is not None else
                     setup.simulation.get("solver", defaults.SIMULATION["solver"]),
                     ("ode3", "rk4", "euler"))
-    setup_dt = positive("the set-up's [simulation] dt",
+    setup_dt = positive_real("the set-up's [simulation] dt",
                         setup.simulation.get("dt", defaults.SIMULATION["dt"]))
     dt = _optional_positive("dt", dt)
     tolerance_db = _tolerance_db(tolerance_db, dt)
@@ -170,7 +166,7 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                              f"{n_samples} samples ({duration:g} s at {sample_rate:g} Hz); "
                              "lower it or lengthen `duration`.")
     estimator = choice("estimator", estimator, ESTIMATORS)
-    floor_db = as_float("floor_db", floor_db)
+    floor_db = real("floor_db", floor_db)
     if not floor_db < 0:
         raise ParameterError(f"`floor_db` must be negative (a level below the base motion) "
                              f"[dB], got {floor_db!r}.")

@@ -126,14 +126,14 @@ class HexapodTransmissibility:
         """
         return transmissibility_dataset(self)
 
-    def plot(self, out: str | Path | None = None, *, title: str | None = None,
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> Figure:
         """The 6x6 grid with the linear model dashed (:func:`qzs.viz.hexapod_matrix.
         plot_transmissibility_matrix`); columns not excited are left empty.
 
         Parameters
         ----------
-        out : str or Path, optional
+        path : str or Path, optional
             Write the figure there (atomically; format from the suffix).
         title : str, optional
             Figure title; default one naming the platform and the run settings.
@@ -149,7 +149,7 @@ class HexapodTransmissibility:
         return plot_transmissibility_matrix(
             self.frequency, linear=np.abs(self.linear_response), simulated=self.magnitude,
             trusted=self.trusted, excited=self.excited, frequency_range=_plot_range(self),
-            title=title or default_title(self), out=out,
+            title=title or default_title(self), out=path,
             linear_label=None if self.linear_stable else "linear model (UNSTABLE loop)",
             untrusted_below=self.settings["trusted_from"], frequency_scale=frequency_scale)
 
