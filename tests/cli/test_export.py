@@ -92,6 +92,6 @@ def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
     assert resolved.dt == simulated["dt"]
     assert "accuracy-driven" in description.description
     # a literal --dt stays literal
-    assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4"]) == 0
+    assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4", "--overwrite"]) == 0
     starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
     assert float(starts["step_size"]) == 2e-4

@@ -1,7 +1,8 @@
 """``qzs export``: the controller as one C file, and the isolator as an FMU (docs/fmu.md)."""
 import sys
 
-from qzs.cli.common import EPILOG, add_set_option, parameters
+from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
+                             parameters)
 from qzs.defaults import SIMULATION
 
 __all__ = ["add_parser", "run", "run_controller", "run_fmu"]
@@ -54,8 +55,8 @@ def add_parser(subparsers):
                             help="integration step of the qzs run it reproduces [s] (default "
                                  f"the configuration's, else {SIMULATION['dt']:g}); the sample "
                                  "period is a whole number of it")
-    controller.add_argument("--out", metavar="FILE.c", default="controller.c",
-                            help="the C file to write (default controller.c)")
+    add_output_options(controller, out={"metavar": "FILE.c", "default": "controller.c",
+                                        "help": "the C file to write (default controller.c)"})
     controller.set_defaults(handler=run_controller)
     fmu = sub.add_parser(
         "fmu", help="the isolator as an FMI co-simulation FMU",
@@ -66,8 +67,8 @@ def add_parser(subparsers):
                     "(the motor force an input); the chirp or sine of the configuration inside, "
                     "or the base motion as inputs (`qzs docs fmu`). Needs a C compiler and "
                     "FMPy's FMI headers (pip install \"qzs[fmu]\").", epilog=EPILOG)
-    fmu.add_argument("--out", metavar="FILE.fmu", default="isolator.fmu",
-                     help="the FMU to write (default isolator.fmu)")
+    add_output_options(fmu, out={"metavar": "FILE.fmu", "default": "isolator.fmu",
+                                 "help": "the FMU to write (default isolator.fmu)"})
     fmu.add_argument("--fmi", type=int, choices=(3, 2), default=3,
                      help="FMI version (default 3)")
     fmu.add_argument("--mode", choices=("closed-loop", "plant"), default="closed-loop",
@@ -136,9 +137,8 @@ def run_controller(args):
     import dataclasses
 
     from qzs.export.controller import export_controller
-    from qzs.iotools.paths import check_output_path
 
-    check_output_path(args.out, argument="--out", suffixes=(".c",))
+    check_output(args, "--out", args.out, suffixes=(".c",))
     config = parameters(args)
     controller = config["controller"]
     if controller.controller_rate <= 0.0:
@@ -148,7 +148,8 @@ def run_controller(args):
               file=sys.stderr)
     dt = args.dt if args.dt is not None else config["simulation"].get("dt", SIMULATION["dt"])
     path = export_controller(args.out, controller, config["isolator"], dt=dt, argument="--out")
-    print(f"wrote {path}")
+    emit(args, f"wrote {path}", {"files": {"out": str(path)},
+                                 "controller_rate": controller.controller_rate, "dt": dt})
     return 0
 
 
@@ -168,9 +169,8 @@ def run_fmu(args):
     from qzs.cli.simulate import _excitation
     from qzs.errors import ParameterError
     from qzs.export.fmu import export_fmu
-    from qzs.iotools.paths import check_output_path
 
-    check_output_path(args.out, argument="--out", suffixes=(".fmu",))
+    check_output(args, "--out", args.out, suffixes=(".fmu",))
     config = parameters(args)
     settings = dict(config["simulation"])
     excitation = None
@@ -192,6 +192,8 @@ def run_fmu(args):
                       duration=args.duration if args.duration is not None
                       else settings.get("duration"),
                       communication_step=args.step, argument="--out")
-    print(f"wrote {path} (FMI {args.fmi}.0 co-simulation, {args.mode}, base motion "
-          f"{args.base_motion}); `qzs docs fmu` shows how to use it")
+    emit(args, f"wrote {path} (FMI {args.fmi}.0 co-simulation, {args.mode}, base motion "
+               f"{args.base_motion}); `qzs docs fmu` shows how to use it",
+         {"files": {"out": str(path)}, "fmi": args.fmi, "mode": args.mode,
+          "base_motion": args.base_motion})
     return 0
