@@ -11,7 +11,7 @@
 ``prepare``         validation and packing shared by single and batch runs
 ``simulate``        :func:`simulate`, the validated single run
 ``batch``           :func:`simulate_batch`, many parameter sets at once
-``results``         :class:`SimulationResult`
+``result``          :class:`SimulationResult`
 ``accuracy``        :func:`choose_step`, the largest step meeting a tolerance
 ``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
 ``step_cache``      the step choices kept on disk, keyed by their inputs and the code
@@ -25,8 +25,8 @@ from qzs._lazy import lazy_exports
 
 _EXPORTS = {
     "simulate": "qzs.engine.simulate", "simulate_batch": "qzs.engine.batch",
-    "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.results",
-    "CHANNELS": "qzs.engine.results", "FLAGS": "qzs.engine.results",
+    "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.result",
+    "CHANNELS": "qzs.engine.result", "FLAGS": "qzs.engine.result",
     "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",

@@ -673,7 +673,7 @@ def step_run_entries(choice):
     dict
         ``step_tolerance_db`` and ``step_error_db`` [dB] (or ``_m`` [m] for the state
         measure; the error NaN where no step met the tolerance), for
-        :attr:`SimulationResult.run <qzs.engine.results.SimulationResult.run>` and the
+        :attr:`SimulationResult.run <qzs.engine.result.SimulationResult.run>` and the
         file's ``run.*`` attributes.
     """
     suffix = MEASURE_UNITS[choice.measure].lower()

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from qzs.errors import DataError, ParameterError
-from qzs.iotools.readers import (DataWarning, Recording, load_channel_map, read_recording,
+from qzs.iotools.rig.recording import (DataWarning, Recording, load_channel_map, read_recording,
                          write_dspace_mat)
 
 RATE = 200.0
@@ -161,7 +161,7 @@ ROLE_OF = {"m": "relative_position", "m/s": "base_velocity", "m/s^2": "base_acce
 
 
 def test_every_unit_of_the_table_is_tested():
-    from qzs.iotools.readers import UNITS
+    from qzs.iotools.rig.recording import UNITS
 
     assert set(UNITS) == set(EXPECTED_UNITS)  # a new unit needs its expectation here
 
