@@ -50,7 +50,7 @@ def test_same_trajectory_as_qzs(library, name):
     q, c = _both(excitation, duration)
     assert c["status"] == "ok"
     assert q.run["stick_events"] == 0 and q.run["stop_contacts"] == 0 and c["stop_contacts"] == 0
-    from qzs.engine.result import CHANNELS
+    from qzs.engine.channels import CHANNELS
 
     assert c["rows"] == len(q.time)
     for channel, (column, _, _) in CHANNELS.items():

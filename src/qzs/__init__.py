@@ -51,7 +51,7 @@ _LAZY = {
     "fit_spring": "qzs.identify", "fit_friction": "qzs.identify",
     "fit_transmissibility": "qzs.identify",
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
-    "load_config": "qzs.iotools", "read_result": "qzs.engine.result",
+    "load_config": "qzs.iotools", "read_result": "qzs.engine.result_file",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
     "simulate_hexapod": "qzs.engine.hexapod.simulate",
@@ -77,10 +77,10 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.batch import BatchResult, simulate_batch
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
-    from qzs.engine.result import read_result
+    from qzs.engine.result_file import read_result
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
-    from qzs.iotools.rig.recording import load_channel_map, read_recording
+    from qzs.iotools.rig import load_channel_map, read_recording
     from qzs.workflows.design.driver import design_controller
     from qzs.workflows.design.result import DesignResult
     from qzs.workflows.design_space.optimizer import optimize

@@ -6,7 +6,7 @@ from helpers import SHORT_CHIRP
 
 import qzs
 from qzs import simulate
-from qzs.engine.result import CHANNELS, FLAGS
+from qzs.engine.channels import CHANNELS, FLAGS
 
 
 @pytest.fixture(scope="module")

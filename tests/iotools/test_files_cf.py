@@ -6,8 +6,9 @@ import pytest
 import xarray as xr
 
 import qzs
-from qzs.engine.result import CHANNELS, FLAGS, RUN_UNITS
-from qzs.engine.result import read_result
+from qzs.engine.channels import CHANNELS, FLAGS
+from qzs.engine.metadata import RUN_UNITS
+from qzs.engine.result_file import read_result
 from qzs.model.registry import unit_of
 
 ISOLATOR = qzs.IsolatorParameters(stiction_force=6.0)  # stop_center stays None
@@ -166,7 +167,7 @@ def test_the_file_readers_agree(run, tmp_path):
     reads any result file: a NetCDF file the same (it describes itself), a CSV one given the
     schema."""
     from qzs import iotools
-    from qzs.engine.result import simulation_schema
+    from qzs.engine.channels import simulation_schema
 
     assert qzs.read_result is read_result
     path = run.save(tmp_path / "run.nc")

@@ -148,7 +148,8 @@ def same_variables(dataset, other, *, exact=True):
 
 
 def test_a_run_streamed_to_a_file_holds_its_dataset(tmp_path):
-    from qzs.engine.result import read_result as read_run, simulation_schema
+    from qzs.engine.result_file import read_result as read_run
+    from qzs.engine.channels import simulation_schema
     from qzs.workflows.run import simulate_to_file
 
     excitation = qzs.Sine(amplitude=0.002, frequency=3.0)
@@ -207,7 +208,7 @@ def test_a_transmissibility_estimate_follows_its_schema():
 
 
 def test_an_experiment_follows_its_schema():
-    from qzs.iotools.rig.recording import read_recording
+    from qzs.iotools.rig import read_recording
     from qzs.workflows.experiment import experiment_schema, process_experiment
 
     recording = read_recording(EXAMPLES / "experiment.csv", EXAMPLES / "experiment_map.toml")

@@ -11,7 +11,10 @@
 ``prepare``         validation and packing shared by single and batch runs
 ``simulate``        :func:`simulate`, the validated single run
 ``batch``           :func:`simulate_batch`, many parameter sets at once
+``channels``        the output channels and flags of a run, and its file schema
+``metadata``        a run's parameters and settings with units, its file's global attributes
 ``result``          :class:`SimulationResult`
+``result_file``     a run's file: :class:`~qzs.engine.result_file.ResultWriter`, save, read, size
 ``accuracy``        :func:`choose_step`, the largest step meeting a tolerance
 ``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
 ``step_cache``      the step choices kept on disk, keyed by their inputs and the code
@@ -26,7 +29,10 @@ from qzs._lazy import lazy_exports
 _EXPORTS = {
     "simulate": "qzs.engine.simulate", "simulate_batch": "qzs.engine.batch",
     "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.result",
-    "CHANNELS": "qzs.engine.result", "FLAGS": "qzs.engine.result",
+    "CHANNELS": "qzs.engine.channels", "FLAGS": "qzs.engine.channels",
+    "simulation_schema": "qzs.engine.channels", "ResultWriter": "qzs.engine.result_file",
+    "save_result": "qzs.engine.result_file", "read_result": "qzs.engine.result_file",
+    "estimated_size": "qzs.engine.result_file",
     "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",

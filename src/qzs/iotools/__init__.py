@@ -1,7 +1,7 @@
 """Files in and out: the file schema, results and configs, rig logs, shipped definitions.
 
 This layer knows no result type: each declares its own schema beside its class
-(``qzs.engine.result.simulation_schema``, ...) and hands it to the functions here.
+(``qzs.engine.channels.simulation_schema``, ...) and hands it to the functions here.
 
 ===========  ==================================================================
 ``schema``   a result's variables, dimensions, units and flags; its dataset

@@ -150,7 +150,7 @@ def read_result(path, schema=None):
         A file written by a :class:`~qzs.iotools.writer.StreamWriter` (any suffix other than
         ``.nc`` is read as CSV).
     schema : Schema, optional
-        What the file holds (:func:`qzs.engine.result.simulation_schema` for a run); the
+        What the file holds (:func:`qzs.engine.channels.simulation_schema` for a run); the
         flags of a NetCDF file without one are its variables with ``flag_values``.
 
     Returns

@@ -7,7 +7,7 @@ an int8 flag, an int64 count or a string), flag meanings and further CF attribut
 :func:`to_dataset` builds a result's ``xarray.Dataset`` from its schema and its arrays, and
 :class:`~qzs.iotools.writer.StreamWriter` writes the same layout to a file chunk by chunk,
 so that ``to_xarray()`` and a streamed file cannot drift apart. Each result type declares
-its schema next to its class (``simulation_schema()`` in :mod:`qzs.engine.result`,
+its schema next to its class (``simulation_schema()`` in :mod:`qzs.engine.channels`,
 ``hexapod_schema()``, ``batch_schema(...)``, ``response_schema(...)``, ...); this module
 knows none of them.
 

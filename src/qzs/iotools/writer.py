@@ -6,7 +6,7 @@
 it fits) or, for a schema whose streamed variables are all one-dimensional, to CSV
 (``.csv``). Which column of an
 appended block goes to which variable is the caller's mapping; the single run's
-:class:`~qzs.engine.result.ResultWriter` and the six-axis run's
+:class:`~qzs.engine.result_file.ResultWriter` and the six-axis run's
 :class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
 
 :func:`write_dataset` writes a whole dataset of a schema (NetCDF, or CSV in long format) and

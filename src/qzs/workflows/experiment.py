@@ -6,7 +6,7 @@ velocity through a first-order 1 Hz high-pass. Both channels pass the same high-
 it cancels in their ratio in theory; in practice the band below 1.5x the corner is not
 trustworthy (tiny, phase-shifted signals) and is flagged. :func:`process_experiment`
 
-1. takes base and payload velocities (or accelerations) of a :class:`~qzs.iotools.rig.recording.Recording`,
+1. takes base and payload velocities (or accelerations) of a :class:`~qzs.iotools.rig.Recording`,
 2. estimates their transmissibility ``sqrt(S_payload/S_base)`` (Welch, Hann window),
 3. infers the chirp from the base signal (:func:`infer_chirp`) unless it is given,
 4. simulates the model under that chirp, at the log's sample rate and length, passes the
@@ -40,7 +40,7 @@ from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
-from qzs.iotools.rig.recording import Recording, load_channel_map, read_recording
+from qzs.iotools.rig import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.excitation import Chirp
@@ -468,7 +468,7 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
         chirp (when it must be inferred).
     """
     if not isinstance(recording, Recording):
-        raise ParameterError(f"`recording` must be a qzs.iotools.rig.recording.Recording, got "
+        raise ParameterError(f"`recording` must be a qzs.iotools.rig.Recording, got "
                              f"{type(recording).__name__}; read the log with read_recording.")
     corner = float(highpass_corner or 0.0)
     if corner < 0:
@@ -576,7 +576,7 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
     log : str or Path
         The log file (.csv, .mat, .mf4, .nc).
     channel_map : str or Path
-        The channel map (TOML, see :mod:`qzs.iotools.rig.recording`).
+        The channel map (TOML, see :mod:`qzs.iotools.rig`).
     out : str or Path
         Output folder, created if missing; checked (writable, free space) before the log
         is read.
@@ -606,7 +606,7 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
         ``out`` cannot be written (checked first, :func:`qzs.iotools.paths.check_output_path`),
         ``fft_length`` below 8 or ``n_averages`` below 1 (the arguments or the map's).
     DataError
-        The log cannot be read or processed (see :func:`qzs.iotools.rig.recording.read_recording`).
+        The log cannot be read or processed (see :func:`qzs.iotools.rig.read_recording`).
     """
     check_output_path(out, argument="out", suffixes=None, directory=True,
                       estimated_bytes=REPORT_BYTES)

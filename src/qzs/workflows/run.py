@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from qzs import defaults
 from qzs.engine.prepare import run_inputs
-from qzs.engine.result import ResultWriter, estimated_size
+from qzs.engine.result_file import ResultWriter, estimated_size
 from qzs.engine.simulate import simulate
 from qzs.iotools.files import RESULT_SUFFIXES as _FORMATS
 from qzs.iotools.paths import check_output_path
@@ -41,7 +41,7 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
     """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are
-    written chunk by chunk (:class:`~qzs.engine.result.ResultWriter`), so memory stays
+    written chunk by chunk (:class:`~qzs.engine.result_file.ResultWriter`), so memory stays
     bounded however long the run; the file appears, complete, only when the run ends (an
     interrupted run, with ``interruptible``, writes what was simulated and says so in
     ``run.completed``); on an error nothing is left behind.

@@ -33,7 +33,7 @@ import numpy as np
 from qzs._optional import require
 from qzs._version import __version__
 from qzs.engine.batch import STATS
-from qzs.engine.result import CHANNELS
+from qzs.engine.channels import CHANNELS
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
 
