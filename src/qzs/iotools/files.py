@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import DataError, WriteError
-from qzs.iotools.schema import NONE_VALUE
+from qzs.iotools.schema import NONE_VALUE, from_file_layout
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
 
@@ -178,6 +178,7 @@ def read_result(path, schema=None):
             dataset = xr.load_dataset(path, engine="h5netcdf")
         except (OSError, ValueError) as error:
             raise DataError(f"{str(path)!r} is not a readable NetCDF file: {error}") from None
+        dataset = from_file_layout(dataset)
         flags = ([v.name for v in schema if v.is_flag] if schema is not None
                  else [name for name in dataset.data_vars
                        if "flag_values" in dataset[name].attrs])

@@ -242,7 +242,9 @@ class ExperimentResult:
             values["simulation"] = np.interp(f, self.simulated.frequency,
                                              self.simulated.magnitude)
         return to_dataset(experiment_schema(self), values,
-                          {"source": self.recording.source,
+                          {"title": f"qzs experiment: transmissibility of "
+                                    f"{self.recording.source}",
+                           "source": self.recording.source,
                            "untrusted_below": self.untrusted_below})
 
     def summary(self) -> str:
@@ -348,7 +350,8 @@ def experiment_schema(result):
     variables = [
         Variable(name="experiment", dims=("frequency",), units="1",
                  long_name="measured transmissibility sqrt(S_payload/S_base)"),
-        Variable(name="coherence", dims=("frequency",), units="1"),
+        Variable(name="coherence", dims=("frequency",), units="1",
+                 long_name="magnitude-squared coherence of payload and base"),
         Variable(name="trusted", dims=("frequency",), units="1", dtype="int8",
                  flag_meanings="untrusted trusted",
                  long_name="1 where the measured estimate is trusted (coherence, base power, "
@@ -358,7 +361,8 @@ def experiment_schema(result):
         variables.append(Variable(name="simulation", dims=("frequency",), units="1",
                                   long_name="simulated transmissibility"))
     return Schema(kind="an experiment", dimensions={"frequency": None},
-                  coordinates=(Variable(name="frequency", dims=("frequency",), units="Hz"),),
+                  coordinates=(Variable(name="frequency", dims=("frequency",), units="Hz",
+                                        long_name="frequency"),),
                   variables=variables)
 
 
