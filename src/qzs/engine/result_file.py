@@ -39,7 +39,8 @@ class ResultWriter(StreamWriter):
     :meth:`abort` (also called on any exception, ``KeyboardInterrupt`` included, when
     used as a context manager) removes it. NetCDF files follow CF-1.10 (docs/model.md §7):
     ``time`` is an unlimited dimension, the flags are int8 with
-    ``flag_values``/``flag_meanings``, the parameters global attributes with their units.
+    ``flag_values``/``flag_meanings``, the parameters attributes of container variables
+    with their units (decision 33; :func:`read_result` gives them back as ``isolator.mass``).
     CSV files have the parameters as ``# key = value [unit]`` header lines, the rows, and
     the run's outcome as trailing ``# run.key = value`` lines (known only at the end).
     MATLAB files (:mod:`qzs.iotools.matfile`) hold the same variables, with the units and
