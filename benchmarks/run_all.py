@@ -194,7 +194,7 @@ def check_agreement():
     kw = dict(duration=20.0, dt=DT, sample_rate=1000.0)
     q = qzs.simulate(ex, **kw)
     c = reference.run_reference(ex, **kw)
-    from qzs.engine.results import CHANNELS
+    from qzs.engine.channels import CHANNELS
 
     worst, identical = 0.0, 0
     for name, (column, _, _) in CHANNELS.items():

@@ -12,7 +12,7 @@ import numpy as np
 
 import qzs
 from qzs.analysis.spectral import highpass
-from qzs.iotools.readers import write_dspace_mat
+from qzs.iotools.rig import write_dspace_mat
 
 SEED = 20240605
 RATE = 500.0  # [Hz] sample rate of the experiment log
@@ -43,7 +43,7 @@ def experiment_log(folder, rng):
 
 
 CSV_MAP = """\
-# Channel map of experiment.csv (read by qzs.iotools.readers; `qzs docs identification`):
+# Channel map of experiment.csv (read by qzs.iotools.rig; `qzs docs identification`):
 # which column is which, and its unit. Every key, commented: `qzs experiment --write-map F.toml`.
 [time]
 source = "time"

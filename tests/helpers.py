@@ -108,3 +108,39 @@ def build_controller(tmp_path, source):
                                         _ctypes.c_double]
     lib.qzs_controller_step.restype = Output
     return lib
+
+
+# ---------------------------------------------------------------- rig logs (tests/iotools/rig)
+#: A rig log's sample rate [Hz], time [s], base and payload velocities [mm/s].
+LOG_RATE = 200.0
+LOG_TIME = np.arange(400) / LOG_RATE
+LOG_BASE = 50.0 * np.sin(2 * np.pi * 3.0 * LOG_TIME)
+LOG_PAYLOAD = 20.0 * np.cos(2 * np.pi * 3.0 * LOG_TIME)
+#: The channel map of those logs (the payload through a scale of 2).
+LOG_MAP = {"channels": {"base_velocity": {"source": "shaker_vel", "unit": "mm/s"},
+                        "payload_velocity": {"source": "payload_vel", "unit": "mm/s",
+                                             "scale": 2.0}}}
+
+
+def check_log_recording(recording, rtol=1e-7):
+    """The Recording of a log of LOG_TIME, LOG_BASE and LOG_PAYLOAD read through LOG_MAP."""
+    import pytest
+
+    from qzs.iotools.rig import Recording
+
+    assert isinstance(recording, Recording)
+    assert recording.sample_rate == pytest.approx(LOG_RATE)
+    np.testing.assert_allclose(recording.time, LOG_TIME, atol=1e-9)
+    np.testing.assert_allclose(recording["base_velocity"], LOG_BASE * 1e-3, rtol=rtol, atol=1e-9)
+    np.testing.assert_allclose(recording["payload_velocity"], 2 * LOG_PAYLOAD * 1e-3, rtol=rtol,
+                               atol=1e-9)
+    assert dict(recording.units) == {"base_velocity": "m/s", "payload_velocity": "m/s"}
+
+
+def write_log_csv(path, time=LOG_TIME, base=LOG_BASE, payload=LOG_PAYLOAD):
+    """A rig log as CSV: a comment line, the names, the rows (and an unused column)."""
+    with open(path, "w") as handle:
+        handle.write("# a comment line\ntime, shaker_vel, payload_vel, unused\n")
+        for row in zip(time, base, payload, np.zeros(len(time))):
+            handle.write(",".join(repr(float(x)) for x in row) + "\n")
+    return path

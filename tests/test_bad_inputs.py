@@ -14,7 +14,7 @@ import pytest
 from qzs.cli import main
 from qzs.errors import DataError, ParameterError
 from qzs.iotools.config import load_config
-from qzs.iotools.readers import load_channel_map, read_recording
+from qzs.iotools.rig import load_channel_map, read_recording
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "examples" / "data"

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import qzs
-from qzs.engine.results import CHANNELS
+from qzs.engine.channels import CHANNELS
 
 REFERENCE = Path(__file__).resolve().parents[1] / "benchmarks" / "c_reference"
 sys.path.insert(0, str(REFERENCE))

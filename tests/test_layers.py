@@ -316,6 +316,8 @@ CROSS_CUTTING = {
     "benchmark_reference": "the benchmarks' C reference model against qzs",
     "typing": "mypy over the annotated public API and over scripts using it (one it must reject)",
     "wheel": "the built wheel and sdist: LICENSE, py.typed, every declared package-data file",
+    "cf_compliance": "every kind of NetCDF file qzs writes, through the IOOS compliance "
+                     "checker (CF-1.10)",
 }
 #: The longest a source file of qzs may be [lines] (one concept per module).
 MAX_LINES = 1000

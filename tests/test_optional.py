@@ -48,7 +48,7 @@ assert main(["simulate", "--excitation", "sine", "--frequency", "3", "--duration
 assert main(["study", "spring", "--out", {str(tmp_path / "study")!r}, "--workers", "1",
              "--quiet"]) == 0
 import qzs.workflows.paper.report, qzs.workflows.sweeps
-from qzs.iotools.readers import read_recording
+from qzs.iotools.rig import read_recording
 from qzs.errors import MissingDependencyError
 open({str(tmp_path / "log.mf4")!r}, "wb").write(b"MDF     ")
 open({str(tmp_path / "map.toml")!r}, "w").write('[channels.base_velocity]\\nsource = "b"\\nunit = "m/s"\\n')

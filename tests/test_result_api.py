@@ -47,7 +47,7 @@ PLOTS, SAVES = _methods("plot"), _methods("save")
 
 def test_the_source_is_read_and_the_result_classes_are_found():
     assert len(PLOTS) >= 10 and len(SAVES) >= 6
-    assert ("qzs.engine.results", "SimulationResult") in PLOTS
+    assert ("qzs.engine.result", "SimulationResult") in PLOTS
     assert ("qzs.workflows.design.result", "DesignResult") in SAVES
 
 

@@ -41,7 +41,7 @@ RESULT_CLASSES = {
     "qzs.analysis.spectral": ["TransmissibilityMetrics"],
     "qzs.analysis.harmonic_balance": ["FrequencyResponseCurve"],
     "qzs.identify": ["SpringFit", "FrictionFit", "TransmissibilityFit"],
-    "qzs.iotools.readers": ["Recording", "ChannelMap"],
+    "qzs.iotools.rig": ["Recording", "ChannelMap"],
     "qzs.workflows.response": ["ResponsePoint"],
     "qzs.workflows.experiment.process": ["ExperimentResult"],
     "qzs.workflows.hexapod.setups": ["HexapodSetup"],

@@ -2,7 +2,7 @@
 A run's time series
 ===================
 
-:meth:`SimulationResult.plot <qzs.engine.results.SimulationResult.plot>` (that is,
+:meth:`SimulationResult.plot <qzs.engine.result.SimulationResult.plot>` (that is,
 :func:`qzs.viz.plot_simulation`) draws what happened during a run: base and payload motion,
 the stroke used between the guide's stops, the forces, the accelerations, and when the payload
 was locked by friction. Here the paper's default isolator under its 0-20 Hz chirp, swept in

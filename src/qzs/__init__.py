@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 from qzs._lazy import lazy_exports
 from qzs._version import __version__
-from qzs.engine.results import SimulationResult
+from qzs.engine.result import SimulationResult
 from qzs.engine.simulate import simulate
 from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, ExcitationError,
@@ -54,7 +54,7 @@ _LAZY = {
     "fit_spring": "qzs.identify", "fit_friction": "qzs.identify",
     "fit_transmissibility": "qzs.identify",
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
-    "load_config": "qzs.iotools", "read_result": "qzs.engine.results",
+    "load_config": "qzs.iotools", "read_result": "qzs.engine.result_file",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
     "simulate_hexapod": "qzs.engine.hexapod.simulate",
@@ -82,14 +82,14 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.batch import BatchResult, simulate_batch
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
-    from qzs.engine.results import read_result
+    from qzs.engine.result_file import read_result
     from qzs.engine.run_spec import ResolvedRun, resolve
     from qzs.engine.step_search import StepChoice
     from qzs.export.controller import export_controller
     from qzs.export.fmu import export_fmu
     from qzs.identify import fit_friction, fit_spring, fit_transmissibility
     from qzs.iotools.config import load_config
-    from qzs.iotools.readers import load_channel_map, read_recording
+    from qzs.iotools.rig import load_channel_map, read_recording
     from qzs.workflows.design.driver import design_controller
     from qzs.workflows.design.result import DesignResult
     from qzs.workflows.design_space.optimizer import optimize

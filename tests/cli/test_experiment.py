@@ -49,7 +49,7 @@ def test_an_output_folder_that_is_a_file_is_refused_before_reading(tmp_path, cap
 
 
 def test_write_map_writes_the_template_without_a_log(tmp_path, capsys):
-    from qzs.iotools.readers import load_channel_map
+    from qzs.iotools.rig import load_channel_map
     from qzs.workflows.experiment.map_template import PLACEHOLDER, channel_map_template
 
     path = tmp_path / "sub" / "map.toml"

@@ -11,6 +11,7 @@ from qzs.model.hexapod import leg_unit_vectors
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.workflows.hexapod.setups import (default_cube_center_height, hexapod_setup, load_hexapod,
                                           supported_mass)
+from qzs.iotools.schema import from_file_layout
 
 
 def run_json(capsys, *argv):
@@ -188,7 +189,8 @@ def test_hexapod_simulate_command(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "stroke used" in text and "Energy ledger residual" in text
     assert "Step: dt = " in text and "(tolerance 1e-05 m" in text
-    with xr.open_dataset(out, engine="h5netcdf") as data:
+    with xr.open_dataset(out, engine="h5netcdf") as raw:
+        data = from_file_layout(raw)  # the containers as dotted attributes
         assert data.sizes["dof"] == 6 and data.sizes["leg"] == 6
         assert data.sizes["time"] == 2001
         # the file states the step, its estimated error and the tolerance

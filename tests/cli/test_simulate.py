@@ -9,6 +9,7 @@ from qzs import Chirp, ControllerParameters, IsolatorParameters, RandomExcitatio
 from qzs.analysis.summary import run_warnings
 from qzs.cli import main
 from qzs.iotools import read_result, save_config
+from qzs.iotools.schema import from_file_layout
 
 
 @pytest.mark.parametrize("flags, excitation", [
@@ -268,7 +269,8 @@ def test_the_chosen_step_is_kept_in_the_file(tmp_path, capsys):
     out = tmp_path / "run.nc"
     assert main(["simulate", "--excitation-duration", "30", "--f1", "5",
                  "--sample-rate", "500", "--plot", "none", "--quiet", "--out", str(out)]) == 0
-    with xr.open_dataset(out) as data:
+    with xr.open_dataset(out) as raw:
+        data = from_file_layout(raw)  # the containers as dotted attributes
         assert data.attrs["run.step_tolerance_db"] == 0.01 and data.attrs["run.step"] == "accuracy-driven"
         assert 0 <= data.attrs["run.step_error_db"] <= 0.01
         assert data.attrs["run.dt"] > 1e-4
@@ -285,7 +287,8 @@ def test_out_mat_writes_what_matlab_and_scipy_load(tmp_path):
         assert main(["simulate", "--duration", "2", "--out", str(out), "--plot", "none",
                      "--quiet"]) == 0
     read = scipy.io.loadmat(mat)
-    with xr.open_dataset(nc) as netcdf:
+    with xr.open_dataset(nc) as raw:
+        netcdf = from_file_layout(raw)  # the containers as dotted attributes
         np.testing.assert_array_equal(read["relative_position"][:, 0],
                                       netcdf["relative_position"].values)
         np.testing.assert_array_equal(read["time"][:, 0], netcdf["time"].values)

@@ -15,7 +15,7 @@ from helpers import LINEAR_SHAPE, linear_controller, linear_isolator
 import qzs
 from qzs import ControllerParameters, IsolatorParameters, ParameterError, Sine
 from qzs.engine.periodic import STATE_VARIABLES, CarriedState, PeriodicRun
-from qzs.engine.results import CHANNELS, FLAGS
+from qzs.engine.channels import CHANNELS, FLAGS
 
 MASS = 6.4
 #: Names of the energy ledger's channels: integrals that a continued run starts from zero.

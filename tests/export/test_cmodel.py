@@ -13,7 +13,7 @@ from helpers import export_settings as settings
 
 import qzs
 from qzs.engine import kernels as K
-from qzs.engine.results import CHANNELS
+from qzs.engine.channels import CHANNELS
 from qzs.errors import CompilerError
 from qzs.export.cmodel import simulate_c
 

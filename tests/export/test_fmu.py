@@ -17,7 +17,7 @@ import pytest
 
 import qzs
 from qzs.engine.base_motion import base_motion_series
-from qzs.engine.results import CHANNELS
+from qzs.engine.channels import CHANNELS
 from qzs.errors import CompilerError, MissingDependencyError, ParameterError
 from qzs.export import fmu as export
 

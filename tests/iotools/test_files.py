@@ -1,4 +1,4 @@
-"""The single run's streaming writer (:class:`qzs.engine.results.ResultWriter`, a
+"""The single run's streaming writer (:class:`qzs.engine.result_file.ResultWriter`, a
 configuration of :class:`qzs.iotools.writer.StreamWriter`): same file in chunks, bounded
 memory, clean I/O failures."""
 import errno
@@ -14,7 +14,7 @@ import xarray as xr
 import qzs
 from qzs.engine import kernels as K
 from qzs.errors import DataError, ParameterError, Terminated
-from qzs.engine.results import ResultWriter, estimated_size, read_result, save_result
+from qzs.engine.result_file import ResultWriter, estimated_size, read_result, save_result
 from qzs.iotools import writer as stream
 
 
@@ -26,7 +26,7 @@ def run():
 
 @pytest.fixture
 def fixed_clock(monkeypatch):
-    monkeypatch.setattr("qzs.engine.results._now", lambda: "2024-01-02T03:04:05+00:00")
+    monkeypatch.setattr("qzs.engine.metadata._now", lambda: "2024-01-02T03:04:05+00:00")
 
 
 def writer(path, run):
@@ -199,7 +199,7 @@ import numpy as np
 import h5netcdf, xarray
 import qzs
 from qzs.engine import kernels as K
-from qzs.engine.results import ResultWriter
+from qzs.engine.result_file import ResultWriter
 
 rows, chunk, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 run = qzs.simulate(qzs.Sine(amplitude=0.001, frequency=1.0), duration=0.01, sample_rate=1000.0)

@@ -6,8 +6,10 @@ import pytest
 import xarray as xr
 
 import qzs
-from qzs.engine.results import CHANNELS, FLAGS, RUN_UNITS
-from qzs.engine.results import read_result
+from qzs.engine.channels import CHANNELS, FLAGS
+from qzs.engine.metadata import RUN_UNITS
+from qzs.engine.result_file import read_result
+from qzs.iotools.schema import from_file_layout
 from qzs.model.registry import unit_of
 
 ISOLATOR = qzs.IsolatorParameters(stiction_force=6.0)  # stop_center stays None
@@ -22,7 +24,20 @@ def run():
 @pytest.fixture(scope="module")
 def netcdf(run, tmp_path_factory):
     path = run.save(tmp_path_factory.mktemp("cf") / "run.nc")
-    return xr.load_dataset(path, engine="h5netcdf"), path  # the file as any reader sees it
+    # the file as any reader sees it, the parameters' containers read as dotted attributes
+    return from_file_layout(xr.load_dataset(path, engine="h5netcdf")), path
+
+
+def test_parameters_are_in_containers_and_no_global_name_has_a_dot(netcdf, run):
+    """CF attribute names are letters, digits and underscores (decision 33)."""
+    raw = xr.load_dataset(netcdf[1], engine="h5netcdf")
+    assert not [key for key in raw.attrs if not key.replace("_", "a").isalnum()]
+    assert raw.attrs["parameter_containers"].split() == ["isolator", "controller",
+                                                         "excitation", "run"]
+    assert raw["isolator"].attrs["mass"] == run.isolator.mass
+    assert raw["isolator"].attrs["mass_units"] == "kg"
+    assert raw["run"].attrs["dt"] == run.run["dt"] and raw["run"].attrs["dt_units"] == "s"
+    assert raw["isolator"].attrs["long_name"].startswith("container")
 
 
 def test_global_attributes(netcdf):
@@ -44,7 +59,7 @@ def test_time_is_a_cf_time_axis(netcdf):
 
 def test_every_variable_has_units_and_long_name(netcdf):
     data, _ = netcdf
-    for name, variable in data.variables.items():
+    for name, variable in data.variables.items():  # (the containers are read as attributes)
         assert variable.attrs.get("units"), name
         assert variable.attrs.get("long_name"), name
     for name, (_, unit, _) in CHANNELS.items():
@@ -166,7 +181,7 @@ def test_the_file_readers_agree(run, tmp_path):
     reads any result file: a NetCDF file the same (it describes itself), a CSV one given the
     schema."""
     from qzs import iotools
-    from qzs.engine.results import simulation_schema
+    from qzs.engine.channels import simulation_schema
 
     assert qzs.read_result is read_result
     path = run.save(tmp_path / "run.nc")

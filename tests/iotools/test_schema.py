@@ -11,6 +11,7 @@ from qzs.errors import ParameterError
 from qzs.iotools.files import read_result
 from qzs.iotools.schema import (CONVENTIONS, Schema, Variable, time_coordinate, to_dataset)
 from qzs.iotools.writer import StreamWriter
+from qzs.iotools.schema import from_file_layout
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "data"
 TOY = Schema(kind="a toy run", dimensions={"time": None, "axis": 2}, coordinates=(
@@ -148,7 +149,8 @@ def same_variables(dataset, other, *, exact=True):
 
 
 def test_a_run_streamed_to_a_file_holds_its_dataset(tmp_path):
-    from qzs.engine.results import read_result as read_run, simulation_schema
+    from qzs.engine.result_file import read_result as read_run
+    from qzs.engine.channels import simulation_schema
     from qzs.workflows.run import simulate_to_file
 
     excitation = qzs.Sine(amplitude=0.002, frequency=3.0)
@@ -188,7 +190,7 @@ def test_a_response_file_holds_its_dataset(tmp_path):
     response = steady_state_response([2.0], 0.010, dt=1e-3, workers=1)
     data = response.to_xarray()
     with xr.open_dataset(response.save(tmp_path / "response.nc"), engine="h5netcdf") as saved:
-        same_variables(data, saved.load())
+        same_variables(data, from_file_layout(saved.load()))  # containers: attributes
     assert data["converged"].dtype == np.int8 and data["periods"].dtype == np.int64
 
 
@@ -207,7 +209,7 @@ def test_a_transmissibility_estimate_follows_its_schema():
 
 
 def test_an_experiment_follows_its_schema():
-    from qzs.iotools.readers import read_recording
+    from qzs.iotools.rig import read_recording
     from qzs.workflows.experiment.process import experiment_schema, process_experiment
 
     recording = read_recording(EXAMPLES / "experiment.csv", EXAMPLES / "experiment_map.toml")
@@ -231,3 +233,35 @@ def test_the_six_axis_matrix_schema_declares_units_and_flags():
     assert list(schema["excited"].attrs()) == ["units", "long_name", "flag_meanings",
                                                "flag_values"]
     assert schema["magnitude"].long_name.startswith("|H1|")
+
+
+# ---------------------------------------------------------------- the file layout (CF names)
+def test_dotted_keys_go_to_containers_and_come_back(tmp_path):
+    """No dot in a file's attribute names, string labels as characters, no fill value on a
+    coordinate; read back (from_file_layout) the dataset is what was written (decision 33)."""
+    import h5py
+
+    from qzs.iotools.schema import container_attributes, from_file_layout, to_file_layout
+    from qzs.iotools.writer import write_netcdf
+
+    plain, containers = container_attributes({"title": "t", "isolator.mass": 6.4,
+                                              "isolator.mass_units": "kg",
+                                              "settings.leg.x": 1.0})
+    assert plain == {"title": "t", "parameter_containers": "isolator settings"}
+    assert containers == {"isolator": {"mass": 6.4, "mass_units": "kg"},
+                          "settings": {"leg__x": 1.0}}
+    dataset = xr.Dataset({"x": (("case", "f"), np.ones((2, 3)), {"units": "m",
+                                                                  "long_name": "x"})},
+                         coords={"case": ("case", ["a", "b µ"], {"long_name": "case"}),
+                                 "f": ("f", np.arange(3.0), {"units": "Hz", "long_name": "f"})},
+                         attrs={"Conventions": CONVENTIONS, "history": "made here",
+                                "isolator.mass": 6.4, "settings.leg.x": 1.0})
+    layout, _ = to_file_layout(dataset)
+    assert set(layout.attrs) == {"Conventions", "history", "parameter_containers"}
+    path = write_netcdf(dataset, tmp_path / "x.nc")
+    with h5py.File(path) as raw:
+        assert raw["case"].ndim == 2 and raw["case"].dtype == "S1"  # characters, not strings
+        assert "_FillValue" not in raw["f"].attrs and raw["isolator"].attrs["mass"] == 6.4
+        assert not [key for key in raw.attrs if "." in key]
+    back = from_file_layout(xr.load_dataset(path, engine="h5netcdf"))
+    xr.testing.assert_identical(back, dataset)

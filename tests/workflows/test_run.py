@@ -113,7 +113,7 @@ def test_ctrl_c_while_a_chunk_is_written_keeps_every_chunk_whole(tmp_path, monke
     the chunk under way: the file holds whole chunks, in order, and says it is incomplete."""
     import signal
 
-    from qzs.engine.results import ResultWriter
+    from qzs.engine.result_file import ResultWriter
 
     monkeypatch.setattr(driver_module, "CHUNK_SAMPLES", 100)  # cut to 128 samples
     # from Python's own handler, whatever the shell gave: a background job starts with SIGINT

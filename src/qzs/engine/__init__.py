@@ -12,7 +12,10 @@
 ``single``          :func:`~qzs.engine.single.integrate`, one run at a given step
 ``simulate``        :func:`simulate`, a run resolved then integrated
 ``batch``           :func:`simulate_batch`, many parameter sets at once
-``results``         :class:`SimulationResult`
+``channels``        the output channels and flags of a run, and its file schema
+``metadata``        a run's parameters and settings with units, its file's global attributes
+``result``          :class:`SimulationResult`
+``result_file``     a run's file: :class:`~qzs.engine.result_file.ResultWriter`, save, read, size
 ``step_search``     the one step search, its fallback and its record (:class:`StepChoice`)
 ``accuracy``        :func:`choose_step`, the step of one axis: its probe and measures
 ``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
@@ -28,8 +31,11 @@ from qzs._lazy import lazy_exports
 
 _EXPORTS = {
     "simulate": "qzs.engine.simulate", "simulate_batch": "qzs.engine.batch",
-    "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.results",
-    "CHANNELS": "qzs.engine.results", "FLAGS": "qzs.engine.results",
+    "BatchResult": "qzs.engine.batch", "SimulationResult": "qzs.engine.result",
+    "CHANNELS": "qzs.engine.channels", "FLAGS": "qzs.engine.channels",
+    "simulation_schema": "qzs.engine.channels", "ResultWriter": "qzs.engine.result_file",
+    "save_result": "qzs.engine.result_file", "read_result": "qzs.engine.result_file",
+    "estimated_size": "qzs.engine.result_file",
     "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "prepare_run": "qzs.engine.prepare", "steps_per_sample": "qzs.engine.prepare",
     "base_motion_series": "qzs.engine.base_motion",

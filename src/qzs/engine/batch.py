@@ -25,7 +25,8 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.results import CHANNELS, FLAGS, _now, simulation_schema
+from qzs.engine.channels import CHANNELS, FLAGS, simulation_schema
+from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.registry import PARAMETERS
@@ -73,8 +74,8 @@ class BatchResult:
     time : ndarray, shape (n_samples,)
         Sample times [s].
     channels : dict of str to ndarray, shape (n_cases, n_samples)
-        The requested channels (names and units of :data:`qzs.engine.results.CHANNELS`;
-        the flags of :data:`qzs.engine.results.FLAGS` as boolean arrays).
+        The requested channels (names and units of :data:`qzs.engine.channels.CHANNELS`;
+        the flags of :data:`qzs.engine.channels.FLAGS` as boolean arrays).
     stats : dict of str to ndarray, shape (n_cases,)
         Per-case statistics, see :data:`STATS`.
     status : ndarray of int8, shape (n_cases,)
@@ -149,7 +150,7 @@ def batch_schema(batch):
     """The CF-1.10 layout of a batch's dataset (:meth:`BatchResult.to_xarray`).
 
     Dimensions ``case`` and ``time``; the kept channels as in a single run's file
-    (:func:`qzs.engine.results.simulation_schema`) on ``(case, time)``; the statistics of
+    (:func:`qzs.engine.channels.simulation_schema`) on ``(case, time)``; the statistics of
     :data:`STATS` (counts int64), ``status`` (int8 flag) and ``message`` on ``case``; the
     coordinates ``case``, ``time`` and every parameter (a string where all cases give one,
     else float64 with NaN for none).
@@ -213,8 +214,8 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     solver : {"ode3", "rk4", "euler"}
         Integrator, as in :func:`qzs.simulate`.
     channels : sequence of str
-        Time series to keep: names of :data:`qzs.engine.results.CHANNELS`, or of the
-        boolean flags :data:`qzs.engine.results.FLAGS` (``"locked"``, ``"stop_contact"``);
+        Time series to keep: names of :data:`qzs.engine.channels.CHANNELS`, or of the
+        boolean flags :data:`qzs.engine.channels.FLAGS` (``"locked"``, ``"stop_contact"``);
         may be empty.
     workers : int, optional
         Threads, each running a share of the cases in the kernel (which releases

@@ -6,7 +6,7 @@ is prepared like any other (:func:`qzs.engine.prepare.prepare_run`), optionally 
 from the final state of another run (:class:`CarriedState`), and each :meth:`PeriodicRun.advance`
 integrates one period into an output buffer. The state at the boundary is read by name
 (:data:`STATE_VARIABLES`), the output columns by channel name
-(:data:`qzs.engine.results.CHANNELS`), so that callers need no kernel index.
+(:data:`qzs.engine.channels.CHANNELS`), so that callers need no kernel index.
 
 A period of a whole number of :data:`~qzs.engine.kernels.PHASE_PERIOD` steps makes the
 numbers those of one uncut run to the last bit (docs/model.md §9).
@@ -145,9 +145,9 @@ class PeriodicRun:
         Returns
         -------
         rows : ndarray, shape (periods, samples_per_period, n_channels)
-            Output rows; columns as :data:`qzs.engine.results.CHANNELS`.
+            Output rows; columns as :data:`qzs.engine.channels.CHANNELS`.
         marks : ndarray of bool, shape (periods, samples_per_period, n_flags)
-            Boolean outputs; columns as :data:`qzs.engine.results.FLAGS`.
+            Boolean outputs; columns as :data:`qzs.engine.channels.FLAGS`.
         """
         rows = np.empty((periods, self.samples_per_period, K.N_CHANNELS))
         marks = np.zeros((periods, self.samples_per_period, 2), dtype=np.bool_)

@@ -28,7 +28,7 @@ from qzs import _validation, defaults
 from qzs.errors import ParameterError
 
 if TYPE_CHECKING:
-    from qzs.engine.results import SimulationResult
+    from qzs.engine.result import SimulationResult
     from qzs.model.controller import ControllerParameters
     from qzs.model.excitation import Excitation
     from qzs.model.isolator import InitialState, IsolatorParameters

@@ -14,7 +14,7 @@ from qzs import defaults
 if TYPE_CHECKING:
     from qzs.model.controller import ControllerParameters
     from qzs.model.excitation import Excitation
-    from qzs.engine.results import SimulationResult
+    from qzs.engine.result import SimulationResult
     from qzs.model.isolator import InitialState, IsolatorParameters
 
 __all__ = ["simulate"]
@@ -67,13 +67,13 @@ def simulate(excitation: Excitation | None = None, isolator: IsolatorParameters 
     sink : callable, optional
         ``sink(data, flags)`` receives every output sample, chunk by chunk, in time order
         (``data`` of shape (n, N_CHANNELS) in the columns of
-        :data:`~qzs.engine.results.CHANNELS`, ``flags`` of shape (n, 2); both are reused
+        :data:`~qzs.engine.channels.CHANNELS`, ``flags`` of shape (n, 2); both are reused
         buffers: consume or copy them). The result then keeps every sample if there are
         at most :data:`PREVIEW_SAMPLES`, else a preview for figures: per group of k
         consecutive samples (``result.run["preview_every"]``) one row of each channel's
         minimum and one of its maximum (the flags' all and any), so memory stays bounded
         however long the run and a plot shows the true envelope, never an aliased pick
-        (:class:`qzs.engine.results.ResultWriter` is such a sink). The summary's
+        (:class:`qzs.engine.result_file.ResultWriter` is such a sink). The summary's
         statistics always come from every sample.
 
     Returns

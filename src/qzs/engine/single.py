@@ -12,7 +12,8 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.results import SimulationResult, named_block
+from qzs.engine.channels import named_block
+from qzs.engine.result import SimulationResult
 from qzs.errors import SimulationError
 
 __all__ = ["integrate", "result_bytes", "SingleAxis", "BYTES_PER_SAMPLE"]

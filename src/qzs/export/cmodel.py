@@ -26,7 +26,7 @@ class CRun:
     Attributes
     ----------
     data : ndarray, shape (samples, N_CHANNELS)
-        The recorded channels, columns as :data:`qzs.engine.results.CHANNELS`.
+        The recorded channels, columns as :data:`qzs.engine.channels.CHANNELS`.
     flags : ndarray of bool, shape (samples, 2)
         The locked and stop-contact flags.
     state : ndarray, shape (N_STATE,)

@@ -4,13 +4,13 @@ Every registry parameter (:data:`qzs.model.registry.PARAMETERS`) is an FMI param
 SI unit, description and start value (the exported configuration's); so are the run's step
 and solver and, with an internal excitation, the chirp or sine of the base. The inputs are
 the motor force (``plant`` mode) or the base motion (``input`` base motion); the outputs are
-the recorded channels (:data:`qzs.engine.results.CHANNELS`) and the two flags. The value
+the recorded channels (:data:`qzs.engine.channels.CHANNELS`) and the two flags. The value
 reference of a variable is its index in :func:`fmu_variables`; :func:`variables_header`
 writes the same table as C (``qzs_fmu_variables.h``) for ``csrc/qzs_fmu.c``.
 """
 from dataclasses import asdict, dataclass
 
-from qzs.engine.results import CHANNELS, FLAGS
+from qzs.engine.channels import CHANNELS, FLAGS
 from qzs.model.excitation import (E_AMPLITUDE, E_DURATION, E_F0, E_F1, E_FADE, E_KIND,
                                   E_PHASE)
 from qzs.model.registry import PARAMETERS

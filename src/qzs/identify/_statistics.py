@@ -52,4 +52,4 @@ def profile_threshold(confidence, dof):
 
 def finite_samples(name, values):
     return finite_series(name, values, DataError,
-                         "clean or interpolate them first (qzs.iotools.readers can, nan = 'interpolate')")
+                         "clean or interpolate them first (qzs.iotools.rig can, nan = 'interpolate')")

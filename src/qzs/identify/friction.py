@@ -137,7 +137,7 @@ def _smoothed_derivatives(time, displacement, window, polyorder, tolerance):
     jitter = float(np.max(np.abs(steps - step))) / step
     if jitter > tolerance:
         raise DataError(f"`time` is not uniformly sampled (relative jitter {jitter:.3g} > "
-                        f"{tolerance:g}); resample it first (qzs.iotools.readers: resample = true).")
+                        f"{tolerance:g}); resample it first (qzs.iotools.rig: resample = true).")
     samples = max(int(round(window / step)) | 1, polyorder + 2 | 1)
     if samples > time.size:
         raise DataError(f"the smoothing window ({samples} samples = {samples * step:g} s) is "

@@ -1,7 +1,7 @@
 """Files in and out: the file schema, results and configs, rig logs, shipped definitions.
 
 This layer knows no result type: each declares its own schema beside its class
-(``qzs.engine.results.simulation_schema``, ...) and hands it to the functions here.
+(``qzs.engine.channels.simulation_schema``, ...) and hands it to the functions here.
 
 ===========  ==================================================================
 ``schema``   a result's variables, dimensions, units and flags; its dataset
@@ -10,7 +10,7 @@ This layer knows no result type: each declares its own schema beside its class
 ``files``    atomic writes; result files read back
 ``paths``    output paths checked before the work starts
 ``config``   run configurations (TOML)
-``readers``  test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
+``rig``      subpackage: test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
 ``shipped``  the study, sweep and hexapod files shipped with qzs
 ``docs``     the model and workflow pages shipped inside the package (``qzs docs``)
 ===========  ==================================================================
@@ -22,9 +22,9 @@ _EXPORTS = {
     "atomic_path": "qzs.iotools.files", "read_result": "qzs.iotools.files",
     "read_displacement_csv": "qzs.iotools.files", "check_output_path": "qzs.iotools.paths",
     "load_config": "qzs.iotools.config", "save_config": "qzs.iotools.config",
-    "Recording": "qzs.iotools.readers", "ChannelMap": "qzs.iotools.readers",
-    "load_channel_map": "qzs.iotools.readers", "read_recording": "qzs.iotools.readers",
-    "write_dspace_mat": "qzs.iotools.readers", "Schema": "qzs.iotools.schema",
+    "Recording": "qzs.iotools.rig", "ChannelMap": "qzs.iotools.rig",
+    "load_channel_map": "qzs.iotools.rig", "read_recording": "qzs.iotools.rig",
+    "write_dspace_mat": "qzs.iotools.rig", "Schema": "qzs.iotools.schema",
     "Variable": "qzs.iotools.schema", "to_dataset": "qzs.iotools.schema",
     "StreamWriter": "qzs.iotools.writer", "estimated_file_size": "qzs.iotools.writer",
     "write_mat": "qzs.iotools.matfile",

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import DataError, WriteError
-from qzs.iotools.schema import NONE_VALUE
+from qzs.iotools.schema import NONE_VALUE, from_file_layout
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
 
@@ -150,7 +150,7 @@ def read_result(path, schema=None):
         A file written by a :class:`~qzs.iotools.writer.StreamWriter` (any suffix other than
         ``.nc`` is read as CSV).
     schema : Schema, optional
-        What the file holds (:func:`qzs.engine.results.simulation_schema` for a run); the
+        What the file holds (:func:`qzs.engine.channels.simulation_schema` for a run); the
         flags of a NetCDF file without one are its variables with ``flag_values``.
 
     Returns
@@ -178,6 +178,7 @@ def read_result(path, schema=None):
             dataset = xr.load_dataset(path, engine="h5netcdf")
         except (OSError, ValueError) as error:
             raise DataError(f"{str(path)!r} is not a readable NetCDF file: {error}") from None
+        dataset = from_file_layout(dataset)
         flags = ([v.name for v in schema if v.is_flag] if schema is not None
                  else [name for name in dataset.data_vars
                        if "flag_values" in dataset[name].attrs])

@@ -6,7 +6,7 @@
 it fits) or, for a schema whose streamed variables are all one-dimensional, to CSV
 (``.csv``). Which column of an
 appended block goes to which variable is the caller's mapping; the single run's
-:class:`~qzs.engine.results.ResultWriter` and the six-axis run's
+:class:`~qzs.engine.result_file.ResultWriter` and the six-axis run's
 :class:`~qzs.engine.hexapod.result.HexapodWriter` are two such configurations.
 
 :func:`write_dataset` writes a whole dataset of a schema (NetCDF, or CSV in long format) and
@@ -36,9 +36,10 @@ import numpy as np
 from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error, atomic_path
 from qzs.iotools.matfile import MatStream
-from qzs.iotools.schema import CONVENTIONS
+from qzs.iotools.schema import CONVENTIONS, container_attributes, to_file_layout
 
-__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_table", "CSV_LAYOUT"]
+__all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_netcdf", "write_table",
+           "CSV_LAYOUT"]
 
 #: How the CSV files of qzs lay out their table (docs/model.md §7): ``#`` comment lines
 #: (``key = value [unit]``), the last of which says on which lines the table starts; a row
@@ -278,8 +279,15 @@ class StreamWriter:
         datasets.flush()  # on disk, inside the space reserved for it
 
     def _finish_netcdf(self, tail):
-        for key, value in {**self._head, **tail}.items():
+        plain, containers = container_attributes({**self._head, **tail})
+        for key, value in plain.items():
             self._file.attrs[key] = value
+        for section, attrs in containers.items():  # CF names have no dots (decision 34)
+            container = self._file.create_variable(section, (), data=np.int8(0))
+            container.attrs["long_name"] = (f"container of the {section} parameters: each "
+                                            "attribute is one, with its unit in <name>_units")
+            for key, value in attrs.items():
+                container.attrs[key] = value
         handle, self._file = self._file, None
         self._variables = {}
         _close(handle)
@@ -572,12 +580,37 @@ def write_dataset(dataset, path):
     try:
         with atomic_path(path) as tmp:
             if suffix == ".nc":
-                dataset.to_netcdf(tmp, engine="h5netcdf")
+                write_netcdf(dataset, tmp)
             else:
                 tmp.write_text(_table_text(dataset), encoding="utf-8")
     except OSError as error:
         raise _write_error(path, error) from None
     return path
+
+
+def write_netcdf(dataset, path):
+    """Write a dataset to NetCDF (h5netcdf) in qzs's file layout, CF-1.10 (not atomic).
+
+    :func:`qzs.iotools.schema.to_file_layout`: dotted global attributes in container
+    variables, no ``_FillValue`` on coordinates;
+    :func:`qzs.iotools.files.read_result` reads it back as ``dataset``. Callers write to a
+    temporary path (:func:`qzs.iotools.files.atomic_path`).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The data, with CF attributes (:func:`qzs.iotools.schema.to_dataset`).
+    path : str or Path
+        The file to write.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    layout, encoding = to_file_layout(dataset)
+    layout.to_netcdf(path, engine="h5netcdf", encoding=encoding)
+    return Path(path)
 
 
 def write_table(rows, path, *, units, attrs=None):

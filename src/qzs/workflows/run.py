@@ -10,13 +10,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from qzs import defaults
+from qzs.engine.result_file import ResultWriter, estimated_size
 from qzs.engine.run_spec import ResolvedRun, resolve
-from qzs.engine.results import ResultWriter, estimated_size
 from qzs.iotools.files import RESULT_SUFFIXES as _FORMATS
 from qzs.iotools.paths import check_output_path
 
 if TYPE_CHECKING:
-    from qzs.engine.results import SimulationResult
+    from qzs.engine.result import SimulationResult
     from qzs.model.controller import ControllerParameters
     from qzs.model.excitation import Excitation
     from qzs.model.isolator import InitialState, IsolatorParameters
@@ -40,7 +40,7 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
     """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are
-    written chunk by chunk (:class:`~qzs.engine.results.ResultWriter`), so memory stays
+    written chunk by chunk (:class:`~qzs.engine.result_file.ResultWriter`), so memory stays
     bounded however long the run; the file appears, complete, only when the run ends (an
     interrupted run, with ``interruptible``, writes what was simulated and says so in
     ``run.completed``); on an error nothing is left behind.

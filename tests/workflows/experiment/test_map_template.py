@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from qzs.errors import OutputPathError
-from qzs.iotools.readers import EXPERIMENT_KEYS, ROLES, UNITS, load_channel_map, read_recording
+from qzs.iotools.rig import load_channel_map, read_recording
+from qzs.iotools.rig.channel_map import EXPERIMENT_KEYS, ROLES, UNITS
 from qzs.workflows.experiment.map_template import (PLACEHOLDER, channel_map_template,
                                                    write_channel_map_template)
 

@@ -16,7 +16,7 @@ from qzs.cli.experiment import add_parser, run
 from qzs.workflows.experiment.process import infer_chirp, process_experiment
 from qzs.analysis.spectral import highpass
 from qzs.errors import DataWarning
-from qzs.iotools.readers import Recording, read_recording
+from qzs.iotools.rig import Recording, read_recording
 from qzs.analysis.spectral import transmissibility
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -127,7 +127,7 @@ def test_bad_input():
         source="noise")
     with pytest.raises(DataError, match="not a rising linear chirp"):
         process_experiment(noise, fft_length=1024, n_averages=None)
-    with pytest.raises(ParameterError, match="must be a qzs.iotools.readers.Recording"):
+    with pytest.raises(ParameterError, match="must be a qzs.iotools.rig.Recording"):
         process_experiment({"time": [0, 1]})
     with pytest.raises(ParameterError, match=r"`highpass_corner` must be non-negative, got "
                                              r"-1.0; in Hz"):

@@ -4,7 +4,7 @@ The dynamics of docs/hexapod.md ("Dynamics"): a rigid platform on six single-axi
 legs (:mod:`qzs.engine.laws`: MagSpring, Stribeck friction, compliant stops, PI + active
 damping), driven by a base moving in up to six axes. The modules mirror the single axis's
 (:mod:`qzs.engine.kernels`, :mod:`~qzs.engine.prepare`, :mod:`~qzs.engine.simulate`,
-:mod:`~qzs.engine.results`), one concept each:
+:mod:`~qzs.engine.result`), one concept each:
 
 ==============  ====================================================================
 ``layout``      the packed layouts: per-leg rows, platform constants, state, outputs

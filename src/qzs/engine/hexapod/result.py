@@ -435,7 +435,7 @@ class HexapodResult:
     def to_xarray(self) -> xr.Dataset:
         """The run as an ``xarray.Dataset`` with dimensions ``time``, ``dof`` and ``leg``.
 
-        CF-1.10 as :meth:`qzs.engine.results.SimulationResult.to_xarray` (time in plain
+        CF-1.10 as :meth:`qzs.engine.result.SimulationResult.to_xarray` (time in plain
         seconds, docs/model.md §7; :func:`hexapod_schema`): every variable has ``units`` and
         ``long_name``; a ``dof`` variable mixes translations and rotations, so its ``units``
         lists one unit per dof in the order of the ``dof`` coordinate (``units_by_dof`` says

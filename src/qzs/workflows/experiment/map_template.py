@@ -1,9 +1,9 @@
 """The channel map template of ``qzs experiment``: every key the map reader accepts, commented.
 
-``qzs experiment LOG --map MAP.toml`` needs a channel map (:mod:`qzs.iotools.readers`):
+``qzs experiment LOG --map MAP.toml`` needs a channel map (:mod:`qzs.iotools.rig`):
 which signal of the log plays which role, in which unit and with which scale.
 :func:`channel_map_template` writes one from the reader's own tables
-(:data:`~qzs.iotools.readers.ROLES`, :data:`~qzs.iotools.readers.UNITS`, the ``[time]``,
+(:data:`~qzs.iotools.rig.channel_map.ROLES`, :data:`~qzs.iotools.rig.channel_map.UNITS`, the ``[time]``,
 ``[options]`` and ``[experiment]`` keys) and the experiment's defaults, so that the template
 names every key the reader takes and nothing else. The two velocity channels the experiment
 needs are active tables with a placeholder ``source``; the other roles and the optional keys
@@ -20,8 +20,8 @@ from qzs.defaults import ANALYSIS
 from qzs.errors import OutputPathError
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
-from qzs.iotools.readers import (EXPERIMENT_KEYS, NAN_POLICIES, ROLES, TIME_UNITS, UNITS,
-                                 ChannelMap)
+from qzs.iotools.rig.channel_map import (EXPERIMENT_KEYS, NAN_POLICIES, ROLES, TIME_UNITS,
+                                         UNITS, ChannelMap)
 from qzs.model.excitation import Chirp
 from qzs.workflows.experiment.process import EXPERIMENT_AVERAGES, SIGNAL_PAIRS, process_experiment
 
@@ -114,7 +114,7 @@ def channel_map_template() -> str:
         "# 3. The experiment needs base_velocity and payload_velocity, or base_acceleration and",
         "#    payload_acceleration (uncomment those two tables and delete the velocity ones).",
         "# Layout and reader: `qzs docs identification`; the reader is",
-        "# qzs.iotools.readers.load_channel_map.",
+        "# qzs.iotools.rig.load_channel_map.",
         "",
     ]
     for role in ROLES:

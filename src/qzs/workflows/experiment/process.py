@@ -6,7 +6,7 @@ velocity through a first-order 1 Hz high-pass. Both channels pass the same high-
 it cancels in their ratio in theory; in practice the band below 1.5x the corner is not
 trustworthy (tiny, phase-shifted signals) and is flagged. :func:`process_experiment`
 
-1. takes base and payload velocities (or accelerations) of a :class:`~qzs.iotools.readers.Recording`,
+1. takes base and payload velocities (or accelerations) of a :class:`~qzs.iotools.rig.Recording`,
 2. estimates their transmissibility ``sqrt(S_payload/S_base)`` (Welch, Hann window),
 3. infers the chirp from the base signal (:func:`infer_chirp`) unless it is given,
 4. simulates the model under that chirp, at the log's sample rate and length, passes the
@@ -40,7 +40,7 @@ from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
-from qzs.iotools.readers import Recording, load_channel_map, read_recording
+from qzs.iotools.rig import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.excitation import Chirp
@@ -242,7 +242,9 @@ class ExperimentResult:
             values["simulation"] = np.interp(f, self.simulated.frequency,
                                              self.simulated.magnitude)
         return to_dataset(experiment_schema(self), values,
-                          {"source": self.recording.source,
+                          {"title": f"qzs experiment: transmissibility of "
+                                    f"{self.recording.source}",
+                           "source": self.recording.source,
                            "untrusted_below": self.untrusted_below})
 
     def summary(self) -> str:
@@ -348,7 +350,8 @@ def experiment_schema(result):
     variables = [
         Variable(name="experiment", dims=("frequency",), units="1",
                  long_name="measured transmissibility sqrt(S_payload/S_base)"),
-        Variable(name="coherence", dims=("frequency",), units="1"),
+        Variable(name="coherence", dims=("frequency",), units="1",
+                 long_name="magnitude-squared coherence of payload and base"),
         Variable(name="trusted", dims=("frequency",), units="1", dtype="int8",
                  flag_meanings="untrusted trusted",
                  long_name="1 where the measured estimate is trusted (coherence, base power, "
@@ -358,7 +361,8 @@ def experiment_schema(result):
         variables.append(Variable(name="simulation", dims=("frequency",), units="1",
                                   long_name="simulated transmissibility"))
     return Schema(kind="an experiment", dimensions={"frequency": None},
-                  coordinates=(Variable(name="frequency", dims=("frequency",), units="Hz"),),
+                  coordinates=(Variable(name="frequency", dims=("frequency",), units="Hz",
+                                        long_name="frequency"),),
                   variables=variables)
 
 
@@ -468,7 +472,7 @@ def process_experiment(recording, *, highpass_corner=1.0, fft_length=ANALYSIS["f
         chirp (when it must be inferred).
     """
     if not isinstance(recording, Recording):
-        raise ParameterError(f"`recording` must be a qzs.iotools.readers.Recording, got "
+        raise ParameterError(f"`recording` must be a qzs.iotools.rig.Recording, got "
                              f"{type(recording).__name__}; read the log with read_recording.")
     corner = non_negative_real("highpass_corner", highpass_corner or 0.0, fix="in Hz")
     fft_length = _welch_setting("fft_length", fft_length, MIN_FFT_LENGTH)
@@ -574,7 +578,7 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
     log : str or Path
         The log file (.csv, .mat, .mf4, .nc).
     channel_map : str or Path
-        The channel map (TOML, see :mod:`qzs.iotools.readers`).
+        The channel map (TOML, see :mod:`qzs.iotools.rig`).
     out : str or Path
         Output folder, created if missing; checked (writable, free space) before the log
         is read.
@@ -604,7 +608,7 @@ def run_experiment(log: str | Path, channel_map: str | Path, *, out: str | Path,
         ``out`` cannot be written (checked first, :func:`qzs.iotools.paths.check_output_path`),
         ``fft_length`` below 8 or ``n_averages`` below 1 (the arguments or the map's).
     DataError
-        The log cannot be read or processed (see :func:`qzs.iotools.readers.read_recording`).
+        The log cannot be read or processed (see :func:`qzs.iotools.rig.read_recording`).
     """
     check_output_path(out, argument="out", suffixes=None, directory=True,
                       estimated_bytes=REPORT_BYTES)

@@ -70,23 +70,34 @@ def response_schema(response):
     variables += [
         Variable(name="harmonics", dims=(*points, "harmonic"), units="1",
                  long_name="payload acceleration at the harmonic over the base's fundamental"),
-        Variable(name="reason", dims=points, dtype="str"),
-        Variable(name="start", dims=points, dtype="str"),
+        Variable(name="reason", dims=points, dtype="str",
+                 long_name="why the point did not converge (empty if it did)"),
+        Variable(name="start", dims=points, dtype="str",
+                 long_name="the state the point's periodic run started from"),
         Variable(name="linear_transmissibility", dims=("linear_frequency",), units="1",
                  long_name="linearised closed loop |X/Y|")]
-    coordinates = [Variable(name="direction", dims=("direction",), dtype="str"),
-                   Variable(name="frequency", dims=("frequency",), units="Hz"),
-                   Variable(name="harmonic", dims=("harmonic",), units="1", dtype="int64"),
-                   Variable(name="linear_frequency", dims=("linear_frequency",), units="Hz")]
+    coordinates = [Variable(name="direction", dims=("direction",), dtype="str",
+                            long_name="direction of the frequency sweep"),
+                   Variable(name="frequency", dims=("frequency",), units="Hz",
+                            long_name="excitation frequency"),
+                   Variable(name="harmonic", dims=("harmonic",), units="1", dtype="int64",
+                            long_name="harmonic number (multiple of the fundamental)"),
+                   Variable(name="linear_frequency", dims=("linear_frequency",), units="Hz",
+                            long_name="frequency of the linearised model's curve")]
     if response.balance is not None:
         dimensions["balance_point"] = response.balance.frequency.size
         coordinates.append(Variable(name="balance_point", dims=("balance_point",),
-                                    dtype="int64"))
+                                    dtype="int64", units="1",
+                                    long_name="index of the point along the harmonic balance "
+                                              "curve"))
         variables += [
-            Variable(name="balance_frequency", dims=("balance_point",), units="Hz"),
+            Variable(name="balance_frequency", dims=("balance_point",), units="Hz",
+                     long_name="harmonic balance, excitation frequency"),
             Variable(name="balance_transmissibility", dims=("balance_point",), units="1",
                      long_name="harmonic balance, fundamental amplitude ratio"),
-            Variable(name="balance_relative_amplitude", dims=("balance_point",), units="m"),
+            Variable(name="balance_relative_amplitude", dims=("balance_point",), units="m",
+                     long_name="harmonic balance, fundamental amplitude of the relative "
+                               "position"),
             Variable(name="balance_stable", dims=("balance_point",), units="1", dtype="int8",
                      long_name="1 where stable (Hill)"),
             Variable(name="balance_valid", dims=("balance_point",), units="1", dtype="int8",
@@ -94,11 +105,12 @@ def response_schema(response):
     if response.chirp is not None:
         dimensions["chirp_frequency"] = response.chirp.frequency.size
         coordinates.append(Variable(name="chirp_frequency", dims=("chirp_frequency",),
-                                    units="Hz"))
+                                    units="Hz", long_name="frequency of the chirp estimate"))
         variables += [
             Variable(name="chirp_transmissibility", dims=("chirp_frequency",), units="1",
                      long_name="chirp and Welch amplitude ratio (PSD ratio)"),
-            Variable(name="chirp_trusted", dims=("chirp_frequency",), units="1", dtype="int8")]
+            Variable(name="chirp_trusted", dims=("chirp_frequency",), units="1", dtype="int8",
+                     long_name="1 where the chirp estimate is trusted")]
     return Schema(kind="a steady-state response", dimensions=dimensions,
                   coordinates=coordinates, variables=variables)
 
@@ -176,6 +188,7 @@ def write_response(response, path):
     Path
     """
     from qzs.iotools.files import atomic_path
+    from qzs.iotools.writer import write_netcdf
     from qzs.iotools.paths import check_output_path
 
     path = check_output_path(path, argument="path", suffixes=RESPONSE_SUFFIXES)
@@ -186,7 +199,7 @@ def write_response(response, path):
         return write_mat(response.to_xarray(), path)
     with atomic_path(path) as tmp:
         if suffix == ".nc":
-            response.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+            write_netcdf(response.to_xarray(), tmp)
         elif suffix == ".json":
             import json
 

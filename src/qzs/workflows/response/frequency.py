@@ -146,7 +146,7 @@ def _dft(values, bins):
 
 def _analyse(rows, flags, period_count, amplitude, motor_force_max, harmonic_count):
     """The steady-state quantities of ``period_count`` whole periods of output rows."""
-    from qzs.engine.results import CHANNELS, FLAGS
+    from qzs.engine.channels import CHANNELS, FLAGS
 
     # the kernel records at the end of each block: the last row is at phase 2*pi*count,
     # i.e. phase 0; rolled to the front, row j is at phase 2*pi*j/samples*count
@@ -194,7 +194,7 @@ def _run_frequency(task):
     final state to start the next frequency from (None after a divergence).
     """
     from qzs.engine.periodic import PeriodicRun
-    from qzs.engine.results import CHANNELS, FLAGS
+    from qzs.engine.channels import CHANNELS, FLAGS
 
     started = time.perf_counter()
     frequency, amplitude = task["frequency"], task["amplitude"]

@@ -21,7 +21,7 @@ from qzs._validation import integer, known_keys, positive_real, read_toml, real
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
-from qzs.engine.results import CHANNELS
+from qzs.engine.channels import CHANNELS
 from qzs.engine.stability import SOLVERS
 from qzs.errors import CountLimitError, ParameterError
 from qzs.iotools.shipped import resolve_shipped, shipped_files

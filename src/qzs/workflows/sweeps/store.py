@@ -33,7 +33,7 @@ import numpy as np
 from qzs._optional import require
 from qzs._version import __version__
 from qzs.engine.batch import STATS
-from qzs.engine.results import CHANNELS
+from qzs.engine.channels import CHANNELS
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
 
@@ -132,7 +132,7 @@ def schema(definition, n_time):
 
 
 def _coords(definition, columns, n_time):
-    coords = {"case": ("case", np.arange(definition.n_cases))}
+    coords = {"case": ("case", np.arange(definition.n_cases), {"long_name": "case index"})}
     for name, values in columns.items():
         values = np.asarray(values)
         if values.dtype.kind in "UO":
@@ -141,10 +141,12 @@ def _coords(definition, columns, n_time):
         coords[name] = ("case", values, {"units": units, "long_name": f"varied: {name}"}
                         if name != "sample" else {"long_name": "index of the random draw"})
     if definition.outputs["transmissibility"] or definition.outputs["coherence"]:
-        coords["frequency"] = ("frequency", definition.frequency, {"units": "Hz"})
+        coords["frequency"] = ("frequency", definition.frequency,
+                               {"units": "Hz", "long_name": "frequency"})
     if n_time:
         rate = definition.analysis["sample_rate"]
-        coords["time"] = ("time", np.arange(n_time) / rate, {"units": "s"})
+        coords["time"] = ("time", np.arange(n_time) / rate,
+                          {"units": "s", "long_name": "time since the start of the run"})
     return coords
 
 

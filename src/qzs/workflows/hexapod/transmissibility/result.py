@@ -167,12 +167,13 @@ class HexapodTransmissibility:
             ``path``.
         """
         from qzs.iotools.files import atomic_path
+        from qzs.iotools.writer import write_netcdf
 
         path = Path(path)
         if path.suffix.lower() != ".nc":
             raise ParameterError(f"`path` must end in .nc (NetCDF), got {str(path)!r}.")
         with atomic_path(path) as tmp:
-            self.to_xarray().to_netcdf(tmp, engine="h5netcdf")
+            write_netcdf(self.to_xarray(), tmp)
         return path
 
     def summary(self) -> str:

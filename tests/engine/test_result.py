@@ -1,4 +1,4 @@
-"""The result of a run (qzs.engine.results.SimulationResult): every channel an attribute and an
+"""The result of a run (qzs.engine.result.SimulationResult): every channel an attribute and an
 item, kinematics consistent with the excitation, the run's metadata, ``to_xarray`` with units."""
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ from helpers import SHORT_CHIRP
 
 import qzs
 from qzs import simulate
-from qzs.engine.results import CHANNELS, FLAGS
+from qzs.engine.channels import CHANNELS, FLAGS
 
 
 @pytest.fixture(scope="module")
