@@ -6,7 +6,7 @@ medium-priority ones) in: a single run (``qzs simulate --out``), a batch's and a
 dataset, a six-axis run (``qzs hexapod simulate --out``), a steady-state response
 (``qzs response --out``), an experiment's transmissibility, a study's curves, an
 optimisation's and a sensitivity analysis's results, and a six-axis transmissibility
-matrix. How qzs encodes what CF has no home for: docs/model.md, decision 33.
+matrix. How qzs encodes what CF has no home for: docs/model.md, decision 34.
 
 Run as a script (``python tests/test_cf_compliance.py FOLDER``) it writes each kind into
 FOLDER and prints the checker's counts per file.
@@ -181,7 +181,7 @@ KINDS = {"single_run": single_run, "streamed_run": streamed_run, "batch": batch,
 
 
 _TIME = ("elapsed run time on the dimension `time`: the checker wants a CF time coordinate "
-         "there (units '<unit> since <datetime>'), an open decision (docs/model.md, decision 33)")
+         "there (units '<unit> since <datetime>'), an open decision (docs/model.md, decision 34)")
 #: The kinds not yet compliant, with what is left (strict: fixing one fails here, so the
 #: entry must go).
 OPEN = {"single_run": _TIME, "streamed_run": _TIME, "batch": _TIME,

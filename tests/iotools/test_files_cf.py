@@ -29,7 +29,7 @@ def netcdf(run, tmp_path_factory):
 
 
 def test_parameters_are_in_containers_and_no_global_name_has_a_dot(netcdf, run):
-    """CF attribute names are letters, digits and underscores (decision 33)."""
+    """CF attribute names are letters, digits and underscores (decision 34)."""
     raw = xr.load_dataset(netcdf[1], engine="h5netcdf")
     assert not [key for key in raw.attrs if not key.replace("_", "a").isalnum()]
     assert raw.attrs["parameter_containers"].split() == ["isolator", "controller",

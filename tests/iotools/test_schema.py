@@ -238,7 +238,7 @@ def test_the_six_axis_matrix_schema_declares_units_and_flags():
 # ---------------------------------------------------------------- the file layout (CF names)
 def test_dotted_keys_go_to_containers_and_come_back(tmp_path):
     """No dot in a file's attribute names, string labels as characters, no fill value on a
-    coordinate; read back (from_file_layout) the dataset is what was written (decision 33)."""
+    coordinate; read back (from_file_layout) the dataset is what was written (decision 34)."""
     import h5py
 
     from qzs.iotools.schema import container_attributes, from_file_layout, to_file_layout
