@@ -93,7 +93,7 @@ def sweep(folder):
 
 
 def hexapod_run(folder):
-    from qzs.workflows.hexapod import load_hexapod, simulate_setup
+    from qzs.workflows.hexapod.setups import load_hexapod, simulate_setup
 
     path = folder / "platform.nc"
     simulate_setup(load_hexapod("paper_legs_cubic"), duration=0.1, dt=1e-3, out=path)
@@ -110,7 +110,7 @@ def response(folder):
 def experiment(folder):
     import qzs
     from qzs.iotools.writer import write_dataset
-    from qzs.workflows.experiment import process_experiment
+    from qzs.workflows.experiment.process import process_experiment
 
     recording = qzs.read_recording(ROOT / "examples" / "data" / "experiment.csv",
                                    ROOT / "examples" / "data" / "experiment_map.toml")
@@ -120,7 +120,7 @@ def experiment(folder):
 
 
 def curves(folder):
-    from qzs.workflows.curves import curves_dataset, write_curves
+    from qzs.workflows.paper.curves import curves_dataset, write_curves
 
     frequency = np.linspace(0.0, 20.0, 41)
     magnitude = 1.0 / np.abs(1.0 - (frequency / 3.0) ** 2 + 0.2j * frequency / 3.0)
@@ -165,8 +165,8 @@ def sensitivity(folder):
 
 
 def hexapod_transmissibility(folder):
-    from qzs.workflows.hexapod import load_hexapod
-    from qzs.workflows.hexapod_transmissibility import hexapod_transmissibility as matrix
+    from qzs.workflows.hexapod.setups import load_hexapod
+    from qzs.workflows.hexapod.transmissibility import hexapod_transmissibility as matrix
 
     result = matrix(load_hexapod("paper_legs_cubic"), axes=("z",), duration=4.0, dt=1e-3,
                     fft_length=512, workers=1)
