@@ -136,9 +136,10 @@ class _Choice:
 
 def _bar(settings, total, desc):
     """A progress bar of ``total`` runs (hidden unless ``settings.progress``)."""
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
-    return tqdm(total=total, unit="run", desc=desc, disable=not settings.progress, leave=False)
+    return progress_bar(total=total, unit="run", desc=desc, disable=not settings.progress,
+                        leave=False)
 
 
 def _search(settings, cases, kd, desc, below=None):
