@@ -153,3 +153,59 @@ def test_a_compile_inside_a_command_is_said_on_stderr_only(capsys, namespace, sa
         assert err.startswith("qzs: compiling the kernels once (about ")
         assert err.count("\n") == 1
         assert err.endswith("s)\n")  # no seconds: the compile took none
+
+
+def _warning_handler(*warnings_to_raise):
+    import warnings
+
+    def handler(args):
+        for message, category in warnings_to_raise:
+            warnings.warn(message, category, stacklevel=1)
+        print("result")
+        return 0
+    return handler
+
+
+@pytest.mark.parametrize("namespace", [dict(command="params"),  # no kernel: no compile notice
+                                       dict(command="simulate", quiet=False, json=False)])
+def test_a_warning_inside_a_command_is_one_qzs_warning_line(capsys, namespace):
+    """No category, no source file, no line number, no source text; lines joined."""
+    from qzs.errors import DataWarning
+
+    handler = _warning_handler(("3 non-finite samples\nof 1000 dropped", DataWarning),
+                               ("invalid value encountered in divide", RuntimeWarning))
+    assert run_handler(handler, argparse.Namespace(**namespace)) == 0
+    out, err = capsys.readouterr()
+    assert out == "result\n"
+    assert err.splitlines() == ["qzs: warning: 3 non-finite samples of 1000 dropped",
+                                "qzs: warning: invalid value encountered in divide"]
+    assert "test_common.py" not in err and "Warning" not in err and "warnings.warn" not in err
+
+
+def test_the_warning_display_is_python_s_again_after_the_command(capsys):
+    import warnings
+
+    before = warnings.showwarning
+    run_handler(_warning_handler(), argparse.Namespace(command="params"))
+    assert warnings.showwarning is before
+
+
+def test_a_warning_comes_above_a_progress_bar_not_inside_it(monkeypatch):
+    """The bar is cleared, the line written whole, the bar drawn again below it."""
+    import io
+    import warnings
+
+    from qzs.cli.common import show_warning
+    from qzs.engine.progress import progress_bar
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    stream = io.StringIO()
+    bar = progress_bar(total=4, desc="cases", file=stream, mininterval=0)
+    bar.update()
+    show_warning(warnings.WarningMessage("a step note", UserWarning, "x.py", 1).message,
+                 UserWarning, "x.py", 1, file=stream)
+    bar.close()
+    text = stream.getvalue()
+    assert "\nqzs: warning: a step note\n" in text.replace("\r", "\n")
+    before, _, after = text.partition("qzs: warning: a step note\n")
+    assert before.endswith("\r") and "1/4" in after  # cleared first, drawn again after

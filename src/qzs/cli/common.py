@@ -19,6 +19,7 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
 import dataclasses
 import json
 import sys
+import warnings
 
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
@@ -33,7 +34,7 @@ __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
            "add_execution_options", "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
-           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
+           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families", "show_warning"]
 
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
@@ -297,7 +298,9 @@ def run_handler(handler, args):
     """Run a subcommand's handler and map its outcome to the exit code (:data:`EXIT_CODES`).
 
     Every error ends as one line ``qzs: error: ...`` on stderr, never a traceback;
-    which exit code follows from the error's class, never from its message. When the
+    which exit code follows from the error's class, never from its message. Every warning
+    raised while it runs (ours, numpy's, xarray's, ...) is one line ``qzs: warning: ...``
+    (:func:`show_warning`), never Python's text with its source file and line. When the
     handler compiles kernels (a first run on an empty cache), a notice on stderr says so at
     once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
     with ``--quiet`` or ``--json`` the notice alone).
@@ -321,14 +324,16 @@ def run_handler(handler, args):
         ``BrokenPipeError`` is left to :func:`qzs.cli.main` (141).
     """
     try:
-        families = kernel_families(args)
-        if not families:
-            return handler(args)
-        from qzs.engine.compiling import compile_notice
+        with warnings.catch_warnings():  # restores Python's own display afterwards
+            warnings.showwarning = show_warning
+            families = kernel_families(args)
+            if not families:
+                return handler(args)
+            from qzs.engine.compiling import compile_notice
 
-        quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
-        with compile_notice(families, ticking=not quiet):
-            return handler(args)
+            quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
+            with compile_notice(families, ticking=not quiet):
+                return handler(args)
     except (SimulationError, FitError, WriteError, CompilerError) as error:  # before DataError
         return _fail(error, 1)
     except (ParameterError, DataError, MissingDependencyError) as error:
@@ -347,6 +352,32 @@ def run_handler(handler, args):
     except MemoryError as error:
         return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; "
                      f"{memory_hint(args)}", 1)
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None):
+    """Show a warning as one line ``qzs: warning: ...`` on stderr, above any progress bar.
+
+    Takes the place of :func:`warnings.showwarning` while a command runs (:func:`run_handler`):
+    the message alone, its lines joined, without the category, source file or line. Python's
+    filters still decide which warnings come, and how often.
+
+    Parameters
+    ----------
+    message : Warning or str
+        The warning.
+    category, filename, lineno, line
+        As for :func:`warnings.showwarning`; not shown.
+    file : file, optional
+        Where to write (default ``sys.stderr``).
+    """
+    text = " ".join(str(message).split())
+    stream = sys.stderr if file is None else file
+    try:
+        from tqdm.std import tqdm  # clears the bars on ``stream``, writes, draws them again
+
+        tqdm.write(f"qzs: warning: {text}", file=stream)
+    except (OSError, ValueError):  # a closed stderr: nothing to say it on
+        pass
 
 
 def _command(args):
