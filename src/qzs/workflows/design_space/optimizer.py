@@ -146,7 +146,6 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         another problem's designs.
     """
     from qzs.engine.progress import progress_bar
-
     from qzs.workflows.design_space.problem import _positive_int
     from qzs.workflows.sweeps.cluster import dask_client
 
