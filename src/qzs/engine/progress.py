@@ -79,6 +79,18 @@ class PlainProgress(std_tqdm):
 
     @staticmethod
     def status_printer(file):
+        """What tqdm displays with: each text a whole line on ``file``, an empty one nothing.
+
+        Parameters
+        ----------
+        file : file
+            The stream of the bar.
+
+        Returns
+        -------
+        callable
+            Writes one text.
+        """
         def print_line(text):
             text = str(text).strip()
             if text:
@@ -87,10 +99,22 @@ class PlainProgress(std_tqdm):
         return print_line
 
     def moveto(self, n):
-        """No cursor movement on a plain console."""
+        """No cursor movement on a plain console.
+
+        Parameters
+        ----------
+        n : int
+            Lines tqdm would move by; ignored.
+        """
 
     def clear(self, nolock=False):
-        """Nothing to clear: the lines written stay."""
+        """Nothing to clear: the lines written stay.
+
+        Parameters
+        ----------
+        nolock : bool
+            tqdm's; ignored.
+        """
 
 
 class _Lines:
