@@ -114,3 +114,37 @@ def test_a_disabled_bar_writes_nothing_even_on_a_plain_console(monkeypatch):
     stream = io.StringIO()
     _run(progress.progress_bar(total=3, desc="quiet", file=stream, disable=True))
     assert stream.getvalue() == ""
+
+
+@pytest.mark.parametrize("columns", ["0", "120"])
+def test_a_bar_without_updates_is_drawn_again_every_heartbeat_until_closed(monkeypatch, columns):
+    """A step taking seconds: the elapsed time moves on, a sign of life each interval."""
+    import time
+
+    monkeypatch.setenv("COLUMNS", columns)
+    monkeypatch.setattr(progress, "HEARTBEAT", 0.1)
+    monkeypatch.setattr(progress, "PLAIN_INTERVAL", 0.1)
+    stream = io.StringIO()
+    bar = progress.progress_bar(total=2, desc="slow", file=stream, leave=False)
+    time.sleep(0.75)
+    drawn = stream.getvalue().replace("\r", "\n").count("slow:")
+    assert 5 <= drawn <= 10  # about one per interval, not a busy loop
+    bar.close()
+    after = stream.getvalue()
+    time.sleep(0.3)
+    assert stream.getvalue() == after  # closed: the heartbeat stops
+
+
+def test_a_bar_updated_often_gets_no_extra_drawing(monkeypatch):
+    import time
+
+    monkeypatch.setenv("COLUMNS", "0")
+    monkeypatch.setattr(progress, "HEARTBEAT", 0.2)
+    monkeypatch.setattr(progress, "PLAIN_INTERVAL", 0.0)
+    stream = io.StringIO()
+    bar = progress.progress_bar(total=20, desc="busy", file=stream, leave=False)
+    for _ in range(20):
+        time.sleep(0.03)
+        bar.update()
+    bar.close()
+    assert len(stream.getvalue().splitlines()) <= 21  # the first drawing and one per update

@@ -8,18 +8,26 @@ and draws nothing at all, so a long run would be silent. There the bar is
 seconds, with no carriage return and no cursor movement. ::
 
     studies:  40%| 2/5 [00:03<00:04,  1.2case/s]
+
+A step of work can take many seconds (a figure, a loop analysis at a long delay); a bar
+not drawn for :data:`HEARTBEAT` seconds is drawn again, its elapsed time moving on, so
+that a console is never silent for longer while a bar is open (:class:`Heartbeat`).
 """
 import os
 import sys
+import threading
+import time
 
 from tqdm.auto import tqdm
 from tqdm.std import tqdm as std_tqdm
 
-__all__ = ["PLAIN_INTERVAL", "terminal_size", "plain_terminal", "PlainProgress",
-           "progress_bar"]
+__all__ = ["PLAIN_INTERVAL", "HEARTBEAT", "terminal_size", "plain_terminal", "PlainProgress",
+           "Heartbeat", "progress_bar"]
 
 #: Seconds between two plain progress lines (a 0-column console).
 PLAIN_INTERVAL = 1.0
+#: Seconds after which a bar not drawn is drawn again.
+HEARTBEAT = 1.0
 
 
 def terminal_size(stream):
@@ -134,6 +142,43 @@ class _Lines:
         return getattr(self._wrapped, name)
 
 
+class Heartbeat:
+    """Draws ``bar`` again whenever it has not been drawn for ``interval`` seconds, until the
+    bar is closed (a daemon thread; tqdm's lock keeps it from drawing over an update).
+
+    Parameters
+    ----------
+    bar : tqdm.tqdm
+        An open bar, not disabled.
+    interval : float
+        Seconds [s].
+    """
+
+    def __init__(self, bar, interval):
+        self.bar, self.interval = bar, interval
+        self.thread = threading.Thread(target=self.run, name="qzs-progress-heartbeat",
+                                       daemon=True)
+        self.thread.start()
+
+    def run(self):
+        """Until the bar is closed (tqdm disables it then): redraw it when it went quiet."""
+        bar, drawn = self.bar, 0.0
+        while True:
+            now = time.time()  # tqdm's clock
+            drawn = max(drawn, getattr(bar, "last_print_t", now),
+                        getattr(bar, "start_t", now) + getattr(bar, "delay", 0.0))
+            if now - drawn < self.interval:
+                time.sleep(self.interval - (now - drawn))
+                continue
+            if bar.disable:
+                return
+            try:
+                bar.refresh()
+            except (OSError, ValueError):  # a closed stream: nothing to draw on
+                return
+            drawn = time.time()
+
+
 def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True, file=None,
                  **options):
     """A progress bar on ``file`` (default stderr): tqdm's, or plain lines on a 0-column console.
@@ -161,9 +206,13 @@ def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True,
         The bar; a :class:`PlainProgress` where :func:`plain_terminal` holds.
     """
     stream = sys.stderr if file is None else file
-    if not disable and plain_terminal(stream):
+    if disable:
+        return tqdm(total=total, desc=desc, unit=unit, disable=True, file=file, **options)
+    if plain_terminal(stream):
         options.update(ncols=0, nrows=10 ** 6, mininterval=PLAIN_INTERVAL, dynamic_ncols=False)
-        return PlainProgress(total=total, desc=desc, unit=unit, leave=leave, file=stream,
-                             **options)
-    return tqdm(total=total, desc=desc, unit=unit, disable=disable, leave=leave, file=file,
-                **options)
+        bar = PlainProgress(total=total, desc=desc, unit=unit, leave=leave, file=stream,
+                            **options)
+    else:
+        bar = tqdm(total=total, desc=desc, unit=unit, leave=leave, file=file, **options)
+    Heartbeat(bar, HEARTBEAT)
+    return bar
