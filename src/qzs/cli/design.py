@@ -170,7 +170,7 @@ def run(args):
         stiction_range=stiction, mass_range=mass, force_steps=steps, band=band, cost=args.cost,
         controller_rate=args.controller_rate, delay=args.delay, quick=args.quick,
         damping_gain_max=args.damping_max, workers=args.workers, progress=not args.quiet)
-    written = result.save(folder, frequency_scale=args.frequency_axis)
+    written = result.save(folder, frequency_scale=args.frequency_axis, progress=not args.quiet)
     record = result.to_dict()
     record["outputs"] = {name: str(path) for name, path in written.items()}
     emit(args, result.summary() + f"\n  wrote            {written['report']}", record)

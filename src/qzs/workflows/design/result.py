@@ -103,6 +103,8 @@ class DesignResult:
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+        progress : bool
+            Show a progress bar: a step for the drawing, then one per file.
 
         Returns
         -------
@@ -147,7 +149,7 @@ class DesignResult:
         return curves_dataset(curves, attrs)
 
     def save(self, folder: str | Path,
-             frequency_scale: str | None = None) -> dict[str, Path]:
+             frequency_scale: str | None = None, progress: bool = False) -> dict[str, Path]:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
         search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
         ``folder``.
@@ -161,6 +163,8 @@ class DesignResult:
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+        progress : bool
+            Show a progress bar: a step for the drawing, then one per file.
 
         Returns
         -------
@@ -174,24 +178,35 @@ class DesignResult:
         from qzs.viz.design import plot_design
         from qzs.viz.figures import save_figure
 
+        from qzs.engine.progress import progress_bar
+
         folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
         folder.mkdir(parents=True, exist_ok=True)
         written = {}
-        for name, figure in plot_design(self, frequency_scale=frequency_scale).items():
-            path = folder / f"{name}.png"
-            save_figure(figure, path, also_svg=True)
-            plt.close(figure)
-            written[name] = path
-        curves = self.curves()
-        if curves is not None:
-            for path in write_curves(curves, folder, "damping"):
-                written[f"curves_{path.suffix.lstrip('.')}"] = path
-        record = self.to_dict()
-        with atomic_path(folder / "design.json") as tmp:
-            tmp.write_text(json_text(record), encoding="utf-8")
-        written["json"] = folder / "design.json"
-        with atomic_path(folder / "report.html") as tmp:
-            tmp.write_text(_html(self, record, written), encoding="utf-8")
-        written["report"] = folder / "report.html"
+        with progress_bar(total=None, unit="part", desc="figures and report",
+                          disable=not progress, leave=False) as bar:
+            figures = plot_design(self, frequency_scale=frequency_scale)
+            bar.total = 1 + len(figures) + 3  # the drawing, each figure, curves, json, report
+            bar.update(1)
+            for name, figure in figures.items():
+                path = folder / f"{name}.png"
+                save_figure(figure, path, also_svg=True)
+                plt.close(figure)
+                written[name] = path
+                bar.update(1)
+            curves = self.curves()
+            if curves is not None:
+                for path in write_curves(curves, folder, "damping"):
+                    written[f"curves_{path.suffix.lstrip('.')}"] = path
+            bar.update(1)
+            record = self.to_dict()
+            with atomic_path(folder / "design.json") as tmp:
+                tmp.write_text(json_text(record), encoding="utf-8")
+            written["json"] = folder / "design.json"
+            bar.update(1)
+            with atomic_path(folder / "report.html") as tmp:
+                tmp.write_text(_html(self, record, written), encoding="utf-8")
+            written["report"] = folder / "report.html"
+            bar.update(1)
         return written
 
