@@ -49,7 +49,10 @@ ENTRY_KERNELS = {
 #: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled): their compile CPU
 #: seconds (numba's compile events) scaled to the cold commands measured on 2026-11-26
 #: (benchmarks/README.md, "Cold start"); the batch kernel's from CONTRIBUTING.md's earlier
-#: figure.
+#: figure. Their ratios hold on a busy machine (each kernel 4-6 times slower at a load of 6
+#: on 2 cores); the notice multiplies them by :func:`slowdown`. Checked cold on 2026-11-28 at
+#: a load of 6 on 2 cores: ``qzs simulate`` said about 50 s and compiled for 45 s,
+#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s.
 COMPILE_SECONDS = {
     "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
     "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
