@@ -148,3 +148,23 @@ def test_a_bar_updated_often_gets_no_extra_drawing(monkeypatch):
         bar.update()
     bar.close()
     assert len(stream.getvalue().splitlines()) <= 21  # the first drawing and one per update
+
+
+def test_a_warning_comes_above_a_progress_bar_not_inside_it(monkeypatch):
+    """The bar is cleared, the line written whole, the bar drawn again below it."""
+    import io
+    import warnings
+
+    from qzs.engine.progress import progress_bar, show_warning
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    stream = io.StringIO()
+    bar = progress_bar(total=4, desc="cases", file=stream, mininterval=0)
+    bar.update()
+    show_warning(warnings.WarningMessage("a step note", UserWarning, "x.py", 1).message,
+                 UserWarning, "x.py", 1, file=stream)
+    bar.close()
+    text = stream.getvalue()
+    assert "\nqzs: warning: a step note\n" in text.replace("\r", "\n")
+    before, _, after = text.partition("qzs: warning: a step note\n")
+    assert before.endswith("\r") and "1/4" in after  # cleared first, drawn again after

@@ -23,6 +23,7 @@ import warnings
 
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
+from qzs.engine.progress import show_warning
 from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
                         ParameterError, SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
@@ -34,7 +35,7 @@ __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
            "add_execution_options", "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
-           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families", "show_warning"]
+           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
 
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
@@ -300,7 +301,7 @@ def run_handler(handler, args):
     Every error ends as one line ``qzs: error: ...`` on stderr, never a traceback;
     which exit code follows from the error's class, never from its message. Every warning
     raised while it runs (ours, numpy's, xarray's, ...) is one line ``qzs: warning: ...``
-    (:func:`show_warning`), never Python's text with its source file and line. When the
+    (:func:`qzs.engine.progress.show_warning`), never Python's text with its source file and line. When the
     handler compiles kernels (a first run on an empty cache), a notice on stderr says so at
     once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
     with ``--quiet`` or ``--json`` the notice alone).
@@ -352,32 +353,6 @@ def run_handler(handler, args):
     except MemoryError as error:
         return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; "
                      f"{memory_hint(args)}", 1)
-
-
-def show_warning(message, category, filename, lineno, file=None, line=None):
-    """Show a warning as one line ``qzs: warning: ...`` on stderr, above any progress bar.
-
-    Takes the place of :func:`warnings.showwarning` while a command runs (:func:`run_handler`):
-    the message alone, its lines joined, without the category, source file or line. Python's
-    filters still decide which warnings come, and how often.
-
-    Parameters
-    ----------
-    message : Warning or str
-        The warning.
-    category, filename, lineno, line
-        As for :func:`warnings.showwarning`; not shown.
-    file : file, optional
-        Where to write (default ``sys.stderr``).
-    """
-    text = " ".join(str(message).split())
-    stream = sys.stderr if file is None else file
-    try:
-        from tqdm.std import tqdm  # clears the bars on ``stream``, writes, draws them again
-
-        tqdm.write(f"qzs: warning: {text}", file=stream)
-    except (OSError, ValueError):  # a closed stderr: nothing to say it on
-        pass
 
 
 def _command(args):

@@ -12,17 +12,23 @@ seconds, with no carriage return and no cursor movement. ::
 A step of work can take many seconds (a figure, a loop analysis at a long delay); a bar
 not drawn for :data:`HEARTBEAT` seconds is drawn again, its elapsed time moving on, so
 that a console is never silent for longer while a bar is open (:class:`Heartbeat`).
+
+A warning meant for the user is one line ``qzs: warning: ...`` above the bars
+(:func:`show_warning`, which the command line puts in place of
+:func:`warnings.showwarning` while a command runs, and :func:`install_warning_lines` in the
+worker processes of a local Dask cluster).
 """
 import os
 import sys
 import threading
 import time
+import warnings
 
 from tqdm.auto import tqdm
 from tqdm.std import tqdm as std_tqdm
 
 __all__ = ["PLAIN_INTERVAL", "HEARTBEAT", "terminal_size", "plain_terminal", "PlainProgress",
-           "Heartbeat", "progress_bar"]
+           "Heartbeat", "progress_bar", "show_warning", "install_warning_lines"]
 
 #: Seconds between two plain progress lines (a 0-column console).
 PLAIN_INTERVAL = 1.0
@@ -216,3 +222,35 @@ def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True,
         bar = tqdm(total=total, desc=desc, unit=unit, leave=leave, file=file, **options)
     Heartbeat(bar, HEARTBEAT)
     return bar
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None):
+    """Show a warning as one line ``qzs: warning: ...`` on stderr, above any progress bar.
+
+    Takes the place of :func:`warnings.showwarning`: the message alone, its lines joined,
+    without the category, source file or line. Python's filters still decide which
+    warnings come, and how often.
+
+    Parameters
+    ----------
+    message : Warning or str
+        The warning.
+    category, filename, lineno, line
+        As for :func:`warnings.showwarning`; not shown.
+    file : file, optional
+        Where to write (default ``sys.stderr``).
+    """
+    text = " ".join(str(message).split())
+    stream = sys.stderr if file is None else file
+    try:
+        tqdm.write(f"qzs: warning: {text}", file=stream)  # clears the bars, writes, redraws
+    except (OSError, ValueError):  # a closed stderr: nothing to say it on
+        pass
+
+
+def install_warning_lines():
+    """Show every warning of this process as :func:`show_warning` does, from now on.
+
+    For worker processes (``distributed.Client.run``), whose stderr is the user's console.
+    """
+    warnings.showwarning = show_warning
