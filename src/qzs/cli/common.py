@@ -302,9 +302,8 @@ def run_handler(handler, args):
     which exit code follows from the error's class, never from its message. Every warning
     raised while it runs (ours, numpy's, xarray's, ...) is one line ``qzs: warning: ...``
     (:func:`qzs.engine.progress.show_warning`), never Python's text with its source file
-    and line. When the
-    handler compiles kernels (a first run on an empty cache), a notice on stderr says so at
-    once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
+    and line. When the handler compiles kernels (a first run on an empty cache), a notice
+    on stderr says so at once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
     with ``--quiet`` or ``--json`` the notice alone).
 
     Parameters
