@@ -103,8 +103,6 @@ class DesignResult:
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
-        progress : bool
-            Show a progress bar: a step for the drawing, then one per file.
 
         Returns
         -------
