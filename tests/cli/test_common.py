@@ -153,3 +153,38 @@ def test_a_compile_inside_a_command_is_said_on_stderr_only(capsys, namespace, sa
         assert err.startswith("qzs: compiling the kernels once (about ")
         assert err.count("\n") == 1
         assert err.endswith("s)\n")  # no seconds: the compile took none
+
+
+def _warning_handler(*warnings_to_raise):
+    import warnings
+
+    def handler(args):
+        for message, category in warnings_to_raise:
+            warnings.warn(message, category, stacklevel=1)
+        print("result")
+        return 0
+    return handler
+
+
+@pytest.mark.parametrize("namespace", [dict(command="params"),  # no kernel: no compile notice
+                                       dict(command="simulate", quiet=False, json=False)])
+def test_a_warning_inside_a_command_is_one_qzs_warning_line(capsys, namespace):
+    """No category, no source file, no line number, no source text; lines joined."""
+    from qzs.errors import DataWarning
+
+    handler = _warning_handler(("3 non-finite samples\nof 1000 dropped", DataWarning),
+                               ("invalid value encountered in divide", RuntimeWarning))
+    assert run_handler(handler, argparse.Namespace(**namespace)) == 0
+    out, err = capsys.readouterr()
+    assert out == "result\n"
+    assert err.splitlines() == ["qzs: warning: 3 non-finite samples of 1000 dropped",
+                                "qzs: warning: invalid value encountered in divide"]
+    assert "test_common.py" not in err and "Warning" not in err and "warnings.warn" not in err
+
+
+def test_the_warning_display_is_python_s_again_after_the_command(capsys):
+    import warnings
+
+    before = warnings.showwarning
+    run_handler(_warning_handler(), argparse.Namespace(command="params"))
+    assert warnings.showwarning is before

@@ -25,10 +25,10 @@ class FakeResult:
         return "qzs design (quick; 1 s)"
 
 
-def fake_write(result, folder, *, frequency_scale=None):
+def fake_write(result, folder, *, frequency_scale=None, progress=False):
     """:func:`qzs.workflows.design.result.write_design` of a :class:`FakeResult`."""
     result.saved_to = folder
-    result.frequency_scale = frequency_scale
+    result.frequency_scale, result.progress = frequency_scale, progress
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "report.html").write_text("<html></html>")
     return {"report": folder / "report.html", "json": folder / "design.json"}
@@ -54,7 +54,7 @@ def test_cli_forwards_the_options_writes_the_report_and_prints_json(monkeypatch,
     assert record["gains"] == {"pi_kp": 123.0, "pi_ki": 49.2, "damping_gain": None}
     assert record["outputs"]["report"] == str(out / "report.html")
     assert result.saved_to == out and (out / "report.html").exists()
-    assert result.frequency_scale == "linear"
+    assert result.frequency_scale == "linear" and result.progress is False  # --quiet
     assert seen["stiction_range"] == (8.0, 12.0) and seen["mass_range"] == (6.4, 6.4)
     assert seen["force_steps"] == (2.0,) and seen["band"] == (1.0, 20.0)
     assert seen["cost"] == "peak" and seen["delay"] == 0.001 and seen["quick"] is True

@@ -205,3 +205,51 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     chunks, stdout, _ = _timed_stderr(argv, env, timeout=300)
     assert b"qzs simulation" in stdout
     assert b"compiling" not in b"".join(c for _, c in chunks)
+
+
+@pytest.mark.parametrize("load, cores, factor", [(0.0, 2, 1.0), (1.0, 2, 1.0), (6.0, 2, 3.5),
+                                                 (3.0, 1, 4.0), (0.5, 8, 1.0)])
+def test_the_slowdown_is_one_core_shared_with_the_runnable_processes(load, cores, factor):
+    assert compiling.slowdown(load, cores) == pytest.approx(factor)
+
+
+def test_the_estimate_scales_with_the_machine_s_slowdown():
+    kernels = ENTRY_KERNELS["single"] + ENTRY_KERNELS["batch"]
+    total = sum(COMPILE_SECONDS[n] for n in kernels)
+    for factor in (1.0, 2.0, 3.5):
+        assert abs(estimate(kernels, factor=factor) - factor * total) <= 2.5
+
+
+def test_the_rest_is_estimated_from_compile_time_alone_not_the_run_between(monkeypatch):
+    """Kernels A and B (1 s each in the table) compile in 0.2 s each with 0.6 s of running
+    between them: the rest (C, 10 s in the table) is about 10 * 0.4 / 2 = 2 s, not the 5 s
+    the whole elapsed time would say."""
+    done = set()
+
+    class Dispatcher:
+        def __init__(self, name):
+            self.overloads = {1: 1} if name in done else {}
+
+    names = ["fake.A", "fake.B", "fake.C"]
+    for name, seconds in zip(names, (1.0, 1.0, 10.0)):
+        monkeypatch.setitem(COMPILE_SECONDS, name, seconds)
+    monkeypatch.setattr(compiling, "cold_kernels", lambda families: list(names))
+    monkeypatch.setattr(compiling, "_dispatcher", Dispatcher)
+    monkeypatch.setattr(compiling, "slowdown", lambda: 2.0)
+    notice = compiling._Notice(["single"], io.StringIO(), ticking=False)
+    assert notice.seconds is None
+    for name, gap in (("fake.A", 0.6), ("fake.B", 0.0)):
+        notice.on_start(SimpleEvent({"dispatcher": _Kernel("qzs.fake")}))
+        time.sleep(0.2)
+        done.add(name)
+        notice.on_end(SimpleEvent({}))
+        time.sleep(gap)
+    assert notice.seconds == estimate(names, factor=2.0)  # the machine's state at the notice
+    elapsed = time.perf_counter() - notice.first
+    assert 0.4 <= notice.compiled < 0.6
+    assert elapsed + 10.0 * 0.4 / 2 - 0.5 <= notice.about <= elapsed + 10.0 * 0.6 / 2 + 0.5
+
+
+class SimpleEvent:
+    def __init__(self, data):
+        self.data = data

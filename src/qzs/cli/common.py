@@ -19,9 +19,11 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
 import dataclasses
 import json
 import sys
+import warnings
 
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
+from qzs.engine.progress import show_warning
 from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
                         ParameterError, SimulationError, Terminated, WriteError)
 from qzs.iotools.config import load_config
@@ -391,9 +393,11 @@ def run_handler(handler, args):
     """Run a subcommand's handler and map its outcome to the exit code (:data:`EXIT_CODES`).
 
     Every error ends as one line ``qzs: error: ...`` on stderr, never a traceback;
-    which exit code follows from the error's class, never from its message. When the
-    handler compiles kernels (a first run on an empty cache), a notice on stderr says so at
-    once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
+    which exit code follows from the error's class, never from its message. Every warning
+    raised while it runs (ours, numpy's, xarray's, ...) is one line ``qzs: warning: ...``
+    (:func:`qzs.engine.progress.show_warning`), never Python's text with its source file
+    and line. When the handler compiles kernels (a first run on an empty cache), a notice
+    on stderr says so at once and the seconds follow while they compile (:func:`qzs.engine.compiling.compile_notice`;
     with ``--quiet`` or ``--json`` the notice alone).
 
     Parameters
@@ -415,14 +419,16 @@ def run_handler(handler, args):
         ``BrokenPipeError`` is left to :func:`qzs.cli.main` (141).
     """
     try:
-        families = kernel_families(args)
-        if not families:
-            return handler(args)
-        from qzs.engine.compiling import compile_notice
+        with warnings.catch_warnings():  # restores Python's own display afterwards
+            warnings.showwarning = show_warning
+            families = kernel_families(args)
+            if not families:
+                return handler(args)
+            from qzs.engine.compiling import compile_notice
 
-        quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
-        with compile_notice(families, ticking=not quiet):
-            return handler(args)
+            quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
+            with compile_notice(families, ticking=not quiet):
+                return handler(args)
     except (SimulationError, FitError, WriteError, CompilerError) as error:  # before DataError
         return _fail(error, 1)
     except (ParameterError, DataError, MissingDependencyError) as error:

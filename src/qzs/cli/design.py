@@ -167,7 +167,8 @@ def run(args):
         controller_rate=args.controller_rate, delay=args.delay, quick=args.quick,
         damping_gain_max=args.damping_max, workers=args.workers,
         progress=not args.quiet and not args.json)
-    written = write_design(result, folder, frequency_scale=args.frequency_axis)
+    written = write_design(result, folder, frequency_scale=args.frequency_axis,
+                           progress=not args.quiet and not args.json)
     record = result.to_dict()
     record["outputs"] = {name: str(path) for name, path in written.items()}
     emit(args, result.summary() + f"\n  wrote            {written['report']}", record)

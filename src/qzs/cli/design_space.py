@@ -106,7 +106,7 @@ def run_optimize_command(args):
         return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept in "
                              f"{store}. Continue with: qzs optimize {args.problem} --out "
                              f"{folder} --resume")
-    written = write_files(result, folder)
+    written = write_files(result, folder, progress=not args.quiet and not args.json)
     emit(args, "\n".join([result.summary(), *(f"  wrote            {path}"
                                               for path in (store, *written))]),
          {"problem": problem.name, "summary": result.summary(),

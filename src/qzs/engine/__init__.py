@@ -24,6 +24,7 @@
 ``driver``          the one run loop: plan, chunks, memory guard, preview, progress, signals
 ``periodic``        :class:`~qzs.engine.periodic.PeriodicRun`, a run advanced one period per call
 ``compiling``       :func:`~qzs.engine.compiling.compile_notice`: say so while kernels compile
+``progress``        :func:`~qzs.engine.progress.progress_bar`: tqdm's bar, or plain lines
 ``hexapod``         subpackage: :func:`simulate_hexapod`, six isolator legs under a rigid platform
 ==================  ==================================================================
 """

@@ -17,16 +17,21 @@ a warm cache prints nothing and costs nothing (no event comes).
 
 The estimate is the sum of :data:`COMPILE_SECONDS` over the family's entry kernels
 (:data:`ENTRY_KERNELS`, the kernels Python calls; their callees compile within them) whose
-cache holds no entry for this machine (:func:`cold_kernels`).
+cache holds no entry for this machine (:func:`cold_kernels`), times how much slower the
+machine is now than quiet (:func:`slowdown`: a compile runs on one core, and shares it with
+the other runnable processes). As each entry kernel is compiled, the estimate of the rest
+follows from the seconds the ones done really took in compiling (the time between
+compiles, when the run itself goes on, not counted).
 """
 import importlib
+import os
 import sys
 import threading
 import time
 from contextlib import contextmanager
 
 __all__ = ["ENTRY_KERNELS", "COMPILE_SECONDS", "NOTICE", "cold_kernels", "estimate",
-           "compile_notice"]
+           "slowdown", "compile_notice"]
 
 #: Kernel family -> the kernels Python calls (``module.function``), in the order a run
 #: compiles them. ``single``: one case (:func:`qzs.simulate`, the response's periodic runs);
@@ -44,7 +49,10 @@ ENTRY_KERNELS = {
 #: and what the kernels before it in :data:`ENTRY_KERNELS` left compiled): their compile CPU
 #: seconds (numba's compile events) scaled to the cold commands measured on 2026-11-26
 #: (benchmarks/README.md, "Cold start"); the batch kernel's from CONTRIBUTING.md's earlier
-#: figure.
+#: figure. Their ratios hold on a busy machine (each kernel 4-6 times slower at a load of 6
+#: on 2 cores); the notice multiplies them by :func:`slowdown`. Checked cold on 2026-11-28 at
+#: a load of 6 on 2 cores: ``qzs simulate`` said about 50 s and compiled for 45 s,
+#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s.
 COMPILE_SECONDS = {
     "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
     "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
@@ -97,7 +105,39 @@ def cold_kernels(families):
     return cold
 
 
-def estimate(kernels):
+def slowdown(load=None, cores=None):
+    """How many times slower than on a quiet machine a compile runs now.
+
+    A compile is one thread: with ``load`` runnable processes (the 1-minute load average)
+    on ``cores`` cores it gets ``cores / (load + 1)`` of a core when that is below one.
+
+    Parameters
+    ----------
+    load : float, optional
+        Runnable processes on average; default the machine's 1-minute load average
+        (:func:`os.getloadavg`; none where it is not known).
+    cores : int, optional
+        Cores this process may run on; default those of its affinity.
+
+    Returns
+    -------
+    float
+        At least 1.
+    """
+    if load is None:
+        try:
+            load = os.getloadavg()[0]
+        except (AttributeError, OSError):  # not known here (Windows)
+            return 1.0
+    if cores is None:
+        try:
+            cores = len(os.sched_getaffinity(0))
+        except AttributeError:
+            cores = os.cpu_count() or 1
+    return max(1.0, (load + 1.0) / max(cores, 1))
+
+
+def estimate(kernels, *, factor=1.0):
     """Seconds the ``kernels`` take to compile, rounded as a person would say it.
 
     Parameters
@@ -105,13 +145,16 @@ def estimate(kernels):
     kernels : iterable of str
         ``module.function`` names (:func:`cold_kernels`); an unknown one counts 5 s, none
         (a kernel outside :data:`ENTRY_KERNELS` compiles) 5 s.
+    factor : float
+        How much slower than :data:`COMPILE_SECONDS` (:func:`slowdown`).
 
     Returns
     -------
     int
-        The sum of :data:`COMPILE_SECONDS`, at least 5, to the nearest multiple of 5 above 10 s.
+        The sum of :data:`COMPILE_SECONDS` times ``factor``, at least 5, to the nearest
+        multiple of 5 above 10 s.
     """
-    seconds = sum(COMPILE_SECONDS.get(name, 5.0) for name in kernels)
+    seconds = factor * sum(COMPILE_SECONDS.get(name, 5.0) for name in kernels)
     if seconds <= 10.0:
         return max(5, int(round(seconds)))
     return int(5 * round(seconds / 5.0))
@@ -140,6 +183,9 @@ class _Notice:
         self.seconds = None  # the estimate said in the notice
         self.cold = []  # the entry kernels that were to compile
         self.about = None  # the estimate of the whole, rescaled as kernels finish
+        self.factor = 1.0  # the machine's slowdown when the notice came
+        self.burst = None  # when the compile under way started
+        self.compiled = 0.0  # seconds spent compiling, bursts ended
         self.line_open = False  # our own line, ticks appended, not yet ended
         self.ticked = False  # a tick was written on it
         self.bars = []  # the progress bars whose postfix shows the seconds
@@ -175,10 +221,12 @@ class _Notice:
             pass
 
     def _burst_starts(self):
+        self.burst = time.perf_counter()
         if self.first is None:
-            self.first = time.perf_counter()
+            self.first = self.burst
             self.cold = cold_kernels(self.families)
-            self.seconds = self.about = estimate(self.cold)
+            self.factor = slowdown()
+            self.seconds = self.about = estimate(self.cold, factor=self.factor)
             notice = NOTICE.format(seconds=self.seconds)
             bars = _progress_bars(self.stream)
             if bars or not self.ticking:
@@ -190,6 +238,9 @@ class _Notice:
 
     def _burst_ends(self):
         self.wake.clear()
+        if self.burst is not None:
+            self.compiled += time.perf_counter() - self.burst
+            self.burst = None
         self._rescale()
         self._end_line()
         for bar in self.bars:
@@ -200,16 +251,17 @@ class _Notice:
         self.bars = []
 
     def _rescale(self):
-        """The whole's estimate, from how much slower than :data:`COMPILE_SECONDS` it goes here."""
+        """The whole's estimate: the seconds so far, and the rest at the pace the kernels done
+        took in compiling (against :data:`COMPILE_SECONDS`)."""
         try:
             done = [name for name in self.cold if _dispatcher(name).overloads]
         except Exception:  # another numba's internals: keep the estimate
             return
         expected = sum(COMPILE_SECONDS.get(name, 5.0) for name in done)
-        if expected >= 0.5:
+        if expected >= 0.5 and self.compiled > 0.0:
             elapsed = time.perf_counter() - self.first
             rest = sum(COMPILE_SECONDS.get(name, 5.0) for name in self.cold if name not in done)
-            self.about = max(self.seconds, int(elapsed + rest * elapsed / expected + 0.5))
+            self.about = int(elapsed + rest * self.compiled / expected + 0.5)
 
     def _end_line(self):
         """End our own line: with the unit after the seconds, if any were written."""

@@ -532,9 +532,10 @@ def drive(stepper, plan, recorder, *, progress=None, interruptible=False):
     """
     bar = None
     if progress:
-        from tqdm.auto import tqdm
+        from qzs.engine.progress import progress_bar
 
-        bar = tqdm(total=plan.steps, unit="step", unit_scale=True, desc=progress, leave=False)
+        bar = progress_bar(total=plan.steps, unit="step", unit_scale=True, desc=progress,
+                           leave=False)
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="qzs-kernel")
     deferred = DeferredInterrupt(interrupt=interruptible)
     completed, interrupted, start = True, False, None

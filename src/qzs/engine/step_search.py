@@ -562,12 +562,12 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     notes = list(notes)
     bar = None
     if progress:
-        from tqdm.auto import tqdm
+        from qzs.engine.progress import progress_bar
 
         # shown after half a second: a cached or quick choice draws nothing, and a first run's
         # compile notice (qzs.engine.compiling) comes before the bar
-        bar = tqdm(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
-                   delay=0.5)
+        bar = progress_bar(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
+                           delay=0.5)
     runs, differences = {}, {}
 
     def integrate(j, members):

@@ -34,3 +34,46 @@ def test_every_delays_needed_rate_keeps_the_margins_with_that_delay(design):
             assert cd.loop_margins(controller=controller, rate=row["required_rate"],
                                    delay=row["delay"]).meets(s["gain_margin_min"],
                                                              s["phase_margin_min"])
+
+
+def test_the_margins_stage_advances_its_bar_after_every_loop_analysis(monkeypatch):
+    """Never silent: one bar step per analysis (each can take seconds), as many as announced."""
+    from types import SimpleNamespace
+
+    from qzs.workflows.design import margins as M
+
+    events = []
+
+    class Margins:
+        gain_margin = phase_margin = 1.0
+
+        def to_dict(self):
+            return {}
+
+        def meets(self, *_):
+            return True
+
+    def analysis(kind, result):
+        def run(*_, **__):
+            events.append(kind)
+            return result
+        return run
+
+    class Bar:
+        def update(self, n):
+            events.append(("step", n))
+
+    monkeypatch.setattr(M.cd, "loop_margins", analysis("margins", Margins()))
+    monkeypatch.setattr(M.cd, "required_controller_rate", analysis("rate", (100.0, "")))
+    settings = SimpleNamespace(controller_at=lambda kp, kd: None, isolator=None,
+                               controller_rate=1000.0, delay=1e-3, gain_margin_min=6.0,
+                               phase_margin_min=30.0)
+    M._margins(settings, 1.0, 2.0, Bar())
+    steps = [e for e in events if e == ("step", 1)]
+    assert len(steps) == M.margin_steps(settings)
+    assert events[-1] == ("step", 1)
+    gaps, run = [], 0  # analyses between two steps: at most two (a delay's rate and margins)
+    for event in events:
+        run = 0 if event == ("step", 1) else run + 1
+        gaps.append(run)
+    assert max(gaps) <= 2

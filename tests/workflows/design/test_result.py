@@ -66,3 +66,39 @@ def test_save_writes_the_damping_curves_the_figure_draws(design, tmp_path):
         rows = table[table[("damping_gain", "N*s/m")] == gain]
         np.testing.assert_allclose(rows[("magnitude", "1")].to_numpy(), magnitude, rtol=1e-9)
     assert "href='damping_curves.nc'" in written["report"].read_text()
+
+
+def test_saving_advances_a_progress_bar_part_by_part(design, tmp_path, monkeypatch):
+    """Never silent while the figures draw and the files are written: a step per part, each
+    after its file is there, the report last."""
+    from qzs.engine import progress
+
+    folder, steps, bars = tmp_path / "out", [], []
+
+    class Recorder:
+        def __init__(self, total, disable):
+            self.total, self.disable = total, disable
+
+        def update(self, n):
+            steps.append((n, {p.name for p in folder.iterdir()}))
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *_):
+            return False
+
+    def bar(*, total, disable, **_):
+        bars.append(Recorder(total, disable))
+        return bars[-1]
+
+    monkeypatch.setattr(progress, "progress_bar", bar)
+    written = design.save(folder, progress=True)
+    (recorder,) = bars
+    assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
+    figures = [name for name in written if name not in ("report", "json")
+               and not name.startswith("curves_")]
+    assert recorder.total == len(figures) + 4
+    assert steps[0][1] == set()  # the drawing, before any file
+    assert [len(files) for _, files in steps] == sorted(len(files) for _, files in steps)
+    assert "report.html" in steps[-1][1] and all("report.html" not in f for _, f in steps[:-1])

@@ -113,3 +113,34 @@ def test_the_report_states_the_chosen_design_with_units(result):
     assert f"Design {result.chosen}," in line
     assert f"pi_kp = {design['pi_kp']:.4g} N/m" in line
     assert "hunting_amplitude = " in line and " m" in line
+
+
+def test_writing_the_files_advances_a_progress_bar_file_by_file(result, tmp_path, monkeypatch):
+    """Never silent while the figure and files are written: a step after each file is there."""
+    from qzs.engine import progress
+
+    folder, steps, bars = tmp_path / "out", [], []
+
+    class Recorder:
+        def __init__(self, total, disable):
+            self.total, self.disable = total, disable
+
+        def update(self, n):
+            steps.append((n, {p.name for p in folder.iterdir()}))
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *_):
+            return False
+
+    def bar(*, total, disable, **_):
+        bars.append(Recorder(total, disable))
+        return bars[-1]
+
+    monkeypatch.setattr(progress, "progress_bar", bar)
+    written = write_files(result, folder, progress=True)
+    (recorder,) = bars
+    assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
+    assert [files for _, files in steps] == [{p.name for p in written[:k]}
+                                             for k in range(1, len(written) + 1)]

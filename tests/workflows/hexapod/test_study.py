@@ -35,3 +35,52 @@ def test_the_figure_shows_the_coupling_that_is_largest_without_units():
     assert titles == ["platform z per base z: transmissibility [-]",
                       "platform x per base x: transmissibility [-]",
                       "platform y per base x: cross-axis response [-]"]
+
+
+def test_writing_the_study_advances_a_progress_bar_file_by_file(tmp_path, monkeypatch):
+    """Never silent while the figures draw and the files are written: a step per part, each
+    after its file is there (the runs' own bars come before)."""
+    import matplotlib.pyplot as plt
+
+    from qzs.engine import progress
+    from qzs.workflows.hexapod import study
+
+    def figure_to(out, **_):
+        figure = plt.figure()
+        out.write_bytes(b"png")
+        return figure
+
+    def case():
+        return SimpleNamespace(plot=figure_to, save=lambda path: path.write_bytes(b"nc") and path,
+                               linear_stable=True, linear_natural_frequencies=[1.0],
+                               settings={"tolerance_db": 0.5}, runs={})
+
+    steps, bars = [], []
+
+    class Recorder:
+        def __init__(self, total, disable):
+            self.total, self.disable = total, disable
+
+        def update(self, n):
+            steps.append((n, sorted(p.name for p in tmp_path.iterdir())))
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *_):
+            return False
+
+    def bar(*, total, disable, **_):
+        bars.append(Recorder(total, disable))
+        return bars[-1]
+
+    monkeypatch.setattr(progress, "progress_bar", bar)
+    monkeypatch.setattr(study, "comparison_figure", lambda cases, out, **_: figure_to(out))
+    monkeypatch.setattr(study, "_markdown", lambda *_: "report")
+    monkeypatch.setattr(study, "CASES", {"PI": ("with PI", {}), "no PI": ("without", {})})
+    study.write_study_outputs({"PI": case(), "no PI": case()}, [], [], tmp_path, progress=True)
+    (recorder,) = bars
+    assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
+    assert [len(files) for _, files in steps] == list(range(1, recorder.total + 1))
+    assert "report.md" in steps[-1][1]
+    assert all("report.md" not in files for _, files in steps[:-1])

@@ -165,3 +165,44 @@ def test_the_spring_data_holds_the_points_and_the_fitted_law(tmp_path):
     written = xr.load_dataset(nc)
     assert written.attrs.pop("history").endswith("written")  # the file's own history line
     xr.testing.assert_identical(written, data)
+
+
+class _Recorder:
+    """A progress bar that records, at each step, the files the folder holds."""
+
+    def __init__(self, folder, total, disable):
+        self.folder, self.total, self.disable, self.steps = folder, total, disable, []
+
+    def update(self, n):
+        self.steps.append((n, sorted(p.name for p in self.folder.iterdir())))
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        return False
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_drawing_and_writing_advance_a_progress_bar_file_by_file(damping_study, tmp_path,
+                                                                 monkeypatch, workers):
+    """Never silent while the figures draw and the report is written: a step per part."""
+    from qzs.engine import progress
+
+    bars = []
+
+    def bar(*, total, disable, **_):
+        bars.append(_Recorder(tmp_path, total, disable))
+        return bars[-1]
+
+    monkeypatch.setattr(progress, "progress_bar", bar)
+    report.write_paper_outputs([damping_study], tmp_path, workers=workers, progress=True)
+    (recorder,) = bars
+    assert not recorder.disable
+    assert [n for n, _ in recorder.steps] == [1] * recorder.total  # each part, and all of them
+    first, *_, last = [files for _, files in recorder.steps]
+    assert "fig14_damping.png" in first and "metrics.json" not in first  # figures first
+    assert "report.html" in last and all("report.html" not in f for _, f in recorder.steps[:-1])
+    assert [len(f) for _, f in recorder.steps] == sorted(len(f) for _, f in recorder.steps)
+    report.write_paper_outputs([damping_study], tmp_path, workers=1)
+    assert bars[-1].disable  # progress=False: no bar shown

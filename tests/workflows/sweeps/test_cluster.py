@@ -58,3 +58,23 @@ def test_nothing_listening_fails_at_once():
         with dask_client(f"tcp://127.0.0.1:{port}"):
             pass
     assert time.perf_counter() - began < 5.0
+
+
+def test_the_workers_of_a_local_cluster_show_warnings_as_one_line():
+    """A warning in a worker process (its stderr is the user's console): one line, no file."""
+    import io
+    import warnings
+
+    pytest.importorskip("distributed")
+    from qzs.engine.progress import show_warning
+    from qzs.workflows.sweeps.cluster import dask_client
+
+    def display():
+        stream = io.StringIO()
+        warnings.showwarning("a band with no trusted bin", RuntimeWarning, "x.py", 394,
+                             file=stream)
+        return warnings.showwarning is show_warning, stream.getvalue()
+
+    with dask_client(workers=1) as client:
+        (shown,) = client.run(display).values()
+    assert shown == (True, "qzs: warning: a band with no trusted bin\n")

@@ -255,9 +255,9 @@ def simulate_hexapods(runs: Sequence[Mapping[str, Any]], *, workers: int | None 
             raise CaseError(i, str(error)) from error
     bar = None
     if progress:
-        from tqdm.auto import tqdm
+        from qzs.engine.progress import progress_bar
 
-        bar = tqdm(total=len(runs), unit="platform", desc="simulating hexapods")
+        bar = progress_bar(total=len(runs), unit="platform", desc="simulating hexapods")
 
     def one(arguments):
         result = simulate_hexapod(**arguments)

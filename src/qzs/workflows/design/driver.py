@@ -23,7 +23,7 @@ from qzs.workflows.design.damping_effect import _why
 from qzs.workflows.design.damping_search import _search_damping
 from qzs.workflows.design.hunting import _check_hunting
 from qzs.workflows.design.inputs import _design_settings
-from qzs.workflows.design.margins import _margins
+from qzs.workflows.design.margins import _margins, margin_steps
 from qzs.workflows.design.proportional_search import _run_cases, _search_pi, _summary
 from qzs.workflows.design.result import DesignResult
 from qzs.workflows.design.settings import BISECTIONS, DAMPING_GAIN_MAX, DAMPING_POINTS, KP_GRID
@@ -134,11 +134,12 @@ class _Choice:
     first_search: dict | None = None
 
 
-def _bar(settings, total, desc):
+def _bar(settings, total, desc, unit="run"):
     """A progress bar of ``total`` runs (hidden unless ``settings.progress``)."""
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
-    return tqdm(total=total, unit="run", desc=desc, disable=not settings.progress, leave=False)
+    return progress_bar(total=total, unit=unit, desc=desc, disable=not settings.progress,
+                        leave=False)
 
 
 def _search(settings, cases, kd, desc, below=None):
@@ -231,7 +232,11 @@ def _check_design(settings, choice, seconds):
         bar.close()
     seconds["hunting"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    margins = _margins(settings, kp, kd)
+    bar = _bar(settings, margin_steps(settings), "sampled-loop margins", unit="analysis")
+    try:
+        margins = _margins(settings, kp, kd, bar)
+    finally:
+        bar.close()
     seconds["margins"] = time.perf_counter() - clock
     clock = time.perf_counter()
     bar = _bar(settings, 40, "why damping")

@@ -167,7 +167,8 @@ class DesignResult:
             attrs.update({"band": np.asarray(band, dtype=float), "band_units": "Hz"})
         return curves_dataset(curves, attrs)
 
-    def save(self, path: str | Path, *, frequency_scale: str | None = None) -> Path:
+    def save(self, path: str | Path, *, frequency_scale: str | None = None,
+             progress: bool = False) -> Path:
         """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
         search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
         the folder ``path``.
@@ -181,17 +182,20 @@ class DesignResult:
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+        progress : bool
+            Show a progress bar: a step for the drawing, then one per file.
 
         Returns
         -------
         Path
             The folder (:func:`write_design` says which file is which).
         """
-        return write_design(self, path, frequency_scale=frequency_scale)["report"].parent
+        return write_design(self, path, frequency_scale=frequency_scale,
+                            progress=progress)["report"].parent
 
 
 def write_design(result: DesignResult, folder: str | Path, *,
-                 frequency_scale: str | None = None) -> dict[str, Path]:
+                 frequency_scale: str | None = None, progress: bool = False) -> dict[str, Path]:
     """Write what :meth:`DesignResult.save` writes; return each file by its role.
 
     Parameters
@@ -203,6 +207,8 @@ def write_design(result: DesignResult, folder: str | Path, *,
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of the transmissibility figure; default
         ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+    progress : bool
+        Show a progress bar: a step for the drawing, then one per file.
 
     Returns
     -------
@@ -212,6 +218,7 @@ def write_design(result: DesignResult, folder: str | Path, *,
     """
     import matplotlib.pyplot as plt
 
+    from qzs.engine.progress import progress_bar
     from qzs.iotools.paths import check_output_path
     from qzs.viz.design import plot_design
     from qzs.viz.figures import save_figure
@@ -219,20 +226,29 @@ def write_design(result: DesignResult, folder: str | Path, *,
     folder = check_output_path(folder, argument="folder", suffixes=None, directory=True)
     folder.mkdir(parents=True, exist_ok=True)
     written = {}
-    for name, figure in plot_design(result, frequency_scale=frequency_scale).items():
-        path = folder / f"{name}.png"
-        save_figure(figure, path, also_svg=True)
-        plt.close(figure)
-        written[name] = path
-    curves = result.curves()
-    if curves is not None:
-        for path in write_curves(curves, folder, "damping"):
-            written[f"curves_{path.suffix.lstrip('.')}"] = path
-    record = result.to_dict()
-    with atomic_path(folder / "design.json") as tmp:
-        tmp.write_text(json_text(record), encoding="utf-8")
-    written["json"] = folder / "design.json"
-    with atomic_path(folder / "report.html") as tmp:
-        tmp.write_text(_html(result, record, written), encoding="utf-8")
-    written["report"] = folder / "report.html"
+    with progress_bar(total=None, unit="part", desc="figures and report",
+                      disable=not progress, leave=False) as bar:
+        figures = plot_design(result, frequency_scale=frequency_scale)
+        bar.total = 1 + len(figures) + 3  # the drawing, each figure, curves, json, report
+        bar.update(1)
+        for name, figure in figures.items():
+            path = folder / f"{name}.png"
+            save_figure(figure, path, also_svg=True)
+            plt.close(figure)
+            written[name] = path
+            bar.update(1)
+        curves = result.curves()
+        if curves is not None:
+            for path in write_curves(curves, folder, "damping"):
+                written[f"curves_{path.suffix.lstrip('.')}"] = path
+        bar.update(1)
+        record = result.to_dict()
+        with atomic_path(folder / "design.json") as tmp:
+            tmp.write_text(json_text(record), encoding="utf-8")
+        written["json"] = folder / "design.json"
+        bar.update(1)
+        with atomic_path(folder / "report.html") as tmp:
+            tmp.write_text(_html(result, record, written), encoding="utf-8")
+        written["report"] = folder / "report.html"
+        bar.update(1)
     return written

@@ -145,8 +145,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         The store cannot be written, exists without ``resume``/``overwrite``, or holds
         another problem's designs.
     """
-    from tqdm.auto import tqdm
-
+    from qzs.engine.progress import progress_bar
     from qzs.workflows.design_space.problem import _positive_int
     from qzs.workflows.sweeps.cluster import dask_client
 
@@ -180,8 +179,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
             if dt is not None:
                 opened.set_step(dt, problem.sweep.simulation.get("step_note", ""))
         total = settings["generations"] * settings["population"] * problem.samples
-        with tqdm(total=total, unit="case", desc=problem.name, disable=not progress,
-                  dynamic_ncols=True) as bar:
+        with progress_bar(total=total, unit="case", desc=problem.name, disable=not progress,
+                          dynamic_ncols=True) as bar:
             evaluated_now, steps = _generations(problem, opened, client, threads, bar)
     return OptimizationResult.from_store(opened, problem, wall=time.perf_counter() - began,
                                          evaluated=evaluated_now, steps=steps)

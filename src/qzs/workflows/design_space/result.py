@@ -487,7 +487,8 @@ OUTPUT_FILES = ("pareto.nc", "pareto.csv", "pareto.mat", "designs.nc", "pareto.p
                 "chosen.toml", "report.md")
 
 
-def write_files(result: OptimizationResult, folder: str | Path) -> list[Path]:
+def write_files(result: OptimizationResult, folder: str | Path, *,
+                progress: bool = False) -> list[Path]:
     """Write a search's outputs into ``folder``, each file atomically.
 
     ``pareto.nc``/``.csv``/``.mat`` (the Pareto set with units), ``designs.nc`` (every
@@ -502,6 +503,8 @@ def write_files(result: OptimizationResult, folder: str | Path) -> list[Path]:
         The search.
     folder : str or Path
         Where to write; created if missing.
+    progress : bool
+        Show a progress bar, one step per file.
 
     Returns
     -------
@@ -510,18 +513,28 @@ def write_files(result: OptimizationResult, folder: str | Path) -> list[Path]:
     """
     import matplotlib.pyplot as plt
 
+    from qzs.engine.progress import progress_bar
     from qzs.iotools.files import atomic_path
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    written = [result.save(folder / name) for name in ("pareto.nc", "pareto.csv", "pareto.mat")]
-    written.append(result.save(folder / "designs.nc", pareto_only=False))
-    figure = result.plot(path=folder / "pareto.png")
-    plt.close(figure)
-    written.append(folder / "pareto.png")
-    if result.chosen is not None:
-        written.append(result.write_config(folder / "chosen.toml"))
-    with atomic_path(folder / "report.md") as tmp:
-        Path(tmp).write_text(result.report(), encoding="utf-8")
-    written.append(folder / "report.md")
+    with progress_bar(total=6 + (result.chosen is not None), unit="file", desc="writing",
+                      disable=not progress, leave=False) as bar:
+        written = []
+        for name in ("pareto.nc", "pareto.csv", "pareto.mat"):
+            written.append(result.save(folder / name))
+            bar.update(1)
+        written.append(result.save(folder / "designs.nc", pareto_only=False))
+        bar.update(1)
+        figure = result.plot(path=folder / "pareto.png")
+        plt.close(figure)
+        written.append(folder / "pareto.png")
+        bar.update(1)
+        if result.chosen is not None:
+            written.append(result.write_config(folder / "chosen.toml"))
+            bar.update(1)
+        with atomic_path(folder / "report.md") as tmp:
+            Path(tmp).write_text(result.report(), encoding="utf-8")
+        written.append(folder / "report.md")
+        bar.update(1)
     return written

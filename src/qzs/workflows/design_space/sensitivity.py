@@ -463,12 +463,12 @@ def _settings(problem, unit_samples):
 
 def _evaluate(problem, settings, plan, evaluate, client, threads, progress):
     """The metric columns of every case, by qzs or by ``evaluate``; the step fixed first."""
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
     n, metrics = len(settings), plan["metrics"]
     definition = problem.sweep
-    with tqdm(total=n, unit="case", desc=f"sensitivity ({plan['method']})",
-              disable=not progress, leave=False) as bar:
+    with progress_bar(total=n, unit="case", desc=f"sensitivity ({plan['method']})",
+                      disable=not progress, leave=False) as bar:
         if evaluate is not None:
             returned = evaluate([dict(case) for case in settings])
             values = _check_returned(returned, metrics, n)

@@ -100,7 +100,8 @@ class HexapodStudyResult:
     quick : bool
         Whether the quick runs were made.
     wall_seconds : float
-        Wall time of the runs [s].
+        Wall time of the whole [s]: the runs, the figures and the report (the files record
+        the runs' alone).
     folder : Path
         The output folder.
     files : mapping
@@ -429,9 +430,10 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
                  for axis in STUDY_AXES)
     findings = _findings(cases, rows)
     files = write_study_outputs(cases, rows, findings, folder, quick=quick, wall_seconds=wall,
-                                frequency_scale=frequency_scale)
+                                frequency_scale=frequency_scale, progress=progress)
     return HexapodStudyResult(cases=MappingProxyType(cases), rows=rows, findings=findings,
-                              quick=quick, wall_seconds=wall, folder=Path(folder),
+                              quick=quick, wall_seconds=time.perf_counter() - start,
+                              folder=Path(folder),
                               files=MappingProxyType(files))
 
 
@@ -515,7 +517,7 @@ def comparison_figure(cases, out=None, frequency_scale=None, title=None):
 
 
 def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seconds=None,
-                        frequency_scale=None):
+                        frequency_scale=None, progress=False):
     """Write the figures, matrices, ``metrics.csv``, ``metrics.json`` and ``report.md``.
 
     Parameters
@@ -535,15 +537,26 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
         (log).
+    progress : bool
+        Show a progress bar: one step per figure and per file.
 
     Returns
     -------
     dict
         Name -> path of every file written.
     """
+    from qzs.engine.progress import progress_bar
+
+    with progress_bar(total=2 * len(cases) + 4, unit="part", desc="figures and report",
+                      disable=not progress, leave=False) as bar:
+        return _write_outputs(cases, rows, findings, Path(folder), quick, wall_seconds,
+                              frequency_scale, bar)
+
+
+def _write_outputs(cases, rows, findings, folder, quick, wall_seconds, frequency_scale, bar):
+    """:func:`write_study_outputs`, advancing ``bar`` after each figure and file."""
     import matplotlib.pyplot as plt
 
-    folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     files = {}
     for label, result in cases.items():
@@ -551,15 +564,19 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
         figure = result.plot(path=folder / f"{name}.png", frequency_scale=frequency_scale)
         plt.close(figure)
         files[f"{name}.png"] = folder / f"{name}.png"
+        bar.update(1)
         files[f"{name}.nc"] = result.save(folder / f"{name}.nc")
+        bar.update(1)
     plt.close(comparison_figure(cases, out=folder / f"{_FIGURE_COMPARISON}.png",
                                 frequency_scale=frequency_scale))
+    bar.update(1)
     files[f"{_FIGURE_COMPARISON}.png"] = folder / f"{_FIGURE_COMPARISON}.png"
     files[f"{_FIGURE_COMPARISON}.svg"] = folder / f"{_FIGURE_COMPARISON}.svg"
 
     with atomic_path(folder / "metrics.csv") as tmp:
         tmp.write_text(csv_text(rows), encoding="utf-8")
     files["metrics.csv"] = folder / "metrics.csv"
+    bar.update(1)
     document = {"qzs_version": __version__, "quick": quick, "wall_seconds": wall_seconds,
                 "setup": SHIPPED_DEFAULT, "axes": list(STUDY_AXES),
                 "cases": {label: {"meaning": CASES[label][0], "overrides": CASES[label][1],
@@ -578,10 +595,12 @@ def write_study_outputs(cases, rows, findings, folder, *, quick=False, wall_seco
     with atomic_path(folder / "metrics.json") as tmp:
         tmp.write_text(json_text(document), encoding="utf-8")
     files["metrics.json"] = folder / "metrics.json"
+    bar.update(1)
     with atomic_path(folder / "report.md") as tmp:
         tmp.write_text(_markdown(cases, rows, findings, files, quick, wall_seconds),
                        encoding="utf-8")
     files["report.md"] = folder / "report.md"
+    bar.update(1)
     return files
 
 

@@ -612,26 +612,34 @@ def _settings(result):
     return {k: v[0] if len(v) == 1 else v for k, v in out.items()}
 
 
-def _draw(study_results, folder, workers, frequency_scale=None):
+def _draw(study_results, folder, workers, frequency_scale=None, bar=None):
     """Every study's figures (:func:`_figures`), in ``workers`` processes if more than one.
 
     Matplotlib holds the GIL, so figures draw in parallel only in processes; about 0.3 s
-    a figure, 3 s for the paper's on one core. Returns ``{study name: drawn}``.
+    a figure, 3 s for the paper's on one core. ``bar`` (a progress bar, optional) advances
+    by one as each study's figures are drawn. Returns ``{study name: drawn}``.
     """
+    step = (lambda: None) if bar is None else (lambda: bar.update(1))
     if workers <= 1:
-        return {r.study.name: _figures(r, folder, frequency_scale) for r in study_results}
-    from concurrent.futures import ProcessPoolExecutor
+        drawn = {}
+        for r in study_results:
+            drawn[r.study.name] = _figures(r, folder, frequency_scale)
+            step()
+        return drawn
+    from concurrent.futures import ProcessPoolExecutor, as_completed
 
     # the studies with most views first, so that no process is left with two at the end
     order = sorted(study_results, key=lambda r: -len(r.study.views or [None]))
     with ProcessPoolExecutor(max_workers=workers) as pool:
         drawn = {r.study.name: pool.submit(_figures, r, folder, frequency_scale)
                  for r in order}
+        for _ in as_completed(drawn.values()):
+            step()
         return {r.study.name: drawn[r.study.name].result() for r in study_results}
 
 
 def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None,
-                        workers=None, frequency_scale=None):
+                        workers=None, frequency_scale=None, progress=False):
     """Write figures, curves, ``metrics.json``, ``metrics.csv`` and ``report.html`` into ``folder``.
 
     The curves of each transmissibility study go to ``<study>_curves.nc`` and
@@ -653,6 +661,9 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of every figure; default each view's own, else
         ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+    progress : bool
+        Show a progress bar: one step per study's figures, per study's curves, and per
+        file of metrics and report.
 
     Returns
     -------
@@ -669,7 +680,17 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
         check_frequency_scale(frequency_scale)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    figures = _draw(study_results, folder, workers, frequency_scale)
+    from qzs.engine.progress import progress_bar
+
+    with progress_bar(total=2 * len(study_results) + 3, unit="part",
+                      desc="figures and report", disable=not progress, leave=False) as bar:
+        return _write_outputs(study_results, folder, quick, wall_seconds, workers,
+                              frequency_scale, bar)
+
+
+def _write_outputs(study_results, folder, quick, wall_seconds, workers, frequency_scale, bar):
+    """:func:`write_paper_outputs` once its arguments are checked, advancing ``bar``."""
+    figures = _draw(study_results, folder, workers, frequency_scale, bar)
     verdicts = decide_claims(study_results)
     rows = _metric_rows(study_results)
 
@@ -682,12 +703,16 @@ def write_paper_outputs(study_results, folder, *, quick=False, wall_seconds=None
                 "claims": _claims_record(verdicts), "step": step_record(study_results)}
     with atomic_path(folder / "metrics.json") as tmp:
         tmp.write_text(json_text(document), encoding="utf-8")
+    bar.update(1)
     write_table(rows, folder / "metrics.csv", units=column_unit)
+    bar.update(1)
     for result in study_results:
         write_curves(curves_of(result, quick=quick), folder, result.study.name)
+        bar.update(1)
     with atomic_path(folder / "report.html") as tmp:
         tmp.write_text(_html(study_results, figures, verdicts, quick, wall_seconds),
                        encoding="utf-8")
+    bar.update(1)
     return verdicts
 
 
@@ -939,7 +964,8 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     results : list of StudyResult
     verdicts : list of Verdict
     wall_seconds : float
-        Wall time of the runs [s].
+        Wall time of the whole [s]: the runs, the figures, the curves and the report (the
+        metrics and the report record the runs' alone).
 
     Raises
     ------
@@ -964,5 +990,6 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
                           tolerance_db=tolerance_db)
     wall = time.perf_counter() - start
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
-                                   workers=workers, frequency_scale=frequency_scale)
-    return results, verdicts, wall
+                                   workers=workers, frequency_scale=frequency_scale,
+                                   progress=progress)
+    return results, verdicts, time.perf_counter() - start

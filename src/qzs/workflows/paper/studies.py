@@ -591,7 +591,7 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     ParameterError
         Both ``dt`` and ``tolerance_db``, or a non-positive one.
     """
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
     from qzs._validation import positive_real
 
@@ -615,7 +615,7 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
             single.append(entry)
     for key in [key for key, members in groups.items() if len(members) == 1]:
         single += groups.pop(key)
-    bar = tqdm(total=len(tasks), unit="case", desc="studies", disable=not progress)
+    bar = progress_bar(total=len(tasks), unit="case", desc="studies", disable=not progress)
     start = time.perf_counter()
     pool = None
     try:

@@ -14,11 +14,11 @@ def _task(base, direction, frequency, carried):
 def _run_chains(chains, base, extra, workers, progress):
     """Run the sweeps (each a chain of frequencies) and the extra tasks; returns
     ``(points in sweep order, {name: outcome})``."""
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
     total = sum(len(c) for c in chains.values())
-    bar = tqdm(total=total, unit="frequency", desc="steady state", disable=not progress,
-               leave=False)
+    bar = progress_bar(total=total, unit="frequency", desc="steady state", disable=not progress,
+                       leave=False)
     points = {d: [] for d in chains}
     outcomes = {}
     try:

@@ -6,6 +6,7 @@ stderr what it waits for) or starts a local cluster, and closes what it opened.
 import contextlib
 
 from qzs._optional import require
+from qzs.engine.progress import install_warning_lines
 from qzs.errors import SchedulerError
 
 __all__ = ["dask_client"]
@@ -22,7 +23,10 @@ def _client(scheduler, workers):
         return _connect(Client, scheduler), None
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None,
                            processes=True)
-    return Client(cluster), cluster
+    client = Client(cluster)
+    # the workers write on the user's console: their warnings one line each, as here
+    client.run(install_warning_lines)
+    return client, cluster
 
 
 @contextlib.contextmanager

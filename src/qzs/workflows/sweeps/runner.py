@@ -53,7 +53,7 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
     dict
         ``cases`` run now, ``failed`` among them, ``steps`` and ``wall`` [s].
     """
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
     check_resume(store, "store", resume, overwrite)
     columns = sample_cases(definition)
@@ -83,9 +83,9 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
             else:
                 results = run_local(definition, batches, settings, n_time, threads)
             failed = _stored_failures(store) if done.any() else 0
-            bar = tqdm(total=definition.n_cases, initial=int(done.sum()), unit="case",
-                       desc=definition.name, disable=not progress, dynamic_ncols=True,
-                       postfix={"failed": failed})
+            bar = progress_bar(total=definition.n_cases, initial=int(done.sum()), unit="case",
+                               desc=definition.name, disable=not progress, dynamic_ncols=True,
+                               postfix={"failed": failed})
             for result in results:
                 write_batch(store, definition, result["start"], result["arrays"], n_time)
                 n = len(result["arrays"]["status"])

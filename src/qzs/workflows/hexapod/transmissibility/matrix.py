@@ -98,12 +98,12 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     axes, amplitudes, common, tasks, workers = _plan(
         setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
         estimator, floor_db, workers, progress, tolerance_db)
-    from tqdm.auto import tqdm
+    from qzs.engine.progress import progress_bar
 
     _dry_run(tasks[0])
     workers = worker_count(workers, len(tasks))
     columns = {}
-    bar = tqdm(total=len(tasks), unit="run", desc="hexapod chirps", disable=not progress)
+    bar = progress_bar(total=len(tasks), unit="run", desc="hexapod chirps", disable=not progress)
     try:
         if workers == 1:
             for task in tasks:
