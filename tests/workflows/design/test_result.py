@@ -93,7 +93,9 @@ def test_saving_advances_a_progress_bar_part_by_part(design, tmp_path, monkeypat
         return bars[-1]
 
     monkeypatch.setattr(progress, "progress_bar", bar)
-    written = design.save(folder, progress=True)
+    from qzs.workflows.design.result import write_design
+
+    written = write_design(design, folder, progress=True)
     (recorder,) = bars
     assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
     figures = [name for name in written if name not in ("report", "json")
