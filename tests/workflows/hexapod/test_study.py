@@ -45,9 +45,9 @@ def test_writing_the_study_advances_a_progress_bar_file_by_file(tmp_path, monkey
     from qzs.engine import progress
     from qzs.workflows.hexapod import study
 
-    def figure_to(out, **_):
+    def figure_to(path, **_):
         figure = plt.figure()
-        out.write_bytes(b"png")
+        path.write_bytes(b"png")
         return figure
 
     def case():
