@@ -99,3 +99,25 @@ def test_sensitivity_refuses_a_base_count_that_is_not_a_power_of_two(problem_fil
                  "--out", str(tmp_path / "s")]) == 2
     assert "power of two" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("population", ["3", "1"])
+def test_a_population_below_the_files_minimum_is_refused_by_the_flag_too(problem_file, tmp_path,
+                                                                         population, capsys):
+    out = tmp_path / "o"
+    assert main(["optimize", str(problem_file), "--population", population,
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--population" in err and population in err
+    assert ">= 4" in err and not out.exists()
+
+
+def test_a_variable_outside_the_parameters_valid_range_is_refused(tmp_path, capsys):
+    path = tmp_path / "mass.toml"
+    bad = dict(PROBLEM, variables={**PROBLEM["variables"], "mass": {"low": -6.4, "high": 6.4}})
+    path.write_text(tomli_w.dumps(bad))
+    out = tmp_path / "o"
+    assert main(["optimize", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "[variables] mass" in err and "-6.4" in err
+    assert "valid range" in err and "positive" in err and not out.exists()

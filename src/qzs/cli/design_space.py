@@ -73,10 +73,14 @@ def add_parsers(subparsers):
 
 
 def _check_counts(args):
+    from qzs.workflows.design_space.problem import MIN_POPULATION
+
     for option in ("workers", "threads", "generations", "population", "samples"):
         value = getattr(args, option, None)
-        if value is not None and value < 1:
-            raise ParameterError(f"`--{option}` must be >= 1, got {value}.")
+        least = MIN_POPULATION if option == "population" and value != 0 else 1
+        if value is not None and value < least:
+            reason = " (NSGA-II needs that many designs per generation)" if least > 1 else ""
+            raise ParameterError(f"`--{option}` must be >= {least}, got {value}{reason}.")
 
 
 def run_optimize_command(args):

@@ -25,7 +25,7 @@ import numpy as np
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
 from qzs.workflows.design_space.metrics import METRICS, evaluate, goal_values
-from qzs.workflows.design_space.problem import DesignProblem, load_problem
+from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check
 
@@ -158,6 +158,9 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
                                                 100_000)
     if population is not None:
         settings["population"] = _positive_int("optimizer", "population", population, 100_000)
+        if population < MIN_POPULATION:
+            raise ProblemError("optimizer", "population", population, "NSGA-II needs at least "
+                               f"{MIN_POPULATION} designs per generation")
     if seed is not None:
         if isinstance(seed, bool) or not isinstance(seed, int):
             raise ProblemError("optimizer", "seed", seed, "must be a whole number")

@@ -71,12 +71,14 @@ from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETER
                                              unit_draws)
 
 __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "plan_text",
-           "shipped_problems", "TABLES", "MAX_SAMPLES"]
+           "shipped_problems", "TABLES", "MAX_SAMPLES", "MIN_POPULATION"]
 
 TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
           "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis")
 #: Folder of the shipped problem files, inside the package.
 SHIPPED = "workflows/design_space/problem_files"
+#: Fewest designs per generation NSGA-II works with (the file's and the flag's minimum).
+MIN_POPULATION = 4
 #: Most Monte Carlo draws per design: each is a simulation of every design.
 MAX_SAMPLES = 1024
 _FORMAT = "qzs-problem-1"
@@ -448,6 +450,7 @@ def _variables(document, kind):
         low, high = _number(where, "low", spec["low"]), _number(where, "high", spec["high"])
         if not low < high:
             _fail("variables", name, [low, high], "empty bounds: `low` must be below `high`")
+        _within_valid_range(name, low, high)
         scale = spec.get("scale", "linear")
         if scale not in SCALES:
             _fail(where, "scale", scale, f"must be one of {SCALES}")
@@ -462,6 +465,24 @@ def _variables(document, kind):
         variables.append(Variable(name=name, low=low, high=high, scale=scale, integer=integer,
                                   units=units))
     return tuple(variables)
+
+
+def _within_valid_range(name, low, high):
+    """Refuse bounds a model parameter cannot take (``mass`` below zero): the designs there
+    would fail one by one instead of being refused before the search."""
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
+    from qzs.model.registry import update_parameters
+
+    if name not in PARAMETERS or not PARAMETERS[name].numeric:
+        return
+    for key, bound in (("low", low), ("high", high)):
+        try:
+            update_parameters(IsolatorParameters(), ControllerParameters(), {name: bound})
+        except ParameterError as error:
+            _fail("variables", name, {"low": low, "high": high},
+                  f"`{key}` = {bound!r} is outside the parameter's valid range "
+                  f"({str(error).rstrip('.')}); choose bounds inside it")
 
 
 def _uncertain(document, kind, variables):
@@ -649,9 +670,9 @@ def _problem(document, where, stem):
                                                                     " (pymoo's NSGA-II)")
         for key in ("population", "generations"):
             _positive_int("optimizer", key, optimizer[key], 100_000)
-        if optimizer["population"] < 4:
+        if optimizer["population"] < MIN_POPULATION:
             _fail("optimizer", "population", optimizer["population"], "NSGA-II needs at least "
-                                                                      "4 designs per generation")
+                  f"{MIN_POPULATION} designs per generation")
         if isinstance(optimizer["seed"], bool) or not isinstance(optimizer["seed"], int):
             _fail("optimizer", "seed", optimizer["seed"], "must be a whole number")
         sensitivity = _sensitivity(document, objectives, constraints)
