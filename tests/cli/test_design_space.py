@@ -121,3 +121,22 @@ def test_a_variable_outside_the_parameters_valid_range_is_refused(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "[variables] mass" in err and "-6.4" in err
     assert "valid range" in err and "positive" in err and not out.exists()
+
+
+def test_a_problem_of_absurdly_long_runs_is_refused_before_any_run_or_store(tmp_path, capsys):
+    path = tmp_path / "long.toml"
+    long = dict(PROBLEM, objectives=[{"metric": "transmissibility_at", "frequency": 1.0},
+                                     {"metric": "peak_stroke"}], analysis={"duration": 1e9})
+    path.write_text(tomli_w.dumps(long))
+    out = tmp_path / "o"
+    assert main(["optimize", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "`duration` = 1e+09 s" in err and "shorter" in err
+    assert not out.exists()
+    # the same duration with linear metrics only simulates nothing: no refusal
+    from qzs.workflows.design_space.optimizer import check_run_length
+    from qzs.workflows.design_space.problem import load_problem
+
+    linear = tmp_path / "linear.toml"
+    linear.write_text(tomli_w.dumps(dict(PROBLEM, analysis={"duration": 1e9})))
+    check_run_length(load_problem(linear))

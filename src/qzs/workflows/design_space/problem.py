@@ -469,7 +469,14 @@ def _variables(document, kind):
 
 def _within_valid_range(name, low, high):
     """Refuse bounds a model parameter cannot take (``mass`` below zero): the designs there
-    would fail one by one instead of being refused before the search."""
+    would fail one by one instead of being refused before the search.
+
+    Only the parameter's own range counts: a bound refused with the defaults of the others
+    (``coulomb_force`` above the default ``stiction_force``) may be fine with their values
+    in a design, which then fails alone as an infeasible case.
+    """
+    import re
+
     from qzs.model.controller import ControllerParameters
     from qzs.model.isolator import IsolatorParameters
     from qzs.model.registry import update_parameters
@@ -480,6 +487,8 @@ def _within_valid_range(name, low, high):
         try:
             update_parameters(IsolatorParameters(), ControllerParameters(), {name: bound})
         except ParameterError as error:
+            if set(re.findall(r"`([a-z_]+)`", str(error))) - {name}:
+                continue  # a relation between parameters, not this one's range
             _fail("variables", name, {"low": low, "high": high},
                   f"`{key}` = {bound!r} is outside the parameter's valid range "
                   f"({str(error).rstrip('.')}); choose bounds inside it")
