@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["decibels", "number", "json_ready", "json_text", "csv_text", "html_head",
+__all__ = ["UndefinedValue", "decibels", "number", "json_ready", "json_text", "csv_text",
+           "html_head",
            "html_table", "html_figure", "markdown_table", "footnoted", "step_line",
            "STEP_RECORD_UNITS"]
 
@@ -26,6 +27,33 @@ STEP_RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB
                      "step_error_m": "m", "step_tolerance_m": "m", "step_band_low": "Hz",
                      "step_band_high": "Hz", "step_reference_dt": "s",
                      "step_probe_duration": "s", "step_reason": ""}
+
+
+class UndefinedValue(float):
+    """A NaN that says why it is undefined: ``math.isnan`` is true, ``reason`` the why.
+
+    Its ``repr`` is ``nan (the reason)``, so a printed dict of metrics explains each of its
+    NaNs; ``str`` and number formats give ``nan``, and arithmetic gives plain NaN floats.
+
+    Parameters
+    ----------
+    reason : str
+        Why the value is undefined.
+    """
+
+    def __new__(cls, reason: str) -> "UndefinedValue":
+        value = super().__new__(cls, math.nan)
+        value.reason = str(reason)
+        return value
+
+    def __repr__(self) -> str:
+        return f"nan ({self.reason})"
+
+    def __str__(self) -> str:
+        return "nan"
+
+    def __reduce__(self):
+        return type(self), (self.reason,)
 
 
 def step_line(run):
