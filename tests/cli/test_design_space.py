@@ -140,3 +140,31 @@ def test_a_problem_of_absurdly_long_runs_is_refused_before_any_run_or_store(tmp_
     linear = tmp_path / "linear.toml"
     linear.write_text(tomli_w.dumps(dict(PROBLEM, analysis={"duration": 1e9})))
     check_run_length(load_problem(linear))
+
+
+def test_a_dry_run_speaks_in_units_and_words_and_simulates_nothing_for_linear_metrics(
+        tmp_path, capsys):
+    from qzs.model.registry import unit_of
+
+    path = tmp_path / "exc.toml"
+    document = dict(PROBLEM, variables={**PROBLEM["variables"],
+                                        "excitation.amplitude": {"low": 0.001, "high": 0.01}},
+                    uncertain={"mass": {"values": [5.0, 10.0, 15.0]},
+                               "stiction_force": {"distribution": "uniform", "low": 5.0,
+                                                  "high": 15.0}})
+    path.write_text(tomli_w.dumps(document))
+    assert main(["optimize", str(path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "{" not in out and "'values'" not in out  # no Python dict
+    amplitude = next(line for line in out.splitlines() if "excitation.amplitude" in line)
+    assert amplitude.split()[-2] == unit_of("excitation.amplitude", "chirp") == "m"
+    assert "5, 10, 15 kg" in out and "uniform 5 .. 15 N" in out
+    # every metric is linear: no excitation, duration or step to describe
+    assert "excitation," not in out and "dt" not in out and "no simulation" in out
+    # a simulated metric brings them back
+    document["objectives"] = [{"metric": "transmissibility_at", "frequency": 1.0},
+                              {"metric": "linear_transmissibility_at", "frequency": 12.0}]
+    path.write_text(tomli_w.dumps(document))
+    assert main(["optimize", str(path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "excitation," in out and "dt" in out and "no simulation" not in out

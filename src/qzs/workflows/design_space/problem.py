@@ -423,7 +423,9 @@ def _parameter_name(table, name, kind):
         hint = f" (did you mean {', '.join(close[:4])}?)" if close else ""
         _fail(table, name, name, f"not a parameter{hint}; `qzs params` lists them: "
                                  f"{', '.join(sorted(PARAMETERS))}")
-    return PARAMETERS[name].unit if name in PARAMETERS else "-"
+    from qzs.model.registry import unit_of
+
+    return unit_of(name, kind)
 
 
 def _number(table, key, value):
@@ -747,6 +749,19 @@ def _sweep(document, name, variables, uncertain, goals=None, resolved=None):
                            str(error).removeprefix("sweep definition: ")) from None
 
 
+def _spread_text(uncertain):
+    """An uncertain parameter's spread in words: ``values 5, 10, 15 kg``,
+    ``uniform 5 .. 15 N``, ``normal mean 6.4, sigma 0.2 kg``."""
+    settings, unit = dict(uncertain.settings), uncertain.units or "-"
+    if uncertain.distribution == "values":
+        return f"values {', '.join(f'{v:g}' for v in settings['values'])} {unit}"
+    if {"low", "high"} <= set(settings) and len(settings) == 2:
+        return f"{uncertain.distribution} {settings['low']:g} .. {settings['high']:g} {unit}"
+    shown = ", ".join(f"{k} {v:g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                      for k, v in settings.items())
+    return f"{uncertain.distribution} {shown} {unit}"
+
+
 def plan_text(problem: DesignProblem) -> str:
     """What a search will evaluate: variables, uncertainty, goals, cases and steps.
 
@@ -762,19 +777,24 @@ def plan_text(problem: DesignProblem) -> str:
     """
     o, a, s = problem.optimizer, problem.sweep.analysis, problem.sweep.simulation
     per_generation = o["population"] * problem.samples
+    simulates = any(METRICS[g.metric].source != "linear" for g in problem.goals)
     lines = [f"problem {problem.name!r}: {problem.title}",
              f"  NSGA-II: {o['population']} designs x {o['generations']} generations, seed "
              f"{o['seed']}; {problem.samples} draw(s) per design -> {per_generation} cases "
-             "per generation, one lockstep batch each",
-             f"  {problem.sweep.excitation_kind} excitation, {a['duration']:g} s per case, "
-             f"{a['sample_rate']:g} Hz output"]
-    lines += [f"  variable  {v.name:<22} {v.low:g} .. {v.high:g} {v.units} ({v.scale}"
+             "per generation, " + ("one lockstep batch each" if simulates else
+                                   "each from the linearised loop's closed forms")]
+    if simulates:
+        lines.append(f"  {problem.sweep.excitation_kind} excitation, {a['duration']:g} s per "
+                     f"case, {a['sample_rate']:g} Hz output")
+    lines += [f"  variable  {v.name:<22} {v.low:g} .. {v.high:g} {v.units or '-'} ({v.scale}"
               f"{', integer' if v.integer else ''})" for v in problem.variables]
-    lines += [f"  uncertain {u.name:<22} {u.distribution} {u.settings} {u.units}"
-              for u in problem.uncertain]
+    lines += [f"  uncertain {u.name:<22} {_spread_text(u)}" for u in problem.uncertain]
     lines += [f"  objective {g.describe()}" for g in problem.objectives]
     lines += [f"  constraint {g.describe()}" for g in problem.constraints]
-    if s["dt"] is not None:
+    if not simulates:
+        lines.append("  linear metrics only: no simulation (neither an excitation nor an "
+                     "integration step)")
+    elif s["dt"] is not None:
         steps = o["generations"] * per_generation * a["duration"] / s["dt"]
         lines.append(f"  dt = {s['dt']:g} s: about {steps:.3g} integration steps in all")
     else:
