@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from qzs._format import unit_label, with_unit
 from qzs._validation import read_toml
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
@@ -247,7 +248,7 @@ class Goal:
         stat = (f" (quantile {self.quantile:g})" if self.statistic == "quantile"
                 else {"mean": "", "worst": " (worst case)"}[self.statistic])
         if self.bound is None:
-            return f"{self.sense} {self.column}{stat} [{self.units}]"
+            return f"{self.sense} {unit_label(self.column + stat, self.units)}"
         op = "<=" if self.sense == "minimize" else ">="
         return f"{self.column}{stat} {op} {self.bound:g}{_unit(self.units)}"
 
@@ -393,8 +394,8 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
 
 
 def _unit(units):
-    """`` m`` for a unit after a number; nothing for a ratio (``1``)."""
-    return "" if units in ("", "1") else f" {units}"
+    """`` m`` for a unit after a number; nothing for a ratio (``1``): :func:`with_unit`."""
+    return with_unit("", units)
 
 
 def _fail(table, key, value, fix):
