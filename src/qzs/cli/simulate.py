@@ -170,7 +170,9 @@ def _check_length(excitation, settings, args):
     own = excitation.duration
     if own is not None and duration > own * (1 + 1e-12):
         return  # longer than the excitation: resolve() says so, with its length
-    fix = f"a shorter {flag.split(' of ')[0]}" + (" or a larger --dt" if args.dt else "")
+    fix = f"a shorter {flag.split(' of ')[0]}" + (
+        " or a larger --dt" if settings.get("dt") else " or a lower --sample-rate (the step is "
+                                                       "at most its period)")
     steps = duration / dt
     if not math.isfinite(steps):
         raise ParameterError(f"{flag} {float(duration):g} s at dt = {dt:g} s is more "
