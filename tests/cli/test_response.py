@@ -125,3 +125,18 @@ def test_a_response_that_cannot_end_is_refused_before_any_run(argv, names, tmp_p
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and all(name in err for name in names)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, names", [
+    (["--frequencies", "1e308"], ["frequencies", "1e+308 Hz"]),  # was an OverflowError
+    (["--range", "1e-300,1,5"], ["1e-300 Hz", "lowest frequency"]),  # was an OverflowError
+])
+def test_frequencies_no_run_can_take_are_one_clear_line(argv, names, tmp_path, monkeypatch,
+                                                        capsys):
+    from qzs.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["response", *argv, "--quiet", "--plot", "none"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and all(name in err for name in names)
+    assert list(tmp_path.iterdir()) == []

@@ -104,18 +104,29 @@ def _check_cap(frequencies, direction, dt, max_periods, max_time):
     from qzs.engine.driver import BEST_STEP_SECONDS, LONGEST_RUN
 
     frequencies = np.asarray(frequencies, dtype=float)
-    longest = min(math.inf if dt is None else dt, 1.0 / (SAMPLES_PER_PERIOD * frequencies.max()))
-    simulated = float(np.minimum(max_periods / frequencies, max_time).sum())
+    longest = min(math.inf if dt is None else dt,
+                  1.0 / (SAMPLES_PER_PERIOD * float(frequencies.max())))
+    if not longest > 0:
+        raise ParameterError(
+            f"`frequencies` reach {frequencies.max():g} Hz: {SAMPLES_PER_PERIOD} samples per "
+            "period need a step shorter than any number holds; give frequencies of the "
+            "isolator's range (up to a few hundred Hz).")
+    # whole periods: at least the settling test's, however short max_time is
+    least = CONSECUTIVE_PERIODS + MAX_PERIOD_MULTIPLE + 1
+    with np.errstate(over="ignore"):
+        periods = np.maximum(np.minimum(max_periods, np.floor(max_time * frequencies)), least)
+        simulated = float((periods / frequencies).sum())
     simulated *= 2 if direction == "both" else 1
     seconds = simulated / longest * BEST_STEP_SECONDS["single"]
     if seconds > LONGEST_RUN:
         raise ParameterError(
             f"`max_periods` = {max_periods} and `max_time` = {max_time:g} s let the "
-            f"{frequencies.size} frequencies run {simulated:.3g} s of simulated time, at least "
+            f"{frequencies.size} frequencies (from {frequencies.min():g} Hz, at least {least} "
+            f"whole periods each) run {simulated:.3g} s of simulated time, at least "
             f"{seconds / 86_400:.3g} days of computing at dt <= {longest:.3g} s even at the "
             f"kernel's best speed, should they not settle; lower `max_time` (its default, "
             f"{MIN_TIME:g}-{MAX_TIME:g} s from the loop's time constants, is enough for a "
-            "settling loop) or `max_periods`.")
+            "settling loop) or `max_periods`, or raise the lowest frequency.")
 
 
 def settle_time_cap(isolator=None, controller=None):
