@@ -40,6 +40,8 @@ class UndefinedValue(float):
         Why the value is undefined.
     """
 
+    reason: str
+
     def __new__(cls, reason: str) -> "UndefinedValue":
         value = super().__new__(cls, math.nan)
         value.reason = str(reason)
