@@ -167,3 +167,28 @@ def test_footnoted_numbers_each_reason_once_in_the_order_met():
     marks = [footnoted("—", reason, notes) for reason in ("a", "b", "a", "c")]
     assert marks == ["—<sup>1</sup>", "—<sup>2</sup>", "—<sup>1</sup>", "—<sup>3</sup>"]
     assert list(notes.items()) == [("a", 1), ("b", 2), ("c", 3)]
+
+
+def test_one_notation_for_dimensionless_units():
+    """Console values bare, labels and axes in [-]: never '0.1715 1' nor '[1]'."""
+    from qzs._format import number, unit_label, with_unit
+
+    for unit in ("1", "-", "", None):
+        assert with_unit("0.1715", unit) == "0.1715"
+        assert unit_label("transmissibility", unit) == "transmissibility [-]"
+    assert number(0.17154, 4, "1") == "0.1715"
+    assert with_unit("0.25", "m") == "0.25 m" and unit_label("stroke", "m") == "stroke [m]"
+
+
+def test_the_design_space_texts_use_the_one_notation(tmp_path):
+    import tomli_w
+
+    from qzs.workflows.design_space.problem import load_problem, plan_text
+
+    path = tmp_path / "p.toml"
+    path.write_text(tomli_w.dumps({
+        "problem": {"name": "p"}, "variables": {"pi_kp": {"low": 1.0, "high": 100.0}},
+        "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
+                       {"metric": "linear_transmissibility_at", "frequency": 12.0}]}))
+    text = plan_text(load_problem(path))
+    assert "[1]" not in text and "linear_transmissibility_at_1_hz [-]" in text

@@ -17,15 +17,84 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["decibels", "number", "json_ready", "json_text", "csv_text", "html_head",
-           "html_table", "html_figure", "markdown_table", "footnoted", "step_line",
-           "STEP_RECORD_UNITS"]
+__all__ = ["UndefinedValue", "DIMENSIONLESS", "with_unit", "unit_label", "decibels", "number",
+           "json_ready", "json_text", "csv_text", "html_head", "html_table", "html_figure",
+           "markdown_table", "footnoted", "step_line", "STEP_RECORD_UNITS"]
 
 #: Units of a step record's entries (:meth:`qzs.engine.step_search.StepChoice.attributes`).
 STEP_RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB",
                      "step_error_m": "m", "step_tolerance_m": "m", "step_band_low": "Hz",
                      "step_band_high": "Hz", "step_reference_dt": "s",
                      "step_probe_duration": "s", "step_reason": ""}
+
+
+class UndefinedValue(float):
+    """A NaN that says why it is undefined: ``math.isnan`` is true, ``reason`` the why.
+
+    Its ``repr`` is ``nan (the reason)``, so a printed dict of metrics explains each of its
+    NaNs; ``str`` and number formats give ``nan``, and arithmetic gives plain NaN floats.
+
+    Parameters
+    ----------
+    reason : str
+        Why the value is undefined.
+    """
+
+    reason: str
+
+    def __new__(cls, reason: str) -> "UndefinedValue":
+        value = super().__new__(cls, math.nan)
+        value.reason = str(reason)
+        return value
+
+    def __repr__(self) -> str:
+        return f"nan ({self.reason})"
+
+    def __str__(self) -> str:
+        return "nan"
+
+    def __reduce__(self):
+        return type(self), (self.reason,)
+
+
+#: Units that mean "no unit": CF's ``1`` (ratios, counts, flags), ``-`` and none.
+DIMENSIONLESS = frozenset({"", "1", "-"})
+
+
+def with_unit(text, unit):
+    """A number's text and its unit, the one notation everywhere: ``0.25 m``, and a
+    dimensionless value bare (``0.1715``, never ``0.1715 1``).
+
+    Parameters
+    ----------
+    text : str
+        The number as text.
+    unit : str or None
+        Its unit (``"1"``, ``"-"``, ``""`` or None: dimensionless).
+
+    Returns
+    -------
+    str
+    """
+    return text if unit is None or unit in DIMENSIONLESS else f"{text} {unit}"
+
+
+def unit_label(name, unit):
+    """A quantity's name and its unit in brackets, for axes, headings and labels:
+    ``stroke [m]``, and ``[-]`` for a dimensionless one (never ``[1]``).
+
+    Parameters
+    ----------
+    name : str
+        The quantity.
+    unit : str or None
+        Its unit (``"1"``, ``"-"``, ``""`` or None: dimensionless).
+
+    Returns
+    -------
+    str
+    """
+    return f"{name} [{'-' if unit is None or unit in DIMENSIONLESS else unit}]"
 
 
 def step_line(run):
@@ -125,7 +194,7 @@ def number(value, digits=3, unit="", *, undefined="undefined", infinite=None):
         text = f"{value:.{digits}g}"
     else:
         return str(value)
-    return f"{text} {unit}" if unit else text
+    return with_unit(text, unit)
 
 
 def json_ready(value, other=None):

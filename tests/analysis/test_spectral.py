@@ -357,3 +357,29 @@ def test_metrics_reject_bad_input(frequency, magnitude, kwargs, match):
 def test_sizing_helpers_reject_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_to_dict_gives_each_nan_its_reason():
+    """The README's promise: the metrics' dict says why a value is NaN, in the dict itself."""
+    import pickle
+
+    from qzs.analysis.spectral import UndefinedValue, transmissibility_metrics
+
+    f = np.linspace(0.0, 20.0, 401)
+    magnitude = 1.0 / np.abs(1 - (f / 3.0) ** 2 + 0.2j * f / 3.0)
+    trusted = f >= 8.0  # only above the resonance: no peak, no onset of isolation
+    metrics = transmissibility_metrics(f, magnitude, trusted=trusted, at_frequencies=(1.0, 10.0))
+    record = metrics.to_dict()
+    undefined = [name for name, value in record.items() if math.isnan(value)]
+    assert "resonance_frequency" in undefined and "transmissibility_at_1_hz" in undefined
+    assert not math.isnan(record["transmissibility_at_10_hz"])
+    for name in undefined:
+        value = record[name]
+        assert isinstance(value, UndefinedValue) and value.reason == metrics.reason(name) != ""
+        assert value.reason in repr(record)  # printed, the dict says why
+        assert str(value) == "nan" and f"{value:.3g}" == "nan"  # tables stay as they were
+        again = pickle.loads(pickle.dumps(value))
+        assert math.isnan(again) and again.reason == value.reason
+    for name in set(record) - set(undefined):
+        assert type(record[name]) is float or not isinstance(record[name], UndefinedValue)
+    assert np.isnan(np.array(list(record.values()), dtype=float)).sum() == len(undefined)

@@ -99,3 +99,72 @@ def test_sensitivity_refuses_a_base_count_that_is_not_a_power_of_two(problem_fil
                  "--out", str(tmp_path / "s")]) == 2
     assert "power of two" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("population", ["3", "1"])
+def test_a_population_below_the_files_minimum_is_refused_by_the_flag_too(problem_file, tmp_path,
+                                                                         population, capsys):
+    out = tmp_path / "o"
+    assert main(["optimize", str(problem_file), "--population", population,
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--population" in err and population in err
+    assert ">= 4" in err and not out.exists()
+
+
+def test_a_variable_outside_the_parameters_valid_range_is_refused(tmp_path, capsys):
+    path = tmp_path / "mass.toml"
+    bad = dict(PROBLEM, variables={**PROBLEM["variables"], "mass": {"low": -6.4, "high": 6.4}})
+    path.write_text(tomli_w.dumps(bad))
+    out = tmp_path / "o"
+    assert main(["optimize", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "[variables] mass" in err and "-6.4" in err
+    assert "valid range" in err and "positive" in err and not out.exists()
+
+
+def test_a_problem_of_absurdly_long_runs_is_refused_before_any_run_or_store(tmp_path, capsys):
+    path = tmp_path / "long.toml"
+    long = dict(PROBLEM, objectives=[{"metric": "transmissibility_at", "frequency": 1.0},
+                                     {"metric": "peak_stroke"}], analysis={"duration": 1e9})
+    path.write_text(tomli_w.dumps(long))
+    out = tmp_path / "o"
+    assert main(["optimize", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "`duration` = 1e+09 s" in err and "shorter" in err
+    assert not out.exists()
+    # the same duration with linear metrics only simulates nothing: no refusal
+    from qzs.workflows.design_space.optimizer import check_run_length
+    from qzs.workflows.design_space.problem import load_problem
+
+    linear = tmp_path / "linear.toml"
+    linear.write_text(tomli_w.dumps(dict(PROBLEM, analysis={"duration": 1e9})))
+    check_run_length(load_problem(linear))
+
+
+def test_a_dry_run_speaks_in_units_and_words_and_simulates_nothing_for_linear_metrics(
+        tmp_path, capsys):
+    from qzs.model.registry import unit_of
+
+    path = tmp_path / "exc.toml"
+    document = dict(PROBLEM, variables={**PROBLEM["variables"],
+                                        "excitation.amplitude": {"low": 0.001, "high": 0.01}},
+                    uncertain={"mass": {"values": [5.0, 10.0, 15.0]},
+                               "stiction_force": {"distribution": "uniform", "low": 5.0,
+                                                  "high": 15.0}})
+    path.write_text(tomli_w.dumps(document))
+    assert main(["optimize", str(path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "{" not in out and "'values'" not in out  # no Python dict
+    amplitude = next(line for line in out.splitlines() if "excitation.amplitude" in line)
+    assert amplitude.split()[-2] == unit_of("excitation.amplitude", "chirp") == "m"
+    assert "5, 10, 15 kg" in out and "uniform 5 .. 15 N" in out
+    # every metric is linear: no excitation, duration or step to describe
+    assert "excitation," not in out and "dt" not in out and "no simulation" in out
+    # a simulated metric brings them back
+    document["objectives"] = [{"metric": "transmissibility_at", "frequency": 1.0},
+                              {"metric": "linear_transmissibility_at", "frequency": 12.0}]
+    path.write_text(tomli_w.dumps(document))
+    assert main(["optimize", str(path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "excitation," in out and "dt" in out and "no simulation" not in out

@@ -291,3 +291,12 @@ def test_linear_plot_takes_the_frequency_axis_asked_for(tmp_path, monkeypatch, g
     monkeypatch.setattr(module, "plot_transmissibility_matrix", spy)
     assert main(["hexapod", "linear", "--plot", str(tmp_path / "grid.png"), *given]) == 0
     assert drawn == [{scale}]
+
+
+@pytest.mark.parametrize("command", [["hexapod", "simulate"], ["simulate"]])
+def test_an_astronomical_duration_with_out_is_one_clear_line(command, tmp_path, capsys):
+    out = tmp_path / "run.nc"
+    assert main([*command, "--duration", "1e308", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "duration" in err and "1e+308" in err
+    assert list(tmp_path.iterdir()) == []

@@ -102,3 +102,46 @@ def test_a_sigterm_landing_in_a_weakref_callback_is_not_lost():
         _restore_sigterm(previous)
     assert sys.unraisablehook is hook
     assert signal.getsignal(signal.SIGTERM) == previous
+
+
+EMPTY_ARGUMENTS = [
+    (["simulate", "--out", ""], "--out"), (["simulate", "--config", ""], "--config"),
+    (["hexapod", "simulate", "--out", ""], "--out"),
+    (["hexapod", "simulate", "--config", ""], "--config"), (["params", "--toml", ""], "--toml"),
+    (["sweep-export", ""], "STORE"), (["optimize", ""], "FILE"), (["sweep", ""], "FILE"),
+    (["experiment", "log.csv", "--map", ""], "--map"), (["simulate", "--plot", ""], "--plot"),
+    (["response", "--out", ""], "--out"), (["design", "--out", ""], "--out"),
+    (["docs", ""], "TOPIC"), (["simulate", "--set", ""], "--set"),
+]
+
+
+@pytest.mark.parametrize("argv, flag", EMPTY_ARGUMENTS)
+def test_an_empty_argument_is_refused_by_name_before_any_work(argv, flag, tmp_path,
+                                                               monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and flag in err and "empty" in err
+    assert "'.'" not in err
+    assert list(tmp_path.iterdir()) == []  # nothing written, not even a default output
+
+
+def test_text_the_console_cannot_encode_is_transliterated_not_a_traceback(monkeypatch, capsys):
+    import io
+    import sys
+
+    raw = io.BytesIO()
+    console = io.TextIOWrapper(raw, encoding="cp1252")  # a Windows console
+    monkeypatch.setattr(sys, "stdout", console)
+    assert main(["docs", "hexapod", "2"]) == 0
+    console.flush()
+    text = raw.getvalue().decode("cp1252")
+    from qzs.iotools.docs import read_topic
+
+    page = read_topic("hexapod", 2)
+    assert "\u2212" in page  # the page has the minus sign the console cannot show
+    assert text.count("?") == page.count("?")  # every character spelled, none lost
+    assert text.splitlines()[0] == page.splitlines()[0].replace("\u2212", "-")
+    minus_line = next(line for line in page.splitlines() if "\u2212" in line
+                      and line.encode("cp1252", "replace").count(b"?") == line.count("\u2212"))
+    assert minus_line.replace("\u2212", "-") in text

@@ -102,3 +102,41 @@ def test_a_curve_file_beside_the_figure_that_cannot_be_written_fails_before_any_
                  "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "--plot" in err and "resp.nc" in err
+
+
+@pytest.mark.parametrize("argv, names", [
+    # a tolerance below double precision never converges: it ran until killed
+    (["--frequencies", "2", "--periodic-tolerance", "1e-300", "--max-periods", "1000000000",
+      "--max-time", "1e9"], ["periodic_tolerance", "1e-300", "1e-12"]),
+    # converging or not, the cap alone is more than a day of computing
+    (["--frequencies", "0.1,0.2", "--max-periods", "1000000000000", "--max-time", "1e13",
+      "--dt", "1e-4"], ["max_time", "max_periods", "1e+13"]),
+])
+def test_a_response_that_cannot_end_is_refused_before_any_run(argv, names, tmp_path,
+                                                              monkeypatch, capsys):
+    import time
+
+    from qzs.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    began = time.perf_counter()
+    assert main(["response", *argv, "--quiet", "--plot", "none"]) == 2
+    assert time.perf_counter() - began < 2.0
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and all(name in err for name in names)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, names", [
+    (["--frequencies", "1e308"], ["frequencies", "1e+308 Hz"]),  # was an OverflowError
+    (["--range", "1e-300,1,5"], ["1e-300 Hz", "lowest frequency"]),  # was an OverflowError
+])
+def test_frequencies_no_run_can_take_are_one_clear_line(argv, names, tmp_path, monkeypatch,
+                                                        capsys):
+    from qzs.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["response", *argv, "--quiet", "--plot", "none"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and all(name in err for name in names)
+    assert list(tmp_path.iterdir()) == []

@@ -302,3 +302,54 @@ def test_out_mat_writes_what_matlab_and_scipy_load(tmp_path):
         assert read["parameter_units"][0, 0]["isolator"][0, 0]["mass"][0] == "kg"
         assert read["parameters"][0, 0]["run"][0, 0]["samples"][0, 0] == netcdf.sizes["time"]
     assert sorted(os.listdir(tmp_path)) == ["run.mat", "run.nc"]
+
+
+@pytest.mark.parametrize("argv, flag, top", [
+    (["--excitation", "sine", "--frequency", "4000", "--duration", "1"], "--frequency", 4000.0),
+    (["--excitation", "sine", "--frequency", "500", "--duration", "1"], "--frequency", 500.0),
+    (["--excitation", "chirp", "--f1", "900", "--excitation-duration", "20"], "--f1", 900.0),
+    (["--excitation", "sine", "--frequency", "30", "--sample-rate", "50", "--duration", "1"],
+     "--frequency", 30.0),
+])
+def test_an_excitation_the_output_rate_cannot_represent_is_refused(argv, flag, top, tmp_path,
+                                                                    monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", *argv, "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and flag in err and "--sample-rate" in err
+    assert f"{top:g} Hz" in err and f"{2 * top:g} Hz" in err  # the rate that would show it
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_excitation_below_half_the_output_rate_still_runs(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--excitation", "sine", "--frequency", "24", "--sample-rate", "50",
+                 "--duration", "0.5", "--plot", "none", "--quiet"]) == 0
+
+
+def test_an_absurd_excitation_duration_is_named_as_the_flag_given(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--excitation-duration", "1e12", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--excitation-duration 1e+12 s" in err
+    assert "--duration" not in err.replace("--excitation-duration", "")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["--excitation", "sine", "--duration", "1e308"], "--duration 1e+308 s"),
+    (["--excitation", "sine", "--duration", "10", "--dt", "1e-300"], "--dt"),
+])
+def test_a_run_of_more_steps_than_a_number_holds_is_one_clear_line(argv, named, tmp_path,
+                                                                   monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", *argv, "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and named in err and list(tmp_path.iterdir()) == []
+
+
+def test_an_absurd_sample_rate_is_named_as_what_bounds_the_step(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--sample-rate", "1e308", "--duration", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--sample-rate" in err and list(tmp_path.iterdir()) == []

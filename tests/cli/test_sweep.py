@@ -55,3 +55,16 @@ def test_sweep_export_writes_the_store_as_a_mat_file(tmp_path, capsys):
     assert read["attributes"][0, 0]["sweep_name"][0] == "tiny"
     assert main(["sweep-export", str(store), "--out", str(tmp_path / "t.nc")]) == 2
     assert "--out" in capsys.readouterr().err and not (tmp_path / "t.nc").exists()
+
+
+def test_a_sweep_of_absurdly_long_runs_leaves_no_store(sweep_file, tmp_path, capsys):
+    import tomllib
+
+    document = tomllib.loads(sweep_file.read_text())
+    document["analysis"] = {"duration": 1e9}
+    sweep_file.write_text(tomli_w.dumps(document))
+    store = tmp_path / "plan.zarr"
+    assert main(["sweep", str(sweep_file), "--out", str(store), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "`duration` = 1e+09 s" in err
+    assert not store.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["plan.toml"]

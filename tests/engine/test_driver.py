@@ -189,12 +189,13 @@ def test_a_divergence_raises_the_steppers_error_after_keeping_the_rows():
 
 
 def test_sigterm_ends_a_run_of_tiny_steps_within_seconds(tmp_path):
-    """`qzs simulate` with 1e9 steps per output sample: SIGTERM ends it within a few seconds
-    (a chunk is bounded in steps), exit 143, and nothing is left in the folder."""
+    """`qzs simulate` with 1e8 steps per output sample: SIGTERM ends it within a few seconds
+    (a chunk is bounded in steps), exit 143, and nothing is left in the folder. (The output
+    rate, 10 Hz, is above twice the sine's 1 Hz: a lower one is refused before the run.)"""
     out = tmp_path / "run.nc"
     process = subprocess.Popen(
         [sys.executable, "-m", "qzs", "simulate", "--excitation", "sine", "--dt", "1e-9",
-         "--duration", "20", "--sample-rate", "1", "--out", str(out), "--plot", "none",
+         "--duration", "20", "--sample-rate", "10", "--out", str(out), "--plot", "none",
          "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while not any(tmp_path.iterdir()) and time.monotonic() < deadline:  # the writer started

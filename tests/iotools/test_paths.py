@@ -67,3 +67,14 @@ def test_too_little_free_space_says_how_much_is_needed(tmp_path, monkeypatch):
 def test_byte_counts_in_binary_units():
     assert [format_bytes(n) for n in (0, 1023, 1024, 1536, 5 * 2 ** 30, 3 * 2 ** 50)] == [
         "0 B", "1023 B", "1.0 KiB", "1.5 KiB", "5.0 GiB", "3072.0 TiB"]
+
+
+@pytest.mark.parametrize("directory", [False, True])
+def test_an_empty_name_says_it_is_empty_not_that_it_is_a_folder(directory, tmp_path,
+                                                                 monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(OutputPathError) as caught:
+        check_output_path("", argument="--out", suffixes=None if directory else (".nc",),
+                          directory=directory)
+    assert caught.value.argument == "--out" and caught.value.value == ""
+    assert "empty" in str(caught.value) and "'.'" not in str(caught.value)

@@ -46,3 +46,29 @@ def test_the_damping_search_draws_frequency_log_by_default(frequency_axes, scale
     frequency_axes(figure.axes[1:], scale or "log")
     assert figure.axes[1].get_xlim()[0] == pytest.approx(0.0 if scale == "linear" else 0.5)
     assert figure.axes[1].get_ylabel() == "transmissibility [dB]"
+
+
+def test_an_unstable_loop_is_off_the_margin_axes():
+    """The sampled loop at 10 Hz is unstable (no margin); at 20 and 50 Hz it is stable. The
+    margin axes carry the stable rates only; the unstable one is marked along the rate axis."""
+    import math
+
+    import matplotlib.pyplot as plt
+
+    from qzs.analysis import control_design as cd
+    from qzs.model.controller import ControllerParameters
+    from qzs.viz.design import plot_margins
+
+    controller = ControllerParameters(damping_gain=200.0)
+    table = [cd.loop_margins(controller=controller, rate=rate).to_dict() for rate in (10, 20, 50)]
+    assert [t["stable"] for t in table] == [False, True, True]
+    fig = plot_margins(table, math.nan, 6.0, 30.0, 0.0)
+    for ax in fig.axes[:2]:
+        on_scale = [line for line in ax.get_lines() if line.get_transform() == ax.transData]
+        drawn = {float(x) for line in on_scale for x, y in zip(*line.get_data())
+                 if math.isfinite(y)}
+        assert 10.0 not in drawn and {20.0, 50.0} <= drawn
+        marks = [line for line in ax.get_lines() if "unstable" in line.get_label()]
+        assert len(marks) == 1 and list(marks[0].get_xdata()) == [10.0]
+        assert marks[0].get_transform() != ax.transData  # not a value on the margin scale
+    plt.close(fig)

@@ -14,6 +14,7 @@ with the reason in :attr:`TransmissibilityMetrics.reasons`.
 """
 from __future__ import annotations
 
+import math
 import numbers
 import warnings
 from dataclasses import dataclass, field
@@ -25,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import signal
 
-from qzs._format import decibels
+from qzs._format import UndefinedValue, decibels
 from qzs._validation import finite_series, integer, optional, positive_real
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
@@ -34,7 +35,8 @@ from qzs.iotools.schema import Schema, Variable, to_dataset
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum", "band_mask",
+__all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "UndefinedValue",
+           "amplitude_spectrum", "band_mask",
            "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
            "welch_average_count", "estimate_schema", "METRIC_UNITS", "metric_unit"]
@@ -679,10 +681,16 @@ class TransmissibilityMetrics:
     trusted_range: tuple = (float("nan"), float("nan"))
 
     def to_dict(self) -> dict[str, float]:
-        """Flat dict of the values; ``at`` becomes keys ``transmissibility_at_<f>_hz``."""
+        """Flat dict of the values; ``at`` becomes keys ``transmissibility_at_<f>_hz``.
+
+        A NaN is an :class:`UndefinedValue`: a float NaN that carries its reason (shown
+        when the dict is printed; ``str`` and number formats give ``nan`` as before).
+        """
         out = {name: getattr(self, name) for name in METRIC_NAMES}
         out.update({_spot_key(f): value for f, value in self.at.items()})
-        return out
+        return {name: UndefinedValue(self.reason(name) or "undefined")
+                if isinstance(value, float) and math.isnan(value) else value
+                for name, value in out.items()}
 
     def reason(self, name: str) -> str:
         """Why metric ``name`` (a key of :meth:`to_dict`) is NaN; ``""`` if it is defined.

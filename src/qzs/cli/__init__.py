@@ -46,13 +46,21 @@ Exit codes, the same for every subcommand (:data:`qzs.cli.common.EXIT_CODES`): 0
 141 the output pipe was closed by its reader (``qzs params | head -1`` ends quietly),
 143 SIGTERM (converted into :class:`qzs.errors.Terminated`, so that cleanup runs and no
 temporary file stays behind).
+
+An empty argument (``--out ''``, ``qzs sweep ''``) is refused by name before any work,
+never read as if the option were absent or as the current folder. On a console whose
+encoding cannot show a character (cp1252 on Windows has no U+2212 minus), the character
+is spelled in ASCII (``-``, ``<=``, ``phi``) instead of failing: one error handler,
+:data:`CONSOLE_ERRORS`, set on stdout and stderr here.
 """
 import argparse
+import codecs
 import os
 import re
 import signal
 import sys
 import threading
+import unicodedata
 
 from qzs._version import __version__
 from qzs.cli import (app, completion, design, design_space, docs, experiment, export, hexapod,
@@ -60,7 +68,17 @@ from qzs.cli import (app, completion, design, design_space, docs, experiment, ex
 from qzs.cli.common import EPILOG, run_handler
 from qzs.errors import Terminated
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "CONSOLE_ERRORS"]
+
+#: Name of the codec error handler that spells a character the console cannot encode.
+CONSOLE_ERRORS = "qzs-transliterate"
+#: ASCII spellings of the symbols the pages and messages use; other characters are
+#: decomposed (x-dot -> x, superscript 4 -> 4) or named (Greek phi -> phi), else ``?``.
+_ASCII = {"\u2212": "-", "\u2013": "-", "\u2014": "--", "\u2192": "->", "\u2190": "<-",
+          "\u21d2": "=>", "\u2264": "<=", "\u2265": ">=", "\u2248": "~", "\u2260": "!=",
+          "\u221e": "inf", "\u221a": "sqrt", "\u00d7": "x", "\u00b7": "*", "\u1d40": "^T",
+          "\u2213": "-+", "\u00b1": "+-", "\u221d": "~", "\u2207": "grad", "\u03a3": "Sum",
+          "\u2026": "...", "\u2018": "'", "\u2019": "'", "\u201c": '"', "\u201d": '"'}
 
 HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run,
             "study": studies.run, "experiment": experiment.run,
@@ -137,13 +155,19 @@ def main(argv=None):
         :data:`qzs.cli.common.EXIT_CODES`.
     """
     previous = _catch_sigterm()
+    _console_safe()
     try:
         try:
-            args = build_parser().parse_args(argv)
+            parser = build_parser()
+            args = parser.parse_args(argv)
         except SystemExit as exit_:  # --help, --version, usage errors (2)
             _flush_stdout()
             return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None
                                                                    else 2)
+        empty = _empty_argument(parser, args)
+        if empty is not None:
+            print(f"qzs: error: {empty}", file=sys.stderr)
+            return 2
         code = run_handler(HANDLERS[args.command], args)
         _flush_stdout()  # a closed pipe shows here, not as "Exception ignored" at exit
         return code
@@ -156,6 +180,71 @@ def main(argv=None):
         return 130
     finally:
         _restore_sigterm(previous)
+
+
+def _empty_argument(parser, args):
+    """The message for the first argument given as an empty string, or None.
+
+    An empty path would otherwise run on as if the option were absent (``--out ''``) or
+    read as the current folder (``Path('')`` is ``'.'``); no option of qzs takes an
+    empty value.
+    """
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            chosen = action.choices.get(getattr(args, action.dest, None))
+            found = None if chosen is None else _empty_argument(chosen, args)
+            if found is not None:
+                return found
+            continue
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        if not any(isinstance(item, str) and not item.strip() for item in values):
+            continue
+        if action.option_strings:
+            flag = max(action.option_strings, key=len)
+            shown = f" {action.metavar}" if isinstance(action.metavar, str) else ""
+            fix = "" if action.required else f", or leave {flag} out for its default"
+            return f"`{flag}` is empty ({value!r}); give{shown or ' a value'} after {flag}{fix}"
+        name = action.metavar if isinstance(action.metavar, str) else action.dest.upper()
+        return f"{name} is empty ({value!r}); give a non-empty {name}"
+    return None
+
+
+def _transliterate(error):
+    """Codec error handler: the unencodable characters of ``error`` spelled in ASCII."""
+    if not isinstance(error, UnicodeEncodeError):
+        raise error
+    spelled = []
+    for char in error.object[error.start:error.end]:
+        ascii_ = _ASCII.get(char)
+        if ascii_ is None:
+            decomposed = unicodedata.normalize("NFKD", char).encode("ascii", "ignore").decode()
+            if decomposed:
+                ascii_ = decomposed
+            else:
+                name = unicodedata.name(char, "")
+                ascii_ = (name.split(" LETTER ")[-1].lower() if "GREEK" in name
+                          and " LETTER " in name else "?")
+                if "CAPITAL" in name and ascii_ != "?":
+                    ascii_ = ascii_.capitalize()
+        spelled.append(ascii_)
+    return "".join(spelled), error.end
+
+
+def _console_safe():
+    """Let stdout and stderr spell in ASCII what their encoding cannot show."""
+    try:
+        codecs.lookup_error(CONSOLE_ERRORS)
+    except LookupError:
+        codecs.register_error(CONSOLE_ERRORS, _transliterate)
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "utf-8").lower().replace("_", "-")
+        if encoding in ("utf-8", "utf8") or not hasattr(stream, "reconfigure"):
+            continue
+        try:
+            stream.reconfigure(errors=CONSOLE_ERRORS)
+        except (ValueError, OSError):  # pragma: no cover - a stream that cannot change
+            pass
 
 
 def _flush_stdout():

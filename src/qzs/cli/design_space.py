@@ -71,6 +71,17 @@ def add_parsers(subparsers):
     return cmd
 
 
+def _check_counts(args):
+    from qzs.workflows.design_space.problem import MIN_POPULATION
+
+    for option in ("workers", "threads", "generations", "population", "samples"):
+        value = getattr(args, option, None)
+        least = MIN_POPULATION if option == "population" and value != 0 else 1
+        if value is not None and value < least:
+            reason = " (NSGA-II needs that many designs per generation)" if least > 1 else ""
+            raise ParameterError(f"`--{option}` must be >= {least}, got {value}{reason}.")
+
+
 def run_optimize_command(args):
     """Run ``qzs optimize`` from parsed arguments; returns the exit code.
 
@@ -87,6 +98,8 @@ def run_optimize_command(args):
     """
     from qzs.workflows.design_space import load_problem, optimize, plan_text, write_files
     from qzs.workflows.design_space.store import check, stored_generations
+
+    _check_counts(args)
 
     problem = load_problem(args.problem)
     if args.dry_run:

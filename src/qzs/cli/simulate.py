@@ -4,14 +4,17 @@
 excitation's own length (a chirp's sweep time, a random record's length) is
 ``--excitation-duration``. An option the chosen excitation does not use is an error.
 """
+import math
+
 from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
                              figure_path, parameters)
-from qzs.defaults import ACCURACY, EXCITATION
+from qzs.defaults import ACCURACY, EXCITATION, SIMULATION
 from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES
-from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, Sine, build_excitation
+from qzs.model.excitation import (EXCITATION_KINDS, EXCITATION_OPTIONS, Chirp, RandomExcitation,
+                                  Sine, build_excitation, highest_frequency)
 
 __all__ = ["add_parser", "run"]
 
@@ -121,6 +124,64 @@ def _excitation(args, table, source):
     return build_excitation(kind, options, names=names)
 
 
+def _check_output_rate(excitation, settings):
+    """Refuse an excitation at or above half the output rate: the time series cannot show it
+    (its samples would alias it to a lower frequency). Below that, the summary warns when the
+    output under-resolves it (fewer than five samples per period)."""
+    if not isinstance(excitation, (Sine, Chirp, RandomExcitation)):
+        return  # a record's bound is the Nyquist frequency of its own samples, not its content
+    rate = float(settings.get("sample_rate", SIMULATION["sample_rate"]))
+    top = highest_frequency(excitation, settings.get("duration"))
+    if top >= rate / 2:
+        flag = {Sine: "--frequency", Chirp: "--f1"}.get(type(excitation), "--f1")
+        raise ParameterError(
+            f"{flag} {top:g} Hz is at or above half the output rate (--sample-rate {rate:g} Hz "
+            f"shows at most {rate / 2:g} Hz; the samples would alias it): raise --sample-rate "
+            f"above {2 * top:g} Hz ({5 * top:g} Hz resolves it well) or lower {flag}.")
+
+
+def _check_length(excitation, settings, args):
+    """Refuse, before the step is chosen, a run that would take absurdly long, naming the
+    option that set its length. The chosen step is never longer than the output period,
+    so counting steps at the output period gives a lower bound and a certain refusal."""
+    from qzs.engine.driver import plan_run
+    from qzs.errors import RunTooLongError
+
+    duration = settings.get("duration", excitation.duration)
+    if duration is None:
+        return
+    if args.duration is not None:
+        flag = "--duration"
+    elif "duration" in settings:
+        flag = f"[simulation] duration of {args.config}"
+    elif args.excitation_duration is not None:
+        flag = "--excitation-duration"
+    else:
+        flag = f"[excitation] duration of {args.config}"
+    rate = settings.get("sample_rate", SIMULATION["sample_rate"])
+    dt = settings.get("dt") or (1.0 / rate if isinstance(rate, (int, float)) and rate > 0
+                                else None)
+    if not isinstance(duration, (int, float)) or not duration > 0 or not dt or not dt > 0:
+        return  # not a length or step at all: resolve() says what is wrong
+    own = excitation.duration
+    if own is not None and duration > own * (1 + 1e-12):
+        return  # longer than the excitation: resolve() says so, with its length
+    fix = f"a shorter {flag.split(' of ')[0]}" + (
+        " or a larger --dt" if settings.get("dt") else " or a lower --sample-rate (the step is "
+                                                       "at most its period)")
+    steps = duration / dt
+    if not math.isfinite(steps):
+        raise ParameterError(f"{flag} {float(duration):g} s at dt = {dt:g} s is more "
+                             f"integration steps than a number holds; choose {fix}.")
+    try:
+        plan_run(float(duration), float(dt), 1)
+    except RunTooLongError as error:
+        raise ParameterError(
+            f"{flag} {float(duration):g} s is at least {error.steps:.3g} integration steps "
+            f"(dt <= {error.dt:g} s): more than the day of computing qzs starts at most; "
+            f"choose {fix}.") from None
+
+
 def run(args):
     """Run ``qzs simulate`` from parsed arguments; returns the exit code (130 if interrupted).
 
@@ -155,6 +216,8 @@ def run(args):
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
+    _check_output_rate(excitation, settings)
+    _check_length(excitation, settings, args)
     plot = figure_path(args)
     if plot is not None:
         check_output(args, "--plot", plot, suffixes=PLOT_SUFFIXES)

@@ -55,8 +55,12 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
         (a :class:`~qzs.errors.ParameterError`; attributes ``argument``, ``value`` and
         ``reason``) for an unknown extension, a directory where a file must go (or the
         reverse), a parent that is a file, a folder that is not writable, too little
-        free space, or (without ``overwrite``) an output that exists.
+        free space, (without ``overwrite``) an output that exists, or an empty name (``''``,
+        which ``Path`` would read as the current folder).
     """
+    if isinstance(path, str) and not path.strip():
+        raise OutputPathError(argument, path, "is empty; give a file name" if not directory
+                              else "is empty; give a folder name")
     path = Path(path)
     value = str(path)
 

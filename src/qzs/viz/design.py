@@ -317,9 +317,10 @@ def plot_margins(table, required_rate, gain_margin_min, phase_margin_min, delay,
         values = np.array([t[key] if t[key] is not None else np.nan for t in table], float)
         finite = np.where(np.isfinite(values), values, np.nan)
         ax.plot(rates[stable], finite[stable], "o-", color="tab:blue", label="stable loop")
-        if (~stable).any():
-            ax.plot(rates[~stable], finite[~stable], "x", color="tab:red", ms=9,
-                    label="unstable loop")
+        if (~stable).any():  # no margin to draw: marked along the rate axis, off the scale
+            ax.plot(rates[~stable], np.full((~stable).sum(), 0.04), "x", color="tab:red",
+                    ms=9, transform=ax.get_xaxis_transform(), clip_on=False,
+                    label="unstable loop (no margin)")
         if np.isinf(values).any():
             top = np.nanmax(finite) if np.isfinite(finite).any() else target
             ax.plot(rates[np.isinf(values)], np.full(np.isinf(values).sum(), top), "^",

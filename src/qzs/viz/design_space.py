@@ -9,6 +9,7 @@ import itertools
 
 import numpy as np
 
+from qzs._format import unit_label
 from qzs.viz.figures import new_figure, save_figure
 
 __all__ = ["plot_pareto", "goal_label"]
@@ -28,7 +29,7 @@ def goal_label(goal):
     """
     stat = (f", quantile {goal.quantile:g}" if goal.statistic == "quantile"
             else {"mean": "", "worst": ", worst case"}[goal.statistic])
-    return f"{goal.title}{stat} [{goal.units}]"
+    return unit_label(f"{goal.title}{stat}", goal.units)
 
 
 def plot_pareto(result, ax=None, *, path=None, title=None):

@@ -8,6 +8,7 @@ same axis (a ``sigma`` near or above ``mu*`` means a non-linear or interacting e
 """
 import numpy as np
 
+from qzs._format import unit_label
 from qzs.viz.figures import new_figure, save_figure
 
 __all__ = ["plot_sensitivity", "SERIES"]
@@ -23,7 +24,7 @@ _HEIGHT = 0.38  # of one bar [in the rows' units]
 
 
 def _label(name, unit, kind):
-    text = f"{name} [{unit}]" if unit and unit not in ("1", "-") else f"{name} [-]"
+    text = unit_label(name, unit)
     return f"{text}\n(uncertain)" if kind == "uncertain" else text
 
 
@@ -115,8 +116,7 @@ def _panel(ax, result, i, unit):
                 label=label, error_kw={"elinewidth": 1.0, "ecolor": "0.15"})
         label, colour = series["sigma"]
         ax.plot(result.sigma[i, order], rows, "D", color=colour, ms=5, label=label)
-        shown = f" [{unit}]" if unit not in ("1", "") else " [-]"
-        ax.set_xlabel(f"elementary effect across the parameter's range{shown}")
+        ax.set_xlabel(unit_label("elementary effect across the parameter's range", unit))
         ax.set_xlim(left=0.0)
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
     ax.axvline(0.0, color="0.5", lw=0.8)

@@ -9,6 +9,7 @@ import json
 
 import numpy as np
 
+from qzs._format import unit_label
 from qzs.errors import ParameterError
 from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure, save_figure
 
@@ -67,7 +68,7 @@ def varied_parameters(dataset):
 def _label(dataset, name):
     variable = dataset[name]
     unit = variable.attrs.get("units", "")
-    return f"{name} [{unit}]" if unit and unit != "1" else (f"{name} [-]" if unit else name)
+    return unit_label(name, unit) if unit else name
 
 
 def _check(dataset, name, what, valid):

@@ -65,3 +65,27 @@ def test_the_required_rate_meets_the_margins_and_a_slower_one_does_not():
 def test_bad_input_names_the_argument(call, words):
     with pytest.raises(ParameterError, match=words):
         call()
+
+
+def test_an_unstable_loop_has_no_margins_only_their_reason():
+    """K T/(z - 1) with K T = 3 closes with its pole at 1 - K T = -2: unstable. |L| at the
+    -180 deg crossing (Nyquist) is K T/2 = 1.5, so a reading of 3.52 dB there is the gain
+    cut that would restore stability, not a margin; it must not look like one."""
+    gain, period = 300.0, 0.01
+    margins = cd.stability_margins_of(control.tf([gain * period], [1.0, -1.0], period))
+    assert not margins.stable and not margins.meets(gain_margin_min=0.0, phase_margin_min=0.0)
+    for name in ("gain_margin", "phase_margin", "gain_crossover_frequency",
+                 "phase_crossover_frequency"):
+        assert math.isnan(getattr(margins, name)), name
+        assert "unstable" in margins.reasons[name]
+    cut = 20 * math.log10(gain * period / 2)
+    assert f"{cut:.3g} dB" in margins.reasons["gain_margin"]
+    record = margins.to_dict()
+    assert math.isnan(record["gain_margin"]) and "unstable" in record["reasons"]["gain_margin"]
+
+
+def test_the_sampled_design_loop_that_is_unstable_has_no_gain_margin():
+    slow = cd.loop_margins(controller=ControllerParameters(damping_gain=200.0), rate=10.0)
+    assert not slow.stable and math.isnan(slow.gain_margin)
+    stable = cd.loop_margins(controller=ControllerParameters(damping_gain=200.0), rate=20.0)
+    assert stable.stable and stable.gain_margin > 0

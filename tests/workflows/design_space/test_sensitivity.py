@@ -31,14 +31,15 @@ def ishigami_indices():
 
 def ishigami_problem(**sensitivity_table):
     return {"problem": {"name": "ishigami", "title": "Ishigami function"},
-            "variables": {n: {"low": -math.pi, "high": math.pi} for n in ISHIGAMI_NAMES},
+            # the gains cannot be negative: searched on [0, 2 pi], shifted by -pi below
+            "variables": {n: {"low": 0.0, "high": 2 * math.pi} for n in ISHIGAMI_NAMES},
             "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
             "sensitivity": sensitivity_table}
 
 
 def ishigami(settings):
     """The evaluator put in place of qzs: the same cases, Ishigami's function of them."""
-    x = np.array([[case[name] for name in ISHIGAMI_NAMES] for case in settings])
+    x = np.array([[case[name] for name in ISHIGAMI_NAMES] for case in settings]) - math.pi
     y = np.sin(x[:, 0]) + A * np.sin(x[:, 1]) ** 2 + B * x[:, 2] ** 4 * np.sin(x[:, 0])
     return {ISHIGAMI_COLUMN: y}
 

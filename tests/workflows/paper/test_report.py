@@ -398,3 +398,32 @@ def test_a_bad_output_folder_fails_before_any_study_runs(tmp_path, monkeypatch, 
     with pytest.raises(OutputPathError) as caught:
         report.run_paper(["stiction"], folder, quick=True, argument="--out")
     assert (caught.value.argument, caught.value.value) == ("--out", str(folder))
+
+
+def test_the_report_says_why_its_chirp_and_natural_frequency_differ_from_the_papers_text():
+    """2015.232 s is what 122 Welch averages of 32768 samples at 1 kHz with 50 % overlap
+    need (required_duration); the table's f_n has the PI's Kp as a spring, the paper's
+    0.08 Hz is the passive isolator's, which the note computes independently."""
+    import math
+
+    from qzs.analysis.spectral import required_duration
+    from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
+    from qzs.model.controller import ControllerParameters
+    from qzs.workflows.paper.report import _case_table, _settings_table
+
+    needed = required_duration(32768, 122, 1000.0, 0.5)
+    assert math.isclose(needed, 2015.232)
+    run = dict(solver="ode3", dt=1e-4, sample_rate=1000.0, chirp_amplitude=0.01, chirp_f0=0.0,
+               chirp_f1=20.0, chirp_duration=needed, window="hann", fft_length=32768,
+               n_averages=122, overlap=0.5, coherence_min=0.9, base_share_min=1e-3)
+    result = study("a", [], [case("Kp 50", {"pi_kp": 50.0})])
+    result.cases[0].run = run
+    text = _settings_table(result)
+    assert "not the paper's 2000 s" in text and "122 complete Welch averages of 32768" in text
+    result.cases[0].run = dict(run, chirp_duration=2000.0)
+    assert "not the paper's" not in _settings_table(result)
+    table = _case_table(result)
+    passive = passive_natural_frequency(IsolatorParameters(),
+                                        ControllerParameters().position_setpoint)
+    assert "f_n with PI [Hz]" in table and "0.08 Hz" in table
+    assert f"{passive:.3g} Hz for Kp 50" in table and 0.07 <= passive <= 0.09

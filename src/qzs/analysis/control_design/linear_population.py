@@ -131,7 +131,8 @@ class PopulationMargins:
     Attributes
     ----------
     stable : ndarray of bool
-        The closed loop is stable.
+        The closed loop is stable; where it is not, the margins and crossovers are NaN (an
+        unstable loop has none).
     gain_margin : ndarray
         [dB]; ``inf`` where the phase never reaches -180 deg.
     phase_margin : ndarray
@@ -334,5 +335,7 @@ def population_margins(isolators=None, controllers=None, *, constants=None):
         stable[k], gm[k], pm[k] = margins.stable, margins.gain_margin, margins.phase_margin
         f_gc[k] = margins.gain_crossover_frequency
         f_pc[k] = margins.phase_crossover_frequency
+    for values in (gm, pm, f_gc, f_pc):  # an unstable loop has no margins (as loop_margins)
+        values[~stable] = np.nan
     return PopulationMargins(stable=stable, gain_margin=gm, phase_margin=pm,
                              gain_crossover_frequency=f_gc, phase_crossover_frequency=f_pc)

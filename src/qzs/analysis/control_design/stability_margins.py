@@ -46,7 +46,9 @@ class LoopMargins:
     gain_margin : float
         Gain margin [dB]: over every frequency where the phase is -180 deg (mod 360), the
         smallest ``|20*log10|L||``, the gain change (up, or down for a conditionally
-        stable loop) that puts ``L`` on -1; ``inf`` if the phase never gets there.
+        stable loop) that puts ``L`` on -1; ``inf`` if the phase never gets there. NaN
+        for an unstable loop, which has no margins (nor crossovers): ``reasons`` says so,
+        with the gain change that would restore stability.
     phase_margin : float
         Phase margin [deg]: over every crossover ``|L| = 1`` (this loop has up to three:
         the PI's, and two around the damping loop's band), the smallest angle between
@@ -131,9 +133,16 @@ def _margins(response, omega, stable, rate, delay, extra_reasons=None):
         reasons["gain_margin"] = ("the phase never reaches -180 deg: no gain change makes the "
                                   "loop unstable")
         reasons["phase_crossover_frequency"] = reasons["gain_margin"]
-    if not stable:
+    if not stable:  # no margin: what reads as one is the change that would restore stability
         reasons["stable"] = ("a closed-loop pole lies outside the stability region: the margins "
                              "of an unstable loop are not margins")
+        unstable = "the closed loop is unstable: it has no margin"
+        reasons["gain_margin"] = unstable + (
+            f" ({gm:.3g} dB is the gain change at {f_pc:.3g} Hz that would make it stable)"
+            if math.isfinite(gm) else "")
+        reasons["phase_margin"] = unstable
+        reasons["gain_crossover_frequency"] = reasons["phase_crossover_frequency"] = unstable
+        gm = pm = f_gc = f_pc = math.nan
     return LoopMargins(rate=float(rate), delay=float(delay), stable=bool(stable),
                        gain_margin=float(gm), phase_margin=float(pm),
                        gain_crossover_frequency=float(f_gc),

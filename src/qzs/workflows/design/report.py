@@ -83,9 +83,11 @@ def design_text(result):
     mg = result.margins
     design = mg["design"]
     rate = f"{s['controller_rate']:g} Hz" if s["controller_rate"] > 0 else "continuous"
-    lines.append(f"  margins          {rate}, delay {s['delay']:g} s: gain "
-                 f"{_fmt(design['gain_margin'], 3)} dB, phase {_fmt(design['phase_margin'], 3)} "
-                 f"deg; needed rate {_fmt(mg['required_rate'], 3, 'Hz')}"
+    held = (f"gain {_fmt(design['gain_margin'], 3)} dB, phase "
+            f"{_fmt(design['phase_margin'], 3)} deg" if design["stable"] else
+            f"none ({design['reasons'].get('gain_margin', 'the loop is unstable')})")
+    lines.append(f"  margins          {rate}, delay {s['delay']:g} s: {held}; needed rate "
+                 f"{_fmt(mg['required_rate'], 3, 'Hz')}"
                  + (f" ({mg['required_rate_reason']})" if mg["required_rate_reason"] else ""))
     lines.append(f"  why damping      {result.why['answer']}")
     return "\n".join(lines)

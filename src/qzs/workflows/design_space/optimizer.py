@@ -25,11 +25,11 @@ import numpy as np
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
 from qzs.workflows.design_space.metrics import METRICS, evaluate, goal_values
-from qzs.workflows.design_space.problem import DesignProblem, load_problem
+from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check
 
-__all__ = ["optimize", "fix_step", "probe_designs"]
+__all__ = ["optimize", "fix_step", "probe_designs", "check_run_length"]
 
 
 def probe_designs(problem):
@@ -52,6 +52,30 @@ def probe_designs(problem):
     high = np.array([v.search_bounds[1] for v in problem.variables])
     points = np.vstack([low, 0.5 * (low + high), high])
     return np.column_stack([v.to_unit(points[:, j]) for j, v in enumerate(problem.variables)])
+
+
+def check_run_length(problem, *, threads=None):
+    """Refuse, before any probe or store, a problem whose every simulation would take
+    absurdly long (``[analysis] duration = 1e9``); a problem of linear metrics only
+    simulates nothing and passes.
+
+    Parameters
+    ----------
+    problem : DesignProblem
+        The problem.
+    threads : int, optional
+        Threads a generation's runs are shared over [-]; default the machine's cores.
+
+    Raises
+    ------
+    RunTooLongError
+        One design's run would take more than a day at the kernel's best speed.
+    """
+    from qzs.workflows.sweeps.store_checks import check_run_length as check_sweep
+
+    if any(METRICS[g.metric].source != "linear" for g in problem.goals):
+        check_sweep(problem.sweep, [{}], threads=threads,
+                    cases=problem.optimizer["population"] * problem.samples)
 
 
 def fix_step(problem, *, progress=False):
@@ -157,6 +181,9 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
                                                 100_000)
     if population is not None:
         settings["population"] = _positive_int("optimizer", "population", population, 100_000)
+        if population < MIN_POPULATION:
+            raise ProblemError("optimizer", "population", population, "NSGA-II needs at least "
+                               f"{MIN_POPULATION} designs per generation")
     if seed is not None:
         if isinstance(seed, bool) or not isinstance(seed, int):
             raise ProblemError("optimizer", "seed", seed, "must be a whole number")
@@ -164,9 +191,13 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     problem = dataclasses.replace(problem, optimizer=settings)
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)
+    check_run_length(problem, threads=threads)  # certain already at the output period
     require("pymoo", "qzs optimize (multi-objective search)")
     began = time.perf_counter()
     with dask_client(scheduler, workers) as client:  # before the store or any probe
+        if not resume:  # the step first: nothing is written until the runs are sure to start
+            problem = fix_step(problem, progress=progress)
+            check_run_length(problem, threads=threads)
         opened = DesignStore(store, problem, resume=resume, overwrite=overwrite)
         if opened.step is not None:
             sweep = problem.sweep
@@ -174,7 +205,9 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
                 sweep, simulation={**sweep.simulation, "dt": opened.step[0],
                                    "step_note": opened.step[1]}))
         else:
-            problem = fix_step(problem, progress=progress)
+            if resume:
+                problem = fix_step(problem, progress=progress)
+                check_run_length(problem, threads=threads)
             dt = problem.sweep.simulation["dt"]
             if dt is not None:
                 opened.set_step(dt, problem.sweep.simulation.get("step_note", ""))

@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from qzs._format import unit_label, with_unit
 from qzs._validation import Structured, integer, read_toml, real
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
@@ -71,12 +72,14 @@ from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETER
                                              unit_draws)
 
 __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "plan_text",
-           "shipped_problems", "TABLES", "MAX_SAMPLES"]
+           "shipped_problems", "TABLES", "MAX_SAMPLES", "MIN_POPULATION"]
 
 TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
           "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis")
 #: Folder of the shipped problem files, inside the package.
 SHIPPED = "workflows/design_space/problem_files"
+#: Fewest designs per generation NSGA-II works with (the file's and the flag's minimum).
+MIN_POPULATION = 4
 #: Most Monte Carlo draws per design: each is a simulation of every design.
 MAX_SAMPLES = 1024
 _FORMAT = "qzs-problem-1"
@@ -245,7 +248,7 @@ class Goal:
         stat = (f" (quantile {self.quantile:g})" if self.statistic == "quantile"
                 else {"mean": "", "worst": " (worst case)"}[self.statistic])
         if self.bound is None:
-            return f"{self.sense} {self.column}{stat} [{self.units}]"
+            return f"{self.sense} {unit_label(self.column + stat, self.units)}"
         op = "<=" if self.sense == "minimize" else ">="
         return f"{self.column}{stat} {op} {self.bound:g}{_unit(self.units)}"
 
@@ -391,8 +394,8 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
 
 
 def _unit(units):
-    """`` m`` for a unit after a number; nothing for a ratio (``1``)."""
-    return "" if units in ("", "1") else f" {units}"
+    """`` m`` for a unit after a number; nothing for a ratio (``1``): :func:`with_unit`."""
+    return with_unit("", units)
 
 
 def _fail(table, key, value, fix):
@@ -421,7 +424,9 @@ def _parameter_name(table, name, kind):
         hint = f" (did you mean {', '.join(close[:4])}?)" if close else ""
         _fail(table, name, name, f"not a parameter{hint}; `qzs params` lists them: "
                                  f"{', '.join(sorted(PARAMETERS))}")
-    return PARAMETERS[name].unit if name in PARAMETERS else "-"
+    from qzs.model.registry import unit_of
+
+    return unit_of(name, kind)
 
 
 def _in(table):
@@ -451,6 +456,7 @@ def _variables(document, kind):
         low, high = _number(where, "low", spec["low"]), _number(where, "high", spec["high"])
         if not low < high:
             _fail("variables", name, [low, high], "empty bounds: `low` must be below `high`")
+        _within_valid_range(name, low, high)
         scale = spec.get("scale", "linear")
         if scale not in SCALES:
             _fail(where, "scale", scale, f"must be one of {SCALES}")
@@ -465,6 +471,33 @@ def _variables(document, kind):
         variables.append(Variable(name=name, low=low, high=high, scale=scale, integer=integer,
                                   units=units))
     return tuple(variables)
+
+
+def _within_valid_range(name, low, high):
+    """Refuse bounds a model parameter cannot take (``mass`` below zero): the designs there
+    would fail one by one instead of being refused before the search.
+
+    Only the parameter's own range counts: a bound refused with the defaults of the others
+    (``coulomb_force`` above the default ``stiction_force``) may be fine with their values
+    in a design, which then fails alone as an infeasible case.
+    """
+    import re
+
+    from qzs.model.controller import ControllerParameters
+    from qzs.model.isolator import IsolatorParameters
+    from qzs.model.registry import update_parameters
+
+    if name not in PARAMETERS or not PARAMETERS[name].numeric:
+        return
+    for key, bound in (("low", low), ("high", high)):
+        try:
+            update_parameters(IsolatorParameters(), ControllerParameters(), {name: bound})
+        except ParameterError as error:
+            if set(re.findall(r"`([a-z_]+)`", str(error))) - {name}:
+                continue  # a relation between parameters, not this one's range
+            _fail("variables", name, {"low": low, "high": high},
+                  f"`{key}` = {bound!r} is outside the parameter's valid range "
+                  f"({str(error).rstrip('.')}); choose bounds inside it")
 
 
 def _uncertain(document, kind, variables):
@@ -650,9 +683,9 @@ def _problem(document, where, stem):
                                                                     " (pymoo's NSGA-II)")
         for key in ("population", "generations"):
             _positive_int("optimizer", key, optimizer[key], 100_000)
-        if optimizer["population"] < 4:
+        if optimizer["population"] < MIN_POPULATION:
             _fail("optimizer", "population", optimizer["population"], "NSGA-II needs at least "
-                                                                      "4 designs per generation")
+                  f"{MIN_POPULATION} designs per generation")
         if isinstance(optimizer["seed"], bool) or not isinstance(optimizer["seed"], int):
             _fail("optimizer", "seed", optimizer["seed"], "must be a whole number")
         sensitivity = _sensitivity(document, objectives, constraints)
@@ -718,6 +751,19 @@ def _sweep(document, name, variables, uncertain, goals=None, resolved=None):
                            str(error).removeprefix("sweep definition: ")) from None
 
 
+def _spread_text(uncertain):
+    """An uncertain parameter's spread in words: ``values 5, 10, 15 kg``,
+    ``uniform 5 .. 15 N``, ``normal mean 6.4, sigma 0.2 kg``."""
+    settings, unit = dict(uncertain.settings), uncertain.units or "-"
+    if uncertain.distribution == "values":
+        return f"values {', '.join(f'{v:g}' for v in settings['values'])} {unit}"
+    if {"low", "high"} <= set(settings) and len(settings) == 2:
+        return f"{uncertain.distribution} {settings['low']:g} .. {settings['high']:g} {unit}"
+    shown = ", ".join(f"{k} {v:g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                      for k, v in settings.items())
+    return f"{uncertain.distribution} {shown} {unit}"
+
+
 def plan_text(problem: DesignProblem) -> str:
     """What a search will evaluate: variables, uncertainty, goals, cases and steps.
 
@@ -733,19 +779,24 @@ def plan_text(problem: DesignProblem) -> str:
     """
     o, a, s = problem.optimizer, problem.sweep.analysis, problem.sweep.simulation
     per_generation = o["population"] * problem.samples
+    simulates = any(METRICS[g.metric].source != "linear" for g in problem.goals)
     lines = [f"problem {problem.name!r}: {problem.title}",
              f"  NSGA-II: {o['population']} designs x {o['generations']} generations, seed "
              f"{o['seed']}; {problem.samples} draw(s) per design -> {per_generation} cases "
-             "per generation, one lockstep batch each",
-             f"  {problem.sweep.excitation_kind} excitation, {a['duration']:g} s per case, "
-             f"{a['sample_rate']:g} Hz output"]
-    lines += [f"  variable  {v.name:<22} {v.low:g} .. {v.high:g} {v.units} ({v.scale}"
+             "per generation, " + ("one lockstep batch each" if simulates else
+                                   "each from the linearised loop's closed forms")]
+    if simulates:
+        lines.append(f"  {problem.sweep.excitation_kind} excitation, {a['duration']:g} s per "
+                     f"case, {a['sample_rate']:g} Hz output")
+    lines += [f"  variable  {v.name:<22} {v.low:g} .. {v.high:g} {v.units or '-'} ({v.scale}"
               f"{', integer' if v.integer else ''})" for v in problem.variables]
-    lines += [f"  uncertain {u.name:<22} {u.distribution} {u.settings} {u.units}"
-              for u in problem.uncertain]
+    lines += [f"  uncertain {u.name:<22} {_spread_text(u)}" for u in problem.uncertain]
     lines += [f"  objective {g.describe()}" for g in problem.objectives]
     lines += [f"  constraint {g.describe()}" for g in problem.constraints]
-    if s["dt"] is not None:
+    if not simulates:
+        lines.append("  linear metrics only: no simulation (neither an excitation nor an "
+                     "integration step)")
+    elif s["dt"] is not None:
         steps = o["generations"] * per_generation * a["duration"] / s["dt"]
         lines.append(f"  dt = {s['dt']:g} s: about {steps:.3g} integration steps in all")
     else:

@@ -16,10 +16,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from qzs._format import with_unit
 from qzs._version import __version__
 from qzs.errors import ParameterError
 from qzs.workflows.design_space.metrics import goal_values
-from qzs.workflows.design_space.problem import DesignProblem, _unit
+from qzs.workflows.design_space.problem import DesignProblem, _spread_text, _unit
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -281,7 +282,7 @@ class OptimizationResult:
         attrs = {"title": f"qzs optimize: {p.title}", "problem": p.name,
                  "objectives": "; ".join(g.describe() for g in p.objectives),
                  "constraints": "; ".join(g.describe() for g in p.constraints) or "none",
-                 "uncertain": "; ".join(f"{u.name} {u.distribution} {u.settings} [{u.units}]"
+                 "uncertain": "; ".join(f"{u.name} {_spread_text(u)}"
                                         for u in p.uncertain) or "none",
                  "monte_carlo_samples": p.samples, "evaluated_designs": len(self.designs),
                  "algorithm": "NSGA-II (pymoo)", "population": p.optimizer["population"],
@@ -343,7 +344,7 @@ class OptimizationResult:
                       "sample_rate": p.sweep.analysis["sample_rate"]}
         if self.step is not None:
             simulation["dt"] = self.step
-        values = ", ".join(f"{g.label} = {self.goal_values[index, j]:.4g} {g.units}"
+        values = ", ".join(f"{g.label} = {with_unit(f'{self.goal_values[index, j]:.4g}', g.units)}"
                            for j, g in enumerate(p.goals))
         return config_text(isolator, controller, excitation, simulation,
                            note=f"design {index} of `qzs optimize` {p.name!r}: {values}")
@@ -404,10 +405,11 @@ class OptimizationResult:
         if chosen is None:
             lines.append("  no design meets every constraint: nothing chosen")
         else:
-            design = ", ".join(f"{v.name} = {self.designs[chosen, j]:.4g} {v.units}"
+            design = ", ".join(f"{v.name} = {with_unit(f'{self.designs[chosen, j]:.4g}', v.units)}"
                                for j, v in enumerate(p.variables))
-            goals = ", ".join(f"{g.label} = {_fmt(self.goal_values[chosen, j])} {g.units}"
-                              for j, g in enumerate(p.goals))
+            goals = ", ".join(
+                f"{g.label} = {with_unit(_fmt(self.goal_values[chosen, j]), g.units)}"
+                for j, g in enumerate(p.goals))
             lines += [f"  chosen design {chosen}: {design}", f"    {goals}"]
         return "\n".join(lines)
 
@@ -421,15 +423,14 @@ class OptimizationResult:
                "## Decision variables", "", "| variable | low | high | scale | unit |",
                "|---|---|---|---|---|"]
         out += [f"| {v.name} | {v.low:g} | {v.high:g} | {v.scale}"
-                f"{' (integer)' if v.integer else ''} | {v.units} |" for v in p.variables]
+                f"{' (integer)' if v.integer else ''} | {v.units or '-'} |" for v in p.variables]
         out += ["", "## Goals", ""]
         out += [f"- objective: {g.describe()}" for g in p.objectives]
         out += [f"- constraint: {g.describe()}" for g in p.constraints]
         if p.uncertain:
             out += ["", f"## Uncertainty ({p.samples} draws, {p.sampling}, seed {p.seed}, the "
                         "same draws for every design)", ""]
-            out += [f"- {u.name} [{u.units}]: {u.distribution} {u.settings}"
-                    for u in p.uncertain]
+            out += [f"- {u.name}: {_spread_text(u)}" for u in p.uncertain]
         out += ["", "## Search", "",
                 f"- {len(self.designs)} designs evaluated ({self.evaluated} by this call, the "
                 f"rest read from the store), {int(self.feasible.sum())} feasible, "

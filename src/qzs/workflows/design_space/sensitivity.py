@@ -51,6 +51,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from qzs._format import unit_label
 from qzs._optional import require
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.schema import Schema, Variable, to_dataset
@@ -602,7 +603,7 @@ def parameter_ranking(result: SensitivityResult, metric: str | None = None) -> t
 
 
 def _label(name, unit):
-    return f"{name} [{unit}]" if unit and unit not in ("1", "-") else f"{name} [-]"
+    return unit_label(name, unit)
 
 
 def sensitivity_summary(result: SensitivityResult) -> str:
@@ -632,7 +633,7 @@ def sensitivity_summary(result: SensitivityResult) -> str:
         lines.append(f"{result.failed} of {result.evaluations} cases failed")
     for i, metric in enumerate(result.metrics):
         unit = result.metric_units[i]
-        lines += ["", f"{metric} [{unit}]"]
+        lines += ["", unit_label(metric, unit)]
         if result.reasons[i]:
             lines.append(f"  undefined: {result.reasons[i]}")
             continue

@@ -737,9 +737,12 @@ def _out_check(out, argument, arguments, built):
         lengths = [e.duration for e in built.values() if e.duration is not None]
         length = min(lengths) if lengths else None
     size = None
-    if isinstance(length, (int, float)) and length > 0 and arguments["sample_rate"] > 0:
+    samples = (length * arguments["sample_rate"]
+               if isinstance(length, (int, float)) and length > 0 and arguments["sample_rate"] > 0
+               else None)
+    if samples is not None and samples < 1e15:  # larger: refused with its reason before the run
         suffix = Path(out).suffix.lower()
-        size = estimated_hexapod_size(int(round(length * arguments["sample_rate"])) + 1,
+        size = estimated_hexapod_size(int(round(samples)) + 1,
                                       suffix if suffix in HEXAPOD_SUFFIXES else ".nc")
     return lambda: check_output_path(out, argument=argument, suffixes=HEXAPOD_SUFFIXES,
                                      estimated_bytes=size)

@@ -790,6 +790,8 @@ _CSS = {"reproduced": "reproduced", "not reproduced": "not", "partly reproduced"
 #: The run settings a study's section lists: key of :attr:`CaseResult.run
 #: <qzs.workflows.paper.studies.CaseResult>` -> name (units from
 #: :data:`qzs.workflows.paper.studies.RUN_UNITS`).
+#: The chirp length the paper states [s] (a report that differs says why).
+PAPER_CHIRP_DURATION = 2000.0
 _RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample rate"),
              ("chirp_amplitude", "chirp amplitude"), ("chirp_f0", "chirp from"),
              ("chirp_f1", "chirp to"), ("chirp_duration", "chirp duration"),
@@ -858,6 +860,19 @@ def _html(study_results, figures, verdicts, quick, wall_seconds):
     return "\n".join(parts)
 
 
+def _duration_note(settings):
+    """Why the chirp is not the paper's 2000 s: it lasts what its Welch averages need."""
+    keys = ("chirp_duration", "n_averages", "fft_length", "sample_rate", "overlap")
+    if any(isinstance(settings.get(k), (list, type(None))) for k in keys) \
+            or settings["chirp_duration"] == PAPER_CHIRP_DURATION:
+        return ""
+    return (f"<p class='notes'>Chirp duration {settings['chirp_duration']:.6g} s, not the "
+            f"paper's {PAPER_CHIRP_DURATION:g} s: the record lasts what "
+            f"{settings['n_averages']} complete Welch averages of {settings['fft_length']} "
+            f"samples at {settings['sample_rate']:g} Hz with overlap {settings['overlap']:g} "
+            "need (qzs.analysis.spectral.required_duration).</p>")
+
+
 def _settings_table(result):
     settings = _settings(result)
     head, cells = [], []
@@ -875,7 +890,7 @@ def _settings_table(result):
                             ([case.label, *(format_value(_value(case, n)) for n in names)]
                              for case in result.cases))
     return "\n".join(["<p>Run settings (every case):</p>",
-                      html_table(head, [cells], separator=""),
+                      html_table(head, [cells], separator="") + _duration_note(settings),
                       parameters + "<p class='notes'>Every other parameter at its default "
                       "(Table 1, docs/model.md §11; <code>qzs params</code>).</p>"])
 
@@ -906,7 +921,7 @@ def _case_table(result):
         return footnoted("&mdash;", reasons.get(name, "not computed"), notes)
 
     head = ["case", *(title for _, title in _TABLE), "stop contacts", "locked [%]",
-            "f_n linear [Hz]"]
+            "f_n with PI [Hz]"]
     entries = [(case.label, case.metrics, case.reasons, case) for case in result.cases]
     if result.study.kind == "processing":
         case = result.cases[0]
@@ -918,10 +933,17 @@ def _case_table(result):
         table.append([e(label), *(cell(metrics, reasons, name) for name, _ in _TABLE),
                       e(f"{s['stop_contacts']}"), e(f"{100 * s['locked_fraction']:.1f}"),
                       e(f"{case.linear['undamped_natural_frequency']:.3g}")])
+    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
+                                             result.cases[0].settings)
     rows = [html_table(head, table, cells_html=True)]
     if notes:
         rows.append("<ol class='notes'>" + "".join(f"<li>{e(reason)}</li>" for reason in notes)
                     + "</ol>")
+    rows.append("<p class='notes'>f_n with PI: sqrt((k + Kp)/m)/2pi, the linearised loop's undamped "
+            "natural frequency, the PI's proportional gain Kp acting as a spring; the paper's "
+            "\"about 0.08 Hz\" is the passive isolator's (Kp = 0): "
+            f"{passive_natural_frequency(isolator, controller.position_setpoint):.3g} Hz for "
+            f"{e(result.cases[0].label)}.</p>")
     return "\n".join(rows)
 
 

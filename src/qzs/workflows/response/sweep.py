@@ -44,6 +44,9 @@ SETTLE_TIME_CONSTANTS = 30.0
 MIN_TIME = 60.0
 #: ... and at most this [s].
 MAX_TIME = 3600.0
+#: Smallest ``periodic_tolerance``: the scaled state change of a periodic response is the
+#: rounding of the state itself (about 1e-13 of its scale over a period), never below.
+SMALLEST_PERIODIC_TOLERANCE = 1e-12
 #: Default fade-in [s] of the first frequency of a sweep (rounded up to whole periods).
 FADE_IN = 2.0
 #: Default highest harmonic reported [-] (2..this).
@@ -89,6 +92,41 @@ def _check_step(dt, frequencies, isolator, controller, solver):
             f"dt = {dt:g} s ({1 / (MIN_STEPS_PER_PERIOD * dt):g} Hz, {MIN_STEPS_PER_PERIOD} "
             f"steps per period); lower `dt` to at most {1 / (MIN_STEPS_PER_PERIOD * top):.3g} "
             "s or drop the higher frequencies.")
+
+
+def _check_cap(frequencies, direction, dt, max_periods, max_time):
+    """Refuse caps under which the frequencies that never settle would take more than a day.
+
+    Each frequency runs at most ``min(max_periods / f, max_time)`` seconds; the step is at
+    most ``dt`` and at most a :data:`SAMPLES_PER_PERIOD`-th of the highest frequency's
+    period, so the count of steps is a lower bound and a refusal is certain.
+    """
+    from qzs.engine.driver import BEST_STEP_SECONDS, LONGEST_RUN
+
+    frequencies = np.asarray(frequencies, dtype=float)
+    longest = min(math.inf if dt is None else dt,
+                  1.0 / (SAMPLES_PER_PERIOD * float(frequencies.max())))
+    if not longest > 0:
+        raise ParameterError(
+            f"`frequencies` reach {frequencies.max():g} Hz: {SAMPLES_PER_PERIOD} samples per "
+            "period need a step shorter than any number holds; give frequencies of the "
+            "isolator's range (up to a few hundred Hz).")
+    # whole periods: at least the settling test's, however short max_time is
+    least = CONSECUTIVE_PERIODS + MAX_PERIOD_MULTIPLE + 1
+    with np.errstate(over="ignore"):
+        periods = np.maximum(np.minimum(max_periods, np.floor(max_time * frequencies)), least)
+        simulated = float((periods / frequencies).sum())
+    simulated *= 2 if direction == "both" else 1
+    seconds = simulated / longest * BEST_STEP_SECONDS["single"]
+    if seconds > LONGEST_RUN:
+        raise ParameterError(
+            f"`max_periods` = {max_periods} and `max_time` = {max_time:g} s let the "
+            f"{frequencies.size} frequencies (from {frequencies.min():g} Hz, at least {least} "
+            f"whole periods each) run {simulated:.3g} s of simulated time, at least "
+            f"{seconds / 86_400:.3g} days of computing at dt <= {longest:.3g} s even at the "
+            f"kernel's best speed, should they not settle; lower `max_time` (its default, "
+            f"{MIN_TIME:g}-{MAX_TIME:g} s from the loop's time constants, is enough for a "
+            "settling loop) or `max_periods`, or raise the lowest frequency.")
 
 
 def settle_time_cap(isolator=None, controller=None):
@@ -292,12 +330,16 @@ def steady_state_response(frequencies: ArrayLike,
     if dt is not None:
         dt = positive_real("dt", dt)
     periodic_tolerance = positive_real("periodic_tolerance", periodic_tolerance)
-    if periodic_tolerance >= 0.1:
-        raise ParameterError(f"`periodic_tolerance` must be below 0.1, got "
-                             f"{periodic_tolerance!r}; 1e-6 is the default.")
+    if not SMALLEST_PERIODIC_TOLERANCE <= periodic_tolerance < 0.1:
+        raise ParameterError(f"`periodic_tolerance` must be from {SMALLEST_PERIODIC_TOLERANCE:g} "
+                             f"(below it the state's own rounding never meets it, and the run "
+                             f"goes on to its cap) up to 0.1, got {periodic_tolerance!r}; 1e-6 "
+                             "is the default.")
     max_periods = integer("max_periods", max_periods, CONSECUTIVE_PERIODS + MAX_PERIOD_MULTIPLE + 1)
     if max_time is not None:
         max_time = positive_real("max_time", max_time)
+    _check_cap(frequencies, direction, dt, max_periods,
+               settle_time_cap(isolator, controller) if max_time is None else max_time)
     fade_in = float(fade_in)
     if not math.isfinite(fade_in) or fade_in < 0:
         raise ParameterError(f"`fade_in` must be a non-negative number of seconds, got "

@@ -17,7 +17,8 @@ from qzs.workflows.sweeps.cluster import dask_client
 from qzs.workflows.sweeps.definition import SweepDefinition, sample_cases
 from qzs.workflows.sweeps.step import choose_sweep_step
 from qzs.workflows.sweeps.store import OK, open_store, prepare_store, write_batch
-from qzs.workflows.sweeps.store_checks import check_resume, check_store, time_samples
+from qzs.workflows.sweeps.store_checks import (check_resume, check_run_length, check_store,
+                                             time_samples)
 
 __all__ = ["execute"]
 
@@ -59,6 +60,8 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
     check_cases(definition, settings)
+    check_run_length(definition, settings, cases=min(definition.batch_size, len(settings)),
+                     threads=threads)  # before any probe or store
     if definition.simulation["dt"] is None:  # sized at the output period until dt is chosen
         check_store(definition, store, time_samples(definition, settings), argument="store",
                      resume=resume, overwrite=overwrite)

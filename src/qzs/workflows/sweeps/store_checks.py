@@ -13,7 +13,8 @@ from qzs.workflows.sweeps.cases import case_duration, case_settings
 from qzs.workflows.sweeps.definition import SweepDefinition, sample_cases
 from qzs.workflows.sweeps.store import estimated_bytes
 
-__all__ = ["check_store_path", "check_resume", "check_store", "time_samples", "STORE_SUFFIX"]
+__all__ = ["check_store_path", "check_resume", "check_store", "check_run_length",
+           "time_samples", "STORE_SUFFIX"]
 
 #: The extension of a sweep store: a Zarr folder, not a NetCDF file (``--out store.nc``
 #: would make a folder named like a file of another format).
@@ -78,9 +79,45 @@ def check_store_path(definition: SweepDefinition, store: str | Path, *,
     """
     check_resume(store, argument, resume, overwrite)
     settings = case_settings(definition, sample_cases(definition))
+    check_run_length(definition, settings)
     check_store(definition, store, time_samples(definition, settings), argument=argument,
                  resume=resume, overwrite=overwrite)
 
+
+
+def check_run_length(definition, settings, *, cases=1, threads=None):
+    """Refuse, before any probe or store, a sweep whose longest case alone would take
+    absurdly long (:func:`qzs.engine.driver.plan_run`'s limit).
+
+    Before the step is chosen (``dt`` None) the output period stands for it: the step is
+    never longer, so the count of steps is a lower bound and a refusal is certain.
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+    settings : list of dict
+        Its cases' varied parameters (:func:`qzs.workflows.sweeps.cases.case_settings`).
+    cases : int
+        Cases stepped together (a batch's) [-].
+    threads : int, optional
+        Threads they are shared over [-]; default the machine's cores.
+
+    Raises
+    ------
+    RunTooLongError
+        Even one case would take more than a day at the kernel's best speed.
+    """
+    from qzs._validation import worker_count
+    from qzs.engine.driver import plan_run
+
+    dt = definition.simulation["dt"]
+    if dt is None:
+        dt = 1.0 / definition.analysis["sample_rate"]
+    duration = max((case_duration(definition, s) for s in settings),
+                   default=definition.analysis["duration"])
+    plan_run(duration, dt, 1, kernel="lanes", cases=cases,
+             workers=worker_count(threads, cases))
 
 
 def check_resume(store, argument, resume, overwrite, work="the sweep"):
