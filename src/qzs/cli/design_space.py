@@ -3,7 +3,7 @@ from pathlib import Path
 
 from qzs.cli.common import (EPILOG, add_execution_options, add_output_options, check_output, emit,
                              integer_at_least, stopped)
-from qzs.errors import Terminated
+from qzs.errors import ParameterError, Terminated
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["add_parsers", "run_optimize_command", "run_sensitivity_command"]

@@ -43,11 +43,12 @@ from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
 from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
 from qzs.workflows.paper.report_step import step_record, step_statement
+from qzs.workflows.paper.studies import column_unit  # noqa: F401 (the metrics table's units)
 from qzs.workflows.paper.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
                                          run_studies, shipped_studies)
 
 __all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
-           "curves_of", "column_unit", "paper_summary", "write_paper_outputs", "run_paper"]
+           "curves_of", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
 #: of the report, its figures (PNG) and metrics.
@@ -553,47 +554,6 @@ def _metric_rows(study_results):
 
 #: Columns of ``metrics.csv`` that are not one of a case's metrics, statistics or run
 #: settings, with their units ("" for text).
-_COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
-                 "seconds": "s"}
-
-
-def column_unit(name):
-    """The unit of a column of ``metrics.csv`` (its units row), from where it is defined.
-
-    Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
-    :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
-    ``spring_shape`` from the registry), statistics and run settings from
-    :data:`qzs.workflows.paper.studies.STATS_UNITS` and :data:`~qzs.workflows.paper.studies.RUN_UNITS`.
-
-    Parameters
-    ----------
-    name : str
-        The column's name.
-
-    Returns
-    -------
-    str
-        The unit; ``""`` for a text column (labels, reasons, the solver's name).
-
-    Raises
-    ------
-    KeyError
-        A column no definition gives a unit for (a programming error).
-    """
-    if name.endswith("_reason") or name in _COLUMN_UNITS:
-        return _COLUMN_UNITS.get(name, "")
-    for prefix, units in (("run.", RUN_UNITS), ("param.", None), ("processed.", None)):
-        if name.startswith(prefix):
-            key = name[len(prefix):]
-            if units is not None:
-                return units[key] or ""
-            return unit_of(key) if prefix == "param." else column_unit(key)
-    unit = metric_unit(name) or STATS_UNITS.get(name)
-    if unit is None and name in PARAMETERS:
-        unit = unit_of(name)
-    if unit is None:
-        raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")
-    return unit
 
 
 def _claims_record(verdicts):

@@ -52,7 +52,7 @@ from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import update_parameters
 
 __all__ = ["CLAIMS", "Study", "StudyResult", "CaseResult", "load_study", "shipped_studies",
-           "run_studies", "run_study", "RUN_UNITS", "STATS_UNITS"]
+           "run_studies", "run_study", "RUN_UNITS", "STATS_UNITS", "column_unit"]
 
 KINDS = ("transmissibility", "processing", "spring_characteristic")
 #: Folder of the shipped study files, inside the package.
@@ -722,3 +722,52 @@ def _step_record(tasks, choices):
                       unmet=[label for label, c in mine if c in choice.unmet],
                       notes=list(choice.notes), seconds=seconds, group=group)
     return record
+
+
+#: Units of the metrics table's own columns (:func:`column_unit`).
+_COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
+                 "seconds": "s"}
+
+
+def column_unit(name):
+    """The unit of a column of ``metrics.csv`` (its units row), from where it is defined.
+
+    Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
+    :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
+    ``spring_shape`` from the registry), statistics and run settings from
+    :data:`STATS_UNITS` and :data:`RUN_UNITS`.
+
+    Parameters
+    ----------
+    name : str
+        The column's name.
+
+    Returns
+    -------
+    str
+        The unit; ``""`` for a text column (labels, reasons, the solver's name).
+
+    Raises
+    ------
+    KeyError
+        A column no definition gives a unit for (a programming error).
+    """
+    if name.endswith("_reason") or name in _COLUMN_UNITS:
+        return _COLUMN_UNITS.get(name, "")
+    from qzs.model.registry import unit_of
+
+    for prefix, units in (("run.", RUN_UNITS), ("param.", None), ("processed.", None)):
+        if name.startswith(prefix):
+            key = name[len(prefix):]
+            if units is not None:
+                return units[key] or ""
+            return unit_of(key) if prefix == "param." else column_unit(key)
+    from qzs.analysis.spectral import metric_unit
+    from qzs.model.registry import PARAMETERS, unit_of
+
+    unit = metric_unit(name) or STATS_UNITS.get(name)
+    if unit is None and name in PARAMETERS:
+        unit = unit_of(name)
+    if unit is None:
+        raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")
+    return unit
