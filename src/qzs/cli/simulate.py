@@ -227,8 +227,6 @@ def run(args):
     resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
                        tolerance=args.tolerance, tolerance_state=args.tolerance_state,
                        step="chosen", progress=show)
-    for note in resolved.notes:
-        print(f"qzs: {note}", file=sys.stderr)
     common = dict(progress=show, interruptible=True)
     # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
     # returning, so that no import is left half done (an error in the run ends it too)

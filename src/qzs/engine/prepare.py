@@ -15,7 +15,8 @@ from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, S
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "run_inputs", "steps_per_sample", "divides",
+__all__ = ["PreparedRun", "prepare_run", "run_inputs", "run_duration", "steps_per_sample",
+           "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
 
 #: Fewest integration steps per period of the excitation's highest frequency a run is
@@ -293,6 +294,37 @@ class PreparedRun:
     sample_rate: float
 
 
+def run_duration(excitation, duration):
+    """A run's simulated time [s], checked: the one place it is worked out.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+    duration : float or None
+        The time asked for [s]; None: the excitation's length (required for a sine).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        No duration for a sine, not a positive finite number, or longer than the excitation.
+    """
+    if duration is None:
+        if excitation.duration is None:
+            raise ParameterError("`duration` is required for a sine excitation, got None.")
+        duration = excitation.duration
+    duration = positive_real("duration", duration)
+    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
+        raise ParameterError(
+            f"`duration` ({duration!r} s) exceeds the excitation's length "
+            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    return duration
+
+
 def prepare_run(excitation=None, isolator=None, controller=None, *, duration=None,
                 dt=defaults.SIMULATION["dt"], sample_rate=defaults.SIMULATION["sample_rate"],
                 solver=defaults.SIMULATION["solver"], initial_state=None):
@@ -329,15 +361,7 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
     solver_code, _ = SOLVERS[choice("solver", solver, tuple(SOLVERS))]
     dt = positive_real("dt", dt)
     sample_rate = positive_real("sample_rate", sample_rate)
-    if duration is None:
-        if excitation.duration is None:
-            raise ParameterError("`duration` is required for a sine excitation, got None.")
-        duration = excitation.duration
-    duration = positive_real("duration", duration)
-    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
-        raise ParameterError(
-            f"`duration` ({duration!r} s) exceeds the excitation's length "
-            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    duration = run_duration(excitation, duration)
     if dt > duration:
         raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
     if not stability_test(isolator, controller, solver)(dt):

@@ -64,8 +64,6 @@ class ResolvedRun:
     step : StepChoice
         How ``dt`` was chosen, or that it was given (:class:`~qzs.engine.step_search.StepChoice`):
         the one record the console, JSON, files and reports show.
-    notes : tuple of str
-        Defaults put in that a person should hear of (a sine's duration).
     """
 
     excitation: Any
@@ -77,7 +75,6 @@ class ResolvedRun:
     sample_rate: float
     solver: str
     step: Any
-    notes: tuple = ()
 
     def arguments(self) -> dict[str, Any]:
         """The keywords of the run for :func:`qzs.engine.simulate.simulate` and its kin.
@@ -188,22 +185,13 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     """
     from qzs.engine.accuracy import (choose_step, default_tolerance, excitation_over,
                                      probe_excitation)
-    from qzs.engine.prepare import run_inputs
+    from qzs.engine.prepare import run_duration, run_inputs
     from qzs.engine.step_search import StepChoice
     from qzs.model.excitation import Sine
 
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    notes: list[str] = []
     _validation.choice("step", step, ("literal", "chosen"))
-    if duration is None:
-        duration = excitation.duration
-        if duration is None:
-            raise ParameterError("`duration` is required for a sine excitation, got None.")
-    duration = _validation.positive_real("duration", duration)
-    if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
-        raise ParameterError(
-            f"`duration` ({duration!r} s) exceeds the excitation's length "
-            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+    duration = run_duration(excitation, duration)
     sample_rate = _validation.positive_real("sample_rate", sample_rate)
     if not duration * sample_rate <= MAX_SAMPLES:
         raise ParameterError(
@@ -239,7 +227,7 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
                            cache=cache)
     return ResolvedRun(excitation=excitation, isolator=isolator, controller=controller,
                        initial_state=initial_state, duration=duration, dt=choice.dt,
-                       sample_rate=sample_rate, solver=solver, step=choice, notes=tuple(notes))
+                       sample_rate=sample_rate, solver=solver, step=choice)
 
 
 
