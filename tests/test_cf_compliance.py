@@ -180,23 +180,12 @@ KINDS = {"single_run": single_run, "streamed_run": streamed_run, "batch": batch,
          "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility}
 
 
-_TIME = ("elapsed run time on the dimension `time`: the checker wants a CF time coordinate "
-         "there (units '<unit> since <datetime>'), an open decision (docs/model.md, decision 34)")
-#: The kinds not yet compliant, with what is left (strict: fixing one fails here, so the
-#: entry must go).
-OPEN = {"single_run": _TIME, "streamed_run": _TIME, "batch": _TIME,
-        "hexapod_run": _TIME + "; six-axis arrays of mixed units ('m, m, m, rad, rad, rad')",
-        "hexapod_transmissibility": "entries and amplitudes of mixed units (m, rad, m/rad, ...)",
-        "sweep": "the roll-off's unit dB/decade has no UDUNITS spelling"}
-
-
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     return tmp_path_factory.mktemp("cf")
 
 
-@pytest.mark.parametrize("kind", [pytest.param(kind, marks=pytest.mark.xfail(
-    reason=OPEN[kind], strict=True)) if kind in OPEN else kind for kind in KINDS])
+@pytest.mark.parametrize("kind", list(KINDS))
 def test_the_checker_finds_no_error_and_no_warning(kind, folder):
     path = KINDS[kind](folder)
     errors, warnings = findings(path)

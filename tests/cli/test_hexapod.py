@@ -11,7 +11,7 @@ from qzs.model.hexapod import leg_unit_vectors
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.workflows.hexapod.setups import (default_cube_center_height, hexapod_setup, load_hexapod,
                                           supported_mass)
-from qzs.iotools.schema import from_file_layout
+from qzs.iotools.cf_layout import from_file_layout
 
 
 def run_json(capsys, *argv):

@@ -9,7 +9,7 @@ from qzs import Chirp, ControllerParameters, IsolatorParameters, RandomExcitatio
 from qzs.analysis.summary import run_warnings
 from qzs.cli import main
 from qzs.iotools import read_result, save_config
-from qzs.iotools.schema import from_file_layout
+from qzs.iotools.cf_layout import from_file_layout
 
 
 @pytest.mark.parametrize("flags, excitation", [

@@ -9,7 +9,7 @@ import qzs
 from qzs.engine.channels import CHANNELS, FLAGS
 from qzs.engine.metadata import RUN_UNITS
 from qzs.engine.result_file import read_result
-from qzs.iotools.schema import from_file_layout
+from qzs.iotools.cf_layout import from_file_layout
 from qzs.model.registry import unit_of
 
 ISOLATOR = qzs.IsolatorParameters(stiction_force=6.0)  # stop_center stays None
@@ -50,11 +50,18 @@ def test_global_attributes(netcdf):
     assert f"qzs {qzs.__version__}" in rest and "ode3" in rest and "steps" in rest
 
 
-def test_time_is_a_cf_time_axis(netcdf):
+def test_time_is_elapsed_time_in_plain_seconds(netcdf):
+    """A run's time has no date: in the file it is ``elapsed_time`` in s, not a CF calendar
+    time (no standard_name ``time``, no axis T, no ``since``), and reads back as ``time``
+    in float seconds, not decoded to dates (decision 34)."""
     time = netcdf[0]["time"]
-    assert time.attrs["standard_name"] == "time" and time.attrs["axis"] == "T"
+    assert "standard_name" not in time.attrs and "axis" not in time.attrs
     assert time.attrs["units"] == "s" and time.dtype == np.float64  # not decoded to dates
     assert time.attrs["long_name"]
+    raw = xr.load_dataset(netcdf[1], engine="h5netcdf")
+    assert "time" not in raw.variables and "time" not in raw.dims
+    assert raw["elapsed_time"].attrs["units"] == "s" and raw["elapsed_time"].dtype == np.float64
+    assert raw["relative_position"].dims == ("elapsed_time",)
 
 
 def test_every_variable_has_units_and_long_name(netcdf):
@@ -148,7 +155,7 @@ def test_csv_header_and_trailer_carry_units(run, tmp_path):
 def test_to_xarray_follows_the_same_conventions(run):
     data = run.to_xarray()
     assert data.attrs["Conventions"] == "CF-1.10"
-    assert data["time"].attrs["axis"] == "T"
+    assert data["time"].attrs["units"] == "s" and "axis" not in data["time"].attrs
     assert data["locked"].attrs["flag_meanings"] == "slipping locked"
     data.to_netcdf(engine="h5netcdf")  # writable as it is: no None, no bool attribute
 
@@ -161,7 +168,7 @@ def test_batch_to_xarray():
     data = batch.to_xarray()
     assert dict(data.sizes) == {"case": 2, "time": batch.time.size}
     assert data.attrs["Conventions"] == "CF-1.10" and data.attrs["history"]
-    assert data["time"].attrs["standard_name"] == "time" and data["time"].attrs["units"] == "s"
+    assert data["time"].attrs["units"] == "s" and "standard_name" not in data["time"].attrs
     assert data["relative_position"].dims == ("case", "time")
     assert data["relative_position"].attrs["units"] == "m"
     np.testing.assert_array_equal(data["viscous_damping"].values, [50.0, 100.0])

@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import DataError, WriteError
-from qzs.iotools.schema import NONE_VALUE, from_file_layout
+from qzs.iotools.cf_layout import from_file_layout
+from qzs.iotools.schema import NONE_VALUE
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
 

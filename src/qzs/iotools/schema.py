@@ -29,8 +29,7 @@ import numpy as np
 from qzs.errors import ParameterError
 
 __all__ = ["Variable", "Schema", "to_dataset", "time_coordinate", "CONVENTIONS", "DTYPES",
-           "FLAG_VALUES", "NONE_VALUE", "CONTAINERS", "container_attributes",
-           "to_file_layout", "from_file_layout"]
+           "FLAG_VALUES", "NONE_VALUE"]
 
 #: The metadata conventions of every dataset and file of qzs (docs/model.md §7).
 CONVENTIONS = "CF-1.10"
@@ -43,13 +42,6 @@ DTYPES = MappingProxyType({"float64": np.float64, "int8": np.int8, "int64": np.i
 #: The values of every flag (CF ``flag_values``): 0 and 1, int8.
 FLAG_VALUES = (0, 1)
 _RESERVED = ("units", "long_name", "flag_values", "flag_meanings")
-#: The global attribute of a file that lists its container variables (docs/model.md,
-#: decision 34): scalar variables whose attributes hold a group of parameters
-#: (``isolator``: ``mass``, ``mass_units``, ...), since CF attribute names have no dots.
-CONTAINERS = "parameter_containers"
-
-
-
 @dataclass(frozen=True, kw_only=True)
 class Variable:
     """One variable of a result: dimensions, units, description, stored type, flags.
@@ -169,6 +161,10 @@ class Variable:
 def time_coordinate(name="time"):
     """The ``time`` coordinate of a run: plain seconds since its start (docs/model.md §7).
 
+    Elapsed time, not an instant: no ``standard_name = "time"`` and no ``axis = "T"``, which
+    in CF mark a calendar time (``"<unit> since <date>"``); a NetCDF file names it
+    ``elapsed_time`` (:mod:`qzs.iotools.cf_layout`, docs/model.md decision 34).
+
     Parameters
     ----------
     name : str
@@ -179,10 +175,10 @@ def time_coordinate(name="time"):
     Variable
     """
     return Variable(name=name, dims=(name,), units="s", long_name="time since the start of the run",
-                    attributes={"standard_name": "time", "axis": "T",
-                                "comment": "relative run time without a calendar date: units "
-                                           "'s' instead of 's since <date>' (docs/model.md §7)"},
-                    order=("units", "standard_name", "axis", "long_name", "comment"))
+                    attributes={"comment": "elapsed run time without a calendar date; a NetCDF "
+                                           "file names it elapsed_time (docs/model.md, "
+                                           "decision 34)"},
+                    order=("units", "long_name", "comment"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -342,115 +338,3 @@ def to_dataset(schema, values, attrs=None, *, boolean_flags=False):
     return xr.Dataset({v.name: entry(v) for v in schema.variables},
                       coords={c.name: entry(c) for c in schema.coordinates},
                       attrs={"Conventions": CONVENTIONS, **(attrs or {})})
-
-
-def container_attributes(attrs):
-    """Split global attributes into CF-legal ones and container variables' attributes.
-
-    A key ``section.name`` (``isolator.mass``, ``run.dt_units``) becomes the attribute
-    ``name`` of the container ``section`` (further dots become ``__``); the other keys stay
-    global. CF attribute names are letters, digits and underscores (CF §2.3).
-
-    Parameters
-    ----------
-    attrs : mapping of str to object
-        Global attributes as qzs keeps them in memory (dotted keys).
-
-    Returns
-    -------
-    (dict, dict of str to dict)
-        The global attributes without dotted keys (with :data:`CONTAINERS` listing the
-        containers, if any), and container name -> its attributes.
-    """
-    plain, containers = {}, {}
-    for key, value in attrs.items():
-        section, dot, name = str(key).partition(".")
-        if dot and section and name:
-            containers.setdefault(section, {})[name.replace(".", "__")] = value
-        else:
-            plain[key] = value
-    if containers:
-        plain[CONTAINERS] = " ".join(containers)
-    return plain, containers
-
-
-def _container_variable(section, attrs):
-    import xarray as xr
-
-    return xr.DataArray(np.int8(0), attrs={
-        "long_name": f"container of the {section} parameters: each attribute is one, "
-                     "with its unit in <name>_units", **attrs})
-
-
-def _history_line():
-    """A CF ``history`` line for a file whose dataset has none: when and by which qzs."""
-    import datetime
-
-    from qzs._version import __version__
-
-    now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
-    return f"{now} qzs {__version__}: written"
-
-
-def to_file_layout(dataset):
-    """A dataset as qzs writes it to NetCDF: CF-1.10 as the compliance checker reads it.
-
-    Dotted global attributes go to container variables (:func:`container_attributes`);
-    coordinates get no ``_FillValue`` and a string coordinate named as its dimension is
-    stored as a character array (the encoding returned; xarray reads both back as they
-    were); a dataset without ``Conventions`` or ``history`` gets them (a sweep's ``title``
-    from its ``sweep_title``).
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        A result's dataset (:func:`to_dataset`).
-
-    Returns
-    -------
-    (xarray.Dataset, dict)
-        The dataset to write and its ``encoding`` for ``to_netcdf``.
-    """
-    plain, containers = container_attributes(dataset.attrs)
-    out = dataset.copy()
-    out.attrs = {"Conventions": CONVENTIONS, **plain}
-    if "title" not in out.attrs and "sweep_title" in out.attrs:  # as export_sweep titles it
-        out.attrs["title"] = (f"qzs sweep {out.attrs.get('sweep_name', '')}: "
-                              f"{out.attrs['sweep_title']}")
-    out.attrs.setdefault("history", _history_line())
-    for name in out.variables:  # CF: flag_values of the flag's own type
-        if "flag_values" in out[name].attrs and out[name].dtype.kind in "iu":
-            out[name].attrs["flag_values"] = np.asarray(out[name].attrs["flag_values"],
-                                                        dtype=out[name].dtype)
-    for section, attrs in containers.items():
-        out[section] = _container_variable(section, attrs)
-    encoding = {name: {"_FillValue": None} for name in out.coords
-                if out[name].dtype.kind in "fc"}
-    for name in out.coords:  # CF allows no 1-D string variable named as its dimension
-        if name in out.dims and out[name].dtype.kind in "OUS":
-            encoding[name] = {"dtype": "S1", "char_dim_name": f"{name}_strlen"}
-    return out, encoding
-
-
-def from_file_layout(dataset):
-    """The inverse of :func:`to_file_layout`: containers back to dotted global attributes.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        A NetCDF file of qzs as xarray reads it.
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    sections = str(dataset.attrs.get(CONTAINERS, "")).split()
-    attrs = {k: v for k, v in dataset.attrs.items() if k != CONTAINERS}
-    for section in sections:
-        if section in dataset.variables:
-            for name, value in dataset[section].attrs.items():
-                if name != "long_name":
-                    attrs[f"{section}.{name.replace('__', '.')}"] = value
-    dataset = dataset.drop_vars([s for s in sections if s in dataset.variables])
-    dataset.attrs = attrs
-    return dataset

@@ -36,7 +36,9 @@ import numpy as np
 from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error, atomic_path
 from qzs.iotools.matfile import MatStream
-from qzs.iotools.schema import CONVENTIONS, container_attributes, to_file_layout
+from qzs.iotools.cf_layout import (container_attributes, container_long_name, file_schema,
+                                   to_file_layout)
+from qzs.iotools.schema import CONVENTIONS
 
 __all__ = ["StreamWriter", "estimated_file_size", "write_dataset", "write_netcdf", "write_table",
            "CSV_LAYOUT"]
@@ -196,6 +198,11 @@ class StreamWriter:
             raise ParameterError(f"{schema.kind} has variables of more than one dimension: "
                                  "write it as NetCDF (.nc), not CSV.")
         self._values = values
+        self._layout = schema
+        if self._suffix == ".nc":  # CF's own means for what it has no home for (decision 34)
+            self._layout, columns, self._values = file_schema(schema, columns, values)
+            self._columns = [(v, list(self._blocks).index(columns[v.name][0]),
+                              columns[v.name][1]) for v in self._layout.streamed()]
         self._head = {"Conventions": CONVENTIONS, **(attributes or {})}
         self._create()
 
@@ -247,7 +254,7 @@ class StreamWriter:
         import h5netcdf
         import h5py
 
-        schema = self.schema
+        schema = self._layout
         self._file = h5netcdf.File(self._tmp, "w")
         self._file.dimensions = dict(schema.dimensions)
         self._variables = {}
@@ -257,6 +264,16 @@ class StreamWriter:
                 created = self._file.create_variable(variable.name, variable.dims,
                                                      variable.cast([]).dtype, chunks=chunks)
                 self._variables[variable.name] = created
+            elif variable.dtype == "str" and variable.dims == (variable.name,):
+                # CF: no 1-D string variable named as its dimension; characters, as xarray
+                # writes them (``_Encoding`` makes xarray read strings back)
+                labels = np.char.encode(variable.cast(self._values[variable.name]), "utf-8")
+                width = max(1, max((len(label) for label in labels), default=1))
+                self._file.dimensions[f"{variable.name}_strlen"] = width
+                created = self._file.create_variable(
+                    variable.name, (variable.name, f"{variable.name}_strlen"), dtype="S1",
+                    data=labels.astype(f"S{width}")[:, None].view("S1"))
+                created.attrs["_Encoding"] = "utf-8"
             elif variable.dtype == "str":  # variable-length strings, as xarray writes them
                 created = self._file.create_variable(variable.name, variable.dims,
                                                      dtype=h5py.string_dtype())
@@ -268,7 +285,7 @@ class StreamWriter:
                 created.attrs[key] = value
 
     def _append_netcdf(self, blocks, start, stop):
-        self._file.resize_dimension(self.schema.unlimited, stop)
+        self._file.resize_dimension(self._layout.unlimited, stop)
         # through the HDF5 datasets themselves, one handle each per append (a handle kept
         # open holds its chunks: 210 MB more at 2e6 samples): h5netcdf's item assignment
         # checks the data type, opening the dataset again, on every call (a quarter of the
@@ -284,8 +301,7 @@ class StreamWriter:
             self._file.attrs[key] = value
         for section, attrs in containers.items():  # CF names have no dots (decision 34)
             container = self._file.create_variable(section, (), data=np.int8(0))
-            container.attrs["long_name"] = (f"container of the {section} parameters: each "
-                                            "attribute is one, with its unit in <name>_units")
+            container.attrs["long_name"] = container_long_name(section)
             for key, value in attrs.items():
                 container.attrs[key] = value
         handle, self._file = self._file, None
@@ -591,7 +607,7 @@ def write_dataset(dataset, path):
 def write_netcdf(dataset, path):
     """Write a dataset to NetCDF (h5netcdf) in qzs's file layout, CF-1.10 (not atomic).
 
-    :func:`qzs.iotools.schema.to_file_layout`: dotted global attributes in container
+    :func:`qzs.iotools.cf_layout.to_file_layout`: dotted global attributes in container
     variables, no ``_FillValue`` on coordinates;
     :func:`qzs.iotools.files.read_result` reads it back as ``dataset``. Callers write to a
     temporary path (:func:`qzs.iotools.files.atomic_path`).

@@ -14,7 +14,7 @@ from qzs.engine.hexapod import simulate as hexapod_simulate
 from qzs.errors import OutputPathError, ParameterError
 from qzs.engine.hexapod.result import HexapodWriter, estimated_hexapod_size
 from qzs.workflows.hexapod.setups import load_hexapod, simulate_setup
-from qzs.iotools.schema import from_file_layout
+from qzs.iotools.cf_layout import from_file_layout
 
 #: Longer than one kernel chunk (200,000 steps at dt 1e-4 s), so that chunks join in the file.
 DURATION = 24.0
@@ -97,9 +97,10 @@ def test_ctrl_c_keeps_what_was_simulated(setup, tmp_path, monkeypatch):
     assert result.run["completed"] is False
     # the kernel steps the next chunk while the last is written: it ends after that one
     assert result.run["samples"] == 1 + 2 * 2000
-    with xr.open_dataset(path) as written:
+    with xr.open_dataset(path) as raw:
+        written = from_file_layout(raw)  # the file layout read back (decision 34)
         assert written.sizes["time"] == result.run["samples"] == sum(calls)
-        assert written["run"].attrs["completed"] == 0  # the run's container
+        assert written.attrs["run.completed"] == 0  # the run's container, read back
     assert "Interrupted" in result.summary()
 
 
@@ -142,7 +143,8 @@ def test_a_run_streamed_to_mat_is_the_netcdf_in_matlab_layout(setup, tmp_path):
     simulate_setup(setup, duration=0.5, out=nc)
     simulate_setup(setup, duration=0.5, out=mat)
     read = scipy.io.loadmat(mat)
-    with xr.open_dataset(nc) as netcdf:
+    with xr.open_dataset(nc) as raw:
+        netcdf = from_file_layout(raw)  # the file layout read back (decision 34)
         for name in ("platform_pose", "relative_position", "kinetic_energy", "time"):
             expected = netcdf[name].values
             assert np.array_equal(read[name], expected if expected.ndim == 2
@@ -156,7 +158,8 @@ def test_a_run_streamed_to_mat_is_the_netcdf_in_matlab_layout(setup, tmp_path):
 
 def test_save_writes_the_held_run_and_refuses_a_preview(setup, in_memory, tmp_path, monkeypatch):
     path = in_memory.save(tmp_path / "saved.nc")
-    with xr.open_dataset(path) as written:
+    with xr.open_dataset(path) as raw:
+        written = from_file_layout(raw)  # the file layout read back (decision 34)
         assert np.array_equal(written["platform_pose"].values, in_memory["platform_pose"])
         assert written.sizes["time"] == len(in_memory)
     monkeypatch.setattr(driver_module, "PREVIEW_SAMPLES", 1000)

@@ -208,9 +208,13 @@ def test_the_result_repackages_and_delegates(raised, tmp_path):
     path = result.save(tmp_path / "matrix.nc")
     import xarray as xr
 
-    with xr.open_dataset(path, engine="h5netcdf") as back:
+    from qzs.iotools.cf_layout import from_file_layout
+
+    with xr.open_dataset(path, engine="h5netcdf") as raw:
+        assert raw["settings"].attrs["floor_db_units"] == "dB"  # a container (CF)
+        assert raw["magnitude_translation_per_rotation"].attrs["units"] == "m/rad"  # one unit
+        back = from_file_layout(raw)  # the blocks joined again (decision 34)
         np.testing.assert_allclose(back["magnitude"].values, result.magnitude)
-        assert back["settings"].attrs["floor_db_units"] == "dB"  # a container (CF)
     with pytest.raises(ParameterError, match="must end in .nc"):
         result.save(tmp_path / "matrix.csv")
     text = result.summary()

@@ -361,7 +361,8 @@ def transmissibility_schema(estimator="h1"):
     dof_doc = "degree of freedom: translations x, y, z [m], rotations rx, ry, rz [rad]"
     variables = (
         Variable(name="magnitude", dims=on, units=mixed,
-                 long_name=f"|{estimator.upper()}| platform motion per base motion"),
+                 long_name=f"|{estimator.upper()}| platform motion per base motion",
+                 attributes={"units_by_entry": "entry_units"}),
         Variable(name="phase", dims=on, units="rad",
                  long_name="phase of the platform motion relative to the base's"),
         Variable(name="coherence", dims=on, units="1",
@@ -373,7 +374,8 @@ def transmissibility_schema(estimator="h1"):
                  long_name="1 where the dimensionless response is below the numerical floor "
                            "(rounding, not response)", flag_meanings="above below"),
         Variable(name="linear_magnitude", dims=on, units=mixed,
-                 long_name="|T| of the linear model at the top frame origin"),
+                 long_name="|T| of the linear model at the top frame origin",
+                 attributes={"units_by_entry": "entry_units"}),
         Variable(name="linear_phase", dims=on, units="rad", long_name="phase of the linear model"),
         Variable(name="entry_units", dims=on[1:], dtype="str",
                  long_name="unit of each matrix entry"),
