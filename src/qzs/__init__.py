@@ -31,9 +31,6 @@ from typing import TYPE_CHECKING
 
 from qzs._lazy import lazy_exports
 from qzs._version import __version__
-from qzs.engine.result import SimulationResult
-from qzs.engine.simulate import simulate
-from qzs.engine.stability import SOLVERS, largest_stable_step
 from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, ExcitationError,
                         FitError, FitWarning, MissingDependencyError, OutputPathError,
                         ParameterError, ProblemError, ResultTooLargeError, SimulationError,
@@ -43,7 +40,11 @@ from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialS
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
 
 # Loaded on first use, so that ``import qzs`` stays lean (PEP 562).
+# The engine (numba) is loaded on first use, so that ``qzs --help`` and the command line's
+# parsing start at once (issue 32: no silence before the first line).
 _LAZY = {
+    "simulate": "qzs.engine.simulate", "SimulationResult": "qzs.engine.result",
+    "SOLVERS": "qzs.engine.stability", "largest_stable_step": "qzs.engine.stability",
     "simulate_batch": "qzs.engine.batch", "BatchResult": "qzs.engine.batch",
     "resolve": "qzs.engine.run_spec", "ResolvedRun": "qzs.engine.run_spec",
     "StepChoice": "qzs.engine.step_search",
@@ -82,8 +83,11 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.batch import BatchResult, simulate_batch
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
+    from qzs.engine.result import SimulationResult
     from qzs.engine.result_file import read_result
     from qzs.engine.run_spec import ResolvedRun, resolve
+    from qzs.engine.simulate import simulate
+    from qzs.engine.stability import SOLVERS, largest_stable_step
     from qzs.engine.step_search import StepChoice
     from qzs.export.controller import export_controller
     from qzs.export.fmu import export_fmu
@@ -107,7 +111,6 @@ __all__ = [
     "__version__",
     "Chirp", "Sine", "RandomExcitation", "DisplacementRecord",
     "IsolatorParameters", "ControllerParameters", "InitialState",
-    "simulate", "largest_stable_step", "SOLVERS", "SimulationResult",
     "spring_force", "spring_stiffness", "friction_force",
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",

@@ -3,6 +3,7 @@ integers, and the exit code chosen by the error's class, never by its message.""
 import argparse
 import json
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -188,3 +189,43 @@ def test_the_warning_display_is_python_s_again_after_the_command(capsys):
     before = warnings.showwarning
     run_handler(_warning_handler(), argparse.Namespace(command="params"))
     assert warnings.showwarning is before
+
+
+def _silent_for(seconds, said=None):
+    import time
+
+    def handler(args):
+        if said:
+            print(said)
+        time.sleep(seconds)
+        return 0
+    return handler
+
+
+@pytest.mark.parametrize("quiet, first, notices", [(False, None, 1), (False, "progress", 0),
+                                                   (True, None, 0)])
+def test_a_command_silent_past_the_delay_says_it_has_started_once(capsys, monkeypatch, quiet,
+                                                                  first, notices):
+    """Silent for 0.4 s with a delay of 0.05 s: one notice on stderr, never on stdout (JSON
+    stays clean), none after the command spoke first, none with --quiet or --json."""
+    import argparse
+
+    from qzs.cli import common
+
+    monkeypatch.setattr(common, "START_NOTICE_DELAY", 0.05)
+    args = argparse.Namespace(command="params", quiet=quiet, json=False)
+    assert run_handler(_silent_for(0.4, first), args) == 0
+    out, err = capsys.readouterr()
+    assert err.count("qzs params: starting") == notices and "starting" not in out
+    assert sys.stdout is not None and type(sys.stdout).__name__ != "_Watched"  # restored
+
+
+def test_a_quick_command_prints_no_start_notice(capsys):
+    import argparse
+
+    args = argparse.Namespace(command="params", quiet=False, json=False)
+    assert run_handler(_silent_for(0.0), args) == 0
+    import time
+
+    time.sleep(1.2)  # past the real delay: the notice was cancelled, not merely late
+    assert "starting" not in capsys.readouterr().err

@@ -26,3 +26,17 @@ def test_a_shipped_file_is_named_without_its_order_prefix(tmp_path):
     with pytest.raises(ParameterError, match=r"study file not found: 'nope'; shipped studies "
                                              r"are \['damping', 'no_pi', 'pi_gains'"):
         resolve_shipped("nope", "workflows/paper/study_files", "study", "studies")
+
+
+def test_a_folder_named_as_a_shipped_file_does_not_hide_it(tmp_path, monkeypatch):
+    """A command's output folder is named as its shipped problem (``qzs optimize
+    isolation_vs_effort`` writes ``isolation_vs_effort/``); run again in the same place, the
+    name must still be the shipped file, not the folder (a folder is never the file)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "isolation_vs_effort").mkdir()
+    found = resolve_shipped("isolation_vs_effort", "workflows/design_space/problem_files",
+                            "problem", "problems")
+    assert found.is_file() and found.suffix == ".toml"
+    (tmp_path / "mine").mkdir()  # a folder that names no shipped file stays what it is
+    assert resolve_shipped("mine", "workflows/design_space/problem_files", "problem",
+                           "problems") == Path("mine")

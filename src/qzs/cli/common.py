@@ -16,9 +16,11 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
   the command stops quietly, as a program killed by SIGPIPE would (128 + 13).
 - 143: terminated by SIGTERM (128 + 15), after the cleanup ran (no temporary file stays).
 """
+import contextlib
 import dataclasses
 import json
 import sys
+import threading
 import warnings
 
 from qzs._format import json_ready
@@ -418,15 +420,15 @@ def run_handler(handler, args):
         (:class:`~qzs.errors.Terminated`, raised by :func:`qzs.cli.main`'s handler).
         ``BrokenPipeError`` is left to :func:`qzs.cli.main` (141).
     """
+    quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
     try:
-        with warnings.catch_warnings():  # restores Python's own display afterwards
-            warnings.showwarning = show_warning
+        with warnings.catch_warnings(), start_notice(_command(args), quiet=quiet):
+            warnings.showwarning = show_warning  # restored by catch_warnings afterwards
             families = kernel_families(args)
             if not families:
                 return handler(args)
             from qzs.engine.compiling import compile_notice
 
-            quiet = getattr(args, "quiet", False) or getattr(args, "json", False)
             with compile_notice(families, ticking=not quiet):
                 return handler(args)
     except (SimulationError, FitError, WriteError, CompilerError) as error:  # before DataError
@@ -447,6 +449,70 @@ def run_handler(handler, args):
     except MemoryError as error:
         return _fail(f"out of memory{': ' + str(error) if str(error) else ''}; "
                      f"{memory_hint(args)}", 1)
+
+
+#: Seconds a command may say nothing before :func:`start_notice` says it has started.
+START_NOTICE_DELAY = 1.0
+
+
+class _Watched:
+    """A stream that notes (``written``) when anything is written to it; the rest delegated."""
+
+    def __init__(self, stream, written):
+        self._stream = stream
+        self._written = written
+
+    def write(self, text):
+        if text:
+            self._written.set()
+        return self._stream.write(text)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def start_notice(command, *, quiet=False, delay=None):
+    """One line on stderr if a command has said nothing ``delay`` seconds after it started.
+
+    Loading numpy, scipy and numba and reading a command's inputs can take a few seconds
+    before its first line of progress (more on a busy machine); a console silent that long
+    looks hung (issue 32). While the block runs, ``sys.stdout`` and ``sys.stderr`` note
+    any writing; if there was none after ``delay`` [s], ``qzs <command>: starting ...`` is
+    written on stderr, once. A command that speaks first, or ends first, prints no notice;
+    ``quiet`` (``--quiet``, ``--json``) none at all.
+
+    Parameters
+    ----------
+    command : str or None
+        The command's name, as the user typed it (``optimize``, ``hexapod study``).
+    quiet : bool
+        Say nothing.
+    delay : float, optional
+        Seconds of silence before the notice [s]; default :data:`START_NOTICE_DELAY`.
+    """
+    delay = START_NOTICE_DELAY if delay is None else delay
+    if quiet or not command:
+        yield
+        return
+    written = threading.Event()
+    out, err = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Watched(out, written), _Watched(err, written)
+
+    def speak():
+        if not written.is_set():
+            err.write(f"qzs {command}: starting (loading the numerical libraries and the "
+                      "inputs) ...\n")
+            err.flush()
+
+    timer = threading.Timer(delay, speak)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+        sys.stdout, sys.stderr = out, err
 
 
 def _command(args):

@@ -22,6 +22,9 @@ def shipped_files(folder):
 def resolve_shipped(source, folder, what, plural):
     """``source`` as an existing path, or the shipped file of that name in ``folder``.
 
+    A folder of a shipped file's name (the output folder a command names after it) does not
+    hide the shipped file.
+
     A shipped file is named by its stem without a leading ``NN_`` order prefix
     (``stiction`` for ``02_stiction.toml``).
 
@@ -40,9 +43,9 @@ def resolve_shipped(source, folder, what, plural):
         Neither a file nor a shipped name; the message lists the shipped names.
     """
     path = Path(source)
-    if path.exists():
-        return path
     names = {_name(p): p for p in shipped_files(folder)}
+    if path.exists() and not (path.is_dir() and str(source) in names):
+        return path  # a folder named as a shipped file (a command's output) is not the file
     if str(source) in names:
         return names[str(source)]
     raise ParameterError(f"{what} file not found: {str(source)!r}; shipped {plural} are "
