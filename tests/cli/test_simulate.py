@@ -348,6 +348,16 @@ def test_a_run_of_more_steps_than_a_number_holds_is_one_clear_line(argv, named, 
     assert err.count("\n") == 0 and named in err and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("argv", [["--amplitude", "1e308"],
+                                  ["--excitation", "sine", "--amplitude", "1e308"]])
+def test_an_amplitude_beyond_float64_is_bad_input_not_a_failed_run(argv, tmp_path, monkeypatch,
+                                                                    capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", *argv, "--duration", "1", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--amplitude" in err and list(tmp_path.iterdir()) == []
+
+
 def test_an_absurd_sample_rate_is_named_as_what_bounds_the_step(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["simulate", "--sample-rate", "1e308", "--duration", "1", "--quiet"]) == 2

@@ -258,3 +258,18 @@ def test_highest_frequency_within_the_run():
     assert highest_frequency(Chirp(f0=0.0, f1=20.0, duration=100.0)) == 20.0
     assert highest_frequency(Sine(frequency=3.0)) == 3.0
     assert highest_frequency(RandomExcitation(f_low=1.0, f_high=15.0)) == 15.0
+
+
+@pytest.mark.parametrize("make, frequency", [
+    (lambda a: Chirp(amplitude=a, f0=0.0, f1=20.0, duration=10.0), 20.0),
+    (lambda a: Sine(amplitude=a, frequency=20.0), 20.0),
+    (lambda a: RandomExcitation(amplitude=a, f_low=1.0, f_high=20.0, duration=10.0), 20.0)])
+def test_an_amplitude_that_overflows_the_base_acceleration_is_refused(make, frequency):
+    """(2 pi f)^2 A beyond float64 (with room for the forces) is bad input naming
+    `amplitude`; an amplitude a factor 100 inside the bound is taken."""
+    crest = 4.0 if isinstance(make(1.0), RandomExcitation) else 1.0
+    bound = np.finfo(float).max / ((2 * np.pi * frequency) ** 2 * 1e3 * crest)
+    with pytest.raises(ExcitationError, match="`amplitude`") as error:
+        make(bound * 1.01)
+    assert error.value.options[0] == "amplitude"  # the command line names its flag
+    make(bound / 100)

@@ -72,6 +72,20 @@ def _resolve_fade(excitation):
             "amplitude.", ("fade_in", "duration"))
 
 
+def _check_peak(amplitude, frequency, names, crest=1.0):
+    """Refuse an amplitude whose peak base acceleration ``(2 pi f)^2 A`` (times the crest
+    factor of a random signal) is not a finite float64 number, with room for the forces
+    (a factor 1e3): the run would overflow at its first step, which is bad input (exit 2),
+    not a diverging model (exit 1)."""
+    with np.errstate(over="ignore"):
+        peak = (2.0 * np.pi * frequency) ** 2 * amplitude * crest * 1e3
+    if not np.isfinite(peak):
+        raise ExcitationError(
+            f"`amplitude` = {amplitude!r} m at {frequency!r} Hz gives a peak base acceleration "
+            f"(2 pi f)^2 A beyond float64's range (about 1.8e308): the run would overflow at "
+            f"its first step; use a physical amplitude (the paper's is 0.01 m).", names)
+
+
 _FADE_DOC = ("fade-in [s]: smooth ramp (slope a raised cosine) of the amplitude from 0 at "
              "t = 0 to full at t = fade_in; 0 starts at full amplitude; default 2 s (a "
              "quarter of the excitation if shorter; none for a chirp)")
@@ -114,6 +128,7 @@ class Chirp:
                                           lambda message: ExcitationError(message, (n,))),
         })
         _resolve_fade(self)
+        _check_peak(self.amplitude, max(self.f0, self.f1), ("amplitude", "f1"))
         if self.method == "logarithmic" and (self.f0 <= 0 or self.f1 <= 0):
             raise ExcitationError(
                 f"a logarithmic chirp needs `f0` > 0 and `f1` > 0, got `f0` = {self.f0!r} Hz, "
@@ -186,6 +201,7 @@ class Sine:
             "phase": _excitation_rule(real),
         })
         _resolve_fade(self)
+        _check_peak(self.amplitude, self.frequency, ("amplitude", "frequency"))
 
     @property
     def max_frequency(self) -> float:
@@ -266,6 +282,7 @@ class RandomExcitation(_Tabulated):
             raise ExcitationError(f"`seed` must be a non-negative integer (numpy's generators "
                                   f"take 0 .. 2**128-1), got {self.seed!r}.", ("seed",))
         _resolve_fade(self)
+        _check_peak(self.amplitude, self.f_high, ("amplitude", "f_high"), crest=4.0)
 
     @property
     def max_frequency(self) -> float:
