@@ -150,3 +150,13 @@ def _close_figures():
     pyplot = sys.modules.get("matplotlib.pyplot")
     if pyplot is not None:
         pyplot.close("all")
+
+
+@pytest.fixture(autouse=True)
+def _no_start_notice(monkeypatch):
+    """Commands run in-process say nothing while they load (``qzs.cli.common.start_notice``):
+    on a busy test machine a quick error could otherwise come after the notice, and tests
+    read exact output. tests/cli/test_common.py tests the notice with its own delay."""
+    from qzs.cli import common
+
+    monkeypatch.setattr(common, "START_NOTICE_DELAY", 3600.0)

@@ -6,6 +6,7 @@ caller may act on it (:class:`CaseError`, :class:`MissingDependencyError`); the
 message is for people, never for parsing.
 """
 
+import copy
 from collections.abc import Iterable, Mapping
 
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
@@ -18,33 +19,29 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
 
 
 class ParameterError(ValueError):
-    """A parameter, option or input value is invalid (names it, its value and the fix)."""
-
-
-class ExcitationError(ParameterError):
-    """An excitation definition or a displacement record is invalid.
+    """A parameter, option or input value is invalid (names it, its value and the fix).
 
     Parameters
     ----------
     message : str
-        What is wrong, the value and the fix; each option it is about written ```name```.
+        What is wrong, the value and the fix; each argument it is about written ```name```.
     options : tuple of str
-        Those options (see the attribute).
+        Those arguments (see the attribute).
 
     Attributes
     ----------
     options : tuple of str
-        The options the message is about, each written ```name``` in it (empty when it
+        The arguments the message is about, each written ```name``` in it (empty when it
         names none in particular), so that a caller that spells them its own way (the
-        command line's ``--excitation-duration`` for ``duration``) can say them so
+        command line's ``--sample-rate`` for ``sample_rate``) can say them so
         (:meth:`renamed`).
     """
 
-    def __init__(self, message: str, options: Iterable[str] = ()) -> None:
+    def __init__(self, message: str = "", options: Iterable[str] = ()) -> None:
         self.options = tuple(str(option) for option in options)
         super().__init__(message)
 
-    def renamed(self, spelling: Mapping[str, str]) -> "ExcitationError":
+    def renamed(self, spelling: Mapping[str, str]) -> "ParameterError":
         """The same error with each of its options written as ``spelling`` says.
 
         Parameters
@@ -55,16 +52,35 @@ class ExcitationError(ParameterError):
 
         Returns
         -------
-        ExcitationError
+        ParameterError
+            Of the same class, with the same attributes.
         """
+        options = getattr(self, "options", ())
+        if not any(option in spelling for option in options):
+            return self
         message = str(self)
-        for option in self.options:
+        for option in options:
             if option in spelling:
                 message = message.replace(f"`{option}`", f"`{spelling[option]}`")
-        return type(self)(message, tuple(spelling.get(o, o) for o in self.options))
+        renamed = copy.copy(self)
+        renamed.args = (message,)
+        renamed.options = tuple(spelling.get(o, o) for o in options)
+        return renamed
 
     def __reduce__(self):
-        return type(self), (str(self), self.options)
+        return type(self), (str(self), getattr(self, "options", ()))
+
+
+class ExcitationError(ParameterError):
+    """An excitation definition or a displacement record is invalid.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, the value and the fix; each option it is about written ```name```.
+    options : tuple of str
+        Those options (:attr:`ParameterError.options`).
+    """
 
 
 class StabilityError(ParameterError):
@@ -386,7 +402,7 @@ class RunTooLongError(ParameterError):
             f"integration steps{of}: at least {_span(self.seconds)} of computing even at the "
             f"kernel's best speed, and qzs starts no run of more than {_span(self.limit)}; use "
             "a larger `dt` (the paper's is 1e-4 s; qzs.largest_stable_step gives the largest "
-            "stable one) or a shorter `duration`.")
+            "stable one) or a shorter `duration`.", ("dt", "duration"))
 
     def __reduce__(self):
         return _rebuild_keywords, (type(self), dict(

@@ -124,62 +124,26 @@ def _excitation(args, table, source):
     return build_excitation(kind, options, names=names)
 
 
-def _check_output_rate(excitation, settings):
-    """Refuse an excitation at or above half the output rate: the time series cannot show it
-    (its samples would alias it to a lower frequency). Below that, the summary warns when the
-    output under-resolves it (fewer than five samples per period)."""
-    if not isinstance(excitation, (Sine, Chirp, RandomExcitation)):
-        return  # a record's bound is the Nyquist frequency of its own samples, not its content
-    rate = float(settings.get("sample_rate", SIMULATION["sample_rate"]))
-    top = highest_frequency(excitation, settings.get("duration"))
-    if top >= rate / 2:
-        flag = {Sine: "--frequency", Chirp: "--f1"}.get(type(excitation), "--f1")
-        raise ParameterError(
-            f"{flag} {top:g} Hz is at or above half the output rate (--sample-rate {rate:g} Hz "
-            f"shows at most {rate / 2:g} Hz; the samples would alias it): raise --sample-rate "
-            f"above {2 * top:g} Hz ({5 * top:g} Hz resolves it well) or lower {flag}.")
+def _spelling(args, settings):
+    """How the command line names each argument of :func:`qzs.resolve`: its flag, or the
+    config file's key where the value came from there (an error says it so)."""
+    def origin(key, flag, table="simulation"):
+        if getattr(args, key, None) is not None or key not in settings:
+            return flag
+        return f"[{table}] {key} of {args.config}"
 
-
-def _check_length(excitation, settings, args):
-    """Refuse, before the step is chosen, a run that would take absurdly long, naming the
-    option that set its length. The chosen step is never longer than the output period,
-    so counting steps at the output period gives a lower bound and a certain refusal."""
-    from qzs.engine.driver import plan_run
-    from qzs.errors import RunTooLongError
-
-    duration = settings.get("duration", excitation.duration)
-    if duration is None:
-        return
     if args.duration is not None:
-        flag = "--duration"
+        duration = "--duration"
     elif "duration" in settings:
-        flag = f"[simulation] duration of {args.config}"
+        duration = f"[simulation] duration of {args.config}"
     elif args.excitation_duration is not None:
-        flag = "--excitation-duration"
+        duration = "--excitation-duration"
     else:
-        flag = f"[excitation] duration of {args.config}"
-    rate = settings.get("sample_rate", SIMULATION["sample_rate"])
-    dt = settings.get("dt") or (1.0 / rate if isinstance(rate, (int, float)) and rate > 0
-                                else None)
-    if not isinstance(duration, (int, float)) or not duration > 0 or not dt or not dt > 0:
-        return  # not a length or step at all: resolve() says what is wrong
-    own = excitation.duration
-    if own is not None and duration > own * (1 + 1e-12):
-        return  # longer than the excitation: resolve() says so, with its length
-    fix = f"a shorter {flag.split(' of ')[0]}" + (
-        " or a larger --dt" if settings.get("dt") else " or a lower --sample-rate (the step is "
-                                                       "at most its period)")
-    steps = duration / dt
-    if not math.isfinite(steps):
-        raise ParameterError(f"{flag} {float(duration):g} s at dt = {dt:g} s is more "
-                             f"integration steps than a number holds; choose {fix}.")
-    try:
-        plan_run(float(duration), float(dt), 1)
-    except RunTooLongError as error:
-        raise ParameterError(
-            f"{flag} {float(duration):g} s is at least {error.steps:.3g} integration steps "
-            f"(dt <= {error.dt:g} s): more than the day of computing qzs starts at most; "
-            f"choose {fix}.") from None
+        duration = f"[excitation] duration of {args.config}"
+    return {"duration": duration, "sample_rate": origin("sample_rate", "--sample-rate"),
+            "dt": origin("dt", "--dt"), "solver": origin("solver", "--solver"),
+            "tolerance": "--tolerance", "tolerance_state": "--tolerance-state",
+            "frequency": "--frequency", "f1": "--f1", "f_high": "--f1"}
 
 
 def run(args):
@@ -209,24 +173,21 @@ def run(args):
             settings[key] = value
     if args.tolerance is not None or args.tolerance_state is not None:
         settings.pop("dt", None)  # a tolerance on the command line replaces the file's dt
-    if args.tolerance is not None and isinstance(excitation, Sine):
-        raise ParameterError(
-            f"--tolerance {args.tolerance:g} is on the transmissibility [dB], which a sine "
-            "has no band to estimate; give --tolerance-state M [m] or a literal --dt.")
     if excitation.duration is None and "duration" not in settings:
         settings["duration"] = 10.0
         print("qzs: no --duration given for the sine; simulating 10 s", file=sys.stderr)
-    _check_output_rate(excitation, settings)
-    _check_length(excitation, settings, args)
     plot = figure_path(args)
     if plot is not None:
         check_output(args, "--plot", plot, suffixes=PLOT_SUFFIXES)
     if args.out:
         check_output(args, "--out", args.out, suffixes=RESULT_SUFFIXES)
     show = not args.quiet and not args.json
-    resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
-                       tolerance=args.tolerance, tolerance_state=args.tolerance_state,
-                       step="chosen", progress=show)
+    try:  # resolve() checks the inputs; the command line only says them its own way
+        resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
+                           tolerance=args.tolerance, tolerance_state=args.tolerance_state,
+                           step="chosen", progress=show)
+    except ParameterError as error:
+        raise error.renamed(_spelling(args, settings)) from None
     common = dict(progress=show, interruptible=True)
     # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
     # returning, so that no import is left half done (an error in the run ends it too)

@@ -195,12 +195,16 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     sample_rate = _validation.positive_real("sample_rate", sample_rate)
     if not duration * sample_rate <= MAX_SAMPLES:
         raise ParameterError(
-            f"`duration` ({duration!r} s) at `sample_rate` {sample_rate:g} Hz asks for "
+            f"`duration` {duration:g} s at `sample_rate` {sample_rate:g} Hz asks for "
             f"{duration * sample_rate:.3g} output samples, more than any run can hold "
-            f"({MAX_SAMPLES:.0e}); shorten the run or lower the rate.")
+            f"({MAX_SAMPLES:.0e}); shorten the run or lower the rate.",
+            ("duration", "sample_rate"))
+    _check_output_rate(excitation, duration, sample_rate)
     given = _one_step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
     if dt is None and not given and step == "literal":
         dt = defaults.SIMULATION["dt"]
+    _check_length(duration, sample_rate, None if dt is None else
+                  _validation.positive_real("dt", dt))
     if dt is not None:
         choice = StepChoice.literal(_validation.positive_real("dt", dt), sample_rate=sample_rate,
                                     solver=solver)
@@ -209,7 +213,8 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
             if isinstance(excitation, Sine):
                 raise ParameterError(
                     f"`tolerance` ({tolerance!r} dB) is on the transmissibility, which a sine "
-                    "has no band to estimate; give `tolerance_state` [m] or a literal `dt`.")
+                    "has no band to estimate; give `tolerance_state` [m] or a literal `dt`.",
+                    ("tolerance", "tolerance_state", "dt"))
             asked = {"tolerance_db": tolerance}
         elif tolerance_state is not None:
             asked = {"tolerance_state": tolerance_state}
@@ -229,6 +234,45 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
                        initial_state=initial_state, duration=duration, dt=choice.dt,
                        sample_rate=sample_rate, solver=solver, step=choice)
 
+
+def _check_output_rate(excitation, duration, sample_rate):
+    """Refuse an excitation at or above half the output rate: the samples could not show it
+    (they would alias it to a lower frequency). A record's bound is its own samples'."""
+    from qzs.model.excitation import Chirp, RandomExcitation, Sine, highest_frequency
+
+    if not isinstance(excitation, (Sine, Chirp, RandomExcitation)):
+        return
+    top = highest_frequency(excitation, duration)
+    if top >= sample_rate / 2:
+        name = {Sine: "frequency", Chirp: "f1", RandomExcitation: "f_high"}[type(excitation)]
+        raise ParameterError(
+            f"`{name}` {top:g} Hz is at or above half the output rate (`sample_rate` "
+            f"{sample_rate:g} Hz shows at most {sample_rate / 2:g} Hz; the samples would alias "
+            f"it): raise `sample_rate` above {2 * top:g} Hz ({5 * top:g} Hz resolves it well) "
+            f"or lower `{name}`.", (name, "sample_rate"))
+
+
+def _check_length(duration, sample_rate, dt):
+    """Refuse, before any step is chosen, a run that would take absurdly long. A chosen step
+    is never longer than the output period, so counting steps at the given ``dt`` or at
+    that period is a lower bound, and the refusal certain."""
+    from qzs.engine.driver import plan_run
+    from qzs.errors import RunTooLongError
+
+    bound = dt if dt is not None else 1.0 / sample_rate
+    fix = ("a shorter `duration` or a larger `dt`" if dt is not None else
+           "a shorter `duration` or a lower `sample_rate` (the step is at most its period)")
+    options = ("duration", "dt") if dt is not None else ("duration", "sample_rate")
+    if not math.isfinite(duration / bound):
+        raise ParameterError(f"`duration` {duration:g} s at dt = {bound:g} s is more "
+                             f"integration steps than a number holds; choose {fix}.", options)
+    try:
+        plan_run(float(duration), float(bound), 1)
+    except RunTooLongError as error:
+        raise ParameterError(
+            f"`duration` {duration:g} s is at least {error.steps:.3g} integration steps "
+            f"(dt <= {error.dt:g} s): more than the day of computing qzs starts at most; "
+            f"choose {fix}.", options) from None
 
 
 @dataclass(frozen=True, kw_only=True)
