@@ -65,7 +65,7 @@ import unicodedata
 from qzs._version import __version__
 from qzs.cli import (app, completion, design, design_space, docs, experiment, export, hexapod,
                      params, response, simulate, studies, sweep)
-from qzs.cli.common import EPILOG, run_handler
+from qzs.cli.common import EPILOG, run_handler, run_subcommand
 from qzs.errors import Terminated
 
 __all__ = ["main", "build_parser", "CONSOLE_ERRORS"]
@@ -84,10 +84,10 @@ HANDLERS = {"simulate": simulate.run, "params": params.run, "paper": studies.run
             "study": studies.run, "experiment": experiment.run,
             "sweep": sweep.run_sweep_command, "sweep-plot": sweep.run_plot_command,
             "sweep-export": sweep.run_export_command,
-            "hexapod": hexapod.run, "response": response.run,
+            "hexapod": run_subcommand, "response": response.run,
             "design": design.run, "optimize": design_space.run_optimize_command,
             "sensitivity": design_space.run_sensitivity_command,
-            "app": app.run, "export": export.run, "docs": docs.run,
+            "app": app.run, "export": run_subcommand, "docs": docs.run,
             "completion": completion.run}
 
 

@@ -515,6 +515,23 @@ def start_notice(command, *, quiet=False, delay=None):
         sys.stdout, sys.stderr = out, err
 
 
+def run_subcommand(args):
+    """Run the subcommand of a command group (``qzs hexapod``, ``qzs export``) the arguments
+    name: ``args.handler``, set by the subcommand's parser; returns its exit code.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments.
+
+    Returns
+    -------
+    int
+        The subcommand's exit code.
+    """
+    return args.handler(args)
+
+
 def _command(args):
     """``args.command``, or ``hexapod <sub>`` for the six-axis subcommands."""
     command = getattr(args, "command", None)

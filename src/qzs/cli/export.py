@@ -105,22 +105,6 @@ def add_parser(subparsers):
     return export
 
 
-def run(args):
-    """Run the ``qzs export`` subcommand the arguments name; returns the exit code.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        The parsed arguments (``args.handler`` is the subcommand's).
-
-    Returns
-    -------
-    int
-        The subcommand's exit code.
-    """
-    return args.handler(args)
-
-
 def run_controller(args):
     """``qzs export controller``: write the controller's C file.
 

@@ -177,22 +177,6 @@ def add_parser(subparsers):
     return hexapod
 
 
-def run(args):
-    """Run the ``qzs hexapod`` subcommand the arguments name; returns the exit code.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        The parsed arguments (``args.handler`` is the subcommand's).
-
-    Returns
-    -------
-    int
-        The subcommand's exit code.
-    """
-    return args.handler(args)
-
-
 def _setup(args):
     """The set-up the options describe (delegates to :mod:`qzs.workflows.hexapod.setups`): the
     --config file, else a --cubic configuration, else the shipped default
