@@ -84,7 +84,15 @@ class ExcitationError(ParameterError):
 
 
 class StabilityError(ParameterError):
-    """The chosen time step is too large for the explicit integrator to be stable."""
+    """The chosen time step is too large for the explicit integrator to be stable.
+
+    Parameters
+    ----------
+    message : str
+        The step, the stability limit and the fix.
+    options : tuple of str
+        The arguments it names (:attr:`ParameterError.options`).
+    """
 
 
 class CaseError(ParameterError):

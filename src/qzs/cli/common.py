@@ -38,7 +38,8 @@ __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
            "OUTPUT_OPTIONS", "NO_FIGURE", "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
-           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families"]
+           "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families",
+           "start_notice", "START_NOTICE_DELAY", "run_subcommand"]
 
 #: The output options every subcommand that writes takes (:func:`add_output_options`):
 #: ``--out`` and/or ``--plot`` (what it writes), then all of ``--json``, ``--quiet`` and

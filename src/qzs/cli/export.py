@@ -5,7 +5,7 @@ from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_ou
                              parameters)
 from qzs.defaults import SIMULATION
 
-__all__ = ["add_parser", "run", "run_controller", "run_fmu"]
+__all__ = ["add_parser", "run_controller", "run_fmu"]
 
 #: The internal excitation's options: flag, type, metavar, help (as ``qzs simulate`` has them).
 _EXCITATION_FLAGS = (

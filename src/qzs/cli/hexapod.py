@@ -6,7 +6,7 @@ from qzs.defaults import ACCURACY, AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT
 
-__all__ = ["add_parser", "run", "run_linear", "run_simulate", "run_transmissibility",
+__all__ = ["add_parser", "run_linear", "run_simulate", "run_transmissibility",
            "run_study"]
 
 #: What every subcommand takes without --config or --cubic (one default for all of them).
