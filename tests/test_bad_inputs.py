@@ -214,7 +214,7 @@ class Bad:
 BAD = {
     # hangs
     "simulate-dt-1e-13": Bad(["simulate", "--dt", "1e-13", "--duration", "100", "--out",
-                              "run.nc"], "--duration 100 s", "dt <= 1e-13 s", "larger --dt",
+                              "run.nc"], "--duration = 100 s", "--dt = 1e-13 s", "larger --dt",
                              hang=True),
     "design-controller-rate-333": Bad(["design", "--quick", "--controller-rate", "333",
                                        "--out", "design"], "`controller_rate` (333 Hz)",

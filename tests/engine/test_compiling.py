@@ -192,7 +192,8 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     first = chunks[0][0]
     assert first <= startup + 4.0, (first, startup)
     notice_at = next(t for t, c in chunks if b"compiling the kernels once" in c)
-    assert notice_at == first  # nothing else came before it
+    before = [c for t, c in chunks if t < notice_at]  # nothing but the start notice (busy)
+    assert all(b"qzs simulate: starting" in c for c in before), before
     # until the last sign of compiling, no gap longer than the bound: the ticker writes every
     # second; a busy machine starves it now and then, as much as it slows the start-up
     last = max(t for t, c in chunks if b"compiling" in c or c.strip(b" s\n").isdigit())

@@ -161,7 +161,7 @@ def run(args):
     """
     import sys
 
-    from qzs.engine.run_spec import resolve
+    from qzs.engine.run_spec import check_output_rate, resolve
     from qzs.workflows.run import simulate_to_file
 
     config = parameters(args)
@@ -183,6 +183,8 @@ def run(args):
         check_output(args, "--out", args.out, suffixes=RESULT_SUFFIXES)
     show = not args.quiet and not args.json
     try:  # resolve() checks the inputs; the command line only says them its own way
+        check_output_rate(excitation, settings.get("duration", excitation.duration),
+                          settings.get("sample_rate", SIMULATION["sample_rate"]))
         resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
                            tolerance=args.tolerance, tolerance_state=args.tolerance_state,
                            step="chosen", progress=show)

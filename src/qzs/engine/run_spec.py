@@ -33,7 +33,8 @@ if TYPE_CHECKING:
     from qzs.model.excitation import Excitation
     from qzs.model.isolator import InitialState, IsolatorParameters
 
-__all__ = ["ResolvedRun", "resolve", "ResolvedHexapodRun", "resolve_hexapod", "MAX_SAMPLES"]
+__all__ = ["ResolvedRun", "resolve", "ResolvedHexapodRun", "resolve_hexapod", "MAX_SAMPLES",
+           "check_output_rate"]
 
 #: Output samples a run may ask for at most [-] (past this, counts lose their integers).
 MAX_SAMPLES = 1e15
@@ -199,7 +200,6 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
             f"{duration * sample_rate:.3g} output samples, more than any run can hold "
             f"({MAX_SAMPLES:.0e}); shorten the run or lower the rate.",
             ("duration", "sample_rate"))
-    _check_output_rate(excitation, duration, sample_rate)
     given = _one_step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
     if dt is None and not given and step == "literal":
         dt = defaults.SIMULATION["dt"]
@@ -235,13 +235,36 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
                        sample_rate=sample_rate, solver=solver, step=choice)
 
 
-def _check_output_rate(excitation, duration, sample_rate):
-    """Refuse an excitation at or above half the output rate: the samples could not show it
-    (they would alias it to a lower frequency). A record's bound is its own samples'."""
+def check_output_rate(excitation, duration, sample_rate):
+    """Refuse an excitation at or above half the output rate, where a time series is shown.
+
+    Its samples could not show the excitation: they would alias it to a lower frequency.
+    :func:`resolve` does not check this (a script may sample a run coarsely on purpose: the
+    final state, the statistics); the commands that write or draw the time series do
+    (``qzs simulate``).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The base motion (a record's bound is its own samples', not checked here).
+    duration : float
+        Simulated time [s] (a chirp reaches its ``f1`` only at its end).
+    sample_rate : float
+        Output rate [Hz].
+
+    Raises
+    ------
+    ParameterError
+        The excitation's highest frequency at or above ``sample_rate / 2``; its ``options``
+        name the excitation's frequency field and ``sample_rate``.
+    """
     from qzs.model.excitation import Chirp, RandomExcitation, Sine, highest_frequency
 
     if not isinstance(excitation, (Sine, Chirp, RandomExcitation)):
         return
+    numbers = [v for v in (duration, sample_rate) if v is not None]
+    if not all(isinstance(v, (int, float)) and 0 < v < math.inf for v in numbers):
+        return  # not a duration or a rate at all: resolve() says what is wrong
     top = highest_frequency(excitation, duration)
     if top >= sample_rate / 2:
         name = {Sine: "frequency", Chirp: "f1", RandomExcitation: "f_high"}[type(excitation)]
@@ -253,9 +276,10 @@ def _check_output_rate(excitation, duration, sample_rate):
 
 
 def _check_length(duration, sample_rate, dt):
-    """Refuse, before any step is chosen, a run that would take absurdly long. A chosen step
-    is never longer than the output period, so counting steps at the given ``dt`` or at
-    that period is a lower bound, and the refusal certain."""
+    """Refuse, before any step is chosen, a run that would take absurdly long: a given ``dt``
+    as the driver would (:class:`~qzs.errors.RunTooLongError`); a step still to be chosen is
+    never longer than the output period, so counting steps at that period is a lower bound,
+    and the refusal certain."""
     from qzs.engine.driver import plan_run
     from qzs.errors import RunTooLongError
 
@@ -266,6 +290,9 @@ def _check_length(duration, sample_rate, dt):
     if not math.isfinite(duration / bound):
         raise ParameterError(f"`duration` {duration:g} s at dt = {bound:g} s is more "
                              f"integration steps than a number holds; choose {fix}.", options)
+    if dt is not None:
+        plan_run(float(duration), float(dt), 1)  # RunTooLongError, with its data
+        return
     try:
         plan_run(float(duration), float(bound), 1)
     except RunTooLongError as error:
