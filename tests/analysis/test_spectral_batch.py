@@ -91,6 +91,11 @@ def test_bad_populations_are_refused_naming_the_argument_and_the_cases(base, pay
         transmissibility_batch(base, payload, SAMPLE_RATE, fft_length=1024)
 
 
+def test_a_population_of_no_case_has_no_estimate():
+    assert transmissibility_batch(np.zeros((0, 5000)), np.zeros((0, 5000)), SAMPLE_RATE,
+                                  fft_length=1024) == ()
+
+
 def test_bad_options_are_refused_as_for_one_case():
     signals = np.zeros((2, 5000))
     with pytest.raises(ParameterError, match="`estimator` must be one of"):

@@ -484,7 +484,7 @@ highpass_factor
     Returns
     -------
     tuple of TransmissibilityEstimate
-        One per row, in order; they share their ``frequency`` array.
+        One per row, in order (none for no row); they share their ``frequency`` array.
 
     Raises
     ------
@@ -517,6 +517,8 @@ highpass_factor
                         f"record longer or reduce `fft_length`/`n_averages`.")
     if n_averages is not None:  # contiguous rows: the FFTs of strided rows are other bits
         base, payload = (np.ascontiguousarray(x[:, :needed]) for x in (base, payload))
+    if base.shape[0] == 0:
+        return ()
     arrays = transmissibility_arrays(base, payload, sample_rate, window=window,
                                      fft_length=fft_length, noverlap=noverlap,
                                      detrend=detrend, estimator=estimator)
