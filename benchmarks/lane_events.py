@@ -13,7 +13,6 @@ package itself never exports.
 """
 import inspect
 import textwrap
-import time
 
 import numpy as np
 from llvmlite import ir
@@ -99,10 +98,8 @@ def measure_events(cases, excitation, *, dt, sample_rate, channels, repeats=2):
     try:
         for _ in range(repeats):
             calls.clear()
-            start = time.perf_counter()
             batch = simulate_batch(cases, excitation, **options)
             best["elapsed"] = min(best["elapsed"], batch.elapsed)
-            del start
     finally:
         lanes.run_lanes = plain_kernel
     plain = None
