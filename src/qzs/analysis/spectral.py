@@ -542,7 +542,7 @@ def _estimates(arrays, *, coherence_min, base_share_min, highpass_corner, highpa
     for array in [frequency, *rows]:
         array.setflags(write=False)
     return tuple(TransmissibilityEstimate(
-        frequency, *(array[i] for array in rows), **fields,  # type: ignore[misc, arg-type]
+        frequency, *(array[i] for array in rows), **fields,
         highpass_corner=highpass_corner, coherence_min=float(coherence_min),
         base_share_min=float(base_share_min), highpass_factor=float(highpass_factor))
         for i in range(rows[0].shape[0]))
