@@ -109,7 +109,8 @@ def _cross(stft_payload, stft_base):
     cases = [payload * base.conj()  # the one-case expression, as written above
              for payload, base in zip(stft_payload.reshape(-1, *shape),
                                       stft_base.reshape(-1, *shape))]
-    return np.reshape(cases, stft_base.shape)
+    return cases[0].reshape(stft_base.shape) if len(cases) == 1 else np.reshape(
+        cases, stft_base.shape)
 
 
 def _by_case(function, *arrays):
@@ -119,7 +120,8 @@ def _by_case(function, *arrays):
     if arrays[0].ndim == 1:
         return function(*arrays)
     rows = [function(*case) for case in zip(*(a.reshape(-1, a.shape[-1]) for a in arrays))]
-    return np.reshape(rows, arrays[0].shape[:-1] + rows[0].shape)
+    shape = arrays[0].shape[:-1] + rows[0].shape
+    return rows[0].reshape(shape) if len(rows) == 1 else np.reshape(rows, shape)
 
 
 def transmissibility_arrays(base, payload, sample_rate, *, window, fft_length, noverlap,
