@@ -5,8 +5,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from qzs._validation import (Structured, choice, integer, interval, non_negative_real, optional,
-                             positive_real, real)
+from qzs._validation import (Structured, choice, finite_rows, integer, interval, non_negative_real,
+                             optional, positive_real, real)
 from qzs.errors import DataError, ParameterError, ProblemError
 
 NOT_NUMBERS = [True, np.True_, "1.0", None, [1.0], 1 + 2j]
@@ -125,3 +125,17 @@ def test_an_interval_is_two_ordered_finite_numbers_above_its_minimum():
         interval("band", "ab", "Hz", example="(1, 20)")
     assert str(info.value) == ("`band` must be two numbers (low, high) in Hz, got 'ab'; "
                                "e.g. (1, 20).")
+
+
+def test_finite_rows_names_the_rows_with_non_finite_samples_and_refuses_other_shapes():
+    rows = np.zeros((30, 5))
+    assert finite_rows("base", rows, DataError).shape == (30, 5)
+    rows[[3, 7]] = [[np.nan] * 5, [np.inf] + [0.0] * 4]
+    with pytest.raises(DataError, match=r"`base` has non-finite .* in 2 of 30 rows \(\[3, 7\]\); "
+                                        r"trim them"):
+        finite_rows("base", rows, DataError, "trim them")
+    rows[:] = np.nan
+    with pytest.raises(DataError, match=r"30 of 30 rows \(\[0, 1, .*, 9\], \.\.\.\)"):
+        finite_rows("base", rows, DataError)
+    with pytest.raises(ParameterError, match=r"`base` must be a 2-D array.*shape \(5,\)"):
+        finite_rows("base", np.zeros(5), ParameterError)

@@ -221,6 +221,21 @@ def finite_series(name, values, error, fix="interpolate or trim them first"):
     return array
 
 
+def finite_rows(name, values, error, fix="interpolate or trim them first"):
+    """``values`` as a 2-D float array (one series per row) with no NaN or inf, or ``error``
+    naming the rows that hold any."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim != 2:
+        raise error(f"`{name}` must be a 2-D array, one series per row, got shape "
+                    f"{array.shape}.")
+    bad = np.flatnonzero(~np.isfinite(array).all(axis=1))
+    if bad.size:
+        raise error(f"`{name}` has non-finite (NaN or inf) samples in {bad.size} of "
+                    f"{array.shape[0]} rows ({bad[:10].tolist()}"
+                    f"{', ...' if bad.size > 10 else ''}); {fix}.")
+    return array
+
+
 def read_toml(path, what, error=ParameterError):
     """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad.
 

@@ -14,7 +14,6 @@ from qzs.analysis.spectral import (
     transmissibility,
     transmissibility_metrics,
     welch_average_count,
-    welch_spectra,
 )
 
 SAMPLE_RATE = 100.0  # [Hz]
@@ -143,26 +142,6 @@ def test_required_samples_round_trips_and_matches_scipy(fft_length, overlap, n_a
     _, times, _ = signal.spectrogram(np.zeros(n + fft_length // 3), nperseg=fft_length, noverlap=noverlap)
     assert welch_average_count(n + fft_length // 3, fft_length, overlap) == times.size
     assert required_duration(fft_length, n_averages, 1000.0, overlap) == n / 1000.0
-
-
-@pytest.mark.parametrize("fft_length, noverlap, window, detrend", [
-    (4096, 2048, "hann", "constant"), (1000, 333, ("tukey", 0.3), False),
-    (2048, 0, "hann", "linear"), (255, 100, "hamming", "constant")])
-def test_welch_spectra_are_scipys_to_the_last_bit(fft_length, noverlap, window, detrend):
-    """One STFT per signal gives scipy.signal.welch's and csd's spectra exactly."""
-    rng = np.random.default_rng(fft_length)
-    base = rng.normal(size=60_001)
-    payload = np.convolve(base, [0.5, 0.3, 0.2], "same") + 0.1 * rng.normal(size=base.size)
-    options = dict(fs=SAMPLE_RATE, window=window, nperseg=fft_length, noverlap=noverlap,
-                   detrend=detrend)
-    frequency, base_power, payload_power, cross = welch_spectra(
-        base, payload, SAMPLE_RATE, window=window, fft_length=fft_length, noverlap=noverlap,
-        detrend=detrend)
-    expected_frequency, expected_base = signal.welch(base, **options)
-    assert np.array_equal(frequency, expected_frequency)
-    assert np.array_equal(base_power, expected_base)
-    assert np.array_equal(payload_power, signal.welch(payload, **options)[1])
-    assert np.array_equal(cross, signal.csd(base, payload, **options)[1])
 
 
 def test_required_duration_of_paper_simulation():

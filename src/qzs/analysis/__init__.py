@@ -2,6 +2,7 @@
 
 ====================  =============================================================================
 ``spectral``          transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
+``welch``             Welch spectra and transmissibility arrays of one record or a population at once
 ``damping``           what active damping changes: largest per-bin reduction and band-RMS change
 ``linear``            the linearised closed loop at the operating point (python-control)
 ``hexapod_linear``    the six-leg platform of isolator legs linearised at its home pose
@@ -15,8 +16,8 @@ from qzs._lazy import lazy_exports
 
 _SPECTRAL = ("TransmissibilityEstimate", "TransmissibilityMetrics", "amplitude_spectrum",
              "band_mask", "rolloff_slope", "highpass", "required_duration", "required_samples",
-             "transmissibility", "transmissibility_at", "transmissibility_metrics",
-             "trusted_bins", "welch_average_count")
+             "transmissibility", "transmissibility_batch", "transmissibility_at",
+             "transmissibility_metrics", "trusted_bins", "welch_average_count")
 _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
             **{name: "qzs.analysis.statistics"
                for name in ("STATISTICS", "RunStatistics", "run_statistics",

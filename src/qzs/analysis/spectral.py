@@ -27,7 +27,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import signal
 
 from qzs._format import UndefinedValue, decibels
-from qzs._validation import finite_series, integer, optional, positive_real
+from qzs._validation import finite_rows, finite_series, integer, optional, positive_real
+from qzs.analysis.welch import transmissibility_arrays
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
@@ -38,6 +39,7 @@ if TYPE_CHECKING:
 __all__ = ["TransmissibilityEstimate", "TransmissibilityMetrics", "UndefinedValue",
            "amplitude_spectrum", "band_mask",
            "rolloff_slope", "highpass", "required_duration", "required_samples", "transmissibility",
+           "transmissibility_batch",
            "transmissibility_at", "transmissibility_metrics", "trusted_bins",
            "welch_average_count", "estimate_schema", "METRIC_UNITS", "metric_unit"]
 
@@ -376,60 +378,6 @@ def estimate_schema(estimator="h1"):
                   variables=variables)
 
 
-def welch_spectra(base, payload, sample_rate, *, window, fft_length, noverlap, detrend):
-    """The Welch auto- and cross-spectra of two signals, from one STFT of each.
-
-    ``scipy.signal.welch(base)``, ``welch(payload)`` and ``csd(base, payload)`` to the
-    last bit (one-sided densities, mean over segments): the same
-    :class:`scipy.signal.ShortTimeFFT` and the same arithmetic as ``csd``, but each
-    signal's segments are transformed once instead of twice (``welch`` and ``csd`` each
-    transform their own), which halves the cost of a transmissibility estimate.
-
-    Parameters
-    ----------
-    base, payload : ndarray, shape (n,)
-        The signals (float), n >= ``fft_length``.
-    sample_rate : float
-        Sample rate [Hz].
-    window : str, tuple or array_like
-        As for ``scipy.signal.welch``.
-    fft_length : int
-        Segment and FFT length [samples].
-    noverlap : int
-        Samples shared by neighbouring segments.
-    detrend : str, callable or False
-        As for ``scipy.signal.welch``.
-
-    Returns
-    -------
-    frequency : ndarray
-        Bin frequencies [Hz].
-    base_power, payload_power : ndarray
-        Power spectral densities [unit^2/Hz].
-    cross : ndarray of complex
-        Cross-spectral density of base and payload [unit^2/Hz] (``csd(base, payload)``).
-    """
-    if isinstance(window, (str, tuple)):
-        win = signal.get_window(window, fft_length)
-    else:
-        win = np.asarray(window)
-    hop = fft_length - noverlap
-    transform = signal.ShortTimeFFT(win, hop, sample_rate, fft_mode="onesided",
-                                    mfft=fft_length, scale_to="psd", phase_shift=None)
-    options = dict(detr=None if detrend is False else detrend, p0=0,
-                   p1=(base.size - noverlap) // transform.hop, k_offset=fft_length // 2)
-    stft_base = transform.stft_detrend(base, **options)
-    stft_payload = transform.stft_detrend(payload, **options)
-    inner = slice(1, -1 if transform.mfft % 2 == 0 else None)  # one-sided: double all but DC
-    spectra = []                                                # (and Nyquist)
-    for product in (stft_base.real ** 2 + stft_base.imag ** 2,
-                    stft_payload.real ** 2 + stft_payload.imag ** 2,
-                    stft_payload * stft_base.conj()):
-        product[inner] *= 2
-        spectra.append(product.mean(axis=-1) if product.shape[-1] > 1 else product[:, 0])
-    return transform.f, spectra[0], spectra[1], spectra[2]
-
-
 def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
                      fft_length: int = ANALYSIS["fft_length"],
                      overlap: float = ANALYSIS["overlap"],
@@ -488,65 +436,116 @@ def transmissibility(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
     DataError
         Signals not 1-D, of different lengths, non-finite, or too short.
     """
+    base, payload = _signal("base", base), _signal("payload", payload)
+    if base.size != payload.size:
+        raise DataError(f"`base` and `payload` must have the same length, "
+                        f"got {base.size} and {payload.size}.")
+    # one case of a population: the same operations, the same bits (qzs.analysis.welch)
+    return transmissibility_batch(
+        base[np.newaxis], payload[np.newaxis], sample_rate, fft_length=fft_length,
+        overlap=overlap, window=window, n_averages=n_averages, estimator=estimator,
+        detrend=detrend, highpass_corner=highpass_corner, coherence_min=coherence_min,
+        base_share_min=base_share_min, highpass_factor=highpass_factor)[0]
+
+
+def transmissibility_batch(base: ArrayLike, payload: ArrayLike, sample_rate: float, *,
+                           fft_length: int = ANALYSIS["fft_length"],
+                           overlap: float = ANALYSIS["overlap"],
+                           window: str | tuple[Any, ...] | ArrayLike = "hann",
+                           n_averages: int | None = None, estimator: str = "psd_ratio",
+                           detrend: str | Callable[..., Any] | Literal[False] = "constant",
+                           highpass_corner: float | None = None,
+                           coherence_min: float = ANALYSIS["coherence_min"],
+                           base_share_min: float = ANALYSIS["base_share_min"],
+                           highpass_factor: float = ANALYSIS["highpass_factor"],
+                           ) -> tuple[TransmissibilityEstimate, ...]:
+    """The transmissibility of every case of a population, from one batched Welch estimate.
+
+    :func:`transmissibility` of each row of ``base`` and ``payload``, the same numbers
+    (the same operations along the rows, :mod:`qzs.analysis.welch`), but every case's
+    segments in one :class:`scipy.signal.ShortTimeFFT` call: the window, its PSD scale and
+    the transform are set up once for the population rather than once per case.
+
+    Parameters
+    ----------
+    base, payload : array_like, shape (n_cases, n)
+        Base and payload acceleration of each case [m/s^2] (any common unit), one case per
+        row, all sampled together at ``sample_rate``.
+    sample_rate : float
+        Sample rate [Hz].
+    fft_length : int
+        Segment and FFT length [samples], >= 8.
+    highpass_corner : float, optional
+        High-pass corner of the measurement chain [Hz].
+    overlap, window, n_averages, estimator, detrend, coherence_min, base_share_min, \
+highpass_factor
+        As for :func:`transmissibility`, the same for every case.
+
+    Returns
+    -------
+    tuple of TransmissibilityEstimate
+        One per row, in order (none for no row); they share their ``frequency`` array.
+
+    Raises
+    ------
+    ParameterError
+        Invalid option.
+    DataError
+        Signals not 2-D, of different shapes, non-finite (the cases are named), or too short.
+    """
     sample_rate = positive_real("sample_rate", sample_rate)
     fft_length = integer("fft_length", fft_length, 8)
     noverlap = _noverlap(fft_length, overlap)
     highpass_corner = optional(positive_real)("highpass_corner", highpass_corner)
     if estimator not in ESTIMATORS:
         raise ParameterError(f"`estimator` must be one of {ESTIMATORS}, got {estimator!r}.")
-    base, payload = _signal("base", base), _signal("payload", payload)
-    if base.size != payload.size:
-        raise DataError(f"`base` and `payload` must have the same length, "
-                        f"got {base.size} and {payload.size}.")
+    fix = "estimate those cases apart, or interpolate or trim them before estimating spectra"
+    base, payload = (finite_rows(name, values, DataError, fix)
+                     for name, values in (("base", base), ("payload", payload)))
+    if base.shape != payload.shape:
+        raise DataError(f"`base` and `payload` must have the same shape, got {base.shape} and "
+                        f"{payload.shape}.")
     if n_averages is None:
         needed, what = fft_length, f"fft_length={fft_length}"
     else:
         needed = required_samples(fft_length, n_averages, overlap)
         what = f"n_averages={n_averages} with fft_length={fft_length} and overlap={overlap}"
-    if base.size < needed:
+    size = base.shape[-1]
+    if size < needed:
         raise DataError(f"{what} needs at least {needed} samples ({needed / sample_rate:g} s at "
-                        f"{sample_rate:g} Hz), got {base.size} ({base.size / sample_rate:g} s); "
+                        f"{sample_rate:g} Hz), got {size} ({size / sample_rate:g} s); "
                         f"record longer or reduce `fft_length`/`n_averages`.")
-    if n_averages is not None:
-        base, payload = base[:needed], payload[:needed]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # each spectrum once; the coherence is scipy.signal.coherence's own formula on them
-        frequency, s_bb, s_pp, s_bp = welch_spectra(base, payload, sample_rate, window=window,
-                                                    fft_length=fft_length, noverlap=noverlap,
-                                                    detrend=detrend)
-        coherence = np.abs(s_bp) ** 2 / s_bb / s_pp
-        if estimator == "psd_ratio":
-            magnitude = np.sqrt(np.divide(s_pp, s_bb, out=np.full_like(s_pp, np.nan), where=s_bb > 0))
-            # S_bb and S_pp are real: H1 = S_bp/S_bb and H2 = S_pp/S_pb share the phase of S_bp
-            phase = np.where(s_bb > 0, np.angle(s_bp), np.nan)
-        else:
-            if estimator == "h1":
-                numerator, denominator = s_bp, s_bb
-            else:
-                denominator = signal.csd(payload, base, fs=sample_rate, window=window,
-                                         nperseg=fft_length, noverlap=noverlap,
-                                         detrend=detrend)[1]
-                numerator = s_pp
-            response = np.divide(numerator, denominator, out=np.full(frequency.shape, np.nan, complex),
-                                 where=np.abs(denominator) > 0)
-            magnitude, phase = np.abs(response), np.angle(response)
-        total = float(np.sum(s_bb[frequency > 0]))
-        base_share = np.where(frequency > 0, s_bb / total if total > 0 else 0.0, 0.0)
-        coherence = np.nan_to_num(np.clip(coherence, 0, 1), nan=0.0)
+    if n_averages is not None:  # contiguous rows: the FFTs of strided rows are other bits
+        base, payload = (np.ascontiguousarray(x[:, :needed]) for x in (base, payload))
+    if base.shape[0] == 0:
+        return ()
+    arrays = transmissibility_arrays(base, payload, sample_rate, window=window,
+                                     fft_length=fft_length, noverlap=noverlap,
+                                     detrend=detrend, estimator=estimator)
+    return _estimates(arrays, estimator=estimator, fft_length=fft_length,
+                      n_averages=welch_average_count(base.shape[-1], fft_length, overlap),
+                      sample_rate=sample_rate, highpass_corner=highpass_corner,
+                      coherence_min=coherence_min, base_share_min=base_share_min,
+                      highpass_factor=highpass_factor)
+
+
+def _estimates(arrays, *, coherence_min, base_share_min, highpass_corner, highpass_factor,
+               **fields):
+    """One :class:`TransmissibilityEstimate` per case (row) of ``arrays``, read-only."""
+    frequency, magnitude, phase, coherence, base_share = arrays
     trusted = trusted_bins(frequency, coherence, base_share, coherence_min=coherence_min,
                            base_share_min=base_share_min, highpass_corner=highpass_corner,
                            highpass_factor=highpass_factor, magnitude=magnitude)
-    arrays = [np.asarray(a, dtype=float) for a in (frequency, magnitude, phase, coherence, base_share)]
-    arrays.append(trusted)
-    for array in arrays:
+    rows = [np.atleast_2d(np.asarray(a, dtype=float))
+            for a in (magnitude, phase, coherence, base_share)] + [np.atleast_2d(trusted)]
+    frequency = np.asarray(frequency, dtype=float)
+    for array in [frequency, *rows]:
         array.setflags(write=False)
-    # six arrays for the six array fields: mypy cannot count a starred list
-    return TransmissibilityEstimate(  # type: ignore[misc]
-        *arrays, estimator=estimator, fft_length=fft_length,  # type: ignore[arg-type]
-        n_averages=welch_average_count(base.size, fft_length, overlap),
-        sample_rate=sample_rate, highpass_corner=highpass_corner,
-        coherence_min=float(coherence_min), base_share_min=float(base_share_min),
-        highpass_factor=float(highpass_factor))
+    return tuple(TransmissibilityEstimate(
+        frequency, *(array[i] for array in rows), **fields,
+        highpass_corner=highpass_corner, coherence_min=float(coherence_min),
+        base_share_min=float(base_share_min), highpass_factor=float(highpass_factor))
+        for i in range(rows[0].shape[0]))
 
 
 def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_length"], window="hann",

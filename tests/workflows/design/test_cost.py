@@ -37,3 +37,29 @@ def test_an_unrelated_payload_has_too_few_trusted_bins_and_no_cost():
         value, share, _ = transmissibility_cost(white(3, 40_000), white(4, 40_000), 200.0,
                                                 band=(1.0, 20.0))
     assert math.isnan(value) and share < 0.5
+
+
+def test_a_batch_costs_each_design_what_its_own_run_costs():
+    """_costs estimates a batch's cases in one batched Welch: each value, share and curve the
+    same bits as transmissibility_cost of that case's own run (qzs.simulate)."""
+    from types import SimpleNamespace
+
+    import qzs
+    from qzs.workflows.design.cost import _costs
+
+    settings = SimpleNamespace(excitation=qzs.Chirp(duration=20.0), duration=None, dt=1e-3,
+                               sample_rate=200.0, workers=1, band=(1.0, 15.0), cost="rms",
+                               fft_length=1024)
+    pairs = [(qzs.IsolatorParameters(stiction_force=force),
+              qzs.ControllerParameters(pi_kp=gain, damping_gain=damping))
+             for force, gain, damping in ((6.0, 20.0, 0.0), (10.0, 200.0, 40.0),
+                                          (14.0, 800.0, 90.0))]
+    for (value, share, estimate, reason, _), pair in zip(_costs(pairs, settings), pairs):
+        run = qzs.simulate(settings.excitation, *pair, dt=settings.dt,
+                           sample_rate=settings.sample_rate)
+        alone = transmissibility_cost(run.base_acceleration, run.payload_acceleration,
+                                      settings.sample_rate, band=settings.band,
+                                      fft_length=settings.fft_length)
+        assert (value, share) == alone[:2] or (math.isnan(value) and math.isnan(alone[0]))
+        assert np.array_equal(estimate.magnitude, alone[2].magnitude, equal_nan=True)
+        assert np.array_equal(estimate.trusted, alone[2].trusted)

@@ -39,3 +39,39 @@ def test_a_scaled_payload_has_that_transmissibility_everywhere():
     assert arrays["rms_transmissibility_mid"][1] == pytest.approx(GAIN, rel=1e-12)
     assert arrays["transmissibility_at_2_hz"][1] == pytest.approx(GAIN, rel=1e-12)
     assert arrays["n_averages"][1] >= 8
+
+
+def test_a_batch_is_estimated_at_once_each_case_as_alone_and_a_bad_case_fails_alone():
+    """estimate_cases: each case's estimate the same bits as its own transmissibility; a
+    case the analysis refuses (NaN samples) gets its own error and the others their
+    estimates."""
+    from qzs.analysis.spectral import transmissibility
+    from qzs.errors import DataError
+    from qzs.workflows.sweeps.reduction import estimate_cases
+
+    definition = load_sweep({"sweep": {"name": "reduce"}, "grid": {"pi_kp": [5.0]},
+                             "analysis": {"fft_length": 1024, "n_averages": 8}})
+    a = definition.analysis
+    rng = np.random.default_rng(5)
+    base = rng.standard_normal((5, int(a["duration"] * a["sample_rate"])))
+    payload = np.cumsum(rng.standard_normal(base.shape), axis=1) * 0.01 + GAIN * base
+    for bad in (None, 2):
+        if bad is not None:
+            payload[bad, 100] = np.nan
+        estimates = estimate_cases(definition, base, payload)
+        assert len(estimates) == 5
+        for i, estimate in enumerate(estimates):
+            if i == bad:
+                assert isinstance(estimate, DataError) and "non-finite" in str(estimate)
+                continue
+            alone = transmissibility(base[i], payload[i], a["sample_rate"],
+                                     fft_length=a["fft_length"], overlap=a["overlap"])
+            for name in ("magnitude", "phase", "coherence", "trusted"):
+                assert np.array_equal(getattr(estimate, name), getattr(alone, name),
+                                      equal_nan=True)
+            arrays, given = arrays_of(definition, 1), arrays_of(definition, 1)
+            reduce_case(definition, base[i], payload[i], arrays, 0)
+            reduce_case(definition, None, None, given, 0, estimate=estimate)
+            for name in arrays:
+                assert np.array_equal(arrays[name], given[name],
+                                      equal_nan=arrays[name].dtype.kind == "f"), name

@@ -5,7 +5,7 @@ import numpy as np
 
 from qzs.analysis import control_design as cd
 from qzs.analysis.damping import band_rms, damping_change
-from qzs.analysis.spectral import band_mask, transmissibility
+from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_batch
 from qzs.engine.batch import simulate_batch
 from qzs.workflows.design.settings import FFT_LENGTH, TRUSTED_SHARE_MIN
 
@@ -44,6 +44,11 @@ def transmissibility_cost(base_acceleration, payload_acceleration, sample_rate, 
     """
     estimate = transmissibility(base_acceleration, payload_acceleration, sample_rate,
                                 fft_length=fft_length)
+    return _cost_of(estimate, band, cost)
+
+
+def _cost_of(estimate, band, cost):
+    """:func:`transmissibility_cost` of an estimate: ``(value, share, estimate)``."""
     inside = band_mask(estimate.frequency, *band)
     keep = band_mask(estimate.frequency, *band, trusted=estimate.trusted)
     share = float(keep.sum() / max(inside.sum(), 1))
@@ -86,15 +91,16 @@ def _costs(pairs, settings):
     batch = simulate_batch(pairs, settings.excitation, duration=settings.duration,
                            dt=settings.dt, sample_rate=settings.sample_rate,
                            workers=settings.workers)
+    ran = np.flatnonzero(batch.status == 0)  # their estimates from one batched Welch
+    estimates = dict(zip(ran.tolist(), transmissibility_batch(
+        batch.channels["base_acceleration"][ran], batch.channels["payload_acceleration"][ran],
+        settings.sample_rate, fft_length=settings.fft_length)))
     out = []
     for i in range(len(pairs)):
         if batch.status[i]:
             out.append((math.nan, 0.0, None, batch.messages[i], math.nan))
             continue
-        value, share, estimate = transmissibility_cost(
-            batch.channels["base_acceleration"][i], batch.channels["payload_acceleration"][i],
-            settings.sample_rate, band=settings.band, cost=settings.cost,
-            fft_length=settings.fft_length)
+        value, share, estimate = _cost_of(estimates[i], settings.band, settings.cost)
         reason = "" if math.isfinite(value) else (
             f"only {100 * share:.0f} % of the band's bins are trusted (coherence below the "
             "threshold: the payload barely responds to the base there)")

@@ -22,7 +22,7 @@ from qzs._optional import require
 from qzs.engine.batch import simulate_batch
 from qzs.errors import CaseError, DataError, ParameterError
 from qzs.workflows.sweeps.cases import build_case
-from qzs.workflows.sweeps.reduction import reduce_case
+from qzs.workflows.sweeps.reduction import estimate_cases, reduce_case
 from qzs.workflows.sweeps.store import ANALYSIS_FAILED, COUNTS, FAILED, INVALID, OK, schema
 
 __all__ = ["run_batch", "run_local", "run_on_dask"]
@@ -118,6 +118,7 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
         break
     else:
         return 0
+    estimates = _estimates(definition, result) if spectral else {}
     for j, (i, _, _) in enumerate(members):
         for name in out["stats"]:
             arrays[name][i] = result.stats[name][j]
@@ -130,13 +131,25 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
         arrays["status"][i] = OK
         if spectral:
             try:
-                reduce_case(definition, result.channels["base_acceleration"][j],
-                            result.channels["payload_acceleration"][j], arrays, i)
+                if isinstance(estimates[j], Exception):
+                    raise estimates[j]
+                reduce_case(definition, None, None, arrays, i, estimate=estimates[j])
             except (DataError, ParameterError) as error:
                 arrays["status"][i] = ANALYSIS_FAILED
                 arrays["message"][i] = f"transmissibility analysis failed: {error}"
     return int(np.nansum(result.stats["steps"]))
 
+
+
+def _estimates(definition, result):
+    """The transmissibility estimate (or its error) of each case of ``result`` that ran to
+    the end, by index, from one batched estimate (:func:`estimate_cases`)."""
+    ran = np.flatnonzero(result.status == 0)
+    base, payload = (result.channels[name] for name in ("base_acceleration",
+                                                         "payload_acceleration"))
+    if ran.size < base.shape[0]:  # a diverged case's signals stop short: left out
+        base, payload = base[ran], payload[ran]
+    return dict(zip(ran.tolist(), estimate_cases(definition, base, payload)))
 
 
 def run_local(definition, batches, settings, n_time, threads):
