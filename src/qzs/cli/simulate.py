@@ -6,7 +6,6 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 import math
 
-from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
                              figure_path, parameters)
@@ -198,7 +197,7 @@ def run(args):
     import sys
 
     from qzs.engine.run_spec import resolve
-    from qzs.workflows.run import simulate_to_file
+    from qzs.workflows.figure_process import simulate_with_figure
 
     config = parameters(args)
     excitation = _excitation(args, config["excitation"], args.config)
@@ -227,23 +226,12 @@ def run(args):
     resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
                        tolerance=args.tolerance, tolerance_state=args.tolerance_state,
                        step="chosen", progress=show)
-    common = dict(progress=show, interruptible=True)
-    # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
-    # returning, so that no import is left half done (an error in the run ends it too)
-    loading = import_in_background("matplotlib.pyplot", "qzs.viz.simulation") if plot else None
-    try:
-        if args.out:
-            result = simulate_to_file(args.out, resolved=resolved, **common, argument="--out")
-        else:
-            result = resolved.simulate(**common)
-    finally:
-        if loading is not None:
-            loading.join()
+    result = simulate_with_figure(resolved, out=args.out, plot=plot, progress=show,
+                                  interruptible=True, argument="--out")
     files = {}
     if args.out:
         files["out"] = args.out
     if plot is not None:
-        result.plot(path=plot)
         files["plot"] = plot
     step = resolved.step
     notes = "".join(f"\n                   note: {note}" for note in step.notes)
