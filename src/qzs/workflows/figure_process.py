@@ -91,7 +91,8 @@ def _helper(connection, suffix):
         from qzs.viz.figures import figure_bytes
         from qzs.viz.simulation import plot_simulation
 
-        _warm_up(suffix)
+        if not connection.poll():  # the run is not over yet: warm up while it goes on
+            _warm_up(suffix)
         result = connection.recv()
         if result is not None:
             connection.send(("ok", figure_bytes(plot_simulation(result), suffix)))
@@ -122,7 +123,7 @@ class FigureProcess:
                                         args=(child, suffix))
         self._process.start()
         child.close()
-        self._sent = False
+        self._sender = None
 
     @staticmethod
     def available() -> bool:
@@ -143,11 +144,17 @@ class FigureProcess:
             The run (a streamed run's preview: at most
             :data:`~qzs.engine.driver.PREVIEW_SAMPLES` rows).
         """
-        try:
-            self._connection.send(result)
-            self._sent = True
-        except OSError:  # the helper is gone: :meth:`figure` says so
-            pass
+        import threading
+
+        def send():
+            try:
+                self._connection.send(result)
+            except OSError:  # the helper is gone: :meth:`figure` says so
+                pass
+
+        # in a thread: the helper may still be importing, and this process closes its file
+        self._sender = threading.Thread(target=send, name="qzs-figure-send", daemon=True)
+        self._sender.start()
 
     def figure(self) -> bytes | None:
         """The figure's file as the helper drew it, or None if it could not; ends the helper.
@@ -159,7 +166,11 @@ class FigureProcess:
             helper failed, or :meth:`draw` was not called): draw here instead.
         """
         try:
-            message = self._connection.recv() if self._sent else ("error", "nothing sent")
+            if self._sender is None:
+                message = ("error", "nothing sent")
+            else:
+                self._sender.join()
+                message = self._connection.recv()
         except (EOFError, OSError):
             message = ("error", "the helper ended")
         finally:
@@ -171,6 +182,8 @@ class FigureProcess:
         if self._process.is_alive():
             self._process.kill()
         self._process.join()
+        if self._sender is not None:  # its send fails once the helper is gone
+            self._sender.join()
         self._connection.close()
 
 
