@@ -221,3 +221,30 @@ def test_warm_up_labels_are_those_of_the_run_figure():
     for label in figure_process._WARM_UP_LABELS:
         assert label in source
     assert np.all([isinstance(label, str) for label in figure_process._WARM_UP_LABELS])
+
+
+def test_a_warmed_up_helper_draws_the_same_bytes(tmp_path, monkeypatch):
+    """The warm-up (a throw-away figure drawn while the run goes on) leaves no trace in the
+    run's figure: the helper, warmed up before the run is sent, draws the bytes this process
+    draws from scratch."""
+    marker = tmp_path / "warmed"
+    real = figure_process._warm_up
+
+    def warm_up(suffix):  # runs in the forked helper
+        real(suffix)
+        marker.write_text("done")
+
+    monkeypatch.setattr(figure_process, "_warm_up", warm_up)
+    helper = FigureProcess(".png")
+    try:
+        deadline = time.monotonic() + 120
+        while not marker.exists():
+            assert time.monotonic() < deadline, "the helper never warmed up"
+            time.sleep(0.05)
+        result = qzs.simulate(EXCITATION, duration=20.0)
+        helper.draw(result)
+        drawn = helper.figure()
+    finally:
+        helper.close()
+    result.plot(path=tmp_path / "here.png")
+    assert drawn == (tmp_path / "here.png").read_bytes()

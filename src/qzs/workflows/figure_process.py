@@ -25,6 +25,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -123,7 +124,7 @@ class FigureProcess:
                                         args=(child, suffix))
         self._process.start()
         child.close()
-        self._sender = None
+        self._sender: threading.Thread | None = None
 
     @staticmethod
     def available() -> bool:
@@ -144,8 +145,6 @@ class FigureProcess:
             The run (a streamed run's preview: at most
             :data:`~qzs.engine.driver.PREVIEW_SAMPLES` rows).
         """
-        import threading
-
         def send():
             try:
                 self._connection.send(result)
@@ -153,8 +152,9 @@ class FigureProcess:
                 pass
 
         # in a thread: the helper may still be importing, and this process closes its file
-        self._sender = threading.Thread(target=send, name="qzs-figure-send", daemon=True)
-        self._sender.start()
+        sender = threading.Thread(target=send, name="qzs-figure-send", daemon=True)
+        sender.start()
+        self._sender = sender
 
     def figure(self) -> bytes | None:
         """The figure's file as the helper drew it, or None if it could not; ends the helper.
@@ -165,17 +165,18 @@ class FigureProcess:
             The file's bytes (those :meth:`SimulationResult.plot` writes), or None (the
             helper failed, or :meth:`draw` was not called): draw here instead.
         """
+        drawn = None
         try:
-            if self._sender is None:
-                message = ("error", "nothing sent")
-            else:
+            if self._sender is not None:
                 self._sender.join()
-                message = self._connection.recv()
-        except (EOFError, OSError):
-            message = ("error", "the helper ended")
+                status, payload = self._connection.recv()
+                if status == "ok" and isinstance(payload, bytes):
+                    drawn = payload
+        except (EOFError, OSError):  # the helper ended without a figure
+            pass
         finally:
             self.close()
-        return message[1] if message[0] == "ok" else None
+        return drawn
 
     def close(self) -> None:
         """End the helper (killed if still running) and wait for it. Idempotent."""
@@ -245,12 +246,12 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
 
     drawn = None
     try:
-        common = dict(progress=progress, interruptible=interruptible)
         if out is not None:
-            result = simulate_to_file(out, resolved=resolved, **common, argument=argument,
+            result = simulate_to_file(out, resolved=resolved, progress=progress,
+                                      interruptible=interruptible, argument=argument,
                                       on_simulated=simulated)
         else:
-            result = resolved.simulate(**common)
+            result = resolved.simulate(progress=progress, interruptible=interruptible)
             simulated(result)
         if helper is not None:
             drawn = helper.figure()
