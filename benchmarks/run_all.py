@@ -267,7 +267,8 @@ def target_default_run(table, args, c_run, duration, only):
                 if fresh_cache:
                     run_env = dict(env, QZS_CACHE_DIR=tempfile.mkdtemp(dir=tmp))
                 wall, out = run_process(qzs + ["simulate", "--duration", f"{duration:g}",
-                                               "--out", name, "--json"] + extra,
+                                               "--out", name, "--json", "--overwrite"]
+                                        + extra,
                                         cwd=tmp, env=run_env)
                 record = json.loads(out)
                 keep[name] = record

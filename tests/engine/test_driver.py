@@ -207,3 +207,35 @@ def test_sigterm_ends_a_run_of_tiny_steps_within_seconds(tmp_path):
     assert time.monotonic() - sent < 5.0
     assert process.returncode == 143, err
     assert list(tmp_path.iterdir()) == []
+
+
+def _envelope_by_reduceat(data, flags, first, every):
+    """The envelope by ``reduceat`` over the block's group starts (the former method)."""
+    group = (first + np.arange(data.shape[0])) // every
+    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    rows = np.empty((2 * starts.size, data.shape[1]))
+    rows[0::2] = np.minimum.reduceat(data, starts, axis=0)
+    rows[1::2] = np.maximum.reduceat(data, starts, axis=0)
+    marks = np.empty((2 * starts.size, flags.shape[1]), dtype=np.bool_)
+    marks[0::2] = np.logical_and.reduceat(flags, starts, axis=0)
+    marks[1::2] = np.logical_or.reduceat(flags, starts, axis=0)
+    return rows, marks
+
+
+@pytest.mark.parametrize("first, every, n", [(0, 20, 4000), (1, 20, 4001), (19, 20, 1),
+                                             (0, 20, 20), (7, 3, 2), (5, 7, 1000),
+                                             (0, 1, 50), (3, 1000, 999)])
+def test_the_envelope_is_that_of_a_reduction_per_group_bit_for_bit(first, every, n):
+    """Against reduceat over the group starts: the same bytes, with ties of +0 and -0 (which
+    one wins depends on the order of comparison), NaN, and groups cut at both ends."""
+    rng = np.random.default_rng(first + every + n)
+    data = rng.choice([-1.5, -0.0, 0.0, 2.0, np.nan], size=(n, 5),
+                      p=[0.2, 0.3, 0.3, 0.15, 0.05])
+    data[:, 0] = np.arange(first, first + n) * 1e-3  # a time channel
+    flags = rng.random((n, 2)) < 0.5
+    rows, marks = driver.envelope_rows(data, flags, first, every)
+    expected_rows, expected_marks = _envelope_by_reduceat(data, flags, first, every)
+    assert rows.tobytes() == expected_rows.tobytes()
+    assert marks.shape == expected_marks.shape and np.array_equal(marks, expected_marks)
+    groups = len({(first + i) // every for i in range(n)})
+    assert rows.shape == (2 * groups, 5)

@@ -92,3 +92,22 @@ def test_the_default_scale_is_the_one_setting_and_others_are_refused():
         figures.check_frequency_scale("semilog", argument="--frequency-axis")
     np.testing.assert_array_equal(figures.drawn([0.0, 1.0, np.nan]), [False, True, False])
     np.testing.assert_array_equal(figures.drawn([0.0, 1.0], "linear"), [True, True])
+
+
+@pytest.mark.parametrize("suffix, magic", [(".png", b"\x89PNG\r\n\x1a\n"), ("", b"\x89PNG")])
+def test_figure_bytes_are_the_file_save_figure_writes(tmp_path, suffix, magic):
+    """Two fresh, equal figures: one written by save_figure, one turned into bytes."""
+    import matplotlib.pyplot as plt
+
+    def draw():
+        fig, axes = figures.new_figure(2)
+        axes[0].plot(np.arange(50.0), np.sin(np.arange(50.0)), label="x")
+        axes[1].set_ylabel("acceleration [m/s$^2$]")
+        return fig
+
+    path = tmp_path / f"figure{suffix or '.png'}"
+    figures.save_figure(draw(), path)
+    data = figures.figure_bytes(draw(), suffix)
+    plt.close("all")
+    assert data.startswith(magic)
+    assert data == path.read_bytes()

@@ -4,17 +4,13 @@
 excitation's own length (a chirp's sweep time, a random record's length) is
 ``--excitation-duration``. An option the chosen excitation does not use is an error.
 """
-import math
-
-from qzs._lazy import import_in_background
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
                              figure_path, parameters)
 from qzs.defaults import ACCURACY, EXCITATION, SIMULATION
 from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES
-from qzs.model.excitation import (EXCITATION_KINDS, EXCITATION_OPTIONS, Chirp, RandomExcitation,
-                                  Sine, build_excitation, highest_frequency)
+from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, build_excitation
 
 __all__ = ["add_parser", "run"]
 
@@ -162,7 +158,7 @@ def run(args):
     import sys
 
     from qzs.engine.run_spec import check_output_rate, resolve
-    from qzs.workflows.run import simulate_to_file
+    from qzs.workflows.figure_process import simulate_with_figure
 
     config = parameters(args)
     excitation = _excitation(args, config["excitation"], args.config)
@@ -190,23 +186,12 @@ def run(args):
                            step="chosen", progress=show)
     except ParameterError as error:
         raise error.renamed(_spelling(args, settings)) from None
-    common = dict(progress=show, interruptible=True)
-    # matplotlib (0.3-0.5 s) loads while the kernel integrates, not after it; joined before
-    # returning, so that no import is left half done (an error in the run ends it too)
-    loading = import_in_background("matplotlib.pyplot", "qzs.viz.simulation") if plot else None
-    try:
-        if args.out:
-            result = simulate_to_file(args.out, resolved=resolved, **common, argument="--out")
-        else:
-            result = resolved.simulate(**common)
-    finally:
-        if loading is not None:
-            loading.join()
+    result = simulate_with_figure(resolved, out=args.out, plot=plot, progress=show,
+                                  interruptible=True, argument="--out")
     files = {}
     if args.out:
         files["out"] = args.out
     if plot is not None:
-        result.plot(path=plot)
         files["plot"] = plot
     step = resolved.step
     notes = "".join(f"\n                   note: {note}" for note in step.notes)

@@ -286,14 +286,29 @@ def envelope_rows(data, flags, first, every):
     flags : ndarray of bool, shape (2 * groups, flag count)
         Two rows per group, in time order.
     """
-    group = (first + np.arange(data.shape[0])) // every
-    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
-    rows = np.empty((2 * starts.size, data.shape[1]))
-    rows[0::2] = np.minimum.reduceat(data, starts, axis=0)
-    rows[1::2] = np.maximum.reduceat(data, starts, axis=0)
-    marks = np.empty((2 * starts.size, flags.shape[1]), dtype=np.bool_)
-    marks[0::2] = np.logical_and.reduceat(flags, starts, axis=0)
-    marks[1::2] = np.logical_or.reduceat(flags, starts, axis=0)
+    n = data.shape[0]
+    # the groups: the end of one begun before the block, whole ones, the start of one more;
+    # the whole ones reduced as a (groups, every, channels) view (reduceat over the block's
+    # group starts gives the same values, in the same order of comparison, 1.6x slower)
+    head = min((-first) % every, n)
+    whole = (n - head) // every
+    cuts = [(0, head, 1)] if head else []
+    if whole:
+        cuts.append((head, head + whole * every, whole))
+    if head + whole * every < n:
+        cuts.append((head + whole * every, n, 1))
+    groups = sum(count for _, _, count in cuts)
+    rows = np.empty((2 * groups, data.shape[1]))
+    marks = np.empty((2 * groups, flags.shape[1]), dtype=np.bool_)
+    at = 0
+    for start, stop, count in cuts:
+        values = data[start:stop].reshape(count, -1, data.shape[1])
+        marked = flags[start:stop].reshape(count, -1, flags.shape[1])
+        np.minimum.reduce(values, axis=1, out=rows[2 * at:2 * (at + count):2])
+        np.maximum.reduce(values, axis=1, out=rows[2 * at + 1:2 * (at + count):2])
+        np.logical_and.reduce(marked, axis=1, out=marks[2 * at:2 * (at + count):2])
+        np.logical_or.reduce(marked, axis=1, out=marks[2 * at + 1:2 * (at + count):2])
+        at += count
     return rows, marks
 
 

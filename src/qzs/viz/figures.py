@@ -2,9 +2,10 @@
 and the frequency axis (log by default, linear on request)."""
 import numpy as np
 
-__all__ = ["envelope", "new_figure", "save_figure", "check_frequency_scale", "nice_floor",
-           "frequency_limits", "frequency_axis", "drawn"]
+__all__ = ["envelope", "new_figure", "save_figure", "figure_bytes", "check_frequency_scale",
+           "nice_floor", "frequency_limits", "frequency_axis", "drawn"]
 
+_DPI = 130  # of every figure file [dots per inch]
 _MAX_POINTS = 4000  # per trace: long runs are drawn as a min/max envelope
 #: Prefixes of matplotlib's backends that open windows (and so need a display).
 _WINDOW_BACKENDS = ("gtk", "qt", "tk", "wx", "macosx")
@@ -111,11 +112,35 @@ def save_figure(fig, path, also_svg=False):
 
     path = Path(path)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=130)
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=_DPI)
     if also_svg and path.suffix.lower() == ".png":
         save_figure(fig, path.with_suffix(".svg"))
 
 
+
+def figure_bytes(fig, suffix=".png"):
+    """The bytes :func:`save_figure` writes for ``fig`` to a file of this suffix.
+
+    For a figure drawn in one process and written in another
+    (:mod:`qzs.workflows.figure_process`).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    suffix : str
+        The file's suffix (``".png"``, ``".svg"``, ``".pdf"``); empty: PNG.
+
+    Returns
+    -------
+    bytes
+        The file's contents.
+    """
+    import io
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=str(suffix).lstrip(".") or "png", dpi=_DPI)
+    return buffer.getvalue()
 
 
 def check_frequency_scale(frequency_scale, argument="frequency_scale"):

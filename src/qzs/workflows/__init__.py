@@ -2,6 +2,7 @@
 
 ==================  ==========================================================================
 ``run``             one run streamed to a file as it is simulated (bounded memory)
+``figure_process``  a run's figure drawn in a second process while the file is written
 ``paper``           ``qzs paper`` and ``qzs study``: the paper's studies (``study_files/``),
                     figures, curves as data, claims decided from the data
 ``experiment``      ``qzs experiment``: a measured log beside its simulation, the channel map

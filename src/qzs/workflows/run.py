@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Callable
 
 from qzs import defaults
 from qzs.engine.result_file import ResultWriter, estimated_size
@@ -36,7 +36,9 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
                      solver: str = defaults.SIMULATION["solver"],
                      initial_state: InitialState | None = None, progress: bool = False,
                      interruptible: bool = False, argument: str = "path",
-                     resolved: ResolvedRun | None = None) -> SimulationResult:
+                     resolved: ResolvedRun | None = None,
+                     on_simulated: Callable[[SimulationResult], Any] | None = None
+                     ) -> SimulationResult:
     """Simulate and stream every output sample to ``path`` (NetCDF, CSV or MATLAB).
 
     The path, its folder and the free space are checked before the run starts; samples are
@@ -77,6 +79,9 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
         The run already resolved (:func:`qzs.engine.run_spec.resolve`); then the run's
         other arguments are not given. Its step record goes into the file's ``run.step_*``
         attributes.
+    on_simulated : callable, optional
+        ``on_simulated(result)`` is called when the last sample is in, before the file is
+        closed and renamed (:mod:`qzs.workflows.figure_process` starts the figure then).
 
     Returns
     -------
@@ -106,6 +111,8 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
                       excitation=resolved.excitation) as writer:
         result = resolved.simulate(progress=progress, interruptible=interruptible,
                                    sink=writer.append)
+        if on_simulated is not None:
+            on_simulated(result)
         # the file holds every sample: the in-memory preview's stride is no property of it
         writer.finish({k: v for k, v in result.run.items() if k != "preview_every"})
     return result
