@@ -13,7 +13,7 @@
    case** (a design under one stiction; per design of three cases the figure is 3x).
 2. **Linear metrics of a Sobol run** (target 3): 512 Sobol designs x 3 stictions = 1536 cases
    of a problem whose goals are the linear transmissibility at 12 Hz and the gain and phase
-   margins, through the design space's own path (``metrics.evaluate_cases``: each case's
+   margins, through the design space's own path (``evaluation.evaluate_cases``: each case's
    model built, then one vectorised evaluation). Baseline: the scalar path
    (``linear_transmissibility`` and ``loop_margins``, python-control) on 96 of the cases,
    scaled to 1536. Target: the 1536 cases in at most **1 s**. An information row adds the
@@ -117,7 +117,7 @@ def _linear_problem(goals):
 def measure_linear(repeats, idle_wait, runs):
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
-    from qzs.workflows.design_space.metrics import evaluate_cases
+    from qzs.workflows.design_space.evaluation import evaluate_cases
 
     designs = sobol_designs(512)
     names = ("spring_force", "pi_kp", "pi_ki", "damping_gain")

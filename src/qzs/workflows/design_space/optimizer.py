@@ -24,7 +24,8 @@ import numpy as np
 
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
-from qzs.workflows.design_space.metrics import METRICS, evaluate, goal_values
+from qzs.workflows.design_space.evaluation import evaluate
+from qzs.workflows.design_space.metrics import METRICS, goal_values
 from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check

@@ -66,7 +66,7 @@ def objective_matrix(problem, goal_values):
     problem : DesignProblem
         The problem.
     goal_values : ndarray, shape (n_designs, n_goals)
-        :meth:`~qzs.workflows.design_space.metrics.Evaluation.goal_values` of
+        :meth:`~qzs.workflows.design_space.evaluation.Evaluation.goal_values` of
         ``problem.goals``.
 
     Returns
