@@ -142,5 +142,45 @@ def test_writing_the_files_advances_a_progress_bar_file_by_file(result, tmp_path
     written = write_files(result, folder, progress=True)
     (recorder,) = bars
     assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
-    assert [files for _, files in steps] == [{p.name for p in written[:k]}
-                                             for k in range(1, len(written) + 1)]
+    # each step once its file is there; the figure, drawn meanwhile, may come sooner
+    for k, (_, files) in enumerate(steps, start=1):
+        assert files - {"pareto.png"} == {p.name for p in written[:k]} - {"pareto.png"}
+    assert written[-1].name == "pareto.png" and "pareto.png" in steps[-1][1]
+
+
+def record_process(result, path):
+    """Stand-in for the figure task: writes the id of the process it runs in."""
+    import os
+    from pathlib import Path
+
+    Path(path).write_text(str(os.getpid()))
+    return Path(path)
+
+
+def test_the_figure_is_drawn_beside_the_files_and_equals_one_drawn_here(result, tmp_path,
+                                                                        monkeypatch):
+    import os
+    import sys
+
+    from qzs.workflows.design_space import result as result_module
+
+    here = result_module.draw_figure(result, tmp_path / "here.png")
+    write_files(result, tmp_path / "out")
+    assert (tmp_path / "out" / "pareto.png").read_bytes() == here.read_bytes()
+    monkeypatch.setattr(result_module, "draw_figure", record_process)
+    write_files(result, tmp_path / "where")
+    drawn_by = int((tmp_path / "where" / "pareto.png").read_text())
+    assert (drawn_by != os.getpid()) == sys.platform.startswith("linux")
+
+
+def fail_to_draw(result, path):
+    """Stand-in for the figure task that fails."""
+    raise ParameterError("the figure could not be drawn")
+
+
+def test_a_figure_that_fails_fails_the_writing(result, tmp_path, monkeypatch):
+    from qzs.workflows.design_space import result as result_module
+
+    monkeypatch.setattr(result_module, "draw_figure", fail_to_draw)
+    with pytest.raises(ParameterError, match="could not be drawn"):
+        write_files(result, tmp_path / "out")

@@ -9,6 +9,7 @@ objective, the best feasible design). It only delegates: ``.to_xarray()`` and
 """
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from qzs.workflows.design_space.store import DesignStore
 
 __all__ = ["OptimizationResult", "objective_matrix", "pareto_front", "write_files",
-           "OUTPUT_FILES"]
+           "draw_figure", "OUTPUT_FILES"]
 
 
 def pareto_front(F):
@@ -496,7 +497,9 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     evaluated design, with ``feasible``, ``pareto`` and ``chosen`` flags), ``pareto.png``
     (:func:`qzs.viz.design_space.plot_pareto`), ``chosen.toml`` (the chosen design as a run
     configuration ``qzs simulate --config`` reads; left out if no design is feasible) and
-    ``report.md``.
+    ``report.md``. Where processes fork (Linux) the figure is drawn in one beside this
+    process while it writes the rest (matplotlib holds the GIL: only a process draws in
+    parallel); elsewhere it is drawn here, first.
 
     Parameters
     ----------
@@ -512,24 +515,21 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     list of Path
         The files written.
     """
-    import matplotlib.pyplot as plt
-
     from qzs.engine.progress import progress_bar
     from qzs.iotools.files import atomic_path
+    from qzs.iotools.writer import write_dataset
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     with progress_bar(total=6 + (result.chosen is not None), unit="file", desc="writing",
-                      disable=not progress, leave=False) as bar:
+                      disable=not progress, leave=False) as bar, _beside() as pool:
+        figure = pool.submit(draw_figure, result, folder / "pareto.png")
         written = []
+        pareto = result.to_xarray(pareto_only=True)  # one dataset for its three files
         for name in ("pareto.nc", "pareto.csv", "pareto.mat"):
-            written.append(result.save(folder / name))
+            written.append(write_dataset(pareto, folder / name))
             bar.update(1)
         written.append(result.save(folder / "designs.nc", pareto_only=False))
-        bar.update(1)
-        figure = result.plot(path=folder / "pareto.png")
-        plt.close(figure)
-        written.append(folder / "pareto.png")
         bar.update(1)
         if result.chosen is not None:
             written.append(result.write_config(folder / "chosen.toml"))
@@ -538,4 +538,61 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
             Path(tmp).write_text(result.report(), encoding="utf-8")
         written.append(folder / "report.md")
         bar.update(1)
+        written.append(figure.result())  # last: drawn meanwhile
+        bar.update(1)
     return written
+
+
+def draw_figure(result: OptimizationResult, path: str | Path) -> Path:
+    """Draw the Pareto figure into a file and close it (the task :func:`write_files` forks).
+
+    Parameters
+    ----------
+    result : OptimizationResult
+        The search.
+    path : str or Path
+        The figure file (format from the suffix).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    import matplotlib.pyplot as plt
+
+    plt.close(result.plot(path=path))
+    return Path(path)
+
+
+class _Here:
+    """An executor that runs what it is given at once, here (where no process forks)."""
+
+    def submit(self, function, *args):
+        from concurrent.futures import Future
+
+        future = Future()
+        try:
+            future.set_result(function(*args))
+        except Exception as error:  # noqa: BLE001 - raised again by .result(), as a pool does
+            future.set_exception(error)
+        return future
+
+
+@contextlib.contextmanager
+def _beside():
+    """One forked process to run a task beside this one (Linux), else :class:`_Here`.
+
+    Forked, the process has this one's modules and data at once; a fresh interpreter
+    (spawn, forkserver) would import qzs again, which takes longer than the figure.
+    """
+    import multiprocessing
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        yield _Here()
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) \
+            as pool:
+        yield pool
