@@ -311,7 +311,7 @@ def case_settings(problem, designs):
 
 def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None,
                    batch_size=None, progress=None):
-    """Evaluate cases, each a dict of parameter values, in lockstep batches.
+    """Evaluate cases, each a dict of parameter values, in batches (one task each).
 
     The one path of every evaluation: :func:`evaluate` crosses designs with draws into
     cases, a sensitivity analysis samples variables and uncertain parameters together;
@@ -336,7 +336,8 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
         Threads per batch; default all cores locally, 1 on a cluster.
     batch_size : int, optional
         Cases per batch (one task); default all of them locally (one task, its cases
-        shared over the cores), about two batches per worker thread on a cluster. Locally
+        shared over the cores), one batch per worker thread on a cluster (the linear
+        metrics cost mostly per call: fewer, larger batches cost less). Locally
         the linear metrics alone are one batch whatever it says.
     progress : callable, optional
         Called with the number of cases each finished batch held.
@@ -374,7 +375,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
     if client is None and (batch_size is None or not simulated):
         batch_size = total  # the linear metrics cost mostly per call: one call here
     elif batch_size is None:
-        batch_size = max(1, -(-total // (2 * sum(client.nthreads().values()))))
+        batch_size = max(1, -(-total // sum(client.nthreads().values())))
     batches = [(a, min(a + batch_size, total)) for a in range(0, total, batch_size)]
     results = run_tasks(problem, batches, settings, [g.column for g in goals], client=client,
                         threads=threads)
@@ -396,7 +397,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
 
 def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
              progress=None):
-    """Evaluate designs: every design under every draw, in lockstep batches.
+    """Evaluate designs: every design under every draw, in batches (one task each).
 
     Parameters
     ----------
@@ -410,8 +411,8 @@ def evaluate(problem, designs, *, client=None, threads=None, batch_size=None,
     threads : int, optional
         Threads per batch; default all cores locally, 1 on a cluster.
     batch_size : int, optional
-        Cases per batch; default all of them locally (one lockstep batch), about two
-        batches per worker thread on a cluster.
+        Cases per batch (one task); default all of them locally, one batch per worker
+        thread on a cluster (:func:`evaluate_cases`).
     progress : callable, optional
         Called with the number of cases each finished batch held.
 
