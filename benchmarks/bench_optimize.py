@@ -17,8 +17,8 @@
    variables, goal values and flags) and every evaluated design (``designs.nc``) equal,
    bit for bit, to the one-worker result.
 4. **Where the time goes** (information): one run of the default configuration in a child
-   process, timed stage by stage (start-up and imports, the step and store, the evaluation,
-   the rest of the search, the files and figure).
+   process, timed stage by stage, wall and CPU time (start-up and imports, the evaluation,
+   the rest of the search, the files and figure); on a busy machine the CPU times say more.
 
 Every timing is the best of N, each run started after waiting up to ``--idle-wait`` s for the
 machine to go quiet (the helpers of ``bench_simulate.py``); the other load before each run is
@@ -49,34 +49,38 @@ log = lambda msg="": print(msg, flush=True)  # noqa: E731
 #: A child process's stages, printed as JSON (what --breakdown times).
 _STAGES = r"""
 import json, sys, time
-t0 = time.perf_counter()
+clock = lambda: (time.perf_counter(), time.process_time())
+t0 = clock()
 marks = {}
 import qzs, qzs.cli
-marks["start-up: python, import qzs and its command line"] = time.perf_counter()
+marks["start-up: python, import qzs and its command line"] = clock()
 from qzs.workflows.design_space import load_problem, optimize, write_files
 from qzs.workflows.design_space import optimizer
-marks["import the design space (scipy.signal, pymoo, ...)"] = time.perf_counter()
-evaluation = [0.0]
+marks["import the design space (scipy.signal, pymoo, ...)"] = clock()
+evaluation = [0.0, 0.0]
 evaluate = optimizer.evaluate
 def timed(*args, **kwargs):
-    began = time.perf_counter()
+    began = clock()
     try:
         return evaluate(*args, **kwargs)
     finally:
-        evaluation[0] += time.perf_counter() - began
+        now = clock()
+        evaluation[0] += now[0] - began[0]
+        evaluation[1] += now[1] - began[1]
 optimizer.evaluate = timed
 result = optimize(load_problem(sys.argv[1]), sys.argv[2] + "/s.zarr", overwrite=True,
                   progress=False)
-marks["search: store, NSGA-II, store writes (evaluation apart)"] = time.perf_counter()
+marks["search: store, NSGA-II, store writes (evaluation apart)"] = clock()
 write_files(result, sys.argv[2])
-marks["files and figure (7 files)"] = time.perf_counter()
+marks["files and figure (7 files; a forked figure's CPU not counted)"] = clock()
 out, last = {}, t0
 for name, t in marks.items():
-    out[name] = t - last
+    out[name] = [t[0] - last[0], t[1] - last[1]]
     last = t
-out["search: store, NSGA-II, store writes (evaluation apart)"] -= evaluation[0]
-out["evaluation: 576 runs, estimates, linear metrics (8 generations)"] = evaluation[0]
-out["total (in the process)"] = last - t0
+search = "search: store, NSGA-II, store writes (evaluation apart)"
+out[search] = [out[search][0] - evaluation[0], out[search][1] - evaluation[1]]
+out["evaluation: 576 runs, estimates, linear metrics (8 generations)"] = evaluation
+out["total (in the process)"] = [last[0] - t0[0], last[1] - t0[1]]
 print(json.dumps(out))
 """
 
@@ -129,7 +133,8 @@ def same_answer(folder, k, reference):
 
 
 def breakdown(folder):
-    """Seconds per stage of one default run (see :data:`_STAGES`)."""
+    """``{stage: [wall, cpu]}`` [s] of one default run (see :data:`_STAGES`; cpu: this
+    process's threads together)."""
     proc = subprocess.run([sys.executable, "-c", _STAGES, PROBLEM, str(folder)], check=True,
                           capture_output=True, text=True)
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -182,8 +187,8 @@ def main(argv=None):
     if noisy:
         log(f"WARNING: {len(noisy)} of {len(runs)} timed runs started on a busy machine")
     log("where one default run's time goes (in the process, after the interpreter starts):")
-    for name, seconds in stages.items():
-        log(f"  {seconds:6.2f} s  {name}")
+    for name, (wall, cpu) in stages.items():
+        log(f"  {wall:6.2f} s wall {cpu:6.2f} s CPU  {name}")
     for row in rows:
         log("  ".join(str(cell) for cell in row))
     log(f"load average at end: {_load()}")

@@ -736,8 +736,8 @@ def target_optimize(table, args):
     runs = []
     rows, stages = bench_optimize.run(args.repeats, args.idle_wait, runs)
     table.note_runs(runs)
-    for name, seconds in stages.items():
-        log(f"  {seconds:6.2f} s  {name}")
+    for name, (wall, cpu) in stages.items():
+        log(f"  {wall:6.2f} s wall {cpu:6.2f} s CPU  {name}")
     for row in rows:
         table.add(*row)
 

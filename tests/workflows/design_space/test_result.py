@@ -184,3 +184,39 @@ def test_a_figure_that_fails_fails_the_writing(result, tmp_path, monkeypatch):
     monkeypatch.setattr(result_module, "draw_figure", fail_to_draw)
     with pytest.raises(ParameterError, match="could not be drawn"):
         write_files(result, tmp_path / "out")
+
+
+def test_a_writer_started_before_the_search_writes_the_files_write_files_writes(result,
+                                                                              tmp_path):
+    import multiprocessing
+
+    import xarray as xr
+
+    from qzs.workflows.design_space.result import file_writer
+
+    here = write_files(result, tmp_path / "here")
+    with file_writer(tmp_path / "there") as writer:
+        there = writer.write(result)
+    assert [p.name for p in there] == [p.name for p in here]
+    for name in ("pareto.nc", "designs.nc"):
+        with xr.open_dataset(tmp_path / "here" / name) as a, \
+                xr.open_dataset(tmp_path / "there" / name) as b:
+            assert a.equals(b)  # values, coordinates; and every attribute but the time
+            assert {**a.attrs, "history": ""} == {**b.attrs, "history": ""}
+    for name in ("pareto.png", "pareto.csv", "chosen.toml", "report.md"):
+        assert (tmp_path / "here" / name).read_bytes() == (tmp_path / "there" / name).read_bytes()
+    assert not multiprocessing.active_children()  # the writer is gone
+
+
+def test_a_writer_says_why_it_could_not_write_and_leaves_when_told_nothing(result, tmp_path):
+    import multiprocessing
+
+    from qzs.workflows.design_space.result import file_writer
+
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    with pytest.raises(OSError), file_writer(blocked) as writer:
+        writer.write(result)
+    with file_writer(tmp_path / "never") as writer:  # the search stopped: no result
+        pass
+    assert not (tmp_path / "never").exists() and not multiprocessing.active_children()

@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from qzs.workflows.design_space.store import DesignStore
 
 __all__ = ["OptimizationResult", "objective_matrix", "pareto_front", "write_files",
-           "draw_figure", "OUTPUT_FILES"]
+           "file_writer", "draw_figure", "OUTPUT_FILES"]
 
 
 def pareto_front(F):
@@ -596,3 +596,109 @@ def _beside():
     with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) \
             as pool:
         yield pool
+
+
+@contextlib.contextmanager
+def file_writer(folder: str | Path, *, progress: bool = False):
+    """A writer of a search's files, started before the search (a forked process on Linux).
+
+    The process imports what the files need (matplotlib; xarray, h5netcdf and what xarray
+    imports when it writes, Dask's hooks where Dask is installed) while this one searches,
+    then waits for the result and writes the files (:func:`write_files`); about a second of
+    imports off the end of ``qzs optimize``. Where no process forks, the files are written
+    here. The context closes the process, whatever happened.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where to write.
+    progress : bool
+        Show a progress bar, one step per file.
+
+    Yields
+    ------
+    object
+        Its ``write(result)`` writes the files of an :class:`OptimizationResult` and returns
+        their paths, as :func:`write_files` does (raising what it raises).
+    """
+    import multiprocessing
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        yield _WriteHere(folder, progress)
+        return
+    context = multiprocessing.get_context("fork")
+    here, there = context.Pipe()
+    process = context.Process(target=_serve, args=(there, here, folder, progress),
+                              name="qzs-files")
+    process.start()
+    there.close()
+    try:
+        yield _WriteThere(here, folder, progress)
+    finally:
+        here.close()  # the process sees the end of its pipe and leaves
+        process.join(timeout=5.0)
+        if process.is_alive():
+            process.terminate()
+            process.join()
+
+
+class _WriteHere:
+    """:func:`file_writer` where no process forks: :func:`write_files` in this process."""
+
+    def __init__(self, folder, progress):
+        self.folder, self.progress = folder, progress
+
+    def write(self, result):
+        return write_files(result, self.folder, progress=self.progress)
+
+
+class _WriteThere(_WriteHere):
+    """:func:`file_writer`'s forked process, told the result through a pipe."""
+
+    def __init__(self, connection, folder, progress):
+        super().__init__(folder, progress)
+        self.connection = connection
+
+    def write(self, result):
+        try:
+            self.connection.send(result)
+            outcome, value = self.connection.recv()
+        except (EOFError, OSError):  # the process is gone (killed): write here instead
+            return super().write(result)
+        if outcome == "error":
+            raise value
+        return value
+
+
+def _serve(connection, other_end, folder, progress):
+    """The forked writer: import what the files need, wait for the result, write them."""
+    other_end.close()  # so that the pipe ends when the searching process closes its end
+    try:
+        _warm()
+        result = connection.recv()
+    except BaseException:  # noqa: BLE001 - no result (stopped, failed): nothing to write
+        return
+    try:
+        written = write_files(result, folder, progress=progress)
+    except Exception as error:  # noqa: BLE001 - raised again in the searching process
+        connection.send(("error", error))
+    else:
+        connection.send(("ok", written))
+
+
+def _warm():
+    """Import what :func:`write_files` needs, as writing would, before it is needed."""
+    import importlib
+    import importlib.util
+
+    import matplotlib.pyplot  # noqa: F401
+    import xarray
+
+    import qzs.iotools.writer  # noqa: F401
+    import qzs.viz.design_space  # noqa: F401
+
+    xarray.Variable("design", np.zeros(1))  # xarray's test for Dask arrays imports Dask
+    for name in ("h5netcdf", "distributed", "scipy.io"):  # what writing a file imports
+        if importlib.util.find_spec(name) is not None:
+            importlib.import_module(name)
