@@ -672,13 +672,21 @@ class _WriteThere(_WriteHere):
 
 
 def _serve(connection, other_end, folder, progress):
-    """The forked writer: import what the files need, wait for the result, write them."""
+    """The forked writer: import what the files need, wait for the result, write them.
+
+    The imports run in a thread of lower priority (Linux priorities are per thread), so
+    that they take the CPU time the search leaves idle rather than the search's own.
+    """
+    import threading
+
     other_end.close()  # so that the pipe ends when the searching process closes its end
+    warming = threading.Thread(target=_warm, kwargs={"nice": 5}, daemon=True)
+    warming.start()
     try:
-        _warm()
         result = connection.recv()
     except BaseException:  # noqa: BLE001 - no result (stopped, failed): nothing to write
         return
+    warming.join()
     try:
         written = write_files(result, folder, progress=progress)
     except Exception as error:  # noqa: BLE001 - raised again in the searching process
@@ -687,10 +695,19 @@ def _serve(connection, other_end, folder, progress):
         connection.send(("ok", written))
 
 
-def _warm():
-    """Import what :func:`write_files` needs, as writing would, before it is needed."""
+def _warm(nice=0):
+    """Import what :func:`write_files` needs, as writing would, before it is needed; at
+    ``nice`` more than this thread's priority."""
     import importlib
     import importlib.util
+    import os
+    import threading
+
+    try:
+        thread = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, thread, os.getpriority(os.PRIO_PROCESS, thread) + nice)
+    except (AttributeError, OSError):  # no such call here: at the same priority
+        pass
 
     import matplotlib.pyplot  # noqa: F401
     import xarray
