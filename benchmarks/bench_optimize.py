@@ -54,8 +54,9 @@ t0 = clock()
 marks = {}
 import qzs, qzs.cli
 marks["start-up: python, import qzs and its command line"] = clock()
-from qzs.workflows.design_space import load_problem, optimize, write_files
+from qzs.workflows.design_space import load_problem, optimize
 from qzs.workflows.design_space import optimizer
+from qzs.workflows.design_space.result import file_writer
 marks["import the design space (scipy.signal, pymoo, ...)"] = clock()
 evaluation = [0.0, 0.0]
 evaluate = optimizer.evaluate
@@ -68,11 +69,12 @@ def timed(*args, **kwargs):
         evaluation[0] += now[0] - began[0]
         evaluation[1] += now[1] - began[1]
 optimizer.evaluate = timed
-result = optimize(load_problem(sys.argv[1]), sys.argv[2] + "/s.zarr", overwrite=True,
-                  progress=False)
-marks["search: store, NSGA-II, store writes (evaluation apart)"] = clock()
-write_files(result, sys.argv[2])
-marks["files and figure (7 files; a forked figure's CPU not counted)"] = clock()
+problem = load_problem(sys.argv[1])
+with file_writer(sys.argv[2]) as writer:  # as the command line: forked before the search
+    result = optimize(problem, sys.argv[2] + "/s.zarr", overwrite=True, progress=False)
+    marks["search: store, NSGA-II, store writes (evaluation apart)"] = clock()
+    writer.write(result)
+marks["files and figure (7 files, by the forked writer; its CPU not counted)"] = clock()
 out, last = {}, t0
 for name, t in marks.items():
     out[name] = [t[0] - last[0], t[1] - last[1]]
