@@ -281,7 +281,7 @@ def measure(problem=PRIMARY, seeds=SEEDS, population=None, generations=None, idl
 
     ``problem`` is a name of :data:`PROBLEMS` or a pair (problem file, its grid file).
     """
-    from qzs.workflows.design_space.metrics import evaluate
+    from qzs.workflows.design_space.evaluation import evaluate
     from qzs.workflows.design_space.problem import load_problem
     from qzs.workflows.design_space.result import pareto_front
     from qzs.workflows.sweeps import load_sweep

@@ -2,7 +2,7 @@
 """The analyses of a population vectorised (issue 34, targets 2 and 3), and the design question.
 
     .venv/bin/python benchmarks/bench_linear.py                # best of 3
-    .venv/bin/python benchmarks/bench_linear.py --quick        # best of 2, no `qzs optimize`
+    .venv/bin/python benchmarks/bench_linear.py --quick        # best of 2
     .venv/bin/python benchmarks/bench_linear.py --repeats 5 --idle-wait 60
 
 1. **Hunting at rest of a population** (target 2): the shipped problem ``isolation_vs_effort``'s
@@ -13,23 +13,19 @@
    case** (a design under one stiction; per design of three cases the figure is 3x).
 2. **Linear metrics of a Sobol run** (target 3): 512 Sobol designs x 3 stictions = 1536 cases
    of a problem whose goals are the linear transmissibility at 12 Hz and the gain and phase
-   margins, through the design space's own path (``metrics.evaluate_cases``: each case's
+   margins, through the design space's own path (``evaluation.evaluate_cases``: each case's
    model built, then one vectorised evaluation). Baseline: the scalar path
    (``linear_transmissibility`` and ``loop_margins``, python-control) on 96 of the cases,
    scaled to 1536. Target: the 1536 cases in at most **1 s**. An information row adds the
    hunting amplitude to the goals.
-3. **The design question** (issue 34, target 1, information here): ``qzs optimize
-   isolation_vs_effort --quiet`` as a whole process, warm (one untimed run first), against
-   the issue's 5 s. Before this work the same command took 32 s on a quiet machine, 86 % of
-   it in the hunting prediction.
+The design question as a whole process (issue 34, target 1), which took 32 s before this
+work (86 % of it in the hunting prediction), is ``bench_optimize.py``'s.
 
 Every timing is the best of N, each run started after waiting up to ``--idle-wait`` s for the
 machine to go quiet (the helpers of ``bench_simulate.py``). Exits 0.
 """
 import argparse
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -41,7 +37,6 @@ from bench_simulate import _busy_note, machine_info, wait_for_idle  # noqa: E402
 
 TARGET_HUNTING = 1e-3     # [s] per case
 TARGET_LINEAR = 1.0       # [s] for 1536 cases
-TARGET_OPTIMIZE = 5.0     # [s] the whole design question (issue 34, target 1)
 STICTIONS = (5.0, 10.0, 15.0)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
@@ -117,7 +112,7 @@ def _linear_problem(goals):
 def measure_linear(repeats, idle_wait, runs):
     from qzs.analysis.control_design.stability_margins import loop_margins
     from qzs.analysis.linear import linear_transmissibility
-    from qzs.workflows.design_space.metrics import evaluate_cases
+    from qzs.workflows.design_space.evaluation import evaluate_cases
 
     designs = sobol_designs(512)
     names = ("spring_force", "pi_kp", "pi_ki", "damping_gain")
@@ -144,24 +139,10 @@ def measure_linear(repeats, idle_wait, runs):
                 scalar=scalar_96 * len(settings) / len(isolators))
 
 
-def measure_optimize(repeats, idle_wait, runs):
-    command = [sys.executable, "-m", "qzs", "optimize", "isolation_vs_effort", "--quiet",
-               "--overwrite"]
-    with tempfile.TemporaryDirectory(prefix="qzs-bench-linear-") as tmp:
-        out = ["--out", str(Path(tmp) / "opt")]
-        subprocess.run(command + out, check=True, capture_output=True)  # warm numba's cache
-        return best(repeats, idle_wait, "qzs optimize isolation_vs_effort",
-                    lambda: subprocess.run(command + out, check=True, capture_output=True),
-                    runs)
-
-
-def measure(repeats, idle_wait, runs, optimize=True):
+def measure(repeats, idle_wait, runs):
     """Every figure of this benchmark (see the module's text)."""
-    out = dict(hunting=measure_hunting(repeats, idle_wait, runs),
-               linear=measure_linear(repeats, idle_wait, runs))
-    if optimize:
-        out["optimize"] = measure_optimize(repeats, idle_wait, runs)
-    return out
+    return dict(hunting=measure_hunting(repeats, idle_wait, runs),
+                linear=measure_linear(repeats, idle_wait, runs))
 
 
 def verdicts(results):
@@ -178,18 +159,12 @@ def verdicts(results):
              "PASS" if lin["vector"] <= TARGET_LINEAR else "FAIL"),
             ("13i", "  the same with the hunting amplitude", f"{lin['hunting']:.2f} s", "-",
              "-", "-", "info")]
-    if "optimize" in results:
-        seconds = results["optimize"]
-        rows.append(("13o", "`qzs optimize isolation_vs_effort` whole process, warm "
-                     "(issue 34 target 1)", f"{seconds:.1f} s", "32 s before", "-",
-                     f"<= {TARGET_OPTIMIZE:g} s",
-                     ("PASS" if seconds <= TARGET_OPTIMIZE else "FAIL") + " (info)"))
     return rows
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="best of 2, no `qzs optimize`")
+    parser.add_argument("--quick", action="store_true", help="best of 2")
     parser.add_argument("--repeats", type=int, default=None, help="best-of-N (3; 2 quick)")
     parser.add_argument("--idle-wait", type=float, default=20.0, metavar="S",
                         help="wait up to S s before each timed run for the machine to go quiet")
@@ -199,7 +174,7 @@ def main(argv=None):
     for key, value in machine_info():
         log(f"  {key:13s} {value}")
     runs = []
-    results = measure(repeats, args.idle_wait, runs, optimize=not args.quick)
+    results = measure(repeats, args.idle_wait, runs)
     noisy = [r for r in runs if r["busy"] is not None and r["busy"] > 0.3]
     log("")
     if noisy:

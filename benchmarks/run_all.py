@@ -41,8 +41,11 @@ the target, PASS/FAIL:
 12. (issue 34, target 2) the hunting prediction of a population (192 designs x 3 stictions of
     ``isolation_vs_effort``) at most 1 ms per case, against python-control's scalar path;
 13. (issue 34, target 3) the linear metrics of 1536 Sobol cases in at most 1 s, against the
-    scalar path; 13o: ``qzs optimize isolation_vs_effort``, whole process, against the 5 s of
-    issue 34's target 1 (``bench_linear.py``; information, not run with --quick).
+    scalar path (``bench_linear.py``);
+14. (issue 34, targets 1 and 5) ``qzs optimize isolation_vs_effort``, whole process, warm, in
+    at most 5 s; with ``--workers 1`` and ``--workers 2`` (the second faster) and ``--threads
+    1``; every configuration's Pareto set and designs equal to the one-worker result bit for
+    bit; where one run's time goes, stage by stage (``bench_optimize.py``).
 
 The C baseline is qzs's own C model of the isolator (``src/qzs/export/csrc``, the FMU's model,
 held bit for bit to the numba kernels by tests/export/test_cmodel.py), compiled here for this
@@ -91,7 +94,7 @@ TARGET_CHOICE = 0.3       # the step choice of the paper's chirp [s]
 TARGET_STARTUP = 0.6      # start-up to the first step [s]
 TOLERANCE_DB = 0.01       # the default tolerance of the accuracy-driven step
 TARGET_JAX = 1.5
-ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13)
+ALL_TARGETS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14)
 
 log = lambda msg="": print(msg, flush=True)  # noqa: E731
 
@@ -722,10 +725,24 @@ def target_linear(table, args):
     import bench_linear
 
     runs = []
-    results = bench_linear.measure(args.repeats, args.idle_wait, runs,
-                                   optimize=not args.quick)
+    results = bench_linear.measure(args.repeats, args.idle_wait, runs)
     table.note_runs(runs)
     for row in bench_linear.verdicts(results):
+        table.add(*row)
+
+
+# --------------------------------------------------------------------------- 14. issue 34
+
+def target_optimize(table, args):
+    """Target 14: ``qzs optimize isolation_vs_effort`` as a whole process (``bench_optimize.py``)."""
+    import bench_optimize
+
+    runs = []
+    rows, stages = bench_optimize.run(args.repeats, args.idle_wait, runs)
+    table.note_runs(runs)
+    for name, (wall, cpu) in stages.items():
+        log(f"  {wall:6.2f} s wall {cpu:6.2f} s CPU  {name}")
+    for row in rows:
         table.add(*row)
 
 
@@ -801,6 +818,8 @@ def main(argv=None):
          lambda: target_design_space(table, args), False, 11 in only),
         (12, "12, 13. a population's hunting and linear metrics, vectorised (issue 34)",
          lambda: target_linear(table, args), False, 12 in only or 13 in only),
+        (14, "14. the design question as a whole process, 1 and 2 workers (issue 34)",
+         lambda: target_optimize(table, args), False, 14 in only),
     ]
     for number, title, fn, needs_c, wanted in steps_targets:
         if not wanted:

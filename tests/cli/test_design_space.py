@@ -65,7 +65,7 @@ def test_counts_below_one_are_refused(problem_file, option, capsys):
 
 def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_file, tmp_path,
                                                                       capsys, monkeypatch):
-    from qzs.workflows.design_space import metrics, optimizer
+    from qzs.workflows.design_space import evaluation, optimizer
 
     calls = []
 
@@ -73,7 +73,7 @@ def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_fi
         calls.append(None)
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return metrics.evaluate(*args, **kwargs)
+        return evaluation.evaluate(*args, **kwargs)
 
     monkeypatch.setattr(optimizer, "evaluate", interrupted)
     out = tmp_path / "out"

@@ -96,7 +96,8 @@ def run_optimize_command(args):
         0, or 130 if Ctrl-C interrupted the search, 143 if SIGTERM ended it (its complete
         generations stay in the store either way).
     """
-    from qzs.workflows.design_space import load_problem, optimize, plan_text, write_files
+    from qzs.workflows.design_space import load_problem, optimize, plan_text
+    from qzs.workflows.design_space.result import file_writer
     from qzs.workflows.design_space.store import check, stored_generations
 
     _check_counts(args)
@@ -110,16 +111,18 @@ def run_optimize_command(args):
     check_output_path(folder, argument="--out", suffixes=None, directory=True,
                       overwrite=args.overwrite or args.resume or store.exists())  # see check
     check(store, resume=args.resume, overwrite=args.overwrite, argument="--out")
-    try:
-        result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
-                          generations=args.generations, population=args.population,
-                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
-                          progress=not args.quiet and not args.json)
-    except (KeyboardInterrupt, Terminated) as stop:
-        return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept in "
-                             f"{store}. Continue with: qzs optimize {args.problem} --out "
-                             f"{folder} --resume")
-    written = write_files(result, folder, progress=not args.quiet and not args.json)
+    quiet = args.quiet or args.json
+    with file_writer(folder, progress=not quiet) as writer:  # its imports beside the search
+        try:
+            result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
+                              generations=args.generations, population=args.population,
+                              scheduler=args.scheduler, workers=args.workers,
+                              threads=args.threads, progress=not quiet)
+        except (KeyboardInterrupt, Terminated) as stop:
+            return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept "
+                                 f"in {store}. Continue with: qzs optimize {args.problem} --out "
+                                 f"{folder} --resume")
+        written = writer.write(result)
     emit(args, "\n".join([result.summary(), *(f"  wrote            {path}"
                                               for path in (store, *written))]),
          {"problem": problem.name, "summary": result.summary(),

@@ -9,7 +9,8 @@ import pytest
 
 import qzs
 from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
-from qzs.workflows.design_space.metrics import METRICS, case_settings, evaluate
+from qzs.workflows.design_space.evaluation import case_settings, evaluate
+from qzs.workflows.design_space.metrics import METRICS
 from qzs.workflows.design_space.problem import load_problem
 
 SHORT = {

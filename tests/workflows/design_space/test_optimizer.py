@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from qzs.errors import OutputPathError, ProblemError
-from qzs.workflows.design_space import metrics
+from qzs.workflows.design_space import evaluation
 from qzs.workflows.design_space.optimizer import fix_step, optimize, probe_designs
 from qzs.workflows.design_space.problem import load_problem
 from qzs.workflows.design_space.result import objective_matrix, pareto_front
@@ -97,7 +97,7 @@ class Interrupt(Exception):
 def test_an_interrupted_search_resumes_bit_identically(tmp_path, monkeypatch):
     whole = optimize(LINEAR, tmp_path / "whole.zarr", progress=False)
     calls = []
-    evaluate = metrics.evaluate
+    evaluate = evaluation.evaluate
 
     def interrupted(*args, **kwargs):
         calls.append(None)
@@ -161,17 +161,17 @@ def test_a_bad_problem_fails_before_any_evaluation(tmp_path, monkeypatch):
     assert not (tmp_path / "x.zarr").exists()
 
 
-def test_a_simulated_search_runs_each_generation_as_one_batch(tmp_path, monkeypatch):
-    from qzs.workflows.sweeps import batch
+def test_a_simulated_search_runs_each_generation_as_one_task(tmp_path, monkeypatch):
+    from qzs.workflows.design_space import evaluation
 
     batches = []
-    run_batch = batch.run_batch
+    task = evaluation.evaluate_batch
 
-    def counted(definition, start, settings, *args, **kwargs):
+    def counted(problem, start, settings, *args, **kwargs):
         batches.append(len(settings))
-        return run_batch(definition, start, settings, *args, **kwargs)
+        return task(problem, start, settings, *args, **kwargs)
 
-    monkeypatch.setattr(batch, "run_batch", counted)
+    monkeypatch.setattr(evaluation, "evaluate_batch", counted)
     result = optimize(SIMULATED, tmp_path / "sim.zarr", progress=False)
     assert batches == [8 * 2] * 3  # population x draws, once per generation
     assert result.values["motor_force_rms"].shape == (24, 2)

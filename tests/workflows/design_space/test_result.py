@@ -142,5 +142,85 @@ def test_writing_the_files_advances_a_progress_bar_file_by_file(result, tmp_path
     written = write_files(result, folder, progress=True)
     (recorder,) = bars
     assert not recorder.disable and [n for n, _ in steps] == [1] * recorder.total
-    assert [files for _, files in steps] == [{p.name for p in written[:k]}
-                                             for k in range(1, len(written) + 1)]
+    # each step once its file is there; the figure, drawn meanwhile (into a hidden
+    # temporary file first), may come sooner
+    def others(names):
+        return {name for name in names if "pareto.png" not in name}
+
+    for k, (_, files) in enumerate(steps, start=1):
+        assert others(files) == others(p.name for p in written[:k])
+    assert written[-1].name == "pareto.png" and "pareto.png" in steps[-1][1]
+
+
+def record_process(result, path):
+    """Stand-in for the figure task: writes the id of the process it runs in."""
+    import os
+    from pathlib import Path
+
+    Path(path).write_text(str(os.getpid()))
+    return Path(path)
+
+
+def test_the_figure_is_drawn_beside_the_files_and_equals_one_drawn_here(result, tmp_path,
+                                                                        monkeypatch):
+    import os
+    import sys
+
+    from qzs.workflows.design_space import result as result_module
+
+    here = result_module.draw_figure(result, tmp_path / "here.png")
+    write_files(result, tmp_path / "out")
+    assert (tmp_path / "out" / "pareto.png").read_bytes() == here.read_bytes()
+    monkeypatch.setattr(result_module, "draw_figure", record_process)
+    write_files(result, tmp_path / "where")
+    drawn_by = int((tmp_path / "where" / "pareto.png").read_text())
+    assert (drawn_by != os.getpid()) == sys.platform.startswith("linux")
+
+
+def fail_to_draw(result, path):
+    """Stand-in for the figure task that fails."""
+    raise ParameterError("the figure could not be drawn")
+
+
+def test_a_figure_that_fails_fails_the_writing(result, tmp_path, monkeypatch):
+    from qzs.workflows.design_space import result as result_module
+
+    monkeypatch.setattr(result_module, "draw_figure", fail_to_draw)
+    with pytest.raises(ParameterError, match="could not be drawn"):
+        write_files(result, tmp_path / "out")
+
+
+def test_a_writer_started_before_the_search_writes_the_files_write_files_writes(result,
+                                                                              tmp_path):
+    import multiprocessing
+
+    import xarray as xr
+
+    from qzs.workflows.design_space.result import file_writer
+
+    here = write_files(result, tmp_path / "here")
+    with file_writer(tmp_path / "there") as writer:
+        there = writer.write(result)
+    assert [p.name for p in there] == [p.name for p in here]
+    for name in ("pareto.nc", "designs.nc"):
+        with xr.open_dataset(tmp_path / "here" / name) as a, \
+                xr.open_dataset(tmp_path / "there" / name) as b:
+            assert a.equals(b)  # values, coordinates; and every attribute but the time
+            assert {**a.attrs, "history": ""} == {**b.attrs, "history": ""}
+    for name in ("pareto.png", "pareto.csv", "chosen.toml", "report.md"):
+        assert (tmp_path / "here" / name).read_bytes() == (tmp_path / "there" / name).read_bytes()
+    assert not multiprocessing.active_children()  # the writer is gone
+
+
+def test_a_writer_says_why_it_could_not_write_and_leaves_when_told_nothing(result, tmp_path):
+    import multiprocessing
+
+    from qzs.workflows.design_space.result import file_writer
+
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    with pytest.raises(OSError), file_writer(blocked) as writer:
+        writer.write(result)
+    with file_writer(tmp_path / "never") as writer:  # the search stopped: no result
+        pass
+    assert not (tmp_path / "never").exists() and not multiprocessing.active_children()

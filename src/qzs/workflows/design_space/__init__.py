@@ -10,14 +10,16 @@ ranks the parameters by Sobol or Morris indices (:mod:`.sensitivity`). The guide
 
 ===============  ================================================================
 ``problem``      problem files: variables, uncertainty, objectives, constraints
-``metrics``      the metrics, and a population evaluated in lockstep batches
+``metrics``      the metrics, and how a design's draws combine
+``evaluation``   a population evaluated, each batch one task: runs, estimates, linear metrics
 ``optimizer``    NSGA-II over the problem, generation by generation (pymoo)
 ``store``        the Zarr store of every evaluated design: resume, replay
 ``result``       the Pareto set: files, figure, chosen design, report
 ``sensitivity``  Sobol and Morris indices of the metrics (SALib)
 ===============  ================================================================
 """
-from qzs.workflows.design_space.metrics import METRICS, Evaluation, evaluate
+from qzs.workflows.design_space.evaluation import Evaluation, evaluate
+from qzs.workflows.design_space.metrics import METRICS
 from qzs.workflows.design_space.optimizer import optimize
 from qzs.workflows.design_space.problem import (DesignProblem, Goal, Uncertainty, Variable,
                                                 load_problem, plan_text, shipped_problems)

@@ -1,10 +1,11 @@
-"""NSGA-II over a design problem, one lockstep batch per generation (pymoo).
+"""NSGA-II over a design problem, one evaluation task per generation (pymoo).
 
 Why pymoo: its NSGA-II asks for a whole generation at once and is told the results
-(``ask``/``tell``), which is exactly one lockstep batch of the lane kernel per
-generation; it handles inequality constraints by constrained domination (a feasible
-design beats an infeasible one, infeasible ones rank by their total violation) without
-penalty weights; and its random state is one seeded generator, so a run is repeatable.
+(``ask``/``tell``), which is exactly one evaluation task per generation
+(:func:`~qzs.workflows.design_space.evaluation.evaluate_batch`: the lane kernel's runs
+in lockstep shares, one per core); it handles inequality constraints by constrained
+domination (a feasible design beats an infeasible one, infeasible ones rank by their total
+violation) without penalty weights; and its random state is one seeded generator, so a run is repeatable.
 Optuna's multi-objective samplers work trial by trial around a database and would
 serialise what the lane kernel does at once.
 
@@ -24,7 +25,8 @@ import numpy as np
 
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
-from qzs.workflows.design_space.metrics import METRICS, evaluate, goal_values
+from qzs.workflows.design_space.evaluation import evaluate
+from qzs.workflows.design_space.metrics import METRICS, goal_values
 from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check
@@ -130,7 +132,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
              scheduler: Any = None,
              workers: int | None = None, threads: int | None = None,
              progress: bool = True) -> OptimizationResult:
-    """Search a design problem with NSGA-II; every generation is one lockstep batch.
+    """Search a design problem with NSGA-II; every generation is one evaluation task.
 
     Parameters
     ----------

@@ -9,6 +9,7 @@ objective, the best feasible design). It only delegates: ``.to_xarray()`` and
 """
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from qzs.workflows.design_space.store import DesignStore
 
 __all__ = ["OptimizationResult", "objective_matrix", "pareto_front", "write_files",
-           "OUTPUT_FILES"]
+           "file_writer", "draw_figure", "OUTPUT_FILES"]
 
 
 def pareto_front(F):
@@ -66,7 +67,7 @@ def objective_matrix(problem, goal_values):
     problem : DesignProblem
         The problem.
     goal_values : ndarray, shape (n_designs, n_goals)
-        :meth:`~qzs.workflows.design_space.metrics.Evaluation.goal_values` of
+        :meth:`~qzs.workflows.design_space.evaluation.Evaluation.goal_values` of
         ``problem.goals``.
 
     Returns
@@ -496,7 +497,9 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     evaluated design, with ``feasible``, ``pareto`` and ``chosen`` flags), ``pareto.png``
     (:func:`qzs.viz.design_space.plot_pareto`), ``chosen.toml`` (the chosen design as a run
     configuration ``qzs simulate --config`` reads; left out if no design is feasible) and
-    ``report.md``.
+    ``report.md``. Where processes fork (Linux) the figure is drawn in one beside this
+    process while it writes the rest (matplotlib holds the GIL: only a process draws in
+    parallel); elsewhere it is drawn here, first.
 
     Parameters
     ----------
@@ -512,24 +515,21 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     list of Path
         The files written.
     """
-    import matplotlib.pyplot as plt
-
     from qzs.engine.progress import progress_bar
     from qzs.iotools.files import atomic_path
+    from qzs.iotools.writer import write_dataset
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     with progress_bar(total=6 + (result.chosen is not None), unit="file", desc="writing",
-                      disable=not progress, leave=False) as bar:
+                      disable=not progress, leave=False) as bar, _beside() as pool:
+        figure = pool.submit(draw_figure, result, folder / "pareto.png")
         written = []
+        pareto = result.to_xarray(pareto_only=True)  # one dataset for its three files
         for name in ("pareto.nc", "pareto.csv", "pareto.mat"):
-            written.append(result.save(folder / name))
+            written.append(write_dataset(pareto, folder / name))
             bar.update(1)
         written.append(result.save(folder / "designs.nc", pareto_only=False))
-        bar.update(1)
-        figure = result.plot(path=folder / "pareto.png")
-        plt.close(figure)
-        written.append(folder / "pareto.png")
         bar.update(1)
         if result.chosen is not None:
             written.append(result.write_config(folder / "chosen.toml"))
@@ -538,4 +538,184 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
             Path(tmp).write_text(result.report(), encoding="utf-8")
         written.append(folder / "report.md")
         bar.update(1)
+        written.append(figure.result())  # last: drawn meanwhile
+        bar.update(1)
     return written
+
+
+def draw_figure(result: OptimizationResult, path: str | Path) -> Path:
+    """Draw the Pareto figure into a file and close it (the task :func:`write_files` forks).
+
+    Parameters
+    ----------
+    result : OptimizationResult
+        The search.
+    path : str or Path
+        The figure file (format from the suffix).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    import matplotlib.pyplot as plt
+
+    plt.close(result.plot(path=path))
+    return Path(path)
+
+
+class _Here:
+    """An executor that runs what it is given at once, here (where no process forks)."""
+
+    def submit(self, function, *args):
+        from concurrent.futures import Future
+
+        future = Future()
+        try:
+            future.set_result(function(*args))
+        except Exception as error:  # noqa: BLE001 - raised again by .result(), as a pool does
+            future.set_exception(error)
+        return future
+
+
+@contextlib.contextmanager
+def _beside():
+    """One forked process to run a task beside this one (Linux), else :class:`_Here`.
+
+    Forked, the process has this one's modules and data at once; a fresh interpreter
+    (spawn, forkserver) would import qzs again, which takes longer than the figure.
+    """
+    import multiprocessing
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        yield _Here()
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) \
+            as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def file_writer(folder: str | Path, *, progress: bool = False):
+    """A writer of a search's files, started before the search (a forked process on Linux).
+
+    The process imports what the files need (matplotlib; xarray, h5netcdf and what xarray
+    imports when it writes, Dask's hooks where Dask is installed) while this one searches,
+    then waits for the result and writes the files (:func:`write_files`); about a second of
+    imports off the end of ``qzs optimize``. Where no process forks, the files are written
+    here. The context closes the process, whatever happened.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where to write.
+    progress : bool
+        Show a progress bar, one step per file.
+
+    Yields
+    ------
+    object
+        Its ``write(result)`` writes the files of an :class:`OptimizationResult` and returns
+        their paths, as :func:`write_files` does (raising what it raises).
+    """
+    import multiprocessing
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        yield _WriteHere(folder, progress)
+        return
+    context = multiprocessing.get_context("fork")
+    here, there = context.Pipe()
+    process = context.Process(target=_serve, args=(there, here, folder, progress),
+                              name="qzs-files")
+    process.start()
+    there.close()
+    try:
+        yield _WriteThere(here, folder, progress)
+    finally:
+        here.close()  # the process sees the end of its pipe and leaves
+        process.join(timeout=5.0)
+        if process.is_alive():
+            process.terminate()
+            process.join()
+
+
+class _WriteHere:
+    """:func:`file_writer` where no process forks: :func:`write_files` in this process."""
+
+    def __init__(self, folder, progress):
+        self.folder, self.progress = folder, progress
+
+    def write(self, result):
+        return write_files(result, self.folder, progress=self.progress)
+
+
+class _WriteThere(_WriteHere):
+    """:func:`file_writer`'s forked process, told the result through a pipe."""
+
+    def __init__(self, connection, folder, progress):
+        super().__init__(folder, progress)
+        self.connection = connection
+
+    def write(self, result):
+        try:
+            self.connection.send(result)
+            outcome, value = self.connection.recv()
+        except (EOFError, OSError):  # the process is gone (killed): write here instead
+            return super().write(result)
+        if outcome == "error":
+            raise value
+        return value
+
+
+def _serve(connection, other_end, folder, progress):
+    """The forked writer: import what the files need, wait for the result, write them.
+
+    The imports run in a thread of lower priority (Linux priorities are per thread), so
+    that they take the CPU time the search leaves idle rather than the search's own.
+    """
+    import threading
+
+    other_end.close()  # so that the pipe ends when the searching process closes its end
+    warming = threading.Thread(target=_warm, kwargs={"nice": 5}, daemon=True)
+    warming.start()
+    try:
+        result = connection.recv()
+    except BaseException:  # noqa: BLE001 - no result (stopped, failed): nothing to write
+        return
+    warming.join()
+    try:
+        written = write_files(result, folder, progress=progress)
+    except Exception as error:  # noqa: BLE001 - raised again in the searching process
+        connection.send(("error", error))
+    else:
+        connection.send(("ok", written))
+
+
+def _warm(nice=0):
+    """Import what :func:`write_files` needs, as writing would, before it is needed; at
+    ``nice`` more than this thread's priority."""
+    import importlib
+    import importlib.util
+    import os
+    import threading
+
+    try:
+        thread = threading.get_native_id()
+        os.setpriority(os.PRIO_PROCESS, thread, os.getpriority(os.PRIO_PROCESS, thread) + nice)
+    except (AttributeError, OSError):  # no such call here: at the same priority
+        pass
+
+    import matplotlib.pyplot  # noqa: F401
+    import xarray
+
+    import qzs.iotools.writer  # noqa: F401
+    import qzs.viz.design_space  # noqa: F401
+
+    xarray.Variable("design", np.zeros(1))  # xarray's test for Dask arrays imports Dask
+    for name in ("h5netcdf", "distributed", "scipy.io"):  # what writing a file imports
+        if importlib.util.find_spec(name) is not None:
+            importlib.import_module(name)

@@ -32,7 +32,7 @@ likely strata (its grid spans the central ``(levels - 1) / levels`` of its proba
 the ends, at probability 0 and 1, are infinite for an unbounded distribution).
 
 Each sample point is one case ``{name: value}``, evaluated by
-:func:`qzs.workflows.design_space.metrics.evaluate_cases`, the path of every design of an
+:func:`qzs.workflows.design_space.evaluation.evaluate_cases`, the path of every design of an
 optimisation: simulated metrics through the sweep batch task (the step chosen first for
 the problem's ``tolerance_db`` if ``[simulation]`` gives no ``dt``, by the optimiser's
 :func:`~qzs.workflows.design_space.optimizer.fix_step`, so both integrate a problem at
@@ -55,7 +55,8 @@ from qzs._format import unit_label
 from qzs._optional import require
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.schema import Schema, Variable, to_dataset
-from qzs.workflows.design_space.metrics import METRICS, evaluate_cases
+from qzs.workflows.design_space.evaluation import evaluate_cases
+from qzs.workflows.design_space.metrics import METRICS
 from qzs.workflows.design_space.problem import (SENSITIVITY_METHODS, DesignProblem,
                                                 load_problem)
 from qzs.workflows.sweeps.definition import MAX_CASES

@@ -190,7 +190,7 @@ class DesignStore:
         search_position : ndarray, shape (n, n_variables)
             Where the optimiser asked.
         evaluation : Evaluation
-            The designs' metrics (:func:`~qzs.workflows.design_space.metrics.evaluate`).
+            The designs' metrics (:func:`~qzs.workflows.design_space.evaluation.evaluate`).
         """
         start = self.designs
         n = len(search_position)

@@ -83,9 +83,10 @@ def run_batch(definition, start, settings, n_time, threads=None):
         with _LOCK, ThreadPoolExecutor(min(cores, len(groups))) as pool:
             steps = sum(pool.map(lambda group: _run_group(
                 definition, *group[0], group[1], arrays, n_time, 1, lock=nullcontext()), groups))
-    else:
+    else:  # one thread needs no turn: one-core batches of several tasks run side by side
+        lock = nullcontext() if threads == 1 else _LOCK
         steps = sum(_run_group(definition, excitation, duration, members, arrays, n_time,
-                               threads) for (excitation, duration), members in groups)
+                               threads, lock=lock) for (excitation, duration), members in groups)
     return {"start": start, "arrays": arrays, "steps": steps,
             "elapsed": time.perf_counter() - began}
 
@@ -178,7 +179,7 @@ def run_local(definition, batches, settings, n_time, threads):
 
 
 
-def run_on_dask(client, definition, batches, settings, n_time, threads):
+def run_on_dask(client, definition, batches, settings, n_time, threads, *, task=None):
     """Submit batches to a Dask cluster (at most two per worker thread in flight).
 
     A failed task is tried twice more (a lost worker, a full disk).
@@ -197,6 +198,10 @@ def run_on_dask(client, definition, batches, settings, n_time, threads):
         Samples kept per time series (0: none).
     threads : int or None
         Threads per batch on a worker (:func:`run_batch`).
+    task : callable, optional
+        What a worker runs, called as ``task(definition, start, settings[start:stop],
+        n_time, threads)``; default :func:`run_batch` (the design space submits its own
+        task, which calls it).
 
     Yields
     ------
@@ -206,6 +211,7 @@ def run_on_dask(client, definition, batches, settings, n_time, threads):
     """
     as_completed = require("distributed", "running a sweep on a Dask cluster").as_completed
 
+    task = run_batch if task is None else task
     pending = iter(batches)
     window = max(2, 2 * sum(client.nthreads().values()))
     futures = as_completed()
@@ -213,8 +219,8 @@ def run_on_dask(client, definition, batches, settings, n_time, threads):
 
     def submit(batch):
         start, stop = batch
-        submitted.append(client.submit(run_batch, definition, start, settings[start:stop], n_time,
-                                  threads, retries=2, pure=False))
+        submitted.append(client.submit(task, definition, start, settings[start:stop], n_time,
+                                       threads, retries=2, pure=False))
         futures.add(submitted[-1])
 
     for batch in [b for _, b in zip(range(window), pending)]:
