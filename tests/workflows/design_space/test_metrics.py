@@ -238,3 +238,23 @@ def test_with_several_draws_each_row_is_its_design_under_each_draw_simulated():
                 assert evaluation.values[name][i, k] == pytest.approx(
                     run.statistics[name], rel=1e-12, abs=1e-15), (name, i, k)
     assert np.unique(evaluation.values["motor_force_rms"]).size == 9
+
+
+def test_with_several_draws_a_failed_design_keeps_its_status_and_messages_in_its_row():
+    """Designs ok, refused (a PI gain the kernel cannot step) and ok, each under 3 draws:
+    status[i, k], messages[i][k] and the NaN metrics are those of design i, every draw."""
+    document = copy.deepcopy(SHORT)
+    document["variables"]["pi_kp"] = {"low": 1.0, "high": 1e9, "scale": "log"}
+    document["excitation"] = {"duration": 4.0}
+    document["analysis"] = {"fft_length": 1024, "duration": 4.0}
+    document["objectives"] = [{"metric": "motor_force_rms"}]
+    document["constraints"] = []
+    problem = _robust(document, {"stiction_force": {"distribution": "uniform", "low": 2.0,
+                                                    "high": 15.0}}, 3)
+    evaluation = evaluate(problem, np.array([[0.0, 20.0], [0.0, 1e9], [150.0, 300.0]]),
+                          batch_size=2)
+    failed = np.array([False, True, False])
+    np.testing.assert_array_equal(evaluation.status != 1, np.repeat(failed[:, None], 3, 1))
+    assert [[bool(m) for m in row] for row in evaluation.messages] == [[f] * 3 for f in failed]
+    values = evaluation.values["motor_force_rms"]
+    assert np.isnan(values[1]).all() and np.isfinite(values[[0, 2]]).all()
