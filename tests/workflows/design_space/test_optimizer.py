@@ -279,3 +279,19 @@ def test_a_search_started_with_a_seed_resumes_only_with_it(tmp_path):
     whole = optimize(LINEAR, tmp_path / "whole.zarr", generations=2, seed=7, progress=False)
     resumed = optimize(LINEAR, store, resume=True, generations=2, seed=7, progress=False)
     assert np.array_equal(resumed.designs, whole.designs)
+
+
+def test_a_store_whose_designs_are_not_asked_for_again_is_refused(tmp_path):
+    """Same problem, seed and population, but stored designs the optimiser does not ask for
+    (as another qzs or pymoo version would have written them; here one value moved by one
+    ulp): the replay refuses it, naming the generation, rather than mixing two searches."""
+    import zarr
+
+    store = tmp_path / "s.zarr"
+    optimize(LINEAR, store, generations=2, progress=False)
+    group = zarr.open_group(str(store), mode="r+")
+    position = group["search_position"][:]
+    position[13, 1] = np.nextafter(position[13, 1], np.inf)  # generation 1's second design
+    group["search_position"][:] = position
+    with pytest.raises(OutputPathError, match=r"does not ask for again \(generation 1\)"):
+        optimize(LINEAR, store, generations=3, resume=True, progress=False)
