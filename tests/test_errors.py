@@ -27,6 +27,8 @@ CARRIERS = [
      {"name": "duration", "value": 1e9, "low": 0.1, "high": 600.0, "unit": "s"}),
     (errors.OutputPathError("--out", "x.txt", "has an unknown extension"),
      {"argument": "--out", "value": "x.txt", "reason": "has an unknown extension"}),
+    (errors.ResumeMismatchError("seed", 4, 5, "s.zarr"),
+     {"option": "seed", "stored": 4, "asked": 5, "store": "s.zarr"}),
     (errors.ResultTooLargeError(2 ** 30, 2 ** 20, 2000.0, 1000.0),
      {"needed": 2 ** 30, "available": 2 ** 20, "duration": 2000.0, "sample_rate": 1000.0}),
     (errors.RunTooLongError(steps=10 ** 15, seconds=1e7, limit=1e4, duration=100.0, dt=1e-13),

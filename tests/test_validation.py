@@ -139,3 +139,26 @@ def test_finite_rows_names_the_rows_with_non_finite_samples_and_refuses_other_sh
         finite_rows("base", rows, DataError)
     with pytest.raises(ParameterError, match=r"`base` must be a 2-D array.*shape \(5,\)"):
         finite_rows("base", np.zeros(5), ParameterError)
+
+
+def test_an_integer_range_includes_both_bounds_and_nothing_beyond():
+    """``minimum <= value <= maximum``, as documented: both bounds accepted, one beyond each
+    refused."""
+    assert [integer("harmonics", v, 1, maximum=8) for v in (1, 8)] == [1, 8]
+    for beyond in (0, 9):
+        with pytest.raises(ParameterError, match=r"must be an integer in \[1, 8\]"):
+            integer("harmonics", beyond, 1, maximum=8)
+
+
+def test_a_repeated_or_decreasing_time_is_refused_at_its_sample():
+    """Strictly increasing: a repeated time (a step of 0) is refused as a decreasing one is,
+    naming the first such sample and how many there are; an increasing one passes."""
+    from qzs._validation import strictly_increasing
+
+    strictly_increasing("time", np.array([0.0, 0.1, 0.2]), DataError)
+    with pytest.raises(DataError, match=r"duplicated at sample 2 .*1 such steps"):
+        strictly_increasing("time", np.array([0.0, 0.1, 0.1, 0.2]), DataError)
+    with pytest.raises(DataError, match=r"duplicated at sample 2 .*2 such steps"):
+        strictly_increasing("time", np.array([0.0, 0.1, 0.1, 0.2, 0.15]), DataError)
+    with pytest.raises(DataError, match=r"decreasing at sample 1 \(t = 0.05 s after t = 0.1"):
+        strictly_increasing("time", np.array([0.1, 0.05, 0.2]), DataError)

@@ -11,7 +11,7 @@ from collections.abc import Iterable, Mapping
 
 __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SimulationError", "DataError", "FitError", "MissingDependencyError",
-           "OutputPathError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
+           "OutputPathError", "ResumeMismatchError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
            "ControllerRateError", "CountLimitError", "InvalidCasesError",
            "SchedulerError", "AddressError", "ProblemError", "CompilerError", "Terminated",
@@ -343,6 +343,37 @@ class OutputPathError(ParameterError):
 
     def __reduce__(self):
         return type(self), (self.argument, self.value, self.reason)
+
+
+class ResumeMismatchError(ParameterError):
+    """A search resumed with another setting than its store was started with.
+
+    The optimiser would ask for other designs than the stored ones (another seed draws
+    another first generation, another population another size); raised before any design
+    is evaluated.
+
+    Attributes
+    ----------
+    option : str
+        The setting (``seed``, ``population``); on the command line ``--<option>``.
+    stored : object
+        The value the store was started with.
+    asked : object
+        The value asked for now.
+    store : str
+        The store's path.
+    """
+
+    def __init__(self, option: str, stored: object, asked: object, store: object) -> None:
+        self.option, self.stored, self.asked, self.store = str(option), stored, asked, str(store)
+        super().__init__(
+            f"`{self.option}` (--{self.option}) = {asked!r} is not the {stored!r} the store "
+            f"{self.store!r} was started with, so the search would ask for other designs than "
+            f"it holds; resume with --{self.option} {stored!r}, or start again with "
+            f"--overwrite.")
+
+    def __reduce__(self):
+        return type(self), (self.option, self.stored, self.asked, self.store)
 
 
 class ResultTooLargeError(ParameterError):

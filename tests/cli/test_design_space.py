@@ -171,3 +171,42 @@ def test_a_dry_run_speaks_in_units_and_words_and_simulates_nothing_for_linear_me
     assert main(["optimize", str(path), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "excitation," in out and "dt" in out and "no simulation" not in out
+
+
+def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
+        problem_file, tmp_path, capsys, monkeypatch):
+    """Exit 2 before any evaluation, the line naming --seed, the stored 1 and the asked 9;
+    the store is left as it was; an interrupted search started with --seed says to resume
+    with it."""
+    from qzs.workflows.design_space import metrics, optimizer
+    from qzs.workflows.design_space.store import stored_generations
+
+    out = tmp_path / "out"
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet",
+                 "--generations", "1"]) == 0
+    capsys.readouterr()
+    evaluate = optimizer.evaluate
+    monkeypatch.setattr(optimizer, "evaluate", pytest.fail)
+    assert main(["optimize", str(problem_file), "--out", str(out), "--quiet", "--resume",
+                 "--generations", "2", "--seed", "9"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--seed" in err and "= 9" in err and "--seed 1" in err
+    assert stored_generations(out / "cli.zarr") == 1
+    monkeypatch.setattr(optimizer, "evaluate", evaluate)
+
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(None)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return metrics.evaluate(*args, **kwargs)
+
+    monkeypatch.setattr(optimizer, "evaluate", interrupted)
+    seeded = tmp_path / "seeded"
+    assert main(["optimize", str(problem_file), "--out", str(seeded), "--quiet",
+                 "--seed", "9"]) == 130
+    assert "--resume --seed 9" in capsys.readouterr().err
+    monkeypatch.setattr(optimizer, "evaluate", evaluate)
+    assert main(["optimize", str(problem_file), "--out", str(seeded), "--quiet", "--resume",
+                 "--seed", "9"]) == 0

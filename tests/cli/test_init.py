@@ -112,6 +112,9 @@ EMPTY_ARGUMENTS = [
     (["experiment", "log.csv", "--map", ""], "--map"), (["simulate", "--plot", ""], "--plot"),
     (["response", "--out", ""], "--out"), (["design", "--out", ""], "--out"),
     (["docs", ""], "TOPIC"), (["simulate", "--set", ""], "--set"),
+    # blank is empty too: a path of spaces is no name either
+    (["simulate", "--out", " "], "--out"), (["optimize", "  "], "FILE"),
+    (["params", "--toml", "\t"], "--toml"),
 ]
 
 

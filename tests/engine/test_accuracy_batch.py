@@ -10,6 +10,7 @@ import math
 
 import pytest
 
+from qzs import defaults
 from qzs import Chirp, ControllerParameters, IsolatorParameters
 from qzs.engine.accuracy import choose_step
 from qzs.engine.accuracy_batch import BatchStepChoice, choose_batch_step
@@ -47,9 +48,30 @@ def test_each_case_gets_its_own_choice_and_the_batch_the_finest_step():
     assert "no PI" in batch.summary()
 
 
-def test_no_case_meeting_the_tolerance_is_an_error():
-    with pytest.raises(ToleranceNotMetError, match="no step down to"):
+def test_no_case_meeting_the_tolerance_is_an_error_and_a_hopeless_case_is_probed_once(
+        monkeypatch):
+    """The case without PI is hopeless at the first comparison (its estimate, brought down
+    at the scheme's order ``2**order`` per halving to the finest candidate, still exceeds the
+    tolerance: read from the error's data), so the search gives it up after the probes of
+    that comparison (dt_0, dt_0/2, dt_0/4) instead of probing every candidate."""
+    from qzs.engine import batch as batch_module
+    from qzs.engine.accuracy_batch import BATCH_MAX_HALVINGS
+    from qzs.engine.stability import SOLVERS
+
+    probed = []
+    simulate_batch = batch_module.simulate_batch
+
+    def counted(cases, *args, **kwargs):
+        probed.append(kwargs["dt"])
+        return simulate_batch(cases, *args, **kwargs)
+
+    monkeypatch.setattr(batch_module, "simulate_batch", counted)
+    with pytest.raises(ToleranceNotMetError, match="no step down to") as caught:
         choose_batch_step([NO_PI], CHIRP, tolerance_db=1e-3, probe_duration=PROBE)
+    error, order = caught.value, SOLVERS[defaults.SIMULATION["solver"]][1]
+    assert error.safety * error.smallest_error > error.tolerance * 2.0 ** (
+        order * (BATCH_MAX_HALVINGS - 2))
+    assert probed == [probed[0], probed[0] / 2, probed[0] / 4]
 
 
 @pytest.mark.parametrize("cases, options, match", [

@@ -239,3 +239,46 @@ def test_the_envelope_is_that_of_a_reduction_per_group_bit_for_bit(first, every,
     assert marks.shape == expected_marks.shape and np.array_equal(marks, expected_marks)
     groups = len({(first + i) // every for i in range(n)})
     assert rows.shape == (2 * groups, 5)
+
+
+# ---------------------------------------------------------------- the memory guard's threshold
+_SINE = qzs.Sine(amplitude=0.01, frequency=1.0)
+_PAIR = (qzs.IsolatorParameters(stiction_force=8.0), qzs.ControllerParameters())
+
+
+def _single():
+    result = qzs.simulate(_SINE, *_PAIR, duration=1.0, sample_rate=100.0)
+    from qzs.engine.channels import CHANNELS, FLAGS
+
+    held = sum(np.asarray(result[name]).nbytes for name in (*CHANNELS, *FLAGS))
+    return held, result.relative_position
+
+
+def _batch():
+    result = qzs.simulate_batch([_PAIR] * 3, _SINE, duration=1.0, sample_rate=100.0,
+                                channels=("relative_position", "motor_force", "locked"),
+                                workers=1)
+    return sum(a.nbytes for a in result.channels.values()), result.channels["relative_position"]
+
+
+@pytest.mark.parametrize("run", [_single, _batch], ids=["single", "batch"])
+def test_the_memory_guard_refuses_exactly_a_result_over_half_the_available_memory(run,
+                                                                              monkeypatch):
+    """As documented (:func:`qzs.engine.driver.check_memory`, ``MEMORY_SHARE``): a result of
+    ``needed`` bytes is refused if and only if it is more than half the available memory.
+    ``needed`` is what the finished result holds (the nbytes of every array it keeps), so the
+    guard's byte count is checked too: at 2 * needed available the run goes (exactly half),
+    at one byte less it is refused, as everywhere between half and all of the memory."""
+    held, reference = run()  # the machine's real memory: a small run goes
+    assert driver.MEMORY_SHARE == 0.5
+    for available, refused in ((2 * held, False), (2 * held - 1, True), (4 * held, False),
+                               ((3 * held) // 2, True), (held + 1, True), (held, True),
+                               (held // 2, True), (None, False)):
+        monkeypatch.setattr(driver, "available_memory", lambda a=available: a)
+        if refused:
+            with pytest.raises(ResultTooLargeError) as caught:
+                run()
+            assert (caught.value.needed, caught.value.available) == (held, available)
+        else:
+            again = run()
+            assert again[0] == held and np.array_equal(again[1], reference), available

@@ -131,3 +131,33 @@ def test_the_record_reads_the_same_from_the_choice_and_from_its_attributes():
     assert fallback.attributes()["step"] == "fallback"
     assert fallback.attributes()["step_reason"] == fallback.notes[-1]
     assert "fallback" in fallback.line()
+
+
+def test_a_hopeless_case_leaves_the_search_at_once_and_a_reachable_one_does_not():
+    """``give_up_early``: a case whose estimate, brought down at the scheme's order to the
+    finest candidate compared (``dt_{max_halvings-2}``), still exceeds the tolerance is
+    integrated only for the first comparison (dt_0, dt_1, dt_2), not at every candidate as
+    without the early exit; a case that meets the tolerance just at that finest candidate is
+    not given up."""
+    tolerance, halvings = 1e-3, 8
+    finest = DT0 / 2 ** (halvings - 2)
+    ok, hopeless = 1e3, 1e12
+    assert SAFETY * hopeless * finest ** ORDER > tolerance  # no candidate can meet it
+
+    def integrations(calls, case):
+        return sorted((dt for dt, c in calls if c == case), reverse=True)
+
+    choice, calls = _search([ok, hopeless], tolerance, give_up_early=True,
+                            max_halvings=halvings)
+    assert integrations(calls, 1) == [DT0, DT0 / 2, DT0 / 4]
+    assert choice.unmet == (1,) and choice.dt == _expected_step(ok, tolerance, halvings)
+    patient, calls = _search([ok, hopeless], tolerance, give_up_early=False,
+                             max_halvings=halvings)
+    assert integrations(calls, 1) == [DT0 / 2 ** j for j in range(halvings + 1)]
+    assert patient.unmet == (1,) and patient.dt == choice.dt
+    # meets the tolerance at the finest candidate compared, and at no coarser one
+    reachable = 0.999 * tolerance / (SAFETY * finest ** ORDER)
+    late, calls = _search([ok, reachable], tolerance, give_up_early=True,
+                          max_halvings=halvings)
+    assert late.dt == finest == _expected_step(reachable, tolerance, halvings)
+    assert late.unmet == ()

@@ -265,3 +265,22 @@ def test_dotted_keys_go_to_containers_and_come_back(tmp_path):
         assert not [key for key in raw.attrs if "." in key]
     back = from_file_layout(xr.load_dataset(path, engine="h5netcdf"))
     xr.testing.assert_identical(back, dataset)
+
+
+@pytest.mark.parametrize("dtype", ["int8", "int16", "int32"])
+def test_a_flags_values_are_written_in_the_flags_own_type(tmp_path, dtype):
+    """CF 1.10 §3.5: ``flag_values`` must be of the flag variable's type. A dataset whose
+    flag carries them as another type (a Python list: int64) is written with them cast."""
+    import h5py
+
+    from qzs.iotools.writer import write_netcdf
+
+    dataset = xr.Dataset({"held": (("t",), np.array([0, 1, 1], dtype=dtype),
+                                   {"units": "1", "long_name": "held",
+                                    "flag_values": [0, 1], "flag_meanings": "free held"})},
+                         coords={"t": ("t", np.arange(3.0), {"units": "s", "long_name": "t"})},
+                         attrs={"Conventions": CONVENTIONS, "history": "made here"})
+    with h5py.File(write_netcdf(dataset, tmp_path / "f.nc")) as raw:
+        written = raw["held"].attrs["flag_values"]
+        assert written.dtype == raw["held"].dtype == np.dtype(dtype)
+        assert written.tolist() == [0, 1]

@@ -180,3 +180,32 @@ def test_a_dataset_of_two_dimensions_writes_a_long_table_with_units(tmp_path):
     with pytest.raises(ParameterError, match=r"\.nc, \.csv or \.mat"):
         write_dataset(data, tmp_path / "curves.txt")
     assert leftovers(tmp_path) == ["curves.csv", "curves.nc"]
+
+
+def test_variables_of_different_dimension_orders_are_written_row_by_row_right(tmp_path):
+    """As :func:`write_dataset` says: one row per point of the dataset's dimensions, every
+    variable's value at that point whatever the order of its own dimensions. The values are
+    a known function of the coordinates (``case + frequency / 100``), written (case,
+    frequency) by one variable, (frequency, case) by another, (frequency,) by a third; the
+    sizes (3 x 4) are not square, but a transposed array would still fit the reshape."""
+    import pandas as pd
+    import xarray as xr
+
+    case, frequency = np.array([10.0, 20.0, 30.0]), np.array([1.0, 2.0, 5.0, 7.0])
+    grid = case[:, None] + frequency[None, :] / 100.0
+    data = xr.Dataset(
+        {"by_case": (("case", "frequency"), grid, {"units": "1"}),
+         "by_frequency": (("frequency", "case"), 2.0 * grid.T, {"units": "1"}),
+         "per_frequency": (("frequency",), frequency ** 2, {"units": "Hz2"})},
+        coords={"case": ("case", case, {"units": "1"}),
+                "frequency": ("frequency", frequency, {"units": "Hz"})})
+    table = pd.read_csv(write_dataset(data, tmp_path / "long.csv"), comment="#",
+                        header=[0, 1])
+    table.columns = [name for name, _ in table.columns]
+    assert len(table) == case.size * frequency.size
+    assert set(zip(table["case"], table["frequency"])) == {(c, f) for c in case
+                                                            for f in frequency}
+    expected = table["case"] + table["frequency"] / 100.0
+    np.testing.assert_allclose(table["by_case"], expected, rtol=1e-9)
+    np.testing.assert_allclose(table["by_frequency"], 2.0 * expected, rtol=1e-9)
+    np.testing.assert_allclose(table["per_frequency"], table["frequency"] ** 2, rtol=1e-9)

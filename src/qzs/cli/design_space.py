@@ -44,6 +44,9 @@ def add_parsers(subparsers):
                      help="generations (default the file's [optimizer] generations)")
     cmd.add_argument("--population", type=integer_at_least(1), metavar="N",
                      help="designs per generation (default the file's [optimizer] population)")
+    cmd.add_argument("--seed", type=int, metavar="N",
+                     help="seed of the search (default the file's [optimizer] seed); a "
+                          "resumed search needs the seed and population it was started with")
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the problem and the work, run nothing")
     add_execution_options(cmd, "evaluate")
@@ -82,6 +85,12 @@ def _check_counts(args):
             raise ParameterError(f"`--{option}` must be >= {least}, got {value}{reason}.")
 
 
+def _search_flags(args):
+    """The flags a resumed search must repeat (its seed and population), as typed."""
+    return "".join(f" --{name} {getattr(args, name)}" for name in ("seed", "population")
+                   if getattr(args, name) is not None)
+
+
 def run_optimize_command(args):
     """Run ``qzs optimize`` from parsed arguments; returns the exit code.
 
@@ -116,12 +125,12 @@ def run_optimize_command(args):
         try:
             result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
                               generations=args.generations, population=args.population,
-                              scheduler=args.scheduler, workers=args.workers,
+                              seed=args.seed, scheduler=args.scheduler, workers=args.workers,
                               threads=args.threads, progress=not quiet)
         except (KeyboardInterrupt, Terminated) as stop:
             return stopped(stop, f"{stored_generations(store)} complete generation(s) are kept "
                                  f"in {store}. Continue with: qzs optimize {args.problem} --out "
-                                 f"{folder} --resume")
+                                 f"{folder} --resume{_search_flags(args)}")
         written = writer.write(result)
     emit(args, "\n".join([result.summary(), *(f"  wrote            {path}"
                                               for path in (store, *written))]),

@@ -89,3 +89,15 @@ def test_the_sampled_design_loop_that_is_unstable_has_no_gain_margin():
     assert not slow.stable and math.isnan(slow.gain_margin)
     stable = cd.loop_margins(controller=ControllerParameters(damping_gain=200.0), rate=20.0)
     assert stable.stable and stable.gain_margin > 0
+
+
+@pytest.mark.parametrize("gain_period, stable", [(1.999, True), (2.0, False), (2.001, False)])
+def test_a_discrete_loop_is_stable_only_with_its_poles_strictly_inside_the_unit_circle(
+        gain_period, stable):
+    """K T/(z - 1) closed: the pole is z = 1 - K T (by hand), inside the unit circle for
+    K T < 2, on it at K T = 2 (not asymptotically stable: no margins), outside beyond."""
+    margins = cd.stability_margins_of(control.tf([gain_period], [1.0, -1.0], 0.01))
+    assert margins.stable is stable
+    assert math.isnan(margins.gain_margin) is not stable
+    if stable:  # the hand computation's 20 log10(2/(K T)), just above 0 dB
+        assert margins.gain_margin == pytest.approx(20 * math.log10(2 / gain_period), abs=1e-9)

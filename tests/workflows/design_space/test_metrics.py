@@ -176,3 +176,86 @@ def test_an_unstable_loop_has_no_margin_and_a_hunting_check_skips_the_friction_l
     assert (quick.hunts, quick.amplitude) == (full.hunts, full.amplitude)
     assert quick.friction_intersections == () and "memoryless" in quick.reasons[
         "friction_intersections"]
+
+
+def _robust(document, uncertain, samples):
+    document = copy.deepcopy(document)
+    document["uncertain"] = uncertain
+    document["robust"] = {"samples": samples}
+    return load_problem(document)
+
+
+def test_with_several_draws_each_row_is_its_design_under_each_draw_linear():
+    """Several designs under several draws of the mass: value[i, k] is the closed form of
+    design i with draw k (design-major, draws fastest), not another design's or draw's."""
+    from qzs.analysis.linear import linear_transmissibility
+
+    document = copy.deepcopy(SHORT)
+    document["simulation"] = {}
+    document["objectives"] = [{"metric": "linear_transmissibility_at", "frequency": 3.0}]
+    document["constraints"] = []
+    problem = _robust(document, {"mass": {"distribution": "uniform", "low": 5.0,
+                                          "high": 8.0}}, 4)
+    designs = np.array([[50.0, 20.0], [300.0, 500.0], [1000.0, 3.0]])
+    evaluation = evaluate(problem, designs)
+    masses = problem.draws()["mass"]
+    column = evaluation.values["linear_transmissibility_at_3_hz"]
+    assert column.shape == (3, 4) and np.unique(masses).size == 4
+    for i, (kd, kp) in enumerate(designs):
+        controller = qzs.ControllerParameters(damping_gain=kd, pi_kp=kp)
+        for k, mass in enumerate(masses):
+            expected = abs(complex(linear_transmissibility(
+                3.0, qzs.IsolatorParameters(mass=float(mass)), controller)))
+            assert column[i, k] == pytest.approx(expected, rel=1e-12), (i, k)
+    assert np.unique(column).size == 12  # every design and draw gives its own number
+    # the designs permuted: the rows permute with them, bit for bit
+    order = [2, 0, 1]
+    permuted = evaluate(problem, designs[order])
+    assert np.array_equal(permuted.values["linear_transmissibility_at_3_hz"], column[order])
+    assert np.array_equal(permuted.designs, designs[order])
+
+
+def test_with_several_draws_each_row_is_its_design_under_each_draw_simulated():
+    """Simulated metrics of 3 designs under 3 draws of the stiction force, in batches of 4
+    cases (cut across designs): value[i, k] and status[i, k] are design i's single run
+    with draw k."""
+    document = copy.deepcopy(SHORT)
+    document["excitation"] = {"duration": 4.0}
+    document["analysis"] = {"fft_length": 1024, "duration": 4.0}
+    document["objectives"] = [{"metric": "motor_force_rms"}]
+    document["constraints"] = [{"metric": "peak_stroke", "max": 0.05}]
+    problem = _robust(document, {"stiction_force": {"distribution": "uniform", "low": 2.0,
+                                                    "high": 15.0}}, 3)
+    designs = np.array([[0.0, 20.0], [150.0, 300.0], [4000.0, 10.0]])
+    evaluation = evaluate(problem, designs, batch_size=4)
+    forces = problem.draws()["stiction_force"]
+    assert evaluation.status.shape == (3, 3) and (evaluation.status == 1).all()
+    for i, (kd, kp) in enumerate(designs):
+        for k, force in enumerate(forces):
+            run = qzs.simulate(qzs.Chirp(duration=4.0), qzs.IsolatorParameters(
+                stiction_force=float(force)), qzs.ControllerParameters(
+                damping_gain=kd, pi_kp=kp), dt=1e-3, sample_rate=1000.0)
+            for name in ("motor_force_rms", "peak_stroke"):
+                assert evaluation.values[name][i, k] == pytest.approx(
+                    run.statistics[name], rel=1e-12, abs=1e-15), (name, i, k)
+    assert np.unique(evaluation.values["motor_force_rms"]).size == 9
+
+
+def test_with_several_draws_a_failed_design_keeps_its_status_and_messages_in_its_row():
+    """Designs ok, refused (a PI gain the kernel cannot step) and ok, each under 3 draws:
+    status[i, k], messages[i][k] and the NaN metrics are those of design i, every draw."""
+    document = copy.deepcopy(SHORT)
+    document["variables"]["pi_kp"] = {"low": 1.0, "high": 1e9, "scale": "log"}
+    document["excitation"] = {"duration": 4.0}
+    document["analysis"] = {"fft_length": 1024, "duration": 4.0}
+    document["objectives"] = [{"metric": "motor_force_rms"}]
+    document["constraints"] = []
+    problem = _robust(document, {"stiction_force": {"distribution": "uniform", "low": 2.0,
+                                                    "high": 15.0}}, 3)
+    evaluation = evaluate(problem, np.array([[0.0, 20.0], [0.0, 1e9], [150.0, 300.0]]),
+                          batch_size=2)
+    failed = np.array([False, True, False])
+    np.testing.assert_array_equal(evaluation.status != 1, np.repeat(failed[:, None], 3, 1))
+    assert [[bool(m) for m in row] for row in evaluation.messages] == [[f] * 3 for f in failed]
+    values = evaluation.values["motor_force_rms"]
+    assert np.isnan(values[1]).all() and np.isfinite(values[[0, 2]]).all()

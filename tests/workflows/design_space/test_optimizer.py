@@ -239,3 +239,59 @@ def test_the_seed_can_be_given_to_the_call_and_changes_the_search(tmp_path):
     assert not np.array_equal(one.designs, other.designs)
     with pytest.raises(ProblemError, match="whole number"):
         optimize(LINEAR, tmp_path / "c.zarr", seed=1.5, progress=False)
+
+
+@pytest.mark.parametrize("option, asked", [("seed", 5), ("population", 16)])
+def test_a_resume_with_another_seed_or_population_is_refused_by_name(tmp_path, monkeypatch,
+                                                                      option, asked):
+    """The optimiser would ask other designs than the stored ones: refused before any
+    evaluation, naming the setting, the value the store was started with and the one asked
+    for; the stored value given again resumes."""
+    from qzs.errors import ResumeMismatchError
+    from qzs.workflows.design_space import optimizer as optimizer_module
+
+    store = tmp_path / "s.zarr"
+    optimize(LINEAR, store, generations=1, progress=False)
+    stored = LINEAR["optimizer"][option]
+    evaluate = optimizer_module.evaluate
+    monkeypatch.setattr(optimizer_module, "evaluate", pytest.fail)
+    with pytest.raises(ResumeMismatchError) as caught:
+        optimize(LINEAR, store, resume=True, progress=False, **{option: asked})
+    error = caught.value
+    assert (error.option, error.stored, error.asked) == (option, stored, asked)
+    assert f"--{option}" in str(error) and f"{stored}" in str(error) and f"{asked}" in str(error)
+    monkeypatch.setattr(optimizer_module, "evaluate", evaluate)
+    resumed = optimize(LINEAR, store, resume=True, generations=2, progress=False,
+                       **{option: stored})
+    assert resumed.evaluated == LINEAR["optimizer"]["population"]  # the second generation
+
+
+def test_a_search_started_with_a_seed_resumes_only_with_it(tmp_path):
+    """Started with seed 7 (not the file's 4), resumed without it: the file's seed is asked
+    for, and refused by name."""
+    from qzs.errors import ResumeMismatchError
+
+    store = tmp_path / "s.zarr"
+    optimize(LINEAR, store, generations=1, seed=7, progress=False)
+    with pytest.raises(ResumeMismatchError) as caught:
+        optimize(LINEAR, store, resume=True, generations=2, progress=False)
+    assert (caught.value.stored, caught.value.asked) == (7, 4)
+    whole = optimize(LINEAR, tmp_path / "whole.zarr", generations=2, seed=7, progress=False)
+    resumed = optimize(LINEAR, store, resume=True, generations=2, seed=7, progress=False)
+    assert np.array_equal(resumed.designs, whole.designs)
+
+
+def test_a_store_whose_designs_are_not_asked_for_again_is_refused(tmp_path):
+    """Same problem, seed and population, but stored designs the optimiser does not ask for
+    (as another qzs or pymoo version would have written them; here one value moved by one
+    ulp): the replay refuses it, naming the generation, rather than mixing two searches."""
+    import zarr
+
+    store = tmp_path / "s.zarr"
+    optimize(LINEAR, store, generations=2, progress=False)
+    group = zarr.open_group(str(store), mode="r+")
+    position = group["search_position"][:]
+    position[13, 1] = np.nextafter(position[13, 1], np.inf)  # generation 1's second design
+    group["search_position"][:] = position
+    with pytest.raises(OutputPathError, match=r"does not ask for again \(generation 1\)"):
+        optimize(LINEAR, store, generations=3, resume=True, progress=False)

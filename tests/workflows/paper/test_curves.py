@@ -206,3 +206,23 @@ def test_drawing_and_writing_advance_a_progress_bar_file_by_file(damping_study, 
     assert [len(f) for _, f in recorder.steps] == sorted(len(f) for _, f in recorder.steps)
     report.write_paper_outputs([damping_study], tmp_path, workers=1)
     assert bars[-1].disable  # progress=False: no bar shown
+
+
+def test_without_a_trusted_flag_every_bin_above_0_hz_is_trusted():
+    """As :func:`curves_dataset` documents: a curve without ``trusted`` trusts each of its
+    bins above 0 Hz and not its 0 Hz bin; bins it lacks are untrusted; a flag given is kept
+    as given, at 0 Hz too."""
+    grid = np.array([0.0, 0.5, 1.0, 2.0])
+    data = curves_dataset([
+        {"label": "default", "frequency": grid, "magnitude": np.ones(4)},
+        {"label": "shifted", "frequency": grid[1:] + 0.25, "magnitude": np.ones(3)},
+        {"label": "given", "frequency": grid, "magnitude": np.ones(4),
+         "trusted": np.array([True, False, True, False])}])
+    frequency = data["frequency"].values
+    trusted = data["trusted"].values.astype(bool)
+    np.testing.assert_array_equal(trusted[0], np.isin(frequency, grid) & (frequency > 0))
+    np.testing.assert_array_equal(trusted[1], np.isin(frequency, grid[1:] + 0.25))
+    assert trusted[2, frequency == 0.0].all()
+    np.testing.assert_array_equal(trusted[2][np.isin(frequency, grid)], [True, False, True,
+                                                                         False])
+    assert not trusted[2][~np.isin(frequency, grid)].any()

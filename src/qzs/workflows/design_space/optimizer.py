@@ -29,7 +29,7 @@ from qzs.workflows.design_space.evaluation import evaluate
 from qzs.workflows.design_space.metrics import METRICS, goal_values
 from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
-from qzs.workflows.design_space.store import DesignStore, check
+from qzs.workflows.design_space.store import DesignStore, check, check_same_search
 
 __all__ = ["optimize", "fix_step", "probe_designs", "check_run_length"]
 
@@ -170,6 +170,9 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     OutputPathError
         The store cannot be written, exists without ``resume``/``overwrite``, or holds
         another problem's designs.
+    ResumeMismatchError
+        ``resume`` with another ``seed`` or ``population`` than the store was started with
+        (before any evaluation).
     """
     from qzs.engine.progress import progress_bar
     from qzs.workflows.design_space.problem import _positive_int
@@ -193,6 +196,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     problem = dataclasses.replace(problem, optimizer=settings)
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)
+    if resume:  # before any work: another seed or population asks for other designs
+        check_same_search(store, problem)
     check_run_length(problem, threads=threads)  # certain already at the output period
     require("pymoo", "qzs optimize (multi-objective search)")
     began = time.perf_counter()

@@ -9,8 +9,9 @@ A Zarr (v3) group whose arrays grow along the evaluated designs:
 - one array per metric column (design, sample) [the metric's unit], and ``status``
   (design, sample): 1 ok, 2 invalid parameters, 3 simulation failed, 4 analysis failed.
 
-The group's attributes hold the problem's hash and document, the integration step, the
-designs and generations complete, and the failure messages. A generation is complete
+The group's attributes hold the problem's hash and document, the optimiser's seed and
+population (a resume must ask for the same, :func:`check_same_search`), the integration step,
+the designs and generations complete, and the failure messages. A generation is complete
 once its rows are written and the attributes name it; rows beyond the count the
 attributes give (an interrupted write) are cut off when the store is opened again, so an
 interrupted run loses at most the generation being written.
@@ -22,13 +23,17 @@ from pathlib import Path
 import numpy as np
 
 from qzs._version import __version__
-from qzs.errors import OutputPathError
+from qzs.errors import OutputPathError, ResumeMismatchError
 from qzs.iotools.paths import check_output_path
 
-__all__ = ["DesignStore", "STORE_SUFFIX", "FORMAT", "check", "stored_generations"]
+__all__ = ["DesignStore", "STORE_SUFFIX", "FORMAT", "SEARCH_SETTINGS", "check",
+           "check_same_search", "stored_generations"]
 
 STORE_SUFFIX = ".zarr"
 FORMAT = "qzs-design-store-1"
+#: The optimiser's settings a resumed search must share with its store: with another seed
+#: or population NSGA-II asks for other designs than the stored ones.
+SEARCH_SETTINGS = ("seed", "population")
 
 
 class DesignStore:
@@ -53,6 +58,8 @@ class DesignStore:
         The name does not end in ``.zarr``, the folder cannot be written, the store exists
         without ``resume``/``overwrite``, ``resume`` names no store, or the store was
         written for another problem.
+    ResumeMismatchError
+        ``resume`` with another seed or population than the store was started with.
     ParameterError
         Both ``resume`` and ``overwrite``.
     """
@@ -73,6 +80,7 @@ class DesignStore:
                                       f"({attrs.get('problem_name')!r}, a different hash); "
                                       "resume it with the file it was started with, or use "
                                       "--overwrite to start again")
+            check_same_search(self.path, problem, attrs)
             self._trim()
         else:
             if overwrite and self.path.exists():
@@ -104,6 +112,7 @@ class DesignStore:
             "variables": [v.name for v in p.variables],
             "variable_units": [v.units for v in p.variables],
             "metric_columns": list(p.columns), "samples": samples,
+            **{f"optimizer_{name}": p.optimizer[name] for name in SEARCH_SETTINGS},
             "designs_done": 0, "generations_done": 0, "messages": {},
             "qzs_version": __version__,
             "created": datetime.now(timezone.utc).isoformat(timespec="seconds")})
@@ -239,6 +248,34 @@ def check(path: str | Path, *, resume: bool = False, overwrite: bool = False,
     if path.exists() and not resume and not overwrite:
         raise OutputPathError(argument, path, "exists; pass --resume to continue it, "
                               "--overwrite to replace it, or choose another name")
+
+
+def check_same_search(path: str | Path, problem, attributes=None) -> None:
+    """Refuse to resume a store with another seed or population than it was started with.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    problem : DesignProblem
+        The problem as resumed, its ``optimizer`` settings with any override applied.
+    attributes : mapping, optional
+        The store's attributes, if already read.
+
+    Raises
+    ------
+    ResumeMismatchError
+        A setting of :data:`SEARCH_SETTINGS` differs from the stored one (a store written
+        before they were recorded is checked by the replay alone).
+    """
+    if attributes is None:
+        import zarr
+
+        attributes = dict(zarr.open_group(str(path), mode="r").attrs)
+    for name in SEARCH_SETTINGS:
+        stored = attributes.get(f"optimizer_{name}")
+        if stored is not None and stored != problem.optimizer[name]:
+            raise ResumeMismatchError(name, stored, problem.optimizer[name], path)
 
 
 def stored_generations(path: str | Path) -> int:
