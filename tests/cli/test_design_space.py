@@ -178,7 +178,7 @@ def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
     """Exit 2 before any evaluation, the line naming --seed, the stored 1 and the asked 9;
     the store is left as it was; an interrupted search started with --seed says to resume
     with it."""
-    from qzs.workflows.design_space import metrics, optimizer
+    from qzs.workflows.design_space import evaluation, optimizer
     from qzs.workflows.design_space.store import stored_generations
 
     out = tmp_path / "out"
@@ -200,7 +200,7 @@ def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
         calls.append(None)
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return metrics.evaluate(*args, **kwargs)
+        return evaluation.evaluate(*args, **kwargs)
 
     monkeypatch.setattr(optimizer, "evaluate", interrupted)
     seeded = tmp_path / "seeded"
