@@ -152,7 +152,9 @@ class Forked:
         self._connection, child = context.Pipe()
         for stream in (sys.stdout, sys.stderr):  # nothing buffered is written twice
             stream.flush()
-        self._process = context.Process(target=_helper, name=name, daemon=True,
+        # not daemonic, so that its job may fork helpers of its own (a daemonic process may
+        # have no children); :meth:`close` ends it
+        self._process = context.Process(target=_helper, name=name,
                                         args=(child, job, prepare, nice))
         self._process.start()
         child.close()
