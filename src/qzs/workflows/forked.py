@@ -238,7 +238,15 @@ class Forked:
 
 class Here:
     """:class:`Forked`'s calls where no helper forks: the job runs in this process, at
-    :meth:`send` (``prepare`` is not needed: nothing runs beside)."""
+    :meth:`send`.
+
+    Parameters
+    ----------
+    job : callable
+        Called with what :meth:`send` sends.
+    **_ignored
+        :class:`Forked`'s other arguments (``prepare`` is not needed: nothing runs beside).
+    """
 
     def __init__(self, job: Callable[[Any], Any], **_ignored: Any):
         self._job = job
@@ -251,7 +259,13 @@ class Here:
         return False
 
     def send(self, item: Any) -> None:
-        """Run the job on ``item`` now; :meth:`result` returns or raises its outcome."""
+        """Run the job on ``item`` now; :meth:`result` returns or raises its outcome.
+
+        Parameters
+        ----------
+        item : object
+            The job's argument.
+        """
         try:
             self._outcome = ("ok", self._job(item))
         except Exception as error:  # noqa: BLE001 - raised again by :meth:`result`

@@ -25,6 +25,8 @@ from qzs.workflows.design_space.metrics import goal_values
 from qzs.workflows.design_space.problem import DesignProblem, _spread_text, _unit
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
+
     import xarray as xr
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -573,7 +575,7 @@ def draw_figure(result: OptimizationResult, path: str | Path) -> Path:
 
 
 @contextlib.contextmanager
-def file_writer(folder: str | Path, *, progress: bool = False):
+def file_writer(folder: str | Path, *, progress: bool = False) -> Iterator[_Writer]:
     """A writer of a search's files, started before the search (a forked process).
 
     The process (a :class:`~qzs.workflows.forked.Forked` helper) imports what the files
@@ -594,7 +596,7 @@ def file_writer(folder: str | Path, *, progress: bool = False):
 
     Yields
     ------
-    object
+    _Writer
         Its ``write(result)`` writes the files of an :class:`OptimizationResult` and returns
         their paths, as :func:`write_files` does (raising what it raises).
     """
