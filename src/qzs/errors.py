@@ -15,6 +15,7 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
            "ControllerRateError", "CountLimitError", "InvalidCasesError",
            "SchedulerError", "AddressError", "ProblemError", "CompilerError", "Terminated",
+           "HelperProcessError",
            "DataWarning", "FitWarning"]
 
 
@@ -653,6 +654,28 @@ class Terminated(BaseException):
 
     def __reduce__(self):
         return type(self), (self.signum,)
+
+
+class HelperProcessError(ChildProcessError):
+    """A helper process (:mod:`qzs.workflows.forked`) ended without sending its job's
+    outcome (killed, or never told the job); the caller does the job itself.
+
+    Attributes
+    ----------
+    name : str
+        The helper's process name.
+    exitcode : int or None
+        Its exit code (negative: the signal that ended it), None if not known.
+    """
+
+    def __init__(self, name, exitcode=None):
+        self.name = str(name)
+        self.exitcode = exitcode
+        super().__init__(f"the helper process {self.name!r} ended without an answer (exit "
+                         f"code {exitcode}); the job is to be done in this process instead.")
+
+    def __reduce__(self):
+        return type(self), (self.name, self.exitcode)
 
 
 class DataWarning(UserWarning):

@@ -15,10 +15,10 @@ import qzs
 from qzs.engine.result import SimulationResult
 from qzs.engine.result_file import ResultWriter
 from qzs.engine.run_spec import resolve
-from qzs.workflows import figure_process
-from qzs.workflows.figure_process import FigureProcess, simulate_with_figure
+from qzs.workflows import figure_process, forked
+from qzs.workflows.figure_process import figure_helper, simulate_with_figure
 
-pytestmark = pytest.mark.skipif(not FigureProcess.available(),
+pytestmark = pytest.mark.skipif(not forked.available(),
                                 reason="needs fork and two usable cores")
 
 EXCITATION = qzs.Chirp(amplitude=0.01, f0=0.0, f1=20.0, duration=30.0)
@@ -92,13 +92,12 @@ def test_the_helper_draws_the_figure_the_run_would_draw_itself(tmp_path, monkeyp
 
 def test_the_default_is_parallel_with_a_file_and_sequential_without(tmp_path, monkeypatch):
     made = []
-    real = FigureProcess.__init__
 
-    def spy(self, suffix):
+    def spy(suffix):
         made.append(suffix)
-        real(self, suffix)
+        return figure_helper(suffix)
 
-    monkeypatch.setattr(FigureProcess, "__init__", spy)
+    monkeypatch.setattr(figure_process, "figure_helper", spy)
     simulate_with_figure(_resolved(), plot=tmp_path / "memory.png")
     assert made == []  # a run in memory holds every sample: drawn here
     simulate_with_figure(_resolved(), out=tmp_path / "run.nc", plot=tmp_path / "run.svg")
@@ -110,14 +109,14 @@ def test_a_helper_that_dies_leaves_the_figure_to_this_process(tmp_path, monkeypa
     """The helper killed before it draws: this process draws, the same bytes."""
     simulate_with_figure(_resolved(), out=tmp_path / "seq.nc", plot=tmp_path / "seq.png",
                          parallel=False)
-    real_draw = FigureProcess.draw
+    real_send = forked.Forked.send
 
-    def kill_then_draw(self, result):
+    def kill_then_send(self, result):
         os.kill(self.pid, signal.SIGKILL)
         self._process.join()
-        real_draw(self, result)
+        real_send(self, result)
 
-    monkeypatch.setattr(FigureProcess, "draw", kill_then_draw)
+    monkeypatch.setattr(forked.Forked, "send", kill_then_send)
     simulate_with_figure(_resolved(), out=tmp_path / "par.nc", plot=tmp_path / "par.png",
                          parallel=True)
     assert (tmp_path / "par.png").read_bytes() == (tmp_path / "seq.png").read_bytes()
@@ -127,11 +126,11 @@ def test_an_error_in_the_run_leaves_no_file_and_no_helper(tmp_path, monkeypatch)
     """KeyboardInterrupt (a non-interruptible run) while a chunk is written: no file, no
     temporary file, and the helper is gone (killed and waited for)."""
     helpers = []
-    real = FigureProcess.__init__
 
-    def spy(self, suffix):
-        real(self, suffix)
-        helpers.append(self.pid)
+    def spy(suffix):
+        helper = figure_helper(suffix)
+        helpers.append(helper.pid)
+        return helper
 
     calls = []
 
@@ -140,7 +139,7 @@ def test_an_error_in_the_run_leaves_no_file_and_no_helper(tmp_path, monkeypatch)
         if len(calls) == 2:
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(FigureProcess, "__init__", spy)
+    monkeypatch.setattr(figure_process, "figure_helper", spy)
     monkeypatch.setattr(ResultWriter, "append", interrupted)
     with pytest.raises(KeyboardInterrupt):
         simulate_with_figure(_resolved(), out=tmp_path / "run.nc", plot=tmp_path / "run.png")
@@ -196,19 +195,19 @@ def test_a_signal_to_the_command_leaves_no_temporary_file_and_no_process(tmp_pat
 def test_the_helper_ignores_ctrl_c(tmp_path):
     """SIGINT reaches the whole process group: the helper must not die of it (the parent
     decides), nor print a traceback; it still draws."""
-    helper = FigureProcess(".png")
+    helper = figure_helper(".png")
     try:
         time.sleep(0.2)
         os.kill(helper.pid, signal.SIGINT)
         time.sleep(0.2)
-        assert helper._process.is_alive()
+        assert helper.is_alive()
         result = qzs.simulate(EXCITATION, duration=2.0)
-        helper.draw(result)
-        drawn = helper.figure()
+        helper.send(result)
+        drawn = helper.result()
     finally:
         helper.close()
-    assert drawn is not None and drawn[:8] == b"\x89PNG\r\n\x1a\n"
-    assert not helper._process.is_alive()
+    assert drawn[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not helper.is_alive()
 
 
 def test_warm_up_labels_are_those_of_the_run_figure():
@@ -235,15 +234,15 @@ def test_a_warmed_up_helper_draws_the_same_bytes(tmp_path, monkeypatch):
         marker.write_text("done")
 
     monkeypatch.setattr(figure_process, "_warm_up", warm_up)
-    helper = FigureProcess(".png")
+    helper = figure_helper(".png")
     try:
         deadline = time.monotonic() + 120
         while not marker.exists():
             assert time.monotonic() < deadline, "the helper never warmed up"
             time.sleep(0.05)
         result = qzs.simulate(EXCITATION, duration=20.0)
-        helper.draw(result)
-        drawn = helper.figure()
+        helper.send(result)
+        drawn = helper.result()
     finally:
         helper.close()
     result.plot(path=tmp_path / "here.png")

@@ -2,6 +2,8 @@
 
 ==================  ==========================================================================
 ``run``             one run streamed to a file as it is simulated (bounded memory)
+``forked``          one job run by a helper process forked now, which prepares (imports,
+                    warm-up) while this one works; dies with it, ignores Ctrl-C
 ``figure_process``  a run's figure drawn in a second process while the file is written
 ``paper``           ``qzs paper`` and ``qzs study``: the paper's studies (``study_files/``),
                     figures, curves as data, claims decided from the data

@@ -4,15 +4,15 @@ A run streamed to a file (:func:`qzs.workflows.run.simulate_to_file`) keeps this
 main thread busy writing while a thread integrates; its figure (matplotlib's import, then
 layout, text and rendering: about a second) used to follow, matplotlib's import competing
 with the writing for the interpreter. :func:`simulate_with_figure` forks a helper
-(:class:`FigureProcess`) before the run: it imports matplotlib and warms its fonts and
-mathtext on the second core while the run goes on, then draws the preview this process
+(:func:`figure_helper`, a :class:`~qzs.workflows.forked.Forked`) before the run: it
+imports matplotlib and warms its fonts and mathtext on the second core while the run goes on, then draws the preview this process
 sends it when the run ends (:meth:`SimulationResult.plot`'s figure, the same bytes), while
 this process closes its file; the bytes come back and are written here, atomically. A
 failed helper falls back to drawing here; an interrupted run is drawn here too.
 
-The helper holds no file and ignores Ctrl-C (it reaches the whole process group); it is
-killed, and waited for, whenever this process stops early, and dies with it on Linux
-(``PR_SET_PDEATHSIG``), so an interrupt leaves neither a temporary file nor an orphan.
+The helper holds no file, ignores Ctrl-C, is killed and waited for whenever this process
+stops early and dies with it (:mod:`qzs.workflows.forked`), so an interrupt leaves neither
+a temporary file nor an orphan.
 
 >>> from qzs.engine.run_spec import resolve
 >>> from qzs.workflows.figure_process import simulate_with_figure
@@ -21,49 +21,34 @@ killed, and waited for, whenever this process stops early, and dies with it on L
 """
 from __future__ import annotations
 
-import multiprocessing
-import os
-import signal
-import sys
-import threading
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from qzs.workflows import forked
 from qzs.workflows.run import simulate_to_file
 
 if TYPE_CHECKING:
     from qzs.engine.result import SimulationResult
     from qzs.engine.run_spec import ResolvedRun
 
-__all__ = ["simulate_with_figure", "FigureProcess"]
+__all__ = ["simulate_with_figure", "figure_helper"]
 
-_PR_SET_PDEATHSIG = 1
 #: What the helper draws once, while it waits, so that fonts, glyphs and the mathtext
 #: parser are loaded before the run's figure (labels of :func:`plot_simulation`'s kind).
 _WARM_UP_LABELS = ("displacement [mm]", "acceleration [m/s$^2$]", "time [s]")
 
 
-def _usable_cpus():
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
+def _agg():
+    """matplotlib without a window: the figure goes back as bytes."""
+    import matplotlib
 
-
-def _die_with_parent():
-    """Linux: the kernel sends this process SIGKILL when its parent dies."""
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
-    except (OSError, AttributeError):  # pragma: no cover - another libc
-        pass
+    matplotlib.use("Agg")
 
 
 def _warm_up(suffix):
     """Draw a throw-away figure: matplotlib's fonts, glyph and text caches are then warm."""
+    _agg()
     import matplotlib.pyplot as plt
 
     from qzs.viz.figures import figure_bytes, new_figure
@@ -79,113 +64,31 @@ def _warm_up(suffix):
     plt.close(fig)
 
 
-def _helper(connection, suffix):
-    """The second process: import matplotlib and warm it up, receive the run, draw it, send
-    ``("ok", bytes)`` back (``("error", text)`` on failure; nothing if told to stop)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the parent's to handle
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # it holds no file: it may simply die
-    _die_with_parent()
-    try:
-        import matplotlib
+def _draw(suffix, result):
+    """The helper's job: the run's figure file as bytes (:meth:`SimulationResult.plot`'s)."""
+    _agg()
+    from qzs.viz.figures import figure_bytes
+    from qzs.viz.simulation import plot_simulation
 
-        matplotlib.use("Agg")  # no window: the figure goes back as bytes
-        from qzs.viz.figures import figure_bytes
-        from qzs.viz.simulation import plot_simulation
-
-        if not connection.poll():  # the run is not over yet: warm up while it goes on
-            _warm_up(suffix)
-        result = connection.recv()
-        if result is not None:
-            connection.send(("ok", figure_bytes(plot_simulation(result), suffix)))
-    except BaseException as error:  # noqa: BLE001 - reported to the parent, which draws
-        try:
-            connection.send(("error", f"{type(error).__name__}: {error}"))
-        except OSError:
-            pass
-    finally:
-        connection.close()
+    return figure_bytes(plot_simulation(result), suffix)
 
 
-class FigureProcess:
-    """The forked helper that draws one run's figure (see the module's docstring).
+def figure_helper(suffix: str) -> forked.Forked:
+    """A :class:`~qzs.workflows.forked.Forked` helper that warms matplotlib up and draws
+    the run it is sent into a figure file's bytes.
 
     Parameters
     ----------
     suffix : str
         The figure's format, a file suffix (``".png"``, ``".svg"``, ``".pdf"``).
+
+    Returns
+    -------
+    Forked
+        Its :meth:`~qzs.workflows.forked.Forked.result` is the file's bytes.
     """
-
-    def __init__(self, suffix: str):
-        context = multiprocessing.get_context("fork")
-        self._connection, child = context.Pipe()
-        for stream in (sys.stdout, sys.stderr):  # nothing buffered is written twice
-            stream.flush()
-        self._process = context.Process(target=_helper, name="qzs-figure", daemon=True,
-                                        args=(child, suffix))
-        self._process.start()
-        child.close()
-        self._sender: threading.Thread | None = None
-
-    @staticmethod
-    def available() -> bool:
-        """Whether a helper can help: ``fork`` exists and two cores are usable."""
-        return "fork" in multiprocessing.get_all_start_methods() and _usable_cpus() >= 2
-
-    @property
-    def pid(self) -> int | None:
-        """The helper's process id."""
-        return self._process.pid
-
-    def draw(self, result: SimulationResult) -> None:
-        """Send the run to the helper, which starts drawing it.
-
-        Parameters
-        ----------
-        result : SimulationResult
-            The run (a streamed run's preview: at most
-            :data:`~qzs.engine.driver.PREVIEW_SAMPLES` rows).
-        """
-        def send():
-            try:
-                self._connection.send(result)
-            except OSError:  # the helper is gone: :meth:`figure` says so
-                pass
-
-        # in a thread: the helper may still be importing, and this process closes its file
-        sender = threading.Thread(target=send, name="qzs-figure-send", daemon=True)
-        sender.start()
-        self._sender = sender
-
-    def figure(self) -> bytes | None:
-        """The figure's file as the helper drew it, or None if it could not; ends the helper.
-
-        Returns
-        -------
-        bytes or None
-            The file's bytes (those :meth:`SimulationResult.plot` writes), or None (the
-            helper failed, or :meth:`draw` was not called): draw here instead.
-        """
-        drawn = None
-        try:
-            if self._sender is not None:
-                self._sender.join()
-                status, payload = self._connection.recv()
-                if status == "ok" and isinstance(payload, bytes):
-                    drawn = payload
-        except (EOFError, OSError):  # the helper ended without a figure
-            pass
-        finally:
-            self.close()
-        return drawn
-
-    def close(self) -> None:
-        """End the helper (killed if still running) and wait for it. Idempotent."""
-        if self._process.is_alive():
-            self._process.kill()
-        self._process.join()
-        if self._sender is not None:  # its send fails once the helper is gone
-            self._sender.join()
-        self._connection.close()
+    return forked.Forked(partial(_draw, suffix), prepare=partial(_warm_up, suffix),
+                         name="qzs-figure")
 
 
 def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None,
@@ -194,8 +97,8 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
                          parallel: bool | None = None) -> SimulationResult:
     """Simulate a resolved run, stream it to ``out`` and write its figure to ``plot``.
 
-    With a file and a figure, the figure is drawn by a :class:`FigureProcess` on the second
-    core (``parallel``; default where :meth:`FigureProcess.available`): matplotlib loads
+    With a file and a figure, the figure is drawn by a :func:`figure_helper` on the second
+    core (``parallel``; default where :func:`qzs.workflows.forked.available`): matplotlib loads
     there while this process integrates and writes, and the figure is drawn there while
     this process closes the file. The figure's bytes are those of
     :meth:`SimulationResult.plot` either way.
@@ -217,7 +120,7 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
     parallel : bool, optional
         Draw the figure in a second process; default: when a file and a figure are asked
         for (a run in memory holds every sample: too many to send) and
-        :meth:`FigureProcess.available`.
+        :func:`qzs.workflows.forked.available`.
 
     Returns
     -------
@@ -233,8 +136,8 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
     from qzs._lazy import import_in_background
 
     if parallel is None:
-        parallel = out is not None and FigureProcess.available()
-    helper = FigureProcess(Path(plot).suffix) if parallel and plot is not None else None
+        parallel = out is not None and forked.available()
+    helper = figure_helper(Path(plot).suffix) if parallel and plot is not None else None
     # without a helper, matplotlib (0.3-0.5 s) loads in a thread while the kernel integrates;
     # joined before returning, so that no import is left half done
     loading = (import_in_background("matplotlib.pyplot", "qzs.viz.simulation")
@@ -242,7 +145,7 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
 
     def simulated(result):  # the samples are all in: drawing starts while the file closes
         if helper is not None and result.completed:
-            helper.draw(result)
+            helper.send(result)
 
     drawn = None
     try:
@@ -253,8 +156,11 @@ def simulate_with_figure(resolved: ResolvedRun, *, out: str | Path | None = None
         else:
             result = resolved.simulate(progress=progress, interruptible=interruptible)
             simulated(result)
-        if helper is not None:
-            drawn = helper.figure()
+        if helper is not None and result.completed:
+            try:
+                drawn = helper.result()
+            except Exception:  # noqa: BLE001 - the helper failed or died: drawn here
+                drawn = None
     finally:
         if helper is not None:
             helper.close()

@@ -164,8 +164,8 @@ def record_process(result, path):
 def test_the_figure_is_drawn_beside_the_files_and_equals_one_drawn_here(result, tmp_path,
                                                                         monkeypatch):
     import os
-    import sys
 
+    from qzs.workflows import forked
     from qzs.workflows.design_space import result as result_module
 
     here = result_module.draw_figure(result, tmp_path / "here.png")
@@ -174,7 +174,7 @@ def test_the_figure_is_drawn_beside_the_files_and_equals_one_drawn_here(result, 
     monkeypatch.setattr(result_module, "draw_figure", record_process)
     write_files(result, tmp_path / "where")
     drawn_by = int((tmp_path / "where" / "pareto.png").read_text())
-    assert (drawn_by != os.getpid()) == sys.platform.startswith("linux")
+    assert (drawn_by != os.getpid()) == forked.available()
 
 
 def fail_to_draw(result, path):
@@ -224,3 +224,49 @@ def test_a_writer_says_why_it_could_not_write_and_leaves_when_told_nothing(resul
     with file_writer(tmp_path / "never") as writer:  # the search stopped: no result
         pass
     assert not (tmp_path / "never").exists() and not multiprocessing.active_children()
+
+
+def test_a_figure_process_that_dies_leaves_the_figure_to_this_one(result, tmp_path,
+                                                                  monkeypatch):
+    """The figure's helper killed before it draws: this process draws it, the same bytes."""
+    import os
+    import signal
+
+    from qzs.workflows import forked
+
+    if not forked.available():
+        pytest.skip("needs fork and two cores")
+    write_files(result, tmp_path / "here")
+    real_send = forked.Forked.send
+    killed = []
+
+    def kill_then_send(self, item):
+        os.kill(self.pid, signal.SIGKILL)
+        self._process.join()
+        killed.append(self._process.exitcode)
+        real_send(self, item)
+
+    monkeypatch.setattr(forked.Forked, "send", kill_then_send)
+    written = write_files(result, tmp_path / "there")
+    assert killed == [-signal.SIGKILL]
+    assert written[-1] == tmp_path / "there" / "pareto.png"
+    assert (tmp_path / "there" / "pareto.png").read_bytes() == \
+        (tmp_path / "here" / "pareto.png").read_bytes()
+
+
+def test_a_writer_that_died_leaves_the_files_to_this_process(result, tmp_path):
+    import os
+    import signal
+
+    from qzs.workflows import forked
+    from qzs.workflows.design_space.result import file_writer
+
+    if not forked.available():
+        pytest.skip("needs fork and two cores")
+    here = write_files(result, tmp_path / "here")
+    with file_writer(tmp_path / "there") as writer:
+        os.kill(writer.helper.pid, signal.SIGKILL)
+        there = writer.write(result)
+    assert [p.name for p in there] == [p.name for p in here]
+    for name in ("pareto.png", "pareto.csv", "report.md"):
+        assert (tmp_path / "here" / name).read_bytes() == (tmp_path / "there" / name).read_bytes()

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -19,11 +20,13 @@ import numpy as np
 
 from qzs._format import with_unit
 from qzs._version import __version__
-from qzs.errors import ParameterError
+from qzs.errors import HelperProcessError, ParameterError
 from qzs.workflows.design_space.metrics import goal_values
 from qzs.workflows.design_space.problem import DesignProblem, _spread_text, _unit
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
+
     import xarray as xr
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -497,9 +500,9 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     evaluated design, with ``feasible``, ``pareto`` and ``chosen`` flags), ``pareto.png``
     (:func:`qzs.viz.design_space.plot_pareto`), ``chosen.toml`` (the chosen design as a run
     configuration ``qzs simulate --config`` reads; left out if no design is feasible) and
-    ``report.md``. Where processes fork (Linux) the figure is drawn in one beside this
-    process while it writes the rest (matplotlib holds the GIL: only a process draws in
-    parallel); elsewhere it is drawn here, first.
+    ``report.md``. Where processes fork (Linux, two cores) the figure is drawn in one beside
+    this process (:mod:`qzs.workflows.forked`) while it writes the rest (matplotlib holds
+    the GIL: only a process draws in parallel); elsewhere it is drawn here, first.
 
     Parameters
     ----------
@@ -518,12 +521,16 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
     from qzs.engine.progress import progress_bar
     from qzs.iotools.files import atomic_path
     from qzs.iotools.writer import write_dataset
+    from qzs.workflows import forked
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    # forked, the process has this one's modules and data at once (nothing is pickled but
+    # the path); a fresh interpreter would import qzs again, which takes longer than the figure
     with progress_bar(total=6 + (result.chosen is not None), unit="file", desc="writing",
-                      disable=not progress, leave=False) as bar, _beside() as pool:
-        figure = pool.submit(draw_figure, result, folder / "pareto.png")
+                      disable=not progress, leave=False) as bar, \
+            forked.start(partial(draw_figure, result), grace=None, name="qzs-pareto") as figure:
+        figure.send(folder / "pareto.png")
         written = []
         pareto = result.to_xarray(pareto_only=True)  # one dataset for its three files
         for name in ("pareto.nc", "pareto.csv", "pareto.mat"):
@@ -538,13 +545,16 @@ def write_files(result: OptimizationResult, folder: str | Path, *,
             Path(tmp).write_text(result.report(), encoding="utf-8")
         written.append(folder / "report.md")
         bar.update(1)
-        written.append(figure.result())  # last: drawn meanwhile
+        try:
+            written.append(figure.result())  # last: drawn meanwhile
+        except HelperProcessError:  # the process is gone (killed): drawn here instead
+            written.append(draw_figure(result, folder / "pareto.png"))
         bar.update(1)
     return written
 
 
 def draw_figure(result: OptimizationResult, path: str | Path) -> Path:
-    """Draw the Pareto figure into a file and close it (the task :func:`write_files` forks).
+    """Draw the Pareto figure into a file and close it (the job :func:`write_files` forks).
 
     Parameters
     ----------
@@ -564,49 +574,18 @@ def draw_figure(result: OptimizationResult, path: str | Path) -> Path:
     return Path(path)
 
 
-class _Here:
-    """An executor that runs what it is given at once, here (where no process forks)."""
-
-    def submit(self, function, *args):
-        from concurrent.futures import Future
-
-        future = Future()
-        try:
-            future.set_result(function(*args))
-        except Exception as error:  # noqa: BLE001 - raised again by .result(), as a pool does
-            future.set_exception(error)
-        return future
-
-
 @contextlib.contextmanager
-def _beside():
-    """One forked process to run a task beside this one (Linux), else :class:`_Here`.
+def file_writer(folder: str | Path, *, progress: bool = False) -> Iterator[_Writer]:
+    """A writer of a search's files, started before the search (a forked process).
 
-    Forked, the process has this one's modules and data at once; a fresh interpreter
-    (spawn, forkserver) would import qzs again, which takes longer than the figure.
-    """
-    import multiprocessing
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        yield _Here()
-        return
-    from concurrent.futures import ProcessPoolExecutor
-
-    with ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork")) \
-            as pool:
-        yield pool
-
-
-@contextlib.contextmanager
-def file_writer(folder: str | Path, *, progress: bool = False):
-    """A writer of a search's files, started before the search (a forked process on Linux).
-
-    The process imports what the files need (matplotlib; xarray, h5netcdf and what xarray
-    imports when it writes, Dask's hooks where Dask is installed) while this one searches,
-    then waits for the result and writes the files (:func:`write_files`); about a second of
-    imports off the end of ``qzs optimize``. Where no process forks, the files are written
-    here. The context closes the process, whatever happened.
+    The process (a :class:`~qzs.workflows.forked.Forked` helper) imports what the files
+    need (matplotlib; xarray, h5netcdf and what xarray imports when it writes, Dask's hooks
+    where Dask is installed) while this one searches, in a thread of lower priority, so
+    that the imports take the CPU time the search leaves idle rather than the search's
+    own; then it waits for the result and writes the files (:func:`write_files`); about a
+    second of imports off the end of ``qzs optimize``. Where no process forks (or one core
+    is usable), or if the process is gone, the files are written here. The context ends
+    the process, whatever happened (a writing under way gets 5 s to finish).
 
     Parameters
     ----------
@@ -617,97 +596,40 @@ def file_writer(folder: str | Path, *, progress: bool = False):
 
     Yields
     ------
-    object
+    _Writer
         Its ``write(result)`` writes the files of an :class:`OptimizationResult` and returns
         their paths, as :func:`write_files` does (raising what it raises).
     """
-    import multiprocessing
-    import sys
+    from qzs.workflows import forked
 
-    if not sys.platform.startswith("linux"):
-        yield _WriteHere(folder, progress)
-        return
-    context = multiprocessing.get_context("fork")
-    here, there = context.Pipe()
-    process = context.Process(target=_serve, args=(there, here, folder, progress),
-                              name="qzs-files")
-    process.start()
-    there.close()
-    try:
-        yield _WriteThere(here, folder, progress)
-    finally:
-        here.close()  # the process sees the end of its pipe and leaves
-        process.join(timeout=5.0)
-        if process.is_alive():
-            process.terminate()
-            process.join()
+    job = partial(_write_files_into, folder, progress)
+    with forked.start(job, prepare=_warm, nice=5, grace=5.0, name="qzs-files") as helper:
+        yield _Writer(helper, job)
 
 
-class _WriteHere:
-    """:func:`file_writer` where no process forks: :func:`write_files` in this process."""
+def _write_files_into(folder, progress, result):
+    """:func:`write_files` with the result last (the job :func:`file_writer` is sent)."""
+    return write_files(result, folder, progress=progress)
 
-    def __init__(self, folder, progress):
-        self.folder, self.progress = folder, progress
+
+class _Writer:
+    """:func:`file_writer`'s writer: its helper writes, or this process if the helper died."""
+
+    def __init__(self, helper, job):
+        self.helper, self.job = helper, job
 
     def write(self, result):
-        return write_files(result, self.folder, progress=self.progress)
-
-
-class _WriteThere(_WriteHere):
-    """:func:`file_writer`'s forked process, told the result through a pipe."""
-
-    def __init__(self, connection, folder, progress):
-        super().__init__(folder, progress)
-        self.connection = connection
-
-    def write(self, result):
+        self.helper.send(result)
         try:
-            self.connection.send(result)
-            outcome, value = self.connection.recv()
-        except (EOFError, OSError):  # the process is gone (killed): write here instead
-            return super().write(result)
-        if outcome == "error":
-            raise value
-        return value
+            return self.helper.result()
+        except HelperProcessError:  # the process is gone (killed): written here instead
+            return self.job(result)
 
 
-def _serve(connection, other_end, folder, progress):
-    """The forked writer: import what the files need, wait for the result, write them.
-
-    The imports run in a thread of lower priority (Linux priorities are per thread), so
-    that they take the CPU time the search leaves idle rather than the search's own.
-    """
-    import threading
-
-    other_end.close()  # so that the pipe ends when the searching process closes its end
-    warming = threading.Thread(target=_warm, kwargs={"nice": 5}, daemon=True)
-    warming.start()
-    try:
-        result = connection.recv()
-    except BaseException:  # noqa: BLE001 - no result (stopped, failed): nothing to write
-        return
-    warming.join()
-    try:
-        written = write_files(result, folder, progress=progress)
-    except Exception as error:  # noqa: BLE001 - raised again in the searching process
-        connection.send(("error", error))
-    else:
-        connection.send(("ok", written))
-
-
-def _warm(nice=0):
-    """Import what :func:`write_files` needs, as writing would, before it is needed; at
-    ``nice`` more than this thread's priority."""
+def _warm():
+    """Import what :func:`write_files` needs, as writing would, before it is needed."""
     import importlib
     import importlib.util
-    import os
-    import threading
-
-    try:
-        thread = threading.get_native_id()
-        os.setpriority(os.PRIO_PROCESS, thread, os.getpriority(os.PRIO_PROCESS, thread) + nice)
-    except (AttributeError, OSError):  # no such call here: at the same priority
-        pass
 
     import matplotlib.pyplot  # noqa: F401
     import xarray
