@@ -93,7 +93,8 @@ def streamed_run(folder):
     simulate_to_file(path, Chirp(duration=30.0, f1=20.0), dt=1e-4, sample_rate=1e4)
     with xr.open_dataset(path) as ds:
         names = sorted(n for n in ds.data_vars if ds[n].ndim)  # not the parameters' containers
-        line("streamed/run.nc", *[ds[n].values for n in names], ds["time"].values,
+        time = ds["elapsed_time" if "elapsed_time" in ds else "time"]  # its CF file name
+        line("streamed/run.nc", *[ds[n].values for n in names], time.values,
              show=(float(ds["relative_position"].values[-1]),))
 
 
