@@ -53,6 +53,16 @@ def _half_dimension(dim, half):
     return half if dim == "dof" else dim.replace("dof", half)
 
 
+def _half_coordinates(dim, labels, present):
+    """The label coordinates of ``dim``'s halves that are dimensions of the file (``present``):
+    ``(name, labels, long_name)`` each, the one description of both file paths."""
+    for half, where in _HALVES:
+        name = _half_dimension(dim, half)
+        if name in present:
+            part = [str(label) for label in list(labels)[where]]
+            yield name, part, f"{half} part of {dim}: {', '.join(part)}"
+
+
 def _units_by_dof(attrs):
     """The six per-axis units of a variable's ``units_by_dof`` ("x: m; ...") or None."""
     text = attrs.get("units_by_dof")
@@ -226,13 +236,9 @@ def to_file_layout(dataset):
     out = xr.Dataset(data, coords=out.coords, attrs=out.attrs)
     for dim in _DOF_DIMENSIONS:  # the halves' labels
         if dim in out.coords:
-            for half, where in _HALVES:
-                half_dim = _half_dimension(dim, half)
-                if half_dim in out.dims:
-                    out = out.assign_coords({half_dim: (half_dim, out[dim].values[where], {
-                        "long_name": f"{half} part of {dim}: "
-                                     f"{', '.join(map(str, out[dim].values[where]))}",
-                        "units": "1"})})
+            for name, labels, long_name in _half_coordinates(dim, out[dim].values, out.dims):
+                out = out.assign_coords({name: (name, np.array(labels, dtype=object), {
+                    "long_name": long_name, "units": "1"})})
     for section, attrs in containers.items():
         out[section] = xr.DataArray(np.int8(0), attrs={
             "long_name": container_long_name(section), **attrs})
@@ -301,15 +307,12 @@ def file_schema(schema, columns, values):
         if coordinate.name in columns:
             file_columns[name] = columns[coordinate.name]
         if coordinate.name in _DOF_DIMENSIONS and coordinate.name in values:
-            for half, where in _HALVES:
-                half_dim = _half_dimension(coordinate.name, half)
-                if half_dim in dimensions:
-                    labels = list(values[coordinate.name])[where]
-                    coordinates.append(Variable(
-                        name=half_dim, dims=(half_dim,), units="1", dtype=coordinate.dtype,
-                        long_name=f"{half} part of {coordinate.name}: {', '.join(labels)}",
-                        order=("long_name", "units")))
-                    file_values[half_dim] = labels
+            for half_dim, labels, long_name in _half_coordinates(
+                    coordinate.name, values[coordinate.name], dimensions):
+                coordinates.append(Variable(name=half_dim, dims=(half_dim,), units="1",
+                                            dtype=coordinate.dtype, long_name=long_name,
+                                            order=("long_name", "units")))
+                file_values[half_dim] = labels
     for variable in schema.variables:
         if variable.name in values:
             file_values[variable.name] = values[variable.name]
