@@ -363,3 +363,25 @@ def test_an_absurd_sample_rate_is_named_as_what_bounds_the_step(tmp_path, monkey
     assert main(["simulate", "--sample-rate", "1e308", "--duration", "1", "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "--sample-rate" in err and list(tmp_path.iterdir()) == []
+
+
+def test_the_sines_default_duration_is_named_as_the_flag_it_stands_for(tmp_path, monkeypatch,
+                                                                        capsys):
+    """No config file: the 10 s a sine takes by default is --duration's, never a config key
+    of a file that was not given ("[simulation] duration of None")."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--excitation", "sine", "--sample-rate", "1e14", "--quiet",
+                 "--plot", "none"]) == 2
+    err = capsys.readouterr().err.replace("`", "")
+    assert "None" not in err and "--duration 10 s" in err and "--sample-rate" in err
+
+
+def test_a_config_without_a_duration_does_not_take_the_sines_default(tmp_path, monkeypatch,
+                                                                     capsys):
+    """A config file that sets no duration: the sine's 10 s default is still --duration's."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "run.toml").write_text("[simulation]\nsolver = \"ode3\"\n")
+    assert main(["simulate", "--config", "run.toml", "--excitation", "sine", "--sample-rate",
+                 "1e14", "--quiet", "--plot", "none"]) == 2
+    err = capsys.readouterr().err.replace("`", "")
+    assert "duration of" not in err and "--duration 10 s" in err

@@ -120,18 +120,17 @@ def _excitation(args, table, source):
     return build_excitation(kind, options, names=names)
 
 
-def _spelling(args, settings):
+def _spelling(args, settings, table):
     """How the command line names each argument of :func:`qzs.resolve`: its flag, or the
-    config file's key where the value came from there (an error says it so)."""
-    def origin(key, flag, table="simulation"):
-        if getattr(args, key, None) is not None or key not in settings:
-            return flag
-        return f"[{table}] {key} of {args.config}"
+    config file's key where the value came from its ``[simulation]`` ``table`` (an error
+    says it so); a default the command line put in (a sine's 10 s) is its flag's."""
+    def origin(key, flag):
+        if getattr(args, key, None) is None and key in table:
+            return f"[simulation] {key} of {args.config}"
+        return flag
 
-    if args.duration is not None:
-        duration = "--duration"
-    elif "duration" in settings:
-        duration = f"[simulation] duration of {args.config}"
+    if "duration" in settings:  # --duration, or the config's [simulation] duration
+        duration = origin("duration", "--duration")
     elif args.excitation_duration is not None:
         duration = "--excitation-duration"
     else:
@@ -185,7 +184,7 @@ def run(args):
                            tolerance=args.tolerance, tolerance_state=args.tolerance_state,
                            step="chosen", progress=show)
     except ParameterError as error:
-        raise error.renamed(_spelling(args, settings)) from None
+        raise error.renamed(_spelling(args, settings, config["simulation"])) from None
     result = simulate_with_figure(resolved, out=args.out, plot=plot, progress=show,
                                   interruptible=True, argument="--out")
     files = {}
