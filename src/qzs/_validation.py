@@ -51,7 +51,11 @@ def refusal(error, name, value, requirement, fix=""):
     if isinstance(error, Structured):
         return error.build(name, value, requirement + (f"; {fix}" if fix else ""))
     shown = f"the boolean {value!r}" if isinstance(value, (bool, np.bool_)) else repr(value)
-    return error(f"`{name}` {requirement}, got {shown}" + (f"; {fix}" if fix else "") + ".")
+    message = f"`{name}` {requirement}, got {shown}" + (f"; {fix}" if fix else "") + "."
+    if isinstance(error, type) and issubclass(error, ParameterError) \
+            and error.__init__ is ParameterError.__init__:
+        return error(message, (name,))  # the argument it names, for a caller's spelling
+    return error(message)
 
 
 def _real(value):

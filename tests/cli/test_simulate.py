@@ -385,3 +385,16 @@ def test_a_config_without_a_duration_does_not_take_the_sines_default(tmp_path, m
                  "1e14", "--quiet", "--plot", "none"]) == 2
     err = capsys.readouterr().err.replace("`", "")
     assert "duration of" not in err and "--duration 10 s" in err
+
+
+def test_a_validators_error_names_the_flag_or_key_the_value_came_from(tmp_path, monkeypatch,
+                                                                     capsys):
+    """The shared validators' errors carry the argument they name: the command line says
+    --dt for a flag and the config's key for a file's value, not the Python name."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--dt", "-1", "--quiet", "--plot", "none"]) == 2
+    assert "`--dt` must be positive" in capsys.readouterr().err
+    (tmp_path / "run.toml").write_text("[simulation]\nduration = 1e12\n")
+    assert main(["simulate", "--config", "run.toml", "--quiet", "--plot", "none"]) == 2
+    assert "`[simulation] duration of run.toml` (1000000000000.0 s) exceeds" in \
+        capsys.readouterr().err

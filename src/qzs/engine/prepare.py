@@ -315,13 +315,15 @@ def run_duration(excitation, duration):
     """
     if duration is None:
         if excitation.duration is None:
-            raise ParameterError("`duration` is required for a sine excitation, got None.")
+            raise ParameterError("`duration` is required for a sine excitation, got None.",
+                                 ("duration",))
         duration = excitation.duration
     duration = positive_real("duration", duration)
     if excitation.duration is not None and duration > excitation.duration * (1 + 1e-12):
         raise ParameterError(
             f"`duration` ({duration!r} s) exceeds the excitation's length "
-            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.")
+            f"({excitation.duration!r} s); shorten the run or lengthen the excitation.",
+            ("duration",))
     return duration
 
 
@@ -363,7 +365,8 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
     sample_rate = positive_real("sample_rate", sample_rate)
     duration = run_duration(excitation, duration)
     if dt > duration:
-        raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).")
+        raise ParameterError(f"`dt` ({dt!r} s) must not exceed `duration` ({duration!r} s).",
+                             ("dt", "duration"))
     if not stability_test(isolator, controller, solver)(dt):
         limit = largest_stable_step(isolator, controller, solver)  # only for the message
         mode, remedy = "the hard-stop contact or the spring/PI/damping loop", "`stop_stiffness`"
