@@ -1,7 +1,5 @@
 """``python -m qzs``: the ``qzs`` command."""
-import sys
-
-from qzs.cli import main
+from qzs.cli import console
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console()

@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING, Any, Literal, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import signal
 
 from qzs._format import UndefinedValue, decibels
 from qzs._validation import finite_rows, finite_series, integer, optional, positive_real
@@ -83,6 +82,8 @@ def highpass(values, corner, sample_rate):
     """
     if not corner:
         return np.asarray(values, dtype=float)
+    from scipy import signal  # on first use: importing scipy.signal takes about 0.9 s
+
     b, a = signal.bilinear([1.0, 0.0], [1.0, 2 * np.pi * corner], fs=sample_rate)
     return signal.lfilter(b, a, values)
 
@@ -582,6 +583,8 @@ def amplitude_spectrum(signal_values, sample_rate, fft_length=ANALYSIS["fft_leng
     if values.size < fft_length:
         raise DataError(f"fft_length={fft_length} needs at least {fft_length} samples "
                         f"({fft_length / sample_rate:g} s at {sample_rate:g} Hz), got {values.size}.")
+    from scipy import signal  # on first use, as above
+
     frequency, power = signal.welch(values, fs=sample_rate, window=window, nperseg=fft_length,
                                     noverlap=noverlap, scaling="spectrum")
     return frequency, np.sqrt(power)

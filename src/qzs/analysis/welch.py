@@ -9,7 +9,6 @@ segment means and the band sums run along the last axis, case by case.
 No validation here: the callers in :mod:`qzs.analysis.spectral` check their input.
 """
 import numpy as np
-from scipy import signal
 
 __all__ = ["welch_spectra", "transmissibility_arrays", "CASES_PER_BLOCK"]
 
@@ -55,6 +54,8 @@ def welch_spectra(base, payload, sample_rate, *, window, fft_length, noverlap, d
     cross : ndarray of complex, shape (..., n_bins)
         Cross-spectral density of base and payload [unit^2/Hz] (``csd(base, payload)``).
     """
+    from scipy import signal  # on first use: importing scipy.signal takes about 0.9 s
+
     shape = base.shape
     if isinstance(window, (str, tuple)):
         win = signal.get_window(window, fft_length)
@@ -165,6 +166,8 @@ def transmissibility_arrays(base, payload, sample_rate, *, window, fft_length, n
             if estimator == "h1":
                 numerator, denominator = s_bp, s_bb
             else:
+                from scipy import signal
+
                 denominator = _by_case(lambda p, b: signal.csd(
                     p, b, fs=sample_rate, window=window, nperseg=fft_length, noverlap=noverlap,
                     detrend=detrend)[1], payload, base)
