@@ -36,3 +36,19 @@ def test_a_module_imported_in_the_background_is_imported_once_and_errors_stay_th
     assert "tabnanny" not in sys.modules  # after a failure the thread stops quietly
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module("qzs_no_such_module")
+
+
+def test_scipy_signal_is_loaded_by_the_first_estimate_not_by_the_workflows_that_import_it():
+    """scipy.signal costs about 0.9 s of imports: the design space, sweeps and the command
+    line import the spectral functions, but only an estimate loads scipy.signal."""
+    import subprocess
+
+    code = ("import sys, numpy as np\n"
+            "import qzs.cli, qzs.workflows.design_space, qzs.workflows.sweeps, qzs.analysis.spectral\n"
+            "print('scipy.signal' in sys.modules)\n"
+            "t = np.arange(4096) / 100.0\n"
+            "qzs.analysis.spectral.transmissibility(np.sin(t), 0.5 * np.sin(t), 100.0, fft_length=1024)\n"
+            "print('scipy.signal' in sys.modules)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.stdout.split() == ["False", "True"], done.stderr
