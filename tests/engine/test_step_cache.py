@@ -115,3 +115,44 @@ def test_without_a_step_meeting_the_tolerance_the_fallback_says_so():
     assert finer.dt == 2.5e-4 and not finer.met
     assert "no step down to" in choice.notes[-1] and "not estimated" in choice.notes[-1]
     assert "no step tried meets" in choice.summary()
+
+
+def test_a_repeated_batch_choice_is_read_back_whole_without_a_probe(cache, monkeypatch):
+    """choose_batch_step(cache=True): every field, the per-case ones (a case no step meets
+    among them) too, read back; other cases or other labels (they are in the notes) are
+    another question; a record of another number of cases is not taken."""
+    from qzs import ControllerParameters
+    from qzs.engine import batch as batch_module
+    from qzs.engine.accuracy_batch import choose_batch_step
+
+    cases = [(IsolatorParameters(), ControllerParameters()),
+             (IsolatorParameters(), ControllerParameters(pi_kp=0.0, pi_ki=0.0))]
+    options = dict(tolerance_db=1e-3, probe_duration=PROBE, fallback=True,
+                   labels=["table 1", "no PI"])
+    first = choose_batch_step(cases, CHIRP, cache=True, **options)
+    assert not first.cached and first.unmet == (1,) and len(list(cache.glob("*.json"))) == 1
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a cached choice ran a probe")
+
+    monkeypatch.setattr(batch_module, "simulate_batch", no_run)
+    again = choose_batch_step(cases, CHIRP, cache=True, workers=1, **options)  # same bits
+    assert again.cached
+    for field in dataclasses.fields(first):
+        if field.name not in ("cached", "probe"):
+            assert getattr(again, field.name) == getattr(first, field.name) or (
+                field.name == "case_steps" and np.array_equal(
+                    again.case_steps, first.case_steps, equal_nan=True)), field.name
+    for other in (dict(options, labels=["a", "b"]), dict(options, tolerance_db=2e-3)):
+        with pytest.raises(AssertionError, match="ran a probe"):
+            choose_batch_step(cases, CHIRP, cache=True, **other)
+    with pytest.raises(AssertionError, match="ran a probe"):
+        choose_batch_step(cases[:1], CHIRP, cache=True, **dict(options, labels=["table 1"]))
+    # the record read as a choice over another number of cases: refused, not misread
+    from qzs.engine.accuracy import _from_record
+
+    (record,) = cache.glob("*.json")
+    assert _from_record(step_cache.load(record.stem), first.probe, first.probe_duration,
+                        cases=2) is not None
+    assert _from_record(step_cache.load(record.stem), first.probe, first.probe_duration,
+                        cases=3) is None

@@ -426,15 +426,18 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
 #: The fields of a :class:`StepChoice` a cache record keeps (the probe is made again).
 _RECORD_FIELDS = ("dt", "error", "measure", "tolerance", "reference_dt", "stability_limit",
                   "sample_rate", "solver", "probe_duration", "band", "history", "notes", "met")
+#: The fields a batch's choice adds (:func:`qzs.engine.accuracy_batch.choose_batch_step`).
+_BATCH_FIELDS = ("case_errors", "case_steps", "unmet")
 
 
 def _to_record(choice):
     """A :class:`StepChoice` as the JSON-able record of the step cache."""
-    return {name: getattr(choice, name) for name in _RECORD_FIELDS}
+    return {name: getattr(choice, name) for name in _RECORD_FIELDS + _BATCH_FIELDS}
 
 
-def _from_record(record, probe, duration):
-    """The :class:`StepChoice` of a cache record (None for none or a damaged one)."""
+def _from_record(record, probe, duration, cases=None):
+    """The :class:`StepChoice` of a cache record (None for none or a damaged one); with
+    ``cases``, a batch's choice over that many cases (its per-case fields read back too)."""
     if record is None:
         return None
     try:
@@ -443,11 +446,18 @@ def _from_record(record, probe, duration):
         values.update(band=None if band is None else (float(band[0]), float(band[1])),
                       history=tuple(tuple(float(x) for x in row) for row in values["history"]),
                       notes=tuple(str(note) for note in values["notes"]))
+        if cases is not None:
+            values.update(case_errors=tuple(float(x) for x in record["case_errors"]),
+                          case_steps=tuple(float(x) for x in record["case_steps"]),
+                          unmet=tuple(int(c) for c in record["unmet"]))
         choice = StepChoice(probe=probe, cached=True, **values)
     except (KeyError, TypeError, ValueError, IndexError):
         return None
     if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in MEASURE_UNITS
             and math.isclose(choice.probe_duration, duration)):
+        return None
+    if cases is not None and not (len(choice.case_errors) == len(choice.case_steps) == cases
+                                  and all(0 <= c < cases for c in choice.unmet)):
         return None
     return choice
 

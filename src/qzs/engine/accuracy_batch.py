@@ -43,7 +43,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
                       sample_rate=defaults.SIMULATION["sample_rate"], band=None,
                       probe_duration=None, fft_length=None, max_halvings=BATCH_MAX_HALVINGS,
                       safety=SAFETY, finest=None, fallback=False, workers=None, progress=False,
-                      labels=None):
+                      labels=None, cache=False):
     """One step for many cases sharing an excitation: the coarsest meeting the tolerance
     for every case (docs/model.md §7).
 
@@ -96,6 +96,12 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         Show a progress bar over the probe batches.
     labels : sequence of str, optional
         Names of the cases in the notes; default ``case 0``, ``case 1``, ...
+    cache : bool
+        Read the choice from, and keep it in, the step cache on disk
+        (:mod:`qzs.engine.step_cache`, keyed by every input above but ``workers`` and
+        ``progress``, which change no bit of it, and by the code that chooses): a repeated
+        ``qzs paper`` skips its probes (1.2 s of the paper's 12 s). The studies and sweeps
+        use it.
 
     Returns
     -------
@@ -143,6 +149,19 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         dt0, k0 = admissible_step(sample_rate, 0.0, lambda dt: stable(dt) and divides_all(dt))
     n = len(cases)
     labels = [f"case {c}" for c in range(n)] if labels is None else [str(x) for x in labels]
+    key = None
+    if cache:
+        from qzs.engine import step_cache
+        from qzs.engine.accuracy import _from_record
+
+        key = step_cache.cache_key(
+            batch=True, cases=cases, excitation=excitation, measure=measure,
+            tolerance=tolerance, solver=solver, sample_rate=sample_rate, band=band,
+            probe_duration=probe_duration, fft_length=fft_length, max_halvings=max_halvings,
+            safety=safety, finest=finest, fallback=fallback, labels=labels)
+        hit = _from_record(step_cache.load(key), probe, duration, cases=n)
+        if hit is not None:
+            return hit
     names = ("base_acceleration", "payload_acceleration", "relative_position")
 
     def run(dt, members):
@@ -156,7 +175,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         return [_ProbeRun(**{name: batch.channels[name][row] for name in names},
                           run={"sample_rate": sample_rate}) for row in range(len(members))]
 
-    return search_step(
+    choice = search_step(
         run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
                                                          fft_length=fft_length),
         cases=n, dt0=dt0, order=order, measure=measure, tolerance=tolerance,
@@ -166,3 +185,9 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
         fallback=fallback, give_up_early=True, labels=labels, per_case=True, progress=progress,
         unit_name="batch")
+    if key is not None:
+        from qzs.engine import step_cache
+        from qzs.engine.accuracy import _to_record
+
+        step_cache.store(key, _to_record(choice))
+    return choice

@@ -38,7 +38,8 @@ CACHE_ENV = "QZS_CACHE_DIR"
 #: The sources (below ``src/qzs``) a step choice depends on: the kernels' (whose fingerprint
 #: also guards numba's cache, :mod:`qzs.engine.arithmetic`) and the Python around them.
 _SOURCES = (*_KERNEL_SOURCES, "engine/prepare.py", "engine/simulate.py", "engine/stability.py",
-            "engine/accuracy.py", "engine/step_search.py", "engine/driver.py",
+            "engine/accuracy.py", "engine/accuracy_batch.py", "engine/batch.py",
+            "engine/step_search.py", "engine/driver.py",
             "model/isolator.py",
             "model/controller.py", "analysis/spectral.py")
 #: Version of the record's layout; a record of another version is ignored.

@@ -185,3 +185,14 @@ def test_the_statement_claims_agreement_only_where_the_test_checks_it():
     assert "agrees" not in other and f"at the default {tol:g} dB only" in other
     given = step_record([_result("a", dt=SIMULATION["dt"], source="given")])["statement"]
     assert "the paper's own" in given and "as given" in given and "agrees" not in given
+
+
+def test_a_step_read_from_the_step_cache_says_so_and_only_when_every_group_was():
+    tol = ACCURACY["tolerance_db"]
+    both = step_record([_result("a", **chosen_step(tol), cached=True),
+                        _result("b", **chosen_step(tol, group=1), cached=True)])
+    assert both["steps"][0]["cached"] and "read from the step cache" in both["statement"]
+    assert "to choose" not in both["statement"]
+    one = step_record([_result("a", **chosen_step(tol), cached=True),
+                       _result("b", **chosen_step(tol, seconds=2.0, group=1), cached=False)])
+    assert not one["steps"][0]["cached"] and "3.0 s to choose" in one["statement"]

@@ -62,7 +62,8 @@ def choose_dt(settings, kp_probe):
     choice = choose_batch_step(probes, settings.excitation,
                                tolerance_db=defaults.ACCURACY["tolerance_db"],
                                sample_rate=settings.sample_rate, band=settings.band,
-                               max_halvings=MAX_HALVINGS, fallback=True, labels=labels)
+                               max_halvings=MAX_HALVINGS, fallback=True, labels=labels,
+                               cache=True)
     if not choice.met:
         return choice.dt, f"no probed case meets the tolerance: {choice.line()}"
     return choice.dt, ("accuracy-driven step (tolerance "

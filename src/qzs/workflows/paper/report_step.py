@@ -38,7 +38,8 @@ def step_record(study_results: Sequence[StudyResult]) -> dict[str, Any]:
         ``"given"``, ``"file"`` or ``"fallback"`` (no step met the tolerance: the paper's),
         ``studies``, and for a chosen step ``tolerance_db``,
         ``estimated_error_db`` (the largest over its studies' cases that met it),
-        ``reference_dt`` [s], ``probe_duration`` [s], ``seconds`` [s] and ``notes``);
+        ``reference_dt`` [s], ``probe_duration`` [s], ``seconds`` [s], ``cached`` (read
+        from the step cache, :mod:`qzs.engine.step_cache`) and ``notes``);
         ``step_dependent``: the cases no step met (study, case); ``paper_dt`` [s];
         ``agreement``: what :data:`AGREEMENT_TEST` checks; ``statement``:
         :func:`step_statement`.
@@ -63,6 +64,7 @@ def step_record(study_results: Sequence[StudyResult]) -> dict[str, Any]:
             groups = entry.setdefault("groups", {})
             groups[step["group"]] = step["seconds"]
             entry["seconds"] = sum(groups.values())
+            entry["cached"] = entry.get("cached", True) and step.get("cached", False)
             entry.setdefault("notes", [])
             entry["notes"] += [n for n in step["notes"] if n not in entry["notes"]]
             dependent += [{"study": result.study.name, "case": label} for label in step["unmet"]]
@@ -105,7 +107,8 @@ def step_statement(study_results: Sequence[StudyResult],
                          f"{step['tolerance_db']:g} dB: estimated error "
                          f"{step['estimated_error_db']:.2g} dB (against dt = "
                          f"{step['reference_dt']:g} s on a {step['probe_duration']:g} s probe, "
-                         f"{step['seconds']:.1f} s to choose)")
+                         + ("read from the step cache)" if step.get("cached") else
+                            f"{step['seconds']:.1f} s to choose)"))
         elif step["source"] == "fallback":
             parts.append(f"dt = {step['dt']:g} s{where}, the paper's own: no step met "
                          f"{step['tolerance_db']:g} dB for any case ({'; '.join(step['notes'])})")

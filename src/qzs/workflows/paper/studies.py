@@ -691,7 +691,7 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
         choice = choose_batch_step(
             list(index), excitation, tolerance_db=tolerance_db, solver=solver,
             sample_rate=rate, fallback=True, workers=workers, progress=progress,
-            labels=[members[0]["label"] for members in index.values()])
+            labels=[members[0]["label"] for members in index.values()], cache=True)
         seconds = time.perf_counter() - start
         for c, members in enumerate(index.values()):
             for task in members:
@@ -720,7 +720,8 @@ def _step_record(tasks, choices):
                       estimated_error_db=max(errors) if errors else float("nan"),
                       reference_dt=choice.reference_dt, probe_duration=choice.probe_duration,
                       unmet=[label for label, c in mine if c in choice.unmet],
-                      notes=list(choice.notes), seconds=seconds, group=group)
+                      notes=list(choice.notes), seconds=seconds, group=group,
+                      cached=choice.cached)
     return record
 
 

@@ -87,7 +87,7 @@ def choose_sweep_step(definition, settings, *, progress=False):
                                   tolerance_db=tolerance, solver=simulation["solver"],
                                   sample_rate=definition.analysis["sample_rate"],
                                   max_halvings=MAX_HALVINGS, fallback=True, progress=progress,
-                                  labels=labels)
+                                  labels=labels, cache=True)
         if not batch.met:  # the one fallback: no case of this excitation sets the step
             unmet.append(f"{', '.join(labels)}: {batch.notes[-1]}")
             continue
