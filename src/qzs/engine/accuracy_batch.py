@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs import defaults
+from qzs._lazy import import_in_background
 from qzs.engine.accuracy import probe_settings, step_error
 from qzs.engine.step_search import (SAFETY, StepChoice, admissible_step, bound_notes,
                                     search_step, tolerance_measure)
@@ -162,6 +163,8 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         hit = _from_record(step_cache.load(key), probe, duration, cases=n)
         if hit is not None:
             return hit
+    if measure == "transmissibility_db":  # as choose_step: beside the first probe batch
+        import_in_background("scipy.signal", "qzs.analysis.spectral")
     names = ("base_acceleration", "payload_acceleration", "relative_position")
 
     def run(dt, members):
