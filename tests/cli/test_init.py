@@ -203,3 +203,18 @@ def test_the_console_script_joins_a_running_thread_the_ordinary_way():
     assert done.returncode == 0, done.stderr
     tail = done.stdout.splitlines()[-2:]
     assert tail == ["thread joined", "exit handler rantorn down"]
+
+
+def test_under_a_profiler_the_console_script_ends_the_ordinary_way_and_its_record_is_written(
+        tmp_path):
+    """``python -m cProfile -o FILE -m qzs ...`` writes FILE after the command returns: the
+    quick end (os._exit) would lose it."""
+    import pstats
+    import subprocess
+    import sys
+
+    record = tmp_path / "qzs.prof"
+    done = subprocess.run([sys.executable, "-m", "cProfile", "-o", str(record), "-m", "qzs",
+                           "params"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert any("console" in function for _, _, function in pstats.Stats(str(record)).stats)

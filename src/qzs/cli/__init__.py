@@ -192,13 +192,16 @@ def console():
     teardown of every loaded module: freeing numba's, scipy's, xarray's and zarr's objects
     one by one took 0.25 s after ``qzs simulate`` and 0.45 s after ``qzs optimize`` on the
     2-core test machine, after the answer was already written. If a thread other than the
-    main one is still running and is not a daemon, the ordinary exit joins it instead.
+    main one is still running and is not a daemon, the ordinary exit joins it instead; so
+    it does under a profiler or a tracer (``python -m cProfile -m qzs``, a debugger), which
+    writes its record after the command returns.
     An exception that escapes :func:`main` (a bug) ends the process the ordinary way, with
     its traceback.
     """
     code = main()
-    if any(thread.is_alive() and not thread.daemon and thread is not threading.main_thread()
-           for thread in threading.enumerate()):
+    if sys.getprofile() is not None or sys.gettrace() is not None or any(
+            thread.is_alive() and not thread.daemon and thread is not threading.main_thread()
+            for thread in threading.enumerate()):
         sys.exit(code)
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
