@@ -20,13 +20,13 @@ import argparse
 import re
 import statistics
 import sys
-import traceback
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import (  # noqa: E402
+    _busy_note, _load, machine_info, report_only, wait_for_idle)
 
 TARGET = 1.0  # s, release -> redrawn transmissibility
 #: Slider moves: (setting, pixels); each lands on a setting not computed before.
@@ -140,8 +140,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

@@ -75,7 +75,6 @@ import sys
 import tempfile
 import time
 import tomllib
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -83,7 +82,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import (  # noqa: E402
+    _busy_note, _load, machine_info, report_only, wait_for_idle)
 
 PROBLEM = HERE / "design_space_problem.toml"
 GRID = HERE / "design_space_grid.toml"
@@ -448,8 +448,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

@@ -65,7 +65,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_simulate import _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import _load, machine_info, report_only, wait_for_idle  # noqa: E402
 
 DT = 1e-4
 N_CASES = 1024
@@ -506,8 +506,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

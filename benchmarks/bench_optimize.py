@@ -34,7 +34,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import (  # noqa: E402
+    _busy_note, busy_runs, _load, log_machine, repeats_of, report_only, timing_options,
+    wait_for_idle)
 
 TARGET_OPTIMIZE = 5.0     # [s] the whole design question (issue 34, target 1)
 PROBLEM = "isolation_vs_effort"
@@ -173,18 +175,13 @@ def run(repeats, idle_wait, runs):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="best of 2")
-    parser.add_argument("--repeats", type=int, default=None, help="best-of-N (3; 2 quick)")
-    parser.add_argument("--idle-wait", type=float, default=20.0, metavar="S",
-                        help="wait up to S s before each timed run for the machine to go quiet")
+    timing_options(parser)
     args = parser.parse_args(argv)
-    repeats = args.repeats or (2 if args.quick else 3)
-    log(f"# bench_optimize: best of {repeats}")
-    for key, value in machine_info():
-        log(f"  {key:13s} {value}")
+    repeats = repeats_of(args)
+    log_machine(log, f"# bench_optimize: best of {repeats}")
     runs = []
     rows, stages = run(repeats, args.idle_wait, runs)
-    noisy = [r for r in runs if r["busy"] is not None and r["busy"] > 0.3]
+    noisy = busy_runs(runs)
     log("")
     if noisy:
         log(f"WARNING: {len(noisy)} of {len(runs)} timed runs started on a busy machine")
@@ -198,10 +195,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        import traceback
-
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

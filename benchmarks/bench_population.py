@@ -56,7 +56,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import (  # noqa: E402
+    _busy_note, busy_runs, _load, log_machine, repeats_of, report_only, timing_options,
+    wait_for_idle)
 
 TARGET = 16.0             # population / single run, at dt = 1e-3 s on 2 cores
 DESIGNS = 256
@@ -250,25 +252,21 @@ def verdicts(results):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="60 s chirp, best of 2")
+    timing_options(parser, quick="60 s chirp, best of 2")
     parser.add_argument("--dt", default="1e-3,1e-4", help="steps [s], comma-separated")
     parser.add_argument("--duration", type=float, default=None,
                         help="simulated time [s] (default 131.072, 60 with --quick)")
-    parser.add_argument("--repeats", type=int, default=None, help="best-of-N (3; 2 quick)")
-    parser.add_argument("--idle-wait", type=float, default=20.0, metavar="S",
-                        help="wait up to S s before each timed run for the machine to go quiet")
     args = parser.parse_args(argv)
     duration = args.duration or (60.0 if args.quick else 131.072)
-    repeats = args.repeats or (2 if args.quick else 3)
+    repeats = repeats_of(args)
     cores = min(2, os.cpu_count() or 1)
-    log(f"# bench_population: {DESIGNS} designs, {duration:g} s chirp, best of {repeats}")
-    for key, value in machine_info():
-        log(f"  {key:13s} {value}")
+    log_machine(log, f"# bench_population: {DESIGNS} designs, {duration:g} s chirp, best of "
+                     f"{repeats}")
     runs = []
     results = {}
     for dt in (float(x) for x in args.dt.split(",")):
         results[dt] = measure(dt, duration, repeats, args.idle_wait, cores, runs)
-    noisy = sum(1 for run in runs if run["busy"] is not None and run["busy"] > 0.3)
+    noisy = len(busy_runs(runs))
     log("")
     if noisy:
         log(f"WARNING: {noisy} of {len(runs)} timed runs started while other processes kept "
@@ -296,10 +294,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        import traceback
-
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

@@ -106,6 +106,45 @@ def _busy_note(busy):
     return "" if busy is None else f" [other load before it: {busy:.2f} CPUs]"
 
 
+def timing_options(parser, *, quick="best of 2", idle_wait=20.0):
+    """Add ``--quick``, ``--repeats`` and ``--idle-wait``, the options of a best-of-N benchmark.
+
+    ``quick`` is ``--quick``'s help; ``repeats_of(args)`` reads ``--repeats`` (3, 2 quick).
+    """
+    parser.add_argument("--quick", action="store_true", help=quick)
+    parser.add_argument("--repeats", type=int, default=None, help="best-of-N (3; 2 quick)")
+    parser.add_argument("--idle-wait", type=float, default=idle_wait, metavar="S",
+                        help="wait up to S s before each timed run for the machine to go quiet")
+
+
+def repeats_of(args):
+    """Best-of-N of :func:`timing_options`' arguments: ``--repeats``, else 3 (2 with --quick)."""
+    return args.repeats or (2 if args.quick else 3)
+
+
+def log_machine(log, title):
+    """Log ``title`` and :func:`machine_info`, one line each."""
+    log(title)
+    for key, value in machine_info():
+        log(f"  {key:13s} {value}")
+
+
+def busy_runs(runs, threshold=0.3):
+    """The timed runs that started while other processes kept more than ``threshold`` CPUs
+    busy (each run a dict with ``busy``, from :func:`wait_for_idle`)."""
+    return [r for r in runs if r["busy"] is not None and r["busy"] > threshold]
+
+
+def report_only(main):
+    """Run a benchmark's ``main()`` and exit 0 whatever happens: a benchmark reports, it
+    never fails its caller (a traceback is printed instead)."""
+    try:
+        main()
+    except Exception:  # noqa: BLE001
+        traceback.print_exc()
+    sys.exit(0)
+
+
 def machine_info():
     import numba
     import scipy
@@ -518,8 +557,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)

@@ -77,7 +77,8 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE / "c_reference"))
 
-from bench_simulate import _busy_note, _load, machine_info, wait_for_idle  # noqa: E402
+from bench_simulate import (  # noqa: E402
+    _busy_note, _load, machine_info, report_only, wait_for_idle)
 
 import reference  # noqa: E402
 
@@ -853,8 +854,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception:  # a benchmark reports; it never fails the caller
-        traceback.print_exc()
-    sys.exit(0)
+    report_only(main)
