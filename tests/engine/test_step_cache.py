@@ -149,10 +149,8 @@ def test_a_repeated_batch_choice_is_read_back_whole_without_a_probe(cache, monke
     with pytest.raises(AssertionError, match="ran a probe"):
         choose_batch_step(cases[:1], CHIRP, cache=True, **dict(options, labels=["table 1"]))
     # the record read as a choice over another number of cases: refused, not misread
-    from qzs.engine.accuracy import _from_record
-
     (record,) = cache.glob("*.json")
-    assert _from_record(step_cache.load(record.stem), first.probe, first.probe_duration,
-                        cases=2) is not None
-    assert _from_record(step_cache.load(record.stem), first.probe, first.probe_duration,
-                        cases=3) is None
+    assert step_cache.load_choice(record.stem, first.probe, first.probe_duration,
+                                  cases=2) is not None
+    assert step_cache.load_choice(record.stem, first.probe, first.probe_duration,
+                                  cases=3) is None

@@ -29,7 +29,7 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 __all__ = ["StepChoice", "choose_step", "default_tolerance", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings"]
+           "probe_settings", "spectral_beside_probes"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -290,6 +290,23 @@ def check_band(band, excitation, sample_rate):
     return (low, high)
 
 
+def spectral_beside_probes(measure):
+    """Start loading what a step choice's estimates need, beside its first probe runs.
+
+    For ``measure`` ``"transmissibility_db"``: the spectral analysis and scipy.signal (0.9 s
+    of imports, loaded by the first estimate, not by :mod:`qzs.analysis.spectral` itself)
+    load in a thread while the probe's first runs integrate in a kernel that holds no GIL.
+    Called once a choice is known to need its probes (not read from the step cache).
+
+    Parameters
+    ----------
+    measure : str
+        The choice's measure, a key of :data:`MEASURE_UNITS`.
+    """
+    if measure == "transmissibility_db":
+        import_in_background("scipy.signal", "qzs.analysis.spectral")
+
+
 def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db=None,
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
@@ -386,14 +403,10 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
             sample_rate=sample_rate, band=band, probe_duration=probe_duration,
             fft_length=fft_length, max_halvings=max_halvings, safety=safety,
             **({"finest": finest, "fallback": True} if fallback else {}))
-        hit = _from_record(step_cache.load(key), probe, duration)
+        hit = step_cache.load_choice(key, probe, duration)
         if hit is not None:
             return hit
-    if measure == "transmissibility_db":
-        # the spectral analysis and scipy.signal (0.9 s of imports, loaded by the first
-        # estimate, not by qzs.analysis.spectral itself) load in a thread while the probe's
-        # first runs integrate, in a kernel that holds no GIL
-        import_in_background("scipy.signal", "qzs.analysis.spectral")
+    spectral_beside_probes(measure)
 
     stable = stability_test(isolator, controller, solver)
     limit = largest_stable_step(isolator, controller, solver)
@@ -420,46 +433,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     if key is not None:
         from qzs.engine import step_cache
 
-        step_cache.store(key, _to_record(choice))
-    return choice
-
-
-#: The fields of a :class:`StepChoice` a cache record keeps (the probe is made again).
-_RECORD_FIELDS = ("dt", "error", "measure", "tolerance", "reference_dt", "stability_limit",
-                  "sample_rate", "solver", "probe_duration", "band", "history", "notes", "met")
-#: The fields a batch's choice adds (:func:`qzs.engine.accuracy_batch.choose_batch_step`).
-_BATCH_FIELDS = ("case_errors", "case_steps", "unmet")
-
-
-def _to_record(choice):
-    """A :class:`StepChoice` as the JSON-able record of the step cache."""
-    return {name: getattr(choice, name) for name in _RECORD_FIELDS + _BATCH_FIELDS}
-
-
-def _from_record(record, probe, duration, cases=None):
-    """The :class:`StepChoice` of a cache record (None for none or a damaged one); with
-    ``cases``, a batch's choice over that many cases (its per-case fields read back too)."""
-    if record is None:
-        return None
-    try:
-        values = {name: record[name] for name in _RECORD_FIELDS}
-        band = values["band"]
-        values.update(band=None if band is None else (float(band[0]), float(band[1])),
-                      history=tuple(tuple(float(x) for x in row) for row in values["history"]),
-                      notes=tuple(str(note) for note in values["notes"]))
-        if cases is not None:
-            values.update(case_errors=tuple(float(x) for x in record["case_errors"]),
-                          case_steps=tuple(float(x) for x in record["case_steps"]),
-                          unmet=tuple(int(c) for c in record["unmet"]))
-        choice = StepChoice(probe=probe, cached=True, **values)
-    except (KeyError, TypeError, ValueError, IndexError):
-        return None
-    if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in MEASURE_UNITS
-            and math.isclose(choice.probe_duration, duration)):
-        return None
-    if cases is not None and not (len(choice.case_errors) == len(choice.case_steps) == cases
-                                  and all(0 <= c < cases for c in choice.unmet)):
-        return None
+        step_cache.store_choice(key, choice)
     return choice
 
 

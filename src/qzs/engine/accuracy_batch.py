@@ -10,8 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs import defaults
-from qzs._lazy import import_in_background
-from qzs.engine.accuracy import probe_settings, step_error
+from qzs.engine.accuracy import probe_settings, spectral_beside_probes, step_error
 from qzs.engine.step_search import (SAFETY, StepChoice, admissible_step, bound_notes,
                                     search_step, tolerance_measure)
 from qzs.errors import ParameterError
@@ -153,18 +152,16 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     key = None
     if cache:
         from qzs.engine import step_cache
-        from qzs.engine.accuracy import _from_record
 
         key = step_cache.cache_key(
             batch=True, cases=cases, excitation=excitation, measure=measure,
             tolerance=tolerance, solver=solver, sample_rate=sample_rate, band=band,
             probe_duration=probe_duration, fft_length=fft_length, max_halvings=max_halvings,
             safety=safety, finest=finest, fallback=fallback, labels=labels)
-        hit = _from_record(step_cache.load(key), probe, duration, cases=n)
+        hit = step_cache.load_choice(key, probe, duration, cases=n)
         if hit is not None:
             return hit
-    if measure == "transmissibility_db":  # as choose_step: beside the first probe batch
-        import_in_background("scipy.signal", "qzs.analysis.spectral")
+    spectral_beside_probes(measure)
     names = ("base_acceleration", "payload_acceleration", "relative_position")
 
     def run(dt, members):
@@ -190,7 +187,6 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         unit_name="batch")
     if key is not None:
         from qzs.engine import step_cache
-        from qzs.engine.accuracy import _to_record
 
-        step_cache.store(key, _to_record(choice))
+        step_cache.store_choice(key, choice)
     return choice

@@ -30,8 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from qzs.engine.arithmetic import _KERNEL_SOURCES
+from qzs.engine.step_search import MEASURE_UNITS, StepChoice
 
-__all__ = ["CACHE_ENV", "cache_folder", "cache_key", "load", "store"]
+__all__ = ["CACHE_ENV", "cache_folder", "cache_key", "load", "store", "load_choice",
+           "store_choice"]
 
 #: Environment variable naming the folder of qzs's caches (the step choices go to ``steps/``).
 CACHE_ENV = "QZS_CACHE_DIR"
@@ -181,3 +183,74 @@ def store(key, record):
         if tmp is not None:
             Path(tmp).unlink(missing_ok=True)
         return False
+
+
+#: The fields of a :class:`StepChoice` a cache record keeps (the probe is made again).
+_RECORD_FIELDS = ("dt", "error", "measure", "tolerance", "reference_dt", "stability_limit",
+                  "sample_rate", "solver", "probe_duration", "band", "history", "notes", "met")
+#: The fields a batch's choice adds (:func:`qzs.engine.accuracy_batch.choose_batch_step`).
+_BATCH_FIELDS = ("case_errors", "case_steps", "unmet")
+
+
+def store_choice(key, choice):
+    """Keep a step choice under ``key`` (:func:`store` of its record; the probe is not kept).
+
+    Parameters
+    ----------
+    key : str
+        From :func:`cache_key`.
+    choice : StepChoice
+        The choice (:func:`qzs.engine.accuracy.choose_step`,
+        :func:`qzs.engine.accuracy_batch.choose_batch_step`).
+
+    Returns
+    -------
+    bool
+        Whether the record was written.
+    """
+    return store(key, {name: getattr(choice, name) for name in _RECORD_FIELDS + _BATCH_FIELDS})
+
+
+def load_choice(key, probe, duration, cases=None):
+    """The step choice kept under ``key``, or None (none, damaged, or not of this question).
+
+    Parameters
+    ----------
+    key : str
+        From :func:`cache_key`.
+    probe : object
+        The choice's probe excitation (made again, not kept).
+    duration : float
+        The probe's length [s]; a record of another length is not taken.
+    cases : int, optional
+        A batch's choice over this many cases: its per-case fields are read back too, and a
+        record of another number of cases is not taken.
+
+    Returns
+    -------
+    StepChoice or None
+        With ``cached`` True.
+    """
+    record = load(key)
+    if record is None:
+        return None
+    try:
+        values = {name: record[name] for name in _RECORD_FIELDS}
+        band = values["band"]
+        values.update(band=None if band is None else (float(band[0]), float(band[1])),
+                      history=tuple(tuple(float(x) for x in row) for row in values["history"]),
+                      notes=tuple(str(note) for note in values["notes"]))
+        if cases is not None:
+            values.update(case_errors=tuple(float(x) for x in record["case_errors"]),
+                          case_steps=tuple(float(x) for x in record["case_steps"]),
+                          unmet=tuple(int(c) for c in record["unmet"]))
+        choice = StepChoice(probe=probe, cached=True, **values)
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+    if not (isinstance(choice.dt, float) and choice.dt > 0 and choice.measure in MEASURE_UNITS
+            and math.isclose(choice.probe_duration, duration)):
+        return None
+    if cases is not None and not (len(choice.case_errors) == len(choice.case_steps) == cases
+                                  and all(0 <= c < cases for c in choice.unmet)):
+        return None
+    return choice
