@@ -63,8 +63,8 @@ def test_counts_below_one_are_refused(problem_file, option, capsys):
     assert f"argument {option}: must be an integer >= 1, got 0" in capsys.readouterr().err
 
 
-def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_file, tmp_path,
-                                                                      capsys, monkeypatch):
+def _interrupt_the_second_generation(monkeypatch):
+    """Ctrl-C while the search evaluates its second generation (the first is kept)."""
     from qzs.workflows.design_space import evaluation, optimizer
 
     calls = []
@@ -76,6 +76,11 @@ def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_fi
         return evaluation.evaluate(*args, **kwargs)
 
     monkeypatch.setattr(optimizer, "evaluate", interrupted)
+
+
+def test_ctrl_c_keeps_the_complete_generations_and_says_how_to_resume(problem_file, tmp_path,
+                                                                      capsys, monkeypatch):
+    _interrupt_the_second_generation(monkeypatch)
     out = tmp_path / "out"
     assert main(["optimize", str(problem_file), "--out", str(out), "--quiet"]) == 130
     err = capsys.readouterr().err
@@ -178,7 +183,7 @@ def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
     """Exit 2 before any evaluation, the line naming --seed, the stored 1 and the asked 9;
     the store is left as it was; an interrupted search started with --seed says to resume
     with it."""
-    from qzs.workflows.design_space import evaluation, optimizer
+    from qzs.workflows.design_space import optimizer
     from qzs.workflows.design_space.store import stored_generations
 
     out = tmp_path / "out"
@@ -194,15 +199,7 @@ def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
     assert stored_generations(out / "cli.zarr") == 1
     monkeypatch.setattr(optimizer, "evaluate", evaluate)
 
-    calls = []
-
-    def interrupted(*args, **kwargs):
-        calls.append(None)
-        if len(calls) == 2:
-            raise KeyboardInterrupt
-        return evaluation.evaluate(*args, **kwargs)
-
-    monkeypatch.setattr(optimizer, "evaluate", interrupted)
+    _interrupt_the_second_generation(monkeypatch)
     seeded = tmp_path / "seeded"
     assert main(["optimize", str(problem_file), "--out", str(seeded), "--quiet",
                  "--seed", "9"]) == 130
