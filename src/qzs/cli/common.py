@@ -305,7 +305,8 @@ def _jsonable_other(value):
     if hasattr(value, "items") and callable(value.items):
         return {str(k): jsonable(v) for k, v in value.items()}
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)
+                if not (f.metadata.get("block") and getattr(value, f.name) is None)}
     if callable(getattr(value, "to_dict", None)):
         return jsonable(value.to_dict())
     return str(value)

@@ -268,8 +268,8 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     lanes = _Lanes(prepared, channels, workers, plan)
     sample, marks = np.empty(K.N_CHANNELS), np.zeros(2, dtype=np.bool_)
     for c in range(n):
-        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], ex, table, sample,
-                   marks)
+        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], lanes.models[c], ex,
+                   table, sample, marks)
         # only the channels kept or read by the statistics: a write to any other would
         # fault in (and zero) a page of the chunk buffer that nothing reads, huge pages of
         # 2 MB for numpy's large arrays (the whole 190 MB buffer for 24 channels)
@@ -332,6 +332,7 @@ class _Lanes(driver.Stepper):
         self.states = np.stack([r.state for r in prepared])
         self.flags = np.stack([r.flags for r in prepared])
         self.params = np.stack([r.params for r in prepared])
+        self.models = np.stack([r.model for r in prepared])
         self.status = np.zeros(n, dtype=np.int64)
         self.written = np.zeros(n, dtype=np.int64)
         self.failed_at = np.full(n, -1, dtype=np.int64)
@@ -390,7 +391,7 @@ class _Lanes(driver.Stepper):
                 data, marks = self.single[a]
                 self.status[a], self.written[a] = _lanes.run_single(
                     self.solver, steps, self.decimation, self.states[a], self.flags[a],
-                    self.params[a], self.ex, self.table, data, marks, 0)
+                    self.params[a], self.models[a], self.ex, self.table, data, marks, 0)
                 written = self.written[a]
                 self.buffer[self.columns, a, :written] = data[:written, self.columns].T
                 self.flag_buffer[:, a, :written] = marks[:written].T
@@ -399,7 +400,8 @@ class _Lanes(driver.Stepper):
             last = min(first + _lanes.MAX_LANES, b)
             code = _lanes.run_lanes(self.solver, self.done, steps, self.decimation,
                                     self.states[first:last], self.flags[first:last],
-                                    self.params[first:last], self.ex, self.table,
+                                    self.params[first:last], self.models[first:last],
+                                    self.ex, self.table,
                                     self.columns, self.buffer, self.flag_buffer, first, 0,
                                     self.status[first:last], self.written[first:last])
             if code != K.STATUS_OK:  # pragma: no cover - the slices above are never too long

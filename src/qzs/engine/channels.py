@@ -11,8 +11,8 @@ from __future__ import annotations
 from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
-__all__ = ["CHANNELS", "FLAGS", "FLAG_MEANINGS", "simulation_schema", "variable_attributes",
-           "named_block"]
+__all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels",
+           "channel_count", "simulation_schema", "variable_attributes", "named_block"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -42,6 +42,18 @@ CHANNELS = {
     "gravity_energy": (K.C_E_GRAVITY, "J", "gravitational potential energy m*g*x"),
     "stop_energy": (K.C_E_STOP, "J", "elastic energy stored in a compliant stop"),
 }
+#: The channels of the controller's blocks beyond PI + damping, recorded only with them:
+#: name -> (kernel column, unit, description, the block that has it).
+BLOCK_CHANNELS = {
+    "compensation_force": (K.C_F_COMPENSATION, "N", "friction compensation command (the "
+                           "feedforward less the observer's estimate, before saturation)",
+                           "compensation"),
+    "friction_estimate": (K.C_F_OBSERVER, "N", "the observer's estimate of the friction "
+                          "left after the feedforward", "observer"),
+    "dither_force": (K.C_F_DITHER, "N", "dither command (before saturation)", "dither"),
+    "linear_force": (K.C_F_LINEAR, "N", "the linear controller's command (before saturation)",
+                     "linear"),
+}
 #: Boolean output channels: name -> (column, description).
 FLAGS = {
     "locked": (K.O_LOCKED, "payload held at zero slip (stuck by friction or on a plastic stop)"),
@@ -51,20 +63,75 @@ FLAGS = {
 FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
 
 
-def simulation_schema():
+def _has(controller, block):
+    if controller is None:
+        return False
+    if block == "observer":
+        return (controller.compensation is not None
+                and controller.compensation.observer_bandwidth > 0)
+    return getattr(controller, block) is not None
+
+
+def run_channels(controller=None, *, every_block=False):
+    """The channels a run with ``controller`` records: name -> (column, unit, description).
+
+    :data:`CHANNELS`, then those of :data:`BLOCK_CHANNELS` whose block the controller has
+    (the friction estimate with an observer only).
+
+    Parameters
+    ----------
+    controller : ControllerParameters, optional
+        The run's controller; None: PI + damping alone.
+    every_block : bool
+        Every block's channels (what a file may hold, for reading it back).
+
+    Returns
+    -------
+    dict
+    """
+    extra = {name: (column, unit, doc) for name, (column, unit, doc, block)
+             in BLOCK_CHANNELS.items() if every_block or _has(controller, block)}
+    return {**CHANNELS, **extra}
+
+
+def channel_count(controller=None):
+    """Columns of a run's output rows [-]: ``K.N_BASE_CHANNELS``, or ``K.N_CHANNELS`` with blocks.
+
+    Parameters
+    ----------
+    controller : ControllerParameters, optional
+        The run's controller.
+
+    Returns
+    -------
+    int
+    """
+    blocks = controller is not None and controller.has_blocks
+    return K.N_CHANNELS if blocks else K.N_BASE_CHANNELS
+
+
+def simulation_schema(controller=None, *, every_block=False):
     """The CF-1.10 layout of a run's dataset and file (docs/model.md §7).
 
     Dimension ``time`` (unlimited: a run is streamed along it); coordinate ``time`` [s]; a
-    float64 variable per channel of :data:`CHANNELS` and an int8 flag per flag of
-    :data:`FLAGS` (``flag_values`` 0 and 1, ``flag_meanings``), each with ``units`` and
-    ``long_name``.
+    float64 variable per channel of :data:`CHANNELS` (and of the controller's blocks,
+    :func:`run_channels`) and an int8 flag per flag of :data:`FLAGS` (``flag_values`` 0 and
+    1, ``flag_meanings``), each with ``units`` and ``long_name``.
+
+    Parameters
+    ----------
+    controller : ControllerParameters, optional
+        The run's controller (its blocks' channels); None: PI + damping alone.
+    every_block : bool
+        Every block's channels (the schema to read any run's file back with).
 
     Returns
     -------
     Schema
     """
     channels = [Variable(name=name, dims=("time",), units=unit, long_name=doc)
-                for name, (_, unit, doc) in CHANNELS.items() if name != "time"]
+                for name, (_, unit, doc) in run_channels(controller, every_block=every_block).items()
+                if name != "time"]
     flags = [Variable(name=name, dims=("time",), units="1", long_name=doc, dtype="int8",
                       flag_meanings=FLAG_MEANINGS[name]) for name, (_, doc) in FLAGS.items()]
     return Schema(kind="a run", dimensions={"time": None}, coordinates=(time_coordinate(),),

@@ -28,11 +28,13 @@ from numba import njit
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.base_motion import advance_phase, base_motion, base_motion_near, excitation_tuple
-from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
+from qzs.engine.laws import (compensation_law, compliant_stop_law, controller_law,
+                             dither_law, saturation_law, sliding_friction_law,
                              spring_energy_law, spring_law)
 from qzs.engine.stickslip import (MODE_SLIP, MODE_STICK, MODE_WALL_HIGH, MODE_WALL_LOW,
                                   crossed_zero, hold_margin, locate, release_direction,
                                   secant_fraction, slip_event)
+from qzs.model.controller import MAX_STATES, SENSORS
 
 # Packed parameters. P_VREG > 0 selects the regularised friction model: no stick-slip events,
 # the mode stays slipping (docs/model.md §3).
@@ -43,15 +45,45 @@ N_PARAMS = 22
 
 # ODE state, then the held controller outputs of a sampled controller.
 S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
-N_ODE = 8
+#: Most states of a user's linear controller (:class:`qzs.model.controller.LinearController`).
+NX_MAX = MAX_STATES
+#: The linear controller's states (``S_X0 + i``), then the friction observer's estimate [N].
+S_X0 = 8
+S_OBSERVER = S_X0 + NX_MAX
+N_ODE = S_OBSERVER + 1
 A_F_PI, A_F_DAMP, A_F_MOTOR = range(N_ODE, N_ODE + 3)
 # The holding margin of the last step (NaN: work it out again), carried across kernel calls so
 # that where a run is cut into chunks changes nothing (docs/model.md §9).
 A_MARGIN = N_ODE + 3
-N_STATE = N_ODE + 4
+# The held outputs of the sampled blocks: friction compensation, dither, linear controller.
+A_F_COMPENSATION, A_F_DITHER, A_F_LINEAR = range(N_ODE + 4, N_ODE + 7)
+N_STATE = N_ODE + 7
+N_HELD = 6
 #: The excitation's sine and cosine are computed exactly every this many steps and rotated in
 #: between; kernel calls start on multiples of it, so chunking changes no bit (docs/model.md §9).
 PHASE_PERIOD = 256
+
+# The controller's blocks beyond PI + damping, packed per case (``M_*``, docs/model.md §5):
+# a flag for any block, the friction compensation (fraction, the compensator's friction law,
+# deadband, observer bandwidth), the dither, and the linear controller: on, states, sample
+# period in grid steps (0: continuous), then its matrices A (NX_MAX x NX_MAX), B (NX_MAX x
+# N_SENSORS), C (NX_MAX), D (N_SENSORS) row by row, zero-padded, and its anti-windup gain.
+(M_BLOCKS, M_COMP_FRACTION, M_COMP_FS, M_COMP_FC, M_COMP_CBC, M_COMP_CV, M_COMP_DEADBAND,
+ M_OBSERVER_RATE, M_DITHER_AMPLITUDE, M_DITHER_OMEGA, M_LINEAR, M_LINEAR_STATES,
+ M_LINEAR_STEPS) = range(13)
+#: The sensors a linear controller may read (``U_*``): the position error z_ref - z [m], the
+#: charge amplifier's payload velocity [m/s], payload and base acceleration [m/s^2], the
+#: relative velocity [m/s].
+U_ERROR, U_VELOCITY, U_PAYLOAD_ACCELERATION, U_BASE_ACCELERATION, U_RELATIVE_VELOCITY = range(5)
+N_SENSORS = 5
+assert tuple(SENSORS) == ("position_error", "measured_payload_velocity", "payload_acceleration",
+                          "base_acceleration", "relative_velocity")
+M_A = 13
+M_B = M_A + NX_MAX * NX_MAX
+M_C = M_B + NX_MAX * N_SENSORS
+M_D = M_C + NX_MAX
+M_ANTIWINDUP = M_D + N_SENSORS
+N_MODEL = M_ANTIWINDUP + NX_MAX
 
 # Integer flags.
 I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)
@@ -60,14 +92,18 @@ N_FLAGS = 6
 
 # Force breakdown returned by the right-hand side.
 (F_Y, F_YD, F_YDD, F_SPRING, F_FRICTION, F_STOP, F_STOP_ELASTIC, F_MOTOR, F_PI, F_DAMP,
- F_V_MEASURED, F_HOLD, F_XDD) = range(13)
-N_FORCES = 13
+ F_V_MEASURED, F_HOLD, F_XDD, F_COMPENSATION, F_DITHER, F_LINEAR, F_OBSERVER) = range(17)
+N_FORCES = 17
 
 # Output channels.
 (C_TIME, C_BASE_Y, C_BASE_YD, C_BASE_YDD, C_X, C_XD, C_XDD, C_Z, C_V, C_F_SPRING,
  C_F_FRICTION, C_F_STOP, C_F_MOTOR, C_F_PI, C_F_DAMP, C_V_MEASURED, C_W_BASE, C_D_FRICTION,
- C_W_MOTOR, C_D_STOP, C_E_KINETIC, C_E_SPRING, C_E_GRAVITY, C_E_STOP) = range(24)
-N_CHANNELS = 24
+ C_W_MOTOR, C_D_STOP, C_E_KINETIC, C_E_SPRING, C_E_GRAVITY, C_E_STOP, C_F_COMPENSATION,
+ C_F_DITHER, C_F_LINEAR, C_F_OBSERVER) = range(28)
+N_CHANNELS = 28
+#: The channels of every run; the last ones (the controller's blocks beyond PI + damping) are
+#: recorded only with blocks, and an output row without them has N_BASE_CHANNELS columns.
+N_BASE_CHANNELS = C_F_COMPENSATION
 O_LOCKED, O_CONTACT = 0, 1
 
 SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
@@ -88,11 +124,79 @@ def controller_output(P, z, v_measured, integral):
 
 
 @njit(**_JIT, inline="always")
-def rhs(y, yd, ydd, s, mode, direction, held, P):
-    """Right-hand side at base motion ``(y, yd, ydd)``: ``(derivatives, forces)``.
+def _linear_output(M, s, u):
+    """Output ``C x + D u`` [N] of the linear controller (states ``s[S_X0:]``, sensors ``u``)."""
+    n = int(M[M_LINEAR_STATES])
+    y = 0.0
+    for j in range(n):
+        y = fma(M[M_C + j], s[S_X0 + j], y)
+    for k in range(N_SENSORS):
+        y = fma(M[M_D + k], u[k], y)
+    return y
+
+
+@njit(**_JIT, inline="always")
+def _linear_rate(i, M, s, u, excess):
+    """Rate of state ``i`` of a continuous linear controller: ``(A x + B u + L excess)_i``.
+
+    ``excess`` is the saturated motor force less the command [N]: the back-calculation
+    anti-windup (docs/model.md §5).
+    """
+    n = int(M[M_LINEAR_STATES])
+    if i >= n:
+        return 0.0
+    rate = M[M_ANTIWINDUP + i] * excess
+    row = M_A + i * NX_MAX
+    for j in range(n):
+        rate = fma(M[row + j], s[S_X0 + j], rate)
+    row = M_B + i * N_SENSORS
+    for k in range(N_SENSORS):
+        rate = fma(M[row + k], u[k], rate)
+    return rate
+
+
+@njit(**_JIT, inline="always")
+def _compensation(v, direction, P, M):
+    """The friction compensation's feedforward [N] at slip velocity ``v`` [m/s]."""
+    if M[M_COMP_FRACTION] == 0.0:
+        return 0.0
+    return compensation_law(v, direction, M[M_COMP_FRACTION], M[M_COMP_FS], M[M_COMP_FC],
+                            M[M_COMP_CBC], M[M_COMP_CV], P[P_VREG], M[M_COMP_DEADBAND])
+
+
+@njit(**_JIT, inline="always")
+def block_forces(t, s, v, direction, ydd, v_measured, held, P, M):
+    """The forces of the controller's blocks beyond PI + damping [N] (docs/model.md §5).
+
+    ``(compensation, dither, linear, feedforward)``: the friction compensation (its
+    feedforward less the observer's estimate of the friction left), the dither and the
+    linear controller's output; a sampled block's is the value it holds. ``feedforward``
+    is the compensation's feedforward alone.
+    """
+    feedforward = 0.0
+    if P[P_CONTROL_STEPS] > 0.0:
+        f_comp, f_dither = held[3], held[4]
+    else:
+        feedforward = _compensation(v, direction, P, M)
+        f_comp = feedforward - s[S_OBSERVER]
+        f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
+    f_linear = 0.0
+    if M[M_LINEAR] != 0.0:
+        if M[M_LINEAR_STEPS] > 0.0:
+            f_linear = held[5]
+        else:  # the payload's acceleration enters only through B (docs/model.md §5)
+            f_linear = _linear_output(M, s, (P[P_ZREF] - s[S_Z], v_measured, 0.0, ydd, v))
+    return f_comp, f_dither, f_linear, feedforward
+
+
+@njit(**_JIT, inline="always")
+def rhs(t, y, yd, ydd, s, mode, direction, held, P, M, blocks):
+    """Right-hand side at time ``t`` and base motion ``(y, yd, ydd)``: ``(derivatives, forces)``.
 
     ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g`` (docs/model.md);
-    while held (stuck, or resting on a plastic stop) ``v = 0`` and ``xdd = ydd``.
+    while held (stuck, or resting on a plastic stop) ``v = 0`` and ``xdd = ydd``. ``blocks``:
+    the controller has blocks beyond PI + damping (``M``, :func:`block_forces`); without them
+    the controller's states stay 0 and the operations are those of PI + damping alone.
     """
     m = P[P_MASS]
     z = s[S_Z]
@@ -108,10 +212,19 @@ def rhs(y, yd, ydd, s, mode, direction, held, P):
 
     v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
     if P[P_CONTROL_STEPS] > 0.0:
-        f_pi, f_damp, f_motor = held
+        f_pi, f_damp, f_motor = held[0], held[1], held[2]
         integral_rate = 0.0
     else:
         f_pi, f_damp, f_motor, integral_rate = controller_output(P, z, v_measured, s[S_INT])
+    f_comp = f_dither = f_linear = feedforward = 0.0
+    command = f_motor
+    if blocks:
+        f_comp, f_dither, f_linear, feedforward = block_forces(t, s, v, direction, ydd,
+                                                               v_measured, held, P, M)
+        command = f_pi + f_damp + f_comp + f_dither + f_linear
+        f_motor, rate = saturation_law(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
+        if P[P_CONTROL_STEPS] == 0.0:
+            integral_rate = rate
 
     f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
     f_hold = m * ydd - f_applied
@@ -131,26 +244,44 @@ def rhs(y, yd, ydd, s, mode, direction, held, P):
             f_stop += f_wall
         xdd = ydd
 
+    r0 = r1 = r2 = r3 = r4 = r5 = r6 = r7 = observer_rate = 0.0
+    if blocks and P[P_CONTROL_STEPS] == 0.0 and M[M_OBSERVER_RATE] > 0.0:
+        # the friction left after the feedforward, as the observer measures it
+        observer_rate = M[M_OBSERVER_RATE] * (f_friction + f_stop + feedforward - s[S_OBSERVER])
+    if blocks and M[M_LINEAR] != 0.0 and M[M_LINEAR_STEPS] == 0.0:
+        u = (P[P_ZREF] - z, v_measured, xdd, ydd, v)
+        excess = f_motor - command
+        r0 = _linear_rate(0, M, s, u, excess)
+        r1 = _linear_rate(1, M, s, u, excess)
+        r2 = _linear_rate(2, M, s, u, excess)
+        r3 = _linear_rate(3, M, s, u, excess)
+        r4 = _linear_rate(4, M, s, u, excess)
+        r5 = _linear_rate(5, M, s, u, excess)
+        r6 = _linear_rate(6, M, s, u, excess)
+        r7 = _linear_rate(7, M, s, u, excess)
     deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
              (f_spring + f_friction + f_stop + f_motor) * yd, -f_friction * v, f_motor * v,
-             -(f_stop - f_elastic) * v)
+             -(f_stop - f_elastic) * v, r0, r1, r2, r3, r4, r5, r6, r7, observer_rate)
     force = (y, yd, ydd, f_spring, f_friction, f_stop, f_elastic, f_motor, f_pi, f_damp,
-             v_measured, f_hold, xdd)
+             v_measured, f_hold, xdd, f_comp, f_dither, f_linear, s[S_OBSERVER])
     return deriv, force
 
 
 @njit(**_JIT)
-def rhs_at(t, s, mode, direction, held, P, E, table):
+def rhs_at(t, s, mode, direction, held, P, M, E, table):
     """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
     y, yd, ydd = base_motion(t, E, table)
-    return rhs(y, yd, ydd, s, mode, direction, held, P)
+    return rhs(t, y, yd, ydd, s, mode, direction, held, P, M, M[M_BLOCKS] != 0.0)
 
 
 @njit(**_JIT, inline="always")
 def _axpy(s, a, k):
     """``s + a * k`` entry by entry, each with one rounding (:func:`fma`)."""
     return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]), fma(a, k[3], s[3]),
-            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]))
+            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]),
+            fma(a, k[8], s[8]), fma(a, k[9], s[9]), fma(a, k[10], s[10]),
+            fma(a, k[11], s[11]), fma(a, k[12], s[12]), fma(a, k[13], s[13]),
+            fma(a, k[14], s[14]), fma(a, k[15], s[15]), fma(a, k[16], s[16]))
 
 
 @njit(**_JIT, inline="always")
@@ -200,7 +331,7 @@ def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
 
 
 @njit(**_JIT, inline="always")
-def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, cos0):
+def rk_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, phase, sin0, cos0):
     """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
 
     ``phase, sin0, cos0`` are the excitation's phase and its sine and cosine at a
@@ -215,7 +346,8 @@ def rk_step(solver, t, h, s, mode, direction, held, P, E, table, phase, sin0, co
     for stage in range(n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
         y, yd, ydd = base_motion_near(t + offset, phase, sin0, cos0, E, table)
-        k = rhs(y, yd, ydd, s if stage == 0 else _axpy(s, a, k), mode, direction, held, P)[0]
+        k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k), mode, direction,
+                held, P, M, blocks)[0]
         result = _axpy(result, weight, k)
     return result
 
@@ -248,7 +380,27 @@ def _with(s, index, value):
     return (value if index == 0 else s[0], value if index == 1 else s[1],
             value if index == 2 else s[2], value if index == 3 else s[3],
             value if index == 4 else s[4], value if index == 5 else s[5],
-            value if index == 6 else s[6], value if index == 7 else s[7])
+            value if index == 6 else s[6], value if index == 7 else s[7],
+            value if index == 8 else s[8], value if index == 9 else s[9],
+            value if index == 10 else s[10], value if index == 11 else s[11],
+            value if index == 12 else s[12], value if index == 13 else s[13],
+            value if index == 14 else s[14], value if index == 15 else s[15],
+            value if index == 16 else s[16])
+
+
+@njit(**_JIT, inline="always")
+def state_tuple(state):
+    """The ODE state (``S_*``) of a persistent state array as a tuple."""
+    return (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
+            state[8], state[9], state[10], state[11], state[12], state[13], state[14],
+            state[15], state[16])
+
+
+@njit(**_JIT, inline="always")
+def held_tuple(state):
+    """The held outputs of a sampled controller (``A_F_*``) of a persistent state array."""
+    return (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR], state[A_F_COMPENSATION],
+            state[A_F_DITHER], state[A_F_LINEAR])
 
 
 @njit(**_JIT, inline="always")
@@ -268,21 +420,21 @@ def _book_impulse(t, s, ledger, E, table, P):
 
 
 @njit(**_JIT)
-def _settle(t, s, direction, held, P, E, table):
+def _settle(t, s, direction, held, P, M, E, table):
     """At a zero crossing of v: stick if friction can hold the payload, else reverse.
 
     Returns ``(state, mode, direction)``. v is set to exactly 0 either way; the
     crossing is located to round-off, so the impulse booked for it is negligible.
     """
     s = _book_impulse(t, s, S_D_FRICTION, E, table, P)
-    f_hold = rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, P, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, P, M, E, table)[1][F_HOLD]
     if abs(f_hold) <= P[P_FS]:
         return s, MODE_STICK, direction
     return s, MODE_SLIP, release_direction(MODE_STICK, f_hold)
 
 
 @njit(**_JIT)
-def _hit_wall(t, s, low, held, P, E, table):
+def _hit_wall(t, s, low, held, P, M, E, table):
     """Perfectly plastic impact: v absorbed by the stop's impulse, z put on the stop.
 
     The payload then rests on the stop if friction and the stop can hold it,
@@ -296,14 +448,14 @@ def _hit_wall(t, s, low, held, P, E, table):
     # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
     s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, slip, P, E, table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
-    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
     if hold_margin(mode, f_hold, P[P_FS]) < 0.0:
         return s, MODE_SLIP, release_direction(mode, f_hold)
     return s, mode, 0
 
 
 @njit(**_JIT)
-def _event_value(event, t, s, mode, direction, held, P, E, table):
+def _event_value(event, t, s, mode, direction, held, P, M, E, table):
     """The function whose sign change defines ``event`` (positive before it)."""
     if event == 1:
         return slip_event(direction, s[S_V])
@@ -311,15 +463,16 @@ def _event_value(event, t, s, mode, direction, held, P, E, table):
         return s[S_Z] - P[P_Z_LOW]
     if event == 3:
         return P[P_Z_HIGH] - s[S_Z]
-    f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
     return hold_margin(mode, f_hold, P[P_FS])
 
 
 @njit(**_JIT)
-def _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0):
+def _margin_near(t, s, mode, held, P, M, E, table, phase, sin0, cos0):
     """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    return hold_margin(mode, rhs(y, yd, ydd, s, mode, 0.0, held, P)[1][F_HOLD], P[P_FS])
+    return hold_margin(mode, rhs(t, y, yd, ydd, s, mode, 0.0, held, P, M,
+                                 M[M_BLOCKS] != 0.0)[1][F_HOLD], P[P_FS])
 
 
 @njit(**_JIT, inline="always")
@@ -367,7 +520,7 @@ def _any_event(s, s1, mode, direction, margin1, P):
 
 
 @njit(**_JIT)
-def _rk(solver, t, h, s, k0, mode, direction, held, P, E, table):
+def _rk(solver, t, h, s, k0, mode, direction, held, P, M, E, table):
     """The Runge-Kutta step of :func:`rk_step` for the event path, stage by stage.
 
     The same tableau and fused updates, in the same order; each stage calls the
@@ -383,7 +536,7 @@ def _rk(solver, t, h, s, k0, mode, direction, held, P, E, table):
     k = k0
     for stage in range(1, n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
-        k = rhs_at(t + offset, _axpy(s, a, k), mode, direction, held, P, E, table)[0]
+        k = rhs_at(t + offset, _axpy(s, a, k), mode, direction, held, P, M, E, table)[0]
         result = _axpy(result, weight, k)
     return result
 
@@ -392,17 +545,17 @@ def _rk(solver, t, h, s, k0, mode, direction, held, P, E, table):
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s] and its event value.
 
-    ``data`` is ``(solver, event, t, s, k0, mode, direction, held, P, E, table)``, the
+    ``data`` is ``(solver, event, t, s, k0, mode, direction, held, P, M, E, table)``, the
     step's start and its first stage's rate; returns ``(event value, state)`` at ``t + at``
     (:func:`_rk`, :func:`_event_value`).
     """
-    solver, event, t, s, k0, mode, direction, held, P, E, table = data
-    state = _rk(solver, t, at, s, k0, mode, float(direction), held, P, E, table)
-    return _event_value(event, t + at, state, mode, direction, held, P, E, table), state
+    solver, event, t, s, k0, mode, direction, held, P, M, E, table = data
+    state = _rk(solver, t, at, s, k0, mode, float(direction), held, P, M, E, table)
+    return _event_value(event, t + at, state, mode, direction, held, P, M, E, table), state
 
 
 @njit(**_JIT)
-def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table):
+def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, M, E, table):
     """Event ``event`` located in ``[t, t + h]`` (:func:`qzs.engine.stickslip.locate`).
 
     Returns ``(time from t, state there)``: at most 6 Runge-Kutta steps from ``t`` (each an
@@ -411,17 +564,19 @@ def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table):
     """
     k0 = s
     if g0 > 0.0:  # else no trial is made
-        k0 = rhs_at(t, s, mode, float(direction), held, P, E, table)[0]
-    return locate(_event_trial, (solver, event, t, s, k0, mode, direction, held, P, E, table),
-                  g0, g1, h, s)
+        k0 = rhs_at(t, s, mode, float(direction), held, P, M, E, table)[0]
+    return locate(_event_trial, (solver, event, t, s, k0, mode, direction, held, P, M, E,
+                                 table), g0, g1, h, s)
 
 
 @njit(**_JIT)
-def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0):
+def grid_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, margin, phase,
+              sin0, cos0):
     """Advance one grid step, locating and handling at most one transition inside it.
 
     ``margin`` is the holding margin at ``t`` if known (NaN if not); ``phase,
-    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``. Returns
+    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``; ``M`` the
+    controller's blocks and ``blocks`` whether it has any (:func:`rhs`). Returns
     ``(state, mode, direction, margin, sticks, impacts)``: the holding margin at
     the end (NaN while slipping), the counts of new stick events and of plastic
     impacts in the step.
@@ -430,75 +585,121 @@ def grid_step(solver, t, h, s, mode, direction, held, P, E, table, margin, phase
     impacts = 0
     # a zero crossing missed earlier
     if mode == MODE_SLIP and P[P_VREG] == 0.0 and slip_event(direction, s[S_V]) < 0.0:
-        s, mode, direction = _settle(t, s, direction, held, P, E, table)
+        s, mode, direction = _settle(t, s, direction, held, P, M, E, table)
         sticks += mode == MODE_STICK
         margin = np.nan
     if mode != MODE_SLIP:
         if margin != margin:  # NaN: not known yet
-            margin = _margin_near(t, s, mode, held, P, E, table, phase, sin0, cos0)
+            margin = _margin_near(t, s, mode, held, P, M, E, table, phase, sin0, cos0)
         if margin < 0.0:
-            f_hold = rhs_at(t, s, mode, 0.0, held, P, E, table)[1][F_HOLD]
+            f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
             direction = release_direction(mode, f_hold)
             mode = MODE_SLIP
 
-    s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, E, table, phase, sin0, cos0)
+    s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, M, blocks, E, table, phase,
+                 sin0, cos0)
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
+        margin1 = _margin_near(t + h, s1, mode, held, P, M, E, table, phase, sin0, cos0)
     event, theta = _first_event(t, h, s, s1, mode, direction, margin, margin1, P)
     if event == 0:
         return s1, mode, direction, margin1, sticks, impacts
 
-    g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, E, table)
+    g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, M, E, table)
     g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
-                                                 E, table)
-    at, s_event = _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, E, table)
+                                                 M, E, table)
+    at, s_event = _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, M, E, table)
     t_event = t + at
     if event == 1:
-        s_event, mode, direction = _settle(t_event, s_event, direction, held, P, E, table)
+        s_event, mode, direction = _settle(t_event, s_event, direction, held, P, M, E, table)
         sticks += mode == MODE_STICK
     elif event == 2 or event == 3:
-        s_event, mode, direction = _hit_wall(t_event, s_event, event == 2, held, P, E, table)
+        s_event, mode, direction = _hit_wall(t_event, s_event, event == 2, held, P, M, E, table)
         impacts += 1
     else:
-        f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, E, table)[1][F_HOLD]
+        f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
         direction = release_direction(mode, f_hold)
         mode = MODE_SLIP
     rest = h - at
     s1 = s_event
     if rest > 0.0:
-        k0 = rhs_at(t_event, s_event, mode, float(direction), held, P, E, table)[0]
-        s1 = _rk(solver, t_event, rest, s_event, k0, mode, float(direction), held, P, E, table)
+        k0 = rhs_at(t_event, s_event, mode, float(direction), held, P, M, E, table)[0]
+        s1 = _rk(solver, t_event, rest, s_event, k0, mode, float(direction), held, P, M, E, table)
     if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
         if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
-            s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, E,
-                                            table)
+            s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, M,
+                                            E, table)
             impacts += 1
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _margin_near(t + h, s1, mode, held, P, E, table, phase, sin0, cos0)
+        margin1 = _margin_near(t + h, s1, mode, held, P, M, E, table, phase, sin0, cos0)
     return s1, mode, direction, margin1, sticks, impacts
 
 
 @njit(**_JIT)
-def sample_controller(t, s, mode, P, E, table):
-    """Sampled controller: read z and the measured velocity; returns ``(held, state)``."""
+def sample_controller(t, s, mode, direction, held, P, M, E, table):
+    """Sampled controller: read z and the measured velocity; returns ``(held, state)``.
+
+    The PI and damping forces with the current integral, then the integral advanced by one
+    sample period (docs/model.md §5); with blocks, the compensation (with the observer's
+    current estimate, then the observer advanced) and the dither too. ``held`` is what the
+    controller held until now (a discrete linear controller's output is its own,
+    :func:`sample_linear`).
+    """
     y, yd, ydd = base_motion(t, E, table)
     xd = yd + (s[S_V] if mode == MODE_SLIP else 0.0)
     v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
     f_pi, f_damp, f_motor, rate = controller_output(P, s[S_Z], v_measured, s[S_INT])
+    f_comp, f_dither = held[3], held[4]
+    if M[M_BLOCKS] != 0.0:
+        v = s[S_V] if mode == MODE_SLIP else 0.0
+        force = rhs(t, y, yd, ydd, s, mode, float(direction), held, P, M, True)[1]
+        feedforward = _compensation(v, float(direction), P, M)
+        f_comp = feedforward - s[S_OBSERVER]
+        f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
+        command = f_pi + f_damp + f_comp + f_dither + force[F_LINEAR]
+        f_motor, rate = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
+        if M[M_OBSERVER_RATE] > 0.0:  # forward Euler over the period, as the integral
+            applied = held[3] + s[S_OBSERVER]  # the feedforward applied until now
+            measured = force[F_FRICTION] + force[F_STOP] + applied
+            s = _with(s, S_OBSERVER, s[S_OBSERVER] + M[M_OBSERVER_RATE] * (
+                measured - s[S_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT])
     s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
-    return (f_pi, f_damp, f_motor), s
+    return (f_pi, f_damp, f_motor, f_comp, f_dither, held[5]), s
 
 
 @njit(**_JIT)
-def record(t, s, mode, direction, held, P, E, table, row, row_flags, phase, sin0, cos0):
+def sample_linear(t, s, mode, direction, held, P, M, E, table):
+    """A discrete linear controller's sample at ``t``: returns ``(held, state)``.
+
+    It reads its sensors (the payload's acceleration with the force held until now),
+    outputs ``y = C x + D u``, held to its next sample, and steps its state
+    ``x <- A x + B u + L (F_motor - command)`` (back-calculation, docs/model.md §5).
+    """
+    force = rhs_at(t, s, mode, float(direction), held, P, M, E, table)[1]
+    v = s[S_V] if mode == MODE_SLIP else 0.0
+    u = (P[P_ZREF] - s[S_Z], force[F_V_MEASURED], force[F_XDD], force[F_YDD], v)
+    output = _linear_output(M, s, u)
+    command = force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER] + output
+    f_motor = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])[0]
+    excess = f_motor - command
+    x = (_linear_rate(0, M, s, u, excess), _linear_rate(1, M, s, u, excess),
+         _linear_rate(2, M, s, u, excess), _linear_rate(3, M, s, u, excess),
+         _linear_rate(4, M, s, u, excess), _linear_rate(5, M, s, u, excess),
+         _linear_rate(6, M, s, u, excess), _linear_rate(7, M, s, u, excess))
+    s = (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], x[0], x[1], x[2], x[3], x[4], x[5],
+         x[6], x[7], s[S_OBSERVER])
+    return (held[0], held[1], held[2], held[3], held[4], output), s
+
+
+@njit(**_JIT)
+def record(t, s, mode, direction, held, P, M, E, table, row, row_flags, phase, sin0, cos0):
     """Write one output sample (channels ``C_*``) of the state at time ``t``.
 
     ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
     """
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    force = rhs(y, yd, ydd, s, mode, float(direction), held, P)[1]
+    force = rhs(t, y, yd, ydd, s, mode, float(direction), held, P, M, M[M_BLOCKS] != 0.0)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     row[C_TIME] = t
     row[C_BASE_Y] = force[F_Y]
@@ -522,6 +723,11 @@ def record(t, s, mode, direction, held, P, E, table, row, row_flags, phase, sin0
     row[C_D_STOP] = s[S_D_STOP]
     row[C_E_KINETIC], row[C_E_SPRING], row[C_E_GRAVITY], row[C_E_STOP] = energies(
         force[F_Y], force[F_YD], s, mode, P)
+    if M[M_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
+        row[C_F_COMPENSATION] = force[F_COMPENSATION]
+        row[C_F_DITHER] = force[F_DITHER]
+        row[C_F_LINEAR] = force[F_LINEAR]
+        row[C_F_OBSERVER] = force[F_OBSERVER]
     row_flags[O_LOCKED] = mode != MODE_SLIP
     row_flags[O_CONTACT] = _in_contact(s, mode, P)
 
@@ -532,20 +738,16 @@ def _in_contact(s, mode, P):
 
 
 @njit(**_JIT)
-def evaluate(t, state, flags, p, ex, table, row, row_flags):
+def evaluate(t, state, flags, p, m, ex, table, row, row_flags):
     """Record the persistent state (arrays, as the driver keeps it) at ``t``."""
-    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
-    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
     E = excitation_tuple(ex)
     phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, np.bool_(True))
-    record(t, s, flags[I_MODE], flags[I_DIRECTION], held, params_tuple(p), E, table, row,
-           row_flags, phase, sin0, cos0)
+    record(t, state_tuple(state), flags[I_MODE], flags[I_DIRECTION], held_tuple(state),
+           params_tuple(p), m, E, table, row, row_flags, phase, sin0, cos0)
 
 
 @njit(**_JIT)
-def hold_force(t, state, p, ex, table):
+def hold_force(t, state, p, m, ex, table):
     """Force friction must supply to keep the payload stuck at ``state`` [N], and the forces."""
-    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
-    held = (state[A_F_PI], state[A_F_DAMP], state[A_F_MOTOR])
-    return rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, params_tuple(p), excitation_tuple(ex),
-                  table)[1]
+    return rhs_at(t, state_tuple(state), np.int64(MODE_STICK), 0.0, held_tuple(state),
+                  params_tuple(p), m, excitation_tuple(ex), table)[1]

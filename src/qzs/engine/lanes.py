@@ -34,11 +34,14 @@ from qzs.engine.stickslip import hold_margin, slip_event
 # Rows of the lane-state array: the persistent state (``K.S_*`` and ``K.A_*``) first.
 R_MARGIN = K.A_MARGIN  # the holding margin is part of the persistent state
 (R_MODE, R_DIRECTION, R_CONTACT, R_CONTACTS, R_STICKS,
- R_FAILED) = range(K.N_STATE, K.N_STATE + 6)
-N_ROWS = K.N_STATE + 6
-# Rows of the per-step scratch array: the running weighted sum, the stage input, the flag.
-T_SUM, T_INPUT, T_FLAGGED = 0, K.N_ODE, K.N_ODE + 4
-N_SCRATCH = K.N_ODE + 5
+ R_FAILED, R_BLOCKS) = range(K.N_STATE, K.N_STATE + 7)
+N_ROWS = K.N_STATE + 7
+# Rows of the per-step scratch array: the running weighted sum of the motion and the ledger
+# (the first N_SUM states; a lane whose controller has blocks beyond PI + damping, with states
+# of their own, steps in pass 2), the stage input, the flag.
+N_SUM = K.S_X0
+T_SUM, T_INPUT, T_FLAGGED = 0, N_SUM, N_SUM + 4
+N_SCRATCH = N_SUM + 5
 # Rows of a sample's scratch array: the output channels (``K.C_*``), then the two flags.
 Q_LOCKED, Q_CONTACT = K.N_CHANNELS + K.O_LOCKED, K.N_CHANNELS + K.O_CONTACT
 N_RECORD = K.N_CHANNELS + 2
@@ -108,12 +111,15 @@ def _params(PP, c, exact=False):
 @njit(**_JIT, inline="always")
 def _state(L, c):
     return (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)],
-            L[_at(5, c)], L[_at(6, c)], L[_at(7, c)])
+            L[_at(5, c)], L[_at(6, c)], L[_at(7, c)], L[_at(8, c)], L[_at(9, c)],
+            L[_at(10, c)], L[_at(11, c)], L[_at(12, c)], L[_at(13, c)], L[_at(14, c)],
+            L[_at(15, c)], L[_at(16, c)])
 
 
 @njit(**_JIT, inline="always")
 def _held(L, c):
-    return L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)]
+    return (L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)],
+            L[_at(K.A_F_COMPENSATION, c)], L[_at(K.A_F_DITHER, c)], L[_at(K.A_F_LINEAR, c)])
 
 
 @njit(**_JIT, inline="always")
@@ -125,10 +131,20 @@ def _finite(s, P):
 
 
 @njit(**_JIT, inline="always")
+def _finite_blocks(s):
+    """The controller blocks' states are finite (an unstable controller diverges)."""
+    finite = True
+    for i in range(K.S_X0, K.N_ODE):
+        finite = finite and np.isfinite(s[i])
+    return finite
+
+
+@njit(**_JIT, inline="always")
 def _store(L, c, s, margin, contact, P):
     """Put the end-of-step state of lane ``c``; counts a new compliant-stop contact."""
     (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)], L[_at(5, c)],
-     L[_at(6, c)], L[_at(7, c)]) = s
+     L[_at(6, c)], L[_at(7, c)], L[_at(8, c)], L[_at(9, c)], L[_at(10, c)], L[_at(11, c)],
+     L[_at(12, c)], L[_at(13, c)], L[_at(14, c)], L[_at(15, c)], L[_at(16, c)]) = s
     L[_at(R_MARGIN, c)] = margin
     new_contact = contact and L[_at(R_CONTACT, c)] == 0.0 and P[K.P_PLASTIC] == 0.0
     L[_at(R_CONTACT, c)] = 1.0 if contact else 0.0
@@ -136,20 +152,22 @@ def _store(L, c, s, margin, contact, P):
 
 
 @njit(**_JIT, inline="always")
-def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, source, at_input, at_sum):
+def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, M0, source, at_input, at_sum):
     """One Runge-Kutta stage of every lane: ``k`` at the stage input, added to the sum.
 
     The stage input and the running sum are read from ``source`` (rows from
     ``at_input`` and ``at_sum``): the state itself for the first stage, the
     scratch array ``T`` after. Then the next stage's input ``s + a_next * k`` goes
     to ``T``. The right-hand side reads the motion states only (z, v, filter,
-    integral); the ledger rates just add up.
+    integral); the ledger rates just add up. The controller is PI + damping alone here
+    (``M0``, no blocks): a lane with blocks is stepped in pass 2.
     """
     for c in range(n):
         x = (source[_at(at_input, c)], source[_at(at_input + 1, c)],
-             source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0)
-        k = K.rhs(base[0], base[1], base[2], x, int(L[_at(R_MODE, c)]),
-                  L[_at(R_DIRECTION, c)], _held(L, c), _params(PP, c, exact))[0]
+             source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0,
+             0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        k = K.rhs(0.0, base[0], base[1], base[2], x, int(L[_at(R_MODE, c)]),
+                  L[_at(R_DIRECTION, c)], _held(L, c), _params(PP, c, exact), M0, False)[0]
         T[_at(T_SUM, c)] = K.fma(weight, k[0], source[_at(at_sum, c)])
         T[_at(T_SUM + 1, c)] = K.fma(weight, k[1], source[_at(at_sum + 1, c)])
         T[_at(T_SUM + 2, c)] = K.fma(weight, k[2], source[_at(at_sum + 2, c)])
@@ -165,38 +183,40 @@ def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, source, at_input, at_
 
 
 @njit(**_JIT, inline="always")
-def _finish_lanes(slipping, n, b_end, L, T, PP):
+def _finish_lanes(slipping, n, b_end, L, T, PP, M0):
     """End the step of every lane: store it, or flag the lane for pass 2.
 
     What :func:`qzs.engine.kernels.grid_step` does after its Runge-Kutta step when
     nothing happens in it. A flagged lane keeps its state at ``t``. ``slipping``: no
     lane is held, so none needs its holding margin. Returns how many lanes pass 2
     has to step: the flagged ones that have not failed (a failed or padding lane
-    is flagged at every step and left as it is).
+    is flagged at every step and left as it is; so is a lane with controller blocks).
     """
     flagged_lanes = 0
     for c in range(n):
         s = _state(L, c)
         s1 = (T[_at(T_SUM, c)], T[_at(T_SUM + 1, c)], T[_at(T_SUM + 2, c)],
               T[_at(T_SUM + 3, c)], T[_at(T_SUM + 4, c)], T[_at(T_SUM + 5, c)],
-              T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)])
+              T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)], s[8], s[9], s[10], s[11], s[12],
+              s[13], s[14], s[15], s[16])
         P = _params(PP, c)
         mode = K.MODE_SLIP if slipping else int(L[_at(R_MODE, c)])
         direction = L[_at(R_DIRECTION, c)]
         margin = L[_at(R_MARGIN, c)]
         margin1 = np.nan
         if mode != K.MODE_SLIP:
-            force = K.rhs(b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c), P)[1]
+            force = K.rhs(0.0, b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c),
+                          P, M0, False)[1]
             margin1 = hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
         if mode == K.MODE_SLIP:  # no zero crossing missed (none is tracked when regularised)
             ready = P[K.P_VREG] > 0.0 or slip_event(direction, s[K.S_V]) >= 0.0
         else:
             ready = margin >= 0.0
-        failed = L[_at(R_FAILED, c)] != 0.0
+        failed = L[_at(R_FAILED, c)] != 0.0 or L[_at(R_BLOCKS, c)] != 0.0
         flagged = (not ready or K._any_event(s, s1, mode, direction, margin1, P)
                    or not _finite(s1, P) or failed)
         T[_at(T_FLAGGED, c)] = 1.0 if flagged else 0.0
-        flagged_lanes += flagged and not failed  # a failed lane is left alone
+        flagged_lanes += flagged and L[_at(R_FAILED, c)] == 0.0  # a failed lane is left alone
         if not flagged:
             _store(L, c, s1, margin1, K._in_contact(s1, mode, P), P)
     return flagged_lanes
@@ -205,86 +225,113 @@ def _finish_lanes(slipping, n, b_end, L, T, PP):
 # Each loop of pass 1 is a function of its own per variant: one function holding all three
 # loops took LLVM ten times as long to compile.
 @njit(**_JIT)
-def _first_stage_exact(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(True, n, a_next, weight, base, L, T, PP, L, 0, 0)
+def _first_stage_exact(n, a_next, weight, base, L, T, PP, M0):
+    _stage_lanes(True, n, a_next, weight, base, L, T, PP, M0, L, 0, 0)
 
 
 @njit(**_JIT)
-def _stage_exact(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(True, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+def _stage_exact(n, a_next, weight, base, L, T, PP, M0):
+    _stage_lanes(True, n, a_next, weight, base, L, T, PP, M0, T, T_INPUT, T_SUM)
 
 
 @njit(**_JIT)
-def _first_stage_any(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(False, n, a_next, weight, base, L, T, PP, L, 0, 0)
+def _first_stage_any(n, a_next, weight, base, L, T, PP, M0):
+    _stage_lanes(False, n, a_next, weight, base, L, T, PP, M0, L, 0, 0)
 
 
 @njit(**_JIT)
-def _stage_any(n, a_next, weight, base, L, T, PP):
-    _stage_lanes(False, n, a_next, weight, base, L, T, PP, T, T_INPUT, T_SUM)
+def _stage_any(n, a_next, weight, base, L, T, PP, M0):
+    _stage_lanes(False, n, a_next, weight, base, L, T, PP, M0, T, T_INPUT, T_SUM)
 
 
 @njit(**_JIT)
-def _finish_slipping(n, b_end, L, T, PP):
-    return _finish_lanes(True, n, b_end, L, T, PP)
+def _finish_slipping(n, b_end, L, T, PP, M0):
+    return _finish_lanes(True, n, b_end, L, T, PP, M0)
 
 
 @njit(**_JIT)
-def _finish_any(n, b_end, L, T, PP):
-    return _finish_lanes(False, n, b_end, L, T, PP)
+def _finish_any(n, b_end, L, T, PP, M0):
+    return _finish_lanes(False, n, b_end, L, T, PP, M0)
 
 
 @njit(**_JIT, inline="always")
-def _sample_lanes(exact, n, t, base, L, PP, Q):
+def _write_channels(Q, c, t, s, mode, force, P):
+    """Lane ``c``'s channels but the energies, from its state and forces, into ``Q``."""
+    v = s[K.S_V] if mode == K.MODE_SLIP else 0.0
+    Q[_at(K.C_TIME, c)] = t
+    Q[_at(K.C_BASE_Y, c)] = force[K.F_Y]
+    Q[_at(K.C_BASE_YD, c)] = force[K.F_YD]
+    Q[_at(K.C_BASE_YDD, c)] = force[K.F_YDD]
+    Q[_at(K.C_X, c)] = force[K.F_Y] + s[K.S_Z]
+    Q[_at(K.C_XD, c)] = force[K.F_YD] + v
+    Q[_at(K.C_XDD, c)] = force[K.F_XDD]
+    Q[_at(K.C_Z, c)] = s[K.S_Z]
+    Q[_at(K.C_V, c)] = v
+    Q[_at(K.C_F_SPRING, c)] = force[K.F_SPRING]
+    Q[_at(K.C_F_FRICTION, c)] = force[K.F_FRICTION]
+    Q[_at(K.C_F_STOP, c)] = force[K.F_STOP]
+    Q[_at(K.C_F_MOTOR, c)] = force[K.F_MOTOR]
+    Q[_at(K.C_F_PI, c)] = force[K.F_PI]
+    Q[_at(K.C_F_DAMP, c)] = force[K.F_DAMP]
+    Q[_at(K.C_V_MEASURED, c)] = force[K.F_V_MEASURED]
+    Q[_at(K.C_W_BASE, c)] = s[K.S_W_BASE]
+    Q[_at(K.C_D_FRICTION, c)] = s[K.S_D_FRICTION]
+    Q[_at(K.C_W_MOTOR, c)] = s[K.S_W_MOTOR]
+    Q[_at(K.C_D_STOP, c)] = s[K.S_D_STOP]
+    Q[_at(K.C_F_COMPENSATION, c)] = force[K.F_COMPENSATION]
+    Q[_at(K.C_F_DITHER, c)] = force[K.F_DITHER]
+    Q[_at(K.C_F_LINEAR, c)] = force[K.F_LINEAR]
+    Q[_at(K.C_F_OBSERVER, c)] = force[K.F_OBSERVER]
+    Q[_at(Q_LOCKED, c)] = 1.0 if mode != K.MODE_SLIP else 0.0
+    Q[_at(Q_CONTACT, c)] = 1.0 if K._in_contact(s, mode, P) else 0.0
+
+
+@njit(**_JIT, inline="always")
+def _sample_lanes(exact, n, t, base, L, PP, M0, Q):
     """The output channels of every lane at a sample, but the energies, into ``Q``.
 
     What :func:`qzs.engine.kernels.record` computes, with the same operations in the same
     order (the right-hand side's forces at the state), lane by lane in a loop LLVM
-    vectorises; the caller keeps the channels it wants (:func:`_keep`).
+    vectorises; the caller keeps the channels it wants (:func:`_keep`). The controller is
+    PI + damping alone here (``M0``); :func:`_sample_blocks` writes the lanes with blocks.
     """
     for c in range(n):
         s = _state(L, c)
         mode = int(L[_at(R_MODE, c)])
         P = _params(PP, c, exact)
-        force = K.rhs(base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)], _held(L, c),
-                      P)[1]
-        v = s[K.S_V] if mode == K.MODE_SLIP else 0.0
-        Q[_at(K.C_TIME, c)] = t
-        Q[_at(K.C_BASE_Y, c)] = force[K.F_Y]
-        Q[_at(K.C_BASE_YD, c)] = force[K.F_YD]
-        Q[_at(K.C_BASE_YDD, c)] = force[K.F_YDD]
-        Q[_at(K.C_X, c)] = force[K.F_Y] + s[K.S_Z]
-        Q[_at(K.C_XD, c)] = force[K.F_YD] + v
-        Q[_at(K.C_XDD, c)] = force[K.F_XDD]
-        Q[_at(K.C_Z, c)] = s[K.S_Z]
-        Q[_at(K.C_V, c)] = v
-        Q[_at(K.C_F_SPRING, c)] = force[K.F_SPRING]
-        Q[_at(K.C_F_FRICTION, c)] = force[K.F_FRICTION]
-        Q[_at(K.C_F_STOP, c)] = force[K.F_STOP]
-        Q[_at(K.C_F_MOTOR, c)] = force[K.F_MOTOR]
-        Q[_at(K.C_F_PI, c)] = force[K.F_PI]
-        Q[_at(K.C_F_DAMP, c)] = force[K.F_DAMP]
-        Q[_at(K.C_V_MEASURED, c)] = force[K.F_V_MEASURED]
-        Q[_at(K.C_W_BASE, c)] = s[K.S_W_BASE]
-        Q[_at(K.C_D_FRICTION, c)] = s[K.S_D_FRICTION]
-        Q[_at(K.C_W_MOTOR, c)] = s[K.S_W_MOTOR]
-        Q[_at(K.C_D_STOP, c)] = s[K.S_D_STOP]
-        Q[_at(Q_LOCKED, c)] = 1.0 if mode != K.MODE_SLIP else 0.0
-        Q[_at(Q_CONTACT, c)] = 1.0 if K._in_contact(s, mode, P) else 0.0
+        force = K.rhs(t, base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)],
+                      _held(L, c), P, M0, False)[1]
+        _write_channels(Q, c, t, s, mode, force, P)
 
 
 @njit(**_JIT)
-def _sample_exact(n, t, base, L, PP, Q):
-    _sample_lanes(True, n, t, base, L, PP, Q)
+def _sample_exact(n, t, base, L, PP, M0, Q):
+    _sample_lanes(True, n, t, base, L, PP, M0, Q)
 
 
 @njit(**_JIT)
-def _sample_any(n, t, base, L, PP, Q):
-    _sample_lanes(False, n, t, base, L, PP, Q)
+def _sample_any(n, t, base, L, PP, M0, Q):
+    _sample_lanes(False, n, t, base, L, PP, M0, Q)
 
 
 @njit(**_JIT)
-def _keep(exact, n, t, base, L, PP, Q, columns, energies, out, out_flags, lane0, row):
+def _sample_blocks(n, t, base, L, PP, models, Q):
+    """The channels of the lanes whose controller has blocks, lane by lane, with the blocks
+    (over what the vectorised pass wrote for them)."""
+    for c in range(n):
+        if L[_at(R_BLOCKS, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
+            continue
+        s = _state(L, c)
+        mode = int(L[_at(R_MODE, c)])
+        P = _params(PP, c)
+        force = K.rhs(t, base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)],
+                      _held(L, c), P, models[c], True)[1]
+        _write_channels(Q, c, t, s, mode, force, P)
+
+
+@njit(**_JIT)
+def _keep(exact, n, t, base, L, PP, M0, models, blocks, Q, columns, energies, out, out_flags,
+          lane0, row):
     """Record a sample: the channels ``columns`` and both flags of every lane that has not
     failed, to ``out[column, lane0 + c, row]`` and ``out_flags[flag, lane0 + c, row]``.
 
@@ -293,9 +340,11 @@ def _keep(exact, n, t, base, L, PP, Q, columns, energies, out, out_flags, lane0,
     and only when ``energies`` (a column asks for them).
     """
     if exact:
-        _sample_exact(n, t, base, L, PP, Q)
+        _sample_exact(n, t, base, L, PP, M0, Q)
     else:
-        _sample_any(n, t, base, L, PP, Q)
+        _sample_any(n, t, base, L, PP, M0, Q)
+    if blocks:
+        _sample_blocks(n, t, base, L, PP, models, Q)
     if energies:
         for c in range(n):
             if L[_at(R_FAILED, c)] == 0.0:
@@ -314,7 +363,7 @@ def _keep(exact, n, t, base, L, PP, Q, columns, energies, out, out_flags, lane0,
 
 
 @njit(**_JIT)
-def _vector_pass(exact, slipping, solver, n, h, L, T, PP, bases, b_end):
+def _vector_pass(exact, slipping, solver, n, h, L, T, PP, M0, bases, b_end):
     """Pass 1: the Runge-Kutta step of every lane; returns how many lanes it flagged.
 
     Stage by stage (``K.tableau``, in the order of ``K.rk_step``) with the
@@ -328,34 +377,45 @@ def _vector_pass(exact, slipping, solver, n, h, L, T, PP, bases, b_end):
         base = bases[stage]
         if stage == 0:
             if exact:
-                _first_stage_exact(n, a_next, weight, base, L, T, PP)
+                _first_stage_exact(n, a_next, weight, base, L, T, PP, M0)
             else:
-                _first_stage_any(n, a_next, weight, base, L, T, PP)
+                _first_stage_any(n, a_next, weight, base, L, T, PP, M0)
         elif exact:
-            _stage_exact(n, a_next, weight, base, L, T, PP)
+            _stage_exact(n, a_next, weight, base, L, T, PP, M0)
         else:
-            _stage_any(n, a_next, weight, base, L, T, PP)
+            _stage_any(n, a_next, weight, base, L, T, PP, M0)
     if slipping:
-        return _finish_slipping(n, b_end, L, T, PP)
-    return _finish_any(n, b_end, L, T, PP)
+        return _finish_slipping(n, b_end, L, T, PP, M0)
+    return _finish_any(n, b_end, L, T, PP, M0)
+
+
+@njit(**_JIT, inline="always")
+def _sample_times(step, control_steps, linear_steps):
+    """Does the sampled controller (PI and its blocks), and does a discrete linear
+    controller, sample at ``step``?"""
+    return (control_steps > 0 and step % control_steps == 0,
+            linear_steps > 0 and step % linear_steps == 0)
 
 
 @njit(**_JIT, nogil=True)
-def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, table, columns,
-              out, out_flags, lane0, row0, status, rows):
+def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models, ex, table,
+              columns, out, out_flags, lane0, row0, status, rows):
     """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
 
-    Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``) and ``params``
-    (``K.N_PARAMS``) is case ``c``; the excitation ``ex, table`` is shared. A sample of case
+    Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
+    (``K.N_PARAMS``) and ``models`` (``K.N_MODEL``, the controller's blocks) is case ``c``;
+    the excitation ``ex, table`` is shared. A sample of case
     ``c`` goes to ``out[column, lane0 + c, row]`` for each channel of ``columns`` (``K.C_*``;
     the other channels are not computed, but the energies only if asked) and to
-    ``out_flags[flag, lane0 + c, row]`` for both flags (``K.O_*``), rows from ``row0``. ``states`` and ``flags`` carry the
+    ``out_flags[flag, lane0 + c, row]`` for both flags (``K.O_*``), rows from ``row0``.
+    ``states`` and ``flags`` carry the
     cases between calls. A case whose ``status`` is not ``K.STATUS_OK`` is left
     alone; one that diverges (non-finite, beyond 100 strokes or 1e4 m/s) gets
     ``K.STATUS_DIVERGED``, keeps its last finite state and, in ``flags[c,
     K.I_STEP]``, that state's step. ``rows[c]`` gets the rows case ``c`` wrote.
     At most ``MAX_LANES`` cases per call: returns ``K.STATUS_OK``, or
-    ``STATUS_TOO_MANY_LANES`` (and does nothing) for more.
+    ``STATUS_TOO_MANY_LANES`` (and does nothing) for more. A case whose controller has
+    blocks beyond PI + damping is stepped in pass 2 at every step.
     """
     n = states.shape[0]
     if n > MAX_LANES:
@@ -365,11 +425,13 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
     L = np.zeros(N_ROWS * W)
     T = np.zeros(N_SCRATCH * W)
     Q = np.zeros(N_RECORD * W)
+    M0 = np.zeros(K.N_MODEL)
     energies = False
     for k in range(columns.size):
-        energies = energies or columns[k] >= K.C_E_KINETIC
+        energies = energies or K.C_E_KINETIC <= columns[k] <= K.C_E_STOP
     failed_step = np.full(n, -1, dtype=np.int64)
     sampled = False
+    blocks = False
     for c in range(n):
         for i in range(K.N_PARAMS):
             PP[_at(i, c)] = params[c, i]
@@ -381,8 +443,11 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         L[_at(R_CONTACTS, c)] = flags[c, K.I_N_CONTACTS]
         L[_at(R_STICKS, c)] = flags[c, K.I_N_STICKS]
         L[_at(R_FAILED, c)] = 0.0 if status[c] == K.STATUS_OK else 1.0
+        L[_at(R_BLOCKS, c)] = 1.0 if models[c, K.M_BLOCKS] != 0.0 else 0.0
         rows[c] = 0
-        sampled = sampled or params[c, K.P_CONTROL_STEPS] > 0.0
+        sampled = (sampled or params[c, K.P_CONTROL_STEPS] > 0.0
+                   or models[c, K.M_LINEAR_STEPS] > 0.0)
+        blocks = blocks or models[c, K.M_BLOCKS] != 0.0
     h = params[0, K.P_DT] if n > 0 else 0.0
     exact = True  # every lane of the exact model (fixed for the call)
     locked = 0  # lanes stuck or resting on a plastic stop (their mode changes in pass 2 only)
@@ -403,25 +468,43 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
         t = step * h
         if sampled:
             for c in range(n):
-                control_steps = int(PP[_at(K.P_CONTROL_STEPS, c)])
-                if control_steps > 0 and step % control_steps == 0 and L[_at(R_FAILED, c)] == 0.0:
-                    held, s = K.sample_controller(t, _state(L, c), int(L[_at(R_MODE, c)]),
-                                                  _params(PP, c), E, table)
-                    L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)] = held
+                if L[_at(R_FAILED, c)] != 0.0:
+                    continue
+                controller, linear = _sample_times(step, int(PP[_at(K.P_CONTROL_STEPS, c)]),
+                                                   int(models[c, K.M_LINEAR_STEPS]))
+                if controller or linear:
+                    s = _state(L, c)
+                    held = _held(L, c)
+                    mode = int(L[_at(R_MODE, c)])
+                    direction = int(L[_at(R_DIRECTION, c)])
+                    if controller:
+                        held, s = K.sample_controller(t, s, mode, direction, held,
+                                                      _params(PP, c), models[c], E, table)
+                    if linear:
+                        held, s = K.sample_linear(t, s, mode, direction, held, _params(PP, c),
+                                                  models[c], E, table)
+                    (L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)],
+                     L[_at(K.A_F_COMPENSATION, c)], L[_at(K.A_F_DITHER, c)],
+                     L[_at(K.A_F_LINEAR, c)]) = held
                     L[_at(K.S_INT, c)] = s[K.S_INT]
+                    if L[_at(R_BLOCKS, c)] != 0.0:
+                        for i in range(K.S_X0, K.N_ODE):
+                            L[_at(i, c)] = s[i]
                     L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
-        if _vector_pass(exact, locked == 0, solver, lanes, h, L, T, PP, bases, b_end) > 0:
+        if _vector_pass(exact, locked == 0, solver, lanes, h, L, T, PP, M0, bases, b_end) > 0:
             for c in range(n):  # pass 2: the flagged lanes
                 if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
                 P = _params(PP, c)
                 s1, mode, direction, margin, sticks, impacts = K.grid_step(
                     solver, t, h, _state(L, c), int(L[_at(R_MODE, c)]),
-                    int(L[_at(R_DIRECTION, c)]), _held(L, c), P, E, table,
-                    L[_at(R_MARGIN, c)], phase, sin0, cos0)
-                if not _finite(s1, P):
+                    int(L[_at(R_DIRECTION, c)]), _held(L, c), P, models[c],
+                    L[_at(R_BLOCKS, c)] != 0.0, E, table, L[_at(R_MARGIN, c)], phase, sin0,
+                    cos0)
+                if not _finite(s1, P) or (L[_at(R_BLOCKS, c)] != 0.0
+                                          and not _finite_blocks(s1)):
                     L[_at(R_FAILED, c)] = 1.0
                     failed_step[c] = step
                     rows[c] = row - row0
@@ -438,8 +521,8 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
                                           step % K.PHASE_PERIOD == 0)
         if step % decimation == 0:
             base = base_motion_near(step * h, phase, sin0, cos0, E, table)
-            _keep(exact, lanes, step * h, base, L, PP, Q, columns, energies, out, out_flags,
-                  lane0, row)
+            _keep(exact, lanes, step * h, base, L, PP, M0, models, blocks, Q, columns,
+                  energies, out, out_flags, lane0, row)
             row += 1
 
     for c in range(n):
@@ -462,12 +545,13 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, ex, tab
 
 
 @njit(**_JIT, nogil=True)
-def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out_flags, row0):
+def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, out_flags, row0):
     """One case: :func:`run_lanes` with a single lane, without the lanes' bookkeeping.
 
     Every step is :func:`qzs.engine.kernels.grid_step`, which takes the very same
     operations as a lane's step in :func:`run_lanes` (pass 1 for an ordinary
     step, pass 2 for one with a transition), so the numbers are identical.
+    ``m`` holds the controller's blocks (``K.M_*``).
     Returns ``(status, rows_written)``; on divergence ``state`` holds the last
     finite state and ``flags[K.I_STEP]`` its step.
     """
@@ -475,8 +559,10 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
     E = excitation_tuple(ex)
     h = P[K.P_DT]
     control_steps = int(P[K.P_CONTROL_STEPS])
-    s = (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
-    held = (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR])
+    linear_steps = int(m[K.M_LINEAR_STEPS])
+    blocks = m[K.M_BLOCKS] != 0.0
+    s = K.state_tuple(state)
+    held = K.held_tuple(state)
     mode = flags[K.I_MODE]
     direction = flags[K.I_DIRECTION]
     contact = flags[K.I_CONTACT]
@@ -487,12 +573,18 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
     phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, np.bool_(True))
     for _ in range(n_steps):
         t = step * h
-        if control_steps > 0 and step % control_steps == 0:
-            held, s = K.sample_controller(t, s, mode, P, E, table)
-            margin = np.nan
+        if control_steps > 0 or linear_steps > 0:
+            controller, linear = _sample_times(step, control_steps, linear_steps)
+            if controller:
+                held, s = K.sample_controller(t, s, mode, direction, held, P, m, E, table)
+                margin = np.nan
+            if linear:
+                held, s = K.sample_linear(t, s, mode, direction, held, P, m, E, table)
+                margin = np.nan
         s1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
-            solver, t, h, s, mode, direction, held, P, E, table, margin, phase, sin0, cos0)
-        if not _finite(s1, P):
+            solver, t, h, s, mode, direction, held, P, m, blocks, E, table, margin, phase,
+            sin0, cos0)
+        if not _finite(s1, P) or (blocks and not _finite_blocks(s1)):
             status = K.STATUS_DIVERGED
             break
         s, mode, direction, margin = s1, mode1, direction1, margin1
@@ -507,12 +599,13 @@ def run_single(solver, n_steps, decimation, state, flags, p, ex, table, out, out
             flags[K.I_N_CONTACTS] += 1
         contact = 1 if now else 0
         if step % decimation == 0:
-            K.record(step * h, s, mode, direction, held, P, E, table, out[row], out_flags[row],
-                     phase, sin0, cos0)
+            K.record(step * h, s, mode, direction, held, P, m, E, table, out[row],
+                     out_flags[row], phase, sin0, cos0)
             row += 1
     for i in range(K.N_ODE):
         state[i] = s[i]
-    state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR] = held
+    (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR], state[K.A_F_COMPENSATION],
+     state[K.A_F_DITHER], state[K.A_F_LINEAR]) = held
     state[K.A_MARGIN] = margin
     flags[K.I_MODE] = mode
     flags[K.I_DIRECTION] = direction

@@ -12,7 +12,7 @@ from numba import njit
 from qzs.engine.arithmetic import JIT, exp, tanh
 
 __all__ = ["spring_law", "spring_energy_law", "sliding_friction_law", "compliant_stop_law",
-           "controller_law"]
+           "controller_law", "saturation_law", "compensation_law", "dither_law"]
 
 
 @njit(**JIT, inline="always")
@@ -171,7 +171,33 @@ def controller_law(z_ref, kp, ki, kd, f_max, z, v_measured, integral):
     error = z_ref - z
     f_pi = kp * error + ki * integral
     f_damp = -kd * v_measured
-    command = f_pi + f_damp
+    command, rate = saturation_law(f_pi + f_damp, error, ki, f_max)
+    return f_pi, f_damp, command, rate
+
+
+@njit(**JIT, inline="always")
+def saturation_law(command, error, ki, f_max):
+    """The motor's saturation and the PI integral's anti-windup (docs/model.md §5).
+
+    Parameters
+    ----------
+    command : float
+        Sum of the controller's forces before saturation [N].
+    error : float
+        Position error ``z_ref - z`` [m].
+    ki : float
+        Integral gain [N/(m*s)].
+    f_max : float
+        Motor force saturation [N].
+
+    Returns
+    -------
+    command : float
+        The command clipped to ``+-f_max`` [N].
+    integral_rate : float
+        Rate of the PI integral [m]: ``error``, or 0 while the motor saturates and the
+        error pushes further into saturation (conditional integration).
+    """
     rate = error
     if command > f_max:
         command = f_max
@@ -181,4 +207,62 @@ def controller_law(z_ref, kp, ki, kd, f_max, z, v_measured, integral):
         command = -f_max
         if error * ki < 0.0:
             rate = 0.0
-    return f_pi, f_damp, command, rate
+    return command, rate
+
+
+@njit(**JIT, inline="always")
+def compensation_law(v, sign, fraction, fs, fc, cbc, cv, v_reg, deadband):
+    """Friction compensation's feedforward [N]: a fraction of the friction law, cancelled.
+
+    ``-fraction * F_friction(v)`` with the compensator's own friction parameters
+    (:func:`sliding_friction_law`, the same law), 0 within the velocity deadband
+    ``|v| <= deadband``; so 0 at ``v = 0`` (stuck). It pushes along the slip.
+
+    Parameters
+    ----------
+    v : float
+        Measured relative (slip) velocity [m/s].
+    sign : float
+        Slip direction, +1 or -1, as the friction law takes it.
+    fraction : float
+        Fraction of the friction law compensated [-], in [0, 1.5].
+    fs, fc : float
+        The compensator's stiction and Coulomb forces [N].
+    cbc : float
+        The compensator's Stribeck decay coefficient [s/m].
+    cv : float
+        The compensator's viscous friction coefficient [N*s/m].
+    v_reg : float
+        The plant's regularisation velocity [m/s] (0: exact model).
+    deadband : float
+        Velocity deadband [m/s].
+
+    Returns
+    -------
+    float
+        Compensation force on the payload [N].
+    """
+    if abs(v) <= deadband:
+        return 0.0
+    return -fraction * sliding_friction_law(v, sign, fs, fc, cbc, cv, v_reg)
+
+
+@njit(**JIT, inline="always")
+def dither_law(t, amplitude, omega):
+    """Dither force ``amplitude * sin(omega * t)`` [N] at time ``t`` [s].
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    amplitude : float
+        Dither amplitude [N].
+    omega : float
+        Dither angular frequency [rad/s].
+
+    Returns
+    -------
+    float
+        Dither force [N].
+    """
+    return amplitude * np.sin(omega * t)

@@ -17,7 +17,8 @@ import numpy as np
 
 from qzs._format import STEP_RECORD_UNITS
 from qzs.iotools.schema import CONVENTIONS, NONE_VALUE
-from qzs.model.registry import unit_of
+from qzs.model.controller import block_parameters
+from qzs.model.registry import parameter_fields, unit_of
 
 __all__ = ["RUN_UNITS", "parameter_metadata", "run_metadata", "history_line",
            "file_attributes"]
@@ -63,9 +64,11 @@ def parameter_metadata(isolator, controller, excitation):
     """
     meta = {}
     for section, params in (("isolator", isolator), ("controller", controller)):
-        for field in dataclasses.fields(params):
+        for field in parameter_fields(params):
             meta[f"{section}.{field.name}"] = (_plain(getattr(params, field.name)),
                                                unit_of(field.name))
+    for name, (value, unit) in block_parameters(controller).items():
+        meta[f"controller.{name}"] = (_plain(value), unit)
     meta["excitation"] = (type(excitation).__name__, "")
     for field in dataclasses.fields(excitation):
         value = getattr(excitation, field.name)

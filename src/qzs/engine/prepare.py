@@ -9,13 +9,14 @@ from qzs.engine import kernels as K
 from qzs.engine.base_motion import base_motion_series
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError, UnresolvedExcitationError
+from qzs.model.controller import SENSORS as K_SENSORS
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, Sine,
                                   highest_frequency)
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "run_inputs", "run_duration", "steps_per_sample",
+__all__ = ["PreparedRun", "prepare_run", "pack_model", "run_inputs", "run_duration", "steps_per_sample",
            "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
 
@@ -56,6 +57,73 @@ def _pack_parameters(isolator, controller, dt, control_steps):
     p[K.P_DT] = dt
     p[K.P_VREG] = isolator.friction_regularisation
     return p
+
+
+def pack_model(isolator, controller, dt):
+    """The controller's blocks beyond PI + damping packed for the kernels (``K.M_*``).
+
+    All zeros for PI + damping alone (the kernels then take exactly its operations). Checks
+    what needs the step: a discrete linear controller's sample time must be a whole number
+    of integration steps.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        The plant (the compensator's friction law where it sets none).
+    controller : ControllerParameters
+        The controller.
+    dt : float
+        Integration step [s].
+
+    Returns
+    -------
+    ndarray, shape (N_MODEL,)
+
+    Raises
+    ------
+    ParameterError
+        A discrete linear controller's sample time that is not a whole number of steps.
+    """
+    m = np.zeros(K.N_MODEL)
+    if not controller.has_blocks:
+        return m
+    m[K.M_BLOCKS] = 1.0
+    compensation = controller.compensation
+    if compensation is not None:
+        m[K.M_COMP_FRACTION] = compensation.fraction
+        (m[K.M_COMP_FS], m[K.M_COMP_FC], m[K.M_COMP_CBC],
+         m[K.M_COMP_CV]) = compensation.law(isolator)
+        m[K.M_COMP_DEADBAND] = compensation.deadband
+        m[K.M_OBSERVER_RATE] = 2 * np.pi * compensation.observer_bandwidth
+    if controller.dither is not None:
+        m[K.M_DITHER_AMPLITUDE] = controller.dither.amplitude
+        m[K.M_DITHER_OMEGA] = 2 * np.pi * controller.dither.frequency
+    linear = controller.linear
+    if linear is not None:
+        n = linear.states
+        m[K.M_LINEAR] = 1.0
+        m[K.M_LINEAR_STATES] = n
+        if linear.discrete:
+            steps = linear.sample_time / dt
+            if abs(steps - round(steps)) > 1e-6 * steps or round(steps) < 1:
+                near = max(round(steps), 1)
+                raise ParameterError(
+                    f"`sample_time` of the LinearController ({linear.sample_time!r} s) must "
+                    f"be a whole number of integration steps (dt = {dt!r} s), got {steps:g} "
+                    f"steps; use sample_time={near * dt:g} s, or a dt that divides it.",
+                    ("sample_time",))
+            m[K.M_LINEAR_STEPS] = round(steps)
+        a, b, c, d = linear.matrices()
+        columns = [list(K_SENSORS).index(name) for name in linear.inputs]
+        for i in range(n):
+            m[K.M_A + i * K.NX_MAX:K.M_A + i * K.NX_MAX + n] = a[i]
+            for j, column in enumerate(columns):
+                m[K.M_B + i * K.N_SENSORS + column] = b[i, j]
+            m[K.M_C + i] = c[0, i]
+        for j, column in enumerate(columns):
+            m[K.M_D + column] = d[0, j]
+        m[K.M_ANTIWINDUP:K.M_ANTIWINDUP + n] = linear.antiwindup_gain()
+    return m
 
 
 def steps_per_sample(rate, dt, name="sample_rate", *, rounding="exact"):
@@ -199,7 +267,7 @@ def _check_type(name, value, kinds):
         raise ParameterError(f"`{name}` must be a {names}, got {type(value).__name__}.")
 
 
-def _initial_state(initial, isolator, controller, p, excitation, packed_excitation):
+def _initial_state(initial, isolator, controller, p, m, excitation, packed_excitation):
     """State vector and flags at t = 0 (at rest at the setpoint by default)."""
     s = np.zeros(K.N_STATE)
     s[K.A_MARGIN] = np.nan  # not known yet: the first step works it out
@@ -213,21 +281,29 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     s[K.S_V] = initial.relative_velocity
     yd0 = base_motion_series(excitation, [0.0])[1][0]
     s[K.S_HP] = yd0 + initial.relative_velocity  # the amplifier's high-pass has settled
-    measured = K.hold_force(0.0, s, p, *packed_excitation)[K.F_V_MEASURED]
+    measured = K.hold_force(0.0, s, p, m, *packed_excitation)[K.F_V_MEASURED]
     if initial.pi_integral is not None:
         s[K.S_INT] = initial.pi_integral
     elif controller.pi_ki > 0:
         # Preload: the motor carries the static load the spring and stops do not, nothing
         # more. Evaluated with the base at rest: the base's acceleration at t = 0 is no load
         # the integrator should hold (docs/model.md §11).
-        force = K.hold_force(0.0, s, p, *_AT_REST)
+        force = K.hold_force(0.0, s, p, m, *_AT_REST)
         without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
         needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
         f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, measured, 0.0)[:2]
-        s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
+        if controller.has_blocks:  # the blocks' static output at t = 0 too
+            blocks = force[K.F_COMPENSATION] + force[K.F_DITHER] + force[K.F_LINEAR]
+            s[K.S_INT] = (needed - f_pi - f_damp - blocks) / controller.pi_ki
+        else:
+            s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
+    if controller.linear is not None:
+        _preload_linear(s, p, m, controller, packed_excitation, initial.pi_integral is None)
     held = K.controller_output(K.params_tuple(p), z0, measured, s[K.S_INT])
     s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
-    force = K.hold_force(0.0, s, p, *packed_excitation)
+    if controller.has_blocks:
+        _hold_blocks(s, p, m, packed_excitation)
+    force = K.hold_force(0.0, s, p, m, *packed_excitation)
     f_hold = force[K.F_HOLD]
     locked = initial.locked
     regularised = isolator.friction_regularisation > 0.0
@@ -248,6 +324,53 @@ def _initial_state(initial, isolator, controller, p, excitation, packed_excitati
     return s, flags
 
 
+def _preload_linear(s, p, m, controller, packed_excitation, preload):
+    """A linear controller's state at t = 0: at equilibrium with its sensors' values there.
+
+    ``x0`` solves ``A x0 + B u0 = 0`` (least squares); and when the PI has no integral
+    (``pi_ki = 0``) and ``preload``, it also carries the static load the spring and stops do
+    not, ``C x0 + D u0 = needed - F_pi - F_damp``, if its states can (an integrator): the
+    same bumpless preload as the PI's (docs/model.md §5). Discrete: ``x0 = A x0 + B u0``.
+    """
+    linear = controller.linear
+    n = linear.states
+    if n == 0:
+        return
+    a, b, c, d = linear.matrices()
+    force = K.hold_force(0.0, s, p, m, *packed_excitation)
+    u_all = np.array([p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD],
+                      force[K.F_YDD], 0.0])
+    u0 = u_all[[list(K_SENSORS).index(name) for name in linear.inputs]]
+    system = a - np.eye(n) if linear.discrete else a
+    rows, rhs = [system], [-(b @ u0)]
+    if preload and controller.pi_ki == 0:
+        at_rest = K.hold_force(0.0, s, p, m, *_AT_REST)
+        needed = np.clip(at_rest[K.F_HOLD] + at_rest[K.F_MOTOR], -p[K.P_FMAX], p[K.P_FMAX])
+        loaded = np.vstack([system, c])
+        target = np.concatenate([-(b @ u0), [needed - at_rest[K.F_PI] - at_rest[K.F_DAMP]
+                                             - float(d[0] @ u0)]])
+        x0 = np.linalg.lstsq(loaded, target, rcond=None)[0]
+        if np.allclose(loaded @ x0, target, rtol=1e-9, atol=1e-12 * max(1.0, abs(needed))):
+            s[K.S_X0:K.S_X0 + n] = x0
+            return
+    s[K.S_X0:K.S_X0 + n] = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+
+
+def _hold_blocks(s, p, m, packed_excitation):
+    """The held outputs of sampled blocks at t = 0: what they put out at the initial state.
+
+    The kernels sample at step 0 before the first step, so these only matter for the
+    first record and the holding force at t = 0; a continuous block's held value is unused.
+    """
+    force = K.hold_force(0.0, s, p, m, *packed_excitation)
+    s[K.A_F_COMPENSATION] = force[K.F_COMPENSATION]
+    s[K.A_F_DITHER] = force[K.F_DITHER]
+    if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's first output: D u at x = 0
+        u = (p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD], force[K.F_YDD],
+             0.0)
+        s[K.A_F_LINEAR] = float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], u))
+
+
 @dataclass
 class PreparedRun:
     """Everything the kernels need for one run, validated (see :func:`prepare_run`).
@@ -262,6 +385,8 @@ class PreparedRun:
         PI and damping loops.
     params : ndarray, shape (N_PARAMS,)
         The packed parameters of the kernels (:mod:`qzs.engine.kernels` ``P_*``).
+    model : ndarray, shape (N_MODEL,)
+        The controller's blocks packed for the kernels (``M_*``, :func:`pack_model`).
     packed : tuple
         The excitation's kernel form ``(scalars, table)`` (its ``pack()``).
     state : ndarray, shape (N_STATE,)
@@ -284,6 +409,7 @@ class PreparedRun:
     isolator: IsolatorParameters
     controller: ControllerParameters
     params: np.ndarray
+    model: np.ndarray
     packed: tuple
     state: np.ndarray
     flags: np.ndarray
@@ -384,9 +510,10 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
         control_steps = steps_per_sample(controller.controller_rate, dt, "controller_rate")
 
     p = _pack_parameters(isolator, controller, dt, control_steps)
+    m = pack_model(isolator, controller, dt)
     packed = excitation.pack()
-    s, flags = _initial_state(initial_state, isolator, controller, p, excitation, packed)
-    return PreparedRun(excitation, isolator, controller, p, packed, s, flags, duration,
+    s, flags = _initial_state(initial_state, isolator, controller, p, m, excitation, packed)
+    return PreparedRun(excitation, isolator, controller, p, m, packed, s, flags, duration,
                        decimation, solver_code, dt, sample_rate)
 
 

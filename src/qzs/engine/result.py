@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from qzs.engine.channels import CHANNELS, FLAGS, named_block, simulation_schema
+from qzs.engine.channels import CHANNELS, FLAGS, named_block, run_channels, simulation_schema
 from qzs.engine.metadata import file_attributes, parameter_metadata, run_metadata
 from qzs.engine.result_file import save_result
 from qzs.iotools.schema import to_dataset
@@ -70,6 +70,7 @@ class SimulationResult:
         self._flags = flags
         self.isolator = isolator
         self.controller = controller
+        self._channels = run_channels(controller)
         self.excitation = excitation
         self.run = run
         self._statistics = statistics
@@ -89,15 +90,23 @@ class SimulationResult:
             self._statistics = statistics.result()
         return self._statistics
 
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """The names of the run's channels and flags (the controller's blocks' included)."""
+        return (*self._channels, *FLAGS)
+
     def __getitem__(self, name: str) -> NDArray[Any]:
-        if name in CHANNELS:
-            return self._data[:, CHANNELS[name][0]]
+        if name in self._channels:
+            return self._data[:, self._channels[name][0]]
         if name in FLAGS:
             return self._flags[:, FLAGS[name][0]]
-        raise KeyError(f"no channel {name!r}; channels are {', '.join([*CHANNELS, *FLAGS])}.")
+        raise KeyError(f"no channel {name!r}; channels are {', '.join(self.channels)}"
+                       + (" (a block's channel is there only when the controller has the "
+                          "block)" if name not in CHANNELS else "") + ".")
 
     def __getattr__(self, name: str) -> NDArray[Any]:
-        if name.startswith("_") or (name not in CHANNELS and name not in FLAGS):
+        if name.startswith("_") or (name not in self.__dict__.get("_channels", CHANNELS)
+                                    and name not in FLAGS):
             raise AttributeError(name)
         return self[name]
 
@@ -151,7 +160,7 @@ class SimulationResult:
         docs/model.md §7), except that the flags stay boolean and ``None`` parameters are
         ``"none"`` (listed in ``none_parameters``).
         """
-        schema = simulation_schema()
+        schema = simulation_schema(self.controller)
         head, tail = file_attributes(self.isolator, self.controller, self.excitation, self.run)
         return to_dataset(schema, {name: self[name] for name in schema.names},
                           {**head, **tail}, boolean_flags=True)

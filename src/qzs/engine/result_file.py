@@ -11,8 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from qzs.engine import kernels as K
-from qzs.engine.channels import CHANNELS, FLAGS, simulation_schema
+from qzs.engine.channels import FLAGS, channel_count, run_channels, simulation_schema
 from qzs.engine.metadata import file_attributes
 from qzs.errors import ParameterError
 from qzs.iotools import files
@@ -25,8 +24,13 @@ __all__ = ["RESULT_SUFFIXES", "ResultWriter", "estimated_size", "save_result", "
 
 #: File formats of a run's result: suffix -> name.
 RESULT_SUFFIXES = files.RESULT_SUFFIXES
-#: Where a run's output rows go in its file: variable -> (block, column) of ``(data, flags)``.
-_COLUMNS = {**{name: ("data", column) for name, (column, _, _) in CHANNELS.items()},
+
+
+def _columns(controller):
+    """Where a run's output rows go in its file: variable -> (block, column) of
+    ``(data, flags)``."""
+    return {**{name: ("data", column) for name, (column, _, _)
+               in run_channels(controller).items()},
             **{name: ("flags", column) for name, (column, _) in FLAGS.items()}}
 
 
@@ -81,8 +85,9 @@ class ResultWriter(StreamWriter):
     def __init__(self, path, *, isolator, controller, excitation):
         self._parameters = (isolator, controller, excitation)
         head, _ = file_attributes(isolator, controller, excitation, None)
-        super().__init__(path, simulation_schema(), blocks={"data": K.N_CHANNELS, "flags": 2},
-                         columns=_COLUMNS, attributes=head, suffixes=tuple(RESULT_SUFFIXES))
+        super().__init__(path, simulation_schema(controller),
+                         blocks={"data": channel_count(controller), "flags": 2},
+                         columns=_columns(controller), attributes=head, suffixes=tuple(RESULT_SUFFIXES))
 
     def finish(self, run):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.
@@ -197,4 +202,4 @@ def read_result(path: str | Path) -> xr.Dataset:
         Missing or unreadable file, or a CSV without a header line or with mismatched
         columns.
     """
-    return files.read_result(path, simulation_schema())
+    return files.read_result(path, simulation_schema(every_block=True))

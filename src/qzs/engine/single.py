@@ -12,7 +12,7 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.channels import named_block
+from qzs.engine.channels import channel_count, named_block
 from qzs.engine.result import SimulationResult
 from qzs.errors import SimulationError
 
@@ -66,13 +66,13 @@ def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
     p = run.params
     statistics = SummaryStatistics(0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]),
                                    run.isolator.motor_force_max)
-    recorder = driver.Recorder(plan, K.N_CHANNELS, 2, sink=sink,
+    recorder = driver.Recorder(plan, channel_count(run.controller), 2, sink=sink,
                                statistics=lambda data, flags: statistics.add(
                                    named_block(data, flags)),
                                duration=run.duration, sample_rate=run.sample_rate)
     stepper = SingleAxis(run, recorder.buffers)
     data, marks = recorder.buffers[0]
-    K.evaluate(0.0, run.state, run.flags, p, *run.packed, data[0], marks[0])
+    K.evaluate(0.0, run.state, run.flags, p, run.model, *run.packed, data[0], marks[0])
     recorder.absorb(0, 0, 1)
     outcome = driver.drive(stepper, plan, recorder, progress="simulating" if progress else None,
                            interruptible=interruptible)
@@ -128,8 +128,8 @@ class SingleAxis(driver.Stepper):
         run = self.run
         data, marks = self.buffers[buffer]
         status, written = _lanes.run_single(run.solver_code, steps, run.decimation, run.state,
-                                            run.flags, run.params, *run.packed, data, marks,
-                                            row0)
+                                            run.flags, run.params, run.model, *run.packed,
+                                            data, marks, row0)
         self.diverged = status != K.STATUS_OK
         return written
 

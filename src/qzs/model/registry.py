@@ -20,7 +20,7 @@ from qzs.model.isolator import IsolatorParameters
 
 __all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "EXCITATION_PARAMETERS", "parameter_info",
            "model_inputs",
-           "unit_of",
+           "unit_of", "parameter_fields",
            "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
            "format_value"]
 
@@ -67,7 +67,7 @@ def _info(section, field, name=None):
 #: Model parameters: name -> :class:`ParameterInfo`, isolator first, then controller.
 PARAMETERS = MappingProxyType({
     f.name: _info(section, f) for section, cls in SECTIONS.items()
-    for f in dataclasses.fields(cls)})
+    for f in dataclasses.fields(cls) if not f.metadata.get("block")})
 
 
 #: Excitation parameters by kind: the factory's options, and the run's duration where the
@@ -130,6 +130,24 @@ def unit_of(name, kind=None):
         Excitation kind, for excitation options.
     """
     return parameter_info(name, kind).unit
+
+
+def parameter_fields(params):
+    """The registry parameters of an isolator's or a controller's fields, in field order.
+
+    A controller's blocks (:data:`qzs.model.controller.BLOCKS`) are no parameters of the
+    registry: :func:`qzs.model.controller.block_parameters` lists theirs.
+
+    Parameters
+    ----------
+    params : IsolatorParameters or ControllerParameters
+        The values.
+
+    Returns
+    -------
+    list of dataclasses.Field
+    """
+    return [field for field in dataclasses.fields(params) if not field.metadata.get("block")]
 
 
 def numeric_parameters():

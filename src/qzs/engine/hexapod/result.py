@@ -25,7 +25,7 @@ from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
 from qzs.iotools.schema import CONVENTIONS, Schema, Variable, time_coordinate, to_dataset
 from qzs.iotools.writer import StreamWriter, estimated_file_size
-from qzs.model.registry import unit_of
+from qzs.model.registry import parameter_fields, unit_of
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -411,7 +411,7 @@ class HexapodResult:
             meta[f"platform.{field.name}"] = (getattr(self.platform, field.name),
                                               field.metadata.get("unit", ""))
         for section, objects in (("isolator", self.isolators), ("controller", self.controllers)):
-            for field in dataclasses.fields(objects[0]):
+            for field in parameter_fields(objects[0]):
                 values = [getattr(o, field.name) for o in objects]
                 value = values[0] if all(v == values[0] for v in values) else values
                 meta[f"{section}.{field.name}"] = (value, unit_of(field.name))

@@ -267,11 +267,12 @@ def _csv(response):
 
 
 def _parameter_attributes(isolator, controller):
-    from qzs.model.registry import unit_of
+    from qzs.model.controller import block_parameters
+    from qzs.model.registry import parameter_fields, unit_of
 
     attrs = {}
     for section, params in (("isolator", isolator), ("controller", controller)):
-        for item in dataclasses.fields(params):
+        for item in parameter_fields(params):
             value = getattr(params, item.name)
             if value is None:
                 value = "none"
@@ -279,5 +280,8 @@ def _parameter_attributes(isolator, controller):
                 value = int(value)
             attrs[f"{section}.{item.name}"] = value
             attrs[f"{section}.{item.name}_units"] = unit_of(item.name)
+    for name, (value, unit) in block_parameters(controller).items():
+        attrs[f"controller.{name}"] = "none" if value is None else value
+        attrs[f"controller.{name}_units"] = unit
     return attrs
 

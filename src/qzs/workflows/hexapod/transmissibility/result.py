@@ -420,7 +420,7 @@ def transmissibility_dataset(result):
     import datetime
 
     from qzs._version import __version__
-    from qzs.model.registry import unit_of
+    from qzs.model.registry import parameter_fields, unit_of
 
     values = {
         "magnitude": result.magnitude, "phase": np.angle(result.response),
@@ -466,7 +466,7 @@ def transmissibility_dataset(result):
 
     setup = result.setup
     for section, obj in (("isolator", setup.isolator), ("controller", setup.controller)):
-        for item in dataclasses.fields(obj):
+        for item in parameter_fields(obj):
             attrs[f"{section}.{item.name}"] = _attribute(getattr(obj, item.name))
             unit = unit_of(item.name)
             if unit:
