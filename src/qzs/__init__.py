@@ -35,8 +35,9 @@ from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, Excita
                         FitError, FitWarning, MissingDependencyError, OutputPathError,
                         ParameterError, ProblemError, ResultTooLargeError, SimulationError,
                         SizeLimitError, StabilityError, ToleranceNotMetError)
-from qzs.model import (Chirp, ControllerParameters, DisplacementRecord, InitialState,
-                       IsolatorParameters, RandomExcitation, Sine, closed_loop_natural_frequency,
+from qzs.model import (Chirp, ControllerParameters, Dither, DisplacementRecord,
+                       FrictionCompensation, InitialState, IsolatorParameters, LinearController,
+                       PIDamping, RandomExcitation, Sine, closed_loop_natural_frequency,
                        friction_force, passive_natural_frequency, spring_force, spring_stiffness)
 
 # Loaded on first use, so that ``import qzs`` stays lean (PEP 562).
@@ -111,6 +112,7 @@ __all__ = [
     "__version__",
     "Chirp", "Sine", "RandomExcitation", "DisplacementRecord",
     "IsolatorParameters", "ControllerParameters", "InitialState",
+    "PIDamping", "FrictionCompensation", "Dither", "LinearController",
     "spring_force", "spring_stiffness", "friction_force",
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",

@@ -389,7 +389,7 @@ class _Lanes(driver.Stepper):
                     self.single[a] = (np.empty((self.buffer.shape[2], K.N_CHANNELS)),
                                       np.zeros((self.buffer.shape[2], 2), dtype=np.bool_))
                 data, marks = self.single[a]
-                self.status[a], self.written[a] = _lanes.run_single(
+                self.status[a], self.written[a] = _lanes.single_kernel(self.models[a])(
                     self.solver, steps, self.decimation, self.states[a], self.flags[a],
                     self.params[a], self.models[a], self.ex, self.table, data, marks, 0)
                 written = self.written[a]

@@ -275,8 +275,17 @@ def rhs_at(t, s, mode, direction, held, P, M, E, table):
 
 
 @njit(**_JIT, inline="always")
-def _axpy(s, a, k):
-    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`)."""
+def _axpy(s, a, k, blocks=True):
+    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`).
+
+    Without ``blocks`` (a constant where it is inlined) the controller blocks' states pass
+    through: their rates are 0 then, and the default controller's hot path skips them.
+    """
+    if not blocks:
+        return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]),
+                fma(a, k[3], s[3]), fma(a, k[4], s[4]), fma(a, k[5], s[5]),
+                fma(a, k[6], s[6]), fma(a, k[7], s[7]), s[8], s[9], s[10], s[11], s[12],
+                s[13], s[14], s[15], s[16])
     return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]), fma(a, k[3], s[3]),
             fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]),
             fma(a, k[8], s[8]), fma(a, k[9], s[9]), fma(a, k[10], s[10]),
@@ -346,9 +355,9 @@ def rk_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, phas
     for stage in range(n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
         y, yd, ydd = base_motion_near(t + offset, phase, sin0, cos0, E, table)
-        k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k), mode, direction,
-                held, P, M, blocks)[0]
-        result = _axpy(result, weight, k)
+        k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k, blocks), mode,
+                direction, held, P, M, blocks)[0]
+        result = _axpy(result, weight, k, blocks)
     return result
 
 

@@ -544,6 +544,12 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
     return K.STATUS_OK
 
 
+def single_kernel(model):
+    """The one-case kernel for a controller packed as ``model`` (``K.M_*``):
+    :func:`run_single`, or :func:`run_single_blocks` when it has blocks beyond PI + damping."""
+    return run_single_blocks if model[K.M_BLOCKS] != 0.0 else run_single
+
+
 @njit(**_JIT, nogil=True)
 def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, out_flags, row0):
     """One case: :func:`run_lanes` with a single lane, without the lanes' bookkeeping.
@@ -551,16 +557,36 @@ def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, 
     Every step is :func:`qzs.engine.kernels.grid_step`, which takes the very same
     operations as a lane's step in :func:`run_lanes` (pass 1 for an ordinary
     step, pass 2 for one with a transition), so the numbers are identical.
-    ``m`` holds the controller's blocks (``K.M_*``).
+    ``m`` holds the controller's blocks (``K.M_*``): this kernel is for PI + damping alone
+    (``m`` all zeros), :func:`run_single_blocks` for a controller with blocks.
     Returns ``(status, rows_written)``; on divergence ``state`` holds the last
     finite state and ``flags[K.I_STEP]`` its step.
     """
+    return _run_single(False, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
+                       out_flags, row0)
+
+
+@njit(**_JIT, nogil=True)
+def run_single_blocks(solver, n_steps, decimation, state, flags, p, m, ex, table, out,
+                      out_flags, row0):
+    """:func:`run_single` for a controller with blocks beyond PI + damping (``m``).
+
+    One kernel for every such controller (its blocks are data), compiled on its first use;
+    the same operations as a lane of :func:`run_lanes` with blocks (its pass 2).
+    """
+    return _run_single(True, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
+                       out_flags, row0)
+
+
+@njit(**_JIT, inline="always")
+def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
+                out_flags, row0):
+    """The body of :func:`run_single` and :func:`run_single_blocks` (``blocks`` a constant)."""
     P = K.params_tuple(p)
     E = excitation_tuple(ex)
     h = P[K.P_DT]
     control_steps = int(P[K.P_CONTROL_STEPS])
-    linear_steps = int(m[K.M_LINEAR_STEPS])
-    blocks = m[K.M_BLOCKS] != 0.0
+    linear_steps = int(m[K.M_LINEAR_STEPS]) if blocks else 0
     s = K.state_tuple(state)
     held = K.held_tuple(state)
     mode = flags[K.I_MODE]
@@ -578,7 +604,7 @@ def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, 
             if controller:
                 held, s = K.sample_controller(t, s, mode, direction, held, P, m, E, table)
                 margin = np.nan
-            if linear:
+            if blocks and linear:
                 held, s = K.sample_linear(t, s, mode, direction, held, P, m, E, table)
                 margin = np.nan
         s1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(

@@ -365,10 +365,11 @@ def _hold_blocks(s, p, m, packed_excitation):
     force = K.hold_force(0.0, s, p, m, *packed_excitation)
     s[K.A_F_COMPENSATION] = force[K.F_COMPENSATION]
     s[K.A_F_DITHER] = force[K.F_DITHER]
-    if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's first output: D u at x = 0
+    if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's output at x(0): C x + D u
         u = (p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD], force[K.F_YDD],
              0.0)
-        s[K.A_F_LINEAR] = float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], u))
+        s[K.A_F_LINEAR] = (float(np.dot(m[K.M_C:K.M_C + K.NX_MAX], s[K.S_X0:K.S_OBSERVER]))
+                           + float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], u)))
 
 
 @dataclass
@@ -534,7 +535,13 @@ def divergence_message(state, step, dt):
     str
         The message of the :class:`~qzs.errors.SimulationError`.
     """
+    controller = ""
+    blocks = np.abs(state[K.S_X0:K.N_ODE])
+    if np.any(blocks):
+        controller = (f", the controller blocks' largest state {np.max(blocks):.6g}; a linear "
+                      "controller whose states grow is unstable in the loop: check its poles "
+                      "and qzs.loop_margins")
     return (f"the simulation diverged at t = {step * dt:.6g} s (last finite state: relative "
             f"position z = {state[K.S_Z]:.6g} m, relative velocity v = {state[K.S_V]:.6g} m/s, "
-            f"PI integral {state[K.S_INT]:.6g} m*s); check the gains and parameters, or reduce "
-            "`dt`.")
+            f"PI integral {state[K.S_INT]:.6g} m*s{controller}); check the gains and "
+            "parameters, or reduce `dt`.")

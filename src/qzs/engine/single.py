@@ -127,9 +127,9 @@ class SingleAxis(driver.Stepper):
         """
         run = self.run
         data, marks = self.buffers[buffer]
-        status, written = _lanes.run_single(run.solver_code, steps, run.decimation, run.state,
-                                            run.flags, run.params, run.model, *run.packed,
-                                            data, marks, row0)
+        kernel = _lanes.single_kernel(run.model)
+        status, written = kernel(run.solver_code, steps, run.decimation, run.state, run.flags,
+                                 run.params, run.model, *run.packed, data, marks, row0)
         self.diverged = status != K.STATUS_OK
         return written
 

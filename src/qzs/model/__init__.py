@@ -6,13 +6,14 @@ The equations, signs and defaults are described in docs/model.md.
 
 ==============  ==================================================================
 ``isolator``    the plant's parameters and force laws (spring, friction), the rest state
-``controller``  the PI position loop with active damping, its closed-loop frequency
+``controller``  the controller as a value: PI + damping and the blocks that add to it
 ``excitation``  base excitations (chirp, sine, random, a displacement record)
 ``registry``    every parameter's name, unit, doc and default; ``--set`` parsing
 ``hexapod``     a six-leg platform of isolator legs: geometry, kinematics, statics
 ==============  ==================================================================
 """
-from qzs.model.controller import ControllerParameters, closed_loop_natural_frequency
+from qzs.model.controller import (ControllerParameters, Dither, FrictionCompensation,
+                                  LinearController, PIDamping, closed_loop_natural_frequency)
 from qzs.model.excitation import (EXCITATION_KINDS, EXCITATION_OPTIONS, Chirp, DisplacementRecord,
                                   RandomExcitation, Sine, build_excitation)
 from qzs.model.hexapod import (LEG_COUNT, HexapodGeometry, PlatformParameters, StrokeCheck,
@@ -27,7 +28,8 @@ from qzs.model.isolator import (STOP_MODELS, InitialState, IsolatorParameters, f
 from qzs.model.registry import (PARAMETERS, ParameterInfo, parameter_info, unit_of,
                                 update_parameters)
 
-__all__ = ["IsolatorParameters", "ControllerParameters", "InitialState", "STOP_MODELS",
+__all__ = ["IsolatorParameters", "ControllerParameters", "PIDamping", "FrictionCompensation",
+           "Dither", "LinearController", "InitialState", "STOP_MODELS",
            "Chirp", "Sine", "RandomExcitation", "DisplacementRecord", "EXCITATION_KINDS",
            "EXCITATION_OPTIONS", "build_excitation", "spring_force", "spring_stiffness",
            "spring_energy", "friction_force", "passive_natural_frequency",

@@ -1,0 +1,157 @@
+"""Tests of the controller's blocks as values (qzs.model.controller): PIDamping and what adds to it.
+
+Friction compensation, dither and a user's linear controller: what they accept, what they
+refuse (naming the argument and the fix), how they add, and what a run records of them.
+"""
+import dataclasses
+
+import control
+import numpy as np
+import pytest
+
+from qzs import (ControllerParameters, Dither, FrictionCompensation, IsolatorParameters,
+                 LinearController, ParameterError, PIDamping)
+from qzs.model.controller import MAX_STATES, SENSORS, block_parameters
+
+
+# ------------------------------------------------------------------ PIDamping and adding blocks
+def test_pidamping_is_todays_controller_and_prints_as_before_without_blocks():
+    assert PIDamping is ControllerParameters
+    default = PIDamping()
+    assert not default.has_blocks
+    assert "compensation" not in repr(default) and "linear" not in repr(default)
+    assert set(default.to_dict()) == {"position_setpoint", "pi_kp", "pi_ki", "damping_gain",
+                                      "velocity_highpass", "controller_rate"}
+    assert block_parameters(default) == {}
+
+
+def test_blocks_add_to_a_controller_each_into_its_own_slot():
+    compensation = FrictionCompensation(fraction=0.8)
+    dither = Dither(amplitude=2.0, frequency=40.0)
+    linear = LinearController.from_transfer_function([-5.0, 0.0], [1.0, 30.0])
+    controller = PIDamping(damping_gain=10.0) + compensation + dither + linear
+    assert controller.compensation is compensation and controller.dither is dither
+    assert controller.linear is linear and controller.damping_gain == 10.0
+    assert controller.has_blocks
+    assert (linear + PIDamping()).linear is linear  # either side
+    assert dataclasses.replace(controller, pi_kp=80.0).compensation is compensation
+
+
+@pytest.mark.parametrize("left, right, match", [
+    (FrictionCompensation(), Dither(), "start from PIDamping"),
+    (PIDamping() + Dither(), Dither(), "already has a `dither` block"),
+])
+def test_adding_blocks_wrongly_says_how_to(left, right, match):
+    with pytest.raises(ParameterError, match=match):
+        left + right
+
+
+def test_a_block_in_the_wrong_slot_is_refused():
+    with pytest.raises(ParameterError, match="`dither` must be a Dither"):
+        ControllerParameters(dither=FrictionCompensation())
+
+
+# ------------------------------------------------------------------ friction compensation
+@pytest.mark.parametrize("value", [-0.1, 1.51, float("nan")])
+def test_a_compensation_fraction_outside_0_to_1_5_is_refused(value):
+    with pytest.raises(ParameterError, match=r"`fraction` .*0 is none, 1 cancels"):
+        FrictionCompensation(fraction=value)
+
+
+def test_compensation_takes_the_plants_friction_law_where_it_sets_none():
+    plant = IsolatorParameters(stiction_force=12.0, coulomb_force=2.0)
+    law = FrictionCompensation(coulomb_force=1.5, viscous_damping=80.0).law(plant)
+    assert law == (12.0, 1.5, plant.stribeck_decay, 80.0)
+    with pytest.raises(ParameterError, match="must not exceed `stiction_force`"):
+        FrictionCompensation(stiction_force=5.0, coulomb_force=6.0)
+
+
+def test_compensation_from_a_friction_fit_takes_its_four_numbers():
+    fit = type("Fit", (), dict(stiction_force=9.0, coulomb_force=1.2, stribeck_decay=90.0,
+                               viscous_damping=101.0))()
+    block = FrictionCompensation.from_fit(fit, fraction=0.5, deadband=1e-4)
+    assert block.law(IsolatorParameters()) == (9.0, 1.2, 90.0, 101.0)
+    assert (block.fraction, block.deadband) == (0.5, 1e-4)
+
+
+def test_dither_needs_a_positive_frequency():
+    with pytest.raises(ParameterError, match="`frequency` must be positive"):
+        Dither(frequency=0.0)
+
+
+# ------------------------------------------------------------------ linear controller
+def test_a_transfer_function_becomes_a_state_space_with_the_same_response():
+    tf = control.tf([-20.0, -200.0], [1.0, 50.0, 400.0])
+    linear = LinearController.from_system(tf, ["measured_payload_velocity"])
+    assert linear.states == 2 and not linear.discrete
+    omega = np.array([0.3, 3.0, 30.0, 300.0])
+    np.testing.assert_allclose(linear.to_system()(1j * omega).ravel(), tf(1j * omega).ravel(),
+                               rtol=1e-12)
+
+
+def test_a_discrete_system_keeps_its_sample_time():
+    linear = LinearController.from_system(control.tf([0.5, 0.1], [1.0, -0.9], 1e-3),
+                                          "position_error")
+    assert linear.discrete and linear.sample_time == 1e-3
+
+
+@pytest.mark.parametrize("build, match", [
+    (lambda: LinearController.from_system(control.tf([1.0, 2.0, 3.0], [1.0, 4.0])),
+     "improper"),
+    (lambda: LinearController.from_system(control.tf([1.0], [1.0, 1.0]),
+                                          ["position_error", "relative_velocity"]),
+     "has 1 inputs but `inputs` names 2"),
+    (lambda: LinearController.from_system(control.ss([[-1.0]], [[1.0]], [[1.0], [2.0]],
+                                                     [[0.0], [0.0]])),
+     "one output"),
+    (lambda: LinearController.from_transfer_function([1.0], [1.0, 1.0], "encoder_speed"),
+     "unknown sensor 'encoder_speed'"),
+    (lambda: LinearController(a=[[np.nan]], b=[[1.0]], c=[1.0], d=[0.0]), "non-finite"),
+    (lambda: LinearController(a=[[-1.0]], b=[[1.0]], c=[np.inf], d=[0.0]), "non-finite"),
+    (lambda: LinearController(a=[[-1.0]], b=[[1.0, 2.0]], c=[1.0], d=[0.0]),
+     r"`b` must have shape \(1, 1\)"),
+    (lambda: LinearController.from_system(control.ss(-np.eye(MAX_STATES + 1),
+                                                     np.ones((MAX_STATES + 1, 1)),
+                                                     np.ones((1, MAX_STATES + 1)), 0.0)),
+     f"at most {MAX_STATES} states"),
+    (lambda: LinearController(a=[[-10.0]], b=[[1.0]], c=[1.0], d=[0.5],
+                              inputs=("payload_acceleration",)),
+     "algebraic loop"),
+    (lambda: LinearController.from_system(np.eye(2)), "StateSpace or TransferFunction"),
+    (lambda: LinearController.from_transfer_function([1.0], [0.0]), "`denominator` must not"),
+    (lambda: LinearController(a=[[-1.0]], b=[[1.0]], c=[1.0], d=[0.0], tracking_time=0.0),
+     "`tracking_time` must be positive"),
+])
+def test_a_bad_linear_controller_is_refused_naming_what_and_how(build, match):
+    with pytest.raises(ParameterError, match=match):
+        build()
+
+
+def test_a_discrete_controller_may_feed_the_acceleration_straight_through():
+    linear = LinearController(a=[[0.5]], b=[[1.0]], c=[1.0], d=[0.5],
+                              inputs=("payload_acceleration",), sample_time=1e-3)
+    assert linear.d == (0.5,)
+
+
+def test_the_antiwindup_gain_makes_the_command_track_saturation_in_the_tracking_time():
+    # C L = 1/T_t: the command's excess decays with the time constant T_t (docs/model.md §5)
+    linear = LinearController(a=np.diag([-1.0, -2.0]), b=[[1.0], [1.0]], c=[3.0, -4.0],
+                              d=[0.0], tracking_time=0.05)
+    gain = linear.antiwindup_gain()
+    assert np.dot(linear.c, gain) == pytest.approx(1 / 0.05, rel=1e-14)
+    pi = LinearController(a=[[0.0]], b=[[1.0]], c=[20.0], d=[50.0], inputs="position_error",
+                          tracking_time=2.5)
+    assert pi.antiwindup_gain()[0] == pytest.approx(1 / (20.0 * 2.5))  # classic 1/(Ki T_t)
+    sampled = dataclasses.replace(pi, sample_time=1e-3)
+    assert 20.0 * sampled.antiwindup_gain()[0] == pytest.approx(1e-3 / 2.5)
+
+
+def test_block_parameters_carry_units_and_the_matrices_row_by_row():
+    linear = LinearController(a=[[-1.0, 2.0], [0.0, -3.0]], b=[[1.0], [0.5]], c=[4.0, 5.0],
+                              d=[0.25], inputs=("relative_velocity",))
+    meta = block_parameters(PIDamping() + linear + Dither(amplitude=3.0))
+    assert meta["linear.a"] == ([-1.0, 2.0, 0.0, -3.0], "1/s")
+    assert meta["linear.states"] == (2, "1")
+    assert meta["linear.inputs"] == ("relative_velocity", "-")
+    assert meta["dither.amplitude"] == (3.0, "N") and meta["dither.frequency"][1] == "Hz"
+    assert set(SENSORS) >= set(meta["linear.inputs"][0].split())
