@@ -7,7 +7,7 @@ summary.
 import numpy as np
 
 __all__ = ["RunStatistics", "run_statistics", "STATISTICS", "SATURATION", "SummaryStatistics",
-           "SUMMARY_STATISTICS"]
+           "SUMMARY_STATISTICS", "BLOCK_STATISTICS"]
 
 #: Statistics of a run: name -> (unit, description).
 STATISTICS = {
@@ -126,11 +126,22 @@ class SummaryStatistics:
     motor_force_max : float
         The motor's force limit [N]: a sample saturates when the loops ask for it or more
         (the conditional-integration anti-windup holds the integral at the limit).
+    blocks : sequence of str
+        The channels of the controller's blocks the run records (``compensation_force``,
+        ``dither_force``, ``linear_force``, ``friction_estimate``): each one's RMS is
+        reported, and they count in what the loops ask of the motor.
+    dither_frequency : float, optional
+        A dither's frequency [Hz]: the payload acceleration's amplitude at it is reported
+        (a single-frequency Fourier coefficient over the samples), the dither's cost.
     """
 
-    def __init__(self, stop_center, motor_force_max):
+    def __init__(self, stop_center, motor_force_max, blocks=(), dither_frequency=None):
         self.run = RunStatistics([stop_center])
         self.force_limit = float(motor_force_max)
+        self.blocks = tuple(blocks)
+        self.block_squares = dict.fromkeys(self.blocks, 0.0)
+        self.dither_omega = None if dither_frequency is None else 2 * np.pi * dither_frequency
+        self.dither_sum = 0j
         self.count = 0
         self.z_sum = 0.0
         self.z_last = np.nan
@@ -168,7 +179,16 @@ class SummaryStatistics:
         self.z_last = float(z[-1])
         self.time_last = float(block["time"][-1])
         self.contact += int(np.count_nonzero(block["stop_contact"]))
-        asked = np.abs(np.asarray(block["pi_force"]) + np.asarray(block["damping_force"]))
+        asked = np.asarray(block["pi_force"]) + np.asarray(block["damping_force"])
+        for name in self.blocks:
+            values = np.asarray(block[name], dtype=float)
+            self.block_squares[name] += float(np.dot(values, values))
+            if name != "friction_estimate":  # it is in the compensation's force
+                asked = asked + values
+        if self.dither_omega is not None:
+            phase = np.exp(-1j * self.dither_omega * np.asarray(block["time"], dtype=float))
+            self.dither_sum += complex(np.dot(np.asarray(block["payload_acceleration"]), phase))
+        asked = np.abs(asked)
         self.saturated += int(np.count_nonzero(asked >= self.force_limit * (1.0 - 1e-9)))
         self.motor_peak = max(self.motor_peak, float(np.abs(motor).max()))
         net = (block["base_work"] + block["motor_work"] - block["friction_dissipation"]
@@ -185,7 +205,11 @@ class SummaryStatistics:
                 "z_final": self.z_last, "contact_fraction": self.contact / counted,
                 "saturated_fraction": self.saturated / counted, "motor_force_peak": self.motor_peak,
                 "energy_residual_max": self.residual_max, "base_work_max": self.base_work_max,
-                "time_first": self.time_first, "time_last": self.time_last}
+                "time_first": self.time_first, "time_last": self.time_last,
+                **{f"{name}_rms": float(np.sqrt(total / counted))
+                   for name, total in self.block_squares.items()},
+                **({} if self.dither_omega is None else
+                   {"dither_payload_acceleration": 2 * abs(self.dither_sum) / counted})}
 
 
 #: What :meth:`SummaryStatistics.result` holds beyond :data:`STATISTICS`: name -> (unit,
@@ -202,4 +226,13 @@ SUMMARY_STATISTICS = {
     "base_work_max": ("J", "largest |work done by the base|"),
     "time_first": ("s", "time of the first sample"),
     "time_last": ("s", "time of the last sample"),
+}
+#: What a run whose controller has blocks adds (each only with its block).
+BLOCK_STATISTICS = {
+    "compensation_force_rms": ("N", "RMS friction compensation command"),
+    "dither_force_rms": ("N", "RMS dither command"),
+    "linear_force_rms": ("N", "RMS command of the linear controller"),
+    "friction_estimate_rms": ("N", "RMS of the observer's friction estimate"),
+    "dither_payload_acceleration": ("m/s^2", "payload acceleration amplitude at the dither "
+                                             "frequency"),
 }

@@ -126,6 +126,25 @@ def _step_line(run):
     return f"  step             {step_line(run)}"
 
 
+def _block_lines(controller, stats):
+    """The controller and what its blocks cost (their RMS forces, the dither's acceleration)."""
+    lines = [f"  controller       {controller.describe()}"]
+    forces = [f"{label} RMS {stats[name + '_rms']:.3g} N"
+              for name, label in (("compensation_force", "compensation"),
+                                  ("friction_estimate", "friction estimate"),
+                                  ("dither_force", "dither"),
+                                  ("linear_force", f"'{getattr(controller.linear, 'name', '')}'"))
+              if name + "_rms" in stats]
+    if forces:
+        lines.append(f"  block forces     {'; '.join(forces)}")
+    if "dither_payload_acceleration" in stats:
+        lines.append(f"  dither cost      payload acceleration "
+                     f"{stats['dither_payload_acceleration']:.3g} m/s^2 at "
+                     f"{controller.dither.frequency:g} Hz; motor RMS "
+                     f"{stats['motor_force_rms']:.3g} N in all")
+    return lines
+
+
 def summary_record(result):
     """The summary as data: run settings, statistics (SI units) and warnings.
 
@@ -188,6 +207,8 @@ def summary_text(result):
         f"  motor force      RMS {stats['motor_force_rms']:.2f} N, "
         f"peak {stats['motor_force_peak']:.2f} N (limit {iso.motor_force_max:g} N)",
     ]
+    if ctrl.has_blocks:
+        lines += _block_lines(ctrl, stats)
     deficit = iso.weight_deficit
     if deficit > 0:
         lines.append(

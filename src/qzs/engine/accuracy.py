@@ -383,7 +383,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import check_resolution, resolving_step, run_inputs
+    from qzs.engine.prepare import check_resolution, divides, resolving_step, run_inputs
     from qzs.engine.single import integrate
     from qzs.engine.stability import largest_stable_step, stability_test
 
@@ -414,8 +414,11 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
     # step follows is refused as a literal step too coarse for it would be, naming it
     check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
-    dt0, k0 = admissible_step(sample_rate, controller.controller_rate,
-                              lambda dt: dt <= resolving and stable(dt))
+    rates = controller.sample_rates  # each sampled period a whole number of steps
+    single = rates[0] if len(rates) == 1 else 0.0
+    dt0, k0 = admissible_step(sample_rate, single,
+                              lambda dt: dt <= resolving and stable(dt)
+                              and (single or all(divides(rate, dt) for rate in rates)))
 
     def run(dt, cases):
         return [integrate(probe, isolator, controller, duration=duration, dt=dt,

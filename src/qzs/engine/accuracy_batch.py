@@ -135,7 +135,8 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     limit = min(largest_stable_step(isolator, controller, solver)
                 for isolator, controller in cases)
     resolving = resolving_step(probe, duration)
-    rates = sorted({controller.controller_rate for _, controller in cases})
+    rates = sorted({rate for _, controller in cases for rate in controller.sample_rates}
+                   or {0.0})
 
     def stable(dt):
         return dt <= resolving and all(test(dt) for test in tests)

@@ -12,7 +12,7 @@ from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
 __all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels",
-           "channel_count", "simulation_schema", "variable_attributes", "named_block"]
+           "channel_count", "summary_statistics", "simulation_schema", "variable_attributes", "named_block"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -94,6 +94,30 @@ def run_channels(controller=None, *, every_block=False):
     return {**CHANNELS, **extra}
 
 
+def summary_statistics(controller, stop_center, motor_force_max):
+    """The accumulator of a run's summary statistics, with what the controller's blocks add.
+
+    Parameters
+    ----------
+    controller : ControllerParameters
+        The run's controller.
+    stop_center : float
+        Centre of the stroke [m].
+    motor_force_max : float
+        The motor's force limit [N].
+
+    Returns
+    -------
+    SummaryStatistics
+    """
+    from qzs.analysis.statistics import SummaryStatistics
+
+    blocks = [name for name in run_channels(controller) if name in BLOCK_CHANNELS]
+    dither = getattr(controller, "dither", None)
+    return SummaryStatistics(stop_center, motor_force_max, blocks=blocks,
+                             dither_frequency=None if dither is None else dither.frequency)
+
+
 def channel_count(controller=None):
     """Columns of a run's output rows [-]: ``K.N_BASE_CHANNELS``, or ``K.N_CHANNELS`` with blocks.
 
@@ -158,8 +182,9 @@ def named_block(data, flags):
 
     Parameters
     ----------
-    data : ndarray, shape (n, N_CHANNELS)
-        Output rows, one column per channel of :data:`CHANNELS`.
+    data : ndarray, shape (n, N_BASE_CHANNELS) or (n, N_CHANNELS)
+        Output rows, one column per channel of :data:`CHANNELS` (then of
+        :data:`BLOCK_CHANNELS`, with blocks).
     flags : ndarray of bool, shape (n, 2)
         The flags of :data:`FLAGS`.
 
@@ -168,7 +193,8 @@ def named_block(data, flags):
     dict of str to ndarray
         Every channel and flag by name (views), plus ``mechanical_energy`` [J].
     """
-    block = {name: data[:, column] for name, (column, _, _) in CHANNELS.items()}
+    named = CHANNELS if data.shape[1] <= K.N_BASE_CHANNELS else run_channels(every_block=True)
+    block = {name: data[:, column] for name, (column, _, _) in named.items()}
     block.update({name: flags[:, column] for name, (column, _) in FLAGS.items()})
     block["mechanical_energy"] = (block["kinetic_energy"] + block["spring_energy"]
                                   + block["gravity_energy"] + block["stop_energy"])

@@ -82,10 +82,11 @@ class SimulationResult:
         A dict, see :data:`qzs.analysis.statistics.SUMMARY_STATISTICS` for names and units.
         """
         if self._statistics is None:  # a result built from arrays: summarise them
-            from qzs.analysis.statistics import SummaryStatistics
+            from qzs.engine.channels import summary_statistics
 
             center = 0.5 * (self.run["stop_low"] + self.run["stop_high"])
-            statistics = SummaryStatistics(center, self.isolator.motor_force_max)
+            statistics = summary_statistics(self.controller, center,
+                                            self.isolator.motor_force_max)
             statistics.add(named_block(self._data, self._flags))
             self._statistics = statistics.result()
         return self._statistics

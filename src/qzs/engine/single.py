@@ -7,12 +7,11 @@ resolves the step first (:func:`qzs.engine.run_spec.resolve`) and integrates her
 from __future__ import annotations
 
 from qzs import defaults
-from qzs.analysis.statistics import SummaryStatistics
 from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.channels import channel_count, named_block
+from qzs.engine.channels import channel_count, named_block, summary_statistics
 from qzs.engine.result import SimulationResult
 from qzs.errors import SimulationError
 
@@ -64,8 +63,8 @@ def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
         step = StepChoice.literal(run.dt, sample_rate=run.sample_rate, solver=solver)
     plan = driver.plan_run(run.duration, run.dt, run.decimation)
     p = run.params
-    statistics = SummaryStatistics(0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]),
-                                   run.isolator.motor_force_max)
+    statistics = summary_statistics(run.controller, 0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]),
+                                    run.isolator.motor_force_max)
     recorder = driver.Recorder(plan, channel_count(run.controller), 2, sink=sink,
                                statistics=lambda data, flags: statistics.add(
                                    named_block(data, flags)),

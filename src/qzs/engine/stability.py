@@ -22,6 +22,9 @@ def _stiff_modes(isolator, controller):
     m = isolator.mass
     stiffness = isolator.spring_force * isolator.spring_shape + controller.pi_kp
     damping = isolator.viscous_damping + controller.damping_gain
+    if controller.compensation is not None:  # its viscous part cancels damping
+        compensation = controller.compensation
+        damping -= compensation.fraction * compensation.law(isolator)[3]
     if isolator.friction_regularisation > 0.0:
         damping += isolator.stiction_force / isolator.friction_regularisation
     cases = [(stiffness, damping)]
@@ -30,7 +33,17 @@ def _stiff_modes(isolator, controller):
     eigenvalues = [-2 * np.pi * controller.velocity_highpass]
     for k, c in cases:
         eigenvalues.extend(np.roots([m, c, k]))
-    return np.asarray(eigenvalues, dtype=complex)
+    if controller.compensation is not None:
+        eigenvalues.append(-2 * np.pi * controller.compensation.observer_bandwidth)
+    linear = controller.linear
+    if linear is not None and not linear.discrete and linear.states:
+        a = linear.matrices()[0]  # its own modes, and how fast its anti-windup tracks
+        eigenvalues.extend(np.linalg.eigvals(a))
+        eigenvalues.append(-1.0 / linear.tracking_time)
+    eigenvalues = np.asarray(eigenvalues, dtype=complex)
+    # a growing mode (over-compensated friction, an unstable controller) grows for any step:
+    # no step makes it stable, and it does not make the integration unstable
+    return eigenvalues[eigenvalues.real <= 0.0]
 
 
 def stability_test(isolator, controller, solver):

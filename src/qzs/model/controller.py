@@ -502,9 +502,43 @@ class ControllerParameters:
         return f"{type(self).__name__}({', '.join(shown)})"
 
     @property
+    def sample_rates(self) -> tuple[float, ...]:
+        """The rates [Hz] the controller samples at: its own (``controller_rate``) and a
+        discrete linear controller's; empty for a continuous controller. The integration
+        step divides the period of each."""
+        rates = [self.controller_rate] if self.controller_rate > 0 else []
+        if self.linear is not None and self.linear.discrete:
+            rates.append(1.0 / self.linear.sample_time)
+        return tuple(dict.fromkeys(rates))
+
+    @property
     def has_blocks(self) -> bool:
         """Whether the controller has blocks beyond PI + damping."""
         return any(getattr(self, name) is not None for name in BLOCKS)
+
+    def describe(self) -> str:
+        """One line naming the controller's loops and blocks with their main settings."""
+        parts = []
+        if self.pi_kp or self.pi_ki:
+            parts.append(f"PI (Kp {self.pi_kp:g} N/m, Ki {self.pi_ki:g} N/(m*s))")
+        if self.damping_gain:
+            parts.append(f"damping (Kd {self.damping_gain:g} N*s/m)")
+        if self.compensation is not None:
+            observer = self.compensation.observer_bandwidth
+            parts.append(f"friction compensation (fraction {self.compensation.fraction:g}"
+                         + (f", deadband {self.compensation.deadband:g} m/s"
+                            if self.compensation.deadband else "")
+                         + (f", observer {observer:g} Hz" if observer else "") + ")")
+        if self.dither is not None:
+            parts.append(f"dither ({self.dither.amplitude:g} N at {self.dither.frequency:g} Hz)")
+        if self.linear is not None:
+            timing = (f"sampled every {self.linear.sample_time:g} s" if self.linear.discrete
+                      else "continuous")
+            parts.append(f"linear controller '{self.linear.name}' ({self.linear.states} states, "
+                         f"{timing}, on {', '.join(self.linear.inputs)})")
+        rate = (f"; sampled at {self.controller_rate:g} Hz" if self.controller_rate > 0
+                else "")
+        return (" + ".join(parts) or "none (the motor gives no force)") + rate
 
     def to_dict(self) -> dict[str, Any]:
         """Return the parameters as a plain ``dict`` (a block only when present)."""
