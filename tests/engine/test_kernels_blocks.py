@@ -178,3 +178,32 @@ def test_a_discrete_sample_time_off_the_step_grid_is_refused_before_the_run():
     with pytest.raises(ParameterError, match=r"`sample_time` .* whole number of integration "
                                              r"steps .* use sample_time=0.0001 s"):
         _run(BASE + off, duration=1.0)
+
+
+def test_the_dithers_cost_is_the_payloads_mobility_at_its_frequency(validation):
+    # frictionless guide, no PI: the payload answers the dither force as m s^2 + Cv s + k
+    plant = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    dither = Dither(amplitude=2.0, frequency=40.0)
+    run = simulate(Sine(amplitude=0.0, frequency=1.0), plant, PIDamping() + dither,
+                   duration=3.0, dt=1e-4, sample_rate=1e4)
+    omega = 2 * np.pi * dither.frequency
+    k = plant.spring_force * plant.spring_shape / np.cosh(plant.spring_shape * -0.06) ** 2
+    k += PIDamping().pi_kp
+    mobility = omega ** 2 / abs(-plant.mass * omega ** 2 + 1j * omega * plant.viscous_damping + k)
+    expected = dither.amplitude * mobility
+    measured = run.statistics["dither_payload_acceleration"]
+    assert measured == pytest.approx(expected, rel=2e-2)
+    validation("The dither's cost: payload acceleration at the dither frequency",
+               "F/|m - j Cv/w - k/w^2| of the frictionless payload", abs(measured / expected - 1),
+               2e-2, measure="relative error")
+    assert run.statistics["dither_force_rms"] == pytest.approx(2.0 / np.sqrt(2), rel=1e-3)
+
+
+def test_the_summary_names_the_blocks_and_their_cost():
+    run = _run(BASE + FrictionCompensation(fraction=0.5) + Dither(amplitude=1.0, frequency=50.0),
+               duration=2.0)
+    text = run.summary()
+    assert "friction compensation (fraction 0.5)" in text and "dither (1 N at 50 Hz)" in text
+    assert "payload acceleration" in text and "at 50 Hz" in text
+    assert "controller" not in _run(BASE, duration=1.0).summary().split("note")[0].split(
+        "motor force")[1]  # PI + damping alone: as before

@@ -179,7 +179,9 @@ def block_forces(t, s, v, direction, ydd, v_measured, held, P, M):
     else:
         feedforward = _compensation(v, direction, P, M)
         f_comp = feedforward - s[S_OBSERVER]
-        f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
+        f_dither = 0.0
+        if M[M_DITHER_AMPLITUDE] != 0.0:
+            f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
     f_linear = 0.0
     if M[M_LINEAR] != 0.0:
         if M[M_LINEAR_STEPS] > 0.0:
@@ -665,7 +667,9 @@ def sample_controller(t, s, mode, direction, held, P, M, E, table):
         force = rhs(t, y, yd, ydd, s, mode, float(direction), held, P, M, True)[1]
         feedforward = _compensation(v, float(direction), P, M)
         f_comp = feedforward - s[S_OBSERVER]
-        f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
+        f_dither = 0.0
+        if M[M_DITHER_AMPLITUDE] != 0.0:
+            f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
         command = f_pi + f_damp + f_comp + f_dither + force[F_LINEAR]
         f_motor, rate = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
         if M[M_OBSERVER_RATE] > 0.0:  # forward Euler over the period, as the integral
