@@ -182,7 +182,8 @@ class SummaryStatistics:
         asked = np.asarray(block["pi_force"]) + np.asarray(block["damping_force"])
         for name in self.blocks:
             values = np.asarray(block[name], dtype=float)
-            self.block_squares[name] += float(np.dot(values, values))
+            with np.errstate(over="ignore"):  # a diverging controller's RMS is inf
+                self.block_squares[name] += float(np.dot(values, values))
             if name != "friction_estimate":  # it is in the compensation's force
                 asked = asked + values
         if self.dither_omega is not None:

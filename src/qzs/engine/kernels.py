@@ -45,19 +45,23 @@ N_PARAMS = 22
 
 # ODE state, then the held controller outputs of a sampled controller.
 S_Z, S_V, S_HP, S_INT, S_W_BASE, S_D_FRICTION, S_W_MOTOR, S_D_STOP = range(8)
-#: Most states of a user's linear controller (:class:`qzs.model.controller.LinearController`).
-NX_MAX = MAX_STATES
-#: The linear controller's states (``S_X0 + i``), then the friction observer's estimate [N].
-S_X0 = 8
-S_OBSERVER = S_X0 + NX_MAX
-N_ODE = S_OBSERVER + 1
+N_ODE = 8
 A_F_PI, A_F_DAMP, A_F_MOTOR = range(N_ODE, N_ODE + 3)
 # The holding margin of the last step (NaN: work it out again), carried across kernel calls so
 # that where a run is cut into chunks changes nothing (docs/model.md §9).
 A_MARGIN = N_ODE + 3
-# The held outputs of the sampled blocks: friction compensation, dither, linear controller.
-A_F_COMPENSATION, A_F_DITHER, A_F_LINEAR = range(N_ODE + 4, N_ODE + 7)
-N_STATE = N_ODE + 7
+#: Most states of a user's linear controller (:class:`qzs.model.controller.LinearController`).
+NX_MAX = MAX_STATES
+#: The controller blocks' own ODE state (``X_*``, a tuple of its own in the kernels): the
+#: linear controller's states ``X_X0 + i``, then the friction observer's estimate [N].
+X_X0 = 0
+X_OBSERVER = NX_MAX
+N_X = NX_MAX + 1
+#: Where the persistent state array keeps them, and the held outputs of the sampled blocks
+#: (friction compensation, dither, linear controller).
+A_X0 = A_MARGIN + 1
+A_F_COMPENSATION, A_F_DITHER, A_F_LINEAR = range(A_X0 + N_X, A_X0 + N_X + 3)
+N_STATE = A_X0 + N_X + 3
 N_HELD = 6
 #: The excitation's sine and cosine are computed exactly every this many steps and rotated in
 #: between; kernel calls start on multiples of it, so chunking changes no bit (docs/model.md §9).
@@ -67,7 +71,8 @@ PHASE_PERIOD = 256
 # a flag for any block, the friction compensation (fraction, the compensator's friction law,
 # deadband, observer bandwidth), the dither, and the linear controller: on, states, sample
 # period in grid steps (0: continuous), then its matrices A (NX_MAX x NX_MAX), B (NX_MAX x
-# N_SENSORS), C (NX_MAX), D (N_SENSORS) row by row, zero-padded, and its anti-windup gain.
+# N_SENSORS, a column per sensor ``U_*``), C (NX_MAX), D (N_SENSORS) row by row, zero-padded,
+# and its anti-windup gain.
 (M_BLOCKS, M_COMP_FRACTION, M_COMP_FS, M_COMP_FC, M_COMP_CBC, M_COMP_CV, M_COMP_DEADBAND,
  M_OBSERVER_RATE, M_DITHER_AMPLITUDE, M_DITHER_OMEGA, M_LINEAR, M_LINEAR_STATES,
  M_LINEAR_STEPS) = range(13)
@@ -84,6 +89,9 @@ M_C = M_B + NX_MAX * N_SENSORS
 M_D = M_C + NX_MAX
 M_ANTIWINDUP = M_D + N_SENSORS
 N_MODEL = M_ANTIWINDUP + NX_MAX
+#: A linear controller of at most this many states takes the short loops (``_rows``).
+NX_SHORT = 4
+assert NX_MAX == 2 * NX_SHORT
 
 # Integer flags.
 I_MODE, I_DIRECTION, I_STEP, I_CONTACT, I_N_CONTACTS, I_N_STICKS = range(6)
@@ -124,35 +132,53 @@ def controller_output(P, z, v_measured, integral):
 
 
 @njit(**_JIT, inline="always")
-def _linear_output(M, s, u):
-    """Output ``C x + D u`` [N] of the linear controller (states ``s[S_X0:]``, sensors ``u``)."""
-    n = int(M[M_LINEAR_STATES])
+def _linear_output(M, x, u):
+    """Output ``C x + D u`` [N] of the linear controller (states ``x``, sensors ``u``).
+
+    Loops of a constant length over the zero-padded rows (short ones for a small controller),
+    so that they unroll and the tuples are indexed by constants; a zero-padded term adds an
+    exact zero."""
     y = 0.0
-    for j in range(n):
-        y = fma(M[M_C + j], s[S_X0 + j], y)
+    if M[M_LINEAR_STATES] <= NX_SHORT:
+        for j in range(NX_SHORT):
+            y = fma(M[M_C + j], x[X_X0 + j], y)
+    else:
+        for j in range(NX_MAX):
+            y = fma(M[M_C + j], x[X_X0 + j], y)
     for k in range(N_SENSORS):
         y = fma(M[M_D + k], u[k], y)
     return y
 
 
 @njit(**_JIT, inline="always")
-def _linear_rate(i, M, s, u, excess):
-    """Rate of state ``i`` of a continuous linear controller: ``(A x + B u + L excess)_i``.
-
-    ``excess`` is the saturated motor force less the command [N]: the back-calculation
-    anti-windup (docs/model.md §5).
-    """
-    n = int(M[M_LINEAR_STATES])
-    if i >= n:
-        return 0.0
+def _linear_row(i, width, M, x, u, excess):
+    """Row ``i`` of ``A x + B u + L excess`` over the first ``width`` states (a constant)."""
     rate = M[M_ANTIWINDUP + i] * excess
     row = M_A + i * NX_MAX
-    for j in range(n):
-        rate = fma(M[row + j], s[S_X0 + j], rate)
+    for j in range(width):
+        rate = fma(M[row + j], x[X_X0 + j], rate)
     row = M_B + i * N_SENSORS
     for k in range(N_SENSORS):
         rate = fma(M[row + k], u[k], rate)
     return rate
+
+
+@njit(**_JIT, inline="always")
+def _linear_rates(M, x, u, excess, observer):
+    """``A x + B u + L excess`` as the blocks' state tuple, then ``observer`` in the
+    observer's entry: a continuous linear controller's state rates, or a discrete one's next
+    states (``excess``: the saturated motor force less the command [N], the back-calculation
+    anti-windup, docs/model.md §5). A padded row is 0."""
+    if M[M_LINEAR_STATES] <= NX_SHORT:
+        return (_linear_row(0, NX_SHORT, M, x, u, excess),
+                _linear_row(1, NX_SHORT, M, x, u, excess),
+                _linear_row(2, NX_SHORT, M, x, u, excess),
+                _linear_row(3, NX_SHORT, M, x, u, excess), 0.0, 0.0, 0.0, 0.0, observer)
+    return (_linear_row(0, NX_MAX, M, x, u, excess), _linear_row(1, NX_MAX, M, x, u, excess),
+            _linear_row(2, NX_MAX, M, x, u, excess), _linear_row(3, NX_MAX, M, x, u, excess),
+            _linear_row(4, NX_MAX, M, x, u, excess), _linear_row(5, NX_MAX, M, x, u, excess),
+            _linear_row(6, NX_MAX, M, x, u, excess), _linear_row(7, NX_MAX, M, x, u, excess),
+            observer)
 
 
 @njit(**_JIT, inline="always")
@@ -165,20 +191,20 @@ def _compensation(v, direction, P, M):
 
 
 @njit(**_JIT, inline="always")
-def block_forces(t, s, v, direction, ydd, v_measured, held, P, M):
+def block_forces(t, s, x, v, direction, ydd, v_measured, held, P, M):
     """The forces of the controller's blocks beyond PI + damping [N] (docs/model.md §5).
 
     ``(compensation, dither, linear, feedforward)``: the friction compensation (its
     feedforward less the observer's estimate of the friction left), the dither and the
-    linear controller's output; a sampled block's is the value it holds. ``feedforward``
-    is the compensation's feedforward alone.
+    linear controller's output (states ``x``); a sampled block's is the value it holds.
+    ``feedforward`` is the compensation's feedforward alone.
     """
     feedforward = 0.0
     if P[P_CONTROL_STEPS] > 0.0:
         f_comp, f_dither = held[3], held[4]
     else:
         feedforward = _compensation(v, direction, P, M)
-        f_comp = feedforward - s[S_OBSERVER]
+        f_comp = feedforward - x[X_OBSERVER]
         f_dither = 0.0
         if M[M_DITHER_AMPLITUDE] != 0.0:
             f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
@@ -187,18 +213,25 @@ def block_forces(t, s, v, direction, ydd, v_measured, held, P, M):
         if M[M_LINEAR_STEPS] > 0.0:
             f_linear = held[5]
         else:  # the payload's acceleration enters only through B (docs/model.md §5)
-            f_linear = _linear_output(M, s, (P[P_ZREF] - s[S_Z], v_measured, 0.0, ydd, v))
+            f_linear = _linear_output(M, x, (P[P_ZREF] - s[S_Z], v_measured, 0.0, ydd, v))
     return f_comp, f_dither, f_linear, feedforward
 
 
-@njit(**_JIT, inline="always")
-def rhs(t, y, yd, ydd, s, mode, direction, held, P, M, blocks):
-    """Right-hand side at time ``t`` and base motion ``(y, yd, ydd)``: ``(derivatives, forces)``.
+#: The blocks' rates of a controller without blocks (or of a sampled one): none.
+_NO_RATES = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
-    ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g`` (docs/model.md);
-    while held (stuck, or resting on a plastic stop) ``v = 0`` and ``xdd = ydd``. ``blocks``:
-    the controller has blocks beyond PI + damping (``M``, :func:`block_forces`); without them
-    the controller's states stay 0 and the operations are those of PI + damping alone.
+
+@njit(**_JIT, inline="always")
+def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
+    """Right-hand side at time ``t`` and base motion ``(y, yd, ydd)``.
+
+    Returns ``(derivatives, forces, block rates)``: the rates of the plant's state ``s``
+    (``S_*``), the force breakdown (``F_*``) and the rates of the blocks' state ``x``
+    (``X_*``). ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g``
+    (docs/model.md); while held (stuck, or resting on a plastic stop) ``v = 0`` and
+    ``xdd = ydd``. ``blocks``: the controller has blocks beyond PI + damping (``M``,
+    :func:`block_forces`); without them (a constant where it is inlined) the operations
+    are those of PI + damping alone.
     """
     m = P[P_MASS]
     z = s[S_Z]
@@ -221,7 +254,7 @@ def rhs(t, y, yd, ydd, s, mode, direction, held, P, M, blocks):
     f_comp = f_dither = f_linear = feedforward = 0.0
     command = f_motor
     if blocks:
-        f_comp, f_dither, f_linear, feedforward = block_forces(t, s, v, direction, ydd,
+        f_comp, f_dither, f_linear, feedforward = block_forces(t, s, x, v, direction, ydd,
                                                                v_measured, held, P, M)
         command = f_pi + f_damp + f_comp + f_dither + f_linear
         f_motor, rate = saturation_law(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
@@ -246,53 +279,45 @@ def rhs(t, y, yd, ydd, s, mode, direction, held, P, M, blocks):
             f_stop += f_wall
         xdd = ydd
 
-    r0 = r1 = r2 = r3 = r4 = r5 = r6 = r7 = observer_rate = 0.0
-    if blocks and P[P_CONTROL_STEPS] == 0.0 and M[M_OBSERVER_RATE] > 0.0:
-        # the friction left after the feedforward, as the observer measures it
-        observer_rate = M[M_OBSERVER_RATE] * (f_friction + f_stop + feedforward - s[S_OBSERVER])
-    if blocks and M[M_LINEAR] != 0.0 and M[M_LINEAR_STEPS] == 0.0:
-        u = (P[P_ZREF] - z, v_measured, xdd, ydd, v)
-        excess = f_motor - command
-        r0 = _linear_rate(0, M, s, u, excess)
-        r1 = _linear_rate(1, M, s, u, excess)
-        r2 = _linear_rate(2, M, s, u, excess)
-        r3 = _linear_rate(3, M, s, u, excess)
-        r4 = _linear_rate(4, M, s, u, excess)
-        r5 = _linear_rate(5, M, s, u, excess)
-        r6 = _linear_rate(6, M, s, u, excess)
-        r7 = _linear_rate(7, M, s, u, excess)
+    rates = _NO_RATES
+    if blocks:
+        observer = 0.0
+        if P[P_CONTROL_STEPS] == 0.0 and M[M_OBSERVER_RATE] > 0.0:
+            # the friction left after the feedforward, as the observer measures it
+            observer = M[M_OBSERVER_RATE] * (f_friction + f_stop + feedforward - x[X_OBSERVER])
+        if M[M_LINEAR] != 0.0 and M[M_LINEAR_STEPS] == 0.0:
+            rates = _linear_rates(M, x, (P[P_ZREF] - z, v_measured, xdd, ydd, v),
+                                  f_motor - command, observer)
+        else:
+            rates = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, observer)
     deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
              (f_spring + f_friction + f_stop + f_motor) * yd, -f_friction * v, f_motor * v,
-             -(f_stop - f_elastic) * v, r0, r1, r2, r3, r4, r5, r6, r7, observer_rate)
+             -(f_stop - f_elastic) * v)
     force = (y, yd, ydd, f_spring, f_friction, f_stop, f_elastic, f_motor, f_pi, f_damp,
-             v_measured, f_hold, xdd, f_comp, f_dither, f_linear, s[S_OBSERVER])
-    return deriv, force
+             v_measured, f_hold, xdd, f_comp, f_dither, f_linear, x[X_OBSERVER])
+    return deriv, force, rates
 
 
 @njit(**_JIT)
-def rhs_at(t, s, mode, direction, held, P, M, E, table):
+def rhs_at(t, s, x, mode, direction, held, P, M, E, table):
     """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
     y, yd, ydd = base_motion(t, E, table)
-    return rhs(t, y, yd, ydd, s, mode, direction, held, P, M, M[M_BLOCKS] != 0.0)
+    return rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, M[M_BLOCKS] != 0.0)
 
 
 @njit(**_JIT, inline="always")
-def _axpy(s, a, k, blocks=True):
-    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`).
-
-    Without ``blocks`` (a constant where it is inlined) the controller blocks' states pass
-    through: their rates are 0 then, and the default controller's hot path skips them.
-    """
-    if not blocks:
-        return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]),
-                fma(a, k[3], s[3]), fma(a, k[4], s[4]), fma(a, k[5], s[5]),
-                fma(a, k[6], s[6]), fma(a, k[7], s[7]), s[8], s[9], s[10], s[11], s[12],
-                s[13], s[14], s[15], s[16])
+def _axpy(s, a, k):
+    """``s + a * k`` entry by entry, each with one rounding (:func:`fma`)."""
     return (fma(a, k[0], s[0]), fma(a, k[1], s[1]), fma(a, k[2], s[2]), fma(a, k[3], s[3]),
-            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]),
-            fma(a, k[8], s[8]), fma(a, k[9], s[9]), fma(a, k[10], s[10]),
-            fma(a, k[11], s[11]), fma(a, k[12], s[12]), fma(a, k[13], s[13]),
-            fma(a, k[14], s[14]), fma(a, k[15], s[15]), fma(a, k[16], s[16]))
+            fma(a, k[4], s[4]), fma(a, k[5], s[5]), fma(a, k[6], s[6]), fma(a, k[7], s[7]))
+
+
+@njit(**_JIT, inline="always")
+def _axpy_blocks(x, a, k):
+    """``x + a * k`` for the blocks' state tuple (:func:`_axpy`)."""
+    return (fma(a, k[0], x[0]), fma(a, k[1], x[1]), fma(a, k[2], x[2]), fma(a, k[3], x[3]),
+            fma(a, k[4], x[4]), fma(a, k[5], x[5]), fma(a, k[6], x[6]), fma(a, k[7], x[7]),
+            fma(a, k[8], x[8]))
 
 
 @njit(**_JIT, inline="always")
@@ -342,8 +367,9 @@ def stage_bases(solver, t, h, E, table, phase, sin0, cos0):
 
 
 @njit(**_JIT, inline="always")
-def rk_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, phase, sin0, cos0):
-    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``.
+def rk_step(solver, t, h, s, x, mode, direction, held, P, M, blocks, E, table, phase, sin0,
+            cos0):
+    """One explicit Runge-Kutta step (see :func:`tableau`) of length ``h`` [s] from ``s``, ``x``.
 
     ``phase, sin0, cos0`` are the excitation's phase and its sine and cosine at a
     nearby time (see :func:`qzs.engine.base_motion.base_motion_near`). The stages run
@@ -351,16 +377,26 @@ def rk_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, phas
     stage cost numba's inliner about 20 s of a cold start, docs/model.md §9); the
     weighted sum is accumulated stage by stage, in the same order as the batched
     stages of :mod:`qzs.engine.lanes` (whose base motion at each stage time,
-    :func:`stage_bases`, is the same call), so both give the same bits.
+    :func:`stage_bases`, is the same call), so both give the same bits. The blocks' states
+    ``x`` are stepped with the plant's only with ``blocks`` (a constant where it is
+    inlined); without, they are returned as they came. Returns ``(s, x)`` at ``t + h``.
     """
     result, k = s, s
+    result_x, k_x = x, x
     for stage in range(n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
         y, yd, ydd = base_motion_near(t + offset, phase, sin0, cos0, E, table)
-        k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k, blocks), mode,
-                direction, held, P, M, blocks)[0]
-        result = _axpy(result, weight, k, blocks)
-    return result
+        if blocks:
+            deriv, _, rates = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k),
+                                  x if stage == 0 else _axpy_blocks(x, a, k_x), mode,
+                                  direction, held, P, M, True)
+            k, k_x = deriv, rates
+            result_x = _axpy_blocks(result_x, weight, k_x)
+        else:
+            k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k), x, mode,
+                    direction, held, P, M, False)[0]
+        result = _axpy(result, weight, k)
+    return result, result_x
 
 
 @njit(**_JIT)
@@ -391,20 +427,20 @@ def _with(s, index, value):
     return (value if index == 0 else s[0], value if index == 1 else s[1],
             value if index == 2 else s[2], value if index == 3 else s[3],
             value if index == 4 else s[4], value if index == 5 else s[5],
-            value if index == 6 else s[6], value if index == 7 else s[7],
-            value if index == 8 else s[8], value if index == 9 else s[9],
-            value if index == 10 else s[10], value if index == 11 else s[11],
-            value if index == 12 else s[12], value if index == 13 else s[13],
-            value if index == 14 else s[14], value if index == 15 else s[15],
-            value if index == 16 else s[16])
+            value if index == 6 else s[6], value if index == 7 else s[7])
 
 
 @njit(**_JIT, inline="always")
 def state_tuple(state):
-    """The ODE state (``S_*``) of a persistent state array as a tuple."""
-    return (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
-            state[8], state[9], state[10], state[11], state[12], state[13], state[14],
-            state[15], state[16])
+    """The plant's ODE state (``S_*``) of a persistent state array as a tuple."""
+    return (state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7])
+
+
+@njit(**_JIT, inline="always")
+def blocks_tuple(state):
+    """The controller blocks' state (``X_*``) of a persistent state array as a tuple."""
+    return (state[A_X0], state[A_X0 + 1], state[A_X0 + 2], state[A_X0 + 3], state[A_X0 + 4],
+            state[A_X0 + 5], state[A_X0 + 6], state[A_X0 + 7], state[A_X0 + 8])
 
 
 @njit(**_JIT, inline="always")
@@ -431,21 +467,21 @@ def _book_impulse(t, s, ledger, E, table, P):
 
 
 @njit(**_JIT)
-def _settle(t, s, direction, held, P, M, E, table):
+def _settle(t, s, x, direction, held, P, M, E, table):
     """At a zero crossing of v: stick if friction can hold the payload, else reverse.
 
     Returns ``(state, mode, direction)``. v is set to exactly 0 either way; the
     crossing is located to round-off, so the impulse booked for it is negligible.
     """
     s = _book_impulse(t, s, S_D_FRICTION, E, table, P)
-    f_hold = rhs_at(t, s, np.int64(MODE_STICK), 0.0, held, P, M, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, x, np.int64(MODE_STICK), 0.0, held, P, M, E, table)[1][F_HOLD]
     if abs(f_hold) <= P[P_FS]:
         return s, MODE_STICK, direction
     return s, MODE_SLIP, release_direction(MODE_STICK, f_hold)
 
 
 @njit(**_JIT)
-def _hit_wall(t, s, low, held, P, M, E, table):
+def _hit_wall(t, s, x, low, held, P, M, E, table):
     """Perfectly plastic impact: v absorbed by the stop's impulse, z put on the stop.
 
     The payload then rests on the stop if friction and the stop can hold it,
@@ -459,14 +495,14 @@ def _hit_wall(t, s, low, held, P, M, E, table):
     # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
     s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, slip, P, E, table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
-    f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, x, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
     if hold_margin(mode, f_hold, P[P_FS]) < 0.0:
         return s, MODE_SLIP, release_direction(mode, f_hold)
     return s, mode, 0
 
 
 @njit(**_JIT)
-def _event_value(event, t, s, mode, direction, held, P, M, E, table):
+def _event_value(event, t, s, x, mode, direction, held, P, M, E, table):
     """The function whose sign change defines ``event`` (positive before it)."""
     if event == 1:
         return slip_event(direction, s[S_V])
@@ -474,15 +510,15 @@ def _event_value(event, t, s, mode, direction, held, P, M, E, table):
         return s[S_Z] - P[P_Z_LOW]
     if event == 3:
         return P[P_Z_HIGH] - s[S_Z]
-    f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
+    f_hold = rhs_at(t, s, x, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
     return hold_margin(mode, f_hold, P[P_FS])
 
 
 @njit(**_JIT)
-def _margin_near(t, s, mode, held, P, M, E, table, phase, sin0, cos0):
+def _margin_near(t, s, x, mode, held, P, M, E, table, phase, sin0, cos0):
     """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    return hold_margin(mode, rhs(t, y, yd, ydd, s, mode, 0.0, held, P, M,
+    return hold_margin(mode, rhs(t, y, yd, ydd, s, x, mode, 0.0, held, P, M,
                                  M[M_BLOCKS] != 0.0)[1][F_HOLD], P[P_FS])
 
 
@@ -531,7 +567,7 @@ def _any_event(s, s1, mode, direction, margin1, P):
 
 
 @njit(**_JIT)
-def _rk(solver, t, h, s, k0, mode, direction, held, P, M, E, table):
+def _rk(solver, t, h, s, x, k0, k0_x, mode, direction, held, P, M, E, table):
     """The Runge-Kutta step of :func:`rk_step` for the event path, stage by stage.
 
     The same tableau and fused updates, in the same order; each stage calls the
@@ -539,117 +575,134 @@ def _rk(solver, t, h, s, k0, mode, direction, held, P, M, E, table):
     rather than rotating it from a nearby phase. Single runs and batches both take this
     path for the part of a step around an event, so they stay identical; compiling
     :func:`rk_step`'s inlined stages a second time here took about 70 s of a cold start
-    (docs/model.md §9). ``k0`` is the first stage's rate, ``rhs_at(t, s, ...)[0]``: every
-    trial step of an event's location starts from the same ``t`` and ``s``, so
-    :func:`_locate` evaluates it once for all of them.
+    (docs/model.md §9). ``k0, k0_x`` are the first stage's rates,
+    ``rhs_at(t, s, x, ...)[0, 2]``: every trial step of an event's location starts from the
+    same ``t``, ``s`` and ``x``, so :func:`_locate` evaluates them once for all of them. The
+    blocks' states step with the plant's (their rates 0 without blocks). Returns ``(s, x)``.
     """
     result = _axpy(s, tableau(solver, h, 0)[2], k0)
-    k = k0
+    result_x = _axpy_blocks(x, tableau(solver, h, 0)[2], k0_x)
+    k, k_x = k0, k0_x
     for stage in range(1, n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
-        k = rhs_at(t + offset, _axpy(s, a, k), mode, direction, held, P, M, E, table)[0]
+        k, _, k_x = rhs_at(t + offset, _axpy(s, a, k), _axpy_blocks(x, a, k_x), mode, direction,
+                           held, P, M, E, table)
         result = _axpy(result, weight, k)
-    return result
+        result_x = _axpy_blocks(result_x, weight, k_x)
+    return result, result_x
 
 
 @njit(**_JIT, inline="always")
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s] and its event value.
 
-    ``data`` is ``(solver, event, t, s, k0, mode, direction, held, P, M, E, table)``, the
-    step's start and its first stage's rate; returns ``(event value, state)`` at ``t + at``
-    (:func:`_rk`, :func:`_event_value`).
+    ``data`` is ``(solver, event, t, s, x, k0, k0_x, mode, direction, held, P, M, E, table)``,
+    the step's start and its first stage's rates; returns ``(event value, (s, x))`` at
+    ``t + at`` (:func:`_rk`, :func:`_event_value`).
     """
-    solver, event, t, s, k0, mode, direction, held, P, M, E, table = data
-    state = _rk(solver, t, at, s, k0, mode, float(direction), held, P, M, E, table)
-    return _event_value(event, t + at, state, mode, direction, held, P, M, E, table), state
+    solver, event, t, s, x, k0, k0_x, mode, direction, held, P, M, E, table = data
+    state, state_x = _rk(solver, t, at, s, x, k0, k0_x, mode, float(direction), held, P, M, E,
+                         table)
+    return (_event_value(event, t + at, state, state_x, mode, direction, held, P, M, E, table),
+            (state, state_x))
 
 
 @njit(**_JIT)
-def _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, M, E, table):
+def _locate(solver, event, t, h, s, x, g0, g1, mode, direction, held, P, M, E, table):
     """Event ``event`` located in ``[t, t + h]`` (:func:`qzs.engine.stickslip.locate`).
 
-    Returns ``(time from t, state there)``: at most 6 Runge-Kutta steps from ``t`` (each an
+    Returns ``(time from t, (s, x) there)``: at most 6 Runge-Kutta steps from ``t`` (each an
     :func:`_event_trial`, all sharing their first stage), the event function then zero to
     round-off.
     """
-    k0 = s
+    k0, k0_x = s, x
     if g0 > 0.0:  # else no trial is made
-        k0 = rhs_at(t, s, mode, float(direction), held, P, M, E, table)[0]
-    return locate(_event_trial, (solver, event, t, s, k0, mode, direction, held, P, M, E,
-                                 table), g0, g1, h, s)
+        k0, _, k0_x = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)
+    return locate(_event_trial, (solver, event, t, s, x, k0, k0_x, mode, direction, held, P, M,
+                                 E, table), g0, g1, h, (s, x))
 
 
 @njit(**_JIT)
-def grid_step(solver, t, h, s, mode, direction, held, P, M, blocks, E, table, margin, phase,
+def grid_step(solver, t, h, s, x, mode, direction, held, P, M, blocks, E, table, margin, phase,
               sin0, cos0):
     """Advance one grid step, locating and handling at most one transition inside it.
 
     ``margin`` is the holding margin at ``t`` if known (NaN if not); ``phase,
-    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``; ``M`` the
-    controller's blocks and ``blocks`` whether it has any (:func:`rhs`). Returns
-    ``(state, mode, direction, margin, sticks, impacts)``: the holding margin at
-    the end (NaN while slipping), the counts of new stick events and of plastic
-    impacts in the step.
+    sin0, cos0`` the excitation's phase and its sine and cosine at ``t``; ``x`` the
+    controller blocks' state, ``M`` the blocks and ``blocks`` whether there are any (a
+    constant where this is inlined: without, ``x`` is returned as it came). Returns
+    ``(state, blocks' state, mode, direction, margin, sticks, impacts)``: the holding margin
+    at the end (NaN while slipping), the counts of new stick events and of plastic impacts
+    in the step.
     """
     sticks = 0
     impacts = 0
     # a zero crossing missed earlier
     if mode == MODE_SLIP and P[P_VREG] == 0.0 and slip_event(direction, s[S_V]) < 0.0:
-        s, mode, direction = _settle(t, s, direction, held, P, M, E, table)
+        s, mode, direction = _settle(t, s, x, direction, held, P, M, E, table)
         sticks += mode == MODE_STICK
         margin = np.nan
     if mode != MODE_SLIP:
         if margin != margin:  # NaN: not known yet
-            margin = _margin_near(t, s, mode, held, P, M, E, table, phase, sin0, cos0)
+            margin = _margin_near(t, s, x, mode, held, P, M, E, table, phase, sin0, cos0)
         if margin < 0.0:
-            f_hold = rhs_at(t, s, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
+            f_hold = rhs_at(t, s, x, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
             direction = release_direction(mode, f_hold)
             mode = MODE_SLIP
 
-    s1 = rk_step(solver, t, h, s, mode, float(direction), held, P, M, blocks, E, table, phase,
-                 sin0, cos0)
+    s1, x1 = rk_step(solver, t, h, s, x, mode, float(direction), held, P, M, blocks, E, table,
+                     phase, sin0, cos0)
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _margin_near(t + h, s1, mode, held, P, M, E, table, phase, sin0, cos0)
+        margin1 = _margin_near(t + h, s1, x1, mode, held, P, M, E, table, phase, sin0, cos0)
     event, theta = _first_event(t, h, s, s1, mode, direction, margin, margin1, P)
     if event == 0:
-        return s1, mode, direction, margin1, sticks, impacts
+        return s1, x1, mode, direction, margin1, sticks, impacts
 
-    g0 = margin if event == 4 else _event_value(event, t, s, mode, direction, held, P, M, E, table)
-    g1 = margin1 if event == 4 else _event_value(event, t + h, s1, mode, direction, held, P,
-                                                 M, E, table)
-    at, s_event = _locate(solver, event, t, h, s, g0, g1, mode, direction, held, P, M, E, table)
+    g0 = margin if event == 4 else _event_value(event, t, s, x, mode, direction, held, P, M, E,
+                                                table)
+    g1 = margin1 if event == 4 else _event_value(event, t + h, s1, x1, mode, direction, held,
+                                                 P, M, E, table)
+    at, (s_event, x_event) = _locate(solver, event, t, h, s, x, g0, g1, mode, direction, held,
+                                     P, M, E, table)
+    if not blocks:
+        x_event = x  # unchanged without blocks: a constant of the caller's loop
     t_event = t + at
     if event == 1:
-        s_event, mode, direction = _settle(t_event, s_event, direction, held, P, M, E, table)
+        s_event, mode, direction = _settle(t_event, s_event, x_event, direction, held, P, M, E,
+                                           table)
         sticks += mode == MODE_STICK
     elif event == 2 or event == 3:
-        s_event, mode, direction = _hit_wall(t_event, s_event, event == 2, held, P, M, E, table)
+        s_event, mode, direction = _hit_wall(t_event, s_event, x_event, event == 2, held, P, M,
+                                             E, table)
         impacts += 1
     else:
-        f_hold = rhs_at(t_event, s_event, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
+        f_hold = rhs_at(t_event, s_event, x_event, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
         direction = release_direction(mode, f_hold)
         mode = MODE_SLIP
     rest = h - at
-    s1 = s_event
+    s1, x1 = s_event, x_event
     if rest > 0.0:
-        k0 = rhs_at(t_event, s_event, mode, float(direction), held, P, M, E, table)[0]
-        s1 = _rk(solver, t_event, rest, s_event, k0, mode, float(direction), held, P, M, E, table)
+        k0, _, k0_x = rhs_at(t_event, s_event, x_event, mode, float(direction), held, P, M, E,
+                             table)
+        s1, x1 = _rk(solver, t_event, rest, s_event, x_event, k0, k0_x, mode, float(direction),
+                     held, P, M, E, table)
+        if not blocks:
+            x1 = x
     if mode == MODE_SLIP and P[P_PLASTIC] != 0.0:  # a second event, not located: clamp
         if s1[S_Z] < P[P_Z_LOW] or s1[S_Z] > P[P_Z_HIGH]:
-            s1, mode, direction = _hit_wall(t + h, s1, s1[S_Z] < P[P_Z_LOW], held, P, M,
+            s1, mode, direction = _hit_wall(t + h, s1, x1, s1[S_Z] < P[P_Z_LOW], held, P, M,
                                             E, table)
             impacts += 1
     margin1 = np.nan
     if mode != MODE_SLIP:
-        margin1 = _margin_near(t + h, s1, mode, held, P, M, E, table, phase, sin0, cos0)
-    return s1, mode, direction, margin1, sticks, impacts
+        margin1 = _margin_near(t + h, s1, x1, mode, held, P, M, E, table, phase, sin0, cos0)
+    return s1, x1, mode, direction, margin1, sticks, impacts
 
 
 @njit(**_JIT)
-def sample_controller(t, s, mode, direction, held, P, M, E, table):
-    """Sampled controller: read z and the measured velocity; returns ``(held, state)``.
+def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
+    """Sampled controller: read z and the measured velocity; returns ``(held, s, x)``.
 
     The PI and damping forces with the current integral, then the integral advanced by one
     sample period (docs/model.md §5); with blocks, the compensation (with the observer's
@@ -664,55 +717,50 @@ def sample_controller(t, s, mode, direction, held, P, M, E, table):
     f_comp, f_dither = held[3], held[4]
     if M[M_BLOCKS] != 0.0:
         v = s[S_V] if mode == MODE_SLIP else 0.0
-        force = rhs(t, y, yd, ydd, s, mode, float(direction), held, P, M, True)[1]
+        force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, True)[1]
         feedforward = _compensation(v, float(direction), P, M)
-        f_comp = feedforward - s[S_OBSERVER]
+        f_comp = feedforward - x[X_OBSERVER]
         f_dither = 0.0
         if M[M_DITHER_AMPLITUDE] != 0.0:
             f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
         command = f_pi + f_damp + f_comp + f_dither + force[F_LINEAR]
         f_motor, rate = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
         if M[M_OBSERVER_RATE] > 0.0:  # forward Euler over the period, as the integral
-            applied = held[3] + s[S_OBSERVER]  # the feedforward applied until now
+            applied = held[3] + x[X_OBSERVER]  # the feedforward applied until now
             measured = force[F_FRICTION] + force[F_STOP] + applied
-            s = _with(s, S_OBSERVER, s[S_OBSERVER] + M[M_OBSERVER_RATE] * (
-                measured - s[S_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT])
+            observer = x[X_OBSERVER] + M[M_OBSERVER_RATE] * (
+                measured - x[X_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT]
+            x = (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], observer)
     s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
-    return (f_pi, f_damp, f_motor, f_comp, f_dither, held[5]), s
+    return (f_pi, f_damp, f_motor, f_comp, f_dither, held[5]), s, x
 
 
 @njit(**_JIT)
-def sample_linear(t, s, mode, direction, held, P, M, E, table):
-    """A discrete linear controller's sample at ``t``: returns ``(held, state)``.
+def sample_linear(t, s, x, mode, direction, held, P, M, E, table):
+    """A discrete linear controller's sample at ``t``: returns ``(held, x)``.
 
     It reads its sensors (the payload's acceleration with the force held until now),
     outputs ``y = C x + D u``, held to its next sample, and steps its state
     ``x <- A x + B u + L (F_motor - command)`` (back-calculation, docs/model.md §5).
     """
-    force = rhs_at(t, s, mode, float(direction), held, P, M, E, table)[1]
+    force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     u = (P[P_ZREF] - s[S_Z], force[F_V_MEASURED], force[F_XDD], force[F_YDD], v)
-    output = _linear_output(M, s, u)
+    output = _linear_output(M, x, u)
     command = force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER] + output
     f_motor = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])[0]
-    excess = f_motor - command
-    x = (_linear_rate(0, M, s, u, excess), _linear_rate(1, M, s, u, excess),
-         _linear_rate(2, M, s, u, excess), _linear_rate(3, M, s, u, excess),
-         _linear_rate(4, M, s, u, excess), _linear_rate(5, M, s, u, excess),
-         _linear_rate(6, M, s, u, excess), _linear_rate(7, M, s, u, excess))
-    s = (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], x[0], x[1], x[2], x[3], x[4], x[5],
-         x[6], x[7], s[S_OBSERVER])
-    return (held[0], held[1], held[2], held[3], held[4], output), s
+    x = _linear_rates(M, x, u, f_motor - command, x[X_OBSERVER])
+    return (held[0], held[1], held[2], held[3], held[4], output), x
 
 
 @njit(**_JIT)
-def record(t, s, mode, direction, held, P, M, E, table, row, row_flags, phase, sin0, cos0):
+def record(t, s, x, mode, direction, held, P, M, E, table, row, row_flags, phase, sin0, cos0):
     """Write one output sample (channels ``C_*``) of the state at time ``t``.
 
     ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
     """
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    force = rhs(t, y, yd, ydd, s, mode, float(direction), held, P, M, M[M_BLOCKS] != 0.0)[1]
+    force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, M[M_BLOCKS] != 0.0)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     row[C_TIME] = t
     row[C_BASE_Y] = force[F_Y]
@@ -755,12 +803,12 @@ def evaluate(t, state, flags, p, m, ex, table, row, row_flags):
     """Record the persistent state (arrays, as the driver keeps it) at ``t``."""
     E = excitation_tuple(ex)
     phase, sin0, cos0 = advance_phase(t, 0.0, 0.0, 1.0, E, np.bool_(True))
-    record(t, state_tuple(state), flags[I_MODE], flags[I_DIRECTION], held_tuple(state),
-           params_tuple(p), m, E, table, row, row_flags, phase, sin0, cos0)
+    record(t, state_tuple(state), blocks_tuple(state), flags[I_MODE], flags[I_DIRECTION],
+           held_tuple(state), params_tuple(p), m, E, table, row, row_flags, phase, sin0, cos0)
 
 
 @njit(**_JIT)
 def hold_force(t, state, p, m, ex, table):
     """Force friction must supply to keep the payload stuck at ``state`` [N], and the forces."""
-    return rhs_at(t, state_tuple(state), np.int64(MODE_STICK), 0.0, held_tuple(state),
-                  params_tuple(p), m, excitation_tuple(ex), table)[1]
+    return rhs_at(t, state_tuple(state), blocks_tuple(state), np.int64(MODE_STICK), 0.0,
+                  held_tuple(state), params_tuple(p), m, excitation_tuple(ex), table)[1]

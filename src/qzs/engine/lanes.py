@@ -36,12 +36,11 @@ R_MARGIN = K.A_MARGIN  # the holding margin is part of the persistent state
 (R_MODE, R_DIRECTION, R_CONTACT, R_CONTACTS, R_STICKS,
  R_FAILED, R_BLOCKS) = range(K.N_STATE, K.N_STATE + 7)
 N_ROWS = K.N_STATE + 7
-# Rows of the per-step scratch array: the running weighted sum of the motion and the ledger
-# (the first N_SUM states; a lane whose controller has blocks beyond PI + damping, with states
-# of their own, steps in pass 2), the stage input, the flag.
-N_SUM = K.S_X0
-T_SUM, T_INPUT, T_FLAGGED = 0, N_SUM, N_SUM + 4
-N_SCRATCH = N_SUM + 5
+# Rows of the per-step scratch array: the running weighted sum, the stage input, the flag. (A
+# lane whose controller has blocks beyond PI + damping, with states of their own, steps in
+# pass 2.)
+T_SUM, T_INPUT, T_FLAGGED = 0, K.N_ODE, K.N_ODE + 4
+N_SCRATCH = K.N_ODE + 5
 # Rows of a sample's scratch array: the output channels (``K.C_*``), then the two flags.
 Q_LOCKED, Q_CONTACT = K.N_CHANNELS + K.O_LOCKED, K.N_CHANNELS + K.O_CONTACT
 N_RECORD = K.N_CHANNELS + 2
@@ -111,9 +110,23 @@ def _params(PP, c, exact=False):
 @njit(**_JIT, inline="always")
 def _state(L, c):
     return (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)],
-            L[_at(5, c)], L[_at(6, c)], L[_at(7, c)], L[_at(8, c)], L[_at(9, c)],
-            L[_at(10, c)], L[_at(11, c)], L[_at(12, c)], L[_at(13, c)], L[_at(14, c)],
-            L[_at(15, c)], L[_at(16, c)])
+            L[_at(5, c)], L[_at(6, c)], L[_at(7, c)])
+
+
+@njit(**_JIT, inline="always")
+def _blocks(L, c):
+    """Lane ``c``'s controller blocks' state (``K.X_*``)."""
+    a = K.A_X0
+    return (L[_at(a, c)], L[_at(a + 1, c)], L[_at(a + 2, c)], L[_at(a + 3, c)],
+            L[_at(a + 4, c)], L[_at(a + 5, c)], L[_at(a + 6, c)], L[_at(a + 7, c)],
+            L[_at(a + 8, c)])
+
+
+@njit(**_JIT, inline="always")
+def _store_blocks(L, c, x):
+    a = K.A_X0
+    (L[_at(a, c)], L[_at(a + 1, c)], L[_at(a + 2, c)], L[_at(a + 3, c)], L[_at(a + 4, c)],
+     L[_at(a + 5, c)], L[_at(a + 6, c)], L[_at(a + 7, c)], L[_at(a + 8, c)]) = x
 
 
 @njit(**_JIT, inline="always")
@@ -131,11 +144,11 @@ def _finite(s, P):
 
 
 @njit(**_JIT, inline="always")
-def _finite_blocks(s):
+def _finite_blocks(x):
     """The controller blocks' states are finite (an unstable controller diverges)."""
     finite = True
-    for i in range(K.S_X0, K.N_ODE):
-        finite = finite and np.isfinite(s[i])
+    for i in range(K.N_X):
+        finite = finite and np.isfinite(x[i])
     return finite
 
 
@@ -143,8 +156,7 @@ def _finite_blocks(s):
 def _store(L, c, s, margin, contact, P):
     """Put the end-of-step state of lane ``c``; counts a new compliant-stop contact."""
     (L[_at(0, c)], L[_at(1, c)], L[_at(2, c)], L[_at(3, c)], L[_at(4, c)], L[_at(5, c)],
-     L[_at(6, c)], L[_at(7, c)], L[_at(8, c)], L[_at(9, c)], L[_at(10, c)], L[_at(11, c)],
-     L[_at(12, c)], L[_at(13, c)], L[_at(14, c)], L[_at(15, c)], L[_at(16, c)]) = s
+     L[_at(6, c)], L[_at(7, c)]) = s
     L[_at(R_MARGIN, c)] = margin
     new_contact = contact and L[_at(R_CONTACT, c)] == 0.0 and P[K.P_PLASTIC] == 0.0
     L[_at(R_CONTACT, c)] = 1.0 if contact else 0.0
@@ -164,9 +176,8 @@ def _stage_lanes(exact, n, a_next, weight, base, L, T, PP, M0, source, at_input,
     """
     for c in range(n):
         x = (source[_at(at_input, c)], source[_at(at_input + 1, c)],
-             source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0,
-             0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        k = K.rhs(0.0, base[0], base[1], base[2], x, int(L[_at(R_MODE, c)]),
+             source[_at(at_input + 2, c)], source[_at(at_input + 3, c)], 0.0, 0.0, 0.0, 0.0)
+        k = K.rhs(0.0, base[0], base[1], base[2], x, K._NO_RATES, int(L[_at(R_MODE, c)]),
                   L[_at(R_DIRECTION, c)], _held(L, c), _params(PP, c, exact), M0, False)[0]
         T[_at(T_SUM, c)] = K.fma(weight, k[0], source[_at(at_sum, c)])
         T[_at(T_SUM + 1, c)] = K.fma(weight, k[1], source[_at(at_sum + 1, c)])
@@ -197,16 +208,15 @@ def _finish_lanes(slipping, n, b_end, L, T, PP, M0):
         s = _state(L, c)
         s1 = (T[_at(T_SUM, c)], T[_at(T_SUM + 1, c)], T[_at(T_SUM + 2, c)],
               T[_at(T_SUM + 3, c)], T[_at(T_SUM + 4, c)], T[_at(T_SUM + 5, c)],
-              T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)], s[8], s[9], s[10], s[11], s[12],
-              s[13], s[14], s[15], s[16])
+              T[_at(T_SUM + 6, c)], T[_at(T_SUM + 7, c)])
         P = _params(PP, c)
         mode = K.MODE_SLIP if slipping else int(L[_at(R_MODE, c)])
         direction = L[_at(R_DIRECTION, c)]
         margin = L[_at(R_MARGIN, c)]
         margin1 = np.nan
         if mode != K.MODE_SLIP:
-            force = K.rhs(0.0, b_end[0], b_end[1], b_end[2], s1, K.MODE_STICK, 0.0, _held(L, c),
-                          P, M0, False)[1]
+            force = K.rhs(0.0, b_end[0], b_end[1], b_end[2], s1, K._NO_RATES, K.MODE_STICK, 0.0,
+                          _held(L, c), P, M0, False)[1]
             margin1 = hold_margin(mode, force[K.F_HOLD], P[K.P_FS])
         if mode == K.MODE_SLIP:  # no zero crossing missed (none is tracked when regularised)
             ready = P[K.P_VREG] > 0.0 or slip_event(direction, s[K.S_V]) >= 0.0
@@ -299,8 +309,8 @@ def _sample_lanes(exact, n, t, base, L, PP, M0, Q):
         s = _state(L, c)
         mode = int(L[_at(R_MODE, c)])
         P = _params(PP, c, exact)
-        force = K.rhs(t, base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)],
-                      _held(L, c), P, M0, False)[1]
+        force = K.rhs(t, base[0], base[1], base[2], s, K._NO_RATES, mode,
+                      L[_at(R_DIRECTION, c)], _held(L, c), P, M0, False)[1]
         _write_channels(Q, c, t, s, mode, force, P)
 
 
@@ -324,8 +334,8 @@ def _sample_blocks(n, t, base, L, PP, models, Q):
         s = _state(L, c)
         mode = int(L[_at(R_MODE, c)])
         P = _params(PP, c)
-        force = K.rhs(t, base[0], base[1], base[2], s, mode, L[_at(R_DIRECTION, c)],
-                      _held(L, c), P, models[c], True)[1]
+        force = K.rhs(t, base[0], base[1], base[2], s, _blocks(L, c), mode,
+                      L[_at(R_DIRECTION, c)], _held(L, c), P, models[c], True)[1]
         _write_channels(Q, c, t, s, mode, force, P)
 
 
@@ -474,22 +484,22 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
                                                    int(models[c, K.M_LINEAR_STEPS]))
                 if controller or linear:
                     s = _state(L, c)
+                    x = _blocks(L, c)
                     held = _held(L, c)
                     mode = int(L[_at(R_MODE, c)])
                     direction = int(L[_at(R_DIRECTION, c)])
                     if controller:
-                        held, s = K.sample_controller(t, s, mode, direction, held,
-                                                      _params(PP, c), models[c], E, table)
+                        held, s, x = K.sample_controller(t, s, x, mode, direction, held,
+                                                         _params(PP, c), models[c], E, table)
                     if linear:
-                        held, s = K.sample_linear(t, s, mode, direction, held, _params(PP, c),
-                                                  models[c], E, table)
+                        held, x = K.sample_linear(t, s, x, mode, direction, held,
+                                                  _params(PP, c), models[c], E, table)
                     (L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)],
                      L[_at(K.A_F_COMPENSATION, c)], L[_at(K.A_F_DITHER, c)],
                      L[_at(K.A_F_LINEAR, c)]) = held
                     L[_at(K.S_INT, c)] = s[K.S_INT]
                     if L[_at(R_BLOCKS, c)] != 0.0:
-                        for i in range(K.S_X0, K.N_ODE):
-                            L[_at(i, c)] = s[i]
+                        _store_blocks(L, c, x)
                     L[_at(R_MARGIN, c)] = np.nan
         bases = K.stage_bases(solver, t, h, E, table, phase, sin0, cos0)
         b_end = base_motion_near(t + h, phase, sin0, cos0, E, table)
@@ -498,13 +508,13 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
                 if T[_at(T_FLAGGED, c)] == 0.0 or L[_at(R_FAILED, c)] != 0.0:
                     continue
                 P = _params(PP, c)
-                s1, mode, direction, margin, sticks, impacts = K.grid_step(
-                    solver, t, h, _state(L, c), int(L[_at(R_MODE, c)]),
+                s1, x1, mode, direction, margin, sticks, impacts = K.grid_step(
+                    solver, t, h, _state(L, c), _blocks(L, c), int(L[_at(R_MODE, c)]),
                     int(L[_at(R_DIRECTION, c)]), _held(L, c), P, models[c],
                     L[_at(R_BLOCKS, c)] != 0.0, E, table, L[_at(R_MARGIN, c)], phase, sin0,
                     cos0)
                 if not _finite(s1, P) or (L[_at(R_BLOCKS, c)] != 0.0
-                                          and not _finite_blocks(s1)):
+                                          and not _finite_blocks(x1)):
                     L[_at(R_FAILED, c)] = 1.0
                     failed_step[c] = step
                     rows[c] = row - row0
@@ -515,6 +525,8 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
                 L[_at(R_CONTACTS, c)] += impacts
                 L[_at(R_STICKS, c)] += sticks
                 _store(L, c, s1, margin, K._in_contact(s1, mode, P), P)
+                if L[_at(R_BLOCKS, c)] != 0.0:
+                    _store_blocks(L, c, x1)
         step += 1
         # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
         phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
@@ -588,6 +600,7 @@ def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, tab
     control_steps = int(P[K.P_CONTROL_STEPS])
     linear_steps = int(m[K.M_LINEAR_STEPS]) if blocks else 0
     s = K.state_tuple(state)
+    x = K.blocks_tuple(state)
     held = K.held_tuple(state)
     mode = flags[K.I_MODE]
     direction = flags[K.I_DIRECTION]
@@ -602,18 +615,19 @@ def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, tab
         if control_steps > 0 or linear_steps > 0:
             controller, linear = _sample_times(step, control_steps, linear_steps)
             if controller:
-                held, s = K.sample_controller(t, s, mode, direction, held, P, m, E, table)
+                held, s, x = K.sample_controller(t, s, x, mode, direction, held, P, m, E,
+                                                 table)
                 margin = np.nan
             if blocks and linear:
-                held, s = K.sample_linear(t, s, mode, direction, held, P, m, E, table)
+                held, x = K.sample_linear(t, s, x, mode, direction, held, P, m, E, table)
                 margin = np.nan
-        s1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
-            solver, t, h, s, mode, direction, held, P, m, blocks, E, table, margin, phase,
+        s1, x1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
+            solver, t, h, s, x, mode, direction, held, P, m, blocks, E, table, margin, phase,
             sin0, cos0)
-        if not _finite(s1, P) or (blocks and not _finite_blocks(s1)):
+        if not _finite(s1, P) or (blocks and not _finite_blocks(x1)):
             status = K.STATUS_DIVERGED
             break
-        s, mode, direction, margin = s1, mode1, direction1, margin1
+        s, x, mode, direction, margin = s1, x1, mode1, direction1, margin1
         step += 1
         # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
         phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
@@ -625,11 +639,14 @@ def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, tab
             flags[K.I_N_CONTACTS] += 1
         contact = 1 if now else 0
         if step % decimation == 0:
-            K.record(step * h, s, mode, direction, held, P, m, E, table, out[row],
+            K.record(step * h, s, x, mode, direction, held, P, m, E, table, out[row],
                      out_flags[row], phase, sin0, cos0)
             row += 1
     for i in range(K.N_ODE):
         state[i] = s[i]
+    if blocks:
+        for i in range(K.N_X):
+            state[K.A_X0 + i] = x[i]
     (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR], state[K.A_F_COMPENSATION],
      state[K.A_F_DITHER], state[K.A_F_LINEAR]) = held
     state[K.A_MARGIN] = margin

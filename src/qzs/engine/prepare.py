@@ -351,9 +351,9 @@ def _preload_linear(s, p, m, controller, packed_excitation, preload):
                                              - float(d[0] @ u0)]])
         x0 = np.linalg.lstsq(loaded, target, rcond=None)[0]
         if np.allclose(loaded @ x0, target, rtol=1e-9, atol=1e-12 * max(1.0, abs(needed))):
-            s[K.S_X0:K.S_X0 + n] = x0
+            s[K.A_X0:K.A_X0 + n] = x0
             return
-    s[K.S_X0:K.S_X0 + n] = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+    s[K.A_X0:K.A_X0 + n] = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
 
 
 def _hold_blocks(s, p, m, packed_excitation):
@@ -368,7 +368,7 @@ def _hold_blocks(s, p, m, packed_excitation):
     if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's output at x(0): C x + D u
         u = (p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD], force[K.F_YDD],
              0.0)
-        s[K.A_F_LINEAR] = (float(np.dot(m[K.M_C:K.M_C + K.NX_MAX], s[K.S_X0:K.S_OBSERVER]))
+        s[K.A_F_LINEAR] = (float(np.dot(m[K.M_C:K.M_C + K.NX_MAX], s[K.A_X0:K.A_X0 + K.NX_MAX]))
                            + float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], u)))
 
 
@@ -536,7 +536,7 @@ def divergence_message(state, step, dt):
         The message of the :class:`~qzs.errors.SimulationError`.
     """
     controller = ""
-    blocks = np.abs(state[K.S_X0:K.N_ODE])
+    blocks = np.abs(state[K.A_X0:K.A_X0 + K.N_X])
     if np.any(blocks):
         controller = (f", the controller blocks' largest state {np.max(blocks):.6g}; a linear "
                       "controller whose states grow is unstable in the loop: check its poles "
