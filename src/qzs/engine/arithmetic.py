@@ -138,7 +138,7 @@ def tanh(u):
 _KERNEL_MODULES = ("arithmetic", "laws", "stickslip", "base_motion", "kernels", "lanes",
                    "hexapod/dynamics", "hexapod/stepping")
 _KERNEL_SOURCES = (*(f"engine/{name}.py" for name in _KERNEL_MODULES), "engine/hexapod/layout.py",
-                   "model/excitation.py", "model/controller.py")
+                   "model/excitation.py", "model/sensors.py")
 #: The fingerprint of those sources, kept beside numba's cache files.
 _STAMP = "qzs-kernel-sources.sha256"
 

@@ -34,7 +34,7 @@ from qzs.engine.laws import (compensation_law, compliant_stop_law, controller_la
 from qzs.engine.stickslip import (MODE_SLIP, MODE_STICK, MODE_WALL_HIGH, MODE_WALL_LOW,
                                   crossed_zero, hold_margin, locate, release_direction,
                                   secant_fraction, slip_event)
-from qzs.model.controller import MAX_STATES, SENSORS
+from qzs.model.sensors import MAX_STATES, SENSORS
 
 # Packed parameters. P_VREG > 0 selects the regularised friction model: no stick-slip events,
 # the mode stays slipping (docs/model.md §3).
@@ -705,8 +705,8 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
     """Sampled controller: read z and the measured velocity; returns ``(held, s, x)``.
 
     The PI and damping forces with the current integral, then the integral advanced by one
-    sample period (docs/model.md §5); with blocks, the compensation (with the observer's
-    current estimate, then the observer advanced) and the dither too. ``held`` is what the
+    sample period (docs/model.md §5); with blocks, the observer advanced from what it
+    measures at the sample, the compensation with its new estimate, and the dither. ``held`` is what the
     controller held until now (a discrete linear controller's output is its own,
     :func:`sample_linear`).
     """
@@ -718,19 +718,21 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
     if M[M_BLOCKS] != 0.0:
         v = s[S_V] if mode == MODE_SLIP else 0.0
         force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, True)[1]
+        if M[M_OBSERVER_RATE] > 0.0:
+            # advanced by forward Euler over the period from what it measures now, the
+            # feedforward applied until now being the held force plus the estimate it held
+            applied = held[3] + x[X_OBSERVER]
+            measured = force[F_FRICTION] + force[F_STOP] + applied
+            observer = x[X_OBSERVER] + M[M_OBSERVER_RATE] * (
+                measured - x[X_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT]
+            x = (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], observer)
         feedforward = _compensation(v, float(direction), P, M)
-        f_comp = feedforward - x[X_OBSERVER]
+        f_comp = feedforward - x[X_OBSERVER]  # the new estimate, applied at once
         f_dither = 0.0
         if M[M_DITHER_AMPLITUDE] != 0.0:
             f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
         command = f_pi + f_damp + f_comp + f_dither + force[F_LINEAR]
         f_motor, rate = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
-        if M[M_OBSERVER_RATE] > 0.0:  # forward Euler over the period, as the integral
-            applied = held[3] + x[X_OBSERVER]  # the feedforward applied until now
-            measured = force[F_FRICTION] + force[F_STOP] + applied
-            observer = x[X_OBSERVER] + M[M_OBSERVER_RATE] * (
-                measured - x[X_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT]
-            x = (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], observer)
     s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
     return (f_pi, f_damp, f_motor, f_comp, f_dither, held[5]), s, x
 

@@ -8,6 +8,7 @@ The equations, signs and defaults are described in docs/model.md.
 ``isolator``    the plant's parameters and force laws (spring, friction), the rest state
 ``controller``  the controller as a value: PI + damping and the blocks that add to it
 ``excitation``  base excitations (chirp, sine, random, a displacement record)
+``sensors``     what a user's controller may read, and its most states
 ``registry``    every parameter's name, unit, doc and default; ``--set`` parsing
 ``hexapod``     a six-leg platform of isolator legs: geometry, kinematics, statics
 ==============  ==================================================================

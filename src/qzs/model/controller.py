@@ -37,24 +37,12 @@ from qzs._validation import (non_negative_real, optional, parameter, positive_re
                              validate_fields)
 from qzs.errors import ParameterError
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
+from qzs.model.sensors import MAX_STATES, SENSORS
 
 __all__ = ["ControllerParameters", "PIDamping", "FrictionCompensation", "Dither",
            "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "block_parameters",
            "closed_loop_natural_frequency"]
 
-#: What a :class:`LinearController` may read, in the kernels' order: name -> (unit,
-#: description). The payload's acceleration enters a continuous controller through its
-#: states only (no direct feedthrough: that would be an algebraic loop through the motor).
-SENSORS: dict[str, tuple[str, str]] = {
-    "position_error": ("m", "encoder position error z_ref - z"),
-    "measured_payload_velocity": ("m/s", "payload velocity from the charge amplifier "
-                                         "(high-passed)"),
-    "payload_acceleration": ("m/s^2", "payload acceleration (accelerometer)"),
-    "base_acceleration": ("m/s^2", "base acceleration (the rig's second accelerometer)"),
-    "relative_velocity": ("m/s", "relative velocity z-dot (the encoder's)"),
-}
-#: Most states of a :class:`LinearController` (the kernels hold this many).
-MAX_STATES = 8
 #: The blocks a controller may carry beyond PI + damping: field name -> class name.
 BLOCKS = ("compensation", "dither", "linear")
 #: Default anti-windup tracking time of a linear controller [s] (docs/model.md §5).
@@ -87,7 +75,9 @@ class FrictionCompensation:
     stribeck_decay : float, optional
         The compensator's Stribeck decay coefficient Cbc [s/m]; default the plant's.
     viscous_damping : float, optional
-        The compensator's viscous coefficient Cv [N*s/m]; default the plant's.
+        The compensator's viscous coefficient Cv [N*s/m]; default 0: the viscous friction is
+        the loop's damping, and cancelling it makes the default PI loop unstable
+        (docs/model.md §5); None takes the plant's.
     deadband : float
         Velocity deadband [m/s]: no feedforward while ``|v|`` is at most this.
     observer_bandwidth : float
@@ -98,7 +88,7 @@ class FrictionCompensation:
     stiction_force: float | None = parameter(None, "N", "compensator's stiction force Fs")
     coulomb_force: float | None = parameter(None, "N", "compensator's Coulomb force Fc")
     stribeck_decay: float | None = parameter(None, "s/m", "compensator's Stribeck decay Cbc")
-    viscous_damping: float | None = parameter(None, "N*s/m", "compensator's viscous damping Cv")
+    viscous_damping: float | None = parameter(0.0, "N*s/m", "compensator's viscous damping Cv")
     deadband: float = parameter(0.0, "m/s", "velocity deadband of the compensation")
     observer_bandwidth: float = parameter(0.0, "Hz", "friction observer bandwidth (0 = none)")
 
@@ -126,16 +116,18 @@ class FrictionCompensation:
         Parameters
         ----------
         fit : FrictionFit
-            The fit; its Fs, Fc, Cbc and Cv become the compensator's.
+            The fit; its Fs, Fc and Cbc become the compensator's (its Cv only if
+            ``viscous_damping=fit.viscous_damping`` is given: see the class).
         **options
-            The other fields (``fraction``, ``deadband``, ``observer_bandwidth``).
+            The other fields (``fraction``, ``deadband``, ``observer_bandwidth``,
+            ``viscous_damping``).
 
         Returns
         -------
         FrictionCompensation
         """
         values = {name: float(getattr(fit, name)) for name in
-                  ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping")
+                  ("stiction_force", "coulomb_force", "stribeck_decay")
                   if getattr(fit, name, None) is not None}
         return cls(**values, **options)
 
@@ -473,11 +465,11 @@ class ControllerParameters:
     velocity_highpass: float = parameter(1.0, "Hz", "charge-amplifier high-pass corner (0 = off)")
     controller_rate: float = parameter(0.0, "Hz", "controller sampling rate (0 = continuous)")
     compensation: FrictionCompensation | None = dataclasses.field(
-        default=None, metadata={"block": True, "doc": "friction compensation block"})
+        default=None, metadata={"block": True, "unit": "-", "doc": "friction compensation block"})
     dither: Dither | None = dataclasses.field(
-        default=None, metadata={"block": True, "doc": "dither block"})
+        default=None, metadata={"block": True, "unit": "-", "doc": "dither block"})
     linear: LinearController | None = dataclasses.field(
-        default=None, metadata={"block": True, "doc": "the user's linear controller"})
+        default=None, metadata={"block": True, "unit": "-", "doc": "the user's linear controller"})
 
     def __post_init__(self):
         validate_fields(self, {
