@@ -14,6 +14,14 @@ absolute transmissibility
 
 This is the frictionless-guide limit the nonlinear simulator must reproduce
 (tests), and the overlay shown with nonlinear transmissibility curves.
+
+A controller with blocks (a user's ``LinearController``, friction compensation) closes the
+same plant through one linear system instead of the closed form (docs/model.md §10): the
+plant with every sensor a controller may read (:func:`plant_system`), the whole controller
+from those sensors to the motor force (:func:`controller_system`: PI + damping, the
+compensation's linear part, the user's controller), and the two closed
+(:func:`close_loop`). A controller without blocks keeps the closed form, operation for
+operation.
 """
 import math
 from dataclasses import dataclass
@@ -112,18 +120,25 @@ def linearize(isolator: IsolatorParameters | None = None,
               relative_position: float | None = None) -> LinearModel:
     """Linearise the closed-loop isolator at its operating point.
 
+    PI + damping: the closed form of the module's text. With blocks: the plant
+    (:func:`plant_system`) and the controller (:func:`controller_system`) closed, ``T`` the
+    payload's acceleration over the base's (pole-zero cancellations removed by ``minreal``).
+
     Parameters
     ----------
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; defaults if omitted.
+        PI and damping loops, and any blocks (a discrete linear controller: use the sampled
+        loop's functions); defaults if omitted.
     relative_position : float, optional
         Operating point z [m]; default the position setpoint.
 
     Returns
     -------
     LinearModel
+        ``stiffness`` and ``undamped_natural_frequency`` are the spring's and ``Kp``'s
+        alone; the poles are the whole loop's.
     """
     import control
 

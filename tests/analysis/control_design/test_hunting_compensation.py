@@ -37,12 +37,12 @@ def test_the_slip_jump_of_a_compensated_coulomb_guide_is_two_a_fs(fraction, vali
     jump, duration = cd.slip_jump(isolator, controller)
     expected = 2 * fraction * 5.0 * (1 + 1e-6) if fraction else 0.0  # the 1e-6 start kick
     k_total = cd.predict_hunting(isolator, controller).stiffness
-    assert jump == pytest.approx(expected, rel=1e-6, abs=1e-9)
+    assert jump == pytest.approx(expected, rel=2e-6, abs=1e-9)
     if fraction:
         assert duration == pytest.approx(math.pi * math.sqrt(isolator.mass / k_total), rel=1e-6)
         validation(f"Slip jump of a compensated Coulomb guide, fraction {fraction}",
                    "2 a Fs (half a period of m v' = F - (1 - a) Fs, F' = -K v)",
-                   abs(jump / expected - 1), 1e-6)
+                   abs(jump / expected - 1), 2e-6)
     prediction = cd.predict_hunting(isolator, controller)
     if fraction >= 1:  # it does not re-stick: no relay, no plateau
         assert not prediction.hunts and "does not re-stick" in prediction.reasons["hunts"]

@@ -9,6 +9,12 @@ cycle, ever. It cannot: the stuck phase, in which the integral winds up, has no 
 velocity law (Olsson 1996; Armstrong-Hélouvry and Amin 1996). :mod:`.hunting` has the
 stick-slip element that does predict the cycle.
 
+A friction compensation changes that: the guide's law less the motor's feedforward, the net
+law (:class:`NetFrictionNonlinearity`), has a negative describing function where it
+over-compensates, and meets the loop at its resonance: a cycle of the payload sliding
+through its reversals (:func:`predict_sliding_cycle`, docs/model.md §5; the describing
+function by quadrature, :func:`net_describing_function`).
+
 References
 ----------
 H. Olsson, "Describing function analysis of a system with friction", Proc. IEEE CCA 1995.

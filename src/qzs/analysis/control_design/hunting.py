@@ -16,6 +16,12 @@ period with instant slips is ``4*h*K/(Ki*d)``. No slip jump (the Stribeck dip do
 the damping: the payload creeps) or no integral: no hunting. :func:`predict_hunting` runs
 both analyses, this one and the memoryless friction law's of :mod:`.describing_functions`.
 
+With a friction compensation (docs/model.md §5) the slip integrates the net law (the
+compensation pushes along the slip beyond its deadband) and the integral loop's viscous term
+is ``Cv - fraction*Cv'``: the jump grows with the fraction, and from ``J >= 2 Fs`` the slip
+no longer re-sticks (no relay). A friction observer or a user's linear controller is refused:
+the relay does not model them.
+
 References
 ----------
 H. Olsson, K. J. Åström, "Friction generated limit cycles", IEEE Trans. Control Syst.
