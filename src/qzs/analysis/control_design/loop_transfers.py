@@ -135,6 +135,27 @@ def _sampled_response(isolator, controller, rate, delay, omega, relative_positio
     return pi * plant[:, 0] + kd * plant[:, 1]
 
 
+def _delay_line(phi, g0, g1, whole, fraction, line):
+    """``(Ad, Bd)`` of ``x[k+1] = Phi x[k] + G0 u[k-n] + G1 u[k-n-1]`` with the past inputs
+    ``q_1 = u[k-1], ..., q_line = u[k-line]`` as states after the plant's."""
+    n_states = phi.shape[0]
+    size = n_states + line
+    ad = np.zeros((size, size))
+    bd = np.zeros((size, 1))
+    ad[:n_states, :n_states] = phi
+    if line:
+        bd[n_states, 0] = 1.0
+        for i in range(1, line):
+            ad[n_states + i, n_states + i - 1] = 1.0
+    if whole == 0:
+        bd[:n_states] += g0
+    else:
+        ad[:n_states, n_states + whole - 1] += g0[:, 0]
+    if fraction > 0:
+        ad[:n_states, n_states + whole] += g1[:, 0]
+    return ad, bd
+
+
 def discretize_with_delay(a, b, c, period, delay=0.0):
     """Exact zero-order-hold discretisation with an input delay (modified z-transform).
 
@@ -162,24 +183,9 @@ def discretize_with_delay(a, b, c, period, delay=0.0):
     a, b, c = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (a, b, c))
     period = real("period", period, minimum=0.0, strict=True)
     delay = real("delay", delay, minimum=0.0)
-    n_states = a.shape[0]
     phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
     line = whole + (1 if fraction > 0 else 0)  # past inputs kept as states
-    size = n_states + line
-    ad = np.zeros((size, size))
-    bd = np.zeros((size, 1))
-    ad[:n_states, :n_states] = phi
-    # past inputs q_1 = u[k-1], ..., q_line = u[k-line]
-    if line:
-        bd[n_states, 0] = 1.0
-        for i in range(1, line):
-            ad[n_states + i, n_states + i - 1] = 1.0
-    if whole == 0:
-        bd[:n_states] += g0
-    else:
-        ad[:n_states, n_states + whole - 1] += g0[:, 0]
-    if fraction > 0:
-        ad[:n_states, n_states + whole] += g1[:, 0]
+    ad, bd = _delay_line(phi, g0, g1, whole, fraction, line)
     cd = np.hstack([c, np.zeros((c.shape[0], line))])
     return control.ss(ad, bd, cd, np.zeros((c.shape[0], 1)), period)
 
@@ -381,18 +387,9 @@ def _held_plant(plant, period, delay):
     (``i = 1 .. n+1``) states, and ``y[k] = C x[k] + D q_{n+1}`` (no feed-through).
     """
     a, b, c, d = plant
-    phi, g0, g1, whole, _ = _delayed_hold(a, b, period, delay)
+    phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
     n, line = a.shape[0], whole + 1
-    ad, bd = np.zeros((n + line, n + line)), np.zeros((n + line, 1))
-    ad[:n, :n] = phi
-    bd[n, 0] = 1.0
-    for i in range(1, line):
-        ad[n + i, n + i - 1] = 1.0
-    if whole == 0:
-        bd[:n] += g0
-    else:
-        ad[:n, n + whole - 1] += g0[:, 0]
-    ad[:n, n + whole] += g1[:, 0]
+    ad, bd = _delay_line(phi, g0, g1, whole, fraction, line)
     cd = np.zeros((c.shape[0], n + line))
     cd[:, :n] = c
     cd[:, n + whole] = d[:, 0]
