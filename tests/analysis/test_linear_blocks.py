@@ -139,6 +139,23 @@ def test_simulated_transmissibility_with_a_lead_lag_loop_is_the_linear_loops(fre
                abs(simulated / expected - 1), 1e-4)
 
 
+@pytest.mark.parametrize("frequency", [2.0, 5.0, 10.0])
+def test_simulated_transmissibility_with_a_friction_observer_is_the_linear_loops(frequency,
+                                                                                validation):
+    """Half the viscous friction compensated and the rest observed (10 Hz): the run's steady
+    state against ``c(s) = (1 - a) Cv s/(s + w_o)`` in the closed loop (docs/model.md §10)."""
+    isolator = linear_isolator()
+    controller = PIDamping(position_setpoint=0.0, pi_kp=50.0, pi_ki=200.0, damping_gain=100.0,
+                           velocity_highpass=0.0) + FrictionCompensation(
+        fraction=0.5, observer_bandwidth=10.0)
+    expected = float(linearize(isolator, controller).transmissibility(frequency))
+    simulated = steady_transmissibility(frequency, isolator, controller)
+    assert simulated == pytest.approx(expected, rel=1e-4)
+    validation(f"Simulated steady state with friction compensation and its observer, "
+               f"{frequency:g} Hz", "the linearised loop with the compensation's linear part",
+               abs(simulated / expected - 1), 1e-4)
+
+
 def test_bad_input_names_the_argument_and_the_fix():
     block = lead_lag()
     with pytest.raises(ParameterError, match=r"`controller`.*PIDamping\(\) \+ LinearController"):

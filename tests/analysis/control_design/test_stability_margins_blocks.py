@@ -48,6 +48,19 @@ def test_over_compensated_viscous_friction_is_an_unstable_loop_with_its_poles(va
                abs(verdict.unstable_poles.real.max() / growth - 1), 1e-9)
 
 
+def test_compensating_the_viscous_friction_costs_the_pi_loop_its_damping():
+    """Without a damping loop, ``m s^3 + (1 - a) Cv s^2 + K s + Ki`` is stable only while
+    ``(1 - a) Cv K > m Ki``: the fraction's limit ``a* = 1 - m Ki/(K Cv)`` (0.975 here)."""
+    isolator = IsolatorParameters()
+    m, cv, k, kp, ki, _, _ = loop_constants(isolator, PIDamping())
+    limit = 1 - m * ki / ((k + kp) * cv)
+    for fraction, stable in ((limit - 0.002, True), (limit + 0.002, False)):
+        verdict = cd.loop_stability(isolator, PIDamping() + FrictionCompensation(
+            fraction=fraction))
+        assert verdict.stable is stable
+    assert limit == pytest.approx(0.975, abs=1e-3)
+
+
 def test_a_controller_unstable_alone_is_accepted_when_its_loop_is_stable():
     """``F = Kp e + 100/(s - 0.2) e``: a pole at +0.2 rad/s, closed stably: the loop's
     polynomial ``(s - 0.2)(m s^2 + Cv s + K) + 100`` (Routh: all its coefficients positive

@@ -328,6 +328,8 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     rate = real("rate", rate, minimum=0.0)
     delay = real("delay", delay, minimum=0.0)
     f = np.asarray(frequency, dtype=float)
+    if not isinstance(exact, (bool, np.bool_)):
+        raise ParameterError(f"`exact` must be True or False, got {exact!r}.", ("exact",))
     if controller.has_blocks or exact:
         linear = controller.linear
         if rate > 0 or (linear is not None and linear.discrete):

@@ -305,6 +305,11 @@ def required_controller_rate(isolator=None, controller=None, delay=0.0, *,
         Why NaN ('' otherwise).
     """
     isolator, controller = model_inputs(isolator, controller)
+    if controller.linear is not None and controller.linear.discrete:
+        raise ParameterError(
+            "`controller` has a discrete LinearController, which runs at its own sample time: "
+            "required_controller_rate scans the rate of PI + damping alone; make the linear "
+            "controller continuous, or check its rate with loop_margins.", ("controller",))
     low, high = interval("rate_range", rate_range, "Hz", minimum=1e-9)
     delay = real("delay", delay, minimum=0.0)
 
@@ -456,9 +461,13 @@ def loop_stability(isolator=None, controller=None, relative_position=None):
         where = (f"|z| = {abs(worst):.6g}, {abs(np.angle(worst)) / (2 * np.pi * period):.3g} Hz"
                  if sampled else f"growth rate {worst.real:.3g} 1/s, "
                                  f"{abs(worst.imag) / (2 * np.pi):.3g} Hz")
+        compensation = controller.compensation
+        fix = ("lower the gains, or add phase lead where the loop crosses over"
+               + (", or compensate less of the guide's viscous friction (the fraction, or "
+                  "the compensator's viscous_damping)" if compensation is not None
+                  and compensation.fraction > 0 else ""))
         reasons["stable"] = (f"{unstable.size} closed-loop pole(s) outside the stability "
-                             f"region, the worst at {where}; lower the gains, or add phase "
-                             "lead where the loop crosses over")
+                             f"region, the worst at {where}; {fix}")
     controller_unstable = bool(np.any(_outside(own, sampled, -1e-9)) or (
         continuous is not None and np.any(_outside(_eigenvalues(continuous[0]), False, -1e-9))))
     if controller_unstable:
