@@ -8,6 +8,7 @@ loop keeps given margins.
 """
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -19,6 +20,8 @@ from qzs.analysis.control_design.loop_transfers import (PADE_ORDER, _continuous_
                                                         loop_transfer, sampled_loop)
 from qzs.analysis.linear import close_loop, continuous_controller_matrices, plant_matrices
 from qzs.errors import ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import model_inputs
 
 __all__ = ["LoopMargins", "loop_margins", "stability_margins_of", "required_controller_rate",
@@ -73,7 +76,8 @@ class LoopMargins:
     phase_crossover_frequency: float
     reasons: dict = field(default_factory=dict)
 
-    def meets(self, gain_margin_min=GAIN_MARGIN_MIN, phase_margin_min=PHASE_MARGIN_MIN):
+    def meets(self, gain_margin_min: float = GAIN_MARGIN_MIN,
+              phase_margin_min: float = PHASE_MARGIN_MIN) -> bool:
         """Stable with at least these margins.
 
         Parameters
@@ -91,7 +95,7 @@ class LoopMargins:
                     else True)
         return bool(self.stable and self.gain_margin >= gain_margin_min and phase_ok)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The margins as a plain ``dict``."""
         return dict(self.__dict__)
 
@@ -152,7 +156,9 @@ def _margins(response, omega, stable, rate, delay, extra_reasons=None):
                        phase_crossover_frequency=float(f_pc), reasons=reasons)
 
 
-def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_position=None):
+def loop_margins(isolator: IsolatorParameters | None = None,
+                 controller: ControllerParameters | None = None, rate: float | None = None,
+                 delay: float = 0.0, relative_position: float | None = None) -> LoopMargins:
     """Gain and phase margins of the loop, continuous or sampled (python-control).
 
     A controller with blocks (docs/design.md §6): its loop is sampled wherever a part of it
@@ -396,7 +402,7 @@ class LoopStability:
                       f"{m.gain_crossover_frequency:.3g} Hz")
         return f"stable loop: {gain}, {phase}"
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The verdict as a plain ``dict`` (poles as lists of [real, imaginary])."""
         out = {name: getattr(self, name) for name in ("stable", "sampled", "period",
                                                        "controller_unstable")}
@@ -416,7 +422,9 @@ def _outside(poles, sampled, margin=0.0):
     return (np.abs(poles) >= 1.0 - margin) if sampled else (poles.real >= -margin)
 
 
-def loop_stability(isolator=None, controller=None, relative_position=None):
+def loop_stability(isolator: IsolatorParameters | None = None,
+                   controller: ControllerParameters | None = None,
+                   relative_position: float | None = None) -> LoopStability:
     """Whether a controller's loop is stable, with its margins, and why not when it is not.
 
     The one verdict on a controller (:class:`LoopStability`): the closed loop's poles from
