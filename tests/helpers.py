@@ -36,6 +36,43 @@ def linear_controller(**overrides):
     return ControllerParameters(**settings)
 
 
+def steady_transmissibility(excitation_frequency, isolator, controller, *, duration=40.0,
+                            window=10.0, dt=1e-4):
+    """``|X/Y|`` [-] of a simulated run in its steady state, from the fundamental's Fourier
+    coefficients of the payload's and the base's velocity over the last ``window`` seconds
+    (whole periods: ``window*f`` a whole number and ``1/(f dt)`` too).
+
+    The velocities, not the accelerations: they are continuous where a held force jumps, so
+    the samples' sum is the integral over whole periods; a slow transient of the position
+    (the PI's integral) is smaller in them by its rate over the excitation's frequency.
+    """
+    run = qzs.simulate(qzs.Sine(amplitude=1e-3, frequency=excitation_frequency, fade_in=0.0),
+                       isolator, controller, duration=duration, dt=dt, sample_rate=1.0 / dt)
+    per_period = int(round(1.0 / (excitation_frequency * dt)))
+    first = int(np.searchsorted(run.time, duration - window - 0.5 * dt))
+    chosen = slice(first, first + int(round(window * excitation_frequency)) * per_period)
+    phase = np.exp(-2j * np.pi * excitation_frequency * run.time[chosen])
+    payload = np.sum(run["payload_velocity"][chosen] * phase)
+    base = np.sum(run["base_velocity"][chosen] * phase)
+    return float(abs(payload / base))
+
+
+#: A lead on the measured payload velocity: -Kd (1 + s/w_z)/(1 + s/w_p), zero 2 Hz, pole 20 Hz.
+LEAD_LAG = dict(gain=50.0, zero=2 * np.pi * 2.0, pole=2 * np.pi * 20.0)
+
+
+def lead_lag(sample_time=0.0):
+    """:data:`LEAD_LAG` as a LinearController on the charge amplifier's velocity (continuous,
+    or held: ``control.c2d`` with a zero-order hold)."""
+    import control
+
+    system = control.tf([-LEAD_LAG["gain"] / LEAD_LAG["zero"], -LEAD_LAG["gain"]],
+                        [1 / LEAD_LAG["pole"], 1.0])
+    if sample_time:
+        system = control.c2d(system, sample_time, "zoh")
+    return qzs.LinearController.from_system(system, inputs=("measured_payload_velocity",))
+
+
 def stick_rises(locked):
     """Number of slip -> locked transitions in a boolean series."""
     return int(np.count_nonzero(np.diff(locked.astype(np.int8)) == 1))

@@ -38,6 +38,7 @@ CACHE = ROOT / ".mypy_cache"
 #: Result classes returned by public functions but not themselves in the flat namespace.
 RESULT_CLASSES = {
     "qzs.analysis.linear": ["LinearModel"],
+    "qzs.analysis.control_design.stability_margins": ["LoopMargins", "LoopStability"],
     "qzs.analysis.spectral": ["TransmissibilityMetrics"],
     "qzs.analysis.harmonic_balance": ["FrequencyResponseCurve"],
     "qzs.identify": ["SpringFit", "FrictionFit", "TransmissibilityFit"],
@@ -188,6 +189,8 @@ USES = '''
     assert_type(chirp.max_frequency, float)
     assert_type(qzs.largest_stable_step(isolator, controller), float)
     assert_type(qzs.linearize(isolator, controller).damping_ratio, float)
+    assert_type(qzs.loop_stability(isolator, controller).message, str)
+    assert_type(qzs.loop_margins(isolator, controller).meets(), bool)
     batch = qzs.simulate_batch([(isolator, controller)], chirp, dt=1e-4)
     assert_type(batch, qzs.BatchResult)
     assert_type(batch.to_xarray(), xr.Dataset)

@@ -53,6 +53,8 @@ _LAZY = {
     "TransmissibilityEstimate": "qzs.analysis.spectral",
     "transmissibility_metrics": "qzs.analysis.spectral",
     "linearize": "qzs.analysis.linear",
+    "loop_margins": "qzs.analysis.control_design",
+    "loop_stability": "qzs.analysis.control_design",
     "fit_spring": "qzs.identify", "fit_friction": "qzs.identify",
     "fit_transmissibility": "qzs.identify",
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
@@ -78,6 +80,7 @@ _LAZY = {
 }
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by test_typing)
+    from qzs.analysis.control_design import loop_margins, loop_stability
     from qzs.analysis.linear import linearize
     from qzs.analysis.spectral import (TransmissibilityEstimate, transmissibility,
                                        transmissibility_metrics)

@@ -4,7 +4,7 @@
 ``spectral``          transmissibility (Welch ratio, H1, H2, coherence), run sizing, metrics, bands
 ``welch``             Welch spectra and transmissibility arrays of one record or a population at once
 ``damping``           what active damping changes: largest per-bin reduction and band-RMS change
-``linear``            the linearised closed loop at the operating point (python-control)
+``linear``            the linearised closed loop at the operating point, any controller (python-control)
 ``hexapod_linear``    the six-leg platform of isolator legs linearised at its home pose
 ``control_design``    static design, Routh-Hurwitz, sampled-loop margins, hunting (describing functions)
 ``harmonic_balance``  periodic responses of the smooth model: AFT, continuation, Hill stability
@@ -22,10 +22,12 @@ _EXPORTS = {**{name: "qzs.analysis.spectral" for name in _SPECTRAL},
             **{name: "qzs.analysis.statistics"
                for name in ("STATISTICS", "RunStatistics", "run_statistics",
                             "SUMMARY_STATISTICS", "SummaryStatistics")},
-            "linearize": "qzs.analysis.linear",
+            **{name: "qzs.analysis.linear"
+               for name in ("linearize", "plant_system", "controller_system")},
             **{name: "qzs.analysis.control_design"
                for name in ("static_design", "routh_hurwitz", "loop_margins",
-                            "required_controller_rate", "predict_hunting")},
+                            "required_controller_rate", "predict_hunting", "loop_stability",
+                            "predict_sliding_cycle")},
             **{name: "qzs.analysis.harmonic_balance"
                for name in ("SmoothModel", "HarmonicBalanceSolution", "FrequencyResponseCurve",
                             "periodic_response", "frequency_response_curve",

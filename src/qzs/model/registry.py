@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from qzs.errors import ParameterError
-from qzs.model.controller import ControllerParameters
+from qzs.model.controller import (ControllerParameters, Dither, FrictionCompensation,
+                                  LinearController)
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_field
 from qzs.model.isolator import IsolatorParameters
 
@@ -262,6 +263,12 @@ def model_inputs(isolator=None, controller=None):
     for name, value, kind in (("isolator", isolator, IsolatorParameters),
                               ("controller", controller, ControllerParameters)):
         if not isinstance(value, kind):
+            fix = ""
+            if name == "controller" and isinstance(value, (FrictionCompensation, Dither,
+                                                           LinearController)):
+                fix = (f"; a {type(value).__name__} is a block: add it to a controller, "
+                       f"PIDamping() + {type(value).__name__}(...) (PIDamping(pi_kp=0, "
+                       "pi_ki=0) for no position loop)")
             raise ParameterError(f"`{name}` must be a {kind.__name__}, got "
-                                 f"{type(value).__name__}.")
+                                 f"{type(value).__name__}{fix}.", (name,))
     return isolator, controller

@@ -9,8 +9,10 @@ python-control. Every public name is importable from here
 ``static``                the static design: spring load, static deficit, force left, the band
 ``linear_stability``      the characteristic polynomial, Routh-Hurwitz bounds on gains, the poles
 ``loop_transfers``        the loop at the motor force, continuous or sampled with a delay
-``stability_margins``     gain and phase margins, continuous or sampled; the rate a design needs
-``describing_functions``  the friction law as a memoryless nonlinearity of slip velocity
+``stability_margins``     gain and phase margins, continuous or sampled; the rate a design needs;
+                          the one verdict on a controller's loop (stable, margins, why not)
+``describing_functions``  the friction law (net of a compensation) as a memoryless nonlinearity of
+                          slip velocity; the sliding cycle of over-compensation
 ``hunting``               the stick-slip relay in the integral loop: slip jump, hunting prediction
 ``hunting_population``    the same prediction for a whole population at once, solved directly
 ``linear_population``     transmissibility, stability and margins of a population at once
@@ -26,8 +28,13 @@ Automatica 32(5), 1996. K. J. Åström, B. Wittenmark, *Computer-Controlled Syst
 3rd ed., §2.3 (sampling a system with a time delay).
 """
 from qzs.analysis.control_design.describing_functions import (FrictionNonlinearity,
+                                                              NetFrictionNonlinearity,
+                                                              SlidingCycle,
                                                               coulomb_describing_function,
-                                                              friction_describing_function)
+                                                              friction_describing_function,
+                                                              friction_velocity_loop,
+                                                              net_describing_function,
+                                                              predict_sliding_cycle)
 from qzs.analysis.control_design.hunting import (SLIP_JUMP_FLOOR, HuntingPrediction,
                                                  hunting_stiffness, integral_loop,
                                                  predict_hunting, restick_force, slip_jump)
@@ -42,7 +49,8 @@ from qzs.analysis.control_design.loop_transfers import (PADE_ORDER, discretize_w
 from qzs.analysis.control_design.stability_margins import (GAIN_MARGIN_MIN, MARGIN_LOWEST,
                                                            MARGIN_POINTS_PER_DECADE,
                                                            PHASE_MARGIN_MIN, LoopMargins,
-                                                           loop_margins,
+                                                           LoopStability, loop_margins,
+                                                           loop_stability,
                                                            required_controller_rate,
                                                            stability_margins_of)
 from qzs.analysis.control_design.static import (PAPER_ADDED_MASS, StaticDesign,
@@ -52,9 +60,11 @@ __all__ = ["StaticDesign", "static_design", "characteristic_polynomial", "RouthH
            "routh_hurwitz", "integral_gain_limit", "damping_gain_limits",
            "closed_loop_poles", "constant_force_band", "integral_loop", "loop_transfer",
            "sampled_loop", "discretize_with_delay", "LoopMargins", "loop_margins",
-           "stability_margins_of", "frequency_response", "required_controller_rate",
+           "stability_margins_of", "LoopStability", "loop_stability", "frequency_response", "required_controller_rate",
            "sampled_transmissibility", "coulomb_describing_function",
            "FrictionNonlinearity", "friction_describing_function", "restick_force", "slip_jump",
+           "NetFrictionNonlinearity", "net_describing_function", "friction_velocity_loop",
+           "SlidingCycle", "predict_sliding_cycle",
            "HuntingPrediction", "predict_hunting", "hunting_stiffness",
            "PAPER_ADDED_MASS", "GAIN_MARGIN_MIN", "PHASE_MARGIN_MIN", "SLIP_JUMP_FLOOR",
            "PADE_ORDER", "MARGIN_POINTS_PER_DECADE", "MARGIN_LOWEST"]

@@ -16,6 +16,12 @@ period with instant slips is ``4*h*K/(Ki*d)``. No slip jump (the Stribeck dip do
 the damping: the payload creeps) or no integral: no hunting. :func:`predict_hunting` runs
 both analyses, this one and the memoryless friction law's of :mod:`.describing_functions`.
 
+With a friction compensation (docs/model.md §5) the slip integrates the net law (the
+compensation pushes along the slip beyond its deadband) and the integral loop's viscous term
+is ``Cv - fraction*Cv'``: the jump grows with the fraction, and from ``J >= 2 Fs`` the slip
+no longer re-sticks (no relay). A friction observer or a user's linear controller is refused:
+the relay does not model them.
+
 References
 ----------
 H. Olsson, K. J. Åström, "Friction generated limit cycles", IEEE Trans. Control Syst.
@@ -28,9 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qzs._validation import real
-from qzs.analysis.control_design.describing_functions import FrictionNonlinearity
+from qzs.analysis.control_design.describing_functions import (FrictionNonlinearity,
+                                                              predict_sliding_cycle)
 from qzs.analysis.control_design.linear_stability import _stable
 from qzs.analysis.linear import loop_constants
+from qzs.errors import ParameterError
 from qzs.model.registry import model_inputs
 
 __all__ = ["restick_force", "slip_jump", "HuntingPrediction", "integral_loop",
@@ -48,24 +56,32 @@ RELAY_AMPLITUDE_POINTS = 80
 RELAY_AMPLITUDE_SPAN = 20
 
 
-def restick_force(isolator=None):
+def restick_force(isolator=None, controller=None):
     """Least driving force [N] that keeps the payload sliding: the re-stick level.
 
     ``min over v >= 0 of Fc + (Fs - Fc)*exp(-Cbc*v) + Cv*v``: at ``v* = ln(Cbc*(Fs - Fc)/Cv)/Cbc``
     when ``Cbc*(Fs - Fc) > Cv`` (the Stribeck dip is steeper than the viscous rise), else at
-    ``v = 0`` (then ``Fs``: no slip jump, no hunting).
+    ``v = 0`` (then ``Fs``: no slip jump, no hunting). With a friction compensation, the
+    least of the net steady force (the law less the compensation's feedforward, beyond its
+    deadband), found numerically; NaN when the net force is not positive at some velocity
+    (it pushes along the slip: the payload never re-sticks by itself).
 
     Parameters
     ----------
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        Its friction compensation, if any, is netted out.
 
     Returns
     -------
     float
         ``F_r`` [N].
     """
-    isolator, _ = model_inputs(isolator, None)
+    isolator, controller = model_inputs(isolator, controller)
+    law = _compensation_law(isolator, controller)
+    if law is not None:
+        return _net_restick_force(isolator, law)
     fs, fc = isolator.stiction_force, isolator.coulomb_force
     cbc, cv = isolator.stribeck_decay, isolator.viscous_damping
     drop = cbc * (fs - fc)
@@ -75,6 +91,33 @@ def restick_force(isolator=None):
         return fs
     velocity = math.log(drop / cv) / cbc
     return fc + cv / cbc + cv * velocity
+
+
+def _net_restick_force(isolator, law):
+    """:func:`restick_force` of the net steady force with a compensation ``law``."""
+    from scipy.optimize import minimize_scalar
+
+    fs, fc = isolator.stiction_force, isolator.coulomb_force
+    cbc, cv = isolator.stribeck_decay, isolator.viscous_damping
+    fraction, fs_c, fc_c, cbc_c, cv_c, deadband = law
+    if cv - fraction * cv_c < 0:
+        return math.nan  # the net force falls without bound as the slip speeds up
+
+    def net(v):
+        value = fc + (fs - fc) * np.exp(-cbc * v) + cv * v
+        beyond = v > deadband
+        return value - np.where(beyond, fraction * (fc_c + (fs_c - fc_c) * np.exp(-cbc_c * v)
+                                                    + cv_c * v), 0.0)
+
+    grid = np.concatenate([[0.0], np.logspace(-9, 3, 4001)])
+    values = net(grid)
+    i = int(np.argmin(values))
+    low, high = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    if high > low:
+        best = minimize_scalar(lambda v: float(net(v)), bounds=(low, high), method="bounded",
+                               options={"xatol": 1e-12})
+        values[i] = min(values[i], best.fun)
+    return float(values[i]) if values[i] > 0 else math.nan
 
 
 def slip_jump(isolator=None, controller=None, relative_position=None):
@@ -109,13 +152,43 @@ def slip_jump(isolator=None, controller=None, relative_position=None):
         Length of the slip [s] (NaN if it did not end within the time allowed).
     """
     isolator, controller = model_inputs(isolator, controller)
+    _relay_controller(controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     return _slip(m, cv, k + kp, kd, w, isolator.stiction_force, isolator.coulomb_force,
-                 isolator.stribeck_decay)
+                 isolator.stribeck_decay, _compensation_law(isolator, controller))
 
 
-def _slip(m, cv, k_total, kd, w, fs, fc, cbc):
-    """:func:`slip_jump` of the loop constants: ``(jump [N], duration [s])``, LSODA."""
+def _compensation_law(isolator, controller):
+    """``(fraction, Fs', Fc', Cbc', Cv', deadband)`` of the compensation, or None."""
+    compensation = controller.compensation
+    if compensation is None or compensation.fraction == 0.0:
+        return None
+    return (compensation.fraction, *compensation.law(isolator), compensation.deadband)
+
+
+def _relay_controller(controller):
+    """Refuse what the stick-slip relay cannot hold: a user's linear controller, an observer."""
+    if controller.linear is not None:
+        raise ParameterError(
+            "`controller` has a LinearController: the stick-slip relay is that of the PI "
+            "integral loop (PI + damping + friction compensation); use "
+            "predict_sliding_cycle for a sliding cycle, and a simulation for stick-slip.",
+            ("controller",))
+    compensation = controller.compensation
+    if compensation is not None and compensation.observer_bandwidth > 0:
+        raise ParameterError(
+            "`controller` has a friction observer: while the payload sticks it integrates "
+            "the holding force (an integral action of its own), which the stick-slip relay "
+            "does not model; use predict_sliding_cycle for a sliding cycle, and a "
+            "simulation for stick-slip.", ("controller",))
+
+
+def _slip(m, cv, k_total, kd, w, fs, fc, cbc, compensation=None):
+    """:func:`slip_jump` of the loop constants: ``(jump [N], duration [s])``, LSODA.
+
+    ``compensation``: ``(fraction, Fs', Fc', Cbc', Cv', deadband)`` of a friction
+    compensation pushing along the slip beyond its deadband, or None.
+    """
     from scipy.integrate import solve_ivp
 
     if fs <= 0 or k_total <= 0:
@@ -124,6 +197,9 @@ def _slip(m, cv, k_total, kd, w, fs, fc, cbc):
     def rates(_, y):
         v, force, lagged = y
         friction = fc + (fs - fc) * math.exp(-cbc * max(v, 0.0))
+        if compensation is not None and v > compensation[5]:
+            fraction, fs_c, fc_c, cbc_c, cv_c, _ = compensation
+            friction -= fraction * (fc_c + (fs_c - fc_c) * math.exp(-cbc_c * v) + cv_c * v)
         return [(force - friction - cv * v - kd * (v - lagged)) / m, -k_total * v,
                 w * (v - lagged)]
 
@@ -247,10 +323,22 @@ def integral_loop(isolator=None, controller=None, relative_position=None):
     import control
 
     isolator, controller = model_inputs(isolator, controller)
-    m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
+    _relay_controller(controller)
+    m, cv, k, kp, ki, kd, w = _relay_constants(isolator, controller, relative_position)
     s = control.tf("s")
     return control.minreal(control.tf(ki / (s * _fast_denominator(m, cv, k + kp, kd, w))),
                            verbose=False)
+
+
+def _relay_constants(isolator, controller, relative_position):
+    """:func:`~qzs.analysis.linear.loop_constants` with the compensation's viscous slope
+    netted out of ``Cv`` (``Cv - fraction*Cv'``; the same tuple without compensation)."""
+    numbers = loop_constants(isolator, controller, relative_position)
+    law = _compensation_law(isolator, controller)
+    if law is None:
+        return numbers
+    m, cv, k, kp, ki, kd, w = numbers
+    return m, cv - law[0] * law[4], k, kp, ki, kd, w
 
 
 def hunting_stiffness(isolator=None, controller=None, half_width=None):
@@ -322,15 +410,21 @@ def predict_hunting(isolator=None, controller=None, relative_position=None, *,
     HuntingPrediction
     """
     isolator, controller = model_inputs(isolator, controller)
-    numbers = tuple(loop_constants(isolator, controller, relative_position))
+    _relay_controller(controller)
+    numbers = tuple(_relay_constants(isolator, controller, relative_position))
     m, cv, k, kp, ki, kd, w = numbers
     k_total = k + kp
     reasons = {}
-    if memoryless:
-        friction = _memoryless_intersections(isolator, numbers)
-    else:
+    if controller.dither is not None:
+        reasons["dither"] = "the dither is left out (it is no feedback)"
+    if not memoryless:
         friction = []
         reasons["friction_intersections"] = "not computed (memoryless=False)"
+    elif controller.compensation is None:
+        friction = _memoryless_intersections(isolator, numbers)
+    else:
+        friction = [(a, f) for a, f, _ in predict_sliding_cycle(
+            isolator, controller, relative_position).intersections]
     jump = slip_jump(isolator, controller, relative_position)[0]
     d = 0.5 * jump
     h = isolator.stiction_force - d
@@ -348,15 +442,23 @@ def predict_hunting(isolator=None, controller=None, relative_position=None, *,
     for name in ("integral_force_amplitude", "frequency", "period", "first_harmonic_amplitude"):
         if not hunts:
             reasons.setdefault(name, reasons.get("hunts", "no limit cycle predicted"))
-    plateau = d / k_total if (d > 0 and k_total > 0) else nan
-    relay_period = 4 * h * k_total / (ki * d) if (ki > 0 and d > 0 and k_total > 0) else nan
+    plateau = d / k_total if (d > 0 and k_total > 0 and h > 0) else nan
+    relay_period = (4 * h * k_total / (ki * d) if (ki > 0 and d > 0 and k_total > 0 and h > 0)
+                    else nan)
     if not math.isfinite(plateau):
         reasons.setdefault("amplitude", reasons.get("hunts", "no slip jump"))
     if not math.isfinite(relay_period):
         reasons.setdefault("relay_period", reasons.get("hunts", "no cycle"))
+    if not h > 0:
+        reasons["switching_force"] = reasons.get("hunts", "the slip does not re-stick")
+    restick = restick_force(isolator, controller)
+    if math.isnan(restick):
+        reasons["steady_restick_force"] = ("the net friction pushes along the slip at some "
+                                           "velocity (over-compensation): no re-stick level")
     return HuntingPrediction(
-        friction_intersections=tuple(friction), steady_restick_force=restick_force(isolator),
-        slip_jump=jump, relay_output=d, switching_force=h, stiffness=k_total, hunts=hunts,
+        friction_intersections=tuple(friction), steady_restick_force=restick,
+        slip_jump=jump, relay_output=d, switching_force=h if h > 0 else nan,
+        stiffness=k_total, hunts=hunts,
         integral_force_amplitude=amplitude_u, frequency=frequency,
         period=1 / frequency if hunts and frequency > 0 else nan,
         amplitude=plateau, first_harmonic_amplitude=first, relay_period=relay_period,
@@ -396,6 +498,10 @@ def _why_no_relay_cycle(isolator, ki, d, k_total):
     if d <= 0:
         return ("no slip jump: after breaking away the payload creeps and stops "
                 "where it broke away (the Stribeck dip does not beat the damping)")
+    if d >= isolator.stiction_force:
+        return ("the slip does not re-stick: where it stops, the force exceeds the breakaway "
+                "force the other way (over-compensation); the payload slides on "
+                "(predict_sliding_cycle)")
     if k_total <= 0:
         return "no stiffness K = k + Kp: the stuck position is undefined"
     return ""

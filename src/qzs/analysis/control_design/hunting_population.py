@@ -86,6 +86,11 @@ def population_constants(isolators, controllers, relative_position=None):
     rows = []
     for isolator, controller in zip(isolators, controllers):
         isolator, controller = model_inputs(isolator, controller)
+        if controller.has_blocks:
+            raise ParameterError(
+                "`controllers` holds a controller with blocks: a population's closed forms "
+                "are PI + damping's; analyse it alone (loop_stability, loop_margins, "
+                "predict_hunting).", ("controllers",))
         rows.append((*loop_constants(isolator, controller, relative_position),
                      isolator.stiction_force, isolator.coulomb_force,
                      isolator.stribeck_decay, controller.controller_rate))

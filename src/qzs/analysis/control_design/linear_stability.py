@@ -30,7 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs.analysis.control_design.loop_transfers import loop_transfer
-from qzs.analysis.linear import loop_constants
+from qzs.analysis.linear import (close_loop, continuous_controller_matrices, loop_constants,
+                                 plant_matrices)
+from qzs.errors import ParameterError
 from qzs.model.registry import model_inputs
 
 __all__ = ["characteristic_polynomial", "RouthHurwitz", "routh_hurwitz", "integral_gain_limit",
@@ -47,6 +49,16 @@ def _coefficients(m, cv, k, kp, ki, kd, w):
     if ki > 0:
         return [m, cv + kd, big_k, ki]
     return [m, cv + kd, big_k]
+
+
+def _closed_form_controller(controller):
+    """Refuse a controller the PI + damping closed forms cannot hold (dither is no feedback)."""
+    blocks = [name for name in ("compensation", "linear") if getattr(controller, name) is not None]
+    if blocks:
+        raise ParameterError(
+            f"`controller` has a {' and a '.join(blocks)} block: the closed forms here are PI + "
+            "damping's; use closed_loop_poles or loop_stability, which take any controller.",
+            ("controller",))
 
 
 def characteristic_polynomial(isolator=None, controller=None, relative_position=None):
@@ -70,6 +82,7 @@ def characteristic_polynomial(isolator=None, controller=None, relative_position=
         Coefficients in SI units (``kg`` for the highest power).
     """
     isolator, controller = model_inputs(isolator, controller)
+    _closed_form_controller(controller)
     return _coefficients(*loop_constants(isolator, controller, relative_position))
 
 
@@ -107,10 +120,16 @@ def closed_loop_poles(isolator=None, controller=None, relative_position=None):
     Returns
     -------
     ndarray of complex
-        The closed-loop poles [rad/s] (pole-zero cancellations removed by ``minreal``).
+        The closed-loop poles [rad/s] (pole-zero cancellations removed by ``minreal``; of a
+        controller with blocks, every mode of the closed loop's state space).
     """
     import control
 
+    isolator, controller = model_inputs(isolator, controller)
+    if controller.has_blocks:  # every mode of the state space, none cancelled
+        closed = close_loop(plant_matrices(isolator, controller, relative_position, base=False),
+                            continuous_controller_matrices(isolator, controller))
+        return np.asarray(np.linalg.eigvals(closed[0]), dtype=complex)
     loop = loop_transfer(isolator, controller, relative_position)
     closed = control.minreal(control.feedback(loop, 1), verbose=False)
     return np.asarray(closed.poles(), dtype=complex)
@@ -194,6 +213,7 @@ def integral_gain_limit(isolator=None, controller=None, relative_position=None):
         The limit [N/(m*s)]; 0 when no positive ``Ki`` is stable.
     """
     isolator, controller = model_inputs(isolator, controller)
+    _closed_form_controller(controller)
     m, cv, k, kp, _, kd, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not (w > 0 and kd > 0):
@@ -234,6 +254,7 @@ def damping_gain_limits(isolator=None, controller=None, relative_position=None):
         when no damping gain is stable.
     """
     isolator, controller = model_inputs(isolator, controller)
+    _closed_form_controller(controller)
     m, cv, k, kp, ki, _, w = loop_constants(isolator, controller, relative_position)
     big_k = k + kp
     if not w > 0 or ki == 0:
@@ -295,6 +316,7 @@ def routh_hurwitz(isolator=None, controller=None, relative_position=None):
     RouthHurwitz
     """
     isolator, controller = model_inputs(isolator, controller)
+    _closed_form_controller(controller)
     numbers = loop_constants(isolator, controller, relative_position)
     a = _coefficients(*numbers)
     conditions = tuple((text, float(value), bool(value > 0))

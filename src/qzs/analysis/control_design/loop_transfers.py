@@ -19,7 +19,10 @@ import math
 import numpy as np
 
 from qzs._validation import real
-from qzs.analysis.linear import loop_constants
+from qzs.analysis.linear import (close_loop, continuous_controller_matrices,
+                                 controller_matrices, loop_constants, plant_matrices)
+from qzs.errors import ParameterError
+from qzs.model.controller import SENSORS
 from qzs.model.registry import model_inputs
 
 __all__ = ["loop_transfer", "sampled_loop", "discretize_with_delay", "frequency_response",
@@ -48,14 +51,17 @@ def loop_transfer(isolator=None, controller=None, relative_position=None, *, del
     ``L = (Kp + Ki/s)*P_z + Kd*P_v`` with ``P_z = 1/(m s^2 + Cv s + k)`` (force to relative
     position, base at rest) and ``P_v = s*HP(s)*P_z`` (force to the measured velocity); the
     loop closes as ``u = -L u``. A delay enters as a Padé approximant of order
-    :data:`PADE_ORDER`.
+    :data:`PADE_ORDER`. A controller with blocks: ``L = -K(s) P(s)``, the plant from the
+    motor force to every sensor (:func:`qzs.analysis.linear.plant_system`, base at rest)
+    and the whole controller back (:func:`qzs.analysis.linear.controller_system`).
 
     Parameters
     ----------
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; defaults if omitted.
+        PI and damping loops, and any blocks (no discrete linear controller: that loop is
+        :func:`sampled_loop`'s); defaults if omitted.
     relative_position : float, optional
         Operating point z [m]; default the setpoint.
     delay : float
@@ -70,6 +76,11 @@ def loop_transfer(isolator=None, controller=None, relative_position=None, *, del
 
     isolator, controller = model_inputs(isolator, controller)
     delay = real("delay", delay, minimum=0.0)
+    if controller.has_blocks:
+        loop = control.ss(*_continuous_blocks_loop(isolator, controller, relative_position))
+        if delay > 0:
+            loop = loop * control.ss(control.tf(*control.pade(delay, PADE_ORDER)))
+        return control.minreal(control.tf(loop), verbose=False)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
     s = control.tf("s")
     plant = 1 / (m * s ** 2 + cv * s + k)
@@ -124,6 +135,27 @@ def _sampled_response(isolator, controller, rate, delay, omega, relative_positio
     return pi * plant[:, 0] + kd * plant[:, 1]
 
 
+def _delay_line(phi, g0, g1, whole, fraction, line):
+    """``(Ad, Bd)`` of ``x[k+1] = Phi x[k] + G0 u[k-n] + G1 u[k-n-1]`` with the past inputs
+    ``q_1 = u[k-1], ..., q_line = u[k-line]`` as states after the plant's."""
+    n_states = phi.shape[0]
+    size = n_states + line
+    ad = np.zeros((size, size))
+    bd = np.zeros((size, 1))
+    ad[:n_states, :n_states] = phi
+    if line:
+        bd[n_states, 0] = 1.0
+        for i in range(1, line):
+            ad[n_states + i, n_states + i - 1] = 1.0
+    if whole == 0:
+        bd[:n_states] += g0
+    else:
+        ad[:n_states, n_states + whole - 1] += g0[:, 0]
+    if fraction > 0:
+        ad[:n_states, n_states + whole] += g1[:, 0]
+    return ad, bd
+
+
 def discretize_with_delay(a, b, c, period, delay=0.0):
     """Exact zero-order-hold discretisation with an input delay (modified z-transform).
 
@@ -151,24 +183,9 @@ def discretize_with_delay(a, b, c, period, delay=0.0):
     a, b, c = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (a, b, c))
     period = real("period", period, minimum=0.0, strict=True)
     delay = real("delay", delay, minimum=0.0)
-    n_states = a.shape[0]
     phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
     line = whole + (1 if fraction > 0 else 0)  # past inputs kept as states
-    size = n_states + line
-    ad = np.zeros((size, size))
-    bd = np.zeros((size, 1))
-    ad[:n_states, :n_states] = phi
-    # past inputs q_1 = u[k-1], ..., q_line = u[k-line]
-    if line:
-        bd[n_states, 0] = 1.0
-        for i in range(1, line):
-            ad[n_states + i, n_states + i - 1] = 1.0
-    if whole == 0:
-        bd[:n_states] += g0
-    else:
-        ad[:n_states, n_states + whole - 1] += g0[:, 0]
-    if fraction > 0:
-        ad[:n_states, n_states + whole] += g1[:, 0]
+    ad, bd = _delay_line(phi, g0, g1, whole, fraction, line)
     cd = np.hstack([c, np.zeros((c.shape[0], line))])
     return control.ss(ad, bd, cd, np.zeros((c.shape[0], 1)), period)
 
@@ -182,14 +199,22 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
     (``C_pi(z) = Kp + Ki*T/(z - 1)``) minus ``Kd*v``, and holds the force (zero-order hold)
     after ``delay``. The plant is discretised exactly (:func:`discretize_with_delay`).
 
+    A controller with blocks (docs/design.md §6): its sampled part ``K_d`` (PI + damping
+    and the compensation at ``rate``, a discrete linear controller at its own sample time;
+    both: the same period) against the plant with its continuous part closed inside,
+    held, delayed and read at the samples (exactly, as above; the payload's acceleration
+    read with the force held until the sample): ``L(z) = -K_d(z) P_d(z)``, broken at the
+    sampled force. The delay is the sampled part's (continuous parts have none).
+
     Parameters
     ----------
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; defaults if omitted.
+        PI and damping loops, and any blocks; defaults if omitted.
     rate : float, optional
-        Controller rate [Hz]; default the controller's ``controller_rate`` (must then be > 0).
+        Controller rate [Hz]; default the controller's ``controller_rate`` (must then be > 0,
+        unless the controller has a discrete linear controller).
     delay : float
         Delay from sampling to the motor force [s].
     relative_position : float, optional
@@ -204,6 +229,10 @@ def sampled_loop(isolator=None, controller=None, rate=None, delay=0.0, relative_
 
     isolator, controller = model_inputs(isolator, controller)
     rate = controller.controller_rate if rate is None else rate
+    if controller.has_blocks:
+        rate = real("rate", rate, minimum=0.0)
+        delay = real("delay", delay, minimum=0.0)
+        return _SampledBlocks(isolator, controller, rate, delay, relative_position).loop()
     rate = real("rate", rate, minimum=0.0, strict=True,
                  fix="a sampled loop needs a controller rate in Hz")
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, relative_position)
@@ -249,7 +278,7 @@ def frequency_response(system, omega):
 
 
 def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=None,
-                             delay=0.0):
+                             delay=0.0, exact=False):
     """``|X/Y|`` [-] of the linear loop with a sampled controller and a delay.
 
     The controller's fundamental-frequency response (the sampled-data loop's response at the
@@ -261,6 +290,18 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
 
     With ``rate`` 0 the controller is continuous (``C_pi = Kp + Ki/s``), delayed by ``delay``.
 
+    ``exact`` (always, for a controller with blocks): the sampled-data loop's exact response
+    at the excitation's frequency ``w`` instead (docs/design.md §6). The sampled sensors
+    are ``s[k] = S(jw) y'' + P_d(z) u[k]`` (``S`` the base's path to the sensors with the
+    continuous parts closed, ``P_d`` the held plant of :func:`sampled_loop`,
+    ``z = exp(jwT)``), the held force ``u = K_d(z) s``, so ``u = K_d S y''/(1 - K_d P_d)``;
+    the payload's acceleration at ``w`` is ``H_y(jw) y'' + H_u(jw) Z(jw) u`` with the held
+    force's component at ``w``, ``Z = exp(-jw delay) (1 - exp(-jwT))/(jwT)``. The other
+    components lie at ``w + 2 pi n/T``: the simulation's Fourier coefficient at ``w`` over
+    whole periods is this one when ``1/(T f)`` is a whole number above 2. A continuous
+    controller with blocks: the closed loop of :func:`qzs.analysis.linear.linearize`,
+    its force delayed by ``exp(-jw delay)``.
+
     Parameters
     ----------
     frequency : array_like
@@ -268,11 +309,14 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; defaults if omitted.
+        PI and damping loops, and any blocks; defaults if omitted.
     rate : float, optional
         Controller rate [Hz]; 0 continuous; default the controller's.
     delay : float
         Delay from sampling to the motor force [s].
+    exact : bool
+        The exact response at each frequency (always so with blocks); False keeps, for PI
+        + damping, the gains-times-hold approximation above (the design search's cost).
 
     Returns
     -------
@@ -284,6 +328,13 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     rate = real("rate", rate, minimum=0.0)
     delay = real("delay", delay, minimum=0.0)
     f = np.asarray(frequency, dtype=float)
+    if not isinstance(exact, (bool, np.bool_)):
+        raise ParameterError(f"`exact` must be True or False, got {exact!r}.", ("exact",))
+    if controller.has_blocks or exact:
+        linear = controller.linear
+        if rate > 0 or (linear is not None and linear.discrete):
+            return _SampledBlocks(isolator, controller, rate, delay, None).transmissibility(f)
+        return _continuous_blocks_transmissibility(f, isolator, controller, delay)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller, None)
     s = 2j * np.pi * f
     lag = np.exp(-s * delay)
@@ -298,3 +349,116 @@ def sampled_transmissibility(frequency, isolator=None, controller=None, *, rate=
     highpass = s / (s + w) if w > 0 else 1.0
     coupling = cv * s + k + pi
     return np.abs(coupling / (m * s ** 2 + coupling + damping * s * highpass))
+
+
+# ---------------------------------------------------------------- a controller with blocks
+def _responses(a, b, c, d, points):
+    """``C (pI - A)^-1 B + D`` at each point of ``points``: shape (N, outputs, inputs)."""
+    points = np.asarray(points, dtype=complex)
+    n = a.shape[0]
+    if n == 0:
+        return np.broadcast_to(d.astype(complex), (points.size,) + d.shape).copy()
+    shifted = points[:, None, None] * np.eye(n)[None] - a[None]
+    solved = np.linalg.solve(shifted, np.broadcast_to(b.astype(complex), (points.size,) + b.shape))
+    return c[None] @ solved + d[None]
+
+
+def _continuous_blocks_loop(isolator, controller, relative_position):
+    """``L = -K(s) P(s)`` of a controller with blocks, continuous, as ``(A, B, C, D)``."""
+    return _series_loop(plant_matrices(isolator, controller, relative_position, base=False),
+                        continuous_controller_matrices(isolator, controller))
+
+
+def _series_loop(plant, controller):
+    """``L = -K P``: the plant (one input, the sensors out) then the controller, negated."""
+    a, b, c, d = plant
+    ak, bk, ck, dk = controller
+    n, nk = a.shape[0], ak.shape[0]
+    a_l = np.block([[a, np.zeros((n, nk))], [bk @ c, ak]])
+    b_l = np.vstack([b, bk @ d])
+    return a_l, b_l, -np.hstack([dk @ c, ck]), -(dk @ d)
+
+
+def _held_plant(plant, period, delay):
+    """The plant held by a zero-order hold and read at the samples, ``delay`` after them.
+
+    ``plant`` ``(A, B, C, D)`` with one input, the held force; its feed-through (the payload's
+    acceleration) reads the force held until the sample. A delay ``n T + e T`` holds
+    each force from ``n T + e T`` after its sample (Åström and Wittenmark §2.3):
+    ``x[k+1] = Phi x[k] + G0 u[k-n] + G1 u[k-n-1]``, the past forces ``q_i = u[k-i]``
+    (``i = 1 .. n+1``) states, and ``y[k] = C x[k] + D q_{n+1}`` (no feed-through).
+    """
+    a, b, c, d = plant
+    phi, g0, g1, whole, fraction = _delayed_hold(a, b, period, delay)
+    n, line = a.shape[0], whole + 1
+    ad, bd = _delay_line(phi, g0, g1, whole, fraction, line)
+    cd = np.zeros((c.shape[0], n + line))
+    cd[:, :n] = c
+    cd[:, n + whole] = d[:, 0]
+    return ad, bd, cd, np.zeros((c.shape[0], 1))
+
+
+class _SampledBlocks:
+    """The sampled loop of a controller with blocks (docs/design.md §6).
+
+    The controller's continuous part ``K_c`` closed around the plant (``P_c``, the held
+    force in), held and sampled (``P_d``), its sampled part ``K_d`` at period ``T``:
+    ``L(z) = -K_d(z) P_d(z)``, broken at the held force.
+    """
+
+    def __init__(self, isolator, controller, rate, delay, relative_position):
+        continuous, discrete, period = controller_matrices(isolator, controller, rate)
+        if discrete is None:
+            raise ParameterError(
+                "`rate` must be positive for a sampled loop, got 0 and no discrete linear "
+                "controller; give a controller rate in Hz, or use loop_transfer for the "
+                "continuous loop.", ("rate",))
+        self.period, self.delay, self.discrete = period, delay, discrete
+        self.continuous = continuous
+        self.closed_base = close_loop(plant_matrices(isolator, controller, relative_position),
+                                      continuous)
+        closed = close_loop(plant_matrices(isolator, controller, relative_position, base=False),
+                            continuous)
+        sensors = len(SENSORS)
+        self.held = _held_plant((closed[0], closed[1], closed[2][:sensors],
+                                 closed[3][:sensors]), period, delay)
+
+    def loop(self):
+        """``L(z)`` as a python-control system, ``dt`` the period."""
+        import control
+
+        return control.ss(*_series_loop(self.held, self.discrete), self.period)
+
+    def transmissibility(self, frequency):
+        """The sampled-data loop's exact response at the excitation's own frequency.
+
+        The sampled sensors ``s[k] = S(jw) y'' + P_d(z) u[k]`` (``S`` the base's path to the
+        sensors with ``K_c`` closed, ``z = exp(jwT)``), the held force ``u = K_d s``; the
+        payload's acceleration at ``w``: ``H_y(jw) y'' + H_u(jw) Z(jw) u`` with the hold's
+        fundamental ``Z = exp(-jw tau) (1 - exp(-jwT))/(jwT)``. Exact for the component at
+        ``w`` (the others lie at ``w + 2 pi n/T``).
+        """
+        omega = 2 * np.pi * np.asarray(frequency, dtype=float).ravel()
+        s, z = 1j * omega, np.exp(1j * omega * self.period)
+        acc = list(SENSORS).index("payload_acceleration")
+        base = _responses(*self.closed_base, s)               # (N, sensors + 1, 2)
+        plant = _responses(*self.held, z)[:, :, 0]            # (N, sensors)
+        gains = _responses(*self.discrete, z)[:, 0, :]        # (N, sensors)
+        hold = np.exp(-s * self.delay) * (1 - np.exp(-s * self.period)) / (s * self.period)
+        sensors = base[:, :len(SENSORS), 0]
+        force = np.sum(gains * sensors, axis=1) / (1 - np.sum(gains * plant, axis=1))
+        response = base[:, acc, 0] + base[:, acc, 1] * hold * force
+        return np.abs(response).reshape(np.shape(frequency))
+
+
+def _continuous_blocks_transmissibility(frequency, isolator, controller, delay):
+    """``|X/Y|`` of a continuous controller with blocks delayed by ``delay`` (exact lag)."""
+    omega = 2 * np.pi * np.asarray(frequency, dtype=float).ravel()
+    s = 1j * omega
+    gains = _responses(*continuous_controller_matrices(isolator, controller), s)[:, 0, :]
+    base = _responses(*plant_matrices(isolator, controller), s)  # (N, sensors, 2)
+    lag = np.exp(-s * delay)
+    acc = list(SENSORS).index("payload_acceleration")
+    force = lag * np.sum(gains * base[:, :, 0], axis=1) / (
+        1 - lag * np.sum(gains * base[:, :, 1], axis=1))
+    return np.abs(base[:, acc, 0] + base[:, acc, 1] * force).reshape(np.shape(frequency))

@@ -8,18 +8,24 @@ loop keeps given margins.
 """
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from qzs._format import decibels
 from qzs._validation import interval, real
-from qzs.analysis.control_design.loop_transfers import (PADE_ORDER, _sampled_response,
-                                                        frequency_response, loop_transfer,
-                                                        sampled_loop)
+from qzs.analysis.control_design.loop_transfers import (PADE_ORDER, _continuous_blocks_loop,
+                                                        _SampledBlocks,
+                                                        _sampled_response, frequency_response,
+                                                        loop_transfer, sampled_loop)
+from qzs.analysis.linear import close_loop, continuous_controller_matrices, plant_matrices
 from qzs.errors import ParameterError
+from qzs.model.controller import ControllerParameters
+from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import model_inputs
 
 __all__ = ["LoopMargins", "loop_margins", "stability_margins_of", "required_controller_rate",
+           "LoopStability", "loop_stability",
            "GAIN_MARGIN_MIN", "PHASE_MARGIN_MIN", "MARGIN_POINTS_PER_DECADE", "MARGIN_LOWEST"]
 
 #: Default margins a sampled design must keep: gain margin [dB] and phase margin [deg].
@@ -70,7 +76,8 @@ class LoopMargins:
     phase_crossover_frequency: float
     reasons: dict = field(default_factory=dict)
 
-    def meets(self, gain_margin_min=GAIN_MARGIN_MIN, phase_margin_min=PHASE_MARGIN_MIN):
+    def meets(self, gain_margin_min: float = GAIN_MARGIN_MIN,
+              phase_margin_min: float = PHASE_MARGIN_MIN) -> bool:
         """Stable with at least these margins.
 
         Parameters
@@ -88,7 +95,7 @@ class LoopMargins:
                     else True)
         return bool(self.stable and self.gain_margin >= gain_margin_min and phase_ok)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         """The margins as a plain ``dict``."""
         return dict(self.__dict__)
 
@@ -149,15 +156,23 @@ def _margins(response, omega, stable, rate, delay, extra_reasons=None):
                        phase_crossover_frequency=float(f_pc), reasons=reasons)
 
 
-def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_position=None):
+def loop_margins(isolator: IsolatorParameters | None = None,
+                 controller: ControllerParameters | None = None, rate: float | None = None,
+                 delay: float = 0.0, relative_position: float | None = None) -> LoopMargins:
     """Gain and phase margins of the loop, continuous or sampled (python-control).
+
+    A controller with blocks (docs/design.md §6): its loop is sampled wherever a part of it
+    is (PI + damping at ``rate``, a discrete linear controller at its own sample time),
+    broken at the sampled force with the continuous parts closed inside the plant
+    (:func:`~qzs.analysis.control_design.loop_transfers.sampled_loop`); else continuous
+    (:func:`~qzs.analysis.control_design.loop_transfers.loop_transfer`).
 
     Parameters
     ----------
     isolator : IsolatorParameters, optional
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
-        PI and damping loops; defaults if omitted.
+        PI and damping loops, and any blocks; defaults if omitted.
     rate : float, optional
         Controller rate [Hz]; 0 for the continuous loop; default the controller's.
     delay : float
@@ -173,6 +188,8 @@ def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_
     rate = controller.controller_rate if rate is None else rate
     rate = real("rate", rate, minimum=0.0)
     delay = real("delay", delay, minimum=0.0)
+    if controller.has_blocks:
+        return _blocks_margins(isolator, controller, rate, delay, relative_position)
     if rate > 0:
         import control
 
@@ -183,6 +200,21 @@ def loop_margins(isolator=None, controller=None, rate=None, delay=0.0, relative_
         return _margins(response, omega, bool(np.all(np.abs(poles) < 1.0 - 1e-12)), rate, delay)
     return stability_margins_of(loop_transfer(isolator, controller, relative_position),
                                 delay=delay)
+
+
+def _blocks_margins(isolator, controller, rate, delay, relative_position):
+    """:func:`loop_margins` of a controller with blocks: sampled if any part is."""
+    import control
+
+    linear = controller.linear
+    if rate > 0 or (linear is not None and linear.discrete):
+        loop = sampled_loop(isolator, controller, rate, delay, relative_position)
+        poles = np.asarray(control.feedback(loop, 1).poles(), dtype=complex)
+        omega = _margin_grid(np.pi / loop.dt)
+        return _margins(frequency_response(loop, omega), omega,
+                        bool(np.all(np.abs(poles) < 1.0 - 1e-12)), 1.0 / loop.dt, delay)
+    loop = control.ss(*_continuous_blocks_loop(isolator, controller, relative_position))
+    return stability_margins_of(loop, delay=delay)
 
 
 def _margin_grid(top):
@@ -279,6 +311,11 @@ def required_controller_rate(isolator=None, controller=None, delay=0.0, *,
         Why NaN ('' otherwise).
     """
     isolator, controller = model_inputs(isolator, controller)
+    if controller.linear is not None and controller.linear.discrete:
+        raise ParameterError(
+            "`controller` has a discrete LinearController, which runs at its own sample time: "
+            "required_controller_rate scans the rate of PI + damping alone; make the linear "
+            "controller continuous, or check its rate with loop_margins.", ("controller",))
     low, high = interval("rate_range", rate_range, "Hz", minimum=1e-9)
     delay = real("delay", delay, minimum=0.0)
 
@@ -304,3 +341,147 @@ def required_controller_rate(isolator=None, controller=None, delay=0.0, *,
         mid = math.sqrt(failing * passing)
         failing, passing = (failing, mid) if ok(mid) else (mid, passing)
     return passing, ""
+
+
+@dataclass(frozen=True)
+class LoopStability:
+    """Whether a controller's loop is stable at the operating point, and with what margins.
+
+    The loop as the simulator runs it: continuous, or sampled wherever a part of the
+    controller is (``controller_rate``, a discrete linear controller's ``sample_time``), no
+    delay; linearised as :func:`qzs.analysis.linear.linearize` (docs/model.md §10). An
+    unstable controller is accepted: what decides is the closed loop.
+
+    Attributes
+    ----------
+    stable : bool
+        Every closed-loop pole strictly inside the stability region (left half plane, or
+        the unit circle for a sampled loop).
+    sampled : bool
+        The loop is sampled (its poles are in the z-plane).
+    period : float
+        Sample period of the loop [s] (0: continuous).
+    margins : LoopMargins
+        Gain and phase margins of the loop broken at the motor force (NaN, with the reason,
+        when unstable).
+    poles : ndarray of complex
+        Closed-loop poles, every mode of the plant and the controller [rad/s] (of a sampled
+        loop: in the z-plane [-]).
+    unstable_poles : ndarray of complex
+        Those outside the stability region [rad/s] (sampled: [-]).
+    controller_poles : ndarray of complex
+        Poles of the controller alone [rad/s]; of a sampled loop, its sampled part's, in the
+        z-plane [-].
+    controller_unstable : bool
+        The controller alone (each part, continuous and sampled) is unstable (an integrator
+        is marginal, not unstable).
+    reasons : dict
+        Name -> why the loop is unstable, or why a number is undefined.
+    """
+
+    stable: bool
+    sampled: bool
+    period: float
+    margins: LoopMargins
+    poles: np.ndarray
+    unstable_poles: np.ndarray
+    controller_poles: np.ndarray
+    controller_unstable: bool
+    reasons: dict = field(default_factory=dict)
+
+    @property
+    def message(self) -> str:
+        """One line: stable with its margins, or unstable and why."""
+        m = self.margins
+        if not self.stable:
+            return "unstable loop: " + self.reasons["stable"]
+        gain = ("no -180 deg crossing (infinite gain margin)" if math.isinf(m.gain_margin)
+                else f"gain margin {m.gain_margin:.3g} dB at {m.phase_crossover_frequency:.3g} Hz")
+        phase = ("|L| never crosses 1" if math.isnan(m.phase_margin)
+                 else f"phase margin {m.phase_margin:.3g} deg at "
+                      f"{m.gain_crossover_frequency:.3g} Hz")
+        return f"stable loop: {gain}, {phase}"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The verdict as a plain ``dict`` (poles as lists of [real, imaginary])."""
+        out = {name: getattr(self, name) for name in ("stable", "sampled", "period",
+                                                       "controller_unstable")}
+        out["margins"] = self.margins.to_dict()
+        for name in ("poles", "unstable_poles", "controller_poles"):
+            out[name] = [[float(p.real), float(p.imag)] for p in getattr(self, name)]
+        out["reasons"] = dict(self.reasons)
+        out["message"] = self.message
+        return out
+
+
+def _eigenvalues(a):
+    return np.asarray(np.linalg.eigvals(a) if a.size else np.zeros(0), dtype=complex)
+
+
+def _outside(poles, sampled, margin=0.0):
+    return (np.abs(poles) >= 1.0 - margin) if sampled else (poles.real >= -margin)
+
+
+def loop_stability(isolator: IsolatorParameters | None = None,
+                   controller: ControllerParameters | None = None,
+                   relative_position: float | None = None) -> LoopStability:
+    """Whether a controller's loop is stable, with its margins, and why not when it is not.
+
+    The one verdict on a controller (:class:`LoopStability`): the closed loop's poles from
+    its state space (every mode, none cancelled), the margins from :func:`loop_margins` at
+    the controller's own rate(s). A controller that is unstable alone is accepted; an
+    unstable loop is flagged (``stable`` False), with its poles and the margins' reasons.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters, optional
+        Plant parameters; Table 1 defaults if omitted.
+    controller : ControllerParameters, optional
+        The controller, with or without blocks; defaults if omitted.
+    relative_position : float, optional
+        Operating point z [m]; default the setpoint.
+
+    Returns
+    -------
+    LoopStability
+    """
+    isolator, controller = model_inputs(isolator, controller)
+    rate = controller.controller_rate
+    linear = controller.linear
+    sampled = rate > 0 or (linear is not None and linear.discrete)
+    margins = loop_margins(isolator, controller, rate, 0.0, relative_position)
+    continuous, own, period = None, np.zeros(0, complex), 0.0
+    if sampled:
+        loop = _SampledBlocks(isolator, controller, rate, 0.0, relative_position)
+        closed, continuous, period = (close_loop(loop.held, loop.discrete), loop.continuous,
+                                      loop.period)
+        own = _eigenvalues(loop.discrete[0])
+    else:
+        parts = continuous_controller_matrices(isolator, controller)
+        closed = close_loop(plant_matrices(isolator, controller, relative_position, base=False),
+                            parts)
+        own = _eigenvalues(parts[0])
+    poles = _eigenvalues(closed[0])
+    unstable = poles[_outside(poles, sampled, 1e-12)]
+    reasons = dict(margins.reasons)
+    if unstable.size:
+        worst = unstable[np.argmax(np.abs(unstable) if sampled else unstable.real)]
+        where = (f"|z| = {abs(worst):.6g}, {abs(np.angle(worst)) / (2 * np.pi * period):.3g} Hz"
+                 if sampled else f"growth rate {worst.real:.3g} 1/s, "
+                                 f"{abs(worst.imag) / (2 * np.pi):.3g} Hz")
+        compensation = controller.compensation
+        fix = ("lower the gains, or add phase lead where the loop crosses over"
+               + (", or compensate less of the guide's viscous friction (the fraction, or "
+                  "the compensator's viscous_damping)" if compensation is not None
+                  and compensation.fraction > 0 else ""))
+        reasons["stable"] = (f"{unstable.size} closed-loop pole(s) outside the stability "
+                             f"region, the worst at {where}; {fix}")
+    controller_unstable = bool(np.any(_outside(own, sampled, -1e-9)) or (
+        continuous is not None and np.any(_outside(_eigenvalues(continuous[0]), False, -1e-9))))
+    if controller_unstable:
+        reasons["controller_unstable"] = ("the controller alone is unstable: accepted, the "
+                                          "closed loop decides")
+    return LoopStability(stable=not unstable.size, sampled=sampled, period=float(period),
+                         margins=margins, poles=poles, unstable_poles=unstable,
+                         controller_poles=own, controller_unstable=controller_unstable,
+                         reasons=reasons)
