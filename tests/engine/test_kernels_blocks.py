@@ -92,7 +92,7 @@ def test_compensation_of_fraction_zero_is_no_compensation_bit_for_bit(pi_sine_ru
 
 def test_compensation_pushes_along_the_slip_with_a_fraction_of_the_friction_law():
     fraction = 0.7
-    run = _run(BASE + FrictionCompensation(fraction=fraction))
+    run = _run(BASE + FrictionCompensation(fraction=fraction, viscous_damping=None))
     plant = IsolatorParameters()
     v = run["relative_velocity"]
     slipping = ~run["locked"] & (np.abs(v) > 1e-6)
@@ -150,7 +150,8 @@ def test_a_batch_runs_every_block_as_a_single_run_does():
                                           err_msg=f"case {index} {name}")
 
 
-@pytest.mark.parametrize("block", [FrictionCompensation(fraction=1.3, observer_bandwidth=5.0),
+@pytest.mark.parametrize("block", [FrictionCompensation(fraction=1.3, observer_bandwidth=5.0,
+                                                        viscous_damping=None),
                                    Dither(amplitude=4.0, frequency=25.0)],
                          ids=["compensation", "dither"])
 def test_the_energy_ledger_closes_with_blocks(block, pi_sine_run):

@@ -66,12 +66,20 @@ def test_compensation_takes_the_plants_friction_law_where_it_sets_none():
         FrictionCompensation(stiction_force=5.0, coulomb_force=6.0)
 
 
-def test_compensation_from_a_friction_fit_takes_its_four_numbers():
+def test_compensation_from_a_friction_fit_takes_its_levels_and_its_cv_only_if_asked():
     fit = type("Fit", (), dict(stiction_force=9.0, coulomb_force=1.2, stribeck_decay=90.0,
                                viscous_damping=101.0))()
     block = FrictionCompensation.from_fit(fit, fraction=0.5, deadband=1e-4)
-    assert block.law(IsolatorParameters()) == (9.0, 1.2, 90.0, 101.0)
+    assert block.law(IsolatorParameters()) == (9.0, 1.2, 90.0, 0.0)
     assert (block.fraction, block.deadband) == (0.5, 1e-4)
+    viscous = FrictionCompensation.from_fit(fit, viscous_damping=fit.viscous_damping)
+    assert viscous.law(IsolatorParameters())[3] == 101.0
+
+
+def test_the_default_compensation_leaves_the_viscous_friction_to_the_loop():
+    plant = IsolatorParameters()
+    assert FrictionCompensation().law(plant)[3] == 0.0
+    assert FrictionCompensation(viscous_damping=None).law(plant)[3] == plant.viscous_damping
 
 
 def test_dither_needs_a_positive_frequency():

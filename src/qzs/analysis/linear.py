@@ -306,7 +306,8 @@ def _pid_matrices(isolator, controller, period=0.0):
     Coulomb and Stribeck terms have no linear part at ``z' = 0``) and its observer of the
     friction left, ``r' = w_o (fraction Cv' z' - Cv z' - r)`` (the plant's friction is
     ``-Cv z'`` in this limit; sampled by forward Euler on the friction at the sample and the
-    feedforward held until then, a state of its own). ``period`` 0: continuous.
+    feedforward held until then, a state of its own, the new estimate applied at once).
+    ``period`` 0: continuous.
     """
     _, cv, _, kp, ki, kd, _ = loop_constants(isolator, controller, None)
     compensation = controller.compensation
@@ -332,6 +333,9 @@ def _pid_matrices(isolator, controller, period=0.0):
             gain = observer * period
             a[i, i], a[i, i + 1], b[i, vr] = 1.0 - gain, gain, -gain * cv
             b[i + 1, vr] = slope
+            # the new estimate is applied at once (docs/model.md §5.1): F = ... - r(n+1)
+            c[0, i], c[0, i + 1] = -(1.0 - gain), -gain
+            d[0, vr] += gain * cv
         else:
             a[i, i], b[i, vr] = -observer, observer * (slope - cv)
     return a, b, c, d

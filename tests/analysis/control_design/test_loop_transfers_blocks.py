@@ -109,12 +109,6 @@ def test_simulated_transmissibility_is_the_sampled_loops_closed_form(name, frequ
                abs(simulated / expected - 1), 1e-4)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the simulator's sampled observer (engine.kernels.sample_controller) advances with the "
-    "estimate of the sample before last, r[n+1] = r[n] + w_o T (friction[n] + f_ff[n-1] - "
-    "r[n-1]), not the forward Euler step its comment and docs/design.md §6 state; the run "
-    "follows that law "
-    "to 1e-6 and differs from the stated one by 23 % at 2 Hz"))
 def test_simulated_transmissibility_with_a_sampled_friction_observer():
     """Half the viscous friction compensated, the rest observed (10 Hz), sampled at 1 kHz."""
     isolator = linear_isolator()
