@@ -11,6 +11,9 @@ import pytest
 
 from qzs import (ControllerParameters, Dither, FrictionCompensation, IsolatorParameters,
                  LinearController, ParameterError, PIDamping)
+from qzs.analysis.harmonic_balance import SmoothModel
+from qzs.analysis.hexapod_linear import hexapod_linearize
+from qzs.model import PlatformParameters, cubic_geometry
 from qzs.model.controller import MAX_STATES, SENSORS, block_parameters
 
 
@@ -163,3 +166,20 @@ def test_block_parameters_carry_units_and_the_matrices_row_by_row():
     assert meta["linear.inputs"] == ("relative_velocity", "-")
     assert meta["dither.amplitude"] == (3.0, "N") and meta["dither.frequency"][1] == "Hz"
     assert set(SENSORS) >= set(meta["linear.inputs"][0].split())
+
+
+def _smooth_model(controller):
+    return SmoothModel.from_parameters(controller=controller, amplitude=1e-3)
+
+
+def _hexapod_linear(controller):
+    geometry = cubic_geometry(cube_edge=0.2, cube_center_height=0.2)
+    return hexapod_linearize(geometry, PlatformParameters(), controller=controller)
+
+
+@pytest.mark.parametrize("call, match", [(_smooth_model, "the harmonic balance"),
+                                         (_hexapod_linear, "the six-axis linear model")])
+def test_what_models_pi_and_damping_alone_refuses_blocks_naming_the_way_out(call, match):
+    with pytest.raises(ParameterError, match=match + r" models PI \+ damping alone; "
+                                                     r"`controller` has blocks .*dither"):
+        call(PIDamping() + Dither())

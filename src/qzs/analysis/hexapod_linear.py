@@ -26,7 +26,7 @@ import numpy as np
 from qzs._validation import choice, real
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
-from qzs.model.controller import ControllerParameters
+from qzs.model.controller import ControllerParameters, refuse_blocks
 from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
                                PlatformParameters, jacobian, mass_matrix, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
@@ -457,6 +457,8 @@ def hexapod_linearize(geometry, platform, isolator=None, controller=None, *, leg
     controllers = _per_leg("controller",
                            ControllerParameters() if controller is None else controller,
                            ControllerParameters)
+    refuse_blocks(controllers, "the six-axis linear model",
+                  "simulate the platform instead (qzs.simulate_hexapod)")
     if cartesian is not None and not isinstance(cartesian, CartesianController):
         raise ParameterError(f"`cartesian` must be a CartesianController or None, got "
                              f"{type(cartesian).__name__}.")

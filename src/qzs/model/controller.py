@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from qzs._validation import (non_negative_real, optional, parameter, positive_real, real,
                              validate_fields)
@@ -41,6 +42,7 @@ from qzs.model.sensors import MAX_STATES, SENSORS
 
 __all__ = ["ControllerParameters", "PIDamping", "FrictionCompensation", "Dither",
            "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "block_parameters",
+           "refuse_blocks",
            "closed_loop_natural_frequency"]
 
 #: The blocks a controller may carry beyond PI + damping: field name -> class name.
@@ -143,10 +145,11 @@ class FrictionCompensation:
         -------
         tuple of float
         """
-        return tuple(float(getattr(isolator, name) if getattr(self, name) is None
-                           else getattr(self, name))
-                     for name in ("stiction_force", "coulomb_force", "stribeck_decay",
-                                  "viscous_damping"))
+        fs, fc, cbc, cv = (float(getattr(isolator, name) if getattr(self, name) is None
+                                 else getattr(self, name))
+                           for name in ("stiction_force", "coulomb_force", "stribeck_decay",
+                                        "viscous_damping"))
+        return fs, fc, cbc, cv
 
     def __add__(self, other):
         return _add(self, other)
@@ -246,10 +249,10 @@ class LinearController:
         What the controller is called in summaries and records.
     """
 
-    a: tuple = parameter((), "1/s", "state matrix A")
-    b: tuple = parameter((), "-", "input matrix B")
-    c: tuple = parameter((), "N", "output matrix C")
-    d: tuple = parameter((), "N", "feedthrough D")
+    a: ArrayLike = parameter((), "1/s", "state matrix A")
+    b: ArrayLike = parameter((), "-", "input matrix B")
+    c: ArrayLike = parameter((), "N", "output matrix C")
+    d: ArrayLike = parameter((), "N", "feedthrough D")
     inputs: tuple = parameter(("measured_payload_velocity",), "-", "sensors the controller reads")
     sample_time: float = parameter(0.0, "s", "sampling period (0 = continuous)")
     tracking_time: float = parameter(TRACKING_TIME, "s", "anti-windup tracking time")
@@ -286,7 +289,7 @@ class LinearController:
     @property
     def states(self) -> int:
         """Number of states [-]."""
-        return len(self.a)
+        return int(np.shape(self.a)[0])
 
     @property
     def discrete(self) -> bool:
@@ -569,6 +572,32 @@ def _add(left, right):
                              f"holds one of each (combine linear loops into one system with "
                              "control.parallel).", (slot,))
     return dataclasses.replace(left, **{slot: right})
+
+
+def refuse_blocks(controller: Any, what: str, fix: str, argument: str = "controller") -> None:
+    """Refuse a controller with blocks where only PI + damping is modelled.
+
+    Parameters
+    ----------
+    controller : ControllerParameters or sequence of them
+        The controller(s).
+    what : str
+        What models PI + damping alone (``"the harmonic balance"``).
+    fix : str
+        What to do instead.
+    argument : str
+        How the caller names the controller.
+
+    Raises
+    ------
+    ParameterError
+        A controller with blocks.
+    """
+    for one in (controller if isinstance(controller, (list, tuple)) else (controller,)):
+        if isinstance(one, ControllerParameters) and one.has_blocks:
+            raise ParameterError(
+                f"{what} models PI + damping alone; `{argument}` has blocks beyond them "
+                f"({one.describe()}); {fix}.", (argument,))
 
 
 def block_parameters(controller: ControllerParameters) -> dict[str, tuple[Any, str]]:

@@ -24,6 +24,7 @@ import numpy as np
 from qzs._validation import non_negative_real, positive_real
 from qzs.model.isolator import (friction_force, friction_slope, spring_force,
                                 spring_stiffness)
+from qzs.model.controller import refuse_blocks
 from qzs.model.registry import model_inputs
 
 __all__ = ["SmoothModel", "smooth_right_hand_side", "FRICTION_VELOCITY"]
@@ -129,6 +130,8 @@ class SmoothModel:
         SmoothModel
         """
         isolator, controller = model_inputs(isolator, controller)
+        refuse_blocks(controller, "the harmonic balance",
+                      "simulate the steady state instead (qzs.simulate of a sine)")
         center = (controller.position_setpoint if isolator.stop_center is None
                   else isolator.stop_center)
         return cls(mass=isolator.mass, gravity=isolator.gravity,
