@@ -174,7 +174,8 @@ def _smooth_model(controller):
 
 def _hexapod_linear(controller):
     geometry = cubic_geometry(cube_edge=0.2, cube_center_height=0.2)
-    return hexapod_linearize(geometry, PlatformParameters(), controller=controller)
+    platform = PlatformParameters(mass=20.0, inertia=np.eye(3))
+    return hexapod_linearize(geometry, platform, controller=controller)
 
 
 @pytest.mark.parametrize("call, match", [(_smooth_model, "the harmonic balance"),
