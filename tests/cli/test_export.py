@@ -95,3 +95,13 @@ def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
     assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4", "--overwrite"]) == 0
     starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
     assert float(starts["step_size"]) == 2e-4
+
+
+def test_the_default_file_is_replaced_and_a_named_one_refused(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "controller.c").write_text("an older export")
+    assert main(["export", "controller"]) == 0, capsys.readouterr().err
+    assert PARAMETERS_NAME in (tmp_path / "controller.c").read_text()
+    capsys.readouterr()
+    assert main(["export", "controller", "--out", "controller.c"]) == 2
+    assert "--out 'controller.c' exists; pass --overwrite" in capsys.readouterr().err

@@ -1,5 +1,5 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from qzs.cli.common import EPILOG, add_set_option, check_output, parameters
+from qzs.cli.common import EPILOG, NamedOutput, add_set_option, check_output, parameters
 from qzs.iotools.config import save_config
 from qzs.model.registry import format_value, parameter_table
 
@@ -24,7 +24,8 @@ def add_parser(subparsers):
         description="Print every parameter with its value (the defaults, or --config's, with "
                     "--set applied), unit and description; or write them as a config file.",
         epilog="--toml never replaces a file without --overwrite. " + EPILOG)
-    params.add_argument("--toml", metavar="FILE.toml", help="write them as a config file instead")
+    params.add_argument("--toml", metavar="FILE.toml", action=NamedOutput,
+                        help="write them as a config file instead")
     params.add_argument("--overwrite", "--force", dest="overwrite", action="store_true",
                         help="let --toml replace an existing file (--force: the old name)")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")

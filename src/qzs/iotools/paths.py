@@ -16,7 +16,7 @@ from pathlib import Path
 
 from qzs.errors import OutputPathError
 
-__all__ = ["check_output_path", "format_bytes"]
+__all__ = ["check_output_path", "free_name", "format_bytes"]
 
 
 def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False,
@@ -103,6 +103,36 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
         what, them = ("exists and holds files", "them") if directory else ("exists", "it")
         fail(f"{what}; pass {flag} to replace {them}, or choose another name")
     return path
+
+
+def free_name(path, *, directory=False):
+    """``path`` if nothing is in the way, else the first free ``STEM-2.SUFFIX``,
+    ``STEM-3.SUFFIX``, ... beside it (``pi.zarr`` -> ``pi-2.zarr``, ``results`` ->
+    ``results-2``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The name a command would write to (its default).
+    directory : bool
+        ``path`` is a folder: an empty one is free (:func:`check_output_path` writes into it).
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+
+    def free(candidate):
+        return (not candidate.exists()
+                or directory and candidate.is_dir() and not any(candidate.iterdir()))
+
+    number = 1
+    candidate = path
+    while not free(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    return candidate
 
 
 def _nearest_existing(folder):
