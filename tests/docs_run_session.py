@@ -51,8 +51,10 @@ def run(request, namespace):
             code = compile("\n" * (request["line"] - 1) + request["source"],
                            request["filename"], "exec")
             exec(code, namespace)
-        except BaseException:   # noqa: BLE001 -- a SystemExit of the block is a failure too
-            error = traceback.format_exc()
+        except BaseException as raised:   # noqa: BLE001 -- a SystemExit fails it too
+            # from the block's own frame on: the page's line first, not this driver's
+            error = "".join(traceback.format_exception(type(raised), raised,
+                                                       raised.__traceback__.tb_next))
         if error is None:
             for check in request["checks"]:
                 try:

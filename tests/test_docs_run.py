@@ -31,13 +31,17 @@ HTML comments right above the block (invisible on the site), never in a list her
 ``<!-- docs-run: prints `TEXT` -->``
     the block's output holds ``TEXT``;
 ``<!-- docs-run: check `EXPRESSION` -->``
-    (``python`` blocks) the page's session finds ``EXPRESSION`` true after the block.
+    (``python`` blocks) the page's session finds ``EXPRESSION`` true after the block;
+``<!-- docs-run: save FILE -->``
+    (above any other block, such as a ```toml file the page shows) the reader saves the
+    block as ``FILE`` at this point of the page, as the page's later commands expect.
 
 A marker that names no command, no text or nothing to check fails the test, and so does
 an unknown marker: a stale marker never hides a command. The page tests carry the marker
 ``docs_run``: ``make docs`` runs them (they take minutes), ``make test`` leaves them out; the
 tests of the reader itself run in both. ``QZS_DOCS_RUN_OUT`` names a JSON Lines file to
-which each block's seconds are appended.
+which each block's seconds (each command's, for ``sh``) and the end of its output are
+appended.
 """
 import json
 import os
@@ -60,6 +64,8 @@ BLOCK_TIMEOUT = 900
 #: JSON Lines file for each block's seconds (unset: none written).
 TIMES_OUT = "QZS_DOCS_RUN_OUT"
 
+#: The languages of the blocks that run.
+RUN = ("sh", "python")
 FENCE = re.compile(r"^(?P<fence>`{3,}|~{3,})(?P<info>[^`\n]*)$")
 MARKER = re.compile(r"^<!--\s*docs-run:\s*(?P<body>.*?)\s*-->\s*$")
 TOCTREE = re.compile(r"^(`{3,}|:{3,})\{toctree\}")
@@ -80,6 +86,7 @@ class Block:
     writes: list = field(default_factory=list)
     prints: list = field(default_factory=list)
     checks: list = field(default_factory=list)
+    save: str | None = None          # a file block: saved under this name
 
     @property
     def where(self):
@@ -130,6 +137,10 @@ def apply_marker(block, body, where):
         if block.language != "python":
             raise ValueError(f"{where}: `check` is for python blocks: {body!r}")
         block.checks.extend(quoted(rest, where))
+    elif verb == "save":
+        if block.language in RUN or not rest.strip():
+            raise ValueError(f"{where}: `save FILE` is for a block that is not run: {body!r}")
+        block.save = rest.strip()
     else:
         raise ValueError(f"{where}: unknown docs-run marker {verb!r}: {body!r}")
 
@@ -152,20 +163,20 @@ def blocks_of(path):
                         if lines[k].startswith(fence.group("fence"))
                         and not lines[k].strip("`~")), len(lines))
             language = fence.group("info").strip()
-            if language in ("sh", "python"):
+            if language in RUN or markers:
                 block = Block(path, index + 2, language, "\n".join(lines[index + 1:end]))
                 for number, body in markers:
                     apply_marker(block, body, f"{shown(path)}:{number}")
+                if language not in RUN and block.save is None:
+                    raise ValueError(f"{shown(path)}:{markers[0][0]}: a docs-run marker "
+                                     f"above a ```{language} block, which does not run")
                 found.append(block)
-            elif markers:
-                raise ValueError(f"{shown(path)}:{markers[0][0]}: a docs-run "
-                                 f"marker above a ```{language} block")
             markers, index = [], end + 1
             continue
         if line.strip() and not marker:
             if markers:
                 raise ValueError(f"{shown(path)}:{markers[0][0]}: a docs-run "
-                                 f"marker not right above a ```sh or ```python block")
+                                 f"marker not right above a block")
         index += 1
     return found
 
@@ -272,7 +283,7 @@ def run_shell(block, folder, env):
     """Run the block's commands; the failures (none: an empty list) and the output."""
     code = prepared(block)
     substituted = Block(block.path, block.line, block.language, code)
-    failures, output = [], ""
+    failures, output, times = [], "", []
     used = {prefix: False for prefix, _ in block.skip_commands}
     for line, command in commands(substituted):
         skipped = [prefix for prefix in used if command.startswith(prefix)]
@@ -280,10 +291,12 @@ def run_shell(block, folder, env):
             used[prefix] = True
         if skipped:
             continue
+        start = time.perf_counter()
         try:
             done = subprocess.run(["bash", "-o", "pipefail", "-c", command], cwd=folder,
                                   env=env, capture_output=True, text=True,
                                   timeout=BLOCK_TIMEOUT, stdin=subprocess.DEVNULL)
+            times.append((line, round(time.perf_counter() - start, 2)))
         except subprocess.TimeoutExpired:
             failures.append(f"{shown(block.path)}:{line}: `{command}` still "
                             f"running after {BLOCK_TIMEOUT} s")
@@ -295,7 +308,7 @@ def run_shell(block, folder, env):
                             f"--- stderr\n{done.stderr[-3000:]}")
     failures += [f"{block.where}: `skip` names `{prefix}`, which starts no command"
                  for prefix, hit in used.items() if not hit]
-    return failures, output
+    return failures, output, times
 
 
 class Session:
@@ -349,14 +362,19 @@ def run_python(block, session):
 def run_page(page, folder, home):
     """Run a page's blocks in ``folder``; the failures, one text each (none: all ran)."""
     env, session, failures = environment(home), None, []
+    times = None
     try:
         for block in blocks_of(page):
             if block.skip:
                 continue
             before = snapshot(folder, block.writes)
             start = time.perf_counter()
-            if block.language == "sh":
-                found, output = run_shell(block, folder, env)
+            if block.save is not None:
+                (folder / block.save).parent.mkdir(parents=True, exist_ok=True)
+                (folder / block.save).write_text(block.code + "\n", encoding="utf-8")
+                found, output = [], ""
+            elif block.language == "sh":
+                found, output, times = run_shell(block, folder, env)
             else:
                 if session is None:
                     session = Session(folder, env, home / f"{page.stem}-session.log")
@@ -375,8 +393,11 @@ def run_page(page, folder, home):
             failures += found
             if os.environ.get(TIMES_OUT):
                 with open(os.environ[TIMES_OUT], "a", encoding="utf-8") as record:
-                    record.write(json.dumps({"block": block.where, "seconds": seconds,
-                                             "ok": not found}) + "\n")
+                    record.write(json.dumps({"block": block.where,
+                                             "seconds": round(seconds, 2), "ok": not found,
+                                             "commands": times,
+                                             "output": output[-4000:]}) + "\n")
+            times = None
     finally:
         if session is not None:
             session.close()
@@ -466,6 +487,8 @@ def test_the_markers_check_what_a_page_states(page_of, tmp_path):
         "<!-- docs-run: replace `x = 1` with `x = 3` (the probe's substitution) -->\n"
         "```python\nx = 1\n```\n\n"
         "<!-- docs-run: skip (never runs) -->\n```sh\nfalse\n```\n\n"
+        "<!-- docs-run: save conf/a.toml -->\n```toml\nkey = 1\n```\n\n"
+        "<!-- docs-run: writes copied.toml -->\n```sh\ncp conf/a.toml copied.toml\n```\n\n"
         "<!-- docs-run: skip `qzs app` (serves until Ctrl-C) -->\n"
         "<!-- docs-run: skip `qzs nothing` (names no command) -->\n"
         "```sh\nqzs app --no-browser\n```\n")
@@ -482,10 +505,14 @@ def test_the_markers_check_what_a_page_states(page_of, tmp_path):
                                     "<!-- docs-run: skip `qzs app` -->",
                                     "<!-- docs-run: replace `a` (why) -->"])
 def test_a_malformed_or_stray_marker_is_an_error(page_of, marker):
+    """A malformed marker, one that is not right above a block, and one above a block
+    that is not run (other than `save`)."""
     with pytest.raises(ValueError, match="docs-run|marker"):
         blocks_of(page_of(f"{marker}\n```sh\necho\n```\n"))
     with pytest.raises(ValueError, match="not right above"):
         blocks_of(page_of("<!-- docs-run: skip (why) -->\n\ntext\n\n```sh\necho\n```\n"))
+    with pytest.raises(ValueError, match="which does not run"):
+        blocks_of(page_of("<!-- docs-run: skip (why) -->\n```toml\na = 1\n```\n"))
 
 
 def test_the_commands_of_a_block_join_continued_lines():
