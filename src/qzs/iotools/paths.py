@@ -16,7 +16,7 @@ from pathlib import Path
 
 from qzs.errors import OutputPathError
 
-__all__ = ["check_output_path", "free_name", "format_bytes"]
+__all__ = ["check_output_path", "free_name", "switch", "format_bytes"]
 
 
 def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False,
@@ -99,10 +99,28 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
                  f"are free on the file system of {str(target)!r}; free some space or "
                  "choose another folder")
     if not overwrite and path.exists() and (not directory or any(path.iterdir())):
-        flag = "--overwrite" if argument.startswith("--") else "overwrite=True"
+        flag = switch(argument, "overwrite")
         what, them = ("exists and holds files", "them") if directory else ("exists", "it")
         fail(f"{what}; pass {flag} to replace {them}, or choose another name")
     return path
+
+
+def switch(argument, name):
+    """A yes/no option as the caller of ``argument`` spells it: ``--name`` on the command
+    line (whose arguments are options, ``--out``), ``name=True`` in Python.
+
+    Parameters
+    ----------
+    argument : str
+        How the caller names the path a message is about (``"--out"``, ``"store"``).
+    name : str
+        The option's Python name (``"overwrite"``, ``"resume"``).
+
+    Returns
+    -------
+    str
+    """
+    return f"--{name.replace('_', '-')}" if argument.startswith("--") else f"{name}=True"
 
 
 def free_name(path, *, directory=False):

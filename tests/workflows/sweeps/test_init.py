@@ -243,7 +243,7 @@ def test_resume_after_an_interrupt_gives_the_same_dataset(reference, tmp_path, m
     assert sweep_batch.simulate_batch is unpatched  # the interrupting patch is gone
     partial = load(store)
     assert partial["done"].values.tolist() == [True, True, False, False]
-    with pytest.raises(ParameterError, match="exists; pass `resume`"):
+    with pytest.raises(ParameterError, match="exists; pass resume=True"):
         run_sweep(definition, store, progress=False)
     calls = _count_cases(monkeypatch)
     resumed = run_sweep(definition, store, resume=True, progress=False).load()
