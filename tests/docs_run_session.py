@@ -18,6 +18,7 @@ the page and the line a reader sees.
 import contextlib
 import io
 import json
+import linecache
 import os
 import sys
 import traceback
@@ -48,8 +49,15 @@ def run(request, namespace):
     error, failed = None, []
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
-            code = compile("\n" * (request["line"] - 1) + request["source"],
-                           request["filename"], "exec")
+            source = "\n" * (request["line"] - 1) + request["source"] + "\n"
+            code = compile(source, request["filename"], "exec")
+            # the page's lines for the traceback (a later block of the page adds its own)
+            known = linecache.cache.get(request["filename"], (0, None, [], ""))[2]
+            lines = source.splitlines(keepends=True)
+            merged = [new if new.strip() else (known[i] if i < len(known) else new)
+                      for i, new in enumerate(lines)] + known[len(lines):]
+            linecache.cache[request["filename"]] = (len(source), None, merged,
+                                                    request["filename"])
             exec(code, namespace)
         except BaseException as raised:   # noqa: BLE001 -- a SystemExit fails it too
             # from the block's own frame on: the page's line first, not this driver's
