@@ -217,7 +217,15 @@ class WarningsThroughBar:
         bar.close = closed
 
     def show(self, message, category, filename, lineno, file=None, line=None):
-        """:func:`warnings.showwarning`'s signature; clears the bars, shows, redraws."""
+        """Show a warning with the bars cleared, then draw them again.
+
+        Parameters
+        ----------
+        message : Warning or str
+            The warning.
+        category, filename, lineno, file, line
+            As for :func:`warnings.showwarning`, passed on to the display it replaced.
+        """
         try:
             with tqdm.external_write_mode(file=self.stream):
                 self.shown(message, category, filename, lineno, file, line)
