@@ -305,6 +305,16 @@ BAD = {
                                     "8123"], "--host '192.0.2.1'", "use 127.0.0.1"),
     "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
                                   "--record", "is a folder", "pass the CSV file"),
+    # seeds: numpy refused a negative one after the store was made (a traceback, the store
+    # left behind); one beyond int64 ran, then failed as a file attribute (a traceback)
+    "optimize-negative-seed": Bad(["optimize", "isolation_vs_effort", "--seed", "-3"],
+                                  "`--seed`", "got -3", "e.g. 1"),
+    "sensitivity-seed-beyond-int64": Bad(["sensitivity", "isolation_vs_effort", "--samples",
+                                          "2", "--seed", str(2 ** 70)], "`--seed`",
+                                         str(2 ** 70), "e.g. 1", hang=True),
+    "simulate-random-seed-beyond-int64": Bad(["simulate", "--excitation", "random", "--seed",
+                                              str(2 ** 70), "--duration", "5", "--out",
+                                              "r.nc"], "`--seed`", str(2 ** 70), "e.g. 1"),
 }
 
 

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
                              strictly_increasing, validate_fields)
+from qzs._validation import seed as checked_seed
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
@@ -277,10 +278,7 @@ class RandomExcitation(_Tabulated):
             raise ExcitationError(
                 f"`f_low` ({self.f_low!r} Hz) must be below `f_high` ({self.f_high!r} Hz), the "
                 "band's upper edge; swap them or widen the band.", ("f_low", "f_high"))
-        if (not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool)
-                or self.seed < 0):
-            raise ExcitationError(f"`seed` must be a non-negative integer (numpy's generators "
-                                  f"take 0 .. 2**128-1), got {self.seed!r}.", ("seed",))
+        object.__setattr__(self, "seed", checked_seed("seed", self.seed, ExcitationError))
         _resolve_fade(self)
         _check_peak(self.amplitude, self.f_high, ("amplitude", "f_high"), crest=4.0)
 

@@ -237,8 +237,28 @@ def test_the_seed_can_be_given_to_the_call_and_changes_the_search(tmp_path):
     other = optimize(LINEAR, tmp_path / "b.zarr", generations=1, seed=99, progress=False)
     assert other.problem.optimizer["seed"] == 99
     assert not np.array_equal(one.designs, other.designs)
-    with pytest.raises(ProblemError, match="whole number"):
+    with pytest.raises(ProblemError, match="must be an integer in"):
         optimize(LINEAR, tmp_path / "c.zarr", seed=1.5, progress=False)
+
+
+@pytest.mark.parametrize("seed", [-3, 2 ** 63])
+def test_a_seed_numpy_or_a_file_cannot_take_is_refused_before_the_store(tmp_path, seed):
+    """-3 was a numpy ValueError traceback once the store was made (and it was left behind)."""
+    with pytest.raises(ProblemError) as caught:
+        optimize(LINEAR, tmp_path / "c.zarr", seed=seed, progress=False)
+    assert (caught.value.table, caught.value.key, caught.value.value) == ("optimizer", "seed",
+                                                                          seed)
+    assert "e.g. 1" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("table", ["optimizer", "robust"])
+def test_a_negative_seed_in_the_problem_file_is_refused_by_its_key(table):
+    document = copy.deepcopy(SIMULATED)
+    document.setdefault(table, {})["seed"] = -3
+    with pytest.raises(ProblemError) as caught:
+        load_problem(document)
+    assert (caught.value.table, caught.value.key, caught.value.value) == (table, "seed", -3)
 
 
 @pytest.mark.parametrize("option, asked", [("seed", 5), ("population", 16)])

@@ -175,7 +175,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         (before any evaluation).
     """
     from qzs.engine.progress import progress_bar
-    from qzs.workflows.design_space.problem import _positive_int
+    from qzs._validation import seed as checked_seed
+    from qzs.workflows.design_space.problem import _in, _positive_int
     from qzs.workflows.sweeps.cluster import dask_client
 
     if not isinstance(problem, DesignProblem):
@@ -190,9 +191,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
             raise ProblemError("optimizer", "population", population, "NSGA-II needs at least "
                                f"{MIN_POPULATION} designs per generation")
     if seed is not None:
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            raise ProblemError("optimizer", "seed", seed, "must be a whole number")
-        settings["seed"] = seed
+        settings["seed"] = checked_seed("seed", seed, _in("optimizer"))
     problem = dataclasses.replace(problem, optimizer=settings)
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)

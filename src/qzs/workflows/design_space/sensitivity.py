@@ -53,6 +53,7 @@ import numpy as np
 
 from qzs._format import unit_label
 from qzs._optional import require
+from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.workflows.design_space.evaluation import evaluate_cases
@@ -387,10 +388,7 @@ def _plan(problem, method, samples, seed, metrics, evaluate):
     if method == "morris" and (levels < 2 or levels % 2):
         refuse("levels", levels, "Morris needs an even number of levels >= 2 (4 is usual); "
                                  "an odd number biases the grid", False)
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
-                             or seed < 0):
-        raise ParameterError(f"`seed` must be a whole number >= 0, got {seed!r}.")
-    seed = int(table["seed"] if seed is None else seed)
+    seed = int(table["seed"] if seed is None else checked_seed("seed", seed))
     columns = list(problem.columns)
     if metrics is None:
         metrics = list(table["metrics"])

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from qzs._validation import integer, known_keys, positive_real, read_toml, real
+from qzs._validation import seed as checked_seed
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
@@ -215,7 +216,7 @@ def _definition(document, where, stem):
                              f"Latin hypercube), got {method!r}.")
     seed = head.get("seed")
     if seed is not None:
-        seed = integer("seed", seed, 0)
+        seed = checked_seed("seed", seed)
     batch_size = integer("batch_size", head.get("batch_size", 32), 1)
 
     excitation = dict(_keys(document.get("excitation", {}), "excitation",
