@@ -190,6 +190,11 @@ AT_ONCE = 2.0
 #: Files the bad inputs read, written into the test's ``in`` folder ({in} in an argument).
 SWEEP = ('[sweep]\nname = "tiny"\nbatch_size = 1\n[grid]\n{grid}\n[excitation]\nf1 = 10.0\n'
          '[analysis]\nfft_length = 1024\nn_averages = 4\nband = [0.0, 10.0]\n')
+#: A design problem of simulated metrics whose runs the {variables} and {excitation} set.
+PROBLEM = ('[problem]\nname = "long"\n[variables]\npi_kp = {{ low = 1.0, high = 1000.0, scale = '
+           '"log" }}\n{variables}\n[excitation]\nf1 = 10.0\n{excitation}\n[analysis]\n'
+           'sample_rate = 100.0\nfft_length = 512\n[[objectives]]\nmetric = "rms_transmissibility"\n'
+           'band = [1.0, 5.0]\n[[objectives]]\nmetric = "motor_force_rms"\n')
 INPUTS = {
     "junk.csv": BINARY,
     "heavy.toml": b'[geometry]\nkind = "cubic"\ncube_edge = 0.15\n[platform]\nmass = "heavy"\n',
@@ -199,6 +204,11 @@ INPUTS = {
     "nan.toml": SWEEP.format(grid="pi_kp = [5.0, nan]").encode(),
     "huge.toml": SWEEP.format(grid="pi_kp = { start = 1.0, stop = 100.0, num = 100000000 }"
                               ).encode(),
+    "long.toml": SWEEP.format(grid="pi_kp = [5.0]").replace("f1 = 10.0", "f1 = 10.0\nduration"
+                                                            " = 1e9").encode(),
+    "long-problem.toml": PROBLEM.format(variables="", excitation="duration = 1e9").encode(),
+    "long-variable.toml": PROBLEM.format(variables='"excitation.duration" = { low = 10.0, '
+                                                   'high = 1e9 }', excitation="").encode(),
 }
 
 
@@ -312,6 +322,20 @@ BAD = {
     "sensitivity-seed-beyond-int64": Bad(["sensitivity", "isolation_vs_effort", "--samples",
                                           "2", "--seed", str(2 ** 70)], "`--seed`",
                                          str(2 ** 70), "e.g. 1", hang=True),
+    # 1e9 s runs: refused as a simulation of them is (their samples exceed the memory),
+    # before the step's probes or any store (the sweep's store was left behind; the search
+    # ran on, and on after SIGTERM)
+    "sweep-1e9-s-cases": Bad(["sweep", "{in}/long.toml", "--out", "long.zarr"],
+                             "a 1e+09 s run at 1000 Hz keeps", "GiB of samples",
+                             "[excitation] duration", "[sweep] batch_size", hang=True),
+    "optimize-1e9-s-designs": Bad(["optimize", "{in}/long-problem.toml", "--out", "o"],
+                                  "a 1e+09 s run at 100 Hz keeps", "[optimizer] population",
+                                  hang=True),
+    "optimize-duration-searched-to-1e9-s": Bad(["optimize", "{in}/long-variable.toml", "--out",
+                                                "o"], "a 1e+09 s run at 100 Hz keeps",
+                                               "`excitation.duration` variable", hang=True),
+    "sensitivity-1e9-s-designs": Bad(["sensitivity", "{in}/long-problem.toml", "--out", "s"],
+                                     "a 1e+09 s run at 100 Hz keeps", hang=True),
     "simulate-random-seed-beyond-int64": Bad(["simulate", "--excitation", "random", "--seed",
                                               str(2 ** 70), "--duration", "5", "--out",
                                               "r.nc"], "`--seed`", str(2 ** 70), "e.g. 1"),

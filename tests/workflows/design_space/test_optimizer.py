@@ -315,3 +315,39 @@ def test_a_store_whose_designs_are_not_asked_for_again_is_refused(tmp_path):
     group["search_position"][:] = position
     with pytest.raises(OutputPathError, match=r"does not ask for again \(generation 1\)"):
         optimize(LINEAR, store, generations=3, resume=True, progress=False)
+
+
+@pytest.mark.parametrize("where", ["excitation", "variable"])
+def test_designs_of_1e9_s_runs_are_refused_before_any_probe_or_store(tmp_path, monkeypatch,
+                                                                     where):
+    """What simulate refuses (a run whose samples exceed the memory) is refused before the
+    step's probes: a 1e9 s excitation, or an excitation duration searched up to 1e9 s
+    (checked at the variables' bounds, not at the file's default duration)."""
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.design_space import optimizer as optimizer_module
+
+    monkeypatch.setattr(optimizer_module, "fix_step", pytest.fail)
+    document = copy.deepcopy(SIMULATED)
+    document["simulation"] = {}
+    if where == "excitation":
+        document["excitation"]["duration"] = 1e9
+    else:
+        del document["excitation"]["duration"]
+        document["variables"]["excitation.duration"] = {"low": 10.0, "high": 1e9}
+    with pytest.raises(ResultTooLargeError, match="1e[+]09 s run at") as caught:
+        optimize(document, tmp_path / "deep" / "x.zarr", progress=False)
+    assert "[optimizer] population" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_search_failing_before_its_first_generation_is_stored_leaves_nothing(tmp_path,
+                                                                             monkeypatch):
+    from qzs.workflows.design_space import optimizer as optimizer_module
+
+    def refused(*args, **kwargs):
+        raise ProblemError("optimizer", "", None, "refused by the generation")
+
+    monkeypatch.setattr(optimizer_module, "_generations", refused)
+    with pytest.raises(ProblemError, match="refused by the generation"):
+        optimize(LINEAR, tmp_path / "deep" / "x.zarr", progress=False)
+    assert list(tmp_path.iterdir()) == []
