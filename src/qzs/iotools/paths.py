@@ -15,6 +15,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from qzs._format import format_bytes
 from qzs.errors import OutputPathError
 
 __all__ = ["check_output_path", "format_bytes", "removed_on_error"]
@@ -178,23 +179,3 @@ def _writable(folder):
     except OSError:
         return False
     return True
-
-
-def format_bytes(count):
-    """A byte count for people: ``1.5 GiB``.
-
-    Parameters
-    ----------
-    count : int or float
-        Bytes [B].
-
-    Returns
-    -------
-    str
-    """
-    value = float(count)
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
-        if abs(value) < 1024 or unit == "TiB":
-            return f"{value:.0f} {unit}" if unit == "B" else f"{value:.1f} {unit}"
-        value /= 1024
-    return f"{value:.1f} TiB"  # pragma: no cover

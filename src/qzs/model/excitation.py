@@ -287,11 +287,16 @@ class RandomExcitation(_Tabulated):
         """Highest frequency in the signal [Hz]."""
         return self.f_high
 
+    @property
+    def record_points(self) -> float:
+        """Points of the tabulated record [-]: 20 per period of ``f_high`` over ``duration``,
+        both ends included (a float: beyond any integer's use for a record of 1e300 s)."""
+        return float(np.ceil(self.duration * 20.0 * self.f_high)) + 1.0
+
     def _spline(self):
         from scipy.interpolate import CubicSpline
 
-        rate = 20.0 * self.f_high
-        n = int(np.ceil(self.duration * rate)) + 1
+        n = int(self.record_points)
         n_fft = n if n % 2 == 0 else n + 1
         spacing = self.duration / (n - 1)
         freqs = np.fft.rfftfreq(n_fft, d=spacing)
