@@ -69,6 +69,34 @@ def test_a_folder_given_as_toml(tmp_path):
         load_config(tmp_path)
 
 
+# ---------------------------------------------------------------- empty TOML files
+#: Every reader of a TOML file (what names the file in its messages).
+def _readers():
+    from qzs.workflows.design_space.problem import load_problem
+    from qzs.workflows.hexapod.setups import load_hexapod
+    from qzs.workflows.paper.studies import load_study
+    from qzs.workflows.sweeps import load_sweep
+
+    return {"config file": load_config, "channel map": load_channel_map,
+            "sweep file": load_sweep, "problem file": load_problem,
+            "hexapod file": load_hexapod, "study file": load_study}
+
+
+@pytest.mark.parametrize("content", ["", "\n  \n", "# only a comment\n# [isolator]\n"],
+                         ids=["empty", "blank", "comments"])
+@pytest.mark.parametrize("what", ["config file", "channel map", "sweep file", "problem file",
+                                  "hexapod file", "study file"])
+def test_an_empty_toml_file_is_refused_by_every_reader(tmp_path, what, content):
+    """`qzs params --toml > my.toml` used to leave an empty my.toml that the commands then
+    read as the defaults without a word."""
+    path = tmp_path / "my.toml"
+    path.write_text(content)
+    with pytest.raises(ParameterError) as caught:
+        _readers()[what](path)
+    message = str(caught.value)
+    assert f"{what} {str(path)!r} is empty" in message and "sets nothing" in message, message
+
+
 # ---------------------------------------------------------------- empty and broken logs
 @pytest.mark.parametrize("content, match", [
     (b"", "is empty"),
@@ -202,6 +230,7 @@ INPUTS = {
     "negative.toml": SWEEP.format(grid="pi_kp = [5.0, 10.0]\nstiction_force = [10.0, -5.0]"
                                   ).encode(),
     "nan.toml": SWEEP.format(grid="pi_kp = [5.0, nan]").encode(),
+    "empty.toml": b"# qzs run configuration\n",
     "huge.toml": SWEEP.format(grid="pi_kp = { start = 1.0, stop = 100.0, num = 100000000 }"
                               ).encode(),
     "long.toml": SWEEP.format(grid="pi_kp = [5.0]").replace("f1 = 10.0", "f1 = 10.0\nduration"
@@ -347,6 +376,18 @@ BAD = {
                                          "--duration", "2"],
                                         "`--excitation-duration` = 1e+12 s", "GiB",
                                         "need not be longer than the run", hang=True),
+    # an empty config (`qzs params --toml > my.toml` left one) was read as the defaults
+    "simulate-empty-config": Bad(["simulate", "--config", "{in}/empty.toml"],
+                                 "config file '{in}/empty.toml' is empty", "sets nothing",
+                                 "qzs params --toml > FILE.toml"),
+    "params-empty-config": Bad(["params", "--config", "{in}/empty.toml"],
+                               "config file '{in}/empty.toml' is empty"),
+    "sweep-empty-file": Bad(["sweep", "{in}/empty.toml", "--out", "s.zarr"],
+                            "sweep file '{in}/empty.toml' is empty", "qzs docs sweeps"),
+    "optimize-empty-file": Bad(["optimize", "{in}/empty.toml"],
+                               "problem file '{in}/empty.toml' is empty"),
+    "hexapod-empty-config": Bad(["hexapod", "linear", "--config", "{in}/empty.toml"],
+                                "hexapod file '{in}/empty.toml' is empty"),
     "simulate-random-seed-beyond-int64": Bad(["simulate", "--excitation", "random", "--seed",
                                               str(2 ** 70), "--duration", "5", "--out",
                                               "r.nc"], "`--seed`", str(2 ** 70), "e.g. 1"),

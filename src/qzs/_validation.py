@@ -270,18 +270,24 @@ def finite_rows(name, values, error, fix="interpolate or trim them first"):
     return array
 
 
-def read_toml(path, what, error=ParameterError):
+def read_toml(path, what, error=ParameterError, empty="write its tables into it"):
     """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad.
 
     A missing file, a folder, a file that is not UTF-8 text (a binary file given by
-    mistake) and invalid TOML each get a message naming the file and the fix.
+    mistake), invalid TOML and a file that sets nothing (empty, blank or only comments:
+    what a failed ``qzs params --toml > FILE.toml`` left) each get a message naming the
+    file and the fix; ``empty`` is the fix of the last.
     """
     import tomllib
 
     path = Path(path)
     try:
         with open(path, "rb") as handle:
-            return tomllib.load(handle)
+            document = tomllib.load(handle)
+        if not document:
+            raise error(f"{what} {str(path)!r} is empty (no table or key, only blanks or "
+                        f"comments): it sets nothing; {empty}.")
+        return document
     except FileNotFoundError:
         raise error(f"{what} not found: {str(path)!r}.") from None
     except IsADirectoryError:

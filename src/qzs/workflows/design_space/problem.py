@@ -385,11 +385,13 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
     else:
         try:
             path = resolve_shipped(source, SHIPPED, "problem", "problems")
-            document = read_toml(path, "problem file")
+            document = read_toml(path, "problem file", empty=(
+                "write the problem's tables into it (`qzs docs design-space` describes them; "
+                "the shipped isolation_vs_effort is an example)"))
         except ProblemError:
             raise
         except ParameterError as error:
-            raise ProblemError("file", "", source, str(error)) from None
+            raise ProblemError("file", "", str(source), str(error)) from None
         where, stem = repr(str(path)), path.stem
     return _problem(document, where, stem)
 

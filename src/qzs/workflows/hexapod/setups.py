@@ -402,7 +402,9 @@ def load_hexapod(path: str | Path,
         A missing or malformed file, an unknown table or key, a bad value.
     """
     path = resolve_shipped(path, SHIPPED, "hexapod", "hexapod files")
-    document = read_toml(path, "hexapod file")
+    document = read_toml(path, "hexapod file", empty=(
+        "write the platform's tables into it (`qzs docs hexapod` describes them; the shipped "
+        "setups are examples), or give no file for the default platform"))
     where = f"{str(path)!r}: "
     allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation",
                "cartesian"}

@@ -184,7 +184,9 @@ def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
         document, where, stem = source, "sweep definition", "sweep"
     else:
         path = resolve_shipped(source, SHIPPED, "sweep", "sweeps")
-        document = read_toml(path, "sweep file")
+        document = read_toml(path, "sweep file", empty=(
+            "write the sweep's tables into it (`qzs docs sweeps` describes them; the shipped "
+            "sweeps are examples)"))
         where, stem = repr(str(path)), path.stem
     try:
         return _definition(document, where, stem)
