@@ -365,6 +365,10 @@ BAD = {
                                                "`excitation.duration` variable", hang=True),
     "sensitivity-1e9-s-designs": Bad(["sensitivity", "{in}/long-problem.toml", "--out", "s"],
                                      "a 1e+09 s run at 100 Hz keeps", hang=True),
+    "hexapod-transmissibility-1e9-s": Bad(["hexapod", "transmissibility", "--axes", "z",
+                                           "--duration", "1e9", "--out", "ht"],
+                                          "`duration` 1e+09 s is at least", "integration steps",
+                                          "choose a shorter `duration`", hang=True),
     # a random record far longer than the run: numpy's "Unable to allocate 1.42 PiB"
     "simulate-random-record-1e12-s": Bad(["simulate", "--excitation", "random",
                                           "--excitation-duration", "1e12", "--duration", "2"],
