@@ -17,7 +17,8 @@ from qzs.model.registry import model_inputs
 
 __all__ = ["PreparedRun", "prepare_run", "run_inputs", "run_duration", "steps_per_sample",
            "divides",
-           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
+           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
+           "check_record", "RECORD_BYTES_PER_POINT"]
 
 #: Fewest integration steps per period of the excitation's highest frequency a run is
 #: started with [-]: below, the fixed-step integrator does not follow the base motion (at

@@ -32,7 +32,7 @@ from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, lo
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check, check_same_search
 
-__all__ = ["optimize", "fix_step", "probe_designs", "check_run_length"]
+__all__ = ["optimize", "fix_step", "probe_designs", "check_run_length", "GENERATION_REMEDY"]
 
 
 def probe_designs(problem):
