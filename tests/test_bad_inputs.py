@@ -212,6 +212,47 @@ def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
     assert (tmp_path / "out" / "report.md").exists()
 
 
+# ---------------------------------------------------------------- the same through the API
+def _api_case(name, folder):
+    """Issue 39's bad inputs as Python calls: ``(call, what the message holds)``."""
+    import tomllib
+
+    import qzs
+
+    problem = tomllib.loads(PROBLEM.format(variables="", excitation="duration = 1e9"))
+    sweep = tomllib.loads(INPUTS["long.toml"].decode())
+    return {
+        "optimize-negative-seed": (lambda: qzs.optimize("isolation_vs_effort",
+                                                        folder / "s.zarr", seed=-3,
+                                                        progress=False), "seed = -3"),
+        "optimize-1e9-s-designs": (lambda: qzs.optimize(problem, folder / "s.zarr",
+                                                        progress=False),
+                                   "a 1e+09 s run at 100 Hz keeps"),
+        "sensitivity-1e9-s-designs": (lambda: qzs.sensitivity(problem, progress=False),
+                                      "a 1e+09 s run at 100 Hz keeps"),
+        "run_sweep-1e9-s-cases": (lambda: qzs.run_sweep(sweep, folder / "deep" / "s.zarr",
+                                                        progress=False),
+                                  "a 1e+09 s run at 1000 Hz keeps"),
+        "simulate-random-record-1e12-s": (
+            lambda: qzs.simulate(qzs.RandomExcitation(duration=1e12), duration=2.0),
+            "`excitation.duration` = 1e+12 s"),
+    }[name]
+
+
+@pytest.mark.parametrize("name", ["optimize-negative-seed", "optimize-1e9-s-designs",
+                                  "sensitivity-1e9-s-designs", "run_sweep-1e9-s-cases",
+                                  "simulate-random-record-1e12-s"])
+def test_the_bad_inputs_of_issue_39_through_the_api(tmp_path, name):
+    """A ParameterError naming the argument and the value, at once, and nothing written."""
+    call, needle = _api_case(name, tmp_path)
+    began = time.perf_counter()
+    with pytest.raises(ParameterError) as caught:
+        call()
+    assert time.perf_counter() - began < 5.0
+    assert needle in str(caught.value), str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 # ---------------------------------------------------------------- every bad input of the CLI
 #: A bad input that used to hang, or fail only after the work, must fail within this [s].
 AT_ONCE = 2.0
