@@ -5,7 +5,9 @@ Properties that fail if the cache is wrong:
 
 * the key changes with every input of the choice (a model parameter, the excitation, an
   array's content, the tolerance) and with the code that chooses;
-* a choice read back equals the one made (every field), and reading it runs no probe;
+* a choice read back equals the one made (every field), and reading it runs no probe: one
+  that met its tolerance, a fallback that met none (still a fallback, its error still
+  undefined), a batch's with its per-case fields;
 * a damaged record, or a folder that cannot be written, costs a new choice, never an error,
   and no temporary file is left behind.
 """
@@ -95,6 +97,66 @@ def test_a_damaged_record_or_an_unwritable_folder_costs_a_new_choice(cache, tmp_
     assert not step_cache.store("k", {"dt": 1.0})
     assert choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True).dt == first.dt
     assert not list(cache.glob("*.part")) and not list(cache.glob(".*"))
+
+
+def _same(a, b):
+    """Equal, NaN equal to NaN, element by element through tuples."""
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return type(a) is type(b) and a == b
+
+
+def _synthetic_choice(constant, cases=1, **options):
+    """The search on runs ``C * dt**3`` (no probe integrated): a choice in a millisecond."""
+    from qzs.engine.step_search import search_step
+
+    return search_step(run=lambda dt, members: [constant * dt ** 3 for _ in members],
+                       compare=lambda coarse, fine: abs(coarse - fine), cases=cases, dt0=1e-3,
+                       order=3, measure="transmissibility_db", tolerance=1e-3,
+                       sample_rate=1000.0, solver="ode3", probe=CHIRP, probe_duration=PROBE,
+                       band=(1.0, 5.0), stability_limit=0.005, **options)
+
+
+@pytest.mark.parametrize("kind", ["met", "fallback", "batch"])
+def test_every_field_of_a_choice_survives_the_cache(cache, kind):
+    """Every field of the record (:class:`StepChoice`'s own list, not the cache's) read back as
+    it was made, but ``cached`` (now True) and the probe (made again): a fallback stays a
+    fallback, with no error estimate and its note."""
+    choice = {"met": lambda: _synthetic_choice(1e6),
+              "fallback": lambda: _synthetic_choice(1e30, fallback=True, finest=1e-3 / 16),
+              "batch": lambda: _synthetic_choice(1e6, cases=3, fallback=True)}[kind]()
+    assert choice.met == (kind != "fallback")
+    assert step_cache.store_choice("key", choice)
+    cases = 3 if kind == "batch" else None
+    again = step_cache.load_choice("key", CHIRP, PROBE, cases=cases)
+    assert again is not None and again.cached and again.probe == CHIRP
+    for field in dataclasses.fields(choice):
+        if field.name != "cached":
+            assert _same(getattr(again, field.name), getattr(choice, field.name)), field.name
+    assert _same(tuple(again.attributes().items()), tuple(choice.attributes().items()))
+    assert dataclasses.replace(again, cached=False).summary() == choice.summary()
+
+
+def test_a_cached_fallback_reads_back_as_a_fallback(cache, monkeypatch):
+    """The fallback of choose_step (no step meets 1e-15 m) made, then read from the cache
+    without a probe: ``met`` False, "fallback" in the run's attributes, error NaN, as made."""
+    options = dict(tolerance_state=1e-15, probe_duration=PROBE, max_halvings=2, fallback=True,
+                   cache=True)
+    first = choose_step(CHIRP, **options)
+    assert not first.met and not first.cached
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a cached choice ran a probe")
+
+    import qzs.engine.single as single
+    monkeypatch.setattr(single, "integrate", no_run)
+    again = choose_step(CHIRP, **options)
+    assert again.cached and not again.met and math.isnan(again.error)
+    assert again.attributes()["step"] == "fallback" == first.attributes()["step"]
+    assert again.attributes()["step_reason"] == first.attributes()["step_reason"]
+    assert "no step tried meets" in again.summary()
 
 
 def test_records_keep_infinite_and_missing_numbers(cache):
