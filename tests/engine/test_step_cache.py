@@ -141,7 +141,8 @@ def test_an_edit_to_any_source_the_choice_runs_changes_the_key(tmp_path):
     unrelated.write_bytes(unrelated.read_bytes() + b"\nEDITED = 1\n")
     assert step_cache._fingerprint(copy) == base
     single = copy / "engine" / "single.py"
-    single.write_bytes(single.read_bytes() + b"\n\ndef later():\n    from qzs.cli import simulate\n")
+    added = b"\n\ndef later():\n    from qzs.cli import simulate\n"
+    single.write_bytes(single.read_bytes() + added)
     assert "cli/simulate.py" in step_cache.choice_sources(copy)
     assert step_cache._fingerprint(copy) != base
 
