@@ -8,6 +8,7 @@ compiler against the FMI headers of the standard's distribution as FMPy ships th
 ``fmu`` extra). No Python inside: the binary steps the same fixed-step scheme, stick-slip
 events, stops and sampled controller as :func:`qzs.simulate` (docs/fmu.md).
 """
+import copy
 import dataclasses
 import datetime
 import math
@@ -24,7 +25,8 @@ from qzs._optional import require
 from qzs.engine.prepare import prepare_run
 from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
-from qzs.errors import ParameterError
+from qzs.errors import (ControllerRateError, ParameterError, StabilityError,
+                        UnresolvedExcitationError)
 from qzs.export.csource import CFLAGS, compile_shared, source_folder
 from qzs.export.fmu_variables import BASE_MOTIONS, MODES, fmu_variables, variables_header
 from qzs.export.fmu_xml import build_description, model_description
@@ -163,6 +165,22 @@ def _check_excitation(excitation, base_motion):
     return excitation
 
 
+def _named(error):
+    """``error`` renamed for the export (the output rate is the communication step's
+    reciprocal), with the arguments it names as its options where it names them in its text
+    only (a step unstable or too coarse, a controller rate), so that the command line can
+    spell them as its flags (:meth:`ParameterError.renamed`)."""
+    if not error.options:
+        named = {StabilityError: ("dt",), ControllerRateError: ("controller_rate", "sample_rate"),
+                 UnresolvedExcitationError: (getattr(error, "name", ""), "dt")}
+        for kind, options in named.items():
+            if isinstance(error, kind):
+                error = copy.copy(error)
+                error.options = tuple(option for option in options if option)
+                break
+    return error.renamed({"sample_rate": "1/communication_step"})
+
+
 def _check_choices(fmi_version, mode, base_motion, model_identifier):
     if fmi_version not in FMI_VERSIONS:
         raise ParameterError(f"`fmi_version` must be 2 or 3, got {fmi_version!r}.")
@@ -264,11 +282,11 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
                            tolerance=tolerance, tolerance_state=tolerance_state,
                            sample_rate=1.0 / communication, solver=solver,
                            step=step if base_motion == "internal" else "literal")
+        dt = resolved.dt
+        # every check qzs.simulate makes, at an output every step: any communication step
+        run = prepare_run(**{**resolved.arguments(), "sample_rate": 1.0 / dt})
     except ParameterError as error:
-        raise error.renamed({"sample_rate": "1/communication_step"}) from None
-    dt = resolved.dt
-    # every check qzs.simulate makes, at an output every step: any communication step is taken
-    run = prepare_run(**{**resolved.arguments(), "sample_rate": 1.0 / dt})
+        raise _named(error) from None
     headers = fmi_headers(fmi_version)
     variables = fmu_variables(isolator=run.isolator, controller=run.controller,
                               excitation_scalars=run.packed[0], dt=dt,
