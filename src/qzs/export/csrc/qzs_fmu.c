@@ -101,7 +101,7 @@ int qzs_fmu_get(QzsFmu *fmu, unsigned int reference, char type, double *value) {
 
 /* A parameter outside its range: logged with its value and what it must be. */
 static int refuse(QzsFmu *fmu, const char *name, double value, const char *rule) {
-    qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.17g must be %s; set it so before initialisation "
+    qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.15g must be %s; set it so before initialisation "
                 "ends", name, value, rule);
     return QZS_FMU_ERROR;
 }
@@ -332,7 +332,7 @@ static int check_step(QzsFmu *fmu, const double *P) {
     int closed_loop = !QZS_FMU_PLANT_MODE;
     if (!qzs_stable_step(P, solver, closed_loop, dt)) {
         qzs_fmu_log(fmu, QZS_FMU_ERROR,
-                    "`step_size` = %.17g s is too large for a stable %s integration of this "
+                    "`step_size` = %.12g s is too large for a stable %s integration of this "
                     "configuration (stiffest mode: the hard-stop contact or the spring%s loop); "
                     "the largest stable step is %.3g s: lower step_size (or soften "
                     "isolator.stop_stiffness) before initialisation ends",
@@ -345,15 +345,15 @@ static int check_step(QzsFmu *fmu, const double *P) {
     double sweep = V(EXCITATION_DURATION);
     if (chirp && fmu->stop_defined && fmu->stop_time > sweep * (1.0 + 1e-12)) {
         qzs_fmu_log(fmu, QZS_FMU_ERROR,
-                    "the stop time %.17g s is past the chirp's end, `excitation.duration` = "
-                    "%.17g s (qzs runs no chirp past its sweep); stop at or before it, or "
+                    "the stop time %.12g s is past the chirp's end, `excitation.duration` = "
+                    "%.12g s (qzs runs no chirp past its sweep); stop at or before it, or "
                     "lengthen excitation.duration", fmu->stop_time, sweep);
         return QZS_FMU_ERROR;
     }
     double top = highest_frequency(fmu, fmu->stop_defined ? fmu->stop_time : sweep);
     if (top > 0.0 && dt > 1.0 / (QZS_FMU_MIN_STEPS_PER_PERIOD * top) * (1.0 + 1e-9)) {
         qzs_fmu_log(fmu, QZS_FMU_ERROR,
-                    "`step_size` = %.17g s resolves the excitation's %g Hz with fewer than %d "
+                    "`step_size` = %.12g s resolves the excitation's %g Hz with fewer than %d "
                     "steps per period; lower step_size to %.3g s or less",
                     dt, top, QZS_FMU_MIN_STEPS_PER_PERIOD,
                     1.0 / (QZS_FMU_MIN_STEPS_PER_PERIOD * top));
@@ -363,15 +363,16 @@ static int check_step(QzsFmu *fmu, const double *P) {
     if (dt > QZS_FMU_EXPORTED_STEP * (1.0 + 1e-9)) {
         if (QZS_FMU_STEP_CHOSEN)
             qzs_fmu_log(fmu, QZS_FMU_WARNING,
-                        "`step_size` = %.17g s is above the %.17g s qzs chose at export for "
+                        "`step_size` = %.12g s is above the %.12g s qzs chose at export for "
                         "accuracy (%s) for the exported parameters: the results may be less "
                         "accurate than that; stable up to %.3g s", dt, QZS_FMU_EXPORTED_STEP,
                         QZS_FMU_STEP_HOW, qzs_largest_stable_step(P, solver, closed_loop));
         else
             qzs_fmu_log(fmu, QZS_FMU_WARNING,
-                        "`step_size` = %.17g s is above the %.17g s given at export, and neither "
+                        "`step_size` = %.12g s is above the %.12g s given at export, and neither "
                         "was chosen for accuracy (export without a literal step to have one "
-                        "chosen: qzs export fmu without --dt); stable up to %.3g s",
+                        "chosen: qzs export fmu without --dt, qzs.export_fmu with step=chosen); "
+                        "stable up to %.3g s",
                         dt, QZS_FMU_EXPORTED_STEP,
                         qzs_largest_stable_step(P, solver, closed_loop));
         return QZS_FMU_WARNING;
@@ -462,7 +463,7 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
     QzsRun *run = &fmu->run;
     double dt = run->plant.P[QZS_P_DT];
     if (!(step > 0.0) || !isfinite(step)) {
-        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the communication step %.17g s must be positive",
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the communication step %.12g s must be positive",
                     step);
         return QZS_FMU_ERROR;
     }
@@ -473,16 +474,16 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
     }
     double end = current + step;
     if (fmu->stop_defined && end > fmu->stop_time + 1e-6 * dt) {
-        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.17g s by %.17g s goes past the stop time "
-                    "%.17g s the experiment set; step to the stop time at most", current, step,
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.12g s by %.12g s goes past the stop time "
+                    "%.12g s the experiment set; step to the stop time at most", current, step,
                     fmu->stop_time);
         return QZS_FMU_ERROR;
     }
 #if !QZS_FMU_BASE_INPUT
     double sweep = V(EXCITATION_DURATION);
     if (V(EXCITATION_KIND) != 2.0 && end > sweep * (1.0 + 1e-12) + 1e-6 * dt) {
-        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.17g s by %.17g s goes past the chirp's "
-                    "end, `excitation.duration` = %.17g s (qzs runs no chirp past its sweep)",
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.12g s by %.12g s goes past the chirp's "
+                    "end, `excitation.duration` = %.12g s (qzs runs no chirp past its sweep)",
                     current, step, sweep);
         return QZS_FMU_ERROR;
     }
@@ -513,7 +514,7 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
     if (status != QZS_STATUS_OK) {
         fmu->time = (double)run->step * dt + fmu->offset;
         fmu->failed = 1;
-        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the state diverged at t = %.17g s (z = %g m, v = %g "
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the state diverged at t = %.12g s (z = %g m, v = %g "
                     "m/s); the step is too large for this configuration: lower step_size",
                     fmu->time, run->s.x[QZS_S_Z], run->s.x[QZS_S_V]);
         return QZS_FMU_ERROR;
