@@ -10,13 +10,20 @@ import pytest
 
 import qzs
 from qzs.engine.channels import CHANNELS
+from qzs.errors import CompilerError
 from qzs.export import fmu as export
+from qzs.export.csource import find_compiler
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE  # noqa: E402
 from fmpy.fmi3 import FMU3Slave  # noqa: E402
+
+try:  # every module that imports this one compiles FMUs
+    find_compiler()
+except CompilerError:  # pragma: no cover
+    pytest.skip("no C compiler", allow_module_level=True)
 
 #: The base-motion inputs of an FMU exported with ``base_motion="input"``.
 BASE_INPUTS = ("base_displacement", "base_velocity", "base_acceleration")

@@ -19,20 +19,14 @@ from helpers import EXPORT_PASSIVE
 
 import qzs
 from qzs.engine.base_motion import base_motion_series
-from qzs.errors import CompilerError, MissingDependencyError, ParameterError
+from qzs.errors import MissingDependencyError, ParameterError
 from qzs.export import fmu as export
 
-from export.fmu_support import Logged, compare, exported, starts
+from export.fmu_support import compare, starts
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import extract, read_model_description, simulate_fmu  # noqa: E402
 from fmpy.fmi3 import FMU3Slave  # noqa: E402
-
-try:
-    from qzs.export.csource import find_compiler
-    find_compiler()
-except CompilerError:  # pragma: no cover
-    pytest.skip("no C compiler", allow_module_level=True)
 
 CHIRP = qzs.Chirp(amplitude=0.01, f0=0.0, f1=20.0, duration=20.0)
 

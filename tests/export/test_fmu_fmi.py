@@ -16,18 +16,13 @@ import pytest
 import qzs
 from qzs.engine import kernels as K
 from qzs.engine.stability import largest_stable_step, stability_test
-from qzs.errors import CompilerError, ParameterError
-from qzs.export.csource import compile_shared, find_compiler, source_folder
+from qzs.errors import ParameterError
+from qzs.export.csource import compile_shared, source_folder
 
 from export.fmu_support import EXCITATIONS, Logged, compare, exported
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import read_model_description, simulate_fmu  # noqa: E402
-
-try:
-    find_compiler()
-except CompilerError:  # pragma: no cover
-    pytest.skip("no C compiler", allow_module_level=True)
 
 CHIRP = EXCITATIONS["chirp-linear"]
 DT = 1e-4  # the Python export's step (literal)
