@@ -94,8 +94,8 @@ def add_parser(subparsers):
     step = fmu.add_mutually_exclusive_group()
     step.add_argument("--dt", type=float, metavar="S",
                       help="a literal internal integration step [s] (default the "
-                           "configuration's, else the step `qzs simulate` chooses); "
-                           "communication steps are whole numbers of it")
+                           "configuration's, else the step `qzs simulate` chooses; "
+                           "`qzs.export_fmu` in Python takes 1e-4 s literally)")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the internal step as `qzs simulate --tolerance` does [dB] "
                            "(default 0.01; a sine: --tolerance-state)")
@@ -107,7 +107,8 @@ def add_parser(subparsers):
                      help="the default experiment's stop time [s] (default the excitation's "
                           "length, 10 for a sine or inputs)")
     fmu.add_argument("--step", type=float, metavar="S",
-                     help="the default experiment's communication step [s] (default 0.001)")
+                     help="the default experiment's communication step [s] (default 0.001); "
+                          "the FMU takes any positive step")
     fmu.set_defaults(handler=run_fmu)
     return export
 
