@@ -129,3 +129,17 @@ def test_inconsistent_or_impossible_requests_are_refused_before_any_run(options,
 def test_a_transmissibility_tolerance_for_a_sine_is_refused():
     with pytest.raises(ParameterError, match="tolerance_state"):
         qzs.resolve(Sine(frequency=2.0), duration=1.0, tolerance=0.01)
+
+
+def test_the_length_check_counts_at_the_kernels_own_speed():
+    """1e12 steps (1e9 s at 1 kHz): 8.3 h of the single axis at its best, started; 3.5
+    days of the six-leg platform, refused before any run (qzs hexapod transmissibility
+    --duration 1e9 refused only in its worker processes)."""
+    from qzs.engine.run_spec import check_length
+    from qzs.errors import ParameterError
+
+    check_length(1e9, 1000.0, None)
+    with pytest.raises(ParameterError, match="`duration` 1e[+]09 s is at least 1e[+]12 "
+                                             "integration steps") as caught:
+        check_length(1e9, 1000.0, None, kernel="hexapod")
+    assert caught.value.options == ("duration", "sample_rate")
