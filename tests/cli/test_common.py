@@ -220,6 +220,45 @@ def test_a_command_silent_past_the_delay_says_it_has_started_once(capsys, monkey
     assert sys.stdout is not None and type(sys.stdout).__name__ != "_Watched"  # restored
 
 
+def _progress_after(silence, open_for):
+    """A handler silent for ``silence`` [s], then with a progress bar on stderr for
+    ``open_for`` [s] (as the step search's bar: qzs.engine.progress.progress_bar)."""
+    import time
+
+    from qzs.engine.progress import progress_bar  # imported before the command starts
+
+    def handler(args):
+        time.sleep(silence)
+        bar = progress_bar(total=2, desc="choosing dt", unit="run")
+        bar.update(1)
+        time.sleep(open_for)
+        bar.update(1)
+        bar.close()
+        return 0
+    return handler
+
+
+@pytest.mark.parametrize("silence", [0.0, 0.5])
+def test_the_start_notice_never_comes_after_a_progress_bar_on_stderr(capsys, monkeypatch,
+                                                                      silence):
+    """stderr as the user reads it: a progress bar drawn at once (the command spoke, on
+    stderr) and open long past the delay is never followed by "starting ..."; a command
+    silent past the delay says it has started, once, before its bar."""
+    import argparse
+
+    from qzs.cli import common
+
+    monkeypatch.setattr(common, "START_NOTICE_DELAY", 0.2)
+    args = argparse.Namespace(command="simulate", quiet=False, json=False)
+    assert run_handler(_progress_after(silence, 0.6), args) == 0
+    out, err = capsys.readouterr()
+    notice = "qzs simulate: starting"
+    assert "choosing dt" in err and out == ""
+    assert err.count(notice) == 1 if silence else err.count(notice) <= 1
+    if notice in err:
+        assert err.index(notice) < err.index("choosing dt"), err
+
+
 def test_a_quick_command_prints_no_start_notice(capsys):
     import argparse
 

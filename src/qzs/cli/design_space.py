@@ -76,8 +76,11 @@ def add_parsers(subparsers):
 
 
 def _check_counts(args):
+    from qzs._validation import seed
     from qzs.workflows.design_space.problem import MIN_POPULATION
 
+    if args.seed is not None:
+        seed("--seed", args.seed)
     for option in ("workers", "threads", "generations", "population", "samples"):
         value = getattr(args, option, None)
         least = MIN_POPULATION if option == "population" and value != 0 else 1
@@ -157,6 +160,7 @@ def run_sensitivity_command(args):
     from qzs.workflows.design_space import load_problem
     from qzs.workflows.design_space.sensitivity import run_sensitivity
 
+    _check_counts(args)
     problem = load_problem(args.problem)
     folder = Path(args.out) if args.out else Path(f"{problem.name}-sensitivity")
     check_output(args, "--out", folder, suffixes=None, directory=True)

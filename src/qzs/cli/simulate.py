@@ -135,7 +135,10 @@ def _spelling(args, settings, table):
         duration = "--excitation-duration"
     else:
         duration = f"[excitation] duration of {args.config}"
-    return {"duration": duration, "sample_rate": origin("sample_rate", "--sample-rate"),
+    record = ("--excitation-duration" if args.excitation_duration is not None
+              else f"[excitation] duration of {args.config}")
+    return {"duration": duration, "excitation.duration": record,
+            "sample_rate": origin("sample_rate", "--sample-rate"),
             "dt": origin("dt", "--dt"), "solver": origin("solver", "--solver"),
             "tolerance": "--tolerance", "tolerance_state": "--tolerance-state",
             "frequency": "--frequency", "f1": "--f1", "f_high": "--f1"}

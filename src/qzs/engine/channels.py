@@ -12,7 +12,7 @@ from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
 __all__ = ["CHANNELS", "FLAGS", "FLAG_MEANINGS", "simulation_schema", "variable_attributes",
-           "named_block"]
+           "named_block", "sample_bytes"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -49,6 +49,21 @@ FLAGS = {
 }
 #: CF ``flag_meanings`` of the flags: the words for the values 0 and 1.
 FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
+
+
+def sample_bytes(channels):
+    """Memory one sample of ``channels`` takes in a result [bytes]: 8 a float channel, 1 a flag.
+
+    Parameters
+    ----------
+    channels : iterable of str
+        Names of :data:`CHANNELS` and :data:`FLAGS`.
+
+    Returns
+    -------
+    int
+    """
+    return sum(1 if name in FLAGS else 8 for name in channels)
 
 
 def simulation_schema():

@@ -27,7 +27,6 @@ import threading
 import time
 import warnings
 
-from tqdm.auto import tqdm
 from tqdm.std import tqdm as std_tqdm
 
 __all__ = ["PLAIN_INTERVAL", "HEARTBEAT", "terminal_size", "plain_terminal", "PlainProgress",
@@ -38,6 +37,17 @@ __all__ = ["PLAIN_INTERVAL", "HEARTBEAT", "terminal_size", "plain_terminal", "Pl
 PLAIN_INTERVAL = 1.0
 #: Seconds after which a bar not drawn is drawn again.
 HEARTBEAT = 1.0
+
+
+def _bar_class():
+    """tqdm's bar for where this runs: tqdm.auto's (a notebook widget) in a Jupyter kernel,
+    else tqdm.std's, imported without tqdm.auto's asyncio and ssl (5 MB more of every
+    command's memory)."""
+    if "ipykernel" in sys.modules:
+        from tqdm.auto import tqdm
+
+        return tqdm
+    return std_tqdm
 
 
 def terminal_size(stream):
@@ -260,6 +270,7 @@ def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True,
         The bar; a :class:`PlainProgress` where :func:`plain_terminal` holds.
     """
     stream = sys.stderr if file is None else file
+    tqdm = _bar_class()
     if disable:
         return tqdm(total=total, desc=desc, unit=unit, disable=True, file=file, **options)
     if plain_terminal(stream):
@@ -292,7 +303,7 @@ def show_warning(message, category, filename, lineno, file=None, line=None):
     text = " ".join(str(message).split())
     stream = sys.stderr if file is None else file
     try:
-        tqdm.write(f"qzs: warning: {text}", file=stream)  # clears the bars, writes, redraws
+        _bar_class().write(f"qzs: warning: {text}", file=stream)  # clears the bars, writes, redraws
     except (OSError, ValueError):  # a closed stderr: nothing to say it on
         pass
 

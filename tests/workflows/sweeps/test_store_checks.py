@@ -72,3 +72,37 @@ def test_a_refusal_names_the_switches_as_the_caller_spells_them(tmp_path):
         check_store_path(sweep, existing, resume=True, overwrite=True)
     with pytest.raises(ParameterError, match=r"leave out resume=True"):
         check_store_path(sweep, tmp_path / "missing.zarr", resume=True)
+
+
+def test_a_batch_whose_samples_exceed_the_memory_is_refused_before_any_run(monkeypatch):
+    """What simulate_batch refuses once the store is made (a batch's samples beyond half the
+    memory) is refused by the checks before it: the same bytes, the same error."""
+    from qzs.engine import driver
+    from qzs.engine.channels import sample_bytes
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.sweeps.cases import batch_channels
+    from qzs.workflows.sweeps.store_checks import check_run_length
+
+    sweep = load_sweep({**DOCUMENT, "sweep": {"name": "checks", "batch_size": 2},
+                        "simulation": {"dt": 1e-3}})
+    settings = case_settings(sweep, sample_cases(sweep))
+    duration, rate = sweep.analysis["duration"], sweep.analysis["sample_rate"]
+    needed = 2 * (int(round(duration * rate)) + 1) * sample_bytes(batch_channels(sweep))
+    assert needed > 0  # the accelerations its estimate needs
+    monkeypatch.setattr(driver, "available_memory", lambda: 2 * needed)  # exactly half: fine
+    check_run_length(sweep, settings, cases=2)
+    monkeypatch.setattr(driver, "available_memory", lambda: 2 * needed - 2)
+    with pytest.raises(ResultTooLargeError) as caught:
+        check_run_length(sweep, settings, cases=2)
+    assert caught.value.needed == needed and caught.value.duration == duration
+    assert "[sweep] batch_size" in str(caught.value) and "[analysis] sample_rate" in str(
+        caught.value)
+
+
+def test_a_sweep_of_1e9_s_cases_is_refused_by_the_store_checks(tmp_path):
+    from qzs.errors import ResultTooLargeError
+
+    sweep = load_sweep({**DOCUMENT, "simulation": {}, "excitation": {"duration": 1e9}})
+    with pytest.raises(ResultTooLargeError, match="a 1e[+]09 s run at 1000 Hz keeps"):
+        check_store_path(sweep, tmp_path / "s.zarr", argument="--out")
+    assert list(tmp_path.iterdir()) == []
