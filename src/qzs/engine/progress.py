@@ -213,7 +213,7 @@ class WarningsThroughBar:
     """
 
     def __init__(self, bar, stream):
-        self.stream, self.shown = stream, warnings.showwarning
+        self.stream, self.shown, self.bars = stream, warnings.showwarning, type(bar)
         show = warnings.showwarning = self.show   # one bound method, to know it again
         close = bar.close
 
@@ -237,7 +237,7 @@ class WarningsThroughBar:
             As for :func:`warnings.showwarning`, passed on to the display it replaced.
         """
         try:
-            with tqdm.external_write_mode(file=self.stream):
+            with self.bars.external_write_mode(file=self.stream):
                 self.shown(message, category, filename, lineno, file, line)
         except (OSError, ValueError):  # a closed stream: shown as it would have been
             self.shown(message, category, filename, lineno, file, line)
