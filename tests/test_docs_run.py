@@ -6,8 +6,9 @@ The pages are README.md, then the site's pages in its toctree order from docs/in
 ``docs/_ext/qzs_app_page.py`` builds it). Every page of docs/ and docs/workflows/ must be
 reached, so a new page is never left out silently.
 
-- An ``sh`` block runs command by command (a line ending in ``\\`` continues), each in
-  ``bash`` in the folder, with this environment's ``qzs`` and ``python`` first on PATH, a
+- An ``sh`` block runs in one ``bash`` in the folder, command by command as typed into a
+  terminal (a line ending in ``\\`` continues; a variable set or a ``cd`` holds for the
+  block's later commands), with this environment's ``qzs`` and ``python`` first on PATH, a
   HOME of its own (inside the folder's parent) and ``MPLBACKEND=Agg`` (no window: a figure
   a page shows is drawn, and closed). A command that exits with anything but 0 fails.
 - The ``python`` blocks of one page run in ONE interpreter session (a fresh ``python`` per
@@ -49,6 +50,7 @@ import re
 import shlex
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -280,34 +282,52 @@ def snapshot(folder, names):
 
 
 def run_shell(block, folder, env):
-    """Run the block's commands; the failures (none: an empty list) and the output."""
+    """Run the block's commands in one bash, one after the other as typed into a terminal
+    (a variable set or a ``cd`` holds for the commands after it; a command that fails does
+    not stop the next); the failures (none: an empty list), the output and each command's
+    seconds."""
     code = prepared(block)
     substituted = Block(block.path, block.line, block.language, code)
-    failures, output, times = [], "", []
     used = {prefix: False for prefix, _ in block.skip_commands}
+    run = []
     for line, command in commands(substituted):
         skipped = [prefix for prefix in used if command.startswith(prefix)]
         for prefix in skipped:
             used[prefix] = True
-        if skipped:
-            continue
-        start = time.perf_counter()
+        if not skipped:
+            run.append((line, command))
+    failures = [f"{block.where}: `skip` names `{prefix}`, which starts no command"
+                for prefix, hit in used.items() if not hit]
+    with tempfile.TemporaryDirectory(prefix="qzs-docs-run-sh-") as scratch:
+        scratch = Path(scratch)
+        script = [f"exec 3>{shlex.quote(str(scratch / 'status'))}"]
+        for k, (_, command) in enumerate(run):
+            out, err = (shlex.quote(str(scratch / f"{k}.{name}")) for name in ("out", "err"))
+            script += ["__docs_run_start=$(date +%s%N)",
+                       f"{{ {command}\n}} >{out} 2>{err} </dev/null",
+                       f"echo {k} $? $__docs_run_start $(date +%s%N) >&3"]
         try:
-            done = subprocess.run(["bash", "-o", "pipefail", "-c", command], cwd=folder,
-                                  env=env, capture_output=True, text=True,
-                                  timeout=BLOCK_TIMEOUT, stdin=subprocess.DEVNULL)
-            times.append((line, round(time.perf_counter() - start, 2)))
+            subprocess.run(["bash", "-o", "pipefail", "-c", "\n".join(script)], cwd=folder,
+                           env=env, timeout=BLOCK_TIMEOUT, stdin=subprocess.DEVNULL,
+                           capture_output=True)
         except subprocess.TimeoutExpired:
-            failures.append(f"{shown(block.path)}:{line}: `{command}` still "
-                            f"running after {BLOCK_TIMEOUT} s")
-            continue
-        output += done.stdout + done.stderr
-        if done.returncode != 0:
-            failures.append(f"{shown(block.path)}:{line}: `{command}` exited "
-                            f"{done.returncode}\n--- stdout\n{done.stdout[-3000:]}"
-                            f"--- stderr\n{done.stderr[-3000:]}")
-    failures += [f"{block.where}: `skip` names `{prefix}`, which starts no command"
-                 for prefix, hit in used.items() if not hit]
+            pass
+        status = {int(k): (int(rc), (int(end) - int(begin)) / 1e9) for k, rc, begin, end in
+                  (entry.split() for entry in (scratch / "status").read_text().splitlines())}
+        output, times = "", []
+        for k, (line, command) in enumerate(run):
+            if k not in status:
+                failures.append(f"{shown(block.path)}:{line}: `{command}` did not finish "
+                                f"within the block's {BLOCK_TIMEOUT} s")
+                break
+            rc, seconds = status[k]
+            stdout, stderr = ((scratch / f"{k}.{name}").read_text(errors="replace")
+                              for name in ("out", "err"))
+            output += stdout + stderr
+            times.append((line, round(seconds, 2)))
+            if rc != 0:
+                failures.append(f"{shown(block.path)}:{line}: `{command}` exited {rc}\n"
+                                f"--- stdout\n{stdout[-3000:]}--- stderr\n{stderr[-3000:]}")
     return failures, output, times
 
 
@@ -520,3 +540,14 @@ def test_the_commands_of_a_block_join_continued_lines():
                   "# a comment\nqzs simulate --a 1 \\\n    --b 2   # note\n\nqzs params\n")
     assert commands(block) == [(11, "qzs simulate --a 1 --b 2   # note"), (14, "qzs params")]
     assert shlex.split(commands(block)[0][1], comments=True)[-1] == "2"
+
+
+def test_a_blocks_commands_share_one_shell(page_of, tmp_path):
+    """A variable set by one command (docs/fmu.md's FMI_HEADERS) or a `cd` holds for the
+    next; a failing command does not stop those after it, and is named with its line."""
+    page = page_of("<!-- docs-run: writes sub/seen.txt, after.txt -->\n"
+                   "```sh\nNAME=value\nmkdir -p sub && cd sub\nfalse\necho \"$NAME\" > seen.txt\n"
+                   "cd .. && echo done > after.txt\n```\n")
+    failures = run_probe(page, tmp_path)
+    assert len(failures) == 1 and ":5: `false` exited 1" in failures[0], failures
+    assert (tmp_path / "folder" / "sub" / "seen.txt").read_text() == "value\n"
