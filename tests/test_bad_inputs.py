@@ -316,7 +316,7 @@ BAD = {
                           "case 1 (pi_kp = nan)", "`pi_kp` must be finite"),
     "sweep-resume-missing-store": Bad(["sweep", "{in}/tiny.toml", "--out", "missing.zarr",
                                        "--resume"], "--out 'missing.zarr'",
-                                      "nothing to resume", "leave out `resume` (--resume)"),
+                                      "nothing to resume", "leave out --resume"),
     "sweep-resume-and-overwrite": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--resume",
                                        "--overwrite"], "--resume", "--overwrite",
                                       "give one of them"),

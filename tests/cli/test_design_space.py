@@ -206,3 +206,23 @@ def test_a_resume_with_another_seed_is_one_line_naming_the_flag_and_both_values(
     monkeypatch.setattr(optimizer, "evaluate", evaluate)
     assert main(["optimize", str(problem_file), "--out", str(seeded), "--quiet", "--resume",
                  "--seed", "9"]) == 0
+
+
+def test_the_default_folder_is_named_anew_for_a_search_and_replaced_for_indices(
+        problem_file, tmp_path, monkeypatch, capsys):
+    """optimize's folder holds its store (resumable work): kept, the new one cli-2/;
+    sensitivity's indices are made again: cli-sensitivity/ replaced."""
+    monkeypatch.chdir(tmp_path)
+    search = [ "optimize", str(problem_file), "--quiet", "--generations", "1"]
+    assert main(search) == 0, capsys.readouterr().err
+    assert main(search) == 0, capsys.readouterr().err
+    assert (tmp_path / "cli" / "cli.zarr").is_dir() and (tmp_path / "cli-2" / "cli.zarr").is_dir()
+    assert "cli exists; writing cli-2 (--out names another)" in capsys.readouterr().err
+    indices = ["sensitivity", str(problem_file), "--method", "morris", "--samples", "2",
+               "--quiet"]
+    assert main(indices) == 0, capsys.readouterr().err
+    (tmp_path / "cli-sensitivity" / "older.txt").write_text("an older run's file")
+    assert main(indices) == 0, capsys.readouterr().err
+    assert not (tmp_path / "cli-sensitivity-2").exists()
+    assert main([*indices, "--out", "cli-sensitivity"]) == 2
+    assert "--out 'cli-sensitivity' exists" in capsys.readouterr().err

@@ -97,6 +97,16 @@ def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
     assert float(starts["step_size"]) == 2e-4
 
 
+def test_the_default_file_is_replaced_and_a_named_one_refused(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "controller.c").write_text("an older export")
+    assert main(["export", "controller"]) == 0, capsys.readouterr().err
+    assert PARAMETERS_NAME in (tmp_path / "controller.c").read_text()
+    capsys.readouterr()
+    assert main(["export", "controller", "--out", "controller.c"]) == 2
+    assert "--out 'controller.c' exists; pass --overwrite" in capsys.readouterr().err
+
+
 def test_the_issues_sine_fmu_starts_and_is_qzs_simulate(tmp_path, capsys):
     """`qzs export fmu --excitation sine --frequency 3 --amplitude 0.008 --duration 4`
     (issue 39: it failed to initialise) runs through FMPy to its stop time as `qzs simulate`

@@ -80,6 +80,21 @@ def test_an_empty_name_says_it_is_empty_not_that_it_is_a_folder(directory, tmp_p
     assert "empty" in str(caught.value) and "'.'" not in str(caught.value)
 
 
+def test_a_free_name_is_the_name_itself_or_the_next_numbered_one(tmp_path):
+    from qzs.iotools.paths import free_name
+
+    store = tmp_path / "pi.zarr"
+    assert free_name(store, directory=True) == store
+    store.mkdir()
+    assert free_name(store, directory=True) == store          # an empty folder is free
+    (store / "a").write_text("")
+    (tmp_path / "pi-2.zarr").mkdir()
+    (tmp_path / "pi-2.zarr" / "a").write_text("")
+    assert free_name(store, directory=True) == tmp_path / "pi-3.zarr"
+    (tmp_path / "results").write_text("")
+    assert free_name(tmp_path / "results") == tmp_path / "results-2"
+
+
 def test_removed_on_error_takes_back_what_a_failed_block_made_and_nothing_else(tmp_path):
     store = tmp_path / "a" / "b" / "s.zarr"
     with pytest.raises(ValueError):

@@ -63,7 +63,7 @@ def add_parser(subparsers):
                                  f"the configuration's, else {SIMULATION['dt']:g}); the sample "
                                  "period is a whole number of it")
     add_output_options(controller, out={"metavar": "FILE.c", "default": "controller.c",
-                                        "help": "the C file to write (default controller.c)"})
+                                        "unnamed": "replace", "help": "the C file to write (default controller.c)"})
     controller.set_defaults(handler=run_controller)
     fmu = sub.add_parser(
         "fmu", help="the isolator as an FMI co-simulation FMU",
@@ -75,7 +75,7 @@ def add_parser(subparsers):
                     "or the base motion as inputs (`qzs docs fmu`). Needs a C compiler and "
                     "FMPy's FMI headers (pip install \"qzs[fmu]\").", epilog=EPILOG)
     add_output_options(fmu, out={"metavar": "FILE.fmu", "default": "isolator.fmu",
-                                 "help": "the FMU to write (default isolator.fmu)"})
+                                 "unnamed": "replace", "help": "the FMU to write (default isolator.fmu)"})
     fmu.add_argument("--fmi", type=int, choices=(3, 2), default=3,
                      help="FMI version (default 3)")
     fmu.add_argument("--mode", choices=("closed-loop", "plant"), default="closed-loop",

@@ -1,5 +1,5 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from qzs.cli.common import EPILOG, add_set_option, check_output, parameters
+from qzs.cli.common import EPILOG, NamedOutput, add_set_option, check_output, parameters
 from qzs.iotools.config import config_text, save_config
 from qzs.model.registry import format_value, parameter_table
 
@@ -25,7 +25,7 @@ def add_parser(subparsers):
                     "--set applied), unit and description; or write them as a config file.",
         epilog="--toml FILE never replaces a file without --overwrite; --toml alone prints "
                "the file to stdout (`qzs params --toml > my.toml`). " + EPILOG)
-    params.add_argument("--toml", metavar="FILE.toml", nargs="?", const="-",
+    params.add_argument("--toml", metavar="FILE.toml", nargs="?", const="-", action=NamedOutput,
                         help="write them as a config file instead (to stdout without FILE, "
                              "or with -)")
     params.add_argument("--overwrite", "--force", dest="overwrite", action="store_true",

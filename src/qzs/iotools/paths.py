@@ -18,7 +18,7 @@ from pathlib import Path
 from qzs._format import format_bytes
 from qzs.errors import OutputPathError
 
-__all__ = ["check_output_path", "format_bytes", "removed_on_error"]
+__all__ = ["check_output_path", "free_name", "switch", "format_bytes", "removed_on_error"]
 
 
 def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False,
@@ -101,7 +101,7 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
                  f"are free on the file system of {str(target)!r}; free some space or "
                  "choose another folder")
     if not overwrite and path.exists() and (not directory or any(path.iterdir())):
-        flag = "--overwrite" if argument.startswith("--") else "overwrite=True"
+        flag = switch(argument, "overwrite")
         what, them = ("exists and holds files", "them") if directory else ("exists", "it")
         fail(f"{what}; pass {flag} to replace {them}, or choose another name")
     return path
@@ -154,6 +154,54 @@ def removed_on_error(path):
             elif made.exists():
                 made.unlink()
         raise
+
+
+def switch(argument, name):
+    """A yes/no option as the caller of ``argument`` spells it: ``--name`` on the command
+    line (whose arguments are options, ``--out``), ``name=True`` in Python.
+
+    Parameters
+    ----------
+    argument : str
+        How the caller names the path a message is about (``"--out"``, ``"store"``).
+    name : str
+        The option's Python name (``"overwrite"``, ``"resume"``).
+
+    Returns
+    -------
+    str
+    """
+    return f"--{name.replace('_', '-')}" if argument.startswith("--") else f"{name}=True"
+
+
+def free_name(path, *, directory=False):
+    """``path`` if nothing is in the way, else the first free ``STEM-2.SUFFIX``,
+    ``STEM-3.SUFFIX``, ... beside it (``pi.zarr`` -> ``pi-2.zarr``, ``results`` ->
+    ``results-2``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The name a command would write to (its default).
+    directory : bool
+        ``path`` is a folder: an empty one is free (:func:`check_output_path` writes into it).
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+
+    def free(candidate):
+        return (not candidate.exists()
+                or directory and candidate.is_dir() and not any(candidate.iterdir()))
+
+    number = 1
+    candidate = path
+    while not free(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    return candidate
 
 
 def _nearest_existing(folder):

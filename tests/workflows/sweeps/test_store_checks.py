@@ -30,7 +30,7 @@ def test_the_store_path_is_checked_before_any_run(tmp_path):
         check_store_path(sweep, tmp_path / "s.nc", argument="--out")
     existing = tmp_path / "s.zarr"
     existing.mkdir()
-    with pytest.raises(OutputPathError, match="exists; pass `resume`"):
+    with pytest.raises(OutputPathError, match="exists; pass resume=True"):
         check_store_path(sweep, existing)
     check_store_path(sweep, existing, overwrite=True)
     check_store_path(sweep, existing, resume=True)
@@ -44,6 +44,34 @@ def test_time_samples_are_the_duration_at_the_output_rate():
     kept = load_sweep({**DOCUMENT, "outputs": {"time_series": ["relative_position"]}})
     duration, rate = kept.analysis["duration"], kept.analysis["sample_rate"]
     assert time_samples(kept, settings) == int(round(duration * rate)) + 1
+
+
+def test_a_refusal_names_the_switches_as_the_caller_spells_them(tmp_path):
+    """Python's run_sweep on an existing store said "pass `resume` (--resume)": a flag that
+    Python has not. Each caller reads its own spelling: resume=True in Python, --resume on
+    the command line; the error is a ParameterError carrying the argument and the path."""
+    from qzs.errors import ParameterError
+    from qzs.workflows.design_space.store import check
+
+    sweep = load_sweep(DOCUMENT)
+    existing = tmp_path / "s.zarr"
+    existing.mkdir()
+    for checked in (lambda **spelt: check_store_path(sweep, existing, **spelt),
+                    lambda **spelt: check(existing, **spelt)):
+        with pytest.raises(ParameterError) as python:
+            checked()
+        assert "pass resume=True to continue it, overwrite=True to replace it" in str(
+            python.value) and "--" not in str(python.value)
+        assert python.value.argument == "store" and str(python.value.value) == str(existing)
+        with pytest.raises(ParameterError) as command_line:
+            checked(argument="--out")
+        assert "pass --resume to continue it, --overwrite to replace it" in str(
+            command_line.value) and "=True" not in str(command_line.value)
+    with pytest.raises(ParameterError, match=r"^resume=True continues the store and "
+                                             r"overwrite=True replaces it"):
+        check_store_path(sweep, existing, resume=True, overwrite=True)
+    with pytest.raises(ParameterError, match=r"leave out resume=True"):
+        check_store_path(sweep, tmp_path / "missing.zarr", resume=True)
 
 
 def test_a_batch_whose_samples_exceed_the_memory_is_refused_before_any_run(monkeypatch):

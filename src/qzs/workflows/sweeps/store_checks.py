@@ -8,10 +8,10 @@ from pathlib import Path
 
 from qzs.engine.prepare import steps_per_sample
 from qzs.errors import OutputPathError, ParameterError
-from qzs.iotools.paths import check_output_path
+from qzs.iotools.paths import check_output_path, switch
 from qzs.workflows.sweeps.cases import batch_channels, case_duration, case_settings
 from qzs.workflows.sweeps.definition import SweepDefinition, sample_cases
-from qzs.workflows.sweeps.store import estimated_bytes
+from qzs.workflows.sweeps.store import estimated_bytes, store_exists
 
 __all__ = ["check_store_path", "check_resume", "check_store", "check_run_length",
            "time_samples", "STORE_SUFFIX", "BATCH_REMEDY"]
@@ -163,13 +163,13 @@ def check_resume(store, argument, resume, overwrite, work="the sweep"):
     OutputPathError
         ``resume`` of a store that does not exist.
     """
+    resume_switch, overwrite_switch = switch(argument, "resume"), switch(argument, "overwrite")
     if resume and overwrite:
-        raise ParameterError("`resume` (--resume) continues the store and `overwrite` "
-                             "(--overwrite) replaces it: give one of them, not both.")
+        raise ParameterError(f"{resume_switch} continues the store and {overwrite_switch} "
+                             "replaces it: give one of them, not both.")
     if resume and not Path(store).exists():
         raise OutputPathError(argument, store, "does not exist, so there is nothing to resume; "
-                              f"check the name, or leave out `resume` (--resume) to start "
-                              f"{work}")
+                              f"check the name, or leave out {resume_switch} to start {work}")
 
 
 
@@ -202,7 +202,6 @@ def check_store(definition, store, n_time, *, argument, resume, overwrite):
     check_output_path(store, argument=argument, suffixes=(STORE_SUFFIX,), directory=True,
                       estimated_bytes=size)
     if Path(store).exists() and not resume and not overwrite:
-        raise OutputPathError(argument, store, "exists; pass `resume` (--resume) to continue "
-                              "it, `overwrite` (--overwrite) to replace it, or choose another "
-                              "store")
+        raise OutputPathError(argument, store, store_exists(argument))
+
 
