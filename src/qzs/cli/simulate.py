@@ -160,6 +160,7 @@ def run(args):
     import sys
 
     from qzs.engine.run_spec import check_output_rate, resolve
+    from qzs.workflows.run import resolve_apart
     from qzs.workflows.figure_process import simulate_with_figure
 
     config = parameters(args)
@@ -183,9 +184,11 @@ def run(args):
     try:  # resolve() checks the inputs; the command line only says them its own way
         check_output_rate(excitation, settings.get("duration", excitation.duration),
                           settings.get("sample_rate", SIMULATION["sample_rate"]))
-        resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
-                           tolerance=args.tolerance, tolerance_state=args.tolerance_state,
-                           step="chosen", progress=show)
+        # a streamed run's step is chosen apart: its imports do not weigh on the run
+        resolved = (resolve_apart if args.out else resolve)(
+            excitation, config["isolator"], config["controller"], **settings,
+            tolerance=args.tolerance, tolerance_state=args.tolerance_state, step="chosen",
+            progress=show)
     except ParameterError as error:
         raise error.renamed(_spelling(args, settings, config["simulation"])) from None
     result = simulate_with_figure(resolved, out=args.out, plot=plot, progress=show,
