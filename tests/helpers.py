@@ -144,6 +144,47 @@ EXPORT_CASES = {
 }
 
 
+#: A 2-state continuous lead-lag damping loop on the charge amplifier's velocity: a lead
+#: between 3 and 30 Hz, rolled off at 200 Hz [N per m/s].
+_LEAD, _LAG, _ROLL = 2 * np.pi * 3.0, 2 * np.pi * 30.0, 2 * np.pi * 200.0
+EXPORT_LEAD_LAG = qzs.LinearController.from_transfer_function(
+    [-40.0 * _LAG * _ROLL / _LEAD, -40.0 * _LAG * _ROLL],
+    np.polymul([1.0, _LAG], [1.0, _ROLL]), "measured_payload_velocity")
+#: A 2-state discrete controller at 1 kHz on the position error and the payload's
+#: acceleration (read with the force held until the sample).
+EXPORT_DISCRETE = qzs.LinearController(
+    a=[[0.9, 0.05], [0.0, 0.8]], b=[[1e-3, 0.0], [0.0, 0.01]], c=[30.0, -2.0], d=[10.0, 0.0],
+    inputs=("position_error", "payload_acceleration"), sample_time=1e-3)
+#: The controllers with blocks the C model, the exported controller and the FMU are checked on
+#: (issue 40), on a 3 Hz sine that sticks and slips at Table 1's friction; name: (excitation,
+#: isolator, controller, run settings).
+EXPORT_BLOCK_CASES = {
+    "compensation with observer": (
+        qzs.Sine(amplitude=0.01, frequency=3.0), None,
+        qzs.PIDamping(compensation=qzs.FrictionCompensation(fraction=0.8,
+                                                            observer_bandwidth=5.0)),
+        dict(duration=3.0)),
+    "sampled compensation with observer": (
+        qzs.Sine(amplitude=0.01, frequency=3.0), None,
+        qzs.PIDamping(controller_rate=1000.0, damping_gain=50.0,
+                      compensation=qzs.FrictionCompensation(fraction=0.8, deadband=1e-4,
+                                                            observer_bandwidth=5.0)),
+        dict(duration=3.0)),
+    "dither": (qzs.Sine(amplitude=0.01, frequency=3.0), None,
+               qzs.PIDamping(dither=qzs.Dither(amplitude=3.0, frequency=40.0)),
+               dict(duration=3.0)),
+    "continuous lead-lag": (qzs.Sine(amplitude=0.01, frequency=3.0), None,
+                            qzs.PIDamping(linear=EXPORT_LEAD_LAG), dict(duration=3.0)),
+    "discrete controller": (qzs.Sine(amplitude=0.01, frequency=3.0), None,
+                            qzs.PIDamping(linear=EXPORT_DISCRETE), dict(duration=3.0)),
+}
+
+
+def export_block_settings(case):
+    """The run settings of a case with blocks: :data:`EXPORT_SETTINGS` updated by its own."""
+    return {**EXPORT_SETTINGS, **EXPORT_BLOCK_CASES[case][3]}
+
+
 def export_settings(case):
     """The run settings of a case: :data:`EXPORT_SETTINGS` updated by its own."""
     return {**EXPORT_SETTINGS, **EXPORT_CASES[case][3]}

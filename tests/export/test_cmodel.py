@@ -89,7 +89,7 @@ def test_a_diverging_case_stops_where_the_kernels_stop():
     out = np.zeros((steps // run.decimation + 1, K.N_CHANNELS))
     marks = np.zeros((out.shape[0], 2), dtype=bool)
     status, _ = lanes.run_single(run.solver_code, steps, run.decimation, state, flags,
-                                 run.params, *run.packed, out, marks, 1)
+                                 run.params, run.model, *run.packed, out, marks, 1)
     assert result.diverged and status == K.STATUS_DIVERGED
     assert 0 < result.steps == flags[K.I_STEP] < steps
     np.testing.assert_array_equal(result.state[:K.N_ODE], state[:K.N_ODE])

@@ -89,16 +89,18 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
     state = np.array(run.state, dtype=np.float64)
     flags = np.array(run.flags, dtype=np.int64)
     params = np.ascontiguousarray(run.params, dtype=np.float64)
+    model = np.ascontiguousarray(run.model, dtype=np.float64)
     scalars = np.ascontiguousarray(run.packed[0], dtype=np.float64)
     table = np.ascontiguousarray(run.packed[1], dtype=np.float64)
     rows = np.zeros(1, dtype=np.int64)
     library.qzs_model_evaluate(0.0, _pointer(state), _pointer(flags, ctypes.c_int64),
-                               _pointer(params), _pointer(scalars), _pointer(table),
-                               table.shape[1], _pointer(out), _pointer(out_flags, ctypes.c_ubyte))
+                               _pointer(params), _pointer(model), _pointer(scalars),
+                               _pointer(table), table.shape[1], _pointer(out),
+                               _pointer(out_flags, ctypes.c_ubyte))
     start = time.perf_counter()
     status = library.qzs_model_run(run.solver_code, steps, run.decimation, _pointer(state),
                                    _pointer(flags, ctypes.c_int64), _pointer(params),
-                                   _pointer(scalars), _pointer(table), table.shape[1],
+                                   _pointer(model), _pointer(scalars), _pointer(table), table.shape[1],
                                    _pointer(out), _pointer(out_flags, ctypes.c_ubyte), 1,
                                    _pointer(rows, ctypes.c_int64))
     seconds = time.perf_counter() - start

@@ -130,12 +130,12 @@ def _declare(library):
     byte_p = ctypes.POINTER(ctypes.c_ubyte)
     run = library.qzs_model_run
     run.argtypes = [ctypes.c_int, ctypes.c_int64, ctypes.c_int64, double_p, long_p, double_p,
-                    double_p, double_p, ctypes.c_int64, double_p, byte_p, ctypes.c_int64,
-                    long_p]
+                    double_p, double_p, double_p, ctypes.c_int64, double_p, byte_p,
+                    ctypes.c_int64, long_p]
     run.restype = ctypes.c_int
     evaluate = library.qzs_model_evaluate
     evaluate.argtypes = [ctypes.c_double, double_p, long_p, double_p, double_p, double_p,
-                         ctypes.c_int64, double_p, byte_p]
+                         double_p, ctypes.c_int64, double_p, byte_p]
     evaluate.restype = None
     return library
 

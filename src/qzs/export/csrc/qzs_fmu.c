@@ -229,18 +229,21 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
         s.x[j] = 0.0;
     s.x[QZS_S_Z] = z0;
     s.x[QZS_S_HP] = qzs_base_motion(plant, 0.0).yd + 0.0;
-    double held[3] = {0.0, 0.0, 0.0};
+    double held[QZS_N_HELD] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    QzsBlocks x;
+    for (int j = 0; j < QZS_N_X; j++)
+        x.x[j] = 0.0;
     QzsForces force;
 #if QZS_FMU_PLANT_MODE
     held[2] = V(MOTOR_FORCE);
 #else
-    qzs_rhs_at(plant, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+    qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
     double measured = force.v_measured;
     if (V(CONTROLLER_PI_KI) > 0.0) {
         QzsPlant at_rest = *plant; /* the base at rest: qzs.engine.prepare._AT_REST */
         double rest[QZS_N_EXCITATION] = {QZS_KIND_SINE, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         memcpy(at_rest.E, rest, sizeof rest);
-        qzs_rhs_at(&at_rest, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+        qzs_rhs_at(&at_rest, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
         double without_motor = force.hold + force.motor;
         double f_max = V(ISOLATOR_MOTOR_FORCE_MAX);
         double needed = without_motor < -f_max ? -f_max : (without_motor > f_max ? f_max
@@ -253,7 +256,7 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
     held[1] = c.damping;
     held[2] = c.motor;
 #endif
-    qzs_rhs_at(plant, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
+    qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
     int locked = P[QZS_P_VREG] == 0.0 && fabs(force.hold) <= P[QZS_P_FS];
     flags[QZS_I_MODE] = locked ? QZS_MODE_STICK : QZS_MODE_SLIP;
     flags[QZS_I_DIRECTION] = force.hold > 0.0 ? -1 : 1;
@@ -270,8 +273,8 @@ static void update_outputs(QzsFmu *fmu) {
     unsigned char row_flags[QZS_N_OUTPUT_FLAGS];
     QzsRun *run = &fmu->run;
     double t = (double)run->step * run->plant.P[QZS_P_DT] + fmu->offset;
-    qzs_record(&run->plant, t, &run->s, run->mode, run->direction, run->held, row, row_flags,
-               run->phase);
+    qzs_record(&run->plant, t, &run->s, &run->x, run->mode, run->direction, run->held, row,
+               row_flags, run->phase);
     for (int i = 0; i < QZS_FMU_N_VARIABLES; i++) {
         int channel = QZS_FMU_CHANNEL[i];
         if (channel >= 100)
@@ -422,7 +425,7 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
     E[QZS_E_PHASE] = V(EXCITATION_PHASE);
     E[QZS_E_FADE] = V(EXCITATION_FADE_IN);
 #endif
-    qzs_plant_init(&fmu->run.plant, P, E, fmu->table, 2);
+    qzs_plant_init(&fmu->run.plant, P, NULL, E, fmu->table, 2);
     double state[QZS_N_STATE];
     int64_t flags[QZS_N_FLAGS];
     initial_state(fmu, state, flags);

@@ -7,13 +7,19 @@ void qzs_run_start(QzsRun *run, int solver, const double *state, const int64_t *
     const double *P = run->plant.P;
     run->solver = solver;
     run->control_steps = (int64_t)P[QZS_P_CONTROL_STEPS];
+    run->linear_steps = run->plant.blocks ? (int64_t)run->plant.M[QZS_M_LINEAR_STEPS] : 0;
     run->sampled = run->control_steps > 0;
     qzs_controller_init(&run->controller, &run->plant.control, state[QZS_S_INT]);
     for (int j = 0; j < QZS_N_ODE; j++)
         run->s.x[j] = state[j];
-    run->held[0] = state[QZS_A_F_PI];
-    run->held[1] = state[QZS_A_F_DAMP];
-    run->held[2] = state[QZS_A_F_MOTOR];
+    for (int j = 0; j < QZS_N_X; j++)
+        run->x.x[j] = state[QZS_A_X0 + j];
+    run->held[QZS_H_PI] = state[QZS_A_F_PI];
+    run->held[QZS_H_DAMP] = state[QZS_A_F_DAMP];
+    run->held[QZS_H_MOTOR] = state[QZS_A_F_MOTOR];
+    run->held[QZS_H_COMPENSATION] = state[QZS_A_F_COMPENSATION];
+    run->held[QZS_H_DITHER] = state[QZS_A_F_DITHER];
+    run->held[QZS_H_LINEAR] = state[QZS_A_F_LINEAR];
     run->margin = state[QZS_A_MARGIN];
     run->mode = (int)flags[QZS_I_MODE];
     run->direction = (int)flags[QZS_I_DIRECTION];
@@ -33,22 +39,33 @@ static int run_one(QzsRun *run, double t, double h, QzsPhase phase, int at_grid_
                    int completes) {
     const QzsPlant *plant = &run->plant;
     const double *P = plant->P;
-    if (at_grid_point && run->sampled && run->step % run->control_steps == 0) {
+    if (at_grid_point && run->sampled && run->step % run->control_steps == 0 &&
+        plant->blocks) {
+        qzs_sample_blocks(plant, t, &run->s, &run->x, run->mode, run->direction, run->held);
+        run->controller.integral = run->s.x[QZS_S_INT];
+        run->margin = NAN;
+    } else if (at_grid_point && run->sampled && run->step % run->control_steps == 0) {
         double z, v_measured;
         qzs_measure(plant, t, &run->s, run->mode, &z, &v_measured);
         run->controller.integral = run->s.x[QZS_S_INT];
         QzsControllerOutput command = qzs_controller_step(&run->controller, z, v_measured);
-        run->held[0] = command.pi;
-        run->held[1] = command.damping;
-        run->held[2] = command.motor;
+        run->held[QZS_H_PI] = command.pi;
+        run->held[QZS_H_DAMP] = command.damping;
+        run->held[QZS_H_MOTOR] = command.motor;
         run->s.x[QZS_S_INT] = run->controller.integral;
         run->margin = NAN;
     }
-    QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->mode, run->direction,
-                                 run->held, run->margin, phase);
-    if (!qzs_finite(plant, &next.s))
+    if (at_grid_point && run->linear_steps > 0 && run->step % run->linear_steps == 0) {
+        qzs_sample_linear(plant, t, &run->s, &run->x, run->mode, run->direction, run->held);
+        run->margin = NAN;
+    }
+    QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->x, run->mode,
+                                 run->direction, run->held, run->margin, phase);
+    if (!qzs_finite(plant, &next.s) || (plant->blocks && !qzs_finite_blocks(&next.x)))
         return QZS_STATUS_DIVERGED;
     run->s = next.s;
+    if (plant->blocks)
+        run->x = next.x;
     run->mode = next.mode;
     run->direction = next.direction;
     run->margin = next.margin;
@@ -79,7 +96,8 @@ int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
         if (status != QZS_STATUS_OK)
             break;
         if (decimation > 0 && run->step % decimation == 0) {
-            qzs_record(plant, (double)run->step * h, &run->s, run->mode, run->direction,
+            qzs_record(plant, (double)run->step * h, &run->s, &run->x, run->mode,
+                       run->direction,
                        run->held, out + row * QZS_N_CHANNELS,
                        out_flags + row * QZS_N_OUTPUT_FLAGS, run->phase);
             row += 1;
@@ -106,9 +124,15 @@ int qzs_run_part(QzsRun *run, double from, double to) {
 void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags) {
     for (int j = 0; j < QZS_N_ODE; j++)
         state[j] = run->s.x[j];
-    state[QZS_A_F_PI] = run->held[0];
-    state[QZS_A_F_DAMP] = run->held[1];
-    state[QZS_A_F_MOTOR] = run->held[2];
+    if (run->plant.blocks)
+        for (int j = 0; j < QZS_N_X; j++)
+            state[QZS_A_X0 + j] = run->x.x[j];
+    state[QZS_A_F_PI] = run->held[QZS_H_PI];
+    state[QZS_A_F_DAMP] = run->held[QZS_H_DAMP];
+    state[QZS_A_F_MOTOR] = run->held[QZS_H_MOTOR];
+    state[QZS_A_F_COMPENSATION] = run->held[QZS_H_COMPENSATION];
+    state[QZS_A_F_DITHER] = run->held[QZS_H_DITHER];
+    state[QZS_A_F_LINEAR] = run->held[QZS_H_LINEAR];
     state[QZS_A_MARGIN] = run->margin;
     flags[QZS_I_MODE] = run->mode;
     flags[QZS_I_DIRECTION] = run->direction;
@@ -119,11 +143,11 @@ void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags) {
 }
 
 int qzs_model_run(int solver, int64_t n_steps, int64_t decimation, double *state,
-                  int64_t *flags, const double *params, const double *excitation,
-                  const double *table, int64_t table_columns, double *out,
-                  unsigned char *out_flags, int64_t row0, int64_t *rows) {
+                  int64_t *flags, const double *params, const double *model,
+                  const double *excitation, const double *table, int64_t table_columns,
+                  double *out, unsigned char *out_flags, int64_t row0, int64_t *rows) {
     QzsRun run;
-    qzs_plant_init(&run.plant, params, excitation, table, (long)table_columns);
+    qzs_plant_init(&run.plant, params, model, excitation, table, (long)table_columns);
     qzs_run_start(&run, solver, state, flags);
     int status = qzs_run_steps(&run, n_steps, decimation, out + row0 * QZS_N_CHANNELS,
                                out_flags + row0 * QZS_N_OUTPUT_FLAGS, rows);
@@ -132,16 +156,22 @@ int qzs_model_run(int solver, int64_t n_steps, int64_t decimation, double *state
 }
 
 void qzs_model_evaluate(double t, const double *state, const int64_t *flags,
-                        const double *params, const double *excitation, const double *table,
-                        int64_t table_columns, double *row, unsigned char *row_flags) {
+                        const double *params, const double *model, const double *excitation,
+                        const double *table, int64_t table_columns, double *row,
+                        unsigned char *row_flags) {
     QzsPlant plant;
-    qzs_plant_init(&plant, params, excitation, table, (long)table_columns);
+    qzs_plant_init(&plant, params, model, excitation, table, (long)table_columns);
     QzsOde s;
     for (int j = 0; j < QZS_N_ODE; j++)
         s.x[j] = state[j];
-    double held[3] = {state[QZS_A_F_PI], state[QZS_A_F_DAMP], state[QZS_A_F_MOTOR]};
+    QzsBlocks x;
+    for (int j = 0; j < QZS_N_X; j++)
+        x.x[j] = state[QZS_A_X0 + j];
+    double held[QZS_N_HELD] = {state[QZS_A_F_PI], state[QZS_A_F_DAMP], state[QZS_A_F_MOTOR],
+                               state[QZS_A_F_COMPENSATION], state[QZS_A_F_DITHER],
+                               state[QZS_A_F_LINEAR]};
     QzsPhase start = {0.0, 0.0, 1.0};
     QzsPhase phase = qzs_advance_phase(&plant, t, start, 1);
-    qzs_record(&plant, t, &s, (int)flags[QZS_I_MODE], (int)flags[QZS_I_DIRECTION], held, row,
-               row_flags, phase);
+    qzs_record(&plant, t, &s, &x, (int)flags[QZS_I_MODE], (int)flags[QZS_I_DIRECTION], held,
+               row, row_flags, phase);
 }

@@ -21,8 +21,10 @@ typedef struct {
     int sampled;          /* the controller is called (closed loop, controller_rate > 0) */
     int64_t control_steps;
     int solver;
+    int64_t linear_steps; /* a discrete linear controller's period in grid steps (0: none) */
     QzsOde s;
-    double held[3];       /* the commands held: PI, damping, motor [N] */
+    QzsBlocks x;          /* the controller blocks' states */
+    double held[QZS_N_HELD]; /* the commands held: PI, damping, motor, blocks [N] */
     double margin;        /* the holding margin at the step's start (NaN: not known) */
     int mode, direction, contact;
     int64_t step, sticks, contacts;
@@ -47,15 +49,18 @@ void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags);
 
 /* Advance `n_steps` from flags[QZS_I_STEP]; rows go to out (QZS_N_CHANNELS doubles each) and
  * out_flags (2 bytes each) from row0. state (QZS_N_STATE) and flags (QZS_N_FLAGS) carry the
- * run between calls. Returns QZS_STATUS_OK or QZS_STATUS_DIVERGED; *rows the rows written. */
+ * run between calls. model: the controller's blocks (QZS_N_MODEL values, qzs.engine.prepare
+ * .pack_model; NULL for PI + damping alone). Returns QZS_STATUS_OK or QZS_STATUS_DIVERGED; *rows the rows written. */
 int qzs_model_run(int solver, int64_t n_steps, int64_t decimation, double *state,
-                  int64_t *flags, const double *params, const double *excitation,
+                  int64_t *flags, const double *params, const double *model,
+                  const double *excitation,
                   const double *table, int64_t table_columns, double *out,
                   unsigned char *out_flags, int64_t row0, int64_t *rows);
 
 /* One recorded row of the persistent state at t (qzs.engine.kernels.evaluate). */
 void qzs_model_evaluate(double t, const double *state, const int64_t *flags,
-                        const double *params, const double *excitation, const double *table,
+                        const double *params, const double *model, const double *excitation,
+                        const double *table,
                         int64_t table_columns, double *row, unsigned char *row_flags);
 
 #endif /* QZS_MODEL_H */

@@ -75,6 +75,35 @@ INLINE void compliant_stop_law(double z, double v, double z_low, double z_high,
     }
 }
 
+/* laws.saturation_law: the command clipped at +-f_max, the integral's rate (anti-windup) */
+INLINE double saturation_law(double command, double error, double ki, double f_max,
+                             double *rate) {
+    *rate = error;
+    if (command > f_max) {
+        command = f_max;
+        if (error * ki > 0.0)
+            *rate = 0.0;
+    } else if (command < -f_max) {
+        command = -f_max;
+        if (error * ki < 0.0)
+            *rate = 0.0;
+    }
+    return command;
+}
+
+/* laws.compensation_law: a fraction of the compensator's friction law, cancelled */
+INLINE double compensation_law(double v, double sign, double fraction, double fs, double fc,
+                               double cbc, double cv, double v_reg, double deadband) {
+    if (fabs(v) <= deadband)
+        return 0.0;
+    return -fraction * sliding_friction_law(v, sign, fs, fc, cbc, cv, v_reg);
+}
+
+/* laws.dither_law */
+INLINE double dither_law(double t, double amplitude, double omega) {
+    return amplitude * sin(omega * t);
+}
+
 /* ------------------------------------------------------------ stickslip.py */
 
 INLINE double slip_event(double direction, double v) { return direction * v; }
@@ -229,9 +258,14 @@ QzsPhase qzs_advance_phase(const QzsPlant *plant, double t, QzsPhase previous, i
 
 /* ------------------------------------------------------------ kernels.py */
 
-void qzs_plant_init(QzsPlant *plant, const double *params, const double *excitation,
-                    const double *table, long table_columns) {
+void qzs_plant_init(QzsPlant *plant, const double *params, const double *model,
+                    const double *excitation, const double *table, long table_columns) {
     memcpy(plant->P, params, sizeof plant->P);
+    if (model)
+        memcpy(plant->M, model, sizeof plant->M);
+    else
+        memset(plant->M, 0, sizeof plant->M);
+    plant->blocks = plant->M[QZS_M_BLOCKS] != 0.0;
     memcpy(plant->E, excitation, sizeof plant->E);
     plant->table = table;
     plant->table_columns = table_columns;
@@ -241,9 +275,79 @@ void qzs_plant_init(QzsPlant *plant, const double *params, const double *excitat
     plant->control = c;
 }
 
-/* kernels.rhs: m*xdd = F_spring + F_friction + F_stop + F_motor - m*g; held: v = 0, xdd = ydd */
-INLINE void rhs(const QzsPlant *plant, QzsBase b, const QzsOde *s, int mode, double direction,
-                const double held[3], QzsOde *deriv, QzsForces *force) {
+/* kernels._linear_output: C x + D u over the zero-padded rows (short ones for a small
+ * controller; a padded term adds an exact zero) */
+INLINE double linear_output(const double *M, const QzsBlocks *x, const double u[QZS_N_SENSORS]) {
+    double y = 0.0;
+    int width = M[QZS_M_LINEAR_STATES] <= QZS_NX_SHORT ? QZS_NX_SHORT : QZS_NX_MAX;
+    for (int j = 0; j < width; j++)
+        y = fma(M[QZS_M_C + j], x->x[j], y);
+    for (int k = 0; k < QZS_N_SENSORS; k++)
+        y = fma(M[QZS_M_D + k], u[k], y);
+    return y;
+}
+
+/* kernels._linear_rates: A x + B u + L excess row by row (a padded row 0), then `observer` */
+INLINE void linear_rates(const double *M, const QzsBlocks *x, const double u[QZS_N_SENSORS],
+                         double excess, double observer, QzsBlocks *rates) {
+    int width = M[QZS_M_LINEAR_STATES] <= QZS_NX_SHORT ? QZS_NX_SHORT : QZS_NX_MAX;
+    for (int i = 0; i < QZS_NX_MAX; i++) {
+        double rate = 0.0;
+        if (i < width) {
+            rate = M[QZS_M_ANTIWINDUP + i] * excess;
+            for (int j = 0; j < width; j++)
+                rate = fma(M[QZS_M_A + i * QZS_NX_MAX + j], x->x[j], rate);
+            for (int k = 0; k < QZS_N_SENSORS; k++)
+                rate = fma(M[QZS_M_B + i * QZS_N_SENSORS + k], u[k], rate);
+        }
+        rates->x[i] = rate;
+    }
+    rates->x[QZS_X_OBSERVER] = observer;
+}
+
+/* kernels._compensation: the friction compensation's feedforward at slip velocity v */
+INLINE double compensation(const double *P, const double *M, double v, double direction) {
+    if (M[QZS_M_COMP_FRACTION] == 0.0)
+        return 0.0;
+    return compensation_law(v, direction, M[QZS_M_COMP_FRACTION], M[QZS_M_COMP_FS],
+                            M[QZS_M_COMP_FC], M[QZS_M_COMP_CBC], M[QZS_M_COMP_CV], P[QZS_P_VREG],
+                            M[QZS_M_COMP_DEADBAND]);
+}
+
+/* kernels.block_forces: compensation, dither, linear output, and the feedforward alone */
+INLINE void block_forces(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x,
+                         double v, double direction, double ydd, double v_measured,
+                         const double *held, double *f_comp, double *f_dither,
+                         double *f_linear, double *feedforward) {
+    const double *P = plant->P, *M = plant->M;
+    *feedforward = 0.0;
+    if (P[QZS_P_CONTROL_STEPS] > 0.0) {
+        *f_comp = held[QZS_H_COMPENSATION];
+        *f_dither = held[QZS_H_DITHER];
+    } else {
+        *feedforward = compensation(P, M, v, direction);
+        *f_comp = *feedforward - x->x[QZS_X_OBSERVER];
+        *f_dither = 0.0;
+        if (M[QZS_M_DITHER_AMPLITUDE] != 0.0)
+            *f_dither = dither_law(t, M[QZS_M_DITHER_AMPLITUDE], M[QZS_M_DITHER_OMEGA]);
+    }
+    *f_linear = 0.0;
+    if (M[QZS_M_LINEAR] != 0.0) {
+        if (M[QZS_M_LINEAR_STEPS] > 0.0) {
+            *f_linear = held[QZS_H_LINEAR];
+        } else { /* the payload's acceleration enters only through B */
+            double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s->x[QZS_S_Z], v_measured, 0.0, ydd, v};
+            *f_linear = linear_output(M, x, u);
+        }
+    }
+}
+
+/* kernels.rhs: m*xdd = F_spring + F_friction + F_stop + F_motor - m*g; held: v = 0, xdd = ydd.
+ * The blocks (plant->blocks) add their forces and their states' rates (`rates`, may be NULL);
+ * without them the operations are those of PI + damping alone. */
+INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, const QzsBlocks *x,
+                int mode, double direction, const double *held, QzsOde *deriv,
+                QzsForces *force, QzsBlocks *rates) {
     const double *P = plant->P;
     double m = P[QZS_P_MASS];
     double z = s->x[QZS_S_Z];
@@ -259,9 +363,9 @@ INLINE void rhs(const QzsPlant *plant, QzsBase b, const QzsOde *s, int mode, dou
     double v_measured = P[QZS_P_HP_OMEGA] > 0.0 ? xd - s->x[QZS_S_HP] : xd;
     double f_pi, f_damp, f_motor, integral_rate;
     if (P[QZS_P_CONTROL_STEPS] > 0.0) {
-        f_pi = held[0];
-        f_damp = held[1];
-        f_motor = held[2];
+        f_pi = held[QZS_H_PI];
+        f_damp = held[QZS_H_DAMP];
+        f_motor = held[QZS_H_MOTOR];
         integral_rate = 0.0;
     } else {
         QzsControllerOutput c = qzs_controller_law(&plant->control, z, v_measured,
@@ -270,6 +374,17 @@ INLINE void rhs(const QzsPlant *plant, QzsBase b, const QzsOde *s, int mode, dou
         f_damp = c.damping;
         f_motor = c.motor;
         integral_rate = c.integral_rate;
+    }
+    double f_comp = 0.0, f_dither = 0.0, f_linear = 0.0, feedforward = 0.0;
+    double command = f_motor;
+    if (plant->blocks) {
+        block_forces(plant, t, s, x, v, direction, b.ydd, v_measured, held, &f_comp, &f_dither,
+                     &f_linear, &feedforward);
+        command = f_pi + f_damp + f_comp + f_dither + f_linear;
+        double rate;
+        f_motor = saturation_law(command, P[QZS_P_ZREF] - z, P[QZS_P_KI], P[QZS_P_FMAX], &rate);
+        if (P[QZS_P_CONTROL_STEPS] == 0.0)
+            integral_rate = rate;
     }
 
     double f_applied = f_spring + f_stop + f_motor - m * P[QZS_P_GRAVITY];
@@ -292,6 +407,23 @@ INLINE void rhs(const QzsPlant *plant, QzsBase b, const QzsOde *s, int mode, dou
         }
         xdd = b.ydd;
     }
+    if (rates) {
+        for (int i = 0; i < QZS_N_X; i++)
+            rates->x[i] = 0.0;
+        if (plant->blocks) {
+            const double *M = plant->M;
+            double observer = 0.0;
+            if (P[QZS_P_CONTROL_STEPS] == 0.0 && M[QZS_M_OBSERVER_RATE] > 0.0)
+                observer = M[QZS_M_OBSERVER_RATE] *
+                           (f_friction + f_stop + feedforward - x->x[QZS_X_OBSERVER]);
+            if (M[QZS_M_LINEAR] != 0.0 && M[QZS_M_LINEAR_STEPS] == 0.0) {
+                double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - z, v_measured, xdd, b.ydd, v};
+                linear_rates(M, x, u, f_motor - command, observer, rates);
+            } else {
+                rates->x[QZS_X_OBSERVER] = observer;
+            }
+        }
+    }
     if (deriv) {
         deriv->x[0] = v;
         deriv->x[1] = xdd - b.ydd;
@@ -304,20 +436,29 @@ INLINE void rhs(const QzsPlant *plant, QzsBase b, const QzsOde *s, int mode, dou
     }
     if (force) {
         QzsForces f = {b.y, b.yd, b.ydd, f_spring, f_friction, f_stop, f_elastic, f_motor,
-                       f_pi, f_damp, v_measured, f_hold, xdd};
+                       f_pi, f_damp, v_measured, f_hold, xdd, f_comp, f_dither, f_linear,
+                       plant->blocks ? x->x[QZS_X_OBSERVER] : 0.0};
         *force = f;
     }
 }
 
-void qzs_rhs_at(const QzsPlant *plant, double t, const QzsOde *s, int mode, double direction,
-                const double held[3], QzsOde *deriv, QzsForces *force) {
-    rhs(plant, qzs_base_motion(plant, t), s, mode, direction, held, deriv, force);
+/* kernels.rhs_at, with the blocks' rates (NULL: not wanted) */
+INLINE void rhs_at(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x,
+                   int mode, double direction, const double *held, QzsOde *deriv,
+                   QzsForces *force, QzsBlocks *rates) {
+    rhs(plant, t, qzs_base_motion(plant, t), s, x, mode, direction, held, deriv, force, rates);
 }
 
-INLINE double hold_at(const QzsPlant *plant, double t, const QzsOde *s, int mode,
-                      const double held[3]) {
+void qzs_rhs_at(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x, int mode,
+                double direction, const double held[QZS_N_HELD], QzsOde *deriv,
+                QzsForces *force) {
+    rhs_at(plant, t, s, x, mode, direction, held, deriv, force, 0);
+}
+
+INLINE double hold_at(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x,
+                      int mode, const double *held) {
     QzsForces f;
-    qzs_rhs_at(plant, t, s, mode, 0.0, held, 0, &f);
+    rhs_at(plant, t, s, x, mode, 0.0, held, 0, &f, 0);
     return f.hold;
 }
 
@@ -325,6 +466,14 @@ INLINE QzsOde axpy(const QzsOde *s, double a, const QzsOde *k) {
     QzsOde out;
     for (int j = 0; j < QZS_N_ODE; j++)
         out.x[j] = fma(a, k->x[j], s->x[j]);
+    return out;
+}
+
+/* kernels._axpy_blocks */
+INLINE QzsBlocks axpy_blocks(const QzsBlocks *x, double a, const QzsBlocks *k) {
+    QzsBlocks out;
+    for (int j = 0; j < QZS_N_X; j++)
+        out.x[j] = fma(a, k->x[j], x->x[j]);
     return out;
 }
 
@@ -355,41 +504,73 @@ INLINE void tableau(int solver, double h, int stage, double *offset, double *a, 
     }
 }
 
-/* kernels.rk_step: the base motion at each stage rotated from a nearby phase */
+/* kernels.rk_step: the base motion at each stage rotated from a nearby phase; the blocks'
+ * states step with the plant's (only with blocks: without, *x_out is not written) */
 INLINE QzsOde rk_step(const QzsPlant *plant, int solver, double t, double h, const QzsOde *s,
-                      int mode, double direction, const double held[3], QzsPhase near) {
-    QzsOde result = *s, k = *s, x;
+                      const QzsBlocks *x, int mode, double direction, const double *held,
+                      QzsPhase near, QzsBlocks *x_out) {
+    QzsOde result = *s, k = *s, input;
+    QzsBlocks result_x, k_x, input_x;
+    if (plant->blocks) {
+        result_x = *x;
+        k_x = *x;
+    }
     int stages = n_stages(solver);
     for (int stage = 0; stage < stages; stage++) {
         double offset, a, weight;
         tableau(solver, h, stage, &offset, &a, &weight);
         QzsBase b = base_motion_near(plant, t + offset, near);
         if (stage == 0)
-            x = *s;
+            input = *s;
         else
-            x = axpy(s, a, &k);
-        rhs(plant, b, &x, mode, direction, held, &k, 0);
+            input = axpy(s, a, &k);
+        if (plant->blocks) {
+            input_x = stage == 0 ? *x : axpy_blocks(x, a, &k_x);
+            rhs(plant, t + offset, b, &input, &input_x, mode, direction, held, &k, 0, &k_x);
+            result_x = axpy_blocks(&result_x, weight, &k_x);
+        } else {
+            rhs(plant, t + offset, b, &input, x, mode, direction, held, &k, 0, 0);
+        }
         result = axpy(&result, weight, &k);
     }
+    if (plant->blocks)
+        *x_out = result_x;
     return result;
 }
 
-/* kernels._rk: the same step for the event path, each stage at the exact base motion */
+/* kernels._rk: the same step for the event path, each stage at the exact base motion; k0, k0_x
+ * the first stage's rates. The blocks' states only with blocks (else *x_out = *x). */
 static QzsOde rk_exact(const QzsPlant *plant, int solver, double t, double h, const QzsOde *s,
-                       const QzsOde *k0, int mode, double direction, const double held[3]) {
+                       const QzsBlocks *x, const QzsOde *k0, const QzsBlocks *k0_x, int mode,
+                       double direction, const double *held, QzsBlocks *x_out) {
     double offset, a, weight;
     tableau(solver, h, 0, &offset, &a, &weight);
     QzsOde result = axpy(s, weight, k0);
     QzsOde k = *k0;
+    int blocks = plant->blocks;
+    QzsBlocks result_x = *x, k_x = *x;
+    if (blocks) {
+        result_x = axpy_blocks(x, weight, k0_x);
+        k_x = *k0_x;
+    }
     int stages = n_stages(solver);
     for (int stage = 1; stage < stages; stage++) {
         tableau(solver, h, stage, &offset, &a, &weight);
-        QzsOde x = axpy(s, a, &k);
+        QzsOde input = axpy(s, a, &k);
         QzsOde next;
-        qzs_rhs_at(plant, t + offset, &x, mode, direction, held, &next, 0);
+        if (blocks) {
+            QzsBlocks input_x = axpy_blocks(x, a, &k_x), next_x;
+            rhs_at(plant, t + offset, &input, &input_x, mode, direction, held, &next, 0, &next_x);
+            k_x = next_x;
+            result = axpy(&result, weight, &next);
+            result_x = axpy_blocks(&result_x, weight, &k_x);
+        } else {
+            rhs_at(plant, t + offset, &input, x, mode, direction, held, &next, 0, 0);
+            result = axpy(&result, weight, &next);
+        }
         k = next;
-        result = axpy(&result, weight, &k);
     }
+    *x_out = result_x;
     return result;
 }
 
@@ -429,10 +610,10 @@ static QzsOde book_impulse(const QzsPlant *plant, double t, QzsOde s, int ledger
 }
 
 /* kernels._settle: at a zero crossing of v, stick if friction can hold, else reverse */
-static QzsOde settle(const QzsPlant *plant, double t, QzsOde s, const double held[3], int *mode,
-                     int *direction) {
+static QzsOde settle(const QzsPlant *plant, double t, QzsOde s, const QzsBlocks *x,
+                     const double *held, int *mode, int *direction) {
     s = book_impulse(plant, t, s, QZS_S_D_FRICTION);
-    double f_hold = hold_at(plant, t, &s, QZS_MODE_STICK, held);
+    double f_hold = hold_at(plant, t, &s, x, QZS_MODE_STICK, held);
     if (fabs(f_hold) <= plant->P[QZS_P_FS]) {
         *mode = QZS_MODE_STICK;
     } else {
@@ -443,15 +624,15 @@ static QzsOde settle(const QzsPlant *plant, double t, QzsOde s, const double hel
 }
 
 /* kernels._hit_wall: perfectly plastic impact on a stop */
-static QzsOde hit_wall(const QzsPlant *plant, double t, QzsOde s, int low, const double held[3],
-                       int *mode, int *direction) {
+static QzsOde hit_wall(const QzsPlant *plant, double t, QzsOde s, const QzsBlocks *x, int low,
+                       const double *held, int *mode, int *direction) {
     const double *P = plant->P;
     s = book_impulse(plant, t, s, QZS_S_D_STOP);
     double before = mechanical_energy(plant, t, &s, QZS_MODE_SLIP);
     s.x[QZS_S_Z] = low ? P[QZS_P_Z_LOW] : P[QZS_P_Z_HIGH];
     s.x[QZS_S_D_STOP] = s.x[QZS_S_D_STOP] + before - mechanical_energy(plant, t, &s, QZS_MODE_SLIP);
     int wall = low ? QZS_MODE_WALL_LOW : QZS_MODE_WALL_HIGH;
-    double f_hold = hold_at(plant, t, &s, wall, held);
+    double f_hold = hold_at(plant, t, &s, x, wall, held);
     if (hold_margin(wall, f_hold, P[QZS_P_FS]) < 0.0) {
         *mode = QZS_MODE_SLIP;
         *direction = release_direction(wall, f_hold);
@@ -463,8 +644,8 @@ static QzsOde hit_wall(const QzsPlant *plant, double t, QzsOde s, int low, const
 }
 
 /* kernels._event_value */
-static double event_value(const QzsPlant *plant, int event, double t, const QzsOde *s, int mode,
-                          int direction, const double held[3]) {
+static double event_value(const QzsPlant *plant, int event, double t, const QzsOde *s,
+                          const QzsBlocks *x, int mode, int direction, const double *held) {
     const double *P = plant->P;
     if (event == 1)
         return slip_event((double)direction, s->x[QZS_S_V]);
@@ -472,14 +653,14 @@ static double event_value(const QzsPlant *plant, int event, double t, const QzsO
         return s->x[QZS_S_Z] - P[QZS_P_Z_LOW];
     if (event == 3)
         return P[QZS_P_Z_HIGH] - s->x[QZS_S_Z];
-    return hold_margin(mode, hold_at(plant, t, s, mode, held), P[QZS_P_FS]);
+    return hold_margin(mode, hold_at(plant, t, s, x, mode, held), P[QZS_P_FS]);
 }
 
 /* kernels._margin_near */
-static double margin_near(const QzsPlant *plant, double t, const QzsOde *s, int mode,
-                          const double held[3], QzsPhase near) {
+static double margin_near(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x,
+                          int mode, const double *held, QzsPhase near) {
     QzsForces f;
-    rhs(plant, base_motion_near(plant, t, near), s, mode, 0.0, held, 0, &f);
+    rhs(plant, t, base_motion_near(plant, t, near), s, x, mode, 0.0, held, 0, &f, 0);
     return hold_margin(mode, f.hold, plant->P[QZS_P_FS]);
 }
 
@@ -521,19 +702,22 @@ INLINE int first_event(const QzsPlant *plant, const QzsOde *s, const QzsOde *s1,
 
 /* stickslip.locate with kernels._locate's trial: regula falsi (Illinois) on fresh steps */
 static double locate(const QzsPlant *plant, int solver, int event, double t, double h,
-                     const QzsOde *s, double g0, double g1, int mode, int direction,
-                     const double held[3], QzsOde *state) {
+                     const QzsOde *s, const QzsBlocks *x, double g0, double g1, int mode,
+                     int direction, const double *held, QzsOde *state, QzsBlocks *state_x) {
     *state = *s;
+    *state_x = *x;
     if (!(g0 > 0.0))
         return 0.0;
     QzsOde k0;
-    qzs_rhs_at(plant, t, s, mode, (double)direction, held, &k0, 0);
+    QzsBlocks k0_x;
+    rhs_at(plant, t, s, x, mode, (double)direction, held, &k0, 0, plant->blocks ? &k0_x : 0);
     double lo = 0.0, hi = h, g_lo = g0, g_hi = g1;
     double at = h * g0 / (g0 - g1);
     int side = 0;
     for (int i = 0; i < LOCATE_ITERATIONS; i++) {
-        *state = rk_exact(plant, solver, t, at, s, &k0, mode, (double)direction, held);
-        double g = event_value(plant, event, t + at, state, mode, direction, held);
+        *state = rk_exact(plant, solver, t, at, s, x, &k0, &k0_x, mode, (double)direction, held,
+                          state_x);
+        double g = event_value(plant, event, t + at, state, state_x, mode, direction, held);
         /* stickslip.illinois_step */
         if (fabs(g) <= 1e-15 * (fabs(g0) + 1e-300) || hi - lo <= 1e-12 * h)
             break;
@@ -555,8 +739,9 @@ static double locate(const QzsPlant *plant, int solver, int event, double t, dou
     return at;
 }
 
-QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, QzsOde s, int mode,
-                      int direction, const double held[3], double margin, QzsPhase phase) {
+QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, QzsOde s,
+                      QzsBlocks x, int mode, int direction, const double held[QZS_N_HELD],
+                      double margin, QzsPhase phase) {
     const double *P = plant->P;
     QzsStep out;
     out.sticks = 0;
@@ -564,73 +749,153 @@ QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, Qzs
     /* a zero crossing missed earlier */
     if (mode == QZS_MODE_SLIP && P[QZS_P_VREG] == 0.0 &&
         slip_event((double)direction, s.x[QZS_S_V]) < 0.0) {
-        s = settle(plant, t, s, held, &mode, &direction);
+        s = settle(plant, t, s, &x, held, &mode, &direction);
         out.sticks += mode == QZS_MODE_STICK;
         margin = NAN;
     }
     if (mode != QZS_MODE_SLIP) {
         if (margin != margin)
-            margin = margin_near(plant, t, &s, mode, held, phase);
+            margin = margin_near(plant, t, &s, &x, mode, held, phase);
         if (margin < 0.0) {
-            double f_hold = hold_at(plant, t, &s, mode, held);
+            double f_hold = hold_at(plant, t, &s, &x, mode, held);
             direction = release_direction(mode, f_hold);
             mode = QZS_MODE_SLIP;
         }
     }
 
-    QzsOde s1 = rk_step(plant, solver, t, h, &s, mode, (double)direction, held, phase);
+    QzsBlocks x1 = x;
+    QzsOde s1 = rk_step(plant, solver, t, h, &s, &x, mode, (double)direction, held, phase, &x1);
     double margin1 = NAN;
     if (mode != QZS_MODE_SLIP)
-        margin1 = margin_near(plant, t + h, &s1, mode, held, phase);
+        margin1 = margin_near(plant, t + h, &s1, &x1, mode, held, phase);
     double theta;
     int event = first_event(plant, &s, &s1, mode, direction, margin, margin1, &theta);
     if (event == 0) {
         out.s = s1;
+        out.x = x1;
         out.mode = mode;
         out.direction = direction;
         out.margin = margin1;
         return out;
     }
 
-    double g0 = event == 4 ? margin : event_value(plant, event, t, &s, mode, direction, held);
+    double g0 = event == 4 ? margin
+                           : event_value(plant, event, t, &s, &x, mode, direction, held);
     double g1 = event == 4 ? margin1
-                           : event_value(plant, event, t + h, &s1, mode, direction, held);
+                           : event_value(plant, event, t + h, &s1, &x1, mode, direction, held);
     QzsOde s_event;
-    double at = locate(plant, solver, event, t, h, &s, g0, g1, mode, direction, held, &s_event);
+    QzsBlocks x_event;
+    double at = locate(plant, solver, event, t, h, &s, &x, g0, g1, mode, direction, held,
+                       &s_event, &x_event);
+    if (!plant->blocks)
+        x_event = x; /* unchanged without blocks */
     double t_event = t + at;
     if (event == 1) {
-        s_event = settle(plant, t_event, s_event, held, &mode, &direction);
+        s_event = settle(plant, t_event, s_event, &x_event, held, &mode, &direction);
         out.sticks += mode == QZS_MODE_STICK;
     } else if (event == 2 || event == 3) {
-        s_event = hit_wall(plant, t_event, s_event, event == 2, held, &mode, &direction);
+        s_event = hit_wall(plant, t_event, s_event, &x_event, event == 2, held, &mode,
+                           &direction);
         out.impacts += 1;
     } else {
-        double f_hold = hold_at(plant, t_event, &s_event, mode, held);
+        double f_hold = hold_at(plant, t_event, &s_event, &x_event, mode, held);
         direction = release_direction(mode, f_hold);
         mode = QZS_MODE_SLIP;
     }
     double rest = h - at;
     s1 = s_event;
+    x1 = x_event;
     if (rest > 0.0) {
         QzsOde k0;
-        qzs_rhs_at(plant, t_event, &s_event, mode, (double)direction, held, &k0, 0);
-        s1 = rk_exact(plant, solver, t_event, rest, &s_event, &k0, mode, (double)direction, held);
+        QzsBlocks k0_x;
+        rhs_at(plant, t_event, &s_event, &x_event, mode, (double)direction, held, &k0, 0,
+               plant->blocks ? &k0_x : 0);
+        s1 = rk_exact(plant, solver, t_event, rest, &s_event, &x_event, &k0, &k0_x, mode,
+                      (double)direction, held, &x1);
+        if (!plant->blocks)
+            x1 = x;
     }
     if (mode == QZS_MODE_SLIP && P[QZS_P_PLASTIC] != 0.0) { /* a second event: clamp */
         if (s1.x[QZS_S_Z] < P[QZS_P_Z_LOW] || s1.x[QZS_S_Z] > P[QZS_P_Z_HIGH]) {
-            s1 = hit_wall(plant, t + h, s1, s1.x[QZS_S_Z] < P[QZS_P_Z_LOW], held, &mode,
+            s1 = hit_wall(plant, t + h, s1, &x1, s1.x[QZS_S_Z] < P[QZS_P_Z_LOW], held, &mode,
                           &direction);
             out.impacts += 1;
         }
     }
     margin1 = NAN;
     if (mode != QZS_MODE_SLIP)
-        margin1 = margin_near(plant, t + h, &s1, mode, held, phase);
+        margin1 = margin_near(plant, t + h, &s1, &x1, mode, held, phase);
     out.s = s1;
+    out.x = x1;
     out.mode = mode;
     out.direction = direction;
     out.margin = margin1;
     return out;
+}
+
+/* kernels.sample_controller with blocks: the PI and damping with the current integral, the
+ * observer advanced by forward Euler from what it measures now, the compensation with its new
+ * estimate, the dither, the saturated sum; then the integral advanced by one period */
+void qzs_sample_blocks(const QzsPlant *plant, double t, QzsOde *s, QzsBlocks *x, int mode,
+                       int direction, double held[QZS_N_HELD]) {
+    const double *P = plant->P, *M = plant->M;
+    QzsBase b = qzs_base_motion(plant, t);
+    double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
+    double xd = b.yd + v;
+    double v_measured = P[QZS_P_HP_OMEGA] > 0.0 ? xd - s->x[QZS_S_HP] : xd;
+    QzsControllerOutput c = qzs_controller_law(&plant->control, s->x[QZS_S_Z], v_measured,
+                                               s->x[QZS_S_INT]);
+    QzsForces force;
+    rhs(plant, t, b, s, x, mode, (double)direction, held, 0, &force, 0);
+    if (M[QZS_M_OBSERVER_RATE] > 0.0) {
+        double applied = held[QZS_H_COMPENSATION] + x->x[QZS_X_OBSERVER];
+        double measured = force.friction + force.stop + applied;
+        x->x[QZS_X_OBSERVER] = x->x[QZS_X_OBSERVER] + M[QZS_M_OBSERVER_RATE] *
+            (measured - x->x[QZS_X_OBSERVER]) * P[QZS_P_CONTROL_STEPS] * P[QZS_P_DT];
+    }
+    double feedforward = compensation(P, M, v, (double)direction);
+    double f_comp = feedforward - x->x[QZS_X_OBSERVER]; /* the new estimate, applied at once */
+    double f_dither = 0.0;
+    if (M[QZS_M_DITHER_AMPLITUDE] != 0.0)
+        f_dither = dither_law(t, M[QZS_M_DITHER_AMPLITUDE], M[QZS_M_DITHER_OMEGA]);
+    double command = c.pi + c.damping + f_comp + f_dither + force.linear;
+    double rate;
+    double f_motor = saturation_law(command, P[QZS_P_ZREF] - s->x[QZS_S_Z], P[QZS_P_KI],
+                                    P[QZS_P_FMAX], &rate);
+    s->x[QZS_S_INT] = s->x[QZS_S_INT] + rate * P[QZS_P_CONTROL_STEPS] * P[QZS_P_DT];
+    held[QZS_H_PI] = c.pi;
+    held[QZS_H_DAMP] = c.damping;
+    held[QZS_H_MOTOR] = f_motor;
+    held[QZS_H_COMPENSATION] = f_comp;
+    held[QZS_H_DITHER] = f_dither;
+}
+
+/* kernels.sample_linear: the sensors read (the payload's acceleration with the force held until
+ * now), the output C x + D u held, the states stepped x <- A x + B u + L (F_motor - command) */
+void qzs_sample_linear(const QzsPlant *plant, double t, const QzsOde *s, QzsBlocks *x, int mode,
+                       int direction, double held[QZS_N_HELD]) {
+    const double *P = plant->P, *M = plant->M;
+    QzsForces force;
+    rhs_at(plant, t, s, x, mode, (double)direction, held, 0, &force, 0);
+    double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
+    double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s->x[QZS_S_Z], force.v_measured, force.xdd,
+                               force.ydd, v};
+    double output = linear_output(M, x, u);
+    double command = force.pi + force.damp + force.compensation + force.dither + output;
+    double rate;
+    double f_motor = saturation_law(command, P[QZS_P_ZREF] - s->x[QZS_S_Z], P[QZS_P_KI],
+                                    P[QZS_P_FMAX], &rate);
+    QzsBlocks next;
+    linear_rates(M, x, u, f_motor - command, x->x[QZS_X_OBSERVER], &next);
+    *x = next;
+    held[QZS_H_LINEAR] = output;
+}
+
+int qzs_finite_blocks(const QzsBlocks *x) {
+    int finite = 1;
+    for (int i = 0; i < QZS_N_X; i++)
+        finite = finite && isfinite(x->x[i]);
+    return finite;
 }
 
 /* kernels.sample_controller's reading: z and the measured velocity at the exact base motion */
@@ -656,10 +921,12 @@ int qzs_in_contact(const QzsPlant *plant, const QzsOde *s, int mode) {
            s->x[QZS_S_Z] > plant->P[QZS_P_Z_HIGH];
 }
 
-void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, int mode, int direction,
-                const double held[3], double *row, unsigned char *row_flags, QzsPhase phase) {
+void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x, int mode,
+                int direction, const double held[QZS_N_HELD], double *row,
+                unsigned char *row_flags, QzsPhase phase) {
     QzsForces f;
-    rhs(plant, base_motion_near(plant, t, phase), s, mode, (double)direction, held, 0, &f);
+    rhs(plant, t, base_motion_near(plant, t, phase), s, x, mode, (double)direction, held, 0, &f,
+        0);
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
     row[QZS_C_TIME] = t;
     row[QZS_C_BASE_Y] = f.y;
@@ -682,6 +949,12 @@ void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, int mode, int 
     row[QZS_C_W_MOTOR] = s->x[QZS_S_W_MOTOR];
     row[QZS_C_D_STOP] = s->x[QZS_S_D_STOP];
     energies(plant, f.y, f.yd, s, mode, row + QZS_C_E_KINETIC);
+    if (plant->blocks) { /* a row without blocks holds QZS_N_BASE_CHANNELS */
+        row[QZS_C_F_COMPENSATION] = f.compensation;
+        row[QZS_C_F_DITHER] = f.dither;
+        row[QZS_C_F_LINEAR] = f.linear;
+        row[QZS_C_F_OBSERVER] = f.observer;
+    }
     row_flags[QZS_O_LOCKED] = mode != QZS_MODE_SLIP;
     row_flags[QZS_O_CONTACT] = (unsigned char)qzs_in_contact(plant, s, mode);
 }

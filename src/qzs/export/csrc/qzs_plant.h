@@ -24,10 +24,28 @@ enum { QZS_P_MASS, QZS_P_GRAVITY, QZS_P_SPRING_A, QZS_P_SPRING_B, QZS_P_FS, QZS_
        QZS_P_CBC, QZS_P_CV, QZS_P_Z_LOW, QZS_P_Z_HIGH, QZS_P_STOP_K, QZS_P_STOP_C,
        QZS_P_PLASTIC, QZS_P_FMAX, QZS_P_ZREF, QZS_P_KP, QZS_P_KI, QZS_P_KD, QZS_P_HP_OMEGA,
        QZS_P_CONTROL_STEPS, QZS_P_DT, QZS_P_VREG, QZS_N_PARAMS };
-/* ODE state (S_*), then the held controller outputs and the holding margin (A_*) */
+/* ODE state (S_*), then the held controller outputs and the holding margin (A_*), the
+ * controller blocks' states (X_*: a linear controller's, then the friction observer's) and
+ * the held outputs of the sampled blocks */
+enum { QZS_NX_MAX = 8, QZS_X_OBSERVER = QZS_NX_MAX, QZS_N_X };
 enum { QZS_S_Z, QZS_S_V, QZS_S_HP, QZS_S_INT, QZS_S_W_BASE, QZS_S_D_FRICTION, QZS_S_W_MOTOR,
        QZS_S_D_STOP, QZS_N_ODE, QZS_A_F_PI = QZS_N_ODE, QZS_A_F_DAMP, QZS_A_F_MOTOR,
-       QZS_A_MARGIN, QZS_N_STATE };
+       QZS_A_MARGIN, QZS_A_X0, QZS_A_F_COMPENSATION = QZS_A_X0 + QZS_N_X, QZS_A_F_DITHER,
+       QZS_A_F_LINEAR, QZS_N_STATE };
+/* the held outputs (kernels.held_tuple): PI, damping, motor, compensation, dither, linear */
+enum { QZS_H_PI, QZS_H_DAMP, QZS_H_MOTOR, QZS_H_COMPENSATION, QZS_H_DITHER, QZS_H_LINEAR,
+       QZS_N_HELD };
+/* the controller's blocks beyond PI + damping, packed per run (kernels.M_*,
+ * qzs.engine.prepare.pack_model): all zeros for PI + damping alone */
+enum { QZS_N_SENSORS = 5 };
+enum { QZS_M_BLOCKS, QZS_M_COMP_FRACTION, QZS_M_COMP_FS, QZS_M_COMP_FC, QZS_M_COMP_CBC,
+       QZS_M_COMP_CV, QZS_M_COMP_DEADBAND, QZS_M_OBSERVER_RATE, QZS_M_DITHER_AMPLITUDE,
+       QZS_M_DITHER_OMEGA, QZS_M_LINEAR, QZS_M_LINEAR_STATES, QZS_M_LINEAR_STEPS, QZS_M_A,
+       QZS_M_B = QZS_M_A + QZS_NX_MAX * QZS_NX_MAX, QZS_M_C = QZS_M_B + QZS_NX_MAX * QZS_N_SENSORS,
+       QZS_M_D = QZS_M_C + QZS_NX_MAX, QZS_M_ANTIWINDUP = QZS_M_D + QZS_N_SENSORS,
+       QZS_N_MODEL = QZS_M_ANTIWINDUP + QZS_NX_MAX };
+/* a linear controller of at most this many states takes the short loops (kernels.NX_SHORT) */
+#define QZS_NX_SHORT 4
 /* integer flags (I_*) */
 enum { QZS_I_MODE, QZS_I_DIRECTION, QZS_I_STEP, QZS_I_CONTACT, QZS_I_N_CONTACTS,
        QZS_I_N_STICKS, QZS_N_FLAGS };
@@ -40,7 +58,10 @@ enum { QZS_C_TIME, QZS_C_BASE_Y, QZS_C_BASE_YD, QZS_C_BASE_YDD, QZS_C_X, QZS_C_X
        QZS_C_Z, QZS_C_V, QZS_C_F_SPRING, QZS_C_F_FRICTION, QZS_C_F_STOP, QZS_C_F_MOTOR,
        QZS_C_F_PI, QZS_C_F_DAMP, QZS_C_V_MEASURED, QZS_C_W_BASE, QZS_C_D_FRICTION,
        QZS_C_W_MOTOR, QZS_C_D_STOP, QZS_C_E_KINETIC, QZS_C_E_SPRING, QZS_C_E_GRAVITY,
-       QZS_C_E_STOP, QZS_N_CHANNELS };
+       QZS_C_E_STOP, QZS_C_F_COMPENSATION, QZS_C_F_DITHER, QZS_C_F_LINEAR, QZS_C_F_OBSERVER,
+       QZS_N_CHANNELS };
+/* the channels of every run; the blocks' (the last four) are written only with blocks */
+#define QZS_N_BASE_CHANNELS QZS_C_F_COMPENSATION
 enum { QZS_O_LOCKED, QZS_O_CONTACT, QZS_N_OUTPUT_FLAGS };
 /* modes of the payload: slipping, stuck to the base, resting on the lower / upper plastic stop */
 enum { QZS_MODE_SLIP, QZS_MODE_STICK, QZS_MODE_WALL_LOW, QZS_MODE_WALL_HIGH };
@@ -51,11 +72,14 @@ enum { QZS_STATUS_OK, QZS_STATUS_DIVERGED };
 
 /* The ODE state (z, v, high-pass, integral, ledger), by value like the kernels' tuples. */
 typedef struct { double x[QZS_N_ODE]; } QzsOde;
+/* The controller blocks' states (X_*). */
+typedef struct { double x[QZS_N_X]; } QzsBlocks;
 /* Base displacement [m], velocity [m/s], acceleration [m/s^2]. */
 typedef struct { double y, yd, ydd; } QzsBase;
 /* The force breakdown of the right-hand side (kernels.F_*). */
 typedef struct {
     double y, yd, ydd, spring, friction, stop, elastic, motor, pi, damp, v_measured, hold, xdd;
+    double compensation, dither, linear, observer; /* the blocks' (0 without) */
 } QzsForces;
 
 /* What does not change during a run: the parameters and the excitation. */
@@ -65,6 +89,8 @@ typedef struct {
     const double *table;  /* 5 rows of table_columns (the excitation's piecewise cubic) */
     long table_columns;
     QzsControllerParameters control;  /* the controller's part of P */
+    double M[QZS_N_MODEL];  /* the controller's blocks (QZS_M_*) */
+    int blocks;             /* M[QZS_M_BLOCKS] != 0: the blocks' code runs */
 } QzsPlant;
 
 /* Where the excitation's sine and cosine were last computed. */
@@ -73,24 +99,39 @@ typedef struct { double phase, sin0, cos0; } QzsPhase;
 /* The result of one grid step. */
 typedef struct {
     QzsOde s;
+    QzsBlocks x;
     int mode, direction;
     double margin;
     int sticks, impacts;
 } QzsStep;
 
-/* Fill the plant from packed parameters, excitation scalars and table (kept by pointer). */
-void qzs_plant_init(QzsPlant *plant, const double *params, const double *excitation,
-                    const double *table, long table_columns);
+/* Fill the plant from packed parameters, the controller's blocks (QZS_N_MODEL values, NULL for
+ * none), excitation scalars and table (kept by pointer). */
+void qzs_plant_init(QzsPlant *plant, const double *params, const double *model,
+                    const double *excitation, const double *table, long table_columns);
 /* Base motion at t [s], exact (libm sine). */
 QzsBase qzs_base_motion(const QzsPlant *plant, double t);
 /* Phase and its sine/cosine at t, rotated from `previous` or computed exactly. */
 QzsPhase qzs_advance_phase(const QzsPlant *plant, double t, QzsPhase previous, int exact);
 /* Right-hand side at t (exact base motion): derivatives and forces. */
-void qzs_rhs_at(const QzsPlant *plant, double t, const QzsOde *s, int mode, double direction,
-                const double held[3], QzsOde *deriv, QzsForces *force);
+void qzs_rhs_at(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x, int mode,
+                double direction, const double held[QZS_N_HELD], QzsOde *deriv,
+                QzsForces *force);
 /* One grid step of length h from t, locating at most one transition inside it. */
-QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, QzsOde s, int mode,
-                      int direction, const double held[3], double margin, QzsPhase phase);
+QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, QzsOde s,
+                      QzsBlocks x, int mode, int direction, const double held[QZS_N_HELD],
+                      double margin, QzsPhase phase);
+/* The sampled controller with blocks at t (kernels.sample_controller): the PI, damping,
+ * compensation (the observer advanced first) and dither computed and held, the integral
+ * advanced. */
+void qzs_sample_blocks(const QzsPlant *plant, double t, QzsOde *s, QzsBlocks *x, int mode,
+                       int direction, double held[QZS_N_HELD]);
+/* A discrete linear controller's sample at t (kernels.sample_linear): its output held, its
+ * states stepped. */
+void qzs_sample_linear(const QzsPlant *plant, double t, const QzsOde *s, QzsBlocks *x, int mode,
+                       int direction, double held[QZS_N_HELD]);
+/* The blocks' states are finite (lanes._finite_blocks). */
+int qzs_finite_blocks(const QzsBlocks *x);
 /* The measured quantities a sampled controller reads at t: z [m] and v_measured [m/s]. */
 void qzs_measure(const QzsPlant *plant, double t, const QzsOde *s, int mode, double *z,
                  double *v_measured);
@@ -99,7 +140,8 @@ int qzs_finite(const QzsPlant *plant, const QzsOde *s);
 /* Is the payload on or beyond a stop? */
 int qzs_in_contact(const QzsPlant *plant, const QzsOde *s, int mode);
 /* One output sample: channels C_* into row, flags O_* into row_flags. */
-void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, int mode, int direction,
-                const double held[3], double *row, unsigned char *row_flags, QzsPhase phase);
+void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x, int mode,
+                int direction, const double held[QZS_N_HELD], double *row,
+                unsigned char *row_flags, QzsPhase phase);
 
 #endif /* QZS_PLANT_H */

@@ -1,0 +1,64 @@
+"""The C model runs a controller with blocks as the numba kernels do, bit for bit (issue 40).
+
+Friction compensation with its observer (continuous and sampled, with a deadband), a dither,
+a continuous 2-state lead-lag and a discrete 2-state controller reading the payload's
+acceleration: every channel of :func:`qzs.simulate`, the blocks' own among them, equals the C
+closed loop's (:func:`qzs.export.cmodel.simulate_c`) to the bit, with the same stick events.
+"""
+import numpy as np
+import pytest
+from helpers import EXPORT_BLOCK_CASES as CASES
+from helpers import export_block_settings as settings
+
+import qzs
+from qzs.engine import kernels as K
+from qzs.engine.channels import BLOCK_CHANNELS, CHANNELS
+from qzs.errors import CompilerError
+from qzs.export.cmodel import simulate_c
+
+try:
+    from qzs.export.csource import load_model
+    load_model()
+except CompilerError as error:  # pragma: no cover - the machines have one
+    pytest.skip(f"no C compiler: {error}", allow_module_level=True)
+
+#: The block channel each case must move, so that it checks the code it is meant to.
+MOVES = {"compensation with observer": ("compensation_force", "friction_estimate"),
+         "sampled compensation with observer": ("compensation_force", "friction_estimate"),
+         "dither": ("dither_force",), "continuous lead-lag": ("linear_force",),
+         "discrete controller": ("linear_force",)}
+
+
+@pytest.fixture(scope="module", params=list(CASES))
+def both(request):
+    name = request.param
+    excitation, isolator, controller, _ = CASES[name]
+    kwargs = settings(name)
+    return name, qzs.simulate(excitation, isolator, controller, **kwargs), simulate_c(
+        excitation, isolator, controller, **kwargs)
+
+
+def test_every_channel_with_blocks_is_the_kernels(both):
+    name, ours, theirs = both
+    assert not theirs.diverged
+    names = [channel for channel in (*CHANNELS, *BLOCK_CHANNELS) if channel in ours.channels]
+    assert set(MOVES[name]) <= set(names)
+    for channel in names:
+        column = {**CHANNELS, **BLOCK_CHANNELS}[channel][0]
+        np.testing.assert_array_equal(theirs.data[:, column], np.asarray(ours[channel]),
+                                      err_msg=f"{name}: {channel}")
+    for channel in MOVES[name]:
+        assert np.ptp(np.asarray(ours[channel])) > 1e-3, (name, channel)  # the block acts
+    np.testing.assert_array_equal(theirs.flags[:, K.O_LOCKED], np.asarray(ours.locked))
+    assert theirs.run_flags[K.I_N_STICKS] == ours.run["stick_events"] >= 1
+    assert theirs.steps == ours.run["steps"]
+
+
+def test_the_blocks_change_the_run():
+    """The same case without its blocks gives another motion: the comparison above is not one
+    of two runs that ignore the blocks."""
+    excitation, isolator, controller, _ = CASES["compensation with observer"]
+    kwargs = settings("compensation with observer")
+    plain = simulate_c(excitation, isolator, qzs.PIDamping(), **kwargs)
+    blocks = simulate_c(excitation, isolator, controller, **kwargs)
+    assert np.abs(plain.data[:, K.C_Z] - blocks.data[:, K.C_Z]).max() > 1e-4
