@@ -22,6 +22,7 @@ from pathlib import Path
 
 from qzs import defaults
 from qzs._optional import require
+from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
 from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
@@ -273,8 +274,9 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
     if duration is None:
         duration = default_stop_time(excitation)
     communication = _communication_step(communication_step, dt, duration)
-    if controller is not None and mode == "plant":
-        controller = dataclasses.replace(controller, controller_rate=0.0)
+    if controller is not None and mode == "plant":  # the importer's controller makes the force
+        controller = dataclasses.replace(controller, controller_rate=0.0, compensation=None,
+                                         dither=None, linear=None)
     # the run resolved as qzs.simulate resolves it: its step literal or chosen, once, with the
     # communication rate as the output rate
     try:
@@ -290,7 +292,8 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
     headers = fmi_headers(fmi_version)
     variables = fmu_variables(isolator=run.isolator, controller=run.controller,
                               excitation_scalars=run.packed[0], dt=dt,
-                              solver_code=SOLVERS[solver][0], mode=mode, base_motion=base_motion)
+                              solver_code=SOLVERS[solver][0], mode=mode, base_motion=base_motion,
+                              model=run.model, blocks_state=run.state[K.A_X0:K.A_X0 + K.N_X])
     token = "{" + str(uuid.uuid4()) + "}"
     sources = (*FMU_SOURCES, INTERFACE[fmi_version])
     description = (f"qzs single-axis QZS isolator, {mode}, base motion {base_motion} "
@@ -306,7 +309,7 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
             shutil.copyfile(source_folder() / name, root / "sources" / name)
         (root / "sources" / VARIABLES_HEADER).write_text(
             variables_header(variables, mode=mode, base_motion=base_motion, token=token,
-                             step=resolved.step),
+                             step=resolved.step, model=run.model if mode == "closed-loop" else None),
             encoding="utf-8")
         if fmi_version == 3:
             (root / "sources" / "buildDescription.xml").write_text(

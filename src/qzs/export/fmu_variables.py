@@ -14,8 +14,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from qzs.engine.channels import CHANNELS, FLAGS
+from qzs.engine import kernels as K
+from qzs.engine.channels import CHANNELS, FLAGS, run_channels
 from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
+from qzs.model.sensors import SENSORS
 from qzs.model.excitation import (E_AMPLITUDE, E_DURATION, E_F0, E_F1, E_FADE, E_KIND,
                                   E_PHASE)
 from qzs.model.isolator import spring_force
@@ -38,8 +40,17 @@ UNITS = {
     "m/s": {"m": 1, "s": -1}, "m/s^2": {"m": 1, "s": -2}, "N": {"kg": 1, "m": 1, "s": -2},
     "1/m": {"m": -1}, "s/m": {"s": 1, "m": -1}, "N*s/m": {"kg": 1, "s": -1},
     "N/m": {"kg": 1, "s": -2}, "N/(m*s)": {"kg": 1, "s": -3},
-    "J": {"kg": 1, "m": 2, "s": -2},
+    "J": {"kg": 1, "m": 2, "s": -2}, "1/s": {"s": -1},
 }
+#: Where a block parameter goes in the C model's packed blocks (``K.M_*``): its index, or
+#: one of these codes plus an index (``qzs_fmu.c``).
+MODEL_TWO_PI = 1000  # the index's entry is 2*pi times the value (a frequency [Hz] as [rad/s])
+MODEL_INITIAL_STATE = 2000  # a linear controller's state at t = 0
+MODEL_SAMPLE_TIME = 3000  # a discrete linear controller's period [s], as whole steps
+#: The unit of a linear controller's feedthrough from each sensor [N per sensor unit].
+_FEEDTHROUGH_UNITS = {"position_error": "N/m", "measured_payload_velocity": "N*s/m",
+                      "payload_acceleration": "kg", "base_acceleration": "kg",
+                      "relative_velocity": "N*s/m"}
 _STOP_MODELS = {"compliant": 0, "plastic": 1}
 #: Codes of the ``solver`` parameter (qzs.engine.kernels.SOLVER_*).
 _SOLVER_DOC = "integrator: 0 euler, 1 ode3 (Bogacki-Shampine), 2 rk4"
@@ -93,6 +104,10 @@ class FmuVariable:
         Start value (parameters and inputs), None for outputs and time.
     channel : int
         The recorded channel an output shows (``K.C_*``), 100 + flag for a flag, -1 for none.
+    model : int
+        Where a controller block's parameter goes in the packed blocks (``K.M_*`` index,
+        :data:`MODEL_TWO_PI`, :data:`MODEL_INITIAL_STATE` or :data:`MODEL_SAMPLE_TIME` plus
+        an index), -1 for none.
     """
 
     name: str
@@ -103,11 +118,14 @@ class FmuVariable:
     description: str
     start: float | None
     channel: int = -1
+    model: int = -1
 
     @property
     def macro(self):
-        """Its value reference's C name (``QZS_VR_EXCITATION_F0``)."""
-        return "QZS_VR_" + self.name.upper().replace(".", "_")
+        """Its value reference's C name (``QZS_VR_EXCITATION_F0``, ``..._A_1_2`` for
+        ``a[1,2]``)."""
+        name = self.name.upper().replace(".", "_").replace("[", "_").replace(",", "_")
+        return "QZS_VR_" + name.replace("]", "")
 
 
 def _parameter_starts(isolator, controller):
@@ -142,8 +160,77 @@ def holding_force(isolator, controller):
     return float(np.clip(force, -isolator.motor_force_max, isolator.motor_force_max))
 
 
+def _block_parameters(isolator, controller, model, blocks_state):
+    """The controller blocks' parameters (rows of :func:`fmu_variables`): the compensation's
+    fraction, law, deadband and observer, the dither, a linear controller's matrices (the
+    columns of the sensors it reads), anti-windup gain, states at t = 0 and sample time."""
+    rows = []
+
+    def add(name, unit, description, start, where):
+        rows.append(dict(name=f"controller.{name}", type="F", causality="parameter",
+                         unit=unit, description=description, start=float(start), model=where))
+
+    compensation = controller.compensation
+    if compensation is not None:
+        add("compensation.fraction", "", "fraction of the friction law the motor cancels, in "
+            "[0, 1.5]", compensation.fraction, K.M_COMP_FRACTION)
+        law = compensation.law(isolator)
+        for (name, unit, doc), value, index in zip(
+                (("stiction_force", "N", "stiction force Fs'"),
+                 ("coulomb_force", "N", "Coulomb force Fc'"),
+                 ("stribeck_decay", "s/m", "Stribeck decay Cbc'"),
+                 ("viscous_damping", "N*s/m", "viscous damping Cv'")),
+                law, (K.M_COMP_FS, K.M_COMP_FC, K.M_COMP_CBC, K.M_COMP_CV)):
+            add(f"compensation.{name}", unit, f"the compensator's {doc} (exported: the plant's "
+                "where the compensation set none; it does not follow the isolator's)", value,
+                index)
+        add("compensation.deadband", "m/s", "velocity deadband of the compensation",
+            compensation.deadband, K.M_COMP_DEADBAND)
+        add("compensation.observer_bandwidth", "Hz", "friction observer bandwidth (0: none)",
+            compensation.observer_bandwidth, MODEL_TWO_PI + K.M_OBSERVER_RATE)
+    if controller.dither is not None:
+        add("dither.amplitude", "N", "dither force amplitude", controller.dither.amplitude,
+            K.M_DITHER_AMPLITUDE)
+        add("dither.frequency", "Hz", "dither frequency", controller.dither.frequency,
+            MODEL_TWO_PI + K.M_DITHER_OMEGA)
+    linear = controller.linear
+    if linear is not None:
+        n = linear.states
+        kind = "discrete: x <- A x + B u" if linear.discrete else "continuous: x' = A x + B u"
+        for i in range(n):
+            for j in range(n):
+                add(f"linear.a[{i + 1},{j + 1}]", "" if linear.discrete else "1/s",
+                    f"the linear controller's state matrix A ({kind})",
+                    model[K.M_A + i * K.NX_MAX + j], K.M_A + i * K.NX_MAX + j)
+        for sensor in linear.inputs:
+            k = list(SENSORS).index(sensor)
+            for i in range(n):
+                add(f"linear.b_{sensor}[{i + 1}]", "", f"the linear controller's input matrix "
+                    f"B, column of {sensor} (its unit: the state's per the sensor's)",
+                    model[K.M_B + i * K.N_SENSORS + k], K.M_B + i * K.N_SENSORS + k)
+        for i in range(n):
+            add(f"linear.c[{i + 1}]", "", "the linear controller's output matrix C "
+                "(force per state [N per the state's unit])", model[K.M_C + i], K.M_C + i)
+        for sensor in linear.inputs:
+            k = list(SENSORS).index(sensor)
+            add(f"linear.d_{sensor}", _FEEDTHROUGH_UNITS[sensor], "the linear controller's "
+                f"feedthrough D from {sensor}", model[K.M_D + k], K.M_D + k)
+        for i in range(n):
+            add(f"linear.antiwindup[{i + 1}]", "", "the back-calculation anti-windup gain L "
+                "(docs/model.md §5.1; exported from tracking_time)", model[K.M_ANTIWINDUP + i],
+                K.M_ANTIWINDUP + i)
+        for i in range(n):
+            add(f"linear.initial_state[{i + 1}]", "", "the linear controller's state at t = 0 "
+                "(exported: at equilibrium with its sensors, as qzs starts it; set it with the "
+                "matrices)", blocks_state[i], MODEL_INITIAL_STATE + i)
+        if linear.discrete:
+            add("linear.sample_time", "s", "the discrete linear controller's period, a whole "
+                "number of step_size", linear.sample_time, MODEL_SAMPLE_TIME)
+    return rows
+
+
 def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, mode,
-                  base_motion):
+                  base_motion, model=None, blocks_state=None):
     """The FMU's variables in value-reference order.
 
     Parameters
@@ -162,6 +249,11 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
         Motor force inside or as input.
     base_motion : {"internal", "input"}
         Base excitation inside or as inputs.
+    model : ndarray, optional
+        The controller's blocks packed for the kernels (``K.M_*``,
+        :func:`qzs.engine.prepare.pack_model`); needed when it has blocks (closed loop).
+    blocks_state : ndarray, optional
+        The blocks' states at t = 0 (``K.X_*``, as the run starts them).
 
     Returns
     -------
@@ -189,6 +281,9 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
                      start=float(dt)))
     rows.append(dict(name="solver", type="I", causality="parameter", unit="",
                      description=_SOLVER_DOC, start=float(solver_code)))
+    blocks = mode == "closed-loop" and controller.has_blocks
+    if blocks:
+        rows += _block_parameters(isolator, controller, model, blocks_state)
     if base_motion == "internal":
         for suffix, (index, registry) in EXCITATION_VARIABLES.items():
             rows.append(dict(name=f"excitation.{suffix}", type="I" if registry is None else "F",
@@ -214,7 +309,7 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
     skipped = {"time", "pi_force", "damping_force", "motor_force"} if mode == "plant" else {"time"}
     if base_motion == "input":
         skipped |= set(_BASE_INPUTS)
-    for name, (column, unit, doc) in CHANNELS.items():
+    for name, (column, unit, doc) in (run_channels(controller) if blocks else CHANNELS).items():
         if name not in skipped:
             rows.append(dict(name=name, type="F", causality="output", unit=unit,
                              description=doc, start=None, channel=column))
@@ -228,7 +323,7 @@ def _c_string(text):
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def variables_header(variables, *, mode, base_motion, token, step=None):
+def variables_header(variables, *, mode, base_motion, token, step=None, model=None):
     """``qzs_fmu_variables.h``: the variable table as C, for ``csrc/qzs_fmu.c``.
 
     Parameters
@@ -245,6 +340,9 @@ def variables_header(variables, *, mode, base_motion, token, step=None):
         How the exported ``step_size`` was chosen (:attr:`qzs.ResolvedRun.step`): the FMU
         warns of a larger step at initialisation, as one above the step chosen for accuracy
         or above the one given. Default: given (literal), ``step_size``'s start.
+    model : ndarray, optional
+        The exported controller's blocks packed (``K.M_*``): the C model's blocks, which the
+        block parameters overwrite at initialisation; None or all zeros for none.
 
     Returns
     -------
@@ -261,6 +359,9 @@ def variables_header(variables, *, mode, base_motion, token, step=None):
     names = ",\n".join(f"    {_c_string(v.name)}" for v in variables)
     causality = "".join("t" if v.causality == "independent" else v.causality[0]
                         for v in variables)
+    blocks = model is not None and model[K.M_BLOCKS] != 0.0
+    base = ", ".join(repr(float(value)) for value in (model if blocks else [0.0]))
+    where = ", ".join(str(v.model) for v in variables)
     return (
         "/* qzs_fmu_variables.h: written by qzs at export; the FMU's variables by value\n"
         " * reference (types F Float64, I Int32, B Boolean; causality t time, p parameter,\n"
@@ -273,11 +374,19 @@ def variables_header(variables, *, mode, base_motion, token, step=None):
         f"#define QZS_FMU_EXPORTED_STEP {float(exported)!r}\n"
         f"#define QZS_FMU_STEP_CHOSEN {int(chosen)}\n"
         f"#define QZS_FMU_STEP_HOW {_c_string(how)}\n"
-        f"#define QZS_FMU_MIN_STEPS_PER_PERIOD {MIN_STEPS_PER_PERIOD}\n\n"
+        f"#define QZS_FMU_MIN_STEPS_PER_PERIOD {MIN_STEPS_PER_PERIOD}\n"
+        f"#define QZS_FMU_BLOCKS {int(blocks)}\n"
+        f"#define QZS_FMU_MODEL_TWO_PI {MODEL_TWO_PI}\n"
+        f"#define QZS_FMU_MODEL_INITIAL_STATE {MODEL_INITIAL_STATE}\n"
+        f"#define QZS_FMU_MODEL_SAMPLE_TIME {MODEL_SAMPLE_TIME}\n\n"
         f"enum {{\n{enum}\n}};\n\n"
         f"static const char QZS_FMU_TYPES[] = {_c_string(''.join(v.type for v in variables))};\n"
         f"static const char QZS_FMU_CAUSALITY[] = {_c_string(causality)};\n"
         f"static const double QZS_FMU_START[] = {{{starts}}};\n"
         f"static const int QZS_FMU_CHANNEL[] = {{{channels}}};\n"
+        "/* the controller's blocks as exported (QZS_M_*; unused without blocks), and where\n"
+        " * each block parameter goes in them (-1: none) */\n"
+        f"static const double QZS_FMU_MODEL_BASE[] = {{{base}}};\n"
+        f"static const int QZS_FMU_MODEL[] = {{{where}}};\n"
         f"static const char *const QZS_FMU_NAMES[] = {{\n{names}\n}};\n\n"
         "#endif /* QZS_FMU_VARIABLES_H */\n")

@@ -214,10 +214,58 @@ static int pack_parameters(QzsFmu *fmu, double *P) {
     return QZS_FMU_OK;
 }
 
+#if QZS_FMU_BLOCKS
+/* The controller's blocks packed as qzs.engine.prepare.pack_model packs them: the exported
+ * ones, each block parameter put in its place (a frequency as 2*pi times it, a discrete
+ * period as whole steps, checked), and the linear controller's states at t = 0 into x0. */
+static int pack_model(QzsFmu *fmu, double *M, double *x0) {
+    memcpy(M, QZS_FMU_MODEL_BASE, sizeof(double) * QZS_N_MODEL);
+    for (int i = 0; i < QZS_N_X; i++)
+        x0[i] = 0.0;
+    for (int i = 0; i < QZS_FMU_N_VARIABLES; i++) {
+        int where = QZS_FMU_MODEL[i];
+        double value = fmu->values[i];
+        if (where < 0)
+            continue;
+        if (where < QZS_N_MODEL) {
+            M[where] = value;
+        } else if (where < QZS_FMU_MODEL_INITIAL_STATE) {
+            M[where - QZS_FMU_MODEL_TWO_PI] = 2 * 3.141592653589793 * value;
+        } else if (where < QZS_FMU_MODEL_SAMPLE_TIME) {
+            x0[where - QZS_FMU_MODEL_INITIAL_STATE] = value;
+        } else { /* qzs.engine.prepare.pack_model: a whole number of steps */
+            double steps = value / V(STEP_SIZE);
+            double whole = floor(steps + 0.5);
+            if (fabs(steps - whole) > 1e-6 * steps || whole < 1.0) {
+                qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                            "`%s` = %g s must be a whole number of integration steps "
+                            "(step_size = %g s), got %g steps; e.g. %g s",
+                            QZS_FMU_NAMES[i], value, V(STEP_SIZE), steps,
+                            (whole < 1.0 ? 1.0 : whole) * V(STEP_SIZE));
+                return QZS_FMU_ERROR;
+            }
+            M[QZS_M_LINEAR_STEPS] = whole;
+        }
+    }
+    if (!(M[QZS_M_COMP_FRACTION] >= 0.0 && M[QZS_M_COMP_FRACTION] <= 1.5) ||
+        !(M[QZS_M_COMP_DEADBAND] >= 0.0) || !(M[QZS_M_OBSERVER_RATE] >= 0.0) ||
+        !(M[QZS_M_COMP_FS] >= 0.0) || !(M[QZS_M_COMP_FC] >= 0.0) ||
+        !(M[QZS_M_COMP_CBC] >= 0.0) || !(M[QZS_M_DITHER_OMEGA] >= 0.0)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "the controller's blocks: controller.compensation.fraction must lie in "
+                    "[0, 1.5], its deadband, observer bandwidth and friction law and "
+                    "controller.dither.frequency must be >= 0; set them so before "
+                    "initialisation ends");
+        return QZS_FMU_ERROR;
+    }
+    return QZS_FMU_OK;
+}
+#endif
+
 /* The initial state, as qzs.engine.prepare._initial_state makes it by default: at rest at the
  * setpoint, the high-pass settled, the PI preloaded with the static load, stuck if friction
  * can hold the payload. */
-static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
+static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t *flags) {
     const QzsPlant *plant = &fmu->run.plant;
     const double *P = plant->P;
     memset(state, 0, sizeof(double) * QZS_N_STATE);
@@ -235,7 +283,8 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
         x.x[j] = 0.0;
     QzsForces force;
 #if QZS_FMU_PLANT_MODE
-    held[2] = V(MOTOR_FORCE);
+    held[QZS_H_MOTOR] = V(MOTOR_FORCE);
+    (void)x0;
 #else
     qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
     double measured = force.v_measured;
@@ -249,12 +298,35 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
         double needed = without_motor < -f_max ? -f_max : (without_motor > f_max ? f_max
                                                                                  : without_motor);
         QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, 0.0);
-        s.x[QZS_S_INT] = (needed - c.pi - c.damping) / V(CONTROLLER_PI_KI);
+        if (plant->blocks) /* the blocks' static output at t = 0 too */
+            s.x[QZS_S_INT] = (needed - c.pi - c.damping -
+                              (force.compensation + force.dither + force.linear)) /
+                             V(CONTROLLER_PI_KI);
+        else
+            s.x[QZS_S_INT] = (needed - c.pi - c.damping) / V(CONTROLLER_PI_KI);
     }
+    for (int j = 0; j < QZS_N_X; j++) /* prepare._preload_linear, as exported */
+        x.x[j] = x0[j];
     QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, s.x[QZS_S_INT]);
-    held[0] = c.pi;
-    held[1] = c.damping;
-    held[2] = c.motor;
+    held[QZS_H_PI] = c.pi;
+    held[QZS_H_DAMP] = c.damping;
+    held[QZS_H_MOTOR] = c.motor;
+    if (plant->blocks) { /* prepare._hold_blocks: what the sampled blocks put out at t = 0 */
+        const double *M = plant->M;
+        qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
+        held[QZS_H_COMPENSATION] = force.compensation;
+        held[QZS_H_DITHER] = force.dither;
+        if (M[QZS_M_LINEAR_STEPS] > 0.0) {
+            double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s.x[QZS_S_Z], force.v_measured,
+                                       force.xdd, force.ydd, 0.0};
+            double cx = 0.0, du = 0.0;
+            for (int j = 0; j < QZS_NX_MAX; j++)
+                cx += M[QZS_M_C + j] * x.x[j];
+            for (int k = 0; k < QZS_N_SENSORS; k++)
+                du += M[QZS_M_D + k] * u[k];
+            held[QZS_H_LINEAR] = cx + du;
+        }
+    }
 #endif
     qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
     int locked = P[QZS_P_VREG] == 0.0 && fabs(force.hold) <= P[QZS_P_FS];
@@ -262,9 +334,14 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
     flags[QZS_I_DIRECTION] = force.hold > 0.0 ? -1 : 1;
     for (int j = 0; j < QZS_N_ODE; j++)
         state[j] = s.x[j];
-    state[QZS_A_F_PI] = held[0];
-    state[QZS_A_F_DAMP] = held[1];
-    state[QZS_A_F_MOTOR] = held[2];
+    for (int j = 0; j < QZS_N_X; j++)
+        state[QZS_A_X0 + j] = x.x[j];
+    state[QZS_A_F_PI] = held[QZS_H_PI];
+    state[QZS_A_F_DAMP] = held[QZS_H_DAMP];
+    state[QZS_A_F_MOTOR] = held[QZS_H_MOTOR];
+    state[QZS_A_F_COMPENSATION] = held[QZS_H_COMPENSATION];
+    state[QZS_A_F_DITHER] = held[QZS_H_DITHER];
+    state[QZS_A_F_LINEAR] = held[QZS_H_LINEAR];
 }
 
 /* The outputs: the recorded channels of the run's state at fmu->time. */
@@ -425,10 +502,18 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
     E[QZS_E_PHASE] = V(EXCITATION_PHASE);
     E[QZS_E_FADE] = V(EXCITATION_FADE_IN);
 #endif
+    double x0[QZS_N_X] = {0.0};
+#if QZS_FMU_BLOCKS
+    double M[QZS_N_MODEL];
+    if (pack_model(fmu, M, x0) != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    qzs_plant_init(&fmu->run.plant, P, M, E, fmu->table, 2);
+#else
     qzs_plant_init(&fmu->run.plant, P, NULL, E, fmu->table, 2);
+#endif
     double state[QZS_N_STATE];
     int64_t flags[QZS_N_FLAGS];
-    initial_state(fmu, state, flags);
+    initial_state(fmu, x0, state, flags);
     qzs_run_start(&fmu->run, (int)V(SOLVER), state, flags);
 #if QZS_FMU_PLANT_MODE
     fmu->run.sampled = 0;
