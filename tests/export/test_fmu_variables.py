@@ -114,7 +114,7 @@ def test_the_motor_force_starts_where_the_kernels_hold_the_payload_at_rest():
         state = run.state.copy()
         state[K.A_F_PI] = state[K.A_F_DAMP] = 0.0
         state[K.A_F_MOTOR] = hold
-        force = K.hold_force(0.0, state, run.params, *run.packed)
+        force = K.hold_force(0.0, state, run.params, run.model, *run.packed)
         assert abs(force[K.F_HOLD]) < 1e-12 * isolator.mass * isolator.gravity, mass
     limited = qzs.IsolatorParameters(mass=9.0, motor_force_max=5.0)
     assert holding_force(limited, qzs.ControllerParameters()) == 5.0
