@@ -180,6 +180,17 @@ EXPORT_BLOCK_CASES = {
 }
 
 
+def run_both(cases, settings, name):
+    """``(name, qzs.simulate's run, the C model's run)`` of case ``name`` of ``cases`` (its
+    settings from ``settings(name)``): what the C model's tests compare."""
+    from qzs.export.cmodel import simulate_c
+
+    excitation, isolator, controller, _ = cases[name]
+    kwargs = settings(name)
+    return name, qzs.simulate(excitation, isolator, controller, **kwargs), simulate_c(
+        excitation, isolator, controller, **kwargs)
+
+
 def export_block_settings(case):
     """The run settings of a case with blocks: :data:`EXPORT_SETTINGS` updated by its own."""
     return {**EXPORT_SETTINGS, **EXPORT_BLOCK_CASES[case][3]}

@@ -9,6 +9,7 @@ in the C too fails here.
 import numpy as np
 import pytest
 from helpers import EXPORT_CASES as CASES
+from helpers import run_both
 from helpers import export_settings as settings
 
 import qzs
@@ -31,11 +32,7 @@ EXPECTED_EVENTS = {"plastic stops": ("stop_contacts", 2), "compliant stops": ("s
 
 @pytest.fixture(scope="module", params=list(CASES))
 def both(request):
-    name = request.param
-    excitation, isolator, controller, _ = CASES[name]
-    kwargs = settings(name)
-    return name, qzs.simulate(excitation, isolator, controller, **kwargs), simulate_c(
-        excitation, isolator, controller, **kwargs)
+    return run_both(CASES, settings, request.param)
 
 
 def test_every_channel_is_the_kernels(both):

@@ -8,6 +8,7 @@ closed loop's (:func:`qzs.export.cmodel.simulate_c`) to the bit, with the same s
 import numpy as np
 import pytest
 from helpers import EXPORT_BLOCK_CASES as CASES
+from helpers import run_both
 from helpers import export_block_settings as settings
 
 import qzs
@@ -31,11 +32,7 @@ MOVES = {"compensation with observer": ("compensation_force", "friction_estimate
 
 @pytest.fixture(scope="module", params=list(CASES))
 def both(request):
-    name = request.param
-    excitation, isolator, controller, _ = CASES[name]
-    kwargs = settings(name)
-    return name, qzs.simulate(excitation, isolator, controller, **kwargs), simulate_c(
-        excitation, isolator, controller, **kwargs)
+    return run_both(CASES, settings, request.param)
 
 
 def test_every_channel_with_blocks_is_the_kernels(both):
