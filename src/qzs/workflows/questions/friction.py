@@ -52,19 +52,22 @@ FRACTIONS = {False: (0.0, 0.25, 0.5, 0.75, 1.0, 1.1, 1.25, 1.4, 1.5),
 #: cycle's velocity amplitude and frequency when ``breakaway_ratio > 1.5`` and
 #: ``distortion < 0.03``.
 DF_TOLERANCE = {"relative": 0.02, "breakaway_ratio": 1.5, "distortion": 0.03}
-#: Shares of the penalty for the verdict: "yes" from the first, "partly" from the second.
+#: Shares of the penalty for the verdict, of the smaller of the two (T over the band, the
+#: isolation onset): "yes" from the first, "partly" from the second.
 SHARES = (0.8, 0.2)
 #: Peak-to-peak relative position [m] in the second half of a run at rest above which the
 #: payload hunts (it does not come to rest).
 HUNT_STROKE = 2e-4
 #: The loops the hunting boundary is predicted and simulated on: name -> (isolator,
-#: controller without compensation). The paper's, and a stiff one without the amplifier's
-#: high-pass where the payload slides through its reversals (docs/model.md §5.1).
+#: controller without compensation, options of its FrictionCompensation). The paper's, and a
+#: stiff one without the amplifier's high-pass whose compensation takes the whole law (its
+#: viscous part too), where the payload slides through its reversals (docs/model.md §5.1).
 HUNTING_RIGS = {
-    "paper loop": (IsolatorParameters(), ControllerParameters()),
-    "stiff loop (Kp = 2000 N/m, Kd = 60 N*s/m, Fs = 2 N)": (
+    "paper loop": (IsolatorParameters(), ControllerParameters(), {}),
+    "stiff loop (Kp = 2000 N/m, Kd = 60 N*s/m, Fs = 2 N, the whole law)": (
         IsolatorParameters(stiction_force=2.0),
-        ControllerParameters(pi_kp=2000.0, damping_gain=60.0, velocity_highpass=0.0)),
+        ControllerParameters(pi_kp=2000.0, damping_gain=60.0, velocity_highpass=0.0),
+        {"viscous_damping": None}),
 }
 
 
@@ -87,7 +90,7 @@ def plan(quick=False, dt=1e-4):
                      sample_rate=200.0, fft_length=fft, dt=dt)
 
 
-def compensated(controller, fraction):
+def compensated(controller, fraction, **options):
     """``controller`` with a compensation of ``fraction``; 0 adds no block at all.
 
     Parameters
@@ -96,6 +99,8 @@ def compensated(controller, fraction):
         The loop without compensation.
     fraction : float
         Fraction of the friction law compensated [-], in [0, 1.5].
+    **options
+        Other fields of the :class:`~qzs.FrictionCompensation`.
 
     Returns
     -------
@@ -103,10 +108,10 @@ def compensated(controller, fraction):
     """
     if fraction == 0:
         return controller
-    return controller + FrictionCompensation(fraction=fraction)
+    return controller + FrictionCompensation(fraction=fraction, **options)
 
 
-def hunting_boundary(isolator, controller, high=1.5, tolerance=5e-3):
+def hunting_boundary(isolator, controller, high=1.5, tolerance=5e-3, options=None):
     """The smallest compensation fraction with a stable sliding cycle, by bisection [-].
 
     Parameters
@@ -119,6 +124,8 @@ def hunting_boundary(isolator, controller, high=1.5, tolerance=5e-3):
         The largest fraction looked at [-].
     tolerance : float
         Width of the final bracket [-].
+    options : dict, optional
+        Other fields of the :class:`~qzs.FrictionCompensation`.
 
     Returns
     -------
@@ -126,7 +133,8 @@ def hunting_boundary(isolator, controller, high=1.5, tolerance=5e-3):
         The fraction; NaN if none up to ``high`` hunts.
     """
     def hunts(a):
-        return predict_sliding_cycle(isolator, compensated(controller, a)).hunts
+        return predict_sliding_cycle(isolator, compensated(controller, a,
+                                                           **(options or {}))).hunts
 
     if not hunts(high):
         return math.nan
@@ -218,8 +226,8 @@ def _hunting_rows(fractions, quick, dt, workers):
 
     def one(task):
         rig, a = task
-        isolator, controller = HUNTING_RIGS[rig]
-        loop = compensated(controller, a)
+        isolator, controller, options = HUNTING_RIGS[rig]
+        loop = compensated(controller, a, **options)
         prediction = predict_sliding_cycle(isolator, loop)
         return prediction, released_run(isolator, loop, prediction, duration=duration, dt=dt)
 
@@ -255,10 +263,10 @@ def _hunting_rows(fractions, quick, dt, workers):
                     "the simulated run has no cycle to measure")
             rows.append(row)
     boundaries = {}
-    for rig, (isolator, controller) in HUNTING_RIGS.items():
+    for rig, (isolator, controller, options) in HUNTING_RIGS.items():
         simulated = [r["fraction"] for r in rows if r["rig"] == rig and r["simulated_hunts"]]
         boundaries[rig] = {"predicted": hunting_boundary(isolator, controller,
-                                                         high=max(fractions)),
+                                                         high=max(fractions), options=options),
                            "simulated": min(simulated) if simulated else math.nan}
     return rows, boundaries
 
@@ -361,7 +369,7 @@ def run_friction_study(quick=False, *, dt=1e-4, workers=None, progress=False):
                              "1e-4.", "dt")
     fractions = FRACTIONS[bool(quick)]
     chirp = plan(quick, dt)
-    isolator, controller = HUNTING_RIGS["paper loop"]
+    isolator, controller, _ = HUNTING_RIGS["paper loop"]
     smooth = dataclasses.replace(isolator, stiction_force=isolator.coulomb_force)
     labels = [f"a = {a:g}" for a in fractions] + ["without stiction (Fs = Fc)"]
     cases = [(isolator, compensated(controller, a)) for a in fractions] + [(smooth, controller)]
