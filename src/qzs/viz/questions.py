@@ -74,7 +74,7 @@ def plot_friction_hunting(rows):
                     label=f"{rig}: predicted")
             ax.plot(a, simulated, "o", color=f"C{i}", label=f"{rig}: simulated")
             regime = [r["in_tolerance_regime"] for r in mine]
-            ax.plot(a[regime], predicted[regime], "*", color="k", ms=9,
+            ax.plot(a[regime], predicted[regime], "*", color="k", ms=13, mfc="none",
                     label="in the stated range" if i == 0 and key == "frequency" else None)
     fractions = [r["fraction"] for r in rows]
     axes[1].set_xlim(min(fractions) - 0.05, max(fractions) + 0.05)

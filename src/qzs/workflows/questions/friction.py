@@ -325,7 +325,7 @@ def friction_answer(table, reference, hunting, boundary):
     hunt_text = ("it starts to hunt at rest at a = " + (f"{simulated:g}" if finite(simulated)
                                                         else "none of those run")
                  + " (simulated), the describing function predicts a sliding cycle from a = "
-                 + (f"{predicted:.3g}" if finite(predicted) else "none") + ")")
+                 + (f"{predicted:.3g}" if finite(predicted) else "none"))
     answer = (f"{'Most' if label == 'yes' else 'Some' if label == 'partly' else 'Little'} of "
               f"it: compensating a = {best['fraction']:g} of the friction law removes "
               f"{share:.0%} of the stiction penalty on T over {BAND[0]:g}-{BAND[1]:g} Hz"
