@@ -19,3 +19,12 @@ def test_the_band_transmissibility_is_the_rms_over_the_trusted_bins():
     trusted = np.array([True, True, True, False, True])
     curve = CaseCurve("c", f, t, trusted)
     assert band_transmissibility(curve, (1.0, 3.0)) == pytest.approx(math.sqrt((9 + 16) / 2))
+
+
+@pytest.mark.parametrize("dt", [0.0, -1e-4, float("nan"), "1e-4", True])
+def test_a_bad_step_is_refused_naming_dt(dt):
+    from qzs.errors import ParameterError
+    from qzs.workflows.questions.common import check_step
+
+    with pytest.raises(ParameterError, match="`dt`"):
+        check_step(dt)

@@ -13,7 +13,7 @@ import numpy as np
 from qzs.analysis.damping import band_rms
 from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
 from qzs.defaults import ANALYSIS
-from qzs.errors import SimulationError
+from qzs.errors import ParameterError, SimulationError
 
 __all__ = ["Answer", "ChirpPlan", "CaseCurve", "run_chirp_cases", "band_transmissibility"]
 
@@ -180,3 +180,22 @@ def run_chirp_cases(labels, cases, plan, *, workers=None, progress=False):
 def finite(*values):
     """All ``values`` are finite numbers."""
     return all(isinstance(v, (int, float, np.floating)) and math.isfinite(v) for v in values)
+
+
+def check_step(dt):
+    """Refuse an integration step that is not a positive finite number of seconds.
+
+    Parameters
+    ----------
+    dt : float
+        The step [s].
+
+    Raises
+    ------
+    ParameterError
+        Naming ``dt``, its value and the paper's step.
+    """
+    if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and math.isfinite(dt)
+                                    and dt > 0):
+        raise ParameterError(f"`dt` must be a positive step [s], got {dt!r}; the paper's is "
+                             "1e-4.", "dt")

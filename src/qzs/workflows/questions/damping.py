@@ -34,11 +34,11 @@ import numpy as np
 from qzs.analysis.damping import damping_change
 from qzs.analysis.linear import close_loop, continuous_controller_matrices, plant_matrices
 from qzs.defaults import DAMPING_CLAIM
-from qzs.errors import ParameterError
 from qzs.model.controller import SENSORS, ControllerParameters, LinearController
 from qzs.model.excitation import Chirp
 from qzs.model.isolator import IsolatorParameters
-from qzs.workflows.questions.common import Answer, ChirpPlan, finite, run_chirp_cases
+from qzs.workflows.questions.common import (Answer, ChirpPlan, check_step, finite,
+                                            run_chirp_cases)
 
 __all__ = ["QUESTION", "STATEMENT", "PAPER_GAINS", "plan", "linear_responses",
            "shaped_skyhook", "base_cancellation", "design_loops", "damping_answer",
@@ -320,9 +320,7 @@ def run_damping_study(quick=False, *, dt=1e-4, workers=None, progress=False):
         linear evidence), ``linear`` (each case's linear transmissibility), ``answer``,
         ``plan``.
     """
-    if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"`dt` must be a positive step [s], got {dt!r}; the paper's is "
-                             "1e-4.", "dt")
+    check_step(dt)
     chirp = plan(quick, dt)
     isolator, controller = IsolatorParameters(), ControllerParameters()
     designs = design_loops(isolator, controller, chirp.excitation)

@@ -29,12 +29,11 @@ import numpy as np
 
 from qzs.analysis.control_design.describing_functions import predict_sliding_cycle
 from qzs.engine.simulate import simulate
-from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters, FrictionCompensation
 from qzs.model.excitation import Chirp, Sine
 from qzs.model.isolator import InitialState, IsolatorParameters
-from qzs.workflows.questions.common import (Answer, ChirpPlan, band_transmissibility, finite,
-                                            run_chirp_cases)
+from qzs.workflows.questions.common import (Answer, ChirpPlan, band_transmissibility, check_step,
+                                            finite, run_chirp_cases)
 
 __all__ = ["QUESTION", "STATEMENT", "BAND", "FRACTIONS", "plan", "compensated",
            "hunting_boundary", "released_run", "measure_cycle", "friction_answer",
@@ -364,9 +363,7 @@ def run_friction_study(quick=False, *, dt=1e-4, workers=None, progress=False):
         (:class:`CaseCurve` per case, the reference last), ``hunting`` (rows per rig and
         fraction), ``boundaries``, ``answer`` (:class:`Answer`), ``plan``.
     """
-    if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ParameterError(f"`dt` must be a positive step [s], got {dt!r}; the paper's is "
-                             "1e-4.", "dt")
+    check_step(dt)
     fractions = FRACTIONS[bool(quick)]
     chirp = plan(quick, dt)
     isolator, controller, _ = HUNTING_RIGS["paper loop"]
