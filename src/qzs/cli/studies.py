@@ -22,7 +22,9 @@ def add_parsers(subparsers):
         cmd = subparsers.add_parser(name, help=text, description=text)
         if name == "study":
             cmd.add_argument("definition", metavar="FILE.toml",
-                             help="study file, or a shipped study name (e.g. stiction)")
+                             help="study file, or a shipped study name (e.g. stiction); or "
+                                  "one of the paper's open questions: friction_compensation, "
+                                  "damping_design (`qzs docs questions`)")
         cmd.add_argument("--quick", action="store_true",
                          help="shorter runs (fewer, shorter Welch segments)")
         step = cmd.add_mutually_exclusive_group()
@@ -61,7 +63,11 @@ def run(args):
     """
     from qzs.workflows.paper.report import paper_summary, run_paper
     from qzs.workflows.paper.report_step import step_statement
+    from qzs.workflows.questions import QUESTIONS
 
+    if args.command == "study" and args.definition in QUESTIONS \
+            and not Path(args.definition).exists():
+        return _question(args)
     if args.out is None:  # qzs study: the study's own folder, so that two never share one
         args.out = f"results/{Path(args.definition).stem}"
     check_output(args, "--out", args.out, suffixes=None, directory=True)
@@ -82,4 +88,30 @@ def run(args):
                  "their curves (<study>_curves.nc, .csv, .mat)")
     emit(args, "\n".join(lines),
          paper_summary(results, verdicts, args.out, quick=args.quick, wall_seconds=wall))
+    return 0
+
+
+def _question(args):
+    """``qzs study friction_compensation`` or ``damping_design``: an open question's study."""
+    from qzs.errors import ParameterError
+    from qzs.workflows.questions import run_question
+
+    if args.tolerance is not None:
+        raise ParameterError(f"--tolerance {args.tolerance!r}: the study {args.definition!r} "
+                             "runs at one given step; give --dt S instead (default 1e-4 s).",
+                             "--tolerance")
+    if args.out is None:
+        args.out = f"results/{args.definition}"
+    check_output(args, "--out", args.out, suffixes=None, directory=True)
+    result, written, wall = run_question(args.definition, args.out, quick=args.quick,
+                                         dt=1e-4 if args.dt is None else args.dt,
+                                         workers=args.workers,
+                                         progress=not args.quiet and not args.json)
+    answer = result["answer"]
+    lines = [f"{args.definition}: wall {wall:.1f} s", f"  [{answer.label}] {answer.answer}",
+             f"      {answer.evidence}",
+             "wrote " + ", ".join(str(path) for path in written.values())]
+    emit(args, "\n".join(lines), {"study": args.definition, "quick": args.quick,
+                                   "wall_seconds": wall, "answer": answer.to_dict(),
+                                   "files": {k: str(v) for k, v in written.items()}})
     return 0

@@ -14,6 +14,7 @@
 ``hexapod_matrix``    the six-axis platform's 6x6 transmissibility as a grid
 ``hexapod_study``     the hexapod study's cases side by side
 ``sensitivity``       Sobol and Morris indices as bars with their intervals
+``questions``         the paper's open questions: compensation fraction, damping loops
 ====================  ================================================================
 """
 from qzs.viz.figures import envelope, new_figure, save_figure

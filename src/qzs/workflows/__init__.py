@@ -19,5 +19,7 @@
                     design, Sobol and Morris indices (``problem_files/``)
 ``hexapod``         ``qzs hexapod``: six-axis set-ups (``hexapod_files/``), the platform's 6x6
                     transmissibility, the six-leg study
+``questions``       ``qzs study friction_compensation``, ``damping_design``: the paper's two
+                    open questions answered, each with one verdict
 ==================  ==========================================================================
 """
