@@ -166,6 +166,18 @@ def test_a_stop_time_at_the_start_time_is_refused(fmus, version):
     fmu.free()
 
 
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_start_time_other_than_zero_is_refused(fmus, version):
+    """qzs runs start at t = 0 (the excitation's phase, the grid): an experiment from 1 s is
+    refused at initialisation, through FMI 3's enterInitializationMode and FMI 2's
+    setupExperiment alike."""
+    fmu = Logged(fmus("chirp-linear", version=version), version)
+    fmu.enter(start_time=1.0)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "start time must be 0 s" in message and "got 1 s" in message
+    fmu.free()
+
+
 # ---------------------------------------------------------------- communication steps
 def test_one_internal_step_per_communication_is_the_run_to_the_bit(fmus):
     result = simulate_fmu(str(fmus("chirp-linear")), stop_time=0.5, output_interval=DT)
@@ -499,7 +511,8 @@ def test_a_sine_neither_requires_nor_checks_a_chirps_parameters(fmus, version):
 
 def test_what_qzs_takes_at_a_bound_the_fmu_takes(fmus):
     """The bounds themselves: amplitude 0 (a base at rest: every base output stays 0) and a
-    fade-in as long as the sweep, both taken by qzs.Chirp, are taken by the FMU."""
+    fade-in as long as the sweep, both taken by qzs.Chirp, and no velocity high-pass (0 Hz),
+    taken by qzs.ControllerParameters, are taken by the FMU."""
     path = fmus("chirp-linear")
     qzs.Chirp(amplitude=0.0)
     fmu = started(path, excitation__amplitude=0.0)
@@ -508,5 +521,9 @@ def test_what_qzs_takes_at_a_bound_the_fmu_takes(fmus):
     fmu.free()
     qzs.Chirp(duration=CHIRP.duration, fade_in=CHIRP.duration)
     fmu = started(path, excitation__fade_in=CHIRP.duration)
+    fmu.fmu.doStep(0.0, 0.1)
+    fmu.free()
+    qzs.ControllerParameters(velocity_highpass=0.0)
+    fmu = started(path, controller__velocity_highpass=0.0)
     fmu.fmu.doStep(0.0, 0.1)
     fmu.free()
