@@ -271,6 +271,27 @@ def test_the_sampled_controller_is_qzs_at_communication_steps_below_the_internal
     assert difference < 1e-6 * np.ptp(ours), difference / np.ptp(ours)
 
 
+def test_base_inputs_between_grid_points_hold_from_the_communication_point(fmus):
+    """A base in uniform acceleration, y = a t^2 / 2, fed as inputs at communication points
+    0.73 internal steps apart: the FMU's quadratic from each point (displacement, velocity,
+    acceleration given, no jerk) is the motion itself, so the base under the payload at the
+    next point (x - z, and its rate) is a t^2 / 2 and a t there (closed form), wherever the
+    points fall on the grid."""
+    path = fmus("input")
+    h, a, stop = 7.3e-5, 1.0, 0.05
+    times = np.arange(int(stop / h) + 1) * h
+    signal = np.array(list(zip(times, 0.5 * a * times ** 2, a * times, a + 0 * times)),
+                      dtype=[("time", float), ("base_displacement", float),
+                             ("base_velocity", float), ("base_acceleration", float)])
+    result = simulate_fmu(str(path), stop_time=times[-1], output_interval=h, input=signal)
+    t = np.asarray(result["time"])
+    assert np.sum(np.abs(t / DT - np.round(t / DT)) > 0.1) > 400  # most inside a grid step
+    base = result["payload_displacement"] - result["relative_position"]  # x - z = y
+    base_velocity = result["payload_velocity"] - result["relative_velocity"]
+    np.testing.assert_allclose(base, 0.5 * a * t ** 2, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(base_velocity, a * t, rtol=0, atol=1e-12)
+
+
 # ---------------------------------------------------------------- the internal step
 def test_a_step_qzs_would_refuse_is_refused_at_initialisation_and_a_coarser_one_warned(fmus):
     """The default configuration is stable up to 6.05 ms (ode3): 1 cm steps are refused with
