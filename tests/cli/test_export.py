@@ -146,6 +146,7 @@ def test_the_issues_sine_fmu_starts_and_is_qzs_simulate(tmp_path, capsys):
     (["--duration", "-2"], "--duration", "-2.0"),
     (["--tolerance", "0"], "--tolerance", "0.0"),
     (["--excitation-duration", "4", "--step", "5"], "--step", "5.0"),
+    (["--excitation-duration", "4", "--duration", "2", "--step", "3"], "--duration", "2.0 s"),
     (["--excitation", "sine", "--frequency", "3", "--dt", "0.05"], "--dt", "0.05"),
     (["--excitation", "sine", "--frequency", "40", "--dt", "5e-3"], "--frequency", "40 Hz"),
 ])
@@ -164,6 +165,20 @@ def test_export_fmu_bad_input_names_the_flag_before_any_work(argv, flag, value, 
     assert f"`{flag}`" in line and value in line, line
     assert "sample_rate" not in line and "communication_step" not in line
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_bad_value_from_the_configuration_file_is_named_as_its_key_there(tmp_path, capsys):
+    """`[simulation] dt = 0.05` in the --config file (unstable): exit 2, the message names
+    the file's key, not a --dt the user never typed; nothing is written."""
+    config = tmp_path / "run.toml"
+    config.write_text("[simulation]\ndt = 0.05\n")
+    out = tmp_path / "iso.fmu"
+    assert main(["export", "fmu", "--config", str(config), "--excitation", "sine",
+                 "--frequency", "3", "--out", str(out)]) == 2
+    line = next(text for text in capsys.readouterr().err.splitlines()
+                if text.startswith("qzs: error:"))
+    assert f"`[simulation] dt of {config}` (0.05 s)" in line and "`--dt`" not in line, line
+    assert not out.exists()
 
 
 def test_a_communication_step_that_is_no_multiple_of_the_internal_step_is_taken(tmp_path,

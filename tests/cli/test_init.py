@@ -157,10 +157,19 @@ class Teardown:
         sys.stdout.write("torn down\n")
 kept = Teardown()  # freed only by the interpreter's teardown of this module
 atexit.register(lambda: sys.stdout.write("exit handler ran"))  # no newline: no line flush
-if "--thread" in sys.argv:
+import qzs.cli
+if "--thread" in sys.argv:  # a thread still running when the command has returned
     sys.argv.remove("--thread")
-    threading.Thread(target=lambda: (time.sleep(0.5), sys.stdout.write("thread joined\n"))
-                     ).start()
+    returned, command = threading.Event(), qzs.cli.main
+    def main(*args, **kwargs):
+        try:
+            return command(*args, **kwargs)
+        finally:
+            qzs.cli.main = command  # nothing of this script's kept by qzs past here
+            returned.set()
+    qzs.cli.main = main
+    threading.Thread(target=lambda: (returned.wait(), time.sleep(0.3),
+                                     sys.stdout.write("thread joined\n"))).start()
 from qzs.cli import console
 sys.argv[0] = "qzs"
 console()

@@ -123,8 +123,9 @@ def test_every_driver_raises_the_same_memory_error(monkeypatch):
 class _Counting(driver.Stepper):
     """A stepper of a fake kernel: the state is the step count; one sample every 3 steps."""
 
-    def __init__(self, buffers, fail_at=None):
+    def __init__(self, buffers, fail_at=None, flag=lambda step: step % 2 == 0):
         self.buffers, self.step, self.fail_at, self.calls = buffers, 0, fail_at, []
+        self.flag = flag
 
     def advance(self, steps, buffer, row0):
         self.calls.append(steps)
@@ -137,7 +138,7 @@ class _Counting(driver.Stepper):
                 return row - row0
             if self.step % 3 == 0:
                 data[row] = self.step
-                marks[row] = self.step % 2 == 0
+                marks[row] = self.flag(self.step)
                 row += 1
         return row - row0
 
@@ -145,12 +146,12 @@ class _Counting(driver.Stepper):
         return qzs.SimulationError(f"failed at {self.step}")
 
 
-def _fake_run(steps, *, sink=None, chunk=256 * 3, fail_at=None, statistics=None):
+def _fake_run(steps, *, sink=None, chunk=256 * 3, fail_at=None, statistics=None, **stepper):
     plan = driver.RunPlan(steps=steps, decimation=3, samples=steps // 3 + 1, chunk=chunk)
     seen = []
     recorder = driver.Recorder(plan, 1, 1, statistics=statistics or (lambda d, f: seen.append(
         d.copy())), sink=sink)
-    stepper = _Counting(recorder.buffers, fail_at)
+    stepper = _Counting(recorder.buffers, fail_at, **stepper)
     recorder.buffers[0][0][0] = 0.0
     recorder.absorb(0, 0, 1)
     outcome = driver.drive(stepper, plan, recorder)
@@ -181,6 +182,25 @@ def test_a_streamed_preview_is_the_min_max_envelope(monkeypatch):
     # one pair per group, also for the groups that chunk boundaries cut
     np.testing.assert_array_equal(preview[0::2, 0], [g.min() for g in groups])
     np.testing.assert_array_equal(preview[1::2, 0], [g.max() for g in groups])
+
+
+def test_a_streamed_previews_flags_are_all_and_any_of_each_group(monkeypatch):
+    """The preview's flag rows: the low row of a group is set where every sample of it is,
+    the high row where any is, also for the groups that chunk boundaries cut (their first
+    part merged with the rest). The flag is set over runs of 37 samples and clear over the
+    next 37: a part of a group may be all set, or all clear, and the rest not."""
+    monkeypatch.setattr(driver, "PREVIEW_SAMPLES", 100)
+    streamed = []
+    _, recorder, _, _ = _fake_run(30_000, sink=lambda d, f: streamed.append(f[:, 0].copy()),
+                                  flag=lambda step: (step // 3) // 37 % 2 == 0)
+    flags = np.concatenate(streamed)
+    _, preview_flags = recorder.result()
+    every = recorder.every
+    groups = [flags[i:i + every] for i in range(0, flags.size, every)]
+    assert 10_001 % every and 256 % every  # groups cut by chunks, and the last one short
+    assert any(g.any() and not g.all() for g in groups)
+    np.testing.assert_array_equal(preview_flags[0::2, 0], [g.all() for g in groups])
+    np.testing.assert_array_equal(preview_flags[1::2, 0], [g.any() for g in groups])
 
 
 def test_a_divergence_raises_the_steppers_error_after_keeping_the_rows():

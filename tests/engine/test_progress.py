@@ -211,3 +211,19 @@ def test_a_python_warning_during_a_bar_lands_on_its_own_line(monkeypatch):
             recorded_bar.update()
     assert [str(w.message) for w in caught] == ["kept"]
     monkeypatch.setattr(warnings, "showwarning", original)
+
+
+def test_the_bar_is_tqdm_std_outside_a_notebook_and_tqdm_auto_inside_one(monkeypatch):
+    """Outside Jupyter the bar is tqdm.std's (tqdm.auto imports asyncio and ssl, 5 MB more
+    of every command's memory); with a notebook's kernel loaded, tqdm.auto's."""
+    import sys
+
+    from tqdm.std import tqdm as std_tqdm
+
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)
+    assert progress._bar_class() is std_tqdm
+    monkeypatch.setitem(sys.modules, "ipykernel", sys.modules["sys"])
+    from tqdm.auto import tqdm as auto_tqdm
+
+    assert progress._bar_class() is auto_tqdm is not std_tqdm
+

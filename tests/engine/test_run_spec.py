@@ -143,3 +143,7 @@ def test_the_length_check_counts_at_the_kernels_own_speed():
                                              "integration steps") as caught:
         check_length(1e9, 1000.0, None, kernel="hexapod")
     assert caught.value.options == ("duration", "sample_rate")
+    # a given dt: the same count, refused as the driver refuses it (RunTooLongError)
+    check_length(1e9, 1000.0, 1e-3)
+    with pytest.raises(qzs.errors.RunTooLongError):
+        check_length(1e9, 1000.0, 1e-3, kernel="hexapod")

@@ -147,6 +147,41 @@ def test_an_edit_to_any_source_the_choice_runs_changes_the_key(tmp_path):
     assert step_cache._fingerprint(copy) != base
 
 
+def _package(root, files):
+    """A package of ``files`` ({path below root: text}) at ``root``."""
+    for name, text in files.items():
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return root
+
+
+def test_every_package_above_a_source_is_in_the_key(tmp_path):
+    """Importing qzs.engine.accuracy runs qzs/__init__.py and qzs/engine/__init__.py first:
+    both are sources of the key, the top package too, also in a package where no module
+    names ``qzs`` itself in an import."""
+    root = _package(tmp_path / "qzs", {"__init__.py": "", "engine/__init__.py": "",
+                                       "engine/accuracy.py": "X = 1\n"})
+    assert step_cache.choice_sources(root) == ("__init__.py", "engine/__init__.py",
+                                               "engine/accuracy.py")
+
+
+def test_text_moved_across_the_boundary_of_two_sources_changes_the_key(tmp_path):
+    """Each source is hashed with its name and its length: two packages whose sources,
+    concatenated with their names between them, are the same bytes (text, a name's line
+    among it, moved from one file into the next) have different keys."""
+    header = "\nengine/helper.py\n"
+    first = "from qzs.engine import helper\n"
+    common = {"__init__.py": "", "engine/__init__.py": ""}
+    one = _package(tmp_path / "one" / "qzs", {**common, "engine/accuracy.py": first,
+                                              "engine/helper.py": "# c" + header + "# d\n"})
+    two = _package(tmp_path / "two" / "qzs", {**common,
+                                              "engine/accuracy.py": first + header + "# c",
+                                              "engine/helper.py": "# d\n"})
+    assert step_cache.choice_sources(one) == step_cache.choice_sources(two)
+    assert step_cache._fingerprint(one) != step_cache._fingerprint(two)
+
+
 def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch):
     first = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
     assert not first.cached and len(list(cache.glob("*.json"))) == 1

@@ -105,12 +105,13 @@ class Logged:
             self._callbacks = callbacks
             self.fmu.instantiate(callbacks=callbacks, loggingOn=True)
 
-    def enter(self, stop_time=None):
-        """Enter initialisation (the experiment from t = 0, to ``stop_time`` if given)."""
+    def enter(self, stop_time=None, start_time=0.0):
+        """Enter initialisation (the experiment from ``start_time``, to ``stop_time`` if
+        given)."""
         if self.version == 3:
-            self.fmu.enterInitializationMode(startTime=0.0, stopTime=stop_time)
+            self.fmu.enterInitializationMode(startTime=start_time, stopTime=stop_time)
         else:
-            self.fmu.setupExperiment(startTime=0.0, stopTime=stop_time)
+            self.fmu.setupExperiment(startTime=start_time, stopTime=stop_time)
             self.fmu.enterInitializationMode()
 
     def set(self, **values):

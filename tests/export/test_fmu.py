@@ -217,6 +217,20 @@ def test_bad_export_arguments_are_refused_before_compiling(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_one_communication_step_over_the_whole_experiment_is_taken(tmp_path):
+    """``communication_step`` may be as long as the experiment (``duration``), which it must
+    not exceed: the default experiment is then one step, whose end is qzs.simulate's state
+    at the stop time (whole internal steps: to the bit)."""
+    path = export.export_fmu(tmp_path / "one.fmu", CHIRP, duration=0.5, communication_step=0.5)
+    experiment = read_model_description(str(path)).defaultExperiment
+    assert float(experiment.stepSize) == float(experiment.stopTime) == 0.5
+    result = simulate_fmu(str(path), output_interval=0.5)
+    assert list(result["time"]) == [0.0, 0.5]
+    reference = qzs.simulate(CHIRP, duration=0.5, dt=1e-4, sample_rate=1e4)
+    for name in ("relative_position", "payload_velocity", "motor_force"):
+        assert result[name][-1] == np.asarray(reference[name])[-1], name
+
+
 def test_without_fmpy_the_export_names_the_extra(monkeypatch, tmp_path):
     import sys
 

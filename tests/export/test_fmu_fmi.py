@@ -137,6 +137,47 @@ def test_a_chirp_is_not_run_past_its_sweep(fmus):
     fmu.free()
 
 
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_step_past_the_end_by_half_an_internal_step_is_refused(fmus, version):
+    """The stop time and a chirp's end are hard ends: a step past either by half an internal
+    step is refused as one past it by many (only rounding, a millionth of a step, is
+    forgiven); the step to the end itself is taken."""
+    path = fmus("chirp-linear", version=version)
+    fmu = started(path, version, stop_time=0.01)
+    fmu.fmu.doStep(0.0, 0.005)
+    assert "past the stop time" in fmu.failing(fmu.fmu.doStep, 0.005, 0.005 + DT / 2)
+    fmu.fmu.doStep(0.005, 0.005)
+    fmu.free()
+    fmu = started(path, version)
+    before = CHIRP.duration - DT
+    fmu.fmu.doStep(0.0, before)
+    assert "past the chirp's end" in fmu.failing(fmu.fmu.doStep, before, 1.5 * DT)
+    fmu.fmu.doStep(before, DT)
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_stop_time_at_the_start_time_is_refused(fmus, version):
+    """An experiment from 0 s to 0 s has no step to take: refused at initialisation."""
+    fmu = Logged(fmus("chirp-linear", version=version), version)
+    fmu.enter(stop_time=0.0)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "stop time must be after the start time" in message and "0 s" in message
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_start_time_other_than_zero_is_refused(fmus, version):
+    """qzs runs start at t = 0 (the excitation's phase, the grid): an experiment from 1 s is
+    refused at initialisation, through FMI 3's enterInitializationMode and FMI 2's
+    setupExperiment alike."""
+    fmu = Logged(fmus("chirp-linear", version=version), version)
+    fmu.enter(start_time=1.0)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "start time must be 0 s" in message and "got 1 s" in message
+    fmu.free()
+
+
 # ---------------------------------------------------------------- communication steps
 def test_one_internal_step_per_communication_is_the_run_to_the_bit(fmus):
     result = simulate_fmu(str(fmus("chirp-linear")), stop_time=0.5, output_interval=DT)
@@ -189,6 +230,66 @@ def test_the_sampled_controller_keeps_its_timing_at_any_communication_step(fmus)
     samples = np.arange(0.0, 2.0 + 1e-9, 1.0 / rate)
     for k in changed:  # a sample point in [t_k, t_k+1): the doStep from t_k took it
         assert np.any((samples >= time[k] - 1e-12) & (samples < time[k + 1] - 1e-12)), time[k]
+
+
+def test_between_grid_points_the_outputs_are_at_the_importers_time(fmus):
+    """At a communication point inside a grid step (0.73 internal steps per communication
+    step), the base motion the FMU reports is the sine's at that very time, A sin(2 pi f t)
+    and A 2 pi f cos(2 pi f t), not the grid point's before or after it (a tenth of a step
+    off would be 8e-6 m)."""
+    h = 7.3e-5
+    result = simulate_fmu(str(fmus("chirp-linear")), stop_time=0.2, output_interval=h,
+                          start_values=SINE_START)
+    t = np.asarray(result["time"])
+    cells = t / DT
+    assert np.sum(np.abs(cells - np.round(cells)) > 0.1) > 1000  # most points are inside one
+    w = 2 * np.pi * SINE.frequency
+    np.testing.assert_allclose(result["base_displacement"], SINE.amplitude * np.sin(w * t),
+                               rtol=0, atol=1e-10)
+    np.testing.assert_allclose(result["base_velocity"], SINE.amplitude * w * np.cos(w * t),
+                               rtol=0, atol=1e-8)
+
+
+def test_the_sampled_controller_is_qzs_at_communication_steps_below_the_internal_one(fmus):
+    """Sampled at 500 Hz with communication steps of 0.7 internal steps, no sample point
+    is reached by a whole grid step: each is the start of a part of a grid step, and is
+    sampled there. At the grid points the held motor force is qzs's, to the splits'
+    truncation error."""
+    h, rate = 7e-5, 500.0
+    start = {"controller.controller_rate": rate, "controller.damping_gain": 300.0}
+    result = simulate_fmu(str(fmus("chirp-linear")), stop_time=0.5, output_interval=h,
+                          start_values=start)
+    reference = qzs.simulate(CHIRP, controller=qzs.ControllerParameters(
+        controller_rate=rate, damping_gain=300.0), duration=0.5, dt=DT, sample_rate=1.0 / DT)
+    times = np.asarray(result["time"])
+    index = np.round(times / DT).astype(int)
+    on_grid = np.abs(times / DT - index) < 1e-6
+    assert on_grid.sum() > 500
+    ours = np.asarray(reference.motor_force)
+    assert np.unique(ours).size > 0.5 * 0.5 * rate  # the command changes at the samples
+    difference = np.abs(result["motor_force"][on_grid] - ours[index[on_grid]]).max()
+    assert difference < 1e-6 * np.ptp(ours), difference / np.ptp(ours)
+
+
+def test_base_inputs_between_grid_points_hold_from_the_communication_point(fmus):
+    """A base in uniform acceleration, y = a t^2 / 2, fed as inputs at communication points
+    0.73 internal steps apart: the FMU's quadratic from each point (displacement, velocity,
+    acceleration given, no jerk) is the motion itself, so the base under the payload at the
+    next point (x - z, and its rate) is a t^2 / 2 and a t there (closed form), wherever the
+    points fall on the grid."""
+    path = fmus("input")
+    h, a, stop = 7.3e-5, 1.0, 0.05
+    times = np.arange(int(stop / h) + 1) * h
+    signal = np.array(list(zip(times, 0.5 * a * times ** 2, a * times, a + 0 * times)),
+                      dtype=[("time", float), ("base_displacement", float),
+                             ("base_velocity", float), ("base_acceleration", float)])
+    result = simulate_fmu(str(path), stop_time=times[-1], output_interval=h, input=signal)
+    t = np.asarray(result["time"])
+    assert np.sum(np.abs(t / DT - np.round(t / DT)) > 0.1) > 400  # most inside a grid step
+    base = result["payload_displacement"] - result["relative_position"]  # x - z = y
+    base_velocity = result["payload_velocity"] - result["relative_velocity"]
+    np.testing.assert_allclose(base, 0.5 * a * t ** 2, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(base_velocity, a * t, rtol=0, atol=1e-12)
 
 
 # ---------------------------------------------------------------- the internal step
@@ -316,6 +417,52 @@ def test_plant_mode_neither_checks_nor_counts_the_controllers_gains(fmus):
     closed.free()
 
 
+def test_the_step_is_checked_at_the_highest_frequency_the_run_reaches(fmus):
+    """qzs.model.excitation.highest_frequency in C. A chirp rising 0 -> 200 Hz over 4 s and
+    stopped at 0.4 s reaches 20 Hz: 4 ms gives 12.5 steps a period, taken (as qzs.simulate
+    takes it over 0.4 s); run to its end (200 Hz), refused. Falling 20 -> 0 Hz, its highest
+    is its start's: 5.5 ms (9.1 steps a period) refused, as qzs.simulate refuses it."""
+    import dataclasses
+
+    path = fmus("chirp-linear")
+    rising = dataclasses.replace(CHIRP, f1=200.0)
+    qzs.simulate(rising, duration=0.4, dt=4e-3, sample_rate=250.0)
+    fmu = started(path, stop_time=0.4, step_size=4e-3, excitation__f1=200.0)
+    fmu.fmu.doStep(0.0, 0.4)
+    fmu.free()
+    fmu = Logged(path)
+    fmu.enter(stop_time=CHIRP.duration)
+    fmu.set(step_size=4e-3, excitation__f1=200.0)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "fewer than 10 steps per period" in message and "200 Hz" in message
+    fmu.free()
+    falling = dataclasses.replace(CHIRP, f0=20.0, f1=0.0)
+    with pytest.raises(qzs.errors.UnresolvedExcitationError):
+        qzs.simulate(falling, duration=CHIRP.duration, dt=5.5e-3, sample_rate=1 / 5.5e-3)
+    fmu = Logged(path)
+    fmu.enter()
+    fmu.set(step_size=5.5e-3, excitation__f0=20.0, excitation__f1=0.0)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "fewer than 10 steps per period" in message and "20 Hz" in message
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_warned_initialisation_returns_the_warning_status(fmus, version):
+    """FMI: a call that logged a warning returns fmi3Warning / fmi2Warning (1), not OK (0):
+    a step above the exported one; the exported step returns OK."""
+    path = fmus("chirp-linear", version=version)
+    for step, status in ((5e-3, 1), (DT, 0)):
+        fmu = Logged(path, version)
+        fmu.enter()
+        fmu.set(step_size=step)
+        call = (fmu.fmu.fmi3ExitInitializationMode if version == 3
+                else fmu.fmu.fmi2ExitInitializationMode)
+        assert call(fmu.fmu.component) == status, step
+        assert len(fmu.warnings()) == status
+        fmu.free()
+
+
 # ---------------------------------------------------------------- the parameters' checks
 #: Values qzs refuses: FMU start values, the variable the FMU names, and how qzs is given them.
 REFUSED = [
@@ -381,3 +528,23 @@ def test_a_sine_neither_requires_nor_checks_a_chirps_parameters(fmus, version):
     fmu.free()
     with pytest.raises(ParameterError):
         qzs.export_fmu(path.with_name("zero.fmu"), qzs.Sine(frequency=0.0))
+
+
+def test_what_qzs_takes_at_a_bound_the_fmu_takes(fmus):
+    """The bounds themselves: amplitude 0 (a base at rest: every base output stays 0) and a
+    fade-in as long as the sweep, both taken by qzs.Chirp, and no velocity high-pass (0 Hz),
+    taken by qzs.ControllerParameters, are taken by the FMU."""
+    path = fmus("chirp-linear")
+    qzs.Chirp(amplitude=0.0)
+    fmu = started(path, excitation__amplitude=0.0)
+    fmu.fmu.doStep(0.0, 0.1)
+    assert fmu.get("base_displacement", "base_velocity", "base_acceleration") == [0.0] * 3
+    fmu.free()
+    qzs.Chirp(duration=CHIRP.duration, fade_in=CHIRP.duration)
+    fmu = started(path, excitation__fade_in=CHIRP.duration)
+    fmu.fmu.doStep(0.0, 0.1)
+    fmu.free()
+    qzs.ControllerParameters(velocity_highpass=0.0)
+    fmu = started(path, controller__velocity_highpass=0.0)
+    fmu.fmu.doStep(0.0, 0.1)
+    fmu.free()

@@ -98,26 +98,32 @@ def test_the_header_is_the_table_and_compiles(tmp_path):
     assert np.isclose(float(header.count("QZS_VR_")), len(variables) + 0)
 
 
-def test_the_motor_force_starts_where_the_kernels_hold_the_payload_at_rest():
-    """The plant mode's start: with it as the motor force, the base at rest, the payload at
-    the setpoint, friction has nothing to hold (qzs's own static balance, kernels.hold_force),
-    whatever the mass; beyond the motor's limit it is the limit."""
-    from qzs.engine.prepare import prepare_run
+def test_the_motor_force_starts_where_qzs_holds_the_payload_at_rest():
+    """The plant mode's start is the motor force a qzs run at rest holds the payload at the
+    setpoint with (its PI preloaded with the static load, qzs.engine.prepare): friction has
+    nothing to hold and the payload does not move, whatever the mass; a light payload, which
+    the spring more than carries, is pulled down (a negative force); beyond the motor's limit,
+    either way, it is the limit."""
     from qzs.export.fmu_variables import holding_force
 
-    for mass in (6.4, 7.5, 5.0):
-        isolator = qzs.IsolatorParameters(mass=mass)
-        controller = qzs.ControllerParameters()
+    controller = qzs.ControllerParameters()
+    for isolator, limited in ((qzs.IsolatorParameters(mass=6.4), False),
+                              (qzs.IsolatorParameters(mass=7.5), False),
+                              (qzs.IsolatorParameters(mass=5.0), False),
+                              (qzs.IsolatorParameters(mass=9.0, motor_force_max=5.0), True),
+                              (qzs.IsolatorParameters(mass=3.0, motor_force_max=5.0), True)):
         hold = holding_force(isolator, controller)
-        run = prepare_run(qzs.Sine(amplitude=0.0, fade_in=0.0), isolator, controller,
-                          duration=1.0)
-        state = run.state.copy()
-        state[K.A_F_PI] = state[K.A_F_DAMP] = 0.0
-        state[K.A_F_MOTOR] = hold
-        force = K.hold_force(0.0, state, run.params, run.model, *run.packed)
-        assert abs(force[K.F_HOLD]) < 1e-12 * isolator.mass * isolator.gravity, mass
-    limited = qzs.IsolatorParameters(mass=9.0, motor_force_max=5.0)
-    assert holding_force(limited, qzs.ControllerParameters()) == 5.0
+        run = qzs.simulate(qzs.Sine(amplitude=0.0, fade_in=0.0), isolator, controller,
+                           duration=0.01, dt=1e-4, sample_rate=1e4)
+        weight = isolator.mass * isolator.gravity
+        assert hold == pytest.approx(float(np.asarray(run.motor_force)[0]),
+                                     rel=0, abs=1e-12 * weight), isolator
+        if limited:
+            assert abs(hold) == isolator.motor_force_max
+        else:
+            assert np.all(np.asarray(run.friction_force) == 0.0)
+            assert np.ptp(np.asarray(run.relative_position)) == 0.0
+    assert holding_force(qzs.IsolatorParameters(mass=5.0), controller) < 0.0
     plant = {v.name: v for v in table("plant")}
     assert plant["motor_force"].start == holding_force(qzs.IsolatorParameters(),
                                                        qzs.ControllerParameters(pi_kp=77.0))

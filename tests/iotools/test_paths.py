@@ -95,6 +95,14 @@ def test_a_free_name_is_the_name_itself_or_the_next_numbered_one(tmp_path):
     assert free_name(tmp_path / "results") == tmp_path / "results-2"
 
 
+def test_a_switch_is_spelt_as_the_caller_spells_options():
+    """On the command line (an argument named ``--out``) a flag, its words joined by dashes
+    as every qzs flag's are; in Python the keyword set to True."""
+    assert paths.switch("--out", "overwrite") == "--overwrite"
+    assert paths.switch("--out", "dry_run") == "--dry-run"
+    assert paths.switch("store", "dry_run") == "dry_run=True"
+
+
 def test_removed_on_error_takes_back_what_a_failed_block_made_and_nothing_else(tmp_path):
     store = tmp_path / "a" / "b" / "s.zarr"
     with pytest.raises(ValueError):

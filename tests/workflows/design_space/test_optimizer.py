@@ -340,6 +340,27 @@ def test_designs_of_1e9_s_runs_are_refused_before_any_probe_or_store(tmp_path, m
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_generations_memory_counts_every_draw_of_every_design(monkeypatch):
+    """A generation evaluates population x [robust] samples runs together: with 2 draws per
+    design its samples take twice the memory of 1 draw, and 4 designs' half of 8's (the
+    bytes the refusal reports, with almost no memory available)."""
+    from qzs.engine import driver
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.design_space.optimizer import check_run_length
+
+    monkeypatch.setattr(driver, "available_memory", lambda: 1)
+
+    def needed(population, samples):
+        document = copy.deepcopy(SIMULATED)
+        document["optimizer"]["population"] = population
+        document["robust"]["samples"] = samples
+        with pytest.raises(ResultTooLargeError) as caught:
+            check_run_length(load_problem(document))
+        return caught.value.needed
+
+    assert needed(8, 2) == 2 * needed(8, 1) == 4 * needed(4, 1) > 0
+
+
 def test_a_search_failing_before_its_first_generation_is_stored_leaves_nothing(tmp_path,
                                                                              monkeypatch):
     from qzs.workflows.design_space import optimizer as optimizer_module

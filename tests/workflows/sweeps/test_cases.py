@@ -85,3 +85,20 @@ def test_a_batch_keeps_the_accelerations_its_estimates_read_then_the_series_it_s
     plain = load_sweep({**base, "outputs": {"transmissibility": False, "metrics": [],
                                             "time_series": ["motor_force"]}})
     assert not needs_estimates(plain) and batch_channels(plain) == ("motor_force",)
+
+
+def test_each_output_read_from_the_estimates_needs_them():
+    """The transmissibility, the coherence, a metric, a band or an RMS band, each alone, is
+    read from the cases' transmissibility estimates: the batch keeps the accelerations."""
+    from qzs.workflows.sweeps.cases import ESTIMATE_CHANNELS, batch_channels, needs_estimates
+    from qzs.workflows.sweeps.definition import load_sweep
+
+    base = {"sweep": {"name": "c"}, "grid": {"pi_kp": [5.0]},
+            "analysis": {"fft_length": 1024, "n_averages": 4}}
+    none = {"transmissibility": False, "metrics": []}
+    for alone in ({"transmissibility": True}, {"coherence": True},
+                  {"metrics": ["resonance_peak"]}, {"bands": {"mid": [2.0, 8.0]}},
+                  {"rms_bands": {"mid": [2.0, 8.0]}}):
+        sweep = load_sweep({**base, "outputs": {**none, **alone}})
+        assert needs_estimates(sweep) and batch_channels(sweep) == ESTIMATE_CHANNELS, alone
+    assert not needs_estimates(load_sweep({**base, "outputs": none}))
