@@ -41,7 +41,8 @@ from qzs.model.isolator import IsolatorParameters, spring_stiffness
 from qzs.model.sensors import MAX_STATES, SENSORS
 
 __all__ = ["ControllerParameters", "PIDamping", "FrictionCompensation", "Dither",
-           "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "block_parameters",
+           "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "BLOCK_CLASSES",
+           "block_parameters",
            "refuse_blocks",
            "closed_loop_natural_frequency"]
 
@@ -483,8 +484,7 @@ class ControllerParameters:
             "velocity_highpass": non_negative_real,
             "controller_rate": non_negative_real,
         })
-        for name, kind in (("compensation", FrictionCompensation), ("dither", Dither),
-                           ("linear", LinearController)):
+        for name, kind in BLOCK_CLASSES.items():
             value = getattr(self, name)
             if value is not None and not isinstance(value, kind):
                 raise ParameterError(f"`{name}` must be a {kind.__name__} or None, got "
@@ -552,7 +552,10 @@ class ControllerParameters:
 #: Today's controller, the default: PI position loop plus active damping (the same class).
 PIDamping = ControllerParameters
 
-_SLOT = {FrictionCompensation: "compensation", Dither: "dither", LinearController: "linear"}
+#: The class of each block: field name of :class:`ControllerParameters` -> block class.
+BLOCK_CLASSES = {"compensation": FrictionCompensation, "dither": Dither,
+                 "linear": LinearController}
+_SLOT = {cls: name for name, cls in BLOCK_CLASSES.items()}
 
 
 def _add(left, right):
