@@ -19,12 +19,15 @@ demo: $(STAMP)
 
 # The suite on every core, at most 4 processes (pytest-xdist), a test module's tests in one
 # process (their module fixtures computed once): 275 s on 2 cores where one took 504 s.
+# The documentation run as written (-m docs_run, tests/test_docs_run.py) is `make docs`'s.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n auto --maxprocesses 4 --dist loadscope
+	$(BIN)/python -m pytest -q -n auto --maxprocesses 4 --dist loadscope -m "not docs_run"
 
 # The documentation site (docs/conf.py): the closed-form tests first, whose records become
-# docs/validation.md's tables; then Sphinx with warnings as errors, executing the tutorials
-# and the gallery; then every internal link of the built pages. Always a clean build.
+# docs/validation.md's tables; then every command and snippet of README.md and the pages, run
+# in page order in one fresh folder (pytest -m docs_run: minutes, so not in `make test`);
+# then Sphinx with warnings as errors, executing the tutorials and the gallery; then every
+# internal link of the built pages. Always a clean build.
 DOCS_STAMP := $(VENV)/.installed-docs
 DOCS_OUT := docs/_build
 
@@ -39,6 +42,9 @@ docs: $(DOCS_STAMP)
 	echo "docs: the validation tests (pytest -m validation)"; \
 	QZS_VALIDATION_OUT=$(CURDIR)/$(DOCS_OUT)/validation.jsonl \
 		$(BIN)/python -m pytest -q -m validation -p no:cacheprovider; \
+	echo "docs: the pages run as written (pytest -m docs_run)"; \
+	QZS_DOCS_RUN_OUT=$(CURDIR)/$(DOCS_OUT)/docs-run.jsonl \
+		$(BIN)/python -m pytest -q -m docs_run -p no:cacheprovider tests/test_docs_run.py; \
 	echo "docs: sphinx-build"; \
 	QZS_VALIDATION_OUT=$(CURDIR)/$(DOCS_OUT)/validation.jsonl \
 		$(BIN)/python -m sphinx -W --keep-going -q -b html -j 1 docs $(DOCS_OUT)/html; \

@@ -473,7 +473,10 @@ def target_cluster(table, args):
             sweep.write_text(SWEEP_QUICK)
             name, n_cases = str(sweep), 40
         else:
-            name, n_cases = "pi_vs_stiction", 180
+            from qzs.workflows.sweeps import load_sweep
+
+            name = "pi_vs_stiction"
+            n_cases = load_sweep(name).n_cases
         log(f"  sweep {Path(name).name}: {n_cases} cases; local = this machine's {n_cores} "
             f"cores in one process; cluster = {n_cores} `dask worker --nthreads 1` processes")
 

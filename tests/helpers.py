@@ -78,6 +78,42 @@ def stick_rises(locked):
     return int(np.count_nonzero(np.diff(locked.astype(np.int8)) == 1))
 
 
+def shipped_designs(count, seed, *, highpass_off=False, page=()):
+    """``count`` random designs across qzs's shipped ranges: ``(isolators, controllers)``.
+
+    Each design takes the shipped design problems in turn
+    (:func:`qzs.workflows.design_space.problem.shipped_problems`, as ``qzs optimize`` builds
+    its cases): the problem's fixed parameters, each decision variable uniform over its
+    bounds (on ``log10`` for a log scale), each uncertain parameter from its own
+    distribution (a list of values: one of them). The parameters named in ``page`` are drawn
+    uniformly over the tuning page's slider ranges instead (``qzs.app.page.SLIDERS``, the
+    ranges a user moves them over). ``highpass_off``: every other design has
+    ``velocity_highpass = 0`` (the damping without its high-pass). All from numpy's
+    generator seeded with ``seed``.
+    """
+    from qzs.workflows.design_space.problem import load_problem, shipped_problems
+    from qzs.workflows.sweeps.cases import build_model
+
+    problems = [load_problem(path) for path in shipped_problems()]
+    sliders = {}
+    if page:
+        from qzs.app.page import SLIDERS as sliders
+    rng = np.random.default_rng(seed)
+    isolators, controllers = [], []
+    for k in range(count):
+        problem = problems[k % len(problems)]
+        case = {v.name: float(v.to_unit(rng.uniform(*v.search_bounds)))
+                for v in problem.variables}
+        case.update({u.name: float(u.quantile(rng.uniform())) for u in problem.uncertain})
+        case.update({name: float(rng.uniform(*sliders[name][:2])) for name in page})
+        if highpass_off and k % 2:
+            case["velocity_highpass"] = 0.0
+        isolator, controller = build_model(problem.sweep, case)
+        isolators.append(isolator)
+        controllers.append(controller)
+    return isolators, controllers
+
+
 EXPORT_PASSIVE = qzs.ControllerParameters(pi_kp=0.0, pi_ki=0.0, damping_gain=0.0)
 EXPORT_SETTINGS = dict(dt=1e-4, sample_rate=1000.0)
 

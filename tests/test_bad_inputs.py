@@ -69,6 +69,34 @@ def test_a_folder_given_as_toml(tmp_path):
         load_config(tmp_path)
 
 
+# ---------------------------------------------------------------- empty TOML files
+#: Every reader of a TOML file (what names the file in its messages).
+def _readers():
+    from qzs.workflows.design_space.problem import load_problem
+    from qzs.workflows.hexapod.setups import load_hexapod
+    from qzs.workflows.paper.studies import load_study
+    from qzs.workflows.sweeps import load_sweep
+
+    return {"config file": load_config, "channel map": load_channel_map,
+            "sweep file": load_sweep, "problem file": load_problem,
+            "hexapod file": load_hexapod, "study file": load_study}
+
+
+@pytest.mark.parametrize("content", ["", "\n  \n", "# only a comment\n# [isolator]\n"],
+                         ids=["empty", "blank", "comments"])
+@pytest.mark.parametrize("what", ["config file", "channel map", "sweep file", "problem file",
+                                  "hexapod file", "study file"])
+def test_an_empty_toml_file_is_refused_by_every_reader(tmp_path, what, content):
+    """`qzs params --toml > my.toml` used to leave an empty my.toml that the commands then
+    read as the defaults without a word."""
+    path = tmp_path / "my.toml"
+    path.write_text(content)
+    with pytest.raises(ParameterError) as caught:
+        _readers()[what](path)
+    message = str(caught.value)
+    assert f"{what} {str(path)!r} is empty" in message and "sets nothing" in message, message
+
+
 # ---------------------------------------------------------------- empty and broken logs
 @pytest.mark.parametrize("content, match", [
     (b"", "is empty"),
@@ -184,12 +212,58 @@ def test_the_resample_option_reads_a_non_uniform_log(tmp_path, capsys):
     assert (tmp_path / "out" / "report.md").exists()
 
 
+# ---------------------------------------------------------------- the same through the API
+def _api_case(name, folder):
+    """Issue 39's bad inputs as Python calls: ``(call, what the message holds)``."""
+    import tomllib
+
+    import qzs
+
+    problem = tomllib.loads(PROBLEM.format(variables="", excitation="duration = 1e9"))
+    sweep = tomllib.loads(INPUTS["long.toml"].decode())
+    return {
+        "optimize-negative-seed": (lambda: qzs.optimize("isolation_vs_effort",
+                                                        folder / "s.zarr", seed=-3,
+                                                        progress=False), "seed = -3"),
+        "optimize-1e9-s-designs": (lambda: qzs.optimize(problem, folder / "s.zarr",
+                                                        progress=False),
+                                   "a 1e+09 s run at 100 Hz keeps"),
+        "sensitivity-1e9-s-designs": (lambda: qzs.sensitivity(problem, progress=False),
+                                      "a 1e+09 s run at 100 Hz keeps"),
+        "run_sweep-1e9-s-cases": (lambda: qzs.run_sweep(sweep, folder / "deep" / "s.zarr",
+                                                        progress=False),
+                                  "a 1e+09 s run at 1000 Hz keeps"),
+        "simulate-random-record-1e12-s": (
+            lambda: qzs.simulate(qzs.RandomExcitation(duration=1e12), duration=2.0),
+            "`excitation.duration` = 1e+12 s"),
+    }[name]
+
+
+@pytest.mark.parametrize("name", ["optimize-negative-seed", "optimize-1e9-s-designs",
+                                  "sensitivity-1e9-s-designs", "run_sweep-1e9-s-cases",
+                                  "simulate-random-record-1e12-s"])
+def test_the_bad_inputs_of_issue_39_through_the_api(tmp_path, name):
+    """A ParameterError naming the argument and the value, at once, and nothing written."""
+    call, needle = _api_case(name, tmp_path)
+    began = time.perf_counter()
+    with pytest.raises(ParameterError) as caught:
+        call()
+    assert time.perf_counter() - began < 5.0
+    assert needle in str(caught.value), str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 # ---------------------------------------------------------------- every bad input of the CLI
 #: A bad input that used to hang, or fail only after the work, must fail within this [s].
 AT_ONCE = 2.0
 #: Files the bad inputs read, written into the test's ``in`` folder ({in} in an argument).
 SWEEP = ('[sweep]\nname = "tiny"\nbatch_size = 1\n[grid]\n{grid}\n[excitation]\nf1 = 10.0\n'
          '[analysis]\nfft_length = 1024\nn_averages = 4\nband = [0.0, 10.0]\n')
+#: A design problem of simulated metrics whose runs the {variables} and {excitation} set.
+PROBLEM = ('[problem]\nname = "long"\n[variables]\npi_kp = {{ low = 1.0, high = 1000.0, scale = '
+           '"log" }}\n{variables}\n[excitation]\nf1 = 10.0\n{excitation}\n[analysis]\n'
+           'sample_rate = 100.0\nfft_length = 512\n[[objectives]]\nmetric = "rms_transmissibility"\n'
+           'band = [1.0, 5.0]\n[[objectives]]\nmetric = "motor_force_rms"\n')
 INPUTS = {
     "junk.csv": BINARY,
     "heavy.toml": b'[geometry]\nkind = "cubic"\ncube_edge = 0.15\n[platform]\nmass = "heavy"\n',
@@ -197,8 +271,14 @@ INPUTS = {
     "negative.toml": SWEEP.format(grid="pi_kp = [5.0, 10.0]\nstiction_force = [10.0, -5.0]"
                                   ).encode(),
     "nan.toml": SWEEP.format(grid="pi_kp = [5.0, nan]").encode(),
+    "empty.toml": b"# qzs run configuration\n",
     "huge.toml": SWEEP.format(grid="pi_kp = { start = 1.0, stop = 100.0, num = 100000000 }"
                               ).encode(),
+    "long.toml": SWEEP.format(grid="pi_kp = [5.0]").replace("f1 = 10.0", "f1 = 10.0\nduration"
+                                                            " = 1e9").encode(),
+    "long-problem.toml": PROBLEM.format(variables="", excitation="duration = 1e9").encode(),
+    "long-variable.toml": PROBLEM.format(variables='"excitation.duration" = { low = 10.0, '
+                                                   'high = 1e9 }', excitation="").encode(),
 }
 
 
@@ -236,7 +316,7 @@ BAD = {
                           "case 1 (pi_kp = nan)", "`pi_kp` must be finite"),
     "sweep-resume-missing-store": Bad(["sweep", "{in}/tiny.toml", "--out", "missing.zarr",
                                        "--resume"], "--out 'missing.zarr'",
-                                      "nothing to resume", "leave out `resume` (--resume)"),
+                                      "nothing to resume", "leave out --resume"),
     "sweep-resume-and-overwrite": Bad(["sweep", "{in}/tiny.toml", "--out", "s.zarr", "--resume",
                                        "--overwrite"], "--resume", "--overwrite",
                                       "give one of them"),
@@ -305,6 +385,57 @@ BAD = {
                                     "8123"], "--host '192.0.2.1'", "use 127.0.0.1"),
     "simulate-record-folder": Bad(["simulate", "--excitation", "file", "--record", "{in}"],
                                   "--record", "is a folder", "pass the CSV file"),
+    # seeds: numpy refused a negative one after the store was made (a traceback, the store
+    # left behind); one beyond int64 ran, then failed as a file attribute (a traceback)
+    "optimize-negative-seed": Bad(["optimize", "isolation_vs_effort", "--seed", "-3"],
+                                  "`--seed`", "got -3", "e.g. 1"),
+    "sensitivity-seed-beyond-int64": Bad(["sensitivity", "isolation_vs_effort", "--samples",
+                                          "2", "--seed", str(2 ** 70)], "`--seed`",
+                                         str(2 ** 70), "e.g. 1", hang=True),
+    # 1e9 s runs: refused as a simulation of them is (their samples exceed the memory),
+    # before the step's probes or any store (the sweep's store was left behind; the search
+    # ran on, and on after SIGTERM)
+    "sweep-1e9-s-cases": Bad(["sweep", "{in}/long.toml", "--out", "long.zarr"],
+                             "a 1e+09 s run at 1000 Hz keeps", "GiB of samples",
+                             "[excitation] duration", "[sweep] batch_size", hang=True),
+    "optimize-1e9-s-designs": Bad(["optimize", "{in}/long-problem.toml", "--out", "o"],
+                                  "a 1e+09 s run at 100 Hz keeps", "[optimizer] population",
+                                  hang=True),
+    "optimize-duration-searched-to-1e9-s": Bad(["optimize", "{in}/long-variable.toml", "--out",
+                                                "o"], "a 1e+09 s run at 100 Hz keeps",
+                                               "`excitation.duration` variable", hang=True),
+    "sensitivity-1e9-s-designs": Bad(["sensitivity", "{in}/long-problem.toml", "--out", "s"],
+                                     "a 1e+09 s run at 100 Hz keeps", hang=True),
+    "hexapod-transmissibility-1e9-s": Bad(["hexapod", "transmissibility", "--axes", "z",
+                                           "--duration", "1e9", "--out", "ht"],
+                                          "`duration` 1e+09 s is at least", "integration steps",
+                                          "choose a shorter `duration`", hang=True),
+    # a random record far longer than the run: numpy's "Unable to allocate 1.42 PiB"
+    "simulate-random-record-1e12-s": Bad(["simulate", "--excitation", "random",
+                                          "--excitation-duration", "1e12", "--duration", "2"],
+                                         "`--excitation-duration` = 1e+12 s", "GiB",
+                                         "need not be longer than the run (`--duration` = 2 s)",
+                                         hang=True),
+    "hexapod-random-record-1e12-s": Bad(["hexapod", "simulate", "--axis", "z", "--excitation",
+                                         "random", "--excitation-duration", "1e12",
+                                         "--duration", "2"],
+                                        "`--excitation-duration` = 1e+12 s", "GiB",
+                                        "need not be longer than the run", hang=True),
+    # an empty config (`qzs params --toml > my.toml` left one) was read as the defaults
+    "simulate-empty-config": Bad(["simulate", "--config", "{in}/empty.toml"],
+                                 "config file '{in}/empty.toml' is empty", "sets nothing",
+                                 "qzs params --toml > FILE.toml"),
+    "params-empty-config": Bad(["params", "--config", "{in}/empty.toml"],
+                               "config file '{in}/empty.toml' is empty"),
+    "sweep-empty-file": Bad(["sweep", "{in}/empty.toml", "--out", "s.zarr"],
+                            "sweep file '{in}/empty.toml' is empty", "qzs docs sweeps"),
+    "optimize-empty-file": Bad(["optimize", "{in}/empty.toml"],
+                               "problem file '{in}/empty.toml' is empty"),
+    "hexapod-empty-config": Bad(["hexapod", "linear", "--config", "{in}/empty.toml"],
+                                "hexapod file '{in}/empty.toml' is empty"),
+    "simulate-random-seed-beyond-int64": Bad(["simulate", "--excitation", "random", "--seed",
+                                              str(2 ** 70), "--duration", "5", "--out",
+                                              "r.nc"], "`--seed`", str(2 ** 70), "e.g. 1"),
 }
 
 

@@ -161,11 +161,17 @@ def test_every_output_path_is_checked_before_any_work(tmp_path, monkeypatch, cap
 WRITES = ("--out", "--plot")
 
 
+def output_rows():
+    """The page's table: command -> (its --out cell, its --plot cell, what becomes of a
+    default output that exists)."""
+    rows = re.findall(r"^\s*\| `([a-z][a-z -]*)` \|([^|\n]*)\|([^|\n]*)\|([^|\n]*)\|\s*$",
+                      page(), flags=re.MULTILINE)
+    return {name: (out.strip(), plot.strip(), fate.strip()) for name, out, plot, fate in rows}
+
+
 def output_table():
     """The page's table: command -> (takes --out, takes --plot)."""
-    rows = re.findall(r"^\s*\| `([a-z][a-z -]*)` \|([^|\n]*)\|([^|\n]*)\|\s*$", page(),
-                      flags=re.MULTILINE)
-    return {name: (bool(out.strip()), bool(plot.strip())) for name, out, plot in rows}
+    return {name: (bool(out), bool(plot)) for name, (out, plot, _) in output_rows().items()}
 
 
 def test_the_output_table_is_every_subcommand_that_writes_with_what_it_writes():
@@ -175,6 +181,32 @@ def test_the_output_table_is_every_subcommand_that_writes_with_what_it_writes():
     assert len(table) >= 15
     assert table == having, ({k: (table.get(k), having.get(k)) for k in set(table) | set(having)
                               if table.get(k) != having.get(k)})
+
+
+#: The page's words for each policy of qzs.cli.common.UNNAMED.
+FATES = {"replaced": "replace", "named anew": "rename"}
+
+
+def test_what_becomes_of_a_default_output_is_the_pages_and_the_helps():
+    """Every output with a default (in the parser, or "default ..." in the page's cell, made
+    by the command) declares what becomes of an existing one; the page's last column and
+    the option's help say the same, and an output without a default says nothing."""
+    from qzs.cli.common import UNNAMED
+
+    parsers = dict(commands())
+    for name, (out, plot, fate) in output_rows().items():
+        declared = parsers[name].get_default("unnamed_outputs")
+        help_texts = {action.option_strings[0]: action.help
+                      for action in parsers[name]._actions if action.option_strings}
+        with_default = {option for option, cell in (("--out", out), ("--plot", plot))
+                        if "default" in cell and "default none" not in cell}
+        assert set(declared) == with_default, name
+        for option in with_default:
+            assert parsers[name].get_default(option.strip("-")) is None or option in declared
+        assert {FATES.get(fate)} == (set(declared.values()) or {None}), (name, fate, declared)
+        for option, policy in declared.items():
+            phrase = ("replaced if it exists" if option == "--plot" else UNNAMED[policy])
+            assert phrase in " ".join(help_texts[option].split()), (name, option)
 
 
 def test_every_subcommand_that_writes_takes_every_output_option_once():
@@ -188,7 +220,8 @@ def test_every_subcommand_that_writes_takes_every_output_option_once():
             assert not missing, f"qzs {name} lacks {sorted(missing)}"
             help_texts = {action.option_strings[0]: action.help for action in parser._actions
                           if action.option_strings}
-            assert help_texts["--overwrite"].startswith("replace an existing output"), name
+            assert help_texts["--overwrite"].startswith("replace an existing output that you "
+                                                        "named"), name
             if "--plot" in help_texts:
                 assert "'none' for no figure" in help_texts["--plot"], name
 

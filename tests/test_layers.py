@@ -309,6 +309,8 @@ CROSS_CUTTING = {
     "docstrings": "every public callable's numpydoc, whatever its module",
     "cli_contract": "exit codes, signals, output paths and --json, the same for every subcommand",
     "cli_doc": "docs/workflows/command-line.md's promises, read from the page, against the parser",
+    "docs_run": "README.md and the documentation's pages, every command and snippet run in page "
+                "order in one fresh folder, with the outputs they state",
     "bad_inputs": "inputs that used to end in a traceback, through the API and every command",
     "result_api": "every result class's plot() and save(), one signature",
     "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "

@@ -162,3 +162,23 @@ def test_a_repeated_or_decreasing_time_is_refused_at_its_sample():
         strictly_increasing("time", np.array([0.0, 0.1, 0.1, 0.2, 0.15]), DataError)
     with pytest.raises(DataError, match=r"decreasing at sample 1 \(t = 0.05 s after t = 0.1"):
         strictly_increasing("time", np.array([0.1, 0.05, 0.2]), DataError)
+
+
+@pytest.mark.parametrize("value", [-3, np.int64(-1), 2 ** 63, 1.0, True, "1"])
+def test_a_seed_is_a_whole_number_a_file_can_hold(value):
+    """numpy's generators refuse a negative seed (a ValueError traceback after the search
+    began); one above 2**63 - 1 ran and then failed as a file attribute (int64)."""
+    from qzs._validation import seed
+
+    with pytest.raises(ParameterError) as info:
+        seed("--seed", value)
+    message = str(info.value)
+    assert message.startswith("`--seed` must be an integer in [0, 9223372036854775807]"), message
+    assert repr(value) in message and "e.g. 1" in message
+
+
+@pytest.mark.parametrize("value", [0, 1, np.int64(7), 2 ** 63 - 1])
+def test_a_seed_comes_back_as_an_int(value):
+    from qzs._validation import seed
+
+    assert seed("seed", value) == value and type(seed("seed", value)) is int

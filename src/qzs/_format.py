@@ -19,7 +19,7 @@ import numpy as np
 
 __all__ = ["UndefinedValue", "DIMENSIONLESS", "with_unit", "unit_label", "decibels", "number",
            "json_ready", "json_text", "csv_text", "html_head", "html_table", "html_figure",
-           "markdown_table", "footnoted", "step_line", "STEP_RECORD_UNITS"]
+           "markdown_table", "footnoted", "step_line", "STEP_RECORD_UNITS", "format_bytes"]
 
 #: Units of a step record's entries (:meth:`qzs.engine.step_search.StepChoice.attributes`).
 STEP_RECORD_UNITS = {"step": "", "step_error_db": "dB", "step_tolerance_db": "dB",
@@ -382,3 +382,23 @@ def footnoted(mark, reason, notes):
         ``mark<sup>number</sup>``.
     """
     return f"{mark}<sup>{notes.setdefault(reason, len(notes) + 1)}</sup>"
+
+
+def format_bytes(count):
+    """A byte count for people: ``1.5 GiB``.
+
+    Parameters
+    ----------
+    count : int or float
+        Bytes [B].
+
+    Returns
+    -------
+    str
+    """
+    value = float(count)
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if abs(value) < 1024 or unit == "TiB":
+            return f"{value:.0f} {unit}" if unit == "B" else f"{value:.1f} {unit}"
+        value /= 1024
+    return f"{value:.1f} TiB"  # pragma: no cover

@@ -144,6 +144,36 @@ def integer(name, value, minimum, error=ParameterError, *, maximum=None, fix="")
     return int(value)
 
 
+#: The largest seed: numpy's generators take any integer >= 0, but the files qzs writes keep
+#: a seed as a 64-bit integer attribute.
+MAX_SEED = 2 ** 63 - 1
+
+
+def seed(name, value, error=ParameterError):
+    """Return ``value`` as the seed of a random generator: an integer in [0, 2**63 - 1].
+
+    The one check of a seed (a random excitation's, a sweep's, a design search's and its
+    draws'): numpy's generators refuse a negative one, and the files qzs writes keep it as
+    a 64-bit integer. ``"`seed` must be an integer in [0, 9223372036854775807], got -3;
+    e.g. 1 (any whole number >= 0 gives its own repeatable draws)."``
+
+    Parameters
+    ----------
+    name : str
+        The argument, option or key, as the user wrote it.
+    value : object
+        The value received.
+    error : type or Structured
+        What to raise (:func:`refusal`).
+
+    Returns
+    -------
+    int
+    """
+    return integer(name, value, 0, error, maximum=MAX_SEED,
+                   fix="e.g. 1 (any whole number >= 0 gives its own repeatable draws)")
+
+
 def worker_count(workers, limit=None, error=ParameterError):
     """The workers (threads or processes) to use: ``workers``, an integer >= 1 (not a bool),
     or the machine's core count if it is None; at most ``limit`` (>= 1) if given."""
@@ -240,18 +270,24 @@ def finite_rows(name, values, error, fix="interpolate or trim them first"):
     return array
 
 
-def read_toml(path, what, error=ParameterError):
+def read_toml(path, what, error=ParameterError, empty="write its tables into it"):
     """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad.
 
     A missing file, a folder, a file that is not UTF-8 text (a binary file given by
-    mistake) and invalid TOML each get a message naming the file and the fix.
+    mistake), invalid TOML and a file that sets nothing (empty, blank or only comments:
+    what a failed ``qzs params --toml > FILE.toml`` left) each get a message naming the
+    file and the fix; ``empty`` is the fix of the last.
     """
     import tomllib
 
     path = Path(path)
     try:
         with open(path, "rb") as handle:
-            return tomllib.load(handle)
+            document = tomllib.load(handle)
+        if not document:
+            raise error(f"{what} {str(path)!r} is empty (no table or key, only blanks or "
+                        f"comments): it sets nothing; {empty}.")
+        return document
     except FileNotFoundError:
         raise error(f"{what} not found: {str(path)!r}.") from None
     except IsADirectoryError:

@@ -298,7 +298,7 @@ class ToleranceNotMetError(ParameterError):
     unit : str
         ``"dB"`` (transmissibility) or ``"m"`` (state).
     smallest_step : float
-        The finest step tried [s].
+        The finest step whose error was estimated [s] (compared with two finer ones).
     smallest_error : float
         The smallest error estimated over the steps tried, in ``unit`` (inf: none).
     safety : float

@@ -39,3 +39,35 @@ def test_the_text_and_the_record_report_the_runs_own_samples(coarse_run):
     record = summary_record(coarse_run)
     assert record["statistics"]["z_min"] == z.min() and record["statistics"]["samples"] == z.size
     assert [w["code"] for w in record["warnings"]] == [c for c, _ in run_warnings(coarse_run)]
+
+
+# ---------------------------------------------------------------- which part of the excitation
+@pytest.mark.parametrize("excitation, duration, expected", [
+    ("chirp", 200.0, "Chirp 0-20 Hz over 2000 s: first 200 s run (0-2 Hz)"),
+    ("chirp", 2000.0, "Chirp 0-20 Hz over 2000 s: all 2000 s run"),
+    ("log-chirp", 50.0, "Chirp 1-16 Hz (logarithmic) over 100 s: first 50 s run (1-4 Hz)"),
+    ("sine", 10.0, "Sine 3 Hz: 10 s run"),
+    ("random", 20.0, "Random 0.5-20 Hz over 100 s: first 20 s run"),
+    ("random", 100.0, "Random 0.5-20 Hz over 100 s: all 100 s run"),
+    ("record", 3.0, "Record of 6 s: first 3 s run"),
+])
+def test_a_summary_says_which_part_of_the_excitation_ran(excitation, duration, expected):
+    """`qzs simulate --duration 200` was headed "Chirp: 200 s" while it ran the first tenth
+    of the 2000 s chirp; the reached frequency is the sweep law's (linear: f0 + (f1 - f0)
+    t / T; logarithmic: f0 (f1/f0)^(t/T))."""
+    from qzs import Chirp, DisplacementRecord, RandomExcitation
+    from qzs.analysis.summary import excitation_part
+
+    made = {"chirp": lambda: Chirp(),
+            "log-chirp": lambda: Chirp(f0=1.0, f1=16.0, duration=100.0, method="logarithmic"),
+            "sine": lambda: Sine(frequency=3.0),
+            "random": lambda: RandomExcitation(),
+            "record": lambda: DisplacementRecord(time=np.linspace(0.0, 6.0, 61),
+                                                 displacement=np.zeros(61))}[excitation]()
+    assert excitation_part(made, duration) == expected
+
+
+def test_the_summary_of_a_cut_run_is_headed_by_the_part_that_ran():
+    text = summary_text(simulate(Sine(frequency=3.0, amplitude=0.002), duration=2.0,
+                                 dt=1e-3, sample_rate=100.0))
+    assert text.splitlines()[0].startswith("qzs simulation  Sine 3 Hz: 2 s run, ode3 dt = ")

@@ -220,6 +220,45 @@ def test_a_command_silent_past_the_delay_says_it_has_started_once(capsys, monkey
     assert sys.stdout is not None and type(sys.stdout).__name__ != "_Watched"  # restored
 
 
+def _progress_after(silence, open_for):
+    """A handler silent for ``silence`` [s], then with a progress bar on stderr for
+    ``open_for`` [s] (as the step search's bar: qzs.engine.progress.progress_bar)."""
+    import time
+
+    from qzs.engine.progress import progress_bar  # imported before the command starts
+
+    def handler(args):
+        time.sleep(silence)
+        bar = progress_bar(total=2, desc="choosing dt", unit="run")
+        bar.update(1)
+        time.sleep(open_for)
+        bar.update(1)
+        bar.close()
+        return 0
+    return handler
+
+
+@pytest.mark.parametrize("silence", [0.0, 0.5])
+def test_the_start_notice_never_comes_after_a_progress_bar_on_stderr(capsys, monkeypatch,
+                                                                      silence):
+    """stderr as the user reads it: a progress bar drawn at once (the command spoke, on
+    stderr) and open long past the delay is never followed by "starting ..."; a command
+    silent past the delay says it has started, once, before its bar."""
+    import argparse
+
+    from qzs.cli import common
+
+    monkeypatch.setattr(common, "START_NOTICE_DELAY", 0.2)
+    args = argparse.Namespace(command="simulate", quiet=False, json=False)
+    assert run_handler(_progress_after(silence, 0.6), args) == 0
+    out, err = capsys.readouterr()
+    notice = "qzs simulate: starting"
+    assert "choosing dt" in err and out == ""
+    assert err.count(notice) == 1 if silence else err.count(notice) <= 1
+    if notice in err:
+        assert err.index(notice) < err.index("choosing dt"), err
+
+
 def test_a_quick_command_prints_no_start_notice(capsys):
     import argparse
 
@@ -229,3 +268,54 @@ def test_a_quick_command_prints_no_start_notice(capsys):
 
     time.sleep(1.2)  # past the real delay: the notice was cancelled, not merely late
     assert "starting" not in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- outputs named or not
+def output_parser():
+    """A command with a default store (named anew) and a default figure (replaced)."""
+    from qzs.cli.common import add_output_options
+
+    parser = argparse.ArgumentParser()
+    add_output_options(parser, out=dict(metavar="STORE.zarr", default="runs.zarr",
+                                        unnamed="rename", help="the store"),
+                       plot=dict(default="figure.png", help="the figure"))
+    return parser
+
+
+def test_an_output_the_user_named_is_refused_and_a_default_one_replaced_or_named_anew(
+        tmp_path, monkeypatch, capsys):
+    from qzs.cli.common import check_output, output_name
+    from qzs.errors import OutputPathError
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "figure.png").write_text("old")
+    (tmp_path / "runs.zarr").mkdir()
+    (tmp_path / "runs.zarr" / "kept").write_text("hours of work")
+    args = output_parser().parse_args([])
+    assert check_output(args, "--plot", args.plot, suffixes=(".png",)) == Path("figure.png")
+    assert check_output(args, "--out", args.out, suffixes=(".zarr",),
+                        directory=True) == Path("runs-2.zarr")
+    assert "runs.zarr exists; writing runs-2.zarr (--out names another)" in capsys.readouterr().err
+    assert output_name(args, "--out", args.out, directory=True,   # --resume: the default
+                       resume=True) == (Path("runs.zarr"), False)
+    # the same names, given by the user: refused, and replaced only with --overwrite
+    args = output_parser().parse_args(["--out", "runs.zarr", "--plot", "figure.png"])
+    for option, path, directory in (("--plot", "figure.png", False),
+                                    ("--out", "runs.zarr", True)):
+        with pytest.raises(OutputPathError, match=f"--overwrite to replace") as error:
+            check_output(args, option, path, suffixes=None, directory=directory)
+        assert (error.value.argument, error.value.value) == (option, path)
+    args = output_parser().parse_args(["--plot", "figure.png", "--overwrite"])
+    assert check_output(args, "--plot", "figure.png", suffixes=(".png",)) == Path("figure.png")
+    args = output_parser().parse_args(["--overwrite"])   # the default store, replaced as asked
+    assert check_output(args, "--out", args.out, suffixes=(".zarr",),
+                        directory=True) == Path("runs.zarr")
+    assert (tmp_path / "runs.zarr" / "kept").read_text() == "hours of work"
+
+
+def test_a_default_output_without_a_policy_is_a_programming_error():
+    from qzs.cli.common import add_output_options
+
+    with pytest.raises(ValueError, match="unnamed"):
+        add_output_options(argparse.ArgumentParser(),
+                           out=dict(metavar="DIR", default="results", help="folder"))

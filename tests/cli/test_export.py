@@ -95,3 +95,89 @@ def test_export_fmu_steps_as_qzs_simulate_chooses(tmp_path, capsys):
     assert main(["export", "fmu", "--out", str(out), *options, "--dt", "2e-4", "--overwrite"]) == 0
     starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
     assert float(starts["step_size"]) == 2e-4
+
+
+def test_the_default_file_is_replaced_and_a_named_one_refused(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "controller.c").write_text("an older export")
+    assert main(["export", "controller"]) == 0, capsys.readouterr().err
+    assert PARAMETERS_NAME in (tmp_path / "controller.c").read_text()
+    capsys.readouterr()
+    assert main(["export", "controller", "--out", "controller.c"]) == 2
+    assert "--out 'controller.c' exists; pass --overwrite" in capsys.readouterr().err
+
+
+def test_the_issues_sine_fmu_starts_and_is_qzs_simulate(tmp_path, capsys):
+    """`qzs export fmu --excitation sine --frequency 3 --amplitude 0.008 --duration 4`
+    (issue 39: it failed to initialise) runs through FMPy to its stop time as `qzs simulate`
+    runs the same options, at the step both chose."""
+    pytest.importorskip("fmpy")
+    import json
+
+    import numpy as np
+    from fmpy import read_model_description, simulate_fmu
+
+    options = ["--excitation", "sine", "--frequency", "3", "--amplitude", "0.008",
+               "--duration", "4"]
+    out = tmp_path / "sine.fmu"
+    assert main(["export", "fmu", "--out", str(out), *options]) == 0, capsys.readouterr().err
+    description = read_model_description(str(out))
+    step = float(description.defaultExperiment.stepSize)
+    result = simulate_fmu(str(out), output_interval=step)
+    capsys.readouterr()
+    assert main(["simulate", *options, "--plot", "none", "--json"]) == 0
+    dt = json.loads(capsys.readouterr().out)["step"]["dt"]
+    starts = {v.name: v.start for v in description.modelVariables}
+    assert float(starts["step_size"]) == dt
+    import qzs
+
+    reference = qzs.simulate(qzs.Sine(amplitude=0.008, frequency=3.0), duration=4.0, dt=dt,
+                             sample_rate=1.0 / step)
+    assert result["time"][-1] == 4.0
+    for name in ("relative_position", "friction_force", "motor_force"):
+        np.testing.assert_array_equal(result[name], np.asarray(reference[name]), name)
+
+
+@pytest.mark.parametrize("argv, flag, value", [
+    (["--step", "0"], "--step", "0.0"),
+    (["--step", "-1e-3"], "--step", "-0.001"),
+    (["--excitation", "sine", "--frequency", "0"], "--frequency", "0.0 Hz"),
+    (["--dt", "0"], "--dt", "0.0"),
+    (["--duration", "-2"], "--duration", "-2.0"),
+    (["--tolerance", "0"], "--tolerance", "0.0"),
+    (["--excitation-duration", "4", "--step", "5"], "--step", "5.0"),
+    (["--excitation", "sine", "--frequency", "3", "--dt", "0.05"], "--dt", "0.05"),
+    (["--excitation", "sine", "--frequency", "40", "--dt", "5e-3"], "--frequency", "40 Hz"),
+])
+def test_export_fmu_bad_input_names_the_flag_before_any_work(argv, flag, value, tmp_path,
+                                                             monkeypatch, capsys):
+    """Exit 2, one line naming the flag and the value, nothing compiled or written."""
+    from qzs.export import fmu
+
+    def compile_shared(*args, **kwargs):  # pragma: no cover - the failure it guards
+        raise AssertionError("compiled before the inputs were checked")
+    monkeypatch.setattr(fmu, "compile_shared", compile_shared)
+    out = tmp_path / "iso.fmu"
+    assert main(["export", "fmu", "--out", str(out), *argv]) == 2
+    err = capsys.readouterr().err
+    line = next(text for text in err.splitlines() if text.startswith("qzs: error:"))
+    assert f"`{flag}`" in line and value in line, line
+    assert "sample_rate" not in line and "communication_step" not in line
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_communication_step_that_is_no_multiple_of_the_internal_step_is_taken(tmp_path,
+                                                                                capsys):
+    """`--dt 1e-4 --step 1.5e-4` (issue 39: a message about `sample_rate`): the FMU takes any
+    communication step, so the default experiment is written as asked and runs."""
+    pytest.importorskip("fmpy")
+    from fmpy import read_model_description, simulate_fmu
+
+    out = tmp_path / "iso.fmu"
+    code = main(["export", "fmu", "--out", str(out), "--dt", "1e-4", "--step", "1.5e-4",
+                 "--excitation-duration", "0.3"])
+    assert code == 0, capsys.readouterr().err
+    experiment = read_model_description(str(out)).defaultExperiment
+    assert float(experiment.stepSize) == 1.5e-4 and float(experiment.stopTime) == 0.3
+    result = simulate_fmu(str(out), output_interval=1.5e-4)
+    assert result["time"][-1] == pytest.approx(0.3) and len(result) == 2001

@@ -18,3 +18,21 @@ def test_params_toml_round_trips(tmp_path):
     from qzs.iotools import load_config
 
     assert load_config(path)["isolator"].mass == 7.0
+
+
+def test_params_toml_without_a_file_prints_the_config_to_stdout(tmp_path, capsys, monkeypatch):
+    """`qzs params --toml > my.toml` (what the help texts point to) failed with `--toml
+    expected one argument` and left an empty my.toml; now stdout holds the file's text."""
+    from qzs.iotools import load_config
+    from qzs.iotools.config import config_text
+    from qzs.model.controller import ControllerParameters
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["params", "--toml", "--set", "pi_kp=75"]) == 0
+    out = capsys.readouterr().out
+    assert out == config_text(controller=ControllerParameters(pi_kp=75.0))
+    (tmp_path / "my.toml").write_text(out)
+    assert load_config(tmp_path / "my.toml")["controller"].pi_kp == 75.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["my.toml"]  # nothing else written
+    assert main(["params", "--toml", "-"]) == 0  # "-": stdout too
+    assert capsys.readouterr().out == config_text()

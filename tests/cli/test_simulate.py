@@ -32,7 +32,9 @@ def test_cli_and_api_give_the_same_base_motion_for_the_same_duration(tmp_path, f
 def test_a_cut_chirp_says_which_band_it_covered(capsys):
     assert main(["simulate", "--duration", "30", "--sample-rate", "100", "--plot", "none",
                  "--quiet"]) == 0
-    assert "the first 30 s of a 2000 s chirp: 0 -> 0.3 Hz of 0 -> 20 Hz" in capsys.readouterr().out
+    head = capsys.readouterr().out.splitlines()[0]
+    assert head.startswith("qzs simulation  Chirp 0-20 Hz over 2000 s: first 30 s run "
+                           "(0-0.3 Hz), ode3 dt = "), head
 
 
 @pytest.mark.parametrize("argv, flag", [
@@ -398,3 +400,21 @@ def test_a_validators_error_names_the_flag_or_key_the_value_came_from(tmp_path, 
     assert main(["simulate", "--config", "run.toml", "--quiet", "--plot", "none"]) == 2
     assert "`[simulation] duration of run.toml` (1000000000000.0 s) exceeds" in \
         capsys.readouterr().err
+
+
+def test_running_twice_replaces_the_default_figure_and_refuses_a_named_one(tmp_path,
+                                                                            monkeypatch, capsys):
+    """getting-started's `qzs simulate` after the README's failed on the figure it never
+    named (`--plot 'qzs-simulation.png' exists`); a figure the user named is still kept."""
+    monkeypatch.chdir(tmp_path)
+    run = ["simulate", "--excitation-duration", "4", "--dt", "1e-3", "--quiet"]
+    assert main(run) == 0, capsys.readouterr().err
+    first = (tmp_path / "qzs-simulation.png").stat().st_mtime_ns
+    (tmp_path / "qzs-simulation.png").write_bytes(b"an older figure")
+    assert main(run) == 0, capsys.readouterr().err
+    assert (tmp_path / "qzs-simulation.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "qzs-simulation.png").stat().st_mtime_ns >= first
+    capsys.readouterr()
+    assert main([*run, "--plot", "qzs-simulation.png"]) == 2
+    assert "--plot 'qzs-simulation.png' exists; pass --overwrite" in capsys.readouterr().err
+    assert main([*run, "--plot", "qzs-simulation.png", "--overwrite"]) == 0

@@ -68,3 +68,28 @@ def test_a_sweep_of_absurdly_long_runs_leaves_no_store(sweep_file, tmp_path, cap
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "`duration` = 1e+09 s" in err
     assert not store.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["plan.toml"]
+
+
+def test_the_default_store_is_named_anew_and_a_named_one_refused(tmp_path, monkeypatch,
+                                                                 capsys):
+    """A sweep's store may hold hours of work: run again without --out, it is kept and the
+    new one is plan-2.zarr; --resume without --out continues plan.zarr."""
+    from qzs.workflows.sweeps import open_sweep
+
+    monkeypatch.chdir(tmp_path)
+    small = tmp_path / "small.toml"
+    small.write_text(tomli_w.dumps({
+        "sweep": {"name": "plan"}, "grid": {"pi_kp": [5.0]}, "excitation": {"f1": 10.0},
+        "analysis": {"fft_length": 1024, "n_averages": 4, "band": [0.0, 10.0]}}))
+    assert main(["sweep", str(small), "--quiet"]) == 0, capsys.readouterr().err
+    first = sorted(p.name for p in (tmp_path / "plan.zarr").rglob("*"))
+    assert main(["sweep", str(small), "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert "plan.zarr exists; writing plan-2.zarr (--out names another)" in captured.err
+    assert "wrote            plan-2.zarr" in captured.out
+    assert open_sweep("plan-2.zarr").sizes["case"] == 1
+    assert sorted(p.name for p in (tmp_path / "plan.zarr").rglob("*")) == first
+    assert main(["sweep", str(small), "--quiet", "--resume"]) == 0
+    assert "plan.zarr" in capsys.readouterr().out and not (tmp_path / "plan-3.zarr").exists()
+    assert main(["sweep", str(small), "--quiet", "--out", "plan.zarr"]) == 2
+    assert "--out 'plan.zarr' exists" in capsys.readouterr().err

@@ -4,13 +4,17 @@ four parts."""
 import numpy as np
 
 from qzs.engine import kernels as K
-from qzs.engine.channels import (CHANNELS, FLAG_MEANINGS, FLAGS, named_block, simulation_schema,
+from qzs.engine.channels import (CHANNELS, FLAG_MEANINGS, FLAGS, named_block, run_channels,
+                                 simulation_schema,
                                  variable_attributes)
 
 
 def test_channels_and_flags_take_distinct_kernel_columns():
     columns = [column for column, _, _ in CHANNELS.values()]
-    assert sorted(columns) == list(range(K.N_CHANNELS))
+    assert sorted(columns) == list(range(K.N_BASE_CHANNELS))
+    # the blocks' channels follow, each its own column
+    every = [column for column, _, _ in run_channels(every_block=True).values()]
+    assert sorted(every) == list(range(K.N_CHANNELS))
     assert sorted(column for column, _ in FLAGS.values()) == [0, 1]
 
 

@@ -101,9 +101,9 @@ def test_fade_in_defaults_and_switch():
         RandomExcitation(duration=10.0, fade_in=20.0)
 
 
-@pytest.mark.parametrize("seed", [-1, 1.5, True])
+@pytest.mark.parametrize("seed", [-1, 1.5, True, 2 ** 63])
 def test_bad_seed_is_named(seed):
-    with pytest.raises(ExcitationError, match="`seed` must be a non-negative integer"):
+    with pytest.raises(ExcitationError, match=r"`seed` must be an integer in \[0, 9223372036854775807\]"):
         RandomExcitation(seed=seed)
 
 
@@ -151,3 +151,36 @@ def test_a_rate_divides_1_over_dt_when_it_is_a_whole_fraction_of_it(rate, dt, ex
     assert divides(rate, dt) is expected
 
 
+
+
+# ---------------------------------------------------------------- a random record's memory
+def test_a_random_record_that_would_not_fit_in_memory_is_refused_before_it_is_made():
+    """A 1e12 s record for a 2 s run: numpy's "Unable to allocate 1.42 PiB" once, naming
+    neither the record's length nor the fix (it need not be longer than the run)."""
+    import time
+
+    began = time.perf_counter()
+    with pytest.raises(ParameterError) as caught:
+        simulate(RandomExcitation(duration=1e12), duration=2.0)
+    assert time.perf_counter() - began < 1.0
+    message = str(caught.value)
+    assert caught.value.options == ("excitation.duration", "duration")
+    assert message.startswith("`excitation.duration` = 1e+12 s makes the random excitation's "
+                              "record 4e+14 points"), message
+    assert "the record need not be longer than the run (`duration` = 2 s)" in message
+
+
+def test_the_record_check_is_the_memory_guard_at_its_threshold(monkeypatch):
+    from qzs.engine import driver
+    from qzs.engine.prepare import RECORD_BYTES_PER_POINT, check_record
+
+    excitation = RandomExcitation(duration=100.0, f_high=20.0)
+    needed = excitation.record_points * RECORD_BYTES_PER_POINT
+    assert excitation.record_points == 40_001  # 20 points a period of f_high, both ends
+    assert excitation.pack()[1].shape[1] == excitation.record_points  # what _spline makes
+    monkeypatch.setattr(driver, "available_memory", lambda: 2 * needed)
+    check_record(excitation, 10.0)
+    monkeypatch.setattr(driver, "available_memory", lambda: 2 * needed - 2)
+    with pytest.raises(ParameterError, match="`excitation.duration` = 100 s makes"):
+        check_record(excitation, 10.0)
+    check_record(Chirp(duration=1e12), 10.0)  # no record: nothing to refuse

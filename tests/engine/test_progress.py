@@ -168,3 +168,46 @@ def test_a_warning_comes_above_a_progress_bar_not_inside_it(monkeypatch):
     assert "\nqzs: warning: a step note\n" in text.replace("\r", "\n")
     before, _, after = text.partition("qzs: warning: a step note\n")
     assert before.endswith("\r") and "1/4" in after  # cleared first, drawn again after
+
+
+def test_a_python_warning_during_a_bar_lands_on_its_own_line(monkeypatch):
+    """In Python (no command line to put show_warning in place) a warning raised while a bar
+    is drawn, such as a DataWarning of a sweep's batch, goes through the bar's write: the
+    bar is cleared, the warning written whole, the bar drawn again; after the bar, warnings
+    are Python's own again, and a recorder (catch_warnings) still records."""
+    import io
+    import warnings
+
+    from qzs.engine.progress import progress_bar
+    from qzs.errors import DataWarning
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    stream = io.StringIO()
+    original = warnings.showwarning
+
+    def python_default(message, category, filename, lineno, file=None, line=None):
+        stream.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    monkeypatch.setattr(warnings, "showwarning", python_default)
+    bar = progress_bar(total=4, desc="cases", file=stream, mininterval=0)
+    bar.update()
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.warn("no trusted bin in the band [1, 3] Hz", DataWarning)
+    bar.update()
+    bar.close()
+    text = stream.getvalue()
+    before, found, after = text.partition("DataWarning: no trusted bin in the band [1, 3] Hz")
+    assert found, text
+    line_start = before.rsplit("\n", 1)[-1].rsplit("\r", 1)[-1]
+    assert "1/4" not in line_start and before.endswith(line_start)   # the bar was cleared
+    assert before.rstrip(" ").endswith(("\r", "\n")) or "cases" not in line_start
+    assert "2/4" in after or "1/4" in after                          # drawn again after it
+    assert warnings.showwarning is python_default                    # put back at the close
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with progress_bar(total=1, file=stream) as recorded_bar:
+            warnings.warn("kept", DataWarning)
+            recorded_bar.update()
+    assert [str(w.message) for w in caught] == ["kept"]
+    monkeypatch.setattr(warnings, "showwarning", original)

@@ -7,6 +7,8 @@ Properties that fail if the resolution is wrong:
   integrate at one step and give bit-identical series;
 * the step of a run shorter than its chirp is chosen over the band the run covers (a chirp
   of the same sweep law ended at the frequency the run reaches), not the whole sweep's;
+* a stationary excitation (a sine, a random one) is never probed longer than its run: every
+  probe run of a 2 s sine run integrates 2 s, not the sine's own 15.3 s probe;
 * a literal step is a record too (nothing chosen, no estimate), and asking for a step two
   ways, or for more samples than can be counted, is refused before any run.
 """
@@ -66,6 +68,37 @@ def test_a_run_shorter_than_its_chirp_chooses_its_step_over_the_band_it_covers()
     assert whole.step.band[1] == 20.0
 
 
+@pytest.mark.parametrize("excitation, own_probe", [
+    (Sine(amplitude=0.008, frequency=3.0, fade_in=2.0), 2.0 + 40 / 3.0),  # fade-in, 40 periods
+    (qzs.RandomExcitation(duration=200.0, f_high=10.0), 60.0)], ids=["sine", "random"])
+def test_a_stationary_excitation_is_never_probed_longer_than_its_run(monkeypatch, excitation,
+                                                                     own_probe):
+    """A 2 s run of a 3 Hz sine: its own probe would be the fade-in and 40 periods (15.3 s),
+    more than seven times the run. Every probe run integrates the run's 2 s, no more, and the
+    record says so; a run longer than the probe keeps the probe's own length (a random
+    excitation's: 60 s)."""
+    from qzs.engine import single
+
+    integrated = []
+    original = single.integrate
+
+    def recording(*args, **kwargs):
+        integrated.append((kwargs["duration"], kwargs["dt"]))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(single, "integrate", recording)
+    run = qzs.resolve(excitation, duration=2.0, step="chosen", cache=False)
+    assert len(integrated) >= 3  # the search compared at least three steps
+    assert {duration for duration, _ in integrated} == {2.0}
+    assert run.step.probe_duration == 2.0 and run.duration == 2.0
+    integrated.clear()
+    longer = qzs.resolve(excitation, duration=100.0, step="chosen", cache=False)
+    probed = {duration for duration, _ in integrated}
+    # a whole number of output periods (1 ms) of the probe's own length
+    assert probed == {longer.step.probe_duration}
+    assert longer.step.probe_duration == pytest.approx(own_probe, abs=1e-3)
+
+
 def test_a_literal_step_is_a_record_and_the_python_default_is_the_papers_step():
     run = qzs.resolve(CHIRP)
     assert run.dt == qzs.defaults.SIMULATION["dt"] and not run.step.chosen
@@ -96,3 +129,17 @@ def test_inconsistent_or_impossible_requests_are_refused_before_any_run(options,
 def test_a_transmissibility_tolerance_for_a_sine_is_refused():
     with pytest.raises(ParameterError, match="tolerance_state"):
         qzs.resolve(Sine(frequency=2.0), duration=1.0, tolerance=0.01)
+
+
+def test_the_length_check_counts_at_the_kernels_own_speed():
+    """1e12 steps (1e9 s at 1 kHz): 8.3 h of the single axis at its best, started; 3.5
+    days of the six-leg platform, refused before any run (qzs hexapod transmissibility
+    --duration 1e9 refused only in its worker processes)."""
+    from qzs.engine.run_spec import check_length
+    from qzs.errors import ParameterError
+
+    check_length(1e9, 1000.0, None)
+    with pytest.raises(ParameterError, match="`duration` 1e[+]09 s is at least 1e[+]12 "
+                                             "integration steps") as caught:
+        check_length(1e9, 1000.0, None, kernel="hexapod")
+    assert caught.value.options == ("duration", "sample_rate")

@@ -18,8 +18,8 @@ import math
 import pytest
 
 from qzs import defaults
-from qzs.engine.step_search import (SAFETY, StepChoice, halving_search, record_line,
-                                    search_step)
+from qzs.engine.step_search import (MAX_HALVINGS, SAFETY, StepChoice, halving_search,
+                                    record_line, search_step)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 ORDER = 3
@@ -93,6 +93,35 @@ def test_the_one_fallback_runs_at_the_finest_allowed_step_and_says_why():
     finer, _ = _search([1e12], 1e-12, fallback=True, finest=DT0 / 4)
     assert finer.dt == DT0 / 4 and not finer.met
     assert all(h[0] >= DT0 / 4 for h in finer.history)  # no candidate finer than `finest`
+
+
+@pytest.mark.parametrize("floor", [DT0 / 4, DT0 / 5, DT0 / 2 ** 5, DT0 / 48, DT0 / 2 ** 10])
+@pytest.mark.parametrize("reach", ["never", "one_below", "at_the_floor"])
+def test_no_step_below_the_finest_allowed_is_integrated_or_returned(floor, reach):
+    """``finest`` is a floor: the candidates are ``dt_0/2**j`` down to the last one at or
+    above it, ``n = floor(log2(dt_0/finest))`` halvings (at most ``max_halvings``), and no
+    further, whether the tolerance is never met, met only one halving below the floor (where
+    the search must not go: the fallback), or met at the finest candidate that can still be
+    estimated (``dt_{n-2}``, compared with ``dt_{n-1}`` and ``dt_n``)."""
+    deepest = min(math.floor(math.log2(DT0 / floor) + 1e-9), MAX_HALVINGS)
+    tolerance = 1e-6
+    # the error C*dt**p just meets the tolerance at dt_level, and at no coarser candidate
+    level = {"never": None, "one_below": deepest - 1, "at_the_floor": deepest - 2}[reach]
+    constant = 1e30 if level is None else 0.999 * tolerance / (SAFETY * (DT0 / 2 ** level)
+                                                               ** ORDER)
+    choice, calls = _search([constant], tolerance, fallback=True, finest=floor)
+    integrated = sorted({dt for dt, _ in calls})
+    assert integrated[0] >= floor and integrated[0] == DT0 / 2 ** deepest
+    assert integrated == [DT0 / 2 ** j for j in range(deepest, -1, -1)]
+    assert choice.dt >= floor and all(h[0] >= floor for h in choice.history)
+    # the record's reference is the finest step integrated, met or not
+    assert choice.reference_dt == integrated[0]
+    if reach == "at_the_floor":
+        assert choice.met and choice.dt == DT0 / 2 ** level
+    else:
+        # the fallback names the finest candidate whose error was estimated, dt_{n-2}
+        assert not choice.met and choice.dt == floor
+        assert f"no step down to {DT0 / 2 ** (deepest - 2):.3g} s" in choice.notes[-1]
 
 
 def test_no_trusted_bin_is_an_error_or_the_fallback():

@@ -96,3 +96,52 @@ def test_the_header_is_the_table_and_compiles(tmp_path):
     library.qzs_check.restype = ctypes.c_double
     assert library.qzs_check() == 2e-4
     assert np.isclose(float(header.count("QZS_VR_")), len(variables) + 0)
+
+
+def test_the_motor_force_starts_where_the_kernels_hold_the_payload_at_rest():
+    """The plant mode's start: with it as the motor force, the base at rest, the payload at
+    the setpoint, friction has nothing to hold (qzs's own static balance, kernels.hold_force),
+    whatever the mass; beyond the motor's limit it is the limit."""
+    from qzs.engine.prepare import prepare_run
+    from qzs.export.fmu_variables import holding_force
+
+    for mass in (6.4, 7.5, 5.0):
+        isolator = qzs.IsolatorParameters(mass=mass)
+        controller = qzs.ControllerParameters()
+        hold = holding_force(isolator, controller)
+        run = prepare_run(qzs.Sine(amplitude=0.0, fade_in=0.0), isolator, controller,
+                          duration=1.0)
+        state = run.state.copy()
+        state[K.A_F_PI] = state[K.A_F_DAMP] = 0.0
+        state[K.A_F_MOTOR] = hold
+        force = K.hold_force(0.0, state, run.params, *run.packed)
+        assert abs(force[K.F_HOLD]) < 1e-12 * isolator.mass * isolator.gravity, mass
+    limited = qzs.IsolatorParameters(mass=9.0, motor_force_max=5.0)
+    assert holding_force(limited, qzs.ControllerParameters()) == 5.0
+    plant = {v.name: v for v in table("plant")}
+    assert plant["motor_force"].start == holding_force(qzs.IsolatorParameters(),
+                                                       qzs.ControllerParameters(pi_kp=77.0))
+
+
+def test_the_excitations_units_are_the_registrys():
+    from qzs.model.registry import unit_of
+
+    variables = {v.name: v for v in table()}
+    assert variables["excitation.duration"].unit == unit_of("excitation.duration", "chirp")
+    assert variables["excitation.f0"].unit == unit_of("excitation.frequency", "sine")
+    assert variables["excitation.phase"].unit == unit_of("excitation.phase", "sine")
+    assert variables["excitation.fade_in"].unit == unit_of("excitation.fade_in", "sine")
+    assert "chirps only" in variables["excitation.duration"].description
+
+
+def test_the_header_carries_the_exported_step_and_how_it_was_chosen():
+    variables = table()
+    literal = variables_header(variables, mode="closed-loop", base_motion="internal",
+                               token="{x}")
+    assert "#define QZS_FMU_EXPORTED_STEP 0.0002\n" in literal
+    assert "#define QZS_FMU_STEP_CHOSEN 0\n" in literal
+    chosen = qzs.resolve(qzs.Chirp(duration=4.0, f1=5.0), step="chosen").step
+    assert chosen.chosen
+    header = variables_header(variables, mode="closed-loop", base_motion="internal",
+                              token="{x}", step=chosen)
+    assert "#define QZS_FMU_STEP_CHOSEN 1\n" in header and chosen.line() in header

@@ -8,7 +8,7 @@ import pytest
 
 from qzs.errors import OutputPathError
 from qzs.iotools import paths
-from qzs.iotools.paths import check_output_path, format_bytes
+from qzs.iotools.paths import check_output_path, format_bytes, removed_on_error
 
 
 def test_a_writable_path_passes_and_the_check_writes_nothing(tmp_path):
@@ -78,3 +78,44 @@ def test_an_empty_name_says_it_is_empty_not_that_it_is_a_folder(directory, tmp_p
                           directory=directory)
     assert caught.value.argument == "--out" and caught.value.value == ""
     assert "empty" in str(caught.value) and "'.'" not in str(caught.value)
+
+
+def test_a_free_name_is_the_name_itself_or_the_next_numbered_one(tmp_path):
+    from qzs.iotools.paths import free_name
+
+    store = tmp_path / "pi.zarr"
+    assert free_name(store, directory=True) == store
+    store.mkdir()
+    assert free_name(store, directory=True) == store          # an empty folder is free
+    (store / "a").write_text("")
+    (tmp_path / "pi-2.zarr").mkdir()
+    (tmp_path / "pi-2.zarr" / "a").write_text("")
+    assert free_name(store, directory=True) == tmp_path / "pi-3.zarr"
+    (tmp_path / "results").write_text("")
+    assert free_name(tmp_path / "results") == tmp_path / "results-2"
+
+
+def test_removed_on_error_takes_back_what_a_failed_block_made_and_nothing_else(tmp_path):
+    store = tmp_path / "a" / "b" / "s.zarr"
+    with pytest.raises(ValueError):
+        with removed_on_error(store):
+            store.mkdir(parents=True)
+            (store / "zarr.json").write_text("{}")
+            raise ValueError("refused")
+    assert list(tmp_path.iterdir()) == []  # the store and the two folders made for it
+    with pytest.raises(ValueError):
+        with removed_on_error(store) as made:
+            store.mkdir(parents=True)
+            made.keep()  # a batch is in it: kept for a resume
+            raise ValueError("a later batch failed")
+    assert store.is_dir()
+    with pytest.raises(ValueError):
+        with removed_on_error(store):  # it existed before: never removed
+            raise ValueError("refused")
+    assert store.is_dir()
+    other = tmp_path / "other.zarr"
+    with pytest.raises(KeyboardInterrupt):
+        with removed_on_error(other):  # Ctrl-C keeps what is there, for a resume
+            other.mkdir()
+            raise KeyboardInterrupt
+    assert other.is_dir()

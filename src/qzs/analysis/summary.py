@@ -3,7 +3,8 @@
 The numbers come from :attr:`SimulationResult.statistics` (every sample, also of a
 run streamed to a file); the warnings from :func:`run_warnings`.
 """
-__all__ = ["summary_text", "summary_record", "run_title", "run_warnings", "WARNING_LIMITS"]
+__all__ = ["summary_text", "summary_record", "run_title", "run_warnings", "excitation_part",
+           "WARNING_LIMITS"]
 
 #: Where the summary starts to warn: the output rate per excitation frequency [-], the
 #: integration steps per period [-], the energy-ledger residual per unit of base work [-].
@@ -11,16 +12,55 @@ WARNING_LIMITS = {"samples_per_period": 5.0, "steps_per_period": 20.0,
                   "energy_residual_share": 1e-4}
 
 
+def excitation_part(excitation, duration):
+    """The excitation and the part of it a run of ``duration`` covers, for people.
+
+    ``Chirp 0-20 Hz over 2000 s: first 200 s run (0-2 Hz)`` (the band reached, by the sweep
+    law), ``Sine 3 Hz: 10 s run``, ``Random 0.5-20 Hz over 100 s: all 100 s run``,
+    ``Record of 60 s: first 20 s run``.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation, DisplacementRecord or None
+        The base motion.
+    duration : float
+        The run's simulated time [s].
+
+    Returns
+    -------
+    str
+    """
+    from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
+
+    if isinstance(excitation, Sine):
+        return f"Sine {excitation.frequency:g} Hz: {duration:g} s run"
+    if isinstance(excitation, Chirp):
+        law = " (logarithmic)" if excitation.method == "logarithmic" else ""
+        what = f"Chirp {excitation.f0:g}-{excitation.f1:g} Hz{law} over {excitation.duration:g} s"
+    elif isinstance(excitation, RandomExcitation):
+        what = (f"Random {excitation.f_low:g}-{excitation.f_high:g} Hz over "
+                f"{excitation.duration:g} s")
+    elif isinstance(excitation, DisplacementRecord):
+        what = f"Record of {excitation.duration:g} s"
+    else:
+        return f"{type(excitation).__name__}: {duration:g} s run"
+    if duration >= excitation.duration * (1 - 1e-12):
+        return f"{what}: all {duration:g} s run"
+    reached = ""
+    if isinstance(excitation, Chirp):
+        reached = (f" ({excitation.f0:g}-{float(excitation.frequency_at(duration)):.3g} Hz)")
+    return f"{what}: first {duration:g} s run{reached}"
+
+
 def run_title(result):
-    """One line naming the excitation, duration, solver and step of a run.
+    """One line naming the excitation and the part of it run, the solver and step of a run.
 
     Parameters
     ----------
     result : SimulationResult
         The run.
     """
-    exc = result.excitation
-    return (f"{type(exc).__name__}: {result.run['duration']:g} s, "
+    return (f"{excitation_part(result.excitation, result.run['duration'])}, "
             f"{result.run['solver']} dt = {result.run['dt']:g} s")
 
 
@@ -106,17 +146,6 @@ def _residual_share(stats):
     return stats["energy_residual_max"] / max(stats["base_work_max"], 1e-300)
 
 
-def _coverage(result):
-    """For a chirp the run cuts short: the band it covers, as a line; else ''."""
-    exc = result.excitation
-    duration = result.run["duration"]
-    if not hasattr(exc, "frequency_at") or duration >= exc.duration * (1 - 1e-12):
-        return ""
-    reached = float(exc.frequency_at(duration))
-    return (f"  excitation       the first {duration:g} s of a {exc.duration:g} s chirp: "
-            f"{exc.f0:g} -> {reached:.3g} Hz of {exc.f0:g} -> {exc.f1:g} Hz")
-
-
 def _step_line(run):
     """How the run's step was chosen, as a line (docs/model.md §7); '' for a literal step."""
     from qzs._format import step_line
@@ -192,9 +221,6 @@ def summary_text(result):
     step = _step_line(run)
     if step:
         lines.append(step)
-    coverage = _coverage(result)
-    if coverage:
-        lines.append(coverage)
     lines += [
         f"  operating point  setpoint z_ref = {ctrl.position_setpoint * 1e3:.1f} mm; "
         f"mean z = {stats['z_mean'] * 1e3:.2f} mm; final z = {stats['z_final'] * 1e3:.2f} mm",

@@ -16,12 +16,14 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
   the command stops quietly, as a program killed by SIGPIPE would (128 + 13).
 - 143: terminated by SIGTERM (128 + 15), after the cleanup ran (no temporary file stays).
 """
+import argparse
 import contextlib
 import dataclasses
 import json
 import sys
 import threading
 import warnings
+from pathlib import Path
 
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
@@ -35,7 +37,8 @@ from qzs.model.registry import update_parameters
 
 __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
            "add_execution_options", "add_output_options", "figure_path", "check_output",
-           "OUTPUT_OPTIONS", "NO_FIGURE", "stopped",
+           "OUTPUT_OPTIONS", "NO_FIGURE", "UNNAMED", "NamedOutput", "named", "output_name",
+           "stopped",
            "add_frequency_axis_option", "emit", "jsonable",
            "integer_at_least", "run_handler", "memory_hint", "EXIT_CODES", "EPILOG",
            "MEMORY_HINTS", "MEMORY_HINT", "KERNEL_FAMILIES", "kernel_families",
@@ -47,6 +50,15 @@ __all__ = ["settings", "parameters", "add_set_option", "add_json_option",
 OUTPUT_OPTIONS = ("--out", "--plot", "--json", "--quiet", "--overwrite")
 #: The value of ``--plot`` that draws no figure.
 NO_FIGURE = "none"
+#: What becomes of an output the user did not name (``--out``/``--plot`` left at its default)
+#: when one of that name exists, by policy: a figure, a report or an export is made again
+#: from the run and replaced; a store (a sweep's, a search's) holds work that may have taken
+#: hours, so it is kept and the new one named anew (``NAME-2.zarr``). The help of each such
+#: option says which (:func:`add_output_options`); an output the user named is never
+#: replaced without ``--overwrite``.
+UNNAMED = {"replace": "a default one that exists is replaced",
+           "rename": "a default one that exists is kept and the next free name taken (NAME-2, "
+                     "NAME-3, ...)"}
 #: Exit code -> meaning, for every subcommand.
 EXIT_CODES = {0: "success", 1: "the run started and failed", 2: "bad input or usage",
               130: "interrupted (Ctrl-C)", 141: "output pipe closed by its reader",
@@ -127,42 +139,83 @@ def add_frequency_axis_option(parser):
                              f"the roll-off to 20 Hz span decades)")
 
 
+class NamedOutput(argparse.Action):
+    """Store an output option's value and remember that the user named it (:func:`named`)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        setattr(namespace, "named_outputs",
+                {*getattr(namespace, "named_outputs", ()), self.option_strings[0]})
+
+
+def named(args, option):
+    """Did the user give ``option`` (``"--out"``), rather than leave it at its default?
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    option : str
+        An output option declared with :class:`NamedOutput` (:func:`add_output_options`,
+        ``qzs params --toml``).
+
+    Returns
+    -------
+    bool
+    """
+    return option in getattr(args, "named_outputs", ())
+
+
 def add_output_options(parser, *, out=None, plot=None, json_help=None):
     """Add the output options of a subcommand that writes: ``--out`` and/or ``--plot``, then
     ``--json``, ``--quiet`` and ``--overwrite`` (:data:`OUTPUT_OPTIONS`).
 
-    One policy for every subcommand: an output that exists (a file, or a folder holding
-    anything) is refused before any work, the message naming the path and ``--overwrite``;
-    with ``--overwrite`` it is replaced, atomically (:func:`check_output`). ``--plot none``
-    draws no figure (:func:`figure_path`).
+    One policy for every subcommand: an output the user named that exists (a file, or a
+    folder holding anything) is refused before any work, the message naming the path and
+    ``--overwrite``; with ``--overwrite`` it is replaced, atomically (:func:`check_output`).
+    An output left at its default name is replaced or named anew, as its help says
+    (:data:`UNNAMED`). ``--plot none`` draws no figure (:func:`figure_path`).
 
     Parameters
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser.
     out : dict, optional
-        ``--out``'s ``metavar``, ``help`` and (optional) ``default``; None: no ``--out``.
+        ``--out``'s ``metavar``, ``help``, (optional) ``default`` and, where there is a
+        default (given here, or made by the command from its input), ``unnamed``: a key of
+        :data:`UNNAMED`, what becomes of an existing output of that name; None: no ``--out``.
     plot : dict, optional
-        ``--plot``'s ``help`` and (optional) ``default`` (None: no figure unless asked);
-        None: no ``--plot``.
+        ``--plot``'s ``help`` and (optional) ``default`` (None: no figure unless asked; a
+        default figure is replaced); None: no ``--plot``.
     json_help : str, optional
         ``--json``'s help, where the record is not one object (:func:`add_json_option`).
     """
+    policies = {}
     if out is not None:
+        text = out["help"]
+        if "unnamed" in out:
+            policies["--out"] = out["unnamed"]
+            text = f"{text}; {UNNAMED[out['unnamed']]}"
+        elif out.get("default") is not None:
+            raise ValueError("an --out with a default needs `unnamed` (qzs.cli.common.UNNAMED)")
         parser.add_argument("--out", metavar=out["metavar"], default=out.get("default"),
-                            help=out["help"])
+                            action=NamedOutput, help=text)
     if plot is not None:
         default = plot.get("default")
-        shown = f"default {default}" if default else "default none"
-        parser.add_argument("--plot", metavar="FILE", default=default,
+        if default:
+            policies["--plot"] = "replace"
+        shown = f"default {default}, replaced if it exists" if default else "default none"
+        parser.add_argument("--plot", metavar="FILE", default=default, action=NamedOutput,
                             help=f"{plot['help']} (.png, .svg or .pdf; {shown}; "
                                  f"'{NO_FIGURE}' for no figure)")
+    parser.set_defaults(unnamed_outputs=policies)
     add_json_option(parser, json_help)
     parser.add_argument("--quiet", action="store_true",
                         help="no progress bar (nor the seconds of a first compilation)")
     parser.add_argument("--overwrite", action="store_true",
-                        help="replace an existing output (without it, one is refused before "
-                             "any work)")
+                        help="replace an existing output that you named (without it, one is "
+                             "refused before any work); one left at its default name is "
+                             "replaced or named anew, as its option says")
 
 
 def figure_path(args):
@@ -183,16 +236,19 @@ def figure_path(args):
 
 def check_output(args, option, path, *, suffixes, directory=False, estimated_bytes=None):
     """Check an output path before any work (:func:`qzs.iotools.paths.check_output_path`)
-    under the command line's policy: an existing output needs ``--overwrite``.
+    under the command line's policy: an existing output the user named needs
+    ``--overwrite``; one left at its default name is replaced, or named anew, as the
+    subcommand declared (:data:`UNNAMED`, :func:`add_output_options`).
 
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments; ``args.overwrite`` (absent: False) allows replacing.
     option : str
-        The option that named the path (``"--out"``), for the message.
+        The option that names the path (``"--out"``), for the message and to tell whether
+        the user gave it (:func:`named`).
     path : str or Path
-        The file or folder.
+        The file or folder: the option's value, or the default the command made.
     suffixes : iterable of str or None
         Allowed extensions (None: any).
     directory : bool
@@ -203,12 +259,54 @@ def check_output(args, option, path, *, suffixes, directory=False, estimated_byt
     Returns
     -------
     Path
+        Where to write: ``path``, or the free name taken in its place (said on stderr).
     """
     from qzs.iotools.paths import check_output_path
 
+    path, overwrite = output_name(args, option, path, directory=directory)
     return check_output_path(path, argument=option, suffixes=suffixes, directory=directory,
-                             estimated_bytes=estimated_bytes,
-                             overwrite=getattr(args, "overwrite", False))
+                             estimated_bytes=estimated_bytes, overwrite=overwrite)
+
+
+def output_name(args, option, path, *, directory=False, resume=False):
+    """Where an output goes, and whether one that exists there may be replaced, under the
+    command line's policy (:func:`check_output`, which checks the path too; a store's own
+    checks take the answer instead).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (``overwrite``, and which outputs the user named).
+    option : str
+        The option that names the path (``"--out"``).
+    path : str or Path
+        The option's value, or the default the command made.
+    directory : bool
+        ``path`` is a folder (an empty one is free).
+    resume : bool
+        The command continues what is there (``--resume``): never named anew (nor with
+        ``--overwrite``, which asks for the default to be replaced).
+
+    Returns
+    -------
+    path : Path
+        ``path``, or the free name taken in its place (said on stderr).
+    overwrite : bool
+        An existing output at ``path`` may be replaced: ``--overwrite`` given, or a default
+        whose policy is ``"replace"``.
+    """
+    from qzs.iotools.paths import free_name
+
+    policy = None if named(args, option) else getattr(args, "unnamed_outputs", {}).get(option)
+    overwrite = getattr(args, "overwrite", False) or policy == "replace"
+    path = Path(path)
+    if policy == "rename" and not resume and not overwrite:
+        free = free_name(path, directory=directory)
+        if free != path:
+            print(f"qzs: {path} exists; writing {free} ({option} names another)",
+                  file=sys.stderr)
+        path = free
+    return path, overwrite
 
 
 def add_execution_options(parser, verb="run"):

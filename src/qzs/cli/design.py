@@ -128,6 +128,7 @@ def add_parser(subparsers):
                      help="threads (default: all cores)")
     add_frequency_axis_option(cmd)
     add_output_options(cmd, out=dict(metavar="FOLDER", default=DEFAULT_FOLDER,
+                                     unnamed="replace",
                                      help=f"output folder (default {DEFAULT_FOLDER})"))
     return cmd
 

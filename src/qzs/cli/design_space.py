@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from qzs.cli.common import (EPILOG, add_execution_options, add_output_options, check_output, emit,
-                             integer_at_least, stopped)
+                             integer_at_least, output_name, stopped)
 from qzs.errors import ParameterError, Terminated
 from qzs.iotools.paths import check_output_path
 
@@ -50,8 +50,9 @@ def add_parsers(subparsers):
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the problem and the work, run nothing")
     add_execution_options(cmd, "evaluate")
-    add_output_options(cmd, out=dict(metavar="DIR", help="output folder (default the problem's "
-                                                         "name); the store is DIR/NAME.zarr"))
+    add_output_options(cmd, out=dict(metavar="DIR", unnamed="rename",
+                                     help="output folder (default the problem's name); the "
+                                          "store is DIR/NAME.zarr"))
 
     sens = subparsers.add_parser(
         "sensitivity", help="global sensitivity of a problem's metrics (Sobol or Morris)",
@@ -69,14 +70,17 @@ def add_parsers(subparsers):
                            "trajectories (N x (d + 1) runs); default the file's")
     sens.add_argument("--seed", type=int, metavar="N", help="default the file's")
     add_execution_options(sens, "evaluate")
-    add_output_options(sens, out=dict(metavar="DIR", help="output folder (default "
-                                                          "NAME-sensitivity)"))
+    add_output_options(sens, out=dict(metavar="DIR", unnamed="replace",
+                                      help="output folder (default NAME-sensitivity)"))
     return cmd
 
 
 def _check_counts(args):
+    from qzs._validation import seed
     from qzs.workflows.design_space.problem import MIN_POPULATION
 
+    if args.seed is not None:
+        seed("--seed", args.seed)
     for option in ("workers", "threads", "generations", "population", "samples"):
         value = getattr(args, option, None)
         least = MIN_POPULATION if option == "population" and value != 0 else 1
@@ -115,15 +119,16 @@ def run_optimize_command(args):
     if args.dry_run:
         print(plan_text(problem))
         return 0
-    folder = Path(args.out) if args.out else Path(problem.name)
+    folder, overwrite = output_name(args, "--out", args.out or problem.name, directory=True,
+                                    resume=args.resume)
     store = folder / f"{problem.name}.zarr"
     check_output_path(folder, argument="--out", suffixes=None, directory=True,
-                      overwrite=args.overwrite or args.resume or store.exists())  # see check
-    check(store, resume=args.resume, overwrite=args.overwrite, argument="--out")
+                      overwrite=overwrite or args.resume or store.exists())  # see check
+    check(store, resume=args.resume, overwrite=overwrite, argument="--out")
     quiet = args.quiet or args.json
     with file_writer(folder, progress=not quiet) as writer:  # its imports beside the search
         try:
-            result = optimize(problem, store, resume=args.resume, overwrite=args.overwrite,
+            result = optimize(problem, store, resume=args.resume, overwrite=overwrite,
                               generations=args.generations, population=args.population,
                               seed=args.seed, scheduler=args.scheduler, workers=args.workers,
                               threads=args.threads, progress=not quiet)
@@ -155,6 +160,7 @@ def run_sensitivity_command(args):
     from qzs.workflows.design_space import load_problem
     from qzs.workflows.design_space.sensitivity import run_sensitivity
 
+    _check_counts(args)
     problem = load_problem(args.problem)
     folder = Path(args.out) if args.out else Path(f"{problem.name}-sensitivity")
     check_output(args, "--out", folder, suffixes=None, directory=True)

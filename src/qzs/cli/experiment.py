@@ -54,6 +54,7 @@ def add_parser(subparsers):
                         help="resample a non-uniform time base onto a uniform grid")
     add_frequency_axis_option(parser)
     add_output_options(parser, out=dict(metavar="DIR", default="qzs-experiment",
+                                        unnamed="replace",
                                         help="output folder (default qzs-experiment)"))
     return parser
 

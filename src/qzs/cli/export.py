@@ -20,6 +20,13 @@ _EXCITATION_FLAGS = (
 )
 #: The sample rate a continuous configuration's controller is exported at [Hz].
 DEFAULT_CONTROLLER_RATE = 1000.0
+#: How ``qzs export fmu`` names the arguments of :func:`qzs.export_fmu` (and of what it
+#: resolves) in its messages: by their flags.
+_FMU_SPELLING = {"communication_step": "--step", "1/communication_step": "1/--step",
+                 "duration": "--duration", "dt": "--dt", "tolerance": "--tolerance",
+                 "tolerance_db": "--tolerance", "tolerance_state": "--tolerance-state",
+                 "solver": "--solver", "frequency": "--frequency", "f1": "--f1", "f0": "--f0",
+                 "fmi_version": "--fmi", "mode": "--mode", "base_motion": "--base-motion"}
 
 
 def add_parser(subparsers):
@@ -56,7 +63,7 @@ def add_parser(subparsers):
                                  f"the configuration's, else {SIMULATION['dt']:g}); the sample "
                                  "period is a whole number of it")
     add_output_options(controller, out={"metavar": "FILE.c", "default": "controller.c",
-                                        "help": "the C file to write (default controller.c)"})
+                                        "unnamed": "replace", "help": "the C file to write (default controller.c)"})
     controller.set_defaults(handler=run_controller)
     fmu = sub.add_parser(
         "fmu", help="the isolator as an FMI co-simulation FMU",
@@ -68,7 +75,7 @@ def add_parser(subparsers):
                     "or the base motion as inputs (`qzs docs fmu`). Needs a C compiler and "
                     "FMPy's FMI headers (pip install \"qzs[fmu]\").", epilog=EPILOG)
     add_output_options(fmu, out={"metavar": "FILE.fmu", "default": "isolator.fmu",
-                                 "help": "the FMU to write (default isolator.fmu)"})
+                                 "unnamed": "replace", "help": "the FMU to write (default isolator.fmu)"})
     fmu.add_argument("--fmi", type=int, choices=(3, 2), default=3,
                      help="FMI version (default 3)")
     fmu.add_argument("--mode", choices=("closed-loop", "plant"), default="closed-loop",
@@ -87,8 +94,8 @@ def add_parser(subparsers):
     step = fmu.add_mutually_exclusive_group()
     step.add_argument("--dt", type=float, metavar="S",
                       help="a literal internal integration step [s] (default the "
-                           "configuration's, else the step `qzs simulate` chooses); "
-                           "communication steps are whole numbers of it")
+                           "configuration's, else the step `qzs simulate` chooses; "
+                           "`qzs.export_fmu` in Python takes 1e-4 s literally)")
     step.add_argument("--tolerance", type=float, metavar="DB",
                       help="choose the internal step as `qzs simulate --tolerance` does [dB] "
                            "(default 0.01; a sine: --tolerance-state)")
@@ -100,7 +107,8 @@ def add_parser(subparsers):
                      help="the default experiment's stop time [s] (default the excitation's "
                           "length, 10 for a sine or inputs)")
     fmu.add_argument("--step", type=float, metavar="S",
-                     help="the default experiment's communication step [s] (default 0.001)")
+                     help="the default experiment's communication step [s] (default 0.001); "
+                          "the FMU takes any positive step")
     fmu.set_defaults(handler=run_fmu)
     return export
 
@@ -137,6 +145,19 @@ def run_controller(args):
     return 0
 
 
+def _fmu_spelling(args, settings):
+    """:data:`_FMU_SPELLING`, with a value the configuration file gave named as its key there
+    (the ``[simulation]`` table's ``dt``, ``duration`` or ``solver``)."""
+    spelling = dict(_FMU_SPELLING)
+    for key, flag in (("dt", "--dt"), ("duration", "--duration"), ("solver", "--solver")):
+        if getattr(args, key, None) is None and key in settings:
+            spelling[key] = f"[simulation] {key} of {args.config}"
+    if args.excitation_duration is not None and args.duration is None \
+            and "duration" not in settings:
+        spelling["duration"] = "--excitation-duration"
+    return spelling
+
+
 def run_fmu(args):
     """``qzs export fmu``: write the FMU.
 
@@ -165,17 +186,20 @@ def run_fmu(args):
                                 for flag, *_ in _EXCITATION_FLAGS):
         raise ParameterError("--excitation and its options are not used with --base-motion "
                              "input (the base motion comes from the FMU's inputs); drop them.")
-    path = export_fmu(args.out, excitation, config["isolator"], config["controller"],
-                      fmi_version=args.fmi, mode=args.mode, base_motion=args.base_motion,
-                      dt=args.dt if args.dt is not None else (
-                          None if args.tolerance is not None or args.tolerance_state is not None
-                          else settings.get("dt")),
-                      tolerance=args.tolerance, tolerance_state=args.tolerance_state,
-                      step="chosen",
-                      solver=args.solver or settings.get("solver", SIMULATION["solver"]),
-                      duration=args.duration if args.duration is not None
-                      else settings.get("duration"),
-                      communication_step=args.step, argument="--out")
+    try:  # export_fmu checks the inputs; the command line only says them its own way
+        path = export_fmu(args.out, excitation, config["isolator"], config["controller"],
+                          fmi_version=args.fmi, mode=args.mode, base_motion=args.base_motion,
+                          dt=args.dt if args.dt is not None else (
+                              None if args.tolerance is not None
+                              or args.tolerance_state is not None else settings.get("dt")),
+                          tolerance=args.tolerance, tolerance_state=args.tolerance_state,
+                          step="chosen",
+                          solver=args.solver or settings.get("solver", SIMULATION["solver"]),
+                          duration=args.duration if args.duration is not None
+                          else settings.get("duration"),
+                          communication_step=args.step, argument="--out")
+    except ParameterError as error:
+        raise error.renamed(_fmu_spelling(args, settings)) from None
     emit(args, f"wrote {path} (FMI {args.fmi}.0 co-simulation, {args.mode}, base motion "
                f"{args.base_motion}); `qzs docs fmu` shows how to use it",
          {"files": {"out": str(path)}, "fmi": args.fmi, "mode": args.mode,

@@ -153,7 +153,7 @@ def add_parser(subparsers):
                         help="parallel runs (default: all cores)")
     add_frequency_axis_option(matrix)
     add_output_options(matrix, out=dict(metavar="DIR", default="results/hexapod_transmissibility",
-                                        help="folder for transmissibility.png and "
+                                        unnamed="replace", help="folder for transmissibility.png and "
                                              "transmissibility.nc (default "
                                              "results/hexapod_transmissibility)"))
     matrix.set_defaults(handler=run_transmissibility)
@@ -170,7 +170,7 @@ def add_parser(subparsers):
                        help="parallel runs per case (default: all cores)")
     add_frequency_axis_option(study)
     add_output_options(study, out=dict(metavar="DIR", default="results/hexapod_study",
-                                       help="output folder (default results/hexapod_study)"))
+                                       unnamed="replace", help="output folder (default results/hexapod_study)"))
     study.set_defaults(handler=run_study)
     for command in sub.choices.values():
         command.epilog = EPILOG

@@ -1,6 +1,6 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from qzs.cli.common import EPILOG, add_set_option, check_output, parameters
-from qzs.iotools.config import save_config
+from qzs.cli.common import EPILOG, NamedOutput, add_set_option, check_output, parameters
+from qzs.iotools.config import config_text, save_config
 from qzs.model.registry import format_value, parameter_table
 
 __all__ = ["add_parser", "run"]
@@ -23,8 +23,11 @@ def add_parser(subparsers):
         "params", help="print the default parameters with units",
         description="Print every parameter with its value (the defaults, or --config's, with "
                     "--set applied), unit and description; or write them as a config file.",
-        epilog="--toml never replaces a file without --overwrite. " + EPILOG)
-    params.add_argument("--toml", metavar="FILE.toml", help="write them as a config file instead")
+        epilog="--toml FILE never replaces a file without --overwrite; --toml alone prints "
+               "the file to stdout (`qzs params --toml > my.toml`). " + EPILOG)
+    params.add_argument("--toml", metavar="FILE.toml", nargs="?", const="-", action=NamedOutput,
+                        help="write them as a config file instead (to stdout without FILE, "
+                             "or with -)")
     params.add_argument("--overwrite", "--force", dest="overwrite", action="store_true",
                         help="let --toml replace an existing file (--force: the old name)")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")
@@ -51,11 +54,15 @@ def run(args):
         ``--toml`` names an existing file without ``--overwrite``, or a path that cannot be
         written (checked before anything is written).
     """
-    if args.toml:
+    to_file = args.toml is not None and args.toml != "-"
+    if to_file:
         check_output(args, "--toml", args.toml, suffixes=(".toml",),
                      estimated_bytes=64 * 1024)
     config = parameters(args)
-    if args.toml:
+    if args.toml == "-":  # only the file's text: `qzs params --toml > my.toml`
+        print(config_text(config["isolator"], config["controller"]), end="")
+        return 0
+    if to_file:
         path = save_config(args.toml, config["isolator"], config["controller"])
         print(f"wrote {path}")
         return 0

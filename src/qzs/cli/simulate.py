@@ -135,7 +135,10 @@ def _spelling(args, settings, table):
         duration = "--excitation-duration"
     else:
         duration = f"[excitation] duration of {args.config}"
-    return {"duration": duration, "sample_rate": origin("sample_rate", "--sample-rate"),
+    record = ("--excitation-duration" if args.excitation_duration is not None
+              else f"[excitation] duration of {args.config}")
+    return {"duration": duration, "excitation.duration": record,
+            "sample_rate": origin("sample_rate", "--sample-rate"),
             "dt": origin("dt", "--dt"), "solver": origin("solver", "--solver"),
             "tolerance": "--tolerance", "tolerance_state": "--tolerance-state",
             "frequency": "--frequency", "f1": "--f1", "f_high": "--f1"}
@@ -157,6 +160,7 @@ def run(args):
     import sys
 
     from qzs.engine.run_spec import check_output_rate, resolve
+    from qzs.workflows.run import resolve_apart
     from qzs.workflows.figure_process import simulate_with_figure
 
     config = parameters(args)
@@ -180,9 +184,11 @@ def run(args):
     try:  # resolve() checks the inputs; the command line only says them its own way
         check_output_rate(excitation, settings.get("duration", excitation.duration),
                           settings.get("sample_rate", SIMULATION["sample_rate"]))
-        resolved = resolve(excitation, config["isolator"], config["controller"], **settings,
-                           tolerance=args.tolerance, tolerance_state=args.tolerance_state,
-                           step="chosen", progress=show)
+        # a streamed run's step is chosen apart: its imports do not weigh on the run
+        resolved = (resolve_apart if args.out else resolve)(
+            excitation, config["isolator"], config["controller"], **settings,
+            tolerance=args.tolerance, tolerance_state=args.tolerance_state, step="chosen",
+            progress=show)
     except ParameterError as error:
         raise error.renamed(_spelling(args, settings, config["simulation"])) from None
     result = simulate_with_figure(resolved, out=args.out, plot=plot, progress=show,

@@ -37,8 +37,13 @@ def add_parsers(subparsers):
         cmd.add_argument("--workers", type=integer_at_least(1), metavar="N",
                          help="worker processes (default: all cores)")
         add_frequency_axis_option(cmd)
-        add_output_options(cmd, out=dict(metavar="DIR", default=f"results/{name}",
-                                         help=f"output folder (default results/{name})"))
+        if name == "paper":
+            out = dict(metavar="DIR", default="results/paper",
+                       help="output folder (default results/paper)")
+        else:
+            out = dict(metavar="DIR", help="output folder (default results/NAME, NAME the "
+                                           "study's, e.g. results/stiction)")
+        add_output_options(cmd, out=dict(out, unnamed="replace"))
 
 
 def run(args):
@@ -57,6 +62,8 @@ def run(args):
     from qzs.workflows.paper.report import paper_summary, run_paper
     from qzs.workflows.paper.report_step import step_statement
 
+    if args.out is None:  # qzs study: the study's own folder, so that two never share one
+        args.out = f"results/{Path(args.definition).stem}"
     check_output(args, "--out", args.out, suffixes=None, directory=True)
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,

@@ -3,7 +3,7 @@ store, their figures, and the store as a MATLAB file."""
 from pathlib import Path
 
 from qzs.cli.common import (EPILOG, add_execution_options, add_output_options, check_output, emit,
-                             stopped)
+                             output_name, stopped)
 from qzs.errors import Terminated
 from qzs.viz.sweeps import FIGURE_BYTES, REDUCTIONS, figure_suffixes
 
@@ -30,8 +30,9 @@ def add_parsers(subparsers):
                     "in a Zarr store, batch by batch; Ctrl-C and --resume continue it.",
         epilog="The sweep is checked before any case runs: every case's values (the invalid "
                "ones are named), at most 1,000,000 cases, the store's name (.zarr), its folder "
-               "(writable, room for its uncompressed size); an existing store needs --resume or "
-               "--overwrite, --resume a store. Ctrl-C (130) and SIGTERM (143) keep the batches "
+               "(writable, room for its uncompressed size); an existing store you named needs "
+               "--resume or --overwrite (one of the default name: a new store is named anew), "
+               "--resume a store. Ctrl-C (130) and SIGTERM (143) keep the batches "
                "already stored. "
                + EPILOG)
     cmd.add_argument("definition", metavar="FILE.toml",
@@ -41,9 +42,9 @@ def add_parsers(subparsers):
     cmd.add_argument("--dry-run", action="store_true",
                      help="print the cases and the work, run nothing")
     add_execution_options(cmd)
-    add_output_options(cmd, out=dict(metavar="STORE.zarr", help="the Zarr store, a folder whose "
-                                                                "name ends in .zarr (default "
-                                                                "NAME.zarr)"))
+    add_output_options(cmd, out=dict(metavar="STORE.zarr", unnamed="rename",
+                                     help="the Zarr store, a folder whose name ends in .zarr "
+                                          "(default NAME.zarr, NAME the sweep's)"))
 
     plot = subparsers.add_parser(
         "sweep-plot", help="figures of a sweep store",
@@ -60,9 +61,9 @@ def add_parsers(subparsers):
                            "default without --y: the band, one per --x level)")
     plot.add_argument("--reduce", choices=REDUCTIONS, default="median",
                       help="combine the cases at one grid point (default median; max = worst)")
-    add_output_options(plot, out=dict(metavar="FILE", help="figure file, format from its "
-                                                           "extension (default "
-                                                           "<sweep>-<...>.png)"))
+    add_output_options(plot, out=dict(metavar="FILE", unnamed="replace",
+                                      help="figure file, format from its extension (default "
+                                           "<sweep>-<...>.png)"))
 
     export = subparsers.add_parser(
         "sweep-export", help="write a sweep store to a MATLAB file (.mat)",
@@ -72,8 +73,9 @@ def add_parsers(subparsers):
                     "variable exceeds 2 GiB).",
         epilog="The file's name is checked before the store is read. " + EPILOG)
     export.add_argument("store", metavar="STORE.zarr", help="sweep store written by `qzs sweep`")
-    add_output_options(export, out=dict(metavar="FILE.mat", help="the MATLAB file (default the "
-                                                                 "store's name with .mat)"))
+    add_output_options(export, out=dict(metavar="FILE.mat", unnamed="replace",
+                                        help="the MATLAB file (default the store's name with "
+                                             ".mat)"))
     return cmd
 
 
@@ -97,14 +99,15 @@ def run_sweep_command(args):
     from qzs.workflows.sweeps.store import summary_text
 
     definition = load_sweep(args.definition)
-    store = Path(args.out) if args.out else Path(f"{definition.name}.zarr")
     if args.dry_run:
         print(plan_text(definition))
         return 0
+    store, overwrite = output_name(args, "--out", args.out or f"{definition.name}.zarr",
+                                   directory=True, resume=args.resume)
     check_store_path(definition, store, argument="--out", resume=args.resume,
-                     overwrite=args.overwrite)
+                     overwrite=overwrite)
     try:
-        report = execute(definition, store, resume=args.resume, overwrite=args.overwrite,
+        report = execute(definition, store, resume=args.resume, overwrite=overwrite,
                          scheduler=args.scheduler, workers=args.workers, threads=args.threads,
                          progress=not args.quiet and not args.json)
     except (KeyboardInterrupt, Terminated) as stop:

@@ -25,7 +25,7 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.channels import CHANNELS, FLAGS, simulation_schema
+from qzs.engine.channels import CHANNELS, FLAGS, sample_bytes, simulation_schema
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
@@ -266,9 +266,8 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     plan = driver.plan_run(first.duration, first.dt, decimation, kernel="lanes", cases=n,
                            workers=workers, max_samples=max(1, _ROWS_PER_CHUNK // n),
                            max_steps=int(round(first.duration / first.dt)))
-    flag_count = sum(c in FLAGS for c in channels)
-    driver.check_memory(n * plan.samples * (8 * (len(channels) - flag_count) + flag_count),
-                        first.duration, first.sample_rate,
+    driver.check_memory(n * plan.samples * sample_bytes(channels), first.duration,
+                        first.sample_rate,
                         remedy="keep fewer `channels`, lower the `sample_rate`, or run the cases "
                                "in several batches")
     lanes = _Lanes(prepared, channels, workers, plan)

@@ -12,7 +12,8 @@ from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
 __all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels",
-           "channel_count", "summary_statistics", "simulation_schema", "variable_attributes", "named_block"]
+           "channel_count", "summary_statistics", "simulation_schema", "variable_attributes",
+           "named_block", "sample_bytes"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
 CHANNELS = {
@@ -132,6 +133,21 @@ def channel_count(controller=None):
     """
     blocks = controller is not None and controller.has_blocks
     return K.N_CHANNELS if blocks else K.N_BASE_CHANNELS
+
+
+def sample_bytes(channels):
+    """Memory one sample of ``channels`` takes in a result [bytes]: 8 a float channel, 1 a flag.
+
+    Parameters
+    ----------
+    channels : iterable of str
+        Names of :func:`run_channels` and :data:`FLAGS`.
+
+    Returns
+    -------
+    int
+    """
+    return sum(1 if name in FLAGS else 8 for name in channels)
 
 
 def simulation_schema(controller=None, *, every_block=False):

@@ -321,7 +321,10 @@ class Recorder:
     ``sink(data, flags)``; the result keeps every sample if there are at most
     :data:`PREVIEW_SAMPLES`, else per group of k samples one row of each channel's
     minimum and one of its maximum (a group that a chunk boundary cuts is merged), so
-    that a figure shows the true envelope and never an aliased pick.
+    that a figure shows the true envelope and never an aliased pick. The preview too is
+    one array allocated at the start (at most :data:`PREVIEW_SAMPLES` rows), filled in
+    place: a streamed run's memory does not grow with its duration, and its result is a
+    view of it, never a copy.
 
     Parameters
     ----------
@@ -353,8 +356,9 @@ class Recorder:
         else:
             self.every = 1 if n_out <= PREVIEW_SAMPLES else -(-n_out // (PREVIEW_SAMPLES // 2))
             rows = min(n_out, plan.chunk_samples)
-            self._preview, self._preview_flags = [], []
-            self._pending = None  # the envelope of the last group, until it is complete
+            kept = n_out if self.every == 1 else 2 * -(-n_out // self.every)
+            self._preview = (np.empty((kept, channels)),
+                             np.zeros((kept, flags), dtype=np.bool_))
         self.buffers = [(np.empty((rows, channels)), np.zeros((rows, flags), dtype=np.bool_))]
         if sink is not None:  # two buffers: the kernel fills one while the other is written
             self.buffers.append((np.empty_like(self.buffers[0][0]),
@@ -397,45 +401,37 @@ class Recorder:
         self.statistics(block, block_flags)
         if self.sink is not None:
             self.sink(block, block_flags)
+            preview, preview_flags = self._preview
             if self.every == 1:
-                self._preview.append(block.copy())
-                self._preview_flags.append(block_flags.copy())
+                preview[self.rows:self.rows + count] = block
+                preview_flags[self.rows:self.rows + count] = block_flags
             elif count:
                 self._envelope(block, block_flags)
         self.rows += count
 
     def _envelope(self, block, block_flags):
-        """Add a block's min/max envelope to the preview: one pair of rows per group of
-        ``every`` samples, a group cut by a block boundary merged with its first part."""
+        """Write a block's min/max envelope into the preview: rows 2g and 2g + 1 for group
+        g of ``every`` samples, a group cut by a block boundary merged with its first
+        part (already written there)."""
         rows, marks = envelope_rows(block, block_flags, self.rows, self.every)
-        first_group = self.rows // self.every
-        if self._pending is not None:  # the group the last block ended in goes on here
-            low, high, low_flags, high_flags = self._pending
-            if first_group * self.every < self.rows:
-                rows[0] = np.minimum(rows[0], low)
-                rows[1] = np.maximum(rows[1], high)
-                marks[0] &= low_flags
-                marks[1] |= high_flags
-            self._pending = None
-        end = self.rows + block.shape[0]
-        if end % self.every:  # the last group is not complete: hold it back
-            self._pending = (rows[-2].copy(), rows[-1].copy(), marks[-2].copy(),
-                             marks[-1].copy())
-            rows, marks = rows[:-2], marks[:-2]
-        self._preview.append(rows)
-        self._preview_flags.append(marks)
+        preview, preview_flags = self._preview
+        at = 2 * (self.rows // self.every)
+        if self.rows % self.every:  # the group the last block ended in goes on here
+            rows[0] = np.minimum(rows[0], preview[at])
+            rows[1] = np.maximum(rows[1], preview[at + 1])
+            marks[0] &= preview_flags[at]
+            marks[1] |= preview_flags[at + 1]
+        preview[at:at + len(rows)] = rows
+        preview_flags[at:at + len(rows)] = marks
 
     def result(self):
-        """``(data, flags)``: every sample, or the preview of a streamed run."""
+        """``(data, flags)``: every sample, or the preview of a streamed run (views)."""
         if self.sink is None:
             data, marks = self.buffers[0]
             return data[:self.rows], marks[:self.rows]
-        if self.every > 1 and self._pending is not None:  # the run ended inside a group
-            low, high, low_flags, high_flags = self._pending
-            self._preview.append(np.stack([low, high]))
-            self._preview_flags.append(np.stack([low_flags, high_flags]))
-            self._pending = None
-        return np.concatenate(self._preview), np.concatenate(self._preview_flags)
+        preview, preview_flags = self._preview
+        kept = self.rows if self.every == 1 else 2 * -(-self.rows // self.every)
+        return preview[:kept], preview_flags[:kept]
 
 
 # ---------------------------------------------------------------- signals

@@ -18,7 +18,8 @@ from qzs.model.registry import model_inputs
 
 __all__ = ["PreparedRun", "prepare_run", "pack_model", "run_inputs", "run_duration", "steps_per_sample",
            "divides",
-           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD"]
+           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
+           "check_record", "RECORD_BYTES_PER_POINT"]
 
 #: Fewest integration steps per period of the excitation's highest frequency a run is
 #: started with [-]: below, the fixed-step integrator does not follow the base motion (at
@@ -451,7 +452,55 @@ def run_duration(excitation, duration):
             f"`duration` ({duration!r} s) exceeds the excitation's length "
             f"({excitation.duration!r} s); shorten the run or lengthen the excitation.",
             ("duration",))
+    check_record(excitation, duration)
     return duration
+
+
+#: Memory a random excitation's record takes while it is made, per point of its table
+#: [bytes] (the phases, the inverse FFT, the spline's coefficients and the packed table:
+#: 157 measured at its peak).
+RECORD_BYTES_PER_POINT = 160
+
+
+def check_record(excitation, duration, name="excitation.duration"):
+    """Refuse a random excitation whose record would not fit in memory, before it is made.
+
+    A :class:`~qzs.model.excitation.RandomExcitation` tabulates its whole record
+    (:attr:`~qzs.model.excitation.RandomExcitation.record_points`) whatever part of it a run
+    uses; one of 1e12 s asks for petabytes. Other excitations hold no record to make.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+    duration : float
+        The run's simulated time [s] (the fix the message gives).
+    name : str
+        How the caller names the excitation's length (the message's first option).
+
+    Raises
+    ------
+    ParameterError
+        The record would take more than :data:`qzs.engine.driver.MEMORY_SHARE` of the
+        memory available; its ``options`` are ``(name, "duration")``.
+    """
+    from qzs.engine import driver
+    from qzs._format import format_bytes
+    from qzs.model.excitation import RandomExcitation
+
+    if not isinstance(excitation, RandomExcitation):
+        return
+    needed = excitation.record_points * RECORD_BYTES_PER_POINT
+    available = driver.available_memory()
+    if available is None or needed <= driver.MEMORY_SHARE * available:
+        return
+    raise ParameterError(
+        f"`{name}` = {excitation.duration:g} s makes the random excitation's record "
+        f"{excitation.record_points:.3g} points (20 a period of its {excitation.f_high:g} Hz), "
+        f"{format_bytes(needed)} while it is made, more than half the "
+        f"{format_bytes(available)} of memory available; the record need not be longer than "
+        f"the run (`duration` = {duration:g} s): give it that length, or one that fits.",
+        (name, "duration"))
 
 
 def prepare_run(excitation=None, isolator=None, controller=None, *, duration=None,

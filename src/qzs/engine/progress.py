@@ -16,7 +16,10 @@ that a console is never silent for longer while a bar is open (:class:`Heartbeat
 A warning meant for the user is one line ``qzs: warning: ...`` above the bars
 (:func:`show_warning`, which the command line puts in place of
 :func:`warnings.showwarning` while a command runs, and :func:`install_warning_lines` in the
-worker processes of a local Dask cluster).
+worker processes of a local Dask cluster). In Python, while a bar is open, whatever shows
+warnings (Python's own display, a notebook's, the command line's) writes through the bar
+(:class:`WarningsThroughBar`): the bar is cleared, the warning written on lines of its own,
+the bar drawn again.
 """
 import os
 import sys
@@ -24,16 +27,27 @@ import threading
 import time
 import warnings
 
-from tqdm.auto import tqdm
 from tqdm.std import tqdm as std_tqdm
 
 __all__ = ["PLAIN_INTERVAL", "HEARTBEAT", "terminal_size", "plain_terminal", "PlainProgress",
-           "Heartbeat", "progress_bar", "show_warning", "install_warning_lines"]
+           "Heartbeat", "WarningsThroughBar", "progress_bar", "show_warning",
+           "install_warning_lines"]
 
 #: Seconds between two plain progress lines (a 0-column console).
 PLAIN_INTERVAL = 1.0
 #: Seconds after which a bar not drawn is drawn again.
 HEARTBEAT = 1.0
+
+
+def _bar_class():
+    """tqdm's bar for where this runs: tqdm.auto's (a notebook widget) in a Jupyter kernel,
+    else tqdm.std's, imported without tqdm.auto's asyncio and ssl (5 MB more of every
+    command's memory)."""
+    if "ipykernel" in sys.modules:
+        from tqdm.auto import tqdm
+
+        return tqdm
+    return std_tqdm
 
 
 def terminal_size(stream):
@@ -185,6 +199,50 @@ class Heartbeat:
             drawn = time.time()
 
 
+class WarningsThroughBar:
+    """While ``bar`` is open, show warnings through it: its stream's bars cleared, the
+    warning shown by whatever showed it before (so a recorder or a notebook keeps it), the
+    bars drawn again; at ``bar.close()`` the display before it is put back.
+
+    Parameters
+    ----------
+    bar : tqdm.tqdm
+        An open bar.
+    stream : file
+        The stream the bar is drawn on.
+    """
+
+    def __init__(self, bar, stream):
+        self.stream, self.shown, self.bars = stream, warnings.showwarning, type(bar)
+        show = warnings.showwarning = self.show   # one bound method, to know it again
+        close = bar.close
+
+        def closed(*arguments, **options):
+            try:
+                return close(*arguments, **options)
+            finally:
+                if warnings.showwarning is show:  # not if another took its place since
+                    warnings.showwarning = self.shown
+
+        bar.close = closed
+
+    def show(self, message, category, filename, lineno, file=None, line=None):
+        """Show a warning with the bars cleared, then draw them again.
+
+        Parameters
+        ----------
+        message : Warning or str
+            The warning.
+        category, filename, lineno, file, line
+            As for :func:`warnings.showwarning`, passed on to the display it replaced.
+        """
+        try:
+            with self.bars.external_write_mode(file=self.stream):
+                self.shown(message, category, filename, lineno, file, line)
+        except (OSError, ValueError):  # a closed stream: shown as it would have been
+            self.shown(message, category, filename, lineno, file, line)
+
+
 def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True, file=None,
                  **options):
     """A progress bar on ``file`` (default stderr): tqdm's, or plain lines on a 0-column console.
@@ -212,6 +270,7 @@ def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True,
         The bar; a :class:`PlainProgress` where :func:`plain_terminal` holds.
     """
     stream = sys.stderr if file is None else file
+    tqdm = _bar_class()
     if disable:
         return tqdm(total=total, desc=desc, unit=unit, disable=True, file=file, **options)
     if plain_terminal(stream):
@@ -221,6 +280,7 @@ def progress_bar(*, total=None, desc=None, unit="it", disable=False, leave=True,
     else:
         bar = tqdm(total=total, desc=desc, unit=unit, leave=leave, file=file, **options)
     Heartbeat(bar, HEARTBEAT)
+    WarningsThroughBar(bar, stream)
     return bar
 
 
@@ -243,7 +303,7 @@ def show_warning(message, category, filename, lineno, file=None, line=None):
     text = " ".join(str(message).split())
     stream = sys.stderr if file is None else file
     try:
-        tqdm.write(f"qzs: warning: {text}", file=stream)  # clears the bars, writes, redraws
+        _bar_class().write(f"qzs: warning: {text}", file=stream)  # clears the bars, writes, redraws
     except (OSError, ValueError):  # a closed stderr: nothing to say it on
         pass
 

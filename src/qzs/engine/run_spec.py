@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from qzs.model.isolator import InitialState, IsolatorParameters
 
 __all__ = ["ResolvedRun", "resolve", "ResolvedHexapodRun", "resolve_hexapod", "MAX_SAMPLES",
-           "check_output_rate"]
+           "check_output_rate", "check_length"]
 
 #: Output samples a run may ask for at most [-] (past this, counts lose their integers).
 MAX_SAMPLES = 1e15
@@ -203,8 +203,8 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     given = _one_step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
     if dt is None and not given and step == "literal":
         dt = defaults.SIMULATION["dt"]
-    _check_length(duration, sample_rate, None if dt is None else
-                  _validation.positive_real("dt", dt))
+    check_length(duration, sample_rate, None if dt is None else
+                 _validation.positive_real("dt", dt))
     if dt is not None:
         choice = StepChoice.literal(_validation.positive_real("dt", dt), sample_rate=sample_rate,
                                     solver=solver)
@@ -275,11 +275,32 @@ def check_output_rate(excitation, duration, sample_rate):
             f"or lower `{name}`.", (name, "sample_rate"))
 
 
-def _check_length(duration, sample_rate, dt):
-    """Refuse, before any step is chosen, a run that would take absurdly long: a given ``dt``
-    as the driver would (:class:`~qzs.errors.RunTooLongError`); a step still to be chosen is
-    never longer than the output period, so counting steps at that period is a lower bound,
-    and the refusal certain."""
+def check_length(duration, sample_rate, dt, kernel="single"):
+    """Refuse, before any step is chosen, a run that would take absurdly long.
+
+    A given ``dt`` is checked as the driver would (:class:`~qzs.errors.RunTooLongError`); a
+    step still to be chosen is never longer than the output period, so counting steps at
+    that period is a lower bound, and the refusal certain.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time [s].
+    sample_rate : float
+        Output rate [Hz].
+    dt : float or None
+        The integration step [s]; None: still to be chosen.
+    kernel : {"single", "lanes", "hexapod"}
+        Which kernel steps (:data:`qzs.engine.driver.BEST_STEP_SECONDS`).
+
+    Raises
+    ------
+    RunTooLongError
+        ``dt`` given, and the run would take more than a day at the kernel's best speed.
+    ParameterError
+        ``dt`` to be chosen, and even at the output period the same; its ``options`` are
+        ``duration`` and ``sample_rate``.
+    """
     from qzs.engine.driver import plan_run
     from qzs.errors import RunTooLongError
 
@@ -291,10 +312,10 @@ def _check_length(duration, sample_rate, dt):
         raise ParameterError(f"`duration` {duration:g} s at dt = {bound:g} s is more "
                              f"integration steps than a number holds; choose {fix}.", options)
     if dt is not None:
-        plan_run(float(duration), float(dt), 1)  # RunTooLongError, with its data
+        plan_run(float(duration), float(dt), 1, kernel=kernel)  # RunTooLongError, its data
         return
     try:
-        plan_run(float(duration), float(bound), 1)
+        plan_run(float(duration), float(bound), 1, kernel=kernel)
     except RunTooLongError as error:
         raise ParameterError(
             f"`duration` {duration:g} s is at least {error.steps:.3g} integration steps "

@@ -9,9 +9,12 @@ inputs and of the code that computes it, so it is kept on disk under a key made 
 - every input of the choice (excitation, isolator, controller, initial state, solver,
   output rate, tolerance and measure, band, probe length, Welch length, halvings, safety),
   each dataclass field by its exact ``repr`` (arrays by the SHA-256 of their bytes);
-- the version of qzs and the SHA-256 of the sources the choice depends on (the kernels,
-  the packing, the spectral estimate and this search): an edited kernel never reuses a
-  choice made by the old one.
+- the version of qzs and the SHA-256 of every source the choice runs: the modules that make
+  it (:data:`_ROOTS`), every ``qzs`` module they import, at module level or inside a
+  function, the modules those import in turn, and the packages above each
+  (:func:`choice_sources`, computed from the sources themselves, so that a module the choice
+  comes to import is in the key without a list to keep): an edited kernel, search, spectral
+  estimate or run never reuses a choice made by the old one.
 
 Records are small JSON files in ``$QZS_CACHE_DIR/steps`` (default
 ``$XDG_CACHE_HOME/qzs/steps``, else ``~/.cache/qzs/steps``), written atomically. The cache is
@@ -24,26 +27,30 @@ import hashlib
 import json
 import math
 import os
+import re
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from qzs.engine.arithmetic import _KERNEL_SOURCES
 from qzs.engine.step_search import MEASURE_UNITS, StepChoice
 
-__all__ = ["CACHE_ENV", "cache_folder", "cache_key", "load", "store", "load_choice",
-           "store_choice"]
+__all__ = ["CACHE_ENV", "cache_folder", "cache_key", "choice_sources", "load", "store",
+           "load_choice", "store_choice"]
 
 #: Environment variable naming the folder of qzs's caches (the step choices go to ``steps/``).
 CACHE_ENV = "QZS_CACHE_DIR"
-#: The sources (below ``src/qzs``) a step choice depends on: the kernels' (whose fingerprint
-#: also guards numba's cache, :mod:`qzs.engine.arithmetic`) and the Python around them.
-_SOURCES = (*_KERNEL_SOURCES, "engine/prepare.py", "engine/simulate.py", "engine/stability.py",
-            "engine/accuracy.py", "engine/accuracy_batch.py", "engine/batch.py",
-            "engine/step_search.py", "engine/driver.py",
-            "model/isolator.py",
-            "model/controller.py", "analysis/spectral.py")
+#: The modules that make a step choice: :func:`qzs.engine.accuracy.choose_step`,
+#: :func:`qzs.engine.accuracy_batch.choose_batch_step` and this record's reader.
+_ROOTS = ("qzs.engine.accuracy", "qzs.engine.accuracy_batch", "qzs.engine.step_cache")
+#: An import statement: ``from <module> import <names>`` (a parenthesised list may span
+#: lines) or ``import <modules>``, at any indentation (inside a function too).
+_IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+([\w.]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)"
+                     r"|import[ \t]+([^\n]*))", re.MULTILINE)
+#: What no run executes: comments, and an ``if TYPE_CHECKING:`` block (its lines indented
+#: deeper than the ``if``, blank lines among them).
+_NOT_RUN = re.compile(r"#[^\n]*|^([ \t]*)if TYPE_CHECKING:[^\n]*\n(?:\1[ \t]+[^\n]*\n|[ \t]*\n)*",
+                      re.MULTILINE)
 #: Version of the record's layout; a record of another version is ignored.
 _FORMAT = 1
 
@@ -64,19 +71,84 @@ def cache_folder():
     return Path(root) / "steps"
 
 
-@functools.lru_cache(maxsize=1)
-def _code_fingerprint():
-    """SHA-256 of qzs's version and of the sources a choice depends on."""
+def _imported(text):
+    """The ``qzs`` module names an import statement of ``text`` may name (a superset: a name
+    imported from a module is a candidate submodule; :func:`_module_file` keeps the files)."""
+    found = set()
+    for module, names, plain in _IMPORT.findall(_NOT_RUN.sub("", text)):
+        if module:
+            candidates = [module] + [f"{module}.{name.split()[0]}"
+                                     for name in names.strip("()").split(",") if name.strip()]
+        else:
+            candidates = [name.split()[0] for name in plain.split(",") if name.strip()]
+        found.update(c for c in candidates if c == "qzs" or c.startswith("qzs."))
+    return found
+
+
+def _module_file(root, module):
+    """The source of ``module`` below the package folder ``root``, or None (not a module)."""
+    path = root.joinpath(*module.split(".")[1:])
+    for candidate in (path.with_name(path.name + ".py"), path / "__init__.py"):
+        if candidate.name != ".py" and candidate.is_file():
+            return candidate
+    return None
+
+
+def _source_texts(root):
+    """Path below ``root`` -> bytes of every source a choice runs (:func:`choice_sources`)."""
+    texts, seen, todo = {}, set(), list(_ROOTS)
+    while todo:
+        module = todo.pop()
+        if module in seen:
+            continue
+        seen.add(module)
+        path = _module_file(root, module)
+        if path is None:
+            continue
+        data = path.read_bytes()
+        texts[path.relative_to(root).as_posix()] = data
+        parts = module.split(".")
+        todo += [".".join(parts[:i]) for i in range(1, len(parts))]  # its packages run too
+        todo += sorted(_imported(data.decode("utf-8")))
+    return dict(sorted(texts.items()))
+
+
+def choice_sources(root=None):
+    """The sources a step choice runs, whose SHA-256 is in every key (:func:`cache_key`).
+
+    The modules of :data:`_ROOTS`, every ``qzs`` module they import (at module level or
+    inside a function), the modules those import in turn, and the packages above each,
+    read from the sources themselves.
+
+    Parameters
+    ----------
+    root : path-like, optional
+        The package folder (default this installation's ``qzs``).
+
+    Returns
+    -------
+    tuple of str
+        Paths below ``root`` (``engine/accuracy.py``), sorted.
+    """
+    root = Path(__file__).resolve().parents[1] if root is None else Path(root)
+    return tuple(_source_texts(root))
+
+
+def _fingerprint(root):
+    """SHA-256 of qzs's version and of the sources a choice runs below ``root``."""
     from qzs._version import __version__
 
     digest = hashlib.sha256(__version__.encode())
-    root = Path(__file__).resolve().parents[1]
-    for name in _SOURCES:
-        try:
-            digest.update((root / name).read_bytes())
-        except OSError:
-            digest.update(f"missing {name}".encode())
+    for name, data in _source_texts(root).items():
+        digest.update(f"\n{name} {len(data)}\n".encode())
+        digest.update(data)
     return digest.hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def _code_fingerprint():
+    """:func:`_fingerprint` of this installation, once per process."""
+    return _fingerprint(Path(__file__).resolve().parents[1])
 
 
 def _canonical(value):

@@ -77,7 +77,8 @@ class StepChoice:
     tolerance : float
         The tolerance asked for, in the unit of ``measure`` (NaN for a literal step).
     reference_dt : float
-        The finest step integrated on the probe [s] (the estimate's reference).
+        The finest step integrated on the probe [s] (the estimate's reference; NaN if none
+        was).
     stability_limit : float
         The solver's largest stable step for this model [s].
     sample_rate : float
@@ -568,13 +569,14 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
         # compile notice (qzs.engine.compiling) comes before the bar
         bar = progress_bar(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
                            delay=0.5)
-    runs, differences = {}, {}
+    runs, differences, integrated = {}, {}, []
 
     def integrate(j, members):
         kept = runs.setdefault(j, {})
         missing = [c for c in members if c not in kept]
         if missing:
             kept.update(zip(missing, run(dt0 / 2 ** j, missing)))
+            integrated.append(dt0 / 2 ** j)
             if bar is not None:
                 bar.update(1)
 
@@ -599,7 +601,8 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
                   sample_rate=float(sample_rate), solver=solver, probe=probe,
                   probe_duration=float(probe_duration), band=band, history=tuple(history))
     if not met:
-        finest_tried = dt0 / 2 ** max(max_halvings - 1, 0)
+        # the finest candidate whose error was estimated (compared with two finer ones)
+        finest_tried = dt0 / 2 ** max(max_halvings - 2, 0)
         if untrusted and len(untrusted) == cases:
             reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
                       f"{probe_duration:g} s probe, so no error is measured")
@@ -614,7 +617,8 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
                       f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
                       "redraw the response at every step)")
         dt = float(finest if finest is not None else defaults.SIMULATION["dt"])
-        return StepChoice(dt=dt, error=math.nan, reference_dt=finest_tried,
+        return StepChoice(dt=dt, error=math.nan,
+                          reference_dt=min(integrated, default=math.nan),
                           notes=tuple(notes + [f"{reason}; running at dt = {dt:.3g} s, whose "
                                                "error is not estimated"]), met=False,
                           case_errors=(math.nan,) * cases if several else (),

@@ -16,6 +16,9 @@ __all__ = ["load_config", "save_config", "config_text", "EXCITATION_KEYS",
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
 EXCITATION_KEYS = ("kind", *dict.fromkeys(o for v in EXCITATION_OPTIONS.values() for o in v))
 SIMULATION_KEYS = ("dt", "sample_rate", "solver", "duration")
+#: The fix of an empty config file.
+EMPTY_CONFIG = ("write the parameters to change into it (`qzs params --toml > FILE.toml` writes "
+                "every one with its default), or give no config file for the defaults")
 
 
 def load_config(path: str | Path) -> dict[str, Any]:
@@ -44,7 +47,7 @@ def load_config(path: str | Path) -> dict[str, Any]:
         A missing, binary or malformed file, an unknown table or key, a bad value.
     """
     path = Path(path)
-    document = read_toml(path, "config file")
+    document = read_toml(path, "config file", empty=EMPTY_CONFIG)
     allowed = {"isolator", "controller", "excitation", "simulation"}
     unknown = set(document) - allowed
     if unknown:

@@ -9,14 +9,16 @@ A missing parent folder is fine when it can be created (the atomic writer,
 ancestor must be a writable directory. A file standing where a folder must go, or a
 read-only folder, is an error.
 """
+import contextlib
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
+from qzs._format import format_bytes
 from qzs.errors import OutputPathError
 
-__all__ = ["check_output_path", "format_bytes"]
+__all__ = ["check_output_path", "free_name", "switch", "format_bytes", "removed_on_error"]
 
 
 def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directory=False,
@@ -99,10 +101,107 @@ def check_output_path(path, *, argument, suffixes, estimated_bytes=None, directo
                  f"are free on the file system of {str(target)!r}; free some space or "
                  "choose another folder")
     if not overwrite and path.exists() and (not directory or any(path.iterdir())):
-        flag = "--overwrite" if argument.startswith("--") else "overwrite=True"
+        flag = switch(argument, "overwrite")
         what, them = ("exists and holds files", "them") if directory else ("exists", "it")
         fail(f"{what}; pass {flag} to replace {them}, or choose another name")
     return path
+
+
+class _Made:
+    """What :func:`removed_on_error` yields: call :meth:`keep` once the output holds work
+    worth keeping (then a later error leaves it for a resume)."""
+
+    kept = False
+
+    def keep(self):
+        """Keep the output whatever happens next."""
+        self.kept = True
+
+
+@contextlib.contextmanager
+def removed_on_error(path):
+    """Remove the output a block makes at ``path`` if the block fails before keeping it.
+
+    The store or folder of a long piece of work (a sweep, a design search) is made before
+    its first result; an error after that (a refusal, a failed batch) would leave an empty
+    one behind. Here ``path``, and the folders above it that did not exist either, are
+    removed on an ``Exception`` unless the yielded object's ``keep()`` was called; an
+    existing ``path`` is never removed (``overwrite`` replaced it on purpose), nor is
+    anything on Ctrl-C or SIGTERM (what is stored stays for a resume).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store, folder or file the block makes.
+
+    Yields
+    ------
+    object
+        With a ``keep()`` method.
+    """
+    path = Path(os.path.abspath(path))
+    made = None  # the highest of path and its folders that the block will make
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        made, probe = probe, probe.parent
+    state = _Made()
+    try:
+        yield state
+    except Exception:
+        if made is not None and not state.kept:
+            if made.is_dir():
+                shutil.rmtree(made, ignore_errors=True)
+            elif made.exists():
+                made.unlink()
+        raise
+
+
+def switch(argument, name):
+    """A yes/no option as the caller of ``argument`` spells it: ``--name`` on the command
+    line (whose arguments are options, ``--out``), ``name=True`` in Python.
+
+    Parameters
+    ----------
+    argument : str
+        How the caller names the path a message is about (``"--out"``, ``"store"``).
+    name : str
+        The option's Python name (``"overwrite"``, ``"resume"``).
+
+    Returns
+    -------
+    str
+    """
+    return f"--{name.replace('_', '-')}" if argument.startswith("--") else f"{name}=True"
+
+
+def free_name(path, *, directory=False):
+    """``path`` if nothing is in the way, else the first free ``STEM-2.SUFFIX``,
+    ``STEM-3.SUFFIX``, ... beside it (``pi.zarr`` -> ``pi-2.zarr``, ``results`` ->
+    ``results-2``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The name a command would write to (its default).
+    directory : bool
+        ``path`` is a folder: an empty one is free (:func:`check_output_path` writes into it).
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+
+    def free(candidate):
+        return (not candidate.exists()
+                or directory and candidate.is_dir() and not any(candidate.iterdir()))
+
+    number = 1
+    candidate = path
+    while not free(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    return candidate
 
 
 def _nearest_existing(folder):
@@ -128,23 +227,3 @@ def _writable(folder):
     except OSError:
         return False
     return True
-
-
-def format_bytes(count):
-    """A byte count for people: ``1.5 GiB``.
-
-    Parameters
-    ----------
-    count : int or float
-        Bytes [B].
-
-    Returns
-    -------
-    str
-    """
-    value = float(count)
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
-        if abs(value) < 1024 or unit == "TiB":
-            return f"{value:.0f} {unit}" if unit == "B" else f"{value:.1f} {unit}"
-        value /= 1024
-    return f"{value:.1f} TiB"  # pragma: no cover

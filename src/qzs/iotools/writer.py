@@ -291,15 +291,11 @@ class StreamWriter:
         # checks the data type, opening the dataset again, on every call (a quarter of the
         # writing's time at one sample per step)
         datasets = self._file._h5file
-        rows = {}  # a block's columns as contiguous rows: one pass over it, not one a column
         for variable, block, column in self._columns:
-            if isinstance(column, (int, np.integer)):
-                if block not in rows:
-                    rows[block] = np.ascontiguousarray(blocks[block].T)
-                values = rows[block][column]
-            else:
-                values = blocks[block][:, column]
-            datasets[variable.name][start:stop] = variable.cast(values)
+            values = blocks[block][:, column]
+            if isinstance(column, (int, np.integer)):  # one column at a time: a transposed
+                values = np.ascontiguousarray(values)  # copy of the block (13 MB) costs the
+            datasets[variable.name][start:stop] = variable.cast(values)  # peak, not speed
         datasets.flush()  # on disk, inside the space reserved for it
 
     def _finish_netcdf(self, tail):

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
                              strictly_increasing, validate_fields)
+from qzs._validation import seed as checked_seed
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
 
@@ -277,10 +278,7 @@ class RandomExcitation(_Tabulated):
             raise ExcitationError(
                 f"`f_low` ({self.f_low!r} Hz) must be below `f_high` ({self.f_high!r} Hz), the "
                 "band's upper edge; swap them or widen the band.", ("f_low", "f_high"))
-        if (not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool)
-                or self.seed < 0):
-            raise ExcitationError(f"`seed` must be a non-negative integer (numpy's generators "
-                                  f"take 0 .. 2**128-1), got {self.seed!r}.", ("seed",))
+        object.__setattr__(self, "seed", checked_seed("seed", self.seed, ExcitationError))
         _resolve_fade(self)
         _check_peak(self.amplitude, self.f_high, ("amplitude", "f_high"), crest=4.0)
 
@@ -289,11 +287,16 @@ class RandomExcitation(_Tabulated):
         """Highest frequency in the signal [Hz]."""
         return self.f_high
 
+    @property
+    def record_points(self) -> float:
+        """Points of the tabulated record [-]: 20 per period of ``f_high`` over ``duration``,
+        both ends included (a float: beyond any integer's use for a record of 1e300 s)."""
+        return float(np.ceil(self.duration * 20.0 * self.f_high)) + 1.0
+
     def _spline(self):
         from scipy.interpolate import CubicSpline
 
-        rate = 20.0 * self.f_high
-        n = int(np.ceil(self.duration * rate)) + 1
+        n = int(self.record_points)
         n_fft = n if n % 2 == 0 else n + 1
         spacing = self.duration / (n - 1)
         freqs = np.fft.rfftfreq(n_fft, d=spacing)

@@ -21,10 +21,64 @@ if TYPE_CHECKING:
     from qzs.model.excitation import Excitation
     from qzs.model.isolator import InitialState, IsolatorParameters
 
-__all__ = ["simulate_to_file", "RESULT_SUFFIXES"]
+__all__ = ["simulate_to_file", "resolve_apart", "RESULT_SUFFIXES"]
 
 #: File formats a run can be written to, by extension.
 RESULT_SUFFIXES = tuple(_FORMATS)
+
+
+def _resolve_job(arguments):
+    """The forked helper's job: :func:`resolve` of ``(args, kwargs)``."""
+    args, kwargs = arguments
+    return resolve(*args, **kwargs)
+
+
+def resolve_apart(*args: Any, **kwargs: Any) -> ResolvedRun:
+    """:func:`qzs.engine.run_spec.resolve`, its step choice run by a forked helper.
+
+    Choosing a step probes the run and estimates spectra: scipy.signal and the probe's
+    samples, about 50 MB that a process keeps to its end (a module is never unloaded). A
+    streamed run (:func:`simulate_to_file`, ``qzs simulate --out``) keeps its memory to its
+    chunk buffers and preview (docs/model.md §8) by resolving in a copy of this process
+    (:mod:`qzs.workflows.forked`), which ends with the choice; the answer (the
+    :class:`~qzs.engine.run_spec.ResolvedRun` and the step cache entry) is the same. Resolved
+    here instead when nothing is to choose (a literal ``dt``, or ``step="literal"`` with no
+    tolerance), when no helper can fork, or when the run's kernels are still to compile (its
+    compile notice and the compiled kernels belong to this process).
+
+    Parameters
+    ----------
+    *args, **kwargs
+        As :func:`~qzs.engine.run_spec.resolve` takes them.
+
+    Returns
+    -------
+    ResolvedRun
+
+    Raises
+    ------
+    ParameterError
+        As :func:`~qzs.engine.run_spec.resolve` raises it (the helper's error raised here).
+    """
+    from qzs.engine.compiling import cold_kernels
+    from qzs.workflows import forked
+
+    literal = kwargs.get("dt") is not None or (
+        kwargs.get("step", "literal") == "literal" and kwargs.get("tolerance") is None
+        and kwargs.get("tolerance_state") is None)
+    if literal or not forked.available() or cold_kernels(("single",)):
+        return resolve(*args, **kwargs)
+    if kwargs.get("progress"):
+        # the helper's progress bar is this command speaking: a console's start notice
+        # (qzs.cli.common.start_notice) watches this process's stderr, not the helper's;
+        # a carriage return tells it so and shows nothing
+        import sys
+
+        sys.stderr.write("\r")
+        sys.stderr.flush()
+    with forked.start(_resolve_job, name="qzs-step-choice", grace=None) as helper:
+        helper.send((args, kwargs))
+        return helper.result()
 
 
 def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
@@ -97,7 +151,7 @@ def simulate_to_file(path: str | Path, excitation: Excitation | None = None,
     # the path first (its extension, folder and permissions), before the step is chosen
     check_output_path(path, argument=argument, suffixes=RESULT_SUFFIXES)
     if resolved is None:
-        resolved = resolve(excitation, isolator, controller, duration=duration, dt=dt,
+        resolved = resolve_apart(excitation, isolator, controller, duration=duration, dt=dt,
                            tolerance=tolerance, tolerance_state=tolerance_state,
                            sample_rate=sample_rate, solver=solver, initial_state=initial_state,
                            progress=progress)

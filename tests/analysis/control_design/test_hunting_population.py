@@ -2,7 +2,9 @@
 
 The table spans the shipped problem's bounds (``isolation_vs_effort``: spring force 58-68 N,
 Kp 10-3000 N/m, Ki 0.1-100 N/(m*s), Kd 0-400 N*s/m, stiction 5-15 N) at its corners, plus the
-cases where the scalar path gives each of its "no cycle" reasons.
+cases where the scalar path gives each of its "no cycle" reasons; designs drawn at random
+across those bounds (seeded) are compared with the scalar path one by one, verdicts and
+numbers.
 """
 import itertools
 import math
@@ -10,6 +12,7 @@ import math
 import control
 import numpy as np
 import pytest
+from helpers import shipped_designs
 from scipy.integrate import solve_ivp
 
 from qzs import ControllerParameters, IsolatorParameters, ParameterError
@@ -100,6 +103,59 @@ def test_the_intersection_solves_python_controls_equation_to_round_off(compared)
             scalar[k].first_harmonic_amplitude, rel=1e-3)
         assert population.period[k] == pytest.approx(1 / population.frequency[k], rel=1e-15)
     assert np.all(np.isnan(population.frequency[~population.hunts]))
+
+
+#: Designs drawn at random across the shipped problem's bounds: the scalar path takes about
+#: 0.1 s each. A wrong regime bound (``h + d`` for ``h + 2d``) flips 3.5 % of such designs.
+RANDOM_DESIGNS = 240
+
+
+@pytest.fixture(scope="module")
+def drawn():
+    isolators, controllers = shipped_designs(RANDOM_DESIGNS, seed=39)
+    population = hp.predict_hunting_population(isolators, controllers)
+    scalar = [predict_hunting(i, c, memoryless=False) for i, c in zip(isolators, controllers)]
+    return isolators, population, scalar
+
+
+def test_random_shipped_designs_get_the_scalar_paths_verdicts_one_by_one(drawn):
+    """Whether each design hunts, and whether its cycle is in the relay's regime (the
+    intersection's amplitude below ``h + 2d``), as the scalar path says, design by design;
+    the designs lie on both sides of both verdicts. A design whose scalar amplitude lies
+    within the two paths' 1e-3 agreement of the bound could go either way: none may decide
+    the test (they are counted)."""
+    isolators, population, scalar = drawn
+    hunts = np.array([p.hunts for p in scalar])
+    in_regime = np.array([p.in_regime for p in scalar])
+    assert np.array_equal(population.hunts, hunts), np.flatnonzero(population.hunts != hunts)
+    bound = np.array([p.switching_force + 2 * p.relay_output for p in scalar])
+    amplitude = np.array([p.integral_force_amplitude for p in scalar])
+    with np.errstate(invalid="ignore"):
+        undecided = np.abs(amplitude / bound - 1) < 1e-3
+    assert undecided.sum() <= 2
+    flipped = np.flatnonzero((population.in_regime != in_regime) & ~undecided)
+    assert flipped.size == 0, f"{flipped.size} designs leave the scalar path's regime: {flipped}"
+    assert 0 < in_regime.sum() < hunts.sum() < len(scalar)  # every verdict is drawn
+    stiction = np.array([i.stiction_force for i in isolators])
+    assert len(set(stiction)) == 3  # the uncertain stiction's three values
+
+
+def test_random_shipped_designs_get_the_scalar_paths_numbers_one_by_one(drawn):
+    """The slip jump within 1e-6 of the stiction force; where the loop hunts, the cycle's
+    frequency, integral force amplitude and first harmonic within the scalar path's own
+    refinement (1e-3), and the plateau ``d/K`` from the same jump."""
+    isolators, population, scalar = drawn
+    stiction = np.array([i.stiction_force for i in isolators])
+    jump = np.array([p.slip_jump for p in scalar])
+    assert np.all(np.abs(population.slip_jump - jump) <= 1e-6 * stiction)
+    hunts = population.hunts
+    for name in ("frequency", "integral_force_amplitude", "first_harmonic_amplitude"):
+        theirs = np.array([getattr(p, name) for p in scalar])
+        np.testing.assert_allclose(getattr(population, name)[hunts], theirs[hunts], rtol=1e-3)
+        assert np.all(np.isnan(getattr(population, name)[~hunts]))
+    plateau = np.array([p.amplitude for p in scalar])
+    large = jump > 0.1 * stiction
+    np.testing.assert_allclose(population.amplitude[large], plateau[large], rtol=1e-5)
 
 
 def _tight_jump(isolator, controller):

@@ -5,12 +5,19 @@ and the scalar path's margin routine on its loop. The scalar path's loop passes 
 ``control.minreal``, which rebuilds the polynomials from their roots and moves the response
 by up to about 1e-7 relative; against the same loop without ``minreal`` the population's
 numbers agree to 1e-10.
+
+Designs drawn at random (seeded) are compared one by one too: across the shipped problem's
+bounds, and across the tuning page's ranges of every parameter the linear loop reads (in the
+problem's bounds, a loop without its high-pass is stable with or without its damping,
+``Cv (k + Kp) > m Ki`` there, so that only the page's ranges hold a design whose stability the
+damping decides); half of each without the high-pass (``velocity_highpass = 0``).
 """
 import itertools
 
 import control
 import numpy as np
 import pytest
+from helpers import shipped_designs
 
 from qzs import ControllerParameters, IsolatorParameters
 from qzs.analysis.control_design import linear_population as lp
@@ -113,6 +120,54 @@ def test_margins_are_the_scalar_paths_to_its_minreal(table):
     assert margins.stable.tolist() == [r.stable for r in reference]
     for name in FIELDS:
         _same(getattr(margins, name), [getattr(r, name) for r in reference], 1e-6)
+
+
+#: Random designs per range (the shipped problem's, the page's): python-control's poles take
+#: about 7 ms a design.
+RANDOM_DESIGNS = 500
+#: The parameters of the linear loop, drawn over the page's ranges in the second half.
+LOOP_PARAMETERS = ("mass", "viscous_damping", "spring_force", "pi_kp", "pi_ki", "damping_gain",
+                   "velocity_highpass")
+
+
+@pytest.fixture(scope="module")
+def drawn():
+    problem = shipped_designs(RANDOM_DESIGNS, seed=39, highpass_off=True)
+    page = shipped_designs(RANDOM_DESIGNS, seed=40, highpass_off=True, page=LOOP_PARAMETERS)
+    return problem[0] + page[0], problem[1] + page[1]
+
+
+def test_random_designs_are_stable_where_python_controls_poles_say_so(drawn):
+    """Routh-Hurwitz on the population against the closed loop's poles from python-control
+    (:func:`closed_loop_poles`: the loop transfer closed by ``control.feedback``, no closed
+    form shared), design by design, with and without the high-pass. A design whose largest
+    real part is within round-off of zero could go either way: none may decide the test."""
+    isolators, controllers = drawn
+    stable = lp.population_stable(isolators, controllers)
+    poles = [closed_loop_poles(i, c) for i, c in zip(isolators, controllers)]
+    largest = np.array([p.real.max() for p in poles])
+    size = np.array([np.abs(p).max() for p in poles])
+    marginal = np.abs(largest) <= 1e-9 * size
+    assert marginal.sum() <= 2
+    wrong = np.flatnonzero((stable != (largest < 0)) & ~marginal)
+    assert wrong.size == 0, f"{wrong.size} designs differ from python-control's poles: {wrong}"
+    assert 0 < stable.sum() < len(stable)
+    # without the high-pass, the damping decides some: stable, but not without it
+    off = np.array([c.velocity_highpass == 0 for c in controllers])
+    without = lp.population_stable(constants={**lp.population_constants(isolators, controllers),
+                                              "damping_gain": np.zeros(len(isolators))})
+    assert np.any(stable & ~without & off)
+
+
+def test_random_designs_transmissibility_is_the_scalar_paths(drawn):
+    """``|X/Y|`` of every design against :func:`linear_transmissibility` (python-control,
+    within its ``minreal``'s 1e-6)."""
+    isolators, controllers = drawn
+    frequency = np.array([0.1, 2.0, 12.0, 50.0])
+    ours = lp.population_transmissibility(frequency, isolators, controllers)
+    scalar = np.array([linear_transmissibility(frequency, i, c)
+                       for i, c in zip(isolators, controllers)])
+    np.testing.assert_allclose(ours, scalar, rtol=1e-6)
 
 
 def test_a_sampled_controller_goes_through_the_scalar_path():

@@ -438,6 +438,8 @@ def test_the_result_repackages_with_units_and_delegates(cubic, tmp_path):
     assert set(HEXAPOD_CHANNELS) - {"time"} <= set(dataset.data_vars)
     text = result.summary()
     assert "stroke used [mm]" in text and "motor RMS [N]" in text and len(text.splitlines()) > 10
+    # which part of the 20 s chirp ran (was "z: Chirp" beside "0.5 s")
+    assert "Base excitation: z: Chirp 0-20 Hz over 20 s: first 0.5 s run (0-0.5 Hz)" in text
     figure = result.plot(path=tmp_path / "hexapod.png")
     assert len(figure.axes) == 4 and (tmp_path / "hexapod.png").stat().st_size > 0
     assert all(ax.get_ylabel().endswith("]") for ax in figure.axes)

@@ -34,3 +34,26 @@ def test_missing_channel_lists_those_found(tmp_path):
     with pytest.raises(DataError, match=r"no signal 'shaker_velocity'.*'shaker_vel', "
                                         r"'payload_vel', 'unused'"):
         read_recording(write_csv(tmp_path / "log.csv"), spec)
+
+
+def test_a_csv_qzs_wrote_reads_without_a_warning_as_numbers(tmp_path):
+    """`qzs experiment` on a run's CSV printed pandas' "Columns (...) have mixed types"
+    DtypeWarning: the units row made every column text until it was dropped. The run's
+    velocities come back as written (the CSV's %.10g digits)."""
+    import warnings
+
+    import numpy as np
+
+    from qzs import Chirp, simulate
+
+    run = simulate(Chirp(duration=100.0), dt=1e-3, sample_rate=1000.0)  # 100,001 rows
+    path = run.save(tmp_path / "run.csv")
+    spec = {"channels": {"base_velocity": {"source": "base_velocity", "unit": "m/s"},
+                         "payload_velocity": {"source": "payload_velocity", "unit": "m/s"}}}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        recording = read_recording(path, spec)
+    dataset = recording.to_xarray()
+    assert dataset["time"].dtype == np.float64 and dataset["time"].size == len(run)
+    for name in ("base_velocity", "payload_velocity"):
+        np.testing.assert_allclose(dataset[name].values, run[name], rtol=1e-9, atol=1e-15)

@@ -237,8 +237,28 @@ def test_the_seed_can_be_given_to_the_call_and_changes_the_search(tmp_path):
     other = optimize(LINEAR, tmp_path / "b.zarr", generations=1, seed=99, progress=False)
     assert other.problem.optimizer["seed"] == 99
     assert not np.array_equal(one.designs, other.designs)
-    with pytest.raises(ProblemError, match="whole number"):
+    with pytest.raises(ProblemError, match="must be an integer in"):
         optimize(LINEAR, tmp_path / "c.zarr", seed=1.5, progress=False)
+
+
+@pytest.mark.parametrize("seed", [-3, 2 ** 63])
+def test_a_seed_numpy_or_a_file_cannot_take_is_refused_before_the_store(tmp_path, seed):
+    """-3 was a numpy ValueError traceback once the store was made (and it was left behind)."""
+    with pytest.raises(ProblemError) as caught:
+        optimize(LINEAR, tmp_path / "c.zarr", seed=seed, progress=False)
+    assert (caught.value.table, caught.value.key, caught.value.value) == ("optimizer", "seed",
+                                                                          seed)
+    assert "e.g. 1" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("table", ["optimizer", "robust"])
+def test_a_negative_seed_in_the_problem_file_is_refused_by_its_key(table):
+    document = copy.deepcopy(SIMULATED)
+    document.setdefault(table, {})["seed"] = -3
+    with pytest.raises(ProblemError) as caught:
+        load_problem(document)
+    assert (caught.value.table, caught.value.key, caught.value.value) == (table, "seed", -3)
 
 
 @pytest.mark.parametrize("option, asked", [("seed", 5), ("population", 16)])
@@ -295,3 +315,39 @@ def test_a_store_whose_designs_are_not_asked_for_again_is_refused(tmp_path):
     group["search_position"][:] = position
     with pytest.raises(OutputPathError, match=r"does not ask for again \(generation 1\)"):
         optimize(LINEAR, store, generations=3, resume=True, progress=False)
+
+
+@pytest.mark.parametrize("where", ["excitation", "variable"])
+def test_designs_of_1e9_s_runs_are_refused_before_any_probe_or_store(tmp_path, monkeypatch,
+                                                                     where):
+    """What simulate refuses (a run whose samples exceed the memory) is refused before the
+    step's probes: a 1e9 s excitation, or an excitation duration searched up to 1e9 s
+    (checked at the variables' bounds, not at the file's default duration)."""
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.design_space import optimizer as optimizer_module
+
+    monkeypatch.setattr(optimizer_module, "fix_step", pytest.fail)
+    document = copy.deepcopy(SIMULATED)
+    document["simulation"] = {}
+    if where == "excitation":
+        document["excitation"]["duration"] = 1e9
+    else:
+        del document["excitation"]["duration"]
+        document["variables"]["excitation.duration"] = {"low": 10.0, "high": 1e9}
+    with pytest.raises(ResultTooLargeError, match="1e[+]09 s run at") as caught:
+        optimize(document, tmp_path / "deep" / "x.zarr", progress=False)
+    assert "[optimizer] population" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_search_failing_before_its_first_generation_is_stored_leaves_nothing(tmp_path,
+                                                                             monkeypatch):
+    from qzs.workflows.design_space import optimizer as optimizer_module
+
+    def refused(*args, **kwargs):
+        raise ProblemError("optimizer", "", None, "refused by the generation")
+
+    monkeypatch.setattr(optimizer_module, "_generations", refused)
+    with pytest.raises(ProblemError, match="refused by the generation"):
+        optimize(LINEAR, tmp_path / "deep" / "x.zarr", progress=False)
+    assert list(tmp_path.iterdir()) == []

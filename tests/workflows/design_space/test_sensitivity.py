@@ -243,6 +243,25 @@ def test_a_simulated_metric_runs_end_to_end():
 
 
 # ---------------------------------------------------------------- refused before any case
+def test_designs_of_1e9_s_runs_are_refused_before_any_probe_or_folder(tmp_path, monkeypatch):
+    """As qzs.optimize: what a simulation refuses (samples beyond the memory) is refused
+    before the step's probes, and run_sensitivity makes no folder."""
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.design_space import optimizer
+    from qzs.workflows.design_space.sensitivity import run_sensitivity
+
+    monkeypatch.setattr(optimizer, "fix_step", pytest.fail)
+    document = {"problem": {"name": "long"},
+                "variables": {"pi_kp": {"low": 10.0, "high": 100.0, "scale": "log"}},
+                "excitation": {"f1": 10.0, "duration": 1e9},
+                "analysis": {"sample_rate": 100.0, "fft_length": 512},
+                "objectives": [{"metric": "transmissibility_at", "frequency": 5.0}],
+                "sensitivity": {"method": "morris", "trajectories": 4}}
+    with pytest.raises(ResultTooLargeError, match="a 1e[+]09 s run at 100 Hz"):
+        run_sensitivity(document, tmp_path / "out", progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
 def refused(evaluations):
     def evaluate(settings):
         evaluations.append(len(settings))
@@ -258,7 +277,8 @@ def refused(evaluations):
     ({"method": "morris", "samples": 1}, ParameterError, "at least 2 trajectories"),
     ({"metrics": ["peak_stroke"]}, ParameterError,
      r"`metrics` must name metric columns .*linear_transmissibility_at_3_hz"),
-    ({"seed": -1}, ParameterError, "`seed` must be a whole number >= 0"),
+    ({"seed": -1}, ParameterError, r"`seed` must be an integer in \[0, 9223372036854775807\]"),
+    ({"seed": 2 ** 64}, ParameterError, "`seed` must be an integer in"),  # failed in the files
     ({"samples": 2 ** 19}, CountLimitError, "asks for 2,621,440 evaluations"),
 ])
 def test_bad_arguments_are_refused_before_any_case(arguments, error, message):

@@ -69,3 +69,19 @@ def test_an_invalid_excitation_value_names_its_cases():
         check_cases(sweep, case_settings(sweep, sample_cases(sweep)))
     assert [i for i, _, _ in caught.value.cases] == [2, 3]
     assert "`amplitude` must be non-negative" in caught.value.reason
+
+
+def test_a_batch_keeps_the_accelerations_its_estimates_read_then_the_series_it_stores():
+    from qzs.workflows.sweeps.cases import ESTIMATE_CHANNELS, batch_channels, needs_estimates
+    from qzs.workflows.sweeps.definition import load_sweep
+
+    base = {"sweep": {"name": "c"}, "grid": {"pi_kp": [5.0]},
+            "analysis": {"fft_length": 1024, "n_averages": 4}}
+    estimated = load_sweep(base)
+    assert needs_estimates(estimated) and batch_channels(estimated) == ESTIMATE_CHANNELS
+    series = load_sweep({**base, "outputs": {"time_series": ["payload_acceleration",
+                                                             "motor_force"]}})
+    assert batch_channels(series) == (*ESTIMATE_CHANNELS, "motor_force")
+    plain = load_sweep({**base, "outputs": {"transmissibility": False, "metrics": [],
+                                            "time_series": ["motor_force"]}})
+    assert not needs_estimates(plain) and batch_channels(plain) == ("motor_force",)

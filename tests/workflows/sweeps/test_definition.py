@@ -144,9 +144,9 @@ def test_missing_file_lists_the_shipped_sweeps(tmp_path):
 def test_the_shipped_example_loads():
     assert [p.stem for p in shipped_sweeps()] == ["pi_vs_stiction"]
     sweep = load_sweep("pi_vs_stiction")
-    assert sweep.n_cases == 9 * 4 * 5
+    assert sweep.n_cases == 8 * 3 * 5
     assert sweep.analysis["duration"] == pytest.approx(131.072)
-    assert "180 cases" in plan_text(sweep)
+    assert "120 cases" in plan_text(sweep)
 
 
 # ---------------------------------------------------------------- grids

@@ -32,3 +32,42 @@ def test_the_report_counts_cases_and_failures_and_a_resume_runs_nothing(tmp_path
     again = execute(sweep, store, resume=True, progress=False)
     assert again["cases"] == 0 and again["failed"] == 0 and again["steps"] == 0
     xr.testing.assert_identical(xr.open_zarr(store, consolidated=False).load(), data)
+
+
+def test_a_refused_sweep_leaves_no_store_behind(tmp_path, monkeypatch):
+    """1e9 s cases: refused before any probe (the step choice is not reached) or store."""
+    import pytest
+
+    from qzs.errors import ResultTooLargeError
+    from qzs.workflows.sweeps import runner
+
+    monkeypatch.setattr(runner, "choose_sweep_step", pytest.fail)
+    sweep = load_sweep({**DOCUMENT, "excitation": {"f1": 10.0, "duration": 1e9}})
+    with pytest.raises(ResultTooLargeError, match="1e[+]09 s run"):
+        execute(sweep, tmp_path / "deep" / "s.zarr", progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sweep_failing_before_its_first_batch_is_stored_removes_its_store(tmp_path,
+                                                                            monkeypatch):
+    """Whatever fails once the store is made and before a batch is in it (here the batch
+    task itself refusing) leaves nothing behind: not the store, not the folders made for
+    it; a store holding batches is kept (it resumes)."""
+    import pytest
+
+    from qzs.errors import ParameterError
+    from qzs.workflows.sweeps import runner
+
+    def refused(*args, **kwargs):
+        raise ParameterError("refused by the batch")
+
+    monkeypatch.setattr(runner, "run_local", refused)
+    sweep = load_sweep(DOCUMENT)
+    with pytest.raises(ParameterError, match="refused by the batch"):
+        execute(sweep, tmp_path / "deep" / "s.zarr", progress=False)
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(ParameterError, match="refused by the batch"):
+        execute(sweep, tmp_path / "kept" / "s.zarr", progress=False)
+    assert list(tmp_path.iterdir()) == [tmp_path / "kept"]
+    assert list((tmp_path / "kept").iterdir()) == []

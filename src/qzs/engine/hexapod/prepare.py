@@ -18,7 +18,7 @@ from qzs.engine.hexapod.layout import (
     PL_ROTATING, S_C, S_INT, S_Q, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV, V_DIR, V_FC, V_FMAX,
     V_FS, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK, V_TX, V_TY, V_TZ, V_ZHIGH,
     V_ZLOW, V_ZREF)
-from qzs.engine.prepare import steps_per_sample
+from qzs.engine.prepare import check_record, steps_per_sample
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError
 from qzs.model.controller import ControllerParameters
@@ -27,7 +27,7 @@ from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformPar
                                jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_force
 
-__all__ = ["hexapod_stability_test", "check_hexapod_run"]
+__all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 
@@ -67,6 +67,22 @@ def _excitations(excitation):
                 f"DisplacementRecord or None, got {type(value).__name__}.")
         moving[axis] = value
     return moving
+
+
+def record_option(axis):
+    """How a platform run's errors name the length of the excitation along ``axis``.
+
+    Parameters
+    ----------
+    axis : str
+        The base axis (``"z"``).
+
+    Returns
+    -------
+    str
+        ``excitation['z'].duration`` (an error's option, for a caller to spell its own way).
+    """
+    return f"excitation[{axis!r}].duration"
 
 
 def _static_forces(geometry, platform):
@@ -243,6 +259,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
             raise ParameterError(
                 f"`duration` ({duration!r} s) exceeds the length of `excitation[{axis!r}]` "
                 f"({value.duration!r} s); shorten the run or lengthen that excitation.")
+        check_record(value, duration, name=record_option(axis))
     dt = positive_real("dt", dt)
     sample_rate = positive_real("sample_rate", sample_rate)
     if dt > duration:

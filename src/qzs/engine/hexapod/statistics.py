@@ -6,6 +6,7 @@ a preview kept): what :meth:`~qzs.engine.hexapod.result.HexapodResult.summary` r
 import numpy as np
 
 from qzs.analysis.statistics import RunStatistics
+from qzs.analysis.summary import excitation_part
 from qzs.engine.hexapod.layout import (C_BASE_POSE, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST,
                                        C_FMO, C_POSE, C_WB, C_WM, C_Z, LEG_COUNT, O_LOCKED)
 
@@ -64,7 +65,8 @@ def _summary_text(result):
     """The text of :meth:`HexapodResult.summary` (from the statistics of every sample)."""
     run = result.run
     stats = result.statistics
-    moving = ", ".join(f"{axis}: {type(e).__name__}" for axis, e in result.excitation.items())
+    moving = "; ".join(f"{axis}: {excitation_part(e, run['duration'])}"
+                       for axis, e in result.excitation.items())
     residual = stats["energy_residual_max_J"]
     scale = max(stats["base_work_max_J"], 1e-300)
     lines = [f"Hexapod run: {run['duration']:g} s, {run['solver']} dt = {run['dt']:g} s, "

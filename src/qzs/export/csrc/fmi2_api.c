@@ -97,10 +97,8 @@ void fmi2FreeInstance(fmi2Component c) {
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined,
                                fmi2Real stopTime) {
-    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
-    Instance *instance = (Instance *)c;
-    instance->fmu.start_time = startTime;
-    instance->fmu.time = startTime;
+    (void)toleranceDefined; (void)tolerance;
+    qzs_fmu_setup(&((Instance *)c)->fmu, startTime, stopTimeDefined, stopTime);
     return fmi2OK;
 }
 

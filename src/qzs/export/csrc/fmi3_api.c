@@ -115,10 +115,9 @@ void fmi3FreeInstance(fmi3Instance instance) {
 fmi3Status fmi3EnterInitializationMode(fmi3Instance handle, fmi3Boolean toleranceDefined,
                                        fmi3Float64 tolerance, fmi3Float64 startTime,
                                        fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
+    (void)toleranceDefined; (void)tolerance;
     Instance *instance = (Instance *)handle;
-    instance->fmu.start_time = startTime;
-    instance->fmu.time = startTime;
+    qzs_fmu_setup(&instance->fmu, startTime, stopTimeDefined, stopTime);
     instance->in_initialization = 1;
     return fmi3OK;
 }

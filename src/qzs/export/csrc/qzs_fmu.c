@@ -1,10 +1,13 @@
 /* qzs: the isolator as an FMU, independent of the FMI version (see qzs_fmu.h). */
 #include "qzs_fmu.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+
+#include "qzs_stability.h"
 
 #define V(name) (fmu->values[QZS_VR_##name])
 
@@ -29,11 +32,21 @@ void qzs_fmu_reset(QzsFmu *fmu, double start_time) {
     fmu->failed = 0;
     fmu->start_time = start_time;
     fmu->time = start_time;
+    fmu->offset = 0.0;
+    fmu->stop_defined = 0;
+    fmu->stop_time = 0.0;
     fmu->values[QZS_VR_TIME] = start_time;
     memset(fmu->table, 0, sizeof fmu->table);
     fmu->has_previous = 0;
     fmu->previous_time = 0.0;
     fmu->previous_acceleration = 0.0;
+}
+
+void qzs_fmu_setup(QzsFmu *fmu, double start_time, int stop_defined, double stop_time) {
+    fmu->start_time = start_time;
+    fmu->time = start_time;
+    fmu->stop_defined = stop_defined;
+    fmu->stop_time = stop_defined ? stop_time : 0.0;
 }
 
 static const char *type_name(char type) {
@@ -88,7 +101,7 @@ int qzs_fmu_get(QzsFmu *fmu, unsigned int reference, char type, double *value) {
 
 /* A parameter outside its range: logged with its value and what it must be. */
 static int refuse(QzsFmu *fmu, const char *name, double value, const char *rule) {
-    qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.17g must be %s; set it so before initialisation "
+    qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.15g must be %s; set it so before initialisation "
                 "ends", name, value, rule);
     return QZS_FMU_ERROR;
 }
@@ -96,6 +109,9 @@ static int refuse(QzsFmu *fmu, const char *name, double value, const char *rule)
 #define REQUIRE(name, condition, rule) \
     if (!(condition)) return refuse(fmu, QZS_FMU_NAMES[QZS_VR_##name], V(name), rule)
 
+/* The checks of qzs.model (IsolatorParameters, ControllerParameters, Chirp, Sine), on the
+ * parameters this FMU uses: an excitation's parameter that its kind does not use (a sine's
+ * sweep time) and, in plant mode, the controller's gains are neither required nor checked. */
 static int check_parameters(QzsFmu *fmu) {
     REQUIRE(ISOLATOR_MASS, V(ISOLATOR_MASS) > 0.0, "positive [kg]");
     REQUIRE(ISOLATOR_GRAVITY, V(ISOLATOR_GRAVITY) >= 0.0, ">= 0 [m/s^2]");
@@ -104,7 +120,8 @@ static int check_parameters(QzsFmu *fmu) {
     REQUIRE(ISOLATOR_STICTION_FORCE, V(ISOLATOR_STICTION_FORCE) >= 0.0, ">= 0 [N]");
     REQUIRE(ISOLATOR_COULOMB_FORCE, V(ISOLATOR_COULOMB_FORCE) >= 0.0 &&
             V(ISOLATOR_COULOMB_FORCE) <= V(ISOLATOR_STICTION_FORCE),
-            "between 0 and stiction_force [N]");
+            "between 0 and isolator.stiction_force [N] (the breakaway force cannot be below "
+            "the sliding friction)");
     REQUIRE(ISOLATOR_STRIBECK_DECAY, V(ISOLATOR_STRIBECK_DECAY) >= 0.0, ">= 0 [s/m]");
     REQUIRE(ISOLATOR_VISCOUS_DAMPING, V(ISOLATOR_VISCOUS_DAMPING) >= 0.0, ">= 0 [N*s/m]");
     REQUIRE(ISOLATOR_FRICTION_REGULARISATION, V(ISOLATOR_FRICTION_REGULARISATION) >= 0.0,
@@ -117,24 +134,37 @@ static int check_parameters(QzsFmu *fmu) {
     REQUIRE(ISOLATOR_FRICTION_REGULARISATION,
             !(V(ISOLATOR_FRICTION_REGULARISATION) > 0.0 && V(ISOLATOR_STOP_MODEL) == 1.0),
             "0 with plastic stops (a regularised slip never rests on a stop)");
+    REQUIRE(CONTROLLER_VELOCITY_HIGHPASS, V(CONTROLLER_VELOCITY_HIGHPASS) >= 0.0, ">= 0 [Hz]");
+#if !QZS_FMU_PLANT_MODE
     REQUIRE(ISOLATOR_MOTOR_FORCE_MAX, V(ISOLATOR_MOTOR_FORCE_MAX) >= 0.0, ">= 0 [N]");
     REQUIRE(CONTROLLER_PI_KP, V(CONTROLLER_PI_KP) >= 0.0, ">= 0 [N/m]");
     REQUIRE(CONTROLLER_PI_KI, V(CONTROLLER_PI_KI) >= 0.0, ">= 0 [N/(m*s)]");
     REQUIRE(CONTROLLER_DAMPING_GAIN, V(CONTROLLER_DAMPING_GAIN) >= 0.0, ">= 0 [N*s/m]");
-    REQUIRE(CONTROLLER_VELOCITY_HIGHPASS, V(CONTROLLER_VELOCITY_HIGHPASS) >= 0.0, ">= 0 [Hz]");
     REQUIRE(CONTROLLER_CONTROLLER_RATE, V(CONTROLLER_CONTROLLER_RATE) >= 0.0, ">= 0 [Hz]");
+#endif
     REQUIRE(STEP_SIZE, V(STEP_SIZE) > 0.0, "positive [s]");
     REQUIRE(SOLVER, V(SOLVER) == 0.0 || V(SOLVER) == 1.0 || V(SOLVER) == 2.0,
             "0 (euler), 1 (ode3) or 2 (rk4)");
 #if !QZS_FMU_BASE_INPUT
-    REQUIRE(EXCITATION_KIND, V(EXCITATION_KIND) == 0.0 || V(EXCITATION_KIND) == 1.0 ||
-            V(EXCITATION_KIND) == 2.0, "0 (linear chirp), 1 (logarithmic chirp) or 2 (sine)");
-    REQUIRE(EXCITATION_F0, V(EXCITATION_F0) >= 0.0 && (V(EXCITATION_KIND) != 1.0 ||
-            V(EXCITATION_F0) > 0.0), ">= 0 [Hz] (positive for a logarithmic chirp)");
-    REQUIRE(EXCITATION_F1, V(EXCITATION_F1) >= 0.0 && (V(EXCITATION_KIND) != 1.0 ||
-            V(EXCITATION_F1) > 0.0), ">= 0 [Hz] (positive for a logarithmic chirp)");
-    REQUIRE(EXCITATION_DURATION, V(EXCITATION_DURATION) > 0.0, "positive [s]");
+    double kind = V(EXCITATION_KIND);
+    REQUIRE(EXCITATION_KIND, kind == 0.0 || kind == 1.0 || kind == 2.0,
+            "0 (linear chirp), 1 (logarithmic chirp) or 2 (sine)");
+    REQUIRE(EXCITATION_AMPLITUDE, V(EXCITATION_AMPLITUDE) >= 0.0, ">= 0 [m]");
     REQUIRE(EXCITATION_FADE_IN, V(EXCITATION_FADE_IN) >= 0.0, ">= 0 [s]");
+    if (kind == 2.0) {
+        REQUIRE(EXCITATION_F0, V(EXCITATION_F0) > 0.0,
+                "positive [Hz] for a sine (its frequency; a sine of 0 Hz does not move the "
+                "base: set excitation.amplitude = 0 for a base at rest)");
+    } else {
+        REQUIRE(EXCITATION_F0, V(EXCITATION_F0) >= 0.0 && (kind == 0.0 || V(EXCITATION_F0) > 0.0),
+                ">= 0 [Hz] (positive for a logarithmic chirp)");
+        REQUIRE(EXCITATION_F1, V(EXCITATION_F1) >= 0.0 && (kind == 0.0 || V(EXCITATION_F1) > 0.0),
+                ">= 0 [Hz] (positive for a logarithmic chirp)");
+        REQUIRE(EXCITATION_DURATION, V(EXCITATION_DURATION) > 0.0,
+                "positive [s] for a chirp (its sweep time)");
+        REQUIRE(EXCITATION_FADE_IN, V(EXCITATION_FADE_IN) <= V(EXCITATION_DURATION),
+                "at most the chirp's sweep time excitation.duration [s]");
+    }
 #endif
     return QZS_FMU_OK;
 }
@@ -200,13 +230,12 @@ static void initial_state(QzsFmu *fmu, double *state, int64_t *flags) {
     s.x[QZS_S_Z] = z0;
     s.x[QZS_S_HP] = qzs_base_motion(plant, 0.0).yd + 0.0;
     double held[3] = {0.0, 0.0, 0.0};
+    QzsForces force;
 #if QZS_FMU_PLANT_MODE
     held[2] = V(MOTOR_FORCE);
-#endif
-    QzsForces force;
+#else
     qzs_rhs_at(plant, 0.0, &s, QZS_MODE_STICK, 0.0, held, 0, &force);
     double measured = force.v_measured;
-#if !QZS_FMU_PLANT_MODE
     if (V(CONTROLLER_PI_KI) > 0.0) {
         QzsPlant at_rest = *plant; /* the base at rest: qzs.engine.prepare._AT_REST */
         double rest[QZS_N_EXCITATION] = {QZS_KIND_SINE, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
@@ -240,8 +269,9 @@ static void update_outputs(QzsFmu *fmu) {
     double row[QZS_N_CHANNELS];
     unsigned char row_flags[QZS_N_OUTPUT_FLAGS];
     QzsRun *run = &fmu->run;
-    qzs_record(&run->plant, fmu->time, &run->s, run->mode, run->direction, run->held, row,
-               row_flags, run->phase);
+    double t = (double)run->step * run->plant.P[QZS_P_DT] + fmu->offset;
+    qzs_record(&run->plant, t, &run->s, run->mode, run->direction, run->held, row, row_flags,
+               run->phase);
     for (int i = 0; i < QZS_FMU_N_VARIABLES; i++) {
         int channel = QZS_FMU_CHANNEL[i];
         if (channel >= 100)
@@ -275,6 +305,81 @@ static void hold_base_inputs(QzsFmu *fmu, double t0, double t1) {
 }
 #endif
 
+static const char *solver_name(int solver) {
+    return solver == QZS_SOLVER_EULER ? "euler" : (solver == QZS_SOLVER_RK4 ? "rk4" : "ode3");
+}
+
+#if !QZS_FMU_BASE_INPUT
+/* The highest frequency [Hz] the internal excitation reaches by `until` [s]: a chirp cut short
+ * only that of its end (qzs.model.excitation.highest_frequency). */
+static double highest_frequency(QzsFmu *fmu, double until) {
+    double f0 = V(EXCITATION_F0), f1 = V(EXCITATION_F1), kind = V(EXCITATION_KIND);
+    if (kind == 2.0)
+        return f0;
+    double fraction = until / V(EXCITATION_DURATION);
+    fraction = fraction < 0.0 ? 0.0 : (fraction > 1.0 ? 1.0 : fraction);
+    double end = kind == 0.0 ? f0 + (f1 - f0) * fraction : f0 * pow(f1 / f0, fraction);
+    return end > f0 ? end : f0;
+}
+#endif
+
+/* The steps qzs refuses (unstable for this configuration, too coarse for the excitation, a
+ * run past a chirp's end), refused; a step above the one the export chose for accuracy,
+ * warned of. Returns QZS_FMU_OK, QZS_FMU_WARNING or QZS_FMU_ERROR. */
+static int check_step(QzsFmu *fmu, const double *P) {
+    double dt = V(STEP_SIZE);
+    int solver = (int)V(SOLVER);
+    int closed_loop = !QZS_FMU_PLANT_MODE;
+    if (!qzs_stable_step(P, solver, closed_loop, dt)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "`step_size` = %.12g s is too large for a stable %s integration of this "
+                    "configuration (stiffest mode: the hard-stop contact or the spring%s loop); "
+                    "the largest stable step is %.3g s: lower step_size (or soften "
+                    "isolator.stop_stiffness) before initialisation ends",
+                    dt, solver_name(solver), closed_loop ? "/PI/damping" : "",
+                    qzs_largest_stable_step(P, solver, closed_loop));
+        return QZS_FMU_ERROR;
+    }
+#if !QZS_FMU_BASE_INPUT
+    int chirp = V(EXCITATION_KIND) != 2.0;
+    double sweep = V(EXCITATION_DURATION);
+    if (chirp && fmu->stop_defined && fmu->stop_time > sweep * (1.0 + 1e-12)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "the stop time %.12g s is past the chirp's end, `excitation.duration` = "
+                    "%.12g s (qzs runs no chirp past its sweep); stop at or before it, or "
+                    "lengthen excitation.duration", fmu->stop_time, sweep);
+        return QZS_FMU_ERROR;
+    }
+    double top = highest_frequency(fmu, fmu->stop_defined ? fmu->stop_time : sweep);
+    if (top > 0.0 && dt > 1.0 / (QZS_FMU_MIN_STEPS_PER_PERIOD * top) * (1.0 + 1e-9)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                    "`step_size` = %.12g s resolves the excitation's %g Hz with fewer than %d "
+                    "steps per period; lower step_size to %.3g s or less",
+                    dt, top, QZS_FMU_MIN_STEPS_PER_PERIOD,
+                    1.0 / (QZS_FMU_MIN_STEPS_PER_PERIOD * top));
+        return QZS_FMU_ERROR;
+    }
+#endif
+    if (dt > QZS_FMU_EXPORTED_STEP * (1.0 + 1e-9)) {
+        if (QZS_FMU_STEP_CHOSEN)
+            qzs_fmu_log(fmu, QZS_FMU_WARNING,
+                        "`step_size` = %.12g s is above the %.12g s qzs chose at export for "
+                        "accuracy (%s) for the exported parameters: the results may be less "
+                        "accurate than that; stable up to %.3g s", dt, QZS_FMU_EXPORTED_STEP,
+                        QZS_FMU_STEP_HOW, qzs_largest_stable_step(P, solver, closed_loop));
+        else
+            qzs_fmu_log(fmu, QZS_FMU_WARNING,
+                        "`step_size` = %.12g s is above the %.12g s given at export, and neither "
+                        "was chosen for accuracy (export without a literal step to have one "
+                        "chosen: qzs export fmu without --dt, qzs.export_fmu with step=chosen); "
+                        "stable up to %.3g s",
+                        dt, QZS_FMU_EXPORTED_STEP,
+                        qzs_largest_stable_step(P, solver, closed_loop));
+        return QZS_FMU_WARNING;
+    }
+    return QZS_FMU_OK;
+}
+
 int qzs_fmu_initialize(QzsFmu *fmu) {
     if (fmu->initialized)
         return QZS_FMU_OK;
@@ -283,10 +388,18 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
                     "got %g s", fmu->start_time);
         return QZS_FMU_ERROR;
     }
+    if (fmu->stop_defined && !(fmu->stop_time > 0.0)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the stop time must be after the start time 0 s, got "
+                    "%g s", fmu->stop_time);
+        return QZS_FMU_ERROR;
+    }
     if (check_parameters(fmu) != QZS_FMU_OK)
         return QZS_FMU_ERROR;
     double P[QZS_N_PARAMS];
     if (pack_parameters(fmu, P) != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    int status = check_step(fmu, P);
+    if (status == QZS_FMU_ERROR)
         return QZS_FMU_ERROR;
     double z0 = V(CONTROLLER_POSITION_SETPOINT);
     if (!(P[QZS_P_Z_LOW] <= z0 && z0 <= P[QZS_P_Z_HIGH])) {
@@ -317,9 +430,25 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
 #if QZS_FMU_PLANT_MODE
     fmu->run.sampled = 0;
 #endif
+    fmu->offset = 0.0;
     fmu->initialized = 1;
     update_outputs(fmu);
-    return QZS_FMU_OK;
+    return status;
+}
+
+/* Where t [s] lies on the grid of internal steps: the grid point at or before it (*index) and
+ * how far past it (*offset, in [0, dt)); a time within a millionth of a step of a grid point is
+ * that point, as a whole number of steps summed in floating point lands there. */
+static void on_grid(double t, double dt, int64_t *index, double *offset) {
+    double cells = t / dt;
+    double nearest = floor(cells + 0.5);
+    if (fabs(cells - nearest) <= 1e-6 + 4.0 * DBL_EPSILON * cells) {
+        *index = (int64_t)nearest;
+        *offset = 0.0;
+    } else {
+        *index = (int64_t)floor(cells);
+        *offset = t - (double)*index * dt;
+    }
 }
 
 int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
@@ -331,13 +460,11 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
         qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep after a failed step; reset or free the FMU");
         return QZS_FMU_ERROR;
     }
-    double dt = fmu->run.plant.P[QZS_P_DT];
-    double steps = floor(step / dt + 0.5);
-    if (!(step > 0.0) || steps < 1.0 || fabs(steps * dt - step) > 1e-9 * step) {
-        qzs_fmu_log(fmu, QZS_FMU_ERROR,
-                    "the communication step %.17g s is not a whole number of internal steps "
-                    "(step_size = %.17g s: %.17g of them); choose a multiple of step_size",
-                    step, dt, step / dt);
+    QzsRun *run = &fmu->run;
+    double dt = run->plant.P[QZS_P_DT];
+    if (!(step > 0.0) || !isfinite(step)) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the communication step %.12g s must be positive",
+                    step);
         return QZS_FMU_ERROR;
     }
     if (fabs(current - fmu->time) > 1e-9 * (dt + fabs(current))) {
@@ -345,24 +472,54 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
                     "time %.17g s", current, fmu->time);
         return QZS_FMU_ERROR;
     }
-    QzsRun *run = &fmu->run;
+    double end = current + step;
+    if (fmu->stop_defined && end > fmu->stop_time + 1e-6 * dt) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.12g s by %.12g s goes past the stop time "
+                    "%.12g s the experiment set; step to the stop time at most", current, step,
+                    fmu->stop_time);
+        return QZS_FMU_ERROR;
+    }
+#if !QZS_FMU_BASE_INPUT
+    double sweep = V(EXCITATION_DURATION);
+    if (V(EXCITATION_KIND) != 2.0 && end > sweep * (1.0 + 1e-12) + 1e-6 * dt) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "doStep from %.12g s by %.12g s goes past the chirp's "
+                    "end, `excitation.duration` = %.12g s (qzs runs no chirp past its sweep)",
+                    current, step, sweep);
+        return QZS_FMU_ERROR;
+    }
+#endif
+    int64_t end_index;
+    double end_offset;
+    on_grid(end, dt, &end_index, &end_offset);
 #if QZS_FMU_PLANT_MODE
     run->held[2] = V(MOTOR_FORCE);
     run->margin = NAN; /* the held force may have changed: the holding margin too */
 #endif
 #if QZS_FMU_BASE_INPUT
-    hold_base_inputs(fmu, (double)run->step * dt, (double)(run->step + (int64_t)steps) * dt);
+    hold_base_inputs(fmu, (double)run->step * dt + fmu->offset,
+                     (double)end_index * dt + end_offset);
     run->margin = NAN; /* the base motion is a new segment */
 #endif
-    int status = qzs_run_steps(run, (int64_t)steps, 0, NULL, NULL, NULL);
-    fmu->time = (double)run->step * dt;
+    int status = QZS_STATUS_OK;
+    while (status == QZS_STATUS_OK &&
+           (run->step < end_index || (run->step == end_index && fmu->offset < end_offset))) {
+        if (fmu->offset > 0.0 || run->step == end_index) { /* part of a grid step */
+            double to = run->step < end_index ? dt : end_offset;
+            status = qzs_run_part(run, fmu->offset, to);
+            fmu->offset = to < dt ? to : 0.0;
+        } else { /* whole grid steps, as qzs takes them */
+            status = qzs_run_steps(run, end_index - run->step, 0, NULL, NULL, NULL);
+        }
+    }
     if (status != QZS_STATUS_OK) {
+        fmu->time = (double)run->step * dt + fmu->offset;
         fmu->failed = 1;
-        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the state diverged at t = %.17g s (z = %g m, v = %g "
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the state diverged at t = %.12g s (z = %g m, v = %g "
                     "m/s); the step is too large for this configuration: lower step_size",
                     fmu->time, run->s.x[QZS_S_Z], run->s.x[QZS_S_V]);
         return QZS_FMU_ERROR;
     }
+    fmu->time = end; /* the importer's time; the grid's is within a millionth of a step of it */
     update_outputs(fmu);
     return QZS_FMU_OK;
 }

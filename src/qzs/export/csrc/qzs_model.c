@@ -25,46 +25,59 @@ void qzs_run_start(QzsRun *run, int solver, const double *state, const int64_t *
     run->phase = qzs_advance_phase(&run->plant, (double)run->step * P[QZS_P_DT], start, 1);
 }
 
+/* One step of the run of length h from t, the excitation's phase at t given: the controller
+ * sampled first where `at_grid_point` and a sample is due; `completes`: the step ends on the
+ * next grid point (the step count and the grid's phase advance). One grid step of
+ * qzs.engine.lanes.run_single when h is the grid step; part of one otherwise. */
+static int run_one(QzsRun *run, double t, double h, QzsPhase phase, int at_grid_point,
+                   int completes) {
+    const QzsPlant *plant = &run->plant;
+    const double *P = plant->P;
+    if (at_grid_point && run->sampled && run->step % run->control_steps == 0) {
+        double z, v_measured;
+        qzs_measure(plant, t, &run->s, run->mode, &z, &v_measured);
+        run->controller.integral = run->s.x[QZS_S_INT];
+        QzsControllerOutput command = qzs_controller_step(&run->controller, z, v_measured);
+        run->held[0] = command.pi;
+        run->held[1] = command.damping;
+        run->held[2] = command.motor;
+        run->s.x[QZS_S_INT] = run->controller.integral;
+        run->margin = NAN;
+    }
+    QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->mode, run->direction,
+                                 run->held, run->margin, phase);
+    if (!qzs_finite(plant, &next.s))
+        return QZS_STATUS_DIVERGED;
+    run->s = next.s;
+    run->mode = next.mode;
+    run->direction = next.direction;
+    run->margin = next.margin;
+    if (completes) {
+        run->step += 1;
+        /* rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps */
+        run->phase = qzs_advance_phase(plant, (double)run->step * P[QZS_P_DT], run->phase,
+                                       run->step % QZS_PHASE_PERIOD == 0);
+    }
+    run->sticks += next.sticks;
+    run->contacts += next.impacts;
+    int now = qzs_in_contact(plant, &run->s, run->mode);
+    if (now && run->contact == 0 && P[QZS_P_PLASTIC] == 0.0)
+        run->contacts += 1;
+    run->contact = now ? 1 : 0;
+    return QZS_STATUS_OK;
+}
+
 int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
                   unsigned char *out_flags, int64_t *rows) {
     const QzsPlant *plant = &run->plant;
-    const double *P = plant->P;
-    const double h = P[QZS_P_DT];
+    const double h = plant->P[QZS_P_DT];
     int status = QZS_STATUS_OK;
     int64_t row = 0;
     for (int64_t i = 0; i < n_steps; i++) {
         double t = (double)run->step * h;
-        if (run->sampled && run->step % run->control_steps == 0) {
-            double z, v_measured;
-            qzs_measure(plant, t, &run->s, run->mode, &z, &v_measured);
-            run->controller.integral = run->s.x[QZS_S_INT];
-            QzsControllerOutput command = qzs_controller_step(&run->controller, z, v_measured);
-            run->held[0] = command.pi;
-            run->held[1] = command.damping;
-            run->held[2] = command.motor;
-            run->s.x[QZS_S_INT] = run->controller.integral;
-            run->margin = NAN;
-        }
-        QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->mode,
-                                     run->direction, run->held, run->margin, run->phase);
-        if (!qzs_finite(plant, &next.s)) {
-            status = QZS_STATUS_DIVERGED;
+        status = run_one(run, t, h, run->phase, 1, 1);
+        if (status != QZS_STATUS_OK)
             break;
-        }
-        run->s = next.s;
-        run->mode = next.mode;
-        run->direction = next.direction;
-        run->margin = next.margin;
-        run->step += 1;
-        /* rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps */
-        run->phase = qzs_advance_phase(plant, (double)run->step * h, run->phase,
-                                       run->step % QZS_PHASE_PERIOD == 0);
-        run->sticks += next.sticks;
-        run->contacts += next.impacts;
-        int now = qzs_in_contact(plant, &run->s, run->mode);
-        if (now && run->contact == 0 && P[QZS_P_PLASTIC] == 0.0)
-            run->contacts += 1;
-        run->contact = now ? 1 : 0;
         if (decimation > 0 && run->step % decimation == 0) {
             qzs_record(plant, (double)run->step * h, &run->s, run->mode, run->direction,
                        run->held, out + row * QZS_N_CHANNELS,
@@ -75,6 +88,19 @@ int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
     if (rows)
         *rows = row;
     return status;
+}
+
+int qzs_run_part(QzsRun *run, double from, double to) {
+    const QzsPlant *plant = &run->plant;
+    const double dt = plant->P[QZS_P_DT];
+    double grid = (double)run->step * dt;
+    int completes = to >= dt;
+    if (from == 0.0)
+        return run_one(run, grid, completes ? dt : to, run->phase, 1, completes);
+    double t = grid + from;
+    double h = (completes ? (double)(run->step + 1) * dt : grid + to) - t;
+    QzsPhase phase = qzs_advance_phase(plant, t, run->phase, 1);
+    return run_one(run, t, h, phase, 0, completes);
 }
 
 void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags) {

@@ -37,6 +37,11 @@ void qzs_run_start(QzsRun *run, int solver, const double *state, const int64_t *
  * *rows the rows written. */
 int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
                   unsigned char *out_flags, int64_t *rows);
+/* Part of the grid step that starts at the grid point run->step * dt: from `from` to `to` [s]
+ * past it (0 <= from < to <= dt). The controller is sampled only at the grid point itself
+ * (from = 0), so that its timing stays the grid's; `to` = dt completes the grid step. What a
+ * communication point inside a grid step needs (qzs_fmu.c). Returns as qzs_run_steps. */
+int qzs_run_part(QzsRun *run, double from, double to);
 /* The packed state and flags of the run (qzs_run_start's inverse). */
 void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags);
 

@@ -141,7 +141,9 @@ def load_channel_map(source: str | Path | Mapping[str, Any] | ChannelMap) -> Cha
     if isinstance(source, ChannelMap):
         return source
     if isinstance(source, (str, Path)):
-        document = read_toml(source, "channel map")
+        document = read_toml(source, "channel map", empty=(
+            "write its [channels] into it (`qzs experiment --write-map FILE.toml` writes a "
+            "template with every key)"))
     elif isinstance(source, Mapping):
         document = dict(source)
     else:

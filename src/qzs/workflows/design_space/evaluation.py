@@ -32,8 +32,8 @@ import numpy as np
 
 from qzs.workflows.design_space.metrics import METRICS, goal_values
 
-__all__ = ["Evaluation", "evaluate", "evaluate_cases", "case_settings", "evaluate_batch",
-           "run_tasks", "linear_metrics", "shares"]
+__all__ = ["Evaluation", "evaluate", "evaluate_cases", "cases_per_batch", "case_settings",
+           "evaluate_batch", "run_tasks", "linear_metrics", "shares"]
 
 
 def shares(n, parts):
@@ -309,6 +309,34 @@ def case_settings(problem, designs):
     return settings
 
 
+def cases_per_batch(total, client=None, batch_size=None, simulated=True):
+    """Cases :func:`evaluate_cases` evaluates in one task [-].
+
+    Parameters
+    ----------
+    total : int
+        Cases to evaluate [-].
+    client : distributed.Client, optional
+        The Dask cluster they go to (None: this process).
+    batch_size : int, optional
+        Cases per task asked for.
+    simulated : bool
+        Whether any metric needs a simulation.
+
+    Returns
+    -------
+    int
+        Here, ``batch_size`` if given for a simulated problem, else every case in one
+        call (the linear metrics cost mostly per call); on a cluster, ``batch_size`` or
+        one task per worker thread.
+    """
+    if client is None and (batch_size is None or not simulated):
+        return total
+    if batch_size is None:
+        return max(1, -(-total // sum(client.nthreads().values())))
+    return batch_size
+
+
 def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None,
                    batch_size=None, progress=None):
     """Evaluate cases, each a dict of parameter values, in batches (one task each).
@@ -372,10 +400,7 @@ def evaluate_cases(problem, settings, *, columns=None, client=None, threads=None
     if simulated and problem.sweep.simulation["dt"] is None:
         raise ValueError("the problem's step is not fixed yet: choose it first "
                          "(qzs.workflows.design_space.optimizer.fix_step)")
-    if client is None and (batch_size is None or not simulated):
-        batch_size = total  # the linear metrics cost mostly per call: one call here
-    elif batch_size is None:
-        batch_size = max(1, -(-total // sum(client.nthreads().values())))
+    batch_size = cases_per_batch(total, client, batch_size, simulated)
     batches = [(a, min(a + batch_size, total)) for a in range(0, total, batch_size)]
     results = run_tasks(problem, batches, settings, [g.column for g in goals], client=client,
                         threads=threads)

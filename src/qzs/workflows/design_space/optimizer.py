@@ -25,13 +25,14 @@ import numpy as np
 
 from qzs._optional import require
 from qzs.errors import OutputPathError, ProblemError
+from qzs.iotools.paths import removed_on_error
 from qzs.workflows.design_space.evaluation import evaluate
 from qzs.workflows.design_space.metrics import METRICS, goal_values
 from qzs.workflows.design_space.problem import MIN_POPULATION, DesignProblem, load_problem
 from qzs.workflows.design_space.result import OptimizationResult, objective_matrix
 from qzs.workflows.design_space.store import DesignStore, check, check_same_search
 
-__all__ = ["optimize", "fix_step", "probe_designs", "check_run_length"]
+__all__ = ["optimize", "fix_step", "probe_designs", "check_run_length", "GENERATION_REMEDY"]
 
 
 def probe_designs(problem):
@@ -56,10 +57,20 @@ def probe_designs(problem):
     return np.column_stack([v.to_unit(points[:, j]) for j, v in enumerate(problem.variables)])
 
 
-def check_run_length(problem, *, threads=None):
-    """Refuse, before any probe or store, a problem whose every simulation would take
-    absurdly long (``[analysis] duration = 1e9``); a problem of linear metrics only
-    simulates nothing and passes.
+#: What to do about a generation whose samples would not fit in memory, in a problem file's
+#: words.
+GENERATION_REMEDY = ("shorten the runs ([excitation] duration, [analysis] duration or "
+                     "n_averages, an `excitation.duration` variable's `high`), lower [analysis] "
+                     "sample_rate, or evaluate fewer designs at once ([optimizer] population, "
+                     "--population; [robust] samples)")
+
+
+def check_run_length(problem, *, threads=None, cases=None):
+    """Refuse, before any probe or store, a problem whose simulations would take absurdly
+    long or keep more samples than the memory holds (``[analysis] duration = 1e9``, or an
+    ``excitation.duration`` searched up to it: the longest of :func:`probe_designs`, the
+    variables' bounds, counts); a problem of linear metrics only simulates nothing and
+    passes. :func:`qzs.workflows.sweeps.store_checks.check_run_length` for a sweep.
 
     Parameters
     ----------
@@ -67,17 +78,30 @@ def check_run_length(problem, *, threads=None):
         The problem.
     threads : int, optional
         Threads a generation's runs are shared over [-]; default the machine's cores.
+    cases : int, optional
+        Runs evaluated together [-]; default a generation's (population x draws).
 
     Raises
     ------
     RunTooLongError
         One design's run would take more than a day at the kernel's best speed.
+    ResultTooLargeError
+        The samples of ``cases`` runs would take more than half the memory available.
     """
     from qzs.workflows.sweeps.store_checks import check_run_length as check_sweep
 
     if any(METRICS[g.metric].source != "linear" for g in problem.goals):
-        check_sweep(problem.sweep, [{}], threads=threads,
-                    cases=problem.optimizer["population"] * problem.samples)
+        if cases is None:
+            cases = problem.optimizer["population"] * problem.samples
+        check_sweep(problem.sweep, _probe_settings(problem), threads=threads, cases=cases,
+                    remedy=GENERATION_REMEDY)
+
+
+def _probe_settings(problem):
+    """The parameters of :func:`probe_designs`, each at the uncertain parameters' medians."""
+    nominal = {u.name: u.nominal for u in problem.uncertain}
+    names = [v.name for v in problem.variables]
+    return [{**dict(zip(names, row.tolist())), **nominal} for row in probe_designs(problem)]
 
 
 def fix_step(problem, *, progress=False):
@@ -105,10 +129,7 @@ def fix_step(problem, *, progress=False):
     if problem.sweep.simulation["dt"] is not None or all(
             METRICS[g.metric].source == "linear" for g in problem.goals):
         return problem
-    nominal = {u.name: u.nominal for u in problem.uncertain}
-    names = [v.name for v in problem.variables]
-    settings = [{**dict(zip(names, row.tolist())), **nominal} for row in probe_designs(problem)]
-    sweep, _ = choose_sweep_step(problem.sweep, settings, progress=progress)
+    sweep, _ = choose_sweep_step(problem.sweep, _probe_settings(problem), progress=progress)
     return dataclasses.replace(problem, sweep=sweep)
 
 
@@ -175,7 +196,8 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         (before any evaluation).
     """
     from qzs.engine.progress import progress_bar
-    from qzs.workflows.design_space.problem import _positive_int
+    from qzs._validation import seed as checked_seed
+    from qzs.workflows.design_space.problem import _in, _positive_int
     from qzs.workflows.sweeps.cluster import dask_client
 
     if not isinstance(problem, DesignProblem):
@@ -190,9 +212,7 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
             raise ProblemError("optimizer", "population", population, "NSGA-II needs at least "
                                f"{MIN_POPULATION} designs per generation")
     if seed is not None:
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            raise ProblemError("optimizer", "seed", seed, "must be a whole number")
-        settings["seed"] = seed
+        settings["seed"] = checked_seed("seed", seed, _in("optimizer"))
     problem = dataclasses.replace(problem, optimizer=settings)
     store = Path(store) if store is not None else Path(f"{problem.name}.zarr")
     check(store, resume=resume, overwrite=overwrite)
@@ -201,11 +221,15 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
     check_run_length(problem, threads=threads)  # certain already at the output period
     require("pymoo", "qzs optimize (multi-objective search)")
     began = time.perf_counter()
-    with dask_client(scheduler, workers) as client:  # before the store or any probe
+    # the cluster before the store or any probe; a store made here and failing before its
+    # first generation is stored goes again
+    with dask_client(scheduler, workers) as client, removed_on_error(store) as made:
         if not resume:  # the step first: nothing is written until the runs are sure to start
             problem = fix_step(problem, progress=progress)
             check_run_length(problem, threads=threads)
         opened = DesignStore(store, problem, resume=resume, overwrite=overwrite)
+        if opened.generations:
+            made.keep()
         if opened.step is not None:
             sweep = problem.sweep
             problem = dataclasses.replace(problem, sweep=dataclasses.replace(
@@ -221,16 +245,18 @@ def optimize(problem: DesignProblem | str | Path | Mapping[str, Any],
         total = settings["generations"] * settings["population"] * problem.samples
         with progress_bar(total=total, unit="case", desc=problem.name, disable=not progress,
                           dynamic_ncols=True) as bar:
-            evaluated_now, steps = _generations(problem, opened, client, threads, bar)
+            evaluated_now, steps = _generations(problem, opened, client, threads, bar,
+                                                stored=made.keep)
     return OptimizationResult.from_store(opened, problem, wall=time.perf_counter() - began,
                                          evaluated=evaluated_now, steps=steps)
 
 
-def _generations(problem, opened, client, threads, bar):
+def _generations(problem, opened, client, threads, bar, stored=lambda: None):
     """Ask NSGA-II for every generation and tell it the designs' objectives.
 
     A generation the store holds is answered from it (after checking bit for bit that
-    the same designs were asked for); the others are evaluated and stored.
+    the same designs were asked for); the others are evaluated and stored (then
+    ``stored()`` is called).
 
     Returns
     -------
@@ -265,6 +291,7 @@ def _generations(problem, opened, client, threads, bar):
             evaluation = evaluate(problem, designs, client=client, threads=threads,
                                   progress=bar.update)
             opened.append(generation, X, evaluation)
+            stored()
             aggregated = evaluation.goal_values(problem.goals)
             evaluated += len(X)
             steps += evaluation.steps

@@ -63,6 +63,7 @@ import numpy as np
 
 from qzs._format import unit_label, with_unit
 from qzs._validation import Structured, integer, read_toml, real
+from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.registry import ALL_PARAMETERS, dotted_names
@@ -384,11 +385,13 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
     else:
         try:
             path = resolve_shipped(source, SHIPPED, "problem", "problems")
-            document = read_toml(path, "problem file")
+            document = read_toml(path, "problem file", empty=(
+                "write the problem's tables into it (`qzs docs design-space` describes them; "
+                "the shipped isolation_vs_effort is an example)"))
         except ProblemError:
             raise
         except ParameterError as error:
-            raise ProblemError("file", "", source, str(error)) from None
+            raise ProblemError("file", "", str(source), str(error)) from None
         where, stem = repr(str(path)), path.stem
     return _problem(document, where, stem)
 
@@ -659,9 +662,7 @@ def _problem(document, where, stem):
             samples = 1
         if robust["method"] not in ("lhs", "random"):
             _fail("robust", "method", robust["method"], "must be \"lhs\" or \"random\"")
-        if isinstance(robust["seed"], bool) or not isinstance(robust["seed"], int) \
-                or robust["seed"] < 0:
-            _fail("robust", "seed", robust["seed"], "must be a whole number >= 0")
+        checked_seed("seed", robust["seed"], _in("robust"))
         base = _sweep(document, name, variables, uncertain)
         objectives = tuple(_goal("objectives", i, spec, False, base.analysis)
                            for i, spec in enumerate(_table(document, "objectives", list)))
@@ -688,8 +689,7 @@ def _problem(document, where, stem):
         if optimizer["population"] < MIN_POPULATION:
             _fail("optimizer", "population", optimizer["population"], "NSGA-II needs at least "
                   f"{MIN_POPULATION} designs per generation")
-        if isinstance(optimizer["seed"], bool) or not isinstance(optimizer["seed"], int):
-            _fail("optimizer", "seed", optimizer["seed"], "must be a whole number")
+        checked_seed("seed", optimizer["seed"], _in("optimizer"))
         sensitivity = _sensitivity(document, objectives, constraints)
     except ProblemError as error:
         if error.source:
@@ -710,6 +710,7 @@ def _sensitivity(document, objectives, constraints):
               f"must be one of {SENSITIVITY_METHODS} (SALib's Saltelli/Sobol or Morris)")
     for key in ("samples", "trajectories", "levels"):
         _positive_int("sensitivity", key, settings[key], 1_000_000)
+    checked_seed("seed", settings["seed"], _in("sensitivity"))
     if not 0 < _number("sensitivity", "confidence", settings["confidence"]) < 1:
         _fail("sensitivity", "confidence", settings["confidence"], "must lie in (0, 1)")
     columns = [g.column for g in (*objectives, *constraints)]

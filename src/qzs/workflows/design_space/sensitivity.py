@@ -53,9 +53,10 @@ import numpy as np
 
 from qzs._format import unit_label
 from qzs._optional import require
+from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.schema import Schema, Variable, to_dataset
-from qzs.workflows.design_space.evaluation import evaluate_cases
+from qzs.workflows.design_space.evaluation import cases_per_batch, evaluate_cases
 from qzs.workflows.design_space.metrics import METRICS
 from qzs.workflows.design_space.problem import (SENSITIVITY_METHODS, DesignProblem,
                                                 load_problem)
@@ -387,10 +388,7 @@ def _plan(problem, method, samples, seed, metrics, evaluate):
     if method == "morris" and (levels < 2 or levels % 2):
         refuse("levels", levels, "Morris needs an even number of levels >= 2 (4 is usual); "
                                  "an odd number biases the grid", False)
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
-                             or seed < 0):
-        raise ParameterError(f"`seed` must be a whole number >= 0, got {seed!r}.")
-    seed = int(table["seed"] if seed is None else seed)
+    seed = int(table["seed"] if seed is None else checked_seed("seed", seed))
     columns = list(problem.columns)
     if metrics is None:
         metrics = list(table["metrics"])
@@ -469,6 +467,12 @@ def _evaluate(problem, settings, plan, evaluate, client, threads, progress):
 
     n, metrics = len(settings), plan["metrics"]
     definition = problem.sweep
+    batch_size = None if client is not None else max(definition.batch_size, -(-n // 50))
+    if evaluate is None and plan["simulated"]:  # before any probe (and its progress bar)
+        from qzs.workflows.design_space.optimizer import check_run_length
+
+        at_once = min(n, cases_per_batch(n, client, batch_size))
+        check_run_length(problem, threads=threads, cases=at_once)
     with progress_bar(total=n, unit="case", desc=f"sensitivity ({plan['method']})",
                       disable=not progress, leave=False) as bar:
         if evaluate is not None:
@@ -480,9 +484,8 @@ def _evaluate(problem, settings, plan, evaluate, client, threads, progress):
             from qzs.workflows.design_space.optimizer import fix_step
 
             problem = fix_step(problem)
+            check_run_length(problem, threads=threads, cases=at_once)
             definition = problem.sweep
-        batch_size = (None if client is not None
-                      else max(definition.batch_size, -(-n // 50)))
         values, _, messages, _ = evaluate_cases(problem, settings, columns=metrics,
                                                 client=client, threads=threads,
                                                 batch_size=batch_size, progress=bar.update)
@@ -792,18 +795,20 @@ def run_sensitivity(problem: DesignProblem | str | Path | Mapping[str, Any],
     import matplotlib.pyplot as plt
 
     from qzs.iotools.files import atomic_path
+    from qzs.iotools.paths import removed_on_error
     from qzs.workflows.sweeps.cluster import dask_client
 
     with dask_client(scheduler, workers) as client:
         result = sensitivity(problem, method=method, samples=samples, seed=seed, client=client,
                              threads=threads, progress=progress)
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = [result.save(folder / name) for name in SENSITIVITY_FILES[:3]]
-    figure = result.plot(folder / "sensitivity.png")
-    plt.close(figure)
-    written.append(folder / "sensitivity.png")
-    with atomic_path(folder / "sensitivity.txt") as tmp:
-        Path(tmp).write_text(result.summary() + "\n", encoding="utf-8")
-    written.append(folder / "sensitivity.txt")
+    with removed_on_error(folder):  # a folder made here holds all of the files or goes
+        folder.mkdir(parents=True, exist_ok=True)
+        written = [result.save(folder / name) for name in SENSITIVITY_FILES[:3]]
+        figure = result.plot(folder / "sensitivity.png")
+        plt.close(figure)
+        written.append(folder / "sensitivity.png")
+        with atomic_path(folder / "sensitivity.txt") as tmp:
+            Path(tmp).write_text(result.summary() + "\n", encoding="utf-8")
+        written.append(folder / "sensitivity.txt")
     return result, written

@@ -240,14 +240,14 @@ def check(path: str | Path, *, resume: bool = False, overwrite: bool = False,
     OutputPathError, ParameterError
         As :class:`DesignStore`.
     """
+    from qzs.workflows.sweeps.store import store_exists
     from qzs.workflows.sweeps.store_checks import check_resume
 
     check_resume(path, argument, resume, overwrite, work="the search")
     path = Path(path)
     check_output_path(path, argument=argument, suffixes=(STORE_SUFFIX,), directory=True)
     if path.exists() and not resume and not overwrite:
-        raise OutputPathError(argument, path, "exists; pass --resume to continue it, "
-                              "--overwrite to replace it, or choose another name")
+        raise OutputPathError(argument, path, store_exists(argument))
 
 
 def check_same_search(path: str | Path, problem, attributes=None) -> None:

@@ -402,7 +402,9 @@ def load_hexapod(path: str | Path,
         A missing or malformed file, an unknown table or key, a bad value.
     """
     path = resolve_shipped(path, SHIPPED, "hexapod", "hexapod files")
-    document = read_toml(path, "hexapod file")
+    document = read_toml(path, "hexapod file", empty=(
+        "write the platform's tables into it (`qzs docs hexapod` describes them; the shipped "
+        "setups are examples), or give no file for the default platform"))
     where = f"{str(path)!r}: "
     allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation",
                "cartesian"}
@@ -675,6 +677,7 @@ def simulate_setup(setup: HexapodSetup, *,
     """
     from qzs.defaults import SIMULATION
     from qzs.engine.hexapod import simulate_hexapod
+    from qzs.engine.hexapod.prepare import record_option
     from qzs.engine.run_spec import resolve_hexapod
     from qzs.model.excitation import build_excitation
 
@@ -701,12 +704,18 @@ def simulate_setup(setup: HexapodSetup, *,
     if out is not None:
         check_out = _out_check(out, argument, arguments, built)
         check_out()
-    resolved = resolve_hexapod(setup.geometry, setup.platform, setup.isolator, setup.controller,
-                               excitation=built, duration=arguments["duration"], dt=dt,
-                               tolerance_db=tolerance_db, tolerance_state=tolerance_state,
-                               sample_rate=arguments["sample_rate"], solver=arguments["solver"],
-                               cartesian=setup.cartesian, finest=arguments["dt"], step="chosen",
-                               progress=progress)
+    try:
+        resolved = resolve_hexapod(
+            setup.geometry, setup.platform, setup.isolator, setup.controller, excitation=built,
+            duration=arguments["duration"], dt=dt, tolerance_db=tolerance_db,
+            tolerance_state=tolerance_state, sample_rate=arguments["sample_rate"],
+            solver=arguments["solver"], cartesian=setup.cartesian, finest=arguments["dt"],
+            step="chosen", progress=progress)
+    except ParameterError as error:  # an excitation's length, as the caller gave it
+        raise error.renamed({
+            record_option(axis): ((names or {}).get("duration", "duration")
+                                  if axis in (excitation or {}) else f"[excitation.{axis}] duration")
+            for axis in built}) from None
     common = dict(cartesian=setup.cartesian, progress=progress, interruptible=interruptible,
                   **resolved.arguments())
     if out is None:

@@ -255,7 +255,9 @@ def load_study(path):
         an unknown claim id.
     """
     path = resolve_shipped(path, SHIPPED, "study", "studies")
-    document = read_toml(path, "study file")
+    document = read_toml(path, "study file", empty=(
+        "write the study's tables into it (copy a shipped study file of "
+        "qzs/workflows/paper/study_files and edit it)"))
     allowed = {"study", "defaults", "case", "excitation", "analysis", "simulation", "spring",
                "processing"}
     unknown = set(document) - allowed

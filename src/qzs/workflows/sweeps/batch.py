@@ -21,7 +21,7 @@ import numpy as np
 from qzs._optional import require
 from qzs.engine.batch import simulate_batch
 from qzs.errors import CaseError, DataError, ParameterError
-from qzs.workflows.sweeps.cases import build_case
+from qzs.workflows.sweeps.cases import batch_channels, build_case, needs_estimates
 from qzs.workflows.sweeps.reduction import estimate_cases, reduce_case
 from qzs.workflows.sweeps.store import ANALYSIS_FAILED, COUNTS, FAILED, INVALID, OK, schema
 
@@ -99,11 +99,8 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
     multi-threaded batch at a time).
     """
     out = definition.outputs
-    spectral = bool(out["transmissibility"] or out["coherence"] or out["metrics"]
-                    or out["bands"] or out["rms_bands"])
-    channels = (["base_acceleration", "payload_acceleration"] if spectral else []) + [
-        c for c in out["time_series"] if not spectral or c not in (
-            "base_acceleration", "payload_acceleration")]
+    spectral = needs_estimates(definition)
+    channels = batch_channels(definition)
     sim = definition.simulation
     while members:
         try:
@@ -111,7 +108,7 @@ def _run_group(definition, excitation, duration, members, arrays, n_time, thread
                 result = simulate_batch(
                     [(iso, ctl) for _, iso, ctl in members], excitation, duration=duration,
                     dt=sim["dt"], sample_rate=definition.analysis["sample_rate"],
-                    solver=sim["solver"], channels=tuple(channels), workers=threads)
+                    solver=sim["solver"], channels=channels, workers=threads)
         except CaseError as error:
             i = members.pop(error.index)[0]
             arrays["status"][i], arrays["message"][i] = INVALID, error.reason

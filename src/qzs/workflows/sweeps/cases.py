@@ -13,7 +13,11 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 from qzs.workflows.sweeps.definition import case_excitation
 
-__all__ = ["case_settings", "case_duration", "build_model", "build_case", "check_cases"]
+__all__ = ["case_settings", "case_duration", "build_model", "build_case", "check_cases",
+           "needs_estimates", "batch_channels", "ESTIMATE_CHANNELS"]
+
+#: The channels a case's transmissibility estimate reads.
+ESTIMATE_CHANNELS = ("base_acceleration", "payload_acceleration")
 
 
 def case_settings(definition, columns):
@@ -157,3 +161,39 @@ def check_cases(definition, settings):
     if invalid:
         raise InvalidCasesError(invalid, len(settings))
 
+
+def needs_estimates(definition):
+    """Does the sweep keep anything of its cases' transmissibility estimates?
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+
+    Returns
+    -------
+    bool
+        True if it stores the transmissibility, the coherence, metrics or band values.
+    """
+    out = definition.outputs
+    return bool(out["transmissibility"] or out["coherence"] or out["metrics"] or out["bands"]
+                or out["rms_bands"])
+
+
+def batch_channels(definition):
+    """The channels a batch of the sweep keeps of its runs (every sample at the output rate).
+
+    Parameters
+    ----------
+    definition : SweepDefinition
+        The sweep.
+
+    Returns
+    -------
+    tuple of str
+        :data:`ESTIMATE_CHANNELS` if :func:`needs_estimates`, then the time series it
+        stores (each once).
+    """
+    estimates = ESTIMATE_CHANNELS if needs_estimates(definition) else ()
+    return estimates + tuple(c for c in definition.outputs["time_series"]
+                             if c not in estimates)

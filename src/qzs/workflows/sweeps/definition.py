@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from qzs._validation import integer, known_keys, positive_real, read_toml, real
+from qzs._validation import seed as checked_seed
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
@@ -183,7 +184,9 @@ def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
         document, where, stem = source, "sweep definition", "sweep"
     else:
         path = resolve_shipped(source, SHIPPED, "sweep", "sweeps")
-        document = read_toml(path, "sweep file")
+        document = read_toml(path, "sweep file", empty=(
+            "write the sweep's tables into it (`qzs docs sweeps` describes them; the shipped "
+            "sweeps are examples)"))
         where, stem = repr(str(path)), path.stem
     try:
         return _definition(document, where, stem)
@@ -215,7 +218,7 @@ def _definition(document, where, stem):
                              f"Latin hypercube), got {method!r}.")
     seed = head.get("seed")
     if seed is not None:
-        seed = integer("seed", seed, 0)
+        seed = checked_seed("seed", seed)
     batch_size = integer("batch_size", head.get("batch_size", 32), 1)
 
     excitation = dict(_keys(document.get("excitation", {}), "excitation",

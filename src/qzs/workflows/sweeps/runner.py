@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from qzs.iotools.paths import removed_on_error
 from qzs.workflows.sweeps.batch import run_local, run_on_dask
 from qzs.workflows.sweeps.cases import case_settings, check_cases
 from qzs.workflows.sweeps.cluster import dask_client
@@ -60,22 +61,26 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
     columns = sample_cases(definition)
     settings = case_settings(definition, columns)
     check_cases(definition, settings)
-    check_run_length(definition, settings, cases=min(definition.batch_size, len(settings)),
-                     threads=threads)  # before any probe or store
+    batch = min(definition.batch_size, len(settings))
+    check_run_length(definition, settings, cases=batch, threads=threads)  # before any probe
     if definition.simulation["dt"] is None:  # sized at the output period until dt is chosen
         check_store(definition, store, time_samples(definition, settings), argument="store",
                      resume=resume, overwrite=overwrite)
     report = {"cases": 0, "failed": 0, "steps": 0, "wall": 0.0}
     began = time.perf_counter()
     bar = results = None
-    with dask_client(scheduler, workers) as client:  # before any probe or store
+    with dask_client(scheduler, workers) as client, removed_on_error(store) as made:
         try:
-            definition, _ = choose_sweep_step(definition, settings)
+            if definition.simulation["dt"] is None:
+                definition, _ = choose_sweep_step(definition, settings)
+                check_run_length(definition, settings, cases=batch, threads=threads)
             n_time = time_samples(definition, settings)
             check_store(definition, store, n_time, argument="store", resume=resume,
                          overwrite=overwrite)
             done = prepare_store(store, definition, columns, n_time, resume=resume,
                                  overwrite=overwrite)
+            if done.any():
+                made.keep()
             size = definition.batch_size
             batches = [(a, min(a + size, definition.n_cases))
                        for a in range(0, definition.n_cases, size)
@@ -91,6 +96,7 @@ def execute(definition: SweepDefinition, store: str | Path, *, resume: bool = Fa
                                postfix={"failed": failed})
             for result in results:
                 write_batch(store, definition, result["start"], result["arrays"], n_time)
+                made.keep()
                 n = len(result["arrays"]["status"])
                 new_failures = int(np.count_nonzero(result["arrays"]["status"] > OK))
                 report["cases"] += n

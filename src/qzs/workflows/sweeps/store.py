@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 
 __all__ = ["STATUS", "PENDING", "OK", "INVALID", "FAILED", "ANALYSIS_FAILED", "COUNTS",
            "COUNT_FILL", "schema", "prepare_store", "write_batch", "open_store",
-           "estimated_bytes", "summary_text"]
+           "estimated_bytes", "store_exists", "summary_text"]
 
 #: Case status codes stored in ``status``.
 STATUS = {0: "pending", 1: "ok", 2: "invalid", 3: "failed", 4: "analysis_failed"}
@@ -231,9 +231,7 @@ def prepare_store(path, definition, columns, n_time, *, resume=False, overwrite=
         _create(path, definition, columns, n_time)
         return np.zeros(definition.n_cases, dtype=bool)
     if not resume:
-        raise ParameterError(f"the store {str(path)!r} exists; pass `resume` (--resume) to "
-                             "continue it, `overwrite` (--overwrite) to replace it, or choose "
-                             "another store.")
+        raise ParameterError(f"the store {str(path)!r} {store_exists('store')}.")
     try:
         dataset = open_store(path)
     except Exception as error:  # noqa: BLE001 - anything that is not a readable store
@@ -285,6 +283,27 @@ def _stored(values, dtype, fill):
     if np.dtype(dtype).kind in "iu" and values.dtype.kind == "f":
         values = np.rint(np.where(np.isfinite(values), values, fill))
     return values.astype(dtype, copy=False)
+
+
+def store_exists(argument):
+    """Why an existing store stops a run that neither resumes nor replaces it, with the
+    switches spelt as the caller of ``argument`` spells them
+    (:func:`qzs.iotools.paths.switch`): ``resume=True`` in Python, ``--resume`` on the
+    command line.
+
+    Parameters
+    ----------
+    argument : str
+        How the caller names the store (``"--out"``, ``"store"``).
+
+    Returns
+    -------
+    str
+    """
+    from qzs.iotools.paths import switch
+
+    return (f"exists; pass {switch(argument, 'resume')} to continue it, "
+            f"{switch(argument, 'overwrite')} to replace it, or choose another store")
 
 
 def estimated_bytes(definition, n_time):

@@ -8,13 +8,13 @@ from pathlib import Path
 
 from qzs.engine.prepare import steps_per_sample
 from qzs.errors import OutputPathError, ParameterError
-from qzs.iotools.paths import check_output_path
-from qzs.workflows.sweeps.cases import case_duration, case_settings
+from qzs.iotools.paths import check_output_path, switch
+from qzs.workflows.sweeps.cases import batch_channels, case_duration, case_settings
 from qzs.workflows.sweeps.definition import SweepDefinition, sample_cases
-from qzs.workflows.sweeps.store import estimated_bytes
+from qzs.workflows.sweeps.store import estimated_bytes, store_exists
 
 __all__ = ["check_store_path", "check_resume", "check_store", "check_run_length",
-           "time_samples", "STORE_SUFFIX"]
+           "time_samples", "STORE_SUFFIX", "BATCH_REMEDY"]
 
 #: The extension of a sweep store: a Zarr folder, not a NetCDF file (``--out store.nc``
 #: would make a folder named like a file of another format).
@@ -76,21 +76,33 @@ def check_store_path(definition: SweepDefinition, store: str | Path, *,
         ``resume``/``overwrite``, or ``resume`` names no store.
     ParameterError
         Both ``resume`` and ``overwrite``.
+    RunTooLongError, ResultTooLargeError
+        A case that would take absurdly long, a batch that would not fit in memory
+        (:func:`check_run_length`).
     """
     check_resume(store, argument, resume, overwrite)
     settings = case_settings(definition, sample_cases(definition))
-    check_run_length(definition, settings)
+    check_run_length(definition, settings, cases=min(definition.batch_size, len(settings)))
     check_store(definition, store, time_samples(definition, settings), argument=argument,
                  resume=resume, overwrite=overwrite)
 
 
 
-def check_run_length(definition, settings, *, cases=1, threads=None):
+#: What to do about a batch whose samples would not fit in memory, in a sweep file's words.
+BATCH_REMEDY = ("shorten the cases ([excitation] duration, [analysis] duration or n_averages), "
+                "lower [analysis] sample_rate, or run fewer cases at once ([sweep] batch_size)")
+
+
+def check_run_length(definition, settings, *, cases=1, threads=None, remedy=BATCH_REMEDY):
     """Refuse, before any probe or store, a sweep whose longest case alone would take
-    absurdly long (:func:`qzs.engine.driver.plan_run`'s limit).
+    absurdly long (:func:`qzs.engine.driver.plan_run`'s limit), or whose batch of ``cases``
+    such cases would keep more samples than the memory holds (what
+    :func:`qzs.engine.batch.simulate_batch` refuses when it runs, and ``qzs simulate``
+    before its run: :func:`qzs.engine.driver.check_memory`).
 
     Before the step is chosen (``dt`` None) the output period stands for it: the step is
-    never longer, so the count of steps is a lower bound and a refusal is certain.
+    never longer, so the count of steps is a lower bound and a refusal is certain. The
+    samples are counted at the output rate, whatever the step.
 
     Parameters
     ----------
@@ -102,14 +114,20 @@ def check_run_length(definition, settings, *, cases=1, threads=None):
         Cases stepped together (a batch's) [-].
     threads : int, optional
         Threads they are shared over [-]; default the machine's cores.
+    remedy : str
+        The memory message's advice (default in the words of a sweep file).
 
     Raises
     ------
     RunTooLongError
         Even one case would take more than a day at the kernel's best speed.
+    ResultTooLargeError
+        The batch's samples (:func:`qzs.workflows.sweeps.cases.batch_channels`) would take
+        more than half the memory available.
     """
     from qzs._validation import worker_count
-    from qzs.engine.driver import plan_run
+    from qzs.engine.channels import sample_bytes
+    from qzs.engine.driver import check_memory, plan_run
 
     dt = definition.simulation["dt"]
     if dt is None:
@@ -118,6 +136,10 @@ def check_run_length(definition, settings, *, cases=1, threads=None):
                    default=definition.analysis["duration"])
     plan_run(duration, dt, 1, kernel="lanes", cases=cases,
              workers=worker_count(threads, cases))
+    rate = definition.analysis["sample_rate"]
+    samples = int(round(duration * rate)) + 1
+    check_memory(cases * samples * sample_bytes(batch_channels(definition)), duration, rate,
+                 remedy)
 
 
 def check_resume(store, argument, resume, overwrite, work="the sweep"):
@@ -141,13 +163,13 @@ def check_resume(store, argument, resume, overwrite, work="the sweep"):
     OutputPathError
         ``resume`` of a store that does not exist.
     """
+    resume_switch, overwrite_switch = switch(argument, "resume"), switch(argument, "overwrite")
     if resume and overwrite:
-        raise ParameterError("`resume` (--resume) continues the store and `overwrite` "
-                             "(--overwrite) replaces it: give one of them, not both.")
+        raise ParameterError(f"{resume_switch} continues the store and {overwrite_switch} "
+                             "replaces it: give one of them, not both.")
     if resume and not Path(store).exists():
         raise OutputPathError(argument, store, "does not exist, so there is nothing to resume; "
-                              f"check the name, or leave out `resume` (--resume) to start "
-                              f"{work}")
+                              f"check the name, or leave out {resume_switch} to start {work}")
 
 
 
@@ -180,7 +202,6 @@ def check_store(definition, store, n_time, *, argument, resume, overwrite):
     check_output_path(store, argument=argument, suffixes=(STORE_SUFFIX,), directory=True,
                       estimated_bytes=size)
     if Path(store).exists() and not resume and not overwrite:
-        raise OutputPathError(argument, store, "exists; pass `resume` (--resume) to continue "
-                              "it, `overwrite` (--overwrite) to replace it, or choose another "
-                              "store")
+        raise OutputPathError(argument, store, store_exists(argument))
+
 

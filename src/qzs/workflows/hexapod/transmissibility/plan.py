@@ -157,6 +157,9 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                 raise ParameterError(f"`{name}` ({step!r} s) must not exceed `duration` "
                                      f"({duration!r} s).")
             steps_per_sample(sample_rate, step, "sample_rate")  # a whole number of steps
+    from qzs.engine.run_spec import check_length
+
+    check_length(duration, sample_rate, dt, kernel="hexapod")  # before any process starts
     n_samples = int(round(duration * sample_rate)) + 1
     if fft_length is None:
         fft_length = _default_fft_length(n_samples, defaults.ANALYSIS["quick_fft_length"])
