@@ -673,7 +673,32 @@ def kernel_families(args):
         Keys of :data:`qzs.engine.compiling.ENTRY_KERNELS`; empty for a command that runs
         no kernel.
     """
-    return KERNEL_FAMILIES.get(_command(args), ())
+    families = KERNEL_FAMILIES.get(_command(args), ())
+    if "single" in families and _has_blocks(args):  # its own kernel (lanes.run_single_blocks)
+        families = tuple("single_blocks" if f == "single" else f for f in families)
+    return families
+
+
+def _has_blocks(args):
+    """Whether the command's controller has blocks beyond PI + damping: a ``--set`` of a
+    block's parameter, or a block's table in ``--controller``'s or ``--config``'s file (read
+    only for that; a file that cannot be read says nothing here: its command refuses it)."""
+    import tomllib
+
+    from qzs.model.controller import BLOCKS
+
+    if any(str(pair).partition("=")[0].strip().partition(".")[0] in BLOCKS
+           for pair in getattr(args, "set", None) or ()):
+        return True
+    path = getattr(args, "controller", None) or getattr(args, "config", None)
+    if path:  # --controller replaces --config's controller
+        try:
+            with open(path, "rb") as handle:
+                table = tomllib.load(handle).get("controller", {})
+        except (OSError, ValueError):
+            return False
+        return isinstance(table, dict) and any(table.get(name) for name in BLOCKS)
+    return False
 
 
 def memory_hint(args):
