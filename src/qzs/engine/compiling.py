@@ -56,11 +56,13 @@ ENTRY_KERNELS = {
 #: figure. Their ratios hold on a busy machine (each kernel 4-6 times slower at a load of 6
 #: on 2 cores); the notice multiplies them by :func:`slowdown`. Checked cold on 2026-11-28 at
 #: a load of 6 on 2 cores: ``qzs simulate`` said about 50 s and compiled for 45 s,
-#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s.
+#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s. ``run_single_blocks``:
+#: ``run_single``'s times the ratio of their compile CPU seconds, each compiled alone with the
+#: rest cached (59.8 s against 48.6 s at a load of 9 on 2 cores, 2026-11-29).
 COMPILE_SECONDS = {
     "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
     "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
-    "qzs.engine.lanes.run_single_blocks": 14.0,
+    "qzs.engine.lanes.run_single_blocks": 11.7,
     "qzs.engine.lanes.run_lanes": 30.0,
     "qzs.engine.hexapod.dynamics._rest_frame": 0.2, "qzs.engine.hexapod.dynamics._evaluate": 9.0,
     "qzs.engine.hexapod.stepping._start": 4.0, "qzs.engine.hexapod.stepping._run": 6.0,
