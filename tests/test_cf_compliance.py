@@ -173,8 +173,42 @@ def hexapod_transmissibility(folder):
     return result.save(folder / "hexapod_transmissibility.nc")
 
 
+def _blocks_controller():
+    import qzs
+
+    return (qzs.PIDamping() + qzs.FrictionCompensation(fraction=0.8, viscous_damping=None)
+            + qzs.Dither(amplitude=0.5) + qzs.LinearController.from_transfer_function(
+                [20.0, -18.0], [1.0, -0.5], ("measured_payload_velocity",), sample_time=1e-3,
+                name="lead lag"))
+
+
+def run_with_blocks(folder):
+    """A run of a controller with every block: its parameters (a linear controller's
+    matrices, sensors, None levels) and the blocks' channels."""
+    import qzs
+
+    return qzs.simulate(qzs.Sine(amplitude=0.002, frequency=3.0), controller=_blocks_controller(),
+                        duration=0.2, dt=1e-4, sample_rate=200.0).save(folder / "blocks.nc")
+
+
+def batch_with_blocks(folder):
+    """A batch over ``compensation.fraction``: a dotted coordinate."""
+    import qzs
+    from qzs.iotools.writer import write_dataset
+
+    cases = [(qzs.IsolatorParameters(), qzs.PIDamping() + qzs.FrictionCompensation(fraction=f))
+             for f in (0.0, 1.2)]
+    result = qzs.simulate_batch(cases, qzs.Sine(amplitude=0.002, frequency=3.0), duration=0.2,
+                                sample_rate=200.0,
+                                channels=("relative_position", "motor_force", "locked"),
+                                workers=1)
+    return write_dataset(result.to_xarray(), folder / "batch_blocks.nc")
+
+
 #: Every kind of NetCDF file qzs writes: name -> writer of one small file into a folder.
-KINDS = {"single_run": single_run, "streamed_run": streamed_run, "batch": batch,
+KINDS = {"single_run": single_run, "run_with_blocks": run_with_blocks,
+         "batch_with_blocks": batch_with_blocks,
+         "streamed_run": streamed_run, "batch": batch,
          "sweep": sweep, "hexapod_run": hexapod_run, "response": response,
          "experiment": experiment, "curves": curves, "optimisation": optimisation,
          "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility}

@@ -59,6 +59,7 @@ _LAZY = {
     "fit_transmissibility": "qzs.identify",
     "read_recording": "qzs.iotools", "load_channel_map": "qzs.iotools",
     "load_config": "qzs.iotools", "read_result": "qzs.engine.result_file",
+    "read_controller": "qzs.engine.result_file",
     "run_sweep": "qzs.workflows.sweeps", "open_sweep": "qzs.workflows.sweeps",
     "simulate_to_file": "qzs.workflows.run",
     "simulate_hexapod": "qzs.engine.hexapod.simulate",
@@ -88,7 +89,7 @@ if TYPE_CHECKING:  # what type checkers see of the lazy names (kept in step by t
     from qzs.engine.hexapod.result import HexapodResult
     from qzs.engine.hexapod.simulate import simulate_hexapod, simulate_hexapods
     from qzs.engine.result import SimulationResult
-    from qzs.engine.result_file import read_result
+    from qzs.engine.result_file import read_controller, read_result
     from qzs.engine.run_spec import ResolvedRun, resolve
     from qzs.engine.simulate import simulate
     from qzs.engine.stability import SOLVERS, largest_stable_step

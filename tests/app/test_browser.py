@@ -75,6 +75,21 @@ def test_slider_release_redraws_the_transmissibility(page):
     assert len(browser.source_data(page, "locked")["share"]) == 2
 
 
+def test_the_compensation_fraction_redraws_and_goes_back_to_none(page):
+    """The compensation slider (0-1.5, 0 none) changes the transmissibility; back at 0 the
+    page draws the run without compensation again."""
+    before = browser.source_data(page, "transmissibility")
+    field = page.locator(f".{browser_class('compensation.fraction')} input").first
+    assert float(field.input_value()) == 0.0
+    browser.type_value(page, "compensation.fraction", "1.2")
+    browser.wait_until_changed(page, before["y"])
+    compensated = browser.source_data(page, "transmissibility")
+    assert compensated["y"] != before["y"] and float(field.input_value()) == 1.2
+    browser.type_value(page, "compensation.fraction", "0")
+    browser.wait_until_changed(page, compensated["y"])
+    assert browser.source_data(page, "transmissibility")["y"] == pytest.approx(before["y"])
+
+
 def test_invalid_value_shows_the_message(page):
     browser.type_value(page, "coulomb_force", "20")
     message = page.get_by_text("must be >=").first

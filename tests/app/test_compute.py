@@ -179,8 +179,12 @@ def test_page_values_round_trip():
     values = page_values()
     assert page_request(values) == page_request()
     for name in compute.MODEL_PARAMETERS:
-        assert values[name] == PARAMETERS[name].default  # the registry's defaults
-    changed = page_request({**values, "stiction_force": 5.0, "excitation.kind": "stepped"})
+        if name != compute.COMPENSATION:
+            assert values[name] == PARAMETERS[name].default  # the registry's defaults
+    assert values[compute.COMPENSATION] == 0.0  # none: no block
+    changed = page_request({**values, "stiction_force": 5.0, "excitation.kind": "stepped",
+                            compute.COMPENSATION: 0.6})
+    assert changed.controller.compensation.fraction == 0.6
     assert page_request(page_values(changed)) == changed
 
 

@@ -15,7 +15,7 @@ pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app
 from qzs.app import page as page_module  # noqa: E402
 from qzs.app.compute import MODEL_PARAMETERS, page_request, page_values  # noqa: E402
 from qzs.iotools.config import load_config  # noqa: E402
-from qzs.model.registry import PARAMETERS  # noqa: E402
+from qzs.model.registry import ALL_PARAMETERS  # noqa: E402
 
 
 class NowExecutor:
@@ -65,7 +65,7 @@ def test_the_page_draws_the_default_request(page):
 
 def test_every_label_carries_the_registry_unit(page):
     for name in MODEL_PARAMETERS:
-        info = PARAMETERS[name]
+        info = ALL_PARAMETERS[name]
         assert label(page.widgets[name]) == f"{info.doc} [{info.unit}]"
     for name, widget in page.widgets.items():
         if name != "excitation.kind":
@@ -83,6 +83,33 @@ def test_a_changed_value_redraws(page):
     after = np.array(page.sources["transmissibility"].data["y"])
     assert before.shape != after.shape or not np.array_equal(before, after)
     page.reset()
+
+
+def test_the_compensation_slider_adds_friction_compensation(page, tmp_path):
+    """0 (its default) is no block; a fraction adds FrictionCompensation with it, and the
+    motor then cancels that share of the sliding friction: the time-response sine sticks
+    for less of its time; beyond 1.5 the API's message; the TOML download carries it."""
+    import qzs
+
+    page.reset()
+    widget = page.widgets["compensation.fraction"]
+    assert (widget.start, widget.end, widget.value) == (0.0, 1.5, 0.0)
+    assert page.data.request.controller.compensation is None
+    assert page.data.request == page_request()
+    locked = page.data.locked_share["sine"]
+    set_value(page, "compensation.fraction", 1.0)
+    assert page.data.request.controller == qzs.PIDamping() + qzs.FrictionCompensation(
+        fraction=1.0)
+    assert page.data.locked_share["sine"] < locked
+    path = tmp_path / "page.toml"
+    path.write_text(page._toml_file().getvalue(), encoding="utf-8")
+    assert load_config(path)["controller"] == page.data.request.controller
+    drawn = page.data
+    assert set_value(page, "compensation.fraction", 1.6) is None  # typed past the slider
+    assert page.alert.visible and "`compensation.fraction`" in page.alert.object
+    assert "[0, 1.5]" in page.alert.object and page.data is drawn
+    page.reset()
+    assert page.data.request.controller.compensation is None and not page.alert.visible
 
 
 def test_an_invalid_value_shows_the_api_message_and_keeps_the_plot(page):

@@ -319,3 +319,26 @@ def test_a_default_output_without_a_policy_is_a_programming_error():
     with pytest.raises(ValueError, match="unnamed"):
         add_output_options(argparse.ArgumentParser(),
                            out=dict(metavar="DIR", default="results", help="folder"))
+
+
+@pytest.mark.parametrize("argv, families", [
+    (["simulate"], ("single",)),
+    (["simulate", "--set", "compensation.fraction=0.8"], ("single_blocks",)),
+    (["simulate", "--set", "pi_kp=80", "--set", "dither.amplitude=2"], ("single_blocks",)),
+    (["simulate", "--controller", "{blocks}"], ("single_blocks",)),
+    (["simulate", "--config", "{blocks}"], ("single_blocks",)),
+    (["simulate", "--config", "{blocks}", "--controller", "{plain}"], ("single",)),
+    (["simulate", "--controller", "{missing}"], ("single",)),
+    (["sweep", "x.toml"], ("single", "batch")),
+])
+def test_a_controller_with_blocks_names_the_blocks_kernel(tmp_path, argv, families):
+    """The compile notice's estimate counts the kernel the run will compile: a controller
+    with blocks runs ``lanes.run_single_blocks``, not ``run_single``."""
+    from qzs.cli import build_parser
+    from qzs.cli.common import kernel_families
+
+    (tmp_path / "blocks.toml").write_text("[controller.linear]\nnum = [1.0]\nden = [1.0, 2.0]\n")
+    (tmp_path / "plain.toml").write_text("[controller]\npi_kp = 60\n")
+    paths = {key: str(tmp_path / f"{key}.toml") for key in ("blocks", "plain", "missing")}
+    args = build_parser().parse_args([a.format(**paths) for a in argv])
+    assert kernel_families(args) == families

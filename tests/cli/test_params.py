@@ -36,3 +36,27 @@ def test_params_toml_without_a_file_prints_the_config_to_stdout(tmp_path, capsys
     assert sorted(p.name for p in tmp_path.iterdir()) == ["my.toml"]  # nothing else written
     assert main(["params", "--toml", "-"]) == 0  # "-": stdout too
     assert capsys.readouterr().out == config_text()
+
+
+def test_params_toml_round_trips_a_controller_with_blocks(tmp_path, capsys):
+    """`--set compensation.fraction=...` adds the block; `--toml` writes the blocks' tables;
+    `--controller` reads them back; the table shows the blocks' dotted names."""
+    import qzs
+    from qzs.iotools import load_config
+
+    path = tmp_path / "p.toml"
+    assert main(["params", "--toml", str(path), "--set", "compensation.fraction=0.8",
+                 "--set", "dither.frequency=40", "--set", "pi_kp=70"]) == 0
+    expected = (qzs.PIDamping(pi_kp=70.0) + qzs.FrictionCompensation(fraction=0.8)
+                + qzs.Dither(frequency=40.0))
+    assert load_config(path)["controller"] == expected
+    controller = tmp_path / "c.toml"
+    text = path.read_text()
+    controller.write_text(text[text.index("[controller]"):])
+    capsys.readouterr()
+    assert main(["params", "--controller", str(controller),
+                 "--set", "compensation.deadband=0.002"]) == 0
+    rows = {line.split()[1]: line.split()[2] for line in capsys.readouterr().out.splitlines()[1:]}
+    assert rows["compensation.fraction"] == "0.8" and rows["compensation.deadband"] == "0.002"
+    assert rows["dither.frequency"] == "40" and rows["pi_kp"] == "70"
+    assert rows["linear.tracking_time"] == "no"  # "no block"

@@ -418,3 +418,45 @@ def test_running_twice_replaces_the_default_figure_and_refuses_a_named_one(tmp_p
     assert main([*run, "--plot", "qzs-simulation.png"]) == 2
     assert "--plot 'qzs-simulation.png' exists; pass --overwrite" in capsys.readouterr().err
     assert main([*run, "--plot", "qzs-simulation.png", "--overwrite"]) == 0
+
+
+def test_a_controller_file_runs_as_its_controller_does_in_the_api(tmp_path):
+    """`qzs simulate --controller FILE.toml` is `qzs.simulate(controller=...)` of that file's
+    controller, sample for sample (a compensation, a discrete lead on the velocity)."""
+    import qzs
+
+    path = tmp_path / "c.toml"
+    path.write_text("[controller]\npi_kp = 70\n[controller.compensation]\nfraction = 0.7\n"
+                    "[controller.linear]\nnum = [20.0, -18.0]\nden = [1.0, -0.5]\n"
+                    "sample_time = 0.001\n")
+    out = tmp_path / "run.nc"
+    assert main(["simulate", "--controller", str(path), "--excitation", "sine", "--frequency",
+                 "3", "--duration", "2", "--dt", "1e-4", "--sample-rate", "100", "--out",
+                 str(out), "--plot", "none", "--quiet"]) == 0
+    controller = (qzs.PIDamping(pi_kp=70.0) + qzs.FrictionCompensation(fraction=0.7)
+                  + qzs.LinearController.from_transfer_function(
+                      [20.0, -18.0], [1.0, -0.5], sample_time=1e-3))
+    api = simulate(Sine(frequency=3.0), controller=controller, duration=2.0,
+                   sample_rate=100.0, dt=1e-4)
+    data = read_result(out)
+    for name in ("relative_position", "motor_force", "compensation_force", "linear_force"):
+        np.testing.assert_array_equal(data[name].values, api[name])
+    assert np.ptp(api["linear_force"]) > 0 and np.ptp(api["compensation_force"]) > 0
+
+
+@pytest.mark.parametrize("body, named", [
+    ("[controller.linear]\nnum = [1.0, 0.0]\nden = [1.0]\n", "[controller.linear] num"),
+    ("[controller.compensation]\nfraction = -0.1\n", "[controller.compensation] fraction"),
+    ("[controller.linear]\nnum = [1.0]\nden = [1.0, 0.5]\nsample_time = 0.00025\n",
+     "[controller.linear] sample_time"),
+])
+def test_a_bad_controller_file_exits_2_before_any_work(tmp_path, capsys, body, named):
+    path = tmp_path / "c.toml"
+    path.write_text("[controller]\n" + body)
+    out, plot = tmp_path / "run.nc", tmp_path / "run.png"
+    assert main(["simulate", "--controller", str(path), "--excitation", "sine", "--frequency",
+                 "3", "--duration", "1", "--dt", "1e-4", "--out", str(out), "--plot",
+                 str(plot), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert named in err and str(path) in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.toml"]

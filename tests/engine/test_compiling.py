@@ -256,3 +256,16 @@ def test_the_rest_is_estimated_from_compile_time_alone_not_the_run_between(monke
 class SimpleEvent:
     def __init__(self, data):
         self.data = data
+
+
+def test_on_an_empty_cache_the_blocks_kernel_is_cold_and_counted_once(tmp_path):
+    """A first run of a controller with blocks compiles ``run_single_blocks`` (not
+    ``run_single``): its family's estimate is its kernels', each counted once."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=str(SOURCE))
+    probe = ("from qzs.engine.compiling import cold_kernels\n"
+             "print(*cold_kernels(['single_blocks', 'single']), sep='\\n')")
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                         text=True, check=True, timeout=120)
+    assert out.stdout.split() == [*ENTRY_KERNELS["single_blocks"], "qzs.engine.lanes.run_single"]
+    assert "qzs.engine.lanes.run_single" not in ENTRY_KERNELS["single_blocks"]
+    assert estimate(ENTRY_KERNELS["single_blocks"]) >= estimate(ENTRY_KERNELS["single"])

@@ -15,7 +15,7 @@ def test_every_parameter_has_a_unit_a_doc_and_its_default():
         assert info.unit and info.doc, name
         cls = SECTIONS[info.section]
         assert getattr(cls(), name) == info.default, name
-    assert [row[1] for row in parameter_table()] == list(PARAMETERS)
+    assert [row[1] for row in parameter_table()][:len(PARAMETERS)] == list(PARAMETERS)
     assert unit_of("pi_kp") == "N/m" and unit_of("stribeck_decay") == "s/m"
     assert "stop_center" not in numeric_parameters() and "stop_model" not in numeric_parameters()
     assert "stiction_force" in numeric_parameters()
@@ -56,3 +56,82 @@ def test_update_parameters_places_each_name_in_its_section():
         update_parameters(qzs.IsolatorParameters(), qzs.ControllerParameters(), {"masss": 1})
     with pytest.raises(ParameterError, match="unknown parameter 'excitation.f_low'"):
         parameter_info("excitation.f_low")
+
+
+def test_every_scalar_of_a_block_is_a_dotted_parameter_from_its_field():
+    from qzs.model.controller import BLOCK_CLASSES
+    from qzs.model.registry import ALL_PARAMETERS, BLOCK_PARAMETERS
+
+    expected = {"compensation.fraction", "compensation.deadband",
+                "compensation.observer_bandwidth", "compensation.stiction_force",
+                "compensation.coulomb_force", "compensation.stribeck_decay",
+                "compensation.viscous_damping", "dither.amplitude", "dither.frequency",
+                "linear.tracking_time", "linear.sample_time"}
+    assert set(BLOCK_PARAMETERS) == expected  # no matrices, inputs or name
+    for name, info in BLOCK_PARAMETERS.items():
+        block, field = name.split(".")
+        declared = {f.name: f for f in dataclasses.fields(BLOCK_CLASSES[block])}[field]
+        assert (info.unit, info.doc, info.default) == (
+            declared.metadata["unit"], declared.metadata["doc"], declared.default), name
+        assert info.section == "controller" and info.numeric, name
+        assert ALL_PARAMETERS[name] is info and parameter_info(name) is info
+    assert unit_of("compensation.observer_bandwidth") == "Hz"
+    assert unit_of("linear.tracking_time") == "s" and unit_of("dither.amplitude") == "N"
+    assert "compensation.fraction" not in PARAMETERS  # the C model's parameters stay as they are
+    assert list(ALL_PARAMETERS)[:len(PARAMETERS)] == list(PARAMETERS)
+
+
+def test_a_block_parameter_adds_its_block_with_its_defaults_or_changes_it():
+    isolator = qzs.IsolatorParameters()
+    _, controller = update_parameters(isolator, qzs.PIDamping(pi_kp=80.0),
+                                      {"compensation.fraction": "0.8", "dither.frequency": 30})
+    assert controller.compensation == qzs.FrictionCompensation(fraction=0.8)
+    assert controller.dither == qzs.Dither(frequency=30.0)
+    assert controller.pi_kp == 80.0 and controller.linear is None
+    _, changed = update_parameters(isolator, controller, {"compensation.deadband": 1e-3,
+                                                          "compensation.stiction_force": "none"})
+    assert changed.compensation == qzs.FrictionCompensation(fraction=0.8, deadband=1e-3)
+    linear = qzs.LinearController.from_transfer_function([2.0], [1.0, 5.0])
+    _, changed = update_parameters(isolator, qzs.PIDamping() + linear,
+                                   {"linear.tracking_time": 0.3})
+    assert changed.linear.tracking_time == 0.3 and changed.linear.a == linear.a
+
+
+@pytest.mark.parametrize("settings, names, message", [
+    ({"compensation.fraction": 2.0}, ("compensation.fraction",), "must lie in [0, 1.5]"),
+    ({"compensation.coulomb_force": 12.0, "compensation.stiction_force": 5.0},
+     ("compensation.coulomb_force", "compensation.stiction_force"), "must not exceed"),
+    ({"dither.frequency": 0.0}, ("dither.frequency",), "must be positive"),
+    ({"linear.tracking_time": 0.2}, ("linear.tracking_time",), "[controller.linear]"),
+    ({"compensation.fractio": 1.0}, (), "valid names are: "),
+])
+def test_a_bad_block_parameter_is_named_as_it_was_given(settings, names, message):
+    with pytest.raises(ParameterError) as error:
+        update_parameters(qzs.IsolatorParameters(), qzs.PIDamping(), settings)
+    assert message in str(error.value)
+    assert error.value.options == names
+    for name in names:
+        assert f"`{name}`" in str(error.value)
+
+
+def test_the_table_shows_a_block_s_parameters_or_that_there_is_no_block():
+    from qzs.model.registry import ALL_PARAMETERS, NO_BLOCK
+
+    rows = {row[1]: row for row in parameter_table(
+        controller=qzs.PIDamping() + qzs.Dither(amplitude=2.0))}
+    assert list(rows) == list(ALL_PARAMETERS)
+    assert rows["dither.amplitude"][2:4] == (2.0, "N")
+    assert rows["compensation.fraction"][2] == NO_BLOCK and rows["linear.sample_time"][2] == NO_BLOCK
+
+
+def test_toml_dotted_keys_are_the_dotted_names():
+    import tomllib
+
+    from qzs.model.registry import dotted_names
+
+    document = tomllib.loads('compensation.fraction = 0.8\n"dither.amplitude" = 2.0\n'
+                             'excitation.f0 = [1, 2]\npi_kp = { start = 1, stop = 2, num = 2 }\n')
+    assert dotted_names(document) == {"compensation.fraction": 0.8, "dither.amplitude": 2.0,
+                                      "excitation.f0": [1, 2],
+                                      "pi_kp": {"start": 1, "stop": 2, "num": 2}}
+    assert dotted_names([1]) == [1]

@@ -32,17 +32,21 @@ from qzs.errors import ParameterError, SizeLimitError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
 from qzs.model.isolator import IsolatorParameters
-from qzs.model.registry import PARAMETERS, parameter_info, update_parameters
+from qzs.model.registry import (ALL_PARAMETERS, parameter_info, parameter_value,
+                                update_parameters)
 
 __all__ = ["PageRequest", "PageData", "SizeLimitError", "page_request", "compute_page",
            "config_text", "resolve_page_run", "page_values", "LIMITS", "PAGE_DEFAULTS",
-           "MODEL_PARAMETERS", "EXCITATION_KINDS", "SAMPLE_RATES", "CONTROLLER_RATES",
+           "MODEL_PARAMETERS", "COMPENSATION", "EXCITATION_KINDS", "SAMPLE_RATES", "CONTROLLER_RATES",
            "MAX_STEPS", "TRACE_POINTS"]
 
 #: The model parameters the page sets (registry names), in the order of its panels.
 MODEL_PARAMETERS = ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping",
                     "mass", "spring_force", "spring_shape", "pi_kp", "pi_ki", "damping_gain",
-                    "velocity_highpass", "controller_rate")
+                    "velocity_highpass", "controller_rate", "compensation.fraction")
+#: The page's friction compensation: a fraction of the friction law [0, 1.5]; 0 (its
+#: default) is no :class:`~qzs.model.controller.FrictionCompensation` block.
+COMPENSATION = "compensation.fraction"
 #: The page's excitations: a chirp estimated by Welch, or a stepped sine (steady state).
 EXCITATION_KINDS = ("chirp", "stepped")
 #: Output rates the page offers [Hz] (each a whole fraction of the paper's 1e4 Hz step rate).
@@ -223,8 +227,8 @@ def page_values(request=None):
         Every key :func:`page_request` takes.
     """
     request = request or page_request()
-    values = {name: getattr(request.isolator if PARAMETERS[name].section == "isolator"
-                            else request.controller, name) for name in MODEL_PARAMETERS}
+    values = {name: parameter_value(request.isolator, request.controller, name, 0.0)
+              for name in MODEL_PARAMETERS}
     values.update({"excitation.kind": request.excitation,
                    "excitation.amplitude": request.amplitude,
                    "excitation.f0": request.band[0], "excitation.f1": request.band[1],
@@ -249,7 +253,8 @@ def page_request(values=None):
     ----------
     values : dict, optional
         Registry names of model parameters (``stiction_force`` [N], ``pi_kp`` [N/m], ...;
-        see ``qzs params``) and the page's own settings: ``excitation.kind`` (``chirp`` or
+        see ``qzs params``; ``compensation.fraction`` [-] adds a friction compensation,
+        0 none) and the page's own settings: ``excitation.kind`` (``chirp`` or
         ``stepped``), ``excitation.amplitude`` [m], ``excitation.f0``, ``excitation.f1``
         [Hz], ``excitation.duration`` [s], ``frequency_count``, ``sine.frequency`` [Hz],
         ``sine.duration`` [s], ``sample_rate`` [Hz]. Missing ones take the paper's
@@ -267,7 +272,9 @@ def page_request(values=None):
         :class:`SizeLimitError`.
     """
     values = dict(values or {})
-    model = {name: values.pop(name) for name in list(values) if name in PARAMETERS}
+    model = {name: values.pop(name) for name in list(values) if name in ALL_PARAMETERS}
+    if not isinstance(model.get(COMPENSATION), str) and model.get(COMPENSATION) == 0:
+        del model[COMPENSATION]  # no compensation: no block (the kernels of PI + damping)
     isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
                                              model)
     band = (values.pop("excitation.f0", parameter_info("excitation.f0", "chirp").default),

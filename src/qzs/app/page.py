@@ -29,7 +29,7 @@ from qzs.app.figure import PIN_COLORS, describe_request, figure_png
 from qzs.app.platform import PLATFORM_PARAMETERS, compute_platform
 from qzs.app.updates import LatestOnly
 from qzs.errors import DataError, ParameterError, SimulationError
-from qzs.model.registry import PARAMETERS, parameter_info
+from qzs.model.registry import ALL_PARAMETERS, PARAMETERS, parameter_info
 from qzs.viz.figures import frequency_limits
 
 __all__ = ["TuningPage", "PlatformTab", "build_page", "css_class", "SLIDERS", "SOURCE_NAMES",
@@ -62,6 +62,7 @@ SLIDERS = {
     "pi_ki": (0.0, 200.0, 1.0),
     "damping_gain": (0.0, 500.0, 5.0),
     "velocity_highpass": (0.0, 10.0, 0.1),
+    "compensation.fraction": (0.0, 1.5, 0.05),
     "excitation.amplitude": (0.0, 50.0, 0.5),
     "excitation.duration": (*LIMITS["excitation.duration"][:2], 10.0),
     "band": (0.0, LIMITS["excitation.f1"][1], 0.1),
@@ -82,15 +83,15 @@ _GROUPS = (("Friction", ("stiction_force", "coulomb_force", "stribeck_decay",
                          "viscous_damping")),
            ("Payload and spring", ("mass", "spring_force", "spring_shape")),
            ("Controller", ("pi_kp", "pi_ki", "damping_gain", "velocity_highpass",
-                           "controller_rate")))
+                           "controller_rate", "compensation.fraction")))
 _MM = 1e3
 _WIDGET_WIDTH = 330
 _EXPECTED = (ParameterError, SimulationError, DataError)
 
 
 def _label(name):
-    if name in PARAMETERS:
-        info = PARAMETERS[name]
+    if name in ALL_PARAMETERS:
+        info = ALL_PARAMETERS[name]
         return f"{info.doc} [{info.unit}]"
     labels = {
         "excitation.amplitude": f"base displacement amplitude "

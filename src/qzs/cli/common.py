@@ -30,12 +30,12 @@ from qzs.defaults import FIGURES, FREQUENCY_SCALES
 from qzs.engine.progress import show_warning
 from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
                         ParameterError, SimulationError, Terminated, WriteError)
-from qzs.iotools.config import load_config
+from qzs.iotools.config import load_config, load_controller
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
-__all__ = ["settings", "parameters", "add_set_option", "add_json_option",
+__all__ = ["settings", "parameters", "add_set_option", "add_controller_option", "add_json_option",
            "add_execution_options", "add_output_options", "figure_path", "check_output",
            "OUTPUT_OPTIONS", "NO_FIGURE", "UNNAMED", "NamedOutput", "named", "output_name",
            "stopped",
@@ -107,6 +107,22 @@ def add_set_option(parser):
     """
     parser.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
                         help="override a parameter by its name (see `qzs params`; repeatable)")
+
+
+def add_controller_option(parser):
+    """Add ``--controller FILE.toml`` to ``parser``: a controller file
+    (:func:`qzs.iotools.config.load_controller`) that replaces ``--config``'s controller;
+    ``--set`` applies after it.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    parser.add_argument("--controller", metavar="FILE.toml",
+                        help="controller file: a [controller] table with its blocks' tables "
+                             "([controller.compensation], [controller.dither], "
+                             "[controller.linear]); replaces --config's controller")
 
 
 def add_json_option(parser, help_text=None):
@@ -469,7 +485,8 @@ def settings(pairs):
 
 
 def parameters(args):
-    """The run configuration of ``--config`` (or the defaults) with ``--set`` applied.
+    """The run configuration of ``--config`` (or the defaults), its controller replaced by
+    ``--controller``'s file where given, with ``--set`` applied.
 
     Parameters
     ----------
@@ -486,6 +503,8 @@ def parameters(args):
               "excitation": {}, "simulation": {}}
     if getattr(args, "config", None):
         config = load_config(args.config)
+    if getattr(args, "controller", None):
+        config["controller"] = load_controller(args.controller)
     config["isolator"], config["controller"] = update_parameters(
         config["isolator"], config["controller"], settings(args.set))
     return config
@@ -654,7 +673,32 @@ def kernel_families(args):
         Keys of :data:`qzs.engine.compiling.ENTRY_KERNELS`; empty for a command that runs
         no kernel.
     """
-    return KERNEL_FAMILIES.get(_command(args), ())
+    families = KERNEL_FAMILIES.get(_command(args), ())
+    if "single" in families and _has_blocks(args):  # its own kernel (lanes.run_single_blocks)
+        families = tuple("single_blocks" if f == "single" else f for f in families)
+    return families
+
+
+def _has_blocks(args):
+    """Whether the command's controller has blocks beyond PI + damping: a ``--set`` of a
+    block's parameter, or a block's table in ``--controller``'s or ``--config``'s file (read
+    only for that; a file that cannot be read says nothing here: its command refuses it)."""
+    import tomllib
+
+    from qzs.model.controller import BLOCKS
+
+    if any(str(pair).partition("=")[0].strip().partition(".")[0] in BLOCKS
+           for pair in getattr(args, "set", None) or ()):
+        return True
+    path = getattr(args, "controller", None) or getattr(args, "config", None)
+    if path:  # --controller replaces --config's controller
+        try:
+            with open(path, "rb") as handle:
+                table = tomllib.load(handle).get("controller", {})
+        except (OSError, ValueError):
+            return False
+        return isinstance(table, dict) and any(table.get(name) for name in BLOCKS)
+    return False
 
 
 def memory_hint(args):

@@ -1,5 +1,6 @@
 """``qzs params``: every parameter with its default (or configured) value and unit."""
-from qzs.cli.common import EPILOG, NamedOutput, add_set_option, check_output, parameters
+from qzs.cli.common import (EPILOG, NamedOutput, add_controller_option, add_set_option,
+                             check_output, parameters)
 from qzs.iotools.config import config_text, save_config
 from qzs.model.registry import format_value, parameter_table
 
@@ -31,6 +32,7 @@ def add_parser(subparsers):
     params.add_argument("--overwrite", "--force", dest="overwrite", action="store_true",
                         help="let --toml replace an existing file (--force: the old name)")
     params.add_argument("--config", metavar="FILE.toml", help="show the values of a config file")
+    add_controller_option(params)
     add_set_option(params)
     return params
 

@@ -5,8 +5,8 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 ``--excitation-duration``. An option the chosen excitation does not use is an error.
 """
 from qzs.analysis.summary import summary_record
-from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
-                             figure_path, parameters)
+from qzs.cli.common import (EPILOG, add_controller_option, add_output_options, add_set_option,
+                             check_output, emit, figure_path, parameters)
 from qzs.defaults import ACCURACY, EXCITATION, SIMULATION
 from qzs.errors import ParameterError
 from qzs.iotools.files import RESULT_SUFFIXES
@@ -49,6 +49,7 @@ def add_parser(subparsers):
         epilog=EPILOG)
     sim.add_argument("--config", metavar="FILE.toml",
                      help="run configuration (see `qzs params --toml`)")
+    add_controller_option(sim)
     add_set_option(sim)
     sim.add_argument("--excitation", choices=tuple(EXCITATION_KINDS),
                      help="base excitation (default chirp)")
@@ -141,7 +142,8 @@ def _spelling(args, settings, table):
             "sample_rate": origin("sample_rate", "--sample-rate"),
             "dt": origin("dt", "--dt"), "solver": origin("solver", "--solver"),
             "tolerance": "--tolerance", "tolerance_state": "--tolerance-state",
-            "frequency": "--frequency", "f1": "--f1", "f_high": "--f1"}
+            "frequency": "--frequency", "f1": "--f1", "f_high": "--f1",
+            "sample_time": f"[controller.linear] sample_time of {args.controller or args.config}"}
 
 
 def run(args):

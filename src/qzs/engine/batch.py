@@ -29,7 +29,8 @@ from qzs.engine.channels import CHANNELS, FLAGS, sample_bytes, simulation_schema
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
-from qzs.model.registry import PARAMETERS
+from qzs.model.controller import BLOCKS
+from qzs.model.registry import ALL_PARAMETERS, BLOCK_PARAMETERS, parameter_value
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -139,11 +140,14 @@ class BatchResult:
 
 def _parameter_values(cases, n):
     """Every registry parameter's value in each case: name -> list (none if ``cases`` is not
-    one pair per case)."""
+    one pair per case); a block's parameters where a case has that block (None in the
+    others)."""
     if len(cases) != n:
         return {}
-    return {name: [getattr(pair[0] if info.section == "isolator" else pair[1], name)
-                   for pair in cases] for name, info in PARAMETERS.items()}
+    blocks = {name for pair in cases for name in BLOCKS if getattr(pair[1], name) is not None}
+    return {name: [parameter_value(*pair, name) for pair in cases]
+            for name in ALL_PARAMETERS if name not in BLOCK_PARAMETERS
+            or name.split(".", 1)[0] in blocks}
 
 
 def batch_schema(batch):
@@ -179,12 +183,14 @@ def batch_schema(batch):
     coordinates = [Variable(name="case", dims=("case",), units="1", long_name="case index",
                             dtype="int64", order=("long_name", "units")), single["time"]]
     for name, column in _parameter_values(batch.cases, n).items():
-        info = PARAMETERS[name]
+        info = ALL_PARAMETERS[name]
         text = all(isinstance(v, str) for v in column)
+        none = ("NaN: no such block in the case, or the plant's value" if name in
+                BLOCK_PARAMETERS else "NaN: none")
         coordinates.append(Variable(
             name=name, dims=("case",), units=info.unit, long_name=info.doc,
             dtype="str" if text else "float64",
-            attributes=({"comment": "NaN: none"} if not text and any(v is None for v in column)
+            attributes=({"comment": none} if not text and any(v is None for v in column)
                         else {})))
     return Schema(kind="a batch", dimensions={"case": n, "time": len(batch.time)},
                   coordinates=coordinates, variables=variables)

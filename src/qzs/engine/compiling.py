@@ -36,10 +36,14 @@ __all__ = ["ENTRY_KERNELS", "COMPILE_SECONDS", "NOTICE", "cold_kernels", "estima
 #: Kernel family -> the kernels Python calls (``module.function``), in the order a run
 #: compiles them. ``single``: one case (:func:`qzs.simulate`, the response's periodic runs);
 #: ``batch``: cases in lockstep (:func:`qzs.simulate_batch`: sweeps, studies, design);
-#: ``hexapod``: the six-leg platform (:func:`qzs.simulate_hexapod`).
+#: ``single_blocks``: one case of a controller with blocks beyond PI + damping (its own
+#: kernel, :func:`qzs.engine.lanes.run_single_blocks`); ``hexapod``: the six-leg platform
+#: (:func:`qzs.simulate_hexapod`).
 ENTRY_KERNELS = {
     "single": ("qzs.engine.base_motion._series", "qzs.engine.kernels.hold_force",
                "qzs.engine.kernels.evaluate", "qzs.engine.lanes.run_single"),
+    "single_blocks": ("qzs.engine.base_motion._series", "qzs.engine.kernels.hold_force",
+                      "qzs.engine.kernels.evaluate", "qzs.engine.lanes.run_single_blocks"),
     "batch": ("qzs.engine.lanes.run_lanes",),
     "hexapod": ("qzs.engine.hexapod.dynamics._rest_frame",
                 "qzs.engine.hexapod.dynamics._evaluate", "qzs.engine.hexapod.stepping._start",
@@ -52,10 +56,13 @@ ENTRY_KERNELS = {
 #: figure. Their ratios hold on a busy machine (each kernel 4-6 times slower at a load of 6
 #: on 2 cores); the notice multiplies them by :func:`slowdown`. Checked cold on 2026-11-28 at
 #: a load of 6 on 2 cores: ``qzs simulate`` said about 50 s and compiled for 45 s,
-#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s.
+#: ``qzs hexapod study --quick`` said about 65 s and compiled for 87 s. ``run_single_blocks``:
+#: ``run_single``'s times the ratio of their compile CPU seconds, each compiled alone with the
+#: rest cached (59.8 s against 48.6 s at a load of 9 on 2 cores, 2026-11-29).
 COMPILE_SECONDS = {
     "qzs.engine.base_motion._series": 0.6, "qzs.engine.kernels.hold_force": 1.2,
     "qzs.engine.kernels.evaluate": 1.7, "qzs.engine.lanes.run_single": 9.5,
+    "qzs.engine.lanes.run_single_blocks": 11.7,
     "qzs.engine.lanes.run_lanes": 30.0,
     "qzs.engine.hexapod.dynamics._rest_frame": 0.2, "qzs.engine.hexapod.dynamics._evaluate": 9.0,
     "qzs.engine.hexapod.stepping._start": 4.0, "qzs.engine.hexapod.stepping._run": 6.0,
@@ -89,19 +96,18 @@ def cold_kernels(families):
         cannot be read counts as cold.
     """
     cold = []
-    for family in families:
-        for name in ENTRY_KERNELS[family]:
-            try:
-                dispatcher = _dispatcher(name)
-                if dispatcher.overloads:
-                    continue
-                index = dispatcher._cache._cache_file._load_index()
-                machine = dispatcher.targetctx.codegen().magic_tuple()
-                if any(key[1] == machine for key in index):
-                    continue
-            except Exception:  # another numba's internals: say so rather than stay silent
-                pass
-            cold.append(name)
+    for name in dict.fromkeys(name for family in families for name in ENTRY_KERNELS[family]):
+        try:  # a kernel two families share counts once
+            dispatcher = _dispatcher(name)
+            if dispatcher.overloads:
+                continue
+            index = dispatcher._cache._cache_file._load_index()
+            machine = dispatcher.targetctx.codegen().magic_tuple()
+            if any(key[1] == machine for key in index):
+                continue
+        except Exception:  # another numba's internals: say so rather than stay silent
+            pass
+        cold.append(name)
     return cold
 
 

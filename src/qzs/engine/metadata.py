@@ -20,8 +20,8 @@ from qzs.iotools.schema import CONVENTIONS, NONE_VALUE
 from qzs.model.controller import block_parameters
 from qzs.model.registry import parameter_fields, unit_of
 
-__all__ = ["RUN_UNITS", "parameter_metadata", "run_metadata", "history_line",
-           "file_attributes"]
+__all__ = ["RUN_UNITS", "parameter_metadata", "controller_from_attributes", "run_metadata",
+           "history_line", "file_attributes"]
 
 #: Units of the entries of :attr:`SimulationResult.run` ("1" for counts and 0/1 booleans,
 #: "-" for a choice).
@@ -77,6 +77,67 @@ def parameter_metadata(isolator, controller, excitation):
     if "excitation.duration" not in meta and getattr(excitation, "duration", None) is not None:
         meta["excitation.duration"] = (float(excitation.duration), "s")
     return meta
+
+
+def controller_from_attributes(attrs):
+    """The controller a result's attributes record (the inverse of :func:`parameter_metadata`
+    for ``controller.*``), its blocks included.
+
+    Parameters
+    ----------
+    attrs : mapping
+        Dotted attributes as :func:`qzs.read_result` gives them (``controller.pi_kp``,
+        ``controller.linear.a``: a linear controller's matrices flattened row by row, their
+        shapes from ``controller.linear.states`` and the sensors in
+        ``controller.linear.inputs``); a list may be its text (``"[1.0, 2.0]"``: CSV).
+        A parameter left out takes its default.
+
+    Returns
+    -------
+    ControllerParameters
+
+    Raises
+    ------
+    DataError
+        Attributes that make no controller (the message names the attribute).
+    """
+    import json
+
+    from qzs.errors import DataError, ParameterError
+    from qzs.model.controller import BLOCK_CLASSES, ControllerParameters
+
+    def plain(value):
+        if isinstance(value, str) and value.startswith("["):
+            return json.loads(value)
+        if isinstance(value, np.ndarray):
+            return value.tolist()
+        return value.item() if isinstance(value, np.generic) else value
+
+    values = {key[len("controller."):]: plain(value) for key, value in attrs.items()
+              if key.startswith("controller.") and not key.endswith("_units")}
+    try:
+        loops = {f.name: values[f.name] for f in parameter_fields(ControllerParameters())
+                 if f.name in values}
+        blocks = {}
+        for block, cls in BLOCK_CLASSES.items():
+            fields = {key.split(".", 1)[1]: value for key, value in values.items()
+                      if key.startswith(f"{block}.")}
+            if not fields:
+                continue
+            if block == "linear":
+                n = int(fields.pop("states"))
+                inputs = str(fields["inputs"]).split()
+                fields["inputs"] = tuple(inputs)
+                for name, shape in (("a", (n, n)), ("b", (n, len(inputs))), ("c", (n,)),
+                                    ("d", (len(inputs),))):
+                    matrix = fields[name] if fields[name] is not None else []  # MAT: [] is None
+                    fields[name] = np.reshape(np.asarray(matrix, dtype=float), shape)
+                fields["name"] = str(fields["name"])
+            blocks[block] = cls(**fields)
+        return ControllerParameters(**loops, **blocks)
+    except (ParameterError, KeyError, TypeError, ValueError) as error:
+        raise DataError(f"the attributes make no controller ({error}); was the file written "
+                        "by qzs?") from None
 
 
 def run_metadata(run):

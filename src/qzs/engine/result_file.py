@@ -12,15 +12,18 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from qzs.engine.channels import FLAGS, channel_count, run_channels, simulation_schema
-from qzs.engine.metadata import file_attributes
-from qzs.errors import ParameterError
+from qzs.engine.metadata import controller_from_attributes, file_attributes
+from qzs.errors import DataError, ParameterError
 from qzs.iotools import files
 from qzs.iotools.writer import StreamWriter, estimated_file_size
 
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["RESULT_SUFFIXES", "ResultWriter", "estimated_size", "save_result", "read_result"]
+    from qzs.model.controller import ControllerParameters
+
+__all__ = ["RESULT_SUFFIXES", "ResultWriter", "estimated_size", "save_result", "read_result",
+           "read_controller"]
 
 #: File formats of a run's result: suffix -> name.
 RESULT_SUFFIXES = files.RESULT_SUFFIXES
@@ -203,3 +206,60 @@ def read_result(path: str | Path) -> xr.Dataset:
         columns.
     """
     return files.read_result(path, simulation_schema(every_block=True))
+
+
+def read_controller(source: str | Path | xr.Dataset) -> ControllerParameters:
+    """The controller of a saved run, its blocks included (a linear controller's matrices,
+    sensors and timing): equal to the run's ``result.controller``.
+
+    Parameters
+    ----------
+    source : str, Path or xarray.Dataset
+        A run's file (``.nc``, ``.csv``: :func:`read_result`; ``.mat``: its ``parameters``
+        struct, MAT 5), or the dataset :func:`read_result` gave.
+
+    Returns
+    -------
+    ControllerParameters
+
+    Raises
+    ------
+    DataError
+        A missing or unreadable file, a MAT 7.3 file (read its ``parameters`` with h5py),
+        or attributes that make no controller.
+    """
+    if not isinstance(source, (str, Path)):
+        return controller_from_attributes(source.attrs)
+    path = Path(source)
+    if path.suffix.lower() != ".mat":
+        return controller_from_attributes(read_result(path).attrs)
+    import scipy.io
+
+    if not path.exists():
+        raise DataError(f"no such file: {str(path)!r}.")
+    try:
+        mat = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False,
+                               variable_names=["parameters"])
+    except NotImplementedError:
+        raise DataError(f"{str(path)!r} is a MAT 7.3 (HDF5) file: read its `parameters` "
+                        "with h5py, or save the run as MAT 5 or NetCDF.") from None
+    except (OSError, ValueError) as error:
+        raise DataError(f"{str(path)!r} is not a readable MATLAB file: {error}") from None
+    if "parameters" not in mat:
+        raise DataError(f"{str(path)!r} has no `parameters` struct: not a run's file of qzs.")
+    return controller_from_attributes(_flat(mat["parameters"], ""))
+
+
+def _flat(struct, prefix):
+    """A MATLAB struct (``scipy.io.loadmat``'s) as dotted names; ``[]`` (None) as None."""
+    import numpy as np
+
+    flat = {}
+    for name in struct._fieldnames:
+        value = getattr(struct, name)
+        if hasattr(value, "_fieldnames"):
+            flat.update(_flat(value, f"{prefix}{name}."))
+        else:
+            flat[f"{prefix}{name}"] = (None if isinstance(value, np.ndarray) and value.size == 0
+                                       else value)
+    return flat

@@ -186,7 +186,7 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     """
     from qzs.engine.accuracy import (choose_step, default_tolerance, excitation_over,
                                      probe_excitation)
-    from qzs.engine.prepare import run_duration, run_inputs
+    from qzs.engine.prepare import pack_model, run_duration, run_inputs
     from qzs.engine.step_search import StepChoice
     from qzs.model.excitation import Sine
 
@@ -208,6 +208,7 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
     if dt is not None:
         choice = StepChoice.literal(_validation.positive_real("dt", dt), sample_rate=sample_rate,
                                     solver=solver)
+        pack_model(isolator, controller, choice.dt)  # a discrete linear controller's steps
     else:
         if tolerance is not None:
             if isinstance(excitation, Sine):

@@ -5,7 +5,9 @@ content in CF's own means (docs/model.md, decision 34), as the IOOS compliance c
 (``compliance-checker --test=cf:1.10``) reads it:
 
 - **Parameters**: dotted global attributes (``isolator.mass``) become the attributes of a
-  *container variable* (``isolator``, a scalar int8), since CF attribute names have no dots.
+  *container variable* (``isolator``, a scalar int8), since CF attribute names have no dots;
+  a dotted variable name (a batch's coordinate ``compensation.fraction``) is written with
+  ``__`` for each dot (``compensation__fraction``).
 - **Elapsed time**: a dimension named ``time`` is, to CF, a calendar time (units
   ``"<unit> since <date>"``); a run's time has no date, so the file names it
   ``elapsed_time`` (plain seconds, no ``standard_name``).
@@ -27,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["CONTAINERS", "FILE_DIMENSIONS", "FILE_UNITS", "container_attributes",
+__all__ = ["CONTAINERS", "FILE_DIMENSIONS", "FILE_UNITS", "container_attributes", "file_name",
            "to_file_layout", "from_file_layout", "file_schema", "split_parts"]
 
 #: The global attribute of a file that lists its container variables (docs/model.md,
@@ -142,12 +144,29 @@ def container_attributes(attrs):
     for key, value in attrs.items():
         section, dot, name = str(key).partition(".")
         if dot and section and name:
-            containers.setdefault(section, {})[name.replace(".", "__")] = value
+            containers.setdefault(section, {})[file_name(name)] = value
         else:
             plain[key] = value
     if containers:
         plain[CONTAINERS] = " ".join(containers)
     return plain, containers
+
+
+def file_name(name):
+    """A variable's name in a file: each dot as ``__`` (``compensation.fraction`` ->
+    ``compensation__fraction``), since CF names are letters, digits and underscores (§2.3);
+    :func:`from_file_layout` gives the dots back.
+
+    Parameters
+    ----------
+    name : str
+        The name in memory.
+
+    Returns
+    -------
+    str
+    """
+    return str(name).replace(".", "__")
 
 
 def container_long_name(section):
@@ -188,6 +207,7 @@ def to_file_layout(dataset):
     """A dataset as qzs writes it to NetCDF: CF-1.10 as the compliance checker reads it.
 
     Dotted global attributes go to container variables (:func:`container_attributes`);
+    a dotted variable name gets ``__`` for its dots (:func:`file_name`);
     ``time`` becomes ``elapsed_time``; a variable of mixed units becomes one variable per
     unit (:func:`split_parts`); a unit UDUNITS cannot parse gets its file spelling
     (:data:`FILE_UNITS`); coordinates get no ``_FillValue`` and a string coordinate named
@@ -243,6 +263,7 @@ def to_file_layout(dataset):
         out[section] = xr.DataArray(np.int8(0), attrs={
             "long_name": container_long_name(section), **attrs})
     out = out.rename({k: v for k, v in FILE_DIMENSIONS.items() if k in out.variables})
+    out = out.rename({name: file_name(name) for name in out.variables if "." in name})
     encoding = {name: {"_FillValue": None} for name in out.coords
                 if out[name].dtype.kind in "fc"}
     for name in out.coords:  # CF allows no 1-D string variable named as its dimension
@@ -323,7 +344,8 @@ def file_schema(schema, columns, values):
 def from_file_layout(dataset):
     """The inverse of :func:`to_file_layout`: the dataset ``to_xarray()`` gives.
 
-    Containers back to dotted global attributes, ``elapsed_time`` back to ``time``, the
+    Containers back to dotted global attributes, ``__`` in a variable's name back to a
+    dot, ``elapsed_time`` back to ``time``, the
     parts of a variable of mixed units joined, units back to their in-memory spelling.
 
     Parameters
@@ -348,6 +370,8 @@ def from_file_layout(dataset):
     dataset.attrs = attrs
     dataset = dataset.rename({v: k for k, v in FILE_DIMENSIONS.items()
                               if v in dataset.variables or v in dataset.dims})
+    dataset = dataset.rename({name: str(name).replace("__", ".") for name in dataset.variables
+                              if "__" in str(name)})
     wholes, names = {}, list(dataset.data_vars)
     for name in names:
         whole = dataset[name].attrs.get(_PART_OF)

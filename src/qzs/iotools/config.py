@@ -1,17 +1,19 @@
 """Run configuration files (TOML): model parameters, excitation and simulation tables."""
+import dataclasses
 from pathlib import Path
 from typing import Any
 
 from qzs._validation import known_keys, read_toml
 from qzs.errors import ParameterError
 from qzs.iotools.files import atomic_path
-from qzs.model.controller import ControllerParameters
+from qzs.model.controller import (BLOCK_CLASSES, BLOCKS, ControllerParameters,
+                                  LinearController)
 from qzs.model.excitation import EXCITATION_OPTIONS
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, update_parameters
 
-__all__ = ["load_config", "save_config", "config_text", "EXCITATION_KEYS",
-           "SIMULATION_KEYS"]
+__all__ = ["load_config", "load_controller", "controller_from_table", "save_config", "config_text", "EXCITATION_KEYS",
+           "SIMULATION_KEYS", "LINEAR_KEYS"]
 
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
 EXCITATION_KEYS = ("kind", *dict.fromkeys(o for v in EXCITATION_OPTIONS.values() for o in v))
@@ -21,11 +23,23 @@ EMPTY_CONFIG = ("write the parameters to change into it (`qzs params --toml > FI
                 "every one with its default), or give no config file for the defaults")
 
 
+#: Keys of a ``[controller.linear]`` table: the matrices (``a``, ``b``, ``c``, ``d``) or a
+#: transfer function (``num``, ``den``), then the fields of
+#: :class:`~qzs.model.controller.LinearController`.
+LINEAR_KEYS = ("a", "b", "c", "d", "num", "den", "inputs", "sample_time", "tracking_time",
+               "name")
+#: Where a config file's options come from: a ``[controller.linear]`` key -> the
+#: :class:`~qzs.model.controller.LinearController` option an error names.
+_LINEAR_OPTIONS = {"numerator": "num", "denominator": "den", "system": "num"}
+
+
 def load_config(path: str | Path) -> dict[str, Any]:
     """Read a TOML run configuration.
 
     Tables ``[isolator]`` and ``[controller]`` take the registry's parameter names
-    (``qzs params``, :data:`qzs.model.registry.PARAMETERS`); ``[excitation]`` (``kind``
+    (``qzs params``, :data:`qzs.model.registry.PARAMETERS`); the controller's blocks are
+    its sub-tables ``[controller.compensation]``, ``[controller.dither]`` and
+    ``[controller.linear]`` (:func:`controller_from_table`). ``[excitation]`` (``kind``
     = chirp, sine, random or file, and its options) and ``[simulation]`` (``dt``,
     ``sample_rate``, ``solver``, ``duration``) are optional. Unknown tables or keys
     are errors.
@@ -44,7 +58,8 @@ def load_config(path: str | Path) -> dict[str, Any]:
     Raises
     ------
     ParameterError
-        A missing, binary or malformed file, an unknown table or key, a bad value.
+        A missing, binary or malformed file, an unknown table or key, a bad value (the
+        message names the table and key, as ``[controller.linear] b in 'FILE'``).
     """
     path = Path(path)
     document = read_toml(path, "config file", empty=EMPTY_CONFIG)
@@ -53,21 +68,160 @@ def load_config(path: str | Path) -> dict[str, Any]:
     if unknown:
         raise ParameterError(f"{str(path)!r}: unknown table(s) {sorted(unknown)}; "
                              f"allowed are {sorted(allowed)}.")
-    settings = {**document.get("isolator", {}), **document.get("controller", {})}
-    for section in ("isolator", "controller"):
-        other = "controller" if section == "isolator" else "isolator"
-        misplaced = {name for name in document.get(section, {})
-                     if name in PARAMETERS and PARAMETERS[name].section == other}
-        if misplaced:
-            raise ParameterError(f"{str(path)!r}: {sorted(misplaced)} belong in [{other}], "
-                                 f"not [{section}].")
-    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
-                                             settings)
+    isolator_table = document.get("isolator", {})
+    if not isinstance(isolator_table, dict):
+        raise ParameterError(f"{str(path)!r}: [isolator] must be a table, got "
+                             f"{isolator_table!r}.")
+    misplaced = {name for name in isolator_table
+                 if name in PARAMETERS and PARAMETERS[name].section == "controller"
+                 or name in BLOCKS}
+    if misplaced:
+        raise ParameterError(f"{str(path)!r}: {sorted(misplaced)} belong in [controller], "
+                             "not [isolator].")
+    isolator, _ = update_parameters(IsolatorParameters(), ControllerParameters(),
+                                    isolator_table)
+    controller = controller_from_table(document.get("controller", {}), path)
     for section, keys in (("excitation", EXCITATION_KEYS), ("simulation", SIMULATION_KEYS)):
         known_keys(document.get(section, {}), keys, f"[{section}]", f"{str(path)!r}: ")
     return {"isolator": isolator, "controller": controller,
             "excitation": dict(document.get("excitation", {})),
             "simulation": dict(document.get("simulation", {}))}
+
+
+def load_controller(path: str | Path) -> ControllerParameters:
+    """Read a controller file: a TOML file with a ``[controller]`` table and nothing else.
+
+    What ``qzs simulate --controller FILE.toml`` reads: the loops' parameters
+    (``pi_kp = 80``) and the blocks' tables ``[controller.compensation]``,
+    ``[controller.dither]`` and ``[controller.linear]`` (:func:`controller_from_table`);
+    a parameter it leaves out takes its default. ``qzs params --toml`` writes one
+    (with an ``[isolator]`` table to remove, or to pass with ``--config``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    ControllerParameters
+
+    Raises
+    ------
+    ParameterError
+        A missing, binary or malformed file, another table than ``[controller]``, an
+        unknown key, a bad value (the message names the table and key).
+    """
+    path = Path(path)
+    document = read_toml(path, "controller file", empty=(
+        "write a [controller] table into it (`qzs params --toml` shows one)"))
+    others = sorted(set(document) - {"controller"})
+    if others or "controller" not in document:
+        raise ParameterError(
+            f"controller file {str(path)!r} must hold a [controller] table (and its "
+            f"[controller.<block>] tables) and nothing else; it has {sorted(document)}: put "
+            "[isolator], [excitation] and [simulation] in a config file (--config).",
+            ("controller",))
+    return controller_from_table(document["controller"], path)
+
+
+def controller_from_table(table: Any, path: str | Path | None = None,
+                          controller: ControllerParameters | None = None
+                          ) -> ControllerParameters:
+    """A controller from a TOML ``[controller]`` table (parsed), blocks included.
+
+    Its keys are the loops' parameters (``pi_kp``, ...; :data:`qzs.model.registry.PARAMETERS`)
+    and the blocks' tables: ``[controller.compensation]`` and ``[controller.dither]`` take
+    their block's scalar fields (``fraction``, ``deadband``, ...; ``"none"`` for an
+    optional level: the plant's), ``[controller.linear]`` takes ``a``, ``b``, ``c``, ``d``
+    (matrices, as lists of rows) or ``num``, ``den`` (one input's transfer function,
+    highest power first), and ``inputs`` (sensor names), ``sample_time`` [s],
+    ``tracking_time`` [s], ``name`` (:data:`LINEAR_KEYS`).
+
+    Parameters
+    ----------
+    table : dict
+        The parsed table.
+    path : str or Path, optional
+        The file, for the messages.
+    controller : ControllerParameters, optional
+        The controller to start from; default :class:`ControllerParameters`.
+
+    Returns
+    -------
+    ControllerParameters
+
+    Raises
+    ------
+    ParameterError
+        An unknown key, an isolator's parameter, or a bad value; the message names the
+        table and key (``[controller.linear] sample_time in 'FILE'``), the value and the fix.
+    """
+    where = f" in {str(path)!r}" if path is not None else ""
+    prefix = f"{str(path)!r}: " if path is not None else ""
+    if not isinstance(table, dict):
+        raise ParameterError(f"{prefix}[controller] must be a table, got {table!r}.",
+                             ("controller",))
+    misplaced = sorted(name for name in table
+                       if name in PARAMETERS and PARAMETERS[name].section == "isolator")
+    if misplaced:
+        raise ParameterError(f"{prefix}{misplaced} belong in [isolator], not [controller].")
+    settings, spelling = {}, {}
+    for name, value in table.items():
+        if name in BLOCKS and isinstance(value, dict):
+            if name == "linear":
+                continue
+            fields = [f.name for f in dataclasses.fields(BLOCK_CLASSES[name])]
+            known_keys(value, fields, f"[controller.{name}]", prefix)
+            for key, item in value.items():
+                settings[f"{name}.{key}"] = item
+                spelling[f"{name}.{key}"] = f"[controller.{name}] {key}{where}"
+        else:
+            settings[name] = value
+            spelling[name] = f"[controller] {name}{where}"
+    controller = controller or ControllerParameters()
+    linear = table.get("linear")
+    if isinstance(linear, dict):
+        controller = dataclasses.replace(controller, linear=_linear(linear, where, prefix))
+    try:
+        _, controller = update_parameters(IsolatorParameters(), controller, settings)
+    except ParameterError as error:
+        raise error.renamed(spelling) from None
+    return controller
+
+
+def _linear(table, where, prefix):
+    """A :class:`LinearController` from its ``[controller.linear]`` table."""
+    known_keys(table, LINEAR_KEYS, "[controller.linear]", prefix)
+    spelling = {key: f"[controller.linear] {key}{where}" for key in LINEAR_KEYS}
+    spelling.update({option: spelling[key] for option, key in _LINEAR_OPTIONS.items()})
+    spelling["denominator"] = spelling["den"]
+    matrices = [key for key in ("a", "b", "c", "d") if key in table]
+    polynomial = [key for key in ("num", "den") if key in table]
+    if bool(matrices) == bool(polynomial) or (polynomial and len(polynomial) != 2):
+        raise ParameterError(
+            f"{prefix}[controller.linear] must give its controller either as matrices (a, b, "
+            f"c, d; a and b may be left out for a static gain) or as a transfer function "
+            f"(num and den), got {sorted(matrices + polynomial) or 'neither'}.",
+            ("controller.linear",))
+    options = {key: table[key] for key in ("inputs", "sample_time", "tracking_time", "name")
+               if key in table}
+    try:
+        if polynomial:
+            inputs = options.pop("inputs", ("measured_payload_velocity",))
+            if not isinstance(inputs, str) and len(inputs) != 1:
+                raise ParameterError(
+                    f"`inputs` names {len(inputs)} sensors ({inputs!r}) but `num`/`den` is "
+                    "one input's transfer function; name one sensor, or give the matrices "
+                    "(a, b, c, d) of a controller with several inputs.", ("inputs",))
+            return LinearController.from_transfer_function(table["num"], table["den"],
+                                                           inputs, **options)
+        return LinearController(**{key: table[key] for key in matrices}, **options)
+    except ParameterError as error:
+        raise error.renamed(spelling) from None
+    except TypeError as error:  # a value of the wrong kind for the library (a string)
+        raise ParameterError(f"{prefix}[controller.linear]: {error}; give numbers.",
+                             ("controller.linear",)) from None
 
 
 def save_config(path, isolator=None, controller=None, excitation=None, simulation=None):
@@ -115,13 +269,38 @@ def config_text(isolator=None, controller=None, excitation=None, simulation=None
     """
     import tomli_w
 
+    controller = controller or ControllerParameters()
     document = {"isolator": (isolator or IsolatorParameters()).to_dict(),
-                "controller": (controller or ControllerParameters()).to_dict()}
+                "controller": controller.to_dict()}
+    for name in BLOCKS:  # a block's table: None is the plant's level, "none" in TOML
+        block = getattr(controller, name)
+        if block is not None:
+            document["controller"][name] = {
+                field.name: "none" if getattr(block, field.name) is None
+                else getattr(block, field.name) for field in dataclasses.fields(block)
+                if getattr(block, field.name) is not None or field.default is not None}
+    linear = document["controller"].pop("linear", None)
+    rest = {}
     if excitation:
-        document["excitation"] = dict(excitation)
+        rest["excitation"] = dict(excitation)
     if simulation:
-        document["simulation"] = dict(simulation)
+        rest["simulation"] = dict(simulation)
     header = "# qzs run configuration: units as in `qzs params` (SI).\n"
     if note:
         header += f"# {note}\n"
-    return header + tomli_w.dumps(document)
+    text = header + tomli_w.dumps(document)
+    if linear is not None:  # its matrices one line each, as they are read (rows of a, b)
+        text += "\n[controller.linear]\n" + "".join(
+            f"{key} = {_inline(value)}\n" for key, value in linear.items())
+    return text + ("\n" + tomli_w.dumps(rest) if rest else "")
+
+
+def _inline(value):
+    """A TOML value on one line: a number, a string, or nested arrays of them."""
+    import json
+
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_inline(item) for item in value) + "]"
+    if isinstance(value, str):
+        return json.dumps(value)  # a JSON string is a TOML basic string
+    return repr(float(value))

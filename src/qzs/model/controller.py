@@ -41,7 +41,8 @@ from qzs.model.isolator import IsolatorParameters, spring_stiffness
 from qzs.model.sensors import MAX_STATES, SENSORS
 
 __all__ = ["ControllerParameters", "PIDamping", "FrictionCompensation", "Dither",
-           "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "block_parameters",
+           "LinearController", "SENSORS", "MAX_STATES", "BLOCKS", "BLOCK_CLASSES",
+           "block_parameters",
            "refuse_blocks",
            "closed_loop_natural_frequency"]
 
@@ -184,6 +185,11 @@ class Dither:
     __radd__ = __add__
 
 
+#: What each dimension of a linear controller's matrix counts (for the messages).
+_SHAPES = {"a": "states x states", "b": "states x inputs",
+           "c": "one output (the motor force) x states", "d": "one output x inputs"}
+
+
 def _matrix(name, value, shape):
     try:
         array = np.array(value, dtype=float, ndmin=2)
@@ -192,11 +198,14 @@ def _matrix(name, value, shape):
     if array.size == 0 and 0 in shape:
         array = np.zeros(shape)
     if array.shape != shape:
-        raise ParameterError(f"`{name}` must have shape {shape}, got {array.shape}; check the "
-                             "controller's state and input counts.", (name,))
+        raise ParameterError(
+            f"`{name}` must have shape {shape} ({_SHAPES[name]}), got {array.shape}: "
+            f"{np.asarray(value).tolist()!r}; check the controller's state, input (one sensor "
+            "per column of b and entry of d) and output (one row of c) counts.", (name,))
     if not np.isfinite(array).all():
-        raise ParameterError(f"`{name}` has non-finite (NaN or inf) entries; every entry of a "
-                             "controller's matrices must be a finite number.", (name,))
+        raise ParameterError(f"`{name}` has non-finite (NaN or inf) entries: "
+                             f"{array.tolist()!r}; every entry of a controller's matrices "
+                             "must be a finite number.", (name,))
     return tuple(tuple(float(x) for x in row) for row in array)
 
 
@@ -261,8 +270,11 @@ class LinearController:
     def __post_init__(self):
         inputs = _inputs(self.inputs)
         object.__setattr__(self, "inputs", inputs)
-        a = np.array(self.a, dtype=float, ndmin=2) if np.size(self.a) else np.zeros((0, 0))
-        n = a.shape[0]
+        try:
+            n = np.array(self.a, dtype=float, ndmin=2).shape[0] if np.size(self.a) else 0
+        except (TypeError, ValueError):
+            raise ParameterError(f"`a` must be a square matrix of numbers, got {self.a!r}.",
+                                 ("a",)) from None
         if n > MAX_STATES:
             raise ParameterError(
                 f"a LinearController may have at most {MAX_STATES} states, got {n}; reduce "
@@ -403,6 +415,14 @@ class LinearController:
                                      f"{value!r}.", (name,))
         if not np.any(np.asarray(denominator, dtype=float)):
             raise ParameterError("`denominator` must not be zero.", ("denominator",))
+        num, den = (np.trim_zeros(np.atleast_1d(np.asarray(v, dtype=float)), "f")
+                    for v in (numerator, denominator))
+        if len(num) > len(den):
+            raise ParameterError(
+                f"the transfer function is improper: `numerator` {list(map(float, num))} has "
+                f"degree {len(num) - 1}, above the degree {len(den) - 1} of `denominator` "
+                f"{list(map(float, den))}; a controller must be proper: add poles (e.g. a "
+                "low-pass) until the degrees match.", ("numerator", "denominator"))
         system = control.tf(list(np.atleast_1d(numerator)), list(np.atleast_1d(denominator)),
                             sample_time if sample_time else 0)
         return cls.from_system(system, inputs, **options)
@@ -483,8 +503,7 @@ class ControllerParameters:
             "velocity_highpass": non_negative_real,
             "controller_rate": non_negative_real,
         })
-        for name, kind in (("compensation", FrictionCompensation), ("dither", Dither),
-                           ("linear", LinearController)):
+        for name, kind in BLOCK_CLASSES.items():
             value = getattr(self, name)
             if value is not None and not isinstance(value, kind):
                 raise ParameterError(f"`{name}` must be a {kind.__name__} or None, got "
@@ -552,7 +571,10 @@ class ControllerParameters:
 #: Today's controller, the default: PI position loop plus active damping (the same class).
 PIDamping = ControllerParameters
 
-_SLOT = {FrictionCompensation: "compensation", Dither: "dither", LinearController: "linear"}
+#: The class of each block: field name of :class:`ControllerParameters` -> block class.
+BLOCK_CLASSES = {"compensation": FrictionCompensation, "dither": Dither,
+                 "linear": LinearController}
+_SLOT = {cls: name for name, cls in BLOCK_CLASSES.items()}
 
 
 def _add(left, right):

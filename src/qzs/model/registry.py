@@ -4,9 +4,16 @@ One source, read by everything that names parameters: the command line's ``--set
 and ``qzs params``, TOML configs, sweeps, identification, and the metadata of saved
 results. The parameters themselves are the fields of the frozen dataclasses
 (:class:`~qzs.model.isolator.IsolatorParameters`,
-:class:`~qzs.model.controller.ControllerParameters` and the excitations), each
+:class:`~qzs.model.controller.ControllerParameters`, its blocks and the excitations), each
 declared with its default, unit and one-line description; this module only reads
 them.
+
+A controller block's scalar parameters have dotted names, ``<block>.<field>``
+(``compensation.fraction``, ``dither.frequency``, ``linear.tracking_time``:
+:data:`BLOCK_PARAMETERS`); a linear controller's matrices, inputs and name are no
+registry parameters (a controller file gives them, docs/model.md §5.1). Setting a block's
+parameter on a controller without that block adds the block, with its defaults and the
+change (:func:`update_parameters`).
 """
 import dataclasses
 import math
@@ -14,14 +21,14 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from qzs.errors import ParameterError
-from qzs.model.controller import (ControllerParameters, Dither, FrictionCompensation,
-                                  LinearController)
+from qzs.model.controller import (BLOCK_CLASSES, ControllerParameters, Dither,
+                                  FrictionCompensation, LinearController)
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_field
 from qzs.model.isolator import IsolatorParameters
 
-__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "EXCITATION_PARAMETERS", "parameter_info",
-           "model_inputs",
-           "unit_of", "parameter_fields",
+__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "BLOCK_PARAMETERS", "ALL_PARAMETERS",
+           "NO_BLOCK", "EXCITATION_PARAMETERS", "parameter_info", "model_inputs",
+           "unit_of", "parameter_fields", "parameter_value", "dotted_names",
            "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
            "format_value"]
 
@@ -37,9 +44,10 @@ class ParameterInfo:
     Attributes
     ----------
     name : str
-        The parameter's name (``stiction_force``, ``excitation.f0``).
+        The parameter's name (``stiction_force``, ``compensation.fraction``,
+        ``excitation.f0``).
     section : str
-        ``isolator``, ``controller`` or ``excitation.<kind>``.
+        ``isolator``, ``controller`` (a block's parameters too) or ``excitation.<kind>``.
     unit : str
         SI unit (``N``, ``m``, ``Hz``; ``-`` for a choice, ``1`` for a count).
     doc : str
@@ -47,7 +55,8 @@ class ParameterInfo:
     default : object
         Default value (``None`` where that has a meaning, e.g. ``stop_center``).
     numeric : bool
-        True for a float parameter that takes any number in its range (fits vary these).
+        True for a float parameter that takes any number in its range (fits vary these;
+        a block's optional levels too: ``None`` there means the plant's).
     """
 
     name: str
@@ -58,17 +67,31 @@ class ParameterInfo:
     numeric: bool
 
 
-def _info(section, field, name=None):
+def _info(section, field, name=None, numeric=(float, "float")):
     default = None if field.default is dataclasses.MISSING else field.default
     return ParameterInfo(name=name or field.name, section=section,
                          unit=field.metadata.get("unit", ""), doc=field.metadata.get("doc", ""),
-                         default=default, numeric=field.type in (float, "float"))
+                         default=default, numeric=field.type in numeric)
 
 
-#: Model parameters: name -> :class:`ParameterInfo`, isolator first, then controller.
+#: Model parameters: name -> :class:`ParameterInfo`, isolator first, then controller; the
+#: fields of the two classes, not the controller's blocks (what the C model and the FMU
+#: have as parameters).
 PARAMETERS = MappingProxyType({
     f.name: _info(section, f) for section, cls in SECTIONS.items()
     for f in dataclasses.fields(cls) if not f.metadata.get("block")})
+#: The types of a block's fields that are registry parameters (scalars).
+_SCALARS = (float, float | None)
+#: The controller blocks' scalar parameters: ``<block>.<field>`` -> :class:`ParameterInfo`
+#: (section ``controller``; unit, doc and default from the block's field).
+BLOCK_PARAMETERS = MappingProxyType({
+    f"{block}.{f.name}": _info("controller", f, f"{block}.{f.name}", _SCALARS)
+    for block, cls in BLOCK_CLASSES.items() for f in dataclasses.fields(cls)
+    if f.type in _SCALARS})
+#: Every registry parameter: :data:`PARAMETERS`, then :data:`BLOCK_PARAMETERS`.
+ALL_PARAMETERS = MappingProxyType({**PARAMETERS, **BLOCK_PARAMETERS})
+#: What :func:`parameter_table` shows for a block's parameter of a controller without it.
+NO_BLOCK = "no block"
 
 
 #: Excitation parameters by kind: the factory's options, and the run's duration where the
@@ -107,15 +130,15 @@ def parameter_info(name, kind=None):
     ParameterError
         Unknown name; the message lists the valid ones.
     """
-    if name in PARAMETERS:
-        return PARAMETERS[name]
+    if name in ALL_PARAMETERS:
+        return ALL_PARAMETERS[name]
     if name.startswith("excitation."):
         option = name.split(".", 1)[1]
         kinds = [kind] if kind is not None else list(EXCITATION_PARAMETERS)
         for k in kinds:
             if option in EXCITATION_PARAMETERS.get(k, ()):
                 return _excitation_info(k, option)
-    valid = sorted(PARAMETERS) + sorted({f"excitation.{o}"
+    valid = sorted(ALL_PARAMETERS) + sorted({f"excitation.{o}"
                                          for v in EXCITATION_PARAMETERS.values() for o in v})
     raise ParameterError(f"unknown parameter {name!r}; valid names are: {', '.join(valid)}.")
 
@@ -136,8 +159,9 @@ def unit_of(name, kind=None):
 def parameter_fields(params):
     """The registry parameters of an isolator's or a controller's fields, in field order.
 
-    A controller's blocks (:data:`qzs.model.controller.BLOCKS`) are no parameters of the
-    registry: :func:`qzs.model.controller.block_parameters` lists theirs.
+    A controller's blocks (:data:`qzs.model.controller.BLOCKS`) are no fields here:
+    :data:`BLOCK_PARAMETERS` has their scalar parameters and
+    :func:`qzs.model.controller.block_parameters` lists all of theirs.
 
     Parameters
     ----------
@@ -159,6 +183,11 @@ def numeric_parameters():
 def update_parameters(isolator, controller, settings):
     """Return ``(isolator, controller)`` with the named parameters replaced.
 
+    A block's parameter (``compensation.fraction``: :data:`BLOCK_PARAMETERS`) changes that
+    block; on a controller without the block it adds the block, with its defaults and the
+    change (``compensation.fraction=0.8`` adds ``FrictionCompensation(fraction=0.8)``). A
+    linear controller has no defaults to add: its matrices come from a controller file.
+
     Parameters
     ----------
     isolator : IsolatorParameters
@@ -166,28 +195,112 @@ def update_parameters(isolator, controller, settings):
     controller : ControllerParameters
         Controller parameters to start from.
     settings : dict
-        Parameter names (``mass``, ``pi_kp``, ...; see :data:`PARAMETERS`) to values in
-        their SI units; string values are parsed (:func:`parse_value`, ``none`` for
-        an optional value).
+        Parameter names (``mass``, ``pi_kp``, ``dither.amplitude``, ...; see
+        :data:`ALL_PARAMETERS`) to values in their SI units; string values are parsed
+        (:func:`parse_value`, ``none`` for an optional value).
 
     Raises
     ------
     ParameterError
-        For an unknown name (the message lists the valid ones) or an invalid value.
+        For an unknown name (the message lists the valid ones) or an invalid value (naming
+        the parameter as given: ``compensation.fraction``).
     """
     changes = {section: {} for section in SECTIONS}
+    blocks = {}
     for name, value in settings.items():
-        if name not in PARAMETERS:
+        if name not in ALL_PARAMETERS:
             raise ParameterError(f"unknown parameter {name!r}; valid names are: "
-                                 f"{', '.join(sorted(PARAMETERS))}.")
-        changes[PARAMETERS[name].section][name] = (parse_value(value) if isinstance(value, str)
-                                                   else value)
+                                 f"{', '.join(sorted(ALL_PARAMETERS))}.")
+        value = parse_value(value) if isinstance(value, str) else value
+        if name in BLOCK_PARAMETERS:
+            block, field = name.split(".", 1)
+            blocks.setdefault(block, {})[field] = value
+        else:
+            changes[PARAMETERS[name].section][name] = value
+    for block, values in blocks.items():
+        changes["controller"][block] = _changed_block(getattr(controller, block), block, values)
     return (dataclasses.replace(isolator, **changes["isolator"]),
             dataclasses.replace(controller, **changes["controller"]))
 
 
+def _changed_block(current, block, values):
+    """The block ``block`` (None: absent, then added with its defaults) with ``values``;
+    an error names the parameters as ``block.field``."""
+    spelling = {field.name: f"{block}.{field.name}"
+                for field in dataclasses.fields(BLOCK_CLASSES[block])}
+    try:
+        if current is not None:
+            return dataclasses.replace(current, **values)
+        if block == "linear":
+            raise ParameterError(
+                f"{', '.join(f'`{spelling[name]}`' for name in values)} changes a linear "
+                "controller, and this controller has none (a linear controller has no "
+                "defaults: its matrices or transfer function are needed); give one in a "
+                "controller file's [controller.linear] table (`qzs params --toml` shows one) "
+                "and pass it with --config or --controller.",
+                tuple(spelling[name] for name in values))
+        return BLOCK_CLASSES[block](**values)
+    except ParameterError as error:
+        raise error.renamed(spelling) from None
+
+
+def parameter_value(isolator, controller, name, absent=None):
+    """The value of the registry parameter ``name`` in ``isolator`` and ``controller``.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Plant parameters.
+    controller : ControllerParameters
+        Controller parameters.
+    name : str
+        A name of :data:`ALL_PARAMETERS`.
+    absent : object
+        What a block's parameter is on a controller without that block.
+
+    Returns
+    -------
+    object
+    """
+    if name in BLOCK_PARAMETERS:
+        block, field = name.split(".", 1)
+        block = getattr(controller, block)
+        return absent if block is None else getattr(block, field)
+    return getattr(isolator if PARAMETERS[name].section == "isolator" else controller, name)
+
+
+def dotted_names(table):
+    """A TOML table of parameters by name with its dotted keys' tables made names again.
+
+    TOML reads an unquoted dotted key (``compensation.fraction = 0.8``) as a nested table
+    (``{"compensation": {"fraction": 0.8}}``); this gives back ``compensation.fraction``
+    (and ``excitation.f0``), as a quoted key (``"compensation.fraction" = 0.8``) gives it.
+
+    Parameters
+    ----------
+    table : object
+        The table (anything else is returned as it is, for the caller to refuse).
+
+    Returns
+    -------
+    dict or object
+    """
+    if not isinstance(table, dict):
+        return table
+    flat = {}
+    for key, value in table.items():
+        if key in (*BLOCK_CLASSES, "excitation") and isinstance(value, dict):
+            flat.update({f"{key}.{inner}": item for inner, item in value.items()})
+        else:
+            flat[key] = value
+    return flat
+
+
 def parameter_table(isolator=None, controller=None):
-    """Rows ``(section, name, value, unit, description)`` of every model parameter.
+    """Rows ``(section, name, value, unit, description)`` of every registry parameter.
+
+    The blocks' parameters (:data:`BLOCK_PARAMETERS`) follow the others; where the
+    controller has no such block, the value is :data:`NO_BLOCK`.
 
     Parameters
     ----------
@@ -196,10 +309,10 @@ def parameter_table(isolator=None, controller=None):
     controller : ControllerParameters, optional
         Values to show; defaults if omitted.
     """
-    objects = {"isolator": isolator or IsolatorParameters(),
-               "controller": controller or ControllerParameters()}
-    return [(info.section, name, getattr(objects[info.section], name), info.unit, info.doc)
-            for name, info in PARAMETERS.items()]
+    isolator = isolator or IsolatorParameters()
+    controller = controller or ControllerParameters()
+    return [(info.section, name, parameter_value(isolator, controller, name, NO_BLOCK),
+             info.unit, info.doc) for name, info in ALL_PARAMETERS.items()]
 
 
 def parse_value(text):

@@ -189,3 +189,26 @@ def test_the_plan_counts_the_cases_and_steps():
     # 64 designs x 4 draws per generation, 20 generations, 20 s at 1 ms
     assert "256 cases per generation" in text
     assert f"about {20 * 256 * 20 / 1e-3:.3g} integration steps" in text
+
+
+def test_a_block_s_parameter_is_a_design_variable_by_its_dotted_name():
+    """``compensation.fraction`` (an unquoted dotted key in a problem file reads the same)
+    is a variable with its unit; its cases are the default loop plus that compensation; a
+    bound outside the block's range is refused naming it."""
+    import tomllib
+
+    import qzs
+    from qzs.workflows.design_space.evaluation import case_settings
+    from qzs.workflows.sweeps.cases import build_model
+
+    variables = tomllib.loads("compensation.fraction = { low = 0.0, high = 1.2 }\n"
+                              "pi_kp = { low = 20.0, high = 80.0 }\n")
+    problem = load_problem(changed(variables=variables))
+    assert [v.name for v in problem.variables] == ["compensation.fraction", "pi_kp"]
+    assert problem.variables[0].units == "-"
+    (case, *_) = case_settings(problem, np.array([[0.6, 40.0]]))
+    _, controller = build_model(problem.sweep, case)
+    assert controller == qzs.PIDamping(pi_kp=40.0) + qzs.FrictionCompensation(fraction=0.6)
+    with pytest.raises(ProblemError) as error:
+        load_problem(changed(variables={"compensation.fraction": {"low": 0.0, "high": 2.0}}))
+    assert "compensation.fraction" in str(error.value) and "1.5" in str(error.value)

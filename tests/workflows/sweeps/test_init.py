@@ -101,6 +101,33 @@ def test_batched_results_equal_single_runs(reference):
         assert int(row["n_averages"]) == 8
 
 
+def test_a_sweep_over_a_controller_block_s_parameter_is_its_single_runs(tmp_path):
+    """A TOML sweep over ``compensation.fraction`` (an unquoted dotted key): each case is the
+    single run of the default controller plus that compensation, bit for bit."""
+    path = tmp_path / "compensation.toml"
+    path.write_text('[sweep]\nname = "compensation"\nbatch_size = 2\n'
+                    '[grid]\ncompensation.fraction = [0.0, 0.6, 1.2]\n'
+                    '[excitation]\nf1 = 10.0\n[simulation]\ndt = 5e-4\n'
+                    '[analysis]\nfft_length = 2048\nn_averages = 8\nband = [0.0, 10.0]\n'
+                    '[outputs]\ntime_series = ["relative_position", "motor_force"]\n')
+    definition = load_sweep(path)
+    assert definition.grid == {"compensation.fraction": (0.0, 0.6, 1.2)}
+    data = run_sweep(definition, tmp_path / "compensation.zarr", threads=1,
+                     progress=False).load()
+    assert (data["status"].values == OK).all()
+    assert data["compensation.fraction"].attrs["units"] == "-"
+    for case, fraction in enumerate((0.0, 0.6, 1.2)):
+        assert float(data["compensation.fraction"][case]) == fraction
+        run = qzs.simulate(qzs.Chirp(f1=10.0, duration=definition.analysis["duration"]),
+                           controller=qzs.PIDamping() + qzs.FrictionCompensation(
+                               fraction=fraction), dt=5e-4)
+        row = data.isel(case=case)
+        np.testing.assert_array_equal(row["relative_position"].values, run.relative_position)
+        np.testing.assert_array_equal(row["motor_force"].values, run.motor_force)
+        assert row["stick_events"] == run.run["stick_events"]
+    assert not np.array_equal(data["motor_force"][0], data["motor_force"][2])
+
+
 def test_store_layout_units_and_attributes(reference):
     definition, data, _ = reference
     assert set(data.dims) == {"case", "frequency", "time"}

@@ -66,7 +66,7 @@ from qzs._validation import Structured, integer, read_toml, real
 from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
-from qzs.model.registry import PARAMETERS
+from qzs.model.registry import ALL_PARAMETERS, dotted_names
 from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_column
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
                                              frozen_distribution, load_sweep, parse_distribution,
@@ -407,6 +407,8 @@ def _fail(table, key, value, fix):
 
 def _table(document, name, kind=dict):
     value = document.get(name, kind())
+    if name in ("variables", "uncertain", "parameters"):  # `compensation.fraction = ...`
+        value = dotted_names(value)
     if not isinstance(value, kind):
         shape = "table" if kind is dict else f"list of tables [[{name}]]"
         _fail(name, "", value, f"[{name}] must be a {shape}")
@@ -422,11 +424,11 @@ def _known(table, name, allowed):
 
 def _parameter_name(table, name, kind):
     excitation = [f"excitation.{k}" for k in EXCITATION_PARAMETERS[kind]]
-    if name not in PARAMETERS and name not in excitation:
-        close = [p for p in (*PARAMETERS, *excitation) if p.split("_")[0] in name]
+    if name not in ALL_PARAMETERS and name not in excitation:
+        close = [p for p in (*ALL_PARAMETERS, *excitation) if p.split("_")[0] in name]
         hint = f" (did you mean {', '.join(close[:4])}?)" if close else ""
         _fail(table, name, name, f"not a parameter{hint}; `qzs params` lists them: "
-                                 f"{', '.join(sorted(PARAMETERS))}")
+                                 f"{', '.join(sorted(ALL_PARAMETERS))}")
     from qzs.model.registry import unit_of
 
     return unit_of(name, kind)
@@ -490,7 +492,7 @@ def _within_valid_range(name, low, high):
     from qzs.model.isolator import IsolatorParameters
     from qzs.model.registry import update_parameters
 
-    if name not in PARAMETERS or not PARAMETERS[name].numeric:
+    if name not in ALL_PARAMETERS or not ALL_PARAMETERS[name].numeric:
         return
     for key, bound in (("low", low), ("high", high)):
         try:

@@ -23,7 +23,7 @@ import numpy as np
 
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
-from qzs.model.registry import PARAMETERS, unit_of
+from qzs.model.registry import ALL_PARAMETERS, unit_of
 
 __all__ = ["curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
            "CURVE_SUFFIXES"]
@@ -78,7 +78,7 @@ def _parameter_info(name, units, values):
     dtype = "float64" if numeric else "str"
     if name in units:
         return (*units[name], dtype)
-    info = PARAMETERS.get(name)
+    info = ALL_PARAMETERS.get(name)
     return (unit_of(name), info.doc if info is not None else name, dtype)
 
 

@@ -36,7 +36,7 @@ from qzs.iotools.files import atomic_path
 from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
-from qzs.model.registry import PARAMETERS, format_value, unit_of, update_parameters
+from qzs.model.registry import ALL_PARAMETERS, format_value, unit_of, update_parameters
 from qzs.viz.figures import check_frequency_scale
 from qzs.viz.identify import plot_spring_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
@@ -105,7 +105,7 @@ class _Undecidable(Exception):
 # ---------------------------------------------------------------- reading cases
 def _value(case, name):
     """A case's value of model parameter ``name``: its override, else the default."""
-    return case.settings.get(name, PARAMETERS[name].default)
+    return case.settings.get(name, ALL_PARAMETERS[name].default)
 
 
 def _ordered(result, name, needed=TREND_CASES):

@@ -766,10 +766,10 @@ def column_unit(name):
                 return units[key] or ""
             return unit_of(key) if prefix == "param." else column_unit(key)
     from qzs.analysis.spectral import metric_unit
-    from qzs.model.registry import PARAMETERS, unit_of
+    from qzs.model.registry import ALL_PARAMETERS, unit_of
 
     unit = metric_unit(name) or STATS_UNITS.get(name)
-    if unit is None and name in PARAMETERS:
+    if unit is None and name in ALL_PARAMETERS:
         unit = unit_of(name)
     if unit is None:
         raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")

@@ -30,7 +30,7 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
 from qzs.model.isolator import IsolatorParameters
 from qzs.model import registry
-from qzs.model.registry import PARAMETERS, update_parameters
+from qzs.model.registry import ALL_PARAMETERS, dotted_names, update_parameters
 
 __all__ = ["SweepDefinition", "load_sweep", "sample_cases", "draw_samples", "unit_draws",
            "shipped_sweeps", "parse_distribution", "frozen_distribution",
@@ -203,9 +203,9 @@ def _keys(table, name, allowed):
 def _check_name(name, kind):
     """A varied parameter must be a model parameter or ``excitation.<parameter of kind>``."""
     excitation = [f"excitation.{k}" for k in EXCITATION_PARAMETERS[kind]]
-    if name not in list(PARAMETERS) and name not in excitation:
+    if name not in ALL_PARAMETERS and name not in excitation:
         raise ParameterError(f"unknown parameter {name!r}; valid names are: "
-                             f"{', '.join(sorted(list(PARAMETERS)) + excitation)}.")
+                             f"{', '.join(sorted(ALL_PARAMETERS) + excitation)}.")
 
 
 def _definition(document, where, stem):
@@ -229,10 +229,11 @@ def _definition(document, where, stem):
         raise ParameterError(f"excitation `kind` must be one of {tuple(EXCITATION_PARAMETERS)}, "
                              f"got {kind!r}.")
     _keys(excitation, "excitation", EXCITATION_PARAMETERS[kind])
-    parameters = dict(_keys(document.get("parameters", {}), "parameters", list(PARAMETERS)))
+    parameters = dict(_keys(dotted_names(document.get("parameters", {})), "parameters",
+                            list(ALL_PARAMETERS)))
     update_parameters(IsolatorParameters(), ControllerParameters(), parameters)  # values
 
-    grid_table = document.get("grid", {})
+    grid_table = dotted_names(document.get("grid", {}))
     if not isinstance(grid_table, dict):
         raise ParameterError(f"[grid] must be a table, got {grid_table!r}.")
     grid = {}
@@ -241,15 +242,15 @@ def _definition(document, where, stem):
         grid[key] = _grid_values(key, spec)
     grid = dict(sorted(grid.items(), key=lambda item: not item[0].startswith("excitation.")))
     distributions = {}
-    table = document.get("distributions", {})
+    table = dotted_names(document.get("distributions", {}))
     if not isinstance(table, dict):
         raise ParameterError(f"[distributions] must be a table, got {table!r}.")
     for key, spec in table.items():
         _check_name(key, kind)
         distributions[key] = parse_distribution(key, spec)
     for key in (*grid, *distributions):
-        fixed = parameters if "." not in key else excitation
-        if key.split(".", 1)[-1] in fixed:
+        if (key.split(".", 1)[1] in excitation if key.startswith("excitation.")
+                else key in parameters):
             raise ParameterError(f"{key!r} is both fixed and varied; remove one of them.")
     both = sorted(set(grid) & set(distributions))
     if both:
