@@ -106,9 +106,10 @@ def test_each_leg_runs_its_own_controller():
                   ) > 1e-6
 
 
-def test_block_channels_exist_only_with_blocks_and_reach_the_dataset():
+def test_block_channels_exist_only_with_blocks_and_reach_the_dataset(tmp_path):
     """Without blocks the rows keep their columns and asking for a block force says why it is
-    absent; with blocks the dataset carries each leg's block forces with their units."""
+    absent; with blocks the dataset and the file carry each leg's block forces with their
+    units."""
     options = dict(excitation={"z": SINE}, duration=0.2)
     plain = simulate_hexapod(vertical_legs(), _platform(), ISOLATOR, **options)
     with pytest.raises(KeyError, match="only when a leg's controller has blocks"):
@@ -121,6 +122,10 @@ def test_block_channels_exist_only_with_blocks_and_reach_the_dataset():
     assert dataset["dither_force"].attrs["units"] == "N"
     np.testing.assert_array_equal(dataset["dither_force"].values, result["dither_force"])
     assert result.metadata()["controller.dither.amplitude"] == (1.0, "N")
+    import xarray as xr
+
+    with xr.open_dataset(result.save(tmp_path / "run.nc")) as stored:
+        np.testing.assert_array_equal(stored["dither_force"].values, result["dither_force"])
 
 
 def test_blocks_are_refused_with_centralised_control_and_a_bad_period_names_the_leg():

@@ -116,9 +116,10 @@ def _attribute(value):
 
 
 #: Where a run's output rows go in its file: variable -> (block, column or the six columns).
+_BLOCK_COLUMNS = {name: ("data", slice(column, column + 6))
+                  for name, (column, _, _, _) in HEXAPOD_BLOCK_CHANNELS.items()}
 _COLUMNS = {**{name: ("data", column if dim is None else slice(column, column + 6))
-               for name, (column, dim, _, _) in {**HEXAPOD_CHANNELS,
-                                                 **HEXAPOD_BLOCK_CHANNELS}.items()},
+               for name, (column, dim, _, _) in HEXAPOD_CHANNELS.items()},
             **{name: ("flags", slice(column, column + 6))
                for name, (column, _) in HEXAPOD_FLAGS.items()}}
 #: The values of the coordinates that are labels: the degrees of freedom and the legs.
@@ -256,7 +257,7 @@ class HexapodWriter(StreamWriter):
         super().__init__(path, hexapod_schema(blocks),
                          blocks={"data": N_CHANNELS if blocks else N_BASE_CHANNELS,
                                  "flags": N_FLAGS},
-                         columns=_COLUMNS, values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
+                         columns={**_COLUMNS, **_BLOCK_COLUMNS} if blocks else _COLUMNS, values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
 
     def finish(self, result):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.
