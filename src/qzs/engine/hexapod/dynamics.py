@@ -47,11 +47,10 @@ from numba import njit
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
 from qzs.engine.hexapod.layout import (
-    LANES, LEG_COUNT, MODE_SLIP, N_MODEL, PL_ACTIVE, PL_BLOCKS, PL_CENTRAL, PL_CKD, PL_CKI, PL_CKP,
-    PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_MODEL, PL_ROTATING, S_C,
+    LANES, LEG_COUNT, MODE_SLIP, N_MODEL, PL_ACTIVE, PL_BLOCKS, PL_CENTRAL, PL_CKD, PL_CKI,
+    PL_CKP, PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_MODEL, PL_ROTATING, S_C,
     S_DF, S_DS, S_X, V_CMD, V_FCO, V_FDI, V_FFF, V_FLI, V_FRESH, V_HCO, V_HDI, V_HLI, V_XDD,
-    V_YDD,
-    S_HP, S_INT, S_Q, S_V, S_W, S_WB, S_WM, SOLVE_FACTORED, SOLVE_MIN_NORM, SOLVE_NONE, V_A,
+    V_YDD, S_HP, S_INT, S_Q, S_V, S_W, S_WB, S_WM, SOLVE_FACTORED, SOLVE_MIN_NORM, SOLVE_NONE, V_A,
     V_B, V_BX, V_BY, V_BZ, V_C0, V_CBC, V_CV, V_DHP, V_DINT, V_DIR, V_EV, V_F, V_FC, V_FDA,
     V_FEL, V_FFR, V_FGX, V_FGY, V_FGZ, V_FMAX, V_FMO, V_FPI, V_FS, V_FSP, V_FST, V_FUX,
     V_FUY, V_FUZ, V_GX, V_GY, V_GZ, V_HDA, V_HMO, V_HP, V_HPI, V_HPS, V_INT, V_KAP, V_KD,

@@ -15,11 +15,10 @@ from qzs.engine import kernels as K
 from qzs.engine.hexapod.dynamics import _advance_phases, _evaluate, _rest_frame
 from qzs.engine.hexapod.layout import (
     AXES, LANES, LEG_COUNT, N_ODE, N_ODE_BLOCKS, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE, PL_BLOCKS,
-    PL_CENTRAL, PL_CKD,
-    PL_CKI, PL_CKP, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_ICINV, PL_JINV, PL_MASS,
-    PL_ROTATING, S_C, S_INT, S_Q, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV, V_DIR, V_FC, V_FMAX,
-    V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK, V_TX, V_TY, V_TZ,
-    V_YDD, V_ZHIGH, V_ZLOW, V_ZREF, S_X)
+    PL_CENTRAL, PL_CKD, PL_CKI, PL_CKP, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_ICINV,
+    PL_JINV, PL_MASS, PL_ROTATING, S_C, S_INT, S_Q, S_X, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV,
+    V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
+    V_TX, V_TY, V_TZ, V_YDD, V_ZHIGH, V_ZLOW, V_ZREF)
 from qzs.engine.prepare import (check_record, linear_initial_state, linear_output, pack_model,
                                 steps_per_sample)
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test

@@ -257,7 +257,8 @@ class HexapodWriter(StreamWriter):
         super().__init__(path, hexapod_schema(blocks),
                          blocks={"data": N_CHANNELS if blocks else N_BASE_CHANNELS,
                                  "flags": N_FLAGS},
-                         columns={**_COLUMNS, **_BLOCK_COLUMNS} if blocks else _COLUMNS, values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
+                         columns={**_COLUMNS, **_BLOCK_COLUMNS} if blocks else _COLUMNS,
+                         values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
 
     def finish(self, result):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.

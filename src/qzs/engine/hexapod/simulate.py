@@ -135,7 +135,8 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
                               for i in range(LEG_COUNT)])
     recorder = driver.Recorder(
-        plan, N_CHANNELS if run.plat[PL_BLOCKS] != 0.0 else N_BASE_CHANNELS, N_FLAGS, statistics=statistics.add, sink=sink,
+        plan, N_CHANNELS if run.plat[PL_BLOCKS] != 0.0 else N_BASE_CHANNELS, N_FLAGS,
+        statistics=statistics.add, sink=sink,
         duration=run.duration, sample_rate=run.sample_rate,
         remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
                "qzs.workflows.hexapod.setups.simulate_setup(..., out=...)), or lower the "
