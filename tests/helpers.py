@@ -73,6 +73,27 @@ def lead_lag(sample_time=0.0):
     return qzs.LinearController.from_system(system, inputs=("measured_payload_velocity",))
 
 
+def vertical_legs(height=0.5):
+    """Six vertical legs, each top joint straight above its base joint, symmetric in pairs.
+
+    ``HexapodGeometry`` rightly refuses parallel legs (its Jacobian is singular: nothing
+    holds the platform sideways), so the object is built around its checks. The engine
+    copes: the static leg forces and, when several legs are locked, their holding forces are
+    the minimum-norm ones (equal shares). Under a platform of six masses and base motion in
+    z, each leg is the single-axis isolator.
+    """
+    from qzs.model.hexapod import HexapodGeometry
+
+    xy = np.array([[0.2, 0.1], [-0.2, -0.1], [0.2, -0.1], [-0.2, 0.1], [0.15, 0.0],
+                   [-0.15, 0.0]])
+    joints = np.column_stack([xy, np.zeros(6)])
+    geometry = object.__new__(HexapodGeometry)
+    for name, value in (("base_joints", joints), ("top_joints", joints.copy()),
+                        ("home_position", np.array([0.0, 0.0, height])), ("stroke_half", 0.080)):
+        object.__setattr__(geometry, name, value)
+    return geometry
+
+
 def stick_rises(locked):
     """Number of slip -> locked transitions in a boolean series."""
     return int(np.count_nonzero(np.diff(locked.astype(np.int8)) == 1))

@@ -182,28 +182,35 @@ def _linear_rates(M, x, u, excess, observer):
 
 
 @njit(**_JIT, inline="always")
-def _compensation(v, direction, P, M):
-    """The friction compensation's feedforward [N] at slip velocity ``v`` [m/s]."""
+def _compensation(v, direction, v_reg, M):
+    """The friction compensation's feedforward [N] at slip velocity ``v`` [m/s] (``v_reg``:
+    the plant's regularisation velocity [m/s], 0 for the exact model)."""
     if M[M_COMP_FRACTION] == 0.0:
         return 0.0
     return compensation_law(v, direction, M[M_COMP_FRACTION], M[M_COMP_FS], M[M_COMP_FC],
-                            M[M_COMP_CBC], M[M_COMP_CV], P[P_VREG], M[M_COMP_DEADBAND])
+                            M[M_COMP_CBC], M[M_COMP_CV], v_reg, M[M_COMP_DEADBAND])
 
 
 @njit(**_JIT, inline="always")
-def block_forces(t, s, x, v, direction, ydd, v_measured, held, P, M):
+def block_forces(t, error, x, v, direction, ydd, v_measured, held, sampled, v_reg, M):
     """The forces of the controller's blocks beyond PI + damping [N] (docs/model.md §5).
 
-    ``(compensation, dither, linear, feedforward)``: the friction compensation (its
-    feedforward less the observer's estimate of the friction left), the dither and the
-    linear controller's output (states ``x``); a sampled block's is the value it holds.
-    ``feedforward`` is the compensation's feedforward alone.
+    One leg's blocks, for every driver (the single axis, the lanes, each leg of the
+    hexapod): ``error`` the position error ``z_ref - z`` [m], ``v`` the slip velocity [m/s]
+    in ``direction``, ``ydd`` the base's acceleration [m/s^2], ``v_measured`` the charge
+    amplifier's velocity [m/s], ``held`` the sampled outputs (``A_F_*`` order), ``sampled``
+    whether the PI and its blocks are sampled, ``v_reg`` the plant's regularisation velocity,
+    ``M`` the packed blocks (``M_*``). Returns ``(compensation, dither, linear,
+    feedforward)``: the friction compensation (its feedforward less the observer's estimate
+    of the friction left), the dither and the linear controller's output (states ``x``); a
+    sampled block's is the value it holds. ``feedforward`` is the compensation's feedforward
+    alone.
     """
     feedforward = 0.0
-    if P[P_CONTROL_STEPS] > 0.0:
+    if sampled:
         f_comp, f_dither = held[3], held[4]
     else:
-        feedforward = _compensation(v, direction, P, M)
+        feedforward = _compensation(v, direction, v_reg, M)
         f_comp = feedforward - x[X_OBSERVER]
         f_dither = 0.0
         if M[M_DITHER_AMPLITUDE] != 0.0:
@@ -213,8 +220,73 @@ def block_forces(t, s, x, v, direction, ydd, v_measured, held, P, M):
         if M[M_LINEAR_STEPS] > 0.0:
             f_linear = held[5]
         else:  # the payload's acceleration enters only through B (docs/model.md §5)
-            f_linear = _linear_output(M, x, (P[P_ZREF] - s[S_Z], v_measured, 0.0, ydd, v))
+            f_linear = _linear_output(M, x, (error, v_measured, 0.0, ydd, v))
     return f_comp, f_dither, f_linear, feedforward
+
+
+@njit(**_JIT, inline="always")
+def block_rates(x, sensors, f_friction, f_stop, feedforward, excess, sampled, M):
+    """The rates of the blocks' state ``x`` (``X_*``) of one leg (docs/model.md §5).
+
+    ``sensors`` the five sensors (``U_*``), ``f_friction + f_stop`` the friction (the
+    holding force when stuck) and stop force [N], ``feedforward`` the compensation's
+    feedforward [N], ``excess`` the saturated motor force less the command [N]. The
+    observer's estimate follows the friction left after the feedforward (a sampled one
+    steps at its samples, :func:`sample_blocks`); a continuous linear controller's states
+    follow ``A x + B u + L excess``.
+    """
+    observer = 0.0
+    if not sampled and M[M_OBSERVER_RATE] > 0.0:
+        # the friction left after the feedforward, as the observer measures it
+        observer = M[M_OBSERVER_RATE] * (f_friction + f_stop + feedforward - x[X_OBSERVER])
+    if M[M_LINEAR] != 0.0 and M[M_LINEAR_STEPS] == 0.0:
+        return _linear_rates(M, x, sensors, excess, observer)
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, observer)
+
+
+@njit(**_JIT, inline="always")
+def sample_blocks(t, x, v, direction, held, f_friction, f_stop, f_pi, f_damp, f_linear, error,
+                  ki, f_max, steps, dt, v_reg, M):
+    """One leg's sampled blocks at a sample of the PI (docs/model.md §5).
+
+    The observer advanced by forward Euler over the period (``steps`` grid steps of ``dt``
+    [s]) from what it measures (``f_friction + f_stop`` [N] with the held outputs ``held``),
+    the compensation with its new estimate, the dither at ``t``; then the motor's command
+    with the PI's ``f_pi, f_damp`` and the linear output ``f_linear`` [N], saturated at
+    ``f_max`` (the PI's anti-windup with ``error`` [m] and ``ki``). Returns
+    ``(compensation, dither, motor force, integral rate, x)``.
+    """
+    if M[M_OBSERVER_RATE] > 0.0:
+        # advanced by forward Euler over the period from what it measures now, the
+        # feedforward applied until now being the held force plus the estimate it held
+        applied = held[3] + x[X_OBSERVER]
+        measured = f_friction + f_stop + applied
+        observer = x[X_OBSERVER] + M[M_OBSERVER_RATE] * (
+            measured - x[X_OBSERVER]) * steps * dt
+        x = (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], observer)
+    feedforward = _compensation(v, direction, v_reg, M)
+    f_comp = feedforward - x[X_OBSERVER]  # the new estimate, applied at once
+    f_dither = 0.0
+    if M[M_DITHER_AMPLITUDE] != 0.0:
+        f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
+    command = f_pi + f_damp + f_comp + f_dither + f_linear
+    f_motor, rate = saturation_law(command, error, ki, f_max)
+    return f_comp, f_dither, f_motor, rate, x
+
+
+@njit(**_JIT, inline="always")
+def linear_sample(M, x, sensors, others, error, ki, f_max):
+    """A discrete linear controller's sample: ``(output, next x)`` (docs/model.md §5).
+
+    Its output ``y = C x + D u`` [N] from the ``sensors`` (``U_*``), held to its next
+    sample, and its next state ``A x + B u + L (F_motor - command)`` (back-calculation),
+    ``command = others + y`` with ``others`` the rest of the motor's command [N],
+    saturated at ``f_max`` (``error`` [m] and ``ki``: the PI's anti-windup).
+    """
+    output = _linear_output(M, x, sensors)
+    command = others + output
+    f_motor = saturation_law(command, error, ki, f_max)[0]
+    return output, _linear_rates(M, x, sensors, f_motor - command, x[X_OBSERVER])
 
 
 #: The blocks' rates of a controller without blocks (or of a sampled one): none.
@@ -254,8 +326,9 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
     f_comp = f_dither = f_linear = feedforward = 0.0
     command = f_motor
     if blocks:
-        f_comp, f_dither, f_linear, feedforward = block_forces(t, s, x, v, direction, ydd,
-                                                               v_measured, held, P, M)
+        f_comp, f_dither, f_linear, feedforward = block_forces(
+            t, P[P_ZREF] - z, x, v, direction, ydd, v_measured, held, P[P_CONTROL_STEPS] > 0.0,
+            P[P_VREG], M)
         command = f_pi + f_damp + f_comp + f_dither + f_linear
         f_motor, rate = saturation_law(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
         if P[P_CONTROL_STEPS] == 0.0:
@@ -281,15 +354,8 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
 
     rates = _NO_RATES
     if blocks:
-        observer = 0.0
-        if P[P_CONTROL_STEPS] == 0.0 and M[M_OBSERVER_RATE] > 0.0:
-            # the friction left after the feedforward, as the observer measures it
-            observer = M[M_OBSERVER_RATE] * (f_friction + f_stop + feedforward - x[X_OBSERVER])
-        if M[M_LINEAR] != 0.0 and M[M_LINEAR_STEPS] == 0.0:
-            rates = _linear_rates(M, x, (P[P_ZREF] - z, v_measured, xdd, ydd, v),
-                                  f_motor - command, observer)
-        else:
-            rates = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, observer)
+        rates = block_rates(x, (P[P_ZREF] - z, v_measured, xdd, ydd, v), f_friction, f_stop,
+                            feedforward, f_motor - command, P[P_CONTROL_STEPS] > 0.0, M)
     deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
              (f_spring + f_friction + f_stop + f_motor) * yd, -f_friction * v, f_motor * v,
              -(f_stop - f_elastic) * v)
@@ -718,21 +784,10 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
     if M[M_BLOCKS] != 0.0:
         v = s[S_V] if mode == MODE_SLIP else 0.0
         force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, True)[1]
-        if M[M_OBSERVER_RATE] > 0.0:
-            # advanced by forward Euler over the period from what it measures now, the
-            # feedforward applied until now being the held force plus the estimate it held
-            applied = held[3] + x[X_OBSERVER]
-            measured = force[F_FRICTION] + force[F_STOP] + applied
-            observer = x[X_OBSERVER] + M[M_OBSERVER_RATE] * (
-                measured - x[X_OBSERVER]) * P[P_CONTROL_STEPS] * P[P_DT]
-            x = (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], observer)
-        feedforward = _compensation(v, float(direction), P, M)
-        f_comp = feedforward - x[X_OBSERVER]  # the new estimate, applied at once
-        f_dither = 0.0
-        if M[M_DITHER_AMPLITUDE] != 0.0:
-            f_dither = dither_law(t, M[M_DITHER_AMPLITUDE], M[M_DITHER_OMEGA])
-        command = f_pi + f_damp + f_comp + f_dither + force[F_LINEAR]
-        f_motor, rate = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
+        f_comp, f_dither, f_motor, rate, x = sample_blocks(
+            t, x, v, float(direction), held, force[F_FRICTION], force[F_STOP], f_pi, f_damp,
+            force[F_LINEAR], P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX], P[P_CONTROL_STEPS],
+            P[P_DT], P[P_VREG], M)
     s = _with(s, S_INT, s[S_INT] + rate * P[P_CONTROL_STEPS] * P[P_DT])
     return (f_pi, f_damp, f_motor, f_comp, f_dither, held[5]), s, x
 
@@ -748,10 +803,9 @@ def sample_linear(t, s, x, mode, direction, held, P, M, E, table):
     force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     u = (P[P_ZREF] - s[S_Z], force[F_V_MEASURED], force[F_XDD], force[F_YDD], v)
-    output = _linear_output(M, x, u)
-    command = force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER] + output
-    f_motor = saturation_law(command, P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])[0]
-    x = _linear_rates(M, x, u, f_motor - command, x[X_OBSERVER])
+    output, x = linear_sample(
+        M, x, u, force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER],
+        P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
     return (held[0], held[1], held[2], held[3], held[4], output), x
 
 

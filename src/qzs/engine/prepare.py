@@ -16,7 +16,8 @@ from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, S
 from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "pack_model", "run_inputs", "run_duration", "steps_per_sample",
+__all__ = ["PreparedRun", "prepare_run", "pack_model", "linear_initial_state", "linear_output",
+           "run_inputs", "run_duration", "steps_per_sample",
            "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
            "check_record", "RECORD_BYTES_PER_POINT"]
@@ -337,24 +338,73 @@ def _preload_linear(s, p, m, controller, packed_excitation, preload):
     n = linear.states
     if n == 0:
         return
-    a, b, c, d = linear.matrices()
     force = K.hold_force(0.0, s, p, m, *packed_excitation)
-    u_all = np.array([p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD],
-                      force[K.F_YDD], 0.0])
-    u0 = u_all[[list(K_SENSORS).index(name) for name in linear.inputs]]
-    system = a - np.eye(n) if linear.discrete else a
-    rows, rhs = [system], [-(b @ u0)]
+    sensors = np.array([p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD],
+                        force[K.F_YDD], 0.0])
+    load, needed = None, 0.0
     if preload and controller.pi_ki == 0:
         at_rest = K.hold_force(0.0, s, p, m, *_AT_REST)
         needed = np.clip(at_rest[K.F_HOLD] + at_rest[K.F_MOTOR], -p[K.P_FMAX], p[K.P_FMAX])
+        load = needed - at_rest[K.F_PI] - at_rest[K.F_DAMP]
+    s[K.A_X0:K.A_X0 + n] = linear_initial_state(linear, sensors, load, needed)
+
+
+def linear_initial_state(linear, sensors, load=None, needed=0.0):
+    """A linear controller's state at t = 0, at equilibrium with its sensors (docs/model.md §5.1).
+
+    ``x0`` solves ``A x0 + B u0 = 0`` (discrete: ``x0 = A x0 + B u0``), least squares; with
+    ``load``, also ``C x0 + D u0 = load``, if its states can carry it (an integrator), else
+    the equilibrium alone. For every driver: the single axis, each leg of the hexapod.
+
+    Parameters
+    ----------
+    linear : LinearController
+        The controller (at least one state).
+    sensors : array_like, shape (5,)
+        The five sensors at t = 0 [SI], in the kernels' order (``K.U_*``).
+    load : float, optional
+        The static load its output should carry besides the PI and damping [N] (the PI has
+        no integral); None: none.
+    needed : float
+        The static load the motor carries [N] (the scale of the tolerance on ``load``).
+
+    Returns
+    -------
+    ndarray, shape (linear.states,)
+    """
+    n = linear.states
+    a, b, c, d = linear.matrices()
+    u0 = np.asarray(sensors)[[list(K_SENSORS).index(name) for name in linear.inputs]]
+    system = a - np.eye(n) if linear.discrete else a
+    rows, rhs = [system], [-(b @ u0)]
+    if load is not None:
         loaded = np.vstack([system, c])
-        target = np.concatenate([-(b @ u0), [needed - at_rest[K.F_PI] - at_rest[K.F_DAMP]
-                                             - float(d[0] @ u0)]])
+        target = np.concatenate([-(b @ u0), [load - float(d[0] @ u0)]])
         x0 = np.linalg.lstsq(loaded, target, rcond=None)[0]
         if np.allclose(loaded @ x0, target, rtol=1e-9, atol=1e-12 * max(1.0, abs(needed))):
-            s[K.A_X0:K.A_X0 + n] = x0
-            return
-    s[K.A_X0:K.A_X0 + n] = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+            return x0
+    return np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+
+
+def linear_output(m, x, sensors):
+    """A linear controller's output ``C x + D u`` [N]: what a discrete one holds at t = 0.
+
+    Parameters
+    ----------
+    m : ndarray, shape (N_MODEL,)
+        The packed blocks (``K.M_*``, :func:`pack_model`).
+    x : array_like, shape (NX_MAX,)
+        Its states, zero-padded.
+    sensors : array_like, shape (5,)
+        The five sensors [SI] (``K.U_*``).
+
+    Returns
+    -------
+    float
+        The output [N].
+    """
+    return (float(np.dot(m[K.M_C:K.M_C + K.NX_MAX], x))
+            + float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], sensors)))
 
 
 def _hold_blocks(s, p, m, packed_excitation):
@@ -369,8 +419,7 @@ def _hold_blocks(s, p, m, packed_excitation):
     if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's output at x(0): C x + D u
         u = (p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD], force[K.F_YDD],
              0.0)
-        s[K.A_F_LINEAR] = (float(np.dot(m[K.M_C:K.M_C + K.NX_MAX], s[K.A_X0:K.A_X0 + K.NX_MAX]))
-                           + float(np.dot(m[K.M_D:K.M_D + K.N_SENSORS], u)))
+        s[K.A_F_LINEAR] = linear_output(m, s[K.A_X0:K.A_X0 + K.NX_MAX], u)
 
 
 @dataclass

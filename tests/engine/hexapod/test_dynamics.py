@@ -16,12 +16,13 @@ import re
 
 import numpy as np
 import pytest
+from helpers import vertical_legs
 
 from qzs import (Chirp, ControllerParameters, DisplacementRecord, IsolatorParameters,
                  ParameterError, Sine, StabilityError, simulate)
 from qzs.analysis.hexapod_linear import hexapod_linearize
 from qzs.engine.hexapod import AXES, HEXAPOD_CHANNELS, HexapodResult, simulate_hexapod
-from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
+from qzs.model.hexapod import (CartesianController, PlatformParameters,
                                cubic_geometry, jacobian, static_leg_forces)
 
 STABLE = ControllerParameters(pi_kp=2000.0, pi_ki=800.0)
@@ -221,24 +222,6 @@ def test_legs_stay_within_their_stops_contact_bound():
 
 
 # ---------------------------------------------------------------- the single axis
-def vertical_legs(height=0.5):
-    """Six vertical legs, each top joint straight above its base joint, symmetric in pairs.
-
-    ``HexapodGeometry`` rightly refuses parallel legs (its Jacobian is singular: nothing
-    holds the platform sideways), so the object is built around its checks. The engine
-    copes: the static leg forces and, when several legs are locked, their holding forces are
-    the minimum-norm ones (equal shares).
-    """
-    xy = np.array([[0.2, 0.1], [-0.2, -0.1], [0.2, -0.1], [-0.2, 0.1], [0.15, 0.0],
-                   [-0.15, 0.0]])
-    joints = np.column_stack([xy, np.zeros(6)])
-    geometry = object.__new__(HexapodGeometry)
-    for name, value in (("base_joints", joints), ("top_joints", joints.copy()),
-                        ("home_position", np.array([0.0, 0.0, height])), ("stroke_half", 0.080)):
-        object.__setattr__(geometry, name, value)
-    return geometry
-
-
 @pytest.mark.parametrize("excitation, duration, isolator", [
     (Chirp(duration=20.0), 8.0, IsolatorParameters()),
     (Sine(amplitude=0.01, frequency=4.0), 6.0, IsolatorParameters(stiction_force=4.0,

@@ -2,18 +2,23 @@
 output columns exactly, and its file layout gives every variable its dims and units."""
 import numpy as np
 
-from qzs.engine.hexapod.layout import AXES, LEG_COUNT, N_CHANNELS, N_FLAGS
-from qzs.engine.hexapod.result import HEXAPOD_CHANNELS, HEXAPOD_FLAGS, hexapod_file_layout
+from qzs.engine.hexapod.layout import AXES, LEG_COUNT, N_BASE_CHANNELS, N_CHANNELS, N_FLAGS
+from qzs.engine.hexapod.result import (HEXAPOD_BLOCK_CHANNELS, HEXAPOD_CHANNELS, HEXAPOD_FLAGS,
+                                       hexapod_file_layout)
 
 WIDTH = {None: 1, "dof": 6, "leg": LEG_COUNT}
 
 
 def test_the_channels_and_flags_tile_the_output_columns():
     """Every column of the kernels' output belongs to exactly one channel (and every flag
-    column to one flag): no channel reads another's column, none is left unnamed."""
+    column to one flag): no channel reads another's column, none is left unnamed; the legs'
+    block forces fill the columns a row with blocks adds."""
     columns = sorted(c for first, dim, _, _ in HEXAPOD_CHANNELS.values()
                      for c in range(first, first + WIDTH[dim]))
-    assert columns == list(range(N_CHANNELS))
+    assert columns == list(range(N_BASE_CHANNELS))
+    extra = sorted(c for first, dim, _, _ in HEXAPOD_BLOCK_CHANNELS.values()
+                   for c in range(first, first + WIDTH[dim]))
+    assert extra == list(range(N_BASE_CHANNELS, N_CHANNELS))
     flags = sorted(c for first, _ in HEXAPOD_FLAGS.values() for c in range(first, first + 6))
     assert flags == list(range(N_FLAGS))
 

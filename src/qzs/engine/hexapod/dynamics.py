@@ -47,9 +47,10 @@ from numba import njit
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
 from qzs.engine.hexapod.layout import (
-    LANES, LEG_COUNT, MODE_SLIP, PL_ACTIVE, PL_CENTRAL, PL_CKD, PL_CKI, PL_CKP,
-    PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_ROTATING, S_C, S_DF, S_DS,
-    S_HP, S_INT, S_Q, S_V, S_W, S_WB, S_WM, SOLVE_FACTORED, SOLVE_MIN_NORM, SOLVE_NONE, V_A,
+    LANES, LEG_COUNT, MODE_SLIP, N_MODEL, PL_ACTIVE, PL_BLOCKS, PL_CENTRAL, PL_CKD, PL_CKI,
+    PL_CKP, PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_MODEL, PL_ROTATING, S_C,
+    S_DF, S_DS, S_X, V_CMD, V_FCO, V_FDI, V_FFF, V_FLI, V_FRESH, V_HCO, V_HDI, V_HLI, V_XDD,
+    V_YDD, S_HP, S_INT, S_Q, S_V, S_W, S_WB, S_WM, SOLVE_FACTORED, SOLVE_MIN_NORM, SOLVE_NONE, V_A,
     V_B, V_BX, V_BY, V_BZ, V_C0, V_CBC, V_CV, V_DHP, V_DINT, V_DIR, V_EV, V_F, V_FC, V_FDA,
     V_FEL, V_FFR, V_FGX, V_FGY, V_FGZ, V_FMAX, V_FMO, V_FPI, V_FS, V_FSP, V_FST, V_FUX,
     V_FUY, V_FUZ, V_GX, V_GY, V_GZ, V_HDA, V_HMO, V_HP, V_HPI, V_HPS, V_INT, V_KAP, V_KD,
@@ -57,8 +58,10 @@ from qzs.engine.hexapod.layout import (
     V_STOPK, V_TX, V_TY, V_TZ, V_UX, V_UY, V_UZ, V_V, V_VME, V_VR, V_XB, V_Z, V_ZHIGH,
     V_ZLOW, V_ZREF, W_ACC, W_AL, W_ALW, W_AO, W_CART, W_FSUM, W_GH, W_IBI, W_IMPULSE, W_OM,
     W_OMW, W_PHASE, W_PIVOTS, W_RB, W_RR, W_SOLVE, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.laws import (compliant_stop_law, controller_law, sliding_friction_law,
-                             spring_law)
+from qzs.engine.kernels import (M_LINEAR_STEPS, N_X, X_OBSERVER, block_forces, block_rates,
+                                linear_sample, sample_blocks)
+from qzs.engine.laws import (compliant_stop_law, controller_law, saturation_law,
+                             sliding_friction_law, spring_law)
 from qzs.engine.stickslip import MODE_STICK, hold_margin, slip_event
 
 #: A Cholesky pivot below this share of the largest diagonal entry marks redundant locked legs.
@@ -415,6 +418,174 @@ def _project(s, plat, ww, V, A, idx, vec):
     s[S_DF] += loss
 
 
+# ---------------------------------------------------------------- each leg's controller blocks
+@njit(**_JIT, inline="always")
+def _model(plat, i):
+    """Leg ``i``'s packed blocks (``qzs.engine.kernels.M_*``): a view of ``plat``."""
+    start = PL_MODEL + i * N_MODEL
+    return plat[start:start + N_MODEL]
+
+
+@njit(**_JIT, inline="always")
+def _leg_state(s, i):
+    """Leg ``i``'s blocks' state (``qzs.engine.kernels.X_*``) as a tuple."""
+    o = S_X + i * N_X
+    return (s[o], s[o + 1], s[o + 2], s[o + 3], s[o + 4], s[o + 5], s[o + 6], s[o + 7],
+            s[o + 8])
+
+
+@njit(**_JIT, inline="always")
+def _base_acceleration(ww, V, i):
+    """Leg ``i``'s base accelerometer [m/s^2]: its base joint's acceleration along the leg.
+
+    ``u_i . (a_O + a_b x b_i + w_b x (w_b x b_i))`` in B (a base that does not rotate leaves
+    ``a_b = w_b = 0``): the single axis's base acceleration ``y''`` for a vertical leg.
+    """
+    bx, by, bz = V[V_BX + i], V[V_BY + i], V[V_BZ + i]
+    obx, oby, obz = ww[W_OM], ww[W_OM + 1], ww[W_OM + 2]
+    e1 = _cross(ww[W_AL], ww[W_AL + 1], ww[W_AL + 2], bx, by, bz)
+    e2 = _cross(obx, oby, obz, bx, by, bz)
+    e3 = _cross(obx, oby, obz, e2[0], e2[1], e2[2])
+    return (V[V_UX + i] * (ww[W_AO] + e1[0] + e3[0]) + V[V_UY + i] * (ww[W_AO + 1] + e1[1] + e3[1])
+            + V[V_UZ + i] * (ww[W_AO + 2] + e1[2] + e3[2]))
+
+
+@njit(**_JIT, inline="always")
+def _slip(V, i):
+    """Leg ``i``'s slip velocity as its blocks read it [m/s]: 0 at the instant it is released.
+
+    The single axis's slip velocity is exactly 0 there (it was held); a leg's is the
+    platform's velocity along it, 0 to the rounding of the locked legs' projection. The
+    compensation, a law that jumps at ``v = 0`` (docs/model.md §5.1), must not see that
+    rounding: until the state moves (the next Runge-Kutta stage, ``FRESH`` cleared by
+    :func:`qzs.engine.hexapod.stepping._rk`) a released leg reads 0.
+    """
+    return 0.0 if V[V_FRESH + i] != 0.0 else V[V_V + i]
+
+
+@njit(**_JIT)
+def _leg_blocks(t, s, plat, ww, V):
+    """Each leg's blocks beyond PI + damping, added to its command (docs/model.md §5.1).
+
+    Per leg, the single axis's :func:`qzs.engine.kernels.block_forces` on that leg's
+    sensors (its encoder's error and slip velocity, its amplifier's velocity, its base
+    accelerometer, :func:`_base_acceleration`) with its own packed blocks (:func:`_model`)
+    and state (:func:`_leg_state`); the motor force is the saturated sum with the PI and
+    damping commands already in ``V`` (continuous, or held), and a continuous PI's integral
+    stops by the same conditional integration. Writes the rows ``FCO, FDI, FLI`` (the
+    blocks' forces), ``FFF`` (the feedforward), ``CMD`` (the command before saturation),
+    ``YDD`` (the base accelerometer), ``FMO`` and ``DINT``.
+    """
+    sampled = plat[PL_CONTROL_STEPS] > 0.0
+    for i in range(LEG_COUNT):
+        error = V[V_ZREF + i] - V[V_Z + i]
+        ydd = _base_acceleration(ww, V, i)
+        held = (V[V_HPI + i], V[V_HDA + i], V[V_HMO + i], V[V_HCO + i], V[V_HDI + i],
+                V[V_HLI + i])
+        f_comp, f_dither, f_linear, feedforward = block_forces(
+            t, error, _leg_state(s, i), _slip(V, i), V[V_DIR + i], ydd, V[V_VME + i], held,
+            sampled, 0.0, _model(plat, i))
+        command = V[V_FPI + i] + V[V_FDA + i] + f_comp + f_dither + f_linear
+        f_motor, rate = saturation_law(command, error, V[V_KI + i], V[V_FMAX + i])
+        V[V_FCO + i] = f_comp
+        V[V_FDI + i] = f_dither
+        V[V_FLI + i] = f_linear
+        V[V_FFF + i] = feedforward
+        V[V_CMD + i] = command
+        V[V_YDD + i] = ydd
+        V[V_FMO + i] = f_motor
+        if not sampled:
+            V[V_DINT + i] = rate
+    for pad in range(LEG_COUNT, LANES):  # the padding lanes copy leg 1
+        V[V_FMO + pad] = V[V_FMO]
+        V[V_DINT + pad] = V[V_DINT]
+
+
+@njit(**_JIT)
+def _leg_block_rates(s, plat, ww, V, d):
+    """Each leg's blocks' state rates into ``d`` (:func:`qzs.engine.kernels.block_rates`).
+
+    After the platform's equation (``ww[W_ACC:]``) and the locked legs' holding forces
+    (``FFR``): a leg's payload accelerometer reads its base accelerometer plus its slip
+    acceleration ``v_i' = G_i nu' + kappa_i`` (0 while locked), the single axis's ``x''``
+    for a vertical leg (row ``XDD``); its observer measures its friction (the holding force
+    when locked) and stop force.
+    """
+    sampled = plat[PL_CONTROL_STEPS] > 0.0
+    for i in range(LEG_COUNT):
+        slip_rate = 0.0
+        if V[V_MODE + i] == MODE_SLIP:
+            slip_rate = (V[V_UX + i] * ww[W_ACC] + V[V_UY + i] * ww[W_ACC + 1]
+                         + V[V_UZ + i] * ww[W_ACC + 2] + V[V_GX + i] * ww[W_ACC + 3]
+                         + V[V_GY + i] * ww[W_ACC + 4] + V[V_GZ + i] * ww[W_ACC + 5]
+                         + V[V_KAP + i])
+        xdd = V[V_YDD + i] + slip_rate
+        V[V_XDD + i] = xdd
+        sensors = (V[V_ZREF + i] - V[V_Z + i], V[V_VME + i], xdd, V[V_YDD + i], _slip(V, i))
+        rates = block_rates(_leg_state(s, i), sensors, V[V_FFR + i], V[V_FST + i],
+                            V[V_FFF + i], V[V_FMO + i] - V[V_CMD + i], sampled,
+                            _model(plat, i))
+        o = S_X + i * N_X
+        for k in range(N_X):
+            d[o + k] = rates[k]
+
+
+@njit(**_JIT)
+def _sample_blocks(t, plat, V, s, h):
+    """Each leg's sampled blocks at a sample of the PI (:func:`qzs.engine.kernels.sample_blocks`).
+
+    After :func:`_commands` (the PI and damping outputs in ``FPI, FDA``), from what the last
+    evaluation left in ``V`` (friction, stop force, the linear output, the sensors): the
+    observer advanced, the compensation and dither held (``HCO, HDI``), the motor's command
+    saturated (``FMO``) and the integral's rate (``DINT``).
+    """
+    for i in range(LEG_COUNT):
+        held = (V[V_HPI + i], V[V_HDA + i], V[V_HMO + i], V[V_HCO + i], V[V_HDI + i],
+                V[V_HLI + i])
+        f_comp, f_dither, f_motor, rate, x = sample_blocks(
+            t, _leg_state(s, i), _slip(V, i), V[V_DIR + i], held, V[V_FFR + i], V[V_FST + i],
+            V[V_FPI + i], V[V_FDA + i], V[V_FLI + i], V[V_ZREF + i] - V[V_Z + i], V[V_KI + i],
+            V[V_FMAX + i], plat[PL_CONTROL_STEPS], h, 0.0, _model(plat, i))
+        V[V_HCO + i] = f_comp
+        V[V_HDI + i] = f_dither
+        V[V_FMO + i] = f_motor
+        V[V_DINT + i] = rate
+        s[S_X + i * N_X + X_OBSERVER] = x[X_OBSERVER]
+    for pad in range(LEG_COUNT, LANES):
+        V[V_FMO + pad] = V[V_FMO]
+        V[V_DINT + pad] = V[V_DINT]
+
+
+@njit(**_JIT)
+def _linear_due(plat, step):
+    """Whether a leg's discrete linear controller samples at grid step ``step``."""
+    for i in range(LEG_COUNT):
+        steps = int(plat[PL_MODEL + i * N_MODEL + M_LINEAR_STEPS])
+        if steps > 0 and step % steps == 0:
+            return True
+    return False
+
+
+@njit(**_JIT)
+def _sample_linear(step, plat, V, s):
+    """Each leg's discrete linear controller that samples at grid step ``step``
+    (:func:`qzs.engine.kernels.linear_sample`), from the sensors and the other commands of an
+    evaluation at that instant: its output held (``HLI``), its states stepped in ``s``."""
+    for i in range(LEG_COUNT):
+        M = _model(plat, i)
+        steps = int(M[M_LINEAR_STEPS])
+        if steps > 0 and step % steps == 0:
+            error = V[V_ZREF + i] - V[V_Z + i]
+            sensors = (error, V[V_VME + i], V[V_XDD + i], V[V_YDD + i], _slip(V, i))
+            output, x = linear_sample(M, _leg_state(s, i), sensors,
+                                      V[V_FPI + i] + V[V_FDA + i] + V[V_FCO + i] + V[V_FDI + i],
+                                      error, V[V_KI + i], V[V_FMAX + i])
+            V[V_HLI + i] = output
+            o = S_X + i * N_X
+            for k in range(N_X):
+                s[o + k] = x[k]
+
+
 # ---------------------------------------------------------------- the right-hand side
 @njit(**_JIT)
 def _commands(plat, ww, V):
@@ -477,13 +648,17 @@ def _commands(plat, ww, V):
 
 
 @njit(**_JIT)
-def _sample(plat, ww, V, s, h):
-    """A sampled controller's sample: outputs from the sensors of the last evaluation, held.
+def _sample(t, plat, ww, V, s, h):
+    """A sampled controller's sample at ``t`` [s]: outputs from the sensors of the last
+    evaluation, held.
 
-    As the single axis's (docs/model.md §5): the outputs with the current integrals, then the
-    integrals advanced by forward Euler over the controller's period, ``I + rate N h``.
+    As the single axis's (docs/model.md §5): the outputs with the current integrals (with
+    blocks, theirs too, :func:`_sample_blocks`), then the integrals advanced by forward Euler
+    over the controller's period, ``I + rate N h``.
     """
     _commands(plat, ww, V)
+    if plat[PL_BLOCKS] != 0.0:
+        _sample_blocks(t, plat, V, s, h)
     for i in range(LANES):
         V[V_HPI + i] = V[V_FPI + i]
         V[V_HDA + i] = V[V_FDA + i]
@@ -590,6 +765,8 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
             V[V_DINT + i] = 0.0
     else:
         _commands(plat, ww, V)
+    if plat[PL_BLOCKS] != 0.0:  # each leg's own blocks (docs/model.md §5.1)
+        _leg_blocks(t, s, plat, ww, V)
     for i in range(LANES):
         slipping = V[V_MODE + i] == MODE_SLIP
         v = V[V_V + i]
@@ -697,6 +874,8 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
     d[S_DF] = friction_loss
     d[S_WM] = motor_power
     d[S_DS] = stop_loss
+    if plat[PL_BLOCKS] != 0.0:
+        _leg_block_rates(s, plat, ww, V, d)
 
 
 # Stale cached kernels of this module are dropped with the others (qzs.engine.arithmetic:

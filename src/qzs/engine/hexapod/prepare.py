@@ -11,23 +11,25 @@ import numpy as np
 from qzs import defaults
 from qzs._validation import choice, positive_real
 from qzs.engine import driver
-from qzs.engine.hexapod.dynamics import _evaluate, _rest_frame
+from qzs.engine import kernels as K
+from qzs.engine.hexapod.dynamics import _advance_phases, _evaluate, _rest_frame
 from qzs.engine.hexapod.layout import (
-    AXES, LANES, LEG_COUNT, N_ODE, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE, PL_CENTRAL, PL_CKD,
-    PL_CKI, PL_CKP, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_ICINV, PL_JINV, PL_MASS,
-    PL_ROTATING, S_C, S_INT, S_Q, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV, V_DIR, V_FC, V_FMAX,
-    V_FS, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK, V_TX, V_TY, V_TZ, V_ZHIGH,
-    V_ZLOW, V_ZREF)
-from qzs.engine.prepare import check_record, steps_per_sample
+    AXES, LANES, LEG_COUNT, N_ODE, N_ODE_BLOCKS, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE, PL_BLOCKS,
+    PL_CENTRAL, PL_CKD, PL_CKI, PL_CKP, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_ICINV,
+    PL_JINV, PL_MASS, PL_ROTATING, S_C, S_INT, S_Q, S_X, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV,
+    V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
+    V_TX, V_TY, V_TZ, V_YDD, V_ZHIGH, V_ZLOW, V_ZREF)
+from qzs.engine.prepare import (check_record, linear_initial_state, linear_output, pack_model,
+                                steps_per_sample)
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError
-from qzs.model.controller import ControllerParameters
+from qzs.model.controller import ControllerParameters, refuse_blocks
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_force
 
-__all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option"]
+__all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 
@@ -41,6 +43,22 @@ def _per_leg(name, value, kind):
         return tuple(value)
     raise ParameterError(f"`{name}` must be a {kind.__name__} or a sequence of six (one per "
                          f"leg), got {value!r}.")
+
+
+def has_blocks(controller):
+    """Whether a platform's controller has blocks beyond PI + damping on any leg.
+
+    Parameters
+    ----------
+    controller : ControllerParameters, sequence of six, or None
+        As :func:`~qzs.engine.hexapod.simulate.simulate_hexapod` takes it.
+
+    Returns
+    -------
+    bool
+    """
+    legs = controller if isinstance(controller, (list, tuple)) else (controller,)
+    return any(isinstance(c, ControllerParameters) and c.has_blocks for c in legs)
 
 
 def _excitations(excitation):
@@ -148,6 +166,29 @@ def _effective_leg_mass(geometry, platform):
     inverse[:3, :3] = np.eye(3) / platform.mass
     inverse[3:, 3:] = np.linalg.inv(platform.inertia)
     return 1.0 / float(np.max(np.linalg.eigvalsh(rows @ inverse @ rows.T)))
+
+
+def _start_blocks(controllers, models, needed, state, V):
+    """Each leg's linear controller at t = 0, as the single axis's (docs/model.md §5.1).
+
+    At equilibrium with the leg's sensors at home, locked (no error, the amplifier settled,
+    both accelerometers reading the base joint's acceleration along the leg, row ``YDD``
+    of the evaluation at t = 0), carrying the leg's static load ``needed`` [N] when its PI
+    has no integral (:func:`qzs.engine.prepare.linear_initial_state`); a discrete one holds
+    its output there. The PI's preload needs no change: the blocks put out nothing at home
+    with the base at rest.
+    """
+    for i, (con, m) in enumerate(zip(controllers, models)):
+        linear = con.linear
+        if linear is None or linear.states == 0:
+            continue
+        sensors = np.array([0.0, 0.0, V[V_YDD + i], V[V_YDD + i], 0.0])
+        load = needed[i] if con.pi_ki == 0 else None
+        x0 = linear_initial_state(linear, sensors, load, needed[i])
+        state[S_X + i * K.N_X:S_X + i * K.N_X + linear.states] = x0
+        if linear.discrete:
+            V[V_HLI + i] = linear_output(m, state[S_X + i * K.N_X:S_X + i * K.N_X + K.NX_MAX],
+                                         sensors)
 
 
 @dataclass
@@ -273,6 +314,16 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
         raise ParameterError(
             f"`cartesian` must be a CartesianController (e.g. CartesianController.from_legs("
             f"geometry, controller)) or None for per-leg loops, got {type(cartesian).__name__}.")
+    if cartesian is not None:  # the blocks are each leg's own, added to its own loop
+        refuse_blocks(controllers, "centralised control (`cartesian`)",
+                      "give the blocks to per-leg loops (cartesian=None)")
+    models = []
+    for leg, (iso, con) in enumerate(zip(isolators, controllers)):
+        try:  # a discrete linear controller's period: a whole number of steps
+            models.append(pack_model(iso, con, dt))
+        except ParameterError as error:
+            raise ParameterError(f"leg {leg + 1}: {error}", error.options) from None
+    blocks = has_blocks(controllers)
     if not hexapod_stability_test(geometry, platform, isolators, controllers, solver)(dt):
         mass = _effective_leg_mass(geometry, platform)
         limit = _stability_limit(geometry, platform, isolators, controllers, solver)
@@ -329,15 +380,20 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     plat[PL_ROTATING] = float(any(axis in moving for axis in AXES[3:]))
     tables = np.ascontiguousarray(np.concatenate(pieces, axis=1))
     toff = np.asarray(offsets, dtype=np.int64)
+    if blocks:  # each leg's blocks packed after the platform's constants (layout: PL_MODEL)
+        plat[PL_BLOCKS] = 1.0
+        plat = np.concatenate([plat, np.ravel(models)])
 
-    state = np.zeros(N_ODE)
+    state = np.zeros(N_ODE_BLOCKS if blocks else N_ODE)
     state[S_C:S_C + 3] = platform.center_of_mass  # at home: c = o + R_r c_t, o = 0, R_r = I
     state[S_Q] = 1.0
     ww = np.zeros(N_WORK)
     _rest_frame(ww)
+    if blocks:  # the base's motion at t = 0, for the legs' base accelerometers (row YDD)
+        _advance_phases(0.0, True, plat, ex, ww)
     _evaluate(0.0, state, plat, ex, tables, toff, ww, V, np.zeros((6, 6)),
-              np.zeros(LEG_COUNT, dtype=np.int64), np.zeros((2, LEG_COUNT)), np.zeros(N_ODE),
-              False)
+              np.zeros(LEG_COUNT, dtype=np.int64), np.zeros((2, LEG_COUNT)),
+              np.zeros(state.size), False)
     # the kernels' own arithmetic: z = z_ref exactly at home
     V[V_LHOME:V_LHOME + LANES] = V[V_L:V_L + LANES]
     # PI preload (docs/model.md §5 for each leg): the motor carries the static leg load the
@@ -353,6 +409,8 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
         wrench = jacobian(geometry, point=cartesian.point_in_top_frame(platform)).T @ needed
         held = cartesian.integral_gain > 0
         state[S_INT:S_INT + LEG_COUNT][held] = wrench[held] / cartesian.integral_gain[held]
+    if blocks:
+        _start_blocks(controllers, models, needed, state, V)
     return _Prepared(geometry, platform, isolators, controllers, moving, duration, dt,
                      sample_rate, decimation, solver, solver_code, V, plat, ex, tables, toff,
                      state, cartesian)

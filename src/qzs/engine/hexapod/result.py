@@ -15,11 +15,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from qzs.defaults import AXIS_RATE_UNITS, AXIS_UNITS
+from qzs.engine.channels import BLOCK_CHANNELS
 from qzs.engine.hexapod.layout import (AXES, C_ACC, C_BASE_ACC, C_BASE_POSE, C_BASE_VEL,
-                                       C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR,
-                                       C_FMO, C_FPI, C_FSP, C_FST, C_POSE, C_TIME, C_TWIST,
-                                       C_V, C_VME, C_WB, C_WM, C_Z, LEG_COUNT, N_CHANNELS,
-                                       N_FLAGS, O_CONTACT, O_LOCKED)
+                                       C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FCO, C_FDA,
+                                       C_FDI, C_FFR, C_FLI, C_FMO, C_FOB, C_FPI, C_FSP, C_FST,
+                                       C_POSE, C_TIME, C_TWIST, C_V, C_VME, C_WB, C_WM, C_Z,
+                                       LEG_COUNT, N_BASE_CHANNELS, N_CHANNELS, N_FLAGS,
+                                       O_CONTACT, O_LOCKED)
 from qzs.engine.hexapod.statistics import _Statistics, _summary_text
 from qzs.errors import ParameterError
 from qzs.iotools.paths import check_output_path
@@ -36,7 +38,8 @@ if TYPE_CHECKING:
     from qzs.model.hexapod import HexapodGeometry, PlatformParameters
     from qzs.model.isolator import IsolatorParameters
 
-__all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_FLAGS", "hexapod_schema",
+__all__ = ["HexapodResult", "HEXAPOD_CHANNELS", "HEXAPOD_BLOCK_CHANNELS", "HEXAPOD_FLAGS",
+           "hexapod_schema",
            "hexapod_file_layout", "HexapodWriter", "estimated_hexapod_size", "HEXAPOD_SUFFIXES",
            "save_hexapod_result"]
 
@@ -84,6 +87,12 @@ HEXAPOD_CHANNELS = {
                                         "mass (world frame)"),
     "stop_energy": (C_EST, None, "J", "elastic energy stored in the compliant stops"),
 }
+#: Each leg's block forces beyond PI + damping (docs/model.md §5.1), recorded only when a
+#: leg's controller has blocks (0 on a leg without that block): name -> as HEXAPOD_CHANNELS.
+HEXAPOD_BLOCK_CHANNELS = {
+    name: (column, "leg", BLOCK_CHANNELS[name][1], f"{BLOCK_CHANNELS[name][2]}, per leg")
+    for name, column in (("compensation_force", C_FCO), ("friction_estimate", C_FOB),
+                         ("dither_force", C_FDI), ("linear_force", C_FLI))}
 #: Boolean outputs per leg: name -> (first column, description).
 HEXAPOD_FLAGS = {
     "locked": (O_LOCKED, "leg held at zero slip by friction"),
@@ -107,6 +116,8 @@ def _attribute(value):
 
 
 #: Where a run's output rows go in its file: variable -> (block, column or the six columns).
+_BLOCK_COLUMNS = {name: ("data", slice(column, column + 6))
+                  for name, (column, _, _, _) in HEXAPOD_BLOCK_CHANNELS.items()}
 _COLUMNS = {**{name: ("data", column if dim is None else slice(column, column + 6))
                for name, (column, dim, _, _) in HEXAPOD_CHANNELS.items()},
             **{name: ("flags", slice(column, column + 6))
@@ -115,7 +126,12 @@ _COLUMNS = {**{name: ("data", column if dim is None else slice(column, column + 
 _LABELS = {"dof": list(AXES), "leg": np.arange(1, LEG_COUNT + 1)}
 
 
-def hexapod_schema():
+def _channels(blocks):
+    """The channels of a run: with ``blocks``, each leg's block forces too."""
+    return {**HEXAPOD_CHANNELS, **HEXAPOD_BLOCK_CHANNELS} if blocks else HEXAPOD_CHANNELS
+
+
+def hexapod_schema(blocks=False):
     """The CF-1.10 layout of a hexapod run's dataset and file (docs/model.md §7).
 
     What :meth:`HexapodResult.to_xarray` builds and :class:`HexapodWriter` streams:
@@ -124,12 +140,18 @@ def hexapod_schema():
     lists one unit per dof (``units_by_dof`` names them); flags are int8 0/1 with
     ``flag_values`` and ``flag_meanings``; time in plain seconds.
 
+    Parameters
+    ----------
+    blocks : bool
+        A run whose controller has blocks beyond PI + damping: its legs' block forces too
+        (:data:`HEXAPOD_BLOCK_CHANNELS`).
+
     Returns
     -------
     Schema
     """
     variables = []
-    for name, (_, dim, unit, doc) in HEXAPOD_CHANNELS.items():
+    for name, (_, dim, unit, doc) in _channels(blocks).items():
         if name == "time":
             continue
         dims = ("time",) if dim is None else ("time", dim)
@@ -170,7 +192,7 @@ def hexapod_file_layout():
                             for c in schema.coordinates}}
 
 
-def estimated_hexapod_size(n_samples, suffix=".nc"):
+def estimated_hexapod_size(n_samples, suffix=".nc", blocks=False):
     """Size of a hexapod result file of ``n_samples`` samples [bytes], an upper estimate.
 
     Parameters
@@ -180,6 +202,8 @@ def estimated_hexapod_size(n_samples, suffix=".nc"):
     suffix : {".nc", ".mat"}
         The file format (a path's suffix; a path is accepted too); a ``.mat`` file needs
         twice the space while it is written (:func:`~qzs.iotools.writer.estimated_file_size`).
+    blocks : bool
+        The legs' block forces too (:func:`hexapod_schema`).
 
     Returns
     -------
@@ -188,7 +212,7 @@ def estimated_hexapod_size(n_samples, suffix=".nc"):
         4096 samples, plus the chunk index and about 256 KiB of header
         (:func:`qzs.iotools.writer.estimated_file_size` of :func:`hexapod_schema`).
     """
-    return estimated_file_size(hexapod_schema(), n_samples, suffix)
+    return estimated_file_size(hexapod_schema(blocks), n_samples, suffix)
 
 
 #: File formats of a hexapod run, by extension (its variables are not columns: no CSV).
@@ -211,6 +235,9 @@ class HexapodWriter(StreamWriter):
     path : str or Path
         Target file, ending in ``.nc`` or ``.mat`` (:mod:`qzs.iotools.matfile`); its folder
         is created if missing.
+    blocks : bool
+        The run's controller has blocks beyond PI + damping: its rows hold the legs' block
+        forces too (:data:`HEXAPOD_BLOCK_CHANNELS`, N_CHANNELS columns).
 
     Raises
     ------
@@ -226,9 +253,12 @@ class HexapodWriter(StreamWriter):
     ...     writer.finish(result)
     """
 
-    def __init__(self, path):
-        super().__init__(path, hexapod_schema(), blocks={"data": N_CHANNELS, "flags": N_FLAGS},
-                         columns=_COLUMNS, values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
+    def __init__(self, path, blocks=False):
+        super().__init__(path, hexapod_schema(blocks),
+                         blocks={"data": N_CHANNELS if blocks else N_BASE_CHANNELS,
+                                 "flags": N_FLAGS},
+                         columns={**_COLUMNS, **_BLOCK_COLUMNS} if blocks else _COLUMNS,
+                         values=_LABELS, suffixes=HEXAPOD_SUFFIXES)
 
     def finish(self, result):
         """Write the run's settings and outcome, flush, and rename the file onto ``path``.
@@ -287,8 +317,9 @@ def save_hexapod_result(result, path):
             f"this result holds every {every}th sample only (a preview of a run streamed to a "
             "file); the whole run is in the file it was streamed to.")
     check_output_path(path, argument="path", suffixes=HEXAPOD_SUFFIXES,
-                      estimated_bytes=estimated_hexapod_size(len(result), _format(path)))
-    with HexapodWriter(path) as writer:
+                      estimated_bytes=estimated_hexapod_size(len(result), _format(path),
+                                                             result.has_blocks))
+    with HexapodWriter(path, blocks=result.has_blocks) as writer:
         for start in range(0, len(result), 100_000):
             writer.append(result._data[start:start + 100_000],
                           result._flags[start:start + 100_000])
@@ -352,18 +383,27 @@ class HexapodResult:
             statistics = running.result()
         self.statistics = statistics
 
+    @property
+    def has_blocks(self) -> bool:
+        """Whether the run's rows hold the legs' block forces (a controller with blocks)."""
+        return self._data.shape[1] > N_BASE_CHANNELS
+
     def __getitem__(self, name: str) -> NDArray[Any]:
-        if name in HEXAPOD_CHANNELS:
-            column, dim = HEXAPOD_CHANNELS[name][:2]
+        channels = _channels(self.has_blocks)
+        if name in channels:
+            column, dim = channels[name][:2]
             return self._data[:, column] if dim is None else self._data[:, column:column + 6]
         if name in HEXAPOD_FLAGS:
             column = HEXAPOD_FLAGS[name][0]
             return self._flags[:, column:column + 6]
-        raise KeyError(f"no channel {name!r}; channels are "
-                       f"{', '.join([*HEXAPOD_CHANNELS, *HEXAPOD_FLAGS])}.")
+        absent = (f" ({name!r} is recorded only when a leg's controller has blocks beyond PI + "
+                  "damping)" if name in HEXAPOD_BLOCK_CHANNELS else "")
+        raise KeyError(f"no channel {name!r}{absent}; channels are "
+                       f"{', '.join([*channels, *HEXAPOD_FLAGS])}.")
 
     def __getattr__(self, name: str) -> NDArray[Any]:
-        if name.startswith("_") or (name not in HEXAPOD_CHANNELS and name not in HEXAPOD_FLAGS):
+        if name.startswith("_") or name not in {**HEXAPOD_CHANNELS, **HEXAPOD_BLOCK_CHANNELS,
+                                                **HEXAPOD_FLAGS}:
             raise AttributeError(name)
         return self[name]
 
@@ -404,6 +444,8 @@ class HexapodResult:
         """
         import dataclasses
 
+        from qzs.model.controller import block_parameters
+
         meta = {}
         for name in ("base_joints", "top_joints", "home_position", "stroke_half"):
             meta[f"geometry.{name}"] = (getattr(self.geometry, name), "m")
@@ -415,6 +457,14 @@ class HexapodResult:
                 values = [getattr(o, field.name) for o in objects]
                 value = values[0] if all(v == values[0] for v in values) else values
                 meta[f"{section}.{field.name}"] = (value, unit_of(field.name))
+        blocks = [block_parameters(c) for c in self.controllers]
+        same = all(b.keys() == blocks[0].keys() and all(
+            np.array_equal(np.asarray(b[k][0]), np.asarray(blocks[0][k][0])) for k in b)
+            for b in blocks)
+        for leg, parameters in enumerate(blocks[:1] if same else blocks):
+            prefix = "controller." if same else f"controller.leg{leg + 1}."
+            for name, (value, unit) in parameters.items():
+                meta[f"{prefix}{name}"] = (value, unit)
         for axis, value in self.excitation.items():
             meta[f"excitation.{axis}"] = (type(value).__name__, "")
             for field in dataclasses.fields(value):
@@ -443,7 +493,7 @@ class HexapodResult:
         Parameters and run settings are global attributes with their units in
         ``<key>_units``.
         """
-        schema = hexapod_schema()
+        schema = hexapod_schema(self.has_blocks)
         values = {name: _LABELS[name] if name in _LABELS else self[name]
                   for name in schema.names}
         return to_dataset(schema, values, self.global_attributes(), boolean_flags=True)

@@ -16,8 +16,9 @@ import numpy as np
 from qzs import defaults
 from qzs._validation import worker_count
 from qzs.engine.hexapod.layout import (CT_CONTACTS, CT_EVENTS, CT_STEP, CT_STICKS, LEG_COUNT,
-                                       N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS, N_ODE, N_WORK,
-                                       S_C, S_V, STATUS_OK, V_Z, V_ZHIGH, V_ZLOW)
+                                       N_BASE_CHANNELS, N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS,
+                                       N_ODE, N_WORK, PL_BLOCKS, S_C, S_V, STATUS_OK, V_Z,
+                                       V_ZHIGH, V_ZLOW)
 from qzs.engine.hexapod.prepare import _prepare
 from qzs.engine.hexapod.result import HexapodResult
 from qzs.engine.hexapod.statistics import _Statistics
@@ -68,10 +69,16 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
         used (the platform's are); ``stroke_half`` must equal the geometry's; compliant stops
         only.
     controller : ControllerParameters or sequence of six, optional
-        Each leg's loop; defaults if omitted. Continuous (``controller_rate`` 0) or sampled
-        with zero-order hold, every leg at the same rate (one controller), as the single
-        axis's (docs/model.md §5). With ``cartesian``, its ``position_setpoint``,
-        ``velocity_highpass`` and ``controller_rate`` are used and its gains are not.
+        Each leg's loop (one for every leg, or one per leg); defaults if omitted. Continuous
+        (``controller_rate`` 0) or sampled with zero-order hold, every leg at the same rate
+        (one controller), as the single axis's (docs/model.md §5). Each leg's blocks beyond
+        PI + damping (friction compensation with its observer, dither, a linear controller,
+        continuous or discrete at its own period: docs/model.md §5.1) act on that leg alone,
+        from its own sensors (docs/hexapod.md §9.5a); their forces are the channels
+        ``compensation_force``, ``friction_estimate``, ``dither_force`` and ``linear_force``
+        (0 on a leg without that block). With ``cartesian``, its ``position_setpoint``,
+        ``velocity_highpass`` and ``controller_rate`` are used and its gains are not, and
+        blocks are refused.
     excitation : dict, optional
         Base motion: axis name (``"x"``, ``"y"``, ``"z"`` [m], ``"rx"``, ``"ry"``, ``"rz"``
         [rad]) to a Chirp, Sine, RandomExcitation or DisplacementRecord (its amplitude in that
@@ -128,7 +135,8 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
                               for i in range(LEG_COUNT)])
     recorder = driver.Recorder(
-        plan, N_CHANNELS, N_FLAGS, statistics=statistics.add, sink=sink,
+        plan, N_CHANNELS if run.plat[PL_BLOCKS] != 0.0 else N_BASE_CHANNELS, N_FLAGS,
+        statistics=statistics.add, sink=sink,
         duration=run.duration, sample_rate=run.sample_rate,
         remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
                "qzs.workflows.hexapod.setups.simulate_setup(..., out=...)), or lower the "
@@ -169,7 +177,7 @@ class _SixLegs(driver.Stepper):
         self.s = run.state
         self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
         self.arrays = (run.plat, run.ex, run.tables, run.toff)
-        self.work = (np.zeros((N_BUF, N_ODE)), np.zeros((2, LEG_COUNT)), np.zeros(N_WORK),
+        self.work = (np.zeros((N_BUF, self.s.size)), np.zeros((2, LEG_COUNT)), np.zeros(N_WORK),
                      run.V, np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64),
                      np.zeros((2, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64), self.counters)
         self.diverged = False
@@ -186,12 +194,17 @@ class _SixLegs(driver.Stepper):
         """The :class:`~qzs.errors.SimulationError` of a diverged run (time and last state)."""
         s, V = self.s, self.run.V
         failed = int(self.counters[CT_STEP])
+        blocks = ""
+        if s.size > N_ODE:
+            blocks = (f", the controller blocks' largest state {np.max(np.abs(s[N_ODE:])):.6g} "
+                      "(an unstable linear controller or over-compensation grows: "
+                      "qzs.loop_margins of the leg's loop says so)")
         return SimulationError(
             f"the hexapod simulation diverged at t = {failed * self.run.dt:.6g} s (last state: "
             f"centre of mass {s[S_C:S_C + 3].tolist()} m and velocity "
             f"{s[S_V:S_V + 3].tolist()} m/s relative to the base, leg positions "
-            f"{V[V_Z:V_Z + LEG_COUNT].tolist()} m); check the gains and parameters, or reduce "
-            "`dt`.")
+            f"{V[V_Z:V_Z + LEG_COUNT].tolist()} m{blocks}); check the gains and parameters, or "
+            "reduce `dt`.")
 
 
 def simulate_hexapods(runs: Sequence[Mapping[str, Any]], *, workers: int | None = None,

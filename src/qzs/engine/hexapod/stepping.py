@@ -15,18 +15,20 @@ from numba import njit
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.hexapod.dynamics import (_advance_phases, _commands, _cross, _evaluate,
-                                         _inertia_times, _matvec, _rest_frame, _sample)
+                                         _inertia_times, _linear_due, _matvec, _rest_frame,
+                                         _sample, _sample_linear)
 from qzs.engine.hexapod.layout import (
     B_K1, B_K2, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
-    C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FDA, C_FFR, C_FMO, C_FPI, C_FSP, C_FST,
+    C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FCO, C_FDA, C_FDI, C_FFR, C_FLI,
+    C_FMO, C_FOB, C_FPI, C_FSP, C_FST, PL_BLOCKS, S_X, V_FCO, V_FDI, V_FLI, V_FRESH,
     C_POSE, C_TIME, C_TWIST, C_V, C_VME, C_WB, C_WM, C_Z, CT_CONTACTS, CT_EVENTS,
-    CT_IN_CONTACT, CT_STEP, CT_STICKS, LANES, LEG_COUNT, MODE_LOCK, MODE_SLIP, N_ODE,
+    CT_IN_CONTACT, CT_STEP, CT_STICKS, LANES, LEG_COUNT, MODE_LOCK, MODE_SLIP,
     O_CONTACT, O_LOCKED, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_MASS,
     PL_ROTATING, S_C, S_DF, S_DS, S_HP, S_V, S_W, S_WB, S_WM, STATUS_DIVERGED, STATUS_OK,
     V_A, V_B, V_DIR, V_EV, V_FDA, V_FFR, V_FMO, V_FPI, V_FSP, V_FST, V_HDA, V_HMO, V_HPI,
     V_MODE, V_STOPK, V_V, V_VME, V_XB, V_Z, V_ZHIGH, V_ZLOW, W_ACC, W_AL, W_ALW, W_FSUM,
     W_GH, W_OM, W_OMW, W_RB, W_RR, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.kernels import PHASE_PERIOD, n_stages, tableau
+from qzs.engine.kernels import N_X, PHASE_PERIOD, X_OBSERVER, n_stages, tableau
 from qzs.engine.laws import spring_energy_law
 from qzs.engine.stickslip import MODE_STICK, crossed_zero, locate, release_direction, \
     secant_fraction
@@ -51,18 +53,22 @@ def _rk(solver, t, h, s, k1, out, buf, plat, ex, tables, toff, ww, V, A, idx, ve
     The diagonal tableau of :func:`qzs.engine.kernels.tableau` (euler, ode3, rk4); each update
     ``s + a k`` is one fused multiply-add, as in the single axis.
     """
+    if plat[PL_BLOCKS] != 0.0:  # the state moves: a leg released at t slips now
+        for i in range(LEG_COUNT):
+            V[V_FRESH + i] = 0.0
     weight = tableau(solver, h, 0)[2]
-    for j in range(N_ODE):
+    n = out.shape[0]  # N_ODE, or with the legs' blocks' states
+    for j in range(n):
         out[j] = fma(weight, k1[j], s[j])
     previous = k1
     for stage in range(1, n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
         tmp = buf[B_TMP]
-        for j in range(N_ODE):
+        for j in range(n):
             tmp[j] = fma(a, previous[j], s[j])
         k = buf[B_K2 + stage - 1]
         _evaluate(t + offset, tmp, plat, ex, tables, toff, ww, V, A, idx, vec, k, _FALSE)
-        for j in range(N_ODE):
+        for j in range(n):
             out[j] = fma(weight, k[j], out[j])
         previous = k
 
@@ -121,16 +127,18 @@ def _locate(solver, leg, t, h, s, k1, g0, g1, buf, plat, ex, tables, toff, ww, V
                                       A, idx, vec), g0, g1, h, False)
     if not tried:
         trial = buf[B_TRIAL]
-        for j in range(N_ODE):
+        for j in range(trial.shape[0]):
             trial[j] = s[j]
     return at
 
 
 @njit(**_JIT, inline="always")
 def _set_mode(V, i, mode, direction):
-    """Mode and slip direction of leg ``i``, and of the padding lanes that copy leg 1."""
+    """Mode and slip direction of leg ``i``, and of the padding lanes that copy leg 1; a leg
+    released is marked ``FRESH`` (:func:`qzs.engine.hexapod.dynamics._slip`)."""
     V[V_MODE + i] = mode
     V[V_DIR + i] = direction
+    V[V_FRESH + i] = 1.0 if mode == MODE_SLIP else 0.0
     if i == 0:
         for pad in range(LEG_COUNT, LANES):
             V[V_MODE + pad] = mode
@@ -220,7 +228,7 @@ def _grid_step(solver, t, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec
         if events < MAX_EVENTS:
             leg, theta = _first_event(V, ev[0], ev[1])
         if leg < 0:
-            for j in range(N_ODE):
+            for j in range(s.shape[0]):
                 s[j] = s1[j]
                 k1[j] = ke[j]
             for i in range(LEG_COUNT):
@@ -230,7 +238,7 @@ def _grid_step(solver, t, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec
         at = _locate(solver, leg, t + elapsed, rest, s, k1, g0, g1, buf, plat, ex, tables, toff,
                      ww, V, A, idx, vec)
         trial = buf[B_TRIAL]
-        for j in range(N_ODE):
+        for j in range(s.shape[0]):
             s[j] = trial[j]
         elapsed += at
         _transition(leg, t + elapsed, s, ev[0], plat, ex, tables, toff, ww, V, A, idx, vec, k1,
@@ -324,6 +332,12 @@ def _record(t, s, plat, ww, V, row, marks):
         stop += 0.5 * V[V_STOPK + i] * pen * pen
         marks[O_LOCKED + i] = V[V_MODE + i] != MODE_SLIP
         marks[O_CONTACT + i] = z < V[V_ZLOW + i] or z > V[V_ZHIGH + i]
+    if plat[PL_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
+        for i in range(LEG_COUNT):
+            row[C_FCO + i] = V[V_FCO + i]
+            row[C_FOB + i] = s[S_X + i * N_X + X_OBSERVER]
+            row[C_FDI + i] = V[V_FDI + i]
+            row[C_FLI + i] = V[V_FLI + i]
     row[C_WB] = s[S_WB]
     row[C_DF] = s[S_DF]
     row[C_WM] = s[S_WM]
@@ -342,8 +356,9 @@ def _record(t, s, plat, ww, V, row, marks):
 # ---------------------------------------------------------------- the drivers
 @njit(**_JIT)
 def _finite(s):
-    """Divergence test: every state entry finite, relative speed below 1e4 m/s."""
-    for j in range(N_ODE):
+    """Divergence test: every state entry finite (the blocks' too), relative speed below
+    1e4 m/s."""
+    for j in range(s.shape[0]):
         if not np.isfinite(s[j]):
             return False
     for a in range(3):
@@ -376,7 +391,7 @@ def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counte
             V[V_HDA + i] = V[V_FDA + i]
             V[V_HMO + i] = V[V_FMO + i]
     _settle(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], newly)
-    for j in range(N_ODE):
+    for j in range(s.shape[0]):
         buf[B_S, j] = s[j]
     for i in range(LEG_COUNT):
         ev[0, i] = V[V_EV + i]
@@ -401,10 +416,19 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
     control_steps = int(plat[PL_CONTROL_STEPS])
     for _ in range(n_steps):
         _advance_phases(step * h, step % PHASE_PERIOD == 0, plat, ex, ww)
-        if control_steps > 0 and step % control_steps == 0:
+        sampled = control_steps > 0 and step % control_steps == 0
+        if sampled:
+            _sample(step * h, plat, ww, V, buf[B_S], h)
+        if plat[PL_BLOCKS] != 0.0 and _linear_due(plat, step):
+            # a leg's discrete linear controller reads its sensors with the outputs the PI
+            # and its blocks hold from now (they sample first, docs/model.md §5.1)
+            _evaluate(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KE],
+                      _FALSE)
+            _sample_linear(step, plat, V, buf[B_S])
+            sampled = True
+        if sampled:
             # a sample: the held outputs jump, so the modes are settled again (a locked leg
             # may break away right here) and the rate and event values are those after it
-            _sample(plat, ww, V, buf[B_S], h)
             _settle(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1],
                     newly)
             for i in range(LEG_COUNT):
@@ -425,7 +449,7 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
             _record(step * h, buf[B_S], plat, ww, V, out[row], out_flags[row])
             row += 1
     counters[CT_STEP] = step
-    for j in range(N_ODE):
+    for j in range(s.shape[0]):
         s[j] = buf[B_S, j]
     return status, row - row0
 

@@ -723,10 +723,11 @@ def simulate_setup(setup: HexapodSetup, *,
                                   setup.controller, **common)
         result.run.update(resolved.step.attributes())
         return result
+    from qzs.engine.hexapod.prepare import has_blocks
     from qzs.engine.hexapod.result import HexapodWriter
 
     check_out()  # again: the probes took a while
-    with HexapodWriter(out) as writer:
+    with HexapodWriter(out, blocks=has_blocks(setup.controller)) as writer:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
                                   setup.controller, sink=writer.append, **common)
         result.run.update(resolved.step.attributes())
