@@ -4,7 +4,8 @@ import ctypes
 
 import numpy as np
 import pytest
-from helpers import EXPORT_DISCRETE, BlockController, BlockOutput, BlockParameters, Blocks, Sensors
+from helpers import (EXPORT_DISCRETE, BlockController, BlockOutput, BlockParameters, Blocks,
+                     Controller, Parameters, Sensors)
 from helpers import build_controller as build
 
 import qzs
@@ -18,8 +19,9 @@ except CompilerError:  # pragma: no cover
     pytest.skip("no C compiler", allow_module_level=True)
 
 SAMPLED = qzs.PIDamping(controller_rate=1000.0)
-#: A 2-state discrete controller at the PI's 1 kHz on four of the rig's sensors (the payload's
-#: acceleration aside: see test_the_payload_acceleration_is_read_after_the_pis_command).
+#: A 2-state discrete controller at the PI's 1 kHz on four of the rig's sensors (not the
+#: payload's acceleration: a sampled run reads it after the PI's new command at the same
+#: instant, which no recorded channel holds; docs/fmu.md).
 LINEAR = qzs.LinearController(
     a=[[0.9, 0.05], [0.0, 0.8]], b=[[1e-3, 0.0, 0.0, 2e-3], [0.0, 0.01, 1e-3, 0.0]],
     c=[30.0, -2.0], d=[10.0, -20.0, 0.0, 5.0],
@@ -90,3 +92,40 @@ def test_every_block_equals_the_simulated_one_sample_for_sample(tmp_path):
         np.testing.assert_array_equal(ours, simulated, err_msg=channel)
         assert np.ptp(simulated) > 1e-3, channel  # each block acts: a real check
     assert state.integral != exported.exported_parameters(EVERY_BLOCK, dt=1e-4)[1]
+
+
+def test_a_continuous_linear_controller_is_refused_naming_the_fix(tmp_path):
+    """Its zero-order-hold discretisation is not the controller qzs simulates (integrated with
+    the plant): refused, nothing written, the error naming `linear` and how to discretise it."""
+    controller = SAMPLED + qzs.LinearController(a=[[-10.0]], b=[[1.0]], c=[5.0], d=[0.0])
+    with pytest.raises(ParameterError, match=r"c2d\(linear.to_system\(\), 0.001, 'zoh'\)") as error:
+        exported.export_controller(tmp_path / "controller.c", controller)
+    assert error.value.options == ("linear",)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_linear_controller_at_another_period_is_refused_naming_the_fix():
+    """The exported step samples every block at once: a discrete linear controller at 2 ms
+    under a 1 kHz PI is refused, naming both ways out."""
+    slow = qzs.LinearController(a=[[0.5]], b=[[1.0]], c=[5.0], d=[0.0], sample_time=2e-3)
+    with pytest.raises(ParameterError, match=r"sample_time=0\.001.*controller_rate=500\.0") as error:
+        exported.controller_source(SAMPLED + slow, dt=1e-4)
+    assert error.value.options == ("sample_time",)
+
+
+def test_without_blocks_both_steps_are_exported_and_agree(tmp_path):
+    """A controller without blocks keeps the PI + damping's own step, and the block step with
+    no block gives the same forces (its blocks add exact zeros)."""
+    lib, state = _exported(tmp_path, SAMPLED)
+    alone = Controller()
+    lib.qzs_controller_init(ctypes.byref(alone), Parameters.in_dll(lib, exported.PARAMETERS_NAME),
+                            ctypes.c_double.in_dll(lib, exported.PRELOAD_NAME).value)
+    for k, z in enumerate(np.linspace(-0.01, 0.01, 50)):
+        sensors = Sensors(k * 1e-3, z, 0.1 * z, 0.0, 0.0, 0.0, 0.0)
+        ours = lib.qzs_block_controller_step(ctypes.byref(state), ctypes.byref(sensors))
+        theirs = lib.qzs_controller_step(ctypes.byref(alone), z, 0.1 * z)
+        assert (ours.pi, ours.damping, ours.motor) == (theirs.pi, theirs.damping, theirs.motor)
+    assert state.integral == alone.integral != 0.0
+    declaration = f"QzsControllerParameters {exported.PARAMETERS_NAME} ="
+    assert declaration in exported.controller_source(SAMPLED)  # with blocks the PI-alone set
+    assert declaration not in exported.controller_source(EVERY_BLOCK)  # is not written
