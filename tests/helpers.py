@@ -5,6 +5,7 @@ import numpy as np
 
 import qzs
 from qzs import Chirp, ControllerParameters, IsolatorParameters
+from qzs.engine import kernels as _K
 
 #: MagSpring shape [1/m] small enough that ``-a*tanh(b*z)`` is linear to ~1e-10 over the
 #: strokes used in the linear tests: the stiffness is then ``a*b`` about z = 0.
@@ -237,22 +238,53 @@ class Controller(_ctypes.Structure):
     _fields_ = [("parameters", Parameters), ("integral", _ctypes.c_double), ("output", Output)]
 
 
+class Blocks(_ctypes.Structure):
+    _fields_ = [("x", _ctypes.c_double * _K.N_X)]
+
+
+class BlockParameters(_ctypes.Structure):
+    _fields_ = [("control", Parameters), ("velocity_regularisation", _ctypes.c_double),
+                ("model", _ctypes.c_double * _K.N_MODEL)]
+
+
+class BlockOutput(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in (
+        "pi", "damping", "compensation", "dither", "linear", "motor", "friction_estimate")]
+
+
+class BlockController(_ctypes.Structure):
+    _fields_ = [("parameters", BlockParameters), ("integral", _ctypes.c_double),
+                ("x", Blocks), ("output", BlockOutput)]
+
+
+class Sensors(_ctypes.Structure):
+    _fields_ = [(name, _ctypes.c_double) for name in (
+        "time", "position", "measured_velocity", "relative_velocity", "payload_acceleration",
+        "base_acceleration", "friction_force")]
+
+
 def build_controller(tmp_path, source):
-    """Compile an exported controller.c alone, strictly, without libm or include folders;
-    its two functions declared for ctypes."""
+    """Compile an exported controller.c alone, strictly (-Wall -Wextra -pedantic -Werror),
+    without include folders; its functions declared for ctypes."""
     from qzs.export.csource import compile_shared
 
     path = tmp_path / "controller.c"
     path.write_text(source)
     library = compile_shared([path], tmp_path / "controller.so",
-                             flags=("-O2", "-std=c99", "-pedantic", "-Wall", "-Werror",
-                                    "-ffp-contract=off", "-fPIC"))
+                             flags=("-O2", "-std=c99", "-pedantic", "-Wall", "-Wextra",
+                                    "-Werror", "-ffp-contract=off", "-fPIC"))
     lib = _ctypes.CDLL(str(library))
     lib.qzs_controller_init.argtypes = [_ctypes.POINTER(Controller), _ctypes.POINTER(Parameters),
                                         _ctypes.c_double]
     lib.qzs_controller_step.argtypes = [_ctypes.POINTER(Controller), _ctypes.c_double,
                                         _ctypes.c_double]
     lib.qzs_controller_step.restype = Output
+    lib.qzs_block_controller_init.argtypes = [
+        _ctypes.POINTER(BlockController), _ctypes.POINTER(BlockParameters), _ctypes.c_double,
+        _ctypes.POINTER(Blocks), _ctypes.POINTER(BlockOutput)]
+    lib.qzs_block_controller_step.argtypes = [_ctypes.POINTER(BlockController),
+                                              _ctypes.POINTER(Sensors)]
+    lib.qzs_block_controller_step.restype = BlockOutput
     return lib
 
 

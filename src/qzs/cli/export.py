@@ -44,17 +44,20 @@ def add_parser(subparsers):
     """
     export = subparsers.add_parser(
         "export", help="the controller as C, the isolator as an FMU",
-        description="qzs outside Python: the sampled PI + active damping controller as one "
-                    "dependency-free C file, and the isolator as an FMI co-simulation FMU "
+        description="qzs outside Python: the sampled controller (PI + active damping and its "
+                    "blocks) as one C file, and the isolator as an FMI co-simulation FMU "
                     "(`qzs docs fmu`).")
     sub = export.add_subparsers(dest="export_command", required=True)
     controller = sub.add_parser(
         "controller", help="the sampled controller as one C file",
-        description="Write the sampled PI + active damping controller (high-passed velocity "
-                    "from the charge amplifier, anti-windup, saturation) of a configuration as "
-                    "one C99 file with an init and a step function: the very code the C model "
-                    "and the closed-loop FMU call. A continuous controller (controller_rate = "
-                    f"0) is exported at {DEFAULT_CONTROLLER_RATE:g} Hz.", epilog=EPILOG)
+        description="Write the sampled controller of a configuration (PI + active damping on "
+                    "the charge amplifier's high-passed velocity, anti-windup, saturation, and "
+                    "its blocks: friction compensation and observer, dither, a discrete linear "
+                    "controller) as one C99 file with an init and a step function: the very "
+                    "laws the C model and the closed-loop FMU call (`qzs docs fmu` §8). A "
+                    "continuous controller (controller_rate = 0) is exported at "
+                    f"{DEFAULT_CONTROLLER_RATE:g} Hz; a continuous linear controller is "
+                    "refused (discretise it).", epilog=EPILOG)
     controller.add_argument("--config", metavar="FILE.toml",
                             help="run configuration (see `qzs params --toml`)")
     add_set_option(controller)

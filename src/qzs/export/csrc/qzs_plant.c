@@ -5,10 +5,10 @@
 #include <math.h>
 #include <string.h>
 
-/* Python's max(a, b) / min(a, b) as numba compiles them: a unless b is larger / smaller. */
-#define PYMAX(a, b) ((b) > (a) ? (b) : (a))
-#define PYMIN(a, b) ((b) < (a) ? (b) : (a))
-#define INLINE static inline __attribute__((always_inline))
+/* qzs_controller.h's: Python's max / min as numba compiles them, always inlined */
+#define PYMAX(a, b) QZS_PYMAX(a, b)
+#define PYMIN(a, b) QZS_PYMIN(a, b)
+#define INLINE QZS_INLINE
 
 static const double TWO_PI = 6.283185307179586; /* 2.0 * np.pi */
 static const double PI = 3.141592653589793;
@@ -16,49 +16,13 @@ static const double PI = 3.141592653589793;
 
 /* ------------------------------------------------------------ arithmetic.py */
 
-INLINE double pow2i(int64_t k) { /* 2**k from the exponent bits */
-    uint64_t bits = (uint64_t)(k + 1023) << 52;
-    double d;
-    memcpy(&d, &bits, sizeof d);
-    return d;
-}
-
-INLINE double own_exp(double x) {
-    x = PYMIN(PYMAX(x, -700.0), 700.0);
-    double k = floor(fma(x, 1.4426950408889634, 0.5));
-    double r = fma(k, -1.90821492927058770002e-10, fma(k, -6.93147180369123816490e-01, x));
-    double r2 = r * r;
-    double r4 = r2 * r2;
-    double low = fma(fma(fma(r, 1.0 / 5040.0, 1.0 / 720.0), r2, fma(r, 1.0 / 120.0, 1.0 / 24.0)),
-                     r4, fma(fma(r, 1.0 / 6.0, 0.5), r2, 1.0 + r));
-    double high = fma(fma(r, 1.0 / 6227020800.0, 1.0 / 479001600.0), r4,
-                      fma(fma(r, 1.0 / 39916800.0, 1.0 / 3628800.0), r2,
-                          fma(r, 1.0 / 362880.0, 1.0 / 40320.0)));
-    double p = fma(high, r4 * r4, low);
-    return p * pow2i((int64_t)k);
-}
-
-INLINE double own_tanh(double u) {
-    double a = PYMIN(fabs(u), 20.0);
-    double r = 1.0 - 2.0 / (own_exp(2.0 * a) + 1.0);
-    return u >= 0.0 ? r : -r;
-}
-
 /* ------------------------------------------------------------ laws.py */
 
-INLINE double spring_law(double a, double b, double z) { return -a * own_tanh(b * z); }
+INLINE double spring_law(double a, double b, double z) { return -a * qzs_tanh(b * z); }
 
 INLINE double spring_energy_law(double a, double b, double z) {
     double u = fabs(b * z);
     return a / b * (u + log1p(exp(-2.0 * u)) - log(2.0));
-}
-
-INLINE double sliding_friction_law(double v, double sign, double fs, double fc, double cbc,
-                                   double cv, double v_reg) {
-    double level = fc + (fs - fc) * own_exp(-cbc * fabs(v));
-    if (v_reg > 0.0)
-        sign = own_tanh(v / v_reg);
-    return -level * sign - cv * v;
 }
 
 INLINE void compliant_stop_law(double z, double v, double z_low, double z_high,
@@ -73,35 +37,6 @@ INLINE void compliant_stop_law(double z, double v, double z_low, double z_high,
         *f_elastic = -stiffness * (z - z_high);
         *f_stop = PYMIN(*f_elastic - damping * v, 0.0);
     }
-}
-
-/* laws.saturation_law: the command clipped at +-f_max, the integral's rate (anti-windup) */
-INLINE double saturation_law(double command, double error, double ki, double f_max,
-                             double *rate) {
-    *rate = error;
-    if (command > f_max) {
-        command = f_max;
-        if (error * ki > 0.0)
-            *rate = 0.0;
-    } else if (command < -f_max) {
-        command = -f_max;
-        if (error * ki < 0.0)
-            *rate = 0.0;
-    }
-    return command;
-}
-
-/* laws.compensation_law: a fraction of the compensator's friction law, cancelled */
-INLINE double compensation_law(double v, double sign, double fraction, double fs, double fc,
-                               double cbc, double cv, double v_reg, double deadband) {
-    if (fabs(v) <= deadband)
-        return 0.0;
-    return -fraction * sliding_friction_law(v, sign, fs, fc, cbc, cv, v_reg);
-}
-
-/* laws.dither_law */
-INLINE double dither_law(double t, double amplitude, double omega) {
-    return amplitude * sin(omega * t);
 }
 
 /* ------------------------------------------------------------ stickslip.py */
@@ -275,45 +210,6 @@ void qzs_plant_init(QzsPlant *plant, const double *params, const double *model,
     plant->control = c;
 }
 
-/* kernels._linear_output: C x + D u over the zero-padded rows (short ones for a small
- * controller; a padded term adds an exact zero) */
-INLINE double linear_output(const double *M, const QzsBlocks *x, const double u[QZS_N_SENSORS]) {
-    double y = 0.0;
-    int width = M[QZS_M_LINEAR_STATES] <= QZS_NX_SHORT ? QZS_NX_SHORT : QZS_NX_MAX;
-    for (int j = 0; j < width; j++)
-        y = fma(M[QZS_M_C + j], x->x[j], y);
-    for (int k = 0; k < QZS_N_SENSORS; k++)
-        y = fma(M[QZS_M_D + k], u[k], y);
-    return y;
-}
-
-/* kernels._linear_rates: A x + B u + L excess row by row (a padded row 0), then `observer` */
-INLINE void linear_rates(const double *M, const QzsBlocks *x, const double u[QZS_N_SENSORS],
-                         double excess, double observer, QzsBlocks *rates) {
-    int width = M[QZS_M_LINEAR_STATES] <= QZS_NX_SHORT ? QZS_NX_SHORT : QZS_NX_MAX;
-    for (int i = 0; i < QZS_NX_MAX; i++) {
-        double rate = 0.0;
-        if (i < width) {
-            rate = M[QZS_M_ANTIWINDUP + i] * excess;
-            for (int j = 0; j < width; j++)
-                rate = fma(M[QZS_M_A + i * QZS_NX_MAX + j], x->x[j], rate);
-            for (int k = 0; k < QZS_N_SENSORS; k++)
-                rate = fma(M[QZS_M_B + i * QZS_N_SENSORS + k], u[k], rate);
-        }
-        rates->x[i] = rate;
-    }
-    rates->x[QZS_X_OBSERVER] = observer;
-}
-
-/* kernels._compensation: the friction compensation's feedforward at slip velocity v */
-INLINE double compensation(const double *P, const double *M, double v, double direction) {
-    if (M[QZS_M_COMP_FRACTION] == 0.0)
-        return 0.0;
-    return compensation_law(v, direction, M[QZS_M_COMP_FRACTION], M[QZS_M_COMP_FS],
-                            M[QZS_M_COMP_FC], M[QZS_M_COMP_CBC], M[QZS_M_COMP_CV], P[QZS_P_VREG],
-                            M[QZS_M_COMP_DEADBAND]);
-}
-
 /* kernels.block_forces: compensation, dither, linear output, and the feedforward alone */
 INLINE void block_forces(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlocks *x,
                          double v, double direction, double ydd, double v_measured,
@@ -325,11 +221,11 @@ INLINE void block_forces(const QzsPlant *plant, double t, const QzsOde *s, const
         *f_comp = held[QZS_H_COMPENSATION];
         *f_dither = held[QZS_H_DITHER];
     } else {
-        *feedforward = compensation(P, M, v, direction);
+        *feedforward = qzs_compensation(M, P[QZS_P_VREG], v, direction);
         *f_comp = *feedforward - x->x[QZS_X_OBSERVER];
         *f_dither = 0.0;
         if (M[QZS_M_DITHER_AMPLITUDE] != 0.0)
-            *f_dither = dither_law(t, M[QZS_M_DITHER_AMPLITUDE], M[QZS_M_DITHER_OMEGA]);
+            *f_dither = qzs_dither_law(t, M[QZS_M_DITHER_AMPLITUDE], M[QZS_M_DITHER_OMEGA]);
     }
     *f_linear = 0.0;
     if (M[QZS_M_LINEAR] != 0.0) {
@@ -337,7 +233,7 @@ INLINE void block_forces(const QzsPlant *plant, double t, const QzsOde *s, const
             *f_linear = held[QZS_H_LINEAR];
         } else { /* the payload's acceleration enters only through B */
             double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s->x[QZS_S_Z], v_measured, 0.0, ydd, v};
-            *f_linear = linear_output(M, x, u);
+            *f_linear = qzs_linear_output(M, x, u);
         }
     }
 }
@@ -382,7 +278,7 @@ INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, con
                      &f_linear, &feedforward);
         command = f_pi + f_damp + f_comp + f_dither + f_linear;
         double rate;
-        f_motor = saturation_law(command, P[QZS_P_ZREF] - z, P[QZS_P_KI], P[QZS_P_FMAX], &rate);
+        f_motor = qzs_saturation_law(command, P[QZS_P_ZREF] - z, P[QZS_P_KI], P[QZS_P_FMAX], &rate);
         if (P[QZS_P_CONTROL_STEPS] == 0.0)
             integral_rate = rate;
     }
@@ -391,7 +287,7 @@ INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, con
     double f_hold = m * b.ydd - f_applied;
     double f_friction, xdd;
     if (mode == QZS_MODE_SLIP) {
-        f_friction = sliding_friction_law(v, direction, P[QZS_P_FS], P[QZS_P_FC], P[QZS_P_CBC],
+        f_friction = qzs_sliding_friction_law(v, direction, P[QZS_P_FS], P[QZS_P_FC], P[QZS_P_CBC],
                                           P[QZS_P_CV], P[QZS_P_VREG]);
         xdd = (f_applied + f_friction) * (1.0 / m);
     } else {
@@ -418,7 +314,7 @@ INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, con
                            (f_friction + f_stop + feedforward - x->x[QZS_X_OBSERVER]);
             if (M[QZS_M_LINEAR] != 0.0 && M[QZS_M_LINEAR_STEPS] == 0.0) {
                 double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - z, v_measured, xdd, b.ydd, v};
-                linear_rates(M, x, u, f_motor - command, observer, rates);
+                qzs_linear_rates(M, x, u, f_motor - command, observer, rates);
             } else {
                 rates->x[QZS_X_OBSERVER] = observer;
             }
@@ -833,62 +729,40 @@ QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, Qzs
     return out;
 }
 
-/* kernels.sample_controller with blocks: the PI and damping with the current integral, the
- * observer advanced by forward Euler from what it measures now, the compensation with its new
- * estimate, the dither, the saturated sum; then the integral advanced by one period */
+/* kernels.sample_controller with blocks: what the controller reads at t (z, the measured
+ * velocity, the slip velocity, the friction and stop forces with the forces held until now),
+ * then qzs_sample_blocks_law (qzs_controller.h): the forces held, the integral advanced */
 void qzs_sample_blocks(const QzsPlant *plant, double t, QzsOde *s, QzsBlocks *x, int mode,
                        int direction, double held[QZS_N_HELD]) {
-    const double *P = plant->P, *M = plant->M;
     QzsBase b = qzs_base_motion(plant, t);
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
-    double xd = b.yd + v;
-    double v_measured = P[QZS_P_HP_OMEGA] > 0.0 ? xd - s->x[QZS_S_HP] : xd;
-    QzsControllerOutput c = qzs_controller_law(&plant->control, s->x[QZS_S_Z], v_measured,
-                                               s->x[QZS_S_INT]);
     QzsForces force;
     rhs(plant, t, b, s, x, mode, (double)direction, held, 0, &force, 0);
-    if (M[QZS_M_OBSERVER_RATE] > 0.0) {
-        double applied = held[QZS_H_COMPENSATION] + x->x[QZS_X_OBSERVER];
-        double measured = force.friction + force.stop + applied;
-        x->x[QZS_X_OBSERVER] = x->x[QZS_X_OBSERVER] + M[QZS_M_OBSERVER_RATE] *
-            (measured - x->x[QZS_X_OBSERVER]) * P[QZS_P_CONTROL_STEPS] * P[QZS_P_DT];
-    }
-    double feedforward = compensation(P, M, v, (double)direction);
-    double f_comp = feedforward - x->x[QZS_X_OBSERVER]; /* the new estimate, applied at once */
-    double f_dither = 0.0;
-    if (M[QZS_M_DITHER_AMPLITUDE] != 0.0)
-        f_dither = dither_law(t, M[QZS_M_DITHER_AMPLITUDE], M[QZS_M_DITHER_OMEGA]);
-    double command = c.pi + c.damping + f_comp + f_dither + force.linear;
-    double rate;
-    double f_motor = saturation_law(command, P[QZS_P_ZREF] - s->x[QZS_S_Z], P[QZS_P_KI],
-                                    P[QZS_P_FMAX], &rate);
-    s->x[QZS_S_INT] = s->x[QZS_S_INT] + rate * P[QZS_P_CONTROL_STEPS] * P[QZS_P_DT];
-    held[QZS_H_PI] = c.pi;
-    held[QZS_H_DAMP] = c.damping;
-    held[QZS_H_MOTOR] = f_motor;
-    held[QZS_H_COMPENSATION] = f_comp;
-    held[QZS_H_DITHER] = f_dither;
+    QzsBlockOutput out = qzs_sample_blocks_law(
+        &plant->control, plant->M, plant->P[QZS_P_VREG], t, s->x[QZS_S_Z], force.v_measured, v,
+        (double)direction, force.friction + force.stop, force.linear, held[QZS_H_COMPENSATION],
+        &s->x[QZS_S_INT], &x->x[QZS_X_OBSERVER]);
+    held[QZS_H_PI] = out.pi;
+    held[QZS_H_DAMP] = out.damping;
+    held[QZS_H_MOTOR] = out.motor;
+    held[QZS_H_COMPENSATION] = out.compensation;
+    held[QZS_H_DITHER] = out.dither;
 }
 
 /* kernels.sample_linear: the sensors read (the payload's acceleration with the force held until
- * now), the output C x + D u held, the states stepped x <- A x + B u + L (F_motor - command) */
+ * now), then qzs_sample_linear_law (qzs_controller.h): the output C x + D u held, the states
+ * stepped x <- A x + B u + L (F_motor - command) */
 void qzs_sample_linear(const QzsPlant *plant, double t, const QzsOde *s, QzsBlocks *x, int mode,
                        int direction, double held[QZS_N_HELD]) {
-    const double *P = plant->P, *M = plant->M;
     QzsForces force;
     rhs_at(plant, t, s, x, mode, (double)direction, held, 0, &force, 0);
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
-    double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s->x[QZS_S_Z], force.v_measured, force.xdd,
+    double u[QZS_N_SENSORS] = {plant->P[QZS_P_ZREF] - s->x[QZS_S_Z], force.v_measured, force.xdd,
                                force.ydd, v};
-    double output = linear_output(M, x, u);
-    double command = force.pi + force.damp + force.compensation + force.dither + output;
-    double rate;
-    double f_motor = saturation_law(command, P[QZS_P_ZREF] - s->x[QZS_S_Z], P[QZS_P_KI],
-                                    P[QZS_P_FMAX], &rate);
-    QzsBlocks next;
-    linear_rates(M, x, u, f_motor - command, x->x[QZS_X_OBSERVER], &next);
-    *x = next;
-    held[QZS_H_LINEAR] = output;
+    double motor;
+    held[QZS_H_LINEAR] = qzs_sample_linear_law(
+        &plant->control, plant->M, s->x[QZS_S_Z], u,
+        force.pi + force.damp + force.compensation + force.dither, x, &motor);
 }
 
 int qzs_finite_blocks(const QzsBlocks *x) {

@@ -25,9 +25,8 @@ enum { QZS_P_MASS, QZS_P_GRAVITY, QZS_P_SPRING_A, QZS_P_SPRING_B, QZS_P_FS, QZS_
        QZS_P_PLASTIC, QZS_P_FMAX, QZS_P_ZREF, QZS_P_KP, QZS_P_KI, QZS_P_KD, QZS_P_HP_OMEGA,
        QZS_P_CONTROL_STEPS, QZS_P_DT, QZS_P_VREG, QZS_N_PARAMS };
 /* ODE state (S_*), then the held controller outputs and the holding margin (A_*), the
- * controller blocks' states (X_*: a linear controller's, then the friction observer's) and
- * the held outputs of the sampled blocks */
-enum { QZS_NX_MAX = 8, QZS_X_OBSERVER = QZS_NX_MAX, QZS_N_X };
+ * controller blocks' states (X_*, qzs_controller.h: a linear controller's, then the friction
+ * observer's) and the held outputs of the sampled blocks */
 enum { QZS_S_Z, QZS_S_V, QZS_S_HP, QZS_S_INT, QZS_S_W_BASE, QZS_S_D_FRICTION, QZS_S_W_MOTOR,
        QZS_S_D_STOP, QZS_N_ODE, QZS_A_F_PI = QZS_N_ODE, QZS_A_F_DAMP, QZS_A_F_MOTOR,
        QZS_A_MARGIN, QZS_A_X0, QZS_A_F_COMPENSATION = QZS_A_X0 + QZS_N_X, QZS_A_F_DITHER,
@@ -35,17 +34,7 @@ enum { QZS_S_Z, QZS_S_V, QZS_S_HP, QZS_S_INT, QZS_S_W_BASE, QZS_S_D_FRICTION, QZ
 /* the held outputs (kernels.held_tuple): PI, damping, motor, compensation, dither, linear */
 enum { QZS_H_PI, QZS_H_DAMP, QZS_H_MOTOR, QZS_H_COMPENSATION, QZS_H_DITHER, QZS_H_LINEAR,
        QZS_N_HELD };
-/* the controller's blocks beyond PI + damping, packed per run (kernels.M_*,
- * qzs.engine.prepare.pack_model): all zeros for PI + damping alone */
-enum { QZS_N_SENSORS = 5 };
-enum { QZS_M_BLOCKS, QZS_M_COMP_FRACTION, QZS_M_COMP_FS, QZS_M_COMP_FC, QZS_M_COMP_CBC,
-       QZS_M_COMP_CV, QZS_M_COMP_DEADBAND, QZS_M_OBSERVER_RATE, QZS_M_DITHER_AMPLITUDE,
-       QZS_M_DITHER_OMEGA, QZS_M_LINEAR, QZS_M_LINEAR_STATES, QZS_M_LINEAR_STEPS, QZS_M_A,
-       QZS_M_B = QZS_M_A + QZS_NX_MAX * QZS_NX_MAX, QZS_M_C = QZS_M_B + QZS_NX_MAX * QZS_N_SENSORS,
-       QZS_M_D = QZS_M_C + QZS_NX_MAX, QZS_M_ANTIWINDUP = QZS_M_D + QZS_N_SENSORS,
-       QZS_N_MODEL = QZS_M_ANTIWINDUP + QZS_NX_MAX };
-/* a linear controller of at most this many states takes the short loops (kernels.NX_SHORT) */
-#define QZS_NX_SHORT 4
+/* the controller's blocks beyond PI + damping: QZS_M_* in qzs_controller.h */
 /* integer flags (I_*) */
 enum { QZS_I_MODE, QZS_I_DIRECTION, QZS_I_STEP, QZS_I_CONTACT, QZS_I_N_CONTACTS,
        QZS_I_N_STICKS, QZS_N_FLAGS };
@@ -72,8 +61,6 @@ enum { QZS_STATUS_OK, QZS_STATUS_DIVERGED };
 
 /* The ODE state (z, v, high-pass, integral, ledger), by value like the kernels' tuples. */
 typedef struct { double x[QZS_N_ODE]; } QzsOde;
-/* The controller blocks' states (X_*). */
-typedef struct { double x[QZS_N_X]; } QzsBlocks;
 /* Base displacement [m], velocity [m/s], acceleration [m/s^2]. */
 typedef struct { double y, yd, ydd; } QzsBase;
 /* The force breakdown of the right-hand side (kernels.F_*). */
