@@ -97,23 +97,29 @@ def test_blocks_that_add_nothing_leave_the_closed_form(adds, what, validation):
 
 
 @pytest.mark.parametrize("observer", [0.0, 2.0])
-def test_compensating_the_viscous_friction_takes_it_out_of_the_loop(observer, validation):
-    """The compensation's linear part: ``Cv`` becomes ``(1 - a) Cv``; with an observer of the
-    friction left, ``(1 - a) Cv s/(s + w_o)`` (it cancels the rest at low frequency)."""
+@pytest.mark.parametrize("viscous", [None, 0.0], ids=["Cv'=Cv", "Cv'=0"])
+def test_compensating_the_viscous_friction_takes_it_out_of_the_loop(observer, viscous,
+                                                                    validation):
+    """The compensation's linear part: ``Cv`` becomes ``Cv - a Cv'``; with an observer of the
+    friction left, ``(Cv - a Cv') s/(s + w_o)`` (it cancels the rest at low frequency). The
+    whole law (``viscous_damping=None``, ``Cv' = Cv``) leaves ``(1 - a) Cv``; the default
+    compensator (``Cv' = 0``) leaves ``Cv``, which the observer still takes out."""
     isolator = IsolatorParameters()
     fraction = 0.7
     controller = PIDamping(damping_gain=20.0) + FrictionCompensation(
-        fraction=fraction, observer_bandwidth=observer)
+        fraction=fraction, viscous_damping=viscous, observer_bandwidth=observer)
     m, cv, k, kp, ki, kd, w = loop_constants(isolator, controller)
+    compensated = fraction * (cv if viscous is None else viscous)
     s = 2j * np.pi * np.logspace(-2, 1.5, 30)
-    damping = (1 - fraction) * cv * (s / (s + 2 * np.pi * observer) if observer else 1.0)
+    damping = (cv - compensated) * (s / (s + 2 * np.pi * observer) if observer else 1.0)
     coupling = damping * s + k + kp + ki / s
     expected = np.abs(coupling / (m * s ** 2 + coupling + kd * s * s / (s + w)))
     found = linearize(isolator, controller).transmissibility(s.imag / (2 * np.pi))
     error = np.max(np.abs(found / expected - 1))
     assert error < 1e-9
-    validation(f"Compensation's linear part, fraction {fraction}, observer {observer} Hz",
-               "T(s) with Cv -> (1 - a) Cv" + (" s/(s + w_o)" if observer else ""), error, 1e-9)
+    validation(f"Compensation's linear part, fraction {fraction}, "
+               f"Cv' = {'Cv' if viscous is None else viscous}, observer {observer} Hz",
+               "T(s) with Cv -> Cv - a Cv'" + (" s/(s + w_o)" if observer else ""), error, 1e-9)
 
 
 @pytest.mark.parametrize("frequency", [0.5, 2.0, 5.0, 10.0])
@@ -147,7 +153,7 @@ def test_simulated_transmissibility_with_a_friction_observer_is_the_linear_loops
     isolator = linear_isolator()
     controller = PIDamping(position_setpoint=0.0, pi_kp=50.0, pi_ki=200.0, damping_gain=100.0,
                            velocity_highpass=0.0) + FrictionCompensation(
-        fraction=0.5, observer_bandwidth=10.0)
+        fraction=0.5, viscous_damping=None, observer_bandwidth=10.0)
     expected = float(linearize(isolator, controller).transmissibility(frequency))
     simulated = steady_transmissibility(frequency, isolator, controller)
     assert simulated == pytest.approx(expected, rel=1e-4)

@@ -22,12 +22,15 @@ from qzs.analysis.linear import loop_constants
 TOLERANCE = 0.02
 
 
-def test_the_net_law_is_the_plants_less_the_compensators():
+@pytest.mark.parametrize("viscous", [None, 0.0, 40.0])
+def test_the_net_law_is_the_plants_less_the_compensators(viscous):
+    """The compensator's viscous slope ``a Cv'`` (the plant's Cv with None, 0 by default) is
+    linear, in the loop: added back here, so only the deadband shows it."""
     plant = IsolatorParameters()
-    law = cd.NetFrictionNonlinearity.of(plant, FrictionCompensation(fraction=1.5,
-                                                                    deadband=2e-3))
+    law = cd.NetFrictionNonlinearity.of(plant, FrictionCompensation(
+        fraction=1.5, viscous_damping=viscous, deadband=2e-3))
     stribeck = cd.FrictionNonlinearity(10.0, 1.0, 100.0)
-    slope = 1.5 * plant.viscous_damping  # linear, in the loop: added back here
+    slope = 1.5 * (plant.viscous_damping if viscous is None else viscous)
     assert law(0.0) == 0.0
     assert law(1e-3) == pytest.approx(stribeck(1e-3) + slope * 1e-3, rel=1e-14)  # deadband
     assert law(0.01) == pytest.approx(-0.5 * stribeck(0.01), rel=1e-12)
@@ -58,23 +61,27 @@ def test_the_net_describing_function_against_closed_forms_and_python_control(fra
 
 
 def test_no_sliding_cycle_without_over_compensation():
-    for controller in (PIDamping(), PIDamping() + FrictionCompensation(fraction=0.9)):
+    for controller in (PIDamping(), PIDamping() + FrictionCompensation(fraction=0.9),
+                       PIDamping() + FrictionCompensation(fraction=0.9, viscous_damping=None)):
         prediction = cd.predict_sliding_cycle(None, controller)
         assert not prediction.hunts and prediction.intersections == ()
         assert "does not meet" in prediction.reasons["hunts"]
         assert math.isnan(prediction.amplitude) and "amplitude" in prediction.reasons
-    unstable = cd.predict_sliding_cycle(None, PIDamping() + FrictionCompensation(fraction=1.5))
+    unstable = cd.predict_sliding_cycle(None, PIDamping() + FrictionCompensation(  # the whole law
+        fraction=1.5, viscous_damping=None))
     assert not unstable.hunts and not unstable.linear_stable
     assert "linearly unstable" in unstable.reasons["hunts"]
 
 
 def test_the_sliding_cycle_of_coulomb_friction_is_the_closed_form(validation):
     """``G = s/(m s^2 + c s + K)``, ``c = (1 - a) Cv + Kd``: real, ``1/c``, at ``sqrt(K/m)``;
-    ``N(A) = -(a - 1) 4 F/(pi A) = -c`` gives ``A = 4 (a - 1) F/(pi c)``."""
+    ``N(A) = -(a - 1) 4 F/(pi A) = -c`` gives ``A = 4 (a - 1) F/(pi c)``; the whole law
+    compensated (``viscous_damping=None``: the compensator's ``Cv' = Cv``)."""
     isolator = IsolatorParameters(stiction_force=2.0, coulomb_force=2.0)
     fraction = 1.4
     controller = PIDamping(pi_kp=2000.0, pi_ki=0.0, damping_gain=60.0,
-                           velocity_highpass=0.0) + FrictionCompensation(fraction=fraction)
+                           velocity_highpass=0.0) + FrictionCompensation(
+        fraction=fraction, viscous_damping=None)
     m, cv, k, kp, _, kd, _ = loop_constants(isolator, controller)
     c = (1 - fraction) * cv + kd
     amplitude = 4 * (fraction - 1) * 2.0 / (math.pi * c)
@@ -116,11 +123,11 @@ CYCLES = {
     "the whole law, over-compensated by 40 %": (
         IsolatorParameters(stiction_force=2.0),
         PIDamping(pi_kp=2000.0, damping_gain=60.0, velocity_highpass=0.0)
-        + FrictionCompensation(fraction=1.4)),
+        + FrictionCompensation(fraction=1.4, viscous_damping=None)),
     "the whole law by 50 %": (
         IsolatorParameters(stiction_force=2.0),
         PIDamping(pi_kp=2000.0, damping_gain=60.0, velocity_highpass=0.0)
-        + FrictionCompensation(fraction=1.5)),
+        + FrictionCompensation(fraction=1.5, viscous_damping=None)),
     "Coulomb and Stribeck only, light viscous friction": (
         IsolatorParameters(stiction_force=2.0, viscous_damping=5.0),
         PIDamping(pi_kp=2000.0, velocity_highpass=0.0)
@@ -149,7 +156,7 @@ def test_the_predicted_sliding_cycle_is_the_simulated_one(name, validation):
 def test_below_the_breakaway_ratio_the_payload_sticks_and_the_cycle_is_not_the_sliding_one():
     isolator = IsolatorParameters(stiction_force=2.0)
     controller = (PIDamping(pi_kp=2000.0, damping_gain=80.0, velocity_highpass=0.0)
-                  + FrictionCompensation(fraction=1.4))
+                  + FrictionCompensation(fraction=1.4, viscous_damping=None))  # the whole law
     prediction = cd.predict_sliding_cycle(isolator, controller)
     assert prediction.hunts and not prediction.in_regime and prediction.breakaway_ratio < 1
     assert "sticks at the reversals" in prediction.reasons["in_regime"]

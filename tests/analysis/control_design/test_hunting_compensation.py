@@ -5,6 +5,7 @@ along the slip, which carries the payload further: the slip jump ``J = 2 a Fs`` 
 Coulomb guide (closed form), a larger plateau in the simulation as in the prediction, and no
 re-stick at all once ``a >= 1``.
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -52,12 +53,20 @@ def test_the_slip_jump_of_a_compensated_coulomb_guide_is_two_a_fs(fraction, vali
 
 
 def test_the_restick_level_scales_with_the_fraction_left():
-    """The net steady force is ``(1 - a)`` times the law when the compensator's is the plant's."""
+    """The net steady force is ``(1 - a)`` times the law when the compensator's is the plant's
+    (``viscous_damping=None``); with the default compensator (``Cv' = 0``) it is the law of a
+    guide with ``(1 - a) Fs``, ``(1 - a) Fc`` and the whole ``Cv`` (closed form)."""
     isolator = IsolatorParameters()
     for fraction in (0.3, 0.9):
-        controller = PIDamping() + FrictionCompensation(fraction=fraction)
+        controller = PIDamping() + FrictionCompensation(fraction=fraction, viscous_damping=None)
         assert cd.restick_force(isolator, controller) == pytest.approx(
             (1 - fraction) * cd.restick_force(isolator), rel=1e-9)
+        controller = PIDamping() + FrictionCompensation(fraction=fraction)
+        left = dataclasses.replace(
+            isolator, stiction_force=(1 - fraction) * isolator.stiction_force,
+            coulomb_force=(1 - fraction) * isolator.coulomb_force)
+        assert cd.restick_force(isolator, controller) == pytest.approx(
+            cd.restick_force(left), rel=1e-9)
     assert math.isnan(cd.restick_force(isolator, PIDamping() + FrictionCompensation(
         fraction=1.1)))
 
@@ -73,11 +82,14 @@ def _stuck_positions(isolator, controller, start, duration=400.0):
 
 def test_compensation_enlarges_the_hunting_plateau_as_predicted(validation):
     """Kp = 200 N/m, Ki = 80 N/(m s): the relay's plateau ``d/K`` against the simulated
-    stuck positions, without compensation and with 30 % of the law."""
+    stuck positions, without compensation, with 30 % of the Coulomb and Stribeck terms (the
+    default compensator, ``Cv' = 0``) and with 30 % of the whole law (``Cv' = Cv``:
+    ``viscous_damping=None``), each plateau larger than the one before."""
     isolator = IsolatorParameters()
     base = ControllerParameters(pi_kp=200.0, pi_ki=80.0)
     plateaus = []
-    for controller in (base + NOTHING, base + FrictionCompensation(fraction=0.3)):
+    for controller in (base + NOTHING, base + FrictionCompensation(fraction=0.3),
+                       base + FrictionCompensation(fraction=0.3, viscous_damping=None)):
         prediction = cd.predict_hunting(isolator, controller)
         assert prediction.hunts and prediction.in_regime
         stuck = _stuck_positions(isolator, controller, prediction.amplitude)
@@ -85,7 +97,8 @@ def test_compensation_enlarges_the_hunting_plateau_as_predicted(validation):
         simulated = float(np.mean(np.abs(stuck)))
         assert simulated == pytest.approx(prediction.amplitude, rel=0.05)
         plateaus.append((prediction.amplitude, simulated))
-    (predicted_0, simulated_0), (predicted_3, simulated_3) = plateaus
+    (predicted_0, simulated_0), (predicted_c, simulated_c), (predicted_3, simulated_3) = plateaus
+    assert predicted_0 < predicted_c < predicted_3 and simulated_0 < simulated_c < simulated_3
     assert predicted_3 > 1.15 * predicted_0 and simulated_3 > 1.15 * simulated_0
     validation("Hunting plateau with 30 % friction compensation (Kp = 200, Ki = 80)",
                "stick-slip relay's d/K with the compensated slip against the simulation",

@@ -29,9 +29,11 @@ def test_margins_of_blocks_that_add_nothing_are_pi_and_dampings(rate, delay):
 
 
 def test_over_compensated_viscous_friction_is_an_unstable_loop_with_its_poles(validation):
-    """Fraction 1.5 of ``Cv`` and no damping gain: ``m s^3 + (1 - a) Cv s^2 + K s + Ki``."""
+    """Fraction 1.5 of ``Cv`` (the compensator's ``Cv' = Cv``: ``viscous_damping=None``) and no
+    damping gain: ``m s^3 + (1 - a) Cv s^2 + K s + Ki``."""
     isolator = IsolatorParameters()
-    controller = PIDamping(damping_gain=0.0) + FrictionCompensation(fraction=1.5)
+    controller = PIDamping(damping_gain=0.0) + FrictionCompensation(fraction=1.5,
+                                                                    viscous_damping=None)
     m, cv, k, kp, ki, _, w = loop_constants(isolator, controller)
     expected = np.concatenate([np.roots([m, (1 - 1.5) * cv, k + kp, ki]), [-w]])
     verdict = cd.loop_stability(isolator, controller)
@@ -50,15 +52,24 @@ def test_over_compensated_viscous_friction_is_an_unstable_loop_with_its_poles(va
 
 def test_compensating_the_viscous_friction_costs_the_pi_loop_its_damping():
     """Without a damping loop, ``m s^3 + (1 - a) Cv s^2 + K s + Ki`` is stable only while
-    ``(1 - a) Cv K > m Ki``: the fraction's limit ``a* = 1 - m Ki/(K Cv)`` (0.975 here)."""
+    ``(1 - a) Cv K > m Ki``: the fraction's limit ``a* = 1 - m Ki/(K Cv)`` (0.975 here), with
+    the compensator's ``Cv' = Cv`` (``viscous_damping=None``). The default compensator
+    (``Cv' = 0``, Coulomb and Stribeck alone) leaves ``Cv`` in place: PI + damping's poles."""
     isolator = IsolatorParameters()
     m, cv, k, kp, ki, _, _ = loop_constants(isolator, PIDamping())
     limit = 1 - m * ki / ((k + kp) * cv)
     for fraction, stable in ((limit - 0.002, True), (limit + 0.002, False)):
         verdict = cd.loop_stability(isolator, PIDamping() + FrictionCompensation(
-            fraction=fraction))
+            fraction=fraction, viscous_damping=None))
         assert verdict.stable is stable
     assert limit == pytest.approx(0.975, abs=1e-3)
+    plain = cd.loop_stability(isolator, PIDamping())
+    for fraction in (limit + 0.002, 1.5):
+        verdict = cd.loop_stability(isolator, PIDamping() + FrictionCompensation(
+            fraction=fraction))
+        assert verdict.stable
+        np.testing.assert_allclose(np.sort_complex(verdict.poles),
+                                   np.sort_complex(plain.poles), rtol=1e-9)
 
 
 def test_a_controller_unstable_alone_is_accepted_when_its_loop_is_stable():
