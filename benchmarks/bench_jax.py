@@ -292,8 +292,9 @@ def check_worker():
         state, flags = run.state.copy(), run.flags.copy()
         out = np.empty((steps // run.decimation + 1, K.N_CHANNELS))
         out_flags = np.zeros((out.shape[0], 2), dtype=np.bool_)
-        status, _ = lanes.run_single(run.solver_code, steps, run.decimation, state, flags,
-                                     run.params, *run.packed, out, out_flags, 0)
+        status, _ = lanes.single_kernel(run.model)(
+            run.solver_code, steps, run.decimation, state, flags, run.params, run.model,
+            *run.packed, out, out_flags, 0)
         assert status == K.STATUS_OK and flags[K.I_N_STICKS] == 0
         contacts += int(flags[K.I_N_CONTACTS])
         final_qzs.append(state[:K.N_ODE])

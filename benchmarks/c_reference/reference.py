@@ -86,7 +86,8 @@ def run_reference(excitation=None, isolator=None, controller=None, **kwargs):
 
 
 def numba_seconds(run, out=None, out_flags=None):
-    """Wall time [s] of the numba kernel (``run_single``, one call) on the same prepared run."""
+    """Wall time [s] of the numba kernel (``lanes.single_kernel`` of the run's controller, one
+    call) on the same prepared run; ``out`` and ``out_flags``, if given, receive its rows."""
     from qzs.engine import kernels as K
     from qzs.engine import lanes
 
@@ -95,11 +96,12 @@ def numba_seconds(run, out=None, out_flags=None):
     out = np.zeros((rows, K.N_CHANNELS)) if out is None else out
     out_flags = np.zeros((rows, 2), dtype=bool) if out_flags is None else out_flags
     state, flags = run.state.copy(), run.flags.copy()
-    lanes.run_single(run.solver_code, 0, run.decimation, state, flags, run.params,
-                     *run.packed, out, out_flags, 1)  # compiled or loaded: not timed
+    kernel = lanes.single_kernel(run.model)
+    kernel(run.solver_code, 0, run.decimation, state, flags, run.params, run.model,
+           *run.packed, out, out_flags, 1)  # compiled or loaded: not timed
     start = time.perf_counter()
-    lanes.run_single(run.solver_code, steps, run.decimation, state, flags, run.params,
-                     *run.packed, out, out_flags, 1)
+    kernel(run.solver_code, steps, run.decimation, state, flags, run.params, run.model,
+           *run.packed, out, out_flags, 1)
     return time.perf_counter() - start
 
 

@@ -114,7 +114,7 @@ def test_every_driver_raises_the_same_memory_error(monkeypatch):
         assert time.perf_counter() - start < 2.0
         errors.append(caught.value)
     assert all(e.available == 10 * 2 ** 20 for e in errors)
-    assert errors[0].needed == (2_000_001) * (8 * K.N_CHANNELS + 2)
+    assert errors[0].needed == (2_000_001) * (8 * K.N_BASE_CHANNELS + 2)  # no blocks: 24
     assert "hexapod simulate --out" in errors[1].remedy
     assert errors[2].needed == 8 * 2_000_001 * 16
     assert "channels" in errors[2].remedy  # the batch's own advice, not --out

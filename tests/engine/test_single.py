@@ -9,6 +9,7 @@ Properties that fail if the run is wrong:
   right number.
 """
 import numpy as np
+import pytest
 
 import qzs
 from qzs import Chirp, Sine
@@ -37,6 +38,9 @@ def test_the_step_record_travels_with_the_run():
     assert 0 <= chosen.run["step_error_m"] <= 1e-6
 
 
-def test_result_bytes_is_what_the_arrays_take():
-    run = integrate(SINE, duration=0.75, dt=1e-3, sample_rate=200.0)
-    assert result_bytes(0.75, 200.0) == run._data.nbytes + run._flags.nbytes
+@pytest.mark.parametrize("controller", [None, qzs.PIDamping() + qzs.Dither(amplitude=2.0)],
+                         ids=["no blocks", "dither"])
+def test_result_bytes_is_what_the_arrays_take(controller):
+    """24 float channels without blocks, 28 with them (the blocks' forces), and 2 flags."""
+    run = integrate(SINE, controller=controller, duration=0.75, dt=1e-3, sample_rate=200.0)
+    assert result_bytes(0.75, 200.0, controller) == run._data.nbytes + run._flags.nbytes

@@ -15,10 +15,10 @@ from qzs.engine.channels import channel_count, named_block, summary_statistics
 from qzs.engine.result import SimulationResult
 from qzs.errors import SimulationError
 
-__all__ = ["integrate", "result_bytes", "SingleAxis", "BYTES_PER_SAMPLE"]
+__all__ = ["integrate", "result_bytes", "SingleAxis"]
 
-#: Bytes one output sample takes in memory: every channel as float64, the flags as bool.
-BYTES_PER_SAMPLE = 8 * K.N_CHANNELS + 2
+#: The flags of an output row (``locked``, ``contact``), one byte each in memory.
+_FLAG_COUNT = 2
 
 
 def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
@@ -65,7 +65,7 @@ def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
     p = run.params
     statistics = summary_statistics(run.controller, 0.5 * (p[K.P_Z_LOW] + p[K.P_Z_HIGH]),
                                     run.isolator.motor_force_max)
-    recorder = driver.Recorder(plan, channel_count(run.controller), 2, sink=sink,
+    recorder = driver.Recorder(plan, channel_count(run.controller), _FLAG_COUNT, sink=sink,
                                statistics=lambda data, flags: statistics.add(
                                    named_block(data, flags)),
                                duration=run.duration, sample_rate=run.sample_rate)
@@ -139,8 +139,11 @@ class SingleAxis(driver.Stepper):
                                                   run.params[K.P_DT]))
 
 
-def result_bytes(duration, sample_rate):
+def result_bytes(duration, sample_rate, controller=None):
     """Memory [bytes] a run's result takes: every channel and flag at every output sample.
+
+    A float64 per channel (:func:`~qzs.engine.channels.channel_count`: the blocks' forces
+    only with blocks) and a bool per flag.
 
     Parameters
     ----------
@@ -148,9 +151,12 @@ def result_bytes(duration, sample_rate):
         Simulated time [s].
     sample_rate : float
         Output sample rate [Hz].
+    controller : ControllerParameters, optional
+        The run's controller; default one without blocks.
 
     Returns
     -------
     int
     """
-    return int((int(round(duration * sample_rate)) + 1) * BYTES_PER_SAMPLE)
+    samples = int(round(duration * sample_rate)) + 1
+    return int(samples * (8 * channel_count(controller) + _FLAG_COUNT))

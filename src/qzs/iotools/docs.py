@@ -42,6 +42,7 @@ TOPICS = {
     "workflows/response-design": "workflows/response-design.md",
     "workflows/hexapod": "workflows/hexapod.md",
     "workflows/app": "workflows/app.md",
+    "workflows/questions": "workflows/questions.md",
 }
 #: Where the pages are inside an installed package.
 PACKAGE_FOLDER = "_docs"

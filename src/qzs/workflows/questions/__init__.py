@@ -12,6 +12,7 @@
 """
 import time
 from pathlib import Path
+from typing import Any
 
 from qzs.errors import ParameterError
 from qzs.workflows.questions.common import Answer
@@ -93,7 +94,9 @@ def _damping(quick, dt, workers, progress):
     return result, figures, tables, how, "Damping design: can a loop attenuate the peaks?"
 
 
-def run_question(name, folder, *, quick=False, dt=1e-4, workers=None, progress=False):
+def run_question(name: str, folder: str | Path, *, quick: bool = False, dt: float = 1e-4,
+                 workers: int | None = None, progress: bool = False
+                 ) -> tuple[dict[str, Any], dict[str, Path], float]:
     """Run one open-question study and write its figures, ``study.json`` and ``report.html``.
 
     Parameters
