@@ -33,3 +33,21 @@ def test_the_energy_figure_draws_the_ledgers_residual(run):
     np.testing.assert_array_equal(residual.get_ydata(), run.energy_residual())
     labels = [line.get_label() for line in figure.axes[0].lines]
     assert labels == ["base work", "motor work", "friction dissipation", "stop dissipation"]
+
+
+def test_a_streamed_runs_title_fits_the_figure(monkeypatch):
+    """The title of a long streamed run (its own line, then the envelope's) stays inside the
+    figure: it was one line, cut at both edges for a 2000 s chirp."""
+    from qzs import Chirp
+    from qzs.engine import driver
+
+    monkeypatch.setattr(driver, "PREVIEW_SAMPLES", 250)
+    streamed = simulate(Chirp(duration=2000.0), duration=1.0, dt=1e-3, sample_rate=1000.0,
+                        sink=lambda data, flags: None)
+    assert streamed.run["preview_every"] > 1
+    figure = plot_simulation(streamed)
+    figure.canvas.draw()
+    title = figure._suptitle
+    box = title.get_window_extent(figure.canvas.get_renderer())
+    assert "envelope" in title.get_text()
+    assert 0 <= box.x0 and box.x1 <= figure.bbox.width and box.y1 <= figure.bbox.height

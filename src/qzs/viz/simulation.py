@@ -59,7 +59,7 @@ def plot_simulation(result, path=None, title=None):
         ax.grid(True, alpha=0.3)
     every = result.run.get("preview_every", 1)
     subtitle = ("" if every == 1 else
-                f" (envelope: min/max per {every} of {result.run['samples']:,} samples)")
+                f"\n(envelope: min/max per {every} of {result.run['samples']:,} samples)")
     fig.suptitle((title or run_title(result)) + subtitle)
     if path is not None:
         save_figure(fig, path)
