@@ -41,8 +41,15 @@ def chromium():
 
 
 @pytest.fixture(scope="module")
-def server(chromium):
-    with browser.start_server() as url:
+def server_log(tmp_path_factory):
+    """The server's output, shown when a page does not load (what it was busy with)."""
+    with open(tmp_path_factory.mktemp("app") / "server.log", "w+") as log:
+        yield log
+
+
+@pytest.fixture(scope="module")
+def server(chromium, server_log):
+    with browser.start_server(log=server_log) as url:
         yield url
 
 
@@ -52,9 +59,22 @@ def context(server):
         yield context
 
 
+def open_page(context, server, server_log):
+    """A new page, or a failure that shows what the server printed meanwhile."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    try:
+        return browser.open_page(context, server, timeout=COLD)
+    except PlaywrightTimeout:
+        server_log.flush()
+        server_log.seek(0)
+        pytest.fail(f"the page did not draw within {COLD:g} s; the server printed:\n"
+                    f"{server_log.read()[-4000:]}")
+
+
 @pytest.fixture
-def page(context, server):
-    page = browser.open_page(context, server, timeout=COLD)
+def page(context, server, server_log):
+    page = open_page(context, server, server_log)
     yield page
     page.close()
 
@@ -157,11 +177,11 @@ def overlaps(first, second):
 
 
 @pytest.mark.parametrize("width", [1280, 1920])
-def test_page_fits_the_window_and_no_legend_covers_data(context, server, width):
+def test_page_fits_the_window_and_no_legend_covers_data(context, server, server_log, width):
     """At 1280 px (and 1920) nothing is clipped or scrolled sideways, on either tab, and
     the legends of the transmissibility and the sine response lie outside their frames
     (the data region), with a pinned curve's long label too."""
-    page = browser.open_page(context, server, timeout=COLD)
+    page = open_page(context, server, server_log)
     try:
         page.set_viewport_size({"width": width, "height": 900})
         page.wait_for_timeout(1000)  # the plots follow the window's width

@@ -134,3 +134,38 @@ def test_a_port_that_is_not_one_is_refused_with_the_range(port):
     with pytest.raises(ParameterError) as info:
         server.serve(port=port, open_browser=False)
     assert str(info.value) == f"`port` must be an integer in [0, 65535], got {shown}; e.g. 5006."
+
+
+def _compiled_signatures():
+    """The number of compiled (or cache-loaded) signatures of every numba kernel of qzs."""
+    from numba.core.registry import CPUDispatcher
+
+    counts = {}
+    for name, module in list(sys.modules.items()):
+        if not name.startswith("qzs."):
+            continue
+        for attribute, value in vars(module).items():
+            if isinstance(value, CPUDispatcher):
+                counts[f"{name}.{attribute}"] = len(value.signatures)
+    return counts
+
+
+def test_the_warm_up_compiles_every_kernel_a_slider_can_reach():
+    """After the warm-up no setting of the page compiles a kernel: a session that moves the
+    compensation slider (a friction-compensation block: the blocks kernel) or asks for the
+    stepped sine waits for a computation, never for numba (minutes on an empty cache, while
+    the page's one computing thread serves nobody else)."""
+    from qzs.app.compute import compute_page, page_request
+    from qzs.app.server import warm_up
+
+    warm_up(stream=open("/dev/null", "w"))
+    before = _compiled_signatures()
+    assert before, "no numba kernel found in qzs's modules"
+    for values in ({"compensation.fraction": 0.5}, {"compensation.fraction": 1.5},
+                   {"excitation.kind": "stepped", "frequency_count": 2,
+                    "compensation.fraction": 0.8}, {"stiction_force": 4.0}):
+        compute_page(page_request(values))
+        after = _compiled_signatures()
+        grown = {name: (before.get(name, 0), count) for name, count in after.items()
+                 if count > before.get(name, 0)}
+        assert not grown, f"{values} compiled after the warm-up: {grown}"

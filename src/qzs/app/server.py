@@ -142,7 +142,9 @@ def _bind(host, port):
 
 
 def warm_up(stream=None):
-    """Compile (or load) the kernels and run each computation of the page once.
+    """Compile (or load) the kernels and run each computation of the page once: the chirp,
+    the stepped sine and a run with the compensation slider's block, so that no setting of
+    the page compiles a kernel afterwards.
 
     Parameters
     ----------
@@ -163,6 +165,10 @@ def warm_up(stream=None):
           "`qzs: compiling the kernels once` says so) ...", file=stream, flush=True)
     data = compute_page(page_request())
     compute_page(page_request({"excitation.kind": "stepped", "frequency_count": 2}))
+    # the compensation slider adds a block: the blocks kernel, compiled here rather than in
+    # the first session that moves it (the page has one computing thread for every session)
+    compute_page(page_request({"compensation.fraction": 0.5, "excitation.duration": 10.0,
+                              "excitation.f1": 2.0}))
     figure_png(data)
     elapsed = time.perf_counter() - start
     print(f"qzs app: warm in {elapsed:.1f} s", file=stream, flush=True)
