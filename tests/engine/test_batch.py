@@ -108,3 +108,46 @@ def test_chunking_changes_no_bit(monkeypatch):
                                       whole.payload_acceleration)
         np.testing.assert_array_equal(batch.channels["relative_position"][c],
                                       whole.relative_position)
+
+
+def _compensated(fraction, observer=0.0):
+    return qzs.ControllerParameters(compensation=qzs.FrictionCompensation(
+        fraction=fraction, observer_bandwidth=observer))
+
+
+def test_a_block_channel_is_kept_and_equals_the_single_run():
+    """A batch keeps a block's force (`compensation_force`, `friction_estimate`) as a
+    single run records it, bit for bit, in one lane or in lockstep lanes."""
+    cases = [(qzs.IsolatorParameters(), _compensated(fraction, observer))
+             for fraction, observer in ((0.5, 0.0), (1.0, 20.0), (0.0, 5.0))]
+    excitation = qzs.Chirp(duration=2.0, f0=0.5, f1=3.0)
+    names = ("compensation_force", "payload_acceleration")
+    for workers in (1, 3):
+        batch = simulate_batch(cases, excitation, sample_rate=500.0, channels=names,
+                               workers=workers)
+        for index, (isolator, controller) in enumerate(cases):
+            single = qzs.simulate(excitation, isolator, controller, sample_rate=500.0)
+            for name in names:
+                assert np.array_equal(batch.channels[name][index], single[name]), (
+                    workers, index, name)
+        assert np.any(batch.channels["compensation_force"][1] != 0.0)
+        assert batch.to_xarray()["compensation_force"].attrs["units"] == "N"
+    observed = simulate_batch(cases[1:], excitation, sample_rate=500.0,
+                              channels=("friction_estimate",), workers=1)
+    single = qzs.simulate(excitation, *cases[1], sample_rate=500.0)
+    assert np.array_equal(observed.channels["friction_estimate"][0], single.friction_estimate)
+
+
+def test_a_block_channel_of_a_case_without_the_block_is_refused_before_any_work():
+    cases = [(qzs.IsolatorParameters(), _compensated(0.5)),
+             (qzs.IsolatorParameters(), qzs.ControllerParameters())]
+    with pytest.raises(qzs.ParameterError) as error:
+        simulate_batch(cases, qzs.Chirp(duration=1e9), channels=("compensation_force",))
+    message = str(error.value)
+    assert "compensation_force" in message and "case 1" in message
+    assert "channels" in error.value.options
+    with pytest.raises(qzs.ParameterError) as error:  # no observer: no estimate
+        simulate_batch(cases[:1], qzs.Chirp(duration=1e9), channels=("friction_estimate",))
+    assert "observer_bandwidth" in str(error.value)
+    with pytest.raises(qzs.ParameterError, match="dither_forse"):
+        simulate_batch(cases[:1], qzs.Chirp(duration=1e9), channels=("dither_forse",))

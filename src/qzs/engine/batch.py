@@ -25,7 +25,8 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run
-from qzs.engine.channels import CHANNELS, FLAGS, sample_bytes, simulation_schema
+from qzs.engine.channels import (BLOCK_CHANNELS, FLAGS, run_channels, sample_bytes,
+                                 simulation_schema)
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
@@ -168,7 +169,7 @@ def batch_schema(batch):
     -------
     Schema
     """
-    single = simulation_schema()
+    single = simulation_schema(every_block=True)
     n = len(batch.status)
     variables = [dataclasses.replace(single[name], dims=("case", "time"))
                  for name in batch.channels]
@@ -220,9 +221,10 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     solver : {"ode3", "rk4", "euler"}
         Integrator, as in :func:`qzs.simulate`.
     channels : sequence of str
-        Time series to keep: names of :data:`qzs.engine.channels.CHANNELS`, or of the
-        boolean flags :data:`qzs.engine.channels.FLAGS` (``"locked"``, ``"stop_contact"``);
-        may be empty.
+        Time series to keep: names of :data:`qzs.engine.channels.CHANNELS`, of a block's
+        force (:data:`qzs.engine.channels.BLOCK_CHANNELS`: ``"compensation_force"`` [N],
+        ...; every case's controller must have that block), or of the boolean flags
+        :data:`qzs.engine.channels.FLAGS` (``"locked"``, ``"stop_contact"``); may be empty.
     workers : int, optional
         Threads, each running a share of the cases in the kernel (which releases
         the GIL); default all cores.
@@ -246,10 +248,11 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     if isinstance(channels, str):
         raise ParameterError(f"`channels` must be a sequence of channel names, got the string "
                              f"{channels!r}; write ({channels!r},).")
-    unknown = [c for c in channels if c not in CHANNELS and c not in FLAGS]
+    recordable = run_channels(every_block=True)
+    unknown = [c for c in channels if c not in recordable and c not in FLAGS]
     if unknown:
         raise ParameterError(f"unknown channel(s) {unknown}; channels are "
-                             f"{[*CHANNELS, *FLAGS]}.")
+                             f"{[*recordable, *FLAGS]}.", options=("channels",))
     prepared = []
     for index, pair in enumerate(cases):
         try:
@@ -258,6 +261,7 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
                                         dt=dt, sample_rate=sample_rate, solver=solver))
         except (TypeError, ValueError) as error:
             raise CaseError(index, error) from error
+    _check_block_channels(channels, [controller for _, controller in cases])
     first = prepared[0]
     n = len(prepared)
     decimation = first.decimation
@@ -302,6 +306,25 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
                        lanes.params[:, [K.P_Z_LOW, K.P_Z_HIGH]].copy())
 
 
+def _check_block_channels(channels, controllers):
+    """Refuse a block's channel (``compensation_force``, ...) that a case has no block for."""
+    for name in channels:
+        if name not in BLOCK_CHANNELS:
+            continue
+        lacking = [index for index, controller in enumerate(controllers)
+                   if name not in run_channels(controller)]
+        if lacking:
+            block = BLOCK_CHANNELS[name][3]
+            what = ("a friction compensation with an observer (`observer_bandwidth` > 0)"
+                    if block == "observer" else f"the `{block}` block")
+            cases = ", ".join(str(index) for index in lacking[:10])
+            more = f" and {len(lacking) - 10} more" if len(lacking) > 10 else ""
+            raise ParameterError(
+                f"`channels` holds {name!r}, which only a controller with {what} records; "
+                f"case {cases}{more} has none. Give every case that block, or keep "
+                f"{name!r} out of `channels`.", options=("channels",))
+
+
 class _Rows:
     """The batch's recorder for the driver: the lanes keep their channels themselves (each
     thread its share, see :class:`_Lanes`), so that the next chunk may start at once."""
@@ -341,9 +364,10 @@ class _Lanes(driver.Stepper):
         self.status = np.zeros(n, dtype=np.int64)
         self.written = np.zeros(n, dtype=np.int64)
         self.failed_at = np.full(n, -1, dtype=np.int64)
-        self.kept = {c: (np.empty((n, plan.samples)) if c in CHANNELS
+        recordable = run_channels(every_block=True)
+        self.kept = {c: (np.empty((n, plan.samples)) if c in recordable
                          else np.zeros((n, plan.samples), dtype=bool)) for c in channels}
-        self.values = [(c, CHANNELS[c][0]) for c in channels if c in CHANNELS]
+        self.values = [(c, recordable[c][0]) for c in channels if c in recordable]
         self.flag_columns = [(c, FLAGS[c][0]) for c in channels if c in FLAGS]
         self.columns = np.array(sorted({col for _, col in self.values}
                                        | set(_STATISTICS_COLUMNS)), dtype=np.int64)

@@ -52,3 +52,26 @@ def test_run_local_yields_every_batch_in_order(sweep):
     for name in ("transmissibility", "peak_stroke"):  # batching does not change a case
         np.testing.assert_array_equal(
             np.concatenate([r["arrays"][name] for r in results]), together[name])
+
+
+def test_a_sweep_keeps_a_block_channel_as_the_single_run_records_it():
+    """A sweep over the compensation fraction keeps `compensation_force` [N] of each case,
+    bit for bit the single run's, with its unit in the store's layout."""
+    from qzs.workflows.sweeps.store import schema
+
+    document = {**DOCUMENT, "grid": {"compensation.fraction": [0.0, 1.0]},
+                "outputs": {"time_series": ["compensation_force"]}}
+    sweep = load_sweep(document)
+    duration = sweep.analysis["duration"]
+    n_time = int(round(duration * sweep.analysis["sample_rate"])) + 1
+    settings = [{"compensation.fraction": 0.0}, {"compensation.fraction": 1.0}]
+    arrays = run_batch(sweep, 0, settings, n_time, threads=1)["arrays"]
+    for i, fraction in enumerate((0.0, 1.0)):
+        run = qzs.simulate(qzs.Chirp(f1=10.0, duration=duration), qzs.IsolatorParameters(),
+                           qzs.ControllerParameters(pi_ki=2.0, compensation=qzs
+                                                    .FrictionCompensation(fraction=fraction)),
+                           dt=DT)
+        np.testing.assert_array_equal(arrays["compensation_force"][i], run.compensation_force)
+    assert np.all(arrays["compensation_force"][0] == 0.0)
+    assert np.any(arrays["compensation_force"][1] != 0.0)
+    assert schema(sweep, n_time)["compensation_force"][3]["units"] == "N"

@@ -102,3 +102,23 @@ def test_each_output_read_from_the_estimates_needs_them():
         sweep = load_sweep({**base, "outputs": {**none, **alone}})
         assert needs_estimates(sweep) and batch_channels(sweep) == ESTIMATE_CHANNELS, alone
     assert not needs_estimates(load_sweep({**base, "outputs": none}))
+
+
+def test_a_block_channel_that_a_case_lacks_is_refused_before_any_run():
+    """`compensation_force` kept from cases without a compensation: every case is named,
+    with the fix, before any run; with the block in [parameters] the same sweep is valid."""
+    from qzs.errors import InvalidCasesError
+    from qzs.workflows.sweeps.cases import check_cases
+
+    document = {**DOCUMENT, "outputs": {"time_series": ["compensation_force"]}}
+    sweep = load_sweep(document)
+    with pytest.raises(InvalidCasesError) as caught:
+        check_cases(sweep, case_settings(sweep, sample_cases(sweep)))
+    assert caught.value.total == 4 and len(caught.value.cases) == 4
+    reason = caught.value.cases[0][2]
+    assert "compensation_force" in reason and "compensation.fraction" in reason
+    fixed = load_sweep({**document, "parameters": {"stiction_force": 7.0,
+                                                   "compensation.fraction": 0.5}})
+    check_cases(fixed, case_settings(fixed, sample_cases(fixed)))
+    with pytest.raises(Exception, match="compensation_forse"):
+        load_sweep({**document, "outputs": {"time_series": ["compensation_forse"]}})

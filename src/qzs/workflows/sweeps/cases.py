@@ -7,6 +7,7 @@ naming every one of them, before any runs.
 """
 import numpy as np
 
+from qzs.engine.channels import BLOCK_CHANNELS, run_channels
 from qzs.errors import InvalidCasesError, ParameterError
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -145,7 +146,7 @@ def check_cases(definition, settings):
     for i, case in enumerate(settings):
         varied = {k.split(".", 1)[1]: v for k, v in case.items() if k.startswith("excitation.")}
         try:
-            build_model(definition, case)
+            _check_block_channels(definition, *build_model(definition, case))
             key = tuple(sorted(varied.items()))
             if key not in excitations:
                 try:
@@ -160,6 +161,21 @@ def check_cases(definition, settings):
             invalid.append((i, case, str(error)))
     if invalid:
         raise InvalidCasesError(invalid, len(settings))
+
+
+def _check_block_channels(definition, isolator, controller):
+    """Refuse a block's time series (``compensation_force``, ...) the case does not record."""
+    recorded = run_channels(controller)
+    missing = [name for name in definition.outputs["time_series"] if name not in recorded]
+    if missing:
+        blocks = sorted({BLOCK_CHANNELS[name][3] for name in missing})
+        raise ParameterError(
+            f"`outputs.time_series` holds {missing}, which only a controller with the "
+            f"{', '.join(blocks)} block records, and this case has none; give the block in "
+            f"[parameters] or [grid] (e.g. `compensation.fraction`, "
+            f"`compensation.observer_bandwidth` > 0 for `friction_estimate`, "
+            f"`dither.amplitude`), or keep them out of `time_series`.",
+            options=("outputs.time_series",))
 
 
 def needs_estimates(definition):

@@ -22,7 +22,7 @@ from qzs._validation import seed as checked_seed
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.batch import STATS
-from qzs.engine.channels import CHANNELS
+from qzs.engine.channels import run_channels
 from qzs.engine.stability import SOLVERS
 from qzs.errors import CountLimitError, ParameterError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
@@ -477,7 +477,8 @@ def _outputs(table, analysis):
     outputs = {"stats": list(STATS), "metrics": metrics, "transmissibility": True,
                "coherence": False, "time_series": [], "bands": {}, "rms_bands": {}, **given}
     for key, valid in (("stats", list(STATS)), ("metrics", metrics),
-                       ("time_series", [c for c in CHANNELS if c != "time"])):
+                       ("time_series", [c for c in run_channels(every_block=True)
+                                        if c != "time"])):
         chosen = outputs[key]
         if not isinstance(chosen, list):
             raise ParameterError(f"`outputs.{key}` must be a list of names, got {chosen!r}.")

@@ -33,7 +33,7 @@ import numpy as np
 from qzs._optional import require
 from qzs._version import __version__
 from qzs.engine.batch import STATS
-from qzs.engine.channels import CHANNELS
+from qzs.engine.channels import run_channels
 from qzs.errors import ParameterError
 from qzs.model.registry import unit_of
 
@@ -124,8 +124,9 @@ def schema(definition, n_time):
     if out["coherence"]:
         variables["coherence"] = (("case", "frequency"), np.float64, np.nan,
                                   {"units": "1", "long_name": "magnitude-squared coherence"})
+    recordable = run_channels(every_block=True)
     for name in out["time_series"]:
-        _, unit, doc = CHANNELS[name]
+        _, unit, doc = recordable[name]
         variables[name] = (("case", "time"), np.float64, np.nan,
                            {"units": unit, "long_name": doc, "sample_rate": rate})
     return variables
