@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-N_CHANNELS = 24
+from qzs.engine.kernels import N_CHANNELS  # noqa: E402 - the C writes every column of a row
 STATUS = {False: "ok", True: "diverged"}
 
 
@@ -66,7 +66,7 @@ def prepare(excitation=None, isolator=None, controller=None, **kwargs):
 def run_prepared(run, out=None, out_flags=None):
     """Integrate a :class:`qzs.engine.prepare.PreparedRun` in C.
 
-    ``out`` (rows, 24) and ``out_flags`` (rows, 2) may be given to reuse a buffer. Returns a
+    ``out`` (rows, N_CHANNELS) and ``out_flags`` (rows, 2) may be given to reuse a buffer. Returns a
     dict: ``out``, ``flags``, ``rows``, ``steps``, ``seconds`` (the C call only),
     ``state`` (the final 8 states), ``stop_contacts``, ``stick_events``, ``status``.
     """

@@ -91,3 +91,26 @@ def test_a_diverging_case_stops_where_the_kernels_stop():
     assert 0 < result.steps == flags[K.I_STEP] < steps
     np.testing.assert_array_equal(result.state[:K.N_ODE], state[:K.N_ODE])
     assert np.all(np.isfinite(result.state[:K.N_ODE]))
+
+
+def test_a_buffer_of_the_wrong_shape_is_refused_not_overrun():
+    """The C writes K.N_CHANNELS doubles a row: a (rows, 24) buffer (the channels before the
+    controller's blocks existed) or too few rows is refused with the shape it needs, before the
+    C runs (it overran such a buffer and the benchmark's process died with SIGSEGV)."""
+    from qzs.engine.prepare import prepare_run
+    from qzs.export.cmodel import run_prepared
+
+    run = prepare_run(qzs.Chirp(duration=0.5), duration=0.5, dt=1e-4, sample_rate=1000.0)
+    samples = 501
+    for out, flags, name in ((np.zeros((samples, 24)), None, "out"),
+                             (np.zeros((samples - 1, K.N_CHANNELS)), None, "out"),
+                             (np.zeros((samples, K.N_CHANNELS), dtype=np.float32), None, "out"),
+                             (np.zeros((samples, K.N_CHANNELS))[:, ::1][::2], None, "out"),
+                             (None, np.zeros((samples, 3), dtype=np.uint8), "out_flags"),
+                             (None, np.zeros((samples, 2), dtype=bool), "out_flags")):
+        with pytest.raises(qzs.ParameterError) as error:
+            run_prepared(run, out=out, out_flags=flags)
+        assert f"`{name}`" in str(error.value) and name in error.value.options
+    good = run_prepared(run, out=np.zeros((samples, K.N_CHANNELS)),
+                        out_flags=np.zeros((samples, 2), dtype=np.uint8))
+    assert len(good.data) == samples and not good.diverged

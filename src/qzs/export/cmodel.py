@@ -14,6 +14,7 @@ import numpy as np
 
 from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
+from qzs.errors import ParameterError
 from qzs.export.csource import load_model
 
 __all__ = ["CRun", "run_prepared", "simulate_c"]
@@ -66,7 +67,8 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
     native : bool
         Use the library compiled for this CPU (:data:`qzs.export.csource.NATIVE_CFLAGS`).
     out : ndarray, shape (samples, N_CHANNELS), optional
-        A buffer to reuse (float64, C-contiguous).
+        A buffer to reuse (float64, C-contiguous, ``K.N_CHANNELS`` columns [various units]:
+        the C writes whole rows, the blocks' columns too).
     out_flags : ndarray of uint8, shape (samples, 2), optional
         Its flags' buffer.
 
@@ -78,14 +80,18 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
     ------
     CompilerError
         No C compiler, or it failed.
+    ParameterError
+        ``out`` or ``out_flags`` of a shape, type or layout the C would overrun.
     """
-    library = load_model(native)
     steps = int(round(run.duration / run.dt))
     samples = steps // run.decimation + 1
     if out is None:
         out = np.zeros((samples, K.N_CHANNELS))
     if out_flags is None:
         out_flags = np.zeros((samples, 2), dtype=np.uint8)
+    _check_buffer("out", out, (samples, K.N_CHANNELS), np.float64)
+    _check_buffer("out_flags", out_flags, (samples, 2), np.uint8)
+    library = load_model(native)
     state = np.array(run.state, dtype=np.float64)
     flags = np.array(run.flags, dtype=np.int64)
     params = np.ascontiguousarray(run.params, dtype=np.float64)
@@ -107,6 +113,21 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
     written = 1 + int(rows[0])
     return CRun(data=out[:written], flags=out_flags[:written].astype(bool), state=state,
                 run_flags=flags, diverged=status != K.STATUS_OK, seconds=seconds)
+
+
+def _check_buffer(name, array, rows_columns, dtype):
+    """Refuse a buffer the C would overrun or misread: it writes whole rows of ``dtype``."""
+    rows, columns = rows_columns
+    if (not isinstance(array, np.ndarray) or array.dtype != dtype or array.ndim != 2
+            or array.shape[1] != columns or array.shape[0] < rows
+            or not array.flags.c_contiguous or not array.flags.writeable):
+        got = (f"{array.dtype} {array.shape}, C-contiguous {array.flags.c_contiguous}"
+               if isinstance(array, np.ndarray) else type(array).__name__)
+        raise ParameterError(f"`{name}` must be a writeable C-contiguous {np.dtype(dtype)} "
+                             f"array of at least {rows} rows and exactly {columns} columns "
+                             f"(the C writes whole rows), got {got}; pass None to have one "
+                             f"made, or np.zeros(({rows}, {columns}), dtype=np.{np.dtype(dtype)}).",
+                             options=(name,))
 
 
 def simulate_c(excitation=None, isolator=None, controller=None, *, native=False, **settings):
