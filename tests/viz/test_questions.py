@@ -33,3 +33,21 @@ def test_the_damping_figure_draws_each_curve_and_both_metrics():
     assert len(fig.axes[0].lines) == 2
     heights = [p.get_height() for p in fig.axes[1].patches]
     assert heights == [4.0, 2.0]
+
+
+def test_the_damping_figure_labels_do_not_run_into_each_other():
+    """Six bars with the study's long labels: no two tick labels share any area."""
+    f = np.linspace(0.5, 20, 40)
+    curves = [CaseCurve("none", f, 1 / (1 + f), np.ones(f.size, bool))]
+    labels = ["Kd = 20 N*s/m", "Kd = 50 N*s/m", "Kd = 100 N*s/m",
+              "Kd = 253 N*s/m (the motor's limit)", "shaped skyhook, k = 209 N*s/m",
+              "Kd = 100 N*s/m + base-velocity cancellation (0.25 Cv, 0.7 Hz)"]
+    rows = [{"label": label, "kind": "paper", "largest_reduction_db": 4.0,
+             "band_rms_change_db": -2.0} for label in labels]
+    fig = plot_damping_design(curves, rows, (1.5, 20.0))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(renderer) for t in fig.axes[1].get_xticklabels()]
+    assert len(boxes) == len(labels)
+    for left, right in zip(boxes, boxes[1:]):
+        assert left.x1 < right.x0, (left, right)

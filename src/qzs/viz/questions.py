@@ -1,5 +1,6 @@
 """Figures of the paper's two open questions (:mod:`qzs.workflows.questions`)."""
 import math
+import textwrap
 
 import numpy as np
 
@@ -130,7 +131,8 @@ def plot_damping_design(curves, rows, band):
            label="largest per-bin reduction [dB]", color="C0")
     ax.bar(x + 0.2, [-r["band_rms_change_db"] for r in rows], 0.4,
            label="band RMS reduction [dB]", color="C1")
-    ax.set_xticks(x, [r["label"].replace(" + ", "\n+ ").replace(" (", "\n(") for r in rows],
+    # wrapped to the bars' width: a long label ran into its neighbour's
+    ax.set_xticks(x, [textwrap.fill(r["label"], 20, break_long_words=False) for r in rows],
                   fontsize=6)
     ax.set_ylabel("reduction [dB]")
     ax.grid(True, axis="y", alpha=0.3)
