@@ -218,10 +218,15 @@ def released_run(isolator, controller, prediction, *, duration, dt):
     return cycle
 
 
-def _hunting_rows(fractions, quick, dt, workers):
-    """Prediction and released run per rig and fraction, and each rig's predicted boundary."""
+def _hunting_rows(fractions, quick, dt, workers, progress=False):
+    """Prediction and released run per rig and fraction, and each rig's predicted boundary
+    (with ``progress``, a bar over them: about 15 s of work after the chirps)."""
+    from qzs.engine.progress import progress_bar
+
     duration = 20.0 if quick else 40.0
     tasks = [(rig, a) for rig in HUNTING_RIGS for a in fractions]
+    bar = progress_bar(total=len(tasks) + len(HUNTING_RIGS), unit="run",
+                       desc="hunting at rest (released runs, boundaries)", disable=not progress)
 
     def one(task):
         rig, a = task
@@ -231,42 +236,51 @@ def _hunting_rows(fractions, quick, dt, workers):
         return prediction, released_run(isolator, loop, prediction, duration=duration, dt=dt)
 
     rows = []
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        for (rig, a), (prediction, measured) in zip(tasks, pool.map(one, tasks)):
-            regime = (prediction.hunts and prediction.breakaway_ratio
-                      > DF_TOLERANCE["breakaway_ratio"]
-                      and prediction.distortion < DF_TOLERANCE["distortion"])
-            row = {"rig": rig, "fraction": a, "predicted": prediction.hunts,
-                   "predicted_velocity_amplitude": prediction.velocity_amplitude,
-                   "predicted_frequency": prediction.frequency,
-                   "breakaway_ratio": prediction.breakaway_ratio,
-                   "distortion": prediction.distortion, "in_tolerance_regime": bool(regime),
-                   **{f"simulated_{k}": v for k, v in measured.items()}}
-            if regime and finite(measured["velocity_amplitude"], measured["frequency"]):
-                row["amplitude_error"] = abs(measured["velocity_amplitude"]
-                                             / prediction.velocity_amplitude - 1)
-                row["frequency_error"] = abs(measured["frequency"] / prediction.frequency - 1)
-                row["within_tolerance"] = bool(max(row["amplitude_error"],
-                                                   row["frequency_error"])
-                                               <= DF_TOLERANCE["relative"])
-            else:
-                row["amplitude_error"] = row["frequency_error"] = math.nan
-                row["within_tolerance"] = None
-                row["tolerance_reason"] = (
-                    "no cycle predicted" if not prediction.hunts else
-                    f"outside the describing function's stated range (breakaway ratio "
-                    f"{prediction.breakaway_ratio:.3g} <= {DF_TOLERANCE['breakaway_ratio']:g} "
-                    f"or distortion {prediction.distortion:.3g} >= "
-                    f"{DF_TOLERANCE['distortion']:g}): the payload sticks at its reversals"
-                    if regime is False and prediction.hunts else
-                    "the simulated run has no cycle to measure")
-            rows.append(row)
+    with bar, ThreadPoolExecutor(max_workers=workers) as pool:
+        rows, boundaries = _collect(tasks, pool.map(one, tasks), fractions, bar)
+    return rows, boundaries
+
+
+def _collect(tasks, results, fractions, bar):
+    """The hunting rows from each task's prediction and released run, then the boundaries."""
+    rows = []
+    for (rig, a), (prediction, measured) in zip(tasks, results):
+        bar.update(1)
+        regime = (prediction.hunts and prediction.breakaway_ratio
+                  > DF_TOLERANCE["breakaway_ratio"]
+                  and prediction.distortion < DF_TOLERANCE["distortion"])
+        row = {"rig": rig, "fraction": a, "predicted": prediction.hunts,
+               "predicted_velocity_amplitude": prediction.velocity_amplitude,
+               "predicted_frequency": prediction.frequency,
+               "breakaway_ratio": prediction.breakaway_ratio,
+               "distortion": prediction.distortion, "in_tolerance_regime": bool(regime),
+               **{f"simulated_{k}": v for k, v in measured.items()}}
+        if regime and finite(measured["velocity_amplitude"], measured["frequency"]):
+            row["amplitude_error"] = abs(measured["velocity_amplitude"]
+                                         / prediction.velocity_amplitude - 1)
+            row["frequency_error"] = abs(measured["frequency"] / prediction.frequency - 1)
+            row["within_tolerance"] = bool(max(row["amplitude_error"],
+                                               row["frequency_error"])
+                                           <= DF_TOLERANCE["relative"])
+        else:
+            row["amplitude_error"] = row["frequency_error"] = math.nan
+            row["within_tolerance"] = None
+            row["tolerance_reason"] = (
+                "no cycle predicted" if not prediction.hunts else
+                f"outside the describing function's stated range (breakaway ratio "
+                f"{prediction.breakaway_ratio:.3g} <= {DF_TOLERANCE['breakaway_ratio']:g} "
+                f"or distortion {prediction.distortion:.3g} >= "
+                f"{DF_TOLERANCE['distortion']:g}): the payload sticks at its reversals"
+                if regime is False and prediction.hunts else
+                "the simulated run has no cycle to measure")
+        rows.append(row)
     boundaries = {}
     for rig, (isolator, controller, options) in HUNTING_RIGS.items():
         simulated = [r["fraction"] for r in rows if r["rig"] == rig and r["simulated_hunts"]]
         boundaries[rig] = {"predicted": hunting_boundary(isolator, controller,
                                                          high=max(fractions), options=options),
                            "simulated": min(simulated) if simulated else math.nan}
+        bar.update(1)
     return rows, boundaries
 
 
@@ -373,7 +387,7 @@ def run_friction_study(quick=False, *, dt=1e-4, workers=None, progress=False):
     curves = run_chirp_cases(labels, cases, chirp, workers=workers, progress=progress)
     rows = [_row(a, curve) for a, curve in zip(fractions, curves)]
     reference = _row(math.nan, curves[-1])
-    hunting, boundaries = _hunting_rows(fractions, quick, dt, workers)
+    hunting, boundaries = _hunting_rows(fractions, quick, dt, workers, progress)
     paper = {r["fraction"]: r["simulated_hunts"] for r in hunting if r["rig"] == "paper loop"}
     answer = friction_answer(rows, reference, paper, boundaries["paper loop"])
     return {"table": rows, "reference": reference, "curves": curves, "hunting": hunting,
