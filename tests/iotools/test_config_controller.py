@@ -99,3 +99,29 @@ def test_a_controller_file_holds_the_controller_alone(tmp_path):
     with pytest.raises(ParameterError, match=r"nothing else.*--config"):
         load_controller(path)
     assert load_config(path)["isolator"].mass == 7.0  # it is a config file
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"dither": {"amplitude": -1.0}}, r"\[legs\.2\.controller\.dither\] amplitude in 'h\.toml'"),
+    ({"linear": {"num": [1.0]}}, r"'h\.toml': \[legs\.2\.controller\.linear\] must give its "
+                                 r"controller either as matrices"),
+    ({"linear": {"d": [2.0], "sample_time": -1.0}},
+     r"\[legs\.2\.controller\.linear\] sample_time in 'h\.toml'"),
+    ({"dither": {"pitch": 1.0}}, r"unknown key\(s\) \['pitch'\] in \[legs\.2\.controller\.dither\]"),
+    ({"pi_kp": "stiff"}, r"\[legs\.2\.controller\] pi_kp in 'h\.toml'"),
+])
+def test_a_controller_table_under_another_name_is_named_so_in_every_message(table, match):
+    """The reader a hexapod file's ``[legs.N.controller]`` tables go through: the messages
+    name the table as the file spells it."""
+    from qzs.iotools.config import controller_from_table
+
+    with pytest.raises(ParameterError, match=match):
+        controller_from_table(table, "h.toml", name="legs.2.controller")
+
+
+def test_a_controller_table_starts_from_the_controller_given():
+    from qzs.iotools.config import controller_from_table
+
+    every = qzs.PIDamping(pi_kp=80.0) + qzs.Dither(amplitude=2.0, frequency=30.0)
+    own = controller_from_table({"dither": {"frequency": 45.0}}, controller=every)
+    assert own == qzs.PIDamping(pi_kp=80.0) + qzs.Dither(amplitude=2.0, frequency=45.0)

@@ -6,8 +6,10 @@ summary.
 """
 import numpy as np
 
+import math
+
 __all__ = ["RunStatistics", "run_statistics", "STATISTICS", "SATURATION", "SummaryStatistics",
-           "SUMMARY_STATISTICS", "BLOCK_STATISTICS"]
+           "SUMMARY_STATISTICS", "BLOCK_STATISTICS", "BlockStatistics"]
 
 #: Statistics of a run: name -> (unit, description).
 STATISTICS = {
@@ -111,6 +113,79 @@ def run_statistics(relative_position, motor_force, locked, stop_center):
     return {name: float(value[0]) for name, value in statistics.result().items()}
 
 
+class BlockStatistics:
+    """What controller blocks cost, accumulated exactly over consecutive blocks of samples.
+
+    One implementation for a single run (one case) and a six-axis platform (a leg per case):
+    each block channel's RMS [N] and, with a dither, the payload's acceleration amplitude at
+    the dither's frequency [m/s^2] (a single-frequency Fourier coefficient over the samples;
+    of several acceleration components, the Euclidean norm of their amplitudes).
+
+    Parameters
+    ----------
+    blocks : sequence of sequence of str
+        Per case, the channels of its controller's blocks (``compensation_force``,
+        ``dither_force``, ``linear_force``, ``friction_estimate``).
+    dither_frequencies : sequence of float or None
+        Per case, its dither's frequency [Hz], or None without a dither.
+    """
+
+    def __init__(self, blocks, dither_frequencies):
+        self.blocks = [tuple(names) for names in blocks]
+        self.squares = [dict.fromkeys(names, 0.0) for names in self.blocks]
+        self.omegas = [None if f is None else 2 * np.pi * f for f in dither_frequencies]
+        self.sums = [None] * len(self.omegas)
+        self.count = 0
+
+    def add(self, time, forces, acceleration):
+        """Absorb one block of consecutive samples of every case.
+
+        Parameters
+        ----------
+        time : ndarray, shape (n_samples,)
+            Sample times [s].
+        forces : mapping of str to ndarray, shape (n_cases, n_samples)
+            The block channels [N] (those of :attr:`blocks`).
+        acceleration : ndarray, shape (n_components, n_samples)
+            The payload's acceleration [m/s^2] (of a platform: its translation's components).
+        """
+        self.count += len(time)
+        for case, names in enumerate(self.blocks):
+            for name in names:
+                values = forces[name][case]
+                with np.errstate(over="ignore"):  # a diverging controller's RMS is inf
+                    self.squares[case][name] += float(np.dot(values, values))
+        for case, omega in enumerate(self.omegas):
+            if omega is None:
+                continue
+            phase = np.exp(-1j * omega * np.asarray(time, dtype=float))
+            sums = [complex(np.dot(np.asarray(component), phase)) for component in acceleration]
+            self.sums[case] = (sums if self.sums[case] is None
+                               else [a + b for a, b in zip(self.sums[case], sums)])
+
+    def result(self, case=0):
+        """The statistics of one case so far (the names of :data:`BLOCK_STATISTICS`).
+
+        Parameters
+        ----------
+        case : int
+            The case (a leg of a platform), from 0.
+
+        Returns
+        -------
+        dict
+            ``<block channel>_rms`` [N], and ``dither_payload_acceleration`` [m/s^2] with a
+            dither.
+        """
+        counted = max(self.count, 1)
+        out = {f"{name}_rms": float(np.sqrt(total / counted))
+               for name, total in self.squares[case].items()}
+        if self.omegas[case] is not None:
+            sums = self.sums[case] or [0j]
+            out["dither_payload_acceleration"] = 2 * math.hypot(*map(abs, sums)) / counted
+        return out
+
+
 class SummaryStatistics:
     """What a run's summary reports, accumulated exactly over consecutive blocks of samples.
 
@@ -139,9 +214,7 @@ class SummaryStatistics:
         self.run = RunStatistics([stop_center])
         self.force_limit = float(motor_force_max)
         self.blocks = tuple(blocks)
-        self.block_squares = dict.fromkeys(self.blocks, 0.0)
-        self.dither_omega = None if dither_frequency is None else 2 * np.pi * dither_frequency
-        self.dither_sum = 0j
+        self.block_costs = BlockStatistics([self.blocks], [dither_frequency])
         self.count = 0
         self.z_sum = 0.0
         self.z_last = np.nan
@@ -180,15 +253,13 @@ class SummaryStatistics:
         self.time_last = float(block["time"][-1])
         self.contact += int(np.count_nonzero(block["stop_contact"]))
         asked = np.asarray(block["pi_force"]) + np.asarray(block["damping_force"])
+        forces = {name: np.asarray(block[name], dtype=float)[None, :] for name in self.blocks}
         for name in self.blocks:
-            values = np.asarray(block[name], dtype=float)
-            with np.errstate(over="ignore"):  # a diverging controller's RMS is inf
-                self.block_squares[name] += float(np.dot(values, values))
             if name != "friction_estimate":  # it is in the compensation's force
-                asked = asked + values
-        if self.dither_omega is not None:
-            phase = np.exp(-1j * self.dither_omega * np.asarray(block["time"], dtype=float))
-            self.dither_sum += complex(np.dot(np.asarray(block["payload_acceleration"]), phase))
+                asked = asked + forces[name][0]
+        self.block_costs.add(block["time"], forces,
+                             [block["payload_acceleration"]]
+                             if self.block_costs.omegas[0] is not None else ())
         asked = np.abs(asked)
         self.saturated += int(np.count_nonzero(asked >= self.force_limit * (1.0 - 1e-9)))
         self.motor_peak = max(self.motor_peak, float(np.abs(motor).max()))
@@ -207,10 +278,7 @@ class SummaryStatistics:
                 "saturated_fraction": self.saturated / counted, "motor_force_peak": self.motor_peak,
                 "energy_residual_max": self.residual_max, "base_work_max": self.base_work_max,
                 "time_first": self.time_first, "time_last": self.time_last,
-                **{f"{name}_rms": float(np.sqrt(total / counted))
-                   for name, total in self.block_squares.items()},
-                **({} if self.dither_omega is None else
-                   {"dither_payload_acceleration": 2 * abs(self.dither_sum) / counted})}
+                **self.block_costs.result()}
 
 
 #: What :meth:`SummaryStatistics.result` holds beyond :data:`STATISTICS`: name -> (unit,

@@ -4,7 +4,7 @@ The numbers come from :attr:`SimulationResult.statistics` (every sample, also of
 run streamed to a file); the warnings from :func:`run_warnings`.
 """
 __all__ = ["summary_text", "summary_record", "run_title", "run_warnings", "excitation_part",
-           "WARNING_LIMITS"]
+           "block_lines", "WARNING_LIMITS"]
 
 #: Where the summary starts to warn: the output rate per excitation frequency [-], the
 #: integration steps per period [-], the energy-ledger residual per unit of base work [-].
@@ -155,8 +155,24 @@ def _step_line(run):
     return f"  step             {step_line(run)}"
 
 
-def _block_lines(controller, stats):
-    """The controller and what its blocks cost (their RMS forces, the dither's acceleration)."""
+def block_lines(controller, stats, payload="payload acceleration"):
+    """The controller and what its blocks cost (their RMS forces, the dither's acceleration).
+
+    Parameters
+    ----------
+    controller : ControllerParameters
+        The controller with blocks (of a run, or of one leg of a platform).
+    stats : dict
+        Its statistics: those of :data:`~qzs.analysis.statistics.BLOCK_STATISTICS` it has,
+        and ``motor_force_rms`` [N].
+    payload : str
+        What the dither's acceleration [m/s^2] is of, for the line.
+
+    Returns
+    -------
+    list of str
+        ``controller``, ``block forces`` and ``dither cost`` lines.
+    """
     lines = [f"  controller       {controller.describe()}"]
     forces = [f"{label} RMS {stats[name + '_rms']:.3g} N"
               for name, label in (("compensation_force", "compensation"),
@@ -167,7 +183,7 @@ def _block_lines(controller, stats):
     if forces:
         lines.append(f"  block forces     {'; '.join(forces)}")
     if "dither_payload_acceleration" in stats:
-        lines.append(f"  dither cost      payload acceleration "
+        lines.append(f"  dither cost      {payload} "
                      f"{stats['dither_payload_acceleration']:.3g} m/s^2 at "
                      f"{controller.dither.frequency:g} Hz; motor RMS "
                      f"{stats['motor_force_rms']:.3g} N in all")
@@ -234,7 +250,7 @@ def summary_text(result):
         f"peak {stats['motor_force_peak']:.2f} N (limit {iso.motor_force_max:g} N)",
     ]
     if ctrl.has_blocks:
-        lines += _block_lines(ctrl, stats)
+        lines += block_lines(ctrl, stats)
     deficit = iso.weight_deficit
     if deficit > 0:
         lines.append(

@@ -94,6 +94,16 @@ def add_parser(subparsers):
                     "summary per leg: stroke used, stop contacts, time locked, motor RMS. "
                     + DEFAULT_SETUP)
     _add_setup_options(simulate)
+    simulate.add_argument("--controller", metavar="FILE.toml",
+                          help="controller file for every leg: a [controller] table with its "
+                               "blocks' tables ([controller.compensation], [controller.dither], "
+                               "[controller.linear]), as `qzs simulate --controller`; replaces "
+                               "the hexapod file's [controller] and [legs.N.controller]")
+    simulate.add_argument("--leg-controller", metavar="N=FILE.toml", action="append",
+                          default=[],
+                          help="leg N's own controller file (N from 1 to 6; repeatable, each "
+                               "leg once); replaces what the hexapod file or --controller "
+                               "gives that leg (`qzs docs hexapod` §9.5a)")
     simulate.add_argument("--axis", choices=AXES,
                           help="the base axis --excitation drives (replaces the file's table "
                                "for that axis); rotations in [rad]")
@@ -193,6 +203,7 @@ def _described_setup(args):
                                               load_hexapod)
 
     overrides = settings(args.set)
+    controllers = _controllers(args)
     cube_options = args.cube_edge is not None or args.cube_center_height is not None
     if args.config and (args.cubic or cube_options):
         raise ParameterError("give either --config or --cubic (with --cube-edge), not both.")
@@ -200,15 +211,31 @@ def _described_setup(args):
         raise ParameterError("--cube-edge and --cube-center-height describe a cubic "
                              "configuration: add --cubic.")
     if args.config:
-        return load_hexapod(args.config, overrides)
+        return load_hexapod(args.config, overrides, **controllers)
     if args.cubic:
         edge = HEXAPOD["cube_edge"] if args.cube_edge is None else args.cube_edge
         positive_real("--cube-edge", edge, fix="a length in m")
         height = (default_cube_center_height(edge) if args.cube_center_height is None
                   else args.cube_center_height)
         geometry = cubic_geometry(cube_edge=edge, cube_center_height=height)
-        return hexapod_setup(geometry=geometry, settings=overrides, kind="cubic")
-    return load_hexapod(SHIPPED_DEFAULT, overrides)
+        controllers.pop("names")
+        return hexapod_setup(geometry=geometry, settings=overrides, kind="cubic", **controllers)
+    return load_hexapod(SHIPPED_DEFAULT, overrides, **controllers)
+
+
+def _controllers(args):
+    """``--leg-controller`` and ``--controller`` (``simulate``'s) as ``load_hexapod``'s
+    ``legs``, ``controller`` and ``names``: every leg number checked before any file is
+    read."""
+    from qzs.iotools.config import load_controller
+    from qzs.workflows.hexapod.setups import read_leg_controllers
+
+    legs, names = read_leg_controllers(getattr(args, "leg_controller", None) or ())
+    path = getattr(args, "controller", None)
+    if path:
+        names["controller"] = f"--controller {path}"
+    return {"controller": load_controller(path) if path else None, "legs": legs,
+            "names": names}
 
 
 def run_linear(args):

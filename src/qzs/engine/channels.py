@@ -12,7 +12,7 @@ from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
 __all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels",
-           "channel_count", "summary_statistics", "simulation_schema", "variable_attributes",
+           "channel_count", "summary_statistics", "block_costs", "simulation_schema", "variable_attributes",
            "named_block", "sample_bytes"]
 
 #: Output channels: descriptive name -> (kernel column, unit, description).
@@ -113,10 +113,29 @@ def summary_statistics(controller, stop_center, motor_force_max):
     """
     from qzs.analysis.statistics import SummaryStatistics
 
+    blocks, dither_frequency = block_costs(controller)
+    return SummaryStatistics(stop_center, motor_force_max, blocks=blocks,
+                             dither_frequency=dither_frequency)
+
+
+def block_costs(controller):
+    """What a controller's blocks cost in a run's summary: the block channels it records
+    (:data:`BLOCK_CHANNELS`) and its dither's frequency [Hz] (None without one), as
+    :class:`qzs.analysis.statistics.BlockStatistics` takes them.
+
+    Parameters
+    ----------
+    controller : ControllerParameters or None
+        The controller (of a run, or of one leg of a platform).
+
+    Returns
+    -------
+    blocks : list of str
+    dither_frequency : float or None
+    """
     blocks = [name for name in run_channels(controller) if name in BLOCK_CHANNELS]
     dither = getattr(controller, "dither", None)
-    return SummaryStatistics(stop_center, motor_force_max, blocks=blocks,
-                             dither_frequency=None if dither is None else dither.frequency)
+    return blocks, None if dither is None else dither.frequency
 
 
 def channel_count(controller=None):

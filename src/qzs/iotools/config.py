@@ -126,8 +126,8 @@ def load_controller(path: str | Path) -> ControllerParameters:
 
 
 def controller_from_table(table: Any, path: str | Path | None = None,
-                          controller: ControllerParameters | None = None
-                          ) -> ControllerParameters:
+                          controller: ControllerParameters | None = None, *,
+                          name: str = "controller") -> ControllerParameters:
     """A controller from a TOML ``[controller]`` table (parsed), blocks included.
 
     Its keys are the loops' parameters (``pi_kp``, ...; :data:`qzs.model.registry.PARAMETERS`)
@@ -146,6 +146,9 @@ def controller_from_table(table: Any, path: str | Path | None = None,
         The file, for the messages.
     controller : ControllerParameters, optional
         The controller to start from; default :class:`ControllerParameters`.
+    name : str
+        The table's name in the file, for the messages (``legs.2.controller`` for a
+        hexapod leg's own: ``[legs.2.controller.dither] amplitude in 'FILE'``).
 
     Returns
     -------
@@ -160,29 +163,29 @@ def controller_from_table(table: Any, path: str | Path | None = None,
     where = f" in {str(path)!r}" if path is not None else ""
     prefix = f"{str(path)!r}: " if path is not None else ""
     if not isinstance(table, dict):
-        raise ParameterError(f"{prefix}[controller] must be a table, got {table!r}.",
-                             ("controller",))
-    misplaced = sorted(name for name in table
-                       if name in PARAMETERS and PARAMETERS[name].section == "isolator")
+        raise ParameterError(f"{prefix}[{name}] must be a table, got {table!r}.", (name,))
+    misplaced = sorted(key for key in table
+                       if key in PARAMETERS and PARAMETERS[key].section == "isolator")
     if misplaced:
-        raise ParameterError(f"{prefix}{misplaced} belong in [isolator], not [controller].")
+        raise ParameterError(f"{prefix}{misplaced} belong in [isolator], not [{name}].")
     settings, spelling = {}, {}
-    for name, value in table.items():
-        if name in BLOCKS and isinstance(value, dict):
-            if name == "linear":
+    for key, value in table.items():
+        if key in BLOCKS and isinstance(value, dict):
+            if key == "linear":
                 continue
-            fields = [f.name for f in dataclasses.fields(BLOCK_CLASSES[name])]
-            known_keys(value, fields, f"[controller.{name}]", prefix)
-            for key, item in value.items():
-                settings[f"{name}.{key}"] = item
-                spelling[f"{name}.{key}"] = f"[controller.{name}] {key}{where}"
+            fields = [f.name for f in dataclasses.fields(BLOCK_CLASSES[key])]
+            known_keys(value, fields, f"[{name}.{key}]", prefix)
+            for field, item in value.items():
+                settings[f"{key}.{field}"] = item
+                spelling[f"{key}.{field}"] = f"[{name}.{key}] {field}{where}"
         else:
-            settings[name] = value
-            spelling[name] = f"[controller] {name}{where}"
+            settings[key] = value
+            spelling[key] = f"[{name}] {key}{where}"
     controller = controller or ControllerParameters()
     linear = table.get("linear")
     if isinstance(linear, dict):
-        controller = dataclasses.replace(controller, linear=_linear(linear, where, prefix))
+        controller = dataclasses.replace(controller, linear=_linear(linear, where, prefix,
+                                                                    f"{name}.linear"))
     try:
         _, controller = update_parameters(IsolatorParameters(), controller, settings)
     except ParameterError as error:
@@ -190,20 +193,20 @@ def controller_from_table(table: Any, path: str | Path | None = None,
     return controller
 
 
-def _linear(table, where, prefix):
-    """A :class:`LinearController` from its ``[controller.linear]`` table."""
-    known_keys(table, LINEAR_KEYS, "[controller.linear]", prefix)
-    spelling = {key: f"[controller.linear] {key}{where}" for key in LINEAR_KEYS}
+def _linear(table, where, prefix, name="controller.linear"):
+    """A :class:`LinearController` from its ``[controller.linear]`` table (``name``)."""
+    known_keys(table, LINEAR_KEYS, f"[{name}]", prefix)
+    spelling = {key: f"[{name}] {key}{where}" for key in LINEAR_KEYS}
     spelling.update({option: spelling[key] for option, key in _LINEAR_OPTIONS.items()})
     spelling["denominator"] = spelling["den"]
     matrices = [key for key in ("a", "b", "c", "d") if key in table]
     polynomial = [key for key in ("num", "den") if key in table]
     if bool(matrices) == bool(polynomial) or (polynomial and len(polynomial) != 2):
         raise ParameterError(
-            f"{prefix}[controller.linear] must give its controller either as matrices (a, b, "
+            f"{prefix}[{name}] must give its controller either as matrices (a, b, "
             f"c, d; a and b may be left out for a static gain) or as a transfer function "
             f"(num and den), got {sorted(matrices + polynomial) or 'neither'}.",
-            ("controller.linear",))
+            (name,))
     options = {key: table[key] for key in ("inputs", "sample_time", "tracking_time", "name")
                if key in table}
     try:
@@ -220,8 +223,8 @@ def _linear(table, where, prefix):
     except ParameterError as error:
         raise error.renamed(spelling) from None
     except TypeError as error:  # a value of the wrong kind for the library (a string)
-        raise ParameterError(f"{prefix}[controller.linear]: {error}; give numbers.",
-                             ("controller.linear",)) from None
+        raise ParameterError(f"{prefix}[{name}]: {error}; give numbers.",
+                             (name,)) from None
 
 
 def save_config(path, isolator=None, controller=None, excitation=None, simulation=None):

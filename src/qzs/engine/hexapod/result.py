@@ -378,7 +378,8 @@ class HexapodResult:
         self.excitation = dict(excitation)
         self.run = run
         if statistics is None:  # from the samples held
-            running = _Statistics([0.5 * (low + high) for low, high in run["stops"]])
+            running = _Statistics([0.5 * (low + high) for low, high in run["stops"]],
+                                  self.controllers if self.has_blocks else None)
             running.add(data, flags)
             statistics = running.result()
         self.statistics = statistics

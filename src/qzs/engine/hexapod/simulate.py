@@ -133,7 +133,7 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     plan = driver.plan_run(run.duration, run.dt, run.decimation, kernel="hexapod",
                            max_samples=PREVIEW_CHUNK, phase_period=1)
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
-                              for i in range(LEG_COUNT)])
+                              for i in range(LEG_COUNT)], run.controllers)
     recorder = driver.Recorder(
         plan, N_CHANNELS if run.plat[PL_BLOCKS] != 0.0 else N_BASE_CHANNELS, N_FLAGS,
         statistics=statistics.add, sink=sink,

@@ -5,10 +5,16 @@ a preview kept): what :meth:`~qzs.engine.hexapod.result.HexapodResult.summary` r
 """
 import numpy as np
 
-from qzs.analysis.statistics import RunStatistics
-from qzs.analysis.summary import excitation_part
-from qzs.engine.hexapod.layout import (C_BASE_POSE, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST,
-                                       C_FMO, C_POSE, C_WB, C_WM, C_Z, LEG_COUNT, O_LOCKED)
+from qzs.analysis.statistics import BlockStatistics, RunStatistics
+from qzs.analysis.summary import block_lines, excitation_part
+from qzs.engine.channels import block_costs
+from qzs.engine.hexapod.layout import (C_ACC, C_BASE_POSE, C_DF, C_DS, C_EG, C_EK, C_ESP,
+                                       C_EST, C_FCO, C_FDI, C_FLI, C_FMO, C_FOB, C_POSE,
+                                       C_TIME, C_WB, C_WM, C_Z, LEG_COUNT, O_LOCKED)
+
+#: Each leg's block channels' first column (six columns, a leg each), as the rows hold them.
+_BLOCK_COLUMNS = {"compensation_force": C_FCO, "friction_estimate": C_FOB,
+                  "dither_force": C_FDI, "linear_force": C_FLI}
 
 
 class _Statistics:
@@ -18,11 +24,18 @@ class _Statistics:
     or streamed to a file with only a preview kept): per leg the largest distance from the
     stops' centre [m], the share of samples locked [-], the motor force's RMS and largest
     magnitude [N]; the largest relative translation [m] and rotation [rad] of the platform;
-    the largest energy-ledger residual [J] and |base work| [J].
+    the largest energy-ledger residual [J] and |base work| [J]; with a leg's controller's
+    blocks, what they cost (the single axis's :class:`BlockStatistics`, a leg per case: each
+    block force's RMS [N], and the platform's acceleration at the leg's dither frequency:
+    the amplitude of its top frame origin's translation [m/s^2]).
     """
 
-    def __init__(self, centers):
+    def __init__(self, centers, controllers=None):
         self._legs = RunStatistics(centers)  # the single axis's statistics, a leg per case
+        costs = [block_costs(c) for c in controllers or ()]
+        self._blocks = (BlockStatistics(*zip(*costs))
+                        if any(names or dither is not None for names, dither in costs)
+                        else None)
         self._rows = 0
         self._motor_max = np.zeros(LEG_COUNT)
         self._translation = self._rotation = 0.0
@@ -47,6 +60,11 @@ class _Statistics:
         self._residual = max(self._residual,
                              float(np.max(np.abs(energy - self._energy0 - net))))
         self._base_work = max(self._base_work, float(np.max(np.abs(block[:, C_WB]))))
+        if self._blocks is not None:
+            self._blocks.add(block[:, C_TIME],
+                             {name: block[:, column:column + LEG_COUNT].T
+                              for name, column in _BLOCK_COLUMNS.items()},
+                             block[:, C_ACC:C_ACC + 3].T)
         self._rows += block.shape[0]
 
     def result(self):
@@ -58,7 +76,9 @@ class _Statistics:
                 "motor_max_N": self._motor_max.tolist(),
                 "relative_translation_max_m": self._translation,
                 "relative_rotation_max_rad": self._rotation,
-                "energy_residual_max_J": self._residual, "base_work_max_J": self._base_work}
+                "energy_residual_max_J": self._residual, "base_work_max_J": self._base_work,
+                **({} if self._blocks is None else
+                   {"blocks": [self._blocks.result(i) for i in range(LEG_COUNT)]})}
 
 
 def _summary_text(result):
@@ -90,6 +110,7 @@ def _summary_text(result):
                      f"{run['stop_contacts'][i]:8d}  {100 * stats['locked_share'][i]:10.1f}  "
                      f"{run['stick_events'][i]:12d}  {stats['motor_rms_N'][i]:13.2f}  "
                      f"{stats['motor_max_N'][i]:13.2f}")
+    lines += _block_cost_lines(result)
     lines += ["",
               f"Platform relative to base: translation up to "
               f"{1e3 * stats['relative_translation_max_m']:.3g} mm, rotation up to "
@@ -103,6 +124,19 @@ def _summary_text(result):
         lines.append(f"In memory: the min/max envelope of groups of {run['preview_every']} "
                      "samples (a preview; the file holds them all)")
     return "\n".join(lines)
+
+
+def _block_cost_lines(result):
+    """Each leg's controller with blocks and what they cost, as a single run's summary says
+    it (:func:`qzs.analysis.summary.block_lines`)."""
+    stats = result.statistics
+    lines = []
+    for i, controller in enumerate(result.controllers):
+        if "blocks" in stats and controller.has_blocks:
+            lines += ["", f"Leg {i + 1}:", *block_lines(
+                controller, {**stats["blocks"][i], "motor_force_rms": stats["motor_rms_N"][i]},
+                payload="platform acceleration")]
+    return lines
 
 
 def _step_line(run):

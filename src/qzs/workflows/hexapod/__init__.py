@@ -9,6 +9,8 @@ side by side (:mod:`.study`). The model is described in docs/hexapod.md.
 =====================  ================================================================
 ``setups``             set-ups: hexapod files, defaults, the linear and simulated
                        reports behind ``qzs hexapod``
+``legs``               each leg's own controller: ``[legs.N.controller]`` tables,
+                       ``--leg-controller N=FILE.toml``
 ``transmissibility``   the simulated 6x6 transmissibility of a platform, chirp per axis
 ``study``              ``qzs hexapod study``: six paper legs with and without PI
 =====================  ================================================================

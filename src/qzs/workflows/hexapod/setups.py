@@ -19,6 +19,11 @@ A hexapod file (``qzs hexapod linear --config FILE.toml``)::
     [controller]              # each leg's PI and damping loop (qzs params)
     pi_kp = 50.0
     controller_rate = 0.0     # [Hz] 0: continuous; else sampled, zero-order hold
+    [controller.dither]       # optional: blocks for every leg, as a single axis's controller
+    amplitude = 0.5           # file (qzs.iotools.config.controller_from_table)
+
+    [legs.2.controller.compensation]  # optional: leg 2's own controller, from every leg's
+    fraction = 0.8            # [controller] with these changes (legs numbered 1 to 6)
 
     [cartesian]               # optional: centralised control, the loops on the platform's
     point = "origin"          # axes at this point ("origin", "center_of_mass" or [x, y, z] [m])
@@ -50,7 +55,10 @@ from qzs.model.hexapod import (LEG_COUNT, CartesianController, HexapodGeometry,
                                PlatformParameters, cubic_geometry, leg_unit_vectors,
                                radial_geometry)
 from qzs.model.isolator import IsolatorParameters, spring_force
-from qzs.model.registry import PARAMETERS, update_parameters
+from qzs.model.registry import update_parameters
+from qzs.workflows.hexapod.legs import (_checked_legs, _controller, _file_legs, _parameters,
+                                        _refuse_central_blocks, _sources, _with_settings,
+                                        read_leg_controllers)
 
 if TYPE_CHECKING:
     from qzs.analysis.hexapod_linear import HexapodLinearModel
@@ -59,7 +67,8 @@ if TYPE_CHECKING:
 __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_setup",
            "supported_mass", "default_platform", "default_cube_center_height",
            "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
-           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised"]
+           "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised",
+           "read_leg_controllers"]
 
 #: Folder of the shipped hexapod files, inside the package.
 SHIPPED = "workflows/hexapod/hexapod_files"
@@ -96,7 +105,8 @@ class HexapodSetup:
     isolator : IsolatorParameters
         Each leg's plant (its ``mass`` and ``gravity`` are not used: the platform's are).
     controller : ControllerParameters
-        Each leg's PI and damping loop.
+        Every leg's controller (the ``[controller]`` table): PI and damping, and blocks
+        (docs/hexapod.md §9.5a).
     kind : str
         How the geometry was described (``cubic``, ``radial``, ``joints``).
     excitation : dict
@@ -107,6 +117,9 @@ class HexapodSetup:
         The file it was read from ('' if built from arguments).
     cartesian : CartesianController or None
         Centralised control (the ``[cartesian]`` table); None: a loop per leg.
+    leg_controllers : tuple of six ControllerParameters or None
+        Each leg's own controller where one leg's differs (``[legs.N.controller]``
+        tables); None: ``controller`` on every leg.
     """
 
     geometry: HexapodGeometry
@@ -118,6 +131,13 @@ class HexapodSetup:
     simulation: dict = field(default_factory=dict)
     source: str = ""
     cartesian: CartesianController | None = None
+    leg_controllers: tuple[ControllerParameters, ...] | None = None
+
+    @property
+    def controllers(self) -> ControllerParameters | tuple[ControllerParameters, ...]:
+        """What the engine takes: ``controller`` for every leg, or the six
+        ``leg_controllers``."""
+        return self.controller if self.leg_controllers is None else self.leg_controllers
 
 
 def default_cube_center_height(cube_edge: float) -> float:
@@ -299,7 +319,8 @@ def hexapod_setup(*, geometry: HexapodGeometry | None = None,
                   isolator: IsolatorParameters | None = None,
                   controller: ControllerParameters | None = None,
                   settings: Mapping[str, Any] | None = None, kind: str = "joints",
-                  cartesian: CartesianController | str | None = None) -> HexapodSetup:
+                  cartesian: CartesianController | str | None = None,
+                  legs: Mapping[int, ControllerParameters] | None = None) -> HexapodSetup:
     """A :class:`HexapodSetup` from objects, with registry overrides applied to every leg.
 
     Parameters
@@ -320,11 +341,15 @@ def hexapod_setup(*, geometry: HexapodGeometry | None = None,
     cartesian : CartesianController or "legs", optional
         Centralised control; ``"legs"`` for the Cartesian loops with the legs' stiffness on
         each axis at the top frame origin (:meth:`CartesianController.from_legs`).
+    legs : dict, optional
+        Leg number (1 to 6) -> that leg's own controller (``controller`` on the others);
+        ``settings`` apply to them too. Refused with ``cartesian`` if one has blocks.
 
     Returns
     -------
     HexapodSetup
     """
+    own = _checked_legs(legs)
     if geometry is None:
         edge = HEXAPOD["cube_edge"]
         geometry = cubic_geometry(cube_edge=edge,
@@ -333,9 +358,9 @@ def hexapod_setup(*, geometry: HexapodGeometry | None = None,
     if not isinstance(geometry, HexapodGeometry):
         raise ParameterError(f"`geometry` must be a HexapodGeometry, got "
                              f"{type(geometry).__name__}.")
-    isolator, controller = update_parameters(isolator or IsolatorParameters(),
-                                             controller or ControllerParameters(),
-                                             settings or {})
+    isolator, controller, leg_controllers = _with_settings(
+        isolator or IsolatorParameters(), controller or ControllerParameters(), own,
+        settings or {})
     if platform is None:
         platform = default_platform(geometry, isolator, controller)
     if not isinstance(platform, PlatformParameters):
@@ -346,8 +371,24 @@ def hexapod_setup(*, geometry: HexapodGeometry | None = None,
     if cartesian is not None and not isinstance(cartesian, CartesianController):
         raise ParameterError(f"`cartesian` must be a CartesianController, 'legs' or None, got "
                              f"{cartesian!r}.")
+    if cartesian is not None:
+        _refuse_central_blocks(controller, leg_controllers, "`cartesian`",
+                               _sources("controller", own, lambda n: f"legs[{n}]"))
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
-                        controller=controller, kind=kind, cartesian=cartesian)
+                        controller=controller, kind=kind, cartesian=cartesian,
+                        leg_controllers=leg_controllers)
+
+
+
+
+
+
+
+
+
+
+
+
 
 
 def centralised(setup: HexapodSetup, *,
@@ -369,21 +410,33 @@ def centralised(setup: HexapodSetup, *,
     Raises
     ------
     ParameterError
-        The set-up has its own ``[cartesian]`` loops already.
+        The set-up has its own ``[cartesian]`` loops already, or a leg's controller has
+        blocks (they act on a leg's own loop).
     """
     import dataclasses
 
     if setup.cartesian is not None:
         raise ParameterError("the set-up has centralised loops already (its [cartesian] table); "
                              "leave out --centralised, or the table.")
-    cartesian = CartesianController.from_legs(setup.geometry, setup.controller,
+    _refuse_central_blocks(setup.controller, setup.leg_controllers, "--centralised",
+                           [f"leg {n}'s controller" for n in range(1, LEG_COUNT + 1)])
+    cartesian = CartesianController.from_legs(setup.geometry, setup.controllers,
                                               platform=setup.platform, point=point)
     return dataclasses.replace(setup, cartesian=cartesian)
 
 
 def load_hexapod(path: str | Path,
-                 settings: Mapping[str, Any] | None = None) -> HexapodSetup:
+                 settings: Mapping[str, Any] | None = None, *,
+                 controller: ControllerParameters | None = None,
+                 legs: Mapping[int, ControllerParameters] | None = None,
+                 names: Mapping[str, str] | None = None) -> HexapodSetup:
     """Read a hexapod TOML file (the layout of this module's docstring).
+
+    The ``[controller]`` table is every leg's controller, blocks included (its
+    ``[controller.compensation]``, ``[controller.dither]``, ``[controller.linear]`` tables,
+    read by :func:`qzs.iotools.config.controller_from_table`, as a single axis's); a
+    ``[legs.N.controller]`` table (N from 1 to 6) gives leg N its own: every leg's with
+    that table's changes and blocks (``[legs.2.controller.dither]``).
 
     Parameters
     ----------
@@ -391,6 +444,14 @@ def load_hexapod(path: str | Path,
         The file, or the name of a shipped one (``paper_legs_cubic``).
     settings : dict, optional
         Registry overrides applied to every leg after the file (``--set``).
+    controller : ControllerParameters, optional
+        Every leg's controller instead of the file's ``[controller]`` and
+        ``[legs.N.controller]`` tables (``--controller``).
+    legs : dict, optional
+        Leg number (1 to 6) -> that leg's controller instead of the file's
+        (``--leg-controller``; :func:`read_leg_controllers`).
+    names : dict, optional
+        How the caller names ``controller`` and ``legs[N]`` in messages.
 
     Returns
     -------
@@ -399,7 +460,8 @@ def load_hexapod(path: str | Path,
     Raises
     ------
     ParameterError
-        A missing or malformed file, an unknown table or key, a bad value.
+        A missing or malformed file, an unknown table or key, a bad value, a leg number
+        outside 1 to 6 or given twice, blocks with centralised control (``[cartesian]``).
     """
     path = resolve_shipped(path, SHIPPED, "hexapod", "hexapod files")
     document = read_toml(path, "hexapod file", empty=(
@@ -407,22 +469,30 @@ def load_hexapod(path: str | Path,
         "setups are examples), or give no file for the default platform"))
     where = f"{str(path)!r}: "
     allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation",
-               "cartesian"}
+               "cartesian", "legs"}
     unknown = sorted(set(document) - allowed)
     if unknown:
         raise ParameterError(f"{where}unknown table(s) {unknown}; allowed are {sorted(allowed)}.")
     if "geometry" not in document:
         raise ParameterError(f"{where}a [geometry] table is needed (kind = 'cubic', 'radial' "
                              "or 'joints').")
-    for section, expected in (("leg", "isolator"), ("controller", "controller")):
-        for name in document.get(section, {}):
-            if name not in PARAMETERS or PARAMETERS[name].section != expected:
-                article = "an" if expected == "isolator" else "a"
-                raise ParameterError(f"{where}[{section}] `{name}` is not {article} {expected} "
-                                     "parameter; see `qzs params`.")
-    isolator, controller = update_parameters(
-        IsolatorParameters(), ControllerParameters(),
-        {**document.get("leg", {}), **document.get("controller", {}), **(settings or {})})
+    _parameters(document.get("leg", {}), "leg", "isolator", where)
+    isolator, _ = update_parameters(IsolatorParameters(), ControllerParameters(),
+                                    document.get("leg", {}))
+    every = _controller(document.get("controller", {}), "controller", path)
+    own = _file_legs(document.get("legs", {}), every, path)
+    names = dict(names or {})
+    sources = _sources(f"[controller] in {str(path)!r}", own,
+                       lambda n: f"[legs.{n}.controller] in {str(path)!r}")
+    if controller is not None:  # instead of the file's every leg and each leg's own
+        every, own = controller, {}
+        sources = (names.get("controller", "controller"),) * LEG_COUNT
+    given = _checked_legs(legs)
+    own.update(given)
+    sources = tuple(names.get(f"legs[{n}]", f"legs[{n}]") if n in given else source
+                    for n, source in enumerate(sources, start=1))
+    isolator, controller, leg_controllers = _with_settings(isolator, every, own,
+                                                           settings or {})
     geometry, kind = _geometry(document["geometry"], where)
     platform = _platform(document.get("platform", {}), geometry, isolator, controller, where)
     excitation = document.get("excitation", {})
@@ -441,10 +511,20 @@ def load_hexapod(path: str | Path,
                                  "random or file) and its options.")
     cartesian = None
     if "cartesian" in document:
-        cartesian = _cartesian(document["cartesian"], geometry, platform, controller, where)
+        _refuse_central_blocks(controller, leg_controllers, f"[cartesian] in {str(path)!r}",
+                               sources)
+        cartesian = _cartesian(document["cartesian"], geometry, platform,
+                               leg_controllers or controller, where)
     return HexapodSetup(geometry=geometry, platform=platform, isolator=isolator,
                         controller=controller, kind=kind, excitation=dict(excitation),
-                        simulation=simulation, source=str(path), cartesian=cartesian)
+                        simulation=simulation, source=str(path), cartesian=cartesian,
+                        leg_controllers=leg_controllers)
+
+
+
+
+
+
 
 
 def linear_record(setup: HexapodSetup, *, leg_stiffness: float | None = None,
@@ -482,7 +562,7 @@ def linear_record(setup: HexapodSetup, *, leg_stiffness: float | None = None,
             raise ParameterError(f"`frame` 'cube_center' needs a cubic geometry, got a "
                                  f"{setup.kind!r} one; use 'center_of_mass', 'origin' or a point.")
         frame = "origin"
-    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller,
+    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controllers,
                               leg_stiffness=leg_stiffness, frame=frame,
                               include_preload=include_preload, cartesian=setup.cartesian)
     record = {
@@ -706,7 +786,7 @@ def simulate_setup(setup: HexapodSetup, *,
         check_out()
     try:
         resolved = resolve_hexapod(
-            setup.geometry, setup.platform, setup.isolator, setup.controller, excitation=built,
+            setup.geometry, setup.platform, setup.isolator, setup.controllers, excitation=built,
             duration=arguments["duration"], dt=dt, tolerance_db=tolerance_db,
             tolerance_state=tolerance_state, sample_rate=arguments["sample_rate"],
             solver=arguments["solver"], cartesian=setup.cartesian, finest=arguments["dt"],
@@ -720,16 +800,16 @@ def simulate_setup(setup: HexapodSetup, *,
                   **resolved.arguments())
     if out is None:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                  setup.controller, **common)
+                                  setup.controllers, **common)
         result.run.update(resolved.step.attributes())
         return result
     from qzs.engine.hexapod.prepare import has_blocks
     from qzs.engine.hexapod.result import HexapodWriter
 
     check_out()  # again: the probes took a while
-    with HexapodWriter(out, blocks=has_blocks(setup.controller)) as writer:
+    with HexapodWriter(out, blocks=has_blocks(setup.controllers)) as writer:
         result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
-                                  setup.controller, sink=writer.append, **common)
+                                  setup.controllers, sink=writer.append, **common)
         result.run.update(resolved.step.attributes())
         writer.finish(result)
     return result

@@ -151,7 +151,8 @@ def _assemble(setup, axes, amplitudes, common, columns):
     trusted &= ~below
     trusted &= (frequency >= common["trusted_from"])[:, None, None]
     cartesian = getattr(setup, "cartesian", None)
-    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controller,
+    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator,
+                              getattr(setup, "controllers", setup.controller),
                               frame="origin",
                               **({} if cartesian is None else {"cartesian": cartesian}))
     linear = np.full((n, 6, 6), np.nan + 0j)

@@ -177,7 +177,14 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
         workers = integer("workers", workers, 1)
     if not isinstance(progress, (bool, np.bool_)):
         raise ParameterError(f"`progress` must be True or False, got {progress!r}.")
-    stable = _stable(setup, setup.controller, solver)
+    from qzs.model.controller import refuse_blocks
+
+    controllers = getattr(setup, "controllers", setup.controller)
+    refuse_blocks(controllers, "the transmissibility matrix's linear overlay "
+                  "(hexapod_linearize)", "simulate a platform whose legs have blocks with "
+                  "`qzs hexapod simulate` (docs/hexapod.md §9.5a), or leave the blocks out of "
+                  "[controller] and [legs.N.controller]")
+    stable = _stable(setup, controllers, solver)
     step = dt if dt is not None else setup_dt
     if not stable(step):
         from qzs.errors import StabilityError
@@ -202,7 +209,7 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                   dt=dt, frame="top frame origin (the cube's centre of a cubic geometry)")
     tasks = [dict(axis=axis, excitation=chirps[axis], geometry=setup.geometry,
                   platform=setup.platform, isolator=setup.isolator,
-                  controller=setup.controller, cartesian=getattr(setup, "cartesian", None),
+                  controller=controllers, cartesian=getattr(setup, "cartesian", None),
                   **common) for axis in axes]
     return axes, amplitudes, common, tasks, workers
 

@@ -207,6 +207,7 @@ def default_title(result):
     setup, s = result.setup, result.settings
     steps = sorted({f"{r['dt']:g} s ({r['step']})" for r in result.runs.values()})
     loop = ("centralised loops" if getattr(setup, "cartesian", None) is not None else
+            "each leg's own loop" if getattr(setup, "leg_controllers", None) is not None else
             f"Kp {setup.controller.pi_kp:g} N/m, Ki {setup.controller.pi_ki:g} N/(m s)")
     return (f"Simulated transmissibility of the {setup.kind} hexapod, platform "
             f"{setup.platform.mass:.3g} kg, {loop}: chirps {s['f0']:g}-{s['f1']:g} Hz over "
