@@ -184,3 +184,12 @@ def test_what_models_pi_and_damping_alone_refuses_blocks_naming_the_way_out(call
     with pytest.raises(ParameterError, match=match + r" models PI \+ damping alone; "
                                                      r"`controller` has blocks .*dither"):
         call(PIDamping() + Dither())
+
+
+@pytest.mark.parametrize("sample_time", [-1.0, float("nan"), float("inf"), "0.01"])
+def test_a_transfer_function_with_a_bad_sample_time_names_it(sample_time):
+    """A negative, NaN or infinite `sample_time` (or text) is qzs's error naming it, not
+    python-control's "invalid timebase" ValueError."""
+    with pytest.raises(ParameterError) as error:
+        LinearController.from_transfer_function([1.0], [1.0, 2.0], sample_time=sample_time)
+    assert "sample_time" in error.value.options and "`sample_time`" in str(error.value)

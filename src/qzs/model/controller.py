@@ -408,6 +408,7 @@ class LinearController:
         """
         import control
 
+        sample_time = non_negative_real("sample_time", sample_time)
         for name, value in (("numerator", numerator), ("denominator", denominator)):
             array = np.atleast_1d(np.asarray(value, dtype=float))
             if array.size == 0 or not np.isfinite(array).all():
