@@ -246,7 +246,7 @@ class ObliqueSpringQZS(SpringLaw):
     the paper's operating point -0.060 m, the preload carries the payload's 62.78 N there
     (6.4 kg at 9.81 m/s^2), and over the stroke +-0.080 m the stiffness stays >= 0 (every
     position has a stable equilibrium for some weight) and rises to 241 N/m at the ends
-    (0.97 Hz with 6.4 kg), the force staying within 62.78 +- 7.6 N.
+    (0.98 Hz with 6.4 kg), the force staying within 62.78 +- 7.6 N.
 
     Parameters
     ----------
