@@ -37,8 +37,10 @@ from qzs.errors import (CaseError, CompilerError, DataError, DataWarning, Excita
                         SizeLimitError, StabilityError, ToleranceNotMetError)
 from qzs.model import (Chirp, ControllerParameters, Dither, DisplacementRecord,
                        FrictionCompensation, InitialState, IsolatorParameters, LinearController,
-                       PIDamping, RandomExcitation, Sine, closed_loop_natural_frequency,
-                       friction_force, passive_natural_frequency, spring_force, spring_stiffness)
+                       ObliqueSpringQZS, PIDamping, PolynomialSpring, RandomExcitation, Sine,
+                       SpringLaw, TabulatedSpring, TanhSpring, check_equilibrium,
+                       closed_loop_natural_frequency, friction_force, passive_natural_frequency,
+                       spring_force, spring_stiffness)
 
 # Loaded on first use, so that ``import qzs`` stays lean (PEP 562).
 # The engine (numba) is loaded on first use, so that ``qzs --help`` and the command line's
@@ -118,6 +120,8 @@ __all__ = [
     "IsolatorParameters", "ControllerParameters", "InitialState",
     "PIDamping", "FrictionCompensation", "Dither", "LinearController",
     "spring_force", "spring_stiffness", "friction_force",
+    "SpringLaw", "TanhSpring", "ObliqueSpringQZS", "PolynomialSpring", "TabulatedSpring",
+    "check_equilibrium",
     "passive_natural_frequency", "closed_loop_natural_frequency",
     "ParameterError", "ExcitationError", "StabilityError", "CaseError", "SimulationError",
     "DataError", "FitError", "MissingDependencyError", "OutputPathError", "ResultTooLargeError",

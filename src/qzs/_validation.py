@@ -270,6 +270,63 @@ def finite_rows(name, values, error, fix="interpolate or trim them first"):
     return array
 
 
+def read_csv_table(path, what, expected, error=None):
+    """Read a CSV file of a header line and rows of numbers: its column names and its data.
+
+    Blank lines and lines starting with ``#`` are skipped. A missing file, a folder, a file
+    that is not UTF-8 text (a binary file given by mistake), an empty file, a non-numeric
+    value and a row of the wrong length each get a message naming the file (``what``, e.g.
+    "displacement record") and the fix; ``expected`` says what the file should hold (e.g.
+    "a header with 'time' and 'displacement', then rows of numbers").
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+    what : str
+        What the file is, for the messages.
+    expected : str
+        What it should hold, for the messages.
+    error : type, optional
+        The exception to raise; default :class:`qzs.errors.DataError`.
+
+    Returns
+    -------
+    names : list of str
+        The header's column names, stripped.
+    data : ndarray
+        The rows, shape (rows, columns), at least one row; not checked for NaN or inf.
+    """
+    from qzs.errors import DataError
+
+    error = DataError if error is None else error
+    path = Path(path)
+    if not path.exists():
+        raise error(f"{what} not found: {str(path)!r}.")
+    if path.is_dir():
+        raise error(f"{what} {str(path)!r} is a folder; pass the CSV file ({expected}).")
+    try:
+        with open(path, encoding="utf-8") as handle:
+            lines = [line for line in handle if line.strip() and not line.startswith("#")]
+    except UnicodeDecodeError as err:
+        raise error(
+            f"{what} {str(path)!r} is not UTF-8 text (byte "
+            f"{err.object[err.start]:#04x} at position {err.start}), so it is not a CSV "
+            "file; was a binary file (a log, a figure, a result) given by mistake? Pass the CSV "
+            f"file ({expected}).") from None
+    if not lines:
+        raise error(f"{str(path)!r} is empty.")
+    names = [n.strip() for n in lines[0].split(",")]
+    try:
+        data = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
+    except ValueError as err:
+        raise error(f"{str(path)!r}: non-numeric value ({err}).") from None
+    if data.shape[0] == 0 or data.shape[1] != len(names):
+        raise error(f"{str(path)!r}: expected rows of {len(names)} numbers, got shape "
+                    f"{data.shape}.")
+    return names, data
+
+
 def read_toml(path, what, error=ParameterError, empty="write its tables into it"):
     """Parse a TOML file, or raise ``error`` saying which file (``what``) is missing or bad.
 

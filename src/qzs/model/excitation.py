@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
-                             strictly_increasing, validate_fields)
+from qzs._validation import (choice, non_negative_real, parameter, positive_real, read_csv_table,
+                             real, strictly_increasing, validate_fields)
 from qzs._validation import seed as checked_seed
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
@@ -530,35 +530,12 @@ def read_displacement_csv(path, time_column="time", displacement_column="displac
         Missing file, a folder, a file that is not UTF-8 text, missing columns (the
         message lists the columns found), non-numeric or non-finite samples.
     """
-    path = Path(path)
-    if not path.exists():
-        raise DataError(f"displacement record not found: {str(path)!r}.")
-    if path.is_dir():
-        raise DataError(f"displacement record {str(path)!r} is a folder; pass the CSV file "
-                        f"(a header with {time_column!r} and {displacement_column!r}, then rows "
-                        "of numbers).")
-    try:
-        with open(path, encoding="utf-8") as handle:
-            lines = [line for line in handle if line.strip() and not line.startswith("#")]
-    except UnicodeDecodeError as error:
-        raise DataError(
-            f"displacement record {str(path)!r} is not UTF-8 text (byte "
-            f"{error.object[error.start]:#04x} at position {error.start}), so it is not a CSV "
-            "file; was a binary file (a log, a figure, a result) given by mistake? Pass the CSV "
-            f"file with columns {time_column!r} and {displacement_column!r}.") from None
-    if not lines:
-        raise DataError(f"{str(path)!r} is empty.")
-    names = [n.strip() for n in lines[0].split(",")]
+    names, data = read_csv_table(
+        path, "displacement record",
+        f"a header with {time_column!r} and {displacement_column!r}, then rows of numbers")
     missing = [c for c in (time_column, displacement_column) if c not in names]
     if missing:
         raise DataError(f"{str(path)!r} has no column(s) {missing}; columns found: {names}.")
-    try:
-        data = np.array([[float(x) for x in line.split(",")] for line in lines[1:]], ndmin=2)
-    except ValueError as error:
-        raise DataError(f"{str(path)!r}: non-numeric value ({error}).") from None
-    if data.shape[0] == 0 or data.shape[1] != len(names):
-        raise DataError(f"{str(path)!r}: expected rows of {len(names)} numbers, got shape "
-                        f"{data.shape}.")
     time = data[:, names.index(time_column)]
     displacement = data[:, names.index(displacement_column)]
     bad = int(np.count_nonzero(~np.isfinite(time)) + np.count_nonzero(~np.isfinite(displacement)))
