@@ -208,3 +208,23 @@ def test_the_summary_names_the_blocks_and_their_cost():
     assert "payload acceleration" in text and "at 50 Hz" in text
     assert "controller" not in _run(BASE, duration=1.0).summary().split("note")[0].split(
         "motor force")[1]  # PI + damping alone: as before
+
+
+@pytest.mark.parametrize("controller_rate", [0.0, 500.0])
+def test_a_discrete_controller_reads_the_acceleration_before_any_sample_changes_it(
+        controller_rate):
+    """A discrete accelerometer loop sampled at the same instant as the sampled PI reads the
+    payload's acceleration as it was before that instant (the force held until then): a real
+    controller reads every sensor before it writes any output. Its held output over the next
+    period is then the gain times the acceleration recorded at the sample instant (an output
+    row there is recorded before the samples)."""
+    gain = -0.5  # [N/(m/s^2)]
+    period = 2e-3  # [s]
+    loop = LinearController(a=np.zeros((0, 0)), b=np.zeros((0, 1)), c=np.zeros(0), d=[gain],
+                            inputs=("payload_acceleration",), sample_time=period)
+    controller = PIDamping(damping_gain=20.0, controller_rate=controller_rate) + loop
+    run = _run(controller, duration=0.4, sample_rate=1.0 / period)
+    expected = gain * run["payload_acceleration"][:-1]
+    # the same acceleration, evaluated once by the sample and once by the recorder
+    np.testing.assert_allclose(run["linear_force"][1:], expected, rtol=0,
+                               atol=1e-12 * np.ptp(expected))
