@@ -99,3 +99,13 @@ def test_a_controller_file_holds_the_controller_alone(tmp_path):
     with pytest.raises(ParameterError, match=r"nothing else.*--config"):
         load_controller(path)
     assert load_config(path)["isolator"].mass == 7.0  # it is a config file
+
+
+def test_a_transfer_function_without_inputs_reads_what_the_api_reads_by_default(tmp_path):
+    # the file and LinearController.from_transfer_function agree: the charge amplifier's
+    # velocity when no sensor is named
+    path = tmp_path / "c.toml"
+    path.write_text("[controller.linear]\nnum = [-20.0]\nden = [1.0, 100.0]\n")
+    expected = qzs.LinearController.from_transfer_function([-20.0], [1.0, 100.0])
+    assert load_controller(path).linear.inputs == expected.inputs == (
+        "measured_payload_velocity",)
