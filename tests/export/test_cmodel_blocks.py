@@ -96,3 +96,19 @@ def test_a_discrete_integral_carrying_the_static_load_starts_as_the_kernels():
     for channel in ("linear_force", "relative_position", "motor_force"):
         np.testing.assert_array_equal(theirs.data[:, {**CHANNELS, **BLOCK_CHANNELS}[channel][0]],
                                       np.asarray(ours[channel]), err_msg=channel)
+
+
+def test_the_observer_measures_the_stop_force_as_the_kernels():
+    """Without the PI the payload sinks onto the lower stop (docs/model.md §5): the observer
+    measures the friction left with the stop's force in it (r_meas = F_friction + F_stop +
+    F_ff), in the C model as in the kernels."""
+    controller = qzs.PIDamping(pi_kp=0.0, pi_ki=0.0, compensation=qzs.FrictionCompensation(
+        fraction=0.5, observer_bandwidth=5.0))
+    excitation = qzs.Sine(amplitude=0.01, frequency=3.0)
+    options = dict(duration=2.0, dt=1e-4, sample_rate=1000.0)
+    ours = qzs.simulate(excitation, None, controller, **options)
+    theirs = simulate_c(excitation, None, controller, **options)
+    assert np.max(np.abs(ours["stop_force"])) > 100.0  # on the stop: the path is checked
+    for channel in ("friction_estimate", "compensation_force", "relative_position"):
+        np.testing.assert_array_equal(theirs.data[:, {**CHANNELS, **BLOCK_CHANNELS}[channel][0]],
+                                      np.asarray(ours[channel]), err_msg=channel)
