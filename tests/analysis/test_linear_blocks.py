@@ -173,3 +173,18 @@ def test_bad_input_names_the_argument_and_the_fix():
     with pytest.raises(ParameterError, match="`isolator`"):
         plant_system(isolator=PIDamping())
     assert qzs.linearize(controller=PIDamping() + lead_lag()).damping_ratio > 0
+
+
+def test_a_loop_with_direct_feedthrough_both_ways_is_solved_for_the_force():
+    # F = u + K y and y = C x + D F: F = (u + K C x) / (1 - K D), the algebraic loop solved
+    # (a discrete controller may feed the payload's acceleration straight through)
+    from qzs.analysis.linear import close_loop
+
+    plant = (np.array([[-1.0]]), np.array([[1.0]]), np.array([[2.0]]), np.array([[0.5]]))
+    gain = 0.4
+    controller = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[gain]]))
+    a, b, c, d = close_loop(plant, controller)
+    loop = 1.0 / (1.0 - gain * 0.5)
+    np.testing.assert_allclose(d, [[0.5 * loop], [loop]], rtol=1e-15)
+    np.testing.assert_allclose(c, [[2.0 * loop], [gain * 2.0 * loop]], rtol=1e-15)
+    np.testing.assert_allclose(a, [[-1.0 + gain * 2.0 * loop]], rtol=1e-15)

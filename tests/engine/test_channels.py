@@ -44,3 +44,12 @@ def test_named_block_takes_columns_by_name_and_sums_the_energy():
     expected = (data[:, K.C_E_KINETIC] + data[:, K.C_E_SPRING] + data[:, K.C_E_GRAVITY]
                 + data[:, K.C_E_STOP])
     np.testing.assert_array_equal(block["mechanical_energy"], expected)
+
+
+def test_the_friction_estimate_is_a_channel_only_with_an_observer():
+    from qzs import FrictionCompensation, PIDamping
+
+    without = run_channels(PIDamping() + FrictionCompensation(fraction=0.5))
+    assert "compensation_force" in without and "friction_estimate" not in without
+    observed = run_channels(PIDamping() + FrictionCompensation(observer_bandwidth=5.0))
+    assert "friction_estimate" in observed

@@ -210,6 +210,7 @@ def test_the_summary_names_the_blocks_and_their_cost():
         "motor force")[1]  # PI + damping alone: as before
 
 
+<<<<<<< HEAD
 @pytest.mark.parametrize("controller_rate", [0.0, 500.0])
 def test_a_discrete_controller_reads_the_acceleration_before_any_sample_changes_it(
         controller_rate):
@@ -228,3 +229,42 @@ def test_a_discrete_controller_reads_the_acceleration_before_any_sample_changes_
     # the same acceleration, evaluated once by the sample and once by the recorder
     np.testing.assert_allclose(run["linear_force"][1:], expected, rtol=0,
                                atol=1e-12 * np.ptp(expected))
+=======
+#: A payload held by a stiction no motor force breaks (stuck all run), 5 mm above the setpoint:
+#: the position error is a constant, and a linear controller on it runs alone.
+HELD_PLANT = IsolatorParameters(stiction_force=200.0, coulomb_force=100.0)
+HELD_ERROR = -0.005
+#: A 2-state controller with a non-symmetric A (its rows packed as rows), whose equilibrium
+#: command (-70 N) is beyond the motor's 44 N.
+WINDUP = LinearController(a=[[-1.0, 2.0], [0.0, -3.0]], b=[[0.0], [3.0]], c=[4000.0, 6000.0],
+                          d=[0.0], inputs=("position_error",), tracking_time=0.1)
+
+
+def saturated_command(linear, plant, error):
+    """The command a saturated linear controller settles at under back-calculation [N].
+
+    ``x' = A x + B e + L (F_motor - C x) = 0`` with ``F_motor = -F_max`` (the command below
+    the limit): ``x = -(A - L C)^-1 (B e - L F_max)`` (docs/model.md §5.1).
+    """
+    a, b, c, _ = linear.matrices()
+    gain = linear.antiwindup_gain()[:, None]
+    x = -np.linalg.solve(a - gain @ c, b * error - gain * plant.motor_force_max)
+    return (c @ x).item(), (c @ -np.linalg.solve(a, b * error)).item()
+
+
+def test_a_saturated_linear_controller_settles_where_back_calculation_puts_it():
+    from qzs.model.isolator import InitialState
+
+    settled, unsaturated = saturated_command(WINDUP, HELD_PLANT, HELD_ERROR)
+    # a real windup: beyond the limit, held back from the unsaturated equilibrium
+    assert unsaturated < settled < -HELD_PLANT.motor_force_max
+    run = simulate(Sine(amplitude=0.0, frequency=1.0), HELD_PLANT, NO_LOOPS + WINDUP,
+                   duration=6.0, dt=1e-4, sample_rate=100.0,
+                   initial_state=InitialState(relative_position=NO_LOOPS.position_setpoint
+                                              - HELD_ERROR))
+    assert run["locked"].all()
+    # it starts in equilibrium with its sensors, then the excess pulls it to the limit
+    assert run["linear_force"][0] == pytest.approx(unsaturated, rel=1e-9)
+    assert run["linear_force"][-1] == pytest.approx(settled, rel=1e-5)
+    assert np.all(run["motor_force"][1:] == -HELD_PLANT.motor_force_max)
+>>>>>>> mut40

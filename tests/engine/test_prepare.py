@@ -184,3 +184,14 @@ def test_the_record_check_is_the_memory_guard_at_its_threshold(monkeypatch):
     with pytest.raises(ParameterError, match="`excitation.duration` = 100 s makes"):
         check_record(excitation, 10.0)
     check_record(Chirp(duration=1e12), 10.0)  # no record: nothing to refuse
+
+
+def test_a_discrete_sample_time_shorter_than_a_step_is_refused_before_the_run():
+    # half a step or less rounds to 0 steps: a "discrete" controller that never samples
+    from qzs import LinearController, PIDamping
+    from qzs.engine.prepare import pack_model
+
+    short = LinearController(a=[[0.5]], b=[[1.0]], c=[1.0], d=[0.0], inputs=("position_error",),
+                             sample_time=4e-5)
+    with pytest.raises(ParameterError, match=r"`sample_time` .* use sample_time=0.0001 s"):
+        pack_model(IsolatorParameters(), PIDamping() + short, 1e-4)

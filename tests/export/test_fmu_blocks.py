@@ -117,3 +117,19 @@ def test_the_sources_with_every_block_rebuild_warning_free(fmu_of, tmp_path, ver
     reference = qzs.simulate(*CASES["discrete controller"][:2], EVERY_BLOCK,
                              **settings("discrete controller"))
     _assert_same(runs[0], reference, "every block")
+
+
+def test_the_bounds_of_the_block_parameters_are_those_of_qzs(fmu_of):
+    """The FMU takes what qzs takes and refuses what it refuses: the largest compensation
+    fraction (1.5, over-compensation) is the run with it; a discrete controller's period of
+    0 steps is refused at initialisation, not run as a continuous controller."""
+    name = "compensation with observer"
+    excitation, isolator, _, _ = CASES[name]
+    largest = qzs.PIDamping(compensation=qzs.FrictionCompensation(fraction=1.5,
+                                                                  observer_bandwidth=5.0))
+    reference = qzs.simulate(excitation, isolator, largest, **settings(name))
+    _assert_same(_run(fmu_of(name, 3), name, **{"controller.compensation.fraction": 1.5}),
+                 reference, "fraction 1.5")
+    with pytest.raises(Exception, match="ExitInitializationMode failed"):
+        _run(fmu_of("discrete controller", 3), "discrete controller",
+             **{"controller.linear.sample_time": 0.0})

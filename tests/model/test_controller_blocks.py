@@ -193,3 +193,53 @@ def test_a_transfer_function_with_a_bad_sample_time_names_it(sample_time):
     with pytest.raises(ParameterError) as error:
         LinearController.from_transfer_function([1.0], [1.0, 2.0], sample_time=sample_time)
     assert "sample_time" in error.value.options and "`sample_time`" in str(error.value)
+
+
+# ------------------------------------------------------------------ bounds and what a block says
+def test_a_controller_of_exactly_max_states_is_accepted():
+    # the kernels hold MAX_STATES states: that many is the largest controller, not one too many
+    n = MAX_STATES
+    linear = LinearController(a=-np.eye(n), b=np.ones((n, 1)), c=np.ones(n), d=[0.0])
+    assert linear.states == n
+
+
+def test_a_sensor_named_twice_is_refused_naming_inputs():
+    with pytest.raises(ParameterError, match=r"`inputs` names a sensor twice") as error:
+        LinearController(a=[[-1.0]], b=[[1.0, 1.0]], c=[1.0], d=[0.0, 0.0],
+                         inputs=("position_error", "position_error"))
+    assert error.value.options == ("inputs",)
+
+
+def test_a_negative_dither_amplitude_is_refused():
+    with pytest.raises(ParameterError, match="`amplitude`"):
+        Dither(amplitude=-1.0)
+
+
+def test_a_pure_coulomb_compensator_with_equal_levels_is_accepted():
+    # Fc = Fs is the Coulomb law without a Stribeck peak: a valid law, not a swap
+    law = FrictionCompensation(stiction_force=3.0, coulomb_force=3.0).law(IsolatorParameters())
+    assert law[:2] == (3.0, 3.0)
+
+
+def test_a_discrete_antiwindup_never_corrects_more_than_the_whole_excess_in_a_period():
+    # L * min(T_s/T_t, 1): a period longer than T_t brings the command back to the limit in
+    # one sample (C L = 1), never past it (docs/model.md §5.1)
+    slow = LinearController(a=[[1.0]], b=[[1.0]], c=[20.0], d=[0.0], inputs="position_error",
+                            sample_time=0.5, tracking_time=0.1)
+    assert np.dot(slow.c, slow.antiwindup_gain()) == pytest.approx(1.0, rel=1e-14)
+
+
+def test_the_sample_rates_are_the_inverse_of_the_periods_each_once():
+    linear = LinearController(a=[[1.0]], b=[[1.0]], c=[1.0], d=[0.0], inputs="position_error",
+                              sample_time=2e-3)
+    assert PIDamping(linear=linear).sample_rates == pytest.approx((500.0,))
+    assert PIDamping(controller_rate=500.0, linear=linear).sample_rates == pytest.approx((500.0,))
+    assert PIDamping(controller_rate=1000.0, linear=linear).sample_rates == pytest.approx(
+        (1000.0, 500.0))
+    assert PIDamping(linear=dataclasses.replace(linear, sample_time=0.0)).sample_rates == ()
+
+
+def test_describe_names_the_observer_only_when_there_is_one():
+    with_observer = PIDamping() + FrictionCompensation(fraction=0.5, observer_bandwidth=5.0)
+    assert "observer 5 Hz" in with_observer.describe()
+    assert "observer" not in (PIDamping() + FrictionCompensation(fraction=0.5)).describe()

@@ -5,6 +5,7 @@ one; the predicted cycle against its closed form for Coulomb friction (``A = 4 (
 c)`` at the loop's resonance); and the predicted amplitude and frequency against simulated
 limit cycles, within the tolerance docs/model.md §5 states.
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -173,3 +174,22 @@ def test_bad_input_names_the_argument():
             d=[-10.0], inputs="measured_payload_velocity", sample_time=1e-3))
     with pytest.raises(ParameterError, match="`controller` must be a ControllerParameters"):
         cd.predict_sliding_cycle(controller=FrictionCompensation(fraction=1.2))
+
+
+def test_the_observer_cancels_the_friction_below_its_bandwidth_in_hertz():
+    # the observer's estimate follows the friction through w_o/(s + w_o), w_o = 2 pi f_o: the
+    # friction left passes s/(s + w_o), down 3 dB and 45 degrees ahead at f_o [Hz]. On a
+    # guide without viscous friction the observer has nothing linear to estimate (r' = -w_o r):
+    # the loop is the same with and without it but for that factor
+    from qzs.analysis.control_design.describing_functions import friction_velocity_loop
+
+    bandwidth = 5.0
+    plant = IsolatorParameters(viscous_damping=0.0)
+    compensation = FrictionCompensation(fraction=0.5)
+    plain = friction_velocity_loop(plant, PIDamping(damping_gain=20.0) + compensation)
+    observed = friction_velocity_loop(plant, PIDamping(damping_gain=20.0) + dataclasses.replace(
+        compensation, observer_bandwidth=bandwidth))
+    s = 2j * np.pi * bandwidth
+    ratio = observed(s) / plain(s)
+    assert abs(ratio) == pytest.approx(1 / np.sqrt(2), rel=1e-9)
+    assert np.degrees(np.angle(ratio)) == pytest.approx(45.0, rel=1e-9)

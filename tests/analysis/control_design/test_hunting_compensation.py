@@ -111,3 +111,19 @@ def test_what_the_relay_cannot_hold_is_refused():
             d=[-10.0], inputs="measured_payload_velocity"))
     with pytest.raises(ParameterError, match=r"`controller` has a friction observer"):
         cd.slip_jump(controller=PIDamping() + FrictionCompensation(observer_bandwidth=5.0))
+
+
+def test_a_compensated_viscous_friction_is_a_guide_with_less_of_it():
+    # the compensation's viscous part fraction*Cv' is linear: to the relay it is the guide's
+    # Cv lowered by it (docs/model.md §5.1), in the slip and in the integral loop alike
+    controller = ControllerParameters(pi_kp=200.0, pi_ki=80.0)
+    fraction, plant = 0.3, IsolatorParameters()
+    viscous = cd.predict_hunting(plant, controller + FrictionCompensation(
+        fraction=fraction, viscous_damping=plant.viscous_damping))
+    lowered = dataclasses.replace(plant, viscous_damping=(1 - fraction) * plant.viscous_damping)
+    reference = cd.predict_hunting(lowered, controller + FrictionCompensation(
+        fraction=fraction, viscous_damping=0.0))
+    assert reference.hunts
+    assert viscous.slip_jump == pytest.approx(reference.slip_jump, rel=1e-6)
+    assert viscous.frequency == pytest.approx(reference.frequency, rel=1e-6)
+    assert viscous.amplitude == pytest.approx(reference.amplitude, rel=1e-6)
