@@ -98,7 +98,7 @@ def run_warnings(result):
             "have no authority left there; lower the gains or the excitation, or check the "
             "load"))
     edge = iso.constant_force_edge
-    if ctrl.position_setpoint > edge:
+    if iso.spring_law.kind == "tanh" and ctrl.position_setpoint > edge:
         from qzs.model.isolator import spring_force, spring_stiffness
 
         force = -float(spring_force(ctrl.position_setpoint, iso))
@@ -251,8 +251,10 @@ def summary_text(result):
     ]
     if ctrl.has_blocks:
         lines += block_lines(ctrl, stats)
+    if iso.spring is not None:
+        lines.append(f"  spring           {iso.spring.describe()}")
     deficit = iso.weight_deficit
-    if deficit > 0:
+    if deficit > 0 and iso.spring_law.kind == "tanh":
         lines.append(
             f"  note             m*g = {iso.mass * iso.gravity:.2f} N exceeds the spring's "
             f"{iso.spring_force:.2f} N plateau: the PI integral must carry {deficit:.2f} N"

@@ -30,12 +30,13 @@ from qzs.defaults import FIGURES, FREQUENCY_SCALES
 from qzs.engine.progress import show_warning
 from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
                         ParameterError, SimulationError, Terminated, WriteError)
-from qzs.iotools.config import load_config, load_controller
+from qzs.iotools.config import load_config, load_controller, load_spring
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 
-__all__ = ["settings", "parameters", "add_set_option", "add_controller_option", "add_json_option",
+__all__ = ["settings", "parameters", "add_set_option", "add_controller_option",
+           "add_spring_option", "add_json_option",
            "add_execution_options", "add_output_options", "figure_path", "check_output",
            "OUTPUT_OPTIONS", "NO_FIGURE", "UNNAMED", "NamedOutput", "named", "output_name",
            "stopped",
@@ -123,6 +124,22 @@ def add_controller_option(parser):
                         help="controller file: a [controller] table with its blocks' tables "
                              "([controller.compensation], [controller.dither], "
                              "[controller.linear]); replaces --config's controller")
+
+
+def add_spring_option(parser):
+    """Add ``--spring FILE.toml`` to ``parser``: a spring file
+    (:func:`qzs.iotools.config.load_spring`, a ``[spring]`` table) whose law replaces
+    ``--config``'s; ``--set`` applies after it.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    parser.add_argument("--spring", metavar="FILE.toml",
+                        help="spring file: a [spring] table (law = \"tanh\", \"oblique\", "
+                             "\"polynomial\" or \"table\" and its parameters, a table's "
+                             "curve as csv = \"FILE.csv\"); replaces --config's spring")
 
 
 def add_json_option(parser, help_text=None):
@@ -505,6 +522,9 @@ def parameters(args):
         config = load_config(args.config)
     if getattr(args, "controller", None):
         config["controller"] = load_controller(args.controller)
+    if getattr(args, "spring", None):
+        config["isolator"] = dataclasses.replace(config["isolator"],
+                                                 spring=load_spring(args.spring))
     config["isolator"], config["controller"] = update_parameters(
         config["isolator"], config["controller"], settings(args.set))
     return config
@@ -674,9 +694,26 @@ def kernel_families(args):
         no kernel.
     """
     families = KERNEL_FAMILIES.get(_command(args), ())
-    if "single" in families and _has_blocks(args):  # its own kernel (lanes.run_single_blocks)
+    if "single" in families and (_has_blocks(args) or _spring_law(args)):
+        # the general kernel (lanes.run_single_blocks)
         families = tuple("single_blocks" if f == "single" else f for f in families)
     return families
+
+
+def _spring_law(args):
+    """Whether the command's spring is a law other than the tanh: ``--spring``'s or
+    ``--config``'s ``[spring]`` table (read only for that, as :func:`_has_blocks`)."""
+    import tomllib
+
+    path = getattr(args, "spring", None) or getattr(args, "config", None)
+    if not path:
+        return False
+    try:
+        with open(path, "rb") as handle:
+            table = tomllib.load(handle).get("spring", {})
+    except (OSError, ValueError):
+        return False
+    return isinstance(table, dict) and table.get("law", "tanh") != "tanh"
 
 
 def _has_blocks(args):

@@ -6,6 +6,7 @@ excitation's own length (a chirp's sweep time, a random record's length) is
 """
 from qzs.analysis.summary import summary_record
 from qzs.cli.common import (EPILOG, add_controller_option, add_output_options, add_set_option,
+                             add_spring_option,
                              check_output, emit, figure_path, parameters)
 from qzs.defaults import ACCURACY, EXCITATION, SIMULATION
 from qzs.errors import ParameterError
@@ -50,6 +51,7 @@ def add_parser(subparsers):
     sim.add_argument("--config", metavar="FILE.toml",
                      help="run configuration (see `qzs params --toml`)")
     add_controller_option(sim)
+    add_spring_option(sim)
     add_set_option(sim)
     sim.add_argument("--excitation", choices=tuple(EXCITATION_KINDS),
                      help="base excitation (default chirp)")

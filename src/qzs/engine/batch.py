@@ -24,7 +24,7 @@ from qzs.analysis.statistics import SATURATION, STATISTICS, RunStatistics
 from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
-from qzs.engine.prepare import divergence_message, prepare_run
+from qzs.engine.prepare import divergence_message, prepare_run, stack_models
 from qzs.engine.channels import (BLOCK_CHANNELS, FLAGS, run_channels, sample_bytes,
                                  simulation_schema)
 from qzs.engine.metadata import _now
@@ -294,7 +294,8 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
         lanes.close()
     states, flags, status = lanes.states, lanes.flags, lanes.status
     messages = ["" if status[c] == K.STATUS_OK else
-                divergence_message(states[c], lanes.failed_at[c], first.dt) for c in range(n)]
+                divergence_message(states[c], lanes.failed_at[c], first.dt, status[c],
+                                   lanes.models[c]) for c in range(n)]
     stats = {"stop_contacts": flags[:, K.I_N_CONTACTS].astype(float),
              **lanes.statistics.result(),
              "stick_events": flags[:, K.I_N_STICKS].astype(float),
@@ -360,7 +361,7 @@ class _Lanes(driver.Stepper):
         self.states = np.stack([r.state for r in prepared])
         self.flags = np.stack([r.flags for r in prepared])
         self.params = np.stack([r.params for r in prepared])
-        self.models = np.stack([r.model for r in prepared])
+        self.models = stack_models([r.model for r in prepared])
         self.status = np.zeros(n, dtype=np.int64)
         self.written = np.zeros(n, dtype=np.int64)
         self.failed_at = np.full(n, -1, dtype=np.int64)

@@ -30,11 +30,13 @@ from qzs.engine.arithmetic import fma
 from qzs.engine.base_motion import advance_phase, base_motion, base_motion_near, excitation_tuple
 from qzs.engine.laws import (compensation_law, compliant_stop_law, controller_law,
                              dither_law, saturation_law, sliding_friction_law,
-                             spring_energy_law, spring_law)
+                             spring_energy_general, spring_energy_law, spring_general,
+                             spring_law)
 from qzs.engine.stickslip import (MODE_SLIP, MODE_STICK, MODE_WALL_HIGH, MODE_WALL_LOW,
                                   crossed_zero, hold_margin, locate, release_direction,
                                   secant_fraction, slip_event)
 from qzs.model.sensors import MAX_STATES, SENSORS
+from qzs.model.springs import TABLE, TABLE_OUTSIDE, TANH
 
 # Packed parameters. P_VREG > 0 selects the regularised friction model: no stick-slip events,
 # the mode stays slipping (docs/model.md §3).
@@ -88,7 +90,15 @@ M_B = M_A + NX_MAX * NX_MAX
 M_C = M_B + NX_MAX * N_SENSORS
 M_D = M_C + NX_MAX
 M_ANTIWINDUP = M_D + N_SENSORS
+#: The blocks' width (what the C model copies).
 N_MODEL = M_ANTIWINDUP + NX_MAX
+#: The spring law after the blocks (docs/model.md §3.1): its packed form
+#: (:meth:`qzs.model.springs.SpringLaw.pack`, a table's pieces inline), the tanh's
+#: ``[0, a, b]`` by default. A row is as wide as its law needs (a batch's rows, the widest
+#: case's), N_MODEL_ROW with the tanh. A law other than the tanh (or any blocks) takes the
+#: general path (:func:`general`).
+M_SPRING = N_MODEL
+N_MODEL_ROW = M_SPRING + 3
 #: A linear controller of at most this many states takes the short loops (``_rows``).
 NX_SHORT = 4
 assert NX_MAX == 2 * NX_SHORT
@@ -115,13 +125,31 @@ N_BASE_CHANNELS = C_F_COMPENSATION
 O_LOCKED, O_CONTACT = 0, 1
 
 SOLVER_EULER, SOLVER_ODE3, SOLVER_RK4 = 0, 1, 2
-STATUS_OK, STATUS_DIVERGED = 0, 1
+#: A run's status: going; diverged; stopped outside a refusing spring table.
+STATUS_OK, STATUS_DIVERGED, STATUS_OUTSIDE = 0, 1, 2
 
 @njit(**_JIT)
 def params_tuple(p):
     """The packed parameter array as a tuple."""
     return (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11], p[12],
             p[13], p[14], p[15], p[16], p[17], p[18], p[19], p[20], p[21])
+
+
+@njit(**_JIT, inline="always")
+def general(M):
+    """Does the case packed as ``M`` take the general path: controller blocks beyond PI +
+    damping, or a spring law other than the tanh (``M_SPRING``)?"""
+    return M[M_BLOCKS] != 0.0 or M[M_SPRING] != TANH
+
+
+@njit(**_JIT, inline="always")
+def failure_status(M):
+    """The status of a case that stopped on a non-finite state: :data:`STATUS_OUTSIDE`
+    when its spring is a table that refuses positions outside it (its force is NaN there),
+    else :data:`STATUS_DIVERGED`."""
+    if M[M_SPRING] == TABLE and M[M_SPRING + TABLE_OUTSIDE] == 0.0:
+        return STATUS_OUTSIDE
+    return STATUS_DIVERGED
 
 
 @njit(**_JIT, inline="always")
@@ -302,14 +330,19 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
     (``X_*``). ``m*xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m*g``
     (docs/model.md); while held (stuck, or resting on a plastic stop) ``v = 0`` and
     ``xdd = ydd``. ``blocks``: the controller has blocks beyond PI + damping (``M``,
-    :func:`block_forces`); without them (a constant where it is inlined) the operations
-    are those of PI + damping alone.
+    :func:`block_forces`) or a spring law other than the tanh (the general path,
+    :func:`general`: the spring from ``M``, :func:`qzs.engine.laws.spring_general`); without
+    (a constant where it is inlined) the operations are those of PI + damping alone with the
+    tanh of ``P``.
     """
     m = P[P_MASS]
     z = s[S_Z]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     xd = yd + v
-    f_spring = spring_law(P[P_SPRING_A], P[P_SPRING_B], z)
+    if blocks:
+        f_spring = spring_general(M, M_SPRING, z)
+    else:
+        f_spring = spring_law(P[P_SPRING_A], P[P_SPRING_B], z)
 
     f_stop = 0.0
     f_elastic = 0.0
@@ -368,7 +401,7 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
 def rhs_at(t, s, x, mode, direction, held, P, M, E, table):
     """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
     y, yd, ydd = base_motion(t, E, table)
-    return rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, M[M_BLOCKS] != 0.0)
+    return rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, general(M))
 
 
 @njit(**_JIT, inline="always")
@@ -466,24 +499,29 @@ def rk_step(solver, t, h, s, x, mode, direction, held, P, M, blocks, E, table, p
 
 
 @njit(**_JIT)
-def energies(y, yd, s, mode, P):
-    """Kinetic, spring, gravity and stop-elastic energy [J] of the payload."""
+def energies(y, yd, s, mode, P, M):
+    """Kinetic, spring, gravity and stop-elastic energy [J] of the payload (the spring's
+    from its law in ``M``, the tanh's from ``P``)."""
     z = s[S_Z]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     m = P[P_MASS]
     pen = 0.0
     if P[P_PLASTIC] == 0.0:
         pen = max(P[P_Z_LOW] - z, 0.0) + max(z - P[P_Z_HIGH], 0.0)
+    if M[M_SPRING] != TANH:
+        spring = spring_energy_general(M, M_SPRING, z)
+    else:
+        spring = spring_energy_law(P[P_SPRING_A], P[P_SPRING_B], z)
     return (0.5 * m * (yd + v) ** 2,
-            spring_energy_law(P[P_SPRING_A], P[P_SPRING_B], z),
+            spring,
             m * P[P_GRAVITY] * (y + z),
             0.5 * P[P_STOP_K] * pen * pen)
 
 
 @njit(**_JIT)
-def _mechanical_energy(t, s, mode, P, E, table):
+def _mechanical_energy(t, s, mode, P, M, E, table):
     y, yd, ydd = base_motion(t, E, table)
-    e = energies(y, yd, s, mode, P)
+    e = energies(y, yd, s, mode, P, M)
     return e[0] + e[1] + e[2] + e[3]
 
 
@@ -556,10 +594,10 @@ def _hit_wall(t, s, x, low, held, P, M, E, table):
     """
     s = _book_impulse(t, s, S_D_STOP, E, table, P)
     slip = np.int64(MODE_SLIP)
-    before = _mechanical_energy(t, s, slip, P, E, table)
+    before = _mechanical_energy(t, s, slip, P, M, E, table)
     s = _with(s, S_Z, P[P_Z_LOW] if low else P[P_Z_HIGH])
     # the move onto the stop (the impact is located to ~1e-12 m) is booked there too
-    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, slip, P, E, table))
+    s = _with(s, S_D_STOP, s[S_D_STOP] + before - _mechanical_energy(t, s, slip, P, M, E, table))
     mode = MODE_WALL_LOW if low else MODE_WALL_HIGH
     f_hold = rhs_at(t, s, x, mode, 0.0, held, P, M, E, table)[1][F_HOLD]
     if hold_margin(mode, f_hold, P[P_FS]) < 0.0:
@@ -585,7 +623,7 @@ def _margin_near(t, s, x, mode, held, P, M, E, table, phase, sin0, cos0):
     """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
     return hold_margin(mode, rhs(t, y, yd, ydd, s, x, mode, 0.0, held, P, M,
-                                 M[M_BLOCKS] != 0.0)[1][F_HOLD], P[P_FS])
+                                 general(M))[1][F_HOLD], P[P_FS])
 
 
 @njit(**_JIT, inline="always")
@@ -821,7 +859,7 @@ def record(t, s, x, mode, direction, held, P, M, E, table, row, row_flags, phase
     ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
     """
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, M[M_BLOCKS] != 0.0)[1]
+    force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, general(M))[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     row[C_TIME] = t
     row[C_BASE_Y] = force[F_Y]
@@ -844,7 +882,7 @@ def record(t, s, x, mode, direction, held, P, M, E, table, row, row_flags, phase
     row[C_W_MOTOR] = s[S_W_MOTOR]
     row[C_D_STOP] = s[S_D_STOP]
     row[C_E_KINETIC], row[C_E_SPRING], row[C_E_GRAVITY], row[C_E_STOP] = energies(
-        force[F_Y], force[F_YD], s, mode, P)
+        force[F_Y], force[F_YD], s, mode, P, M)
     if M[M_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
         row[C_F_COMPENSATION] = force[F_COMPENSATION]
         row[C_F_DITHER] = force[F_DITHER]

@@ -360,7 +360,8 @@ def _keep(exact, n, t, base, L, PP, M0, models, blocks, Q, columns, energies, ou
             if L[_at(R_FAILED, c)] == 0.0:
                 (Q[_at(K.C_E_KINETIC, c)], Q[_at(K.C_E_SPRING, c)], Q[_at(K.C_E_GRAVITY, c)],
                  Q[_at(K.C_E_STOP, c)]) = K.energies(base[0], base[1], _state(L, c),
-                                                      int(L[_at(R_MODE, c)]), _params(PP, c))
+                                                      int(L[_at(R_MODE, c)]), _params(PP, c),
+                                                      models[c])
     for k in range(columns.size):
         column = columns[k]
         for c in range(n):
@@ -413,7 +414,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
     """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
 
     Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
-    (``K.N_PARAMS``) and ``models`` (``K.N_MODEL``, the controller's blocks) is case ``c``;
+    (``K.N_PARAMS``) and ``models`` (``K.M_*``: the controller's blocks, the spring law) is case ``c``;
     the excitation ``ex, table`` is shared. A sample of case
     ``c`` goes to ``out[column, lane0 + c, row]`` for each channel of ``columns`` (``K.C_*``;
     the other channels are not computed, but the energies only if asked) and to
@@ -421,11 +422,13 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
     ``states`` and ``flags`` carry the
     cases between calls. A case whose ``status`` is not ``K.STATUS_OK`` is left
     alone; one that diverges (non-finite, beyond 100 strokes or 1e4 m/s) gets
-    ``K.STATUS_DIVERGED``, keeps its last finite state and, in ``flags[c,
+    ``K.STATUS_DIVERGED`` (``K.STATUS_OUTSIDE`` when its spring is a refusing table, whose
+    force is NaN outside it), keeps its last finite state and, in ``flags[c,
     K.I_STEP]``, that state's step. ``rows[c]`` gets the rows case ``c`` wrote.
     At most ``MAX_LANES`` cases per call: returns ``K.STATUS_OK``, or
     ``STATUS_TOO_MANY_LANES`` (and does nothing) for more. A case whose controller has
-    blocks beyond PI + damping is stepped in pass 2 at every step.
+    blocks beyond PI + damping, or whose spring law is not the tanh (``K.general``), is
+    stepped in pass 2 at every step. ``models`` is as wide as its widest case's law.
     """
     n = states.shape[0]
     if n > MAX_LANES:
@@ -435,7 +438,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
     L = np.zeros(N_ROWS * W)
     T = np.zeros(N_SCRATCH * W)
     Q = np.zeros(N_RECORD * W)
-    M0 = np.zeros(K.N_MODEL)
+    M0 = np.zeros(K.N_MODEL_ROW)  # PI + damping, the tanh of P
     energies = False
     for k in range(columns.size):
         energies = energies or K.C_E_KINETIC <= columns[k] <= K.C_E_STOP
@@ -453,11 +456,12 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
         L[_at(R_CONTACTS, c)] = flags[c, K.I_N_CONTACTS]
         L[_at(R_STICKS, c)] = flags[c, K.I_N_STICKS]
         L[_at(R_FAILED, c)] = 0.0 if status[c] == K.STATUS_OK else 1.0
-        L[_at(R_BLOCKS, c)] = 1.0 if models[c, K.M_BLOCKS] != 0.0 else 0.0
+        general = K.general(models[c])  # blocks, or a spring law other than the tanh
+        L[_at(R_BLOCKS, c)] = 1.0 if general else 0.0
         rows[c] = 0
         sampled = (sampled or params[c, K.P_CONTROL_STEPS] > 0.0
                    or models[c, K.M_LINEAR_STEPS] > 0.0)
-        blocks = blocks or models[c, K.M_BLOCKS] != 0.0
+        blocks = blocks or general
     h = params[0, K.P_DT] if n > 0 else 0.0
     exact = True  # every lane of the exact model (fixed for the call)
     locked = 0  # lanes stuck or resting on a plastic stop (their mode changes in pass 2 only)
@@ -550,7 +554,7 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
         flags[c, K.I_N_CONTACTS] = int(L[_at(R_CONTACTS, c)])
         flags[c, K.I_N_STICKS] = int(L[_at(R_STICKS, c)])
         if failed_step[c] >= 0:
-            status[c] = K.STATUS_DIVERGED
+            status[c] = K.failure_status(models[c])
             flags[c, K.I_STEP] = failed_step[c]
         else:
             flags[c, K.I_STEP] = step
@@ -559,9 +563,10 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
 
 
 def single_kernel(model):
-    """The one-case kernel for a controller packed as ``model`` (``K.M_*``):
-    :func:`run_single`, or :func:`run_single_blocks` when it has blocks beyond PI + damping."""
-    return run_single_blocks if model[K.M_BLOCKS] != 0.0 else run_single
+    """The one-case kernel for a case packed as ``model`` (``K.M_*``): :func:`run_single`,
+    or :func:`run_single_blocks` when its controller has blocks beyond PI + damping or its
+    spring law is not the tanh (:func:`qzs.engine.kernels.general`)."""
+    return run_single_blocks if K.general(model) else run_single
 
 
 @njit(**_JIT, nogil=True)
@@ -583,10 +588,12 @@ def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, 
 @njit(**_JIT, nogil=True)
 def run_single_blocks(solver, n_steps, decimation, state, flags, p, m, ex, table, out,
                       out_flags, row0):
-    """:func:`run_single` for a controller with blocks beyond PI + damping (``m``).
+    """:func:`run_single` for a controller with blocks beyond PI + damping, or a spring law
+    other than the tanh (``m``, the general path).
 
-    One kernel for every such controller (its blocks are data), compiled on its first use;
-    the same operations as a lane of :func:`run_lanes` with blocks (its pass 2).
+    One kernel for every such controller and law (its blocks and law are data), compiled on
+    its first use; the same operations as a lane of :func:`run_lanes` with blocks (its pass
+    2). Stops with ``K.STATUS_OUTSIDE`` where a refusing spring table's force is NaN.
     """
     return _run_single(True, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
                        out_flags, row0)
@@ -629,7 +636,7 @@ def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, tab
             solver, t, h, s, x, mode, direction, held, P, m, blocks, E, table, margin, phase,
             sin0, cos0)
         if not _finite(s1, P) or (blocks and not _finite_blocks(x1)):
-            status = K.STATUS_DIVERGED
+            status = K.failure_status(m)
             break
         s, x, mode, direction, margin = s1, x1, mode1, direction1, margin1
         step += 1

@@ -10,8 +10,11 @@ import numpy as np
 from numba import njit
 
 from qzs.engine.arithmetic import JIT, exp, tanh
+from qzs.model.springs import (OBLIQUE, POLYNOMIAL, TABLE_COUNT, TABLE_END_FORCE,
+                               TABLE_END_SLOPE, TABLE_OUTSIDE, TABLE_POSITIONS, TANH)
 
-__all__ = ["spring_law", "spring_energy_law", "sliding_friction_law", "compliant_stop_law",
+__all__ = ["spring_law", "spring_energy_law", "spring_general", "spring_energy_general",
+           "sliding_friction_law", "compliant_stop_law",
            "controller_law", "saturation_law", "compensation_law", "dither_law"]
 
 
@@ -56,6 +59,128 @@ def spring_energy_law(a, b, z):
     """
     u = abs(b * z)
     return a / b * (u + np.log1p(np.exp(-2.0 * u)) - np.log(2.0))
+
+
+@njit(**JIT, inline="always")
+def _table_piece(M, at, z):
+    """The piece of the packed table ``M[at:]`` that holds ``z``: binary search, as
+    :func:`qzs.model.springs.evaluate_packed`. Returns ``(piece index, t = z - x_i)``."""
+    n = int(M[at + TABLE_COUNT])
+    first = at + TABLE_POSITIONS
+    low, high = 0, n - 1
+    while high - low > 1:
+        middle = (low + high) // 2
+        if z >= M[first + middle]:
+            low = middle
+        else:
+            high = middle
+    return low, z - M[first + low]
+
+
+@njit(**JIT, inline="always")
+def spring_general(M, at, z):
+    """Force [N] at ``z`` [m] of the spring law packed in ``M`` from index ``at``.
+
+    The law's code first, then its numbers (:meth:`qzs.model.springs.SpringLaw.pack`,
+    docs/model.md §3.1); the arithmetic of :func:`qzs.model.springs.evaluate_packed`, the
+    tanh's that of :func:`spring_law` (bit for bit). NaN outside a refusing table: the run
+    then stops (the kernels' ``STATUS_OUTSIDE``).
+
+    Parameters
+    ----------
+    M : ndarray
+        An array holding the packed law.
+    at : int
+        Index of the law's code in ``M``.
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Spring force on the payload [N].
+    """
+    code = M[at]
+    if code == TANH:
+        return -M[at + 1] * tanh(M[at + 2] * z)
+    if code == OBLIQUE:
+        u = z - M[at + 5]
+        length = np.hypot(u, M[at + 4])
+        return M[at + 6] - M[at + 1] * u - 2.0 * M[at + 2] * (1.0 - M[at + 3] / length) * u
+    if code == POLYNOMIAL:
+        u = z - M[at + 1]
+        force = 0.0
+        for k in range(int(M[at + 2]) - 1, -1, -1):
+            force = force * u + M[at + 3 + k]
+        return force
+    n = int(M[at + TABLE_COUNT])
+    x0 = M[at + TABLE_POSITIONS]
+    xn = M[at + TABLE_POSITIONS + n - 1]
+    pieces = at + TABLE_POSITIONS + n
+    if z < x0 or z > xn:
+        if M[at + TABLE_OUTSIDE] == 0.0:
+            return np.nan
+        if z < x0:
+            return M[pieces] + (z - x0) * M[pieces + 1]
+        return M[at + TABLE_END_FORCE] + (z - xn) * M[at + TABLE_END_SLOPE]
+    i, t = _table_piece(M, at, z)
+    c = pieces + 4 * i
+    return M[c] + t * (M[c + 1] + t * (M[c + 2] + t * M[c + 3]))
+
+
+@njit(**JIT, inline="always")
+def spring_energy_general(M, at, z):
+    """Stored energy [J] at ``z`` [m] of the spring law packed in ``M`` from index ``at``.
+
+    As :func:`spring_general` (:func:`spring_energy_law` for the tanh); NaN outside a
+    refusing table.
+
+    Parameters
+    ----------
+    M : ndarray
+        An array holding the packed law.
+    at : int
+        Index of the law's code in ``M``.
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Stored energy [J], zero at the law's reference position (docs/model.md §3.1).
+    """
+    code = M[at]
+    if code == TANH:
+        return spring_energy_law(M[at + 1], M[at + 2], z)
+    if code == OBLIQUE:
+        u = z - M[at + 5]
+        d = M[at + 4]
+        spread = 2.0 * M[at + 3] / (np.hypot(u, d) + d)
+        return u * (-M[at + 6] + u * (0.5 * M[at + 1] + M[at + 2] * (1.0 - spread)))
+    if code == POLYNOMIAL:
+        u = z - M[at + 1]
+        work = 0.0
+        for k in range(int(M[at + 2]) - 1, -1, -1):
+            work = work * u + M[at + 3 + k] / (k + 1)
+        return -work * u
+    n = int(M[at + TABLE_COUNT])
+    x0 = M[at + TABLE_POSITIONS]
+    xn = M[at + TABLE_POSITIONS + n - 1]
+    pieces = at + TABLE_POSITIONS + n
+    energies = pieces + 4 * (n - 1)
+    if z < x0 or z > xn:
+        if M[at + TABLE_OUTSIDE] == 0.0:
+            return np.nan
+        if z < x0:
+            t = z - x0
+            return M[energies] - t * (M[pieces] + t * (M[pieces + 1] / 2.0))
+        t = z - xn
+        return M[energies + n - 1] - t * (M[at + TABLE_END_FORCE]
+                                          + t * (M[at + TABLE_END_SLOPE] / 2.0))
+    i, t = _table_piece(M, at, z)
+    c = pieces + 4 * i
+    return M[energies + i] - t * (M[c] + t * (M[c + 1] / 2.0 + t * (M[c + 2] / 3.0
+                                                                    + t * (M[c + 3] / 4.0))))
 
 
 @njit(**JIT, inline="always")

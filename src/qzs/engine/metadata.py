@@ -44,7 +44,8 @@ def _plain(value):
 def parameter_metadata(isolator, controller, excitation):
     """Every parameter of a run with its unit: ``{key: (value, unit)}``.
 
-    Keys are ``isolator.<name>``, ``controller.<name>``, ``excitation`` (the class
+    Keys are ``isolator.<name>`` (a spring law's ``isolator.spring.law`` and its fields,
+    :meth:`~qzs.model.springs.SpringLaw.parameters`), ``controller.<name>``, ``excitation`` (the class
     name, no unit) and ``excitation.<field>``; units come from the parameter
     registry and the excitation's field metadata. ``None`` values are kept,
     booleans become 0/1; a displacement record's arrays are data, not metadata.
@@ -67,6 +68,9 @@ def parameter_metadata(isolator, controller, excitation):
         for field in parameter_fields(params):
             meta[f"{section}.{field.name}"] = (_plain(getattr(params, field.name)),
                                                unit_of(field.name))
+    if isolator.spring is not None:  # the spring law, as the controller's blocks
+        for name, (value, unit) in isolator.spring.parameters().items():
+            meta[f"isolator.spring.{name}"] = (_plain(value), unit)
     for name, (value, unit) in block_parameters(controller).items():
         meta[f"controller.{name}"] = (_plain(value), unit)
     meta["excitation"] = (type(excitation).__name__, "")

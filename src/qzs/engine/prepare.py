@@ -14,9 +14,10 @@ from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import (Chirp, DisplacementRecord, RandomExcitation, Sine,
                                   highest_frequency)
 from qzs.model.isolator import InitialState, IsolatorParameters
+from qzs.model.springs import TABLE_COUNT, TABLE_POSITIONS, TanhSpring, check_equilibrium
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "pack_model", "linear_initial_state", "linear_output",
+__all__ = ["PreparedRun", "prepare_run", "pack_model", "stack_models", "check_spring", "linear_initial_state", "linear_output",
            "run_inputs", "run_duration", "steps_per_sample",
            "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
@@ -62,11 +63,14 @@ def _pack_parameters(isolator, controller, dt, control_steps):
 
 
 def pack_model(isolator, controller, dt):
-    """The controller's blocks beyond PI + damping packed for the kernels (``K.M_*``).
+    """The controller's blocks beyond PI + damping and the spring law packed for the kernels
+    (``K.M_*``).
 
-    All zeros for PI + damping alone (the kernels then take exactly its operations). Checks
-    what needs the step: a discrete linear controller's sample time must be a whole number
-    of integration steps.
+    The blocks all zeros for PI + damping alone, the spring the tanh ``[0, a, b]`` by default
+    (the kernels then take exactly the operations of PI + damping with the tanh); after the
+    blocks (``K.M_SPRING``) the law's :meth:`~qzs.model.springs.SpringLaw.pack`, so a row is
+    as wide as its law needs. Checks what needs the step: a discrete linear controller's
+    sample time must be a whole number of integration steps.
 
     Parameters
     ----------
@@ -79,14 +83,16 @@ def pack_model(isolator, controller, dt):
 
     Returns
     -------
-    ndarray, shape (N_MODEL,)
+    ndarray, shape (M_SPRING + the packed law's size,)
 
     Raises
     ------
     ParameterError
         A discrete linear controller's sample time that is not a whole number of steps.
     """
-    m = np.zeros(K.N_MODEL)
+    law = isolator.spring_law.pack()
+    m = np.zeros(K.M_SPRING + law.size)
+    m[K.M_SPRING:] = law
     if not controller.has_blocks:
         return m
     m[K.M_BLOCKS] = 1.0
@@ -261,6 +267,68 @@ def run_inputs(excitation=None, isolator=None, controller=None):
     excitation = Chirp() if excitation is None else excitation
     _check_type("excitation", excitation, _EXCITATIONS)
     return (excitation, *model_inputs(isolator, controller))
+
+
+def stack_models(models):
+    """The packed models of a batch's cases as one array, each row zero-padded to the widest.
+
+    Parameters
+    ----------
+    models : sequence of ndarray
+        :func:`pack_model`'s rows.
+
+    Returns
+    -------
+    ndarray, shape (len(models), widest)
+    """
+    width = max(m.size for m in models)
+    out = np.zeros((len(models), width))
+    for i, m in enumerate(models):
+        out[i, :m.size] = m
+    return out
+
+
+def check_spring(isolator, controller, p):
+    """Refuse a spring law with no stable equilibrium inside the stroke for the payload.
+
+    The MagSpring's tanh (the default, or a TanhSpring) is not checked: on the paper's rig
+    it alone falls short of the weight and the PI integral carries the rest, or the payload
+    rests on its lower stop (docs/model.md §3). Another law must hold the payload's weight
+    ``m g`` in the stroke with a positive (or quasi-zero) stiffness, the motor adding what the
+    PI's bumpless preload holds at the setpoint where the controller has an integral
+    (``clip(m g - F(z_ref), -F_max, F_max)``; docs/model.md §3.1).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        The plant, its ``spring``.
+    controller : ControllerParameters
+        The controller (its setpoint and integral gain).
+    p : ndarray
+        The packed parameters (the stops ``K.P_Z_LOW``, ``K.P_Z_HIGH``).
+
+    Raises
+    ------
+    ParameterError
+        No stable equilibrium (``qzs.model.springs.check_equilibrium``'s message), naming
+        ``spring``.
+    """
+    law = isolator.spring
+    if law is None or isinstance(law, TanhSpring):
+        return
+    weight = isolator.mass * isolator.gravity
+    hold = 0.0
+    if controller.pi_ki > 0.0:
+        first, last = law.domain
+        if first <= controller.position_setpoint <= last:
+            hold = float(np.clip(weight - float(law.force(controller.position_setpoint)),
+                                 -isolator.motor_force_max, isolator.motor_force_max))
+    try:
+        check_equilibrium(law, weight, (float(p[K.P_Z_LOW]), float(p[K.P_Z_HIGH])), hold=hold)
+    except ParameterError as error:
+        raise ParameterError(f"`spring`: {error} (the stroke from the stops, the weight "
+                             f"m g, the hold the PI's integral preload)",
+                             ("spring", *error.options)) from None
 
 
 def _check_type(name, value, kinds):
@@ -609,6 +677,7 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
         control_steps = steps_per_sample(controller.controller_rate, dt, "controller_rate")
 
     p = _pack_parameters(isolator, controller, dt, control_steps)
+    check_spring(isolator, controller, p)
     m = pack_model(isolator, controller, dt)
     packed = excitation.pack()
     s, flags = _initial_state(initial_state, isolator, controller, p, m, excitation, packed)
@@ -616,8 +685,8 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
                        decimation, solver_code, dt, sample_rate)
 
 
-def divergence_message(state, step, dt):
-    """What a diverged run reports: the time [s] of the failing step and the last finite state.
+def divergence_message(state, step, dt, status=K.STATUS_DIVERGED, model=None):
+    """What a stopped run reports: the time [s] of the failing step and the last finite state.
 
     Parameters
     ----------
@@ -627,12 +696,29 @@ def divergence_message(state, step, dt):
         Index of the failing step.
     dt : float
         Integration step [s].
+    status : int
+        The kernel's status: ``K.STATUS_DIVERGED``, or ``K.STATUS_OUTSIDE`` (the payload
+        left a spring table that refuses positions outside it; ``model`` then needed).
+    model : ndarray, optional
+        The case's packed model (``K.M_*``), its spring table.
 
     Returns
     -------
     str
         The message of the :class:`~qzs.errors.SimulationError`.
     """
+    if status == K.STATUS_OUTSIDE:
+        n = int(model[K.M_SPRING + TABLE_COUNT])
+        first = float(model[K.M_SPRING + TABLE_POSITIONS])
+        last = float(model[K.M_SPRING + TABLE_POSITIONS + n - 1])
+        z, v = float(state[K.S_Z]), float(state[K.S_V])
+        end = last if v > 0 or z > 0.5 * (first + last) else first
+        return (f"the run stopped at t = {step * dt:.6g} s: the payload left the spring table "
+                f"[{first:.6g}, {last:.6g}] m past its end at {end:.6g} m (last position "
+                f"inside z = {z:.6g} m, moving at v = {v:.6g} m/s), and the TabulatedSpring "
+                "refuses positions outside it (outside='refuse'); measure the curve over the "
+                "whole stroke and a margin for the stops' penetration, or build it with "
+                "outside='extend' (linear beyond the ends).")
     controller = ""
     blocks = np.abs(state[K.A_X0:K.A_X0 + K.N_X])
     if np.any(blocks):

@@ -106,6 +106,7 @@ class SingleAxis(driver.Stepper):
         self.run = run
         self.buffers = buffers
         self.diverged = False
+        self.status = K.STATUS_OK
 
     def advance(self, steps, buffer, row0):
         """Advance the kernel, recording the samples that fall in the steps.
@@ -130,13 +131,14 @@ class SingleAxis(driver.Stepper):
         status, written = kernel(run.solver_code, steps, run.decimation, run.state, run.flags,
                                  run.params, run.model, *run.packed, data, marks, row0)
         self.diverged = status != K.STATUS_OK
+        self.status = status
         return written
 
     def divergence(self):
         """The :class:`~qzs.errors.SimulationError` of a diverged run (time and last state)."""
         run = self.run
         return SimulationError(divergence_message(run.state, run.flags[K.I_STEP],
-                                                  run.params[K.P_DT]))
+                                                  run.params[K.P_DT], self.status, run.model))
 
 
 def result_bytes(duration, sample_rate, controller=None):

@@ -5,13 +5,47 @@ from qzs._validation import choice
 from qzs.engine import kernels as K
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
+from qzs.model.springs import EQUILIBRIUM_SAMPLES, TabulatedSpring, TanhSpring
 
-__all__ = ["SOLVERS", "largest_stable_step", "stability_test"]
+__all__ = ["SOLVERS", "largest_stable_step", "stability_test", "spring_stiffness_peak"]
 
 #: Fixed-step integrators: name -> (kernel code, order of accuracy).
 SOLVERS = {"euler": (K.SOLVER_EULER, 1), "ode3": (K.SOLVER_ODE3, 3), "rk4": (K.SOLVER_RK4, 4)}
 _STABILITY_POLYNOMIALS = {  # |R(h*lambda)| <= 1 is linear stability (Taylor coefficients)
     "euler": [1, 1], "ode3": [1, 1, 1 / 2, 1 / 6], "rk4": [1, 1, 1 / 2, 1 / 6, 1 / 24]}
+
+
+def spring_stiffness_peak(isolator, controller):
+    """The spring's largest tangent stiffness over the stroke [N/m] (what the step must resolve).
+
+    The MagSpring's ``a b`` (its peak, at ``z = 0``) for the tanh; for another law the
+    largest of its stiffness at :data:`qzs.model.springs.EQUILIBRIUM_SAMPLES` positions over
+    the stops' span (and a table's breakpoints there).
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        The plant, its spring law.
+    controller : ControllerParameters
+        The controller (its setpoint centres the stops by default).
+
+    Returns
+    -------
+    float
+        Stiffness [N/m].
+    """
+    law = isolator.spring
+    if law is None or isinstance(law, TanhSpring):
+        return isolator.spring_force * isolator.spring_shape
+    center = (controller.position_setpoint if isolator.stop_center is None
+              else isolator.stop_center)
+    first, last = law.domain
+    low = max(center - isolator.stroke_half, first)
+    high = min(center + isolator.stroke_half, last)
+    z = np.linspace(low, high, EQUILIBRIUM_SAMPLES)
+    if isinstance(law, TabulatedSpring):
+        z = np.union1d(z, law.positions[(law.positions >= low) & (law.positions <= high)])
+    return float(np.max(law.stiffness(z)))
 
 
 def _stiff_modes(isolator, controller):
@@ -20,7 +54,7 @@ def _stiff_modes(isolator, controller):
     Regularised friction adds its slope at ``v = 0``, ``Fs/v_reg`` [N*s/m], to the damping.
     """
     m = isolator.mass
-    stiffness = isolator.spring_force * isolator.spring_shape + controller.pi_kp
+    stiffness = spring_stiffness_peak(isolator, controller) + controller.pi_kp
     damping = isolator.viscous_damping + controller.damping_gain
     if controller.compensation is not None:  # its viscous part cancels damping
         compensation = controller.compensation

@@ -11,9 +11,11 @@ from qzs.model.controller import (BLOCK_CLASSES, BLOCKS, ControllerParameters,
 from qzs.model.excitation import EXCITATION_OPTIONS
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, update_parameters
+from qzs.model.springs import SPRING_LAWS, ObliqueSpringQZS, TabulatedSpring
 
-__all__ = ["load_config", "load_controller", "controller_from_table", "save_config", "config_text", "EXCITATION_KEYS",
-           "SIMULATION_KEYS", "LINEAR_KEYS"]
+__all__ = ["load_config", "load_controller", "load_spring", "controller_from_table",
+           "spring_from_table", "save_config", "config_text", "EXCITATION_KEYS",
+           "SIMULATION_KEYS", "LINEAR_KEYS", "SPRING_CSV_KEYS"]
 
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
 EXCITATION_KEYS = ("kind", *dict.fromkeys(o for v in EXCITATION_OPTIONS.values() for o in v))
@@ -31,6 +33,12 @@ LINEAR_KEYS = ("a", "b", "c", "d", "num", "den", "inputs", "sample_time", "track
 #: Where a config file's options come from: a ``[controller.linear]`` key -> the
 #: :class:`~qzs.model.controller.LinearController` option an error names.
 _LINEAR_OPTIONS = {"numerator": "num", "denominator": "den", "system": "num"}
+#: Keys of a ``[spring]`` table with ``law = "table"`` beyond the law's fields: the CSV file
+#: of the force curve (relative to the TOML file) and its reader's options
+#: (:meth:`~qzs.model.springs.TabulatedSpring.read_csv`).
+SPRING_CSV_KEYS = ("csv", "position_unit", "force_unit", "position_column", "force_column")
+#: What ``vertical_stiffness`` may say of an oblique-spring law instead of a number.
+QUASI_ZERO = "quasi-zero"
 
 
 def load_config(path: str | Path) -> dict[str, Any]:
@@ -39,10 +47,10 @@ def load_config(path: str | Path) -> dict[str, Any]:
     Tables ``[isolator]`` and ``[controller]`` take the registry's parameter names
     (``qzs params``, :data:`qzs.model.registry.PARAMETERS`); the controller's blocks are
     its sub-tables ``[controller.compensation]``, ``[controller.dither]`` and
-    ``[controller.linear]`` (:func:`controller_from_table`). ``[excitation]`` (``kind``
-    = chirp, sine, random or file, and its options) and ``[simulation]`` (``dt``,
-    ``sample_rate``, ``solver``, ``duration``) are optional. Unknown tables or keys
-    are errors.
+    ``[controller.linear]`` (:func:`controller_from_table`). ``[spring]`` (the spring law,
+    :func:`spring_from_table`), ``[excitation]`` (``kind`` = chirp, sine, random or file,
+    and its options) and ``[simulation]`` (``dt``, ``sample_rate``, ``solver``,
+    ``duration``) are optional. Unknown tables or keys are errors.
 
     Parameters
     ----------
@@ -63,7 +71,7 @@ def load_config(path: str | Path) -> dict[str, Any]:
     """
     path = Path(path)
     document = read_toml(path, "config file", empty=EMPTY_CONFIG)
-    allowed = {"isolator", "controller", "excitation", "simulation"}
+    allowed = {"isolator", "controller", "excitation", "simulation", "spring"}
     unknown = set(document) - allowed
     if unknown:
         raise ParameterError(f"{str(path)!r}: unknown table(s) {sorted(unknown)}; "
@@ -80,6 +88,9 @@ def load_config(path: str | Path) -> dict[str, Any]:
                              "not [isolator].")
     isolator, _ = update_parameters(IsolatorParameters(), ControllerParameters(),
                                     isolator_table)
+    if "spring" in document:
+        isolator = dataclasses.replace(isolator,
+                                       spring=spring_from_table(document["spring"], path))
     controller = controller_from_table(document.get("controller", {}), path)
     for section, keys in (("excitation", EXCITATION_KEYS), ("simulation", SIMULATION_KEYS)):
         known_keys(document.get(section, {}), keys, f"[{section}]", f"{str(path)!r}: ")
@@ -123,6 +134,125 @@ def load_controller(path: str | Path) -> ControllerParameters:
             "[isolator], [excitation] and [simulation] in a config file (--config).",
             ("controller",))
     return controller_from_table(document["controller"], path)
+
+
+def load_spring(path: str | Path):
+    """Read a spring file: a TOML file with a ``[spring]`` table and nothing else.
+
+    What ``qzs simulate --spring FILE.toml`` reads (:func:`spring_from_table`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    SpringLaw
+
+    Raises
+    ------
+    ParameterError
+        A missing, binary or malformed file, another table than ``[spring]``, an unknown
+        law or key, a bad value (the message names the table and key).
+    DataError
+        A table's CSV file that is missing or malformed.
+    """
+    path = Path(path)
+    document = read_toml(path, "spring file", empty=(
+        'write a [spring] table into it, e.g. law = "oblique"'))
+    others = sorted(set(document) - {"spring"})
+    if others or "spring" not in document:
+        raise ParameterError(
+            f"spring file {str(path)!r} must hold a [spring] table and nothing else; it has "
+            f"{sorted(document)}: put the other tables in a config file (--config).",
+            ("spring",))
+    return spring_from_table(document["spring"], path)
+
+
+def spring_from_table(table: Any, path: str | Path | None = None, *, name: str = "spring"):
+    """A spring law from a TOML ``[spring]`` table (parsed; docs/model.md §3.1).
+
+    ``law`` is ``"tanh"``, ``"oblique"``, ``"polynomial"`` or ``"table"``; the other keys are
+    the law's fields in SI units (``plateau`` [N] and ``shape`` [1/m]; ``vertical_stiffness``
+    [N/m], ..., ``vertical_stiffness = "quasi-zero"`` choosing the quasi-zero value;
+    ``coefficients`` and ``center``; ``positions`` [m] and ``forces`` [N], or ``csv`` = a
+    CSV file of the force curve, relative to the TOML file, with ``position_unit``,
+    ``force_unit``, ``position_column``, ``force_column`` as
+    :meth:`~qzs.model.springs.TabulatedSpring.read_csv` takes them, and ``outside``).
+
+    Parameters
+    ----------
+    table : dict
+        The parsed table.
+    path : str or Path, optional
+        The TOML file, for the messages and a relative ``csv``.
+    name : str
+        The table's name in the file, for the messages.
+
+    Returns
+    -------
+    SpringLaw
+
+    Raises
+    ------
+    ParameterError
+        No or an unknown ``law``, an unknown key, a bad value; the message names the table
+        and key (``[spring] free_length in 'FILE'``), the value and the fix.
+    DataError
+        A missing or malformed CSV file.
+    """
+    where = f" in {str(path)!r}" if path is not None else ""
+    prefix = f"{str(path)!r}: " if path is not None else ""
+    if not isinstance(table, dict):
+        raise ParameterError(f"{prefix}[{name}] must be a table, got {table!r}.", (name,))
+    kind = table.get("law")
+    if kind not in SPRING_LAWS:
+        got = "no `law`" if "law" not in table else f"law = {kind!r}"
+        raise ParameterError(f"{prefix}[{name}] has {got}; write law = one of "
+                             f"{', '.join(repr(k) for k in SPRING_LAWS)} (e.g. law = "
+                             '"oblique").', ("law",))
+    cls = SPRING_LAWS[kind]
+    fields = [f.name for f in dataclasses.fields(cls)]
+    allowed = ["law", *fields, *(SPRING_CSV_KEYS if cls is TabulatedSpring else ())]
+    known_keys(table, allowed, f"[{name}] (law = {kind!r})", prefix)
+    values = {key: value for key, value in table.items() if key in fields}
+    spelling = {key: f"[{name}] {key}{where}" for key in allowed}
+    try:
+        if cls is TabulatedSpring:
+            return _table_law(table, values, path, prefix, name)
+        if cls is ObliqueSpringQZS and values.get("vertical_stiffness") == QUASI_ZERO:
+            del values["vertical_stiffness"]
+            return ObliqueSpringQZS.quasi_zero(**values)
+        return cls(**values)
+    except ParameterError as error:
+        raise error.renamed(spelling) from None
+
+
+def _table_law(table, values, path, prefix, name):
+    """A :class:`TabulatedSpring` from a ``[spring]`` table: ``csv`` or the two columns."""
+    if "csv" in table:
+        inline = sorted({"positions", "forces"} & set(table))
+        if inline:
+            raise ParameterError(f"{prefix}[{name}] gives `csv` and {inline}: give the force "
+                                 "curve once, as a CSV file or as positions and forces.",
+                                 ("csv",))
+        csv = Path(str(table["csv"]))
+        if path is not None and not csv.is_absolute():
+            csv = Path(path).parent / csv
+        options = {key: table[key] for key in SPRING_CSV_KEYS[1:] if key in table}
+        return TabulatedSpring.read_csv(csv, outside=values.get("outside", "refuse"),
+                                        **options)
+    missing = [key for key in ("positions", "forces") if key not in table]
+    if missing:
+        raise ParameterError(f"{prefix}[{name}] (law = 'table') needs csv = \"FILE.csv\", or "
+                             f"positions [m] and forces [N]; {missing} missing.",
+                             tuple(missing))
+    stray = sorted(set(SPRING_CSV_KEYS[1:]) & set(table))
+    if stray:
+        raise ParameterError(f"{prefix}[{name}] {stray} are options of `csv`, which is not "
+                             "given: positions are in m and forces in N.", tuple(stray))
+    return TabulatedSpring(**values)
 
 
 def controller_from_table(table: Any, path: str | Path | None = None,
@@ -275,6 +405,9 @@ def config_text(isolator=None, controller=None, excitation=None, simulation=None
     controller = controller or ControllerParameters()
     document = {"isolator": (isolator or IsolatorParameters()).to_dict(),
                 "controller": controller.to_dict()}
+    spring = document["isolator"].pop("spring", None)  # its own table, [spring]
+    if spring is not None:
+        document["spring"] = spring
     for name in BLOCKS:  # a block's table: None is the plant's level, "none" in TOML
         block = getattr(controller, name)
         if block is not None:

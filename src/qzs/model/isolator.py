@@ -5,7 +5,8 @@ relative position (encoder), ``v = xd - yd`` relative (slip) velocity; upward po
 
     m * xdd = F_spring(z) + F_friction(v) + F_stop(z, v) + F_motor - m * g
 """
-from dataclasses import asdict, dataclass
+import dataclasses
+from dataclasses import dataclass
 from typing import Any, overload
 
 import numpy as np
@@ -14,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from qzs._validation import (choice, non_negative_real, optional, parameter, positive_real, real,
                              validate_fields)
 from qzs.errors import ParameterError
+from qzs.model.springs import SpringLaw, TanhSpring
 
 __all__ = [
     "IsolatorParameters",
@@ -79,6 +81,13 @@ class IsolatorParameters:
         stop that absorbs the relative velocity on impact and holds the payload at the limit.
     motor_force_max : float
         Motor force saturation [N] (LinMot PS01-23x80: 44 N).
+    spring : SpringLaw or None
+        The spring law (docs/model.md §3.1): None (default) is the MagSpring's tanh of
+        ``spring_force`` and ``spring_shape``; a :class:`~qzs.model.springs.TanhSpring` sets
+        those two fields (left at their defaults, or equal to its own); another law
+        (:class:`~qzs.model.springs.ObliqueSpringQZS`,
+        :class:`~qzs.model.springs.PolynomialSpring`,
+        :class:`~qzs.model.springs.TabulatedSpring`) replaces the tanh in the run.
     """
 
     mass: float = parameter(6.4, "kg", "moving mass m")
@@ -97,6 +106,10 @@ class IsolatorParameters:
     stop_damping: float = parameter(1e3, "N*s/m", "hard-stop contact damping")
     stop_model: str = parameter("compliant", "-", "hard-stop model: compliant or plastic")
     motor_force_max: float = parameter(44.0, "N", "motor force saturation")
+    # a value of its own (its parameters are no registry parameters, as a controller's blocks)
+    spring: SpringLaw | None = dataclasses.field(default=None, metadata={
+        "block": True, "unit": "-",
+        "doc": "spring law (None: the MagSpring's tanh of spring_force, spring_shape)"})
 
     def __post_init__(self):
         validate_fields(self, {
@@ -116,6 +129,7 @@ class IsolatorParameters:
             "stop_model": lambda n, v: choice(n, v, STOP_MODELS),
             "motor_force_max": non_negative_real,
         })
+        self._check_spring()
         if self.coulomb_force > self.stiction_force:
             raise ParameterError(
                 f"`stiction_force` ({self.stiction_force!r} N) must be >= `coulomb_force` "
@@ -131,6 +145,35 @@ class IsolatorParameters:
                 "or `friction_regularisation=0` (exact stick-slip)."
             )
 
+    def _check_spring(self):
+        """``spring`` a law or None; a TanhSpring's numbers are the fields' (set or agreeing)."""
+        law = self.spring
+        if law is None:
+            return
+        if not isinstance(law, SpringLaw):
+            raise ParameterError(
+                f"`spring` must be a spring law (TanhSpring, ObliqueSpringQZS, "
+                f"PolynomialSpring, TabulatedSpring) or None for the MagSpring of "
+                f"`spring_force` and `spring_shape`, got {law!r}.", ("spring",))
+        if not isinstance(law, TanhSpring):
+            return
+        defaults = {f.name: f.default for f in dataclasses.fields(self)}
+        for name, value in (("spring_force", law.plateau), ("spring_shape", law.shape)):
+            given = getattr(self, name)
+            if given != value and given != defaults[name]:
+                raise ParameterError(
+                    f"`spring` ({law.describe()}) and `{name}` ({given!r}) disagree: a "
+                    f"TanhSpring sets `{name}` to {value!r}; give the tanh's numbers once, "
+                    "in the law or in the fields.", ("spring", name))
+            object.__setattr__(self, name, value)
+
+    @property
+    def spring_law(self) -> SpringLaw:
+        """The run's spring law: ``spring``, or the MagSpring's tanh of the fields."""
+        if self.spring is not None:
+            return self.spring
+        return TanhSpring(plateau=self.spring_force, shape=self.spring_shape)
+
     @property
     def weight_deficit(self) -> float:
         """``m*g - a`` [N]: how much of the weight the spring's plateau cannot carry."""
@@ -143,8 +186,12 @@ class IsolatorParameters:
         return -float(np.arctanh(1.0 - CONSTANT_FORCE_TOLERANCE)) / self.spring_shape
 
     def to_dict(self) -> dict[str, Any]:
-        """Return the parameters as a plain ``dict`` (``None`` values omitted)."""
-        return {k: v for k, v in asdict(self).items() if v is not None}
+        """Return the parameters as a plain ``dict`` (``None`` values omitted; a spring law
+        as :meth:`~qzs.model.springs.SpringLaw.to_dict`'s ``{"law": kind, ...}``)."""
+        data = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        if self.spring is not None:
+            data["spring"] = self.spring.to_dict()
+        return {k: v for k, v in data.items() if v is not None}
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -139,6 +139,23 @@ class SpringLaw:
             data[f.name] = value.tolist() if isinstance(value, np.ndarray) else value
         return data
 
+    def parameters(self) -> dict[str, tuple[Any, str]]:
+        """The law with its units, as a run's records write it: ``{name: (value, unit)}``.
+
+        ``law`` (its kind, unit ``-``) first, then each field; arrays as lists of floats.
+
+        Returns
+        -------
+        dict of str to (object, str)
+        """
+        meta: dict[str, tuple[Any, str]] = {"law": (self.kind, "-")}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, np.ndarray):
+                value = [float(x) for x in value]
+            meta[f.name] = (value, f.metadata.get("unit", ""))
+        return meta
+
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "SpringLaw":
         """A law from :meth:`to_dict`'s data; on the base class the ``law`` key picks the class.

@@ -28,6 +28,7 @@ from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Si
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.model.springs import TanhSpring
 
 __all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks"]
 
@@ -263,6 +264,12 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if not isinstance(progress, (bool, np.bool_)):
         raise ParameterError(f"`progress` must be True or False, got {progress!r}.")
     for leg, (iso, con) in enumerate(zip(isolators, controllers)):
+        if iso.spring is not None and not isinstance(iso.spring, TanhSpring):
+            raise ParameterError(
+                f"leg {leg + 1}: `spring` ({iso.spring.describe()}) is not supported by the "
+                "hexapod yet: its legs evaluate the MagSpring's tanh of `spring_force` and "
+                "`spring_shape` only (docs/model.md §3.1); give the legs spring=None or a "
+                "TanhSpring, or simulate one axis with this law (qzs.simulate).", ("spring",))
         if iso.stop_model != "compliant":
             raise ParameterError(
                 f"leg {leg + 1}: `stop_model` {iso.stop_model!r} is not supported by the hexapod "
