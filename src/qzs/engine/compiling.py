@@ -36,7 +36,8 @@ __all__ = ["ENTRY_KERNELS", "COMPILE_SECONDS", "NOTICE", "cold_kernels", "estima
 #: Kernel family -> the kernels Python calls (``module.function``), in the order a run
 #: compiles them. ``single``: one case (:func:`qzs.simulate`, the response's periodic runs);
 #: ``batch``: cases in lockstep (:func:`qzs.simulate_batch`: sweeps, studies, design);
-#: ``single_blocks``: one case of a controller with blocks beyond PI + damping (its own
+#: ``single_blocks``: one case of a controller with blocks beyond PI + damping, or of a spring
+#: law other than the tanh (the general
 #: kernel, :func:`qzs.engine.lanes.run_single_blocks`); ``hexapod``: the six-leg platform
 #: (:func:`qzs.simulate_hexapod`).
 ENTRY_KERNELS = {
