@@ -234,7 +234,7 @@ def _table_law(table, values, path, prefix, name):
     if "csv" in table:
         inline = sorted({"positions", "forces"} & set(table))
         if inline:
-            raise ParameterError(f"{prefix}[{name}] gives `csv` and {inline}: give the force "
+            raise ParameterError(f"{prefix}[{name}] gives both csv and {inline}: give the force "
                                  "curve once, as a CSV file or as positions and forces.",
                                  ("csv",))
         csv = Path(str(table["csv"]))
@@ -250,7 +250,7 @@ def _table_law(table, values, path, prefix, name):
                              tuple(missing))
     stray = sorted(set(SPRING_CSV_KEYS[1:]) & set(table))
     if stray:
-        raise ParameterError(f"{prefix}[{name}] {stray} are options of `csv`, which is not "
+        raise ParameterError(f"{prefix}[{name}] {stray} are options of csv, which is not "
                              "given: positions are in m and forces in N.", tuple(stray))
     return TabulatedSpring(**values)
 
