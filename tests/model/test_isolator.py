@@ -146,7 +146,7 @@ TABLE_1 = dict(mass=6.4, gravity=9.81, spring_force=60.84, spring_shape=78.10, s
                coulomb_force=1.0, stribeck_decay=100.0, viscous_damping=100.0,
                friction_regularisation=0.0, stroke_half=0.080,
                stop_center=None, stop_stiffness=1e6, stop_damping=1e3, stop_model="compliant",
-               motor_force_max=44.0)
+               motor_force_max=44.0, spring=None)  # None: the tanh of spring_force, spring_shape
 
 
 def test_defaults_are_table_1_of_model_md():
