@@ -295,8 +295,9 @@ def check_spring(isolator, controller, p):
     it alone falls short of the weight and the PI integral carries the rest, or the payload
     rests on its lower stop (docs/model.md §3). Another law must hold the payload's weight
     ``m g`` in the stroke with a positive (or quasi-zero) stiffness, the motor adding what the
-    PI's bumpless preload holds at the setpoint where the controller has an integral
-    (``clip(m g - F(z_ref), -F_max, F_max)``; docs/model.md §3.1).
+    PI's bumpless preload holds where the controller has an integral: the setpoint is then the
+    equilibrium when the motor can carry ``m g - F(z_ref)``, else the saturated motor's
+    ``+-F_max`` is the hold (docs/model.md §3.1).
 
     Parameters
     ----------
@@ -318,11 +319,12 @@ def check_spring(isolator, controller, p):
         return
     weight = isolator.mass * isolator.gravity
     hold = 0.0
-    if controller.pi_ki > 0.0:
-        first, last = law.domain
-        if first <= controller.position_setpoint <= last:
-            hold = float(np.clip(weight - float(law.force(controller.position_setpoint)),
-                                 -isolator.motor_force_max, isolator.motor_force_max))
+    first, last = law.domain
+    if controller.pi_ki > 0.0 and first <= controller.position_setpoint <= last:
+        needed = weight - float(law.force(controller.position_setpoint))
+        if abs(needed) <= isolator.motor_force_max:
+            return  # the PI's integral holds the payload at the setpoint
+        hold = float(np.clip(needed, -isolator.motor_force_max, isolator.motor_force_max))
     try:
         check_equilibrium(law, weight, (float(p[K.P_Z_LOW]), float(p[K.P_Z_HIGH])), hold=hold)
     except ParameterError as error:
