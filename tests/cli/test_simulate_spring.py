@@ -10,7 +10,8 @@ from qzs.iotools import read_result
     ('[spring]\nlaw = "cubic"\n', "law = 'cubic'; write law = one of"),
     ('[spring]\nlaw = "oblique"\nfree_length = "long"\n', "[spring] free_length in"),
     ('spring = 3\n', "[spring] must be a table, got 3"),
-    ('[spring]\nlaw = "tanh"\n[simulation]\ndt = 1e-4\n', "must hold a [spring] table and nothing else"),
+    ('[spring]\nlaw = "tanh"\n[simulation]\ndt = 1e-4\n',
+     "must hold a [spring] table and nothing else"),
     ('[spring]\nlaw = "polynomial"\ncoefficients = [0.0, -10.0]\n', "no stable equilibrium"),
 ])
 def test_a_bad_spring_file_exits_2_before_any_run(tmp_path, capsys, text, said):

@@ -26,7 +26,8 @@ def test_a_spring_file_reads_a_table_from_csv_relative_to_it_with_its_units(tmp_
     forces = TanhSpring().force(z_mm * 1e-3)
     (tmp_path / "curves").mkdir()
     (tmp_path / "curves" / "rig.csv").write_text(
-        "position [mm],force [N]\n" + "".join(f"{float(z)!r},{float(f)!r}\n" for z, f in zip(z_mm, forces)))
+        "position [mm],force [N]\n"
+        + "".join(f"{float(z)!r},{float(f)!r}\n" for z, f in zip(z_mm, forces)))
     path = _write(tmp_path / "spring.toml",
                   '[spring]\nlaw = "table"\ncsv = "curves/rig.csv"\noutside = "extend"\n')
     law = load_spring(path)
@@ -49,7 +50,8 @@ def test_config_text_writes_the_law_as_its_spring_table_and_reads_it_back(tmp_pa
     ('[spring]\nplateau = 60.0\n', r"\[spring\] has no `law`; write law = one of 'tanh'"),
     ('[spring]\nlaw = "cubic"\n', r"law = 'cubic'; write law = one of"),
     ('[spring]\nlaw = "oblique"\nstiffness = 3.0\n', r"unknown key\(s\) \['stiffness'\]"),
-    ('[spring]\nlaw = "oblique"\nfree_length = -1.0\n', r"\[spring\] free_length in '.*spring.toml'"),
+    ('[spring]\nlaw = "oblique"\nfree_length = -1.0\n',
+     r"\[spring\] free_length in '.*spring.toml'"),
     ('[spring]\nlaw = "table"\n', r"needs csv = \"FILE.csv\", or positions \[m\] and forces \[N\]"),
     ('[spring]\nlaw = "table"\ncsv = "a.csv"\npositions = [0.0, 1.0, 2.0]\n',
      r"gives both csv and \['positions'\]: give the force curve once"),

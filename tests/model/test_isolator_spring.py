@@ -17,7 +17,8 @@ def test_the_default_law_is_the_magsprings_tanh_of_the_fields():
 def test_a_tanh_law_sets_the_fields_and_a_disagreeing_field_is_refused():
     iso = IsolatorParameters(spring=TanhSpring(plateau=55.0, shape=70.0))
     assert (iso.spring_force, iso.spring_shape) == (55.0, 70.0)
-    assert IsolatorParameters(spring=TanhSpring(plateau=55.0), spring_force=55.0).spring_force == 55.0
+    agreeing = IsolatorParameters(spring=TanhSpring(plateau=55.0), spring_force=55.0)
+    assert agreeing.spring_force == 55.0
     with pytest.raises(ParameterError, match=r"`spring_shape` \(70.0\) disagree") as error:
         IsolatorParameters(spring=TanhSpring(shape=80.0), spring_shape=70.0)
     assert error.value.options == ("spring", "spring_shape")

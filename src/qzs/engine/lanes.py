@@ -414,7 +414,8 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
     """Advance every case ``n_steps`` grid steps from ``step0``, recording every ``decimation``-th.
 
     Row ``c`` of ``states`` (``K.N_STATE``), ``flags`` (``K.N_FLAGS``), ``params``
-    (``K.N_PARAMS``) and ``models`` (``K.M_*``: the controller's blocks, the spring law) is case ``c``;
+    (``K.N_PARAMS``) and ``models`` (``K.M_*``: the controller's blocks, the spring law) is
+    case ``c``;
     the excitation ``ex, table`` is shared. A sample of case
     ``c`` goes to ``out[column, lane0 + c, row]`` for each channel of ``columns`` (``K.C_*``;
     the other channels are not computed, but the energies only if asked) and to

@@ -45,7 +45,8 @@ def parameter_metadata(isolator, controller, excitation):
     """Every parameter of a run with its unit: ``{key: (value, unit)}``.
 
     Keys are ``isolator.<name>`` (a spring law's ``isolator.spring.law`` and its fields,
-    :meth:`~qzs.model.springs.SpringLaw.parameters`), ``controller.<name>``, ``excitation`` (the class
+    :meth:`~qzs.model.springs.SpringLaw.parameters`), ``controller.<name>``, ``excitation``
+    (the class
     name, no unit) and ``excitation.<field>``; units come from the parameter
     registry and the excitation's field metadata. ``None`` values are kept,
     booleans become 0/1; a displacement record's arrays are data, not metadata.

@@ -17,7 +17,8 @@ from qzs.model.isolator import InitialState, IsolatorParameters
 from qzs.model.springs import TABLE_COUNT, TABLE_POSITIONS, TanhSpring, check_equilibrium
 from qzs.model.registry import model_inputs
 
-__all__ = ["PreparedRun", "prepare_run", "pack_model", "stack_models", "check_spring", "linear_initial_state", "linear_output",
+__all__ = ["PreparedRun", "prepare_run", "pack_model", "stack_models", "check_spring",
+           "linear_initial_state", "linear_output",
            "run_inputs", "run_duration", "steps_per_sample",
            "divides",
            "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
