@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs.engine import kernels as K
-from qzs.engine.prepare import prepare_run
+from qzs.engine.prepare import prepare_run, refuse_spring_law
 from qzs.errors import ParameterError
 from qzs.export.csource import load_model
 
@@ -91,6 +91,7 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
         out_flags = np.zeros((samples, 2), dtype=np.uint8)
     _check_buffer("out", out, (samples, K.N_CHANNELS), np.float64)
     _check_buffer("out_flags", out_flags, (samples, 2), np.uint8)
+    refuse_spring_law(run.isolator, "the C model")
     library = load_model(native)
     state = np.array(run.state, dtype=np.float64)
     flags = np.array(run.flags, dtype=np.int64)

@@ -23,7 +23,7 @@ from pathlib import Path
 from qzs import defaults
 from qzs._optional import require
 from qzs.engine import kernels as K
-from qzs.engine.prepare import prepare_run
+from qzs.engine.prepare import prepare_run, refuse_spring_law
 from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
 from qzs.errors import (ControllerRateError, ParameterError, StabilityError,
@@ -287,6 +287,7 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
         dt = resolved.dt
         # every check qzs.simulate makes, at an output every step: any communication step
         run = prepare_run(**{**resolved.arguments(), "sample_rate": 1.0 / dt})
+        refuse_spring_law(run.isolator, "the FMU")
     except ParameterError as error:
         raise _named(error) from None
     headers = fmi_headers(fmi_version)

@@ -20,6 +20,7 @@ from qzs.engine.hexapod.layout import (
     V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
     V_TX, V_TY, V_TZ, V_YDD, V_ZHIGH, V_ZLOW, V_ZREF)
 from qzs.engine.prepare import (check_record, linear_initial_state, linear_output, pack_model,
+                                refuse_spring_law,
                                 steps_per_sample)
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError
@@ -28,7 +29,6 @@ from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Si
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
 from qzs.model.isolator import IsolatorParameters, spring_force
-from qzs.model.springs import TanhSpring
 
 __all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks"]
 
@@ -264,12 +264,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if not isinstance(progress, (bool, np.bool_)):
         raise ParameterError(f"`progress` must be True or False, got {progress!r}.")
     for leg, (iso, con) in enumerate(zip(isolators, controllers)):
-        if iso.spring is not None and not isinstance(iso.spring, TanhSpring):
-            raise ParameterError(
-                f"leg {leg + 1}: `spring` ({iso.spring.describe()}) is not supported by the "
-                "hexapod yet: its legs evaluate the MagSpring's tanh of `spring_force` and "
-                "`spring_shape` only (docs/model.md §3.1); give the legs spring=None or a "
-                "TanhSpring, or simulate one axis with this law (qzs.simulate).", ("spring",))
+        refuse_spring_law(iso, "the hexapod", f"leg {leg + 1}: ")
         if iso.stop_model != "compliant":
             raise ParameterError(
                 f"leg {leg + 1}: `stop_model` {iso.stop_model!r} is not supported by the hexapod "
