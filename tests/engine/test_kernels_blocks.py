@@ -210,7 +210,6 @@ def test_the_summary_names_the_blocks_and_their_cost():
         "motor force")[1]  # PI + damping alone: as before
 
 
-<<<<<<< HEAD
 @pytest.mark.parametrize("controller_rate", [0.0, 500.0])
 def test_a_discrete_controller_reads_the_acceleration_before_any_sample_changes_it(
         controller_rate):
@@ -232,7 +231,8 @@ def test_a_discrete_controller_reads_the_acceleration_before_any_sample_changes_
     # the same acceleration, evaluated once by the sample and once by the recorder
     np.testing.assert_allclose(run["linear_force"][1:], expected, rtol=0,
                                atol=1e-12 * np.ptp(expected))
-=======
+
+
 #: A payload held by a stiction no motor force breaks (stuck all run), 5 mm above the setpoint:
 #: the position error is a constant, and a linear controller on it runs alone.
 HELD_PLANT = IsolatorParameters(stiction_force=200.0, coulomb_force=100.0)
@@ -270,4 +270,3 @@ def test_a_saturated_linear_controller_settles_where_back_calculation_puts_it():
     assert run["linear_force"][0] == pytest.approx(unsaturated, rel=1e-9)
     assert run["linear_force"][-1] == pytest.approx(settled, rel=1e-5)
     assert np.all(run["motor_force"][1:] == -HELD_PLANT.motor_force_max)
->>>>>>> mut40

@@ -101,7 +101,6 @@ def test_a_controller_file_holds_the_controller_alone(tmp_path):
     assert load_config(path)["isolator"].mass == 7.0  # it is a config file
 
 
-<<<<<<< HEAD
 @pytest.mark.parametrize("table, match", [
     ({"dither": {"amplitude": -1.0}}, r"\[legs\.2\.controller\.dither\] amplitude in 'h\.toml'"),
     ({"linear": {"num": [1.0]}}, r"'h\.toml': \[legs\.2\.controller\.linear\] must give its "
@@ -126,7 +125,8 @@ def test_a_controller_table_starts_from_the_controller_given():
     every = qzs.PIDamping(pi_kp=80.0) + qzs.Dither(amplitude=2.0, frequency=30.0)
     own = controller_from_table({"dither": {"frequency": 45.0}}, controller=every)
     assert own == qzs.PIDamping(pi_kp=80.0) + qzs.Dither(amplitude=2.0, frequency=45.0)
-=======
+
+
 def test_a_transfer_function_without_inputs_reads_what_the_api_reads_by_default(tmp_path):
     # the file and LinearController.from_transfer_function agree: the charge amplifier's
     # velocity when no sensor is named
@@ -135,4 +135,3 @@ def test_a_transfer_function_without_inputs_reads_what_the_api_reads_by_default(
     expected = qzs.LinearController.from_transfer_function([-20.0], [1.0, 100.0])
     assert load_controller(path).linear.inputs == expected.inputs == (
         "measured_payload_velocity",)
->>>>>>> mut40
