@@ -68,3 +68,6 @@ def test_the_block_costs_are_the_recorded_block_channels_and_the_dithers_frequen
     blocks, frequency = block_costs(PIDamping(compensation=FrictionCompensation(fraction=0.5)))
     assert frequency is None and "compensation_force" in blocks
     assert "friction_estimate" not in blocks  # no observer: no estimate recorded
+    observed = PIDamping(compensation=FrictionCompensation(fraction=0.5,
+                                                           observer_bandwidth=5.0))
+    assert {"compensation_force", "friction_estimate"} <= set(block_costs(observed)[0])
