@@ -191,7 +191,10 @@ def _compensation(v, direction, v_reg, M):
                             M[M_COMP_CBC], M[M_COMP_CV], v_reg, M[M_COMP_DEADBAND])
 
 
-@njit(**_JIT, inline="always")
+# The blocks' functions are compiled once and called, not inlined into every caller of
+# :func:`rhs` (eight entry points inline it): a run without blocks never calls them, and
+# inlined they made its first compile 116 s of CPU instead of 47 (22 before blocks existed).
+@njit(**_JIT)
 def block_forces(t, error, x, v, direction, ydd, v_measured, held, sampled, v_reg, M):
     """The forces of the controller's blocks beyond PI + damping [N] (docs/model.md §5).
 
@@ -224,7 +227,7 @@ def block_forces(t, error, x, v, direction, ydd, v_measured, held, sampled, v_re
     return f_comp, f_dither, f_linear, feedforward
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def block_rates(x, sensors, f_friction, f_stop, feedforward, excess, sampled, M):
     """The rates of the blocks' state ``x`` (``X_*``) of one leg (docs/model.md §5).
 
@@ -244,7 +247,7 @@ def block_rates(x, sensors, f_friction, f_stop, feedforward, excess, sampled, M)
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, observer)
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def sample_blocks(t, x, v, direction, held, f_friction, f_stop, f_pi, f_damp, f_linear, error,
                   ki, f_max, steps, dt, v_reg, M):
     """One leg's sampled blocks at a sample of the PI (docs/model.md §5).
@@ -274,7 +277,7 @@ def sample_blocks(t, x, v, direction, held, f_friction, f_stop, f_pi, f_damp, f_
     return f_comp, f_dither, f_motor, rate, x
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def linear_sample(M, x, sensors, others, error, ki, f_max):
     """A discrete linear controller's sample: ``(output, next x)`` (docs/model.md §5).
 
