@@ -796,21 +796,16 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
 
 
 @njit(**_JIT)
-def sample_linear(t, s, x, mode, direction, held, sensed, resampled, P, M, E, table):
+def sample_linear(t, s, x, mode, direction, held, P, M, E, table):
     """A discrete linear controller's sample at ``t``: returns ``(held, x)``.
 
-    It reads its sensors with ``sensed``, the outputs held until ``t`` (the payload's
-    acceleration before any sample at ``t`` changes the force: a controller reads every
-    sensor before it writes an output), outputs ``y = C x + D u``, held to its next sample,
-    and steps its state ``x <- A x + B u + L (F_motor - command)`` (back-calculation,
-    docs/model.md §5.1) with the other blocks' commands from now (``held``; they differ
-    from ``sensed`` when the PI sampled at ``t`` too: ``resampled``).
+    It reads its sensors (the payload's acceleration with the force held until now),
+    outputs ``y = C x + D u``, held to its next sample, and steps its state
+    ``x <- A x + B u + L (F_motor - command)`` (back-calculation, docs/model.md §5).
     """
-    force = rhs_at(t, s, x, mode, float(direction), sensed, P, M, E, table)[1]
+    force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     u = (P[P_ZREF] - s[S_Z], force[F_V_MEASURED], force[F_XDD], force[F_YDD], v)
-    if resampled:
-        force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     output, x = linear_sample(
         M, x, u, force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER],
         P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])
