@@ -27,6 +27,7 @@ piece and Horner's rule: force ``c0 + t(c1 + t(c2 + t c3))``, energy
 """
 import dataclasses
 import math
+import os
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -516,7 +517,8 @@ class TabulatedSpring(SpringLaw):
         return cls(positions=x, forces=law.force(x), outside=outside)
 
     @classmethod
-    def read_csv(cls, path, *, position_unit: str | None = None, force_unit: str | None = None,
+    def read_csv(cls, path: "str | os.PathLike[str]", *, position_unit: str | None = None,
+                 force_unit: str | None = None,
                  outside: str = "refuse", position_column: str = "position",
                  force_column: str = "force") -> "TabulatedSpring":
         """A measured force curve from a CSV file with a header (see ``read_force_curve``).
@@ -545,7 +547,7 @@ class TabulatedSpring(SpringLaw):
         return cls(positions=positions, forces=forces, outside=outside)
 
     @property
-    def domain(self):
+    def domain(self) -> tuple[float, float]:
         """Positions [m] where the law is defined: the table's, or all if it extends."""
         if self.outside == "extend":
             return (-math.inf, math.inf)
