@@ -34,8 +34,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
-                             validate_fields)
+from qzs._validation import (choice, known_keys, non_negative_real, parameter, positive_real,
+                             real, validate_fields)
 from qzs.errors import ParameterError
 from qzs.model.spring_table import hermite_pieces, pchip_slopes, piece_energies, read_force_curve
 
@@ -164,11 +164,8 @@ class SpringLaw:
         else:
             choice("law", kind, (cls.kind,), fix=f"use SpringLaw.from_dict for a {kind!r} law")
             target = cls
-        allowed = [f.name for f in dataclasses.fields(target)]
-        unknown = sorted(set(fields) - set(allowed))
-        if unknown:
-            raise ParameterError(f"unknown key(s) {unknown} for a {target.kind!r} spring law; "
-                                 f"allowed are {['law', *allowed]}.", ("data",))
+        known_keys(fields, ["law", *(f.name for f in dataclasses.fields(target))],
+                   f"a {target.kind!r} spring law", options=("data",))
         return target(**fields)
 
     def _force(self, z):
