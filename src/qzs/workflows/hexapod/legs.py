@@ -89,6 +89,7 @@ def _checked_legs(legs):
                                  f"{type(controller).__name__}.", (f"legs[{number}]",))
     return {int(number): controller for number, controller in legs.items()}
 
+
 def _file_legs(table, every, path):
     """The ``[legs.N]`` tables: leg number -> its own controller, from ``every``."""
     where = f"{str(path)!r}: "
