@@ -372,15 +372,16 @@ def strictly_increasing(name, time, error, fix="sort it and drop duplicates firs
                     f"{int(np.count_nonzero(steps <= 0))} such steps); {fix}.")
 
 
-def known_keys(table, allowed, where, prefix=""):
+def known_keys(table, allowed, where, prefix="", options=()):
     """Return ``table`` if it is a dict whose keys are all in ``allowed``, else raise.
 
-    ``where`` names the table in the message (e.g. ``[analysis]``); ``prefix`` the file.
+    ``where`` names the table in the message (e.g. ``[analysis]``); ``prefix`` the file;
+    ``options`` the arguments the error is about (:attr:`ParameterError.options`).
     """
     if not isinstance(table, dict):
-        raise ParameterError(f"{prefix}{where} must be a table, got {table!r}.")
+        raise ParameterError(f"{prefix}{where} must be a table, got {table!r}.", options)
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         raise ParameterError(f"{prefix}unknown key(s) {unknown} in {where}; allowed are "
-                             f"{sorted(allowed)}.")
+                             f"{sorted(allowed)}.", options)
     return table

@@ -147,3 +147,30 @@ def test_a_runs_summary_residual_is_its_signed_ledger():
                                                                      rel=1e-9)
     # a wrong sign on any term would leave joules; truncation leaves 1e-4 J of 257 J
     assert np.abs(signed).max() < 1e-6 * result.statistics["base_work_max"]
+
+
+def test_the_dithers_acceleration_is_the_amplitude_of_its_first_harmonic_block_by_block():
+    """Over whole dither periods, a payload acceleration ``3 sin(w t + 0.4)`` plus a 4 m/s^2
+    component ``4 cos(w t)`` and a harmonic at ``2 w`` that the coefficient rejects has the
+    amplitude ``hypot(3, 4) = 5`` m/s^2 at the dither's frequency, fed whole or in uneven
+    blocks; a block force ``F0 sin(w t)`` has the RMS ``F0 / sqrt(2)``."""
+    from qzs.analysis.statistics import BlockStatistics
+
+    frequency, n = 40.0, 4000
+    w = 2 * np.pi * frequency
+    t = np.arange(n) / (n / 0.25)  # 0.25 s: ten whole dither periods
+    acceleration = np.array([3 * np.sin(w * t + 0.4) + 2 * np.sin(2 * w * t),
+                             4 * np.cos(w * t)])
+    force = 1.5 * np.sin(w * t)
+    expected = {"dither_force_rms": 1.5 / np.sqrt(2), "dither_payload_acceleration": 5.0}
+    for cuts in ((n,), (1000, 2999, n)):
+        stats = BlockStatistics([("dither_force",)], [frequency])
+        start = 0
+        for end in cuts:
+            stats.add(t[start:end], {"dither_force": force[None, start:end]},
+                      acceleration[:, start:end])
+            start = end
+        result = stats.result()
+        assert set(result) == set(expected), cuts
+        for name, value in expected.items():
+            assert result[name] == pytest.approx(value, rel=1e-9, abs=1e-12), (cuts, name)

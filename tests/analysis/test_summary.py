@@ -71,3 +71,20 @@ def test_the_summary_of_a_cut_run_is_headed_by_the_part_that_ran():
     text = summary_text(simulate(Sine(frequency=3.0, amplitude=0.002), duration=2.0,
                                  dt=1e-3, sample_rate=100.0))
     assert text.splitlines()[0].startswith("qzs simulation  Sine 3 Hz: 2 s run, ode3 dt = ")
+
+
+def test_each_block_line_reports_its_own_cost():
+    """Each block's RMS force stands by its own name, and the dither's cost line gives the
+    payload's acceleration at the dither's frequency and the motor's whole RMS (not a block's)."""
+    from qzs import Dither, FrictionCompensation, PIDamping
+    from qzs.analysis.summary import block_lines
+
+    controller = PIDamping(compensation=FrictionCompensation(fraction=0.5),
+                           dither=Dither(amplitude=3.0, frequency=40.0))
+    stats = {"compensation_force_rms": 1.25, "dither_force_rms": 2.5,
+             "dither_payload_acceleration": 0.75, "motor_force_rms": 7.5}
+    lines = block_lines(controller, stats)
+    forces = next(line for line in lines if "block forces" in line)
+    assert "compensation RMS 1.25 N" in forces and "dither RMS 2.5 N" in forces
+    cost = next(line for line in lines if "dither cost" in line)
+    assert "0.75 m/s^2 at 40 Hz" in cost and "motor RMS 7.5 N in all" in cost

@@ -59,17 +59,36 @@ def context(server):
         yield context
 
 
+#: Bound [s] on a new page's first draw: the server compiled every kernel the page reaches
+#: before it listened (qzs.app.server.warm_up), so a draw takes seconds even when loaded.
+DRAW = 120.0
+
+
 def open_page(context, server, server_log):
-    """A new page, or a failure that shows what the server printed meanwhile."""
+    """A new page, or a failure that shows what the server printed meanwhile.
+
+    A page that has not drawn within :data:`DRAW` is closed and opened once more, saying so
+    on the test's output: twice lately (CI, and a fresh clone's suite), a new
+    page never drew while the server sat idle after its warm-up (no request pending, nothing
+    compiling), and the cause is not found yet (CHANGELOG, issue 40's notes). A second page
+    that does not draw either fails the test with the server's output.
+    """
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-    try:
-        return browser.open_page(context, server, timeout=COLD)
-    except PlaywrightTimeout:
-        server_log.flush()
-        server_log.seek(0)
-        pytest.fail(f"the page did not draw within {COLD:g} s; the server printed:\n"
-                    f"{server_log.read()[-4000:]}")
+    for attempt in (1, 2):
+        try:
+            return browser.open_page(context, server, timeout=DRAW)
+        except PlaywrightTimeout:
+            server_log.flush()
+            server_log.seek(0)
+            printed = server_log.read()[-4000:]
+            for stale in context.pages[-1:]:
+                stale.close()
+            if attempt == 2:
+                pytest.fail(f"the page did not draw within {DRAW:g} s, twice; the server "
+                            f"printed:\n{printed}")
+            print(f"\na new page did not draw within {DRAW:g} s; opening it again. The "
+                  f"server printed:\n{printed}")
 
 
 @pytest.fixture

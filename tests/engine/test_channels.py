@@ -53,3 +53,21 @@ def test_the_friction_estimate_is_a_channel_only_with_an_observer():
     assert "compensation_force" in without and "friction_estimate" not in without
     observed = run_channels(PIDamping() + FrictionCompensation(observer_bandwidth=5.0))
     assert "friction_estimate" in observed
+
+
+def test_the_block_costs_are_the_recorded_block_channels_and_the_dithers_frequency():
+    """block_costs gives what BlockStatistics takes: the block channels the run records and
+    the dither's frequency [Hz] (not its amplitude), None without a dither."""
+    from qzs import Dither, FrictionCompensation, PIDamping
+    from qzs.engine.channels import BLOCK_CHANNELS, block_costs
+
+    dithered = PIDamping(dither=Dither(amplitude=3.0, frequency=40.0))
+    blocks, frequency = block_costs(dithered)
+    assert frequency == 40.0
+    assert "dither_force" in blocks and set(blocks) <= set(BLOCK_CHANNELS)
+    blocks, frequency = block_costs(PIDamping(compensation=FrictionCompensation(fraction=0.5)))
+    assert frequency is None and "compensation_force" in blocks
+    assert "friction_estimate" not in blocks  # no observer: no estimate recorded
+    observed = PIDamping(compensation=FrictionCompensation(fraction=0.5,
+                                                           observer_bandwidth=5.0))
+    assert {"compensation_force", "friction_estimate"} <= set(block_costs(observed)[0])

@@ -129,3 +129,27 @@ def test_without_blocks_both_steps_are_exported_and_agree(tmp_path):
     declaration = f"QzsControllerParameters {exported.PARAMETERS_NAME} ="
     assert declaration in exported.controller_source(SAMPLED)  # with blocks the PI-alone set
     assert declaration not in exported.controller_source(EVERY_BLOCK)  # is not written
+
+
+def test_the_c_files_labels_name_the_entries_they_stand_by():
+    """The exported C file labels each packed entry: the value beside ``A[i][j]``,
+    ``B[i][sensor]``, ``C[i]``, ``D[sensor]`` is that entry of the controller's matrices (0-based,
+    a sensor by its name), so that a reader of the file edits the entry they mean."""
+    from qzs.model.sensors import SENSORS
+
+    values = {}
+    for line in exported.controller_source(EVERY_BLOCK, dt=1e-4).splitlines():
+        value, _, label = line.strip().partition(",  /* ")
+        if label.endswith(" */"):
+            values.setdefault(label[:-3], float(value))
+    a, b, c, d = (np.atleast_2d(m) for m in (LINEAR.a, LINEAR.b, LINEAR.c, LINEAR.d))
+    for k, sensor in enumerate(LINEAR.inputs):
+        assert values[f"D[{sensor}]"] == d[0, k], sensor
+        for i in range(2):
+            assert values[f"B[{i}][{sensor}]"] == b[i, k], (i, sensor)
+    unread = set(SENSORS) - set(LINEAR.inputs)
+    assert all(values[f"D[{sensor}]"] == 0.0 for sensor in unread)
+    for i in range(2):
+        assert values[f"C[{i}]"] == c[0, i]
+        for j in range(2):
+            assert values[f"A[{i}][{j}]"] == a[i, j]

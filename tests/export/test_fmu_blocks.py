@@ -133,3 +133,29 @@ def test_the_bounds_of_the_block_parameters_are_those_of_qzs(fmu_of):
     with pytest.raises(Exception, match="ExitInitializationMode failed"):
         _run(fmu_of("discrete controller", 3), "discrete controller",
              **{"controller.linear.sample_time": 0.0})
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_the_pi_preload_counts_a_linear_feedthrough_as_qzs_simulate_does(tmp_path, version):
+    """A base already moving at t = 0 (no fade-in: y' = 2 pi f A) and the lead-lag with a
+    feedthrough D on the measured velocity, set as an FMU start value: the PI's preload counts
+    the linear output the preload sees (D times the measured velocity with the base at rest,
+    not 0) as qzs.simulate's does, so every channel is the run's to the bit. The exported
+    lead-lag has D = 0 and the faded-in cases a base at rest: there that term is 0 and a preload
+    that left it out would pass (docs/model.md §5.1, initial state)."""
+    name = "continuous lead-lag"
+    _, isolator, controller, _ = CASES[name]
+    moving = qzs.Sine(amplitude=0.01, frequency=3.0, fade_in=0.0)
+    kwargs = settings(name)
+    path = export.export_fmu(tmp_path / "moving.fmu", moving, isolator, controller,
+                             fmi_version=version, dt=kwargs["dt"], duration=kwargs["duration"],
+                             communication_step=1.0 / kwargs["sample_rate"])
+    d = -40.0  # [N*s/m]
+    changed = dataclasses.replace(controller, linear=dataclasses.replace(controller.linear,
+                                                                        d=[[d]]))
+    reference = qzs.simulate(moving, isolator, changed, **kwargs)
+    without = qzs.simulate(moving, isolator, controller, **{**kwargs, "duration": 0.01})
+    # the preload's linear term is not 0 here: the PI starts elsewhere than without D
+    assert reference["pi_force"][0] != without["pi_force"][0]
+    result = _run(path, name, **{"controller.linear.d_measured_payload_velocity": d})
+    _assert_same(result, reference, "feedthrough on a moving base")

@@ -151,3 +151,34 @@ def test_the_header_carries_the_exported_step_and_how_it_was_chosen():
     header = variables_header(variables, mode="closed-loop", base_motion="internal",
                               token="{x}", step=chosen)
     assert "#define QZS_FMU_STEP_CHOSEN 1\n" in header and chosen.line() in header
+
+
+def test_a_linear_controllers_parameters_are_its_matrices_by_name_with_their_units():
+    """A 2-state controller on all five sensors, A not symmetric: each ``linear.a[i,j]``,
+    ``b_<sensor>[i]``, ``c[i]``, ``d_<sensor>`` starts at that entry of the matrices (1-based,
+    row then column), and a feedthrough's unit is the force [N] per its sensor's unit."""
+    from qzs.engine.prepare import pack_model
+    from qzs.model.sensors import SENSORS
+
+    a = np.array([[-3.0, 5.0], [-7.0, -11.0]])
+    b = np.arange(1.0, 11.0).reshape(2, 5)
+    c, d = np.array([13.0, 17.0]), np.array([[19.0, 23.0, 0.0, 29.0, 31.0]])
+    linear = qzs.LinearController(a=a, b=b, c=c, d=d, inputs=tuple(SENSORS))
+    isolator, controller = qzs.IsolatorParameters(), qzs.PIDamping(linear=linear)
+    rows = {v.name: v for v in fmu_variables(
+        isolator=isolator, controller=controller, excitation_scalars=EXCITATION, dt=2e-4,
+        solver_code=K.SOLVER_RK4, mode="closed-loop", base_motion="internal",
+        model=pack_model(isolator, controller, 2e-4), blocks_state=np.zeros(K.N_X))}
+    for i in range(2):
+        assert float(rows[f"controller.linear.c[{i + 1}]"].start) == c[i]
+        for j in range(2):
+            assert float(rows[f"controller.linear.a[{i + 1},{j + 1}]"].start) == a[i, j]
+        for k, sensor in enumerate(SENSORS):
+            assert float(rows[f"controller.linear.b_{sensor}[{i + 1}]"].start) == b[i, k]
+    for k, (sensor, (unit, _)) in enumerate(SENSORS.items()):
+        row = rows[f"controller.linear.d_{sensor}"]
+        assert float(row.start) == d[0, k], sensor
+        per = {base: UNITS["N"].get(base, 0) - UNITS[unit].get(base, 0)
+               for base in set(UNITS["N"]) | set(UNITS[unit])}
+        assert {k: v for k, v in UNITS[row.unit].items() if v} == \
+            {k: v for k, v in per.items() if v}, sensor

@@ -79,6 +79,9 @@ LINEAR = "[controller.linear]\n"
      "[controller.compensation] fraction", "1.6", "up to 1.5 over-compensates"),
     ("[controller.compensation]\nfractio = 1.0\n", "[controller.compensation]", "fractio",
      "allowed are"),
+    (LINEAR + 'num = [1.0]\nden = [1.0, 5.0]\ninputs = ["position_error", '
+     '"relative_velocity"]\n', "[controller.linear] inputs",
+     "['position_error', 'relative_velocity']", "name one sensor"),
     (LINEAR + 'num = [1.0]\nden = [1.0, 5.0]\na = [[1.0]]\n', "[controller.linear]",
      "'a', 'den', 'num'", "either as matrices"),
 ])

@@ -37,6 +37,10 @@ def test_each_sensor_is_the_quantity_it_names(sensor):
 
 def test_the_sensors_have_units_and_a_controller_its_state_bound():
     assert all(unit in ("m", "m/s", "m/s^2") for unit, _ in SENSORS.values())
+    # each its quantity's unit: a position error in m, a velocity in m/s, an acceleration in m/s^2
+    quantity = {"error": "m", "velocity": "m/s", "acceleration": "m/s^2"}
+    assert {name: unit for name, (unit, _) in SENSORS.items()} == \
+        {name: quantity[name.rsplit("_", 1)[1]] for name in SENSORS}
     with pytest.raises(ValueError, match="states"):
         LinearController(a=np.eye(MAX_STATES + 1), b=np.ones((MAX_STATES + 1, 1)),
                          c=np.ones((1, MAX_STATES + 1)), d=[[0.0]])

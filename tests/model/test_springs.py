@@ -273,7 +273,7 @@ def test_a_law_goes_to_a_dict_and_back(name):
 
 @pytest.mark.parametrize("data, match", [
     ({"law": "magnet"}, r"`law` must be one of 'tanh', 'oblique', 'polynomial', 'table'"),
-    ({"law": "tanh", "force": 3.0}, r"unknown key\(s\) \['force'\] for a 'tanh' spring law"),
+    ({"law": "tanh", "force": 3.0}, r"unknown key\(s\) \['force'\] in a 'tanh' spring law"),
     ([1, 2], "`data` must be a dict"),
 ])
 def test_bad_law_data_is_refused(data, match):

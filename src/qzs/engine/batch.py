@@ -26,7 +26,7 @@ from qzs.engine import kernels as K
 from qzs.engine import lanes as _lanes
 from qzs.engine.prepare import divergence_message, prepare_run, stack_models
 from qzs.engine.channels import (BLOCK_CHANNELS, FLAGS, run_channels, sample_bytes,
-                                 simulation_schema)
+                                 simulation_schema, unrecorded)
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
@@ -309,11 +309,9 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
 
 def _check_block_channels(channels, controllers):
     """Refuse a block's channel (``compensation_force``, ...) that a case has no block for."""
+    missing = [unrecorded(channels, controller) for controller in controllers]
     for name in channels:
-        if name not in BLOCK_CHANNELS:
-            continue
-        lacking = [index for index, controller in enumerate(controllers)
-                   if name not in run_channels(controller)]
+        lacking = [index for index, names in enumerate(missing) if name in names]
         if lacking:
             block = BLOCK_CHANNELS[name][3]
             what = ("a friction compensation with an observer (`observer_bandwidth` > 0)"

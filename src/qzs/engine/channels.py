@@ -11,7 +11,7 @@ from __future__ import annotations
 from qzs.engine import kernels as K
 from qzs.iotools.schema import Schema, Variable, time_coordinate
 
-__all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels",
+__all__ = ["CHANNELS", "BLOCK_CHANNELS", "FLAGS", "FLAG_MEANINGS", "run_channels", "unrecorded",
            "channel_count", "summary_statistics", "block_costs", "simulation_schema", "variable_attributes",
            "named_block", "sample_bytes"]
 
@@ -93,6 +93,25 @@ def run_channels(controller=None, *, every_block=False):
     extra = {name: (column, unit, doc) for name, (column, unit, doc, block)
              in BLOCK_CHANNELS.items() if every_block or _has(controller, block)}
     return {**CHANNELS, **extra}
+
+
+def unrecorded(names, controller):
+    """The blocks' channels among ``names`` that a run with ``controller`` does not record.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Channel (or flag) names asked for.
+    controller : ControllerParameters
+        The run's controller.
+
+    Returns
+    -------
+    list of str
+        Those of :data:`BLOCK_CHANNELS` whose block the controller lacks, in order.
+    """
+    recorded = run_channels(controller)
+    return [name for name in names if name in BLOCK_CHANNELS and name not in recorded]
 
 
 def summary_statistics(controller, stop_center, motor_force_max):

@@ -219,7 +219,10 @@ def _compensation(v, direction, v_reg, M):
                             M[M_COMP_CBC], M[M_COMP_CV], v_reg, M[M_COMP_DEADBAND])
 
 
-@njit(**_JIT, inline="always")
+# The blocks' functions are compiled once and called, not inlined into every caller of
+# :func:`rhs` (eight entry points inline it): a run without blocks never calls them, and
+# inlined they made its first compile 116 s of CPU instead of 47 (22 before blocks existed).
+@njit(**_JIT)
 def block_forces(t, error, x, v, direction, ydd, v_measured, held, sampled, v_reg, M):
     """The forces of the controller's blocks beyond PI + damping [N] (docs/model.md §5).
 
@@ -252,7 +255,7 @@ def block_forces(t, error, x, v, direction, ydd, v_measured, held, sampled, v_re
     return f_comp, f_dither, f_linear, feedforward
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def block_rates(x, sensors, f_friction, f_stop, feedforward, excess, sampled, M):
     """The rates of the blocks' state ``x`` (``X_*``) of one leg (docs/model.md §5).
 
@@ -272,7 +275,7 @@ def block_rates(x, sensors, f_friction, f_stop, feedforward, excess, sampled, M)
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, observer)
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def sample_blocks(t, x, v, direction, held, f_friction, f_stop, f_pi, f_damp, f_linear, error,
                   ki, f_max, steps, dt, v_reg, M):
     """One leg's sampled blocks at a sample of the PI (docs/model.md §5).
@@ -302,7 +305,7 @@ def sample_blocks(t, x, v, direction, held, f_friction, f_stop, f_pi, f_damp, f_
     return f_comp, f_dither, f_motor, rate, x
 
 
-@njit(**_JIT, inline="always")
+@njit(**_JIT)
 def linear_sample(M, x, sensors, others, error, ki, f_max):
     """A discrete linear controller's sample: ``(output, next x)`` (docs/model.md §5).
 
@@ -831,21 +834,16 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
 
 
 @njit(**_JIT)
-def sample_linear(t, s, x, mode, direction, held, sensed, resampled, P, M, E, table):
+def sample_linear(t, s, x, mode, direction, held, P, M, E, table):
     """A discrete linear controller's sample at ``t``: returns ``(held, x)``.
 
-    It reads its sensors with ``sensed``, the outputs held until ``t`` (the payload's
-    acceleration before any sample at ``t`` changes the force: a controller reads every
-    sensor before it writes an output), outputs ``y = C x + D u``, held to its next sample,
-    and steps its state ``x <- A x + B u + L (F_motor - command)`` (back-calculation,
-    docs/model.md §5.1) with the other blocks' commands from now (``held``; they differ
-    from ``sensed`` when the PI sampled at ``t`` too: ``resampled``).
+    It reads its sensors (the payload's acceleration with the force held until now),
+    outputs ``y = C x + D u``, held to its next sample, and steps its state
+    ``x <- A x + B u + L (F_motor - command)`` (back-calculation, docs/model.md §5).
     """
-    force = rhs_at(t, s, x, mode, float(direction), sensed, P, M, E, table)[1]
+    force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     u = (P[P_ZREF] - s[S_Z], force[F_V_MEASURED], force[F_XDD], force[F_YDD], v)
-    if resampled:
-        force = rhs_at(t, s, x, mode, float(direction), held, P, M, E, table)[1]
     output, x = linear_sample(
         M, x, u, force[F_PI] + force[F_DAMP] + force[F_COMPENSATION] + force[F_DITHER],
         P[P_ZREF] - s[S_Z], P[P_KI], P[P_FMAX])

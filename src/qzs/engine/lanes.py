@@ -493,14 +493,12 @@ def run_lanes(solver, step0, n_steps, decimation, states, flags, params, models,
                     held = _held(L, c)
                     mode = int(L[_at(R_MODE, c)])
                     direction = int(L[_at(R_DIRECTION, c)])
-                    sensed = held  # what every sensor reads at t (docs/model.md §5.1)
                     if controller:
                         held, s, x = K.sample_controller(t, s, x, mode, direction, held,
                                                          _params(PP, c), models[c], E, table)
                     if linear:
-                        held, x = K.sample_linear(t, s, x, mode, direction, held, sensed,
-                                                  controller, _params(PP, c), models[c], E,
-                                                  table)
+                        held, x = K.sample_linear(t, s, x, mode, direction, held,
+                                                  _params(PP, c), models[c], E, table)
                     (L[_at(K.A_F_PI, c)], L[_at(K.A_F_DAMP, c)], L[_at(K.A_F_MOTOR, c)],
                      L[_at(K.A_F_COMPENSATION, c)], L[_at(K.A_F_DITHER, c)],
                      L[_at(K.A_F_LINEAR, c)]) = held
@@ -624,14 +622,12 @@ def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, tab
         t = step * h
         if control_steps > 0 or linear_steps > 0:
             controller, linear = _sample_times(step, control_steps, linear_steps)
-            sensed = held  # what every sensor reads at t: the outputs held until t
             if controller:
                 held, s, x = K.sample_controller(t, s, x, mode, direction, held, P, m, E,
                                                  table)
                 margin = np.nan
             if blocks and linear:
-                held, x = K.sample_linear(t, s, x, mode, direction, held, sensed, controller,
-                                          P, m, E, table)
+                held, x = K.sample_linear(t, s, x, mode, direction, held, P, m, E, table)
                 margin = np.nan
         s1, x1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
             solver, t, h, s, x, mode, direction, held, P, m, blocks, E, table, margin, phase,

@@ -27,14 +27,15 @@ piece and Horner's rule: force ``c0 + t(c1 + t(c2 + t c3))``, energy
 """
 import dataclasses
 import math
+import os
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import (choice, non_negative_real, parameter, positive_real, real,
-                             validate_fields)
+from qzs._validation import (choice, known_keys, non_negative_real, parameter, positive_real,
+                             real, validate_fields)
 from qzs.errors import ParameterError
 from qzs.model.spring_table import hermite_pieces, pchip_slopes, piece_energies, read_force_curve
 
@@ -180,11 +181,8 @@ class SpringLaw:
         else:
             choice("law", kind, (cls.kind,), fix=f"use SpringLaw.from_dict for a {kind!r} law")
             target = cls
-        allowed = [f.name for f in dataclasses.fields(target)]
-        unknown = sorted(set(fields) - set(allowed))
-        if unknown:
-            raise ParameterError(f"unknown key(s) {unknown} for a {target.kind!r} spring law; "
-                                 f"allowed are {['law', *allowed]}.", ("data",))
+        known_keys(fields, ["law", *(f.name for f in dataclasses.fields(target))],
+                   f"a {target.kind!r} spring law", options=("data",))
         return target(**fields)
 
     def _force(self, z):
@@ -533,7 +531,8 @@ class TabulatedSpring(SpringLaw):
         return cls(positions=x, forces=law.force(x), outside=outside)
 
     @classmethod
-    def read_csv(cls, path, *, position_unit: str | None = None, force_unit: str | None = None,
+    def read_csv(cls, path: "str | os.PathLike[str]", *, position_unit: str | None = None,
+                 force_unit: str | None = None,
                  outside: str = "refuse", position_column: str = "position",
                  force_column: str = "force") -> "TabulatedSpring":
         """A measured force curve from a CSV file with a header (see ``read_force_curve``).
@@ -562,7 +561,7 @@ class TabulatedSpring(SpringLaw):
         return cls(positions=positions, forces=forces, outside=outside)
 
     @property
-    def domain(self):
+    def domain(self) -> tuple[float, float]:
         """Positions [m] where the law is defined: the table's, or all if it extends."""
         if self.outside == "extend":
             return (-math.inf, math.inf)

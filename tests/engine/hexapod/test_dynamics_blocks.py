@@ -36,6 +36,10 @@ CONTROLLERS = {
     "sampled-pi-with-blocks": PIDamping(controller_rate=1000.0) + FrictionCompensation(
         fraction=0.8, observer_bandwidth=3.0) + Dither(amplitude=1.5, frequency=30.0),
     "discrete-linear": PIDamping() + lead_lag(sample_time=2e-3),
+    # sampled at the PI's instants: it reads the acceleration before the PI's new command
+    "discrete-accelerometer-with-sampled-pi": PIDamping(controller_rate=500.0) + LinearController(
+        a=[[0.5]], b=[[1e-3]], c=[-2.0], d=[-0.5], inputs=("payload_acceleration",),
+        sample_time=2e-3),
 }
 
 

@@ -76,3 +76,18 @@ def test_the_quick_study_runs_in_seconds_and_its_designs_keep_their_limits():
     paper = [r for r in result["rows"] if r["kind"] == "paper"]
     assert np.all(np.diff([r["band_rms_change_db"] for r in paper]) < 0)
     assert result["answer"].label in ("yes", "no")
+
+
+def test_the_peak_motor_force_of_a_slow_chirp_is_the_payloads_inertia():
+    """Far below the loop's corners the PI holds the payload on the base (T -> 1, the
+    integral takes the error to 0): the motor then carries the payload's inertia alone, and
+    the linear peak force at f is ``m * A * (2 pi f)^2`` for a chirp of displacement
+    amplitude A (the base's acceleration amplitude), within 1e-3 at 1 mHz."""
+    import qzs
+
+    isolator, controller = IsolatorParameters(), ControllerParameters()
+    chirp = qzs.Chirp(amplitude=0.002, f0=0.1, f1=10.0, duration=100.0)
+    for f in (1e-3, 5e-4):
+        inertia = isolator.mass * chirp.amplitude * (2 * np.pi * f) ** 2
+        assert dm._peak_force(isolator, controller, chirp, np.array([f])) == \
+            pytest.approx(inertia, rel=1e-3), f

@@ -567,29 +567,16 @@ def _linear_due(plat, step):
 
 
 @njit(**_JIT)
-def linear_sensors(plat, V, sensed):
-    """Each leg's sensors as an evaluation in ``V`` left them, into ``sensed`` (legs x 5, the
-    order of :data:`qzs.model.sensors.SENSORS`)."""
-    for i in range(LEG_COUNT):
-        sensed[i, 0] = V[V_ZREF + i] - V[V_Z + i]
-        sensed[i, 1] = V[V_VME + i]
-        sensed[i, 2] = V[V_XDD + i]
-        sensed[i, 3] = V[V_YDD + i]
-        sensed[i, 4] = _slip(V, i)
-
-
-@njit(**_JIT)
-def _sample_linear(step, plat, V, s, sensed):
+def _sample_linear(step, plat, V, s):
     """Each leg's discrete linear controller that samples at grid step ``step``
-    (:func:`qzs.engine.kernels.linear_sample`), from its sensors ``sensed`` (read with the
-    outputs held until then, :func:`linear_sensors`) and the other commands of an evaluation
-    at that instant in ``V``: its output held (``HLI``), its states stepped in ``s``."""
+    (:func:`qzs.engine.kernels.linear_sample`), from the sensors and the other commands of an
+    evaluation at that instant: its output held (``HLI``), its states stepped in ``s``."""
     for i in range(LEG_COUNT):
         M = _model(plat, i)
         steps = int(M[M_LINEAR_STEPS])
         if steps > 0 and step % steps == 0:
             error = V[V_ZREF + i] - V[V_Z + i]
-            sensors = (sensed[i, 0], sensed[i, 1], sensed[i, 2], sensed[i, 3], sensed[i, 4])
+            sensors = (error, V[V_VME + i], V[V_XDD + i], V[V_YDD + i], _slip(V, i))
             output, x = linear_sample(M, _leg_state(s, i), sensors,
                                       V[V_FPI + i] + V[V_FDA + i] + V[V_FCO + i] + V[V_FDI + i],
                                       error, V[V_KI + i], V[V_FMAX + i])

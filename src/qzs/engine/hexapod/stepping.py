@@ -16,7 +16,7 @@ from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.hexapod.dynamics import (_advance_phases, _commands, _cross, _evaluate,
                                          _inertia_times, _linear_due, _matvec, _rest_frame,
-                                         _sample, _sample_linear, linear_sensors)
+                                         _sample, _sample_linear)
 from qzs.engine.hexapod.layout import (
     B_K1, B_K2, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
     C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FCO, C_FDA, C_FDI, C_FFR, C_FLI,
@@ -414,24 +414,17 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
     row = row0
     step = counters[CT_STEP]
     control_steps = int(plat[PL_CONTROL_STEPS])
-    sensed = np.empty((LEG_COUNT, 5))
     for _ in range(n_steps):
         _advance_phases(step * h, step % PHASE_PERIOD == 0, plat, ex, ww)
         sampled = control_steps > 0 and step % control_steps == 0
-        linear = plat[PL_BLOCKS] != 0.0 and _linear_due(plat, step)
-        if linear:
-            # a leg's discrete linear controller reads its sensors with the outputs held
-            # until now, before the PI and its blocks sample (docs/model.md §5.1)
-            _evaluate(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KE],
-                      _FALSE)
-            linear_sensors(plat, V, sensed)
         if sampled:
             _sample(step * h, plat, ww, V, buf[B_S], h)
-        if linear:
-            if sampled:  # the other commands from now, for the anti-windup
-                _evaluate(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec,
-                          buf[B_KE], _FALSE)
-            _sample_linear(step, plat, V, buf[B_S], sensed)
+        if plat[PL_BLOCKS] != 0.0 and _linear_due(plat, step):
+            # a leg's discrete linear controller reads its sensors with the outputs the PI
+            # and its blocks hold from now (they sample first, docs/model.md §5.1)
+            _evaluate(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KE],
+                      _FALSE)
+            _sample_linear(step, plat, V, buf[B_S])
             sampled = True
         if sampled:
             # a sample: the held outputs jump, so the modes are settled again (a locked leg

@@ -39,11 +39,6 @@ static int run_one(QzsRun *run, double t, double h, QzsPhase phase, int at_grid_
                    int completes) {
     const QzsPlant *plant = &run->plant;
     const double *P = plant->P;
-    /* what every sensor reads at t: the outputs held until t (docs/model.md §5.1) */
-    double sensed[QZS_N_HELD];
-    for (int k = 0; k < QZS_N_HELD; k++)
-        sensed[k] = run->held[k];
-    int resampled = at_grid_point && run->sampled && run->step % run->control_steps == 0;
     if (at_grid_point && run->sampled && run->step % run->control_steps == 0 &&
         plant->blocks) {
         qzs_sample_blocks(plant, t, &run->s, &run->x, run->mode, run->direction, run->held);
@@ -61,8 +56,7 @@ static int run_one(QzsRun *run, double t, double h, QzsPhase phase, int at_grid_
         run->margin = NAN;
     }
     if (at_grid_point && run->linear_steps > 0 && run->step % run->linear_steps == 0) {
-        qzs_sample_linear(plant, t, &run->s, &run->x, run->mode, run->direction, run->held,
-                          sensed, resampled);
+        qzs_sample_linear(plant, t, &run->s, &run->x, run->mode, run->direction, run->held);
         run->margin = NAN;
     }
     QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->x, run->mode,

@@ -749,21 +749,16 @@ void qzs_sample_blocks(const QzsPlant *plant, double t, QzsOde *s, QzsBlocks *x,
     held[QZS_H_DITHER] = out.dither;
 }
 
-/* kernels.sample_linear: the sensors read with `sensed`, the outputs held until t (the payload's
- * acceleration before any sample at t changes the force), then qzs_sample_linear_law
- * (qzs_controller.h) with the other blocks' commands from now (`held`; they differ where the PI
- * sampled at t too: `resampled`): the output C x + D u held, the states stepped
- * x <- A x + B u + L (F_motor - command) */
+/* kernels.sample_linear: the sensors read (the payload's acceleration with the force held until
+ * now), then qzs_sample_linear_law (qzs_controller.h): the output C x + D u held, the states
+ * stepped x <- A x + B u + L (F_motor - command) */
 void qzs_sample_linear(const QzsPlant *plant, double t, const QzsOde *s, QzsBlocks *x, int mode,
-                       int direction, double held[QZS_N_HELD], const double sensed[QZS_N_HELD],
-                       int resampled) {
+                       int direction, double held[QZS_N_HELD]) {
     QzsForces force;
-    rhs_at(plant, t, s, x, mode, (double)direction, sensed, 0, &force, 0);
+    rhs_at(plant, t, s, x, mode, (double)direction, held, 0, &force, 0);
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
     double u[QZS_N_SENSORS] = {plant->P[QZS_P_ZREF] - s->x[QZS_S_Z], force.v_measured, force.xdd,
                                force.ydd, v};
-    if (resampled)
-        rhs_at(plant, t, s, x, mode, (double)direction, held, 0, &force, 0);
     double motor;
     held[QZS_H_LINEAR] = qzs_sample_linear_law(
         &plant->control, plant->M, s->x[QZS_S_Z], u,

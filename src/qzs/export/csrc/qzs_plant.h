@@ -113,12 +113,10 @@ QzsStep qzs_grid_step(const QzsPlant *plant, int solver, double t, double h, Qzs
  * advanced. */
 void qzs_sample_blocks(const QzsPlant *plant, double t, QzsOde *s, QzsBlocks *x, int mode,
                        int direction, double held[QZS_N_HELD]);
-/* A discrete linear controller's sample at t (kernels.sample_linear): its sensors read with
- * `sensed` (the outputs held until t), its output held, its states stepped; `resampled`: the PI
- * sampled at t too (its new commands in `held`). */
+/* A discrete linear controller's sample at t (kernels.sample_linear): its output held, its
+ * states stepped. */
 void qzs_sample_linear(const QzsPlant *plant, double t, const QzsOde *s, QzsBlocks *x, int mode,
-                       int direction, double held[QZS_N_HELD], const double sensed[QZS_N_HELD],
-                       int resampled);
+                       int direction, double held[QZS_N_HELD]);
 /* The blocks' states are finite (lanes._finite_blocks). */
 int qzs_finite_blocks(const QzsBlocks *x);
 /* The measured quantities a sampled controller reads at t: z [m] and v_measured [m/s]. */

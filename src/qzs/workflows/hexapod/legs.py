@@ -46,7 +46,8 @@ def read_leg_controllers(pairs: Sequence[str], argument: str = "--leg-controller
     """
     from qzs.iotools.config import load_controller
 
-    files, given = {}, {}
+    files: dict[int, str] = {}
+    given: dict[int, object] = {}
     for pair in pairs:
         number, _, path = str(pair).partition("=")
         number = _leg_number(number, f"{argument} {pair!r}",
@@ -60,6 +61,7 @@ def read_leg_controllers(pairs: Sequence[str], argument: str = "--leg-controller
         files[number], given[number] = path.strip(), pair
     legs = {number: load_controller(path) for number, path in files.items()}
     return legs, {f"legs[{n}]": f"{argument} {given[n]}" for n in files}
+
 
 def _leg_number(text, where, fix):
     """A leg's number (1 to 6) from its key or text; a ParameterError naming ``where``."""
@@ -86,6 +88,7 @@ def _checked_legs(legs):
             raise ParameterError(f"`legs[{number}]` must be a ControllerParameters, got "
                                  f"{type(controller).__name__}.", (f"legs[{number}]",))
     return {int(number): controller for number, controller in legs.items()}
+
 
 def _file_legs(table, every, path):
     """The ``[legs.N]`` tables: leg number -> its own controller, from ``every``."""

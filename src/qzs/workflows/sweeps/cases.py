@@ -7,7 +7,7 @@ naming every one of them, before any runs.
 """
 import numpy as np
 
-from qzs.engine.channels import BLOCK_CHANNELS, run_channels
+from qzs.engine.channels import BLOCK_CHANNELS, unrecorded
 from qzs.errors import InvalidCasesError, ParameterError
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -165,8 +165,7 @@ def check_cases(definition, settings):
 
 def _check_block_channels(definition, isolator, controller):
     """Refuse a block's time series (``compensation_force``, ...) the case does not record."""
-    recorded = run_channels(controller)
-    missing = [name for name in definition.outputs["time_series"] if name not in recorded]
+    missing = unrecorded(definition.outputs["time_series"], controller)
     if missing:
         blocks = sorted({BLOCK_CHANNELS[name][3] for name in missing})
         raise ParameterError(
