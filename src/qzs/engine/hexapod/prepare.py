@@ -322,7 +322,8 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     models = []
     for leg, (iso, con) in enumerate(zip(isolators, controllers)):
         try:  # a discrete linear controller's period: a whole number of steps
-            models.append(pack_model(iso, con, dt))
+            # the blocks' columns (K.N_MODEL): plat holds each leg's blocks, its spring the tanh
+            models.append(pack_model(iso, con, dt)[:K.N_MODEL])
         except ParameterError as error:
             raise ParameterError(f"leg {leg + 1}: {error}", error.options) from None
     blocks = has_blocks(controllers)
