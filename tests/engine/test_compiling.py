@@ -171,6 +171,12 @@ def _timed_stderr(argv, env, timeout):
 
 
 @pytest.mark.slow
+#: The kernels only the general path calls (controller blocks, a spring law other than the
+#: tanh): a default run compiles none of them (qzs.engine.kernels.kernel_model).
+GENERAL_PATH = ("block_forces", "block_rates", "sample_blocks", "linear_sample",
+                "sample_linear", "_general_spring", "_general_spring_energy", "_saturated")
+
+
 def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path):
     """A cold ``qzs simulate``: the notice within seconds, then no silence over a few seconds.
 
@@ -187,6 +193,12 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     argv = [sys.executable, "-m", "qzs", "simulate", "--duration", "0.2", "--plot", "none"]
     chunks, stdout, _ = _timed_stderr(argv, env, timeout=900)
     assert b"qzs simulation" in stdout
+    # the default model compiled none of the general path's code (its functions would have
+    # cache files): no controller blocks, no spring law but the tanh of the parameters
+    compiled = {path.name.split("-")[0] for path in (tmp_path / "cache").rglob("*.nbi")}
+    assert "lanes.run_single" in compiled, compiled  # file names: module.function-line
+    general = {f"kernels.{name}" for name in GENERAL_PATH} | {"lanes.run_single_blocks"}
+    assert not compiled & general, sorted(compiled & general)
     text = b"".join(c for _, c in chunks).decode()
     assert "qzs: compiling the kernels once (about " in text
     first = chunks[0][0]

@@ -277,8 +277,8 @@ def simulate_batch(cases: Sequence[tuple[IsolatorParameters, ControllerParameter
     lanes = _Lanes(prepared, channels, workers, plan)
     sample, marks = np.empty(K.N_CHANNELS), np.zeros(2, dtype=np.bool_)
     for c in range(n):
-        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c], lanes.models[c], ex,
-                   table, sample, marks)
+        K.evaluate(0.0, lanes.states[c], lanes.flags[c], lanes.params[c],
+                   K.kernel_model(lanes.models[c]), ex, table, sample, marks)
         # only the channels kept or read by the statistics: a write to any other would
         # fault in (and zero) a page of the chunk buffer that nothing reads, huge pages of
         # 2 MB for numpy's large arrays (the whole 190 MB buffer for 24 channels)

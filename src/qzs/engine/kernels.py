@@ -142,12 +142,23 @@ def general(M):
     return M[M_BLOCKS] != 0.0 or M[M_SPRING] != TANH
 
 
+def kernel_model(model):
+    """The packed model row as the kernels take it: ``None`` on the default path (PI +
+    damping, the tanh of ``P``), the row itself on the general path (:func:`general`).
+
+    A kernel given ``None`` is compiled without the general path's code (numba prunes the
+    branches on ``M is None``): a first run of the default model compiles none of the
+    blocks' or the spring laws' code.
+    """
+    return model if model is not None and general(model) else None
+
+
 @njit(**_JIT, inline="always")
 def failure_status(M):
     """The status of a case that stopped on a non-finite state: :data:`STATUS_OUTSIDE`
     when its spring is a table that refuses positions outside it (its force is NaN there),
     else :data:`STATUS_DIVERGED`."""
-    if M[M_SPRING] == TABLE and M[M_SPRING + TABLE_OUTSIDE] == 0.0:
+    if M is not None and M[M_SPRING] == TABLE and M[M_SPRING + TABLE_OUTSIDE] == 0.0:
         return STATUS_OUTSIDE
     return STATUS_DIVERGED
 
@@ -320,6 +331,28 @@ def linear_sample(M, x, sensors, others, error, ki, f_max):
     return output, _linear_rates(M, x, sensors, f_motor - command, x[X_OBSERVER])
 
 
+# The general path's laws, called from the inlined right-hand side, not inlined into it:
+# numba's inliner copies an inlined function's callees into every caller before it prunes the
+# branches a constant ``blocks`` or a ``None`` model rules out, and these copies made a default
+# run's first compile about four times longer (benchmarks/compile_times.py).
+@njit(**_JIT)
+def _general_spring(M, z):
+    """The spring force of the law packed in ``M`` [N] (:func:`spring_general`)."""
+    return spring_general(M, M_SPRING, z)
+
+
+@njit(**_JIT)
+def _general_spring_energy(M, z):
+    """The spring energy of the law packed in ``M`` [J] (:func:`spring_energy_general`)."""
+    return spring_energy_general(M, M_SPRING, z)
+
+
+@njit(**_JIT)
+def _saturated(command, error, ki, f_max):
+    """:func:`qzs.engine.laws.saturation_law`: ``(motor force [N], integral rate [m])``."""
+    return saturation_law(command, error, ki, f_max)
+
+
 #: The blocks' rates of a controller without blocks (or of a sampled one): none.
 _NO_RATES = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -343,7 +376,7 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
     v = s[S_V] if mode == MODE_SLIP else 0.0
     xd = yd + v
     if blocks:
-        f_spring = spring_general(M, M_SPRING, z)
+        f_spring = _general_spring(M, z)
     else:
         f_spring = spring_law(P[P_SPRING_A], P[P_SPRING_B], z)
 
@@ -366,7 +399,7 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
             t, P[P_ZREF] - z, x, v, direction, ydd, v_measured, held, P[P_CONTROL_STEPS] > 0.0,
             P[P_VREG], M)
         command = f_pi + f_damp + f_comp + f_dither + f_linear
-        f_motor, rate = saturation_law(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
+        f_motor, rate = _saturated(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
         if P[P_CONTROL_STEPS] == 0.0:
             integral_rate = rate
 
@@ -404,6 +437,8 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
 def rhs_at(t, s, x, mode, direction, held, P, M, E, table):
     """:func:`rhs` at time ``t`` [s] (evaluates the base motion itself)."""
     y, yd, ydd = base_motion(t, E, table)
+    if M is None:  # pruned by type before inlining: one rhs compiled (kernel_model)
+        return rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, False)
     return rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, general(M))
 
 
@@ -511,8 +546,8 @@ def energies(y, yd, s, mode, P, M):
     pen = 0.0
     if P[P_PLASTIC] == 0.0:
         pen = max(P[P_Z_LOW] - z, 0.0) + max(z - P[P_Z_HIGH], 0.0)
-    if M[M_SPRING] != TANH:
-        spring = spring_energy_general(M, M_SPRING, z)
+    if M is not None and M[M_SPRING] != TANH:
+        spring = _general_spring_energy(M, z)
     else:
         spring = spring_energy_law(P[P_SPRING_A], P[P_SPRING_B], z)
     return (0.5 * m * (yd + v) ** 2,
@@ -625,8 +660,11 @@ def _event_value(event, t, s, x, mode, direction, held, P, M, E, table):
 def _margin_near(t, s, x, mode, held, P, M, E, table, phase, sin0, cos0):
     """Holding margin at ``t`` with the excitation rotated from a nearby phase (no sin/cos)."""
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    return hold_margin(mode, rhs(t, y, yd, ydd, s, x, mode, 0.0, held, P, M,
-                                 general(M))[1][F_HOLD], P[P_FS])
+    if M is None:  # pruned by type before inlining (kernel_model)
+        f_hold = rhs(t, y, yd, ydd, s, x, mode, 0.0, held, P, M, False)[1][F_HOLD]
+    else:
+        f_hold = rhs(t, y, yd, ydd, s, x, mode, 0.0, held, P, M, general(M))[1][F_HOLD]
+    return hold_margin(mode, f_hold, P[P_FS])
 
 
 @njit(**_JIT, inline="always")
@@ -822,7 +860,7 @@ def sample_controller(t, s, x, mode, direction, held, P, M, E, table):
     v_measured = xd - s[S_HP] if P[P_HP_OMEGA] > 0.0 else xd
     f_pi, f_damp, f_motor, rate = controller_output(P, s[S_Z], v_measured, s[S_INT])
     f_comp, f_dither = held[3], held[4]
-    if M[M_BLOCKS] != 0.0:
+    if M is not None and M[M_BLOCKS] != 0.0:
         v = s[S_V] if mode == MODE_SLIP else 0.0
         force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, True)[1]
         f_comp, f_dither, f_motor, rate, x = sample_blocks(
@@ -857,7 +895,10 @@ def record(t, s, x, mode, direction, held, P, M, E, table, row, row_flags, phase
     ``phase, sin0, cos0``: the excitation's phase and its sine and cosine near ``t``.
     """
     y, yd, ydd = base_motion_near(t, phase, sin0, cos0, E, table)
-    force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, general(M))[1]
+    if M is None:  # pruned by type before inlining (kernel_model)
+        force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, False)[1]
+    else:
+        force = rhs(t, y, yd, ydd, s, x, mode, float(direction), held, P, M, general(M))[1]
     v = s[S_V] if mode == MODE_SLIP else 0.0
     row[C_TIME] = t
     row[C_BASE_Y] = force[F_Y]
@@ -881,7 +922,7 @@ def record(t, s, x, mode, direction, held, P, M, E, table, row, row_flags, phase
     row[C_D_STOP] = s[S_D_STOP]
     row[C_E_KINETIC], row[C_E_SPRING], row[C_E_GRAVITY], row[C_E_STOP] = energies(
         force[F_Y], force[F_YD], s, mode, P, M)
-    if M[M_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
+    if M is not None and M[M_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
         row[C_F_COMPENSATION] = force[F_COMPENSATION]
         row[C_F_DITHER] = force[F_DITHER]
         row[C_F_LINEAR] = force[F_LINEAR]

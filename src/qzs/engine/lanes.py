@@ -568,98 +568,96 @@ def single_kernel(model):
     return run_single_blocks if K.general(model) else run_single
 
 
-@njit(**_JIT, nogil=True)
-def run_single(solver, n_steps, decimation, state, flags, p, m, ex, table, out, out_flags, row0):
-    """One case: :func:`run_lanes` with a single lane, without the lanes' bookkeeping.
+def _single(blocks, name, doc):
+    """The one-case kernel ``name``, its ``blocks`` a constant of the closure (not an argument,
+    nor an inlined body's): numba prunes the branches on it before it inlines anything, so
+    :func:`run_single` inlines none of the blocks' code (an inlined body with ``blocks`` as
+    an argument made its first compile about 3x longer, benchmarks/compile_times.py)."""
+
+    def kernel(solver, n_steps, decimation, state, flags, p, m, ex, table, out, out_flags, row0):
+        M = m if blocks else None  # None: no general path is compiled (K.kernel_model)
+        P = K.params_tuple(p)
+        E = excitation_tuple(ex)
+        h = P[K.P_DT]
+        control_steps = int(P[K.P_CONTROL_STEPS])
+        linear_steps = int(m[K.M_LINEAR_STEPS]) if blocks else 0
+        s = K.state_tuple(state)
+        x = K.blocks_tuple(state)
+        held = K.held_tuple(state)
+        mode = flags[K.I_MODE]
+        direction = flags[K.I_DIRECTION]
+        contact = flags[K.I_CONTACT]
+        step = flags[K.I_STEP]
+        status = K.STATUS_OK
+        row = row0
+        margin = state[K.A_MARGIN]
+        phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, np.bool_(True))
+        for _ in range(n_steps):
+            t = step * h
+            if control_steps > 0 or linear_steps > 0:
+                controller, linear = _sample_times(step, control_steps, linear_steps)
+                if controller:
+                    held, s, x = K.sample_controller(t, s, x, mode, direction, held, P, M, E,
+                                                     table)
+                    margin = np.nan
+                if blocks and linear:
+                    held, x = K.sample_linear(t, s, x, mode, direction, held, P, M, E, table)
+                    margin = np.nan
+            s1, x1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
+                solver, t, h, s, x, mode, direction, held, P, M, blocks, E, table, margin, phase,
+                sin0, cos0)
+            if not _finite(s1, P) or (blocks and not _finite_blocks(x1)):
+                status = K.failure_status(M)
+                break
+            s, x, mode, direction, margin = s1, x1, mode1, direction1, margin1
+            step += 1
+            # rotate the excitation's sine/cosine to the next step (exact every PHASE_PERIOD)
+            phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
+                                              step % K.PHASE_PERIOD == 0)
+            flags[K.I_N_STICKS] += sticks
+            flags[K.I_N_CONTACTS] += impacts
+            now = K._in_contact(s, mode, P)
+            if now and contact == 0 and P[K.P_PLASTIC] == 0.0:
+                flags[K.I_N_CONTACTS] += 1
+            contact = 1 if now else 0
+            if step % decimation == 0:
+                K.record(step * h, s, x, mode, direction, held, P, M, E, table, out[row],
+                         out_flags[row], phase, sin0, cos0)
+                row += 1
+        for i in range(K.N_ODE):
+            state[i] = s[i]
+        if blocks:
+            for i in range(K.N_X):
+                state[K.A_X0 + i] = x[i]
+        (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR], state[K.A_F_COMPENSATION],
+         state[K.A_F_DITHER], state[K.A_F_LINEAR]) = held
+        state[K.A_MARGIN] = margin
+        flags[K.I_MODE] = mode
+        flags[K.I_DIRECTION] = direction
+        flags[K.I_CONTACT] = contact
+        flags[K.I_STEP] = step
+        return status, row - row0
+
+    kernel.__name__ = kernel.__qualname__ = name
+    kernel.__doc__ = doc
+    return njit(**_JIT, nogil=True)(kernel)
+
+
+run_single = _single(False, "run_single", """One case: :func:`run_lanes` with a single lane, without the lanes' bookkeeping.
 
     Every step is :func:`qzs.engine.kernels.grid_step`, which takes the very same
     operations as a lane's step in :func:`run_lanes` (pass 1 for an ordinary
     step, pass 2 for one with a transition), so the numbers are identical.
-    ``m`` holds the controller's blocks (``K.M_*``): this kernel is for PI + damping alone
-    (``m`` all zeros), :func:`run_single_blocks` for a controller with blocks.
-    Returns ``(status, rows_written)``; on divergence ``state`` holds the last
+    ``m`` holds the controller's blocks and the spring law (``K.M_*``): this kernel is for PI
+    + damping with the tanh of ``p`` (``m`` is not read), :func:`run_single_blocks` for the
+    general path. Returns ``(status, rows_written)``; on divergence ``state`` holds the last
     finite state and ``flags[K.I_STEP]`` its step.
-    """
-    return _run_single(False, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
-                       out_flags, row0)
+    """)
 
-
-@njit(**_JIT, nogil=True)
-def run_single_blocks(solver, n_steps, decimation, state, flags, p, m, ex, table, out,
-                      out_flags, row0):
-    """:func:`run_single` for a controller with blocks beyond PI + damping, or a spring law
-    other than the tanh (``m``, the general path).
+run_single_blocks = _single(True, "run_single_blocks", """:func:`run_single` for the general path: a controller with blocks beyond PI + damping, or
+    a spring law other than the tanh (``m``).
 
     One kernel for every such controller and law (its blocks and law are data), compiled on
     its first use; the same operations as a lane of :func:`run_lanes` with blocks (its pass
     2). Stops with ``K.STATUS_OUTSIDE`` where a refusing spring table's force is NaN.
-    """
-    return _run_single(True, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
-                       out_flags, row0)
-
-
-@njit(**_JIT, inline="always")
-def _run_single(blocks, solver, n_steps, decimation, state, flags, p, m, ex, table, out,
-                out_flags, row0):
-    """The body of :func:`run_single` and :func:`run_single_blocks` (``blocks`` a constant)."""
-    P = K.params_tuple(p)
-    E = excitation_tuple(ex)
-    h = P[K.P_DT]
-    control_steps = int(P[K.P_CONTROL_STEPS])
-    linear_steps = int(m[K.M_LINEAR_STEPS]) if blocks else 0
-    s = K.state_tuple(state)
-    x = K.blocks_tuple(state)
-    held = K.held_tuple(state)
-    mode = flags[K.I_MODE]
-    direction = flags[K.I_DIRECTION]
-    contact = flags[K.I_CONTACT]
-    step = flags[K.I_STEP]
-    status = K.STATUS_OK
-    row = row0
-    margin = state[K.A_MARGIN]
-    phase, sin0, cos0 = advance_phase(step * h, 0.0, 0.0, 1.0, E, np.bool_(True))
-    for _ in range(n_steps):
-        t = step * h
-        if control_steps > 0 or linear_steps > 0:
-            controller, linear = _sample_times(step, control_steps, linear_steps)
-            if controller:
-                held, s, x = K.sample_controller(t, s, x, mode, direction, held, P, m, E,
-                                                 table)
-                margin = np.nan
-            if blocks and linear:
-                held, x = K.sample_linear(t, s, x, mode, direction, held, P, m, E, table)
-                margin = np.nan
-        s1, x1, mode1, direction1, margin1, sticks, impacts = _grid_step_inline(
-            solver, t, h, s, x, mode, direction, held, P, m, blocks, E, table, margin, phase,
-            sin0, cos0)
-        if not _finite(s1, P) or (blocks and not _finite_blocks(x1)):
-            status = K.failure_status(m)
-            break
-        s, x, mode, direction, margin = s1, x1, mode1, direction1, margin1
-        step += 1
-        # rotate the excitation's sine/cosine to the next step; exact every PHASE_PERIOD steps
-        phase, sin0, cos0 = advance_phase(step * h, phase, sin0, cos0, E,
-                                          step % K.PHASE_PERIOD == 0)
-        flags[K.I_N_STICKS] += sticks
-        flags[K.I_N_CONTACTS] += impacts
-        now = K._in_contact(s, mode, P)
-        if now and contact == 0 and P[K.P_PLASTIC] == 0.0:
-            flags[K.I_N_CONTACTS] += 1
-        contact = 1 if now else 0
-        if step % decimation == 0:
-            K.record(step * h, s, x, mode, direction, held, P, m, E, table, out[row],
-                     out_flags[row], phase, sin0, cos0)
-            row += 1
-    for i in range(K.N_ODE):
-        state[i] = s[i]
-    if blocks:
-        for i in range(K.N_X):
-            state[K.A_X0 + i] = x[i]
-    (state[K.A_F_PI], state[K.A_F_DAMP], state[K.A_F_MOTOR], state[K.A_F_COMPENSATION],
-     state[K.A_F_DITHER], state[K.A_F_LINEAR]) = held
-    state[K.A_MARGIN] = margin
-    flags[K.I_MODE] = mode
-    flags[K.I_DIRECTION] = direction
-    flags[K.I_CONTACT] = contact
-    flags[K.I_STEP] = step
-    return status, row - row0
+    """)

@@ -381,14 +381,15 @@ def _initial_state(initial, isolator, controller, p, m, excitation, packed_excit
     s[K.S_V] = initial.relative_velocity
     yd0 = base_motion_series(excitation, [0.0])[1][0]
     s[K.S_HP] = yd0 + initial.relative_velocity  # the amplifier's high-pass has settled
-    measured = K.hold_force(0.0, s, p, m, *packed_excitation)[K.F_V_MEASURED]
+    model = K.kernel_model(m)  # None on the default path: its kernels only
+    measured = K.hold_force(0.0, s, p, model, *packed_excitation)[K.F_V_MEASURED]
     if initial.pi_integral is not None:
         s[K.S_INT] = initial.pi_integral
     elif controller.pi_ki > 0:
         # Preload: the motor carries the static load the spring and stops do not, nothing
         # more. Evaluated with the base at rest: the base's acceleration at t = 0 is no load
         # the integrator should hold (docs/model.md §11).
-        force = K.hold_force(0.0, s, p, m, *_AT_REST)
+        force = K.hold_force(0.0, s, p, model, *_AT_REST)
         without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
         needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
         f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, measured, 0.0)[:2]
@@ -403,7 +404,7 @@ def _initial_state(initial, isolator, controller, p, m, excitation, packed_excit
     s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
     if controller.has_blocks:
         _hold_blocks(s, p, m, packed_excitation)
-    force = K.hold_force(0.0, s, p, m, *packed_excitation)
+    force = K.hold_force(0.0, s, p, model, *packed_excitation)
     f_hold = force[K.F_HOLD]
     locked = initial.locked
     regularised = isolator.friction_regularisation > 0.0

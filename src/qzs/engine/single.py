@@ -71,7 +71,8 @@ def integrate(excitation=None, isolator=None, controller=None, *, duration=None,
                                duration=run.duration, sample_rate=run.sample_rate)
     stepper = SingleAxis(run, recorder.buffers)
     data, marks = recorder.buffers[0]
-    K.evaluate(0.0, run.state, run.flags, p, run.model, *run.packed, data[0], marks[0])
+    K.evaluate(0.0, run.state, run.flags, p, K.kernel_model(run.model), *run.packed, data[0],
+               marks[0])
     recorder.absorb(0, 0, 1)
     outcome = driver.drive(stepper, plan, recorder, progress="simulating" if progress else None,
                            interruptible=interruptible)
