@@ -170,13 +170,13 @@ def _timed_stderr(argv, env, timeout):
     return chunks, stdout, time.perf_counter() - start
 
 
-@pytest.mark.slow
 #: The kernels only the general path calls (controller blocks, a spring law other than the
 #: tanh): a default run compiles none of them (qzs.engine.kernels.kernel_model).
 GENERAL_PATH = ("block_forces", "block_rates", "sample_blocks", "linear_sample",
                 "sample_linear", "_general_spring", "_general_spring_energy", "_saturated")
 
 
+@pytest.mark.slow
 def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path):
     """A cold ``qzs simulate``: the notice within seconds, then no silence over a few seconds.
 
