@@ -174,6 +174,16 @@ def _timed_stderr(argv, env, timeout):
 #: tanh): a default run compiles none of them (qzs.engine.kernels.kernel_model).
 GENERAL_PATH = ("block_forces", "block_rates", "sample_blocks", "linear_sample",
                 "sample_linear", "_general_spring", "_general_spring_energy", "_saturated")
+#: The six legs' kernels only a platform with controller blocks calls (besides the single
+#: axis's block kernels): a run without blocks compiles none of them (``models`` None).
+HEXAPOD_BLOCKS = ("_leg_blocks", "_leg_block_rates", "_sample_blocks", "_linear_due",
+                  "_sample_linear")
+
+
+def _compiled(cache):
+    """The kernels a run compiled into the numba cache ``cache``, as ``module.function``
+    (the name of each function's cache index: ``module.function-line.pyXY.nbi``)."""
+    return {path.name.split("-")[0] for path in cache.rglob("*.nbi")}
 
 
 @pytest.mark.slow
@@ -195,8 +205,8 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     assert b"qzs simulation" in stdout
     # the default model compiled none of the general path's code (its functions would have
     # cache files): no controller blocks, no spring law but the tanh of the parameters
-    compiled = {path.name.split("-")[0] for path in (tmp_path / "cache").rglob("*.nbi")}
-    assert "lanes.run_single" in compiled, compiled  # file names: module.function-line
+    compiled = _compiled(tmp_path / "cache")
+    assert "lanes.run_single" in compiled, compiled
     general = {f"kernels.{name}" for name in GENERAL_PATH} | {"lanes.run_single_blocks"}
     assert not compiled & general, sorted(compiled & general)
     text = b"".join(c for _, c in chunks).decode()
@@ -220,6 +230,34 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
     chunks, stdout, _ = _timed_stderr(argv, env, timeout=300)
     assert b"qzs simulation" in stdout
     assert b"compiling" not in b"".join(c for _, c in chunks)
+
+
+@pytest.mark.slow
+def test_a_first_six_leg_run_without_blocks_compiles_none_of_the_blocks_code(tmp_path):
+    """A cold six-leg run, PI + damping on every leg: none of the blocks' functions, the six
+    legs' nor the single axis's they call, has a cache index; the six legs' kernels have.
+
+    Failed when the switch was a value in ``plat``: numba compiled the blocks' code into every
+    run (35.8 s against 24.2 s of compile CPU, benchmarks/compile_times.py --hexapod).
+    """
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=str(SOURCE))
+    env.pop("NUMBA_DISABLE_JIT", None)
+    run = ("from qzs import ControllerParameters, Sine\n"
+           "from qzs.engine.hexapod import simulate_hexapod\n"
+           "from qzs.model.hexapod import PlatformParameters, cubic_geometry\n"
+           "result = simulate_hexapod(cubic_geometry(cube_edge=0.3, cube_center_height=0.3),\n"
+           "    PlatformParameters(mass=22.17, inertia=[[0.3, 0, 0], [0, 0.3, 0], [0, 0, 0.5]]),\n"
+           "    controller=ControllerParameters(pi_kp=2000.0, pi_ki=800.0),\n"
+           "    excitation={'z': Sine(amplitude=0.002, frequency=5.0)}, duration=0.01)\n"
+           "print(result.has_blocks, result.run['steps'])")
+    out = subprocess.run([sys.executable, "-c", run], env=env, capture_output=True, text=True,
+                         check=True, timeout=900)
+    assert out.stdout.split() == ["False", "100"]
+    compiled = _compiled(tmp_path)
+    assert {"dynamics._evaluate", "stepping._start", "stepping._run"} <= compiled, compiled
+    blocks = ({f"kernels.{name}" for name in GENERAL_PATH}
+              | {f"dynamics.{name}" for name in HEXAPOD_BLOCKS})
+    assert not compiled & blocks, sorted(compiled & blocks)
 
 
 @pytest.mark.parametrize("load, cores, factor", [(0.0, 2, 1.0), (1.0, 2, 1.0), (6.0, 2, 3.5),

@@ -47,8 +47,8 @@ from numba import njit
 from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.base_motion import advance_phase, base_motion_near, excitation_tuple
 from qzs.engine.hexapod.layout import (
-    LANES, LEG_COUNT, MODE_SLIP, N_MODEL, PL_ACTIVE, PL_BLOCKS, PL_CENTRAL, PL_CKD, PL_CKI,
-    PL_CKP, PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_MODEL, PL_ROTATING, S_C,
+    LANES, LEG_COUNT, MODE_SLIP, PL_ACTIVE, PL_CENTRAL, PL_CKD, PL_CKI,
+    PL_CKP, PL_CONTROL_STEPS, PL_G, PL_IC, PL_ICINV, PL_JINV, PL_MASS, PL_ROTATING, S_C,
     S_DF, S_DS, S_X, V_CMD, V_FCO, V_FDI, V_FFF, V_FLI, V_FRESH, V_HCO, V_HDI, V_HLI, V_XDD,
     V_YDD, S_HP, S_INT, S_Q, S_V, S_W, S_WB, S_WM, SOLVE_FACTORED, SOLVE_MIN_NORM, SOLVE_NONE, V_A,
     V_B, V_BX, V_BY, V_BZ, V_C0, V_CBC, V_CV, V_DHP, V_DINT, V_DIR, V_EV, V_F, V_FC, V_FDA,
@@ -419,13 +419,12 @@ def _project(s, plat, ww, V, A, idx, vec):
 
 
 # ---------------------------------------------------------------- each leg's controller blocks
-@njit(**_JIT, inline="always")
-def _model(plat, i):
-    """Leg ``i``'s packed blocks (``qzs.engine.kernels.M_*``): a view of ``plat``."""
-    start = PL_MODEL + i * N_MODEL
-    return plat[start:start + N_MODEL]
-
-
+# ``models``: each leg's packed blocks, row ``i`` leg ``i``'s (``qzs.engine.kernels.M_*``), or
+# ``None`` when no leg has blocks (layout.py). Every kernel that reaches the blocks' code takes
+# it as an argument and branches on ``models is not None``: numba prunes that branch by the
+# argument's type before it types the callees, so a run without blocks compiles none of the
+# functions below nor the single axis's block kernels they call (benchmarks/compile_times.py
+# --hexapod). A flag's value (in ``plat``) would not: numba compiles both branches' callees.
 @njit(**_JIT, inline="always")
 def _leg_state(s, i):
     """Leg ``i``'s blocks' state (``qzs.engine.kernels.X_*``) as a tuple."""
@@ -464,12 +463,12 @@ def _slip(V, i):
 
 
 @njit(**_JIT)
-def _leg_blocks(t, s, plat, ww, V):
+def _leg_blocks(t, s, plat, models, ww, V):
     """Each leg's blocks beyond PI + damping, added to its command (docs/model.md §5.1).
 
     Per leg, the single axis's :func:`qzs.engine.kernels.block_forces` on that leg's
     sensors (its encoder's error and slip velocity, its amplifier's velocity, its base
-    accelerometer, :func:`_base_acceleration`) with its own packed blocks (:func:`_model`)
+    accelerometer, :func:`_base_acceleration`) with its own packed blocks (``models[i]``)
     and state (:func:`_leg_state`); the motor force is the saturated sum with the PI and
     damping commands already in ``V`` (continuous, or held), and a continuous PI's integral
     stops by the same conditional integration. Writes the rows ``FCO, FDI, FLI`` (the
@@ -484,7 +483,7 @@ def _leg_blocks(t, s, plat, ww, V):
                 V[V_HLI + i])
         f_comp, f_dither, f_linear, feedforward = block_forces(
             t, error, _leg_state(s, i), _slip(V, i), V[V_DIR + i], ydd, V[V_VME + i], held,
-            sampled, 0.0, _model(plat, i))
+            sampled, 0.0, models[i])
         command = V[V_FPI + i] + V[V_FDA + i] + f_comp + f_dither + f_linear
         f_motor, rate = saturation_law(command, error, V[V_KI + i], V[V_FMAX + i])
         V[V_FCO + i] = f_comp
@@ -502,7 +501,7 @@ def _leg_blocks(t, s, plat, ww, V):
 
 
 @njit(**_JIT)
-def _leg_block_rates(s, plat, ww, V, d):
+def _leg_block_rates(s, plat, models, ww, V, d):
     """Each leg's blocks' state rates into ``d`` (:func:`qzs.engine.kernels.block_rates`).
 
     After the platform's equation (``ww[W_ACC:]``) and the locked legs' holding forces
@@ -523,15 +522,14 @@ def _leg_block_rates(s, plat, ww, V, d):
         V[V_XDD + i] = xdd
         sensors = (V[V_ZREF + i] - V[V_Z + i], V[V_VME + i], xdd, V[V_YDD + i], _slip(V, i))
         rates = block_rates(_leg_state(s, i), sensors, V[V_FFR + i], V[V_FST + i],
-                            V[V_FFF + i], V[V_FMO + i] - V[V_CMD + i], sampled,
-                            _model(plat, i))
+                            V[V_FFF + i], V[V_FMO + i] - V[V_CMD + i], sampled, models[i])
         o = S_X + i * N_X
         for k in range(N_X):
             d[o + k] = rates[k]
 
 
 @njit(**_JIT)
-def _sample_blocks(t, plat, V, s, h):
+def _sample_blocks(t, plat, models, V, s, h):
     """Each leg's sampled blocks at a sample of the PI (:func:`qzs.engine.kernels.sample_blocks`).
 
     After :func:`_commands` (the PI and damping outputs in ``FPI, FDA``), from what the last
@@ -545,7 +543,7 @@ def _sample_blocks(t, plat, V, s, h):
         f_comp, f_dither, f_motor, rate, x = sample_blocks(
             t, _leg_state(s, i), _slip(V, i), V[V_DIR + i], held, V[V_FFR + i], V[V_FST + i],
             V[V_FPI + i], V[V_FDA + i], V[V_FLI + i], V[V_ZREF + i] - V[V_Z + i], V[V_KI + i],
-            V[V_FMAX + i], plat[PL_CONTROL_STEPS], h, 0.0, _model(plat, i))
+            V[V_FMAX + i], plat[PL_CONTROL_STEPS], h, 0.0, models[i])
         V[V_HCO + i] = f_comp
         V[V_HDI + i] = f_dither
         V[V_FMO + i] = f_motor
@@ -557,22 +555,22 @@ def _sample_blocks(t, plat, V, s, h):
 
 
 @njit(**_JIT)
-def _linear_due(plat, step):
+def _linear_due(models, step):
     """Whether a leg's discrete linear controller samples at grid step ``step``."""
     for i in range(LEG_COUNT):
-        steps = int(plat[PL_MODEL + i * N_MODEL + M_LINEAR_STEPS])
+        steps = int(models[i, M_LINEAR_STEPS])
         if steps > 0 and step % steps == 0:
             return True
     return False
 
 
 @njit(**_JIT)
-def _sample_linear(step, plat, V, s):
+def _sample_linear(step, models, V, s):
     """Each leg's discrete linear controller that samples at grid step ``step``
     (:func:`qzs.engine.kernels.linear_sample`), from the sensors and the other commands of an
     evaluation at that instant: its output held (``HLI``), its states stepped in ``s``."""
     for i in range(LEG_COUNT):
-        M = _model(plat, i)
+        M = models[i]
         steps = int(M[M_LINEAR_STEPS])
         if steps > 0 and step % steps == 0:
             error = V[V_ZREF + i] - V[V_Z + i]
@@ -648,7 +646,7 @@ def _commands(plat, ww, V):
 
 
 @njit(**_JIT)
-def _sample(t, plat, ww, V, s, h):
+def _sample(t, plat, models, ww, V, s, h):
     """A sampled controller's sample at ``t`` [s]: outputs from the sensors of the last
     evaluation, held.
 
@@ -657,8 +655,8 @@ def _sample(t, plat, ww, V, s, h):
     over the controller's period, ``I + rate N h``.
     """
     _commands(plat, ww, V)
-    if plat[PL_BLOCKS] != 0.0:
-        _sample_blocks(t, plat, V, s, h)
+    if models is not None:  # pruned by type without blocks (see _leg_blocks)
+        _sample_blocks(t, plat, models, V, s, h)
     for i in range(LANES):
         V[V_HPI + i] = V[V_FPI + i]
         V[V_HDA + i] = V[V_FDA + i]
@@ -668,7 +666,7 @@ def _sample(t, plat, ww, V, s, h):
 
 
 @njit(**_JIT)
-def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
+def _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, project):
     """The right-hand side at ``(t, s)`` into ``d``; every leg's forces and events into ``V``.
 
     1. the base's motion and frame (:func:`_base_frame`);
@@ -765,8 +763,8 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
             V[V_DINT + i] = 0.0
     else:
         _commands(plat, ww, V)
-    if plat[PL_BLOCKS] != 0.0:  # each leg's own blocks (docs/model.md §5.1)
-        _leg_blocks(t, s, plat, ww, V)
+    if models is not None:  # each leg's own blocks (docs/model.md §5.1); pruned by type
+        _leg_blocks(t, s, plat, models, ww, V)
     for i in range(LANES):
         slipping = V[V_MODE + i] == MODE_SLIP
         v = V[V_V + i]
@@ -874,8 +872,8 @@ def _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, project):
     d[S_DF] = friction_loss
     d[S_WM] = motor_power
     d[S_DS] = stop_loss
-    if plat[PL_BLOCKS] != 0.0:
-        _leg_block_rates(s, plat, ww, V, d)
+    if models is not None:
+        _leg_block_rates(s, plat, models, ww, V, d)
 
 
 # Stale cached kernels of this module are dropped with the others (qzs.engine.arithmetic:

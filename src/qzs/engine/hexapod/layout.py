@@ -7,7 +7,7 @@ the driver (:mod:`~qzs.engine.hexapod.simulate`) and the result
 as constants.
 """
 from qzs.defaults import AXES  # the six axes of a pose: translations [m], rotation angles [rad]
-from qzs.engine.kernels import N_MODEL, N_X
+from qzs.engine.kernels import N_X
 from qzs.model.hexapod import LEG_COUNT
 
 __all__ = ["AXES", "LANES"]
@@ -40,15 +40,16 @@ N_ROWS = 79 + LEG_COUNT - 1
 # Platform ``plat``: mass, gravity, COM in the top frame, inertia and its inverse (row-major),
 # home position, which base axes move, whether the base rotates; the control: grid steps per
 # controller sample (0: continuous), centralised (1) or per leg (0), and the Cartesian loops'
-# ``J^-1`` (row-major) and gains per axis (proportional, integral, damping); whether any leg's
-# controller has blocks beyond PI + damping. With blocks, ``plat`` goes on with each leg's
-# packed blocks (``qzs.engine.kernels.M_*``, :func:`qzs.engine.prepare.pack_model`): leg
-# ``i``'s row at ``PL_MODEL + i * N_MODEL`` (without, ``plat`` ends at ``N_PLAT``).
+# ``J^-1`` (row-major) and gains per axis (proportional, integral, damping).
 (PL_MASS, PL_G, PL_CT, PL_IC, PL_ICINV, PL_HOME, PL_ACTIVE, PL_ROTATING, PL_CONTROL_STEPS,
- PL_CENTRAL, PL_JINV, PL_CKP, PL_CKI, PL_CKD, PL_BLOCKS) = (0, 1, 2, 5, 14, 23, 26, 32, 33, 34,
-                                                           35, 71, 77, 83, 89)
-N_PLAT = 90
-PL_MODEL = N_PLAT
+ PL_CENTRAL, PL_JINV, PL_CKP, PL_CKI, PL_CKD) = (0, 1, 2, 5, 14, 23, 26, 32, 33, 34, 35, 71, 77,
+                                                83)
+N_PLAT = 89
+# The legs' controller blocks beyond PI + damping, ``models``: with blocks on any leg, each
+# leg's packed blocks (``qzs.engine.kernels.M_*``, :func:`qzs.engine.prepare.pack_model`), an
+# array (LEG_COUNT, ``qzs.engine.kernels.N_MODEL``); without, ``None``. The kernels take it as
+# an argument and branch on ``models is not None``, which numba prunes by type before it
+# compiles a callee: a run without blocks compiles none of the blocks' code (dynamics.py).
 
 # ODE state; with blocks, each leg's blocks' state (``qzs.engine.kernels.X_*``: a linear
 # controller's states, the friction observer's estimate) follows: leg ``i``'s at

@@ -14,7 +14,7 @@ from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine.hexapod.dynamics import _advance_phases, _evaluate, _rest_frame
 from qzs.engine.hexapod.layout import (
-    AXES, LANES, LEG_COUNT, N_ODE, N_ODE_BLOCKS, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE, PL_BLOCKS,
+    AXES, LANES, LEG_COUNT, N_ODE, N_ODE_BLOCKS, N_PLAT, N_ROWS, N_WORK, PL_ACTIVE,
     PL_CENTRAL, PL_CKD, PL_CKI, PL_CKP, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_ICINV,
     PL_JINV, PL_MASS, PL_ROTATING, S_C, S_INT, S_Q, S_X, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV,
     V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
@@ -207,6 +207,7 @@ class _Prepared:
     solver_code: int
     V: np.ndarray
     plat: np.ndarray
+    models: np.ndarray | None  # each leg's packed blocks, None without (layout.py)
     ex: np.ndarray
     tables: np.ndarray
     toff: np.ndarray
@@ -383,9 +384,8 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     plat[PL_ROTATING] = float(any(axis in moving for axis in AXES[3:]))
     tables = np.ascontiguousarray(np.concatenate(pieces, axis=1))
     toff = np.asarray(offsets, dtype=np.int64)
-    if blocks:  # each leg's blocks packed after the platform's constants (layout: PL_MODEL)
-        plat[PL_BLOCKS] = 1.0
-        plat = np.concatenate([plat, np.ravel(models)])
+    # each leg's blocks, or None: the kernels compile their code only for a run with blocks
+    packed = np.array(models) if blocks else None  # (layout.py: models)
 
     state = np.zeros(N_ODE_BLOCKS if blocks else N_ODE)
     state[S_C:S_C + 3] = platform.center_of_mass  # at home: c = o + R_r c_t, o = 0, R_r = I
@@ -394,7 +394,7 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     _rest_frame(ww)
     if blocks:  # the base's motion at t = 0, for the legs' base accelerometers (row YDD)
         _advance_phases(0.0, True, plat, ex, ww)
-    _evaluate(0.0, state, plat, ex, tables, toff, ww, V, np.zeros((6, 6)),
+    _evaluate(0.0, state, plat, packed, ex, tables, toff, ww, V, np.zeros((6, 6)),
               np.zeros(LEG_COUNT, dtype=np.int64), np.zeros((2, LEG_COUNT)),
               np.zeros(state.size), False)
     # the kernels' own arithmetic: z = z_ref exactly at home
@@ -415,5 +415,5 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if blocks:
         _start_blocks(controllers, models, needed, state, V)
     return _Prepared(geometry, platform, isolators, controllers, moving, duration, dt,
-                     sample_rate, decimation, solver, solver_code, V, plat, ex, tables, toff,
-                     state, cartesian)
+                     sample_rate, decimation, solver, solver_code, V, plat, packed, ex, tables,
+                     toff, state, cartesian)

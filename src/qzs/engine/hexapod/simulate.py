@@ -17,8 +17,8 @@ from qzs import defaults
 from qzs._validation import worker_count
 from qzs.engine.hexapod.layout import (CT_CONTACTS, CT_EVENTS, CT_STEP, CT_STICKS, LEG_COUNT,
                                        N_BASE_CHANNELS, N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS,
-                                       N_ODE, N_WORK, PL_BLOCKS, S_C, S_V, STATUS_OK, V_Z,
-                                       V_ZHIGH, V_ZLOW)
+                                       N_ODE, N_WORK, S_C, S_V, STATUS_OK, V_Z, V_ZHIGH,
+                                       V_ZLOW)
 from qzs.engine.hexapod.prepare import _prepare
 from qzs.engine.hexapod.result import HexapodResult
 from qzs.engine.hexapod.statistics import _Statistics
@@ -135,7 +135,7 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
                               for i in range(LEG_COUNT)], run.controllers)
     recorder = driver.Recorder(
-        plan, N_CHANNELS if run.plat[PL_BLOCKS] != 0.0 else N_BASE_CHANNELS, N_FLAGS,
+        plan, N_CHANNELS if run.models is not None else N_BASE_CHANNELS, N_FLAGS,
         statistics=statistics.add, sink=sink,
         duration=run.duration, sample_rate=run.sample_rate,
         remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
@@ -176,7 +176,7 @@ class _SixLegs(driver.Stepper):
         self.buffers = buffers
         self.s = run.state
         self.counters = np.zeros(N_COUNTERS, dtype=np.int64)
-        self.arrays = (run.plat, run.ex, run.tables, run.toff)
+        self.arrays = (run.plat, run.models, run.ex, run.tables, run.toff)
         self.work = (np.zeros((N_BUF, self.s.size)), np.zeros((2, LEG_COUNT)), np.zeros(N_WORK),
                      run.V, np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64),
                      np.zeros((2, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64), self.counters)

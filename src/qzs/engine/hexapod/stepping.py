@@ -20,7 +20,7 @@ from qzs.engine.hexapod.dynamics import (_advance_phases, _commands, _cross, _ev
 from qzs.engine.hexapod.layout import (
     B_K1, B_K2, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
     C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FCO, C_FDA, C_FDI, C_FFR, C_FLI,
-    C_FMO, C_FOB, C_FPI, C_FSP, C_FST, PL_BLOCKS, S_X, V_FCO, V_FDI, V_FLI, V_FRESH,
+    C_FMO, C_FOB, C_FPI, C_FSP, C_FST, S_X, V_FCO, V_FDI, V_FLI, V_FRESH,
     C_POSE, C_TIME, C_TWIST, C_V, C_VME, C_WB, C_WM, C_Z, CT_CONTACTS, CT_EVENTS,
     CT_IN_CONTACT, CT_STEP, CT_STICKS, LANES, LEG_COUNT, MODE_LOCK, MODE_SLIP,
     O_CONTACT, O_LOCKED, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_MASS,
@@ -47,13 +47,13 @@ SIMULTANEOUS = 1e-9
 
 # ---------------------------------------------------------------- Runge-Kutta
 @njit(**_JIT)
-def _rk(solver, t, h, s, k1, out, buf, plat, ex, tables, toff, ww, V, A, idx, vec):
+def _rk(solver, t, h, s, k1, out, buf, plat, models, ex, tables, toff, ww, V, A, idx, vec):
     """One explicit Runge-Kutta step of length ``h`` from ``s`` (rate ``k1`` given) into ``out``.
 
     The diagonal tableau of :func:`qzs.engine.kernels.tableau` (euler, ode3, rk4); each update
     ``s + a k`` is one fused multiply-add, as in the single axis.
     """
-    if plat[PL_BLOCKS] != 0.0:  # the state moves: a leg released at t slips now
+    if models is not None:  # the state moves: a leg released at t slips now
         for i in range(LEG_COUNT):
             V[V_FRESH + i] = 0.0
     weight = tableau(solver, h, 0)[2]
@@ -67,7 +67,7 @@ def _rk(solver, t, h, s, k1, out, buf, plat, ex, tables, toff, ww, V, A, idx, ve
         for j in range(n):
             tmp[j] = fma(a, previous[j], s[j])
         k = buf[B_K2 + stage - 1]
-        _evaluate(t + offset, tmp, plat, ex, tables, toff, ww, V, A, idx, vec, k, _FALSE)
+        _evaluate(t + offset, tmp, plat, models, ex, tables, toff, ww, V, A, idx, vec, k, _FALSE)
         for j in range(n):
             out[j] = fma(weight, k[j], out[j])
         previous = k
@@ -103,19 +103,20 @@ def _first_event(V, ev0, ev1):
 def _event_trial(at, data):
     """The trial of :func:`qzs.engine.stickslip.locate`: a step of ``at`` [s], leg ``leg``'s event.
 
-    ``data`` is ``(solver, leg, t, s, k1, buf, plat, ex, tables, toff, ww, V, A, idx, vec)``,
-    the (sub)step's start; the state at ``t + at`` goes to ``buf[B_TRIAL]`` (the workspaces
+    ``data`` is ``(solver, leg, t, s, k1, buf, plat, models, ex, tables, toff, ww, V, A, idx,
+    vec)``, the (sub)step's start; the state at ``t + at`` goes to ``buf[B_TRIAL]`` (the workspaces
     hold its evaluation). Returns the leg's event value there and True (a trial was made).
     """
-    solver, leg, t, s, k1, buf, plat, ex, tables, toff, ww, V, A, idx, vec = data
+    solver, leg, t, s, k1, buf, plat, models, ex, tables, toff, ww, V, A, idx, vec = data
     trial = buf[B_TRIAL]
-    _rk(solver, t, at, s, k1, trial, buf, plat, ex, tables, toff, ww, V, A, idx, vec)
-    _evaluate(t + at, trial, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KT], _FALSE)
+    _rk(solver, t, at, s, k1, trial, buf, plat, models, ex, tables, toff, ww, V, A, idx, vec)
+    _evaluate(t + at, trial, plat, models, ex, tables, toff, ww, V, A, idx, vec, buf[B_KT], _FALSE)
     return V[V_EV + leg], True
 
 
 @njit(**_JIT)
-def _locate(solver, leg, t, h, s, k1, g0, g1, buf, plat, ex, tables, toff, ww, V, A, idx, vec):
+def _locate(solver, leg, t, h, s, k1, g0, g1, buf, plat, models, ex, tables, toff, ww, V, A,
+            idx, vec):
     """Leg ``leg``'s event located in ``[t, t + h]`` (:func:`qzs.engine.stickslip.locate`).
 
     Returns the time from ``t``: at most 6 Runge-Kutta steps from the (sub)step's start (each
@@ -123,8 +124,8 @@ def _locate(solver, leg, t, h, s, k1, g0, g1, buf, plat, ex, tables, toff, ww, V
     at the start). A float, not the state array: returning the array to :func:`_grid_step`
     made the hexapod's every step slower (0.70 against 0.79 million steps per CPU second).
     """
-    at, tried = locate(_event_trial, (solver, leg, t, s, k1, buf, plat, ex, tables, toff, ww, V,
-                                      A, idx, vec), g0, g1, h, False)
+    at, tried = locate(_event_trial, (solver, leg, t, s, k1, buf, plat, models, ex, tables, toff,
+                                      ww, V, A, idx, vec), g0, g1, h, False)
     if not tried:
         trial = buf[B_TRIAL]
         for j in range(trial.shape[0]):
@@ -146,7 +147,7 @@ def _set_mode(V, i, mode, direction):
 
 
 @njit(**_JIT)
-def _settle(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, newly):
+def _settle(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, newly):
     """Consistent modes at an instant: the complementarity loop of the locked legs.
 
     Repeatedly solve the locked legs' holding forces and release the one whose ``|lambda_i|``
@@ -158,7 +159,7 @@ def _settle(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, newly):
     right-hand side evaluated at ``(t, s)`` in the final modes (into ``d`` and the workspaces).
     """
     for _ in range(MAX_SETTLE):
-        _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, _TRUE)
+        _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, _TRUE)
         worst = -1
         excess = 0.0
         for i in range(LEG_COUNT):
@@ -169,11 +170,12 @@ def _settle(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, newly):
             return
         _set_mode(V, worst, MODE_SLIP, release_direction(MODE_STICK, V[V_FFR + worst]))
         newly[worst] = 0
-    _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, _TRUE)
+    _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, _TRUE)
 
 
 @njit(**_JIT)
-def _transition(leg, t, s, ev0, plat, ex, tables, toff, ww, V, A, idx, vec, d, newly, counters):
+def _transition(leg, t, s, ev0, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, newly,
+                counters):
     """Apply the located event of ``leg`` at ``(t, s)``, settle the modes, count stick events.
 
     A zero crossing locks the leg; a breakaway releases it towards the net force. Legs of the
@@ -183,7 +185,7 @@ def _transition(leg, t, s, ev0, plat, ex, tables, toff, ww, V, A, idx, vec, d, n
     """
     for i in range(LEG_COUNT):
         newly[i] = 0
-    _evaluate(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, _FALSE)
+    _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, _FALSE)
     crossing = V[V_MODE + leg] == MODE_SLIP
     level = max(V[V_EV + leg], 0.0)
     for i in range(LEG_COUNT):
@@ -195,7 +197,7 @@ def _transition(leg, t, s, ev0, plat, ex, tables, toff, ww, V, A, idx, vec, d, n
                 newly[i] = 1
             else:
                 _set_mode(V, i, MODE_SLIP, release_direction(MODE_STICK, V[V_FFR + i]))
-    _settle(t, s, plat, ex, tables, toff, ww, V, A, idx, vec, d, newly)
+    _settle(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, newly)
     for i in range(LEG_COUNT):
         if newly[i] != 0 and V[V_MODE + i] != MODE_SLIP:
             counters[CT_STICKS + i] += 1
@@ -203,7 +205,7 @@ def _transition(leg, t, s, ev0, plat, ex, tables, toff, ww, V, A, idx, vec, d, n
 
 
 @njit(**_JIT)
-def _grid_step(solver, t, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec, newly,
+def _grid_step(solver, t, h, buf, ev, plat, models, ex, tables, toff, ww, V, A, idx, vec, newly,
                counters):
     """Advance ``buf[B_S]`` (rate ``buf[B_K1]``, event values ``ev[0]``) by one grid step.
 
@@ -219,9 +221,9 @@ def _grid_step(solver, t, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec
     elapsed = 0.0
     for events in range(MAX_EVENTS + 1):
         rest = h - elapsed
-        _rk(solver, t + elapsed, rest, s, k1, s1, buf, plat, ex, tables, toff, ww, V, A, idx,
-            vec)
-        _evaluate(t + h, s1, plat, ex, tables, toff, ww, V, A, idx, vec, ke, _TRUE)
+        _rk(solver, t + elapsed, rest, s, k1, s1, buf, plat, models, ex, tables, toff, ww, V, A,
+            idx, vec)
+        _evaluate(t + h, s1, plat, models, ex, tables, toff, ww, V, A, idx, vec, ke, _TRUE)
         for i in range(LEG_COUNT):
             ev[1, i] = V[V_EV + i]
         leg, theta = -1, 2.0
@@ -235,14 +237,14 @@ def _grid_step(solver, t, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec
                 ev[0, i] = ev[1, i]
             return
         g0, g1 = ev[0, leg], ev[1, leg]
-        at = _locate(solver, leg, t + elapsed, rest, s, k1, g0, g1, buf, plat, ex, tables, toff,
-                     ww, V, A, idx, vec)
+        at = _locate(solver, leg, t + elapsed, rest, s, k1, g0, g1, buf, plat, models, ex, tables,
+                     toff, ww, V, A, idx, vec)
         trial = buf[B_TRIAL]
         for j in range(s.shape[0]):
             s[j] = trial[j]
         elapsed += at
-        _transition(leg, t + elapsed, s, ev[0], plat, ex, tables, toff, ww, V, A, idx, vec, k1,
-                    newly, counters)
+        _transition(leg, t + elapsed, s, ev[0], plat, models, ex, tables, toff, ww, V, A, idx, vec,
+                    k1, newly, counters)
         for i in range(LEG_COUNT):
             ev[0, i] = V[V_EV + i]
         if elapsed >= h:
@@ -269,7 +271,7 @@ def _angles(ww):
 
 
 @njit(**_JIT)
-def _record(t, s, plat, ww, V, row, marks):
+def _record(t, s, plat, models, ww, V, row, marks):
     """One output sample (``C_*`` channels, ``O_*`` flags) of the last evaluation at ``t``."""
     m = plat[PL_MASS]
     row[C_TIME] = t
@@ -332,7 +334,7 @@ def _record(t, s, plat, ww, V, row, marks):
         stop += 0.5 * V[V_STOPK + i] * pen * pen
         marks[O_LOCKED + i] = V[V_MODE + i] != MODE_SLIP
         marks[O_CONTACT + i] = z < V[V_ZLOW + i] or z > V[V_ZHIGH + i]
-    if plat[PL_BLOCKS] != 0.0:  # a row without blocks holds N_BASE_CHANNELS
+    if models is not None:  # a row without blocks holds N_BASE_CHANNELS
         for i in range(LEG_COUNT):
             row[C_FCO + i] = V[V_FCO + i]
             row[C_FOB + i] = s[S_X + i * N_X + X_OBSERVER]
@@ -368,7 +370,8 @@ def _finite(s):
 
 
 @njit(**_JIT)
-def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counters, row, marks):
+def _start(s, plat, models, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counters, row,
+           marks):
     """Settle the modes at t = 0 from all legs locked; evaluate; record the first sample.
 
     The amplifiers' high-passes start settled (``w_i = xd_i(0)``, measured velocity 0); a
@@ -380,29 +383,29 @@ def _start(s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec, newly, counte
         newly[i] = 0
     _rest_frame(ww)
     _advance_phases(0.0, _TRUE, plat, ex, ww)
-    _evaluate(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
+    _evaluate(0.0, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
     for i in range(LEG_COUNT):
         s[S_HP + i] = V[V_XB + i]
     if plat[PL_CONTROL_STEPS] > 0.0:  # a sampled controller's outputs at t = 0, held
-        _evaluate(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
+        _evaluate(0.0, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], _FALSE)
         _commands(plat, ww, V)
         for i in range(LANES):
             V[V_HPI + i] = V[V_FPI + i]
             V[V_HDA + i] = V[V_FDA + i]
             V[V_HMO + i] = V[V_FMO + i]
-    _settle(0.0, s, plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], newly)
+    _settle(0.0, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1], newly)
     for j in range(s.shape[0]):
         buf[B_S, j] = s[j]
     for i in range(LEG_COUNT):
         ev[0, i] = V[V_EV + i]
         counters[CT_IN_CONTACT + i] = 1 if (V[V_Z + i] < V[V_ZLOW + i]
                                             or V[V_Z + i] > V[V_ZHIGH + i]) else 0
-    _record(0.0, s, plat, ww, V, row, marks)
+    _record(0.0, s, plat, models, ww, V, row, marks)
 
 
 @njit(**_JIT, nogil=True)
-def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww, V, A, idx, vec,
-         newly, counters, out, out_flags, row0):
+def _run(solver, n_steps, decimation, h, s, plat, models, ex, tables, toff, buf, ev, ww, V, A,
+         idx, vec, newly, counters, out, out_flags, row0):
     """Advance ``n_steps`` grid steps, recording every ``decimation``-th into ``out`` from ``row0``.
 
     The carried state (``buf[B_S]``, its rate ``buf[B_K1]``, event values ``ev[0]``, modes,
@@ -418,22 +421,22 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
         _advance_phases(step * h, step % PHASE_PERIOD == 0, plat, ex, ww)
         sampled = control_steps > 0 and step % control_steps == 0
         if sampled:
-            _sample(step * h, plat, ww, V, buf[B_S], h)
-        if plat[PL_BLOCKS] != 0.0 and _linear_due(plat, step):
+            _sample(step * h, plat, models, ww, V, buf[B_S], h)
+        if models is not None and _linear_due(models, step):
             # a leg's discrete linear controller reads its sensors with the outputs the PI
             # and its blocks hold from now (they sample first, docs/model.md §5.1)
-            _evaluate(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_KE],
-                      _FALSE)
-            _sample_linear(step, plat, V, buf[B_S])
+            _evaluate(step * h, buf[B_S], plat, models, ex, tables, toff, ww, V, A, idx, vec,
+                      buf[B_KE], _FALSE)
+            _sample_linear(step, models, V, buf[B_S])
             sampled = True
         if sampled:
             # a sample: the held outputs jump, so the modes are settled again (a locked leg
             # may break away right here) and the rate and event values are those after it
-            _settle(step * h, buf[B_S], plat, ex, tables, toff, ww, V, A, idx, vec, buf[B_K1],
-                    newly)
+            _settle(step * h, buf[B_S], plat, models, ex, tables, toff, ww, V, A, idx, vec,
+                    buf[B_K1], newly)
             for i in range(LEG_COUNT):
                 ev[0, i] = V[V_EV + i]
-        _grid_step(solver, step * h, h, buf, ev, plat, ex, tables, toff, ww, V, A, idx, vec,
+        _grid_step(solver, step * h, h, buf, ev, plat, models, ex, tables, toff, ww, V, A, idx, vec,
                    newly, counters)
         if not _finite(buf[B_S]):
             status = STATUS_DIVERGED
@@ -446,7 +449,7 @@ def _run(solver, n_steps, decimation, h, s, plat, ex, tables, toff, buf, ev, ww,
                 counters[CT_CONTACTS + i] += 1
             counters[CT_IN_CONTACT + i] = now
         if step % decimation == 0:
-            _record(step * h, buf[B_S], plat, ww, V, out[row], out_flags[row])
+            _record(step * h, buf[B_S], plat, models, ww, V, out[row], out_flags[row])
             row += 1
     counters[CT_STEP] = step
     for j in range(s.shape[0]):
