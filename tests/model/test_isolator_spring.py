@@ -36,3 +36,30 @@ def test_a_spring_that_is_no_law_is_refused():
     with pytest.raises(ParameterError, match=r"`spring` must be a spring law .* got 3.0") as error:
         IsolatorParameters(spring=3.0)
     assert error.value.options == ("spring",)
+
+
+def test_the_model_functions_follow_the_isolators_law():
+    """spring_force, spring_stiffness and spring_energy are the law's where the isolator has
+    one (what linearisation, summaries and static checks read), the tanh of the fields bit for
+    bit where it has the tanh (set or default)."""
+    import numpy as np
+
+    from qzs.model.isolator import spring_energy, spring_force, spring_stiffness
+    from qzs.model.springs import PolynomialSpring
+
+    z = np.linspace(-0.09, -0.03, 7)
+    duffing = PolynomialSpring(coefficients=(62.78, -100.0, 0.0, -5.0e4), center=-0.06)
+    iso = IsolatorParameters(spring=duffing)
+    u = z + 0.06
+    np.testing.assert_allclose(spring_force(z, iso), 62.78 - 100.0 * u - 5.0e4 * u ** 3,
+                               rtol=1e-13, atol=1e-12)
+    np.testing.assert_allclose(spring_stiffness(z, iso), 100.0 + 1.5e5 * u ** 2, rtol=1e-13)
+    np.testing.assert_allclose(spring_energy(z, iso),
+                               -(62.78 * u - 50.0 * u ** 2 - 1.25e4 * u ** 4), rtol=1e-12,
+                               atol=1e-15)
+    default, named = IsolatorParameters(), IsolatorParameters(spring=TanhSpring())
+    for function in (spring_force, spring_stiffness, spring_energy):
+        expected = function(z, default)
+        assert np.array_equal(function(z, named), expected)
+        assert np.array_equal(expected, function(z, IsolatorParameters(spring=None)))
+    assert np.array_equal(spring_force(z, default), -60.84 * np.tanh(78.10 * z))

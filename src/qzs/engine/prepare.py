@@ -18,7 +18,6 @@ from qzs.model.springs import TABLE_COUNT, TABLE_POSITIONS, TanhSpring, check_eq
 from qzs.model.registry import model_inputs
 
 __all__ = ["PreparedRun", "prepare_run", "pack_model", "stack_models", "check_spring",
-           "refuse_spring_law",
            "linear_initial_state", "linear_output",
            "run_inputs", "run_duration", "steps_per_sample",
            "divides",
@@ -288,32 +287,6 @@ def stack_models(models):
     for i, m in enumerate(models):
         out[i, :m.size] = m
     return out
-
-
-def refuse_spring_law(isolator, what, where=""):
-    """Refuse a spring law other than the tanh where only the tanh is evaluated yet.
-
-    Parameters
-    ----------
-    isolator : IsolatorParameters
-        The plant.
-    what : str
-        What evaluates the tanh only (``"the hexapod"``, ``"the C model"``), for the message.
-    where : str
-        A prefix naming the part (``"leg 6: "``).
-
-    Raises
-    ------
-    ParameterError
-        ``spring`` neither None nor a TanhSpring, naming the fix.
-    """
-    law = isolator.spring
-    if law is not None and not isinstance(law, TanhSpring):
-        raise ParameterError(
-            f"{where}`spring` ({law.describe()}) is not supported by {what} yet: it evaluates "
-            "the MagSpring's tanh of `spring_force` and `spring_shape` only (docs/model.md "
-            "§3.1); give spring=None or a TanhSpring, or simulate one axis with this law "
-            "(qzs.simulate).", ("spring",))
 
 
 def check_spring(isolator, controller, p):

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs.engine import kernels as K
-from qzs.engine.prepare import prepare_run, refuse_spring_law
+from qzs.engine.prepare import prepare_run
+from qzs.model.isolator import refuse_spring_law
 from qzs.errors import ParameterError
 from qzs.export.csource import load_model
 

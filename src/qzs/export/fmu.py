@@ -23,7 +23,8 @@ from pathlib import Path
 from qzs import defaults
 from qzs._optional import require
 from qzs.engine import kernels as K
-from qzs.engine.prepare import prepare_run, refuse_spring_law
+from qzs.engine.prepare import prepare_run
+from qzs.model.isolator import refuse_spring_law
 from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
 from qzs.errors import (ControllerRateError, ParameterError, StabilityError,

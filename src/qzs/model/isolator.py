@@ -28,6 +28,7 @@ __all__ = [
     "friction_force",
     "friction_slope",
     "passive_natural_frequency",
+    "refuse_spring_law",
 ]
 
 #: Hard-stop contact models: a stiff spring-damper, or a perfectly plastic stop.
@@ -242,22 +243,64 @@ def spring_force(relative_position: ArrayLike,
 
 def spring_force(relative_position: ArrayLike,
                  params: "IsolatorParameters") -> float | NDArray[np.float64]:
-    """MagSpring force ``-a*tanh(b*z)`` [N] at relative position ``z`` [m] (eq. 2).
+    """Spring force [N] at relative position ``z`` [m]: the MagSpring's ``-a*tanh(b*z)``
+    (eq. 2), or the isolator's own law (``spring``, docs/model.md §3.1).
 
     Parameters
     ----------
     relative_position : float or array_like
         Relative position z [m].
     params : IsolatorParameters
-        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b), or its ``spring`` law.
 
     Returns
     -------
     float or ndarray
         Spring force on the payload [N].
     """
+    law = _other_law(params)
+    if law is not None:
+        return law.force(relative_position)
     z = np.asarray(relative_position, dtype=float)
     return -params.spring_force * np.tanh(params.spring_shape * z)
+
+
+def _other_law(params):
+    """``params``' spring law when it is not the MagSpring's tanh (which the functions here
+    evaluate from ``spring_force`` and ``spring_shape``, bit for bit as before laws), else
+    None. A model without a ``spring`` law (a smooth model's copy of the fields) has the tanh."""
+    law = getattr(params, "spring", None)
+    if isinstance(law, SpringLaw) and not isinstance(law, TanhSpring):
+        return law
+    return None
+
+
+def refuse_spring_law(isolator, what, where="",
+                      fix="simulate one axis with this law (qzs.simulate)"):
+    """Refuse a spring law other than the tanh where only the tanh is evaluated yet.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        The plant.
+    what : str
+        What evaluates the tanh only (``"the hexapod"``, ``"the C model"``), for the message.
+    where : str
+        A prefix naming the part (``"leg 6: "``).
+    fix : str
+        The way out, after "give spring=None or a TanhSpring, or".
+
+    Raises
+    ------
+    ParameterError
+        ``spring`` neither None nor a TanhSpring, naming the fix.
+    """
+    law = _other_law(isolator)
+    if law is not None:
+        raise ParameterError(
+            f"{where}`spring` ({law.describe()}) is not supported by {what} yet: it evaluates "
+            "the MagSpring's tanh of `spring_force` and `spring_shape` only (docs/model.md "
+            f"§3.1); give spring=None or a TanhSpring, or {fix}.", ("spring",))
 
 
 @overload
@@ -269,39 +312,48 @@ def spring_stiffness(relative_position: ArrayLike,
 
 def spring_stiffness(relative_position: ArrayLike,
                      params: "IsolatorParameters") -> float | NDArray[np.float64]:
-    """Tangent stiffness ``a*b/cosh(b*z)^2`` [N/m] of the MagSpring at ``z`` [m].
+    """Tangent stiffness ``-dF/dz`` [N/m] at ``z`` [m]: the MagSpring's ``a*b/cosh(b*z)^2``,
+    or the isolator's own law's (``spring``, docs/model.md §3.1).
 
     Parameters
     ----------
     relative_position : float or array_like
         Relative position z [m].
     params : IsolatorParameters
-        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b), or its ``spring`` law.
 
     Returns
     -------
     float or ndarray
-        Tangent stiffness [N/m].
+        Tangent stiffness [N/m], positive restoring.
     """
+    law = _other_law(params)
+    if law is not None:
+        return law.stiffness(relative_position)
     z = np.asarray(relative_position, dtype=float)
     return params.spring_force * params.spring_shape / np.cosh(params.spring_shape * z) ** 2
 
 
 def spring_energy(relative_position, params):
-    """Potential energy ``(a/b)*ln(cosh(b*z))`` [J] stored in the MagSpring, 0 at z = 0.
+    """Potential energy [J] stored in the spring: the MagSpring's ``(a/b)*ln(cosh(b*z))``,
+    0 at z = 0, or the isolator's own law's (``spring``, zero at the law's reference
+    position, docs/model.md §3.1).
 
     Parameters
     ----------
     relative_position : float or array_like
         Relative position z [m].
     params : IsolatorParameters
-        Supplies ``spring_force`` (a) and ``spring_shape`` (b).
+        Supplies ``spring_force`` (a) and ``spring_shape`` (b), or its ``spring`` law.
 
     Returns
     -------
     float or ndarray
         Stored energy [J].
     """
+    law = _other_law(params)
+    if law is not None:
+        return law.energy(relative_position)
     u = np.abs(params.spring_shape * np.asarray(relative_position, dtype=float))
     return params.spring_force / params.spring_shape * (u + np.log1p(np.exp(-2 * u)) - np.log(2))
 

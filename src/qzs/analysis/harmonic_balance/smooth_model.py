@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs._validation import non_negative_real, positive_real
-from qzs.model.isolator import (friction_force, friction_slope, spring_force,
-                                spring_stiffness)
+from qzs.model.isolator import (friction_force, friction_slope, refuse_spring_law,
+                                spring_force, spring_stiffness)
 from qzs.model.controller import refuse_blocks
 from qzs.model.registry import model_inputs
 
@@ -132,6 +132,8 @@ class SmoothModel:
         isolator, controller = model_inputs(isolator, controller)
         refuse_blocks(controller, "the harmonic balance",
                       "simulate the steady state instead (qzs.simulate of a sine)")
+        refuse_spring_law(isolator, "the harmonic balance",
+                          fix="simulate the steady state instead (qzs.simulate of a sine)")
         center = (controller.position_setpoint if isolator.stop_center is None
                   else isolator.stop_center)
         return cls(mass=isolator.mass, gravity=isolator.gravity,

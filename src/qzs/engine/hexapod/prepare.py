@@ -20,7 +20,6 @@ from qzs.engine.hexapod.layout import (
     V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
     V_TX, V_TY, V_TZ, V_YDD, V_ZHIGH, V_ZLOW, V_ZREF)
 from qzs.engine.prepare import (check_record, linear_initial_state, linear_output, pack_model,
-                                refuse_spring_law,
                                 steps_per_sample)
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError
@@ -28,7 +27,7 @@ from qzs.model.controller import ControllerParameters, refuse_blocks
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
-from qzs.model.isolator import IsolatorParameters, spring_force
+from qzs.model.isolator import IsolatorParameters, refuse_spring_law, spring_force
 
 __all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks"]
 
