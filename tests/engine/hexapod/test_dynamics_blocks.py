@@ -81,8 +81,9 @@ ACCELERATING = Sine(amplitude=0.01, frequency=3.0, phase=np.pi / 2, fade_in=0.0)
 #: acceleration (+7.1 N), a discrete controller's states at equilibrium with the payload's
 #: acceleration (C x0 + D u0 = -2.3 N).
 STARTS = {
-    "measured velocity, moving base": (MOVING, PIDamping() + LinearController.from_transfer_function(
-        [-40.0], [1.0], "measured_payload_velocity")),
+    "measured velocity, moving base": (
+        MOVING, PIDamping() + LinearController.from_transfer_function(
+            [-40.0], [1.0], "measured_payload_velocity")),
     "base acceleration, accelerating base": (
         ACCELERATING, PIDamping() + LinearController.from_transfer_function(
             [-2.0], [1.0], "base_acceleration")),
