@@ -197,12 +197,6 @@ def test_a_discrete_sample_time_shorter_than_a_step_is_refused_before_the_run():
         pack_model(IsolatorParameters(), PIDamping() + short, 1e-4)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "known bug (mutation round mut40b, issue 40): _initial_state counts the blocks' output at "
-    "t = 0 with the base at rest but the charge amplifier's high-pass settled on the moving "
-    "base, so a feedthrough D on the measured velocity is counted as D*(-y'(0)) while its "
-    "output at t = 0 is 0; the motor starts D*y'(0) off the static load. Fix in prepare.py, "
-    "its C mirror (qzs_fmu.c initial_state, the C model) and the legs; then drop this mark."))
 def test_a_feedthrough_on_the_measured_velocity_leaves_the_motor_at_the_static_load():
     """The preload is bumpless with a linear controller too (docs/model.md §5.1, initial
     state): on a base already moving at t = 0 (no fade-in), a static gain on the measured

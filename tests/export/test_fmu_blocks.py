@@ -5,7 +5,9 @@ lead-lag and a discrete 2-state controller, the closed-loop FMU stepped by FMPy 
 internal steps gives every recorded channel of :func:`qzs.simulate`, the blocks' own among
 them, to the bit, in FMI 3.0 and 2.0. The blocks' parameters are FMU parameters with units,
 their exported values as start, and the C model takes a changed one; the sources of an FMU
-with every block compile with every warning an error.
+with every block compile with every warning an error. The FMU starts as qzs does on a base
+moving or accelerating at t = 0: the PI's preload nets the blocks' output there, the linear
+controller's initial state loaded first.
 """
 import dataclasses
 
@@ -135,27 +137,80 @@ def test_the_bounds_of_the_block_parameters_are_those_of_qzs(fmu_of):
              **{"controller.linear.sample_time": 0.0})
 
 
+#: A base moving at t = 0 (y' = 2 pi f A = 0.19 m/s, y'' = 0) and one accelerating
+#: (y'' = -(2 pi f)^2 A = -3.55 m/s^2, y' = 0): no fade-in.
+MOVING = qzs.Sine(amplitude=0.01, frequency=3.0, fade_in=0.0)
+ACCELERATING = qzs.Sine(amplitude=0.01, frequency=3.0, phase=np.pi / 2, fade_in=0.0)
+#: A short run: what these tests look at is the start.
+SHORT = dict(dt=1e-4, sample_rate=1000.0, duration=0.2)
+
+
+def _short_fmu(folder, excitation, controller, version):
+    return export.export_fmu(folder / "start.fmu", excitation, None, controller,
+                             fmi_version=version, dt=SHORT["dt"], duration=SHORT["duration"],
+                             communication_step=1.0 / SHORT["sample_rate"])
+
+
+def _short_run(path, **start_values):
+    return fmpy.simulate_fmu(str(path), stop_time=SHORT["duration"],
+                             output_interval=1.0 / SHORT["sample_rate"],
+                             start_values=start_values)
+
+
+def _static_load(isolator=qzs.IsolatorParameters()):
+    """m*g - a*tanh(-b*z_ref): the load the spring does not carry at the setpoint [N]."""
+    return isolator.mass * isolator.gravity - isolator.spring_force * np.tanh(
+        -isolator.spring_shape * qzs.PIDamping().position_setpoint)
+
+
 @pytest.mark.parametrize("version", VERSIONS)
-def test_the_pi_preload_counts_a_linear_feedthrough_as_qzs_simulate_does(tmp_path, version):
-    """A base already moving at t = 0 (no fade-in: y' = 2 pi f A) and the lead-lag with a
-    feedthrough D on the measured velocity, set as an FMU start value: the PI's preload counts
-    the linear output the preload sees (D times the measured velocity with the base at rest,
-    not 0) as qzs.simulate's does, so every channel is the run's to the bit. The exported
-    lead-lag has D = 0 and the faded-in cases a base at rest: there that term is 0 and a preload
-    that left it out would pass (docs/model.md §5.1, initial state)."""
-    name = "continuous lead-lag"
-    _, isolator, controller, _ = CASES[name]
-    moving = qzs.Sine(amplitude=0.01, frequency=3.0, fade_in=0.0)
-    kwargs = settings(name)
-    path = export.export_fmu(tmp_path / "moving.fmu", moving, isolator, controller,
-                             fmi_version=version, dt=kwargs["dt"], duration=kwargs["duration"],
-                             communication_step=1.0 / kwargs["sample_rate"])
+def test_a_feedthrough_on_the_measured_velocity_starts_the_fmu_at_the_static_load(tmp_path,
+                                                                                 version):
+    """A base already moving at t = 0 and a feedthrough D on the measured velocity, set as an
+    FMU start value: at t = 0 the amplifier's high-pass has settled, D puts out 0, and the PI
+    starts where it starts without D, the motor at the static load, as in qzs.simulate, every
+    channel to the bit (docs/model.md §5.1, initial state). The FMU's preload used to count D
+    times the velocity measured with the base at rest, -y'(0): the motor started at -5.6 N."""
+    controller = CASES["continuous lead-lag"][2]
     d = -40.0  # [N*s/m]
     changed = dataclasses.replace(controller, linear=dataclasses.replace(controller.linear,
                                                                         d=[[d]]))
-    reference = qzs.simulate(moving, isolator, changed, **kwargs)
-    without = qzs.simulate(moving, isolator, controller, **{**kwargs, "duration": 0.01})
-    # the preload's linear term is not 0 here: the PI starts elsewhere than without D
-    assert reference["pi_force"][0] != without["pi_force"][0]
-    result = _run(path, name, **{"controller.linear.d_measured_payload_velocity": d})
+    reference = qzs.simulate(MOVING, None, changed, **SHORT)
+    without = qzs.simulate(MOVING, None, controller, **SHORT)
+    assert reference["pi_force"][0] == pytest.approx(without["pi_force"][0], rel=1e-12)
+    assert reference["motor_force"][0] == pytest.approx(_static_load(), rel=1e-12)
+    result = _short_run(_short_fmu(tmp_path, MOVING, controller, version),
+                        **{"controller.linear.d_measured_payload_velocity": d})
     _assert_same(result, reference, "feedthrough on a moving base")
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_the_fmu_preload_nets_the_linear_output_of_its_initial_state_as_qzs(tmp_path, version):
+    """The discrete controller reading the payload's acceleration, on a base accelerating at
+    t = 0: its states start at equilibrium with that acceleration (the exported
+    linear.initial_state), so its output at t = 0 is C x0 + D u0 = -2.3 N, and the PI's
+    preload nets it: the motor starts at the static load, as in qzs.simulate, every channel
+    to the bit. The FMU used to load linear.initial_state after the preload: the motor started
+    C x0 off."""
+    controller = CASES["discrete controller"][2]
+    reference = qzs.simulate(ACCELERATING, None, controller, **SHORT)
+    assert abs(reference["linear_force"][0]) > 2.0
+    assert reference["motor_force"][0] == pytest.approx(_static_load(), rel=1e-12)
+    _assert_same(_short_run(_short_fmu(tmp_path, ACCELERATING, controller, version)),
+                 reference, "linear output at t = 0 from its states")
+
+
+def test_a_linear_initial_state_set_in_the_fmu_is_netted_by_the_pi_preload(tmp_path):
+    """linear.initial_state is loaded before the PI's preload (docs/fmu.md §3, docs/model.md
+    §5.1): a state set as a start value puts out C x0 at t = 0 and the PI's integral nets it,
+    so the motor starts at the static load whatever the state; the base at rest at t = 0."""
+    controller = CASES["continuous lead-lag"][2]
+    path = _short_fmu(tmp_path, CASES["continuous lead-lag"][0], controller, 3)
+    default = _short_run(path)
+    result = _short_run(path, **{"controller.linear.initial_state[1]": 4e-6})  # C x0 = -2 N
+    assert default["linear_force"][0] == 0.0  # the exported state: at rest, 0
+    assert abs(result["linear_force"][0]) > 1.0
+    for run in (default, result):
+        assert run["motor_force"][0] == pytest.approx(_static_load(), rel=1e-12)
+        assert run["pi_force"][0] + run["linear_force"][0] == pytest.approx(_static_load(),
+                                                                            rel=1e-12)

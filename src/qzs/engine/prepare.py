@@ -341,7 +341,13 @@ def _check_type(name, value, kinds):
 
 
 def _initial_state(initial, isolator, controller, p, m, excitation, packed_excitation):
-    """State vector and flags at t = 0 (at rest at the setpoint by default)."""
+    """State vector and flags at t = 0 (at rest at the setpoint by default).
+
+    The PI's integral (or, without one, a linear controller's integrator) carries the static
+    load, worked out with the base at rest, less every other term of the motor's command as
+    it stands at the run's own t = 0 (:func:`_at_start`): the motor starts at the static load
+    (docs/model.md §5, §5.1).
+    """
     s = np.zeros(K.N_STATE)
     s[K.A_MARGIN] = np.nan  # not known yet: the first step works it out
     flags = np.zeros(K.N_FLAGS, dtype=np.int64)
@@ -355,24 +361,30 @@ def _initial_state(initial, isolator, controller, p, m, excitation, packed_excit
     yd0 = base_motion_series(excitation, [0.0])[1][0]
     s[K.S_HP] = yd0 + initial.relative_velocity  # the amplifier's high-pass has settled
     model = K.kernel_model(m)  # None on the default path: its kernels only
-    measured = K.hold_force(0.0, s, p, model, *packed_excitation)[K.F_V_MEASURED]
-    if initial.pi_integral is not None:
+    measured = _at_start(s, p, model, packed_excitation)[0][K.F_V_MEASURED]
+    preload = initial.pi_integral is None
+    needed = None
+    if not preload:
         s[K.S_INT] = initial.pi_integral
-    elif controller.pi_ki > 0:
-        # Preload: the motor carries the static load the spring and stops do not, nothing
-        # more. Evaluated with the base at rest: the base's acceleration at t = 0 is no load
-        # the integrator should hold (docs/model.md §11).
+    elif controller.pi_ki > 0 or controller.linear is not None:
+        # The static load the motor carries: what the spring and stops do not, nothing more.
+        # Evaluated with the base at rest: the base's acceleration at t = 0 is no load the
+        # integrator should hold (docs/model.md §5).
         force = K.hold_force(0.0, s, p, model, *_AT_REST)
         without_motor = force[K.F_HOLD] + force[K.F_MOTOR]
         needed = np.clip(without_motor, -isolator.motor_force_max, isolator.motor_force_max)
+    if controller.linear is not None:  # its states first: its output at t = 0 is netted below
+        _preload_linear(s, p, m, controller, packed_excitation,
+                        needed if controller.pi_ki == 0 else None)
+    if preload and controller.pi_ki > 0:
+        # the rest of the command at the run's own t = 0: the motor starts at `needed`
         f_pi, f_damp = K.controller_output(K.params_tuple(p), z0, measured, 0.0)[:2]
-        if controller.has_blocks:  # the blocks' static output at t = 0 too
-            blocks = force[K.F_COMPENSATION] + force[K.F_DITHER] + force[K.F_LINEAR]
+        if controller.has_blocks:
+            f_comp, f_dither, f_linear = _blocks_at_start(s, p, m, packed_excitation)
+            blocks = f_comp + f_dither + f_linear
             s[K.S_INT] = (needed - f_pi - f_damp - blocks) / controller.pi_ki
         else:
             s[K.S_INT] = (needed - f_pi - f_damp) / controller.pi_ki
-    if controller.linear is not None:
-        _preload_linear(s, p, m, controller, packed_excitation, initial.pi_integral is None)
     held = K.controller_output(K.params_tuple(p), z0, measured, s[K.S_INT])
     s[K.A_F_PI], s[K.A_F_DAMP], s[K.A_F_MOTOR] = held[:3]
     if controller.has_blocks:
@@ -398,27 +410,65 @@ def _initial_state(initial, isolator, controller, p, m, excitation, packed_excit
     return s, flags
 
 
-def _preload_linear(s, p, m, controller, packed_excitation, preload):
+def _at_start(s, p, model, packed_excitation):
+    """The forces (``F_*``) and the five sensors (``K.U_*``) at the run's own t = 0.
+
+    State ``s`` on the real base motion, slipping if it starts with a relative velocity
+    (``S_V`` != 0, in its direction) else held (the payload's acceleration the base's), each
+    block by its law (a sampled one's output at the initial state, not the value it held
+    before it: none); the PI's integral as ``s`` holds it.
+    """
+    laws = p.copy()
+    laws[K.P_CONTROL_STEPS] = 0.0
+    if s[K.S_V] == 0.0:
+        force = K.hold_force(0.0, s, laws, model, *packed_excitation)
+    else:
+        ex, table = packed_excitation
+        force = K.rhs_at(0.0, K.state_tuple(s), K.blocks_tuple(s), np.int64(K.MODE_SLIP),
+                         float(np.sign(s[K.S_V])), K.held_tuple(s), K.params_tuple(laws), model,
+                         K.excitation_tuple(ex), table)[1]
+    sensors = np.array([p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD],
+                        force[K.F_YDD], s[K.S_V]])
+    return force, sensors
+
+
+def _blocks_at_start(s, p, m, packed_excitation):
+    """What the blocks put out at the run's own t = 0 (:func:`_at_start`) [N].
+
+    Returns ``(compensation, dither, linear)``: the compensation with the observer's
+    estimate at 0, the dither at t = 0, the linear controller's ``C x0 + D u0`` with its
+    states as ``s`` holds them (a continuous one's without the payload's acceleration, which
+    it reads through ``B`` only).
+    """
+    force, sensors = _at_start(s, p, m, packed_excitation)
+    f_linear = force[K.F_LINEAR]
+    if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's output at x(0): C x + D u
+        f_linear = linear_output(m, s[K.A_X0:K.A_X0 + K.NX_MAX], sensors)
+    return force[K.F_COMPENSATION], force[K.F_DITHER], f_linear
+
+
+def _preload_linear(s, p, m, controller, packed_excitation, needed):
     """A linear controller's state at t = 0: at equilibrium with its sensors' values there.
 
-    ``x0`` solves ``A x0 + B u0 = 0`` (least squares); and when the PI has no integral
-    (``pi_ki = 0``) and ``preload``, it also carries the static load the spring and stops do
-    not, ``C x0 + D u0 = needed - F_pi - F_damp``, if its states can (an integrator): the
-    same bumpless preload as the PI's (docs/model.md §5). Discrete: ``x0 = A x0 + B u0``.
+    ``x0`` solves ``A x0 + B u0 = 0`` (least squares), ``u0`` the sensors at the run's own
+    t = 0 (:func:`_at_start`); with the static load ``needed`` [N] (the PI has no integral,
+    ``pi_ki = 0``, and its integral is not given; else None), it also carries what the rest
+    of the command does not there, ``C x0 + D u0 = needed - F_pi - F_damp - F_comp -
+    F_dither``, if its states can (an integrator): the same bumpless preload as the PI's
+    (docs/model.md §5.1). Discrete: ``x0 = A x0 + B u0``.
     """
     linear = controller.linear
     n = linear.states
     if n == 0:
         return
-    force = K.hold_force(0.0, s, p, m, *packed_excitation)
-    sensors = np.array([p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD],
-                        force[K.F_YDD], 0.0])
-    load, needed = None, 0.0
-    if preload and controller.pi_ki == 0:
-        at_rest = K.hold_force(0.0, s, p, m, *_AT_REST)
-        needed = np.clip(at_rest[K.F_HOLD] + at_rest[K.F_MOTOR], -p[K.P_FMAX], p[K.P_FMAX])
-        load = needed - at_rest[K.F_PI] - at_rest[K.F_DAMP]
-    s[K.A_X0:K.A_X0 + n] = linear_initial_state(linear, sensors, load, needed)
+    force, sensors = _at_start(s, p, m, packed_excitation)
+    load = None
+    if needed is not None:
+        f_pi, f_damp = K.controller_output(K.params_tuple(p), s[K.S_Z],
+                                           force[K.F_V_MEASURED], s[K.S_INT])[:2]
+        load = needed - f_pi - f_damp - force[K.F_COMPENSATION] - force[K.F_DITHER]
+    s[K.A_X0:K.A_X0 + n] = linear_initial_state(linear, sensors, load,
+                                                0.0 if needed is None else needed)
 
 
 def linear_initial_state(linear, sensors, load=None, needed=0.0):
@@ -480,18 +530,17 @@ def linear_output(m, x, sensors):
 
 
 def _hold_blocks(s, p, m, packed_excitation):
-    """The held outputs of sampled blocks at t = 0: what they put out at the initial state.
+    """The held outputs of sampled blocks at t = 0: what they put out at the initial state
+    (:func:`_blocks_at_start`, the values the PI's preload netted).
 
     The kernels sample at step 0 before the first step, so these only matter for the
     first record and the holding force at t = 0; a continuous block's held value is unused.
     """
-    force = K.hold_force(0.0, s, p, m, *packed_excitation)
-    s[K.A_F_COMPENSATION] = force[K.F_COMPENSATION]
-    s[K.A_F_DITHER] = force[K.F_DITHER]
-    if m[K.M_LINEAR_STEPS] > 0:  # a discrete controller's output at x(0): C x + D u
-        u = (p[K.P_ZREF] - s[K.S_Z], force[K.F_V_MEASURED], force[K.F_XDD], force[K.F_YDD],
-             0.0)
-        s[K.A_F_LINEAR] = linear_output(m, s[K.A_X0:K.A_X0 + K.NX_MAX], u)
+    f_comp, f_dither, f_linear = _blocks_at_start(s, p, m, packed_excitation)
+    s[K.A_F_COMPENSATION] = f_comp
+    s[K.A_F_DITHER] = f_dither
+    if m[K.M_LINEAR_STEPS] > 0:
+        s[K.A_F_LINEAR] = f_linear
 
 
 @dataclass

@@ -222,7 +222,8 @@ def _block_parameters(isolator, controller, model, blocks_state):
         for i in range(n):
             add(f"linear.initial_state[{i + 1}]", "", "the linear controller's state at t = 0 "
                 "(exported: at equilibrium with its sensors, as qzs starts it; set it with the "
-                "matrices)", blocks_state[i], MODEL_INITIAL_STATE + i)
+                "matrices; loaded before the PI's preload, which nets its output)",
+                blocks_state[i], MODEL_INITIAL_STATE + i)
         if linear.discrete:
             add("linear.sample_time", "s", "the discrete linear controller's period, a whole "
                 "number of step_size", linear.sample_time, MODEL_SAMPLE_TIME)

@@ -72,6 +72,44 @@ def test_six_vertical_legs_with_blocks_are_six_single_axes(name, validation):
                "events included", difference, 1e-9, measure="largest leg position difference [m]")
 
 
+
+#: A base moving at t = 0 (y' = 0.19 m/s) and one accelerating (y'' = -3.55 m/s^2): no fade-in.
+MOVING = Sine(amplitude=0.01, frequency=3.0, fade_in=0.0)
+ACCELERATING = Sine(amplitude=0.01, frequency=3.0, phase=np.pi / 2, fade_in=0.0)
+#: What each leg's controller puts out at t = 0 besides the PI's integral: nothing (a
+#: feedthrough on the measured velocity, the amplifier settled), a feedthrough on the base's
+#: acceleration (+7.1 N), a discrete controller's states at equilibrium with the payload's
+#: acceleration (C x0 + D u0 = -2.3 N).
+STARTS = {
+    "measured velocity, moving base": (
+        MOVING, PIDamping() + LinearController.from_transfer_function(
+            [-40.0], [1.0], "measured_payload_velocity")),
+    "base acceleration, accelerating base": (
+        ACCELERATING, PIDamping() + LinearController.from_transfer_function(
+            [-2.0], [1.0], "base_acceleration")),
+    "discrete on the payload's acceleration": (ACCELERATING, PIDamping() + LinearController(
+        a=[[0.9, 0.05], [0.0, 0.8]], b=[[1e-3, 0.0], [0.0, 0.01]], c=[30.0, -2.0],
+        d=[10.0, 0.0], inputs=("position_error", "payload_acceleration"), sample_time=1e-3)),
+}
+
+
+@pytest.mark.parametrize("name", list(STARTS))
+def test_six_vertical_legs_start_their_motors_where_the_single_axis_does(name):
+    """docs/model.md §5.1, initial state: each leg's PI preload nets what its blocks put out at
+    t = 0, as the single axis's does, so each of the six motors starts at the single axis's
+    motor force, the static load the spring does not carry, on a base already moving or
+    accelerating at t = 0. The legs used to leave their blocks' output out (the base at rest)."""
+    excitation, controller = STARTS[name]
+    options = dict(duration=0.01, sample_rate=10000.0)
+    single = simulate(excitation, ISOLATOR, controller, **options)
+    result = simulate_hexapod(vertical_legs(), _platform(), ISOLATOR, controller,
+                              excitation={"z": excitation}, **options)
+    static = ISOLATOR.mass * ISOLATOR.gravity - ISOLATOR.spring_force * np.tanh(
+        -ISOLATOR.spring_shape * controller.position_setpoint)
+    assert single["motor_force"][0] == pytest.approx(static, rel=1e-12)
+    np.testing.assert_allclose(result["motor_force"][0], single["motor_force"][0], rtol=0,
+                               atol=1e-9)
+
 @pytest.mark.parametrize("rate", [0.0, 1000.0], ids=["continuous", "sampled"])
 def test_compensation_of_fraction_zero_is_no_compensation_bit_for_bit(rate):
     """On the cubic platform (nothing decouples), a compensation of fraction 0 on every leg

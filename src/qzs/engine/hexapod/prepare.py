@@ -175,20 +175,24 @@ def _start_blocks(controllers, models, needed, state, V):
     both accelerometers reading the base joint's acceleration along the leg, row ``YDD``
     of the evaluation at t = 0), carrying the leg's static load ``needed`` [N] when its PI
     has no integral (:func:`qzs.engine.prepare.linear_initial_state`); a discrete one holds
-    its output there. The PI's preload needs no change: the blocks put out nothing at home
-    with the base at rest.
+    its output there. Returns each leg's blocks' output at t = 0 [N], shape (6,), which the
+    PI's preload nets: the linear controller's ``C x0 + D u0`` (the compensation puts out
+    nothing with the payload held, the dither nothing at t = 0).
     """
+    outputs = np.zeros(LEG_COUNT)
     for i, (con, m) in enumerate(zip(controllers, models)):
         linear = con.linear
-        if linear is None or linear.states == 0:
+        if linear is None:
             continue
         sensors = np.array([0.0, 0.0, V[V_YDD + i], V[V_YDD + i], 0.0])
-        load = needed[i] if con.pi_ki == 0 else None
-        x0 = linear_initial_state(linear, sensors, load, needed[i])
-        state[S_X + i * K.N_X:S_X + i * K.N_X + linear.states] = x0
+        x = state[S_X + i * K.N_X:S_X + i * K.N_X + K.NX_MAX]  # a view: written in place
+        if linear.states:
+            load = needed[i] if con.pi_ki == 0 else None
+            x[:linear.states] = linear_initial_state(linear, sensors, load, needed[i])
+        outputs[i] = linear_output(m, x, sensors)
         if linear.discrete:
-            V[V_HLI + i] = linear_output(m, state[S_X + i * K.N_X:S_X + i * K.N_X + K.NX_MAX],
-                                         sensors)
+            V[V_HLI + i] = outputs[i]
+    return outputs
 
 
 @dataclass
@@ -399,20 +403,23 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     # the kernels' own arithmetic: z = z_ref exactly at home
     V[V_LHOME:V_LHOME + LANES] = V[V_L:V_L + LANES]
     # PI preload (docs/model.md §5 for each leg): the motor carries the static leg load the
-    # spring does not (stops untouched at the setpoint), the base at rest.
+    # spring does not (stops untouched at the setpoint), the base at rest, less the blocks'
+    # output at t = 0 (the linear controller's states first); P and D put out nothing at home.
     loads = _static_forces(geometry, platform)
     needed = np.zeros(LEG_COUNT)
     for i, (iso, con) in enumerate(zip(isolators, controllers)):
         spring = spring_force(con.position_setpoint, iso)
         needed[i] = np.clip(loads[i] - spring, -iso.motor_force_max, iso.motor_force_max)
+    started = np.zeros(LEG_COUNT)
+    if blocks:  # refused with centralised control
+        started = _start_blocks(controllers, models, needed, state, V)
+    for i, con in enumerate(controllers):
         if cartesian is None and con.pi_ki > 0:
-            state[S_INT + i] = needed[i] / con.pi_ki
+            state[S_INT + i] = (needed[i] - started[i]) / con.pi_ki
     if cartesian is not None:  # the same leg forces from the axes' integrals, J^-T Ki I = f
         wrench = jacobian(geometry, point=cartesian.point_in_top_frame(platform)).T @ needed
         held = cartesian.integral_gain > 0
         state[S_INT:S_INT + LEG_COUNT][held] = wrench[held] / cartesian.integral_gain[held]
-    if blocks:
-        _start_blocks(controllers, models, needed, state, V)
     return _Prepared(geometry, platform, isolators, controllers, moving, duration, dt,
                      sample_rate, decimation, solver, solver_code, V, plat, packed, ex, tables,
                      toff, state, cartesian)

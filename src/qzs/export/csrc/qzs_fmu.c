@@ -262,9 +262,40 @@ static int pack_model(QzsFmu *fmu, double *M, double *x0) {
 }
 #endif
 
+#if !QZS_FMU_PLANT_MODE
+/* qzs.engine.prepare._blocks_at_start: what the blocks put out at the run's own t = 0 (the
+ * real base motion, the payload held, the linear controller's states x), each block by its
+ * law (a sampled one's output at the initial state, the observer's estimate 0):
+ * compensation, dither and the linear output, a discrete one's C x + D u. */
+static void blocks_at_start(const QzsPlant *plant, const QzsOde *s, const QzsBlocks *x,
+                            double *f_comp, double *f_dither, double *f_linear) {
+    QzsPlant laws = *plant;
+    laws.P[QZS_P_CONTROL_STEPS] = 0.0;
+    const double none[QZS_N_HELD] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    QzsForces force;
+    qzs_rhs_at(&laws, 0.0, s, x, QZS_MODE_STICK, 0.0, none, 0, &force);
+    *f_comp = force.compensation;
+    *f_dither = force.dither;
+    *f_linear = force.linear;
+    const double *M = plant->M;
+    if (M[QZS_M_LINEAR_STEPS] > 0.0) {
+        double u[QZS_N_SENSORS] = {plant->P[QZS_P_ZREF] - s->x[QZS_S_Z], force.v_measured,
+                                   force.xdd, force.ydd, 0.0};
+        double cx = 0.0, du = 0.0;
+        for (int j = 0; j < QZS_NX_MAX; j++)
+            cx += M[QZS_M_C + j] * x->x[j];
+        for (int k = 0; k < QZS_N_SENSORS; k++)
+            du += M[QZS_M_D + k] * u[k];
+        *f_linear = cx + du;
+    }
+}
+#endif
+
 /* The initial state, as qzs.engine.prepare._initial_state makes it by default: at rest at the
- * setpoint, the high-pass settled, the PI preloaded with the static load, stuck if friction
- * can hold the payload. */
+ * setpoint, the high-pass settled, the linear controller's states x0 (linear.initial_state),
+ * the PI preloaded with the static load (worked out with the base at rest) less the rest of
+ * the command at the run's own t = 0, the blocks' output with x0 among it (docs/model.md §5,
+ * §5.1), stuck if friction can hold the payload. */
 static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t *flags) {
     const QzsPlant *plant = &fmu->run.plant;
     const double *P = plant->P;
@@ -288,6 +319,7 @@ static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t 
 #else
     qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
     double measured = force.v_measured;
+    double needed = 0.0;
     if (V(CONTROLLER_PI_KI) > 0.0) {
         QzsPlant at_rest = *plant; /* the base at rest: qzs.engine.prepare._AT_REST */
         double rest[QZS_N_EXCITATION] = {QZS_KIND_SINE, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
@@ -295,37 +327,34 @@ static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t 
         qzs_rhs_at(&at_rest, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
         double without_motor = force.hold + force.motor;
         double f_max = V(ISOLATOR_MOTOR_FORCE_MAX);
-        double needed = without_motor < -f_max ? -f_max : (without_motor > f_max ? f_max
-                                                                                 : without_motor);
-        QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, 0.0);
-        if (plant->blocks) /* the blocks' static output at t = 0 too */
-            s.x[QZS_S_INT] = (needed - c.pi - c.damping -
-                              (force.compensation + force.dither + force.linear)) /
-                             V(CONTROLLER_PI_KI);
-        else
-            s.x[QZS_S_INT] = (needed - c.pi - c.damping) / V(CONTROLLER_PI_KI);
+        needed = without_motor < -f_max ? -f_max : (without_motor > f_max ? f_max
+                                                                          : without_motor);
     }
+    /* linear.initial_state before the PI's preload, which nets its output (C x0 + D u0) */
     for (int j = 0; j < QZS_N_X; j++) /* prepare._preload_linear, as exported */
         x.x[j] = x0[j];
+    if (V(CONTROLLER_PI_KI) > 0.0) {
+        QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, 0.0);
+        if (plant->blocks) {
+            double f_comp, f_dither, f_linear;
+            blocks_at_start(plant, &s, &x, &f_comp, &f_dither, &f_linear);
+            double blocks = f_comp + f_dither + f_linear;
+            s.x[QZS_S_INT] = (needed - c.pi - c.damping - blocks) / V(CONTROLLER_PI_KI);
+        } else {
+            s.x[QZS_S_INT] = (needed - c.pi - c.damping) / V(CONTROLLER_PI_KI);
+        }
+    }
     QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, s.x[QZS_S_INT]);
     held[QZS_H_PI] = c.pi;
     held[QZS_H_DAMP] = c.damping;
     held[QZS_H_MOTOR] = c.motor;
     if (plant->blocks) { /* prepare._hold_blocks: what the sampled blocks put out at t = 0 */
-        const double *M = plant->M;
-        qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
-        held[QZS_H_COMPENSATION] = force.compensation;
-        held[QZS_H_DITHER] = force.dither;
-        if (M[QZS_M_LINEAR_STEPS] > 0.0) {
-            double u[QZS_N_SENSORS] = {P[QZS_P_ZREF] - s.x[QZS_S_Z], force.v_measured,
-                                       force.xdd, force.ydd, 0.0};
-            double cx = 0.0, du = 0.0;
-            for (int j = 0; j < QZS_NX_MAX; j++)
-                cx += M[QZS_M_C + j] * x.x[j];
-            for (int k = 0; k < QZS_N_SENSORS; k++)
-                du += M[QZS_M_D + k] * u[k];
-            held[QZS_H_LINEAR] = cx + du;
-        }
+        double f_comp, f_dither, f_linear;
+        blocks_at_start(plant, &s, &x, &f_comp, &f_dither, &f_linear);
+        held[QZS_H_COMPENSATION] = f_comp;
+        held[QZS_H_DITHER] = f_dither;
+        if (plant->M[QZS_M_LINEAR_STEPS] > 0.0)
+            held[QZS_H_LINEAR] = f_linear;
     }
 #endif
     qzs_rhs_at(plant, 0.0, &s, &x, QZS_MODE_STICK, 0.0, held, 0, &force);
