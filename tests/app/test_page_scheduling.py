@@ -8,9 +8,9 @@ before), the moment at which a new page of the browser tests once never drew.
 """
 import asyncio
 import threading
-from concurrent.futures import Future
 
 import pytest
+from helpers import HeldExecutor
 
 pytest.importorskip("panel", reason='the page needs Panel: pip install -e ".[app]"')
 
@@ -24,29 +24,12 @@ from qzs.app import page as page_module  # noqa: E402
 from qzs.app.compute import page_request  # noqa: E402
 
 
-class HeldExecutor:
-    """An executor whose computations run when the test says, on a thread of its own."""
-
-    def __init__(self):
-        self.jobs = []
-
-    def submit(self, function, request):
-        future = Future()
-        self.jobs.append((future, function, request))
-        return future
-
-    def finish_on_another_thread(self):
-        """Run every waiting computation on a new thread (as the server's computing
-        thread would) and wait for it; the futures' callbacks run on that thread."""
-        jobs, self.jobs = self.jobs, []
-
-        def work():
-            for future, function, request in jobs:
-                future.set_result(function(request))
-
-        thread = threading.Thread(target=work)
-        thread.start()
-        thread.join()
+def _finish_on_another_thread(executor):
+    """Run the waiting computations on a new thread, as the server's computing thread
+    would (their futures' callbacks run there), and wait for it."""
+    thread = threading.Thread(target=lambda: [executor.finish() for _ in list(executor.jobs)])
+    thread.start()
+    thread.join()
 
 
 async def _serve_and_render(monkeypatch, during):
@@ -65,14 +48,14 @@ async def _serve_and_render(monkeypatch, during):
     def finish_while_rendering(stylesheet, dist_url):
         if during and not seen:  # the first stylesheet: the document is held now
             seen["hold"] = document.callbacks.hold_value
-            executor.finish_on_another_thread()
+            _finish_on_another_thread(executor)
         return patch_stylesheet(stylesheet, dist_url)
 
     monkeypatch.setattr(resources, "patch_stylesheet", finish_while_rendering)
     resources.patch_model_css(root, dist_url="static/extensions/panel/")  # as GET / does
     if not during:
         seen["hold"] = document.callbacks.hold_value
-        executor.finish_on_another_thread()
+        _finish_on_another_thread(executor)
     for _ in range(200):  # the event loop runs the session's callbacks
         if page.data is not None:
             break
