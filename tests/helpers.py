@@ -322,3 +322,25 @@ def write_log_csv(path, time=LOG_TIME, base=LOG_BASE, payload=LOG_PAYLOAD):
         for row in zip(time, base, payload, np.zeros(len(time))):
             handle.write(",".join(repr(float(x)) for x in row) + "\n")
     return path
+
+
+class HeldExecutor:
+    """An executor whose futures the test completes, in any order (the app's updates)."""
+
+    def __init__(self):
+        self.jobs = []
+
+    def submit(self, function, request):
+        from concurrent.futures import Future
+
+        future = Future()
+        self.jobs.append((future, function, request))
+        return future
+
+    def finish(self, index=0):
+        """Compute the job at ``index`` in this thread; its future's callbacks run here."""
+        future, function, request = self.jobs.pop(index)
+        try:
+            future.set_result(function(request))
+        except Exception as error:  # noqa: BLE001 - the updater delivers it
+            future.set_exception(error)

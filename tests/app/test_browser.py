@@ -67,28 +67,20 @@ DRAW = 120.0
 def open_page(context, server, server_log):
     """A new page, or a failure that shows what the server printed meanwhile.
 
-    A page that has not drawn within :data:`DRAW` is closed and opened once more, saying so
-    on the test's output: twice lately (CI, and a fresh clone's suite), a new
-    page never drew while the server sat idle after its warm-up (no request pending, nothing
-    compiling), and the cause is not found yet (CHANGELOG, issue 40's notes). A second page
-    that does not draw either fails the test with the server's output.
+    No second try: a new page that once never drew while the server sat idle had lost its
+    first result (it ended while the server rendered the page, and the document's hold
+    dropped the callback that delivers it); the page now hands results to the event loop
+    first (tests/app/test_page_scheduling.py), so a page that does not draw is a failure.
     """
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
-    for attempt in (1, 2):
-        try:
-            return browser.open_page(context, server, timeout=DRAW)
-        except PlaywrightTimeout:
-            server_log.flush()
-            server_log.seek(0)
-            printed = server_log.read()[-4000:]
-            for stale in context.pages[-1:]:
-                stale.close()
-            if attempt == 2:
-                pytest.fail(f"the page did not draw within {DRAW:g} s, twice; the server "
-                            f"printed:\n{printed}")
-            print(f"\na new page did not draw within {DRAW:g} s; opening it again. The "
-                  f"server printed:\n{printed}")
+    try:
+        return browser.open_page(context, server, timeout=DRAW)
+    except PlaywrightTimeout:
+        server_log.flush()
+        server_log.seek(0)
+        pytest.fail(f"the page did not draw within {DRAW:g} s; the server printed:\n"
+                    f"{server_log.read()[-4000:]}")
 
 
 @pytest.fixture

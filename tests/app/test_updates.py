@@ -1,28 +1,9 @@
 """One computation at a time per page (qzs.app.updates): the newest request only, a superseded
 result dropped, errors delivered, a cancelled request never delivered."""
-from concurrent.futures import Future
+from helpers import HeldExecutor
 
 from qzs.app.updates import LatestOnly
 from qzs.errors import ParameterError
-
-
-class HeldExecutor:
-    """An executor whose futures the test completes, in any order."""
-
-    def __init__(self):
-        self.jobs = []
-
-    def submit(self, function, request):
-        future = Future()
-        self.jobs.append((future, function, request))
-        return future
-
-    def finish(self, index=0):
-        future, function, request = self.jobs.pop(index)
-        try:
-            future.set_result(function(request))
-        except Exception as error:  # noqa: BLE001 - the updater delivers it
-            future.set_exception(error)
 
 
 def test_latest_only_drops_superseded_results():

@@ -10,6 +10,7 @@ released (``value_throttled``), a field when its value is entered.
 Panel is imported here, never by the layers below; :func:`qzs.app.server.serve` checks
 that it is installed before this module is imported.
 """
+import asyncio
 import io
 import logging
 import sys
@@ -151,6 +152,15 @@ def css_class(name):
     return "qzs-w-" + name.replace(".", "-")
 
 
+def _running_loop():
+    """The event loop running in this thread (the server's, when a session builds its
+    page), or None."""
+    try:
+        return asyncio.get_running_loop()
+    except RuntimeError:
+        return None
+
+
 def _message(error):
     """What the page says about an exception: its message, never a traceback."""
     if isinstance(error, _EXPECTED):
@@ -166,13 +176,14 @@ class TuningPage:
     ----------
     schedule : callable, optional
         ``schedule(callback)`` runs ``callback`` on the session's event loop; default:
-        the current Bokeh document's ``add_next_tick_callback``.
+        the current Bokeh document's ``add_next_tick_callback``, called on that loop.
     executor : concurrent.futures.Executor, optional
         Where computations run; default :data:`EXECUTOR`.
     """
 
     def __init__(self, *, schedule=None, executor=None):
         self.document = pn.state.curdoc
+        self._loop = _running_loop() if self.document is not None else None
         self.data = None
         self.pins = []
         self._resetting = False
@@ -367,6 +378,18 @@ class TuningPage:
 
     # ------------------------------------------------------------ updates
     def _schedule(self, callback):
+        """Run ``callback()`` on the session's event loop, the document locked.
+
+        Called on the computing thread when a computation ends. The Bokeh document is
+        touched on the event loop's thread only: ``callback`` goes to the loop first
+        (``call_soon_threadsafe``), which then adds it as the document's next-tick
+        callback. Added from the computing thread directly (as Bokeh allows), the
+        callback was lost when it came while Panel rendered a new page's HTML: that holds
+        the document and puts back the events it held before
+        (``panel.io.resources.patch_model_css``), dropping the one that hands the callback
+        to the session; the page never drew and its later requests waited behind the lost
+        one (tests/app/test_page_scheduling.py).
+        """
         if self._closed or self.document is None:
             return
         document = self.document
@@ -377,9 +400,20 @@ class TuningPage:
             with set_curdoc(document):
                 callback()
 
+        def add():
+            if self._closed:
+                return
+            try:
+                document.add_next_tick_callback(run)
+            except Exception:  # the session went away meanwhile  # pragma: no cover
+                pass
+
+        if self._loop is None:  # a document outside a running server
+            add()
+            return
         try:
-            document.add_next_tick_callback(run)
-        except Exception:  # the session went away meanwhile  # pragma: no cover
+            self._loop.call_soon_threadsafe(add)
+        except RuntimeError:  # the loop is closed: the server stopped  # pragma: no cover
             pass
 
     def _destroyed(self, session_context):

@@ -5,7 +5,8 @@ only the last. :class:`LatestOnly` runs one at a time in an executor (a thread: 
 kernels release the GIL, so the server's event loop stays free), keeps only the newest
 request waiting, and drops the result of any computation a newer request superseded
 (a generation counter). It knows nothing of Panel: the page passes ``schedule``, which
-hands a callable to the server's event loop (``document.add_next_tick_callback``).
+hands a callable to the server's event loop (and there to
+``document.add_next_tick_callback``).
 """
 import threading
 from functools import partial
