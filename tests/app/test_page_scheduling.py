@@ -72,3 +72,28 @@ def test_a_result_that_ends_while_the_page_is_rendered_is_drawn(monkeypatch, dur
     assert len(page.sources["transmissibility"].data["x"]) == len(page.data.frequency[
         page.data.frequency > 0]) > 0
     assert not page.updates.running and page.updates.delivered == 1
+
+
+async def _close_before_the_loop_runs():
+    """A page in a server session whose first result ends on another thread, the session
+    destroyed before the event loop gets to it; returns the page after the loop ran."""
+    document = Document()
+    executor = HeldExecutor()
+    with set_curdoc(document):
+        page = page_module.TuningPage(executor=executor)
+        root = page.layout.get_root(document)
+    document.add_root(root)
+    ServerSession("qzs-test", document, io_loop=IOLoop.current())
+    _finish_on_another_thread(executor)  # handed to the loop, which has not run it yet
+    page._destroyed(None)  # the browser went away meanwhile
+    for _ in range(50):  # the event loop runs what was handed to it
+        await asyncio.sleep(0.01)
+    return page
+
+
+def test_a_result_that_ends_after_its_session_closed_is_not_drawn():
+    """A result handed to the loop for a session that is closed by the time the loop runs
+    it touches the session's document no more: the page stays as it was, undrawn."""
+    page = asyncio.run(_close_before_the_loop_runs())
+    assert page.data is None
+    assert not any(len(source.data.get("x", ())) for source in page.sources.values())

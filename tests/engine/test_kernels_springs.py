@@ -78,3 +78,21 @@ def test_an_oblique_spring_qzs_oscillates_at_its_stiffness_at_the_centre(validat
     validation("Oblique-spring QZS: free oscillation at the centre",
                "sqrt(k/m)/2 pi with k = k_v + 2 k_o (1 - L0/d) = 20 N/m",
                abs(measured / expected - 1), 1e-3)
+
+
+def test_a_payload_stuck_on_a_law_holding_its_weight_stays_stuck_below_the_breakaway():
+    """A 10 kg payload on a law that alone holds its weight at the setpoint (98.1 N, where the
+    MagSpring's tanh of ``P`` holds 61 N), the base shaking it by ``m |y''| = 5 N`` < Fs = 10 N:
+    friction holds it throughout (docs/model.md §3), z never moves. The holding margin is the
+    law's: with the tanh's the 37 N it lacks would break the payload away at once."""
+    mass = 10.0
+    law = PolynomialSpring(coefficients=(mass * 9.81, -300.0, 0.0, -2e5), center=-0.06)
+    isolator = IsolatorParameters(mass=mass, gravity=9.81, stiction_force=10.0, spring=law)
+    frequency = 2.0
+    gentle = Sine(amplitude=0.5 / (2 * np.pi * frequency) ** 2, frequency=frequency,
+                  fade_in=0.0)
+    r = qzs.simulate(gentle, isolator, duration=1.0)
+    assert mass * np.abs(r.base_acceleration).max() == pytest.approx(5.0, rel=1e-3)
+    assert r.locked.all()
+    assert r.run["stick_events"] == 0
+    np.testing.assert_array_equal(r.relative_position, r.relative_position[0])
