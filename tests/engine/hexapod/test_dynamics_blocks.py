@@ -184,3 +184,21 @@ def test_blocks_are_refused_with_centralised_control_and_a_bad_period_names_the_
                                              ) as error:
         simulate_hexapod(geometry, platform, controller=legs, duration=0.1)
     assert error.value.options == ("sample_time",)
+
+
+def test_a_legs_discrete_controller_samples_at_its_period_whatever_leg_0_runs():
+    """Leg 0 without a linear controller, legs 1-5 with a discrete one of period 2 ms: each of
+    those holds its output between its samples and changes at them (the base moves the
+    payload, the amplifier's velocity with it), once every period throughout."""
+    period, duration = 2e-3, 0.1
+    controllers = [PIDamping()] + [PIDamping() + lead_lag(sample_time=period)] * 5
+    result = simulate_hexapod(vertical_legs(), _platform(), ISOLATOR, controllers,
+                              excitation={"z": SINE}, duration=duration, sample_rate=10000.0)
+    time = result["time"]
+    for leg in range(1, 6):
+        linear = result["linear_force"][:, leg]
+        changes = time[np.flatnonzero(np.diff(linear) != 0.0) + 1]
+        assert len(changes) >= duration / period - 1  # it samples all along
+        # once a period: held in between
+        np.testing.assert_allclose(np.diff(changes), period, rtol=0, atol=1e-9)
+    assert not np.any(result["linear_force"][:, 0])
