@@ -4,8 +4,8 @@ import numpy as np
 from qzs._validation import choice
 from qzs.engine import kernels as K
 from qzs.model.controller import ControllerParameters
-from qzs.model.isolator import IsolatorParameters
-from qzs.model.springs import EQUILIBRIUM_SAMPLES, TabulatedSpring, TanhSpring
+from qzs.model.isolator import IsolatorParameters, other_spring_law
+from qzs.model.springs import EQUILIBRIUM_SAMPLES, TabulatedSpring
 
 __all__ = ["SOLVERS", "largest_stable_step", "stability_test", "spring_stiffness_peak"]
 
@@ -34,8 +34,8 @@ def spring_stiffness_peak(isolator, controller):
     float
         Stiffness [N/m].
     """
-    law = isolator.spring
-    if law is None or isinstance(law, TanhSpring):
+    law = other_spring_law(isolator)
+    if law is None:
         return isolator.spring_force * isolator.spring_shape
     center = (controller.position_setpoint if isolator.stop_center is None
               else isolator.stop_center)

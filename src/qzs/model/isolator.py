@@ -29,6 +29,7 @@ __all__ = [
     "friction_slope",
     "passive_natural_frequency",
     "refuse_spring_law",
+    "other_spring_law",
 ]
 
 #: Hard-stop contact models: a stiff spring-damper, or a perfectly plastic stop.
@@ -258,17 +259,30 @@ def spring_force(relative_position: ArrayLike,
     float or ndarray
         Spring force on the payload [N].
     """
-    law = _other_law(params)
+    law = other_spring_law(params)
     if law is not None:
         return law.force(relative_position)
     z = np.asarray(relative_position, dtype=float)
     return -params.spring_force * np.tanh(params.spring_shape * z)
 
 
-def _other_law(params):
-    """``params``' spring law when it is not the MagSpring's tanh (which the functions here
-    evaluate from ``spring_force`` and ``spring_shape``, bit for bit as before laws), else
-    None. A model without a ``spring`` law (a smooth model's copy of the fields) has the tanh."""
+def other_spring_law(params):
+    """``params``' spring law when it is not the MagSpring's tanh, else None.
+
+    The tanh (``spring`` None or a :class:`~qzs.model.springs.TanhSpring`) is evaluated
+    from ``spring_force`` and ``spring_shape``, bit for bit as before laws; a model without
+    a ``spring`` law (a smooth model's copy of the fields) has the tanh.
+
+    Parameters
+    ----------
+    params : IsolatorParameters or any object with the spring fields
+        The plant.
+
+    Returns
+    -------
+    SpringLaw or None
+        The law other than the tanh, or None.
+    """
     law = getattr(params, "spring", None)
     if isinstance(law, SpringLaw) and not isinstance(law, TanhSpring):
         return law
@@ -295,7 +309,7 @@ def refuse_spring_law(isolator, what, where="",
     ParameterError
         ``spring`` neither None nor a TanhSpring, naming the fix.
     """
-    law = _other_law(isolator)
+    law = other_spring_law(isolator)
     if law is not None:
         raise ParameterError(
             f"{where}`spring` ({law.describe()}) is not supported by {what} yet: it evaluates "
@@ -327,7 +341,7 @@ def spring_stiffness(relative_position: ArrayLike,
     float or ndarray
         Tangent stiffness [N/m], positive restoring.
     """
-    law = _other_law(params)
+    law = other_spring_law(params)
     if law is not None:
         return law.stiffness(relative_position)
     z = np.asarray(relative_position, dtype=float)
@@ -351,7 +365,7 @@ def spring_energy(relative_position, params):
     float or ndarray
         Stored energy [J].
     """
-    law = _other_law(params)
+    law = other_spring_law(params)
     if law is not None:
         return law.energy(relative_position)
     u = np.abs(params.spring_shape * np.asarray(relative_position, dtype=float))
