@@ -1,8 +1,11 @@
 """Model identification from test-rig data (paper Section 2.1.2), one module per fit.
 
 ====================  =============================================================================
-``spring``            :func:`fit_spring`: the MagSpring's static force-displacement pairs -> ``a``,
-                      ``b`` of ``F = -a*tanh(b*z)``, in either displacement convention
+``spring``            :func:`fit_spring`: static force-displacement pairs -> a spring law: the
+                      MagSpring's ``a``, ``b`` of ``F = -a*tanh(b*z)`` (the default), a
+                      polynomial, the three-spring mechanism, a smoothed table, or the best of
+                      them by BIC; either displacement convention
+``spring_laws``       how the polynomial, the mechanism and the table are fitted
 ``friction``          :func:`fit_friction`: a dynamic test with imposed displacement and measured
                       force (the paper's Instron tests) -> stiction, Coulomb, Stribeck and viscous
                       friction (eq. 3)

@@ -14,7 +14,7 @@ from qzs.model.registry import PARAMETERS, update_parameters
 from qzs.model.springs import SPRING_LAWS, ObliqueSpringQZS, TabulatedSpring
 
 __all__ = ["load_config", "load_controller", "load_spring", "controller_from_table",
-           "spring_from_table", "save_config", "config_text", "EXCITATION_KEYS",
+           "spring_from_table", "save_config", "config_text", "spring_text", "EXCITATION_KEYS",
            "SIMULATION_KEYS", "LINEAR_KEYS", "SPRING_CSV_KEYS"]
 
 #: Keys allowed in the ``[excitation]`` and ``[simulation]`` tables of a config file.
@@ -377,6 +377,35 @@ def save_config(path, isolator=None, controller=None, excitation=None, simulatio
     with atomic_path(path) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     return Path(path)
+
+
+def spring_text(law, note=None):
+    """A spring law as a TOML ``[spring]`` table: what ``qzs simulate --spring FILE.toml`` and
+    :func:`load_spring` read (the law's fields in SI units, docs/model.md §3.1).
+
+    Parameters
+    ----------
+    law : SpringLaw
+        The law.
+    note : str, optional
+        A comment line under the header (where the law comes from).
+
+    Returns
+    -------
+    str
+        UTF-8 TOML text.
+    """
+    import tomli_w
+
+    from qzs.model.springs import SpringLaw
+
+    if not isinstance(law, SpringLaw):
+        raise ParameterError(f"`law` must be a spring law (TanhSpring, ...), got {law!r}.",
+                             ("law",))
+    header = "# qzs spring law: SI units (m, N); read by `qzs simulate --spring FILE.toml`.\n"
+    if note:
+        header += f"# {note}\n"
+    return header + tomli_w.dumps({"spring": law.to_dict()})
 
 
 def config_text(isolator=None, controller=None, excitation=None, simulation=None, note=None):

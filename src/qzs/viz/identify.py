@@ -4,7 +4,8 @@ import numpy as np
 from qzs.viz.figures import new_figure, save_figure
 from qzs.viz.transmissibility import plot_transmissibility
 
-__all__ = ["plot_spring_fit", "plot_friction_fit", "plot_transmissibility_fit"]
+__all__ = ["plot_spring_fit", "plot_spring_law_fit", "plot_friction_fit",
+           "plot_transmissibility_fit"]
 
 
 def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=None, title=""):
@@ -40,6 +41,54 @@ def plot_spring_fit(displacement, force, spring_force, spring_shape, *, path=Non
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
     ax.set_title(title)
+    if path is not None:
+        save_figure(fig, path, also_svg=True)
+    return fig
+
+
+def plot_spring_law_fit(fit, *, path=None, title=""):
+    """Force against displacement with the fitted law (and the other candidates of a
+    ``law="best"`` fit, dashed), and the residuals against displacement.
+
+    Parameters
+    ----------
+    fit : SpringFit
+        The fit (:func:`qzs.identify.fit_spring`).
+    path : str or Path, optional
+        Write the figure there (a .png also as .svg).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = new_figure(2, height=3.0, height_ratios=(2.0, 1.0))
+    top, bottom = axes
+    z, force = fit.displacement, fit.force
+    grid = np.linspace(z.min(), z.max(), 801)
+    top.plot(z * 1e3, force, "o", ms=3.5, mfc="none", color="0.35", zorder=3,
+             label=f"measured ({fit.n_points})")
+    for kind, other in fit.candidates.items():
+        if kind != fit.kind:
+            top.plot(grid * 1e3, other.predict(grid), "--", lw=1.0,
+                     label=f"{kind}: BIC {other.criterion:.1f}")
+    chosen = f", BIC {fit.criterion:.1f}" + (" (chosen)" if fit.candidates else "")
+    top.plot(grid * 1e3, fit.predict(grid), "-", color="C3", lw=1.4,
+             label=f"{fit.kind} fit: rms residual {fit.residual_rms:.3g} N{chosen}")
+    margin = 0.15 * max(np.ptp(force), 1e-9)  # a far-off candidate does not squash the data
+    top.set_ylim(force.min() - margin, force.max() + margin)
+    top.set_ylabel("spring force on the payload F [N]")
+    top.legend(fontsize="small")
+    bottom.plot(z * 1e3, fit.residual, "o", ms=3, color="C0")
+    bottom.axhline(0.0, color="k", lw=0.6)
+    for sign in (-1.0, 1.0):
+        bottom.axhline(sign * fit.residual_rms, color="C3", lw=0.6, ls=":")
+    bottom.set_xlabel("relative position z [mm] (model convention)")
+    bottom.set_ylabel("residual [N]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    top.set_title(title)
     if path is not None:
         save_figure(fig, path, also_svg=True)
     return fig

@@ -1,0 +1,277 @@
+"""The spring laws other than the tanh fitted to force-displacement pairs (docs/model.md §3.1).
+
+:func:`qzs.identify.fit_spring` validates the data and calls one of these; each returns a
+:class:`LawFit` (the law, its parameters and intervals, its prediction at the data and the
+number of parameters the selection criterion counts). The data are in the model's convention
+(``z`` the relative position [m], ``F`` the force on the payload [N], upward positive).
+
+=============  ===========================================================================
+law            how it is fitted
+=============  ===========================================================================
+polynomial     ``F = sum_k c_k (z - center)^k``, linear least squares (columns scaled to
+               ``|u| <= 1``); Student-t intervals on ``s^2 (X^T X)^-1``, exact for
+               Gaussian noise; ``degree + 1`` parameters
+oblique        ``F = P - K u + A u / sqrt(u^2 + d^2)``, ``u = z - center``: the only
+               combinations a force curve determines are ``K = k_v + 2 k_o`` and
+               ``A = 2 k_o L0`` (``k_o`` and ``L0`` enter as their product), so 5
+               parameters (center, P, K, A, d) are fitted: a grid over (center, d) with
+               (P, K, A) by linear least squares, then Levenberg-Marquardt on all five;
+               linearised Student-t intervals. ``k_v``, ``k_o`` and ``L0`` follow when
+               ``free_length`` is given; otherwise the law is the mechanism with ``k_v = 0``
+               (every split gives the same force) and those three are undefined
+table          a cubic smoothing spline (``scipy.interpolate.make_smoothing_spline``) through
+               the mean force at each distinct position (weighted by its count), positions
+               scaled to [0, 1]; ``lam`` (or given) minimises the corrected Akaike
+               criterion of a linear smoother (Hurvich, Simonoff & Tsai, J. R. Stat. Soc. B
+               60 (1998) 271-293) ``ln(RSS/n) + 1 + 2 (tr H + 1) / (n - tr H - 2)`` over
+               ``log10 lam`` in [-12, 3], ``tr H`` the trace of the spline's hat matrix;
+               the spline is sampled at ``table_points`` evenly spaced positions over the
+               data's range as a :class:`TabulatedSpring` (PCHIP, ``outside="refuse"``);
+               its parameters are the spline's effective degrees of freedom, ``tr H``.
+               (Not scipy's default, generalised cross-validation: where the points barely
+               resolve the curve, as 41 points over the MagSpring's stroke, its minimum is
+               at ``lam -> 0``, interpolating the noise.)
+=============  ===========================================================================
+"""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+from scipy.interpolate import make_smoothing_spline
+
+from qzs.errors import DataError, FitError
+from qzs.identify._statistics import fit_covariance, student_quantile
+from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, TabulatedSpring
+
+__all__ = ["LawFit", "fit_polynomial", "fit_oblique", "fit_table", "oblique_force",
+           "OBLIQUE_FITTED", "TABLE_LAMBDA_RANGE"]
+
+#: The oblique law's fitted parameters, their units, and what each is.
+OBLIQUE_FITTED = {"center": ("m", "position where the oblique springs are horizontal"),
+                  "preload": ("N", "force at the centre, P"),
+                  "far_stiffness": ("N/m", "k_v + 2 k_o, the stiffness far from the centre"),
+                  "oblique_force": ("N", "2 k_o L0, the oblique springs' force scale"),
+                  "horizontal_distance": ("m", "distance to the hinges, d")}
+#: The range of ``log10 lam`` the table's generalised cross-validation searches.
+TABLE_LAMBDA_RANGE = (-12.0, 3.0)
+#: Columns of the identity solved at once for the trace of the smoothing spline's hat matrix.
+_TRACE_BLOCK = 256
+#: Why a mechanism's springs are not determined by its force curve.
+_SPLIT = ("a force curve determines only k_v + 2 k_o and 2 k_o L0 (k_o and L0 enter as their "
+          "product): the law is the mechanism with vertical_stiffness = 0, one of the many with "
+          "the same force at every z; give free_length = L0 [m] to determine the three")
+
+
+@dataclass(frozen=True)
+class LawFit:
+    """One law fitted (internal to :func:`qzs.identify.fit_spring`).
+
+    Attributes
+    ----------
+    law : SpringLaw or None
+        The law; None when the fitted numbers make no law (``undefined["law"]`` says why).
+    parameters : dict of str to float
+        Fitted (or derived) parameters.
+    intervals : dict of str to tuple of float
+        Their confidence intervals.
+    units : dict of str to str
+        Their units.
+    undefined : dict of str to str
+        What is undefined and why.
+    predicted : ndarray
+        The fitted force at the data [N].
+    n_parameters : float
+        Parameters the criterion counts (a table's effective degrees of freedom).
+    """
+
+    law: object
+    parameters: dict
+    intervals: dict
+    units: dict
+    undefined: dict = field(default_factory=dict)
+    predicted: np.ndarray = None
+    n_parameters: float = 0.0
+
+
+def _intervals(names, values, covariance, confidence, dof):
+    """Student-t intervals ``value -+ t * sqrt(var)``; infinite where the data do not determine."""
+    half = np.sqrt(np.clip(np.diag(covariance), 0.0, np.inf)) * student_quantile(confidence, dof)
+    return {n: (float(v - h), float(v + h)) for n, v, h in zip(names, values, half)}
+
+
+def _distinct(z, needed, law, why):
+    count = np.unique(z).size
+    if count < needed:
+        raise DataError(f"a {law} spring fit needs at least {needed} distinct positions in "
+                        f"`displacement` ({why}), got {count}; measure more positions.")
+
+
+def fit_polynomial(z, f, degree, center, confidence):
+    """``degree``-th polynomial about ``center`` (None: the middle of the data's range)."""
+    k = degree + 1
+    _distinct(z, k, "polynomial", f"one per coefficient of degree {degree}")
+    center = 0.5 * (float(z.min()) + float(z.max())) if center is None else center
+    u = z - center
+    scale = float(np.max(np.abs(u))) or 1.0
+    design = np.vander(u / scale, k, increasing=True)
+    scaled, *_ = np.linalg.lstsq(design, f, rcond=None)
+    predicted = design @ scaled
+    covariance, dof = fit_covariance(design, f - predicted, k)
+    powers = scale ** np.arange(k)
+    coefficients = scaled / powers
+    covariance = covariance / np.outer(powers, powers)
+    names = [f"c{i}" for i in range(k)]
+    units = {n: "N" if i == 0 else "N/m" if i == 1 else f"N/m^{i}" for i, n in enumerate(names)}
+    parameters = {n: float(c) for n, c in zip(names, coefficients)}
+    parameters["center"] = float(center)
+    units["center"] = "m"
+    return LawFit(PolynomialSpring(coefficients=coefficients, center=center), parameters,
+                  _intervals(names, coefficients, covariance, confidence, dof), units,
+                  {"center": "chosen, not fitted: the position the powers are taken about"},
+                  predicted, float(k))
+
+
+def oblique_force(u, preload, far, amplitude, distance):
+    """The mechanism's force [N] at ``u = z - center`` [m] from its determined parameters."""
+    return preload - far * u + amplitude * u / np.hypot(u, distance)
+
+
+def fit_oblique(z, f, free_length, confidence):
+    """The three-spring mechanism's five determined parameters, and its law."""
+    _distinct(z, 5, "oblique", "five parameters: centre, preload, k_v + 2 k_o, 2 k_o L0, d")
+    low, high = float(z.min()), float(z.max())
+    span = high - low
+    best = (np.inf, None)
+    for center in np.linspace(low, high, 41):  # (P, K, A) are linear once (center, d) are set
+        u = z - center
+        for distance in np.geomspace(span / 100.0, span * 10.0, 31):
+            design = np.column_stack([np.ones_like(u), -u, u / np.hypot(u, distance)])
+            linear, *_ = np.linalg.lstsq(design, f, rcond=None)
+            cost = float(np.sum((design @ linear - f) ** 2))
+            if cost < best[0]:
+                best = (cost, (center, *linear, distance))
+
+    def residual(x):
+        return oblique_force(z - x[0], *x[1:]) - f
+
+    def jacobian(x):
+        center, _, far, amplitude, distance = x
+        u = z - center
+        length = np.hypot(u, distance)
+        cube = length ** 3
+        return np.column_stack([far - amplitude * distance ** 2 / cube, np.ones_like(u), -u,
+                                u / length, -amplitude * u * distance / cube])
+
+    solution = optimize.least_squares(residual, best[1], jac=jacobian, method="lm",
+                                      x_scale="jac", max_nfev=20000)
+    if not solution.success:
+        raise FitError(f"the oblique-spring fit did not converge ({solution.message}); check "
+                       "that the data span the mechanism's centre.")
+    values = solution.x.copy()
+    values[4] = abs(values[4])  # d enters squared
+    names = list(OBLIQUE_FITTED)
+    covariance, dof = fit_covariance(jacobian(values), solution.fun, 5)
+    parameters = dict(zip(names, map(float, values)))
+    intervals = _intervals(names, values, covariance, confidence, dof)
+    units = {n: unit for n, (unit, _) in OBLIQUE_FITTED.items()}
+    center, preload, far, amplitude, distance = values
+    predicted = oblique_force(z - center, preload, far, amplitude, distance)
+    undefined = {}
+    if free_length is None:
+        law = None
+        if far > 0.0 and amplitude > 0.0:
+            law = ObliqueSpringQZS(vertical_stiffness=0.0, oblique_stiffness=far / 2.0,
+                                   free_length=amplitude / far, horizontal_distance=distance,
+                                   center=center, preload=preload)
+        for name in ("vertical_stiffness", "oblique_stiffness", "free_length"):
+            undefined[name] = _SPLIT
+    else:
+        oblique, vertical = amplitude / (2.0 * free_length), far - amplitude / free_length
+        parameters.update(vertical_stiffness=float(vertical), oblique_stiffness=float(oblique),
+                          free_length=float(free_length))
+        units.update(vertical_stiffness="N/m", oblique_stiffness="N/m", free_length="m")
+        undefined["free_length"] = "given, not fitted"
+        # k_v = K - A / L0 and k_o = A / (2 L0) are linear in (K, A): their covariance
+        block = covariance[2:4, 2:4]
+        derived = np.array([[1.0, -1.0 / free_length], [0.0, 0.5 / free_length]])
+        spread = (derived @ block @ derived.T if np.all(np.isfinite(block))
+                  else np.diag([np.inf, np.inf]))  # (K, A) not determined by the data
+        intervals.update(_intervals(["vertical_stiffness", "oblique_stiffness"],
+                                    [vertical, oblique], spread, confidence, dof))
+        law = None
+        if vertical >= 0.0 and oblique >= 0.0:
+            law = ObliqueSpringQZS(vertical_stiffness=vertical, oblique_stiffness=oblique,
+                                   free_length=free_length, horizontal_distance=distance,
+                                   center=center, preload=preload)
+    if law is None:
+        undefined["law"] = _oblique_refusal(far, amplitude, free_length)
+    return LawFit(law, parameters, intervals, units, undefined, predicted, 5.0)
+
+
+def _oblique_refusal(far, amplitude, free_length):
+    """Why the fitted numbers make no mechanism of springs of non-negative stiffness."""
+    if amplitude <= 0.0:
+        return (f"the fit's 2 k_o L0 = {amplitude:.4g} N is not positive: no oblique springs "
+                "of positive stiffness and length give this curve (its slope near the centre "
+                "falls, where compressed oblique springs make it rise); fit another law")
+    if far <= 0.0:
+        return (f"the fit's k_v + 2 k_o = {far:.4g} N/m is not positive: no springs of "
+                "non-negative stiffness give it; fit another law")
+    return (f"with free_length = {free_length:g} m the vertical spring's stiffness would be "
+            f"{far - amplitude / free_length:.4g} N/m < 0; the data need free_length >= "
+            f"{amplitude / far:.4g} m (2 k_o L0 / (k_v + 2 k_o)), or leave it out")
+
+
+def _hat_trace(s, weights, lam):
+    """Trace of the smoothing spline's hat matrix at ``lam``: its effective parameters."""
+    m = s.size
+    total = 0.0
+    for start in range(0, m, _TRACE_BLOCK):
+        columns = np.arange(start, min(start + _TRACE_BLOCK, m))
+        unit = np.zeros((m, columns.size))
+        unit[columns, np.arange(columns.size)] = 1.0
+        spline = make_smoothing_spline(s, unit, w=weights, lam=lam)
+        total += float(np.trace(spline(s[columns])))
+    return total
+
+
+def fit_table(z, f, smoothing, points):
+    """A smoothing spline's forces at ``points`` positions: a :class:`TabulatedSpring`."""
+    _distinct(z, 5, "table", "the smoothing spline's least")
+    positions, inverse, counts = np.unique(z, return_inverse=True, return_counts=True)
+    means = np.bincount(inverse, weights=f) / counts
+    within = float(np.sum((f - means[inverse]) ** 2))  # what no curve through z can remove
+    origin, span = float(positions[0]), float(positions[-1] - positions[0])
+    scaled = (positions - origin) / span
+    weights = counts.astype(float)
+
+    def smooth(log_lam):
+        spline = make_smoothing_spline(scaled, means, w=weights, lam=10.0 ** log_lam)
+        rss = within + float(weights @ (means - spline(scaled)) ** 2)
+        return spline, rss, _hat_trace(scaled, weights, 10.0 ** log_lam)
+
+    def criterion(log_lam):  # Hurvich, Simonoff & Tsai's AICc of a linear smoother
+        _, rss, trace = smooth(log_lam)
+        if trace >= f.size - 2.0 or rss <= 0.0:
+            return np.inf
+        return math.log(rss / f.size) + 1.0 + 2.0 * (trace + 1.0) / (f.size - trace - 2.0)
+
+    if smoothing == "aicc":
+        grid = np.linspace(*TABLE_LAMBDA_RANGE, 16)
+        scores = [criterion(x) for x in grid]
+        i = int(np.argmin(scores))
+        bracket = (grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)])
+        found = optimize.minimize_scalar(criterion, bounds=bracket, method="bounded",
+                                         options={"xatol": 0.01})
+        log_lam = float(found.x) if found.fun <= scores[i] else float(grid[i])
+    else:
+        log_lam = float(np.log10(smoothing)) if smoothing > 0.0 else -np.inf
+    spline, _, trace = smooth(log_lam)
+    table = np.linspace(positions[0], positions[-1], points)
+    law = TabulatedSpring(positions=table, forces=spline((table - origin) / span))
+    parameters = {"smoothing": float(10.0 ** log_lam), "effective_parameters": trace}
+    units = {"smoothing": "-", "effective_parameters": "-"}
+    undefined = {"intervals": "a smoothed table has no parameter intervals: its forces are a "
+                              "smoother's output, biased by the smoothing"}
+    return LawFit(law, parameters, {}, units, undefined, law.force(z), trace)
