@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from qzs.errors import DataError, ParameterError
-from qzs.iotools.config import config_text, load_config, load_spring
+from qzs.iotools.config import config_text, load_config, load_spring, spring_text
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, TabulatedSpring, TanhSpring
 
@@ -36,10 +36,21 @@ def test_a_spring_file_reads_a_table_from_csv_relative_to_it_with_its_units(tmp_
     np.testing.assert_array_equal(law.forces, forces)
 
 
-@pytest.mark.parametrize("law", [
-    TanhSpring(plateau=55.0, shape=70.0), ObliqueSpringQZS(),
-    PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -2e5), center=-0.06),
-    TabulatedSpring.from_law(ObliqueSpringQZS(), np.linspace(-0.15, 0.03, 7))])
+LAWS = [TanhSpring(plateau=55.0, shape=70.0), ObliqueSpringQZS(),
+        PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -2e5), center=-0.06),
+        TabulatedSpring.from_law(ObliqueSpringQZS(), np.linspace(-0.15, 0.03, 7))]
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_spring_text_is_a_spring_file_of_the_law(tmp_path, law):
+    path = _write(tmp_path / "spring.toml", spring_text(law, note="from a fit"))
+    assert path.read_text().splitlines()[1] == "# from a fit"
+    assert load_spring(path) == law
+    with pytest.raises(ParameterError, match="`law` must be a spring law"):
+        spring_text(law.to_dict())
+
+
+@pytest.mark.parametrize("law", LAWS)
 def test_config_text_writes_the_law_as_its_spring_table_and_reads_it_back(tmp_path, law):
     path = _write(tmp_path / "run.toml", config_text(IsolatorParameters(spring=law)))
     assert "[spring]" in path.read_text()
