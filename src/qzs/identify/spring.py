@@ -44,7 +44,7 @@ LAWS = ("tanh", "polynomial", "oblique", "table", "best")
 CRITERION = "BIC = n ln(RSS/n) + k ln n"
 #: Files :meth:`SpringFit.save` writes.
 SPRING_FIT_SUFFIXES = (".json", ".toml")
-_EMPTY = MappingProxyType({})
+_EMPTY: Mapping[str, Any] = MappingProxyType({})
 
 
 @dataclass(frozen=True, eq=False)

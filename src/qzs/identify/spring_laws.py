@@ -34,7 +34,7 @@ table          a cubic smoothing spline (``scipy.interpolate.make_smoothing_spli
 =============  ===========================================================================
 """
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import optimize
@@ -42,7 +42,7 @@ from scipy.interpolate import make_smoothing_spline
 
 from qzs.errors import DataError, FitError
 from qzs.identify._statistics import fit_covariance, student_quantile
-from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, TabulatedSpring
+from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, SpringLaw, TabulatedSpring
 
 __all__ = ["LawFit", "fit_polynomial", "fit_oblique", "fit_table", "oblique_force",
            "OBLIQUE_FITTED", "TABLE_LAMBDA_RANGE"]
@@ -85,13 +85,13 @@ class LawFit:
         Parameters the criterion counts (a table's effective degrees of freedom).
     """
 
-    law: object
+    law: SpringLaw | None
     parameters: dict
     intervals: dict
     units: dict
-    undefined: dict = field(default_factory=dict)
-    predicted: np.ndarray = None
-    n_parameters: float = 0.0
+    undefined: dict
+    predicted: np.ndarray
+    n_parameters: float
 
 
 def _intervals(names, values, covariance, confidence, dof):
@@ -108,7 +108,25 @@ def _distinct(z, needed, law, why):
 
 
 def fit_polynomial(z, f, degree, center, confidence):
-    """``degree``-th polynomial about ``center`` (None: the middle of the data's range)."""
+    """The polynomial of ``degree`` about ``center`` by linear least squares (module docstring).
+
+    Parameters
+    ----------
+    z : ndarray
+        Relative positions [m], model convention, finite.
+    f : ndarray
+        Forces on the payload [N], finite, as many.
+    degree : int
+        Degree, >= 1.
+    center : float or None
+        Position the powers are taken about [m]; None: the middle of the data's range.
+    confidence : float
+        Level of the intervals.
+
+    Returns
+    -------
+    LawFit
+    """
     k = degree + 1
     _distinct(z, k, "polynomial", f"one per coefficient of degree {degree}")
     center = 0.5 * (float(z.min()) + float(z.max())) if center is None else center
@@ -133,12 +151,47 @@ def fit_polynomial(z, f, degree, center, confidence):
 
 
 def oblique_force(u, preload, far, amplitude, distance):
-    """The mechanism's force [N] at ``u = z - center`` [m] from its determined parameters."""
+    """The mechanism's force from its determined parameters: ``P - K u + A u / sqrt(u^2 + d^2)``.
+
+    Parameters
+    ----------
+    u : ndarray
+        Position from the centre, ``z - center`` [m].
+    preload : float
+        P [N].
+    far : float
+        K = k_v + 2 k_o [N/m].
+    amplitude : float
+        A = 2 k_o L0 [N].
+    distance : float
+        d [m].
+
+    Returns
+    -------
+    ndarray
+        Force on the payload [N].
+    """
     return preload - far * u + amplitude * u / np.hypot(u, distance)
 
 
 def fit_oblique(z, f, free_length, confidence):
-    """The three-spring mechanism's five determined parameters, and its law."""
+    """The three-spring mechanism's five determined parameters, and its law (module docstring).
+
+    Parameters
+    ----------
+    z : ndarray
+        Relative positions [m], model convention, finite.
+    f : ndarray
+        Forces on the payload [N], finite, as many.
+    free_length : float or None
+        The oblique springs' free length L0 [m] if known: then k_v and k_o are determined.
+    confidence : float
+        Level of the intervals.
+
+    Returns
+    -------
+    LawFit
+    """
     _distinct(z, 5, "oblique", "five parameters: centre, preload, k_v + 2 k_o, 2 k_o L0, d")
     low, high = float(z.min()), float(z.max())
     span = high - low
@@ -237,7 +290,24 @@ def _hat_trace(s, weights, lam):
 
 
 def fit_table(z, f, smoothing, points):
-    """A smoothing spline's forces at ``points`` positions: a :class:`TabulatedSpring`."""
+    """A smoothing spline's forces at ``points`` positions: a :class:`TabulatedSpring`.
+
+    Parameters
+    ----------
+    z : ndarray
+        Relative positions [m], model convention, finite.
+    f : ndarray
+        Forces on the payload [N], finite, as many.
+    smoothing : float or "aicc"
+        The spline's penalty weight (positions scaled to [0, 1]), or ``"aicc"`` to choose it
+        (module docstring).
+    points : int
+        Positions of the table, evenly spaced over the data's range.
+
+    Returns
+    -------
+    LawFit
+    """
     _distinct(z, 5, "table", "the smoothing spline's least")
     positions, inverse, counts = np.unique(z, return_inverse=True, return_counts=True)
     means = np.bincount(inverse, weights=f) / counts
