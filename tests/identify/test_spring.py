@@ -66,3 +66,18 @@ def test_fit_agrees_with_model_force_law():
     fit = fit_spring(z, f)
     iso = qzs.IsolatorParameters(spring_force=fit.spring_force, spring_shape=fit.spring_shape)
     np.testing.assert_allclose(qzs.spring_force(z, iso), f, atol=1e-6)
+
+
+def test_fit_travels_as_the_paper_report_carries_it():
+    """The paper's spring study keeps ``dataclasses.asdict(fit)`` in a case that a worker
+    process pickles back: every law's fit must survive both."""
+    import dataclasses
+    import pickle
+
+    z, f = synthetic()
+    for law in ("tanh", "best"):
+        fit = fit_spring(z, f, law=law)
+        record = pickle.loads(pickle.dumps(dataclasses.asdict(fit)))
+        assert record["spring_force"] == fit.spring_force
+        assert record["law"] == {"plateau": fit.law.plateau, "shape": fit.law.shape}
+        assert pickle.loads(pickle.dumps(fit)).law == fit.law

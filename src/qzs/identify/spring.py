@@ -17,7 +17,6 @@ import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -44,7 +43,6 @@ LAWS = ("tanh", "polynomial", "oblique", "table", "best")
 CRITERION = "BIC = n ln(RSS/n) + k ln n"
 #: Files :meth:`SpringFit.save` writes.
 SPRING_FIT_SUFFIXES = (".json", ".toml")
-_EMPTY: Mapping[str, Any] = MappingProxyType({})
 
 
 @dataclass(frozen=True, eq=False)
@@ -342,12 +340,10 @@ def _fit_one(kind, z, f, convention, confidence, degree, center, smoothing, free
         criterion = n * math.log(rss / n) + fitted.n_parameters * math.log(n)
     scale = 1.4826 * np.median(np.abs(residual - np.median(residual)))
     outliers = tuple(int(i) for i in np.flatnonzero(np.abs(residual) > 4 * max(scale, 1e-300)))
-    frozen = MappingProxyType
     return SpringFit(a, b, a_interval, b_interval, confidence, convention,
                      float(np.sqrt(np.mean(residual ** 2))), outliers, kind, fitted.law,
-                     frozen(fitted.parameters), frozen(fitted.intervals), frozen(fitted.units),
-                     frozen(undefined), criterion, n, fitted.n_parameters, _EMPTY, _EMPTY,
-                     z, f, residual)
+                     dict(fitted.parameters), dict(fitted.intervals), dict(fitted.units),
+                     undefined, criterion, n, fitted.n_parameters, {}, {}, z, f, residual)
 
 
 def _fit_best(z, f, *options):
@@ -371,8 +367,7 @@ def _fit_best(z, f, *options):
     chosen = min(candidates.values(), key=lambda fit: fit.criterion)
     for heard in caught[chosen.kind]:  # the chosen fit's warnings, not the others'
         warnings.warn_explicit(heard.message, heard.category, heard.filename, heard.lineno)
-    return dataclasses.replace(chosen, candidates=MappingProxyType(candidates),
-                               rejected=MappingProxyType(rejected))
+    return dataclasses.replace(chosen, candidates=candidates, rejected=rejected)
 
 
 def _smoothing(value):
