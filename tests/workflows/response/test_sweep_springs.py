@@ -65,3 +65,23 @@ def test_the_steady_state_is_the_harmonic_balance_of_the_same_law(duffing_respon
                                                        rel=INTEGRATION)
     top = float(np.max(response.balance.relative_amplitude))
     assert top == pytest.approx(duffing_amplitudes(1.36, k3, amplitude)[-1], rel=0.02)
+
+
+
+def test_the_responses_files_record_the_law(duffing_response, tmp_path):
+    """The dataset and the NetCDF and CSV files write the law as a run's records do:
+    ``isolator.spring.law`` and its fields with their units."""
+    import qzs
+
+    _, _, response = duffing_response
+    attrs = response.to_xarray().attrs
+    assert attrs["isolator.spring.law"] == "polynomial"
+    assert list(attrs["isolator.spring.coefficients"]) == list(
+        response.isolator.spring.coefficients)
+    assert attrs["isolator.spring.center"] == -0.060
+    assert attrs["isolator.spring.center_units"] == "m"
+    read = qzs.read_result(response.save(tmp_path / "duffing.nc")).attrs
+    assert read["isolator.spring.law"] == "polynomial"
+    assert list(read["isolator.spring.coefficients"]) == list(attrs["isolator.spring.coefficients"])
+    text = response.save(tmp_path / "duffing.csv").read_text(encoding="utf-8")
+    assert "# isolator.spring.law = polynomial" in text
