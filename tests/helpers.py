@@ -344,3 +344,67 @@ class HeldExecutor:
             future.set_result(function(request))
         except Exception as error:  # noqa: BLE001 - the updater delivers it
             future.set_exception(error)
+
+
+#: A Duffing isolator (issue 41): mass [kg], linear stiffness k1 [N/m] and viscous damping c
+#: [N*s/m] (damping ratio 0.030 at 1.258 Hz) about the equilibrium z = -0.060 m, where the
+#: polynomial's constant carries the weight; no dry friction, no controller, stops 79 mm away.
+DUFFING_MASS, DUFFING_K1, DUFFING_DAMPING, DUFFING_CENTER = 6.4, 400.0, 3.0, -0.060
+#: Cubic stiffness k3 [N/m^3] and base amplitude Y [m] of a hardening and a softening case.
+DUFFING_HARDENING = (3.2e6, 0.3e-3)
+DUFFING_SOFTENING = (-1.6e6, 0.35e-3)
+
+
+def duffing_case(k3):
+    """``(isolator, controller)`` of the Duffing isolator with cubic stiffness ``k3``.
+
+    In relative coordinates ``u = z - center`` under the base ``y = Y cos(w t)`` it is
+    ``m u'' + c u' + k1 u + k3 u^3 = m Y w^2 cos(w t)`` (the weight carried by the
+    polynomial's constant, so the mean of ``u`` is zero for an odd restoring force).
+    """
+    m = DUFFING_MASS
+    law = qzs.PolynomialSpring(coefficients=(m * 9.81, -DUFFING_K1, 0.0, -k3),
+                               center=DUFFING_CENTER)
+    isolator = IsolatorParameters(mass=m, gravity=9.81, stiction_force=0.0, coulomb_force=0.0,
+                                  viscous_damping=DUFFING_DAMPING, spring=law, stroke_half=0.079)
+    return isolator, ControllerParameters(pi_kp=0.0, pi_ki=0.0, damping_gain=0.0,
+                                          position_setpoint=DUFFING_CENTER)
+
+
+def duffing_amplitudes(frequency, k3, amplitude):
+    """The single-harmonic closed form: every fundamental amplitude A [m] of ``u`` at
+    ``frequency`` [Hz], the positive roots of
+    ``[(k1 + 3/4 k3 A^2 - m w^2)^2 + (c w)^2] A^2 = (m Y w^2)^2`` (a cubic in A^2),
+    ascending (three inside the folds)."""
+    m, k1, c = DUFFING_MASS, DUFFING_K1, DUFFING_DAMPING
+    w = 2 * np.pi * frequency
+    a, d = 0.75 * k3, k1 - m * w * w
+    roots = np.roots([a * a, 2 * a * d, d * d + (c * w) ** 2, -(m * amplitude * w * w) ** 2])
+    squares = roots[(np.abs(roots.imag) <= 1e-9 * np.abs(roots)) & (roots.real > 0)].real
+    return np.sort(np.sqrt(squares))
+
+
+def duffing_transmissibility(frequency, k3, amplitude, relative):
+    """Payload over base fundamental of the closed form at the amplitude ``relative`` [m]:
+    ``|1 + m w^2 / (k1 + 3/4 k3 A^2 - m w^2 + i c w)|`` [-]."""
+    w = 2 * np.pi * frequency
+    m = DUFFING_MASS
+    stiffness = DUFFING_K1 + 0.75 * k3 * relative ** 2
+    return abs(1 + m * w * w / (stiffness - m * w * w + 1j * DUFFING_DAMPING * w))
+
+
+def duffing_harmonic_bound(frequency, k3, relative, third):
+    """Bound [m] on how far the fundamental of a response with harmonics lies from the
+    single-harmonic closed form's ``relative`` [m], its third harmonic being ``third`` [m].
+
+    The third harmonic adds ``3/4 k3 A^2 A3`` to the cubic force's fundamental (to first
+    order); a force ``dF`` on the fundamental moves the amplitude of
+    ``Phi(A) = A sqrt((K(A) - m w^2)^2 + (c w)^2) = F`` by at most ``dF / |Phi'(A)|`` to
+    first order; twice that covers the higher orders (off the folds, where Phi' = 0).
+    """
+    m, c = DUFFING_MASS, DUFFING_DAMPING
+    w = 2 * np.pi * frequency
+    detuning = DUFFING_K1 + 0.75 * k3 * relative ** 2 - m * w * w
+    dynamic = np.hypot(detuning, c * w)
+    slope = dynamic + relative * detuning * 1.5 * k3 * relative / dynamic
+    return 2 * 0.75 * abs(k3) * relative ** 2 * third / abs(slope)

@@ -125,19 +125,3 @@ def test_a_negative_gain_is_refused():
     with pytest.raises(ParameterError, match="damping_gain"):
         dataclasses.replace(model, damping_gain=-1.0)
 
-
-def test_a_spring_law_other_than_the_tanh_is_refused_not_replaced_by_the_tanh():
-    """The smooth model evaluates the tanh of the fields only: another law would be silently
-    the MagSpring, so it is refused, naming the steady-state simulation as the way out."""
-    from qzs.errors import ParameterError
-    from qzs.model.isolator import IsolatorParameters
-    from qzs.model.springs import PolynomialSpring, TanhSpring
-
-    duffing = IsolatorParameters(spring=PolynomialSpring(coefficients=(62.78, -100.0, 0.0,
-                                                                       -5e4), center=-0.06))
-    with pytest.raises(ParameterError, match=r"not supported by the harmonic balance yet.*"
-                       r"qzs.simulate of a sine") as error:
-        SmoothModel.from_parameters(duffing, amplitude=0.005)
-    assert error.value.options == ("spring",)
-    tanh = SmoothModel.from_parameters(IsolatorParameters(spring=TanhSpring()), amplitude=0.005)
-    assert tanh == SmoothModel.from_parameters(IsolatorParameters(), amplitude=0.005)

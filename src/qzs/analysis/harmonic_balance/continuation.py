@@ -136,8 +136,8 @@ def _continue(model, low, high, harmonics, time_points, max_points, step):
             break
     if found is None:
         notes.append(f"no periodic solution found at any of {START_ATTEMPTS} frequencies from "
-                     f"{low:g} to {high:g} Hz (Newton's residual {norm:.2g}); try more "
-                     "harmonics or a larger friction_velocity")
+                     f"{low:g} to {high:g} Hz (Newton's residual {norm:.2g}){_table_note(model)}; "
+                     "try more harmonics or a larger friction_velocity")
         return _curve([], [], model, harmonics, notes)
     frequency, q, norm = found
     if frequency > low:
@@ -186,8 +186,8 @@ def _follow(u, tangent, inside, max_points, *, model, basis, scale, omega_scale,
             if ds < ds_min:
                 notes.append(f"continuation stopped at {u[-1] * omega_scale / (2 * np.pi):.4g} "
                              "Hz: the corrector no longer converges (a steep friction "
-                             "transition or a branch point); try more harmonics or a larger "
-                             "friction_velocity")
+                             f"transition or a branch point{_table_note(model)}); try more "
+                             "harmonics or a larger friction_velocity")
                 break
             continue
         u, tangent = u_new, new_tangent
@@ -195,6 +195,15 @@ def _follow(u, tangent, inside, max_points, *, model, basis, scale, omega_scale,
         tangents.append(tangent[-1])
         ds *= 1.5 if iterations <= 3 else 1.0 if iterations <= 6 else 0.5
     return points, tangents
+
+
+def _table_note(model):
+    """What a refusing spring table adds to a note on Newton's failure: its range [m]."""
+    low, high = (-np.inf, np.inf) if model.spring_law is None else model.spring_law.domain
+    if np.isfinite(low) or np.isfinite(high):
+        return (f", or the motion leaves the spring's table [{low:g}, {high:g}] m "
+                "(outside='refuse': measure it wider or build it with outside='extend')")
+    return ""
 
 
 def _point(u, scale, omega_scale, model, basis, norm):

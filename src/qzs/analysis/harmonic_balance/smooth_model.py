@@ -6,7 +6,10 @@ out, so that a periodic response is a zero of a smooth function of its Fourier c
 
 * one degree of freedom, relative coordinates ``z = x - y``, ``v = dz/dt``, base
   ``y = A cos(w t)``;
-* the MagSpring ``-a tanh(b z)`` as it is;
+* the spring law as it is: the MagSpring ``-a tanh(b z)`` of ``spring_force`` and
+  ``spring_shape``, or the isolator's own law (``spring_law``, docs/model.md §3.1: its
+  force and stiffness evaluated on the AFT's time samples; NaN outside a refusing table, so
+  Newton backs off and a branch that leaves the table ends with a note);
 * friction regularised: ``-[Fc + (Fs - Fc) exp(-Cbc |v|)] tanh(v/v_reg) - Cv v``, the sign
   function replaced by ``tanh(v/v_reg)`` (``friction_velocity`` = ``v_reg`` [m/s]); there
   is no sticking, a held payload creeps at a velocity of the order of ``v_reg``;
@@ -22,8 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from qzs._validation import non_negative_real, positive_real
-from qzs.model.isolator import (friction_force, friction_slope, refuse_spring_law,
+from qzs.errors import ParameterError
+from qzs.model.isolator import (friction_force, friction_slope, other_spring_law,
                                 spring_force, spring_stiffness)
+from qzs.model.springs import SpringLaw, TanhSpring
 from qzs.model.controller import refuse_blocks
 from qzs.model.registry import model_inputs
 
@@ -49,9 +54,9 @@ class SmoothModel:
     gravity : float
         Gravitational acceleration [m/s^2].
     spring_force : float
-        MagSpring plateau force a [N].
+        MagSpring plateau force a [N] (unused with a ``spring_law``).
     spring_shape : float
-        MagSpring transition coefficient b [1/m].
+        MagSpring transition coefficient b [1/m] (unused with a ``spring_law``).
     stiction_force : float
         Breakaway friction level Fs [N] (the regularised law's level at small velocity).
     coulomb_force : float
@@ -78,6 +83,11 @@ class SmoothModel:
         Motor saturation [N]: not modelled, only checked (:attr:`FrequencyResponseCurve.valid`).
     stop_low, stop_high : float
         Hard stops in z [m]: not modelled, only checked.
+    spring_law : SpringLaw or None
+        The spring law (docs/model.md §3.1): None (default) is the MagSpring's tanh of
+        ``spring_force`` and ``spring_shape``; a
+        :class:`~qzs.model.springs.TanhSpring` must agree with those two fields and is
+        kept as None (the same arithmetic); another law replaces the tanh.
     """
 
     mass: float
@@ -98,6 +108,7 @@ class SmoothModel:
     motor_force_max: float = np.inf
     stop_low: float = -np.inf
     stop_high: float = np.inf
+    spring_law: SpringLaw | None = None
 
     def __post_init__(self):
         for name in ("mass", "spring_shape", "friction_velocity", "amplitude"):
@@ -106,6 +117,20 @@ class SmoothModel:
                      "stribeck_decay", "viscous_damping", "pi_kp", "pi_ki", "damping_gain",
                      "velocity_highpass"):
             non_negative_real(name, getattr(self, name))
+        law = self.spring_law
+        if law is not None and not isinstance(law, SpringLaw):
+            raise ParameterError(
+                f"`spring_law` must be a spring law (TanhSpring, ObliqueSpringQZS, "
+                f"PolynomialSpring, TabulatedSpring) or None for the tanh of `spring_force` "
+                f"and `spring_shape`, got {law!r}.", ("spring_law",))
+        if isinstance(law, TanhSpring):
+            if (law.plateau, law.shape) != (self.spring_force, self.spring_shape):
+                raise ParameterError(
+                    f"`spring_law` ({law.describe()}) and `spring_force`, `spring_shape` "
+                    f"({self.spring_force!r} N, {self.spring_shape!r} 1/m) disagree: give the "
+                    "MagSpring's numbers once, in the fields (spring_law=None).",
+                    ("spring_law", "spring_force", "spring_shape"))
+            object.__setattr__(self, "spring_law", None)
 
     @classmethod
     def from_parameters(cls, isolator=None, controller=None, *, amplitude,
@@ -132,8 +157,6 @@ class SmoothModel:
         isolator, controller = model_inputs(isolator, controller)
         refuse_blocks(controller, "the harmonic balance",
                       "simulate the steady state instead (qzs.simulate of a sine)")
-        refuse_spring_law(isolator, "the harmonic balance",
-                          fix="simulate the steady state instead (qzs.simulate of a sine)")
         center = (controller.position_setpoint if isolator.stop_center is None
                   else isolator.stop_center)
         return cls(mass=isolator.mass, gravity=isolator.gravity,
@@ -146,7 +169,8 @@ class SmoothModel:
                    velocity_highpass=controller.velocity_highpass,
                    friction_velocity=friction_velocity, amplitude=amplitude,
                    motor_force_max=isolator.motor_force_max,
-                   stop_low=center - isolator.stroke_half, stop_high=center + isolator.stroke_half)
+                   stop_low=center - isolator.stroke_half, stop_high=center + isolator.stroke_half,
+                   spring_law=other_spring_law(isolator))
 
     @property
     def friction_regularisation(self):
@@ -219,7 +243,8 @@ class SmoothModel:
     def spring(self, relative_position):
         """Spring force [N] and its slope dF/dz [N/m] at ``relative_position`` [m]: the
         model's laws, :func:`~qzs.model.isolator.spring_force` and minus
-        :func:`~qzs.model.isolator.spring_stiffness`.
+        :func:`~qzs.model.isolator.spring_stiffness` of the tanh, or the ``spring_law``'s
+        ``force`` and minus its ``stiffness``.
 
         Parameters
         ----------
@@ -229,9 +254,22 @@ class SmoothModel:
         Returns
         -------
         force, slope : ndarray
-            ``-a tanh(b z)`` [N] and ``-a b / cosh(b z)^2`` [N/m].
+            ``-a tanh(b z)`` [N] and ``-a b / cosh(b z)^2`` [N/m], or the law's; NaN
+            where ``z`` is outside a refusing table (``outside='refuse'``), so that a
+            Newton iterate there is rejected instead of raising.
         """
-        return spring_force(relative_position, self), -spring_stiffness(relative_position, self)
+        law = self.spring_law
+        if law is None:
+            return (spring_force(relative_position, self),
+                    -spring_stiffness(relative_position, self))
+        z = np.asarray(relative_position, dtype=float)
+        low, high = law.domain
+        if low == -np.inf and high == np.inf:
+            return law.force(z), -law.stiffness(z)
+        inside = (z >= low) & (z <= high)  # NaN positions are outside too
+        held = np.where(inside, z, low)
+        return (np.where(inside, law.force(held), np.nan),
+                np.where(inside, -law.stiffness(held), np.nan))
 
     def friction(self, relative_velocity):
         """Regularised friction force [N] and its slope dF/dv [N*s/m] at ``relative_velocity``:
@@ -283,6 +321,6 @@ def smooth_right_hand_side(time, state, frequency, model):
     ydd = -a * omega ** 2 * np.cos(omega * time)
     xd = yd + v
     motor = model.motor_force(z, integral, xd, w)
-    force = spring_force(z, model) + friction_force(v, model) + motor - model.mass * model.gravity
+    force = model.spring(z)[0] + friction_force(v, model) + motor - model.mass * model.gravity
     return np.array([v, force / model.mass - ydd, model.highpass_omega * (xd - w),
                      model.position_setpoint - z])

@@ -16,7 +16,7 @@ from qzs.analysis.harmonic_balance.residual import (_force_scale, _linear_terms,
                                                     _relative_coefficients, _residual, _scales)
 from qzs.analysis.harmonic_balance.smooth_model import SmoothModel
 from qzs.errors import ParameterError
-from qzs.model.isolator import friction_level, friction_slope, spring_force, spring_stiffness
+from qzs.model.isolator import friction_level, friction_slope
 
 __all__ = ["HarmonicBalanceSolution", "periodic_response"]
 
@@ -201,7 +201,8 @@ def _linear_guess(omega, model, basis):
     ``4 F(V)/(pi V) + Cv`` at the velocity amplitude ``V`` of the fundamental (at most the
     regularised law's slope at rest), found by a few fixed-point iterations."""
     q = np.zeros(basis.size)
-    k_spring = spring_stiffness(model.position_setpoint, model)
+    spring_at_setpoint, spring_slope = model.spring(model.position_setpoint)
+    k_spring = -spring_slope
     rest_slope = -friction_slope(0.0, model)
     on_z, on_y, _, _ = _linear_terms(omega, model, 1)
     damping = rest_slope
@@ -214,7 +215,7 @@ def _linear_guess(omega, model, basis):
         equivalent = 4 * level / (np.pi * velocity) if velocity > 0 else np.inf
         damping = min(equivalent, rest_slope - model.viscous_damping) + model.viscous_damping
     q[1], q[2] = z1.real, -z1.imag
-    static = model.mass * model.gravity - spring_force(model.position_setpoint, model)
+    static = model.mass * model.gravity - spring_at_setpoint
     if model.pi_ki > 0:
         q[0] = float(static) / model.pi_ki
     else:

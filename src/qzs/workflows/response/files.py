@@ -280,6 +280,10 @@ def _parameter_attributes(isolator, controller):
                 value = int(value)
             attrs[f"{section}.{item.name}"] = value
             attrs[f"{section}.{item.name}_units"] = unit_of(item.name)
+    if isolator.spring is not None:  # the spring law, as a run's records write it
+        for name, (value, unit) in isolator.spring.parameters().items():
+            attrs[f"isolator.spring.{name}"] = value
+            attrs[f"isolator.spring.{name}_units"] = unit
     for name, (value, unit) in block_parameters(controller).items():
         attrs[f"controller.{name}"] = "none" if value is None else value
         attrs[f"controller.{name}_units"] = unit
