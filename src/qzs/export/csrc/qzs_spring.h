@@ -12,8 +12,11 @@
 #ifndef QZS_SPRING_H
 #define QZS_SPRING_H
 
-/* codes of the laws (qzs.model.springs TANH, OBLIQUE, POLYNOMIAL, TABLE) */
-enum { QZS_SPRING_TANH, QZS_SPRING_OBLIQUE, QZS_SPRING_POLYNOMIAL, QZS_SPRING_TABLE };
+/* codes of the laws (qzs.model.springs TANH, OBLIQUE, POLYNOMIAL, TABLE); macros, for #if */
+#define QZS_SPRING_TANH 0
+#define QZS_SPRING_OBLIQUE 1
+#define QZS_SPRING_POLYNOMIAL 2
+#define QZS_SPRING_TABLE 3
 /* offsets in a packed table (qzs.model.springs.TABLE_*) */
 enum { QZS_TABLE_OUTSIDE = 1, QZS_TABLE_COUNT, QZS_TABLE_END_FORCE, QZS_TABLE_END_SLOPE,
        QZS_TABLE_POSITIONS };
