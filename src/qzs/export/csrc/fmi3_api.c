@@ -167,6 +167,8 @@ static fmi3Status set_values(fmi3Instance handle, const fmi3ValueReference refs[
 static fmi3Status float64_elements(fmi3Instance handle, const fmi3ValueReference refs[],
                                    size_t n, size_t nValues, fmi3ValueReference *elements) {
     QzsFmu *fmu = &((Instance *)handle)->fmu;
+    if (nValues > QZS_FMU_N_VARIABLES)
+        return refuse(handle, "accessing more Float64 values than the FMU has");
     size_t k = 0;
     for (size_t i = 0; i < n; i++) {
         size_t size;
@@ -187,8 +189,6 @@ static fmi3Status float64_elements(fmi3Instance handle, const fmi3ValueReference
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference refs[], size_t n,
                           fmi3Float64 values[], size_t nValues) {
     fmi3ValueReference elements[QZS_FMU_N_VARIABLES];
-    if (nValues > QZS_FMU_N_VARIABLES)
-        return refuse(instance, "getting more values than the FMU has");
     if (float64_elements(instance, refs, n, nValues, elements) != fmi3OK)
         return fmi3Error;
     return get_values(instance, elements, nValues, 'F', values);
@@ -197,8 +197,6 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference refs[]
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference refs[], size_t n,
                           const fmi3Float64 values[], size_t nValues) {
     fmi3ValueReference elements[QZS_FMU_N_VARIABLES];
-    if (nValues > QZS_FMU_N_VARIABLES)
-        return refuse(instance, "setting more values than the FMU has");
     if (float64_elements(instance, refs, n, nValues, elements) != fmi3OK)
         return fmi3Error;
     return set_values(instance, elements, nValues, 'F', values);

@@ -25,22 +25,17 @@ INLINE double spring_energy_law(double a, double b, double z) {
     return a / b * (u + log1p(exp(-2.0 * u)) - log(2.0));
 }
 
-/* kernels._general_spring / _general_spring_energy: the law's force [N] or energy [J] (NaN
- * outside a refusing table: the run then stops, qzs_failure_status), else the tanh's */
-INLINE double spring_force_of(const QzsPlant *plant, double z) {
+/* kernels._general_spring / _general_spring_energy: the law's force [N] (`want`
+ * QZS_SPRING_FORCE) or energy [J] (QZS_SPRING_ENERGY), NaN outside a refusing table (the run
+ * then stops, qzs_failure_status); the tanh's without a law */
+INLINE double spring_of(const QzsPlant *plant, double z, int want) {
+    const double *P = plant->P;
     if (!plant->spring)
-        return spring_law(plant->P[QZS_P_SPRING_A], plant->P[QZS_P_SPRING_B], z);
+        return want == QZS_SPRING_FORCE ? spring_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z)
+                                        : spring_energy_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z);
     QzsSpringValues values;
-    qzs_spring_evaluate(plant->spring, z, QZS_SPRING_FORCE, &values);
-    return values.force;
-}
-
-INLINE double spring_energy_of(const QzsPlant *plant, double z) {
-    if (!plant->spring)
-        return spring_energy_law(plant->P[QZS_P_SPRING_A], plant->P[QZS_P_SPRING_B], z);
-    QzsSpringValues values;
-    qzs_spring_evaluate(plant->spring, z, QZS_SPRING_ENERGY, &values);
-    return values.energy;
+    qzs_spring_evaluate(plant->spring, z, want, &values);
+    return want == QZS_SPRING_FORCE ? values.force : values.energy;
 }
 
 INLINE void compliant_stop_law(double z, double v, double z_low, double z_high,
@@ -268,7 +263,7 @@ INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, con
     double z = s->x[QZS_S_Z];
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
     double xd = b.yd + v;
-    double f_spring = spring_force_of(plant, z);
+    double f_spring = spring_of(plant, z, QZS_SPRING_FORCE);
 
     double f_stop = 0.0, f_elastic = 0.0;
     if (P[QZS_P_PLASTIC] == 0.0)
@@ -501,7 +496,7 @@ static void energies(const QzsPlant *plant, double y, double yd, const QzsOde *s
         pen = PYMAX(P[QZS_P_Z_LOW] - z, 0.0) + PYMAX(z - P[QZS_P_Z_HIGH], 0.0);
     double xd = yd + v;
     e[0] = 0.5 * m * (xd * xd);
-    e[1] = spring_energy_of(plant, z);
+    e[1] = spring_of(plant, z, QZS_SPRING_ENERGY);
     e[2] = m * P[QZS_P_GRAVITY] * (y + z);
     e[3] = 0.5 * P[QZS_P_STOP_K] * pen * pen;
 }
