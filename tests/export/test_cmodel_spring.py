@@ -4,8 +4,9 @@ An oblique-spring QZS at its quasi-zero condition, a cubic polynomial and a tabl
 the tanh that extends: every recorded channel of :func:`qzs.simulate` equals the C closed
 loop's to the bit, with the same stick events. A table that refuses positions outside it stops
 the C run where the kernel stops (status outside, the same step and last state). The C
-evaluator (``qzs_spring_evaluate``) is the kernels' and :func:`qzs.model.springs.evaluate_packed`
-at positions inside, outside and on a table's breakpoints, its table packing (``qzs_spring_table``) is
+evaluator (``qzs_spring_evaluate``) is the kernels' and
+:func:`qzs.model.springs.evaluate_packed` at positions inside, outside and on a table's
+breakpoints, its table packing (``qzs_spring_table``) is
 :class:`~qzs.model.springs.TabulatedSpring`'s (PCHIP slopes, pieces, energies) on a measured-like
 curve with extrema, flat steps and sign changes, and its stiffness peak is
 :func:`qzs.engine.stability.spring_stiffness_peak`'s (what an FMU's step is checked against).

@@ -445,6 +445,7 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
     law = np.array([float(TANH), 0.0, 0.0]) if spring is None else np.asarray(spring)
     points = int(law[2]) if law[0] == TABLE else 0
     spring_where = ", ".join(str(v.spring) for v in variables)
+    base_law = ", ".join(repr(float(x)) for x in law)
     sizes = ", ".join(str(n) for n in _sizes(variables, fmi_version))
     return (
         "/* qzs_fmu_variables.h: written by qzs at export; the FMU's variables by value\n"
@@ -480,7 +481,7 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
         "/* the spring law as exported (QZS_FMU_SPRING_LAW 0: the tanh of the isolator's\n"
         " * parameters), where each spring parameter goes in it (-1: none), and how many values\n"
         " * each value reference holds (an FMI 3 array's elements follow its first) */\n"
-        f"static const double QZS_FMU_SPRING_BASE[] = {{{', '.join(repr(float(x)) for x in law)}}};\n"
+        f"static const double QZS_FMU_SPRING_BASE[] = {{{base_law}}};\n"
         f"static const int QZS_FMU_SPRING[] = {{{spring_where}}};\n"
         f"static const int QZS_FMU_SIZE[] = {{{sizes}}};\n"
         f"static const char *const QZS_FMU_NAMES[] = {{\n{names}\n}};\n\n"

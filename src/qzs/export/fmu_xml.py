@@ -3,8 +3,8 @@
 
 Written with :mod:`xml.etree.ElementTree` from the variable table of
 :mod:`qzs.export.fmu_variables` (an array's elements one FMI 3 array variable with its
-``Dimension``, FMI 2 scalars ``name[k]``); every unit used is declared in ``UnitDefinitions`` with its SI
-base-unit exponents. Co-simulation only: the FMU steps itself (fixed internal step, events
+``Dimension``, FMI 2 scalars ``name[k]``); every unit used is declared in
+``UnitDefinitions`` with its SI base-unit exponents. Co-simulation only: the FMU steps itself (fixed internal step, events
 inside the step), so the importer needs no event handling.
 """
 import xml.etree.ElementTree as ET

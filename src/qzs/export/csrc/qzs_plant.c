@@ -29,10 +29,9 @@ INLINE double spring_energy_law(double a, double b, double z) {
  * QZS_SPRING_FORCE) or energy [J] (QZS_SPRING_ENERGY), NaN outside a refusing table (the run
  * then stops, qzs_failure_status); the tanh's without a law */
 INLINE double spring_of(const QzsPlant *plant, double z, int want) {
-    const double *P = plant->P;
+    double a = plant->P[QZS_P_SPRING_A], b = plant->P[QZS_P_SPRING_B];
     if (!plant->spring)
-        return want == QZS_SPRING_FORCE ? spring_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z)
-                                        : spring_energy_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z);
+        return want == QZS_SPRING_FORCE ? spring_law(a, b, z) : spring_energy_law(a, b, z);
     QzsSpringValues values;
     qzs_spring_evaluate(plant->spring, z, want, &values);
     return want == QZS_SPRING_FORCE ? values.force : values.energy;
