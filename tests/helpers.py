@@ -202,6 +202,25 @@ EXPORT_BLOCK_CASES = {
 }
 
 
+#: The spring laws the C model and the FMU are checked on (issue 41), name: law, each run on
+#: :data:`EXPORT_SPRING_SINE` (the payload slides and sticks on them): an oblique-spring QZS at
+#: its quasi-zero condition, a cubic polynomial and a table sampled from the tanh that extends.
+EXPORT_SPRING_LAWS = {
+    "oblique": qzs.ObliqueSpringQZS.quasi_zero(),
+    "cubic polynomial": qzs.PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -4e4),
+                                             center=-0.06),
+    "table of the tanh": qzs.TabulatedSpring.from_law(qzs.TanhSpring(),
+                                                      np.linspace(-0.2, 0.1, 61),
+                                                      outside="extend"),
+}
+EXPORT_SPRING_SINE = qzs.Sine(amplitude=5e-3, frequency=5.0)
+#: A table of the tanh that refuses positions outside it, and a base motion that takes the
+#: payload out of it (at t = 0.6812 s with EXPORT_SETTINGS).
+EXPORT_REFUSING_TABLE = qzs.TabulatedSpring.from_law(qzs.TanhSpring(),
+                                                     np.linspace(-0.065, -0.055, 21))
+EXPORT_LEAVING_SINE = qzs.Sine(amplitude=0.03, frequency=6.0)
+
+
 def run_both(cases, settings, name):
     """``(name, qzs.simulate's run, the C model's run)`` of case ``name`` of ``cases`` (its
     settings from ``settings(name)``): what the C model's tests compare."""

@@ -196,3 +196,22 @@ def test_a_communication_step_that_is_no_multiple_of_the_internal_step_is_taken(
     assert float(experiment.stepSize) == 1.5e-4 and float(experiment.stopTime) == 0.3
     result = simulate_fmu(str(out), output_interval=1.5e-4)
     assert result["time"][-1] == pytest.approx(0.3) and len(result) == 2001
+
+
+def test_export_fmu_takes_a_spring_file_as_simulate_does(tmp_path, capsys):
+    """``--spring FILE.toml``: the law of the file is the FMU's, its numbers its parameters
+    (an FMI 3 array for the coefficients), and the FMU is valid."""
+    fmpy = pytest.importorskip("fmpy")
+    from fmpy.validation import validate_fmu
+
+    spring = tmp_path / "spring.toml"
+    spring.write_text('[spring]\nlaw = "polynomial"\ncoefficients = [62.78, -300.0, 0.0, -4e4]\n'
+                      'center = -0.06\n')
+    out = tmp_path / "poly.fmu"
+    code = main(["export", "fmu", "--spring", str(spring), "--out", str(out), "--excitation",
+                 "sine", "--duration", "1", "--dt", "1e-4"])
+    assert code == 0, capsys.readouterr().err
+    assert validate_fmu(str(out)) == []
+    starts = {v.name: v.start for v in fmpy.read_model_description(str(out)).modelVariables}
+    assert [float(v) for v in starts["spring.coefficients"].split()] == [62.78, -300.0, 0.0, -4e4]
+    assert float(starts["spring.center"]) == -0.06

@@ -1,8 +1,8 @@
 """``qzs export``: the controller as one C file, and the isolator as an FMU (docs/fmu.md)."""
 import sys
 
-from qzs.cli.common import (EPILOG, add_output_options, add_set_option, check_output, emit,
-                             parameters)
+from qzs.cli.common import (EPILOG, add_output_options, add_set_option, add_spring_option,
+                             check_output, emit, parameters)
 from qzs.defaults import SIMULATION
 
 __all__ = ["add_parser", "run_controller", "run_fmu"]
@@ -89,6 +89,7 @@ def add_parser(subparsers):
                           "displacement, velocity and acceleration as inputs")
     fmu.add_argument("--config", metavar="FILE.toml",
                      help="run configuration (see `qzs params --toml`)")
+    add_spring_option(fmu)
     add_set_option(fmu)
     fmu.add_argument("--excitation", choices=("chirp", "sine"),
                      help="the internal excitation (default the configuration's, else chirp)")

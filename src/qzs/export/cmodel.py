@@ -14,7 +14,6 @@ import numpy as np
 
 from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
-from qzs.model.isolator import refuse_spring_law
 from qzs.errors import ParameterError
 from qzs.export.csource import load_model
 
@@ -36,7 +35,10 @@ class CRun:
     run_flags : ndarray of int64, shape (N_FLAGS,)
         The final integer flags (``I_*``: mode, direction, step, contact and counters).
     diverged : bool
-        The state diverged (the run stopped at ``run_flags[I_STEP]``).
+        The run stopped at ``run_flags[I_STEP]``: the state diverged, or the payload left a
+        spring table that refuses positions outside it (``status``).
+    status : int
+        The C's status: ``K.STATUS_OK``, ``K.STATUS_DIVERGED`` or ``K.STATUS_OUTSIDE``.
     seconds : float
         Wall time of the C call [s].
     """
@@ -46,6 +48,7 @@ class CRun:
     state: np.ndarray
     run_flags: np.ndarray
     diverged: bool
+    status: int
     seconds: float
 
     @property
@@ -92,7 +95,6 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
         out_flags = np.zeros((samples, 2), dtype=np.uint8)
     _check_buffer("out", out, (samples, K.N_CHANNELS), np.float64)
     _check_buffer("out_flags", out_flags, (samples, 2), np.uint8)
-    refuse_spring_law(run.isolator, "the C model")
     library = load_model(native)
     state = np.array(run.state, dtype=np.float64)
     flags = np.array(run.flags, dtype=np.int64)
@@ -114,7 +116,8 @@ def run_prepared(run, *, native=False, out=None, out_flags=None):
     seconds = time.perf_counter() - start
     written = 1 + int(rows[0])
     return CRun(data=out[:written], flags=out_flags[:written].astype(bool), state=state,
-                run_flags=flags, diverged=status != K.STATUS_OK, seconds=seconds)
+                run_flags=flags, diverged=status != K.STATUS_OK, status=int(status),
+                seconds=seconds)
 
 
 def _check_buffer(name, array, rows_columns, dtype):

@@ -23,8 +23,8 @@ from qzs.errors import CompilerError
 __all__ = ["SOURCES", "CFLAGS", "NATIVE_CFLAGS", "source_folder", "source_text",
            "find_compiler", "compile_shared", "load_model"]
 
-#: The C model's translation units, in ``csrc/``: controller, plant, closed loop.
-SOURCES = ("qzs_controller.c", "qzs_plant.c", "qzs_model.c")
+#: The C model's translation units, in ``csrc/``: controller, spring laws, plant, closed loop.
+SOURCES = ("qzs_controller.c", "qzs_spring.c", "qzs_plant.c", "qzs_model.c")
 #: Portable flags (an FMU's binary, the tests): optimised, IEEE arithmetic as the kernels'.
 CFLAGS = ("-O2", "-std=c99", "-ffp-contract=off", "-fno-math-errno", "-fPIC")
 #: The benchmarks' flags: as numba compiles, for this CPU (``fma()`` becomes one instruction).

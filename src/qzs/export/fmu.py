@@ -24,7 +24,6 @@ from qzs import defaults
 from qzs._optional import require
 from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
-from qzs.model.isolator import refuse_spring_law
 from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
 from qzs.errors import (ControllerRateError, ParameterError, StabilityError,
@@ -36,15 +35,17 @@ from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp, Sine
-from qzs.model.isolator import IsolatorParameters
+from qzs.model.isolator import IsolatorParameters, other_spring_law
 
 __all__ = ["export_fmu", "fmi_headers", "platform_folder", "default_stop_time", "FMU_SOURCES",
            "FMI_VERSIONS", "DEFAULT_STOP_TIME", "DEFAULT_COMMUNICATION_STEP"]
 
 FMI_VERSIONS = (2, 3)
 #: The C files of the FMU's model, from ``csrc/``, and the interface of each FMI version.
-FMU_SOURCES = ("qzs_controller.c", "qzs_plant.c", "qzs_model.c", "qzs_stability.c", "qzs_fmu.c")
-FMU_HEADERS = ("qzs_controller.h", "qzs_plant.h", "qzs_model.h", "qzs_stability.h", "qzs_fmu.h")
+FMU_SOURCES = ("qzs_controller.c", "qzs_spring.c", "qzs_plant.c", "qzs_model.c",
+               "qzs_stability.c", "qzs_fmu.c")
+FMU_HEADERS = ("qzs_controller.h", "qzs_spring.h", "qzs_plant.h", "qzs_model.h",
+               "qzs_stability.h", "qzs_fmu.h")
 #: The default experiment's stop time [s] of an FMU whose excitation has no length of its own
 #: (a sine, base-motion inputs), as ``qzs simulate`` runs a sine.
 DEFAULT_STOP_TIME = 10.0
@@ -216,7 +217,9 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
         The internal base excitation (its parameters become the FMU's ``excitation.*``);
         default the paper's chirp. Not used with ``base_motion="input"``.
     isolator : IsolatorParameters, optional
-        Plant parameters (the start values); Table 1 defaults if omitted.
+        Plant parameters (the start values); Table 1 defaults if omitted. A spring law other
+        than the tanh (``spring``) is the FMU's, its kind fixed and its numbers parameters
+        (``spring.*``, docs/fmu.md).
     controller : ControllerParameters, optional
         PI and damping loops; defaults if omitted (in ``plant`` mode only the setpoint and
         the charge amplifier's high-pass are used).
@@ -288,10 +291,10 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
         dt = resolved.dt
         # every check qzs.simulate makes, at an output every step: any communication step
         run = prepare_run(**{**resolved.arguments(), "sample_rate": 1.0 / dt})
-        refuse_spring_law(run.isolator, "the FMU")
     except ParameterError as error:
         raise _named(error) from None
     headers = fmi_headers(fmi_version)
+    law = other_spring_law(run.isolator)
     variables = fmu_variables(isolator=run.isolator, controller=run.controller,
                               excitation_scalars=run.packed[0], dt=dt,
                               solver_code=SOLVERS[solver][0], mode=mode, base_motion=base_motion,
@@ -311,7 +314,8 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
             shutil.copyfile(source_folder() / name, root / "sources" / name)
         (root / "sources" / VARIABLES_HEADER).write_text(
             variables_header(variables, mode=mode, base_motion=base_motion, token=token,
-                             step=resolved.step, model=run.model if mode == "closed-loop" else None),
+                             step=resolved.step, model=run.model if mode == "closed-loop" else None,
+                             spring=None if law is None else law.pack(), fmi_version=fmi_version),
             encoding="utf-8")
         if fmi_version == 3:
             (root / "sources" / "buildDescription.xml").write_text(

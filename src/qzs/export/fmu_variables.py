@@ -3,13 +3,17 @@
 Every registry parameter (:data:`qzs.model.registry.PARAMETERS`) is an FMI parameter with its
 SI unit, description and start value (the exported configuration's); so are the run's step
 and solver and, with an internal excitation, the chirp or sine of the base (units from the
-registry, :func:`qzs.model.registry.unit_of`). The inputs are the motor force (``plant``
+registry, :func:`qzs.model.registry.unit_of`), and a spring law other than the tanh's fields
+(``spring.*``: its kind and sizes fixed at export, its numbers parameters; an array one
+scalar per element, ``spring.positions[1]``, an FMI 3 array variable in the model
+description). The inputs are the motor force (``plant``
 mode, starting at the force that holds the setpoint: :func:`holding_force`) or the base
 motion (``input`` base motion); the outputs are the recorded channels
 (:data:`qzs.engine.channels.CHANNELS`) and the two flags. The value reference of a variable is
 its index in :func:`fmu_variables`; :func:`variables_header` writes the same table as C
 (``qzs_fmu_variables.h``) for ``csrc/qzs_fmu.c``, with what the C checks the step against.
 """
+import dataclasses
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -20,12 +24,13 @@ from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
 from qzs.model.sensors import SENSORS
 from qzs.model.excitation import (E_AMPLITUDE, E_DURATION, E_F0, E_F1, E_FADE, E_KIND,
                                   E_PHASE)
-from qzs.model.isolator import spring_force
+from qzs.model.isolator import other_spring_law, spring_force
 from qzs.model.registry import PARAMETERS, unit_of
+from qzs.model.springs import OUTSIDE_RULES, TABLE, TABLE_OUTSIDE, TANH
 
 __all__ = ["FmuVariable", "fmu_variables", "variables_header", "holding_force", "UNITS",
            "MODES", "BASE_MOTIONS", "EXCITATION_KINDS", "EXCITATION_VARIABLES",
-           "PLANT_UNUSED"]
+           "PLANT_UNUSED", "SPRING_POSITION", "SPRING_FORCE"]
 
 #: How the motor force is made: by the PI + damping inside, or given as an input.
 MODES = ("closed-loop", "plant")
@@ -47,6 +52,11 @@ UNITS = {
 MODEL_TWO_PI = 1000  # the index's entry is 2*pi times the value (a frequency [Hz] as [rad/s])
 MODEL_INITIAL_STATE = 2000  # a linear controller's state at t = 0
 MODEL_SAMPLE_TIME = 3000  # a discrete linear controller's period [s], as whole steps
+#: Where a spring law's parameter goes (``qzs_fmu.c``): its index in the packed law
+#: (:meth:`qzs.model.springs.SpringLaw.pack`), or a table's point k as one of these plus k
+#: (the C packs the table's pieces from its points at initialisation).
+SPRING_POSITION = 1000
+SPRING_FORCE = 2000
 #: The unit of a linear controller's feedthrough from each sensor [N per sensor unit].
 _FEEDTHROUGH_UNITS = {"position_error": "N/m", "measured_payload_velocity": "N*s/m",
                       "payload_acceleration": "kg", "base_acceleration": "kg",
@@ -108,6 +118,12 @@ class FmuVariable:
         Where a controller block's parameter goes in the packed blocks (``K.M_*`` index,
         :data:`MODEL_TWO_PI`, :data:`MODEL_INITIAL_STATE` or :data:`MODEL_SAMPLE_TIME` plus
         an index), -1 for none.
+    spring : int
+        Where a spring law's parameter goes (an index in the packed law, or
+        :data:`SPRING_POSITION` or :data:`SPRING_FORCE` plus a table's point), -1 for none.
+    array : str
+        The array an element belongs to (``spring.positions`` of ``spring.positions[2]``: one
+        FMI 3 array variable), ``""`` for a scalar.
     """
 
     name: str
@@ -119,6 +135,8 @@ class FmuVariable:
     start: float | None
     channel: int = -1
     model: int = -1
+    spring: int = -1
+    array: str = ""
 
     @property
     def macro(self):
@@ -230,6 +248,42 @@ def _block_parameters(isolator, controller, model, blocks_state):
     return rows
 
 
+def _spring_parameters(law):
+    """A spring law's parameters (rows of :func:`fmu_variables`): its fields with their units
+    and descriptions (qzs.model.springs), an array's elements one row each."""
+    if law.code == TABLE:
+        rows = [dict(name="spring.outside", type="I", causality="parameter", unit="",
+                     description="outside the table: 0 refuse (the run stops with an error), 1 "
+                                 "extend (linear with the end slope)",
+                     start=float(OUTSIDE_RULES.index(law.outside)), spring=TABLE_OUTSIDE)]
+        for field, where, doc in (("positions", SPRING_POSITION, "relative positions of the "
+                                   "table, strictly increasing (PCHIP, docs/model.md §3.1)"),
+                                  ("forces", SPRING_FORCE, "forces on the payload at the "
+                                   "positions, upward positive")):
+            unit = "m" if field == "positions" else "N"
+            rows += [dict(name=f"spring.{field}[{k + 1}]", type="F", causality="parameter",
+                          unit=unit, description=doc, start=float(value), spring=where + k,
+                          array=f"spring.{field}")
+                     for k, value in enumerate(getattr(law, field))]
+        return rows
+    packed = law.pack()
+    if law.kind == "polynomial":
+        rows = [dict(name="spring.center", type="F", causality="parameter", unit="m",
+                     description="position the powers are taken about", start=float(packed[1]),
+                     spring=1)]
+        return rows + [dict(name=f"spring.coefficients[{k + 1}]", type="F",
+                            causality="parameter", unit="",
+                            description="coefficient c_k of (z - center)^k, ascending from c_0 "
+                                        "[N], c_1 [N/m], ... (c_k in N/m^k)",
+                            start=float(value), spring=3 + k, array="spring.coefficients")
+                       for k, value in enumerate(law.coefficients)]
+    return [dict(name=f"spring.{f.name}", type="F", causality="parameter",
+                 unit=f.metadata["unit"], description=f.metadata["doc"] + " (the "
+                 f"{law.kind} spring law, docs/model.md §3.1)", start=float(packed[1 + i]),
+                 spring=1 + i)
+            for i, f in enumerate(dataclasses.fields(law))]
+
+
 def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, mode,
                   base_motion, model=None, blocks_state=None):
     """The FMU's variables in value-reference order.
@@ -263,6 +317,7 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
     rows = [dict(name="time", type="F", causality="independent", unit="s",
                  description="simulation time", start=None)]
     starts = _parameter_starts(isolator, controller)
+    law = other_spring_law(isolator)
     for name, info in PARAMETERS.items():
         description = info.doc
         if name == "stop_model":
@@ -271,6 +326,8 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
             description = "centre of the stops in z (exported: the setpoint if none was set)"
         if mode == "plant" and name in PLANT_UNUSED:
             description += " (not used in plant mode: the motor force is the input)"
+        if law is not None and name in ("spring_force", "spring_shape"):
+            description += f" (not used: the spring is the exported {law.kind} law, spring.*)"
         kind = "I" if name == "stop_model" else "F"
         rows.append(dict(name=f"{info.section}.{name}", type=kind,
                          causality="parameter", unit=info.unit if info.unit in UNITS else "",
@@ -282,6 +339,8 @@ def fmu_variables(*, isolator, controller, excitation_scalars, dt, solver_code, 
                      start=float(dt)))
     rows.append(dict(name="solver", type="I", causality="parameter", unit="",
                      description=_SOLVER_DOC, start=float(solver_code)))
+    if law is not None:
+        rows += _spring_parameters(law)
     blocks = mode == "closed-loop" and controller.has_blocks
     if blocks:
         rows += _block_parameters(isolator, controller, model, blocks_state)
@@ -324,7 +383,21 @@ def _c_string(text):
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def variables_header(variables, *, mode, base_motion, token, step=None, model=None):
+def _sizes(variables, fmi_version):
+    """How many values each value reference holds: an FMI 3 array's length at its first
+    element and 0 (no variable) at the others; 1 for every other variable."""
+    sizes = []
+    for i, v in enumerate(variables):
+        if fmi_version == 3 and v.array:
+            first = i == 0 or variables[i - 1].array != v.array
+            sizes.append(sum(1 for w in variables if w.array == v.array) if first else 0)
+        else:
+            sizes.append(1)
+    return sizes
+
+
+def variables_header(variables, *, mode, base_motion, token, step=None, model=None,
+                     spring=None, fmi_version=2):
     """``qzs_fmu_variables.h``: the variable table as C, for ``csrc/qzs_fmu.c``.
 
     Parameters
@@ -344,6 +417,12 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
     model : ndarray, optional
         The exported controller's blocks packed (``K.M_*``): the C model's blocks, which the
         block parameters overwrite at initialisation; None or all zeros for none.
+    spring : ndarray, optional
+        A spring law other than the tanh, packed (:meth:`qzs.model.springs.SpringLaw.pack`):
+        its kind and size, which the spring parameters fill at initialisation; None for the
+        tanh of ``isolator.spring_force`` and ``isolator.spring_shape``.
+    fmi_version : {2, 3}
+        FMI version: FMI 3 addresses an array by its first element's value reference.
 
     Returns
     -------
@@ -363,6 +442,11 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
     blocks = model is not None and model[K.M_BLOCKS] != 0.0
     base = ", ".join(repr(float(value)) for value in (model if blocks else [0.0]))
     where = ", ".join(str(v.model) for v in variables)
+    law = np.array([float(TANH), 0.0, 0.0]) if spring is None else np.asarray(spring)
+    points = int(law[2]) if law[0] == TABLE else 0
+    spring_where = ", ".join(str(v.spring) for v in variables)
+    base_law = ", ".join(repr(float(x)) for x in law)
+    sizes = ", ".join(str(n) for n in _sizes(variables, fmi_version))
     return (
         "/* qzs_fmu_variables.h: written by qzs at export; the FMU's variables by value\n"
         " * reference (types F Float64, I Int32, B Boolean; causality t time, p parameter,\n"
@@ -379,7 +463,12 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
         f"#define QZS_FMU_BLOCKS {int(blocks)}\n"
         f"#define QZS_FMU_MODEL_TWO_PI {MODEL_TWO_PI}\n"
         f"#define QZS_FMU_MODEL_INITIAL_STATE {MODEL_INITIAL_STATE}\n"
-        f"#define QZS_FMU_MODEL_SAMPLE_TIME {MODEL_SAMPLE_TIME}\n\n"
+        f"#define QZS_FMU_MODEL_SAMPLE_TIME {MODEL_SAMPLE_TIME}\n"
+        f"#define QZS_FMU_SPRING_LAW {int(law[0])}\n"
+        f"#define QZS_FMU_SPRING_SIZE {law.size}\n"
+        f"#define QZS_FMU_SPRING_POINTS {points}\n"
+        f"#define QZS_FMU_SPRING_POSITION {SPRING_POSITION}\n"
+        f"#define QZS_FMU_SPRING_FORCE {SPRING_FORCE}\n\n"
         f"enum {{\n{enum}\n}};\n\n"
         f"static const char QZS_FMU_TYPES[] = {_c_string(''.join(v.type for v in variables))};\n"
         f"static const char QZS_FMU_CAUSALITY[] = {_c_string(causality)};\n"
@@ -389,5 +478,11 @@ def variables_header(variables, *, mode, base_motion, token, step=None, model=No
         " * each block parameter goes in them (-1: none) */\n"
         f"static const double QZS_FMU_MODEL_BASE[] = {{{base}}};\n"
         f"static const int QZS_FMU_MODEL[] = {{{where}}};\n"
+        "/* the spring law as exported (QZS_FMU_SPRING_LAW 0: the tanh of the isolator's\n"
+        " * parameters), where each spring parameter goes in it (-1: none), and how many values\n"
+        " * each value reference holds (an FMI 3 array's elements follow its first) */\n"
+        f"static const double QZS_FMU_SPRING_BASE[] = {{{base_law}}};\n"
+        f"static const int QZS_FMU_SPRING[] = {{{spring_where}}};\n"
+        f"static const int QZS_FMU_SIZE[] = {{{sizes}}};\n"
         f"static const char *const QZS_FMU_NAMES[] = {{\n{names}\n}};\n\n"
         "#endif /* QZS_FMU_VARIABLES_H */\n")

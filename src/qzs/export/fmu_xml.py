@@ -2,8 +2,9 @@
 ``sources/buildDescription.xml``.
 
 Written with :mod:`xml.etree.ElementTree` from the variable table of
-:mod:`qzs.export.fmu_variables`; every unit used is declared in ``UnitDefinitions`` with its SI
-base-unit exponents. Co-simulation only: the FMU steps itself (fixed internal step, events
+:mod:`qzs.export.fmu_variables` (an array's elements one FMI 3 array variable with its
+``Dimension``, FMI 2 scalars ``name[k]``); every unit used is declared in
+``UnitDefinitions`` with its SI base-unit exponents. Co-simulation only: the FMU steps itself (fixed internal step, events
 inside the step), so the importer needs no event handling.
 """
 import xml.etree.ElementTree as ET
@@ -107,9 +108,11 @@ def model_description(variables, *, fmi_version, model_identifier, token, descri
                   stepSize=repr(float(step)))
     model_variables = ET.SubElement(root, "ModelVariables")
     listed = []
-    for v in variables:
+    for i, v in enumerate(variables):
         if fmi_version == 2 and v.causality == "independent":
             continue  # FMI 2 has no time variable
+        if fmi_version == 3 and v.array and i > 0 and variables[i - 1].array == v.array:
+            continue  # an element of the FMI 3 array its first element declares
         listed.append(v)
         attributes = dict(name=v.name, valueReference=str(v.reference),
                           description=v.description, causality=v.causality)
@@ -118,11 +121,16 @@ def model_description(variables, *, fmi_version, model_identifier, token, descri
         elif v.causality != "independent":
             attributes.update(variability="discrete" if v.type in "IB" else "continuous")
         if fmi_version == 3:
+            elements = [w for w in variables if w.array == v.array] if v.array else [v]
+            if v.array:
+                attributes["name"] = v.array
             if v.unit and v.type == "F":
                 attributes["unit"] = v.unit
             if v.start is not None:
-                attributes["start"] = _number(v.start, v.type)
-            ET.SubElement(model_variables, _FMI3_TYPES[v.type], attributes)
+                attributes["start"] = " ".join(_number(w.start, w.type) for w in elements)
+            declared = ET.SubElement(model_variables, _FMI3_TYPES[v.type], attributes)
+            if v.array:
+                ET.SubElement(declared, "Dimension", start=str(len(elements)))
         else:
             if v.causality == "output":
                 attributes["initial"] = "calculated"

@@ -161,16 +161,45 @@ static fmi3Status set_values(fmi3Instance handle, const fmi3ValueReference refs[
     return fmi3OK;
 }
 
+/* The value references of a Float64 access, each array's elements after its own (an array
+ * holds its elements at the references after its first: qzs_fmu_variables.h), into
+ * `elements`; refused if they do not hold nValues values. */
+static fmi3Status float64_elements(fmi3Instance handle, const fmi3ValueReference refs[],
+                                   size_t n, size_t nValues, fmi3ValueReference *elements) {
+    QzsFmu *fmu = &((Instance *)handle)->fmu;
+    if (nValues > QZS_FMU_N_VARIABLES)
+        return refuse(handle, "accessing more Float64 values than the FMU has");
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t size;
+        if (qzs_fmu_size(fmu, refs[i], &size) != QZS_FMU_OK)
+            return fmi3Error;
+        for (size_t j = 0; j < size; j++, k++)
+            if (k < nValues)
+                elements[k] = refs[i] + (fmi3ValueReference)j;
+    }
+    if (k != nValues) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the %zu value references hold %zu Float64 values, "
+                    "not the %zu given", n, k, nValues);
+        return fmi3Error;
+    }
+    return fmi3OK;
+}
+
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference refs[], size_t n,
                           fmi3Float64 values[], size_t nValues) {
-    (void)nValues;
-    return get_values(instance, refs, n, 'F', values);
+    fmi3ValueReference elements[QZS_FMU_N_VARIABLES];
+    if (float64_elements(instance, refs, n, nValues, elements) != fmi3OK)
+        return fmi3Error;
+    return get_values(instance, elements, nValues, 'F', values);
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference refs[], size_t n,
                           const fmi3Float64 values[], size_t nValues) {
-    (void)nValues;
-    return set_values(instance, refs, n, 'F', values);
+    fmi3ValueReference elements[QZS_FMU_N_VARIABLES];
+    if (float64_elements(instance, refs, n, nValues, elements) != fmi3OK)
+        return fmi3Error;
+    return set_values(instance, elements, nValues, 'F', values);
 }
 
 fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference refs[], size_t n,

@@ -99,6 +99,15 @@ int qzs_fmu_get(QzsFmu *fmu, unsigned int reference, char type, double *value) {
     return QZS_FMU_OK;
 }
 
+int qzs_fmu_size(QzsFmu *fmu, unsigned int reference, size_t *size) {
+    if (reference >= QZS_FMU_N_VARIABLES || QZS_FMU_SIZE[reference] == 0) {
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "no variable has value reference %u", reference);
+        return QZS_FMU_ERROR;
+    }
+    *size = (size_t)QZS_FMU_SIZE[reference];
+    return QZS_FMU_OK;
+}
+
 /* A parameter outside its range: logged with its value and what it must be. */
 static int refuse(QzsFmu *fmu, const char *name, double value, const char *rule) {
     qzs_fmu_log(fmu, QZS_FMU_ERROR, "`%s` = %.15g must be %s; set it so before initialisation "
@@ -166,8 +175,57 @@ static int check_parameters(QzsFmu *fmu) {
                 "at most the chirp's sweep time excitation.duration [s]");
     }
 #endif
+#if QZS_FMU_SPRING_LAW == QZS_SPRING_OBLIQUE /* qzs.model.springs.ObliqueSpringQZS */
+    REQUIRE(SPRING_VERTICAL_STIFFNESS, V(SPRING_VERTICAL_STIFFNESS) >= 0.0, ">= 0 [N/m]");
+    REQUIRE(SPRING_OBLIQUE_STIFFNESS, V(SPRING_OBLIQUE_STIFFNESS) >= 0.0, ">= 0 [N/m]");
+    REQUIRE(SPRING_FREE_LENGTH, V(SPRING_FREE_LENGTH) > 0.0, "positive [m]");
+    REQUIRE(SPRING_HORIZONTAL_DISTANCE, V(SPRING_HORIZONTAL_DISTANCE) > 0.0, "positive [m]");
+#elif QZS_FMU_SPRING_LAW == QZS_SPRING_TABLE
+    REQUIRE(SPRING_OUTSIDE, V(SPRING_OUTSIDE) == 0.0 || V(SPRING_OUTSIDE) == 1.0,
+            "0 (refuse) or 1 (extend)");
+#endif
     return QZS_FMU_OK;
 }
+
+#if QZS_FMU_SPRING_LAW != QZS_SPRING_TANH
+/* The spring law from its parameters into law (QZS_FMU_SPRING_SIZE values): the exported one
+ * with each parameter put in its place; a table packed from its points (qzs_spring_table: its
+ * PCHIP pieces and energies, as qzs.model.springs.TabulatedSpring packs them), its positions
+ * checked to increase strictly. */
+static int pack_spring(QzsFmu *fmu, double *law) {
+    memcpy(law, QZS_FMU_SPRING_BASE, sizeof(double) * QZS_FMU_SPRING_SIZE);
+#if QZS_FMU_SPRING_LAW == QZS_SPRING_TABLE
+    double x[QZS_FMU_SPRING_POINTS], y[QZS_FMU_SPRING_POINTS];
+    int first = -1; /* the value reference of the first position */
+    for (int i = 0; i < QZS_FMU_N_VARIABLES; i++) {
+        int where = QZS_FMU_SPRING[i];
+        if (where >= QZS_FMU_SPRING_FORCE) {
+            y[where - QZS_FMU_SPRING_FORCE] = fmu->values[i];
+        } else if (where >= QZS_FMU_SPRING_POSITION) {
+            x[where - QZS_FMU_SPRING_POSITION] = fmu->values[i];
+            if (first < 0)
+                first = i;
+        }
+    }
+    for (int k = 1; k < QZS_FMU_SPRING_POINTS; k++) {
+        if (!(x[k] > x[k - 1])) {
+            qzs_fmu_log(fmu, QZS_FMU_ERROR,
+                        "`%s` = %.15g m must exceed `%s` = %.15g m: the table's positions must "
+                        "increase strictly (sort the table by position); set them so before "
+                        "initialisation ends", QZS_FMU_NAMES[first + k], x[k],
+                        QZS_FMU_NAMES[first + k - 1], x[k - 1]);
+            return QZS_FMU_ERROR;
+        }
+    }
+    qzs_spring_table(law, QZS_FMU_SPRING_POINTS, x, y, V(SPRING_OUTSIDE) == 1.0);
+#else
+    for (int i = 0; i < QZS_FMU_N_VARIABLES; i++)
+        if (QZS_FMU_SPRING[i] >= 0)
+            law[QZS_FMU_SPRING[i]] = fmu->values[i];
+#endif
+    return QZS_FMU_OK;
+}
+#endif
 
 /* The packed parameters, as qzs.engine.prepare._pack_parameters packs them. */
 static int pack_parameters(QzsFmu *fmu, double *P) {
@@ -335,7 +393,7 @@ static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t 
         x.x[j] = x0[j];
     if (V(CONTROLLER_PI_KI) > 0.0) {
         QzsControllerOutput c = qzs_controller_law(&plant->control, z0, measured, 0.0);
-        if (plant->blocks) {
+        if (QZS_FMU_BLOCKS) { /* the controller's blocks (not a law's general path) */
             double f_comp, f_dither, f_linear;
             blocks_at_start(plant, &s, &x, &f_comp, &f_dither, &f_linear);
             double blocks = f_comp + f_dither + f_linear;
@@ -348,7 +406,7 @@ static void initial_state(QzsFmu *fmu, const double *x0, double *state, int64_t 
     held[QZS_H_PI] = c.pi;
     held[QZS_H_DAMP] = c.damping;
     held[QZS_H_MOTOR] = c.motor;
-    if (plant->blocks) { /* prepare._hold_blocks: what the sampled blocks put out at t = 0 */
+    if (QZS_FMU_BLOCKS) { /* prepare._hold_blocks: what the sampled blocks put out at t = 0 */
         double f_comp, f_dither, f_linear;
         blocks_at_start(plant, &s, &x, &f_comp, &f_dither, &f_linear);
         held[QZS_H_COMPENSATION] = f_comp;
@@ -435,8 +493,16 @@ static double highest_frequency(QzsFmu *fmu, double until) {
 /* The steps qzs refuses (unstable for this configuration, too coarse for the excitation, a
  * run past a chirp's end), refused; a step above the one the export chose for accuracy,
  * warned of. Returns QZS_FMU_OK, QZS_FMU_WARNING or QZS_FMU_ERROR. */
-static int check_step(QzsFmu *fmu, const double *P) {
+static int check_step(QzsFmu *fmu, const double *given, const double *law) {
     double dt = V(STEP_SIZE);
+    /* qzs_stable_step reads the spring's stiffness as P[A] P[B] (the tanh's peak); another
+     * law's peak over the stroke (qzs.engine.stability.spring_stiffness_peak) goes in as a */
+    double P[QZS_N_PARAMS];
+    memcpy(P, given, sizeof P);
+    if (law) {
+        P[QZS_P_SPRING_A] = qzs_spring_stiffness_peak(law, P[QZS_P_Z_LOW], P[QZS_P_Z_HIGH]);
+        P[QZS_P_SPRING_B] = 1.0;
+    }
     int solver = (int)V(SOLVER);
     int closed_loop = !QZS_FMU_PLANT_MODE;
     if (!qzs_stable_step(P, solver, closed_loop, dt)) {
@@ -507,7 +573,20 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
     double P[QZS_N_PARAMS];
     if (pack_parameters(fmu, P) != QZS_FMU_OK)
         return QZS_FMU_ERROR;
-    int status = check_step(fmu, P);
+    /* the model row: the blocks (below) and the spring law, the tanh's [0, a, b] by default */
+    double *M = fmu->model, *law = fmu->model + QZS_N_MODEL;
+    memset(M, 0, sizeof(double) * QZS_N_MODEL);
+#if QZS_FMU_SPRING_LAW != QZS_SPRING_TANH
+    if (pack_spring(fmu, law) != QZS_FMU_OK)
+        return QZS_FMU_ERROR;
+    int general = 1;
+#else
+    law[0] = QZS_SPRING_TANH;
+    law[1] = P[QZS_P_SPRING_A];
+    law[2] = P[QZS_P_SPRING_B];
+    int general = QZS_FMU_BLOCKS;
+#endif
+    int status = check_step(fmu, P, law[0] != QZS_SPRING_TANH ? law : NULL);
     if (status == QZS_FMU_ERROR)
         return QZS_FMU_ERROR;
     double z0 = V(CONTROLLER_POSITION_SETPOINT);
@@ -533,13 +612,10 @@ int qzs_fmu_initialize(QzsFmu *fmu) {
 #endif
     double x0[QZS_N_X] = {0.0};
 #if QZS_FMU_BLOCKS
-    double M[QZS_N_MODEL];
     if (pack_model(fmu, M, x0) != QZS_FMU_OK)
         return QZS_FMU_ERROR;
-    qzs_plant_init(&fmu->run.plant, P, M, E, fmu->table, 2);
-#else
-    qzs_plant_init(&fmu->run.plant, P, NULL, E, fmu->table, 2);
 #endif
+    qzs_plant_init(&fmu->run.plant, P, general ? M : NULL, E, fmu->table, 2);
     double state[QZS_N_STATE];
     int64_t flags[QZS_N_FLAGS];
     initial_state(fmu, x0, state, flags);
@@ -627,6 +703,20 @@ int qzs_fmu_do_step(QzsFmu *fmu, double current, double step) {
         } else { /* whole grid steps, as qzs takes them */
             status = qzs_run_steps(run, end_index - run->step, 0, NULL, NULL, NULL);
         }
+    }
+    if (status == QZS_STATUS_OUTSIDE) {
+        const double *law = run->plant.spring;
+        long n = (long)law[QZS_TABLE_COUNT];
+        fmu->time = (double)run->step * dt + fmu->offset;
+        fmu->failed = 1;
+        qzs_fmu_log(fmu, QZS_FMU_ERROR, "the run stopped at t = %.12g s: the payload left the "
+                    "spring table [%g, %g] m (last position inside z = %g m, moving at v = %g "
+                    "m/s), and the table refuses positions outside it (spring.outside = 0); "
+                    "measure the curve over the whole stroke and a margin for the stops' "
+                    "penetration, or set spring.outside = 1 (linear beyond the ends)", fmu->time,
+                    law[QZS_TABLE_POSITIONS], law[QZS_TABLE_POSITIONS + n - 1],
+                    run->s.x[QZS_S_Z], run->s.x[QZS_S_V]);
+        return QZS_FMU_ERROR;
     }
     if (status != QZS_STATUS_OK) {
         fmu->time = (double)run->step * dt + fmu->offset;

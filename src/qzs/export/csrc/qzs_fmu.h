@@ -40,6 +40,9 @@ typedef struct {
     int has_previous;                   /* input mode: an earlier communication point... */
     double previous_time;               /* ...its time [s] */
     double previous_acceleration;       /* ...and base acceleration [m/s^2] */
+    /* the run's model row: the controller's blocks, then the spring law (the plant keeps it
+     * by pointer) */
+    double model[QZS_N_MODEL + QZS_FMU_SPRING_SIZE];
     QzsRun run;
     QzsFmuLogger log;
     void *environment;
@@ -55,6 +58,9 @@ void qzs_fmu_setup(QzsFmu *fmu, double start_time, int stop_defined, double stop
 int qzs_fmu_set(QzsFmu *fmu, unsigned int reference, char type, double value);
 /* Get a variable (its type must match). */
 int qzs_fmu_get(QzsFmu *fmu, unsigned int reference, char type, double *value);
+/* How many values `reference` holds into *size: an FMI 3 array's length, 1 for a scalar; an
+ * error for no variable (an array's later elements have no reference of their own). */
+int qzs_fmu_size(QzsFmu *fmu, unsigned int reference, size_t *size);
 /* End initialisation: check and pack the parameters, the initial state as qzs starts a run.
  * QZS_FMU_WARNING: initialised, with a warning logged. */
 int qzs_fmu_initialize(QzsFmu *fmu);

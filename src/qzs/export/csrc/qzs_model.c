@@ -62,7 +62,7 @@ static int run_one(QzsRun *run, double t, double h, QzsPhase phase, int at_grid_
     QzsStep next = qzs_grid_step(plant, run->solver, t, h, run->s, run->x, run->mode,
                                  run->direction, run->held, run->margin, phase);
     if (!qzs_finite(plant, &next.s) || (plant->blocks && !qzs_finite_blocks(&next.x)))
-        return QZS_STATUS_DIVERGED;
+        return qzs_failure_status(plant);
     run->s = next.s;
     if (plant->blocks)
         run->x = next.x;

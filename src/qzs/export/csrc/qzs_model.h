@@ -35,8 +35,8 @@ typedef struct {
  * initialised. */
 void qzs_run_start(QzsRun *run, int solver, const double *state, const int64_t *flags);
 /* Advance n_steps; a row to out/out_flags every `decimation` steps (decimation 0: none).
- * Returns QZS_STATUS_OK or QZS_STATUS_DIVERGED (the run then holds its last finite state);
- * *rows the rows written. */
+ * Returns QZS_STATUS_OK, or QZS_STATUS_DIVERGED or QZS_STATUS_OUTSIDE (the run then holds its
+ * last finite state: qzs_failure_status); *rows the rows written. */
 int qzs_run_steps(QzsRun *run, int64_t n_steps, int64_t decimation, double *out,
                   unsigned char *out_flags, int64_t *rows);
 /* Part of the grid step that starts at the grid point run->step * dt: from `from` to `to` [s]
@@ -49,8 +49,9 @@ void qzs_run_pack(const QzsRun *run, double *state, int64_t *flags);
 
 /* Advance `n_steps` from flags[QZS_I_STEP]; rows go to out (QZS_N_CHANNELS doubles each) and
  * out_flags (2 bytes each) from row0. state (QZS_N_STATE) and flags (QZS_N_FLAGS) carry the
- * run between calls. model: the controller's blocks (QZS_N_MODEL values, qzs.engine.prepare
- * .pack_model; NULL for PI + damping alone). Returns QZS_STATUS_OK or QZS_STATUS_DIVERGED; *rows the rows written. */
+ * run between calls. model: the controller's blocks and the spring law (qzs.engine.prepare
+ * .pack_model's row; NULL for PI + damping alone with the tanh). Returns as qzs_run_steps;
+ * *rows the rows written. */
 int qzs_model_run(int solver, int64_t n_steps, int64_t decimation, double *state,
                   int64_t *flags, const double *params, const double *model,
                   const double *excitation,

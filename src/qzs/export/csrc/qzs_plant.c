@@ -25,6 +25,18 @@ INLINE double spring_energy_law(double a, double b, double z) {
     return a / b * (u + log1p(exp(-2.0 * u)) - log(2.0));
 }
 
+/* kernels._general_spring / _general_spring_energy: the law's force [N] (`want`
+ * QZS_SPRING_FORCE) or energy [J] (QZS_SPRING_ENERGY), NaN outside a refusing table (the run
+ * then stops, qzs_failure_status); the tanh's without a law */
+INLINE double spring_of(const QzsPlant *plant, double z, int want) {
+    double a = plant->P[QZS_P_SPRING_A], b = plant->P[QZS_P_SPRING_B];
+    if (!plant->spring)
+        return want == QZS_SPRING_FORCE ? spring_law(a, b, z) : spring_energy_law(a, b, z);
+    QzsSpringValues values;
+    qzs_spring_evaluate(plant->spring, z, want, &values);
+    return want == QZS_SPRING_FORCE ? values.force : values.energy;
+}
+
 INLINE void compliant_stop_law(double z, double v, double z_low, double z_high,
                                double stiffness, double damping, double *f_stop,
                                double *f_elastic) {
@@ -200,7 +212,8 @@ void qzs_plant_init(QzsPlant *plant, const double *params, const double *model,
         memcpy(plant->M, model, sizeof plant->M);
     else
         memset(plant->M, 0, sizeof plant->M);
-    plant->blocks = plant->M[QZS_M_BLOCKS] != 0.0;
+    plant->spring = model && model[QZS_N_MODEL] != QZS_SPRING_TANH ? model + QZS_N_MODEL : 0;
+    plant->blocks = plant->M[QZS_M_BLOCKS] != 0.0 || plant->spring;
     memcpy(plant->E, excitation, sizeof plant->E);
     plant->table = table;
     plant->table_columns = table_columns;
@@ -249,7 +262,7 @@ INLINE void rhs(const QzsPlant *plant, double t, QzsBase b, const QzsOde *s, con
     double z = s->x[QZS_S_Z];
     double v = mode == QZS_MODE_SLIP ? s->x[QZS_S_V] : 0.0;
     double xd = b.yd + v;
-    double f_spring = spring_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z);
+    double f_spring = spring_of(plant, z, QZS_SPRING_FORCE);
 
     double f_stop = 0.0, f_elastic = 0.0;
     if (P[QZS_P_PLASTIC] == 0.0)
@@ -482,7 +495,7 @@ static void energies(const QzsPlant *plant, double y, double yd, const QzsOde *s
         pen = PYMAX(P[QZS_P_Z_LOW] - z, 0.0) + PYMAX(z - P[QZS_P_Z_HIGH], 0.0);
     double xd = yd + v;
     e[0] = 0.5 * m * (xd * xd);
-    e[1] = spring_energy_law(P[QZS_P_SPRING_A], P[QZS_P_SPRING_B], z);
+    e[1] = spring_of(plant, z, QZS_SPRING_ENERGY);
     e[2] = m * P[QZS_P_GRAVITY] * (y + z);
     e[3] = 0.5 * P[QZS_P_STOP_K] * pen * pen;
 }
@@ -790,6 +803,13 @@ int qzs_finite(const QzsPlant *plant, const QzsOde *s) {
            fabs(s->x[QZS_S_V]) <= 1e4;
 }
 
+int qzs_failure_status(const QzsPlant *plant) {
+    const double *law = plant->spring;
+    if (law && law[0] == QZS_SPRING_TABLE && law[QZS_TABLE_OUTSIDE] == 0.0)
+        return QZS_STATUS_OUTSIDE;
+    return QZS_STATUS_DIVERGED;
+}
+
 int qzs_in_contact(const QzsPlant *plant, const QzsOde *s, int mode) {
     return mode >= QZS_MODE_WALL_LOW || s->x[QZS_S_Z] < plant->P[QZS_P_Z_LOW] ||
            s->x[QZS_S_Z] > plant->P[QZS_P_Z_HIGH];
@@ -823,7 +843,7 @@ void qzs_record(const QzsPlant *plant, double t, const QzsOde *s, const QzsBlock
     row[QZS_C_W_MOTOR] = s->x[QZS_S_W_MOTOR];
     row[QZS_C_D_STOP] = s->x[QZS_S_D_STOP];
     energies(plant, f.y, f.yd, s, mode, row + QZS_C_E_KINETIC);
-    if (plant->blocks) { /* a row without blocks holds QZS_N_BASE_CHANNELS */
+    if (plant->M[QZS_M_BLOCKS] != 0.0) { /* a row without blocks holds QZS_N_BASE_CHANNELS */
         row[QZS_C_F_COMPENSATION] = f.compensation;
         row[QZS_C_F_DITHER] = f.dither;
         row[QZS_C_F_LINEAR] = f.linear;

@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "qzs_controller.h"
+#include "qzs_spring.h"
 
 /* packed parameters (qzs.engine.kernels.P_*) */
 enum { QZS_P_MASS, QZS_P_GRAVITY, QZS_P_SPRING_A, QZS_P_SPRING_B, QZS_P_FS, QZS_P_FC,
@@ -55,7 +56,8 @@ enum { QZS_O_LOCKED, QZS_O_CONTACT, QZS_N_OUTPUT_FLAGS };
 /* modes of the payload: slipping, stuck to the base, resting on the lower / upper plastic stop */
 enum { QZS_MODE_SLIP, QZS_MODE_STICK, QZS_MODE_WALL_LOW, QZS_MODE_WALL_HIGH };
 enum { QZS_SOLVER_EULER, QZS_SOLVER_ODE3, QZS_SOLVER_RK4 };
-enum { QZS_STATUS_OK, QZS_STATUS_DIVERGED };
+/* a run's status (kernels.STATUS_*): going; diverged; stopped outside a refusing spring table */
+enum { QZS_STATUS_OK, QZS_STATUS_DIVERGED, QZS_STATUS_OUTSIDE };
 /* excitation's sine and cosine computed exactly every this many steps (kernels.PHASE_PERIOD) */
 #define QZS_PHASE_PERIOD 256
 
@@ -77,7 +79,10 @@ typedef struct {
     long table_columns;
     QzsControllerParameters control;  /* the controller's part of P */
     double M[QZS_N_MODEL];  /* the controller's blocks (QZS_M_*) */
-    int blocks;             /* M[QZS_M_BLOCKS] != 0: the blocks' code runs */
+    const double *spring;   /* the spring law packed (qzs_spring.h, kept by pointer); NULL: the
+                               tanh of P[QZS_P_SPRING_A], P[QZS_P_SPRING_B] */
+    int blocks;             /* the general path (kernels.general): blocks (M[QZS_M_BLOCKS] != 0)
+                               or a spring law other than the tanh; their code runs */
 } QzsPlant;
 
 /* Where the excitation's sine and cosine were last computed. */
@@ -92,8 +97,10 @@ typedef struct {
     int sticks, impacts;
 } QzsStep;
 
-/* Fill the plant from packed parameters, the controller's blocks (QZS_N_MODEL values, NULL for
- * none), excitation scalars and table (kept by pointer). */
+/* Fill the plant from packed parameters, the model row (qzs.engine.prepare.pack_model: the
+ * controller's blocks, QZS_N_MODEL values, then the spring law packed, kept by pointer; NULL
+ * for no blocks and the tanh of the parameters), excitation scalars and table (kept by
+ * pointer). */
 void qzs_plant_init(QzsPlant *plant, const double *params, const double *model,
                     const double *excitation, const double *table, long table_columns);
 /* Base motion at t [s], exact (libm sine). */
@@ -124,6 +131,9 @@ void qzs_measure(const QzsPlant *plant, double t, const QzsOde *s, int mode, dou
                  double *v_measured);
 /* The divergence test: finite, within 100 strokes of the stops and below 1e4 m/s. */
 int qzs_finite(const QzsPlant *plant, const QzsOde *s);
+/* The status of a run stopped on a non-finite state (kernels.failure_status): QZS_STATUS_OUTSIDE
+ * when its spring is a table that refuses positions outside it, else QZS_STATUS_DIVERGED. */
+int qzs_failure_status(const QzsPlant *plant);
 /* Is the payload on or beyond a stop? */
 int qzs_in_contact(const QzsPlant *plant, const QzsOde *s, int mode);
 /* One output sample: channels C_* into row, flags O_* into row_flags. */
