@@ -39,3 +39,21 @@ def test_a_spring_file_runs_the_general_kernel_and_the_result_records_the_law(tm
     assert attrs["isolator.spring.law"] == "oblique"
     assert attrs["isolator.spring.free_length"] == 0.1875
     assert attrs["isolator.spring.free_length_units"] == "m"
+
+
+def test_set_changes_a_parameter_of_the_spring_file_s_law(tmp_path, capsys):
+    """``--set spring.preload=61`` (docs/model.md §3.1) changes the --spring file's law: the
+    run records the changed preload; without a law the same --set exits 2 naming the fix."""
+    path = tmp_path / "spring.toml"
+    path.write_text('[spring]\nlaw = "oblique"\nvertical_stiffness = "quasi-zero"\n')
+    out = tmp_path / "run.nc"
+    argv = ["simulate", "--excitation", "sine", "--amplitude", "0.001", "--frequency", "2",
+            "--duration", "0.2", "--plot", "none", "--quiet", "--set", "spring.preload=61"]
+    assert main([*argv, "--spring", str(path), "--out", str(out)]) == 0
+    attrs = read_result(out).attrs
+    assert attrs["isolator.spring.preload"] == 61.0
+    assert attrs["isolator.spring.vertical_stiffness"] == 200.0
+    capsys.readouterr()
+    assert main([*argv, "--out", str(tmp_path / "none.nc")]) == 2
+    assert "give the law first" in capsys.readouterr().err
+    assert not (tmp_path / "none.nc").exists()

@@ -119,7 +119,7 @@ def test_the_table_shows_a_block_s_parameters_or_that_there_is_no_block():
 
     rows = {row[1]: row for row in parameter_table(
         controller=qzs.PIDamping() + qzs.Dither(amplitude=2.0))}
-    assert list(rows) == list(ALL_PARAMETERS)
+    assert list(rows) == [n for n in ALL_PARAMETERS if not n.startswith("spring.")]
     assert rows["dither.amplitude"][2:4] == (2.0, "N")
     assert rows["compensation.fraction"][2] == NO_BLOCK and rows["linear.sample_time"][2] == NO_BLOCK
 
@@ -135,3 +135,59 @@ def test_toml_dotted_keys_are_the_dotted_names():
                                       "excitation.f0": [1, 2],
                                       "pi_kp": {"start": 1, "stop": 2, "num": 2}}
     assert dotted_names([1]) == [1]
+
+
+# --- a spring law's parameters (spring.*): docs/model.md §3.1 -------------------------------
+
+def test_every_float_field_of_a_law_but_the_tanh_s_is_a_spring_parameter_with_its_unit():
+    from qzs.model.registry import SPRING_PARAMETERS, SPRING_POWERS
+    from qzs.model.springs import SPRING_LAWS, TanhSpring
+
+    fields = {f"spring.{f.name}": f.metadata["unit"] for cls in SPRING_LAWS.values()
+              if cls is not TanhSpring for f in dataclasses.fields(cls) if f.type is float}
+    powers = {f"spring.c{k}": "N" if k == 0 else "N/m" if k == 1 else f"N/m^{k}"
+              for k in range(SPRING_POWERS + 1)}
+    assert {n: i.unit for n, i in SPRING_PARAMETERS.items()} == {**fields, **powers}
+    assert "spring.plateau" not in SPRING_PARAMETERS  # the tanh's are spring_force/_shape
+    assert all(info.numeric and info.section == "isolator" and info.doc
+               for info in SPRING_PARAMETERS.values())
+
+
+def test_a_spring_parameter_changes_the_isolator_s_law_and_reads_back():
+    from qzs.model.registry import parameter_value
+
+    oblique = qzs.IsolatorParameters(spring=qzs.ObliqueSpringQZS.quasi_zero())
+    isolator, _ = update_parameters(oblique, qzs.ControllerParameters(),
+                                    {"spring.vertical_stiffness": "150", "spring.preload": 60.0})
+    expected = {**oblique.spring.to_dict(), "vertical_stiffness": 150.0, "preload": 60.0}
+    assert isolator.spring == qzs.SpringLaw.from_dict(expected)
+    assert parameter_value(isolator, None, "spring.vertical_stiffness") == 150.0
+    assert parameter_value(isolator, None, "spring.c0", "absent") == "absent"
+    # a polynomial: c_k by index, a higher power pads with zeros, the force follows
+    quadratic = qzs.IsolatorParameters(spring=qzs.PolynomialSpring(coefficients=(62.78, -100.0),
+                                                                   center=-0.06))
+    cubic, _ = update_parameters(quadratic, qzs.ControllerParameters(), {"spring.c3": -5e4})
+    assert cubic.spring.coefficients.tolist() == [62.78, -100.0, 0.0, -5e4]
+    assert cubic.spring.force(-0.04) == pytest.approx(62.78 - 100.0 * 0.02 - 5e4 * 0.02 ** 3,
+                                                      rel=1e-14)
+    assert parameter_value(cubic, None, "spring.c3") == -5e4
+    rows = {row[1]: row for row in parameter_table(cubic)}
+    assert [n for n in rows if n.startswith("spring.")] == [
+        "spring.center", "spring.c0", "spring.c1", "spring.c2", "spring.c3"]
+    assert rows["spring.c3"][2:4] == (-5e4, "N/m^3")
+
+
+@pytest.mark.parametrize("isolator, settings, names, message", [
+    (qzs.IsolatorParameters(), {"spring.preload": 60.0}, ("spring.preload",),
+     "MagSpring's tanh"),
+    (qzs.IsolatorParameters(spring=qzs.ObliqueSpringQZS()), {"spring.c3": 1.0},
+     ("spring.c3",), "no parameter of this 'oblique' spring law"),
+    (qzs.IsolatorParameters(spring=qzs.ObliqueSpringQZS()), {"spring.free_length": -1.0},
+     ("spring.free_length",), "`spring.free_length` must be positive"),
+    (qzs.IsolatorParameters(spring=qzs.PolynomialSpring(coefficients=(60.0,))),
+     {"spring.c2": float("nan")}, ("spring.c2",), "`spring.c2`"),
+])
+def test_a_bad_spring_parameter_is_named_with_its_fix(isolator, settings, names, message):
+    with pytest.raises(ParameterError, match=message) as caught:
+        update_parameters(isolator, qzs.ControllerParameters(), settings)
+    assert caught.value.options == names

@@ -31,7 +31,8 @@ from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.controller import BLOCKS
-from qzs.model.registry import ALL_PARAMETERS, BLOCK_PARAMETERS, parameter_value
+from qzs.model.registry import (ALL_PARAMETERS, BLOCK_PARAMETERS, SPRING_PARAMETERS,
+                                law_parameters, parameter_value)
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -146,9 +147,10 @@ def _parameter_values(cases, n):
     if len(cases) != n:
         return {}
     blocks = {name for pair in cases for name in BLOCKS if getattr(pair[1], name) is not None}
+    laws = {name for pair in cases for name in law_parameters(pair[0].spring)}
     return {name: [parameter_value(*pair, name) for pair in cases]
-            for name in ALL_PARAMETERS if name not in BLOCK_PARAMETERS
-            or name.split(".", 1)[0] in blocks}
+            for name in ALL_PARAMETERS if name in laws or name not in BLOCK_PARAMETERS
+            and name not in SPRING_PARAMETERS or name.split(".", 1)[0] in blocks}
 
 
 def batch_schema(batch):
@@ -187,7 +189,8 @@ def batch_schema(batch):
         info = ALL_PARAMETERS[name]
         text = all(isinstance(v, str) for v in column)
         none = ("NaN: no such block in the case, or the plant's value" if name in
-                BLOCK_PARAMETERS else "NaN: none")
+                BLOCK_PARAMETERS else "NaN: no such parameter in the case's spring law"
+                if name in SPRING_PARAMETERS else "NaN: none")
         coordinates.append(Variable(
             name=name, dims=("case",), units=info.unit, long_name=info.doc,
             dtype="str" if text else "float64",

@@ -395,13 +395,14 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
     f_comp = f_dither = f_linear = feedforward = 0.0
     command = f_motor
     if blocks:
-        f_comp, f_dither, f_linear, feedforward = block_forces(
-            t, P[P_ZREF] - z, x, v, direction, ydd, v_measured, held, P[P_CONTROL_STEPS] > 0.0,
-            P[P_VREG], M)
-        command = f_pi + f_damp + f_comp + f_dither + f_linear
-        f_motor, rate = _saturated(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
-        if P[P_CONTROL_STEPS] == 0.0:
-            integral_rate = rate
+        if M[M_BLOCKS] != 0.0:  # a law alone: PI + damping's command as it is
+            f_comp, f_dither, f_linear, feedforward = block_forces(
+                t, P[P_ZREF] - z, x, v, direction, ydd, v_measured, held,
+                P[P_CONTROL_STEPS] > 0.0, P[P_VREG], M)
+            command = f_pi + f_damp + f_comp + f_dither + f_linear
+            f_motor, rate = _saturated(command, P[P_ZREF] - z, P[P_KI], P[P_FMAX])
+            if P[P_CONTROL_STEPS] == 0.0:
+                integral_rate = rate
 
     f_applied = f_spring + f_stop + f_motor - m * P[P_GRAVITY]
     f_hold = m * ydd - f_applied
@@ -422,7 +423,7 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
         xdd = ydd
 
     rates = _NO_RATES
-    if blocks:
+    if blocks and M[M_BLOCKS] != 0.0:
         rates = block_rates(x, (P[P_ZREF] - z, v_measured, xdd, ydd, v), f_friction, f_stop,
                             feedforward, f_motor - command, P[P_CONTROL_STEPS] > 0.0, M)
     deriv = (v, xdd - ydd, P[P_HP_OMEGA] * (xd - s[S_HP]), integral_rate,
@@ -523,12 +524,14 @@ def rk_step(solver, t, h, s, x, mode, direction, held, P, M, blocks, E, table, p
     for stage in range(n_stages(solver)):
         offset, a, weight = tableau(solver, h, stage)
         y, yd, ydd = base_motion_near(t + offset, phase, sin0, cos0, E, table)
-        if blocks:
+        if blocks:  # a law alone (no blocks) leaves x as it came: its rates are all 0
+            stepping = M[M_BLOCKS] != 0.0
             deriv, _, rates = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k),
-                                  x if stage == 0 else _axpy_blocks(x, a, k_x), mode,
-                                  direction, held, P, M, True)
+                                  _axpy_blocks(x, a, k_x) if stage > 0 and stepping else x,
+                                  mode, direction, held, P, M, True)
             k, k_x = deriv, rates
-            result_x = _axpy_blocks(result_x, weight, k_x)
+            if stepping:
+                result_x = _axpy_blocks(result_x, weight, k_x)
         else:
             k = rhs(t + offset, y, yd, ydd, s if stage == 0 else _axpy(s, a, k), x, mode,
                     direction, held, P, M, False)[0]

@@ -8,6 +8,11 @@ results. The parameters themselves are the fields of the frozen dataclasses
 declared with its default, unit and one-line description; this module only reads
 them.
 
+A spring law's scalar parameters are ``spring.<field>`` (``spring.vertical_stiffness``,
+``spring.center``) and a polynomial's coefficients ``spring.c<k>`` (:data:`SPRING_PARAMETERS`):
+they change the isolator's own law (``IsolatorParameters.spring``), so a sweep or a design
+may vary them; the MagSpring's tanh keeps its ``spring_force`` and ``spring_shape``.
+
 A controller block's scalar parameters have dotted names, ``<block>.<field>``
 (``compensation.fraction``, ``dither.frequency``, ``linear.tracking_time``:
 :data:`BLOCK_PARAMETERS`); a linear controller's matrices, inputs and name are no
@@ -25,8 +30,10 @@ from qzs.model.controller import (BLOCK_CLASSES, ControllerParameters, Dither,
                                   FrictionCompensation, LinearController)
 from qzs.model.excitation import EXCITATION_KINDS, EXCITATION_OPTIONS, option_field
 from qzs.model.isolator import IsolatorParameters
+from qzs.model.springs import SPRING_LAWS, PolynomialSpring, TanhSpring
 
-__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "BLOCK_PARAMETERS", "ALL_PARAMETERS",
+__all__ = ["ParameterInfo", "SECTIONS", "PARAMETERS", "BLOCK_PARAMETERS", "SPRING_PARAMETERS",
+           "SPRING_POWERS", "ALL_PARAMETERS", "law_parameters", "check_law_parameters",
            "NO_BLOCK", "EXCITATION_PARAMETERS", "parameter_info", "model_inputs",
            "unit_of", "parameter_fields", "parameter_value", "dotted_names",
            "numeric_parameters", "update_parameters", "parameter_table", "parse_value",
@@ -88,8 +95,39 @@ BLOCK_PARAMETERS = MappingProxyType({
     f"{block}.{f.name}": _info("controller", f, f"{block}.{f.name}", _SCALARS)
     for block, cls in BLOCK_CLASSES.items() for f in dataclasses.fields(cls)
     if f.type in _SCALARS})
-#: Every registry parameter: :data:`PARAMETERS`, then :data:`BLOCK_PARAMETERS`.
-ALL_PARAMETERS = MappingProxyType({**PARAMETERS, **BLOCK_PARAMETERS})
+#: The highest power ``k`` of a polynomial spring's coefficient ``spring.c<k>``.
+SPRING_POWERS = 7
+#: What ``spring.center`` is in each law that has one.
+_CENTER_DOC = ("spring law's centre: the oblique springs horizontal, or the polynomial's powers "
+               "taken about it")
+
+
+def _spring_parameters():
+    """``spring.<field>`` of every law's float fields but the tanh's (``spring_force`` and
+    ``spring_shape`` are its), then ``spring.c0`` .. ``spring.c<SPRING_POWERS>``."""
+    found = {}
+    for cls in SPRING_LAWS.values():
+        for f in dataclasses.fields(cls):
+            name = f"spring.{f.name}"
+            if cls is not TanhSpring and f.type is float and name not in found:
+                info = _info("isolator", f, name)
+                found[name] = dataclasses.replace(
+                    info, default=None, doc=_CENTER_DOC if f.name == "center" else info.doc)
+    for k in range(SPRING_POWERS + 1):
+        unit = "N" if k == 0 else "N/m" if k == 1 else f"N/m^{k}"
+        found[f"spring.c{k}"] = ParameterInfo(
+            name=f"spring.c{k}", section="isolator", unit=unit, default=None, numeric=True,
+            doc=f"polynomial spring's coefficient c_{k} of (z - center)^{k}")
+    return found
+
+
+#: A spring law's scalar parameters: ``spring.<field>`` -> :class:`ParameterInfo` (section
+#: ``isolator``; default None: the value is the law's); each names a field of the laws that
+#: have it, ``spring.c<k>`` a :class:`~qzs.model.springs.PolynomialSpring`'s coefficient.
+SPRING_PARAMETERS = MappingProxyType(_spring_parameters())
+#: Every registry parameter: :data:`PARAMETERS`, :data:`BLOCK_PARAMETERS`, then
+#: :data:`SPRING_PARAMETERS`.
+ALL_PARAMETERS = MappingProxyType({**PARAMETERS, **BLOCK_PARAMETERS, **SPRING_PARAMETERS})
 #: What :func:`parameter_table` shows for a block's parameter of a controller without it.
 NO_BLOCK = "no block"
 
@@ -206,19 +244,23 @@ def update_parameters(isolator, controller, settings):
         the parameter as given: ``compensation.fraction``).
     """
     changes = {section: {} for section in SECTIONS}
-    blocks = {}
+    blocks, law = {}, {}
     for name, value in settings.items():
         if name not in ALL_PARAMETERS:
             raise ParameterError(f"unknown parameter {name!r}; valid names are: "
                                  f"{', '.join(sorted(ALL_PARAMETERS))}.")
         value = parse_value(value) if isinstance(value, str) else value
-        if name in BLOCK_PARAMETERS:
+        if name in SPRING_PARAMETERS:
+            law[name] = value
+        elif name in BLOCK_PARAMETERS:
             block, field = name.split(".", 1)
             blocks.setdefault(block, {})[field] = value
         else:
             changes[PARAMETERS[name].section][name] = value
     for block, values in blocks.items():
         changes["controller"][block] = _changed_block(getattr(controller, block), block, values)
+    if law:
+        changes["isolator"]["spring"] = _changed_law(isolator.spring, law)
     return (dataclasses.replace(isolator, **changes["isolator"]),
             dataclasses.replace(controller, **changes["controller"]))
 
@@ -244,6 +286,88 @@ def _changed_block(current, block, values):
         raise error.renamed(spelling) from None
 
 
+def law_parameters(law):
+    """The ``spring.*`` names (:data:`SPRING_PARAMETERS`) a spring law has.
+
+    Parameters
+    ----------
+    law : SpringLaw or None
+        An isolator's ``spring``; None or a TanhSpring (the MagSpring) has none.
+
+    Returns
+    -------
+    tuple of str
+        A polynomial's ``spring.center`` and ``spring.c<k>`` up to its degree (a higher
+        power may still be set: :func:`check_law_parameters`); an oblique spring's six
+        fields.
+    """
+    if law is None or isinstance(law, TanhSpring):
+        return ()
+    names = [f"spring.{f.name}" for f in dataclasses.fields(law)
+             if f"spring.{f.name}" in SPRING_PARAMETERS]
+    if isinstance(law, PolynomialSpring):
+        names += [f"spring.c{k}" for k in range(min(law.coefficients.size, SPRING_POWERS + 1))]
+    return tuple(names)
+
+
+def check_law_parameters(law, names):
+    """Refuse ``spring.*`` names ``law`` does not have, before any work.
+
+    Parameters
+    ----------
+    law : SpringLaw or None
+        The isolator's spring law (None: the MagSpring's tanh).
+    names : sequence of str
+        Names of :data:`SPRING_PARAMETERS` to be set or varied.
+
+    Raises
+    ------
+    ParameterError
+        The law is the tanh (it has no ``spring.*`` parameter), or a name is not one of its
+        parameters; the error's ``options`` are the names, the message gives the fix.
+    """
+    names = tuple(names)
+    if not names:
+        return
+    if law is None or isinstance(law, TanhSpring):
+        raise ParameterError(
+            f"{', '.join(f'`{n}`' for n in names)} changes a spring law's parameter, and this "
+            "isolator's spring is the MagSpring's tanh (its parameters are `spring_force` and "
+            "`spring_shape`); give the law first: a [spring] table (law = \"oblique\" or "
+            "\"polynomial\", docs/model.md §3.1) in the config, sweep or problem file, "
+            "`qzs simulate --spring FILE.toml`, or IsolatorParameters(spring=...).", names)
+    own = law_parameters(law)
+    if isinstance(law, PolynomialSpring):
+        own += tuple(f"spring.c{k}" for k in range(law.coefficients.size, SPRING_POWERS + 1))
+    foreign = [n for n in names if n not in own]
+    if foreign:
+        raise ParameterError(
+            f"`{foreign[0]}` is no parameter of this {law.kind!r} spring law; its parameters "
+            f"are {', '.join(own)}.", (foreign[0],))
+
+
+def _changed_law(law, values):
+    """``law`` with the ``spring.*`` parameters of ``values`` replaced (a polynomial's
+    coefficients padded with zeros up to the highest power set)."""
+    check_law_parameters(law, values)
+    fields = {n.split(".", 1)[1]: v for n, v in values.items()
+              if not (isinstance(law, PolynomialSpring) and n.startswith("spring.c")
+                      and n[8:].isdigit())}
+    powers = {int(n[8:]): v for n, v in values.items() if n.split(".", 1)[1] not in fields}
+    if powers:
+        coefficients = list(law.coefficients) + [0.0] * (max(powers) + 1 - law.coefficients.size)
+        for k, value in powers.items():
+            coefficients[k] = value
+        fields["coefficients"] = coefficients
+    try:
+        return dataclasses.replace(law, **fields)
+    except ParameterError as error:
+        spelling = {f.name: f"spring.{f.name}" for f in dataclasses.fields(law)}
+        if powers:
+            spelling["coefficients"] = ", ".join(f"spring.c{k}" for k in sorted(powers))
+        raise error.renamed(spelling) from None
+
+
 def parameter_value(isolator, controller, name, absent=None):
     """The value of the registry parameter ``name`` in ``isolator`` and ``controller``.
 
@@ -256,12 +380,20 @@ def parameter_value(isolator, controller, name, absent=None):
     name : str
         A name of :data:`ALL_PARAMETERS`.
     absent : object
-        What a block's parameter is on a controller without that block.
+        What a block's parameter is on a controller without that block, and a spring law's
+        on an isolator whose law has no such parameter.
 
     Returns
     -------
     object
     """
+    if name in SPRING_PARAMETERS:
+        law = isolator.spring
+        if name not in law_parameters(law):
+            return absent
+        if isinstance(law, PolynomialSpring) and name[8:].isdigit():
+            return float(law.coefficients[int(name[8:])])
+        return getattr(law, name.split(".", 1)[1])
     if name in BLOCK_PARAMETERS:
         block, field = name.split(".", 1)
         block = getattr(controller, block)
@@ -289,7 +421,7 @@ def dotted_names(table):
         return table
     flat = {}
     for key, value in table.items():
-        if key in (*BLOCK_CLASSES, "excitation") and isinstance(value, dict):
+        if key in (*BLOCK_CLASSES, "excitation", "spring") and isinstance(value, dict):
             flat.update({f"{key}.{inner}": item for inner, item in value.items()})
         else:
             flat[key] = value
@@ -300,7 +432,9 @@ def parameter_table(isolator=None, controller=None):
     """Rows ``(section, name, value, unit, description)`` of every registry parameter.
 
     The blocks' parameters (:data:`BLOCK_PARAMETERS`) follow the others; where the
-    controller has no such block, the value is :data:`NO_BLOCK`.
+    controller has no such block, the value is :data:`NO_BLOCK`. Then the spring law's
+    (:data:`SPRING_PARAMETERS`) the isolator's law has (a polynomial's coefficients up to its
+    degree), none for the MagSpring's tanh.
 
     Parameters
     ----------
@@ -311,8 +445,10 @@ def parameter_table(isolator=None, controller=None):
     """
     isolator = isolator or IsolatorParameters()
     controller = controller or ControllerParameters()
+    shown = law_parameters(isolator.spring)
     return [(info.section, name, parameter_value(isolator, controller, name, NO_BLOCK),
-             info.unit, info.doc) for name, info in ALL_PARAMETERS.items()]
+             info.unit, info.doc) for name, info in ALL_PARAMETERS.items()
+            if name not in SPRING_PARAMETERS or name in shown]
 
 
 def parse_value(text):

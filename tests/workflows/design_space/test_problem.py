@@ -28,7 +28,7 @@ def changed(**tables):
     document = copy.deepcopy(BASE)
     for name, value in tables.items():
         if value is None:
-            document.pop(name)
+            document.pop(name, None)
         else:
             document[name] = value
     return document
@@ -212,3 +212,51 @@ def test_a_block_s_parameter_is_a_design_variable_by_its_dotted_name():
     with pytest.raises(ProblemError) as error:
         load_problem(changed(variables={"compensation.fraction": {"low": 0.0, "high": 2.0}}))
     assert "compensation.fraction" in str(error.value) and "1.5" in str(error.value)
+
+
+def test_a_spring_law_s_parameter_is_a_design_variable_of_the_problem_s_law(tmp_path):
+    """A problem file with a [spring] table (a polynomial, docs/model.md §3.1) searches its
+    ``spring.c1`` (an unquoted dotted key): a case's isolator carries that law with the
+    design's coefficient, and the linear metric follows it: the loop's linear
+    transmissibility equals the scalar linearisation of that law (python-level
+    ``qzs.linearize``), and a stiffer spring moves it."""
+    import qzs
+    from qzs.workflows.design_space.evaluation import case_settings, evaluate_batch
+    from qzs.workflows.sweeps.cases import build_model
+
+    path = tmp_path / "duffing.toml"
+    path.write_text(
+        '[problem]\nname = "duffing"\n'
+        '[spring]\nlaw = "polynomial"\ncoefficients = [62.78, -100.0, 0.0, -5e4]\n'
+        'center = -0.06\n'
+        '[variables]\nspring.c1 = { low = -400.0, high = -10.0 }\n'
+        'pi_kp = { low = 20.0, high = 80.0 }\n'
+        '[[objectives]]\nmetric = "linear_transmissibility_at"\nfrequency = 3.0\n')
+    problem = load_problem(path)
+    assert [v.name for v in problem.variables] == ["spring.c1", "pi_kp"]
+    assert problem.variables[0].units == "N/m"
+    settings = case_settings(problem, np.array([[-300.0, 40.0], [-20.0, 40.0]]))
+    isolator, controller = build_model(problem.sweep, settings[0])
+    assert isolator.spring == qzs.PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -5e4),
+                                                   center=-0.06)
+    got = evaluate_batch(problem, 0, settings, problem.columns, threads=1)
+    column = problem.columns[0]
+    for case, values in zip(settings, got["values"][column]):
+        iso, con = build_model(problem.sweep, case)
+        assert values == pytest.approx(qzs.linearize(iso, con).transmissibility(3.0),
+                                       rel=1e-9)
+    assert abs(got["values"][column][0] - got["values"][column][1]) > 0.01
+
+
+@pytest.mark.parametrize("spring, variables, fix", [
+    (None, {"spring.preload": {"low": 50.0, "high": 70.0}}, "MagSpring's tanh"),
+    ({"law": "oblique"}, {"spring.c3": {"low": 0.0, "high": 1.0}},
+     "no parameter of this 'oblique' spring law"),
+    ({"law": "oblique"}, {"spring.free_length": {"low": -1.0, "high": 0.2}}, "must be positive"),
+    ({"law": "cubic"}, {"pi_kp": {"low": 1.0, "high": 2.0}}, "law = one of"),
+])
+def test_a_spring_variable_the_law_cannot_take_is_refused_naming_it(spring, variables, fix):
+    document = changed(variables=variables, spring=spring)
+    with pytest.raises(ProblemError, match=fix) as error:
+        load_problem(document)
+    assert error.value.table in ("variables", "spring")

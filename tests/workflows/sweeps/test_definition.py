@@ -260,3 +260,20 @@ def test_a_sweep_of_1e8_cases_fails_before_building_any(tables, name):
     error = caught.value
     assert (error.name, error.limit, error.items) == (name, MAX_CASES, "cases")
     assert error.count >= 10 ** 8 and f"`{name}`" in str(error) and "split" in str(error)
+
+
+@pytest.mark.parametrize("spring, grid, message", [
+    (None, {"spring.preload": [60.0, 62.0]}, "MagSpring's tanh"),
+    ({"law": "polynomial", "coefficients": [62.78, -100.0]}, {"spring.preload": [60.0, 62.0]},
+     "no parameter of this 'polynomial' spring law"),
+])
+def test_a_varied_spring_parameter_the_law_lacks_is_refused_before_any_run(spring, grid,
+                                                                            message):
+    """``spring.*`` names a parameter of the sweep's [spring] law (docs/model.md §3.1): one
+    the law has not is refused when the file is read, naming it and the fix."""
+    from qzs.workflows.sweeps import load_sweep
+
+    document = {"sweep": {"name": "s"}, "grid": grid,
+                **({"spring": spring} if spring else {})}
+    with pytest.raises(ParameterError, match=message):
+        load_sweep(document)

@@ -479,3 +479,30 @@ def test_the_shipped_sweep_runs_without_a_warning_and_defines_the_band_it_asks_f
     assert float(data.peak_stroke.max()) < 0.080          # inside the stops: +-80 mm
     assert int(data.stop_contacts.sum()) == 0
     assert "no step" not in data.attrs.get("dt_note", "")
+
+
+def test_a_sweep_over_a_spring_law_s_parameter_is_its_single_runs(tmp_path):
+    """A TOML sweep with a [spring] table (an oblique-spring QZS, docs/model.md §3.1) over
+    ``spring.vertical_stiffness``: each case is the single run of that law, bit for bit, and
+    the store keeps the varied value with its unit."""
+    path = tmp_path / "oblique.toml"
+    path.write_text('[sweep]\nname = "oblique"\nbatch_size = 2\n'
+                    '[spring]\nlaw = "oblique"\nvertical_stiffness = "quasi-zero"\n'
+                    '[grid]\nspring.vertical_stiffness = [200.0, 400.0]\n'
+                    '[excitation]\nf1 = 10.0\n[simulation]\ndt = 5e-4\n'
+                    '[analysis]\nfft_length = 2048\nn_averages = 8\nband = [0.0, 10.0]\n'
+                    '[outputs]\ntime_series = ["relative_position", "spring_force"]\n')
+    definition = load_sweep(path)
+    assert definition.spring == qzs.ObliqueSpringQZS.quasi_zero()
+    data = run_sweep(definition, tmp_path / "oblique.zarr", threads=1, progress=False).load()
+    assert (data["status"].values == OK).all()
+    assert data["spring.vertical_stiffness"].attrs["units"] == "N/m"
+    for case, stiffness in enumerate((200.0, 400.0)):
+        assert float(data["spring.vertical_stiffness"][case]) == stiffness
+        law = qzs.ObliqueSpringQZS(vertical_stiffness=stiffness)
+        run = qzs.simulate(qzs.Chirp(f1=10.0, duration=definition.analysis["duration"]),
+                           qzs.IsolatorParameters(spring=law), dt=5e-4)
+        row = data.isel(case=case)
+        np.testing.assert_array_equal(row["relative_position"].values, run.relative_position)
+        np.testing.assert_array_equal(row["spring_force"].values, run.spring_force)
+    assert not np.array_equal(data["spring_force"][0], data["spring_force"][1])

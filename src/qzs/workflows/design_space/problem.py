@@ -66,7 +66,9 @@ from qzs._validation import Structured, integer, read_toml, real
 from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
-from qzs.model.registry import ALL_PARAMETERS, dotted_names
+from qzs.iotools.config import spring_from_table
+from qzs.model.registry import (ALL_PARAMETERS, SPRING_PARAMETERS, check_law_parameters,
+                                dotted_names)
 from qzs.workflows.design_space.metrics import METRICS, STATISTICS, metric_column
 from qzs.workflows.sweeps.definition import (DISTRIBUTIONS, EXCITATION_PARAMETERS, SweepDefinition,
                                              frozen_distribution, load_sweep, parse_distribution,
@@ -76,7 +78,8 @@ __all__ = ["DesignProblem", "Variable", "Uncertainty", "Goal", "load_problem", "
            "shipped_problems", "TABLES", "MAX_SAMPLES", "MIN_POPULATION"]
 
 TABLES = ("problem", "variables", "parameters", "excitation", "uncertain", "robust",
-          "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis")
+          "objectives", "constraints", "optimizer", "sensitivity", "simulation", "analysis",
+          "spring")
 #: Folder of the shipped problem files, inside the package.
 SHIPPED = "workflows/design_space/problem_files"
 #: Fewest designs per generation NSGA-II works with (the file's and the flag's minimum).
@@ -380,6 +383,7 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
         statistic, no objective, or a constraint set no design can meet (its ``table``,
         ``key``, ``value`` and ``fix`` attributes say which and what to do).
     """
+    path = None
     if isinstance(source, Mapping):
         document, where, stem = dict(source), "problem definition", "problem"
     else:
@@ -393,7 +397,7 @@ def load_problem(source: str | Path | Mapping[str, Any]) -> DesignProblem:
         except ParameterError as error:
             raise ProblemError("file", "", str(source), str(error)) from None
         where, stem = repr(str(path)), path.stem
-    return _problem(document, where, stem)
+    return _problem(document, where, stem, path)
 
 
 def _unit(units):
@@ -443,7 +447,7 @@ def _number(table, key, value):
     return real(key, value, error=_in(table))
 
 
-def _variables(document, kind):
+def _variables(document, kind, law=None):
     table = _table(document, "variables")
     if not table:
         _fail("variables", "", {}, "a problem needs at least one decision variable: add "
@@ -461,7 +465,7 @@ def _variables(document, kind):
         low, high = _number(where, "low", spec["low"]), _number(where, "high", spec["high"])
         if not low < high:
             _fail("variables", name, [low, high], "empty bounds: `low` must be below `high`")
-        _within_valid_range(name, low, high)
+        _within_valid_range(name, low, high, law)
         scale = spec.get("scale", "linear")
         if scale not in SCALES:
             _fail(where, "scale", scale, f"must be one of {SCALES}")
@@ -478,7 +482,7 @@ def _variables(document, kind):
     return tuple(variables)
 
 
-def _within_valid_range(name, low, high):
+def _within_valid_range(name, low, high, law=None):
     """Refuse bounds a model parameter cannot take (``mass`` below zero): the designs there
     would fail one by one instead of being refused before the search.
 
@@ -494,9 +498,11 @@ def _within_valid_range(name, low, high):
 
     if name not in ALL_PARAMETERS or not ALL_PARAMETERS[name].numeric:
         return
+    _law_has("variables", name, {"low": low, "high": high}, law)
     for key, bound in (("low", low), ("high", high)):
         try:
-            update_parameters(IsolatorParameters(), ControllerParameters(), {name: bound})
+            update_parameters(IsolatorParameters(spring=law), ControllerParameters(),
+                              {name: bound})
         except ParameterError as error:
             if set(re.findall(r"`([a-z_]+)`", str(error))) - {name}:
                 continue  # a relation between parameters, not this one's range
@@ -505,11 +511,21 @@ def _within_valid_range(name, low, high):
                   f"({str(error).rstrip('.')}); choose bounds inside it")
 
 
-def _uncertain(document, kind, variables):
+def _law_has(table, name, spec, law):
+    """Refuse a ``spring.*`` parameter the problem's spring law does not have."""
+    if name in SPRING_PARAMETERS:
+        try:
+            check_law_parameters(law, [name])
+        except ParameterError as error:
+            _fail(table, name, spec, str(error).rstrip("."))
+
+
+def _uncertain(document, kind, variables, law=None):
     table = _table(document, "uncertain")
     uncertain = []
     for name, spec in table.items():
         units = _parameter_name("uncertain", name, kind)
+        _law_has("uncertain", name, spec, law)
         if name in variables:
             _fail("uncertain", name, spec, "is also a decision variable; a parameter is either "
                                            "searched or uncertain")
@@ -634,9 +650,24 @@ def _infeasible(constraints):
                   f"meets `min = {goal.bound:g}`")
 
 
-def _problem(document, where, stem):
+def _spring(document, path):
+    """The ``[spring]`` table's law (None: the MagSpring's tanh), as plain data for the sweep
+    (a table's CSV read here, relative to the problem file)."""
+    if "spring" not in document:
+        return None
+    try:
+        return spring_from_table(document["spring"], path)
+    except ParameterError as error:
+        raise ProblemError("spring", (error.options or ("",))[0], document["spring"],
+                           str(error)) from None
+
+
+def _problem(document, where, stem, path=None):
     try:
         _known(document, "top level", TABLES)
+        law = _spring(document, path)
+        if law is not None:
+            document = {**document, "spring": law.to_dict()}
         head = _table(document, "problem")
         _known(head, "problem", ("name", "title", "description"))
         name = str(head.get("name", stem))
@@ -644,9 +675,9 @@ def _problem(document, where, stem):
         kind = excitation.get("kind", "chirp")
         if kind not in EXCITATION_PARAMETERS:
             _fail("excitation", "kind", kind, f"must be one of {tuple(EXCITATION_PARAMETERS)}")
-        variables = _variables(document, kind)
+        variables = _variables(document, kind, law)
         names = [v.name for v in variables]
-        uncertain = _uncertain(document, kind, names)
+        uncertain = _uncertain(document, kind, names, law)
         fixed = _table(document, "parameters")
         for key in fixed:
             if key in names or key in [u.name for u in uncertain]:
@@ -736,6 +767,7 @@ def _sweep(document, name, variables, uncertain, goals=None, resolved=None):
     grid.update({u.name: [u.nominal] for u in uncertain})
     analysis = dict(_table(document, "analysis"))
     sweep = {"sweep": {"name": name}, "parameters": _table(document, "parameters"),
+             **({"spring": document["spring"]} if "spring" in document else {}),
              "excitation": _table(document, "excitation"), "grid": grid,
              "simulation": _table(document, "simulation"), "analysis": analysis,
              "outputs": {"transmissibility": False}}

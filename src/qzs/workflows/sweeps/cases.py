@@ -84,8 +84,8 @@ def build_model(definition, case):
         Invalid parameter values.
     """
     model = {k: v for k, v in case.items() if not k.startswith("excitation.")}
-    return update_parameters(IsolatorParameters(), ControllerParameters(),
-                             {**definition.parameters, **model})
+    return update_parameters(IsolatorParameters(spring=definition.spring),
+                             ControllerParameters(), {**definition.parameters, **model})
 
 
 def build_case(definition, case):

@@ -25,6 +25,7 @@ from qzs.engine.batch import STATS
 from qzs.engine.channels import run_channels
 from qzs.engine.stability import SOLVERS
 from qzs.errors import CountLimitError, ParameterError
+from qzs.iotools.config import spring_from_table
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
@@ -54,7 +55,7 @@ DISTRIBUTIONS = {
 EXCITATION_PARAMETERS = {kind: parameters for kind, parameters
                          in registry.EXCITATION_PARAMETERS.items() if kind != "file"}
 TABLES = ("sweep", "parameters", "excitation", "grid", "distributions", "simulation",
-          "analysis", "outputs")
+          "analysis", "outputs", "spring")
 SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batch_size")
 #: ``dt`` None: the step is chosen for ``tolerance_db`` before the sweep runs
 #: (:func:`qzs.workflows.sweeps.step.choose_sweep_step`); a ``dt`` in the file fixes it.
@@ -95,6 +96,9 @@ class SweepDefinition:
         Cases per batch [cases].
     parameters : dict
         Fixed model parameters (registry names).
+    spring : SpringLaw or None
+        The isolator's spring law from the file's ``[spring]`` table (docs/model.md §3.1;
+        its ``spring.*`` parameters may be fixed or varied), None for the MagSpring's tanh.
     excitation_kind : str
         Kind of the excitation (``chirp``, ``sine``, ``random``).
     excitation : dict
@@ -118,6 +122,7 @@ class SweepDefinition:
     seed: int | None
     batch_size: int
     parameters: dict
+    spring: Any
     excitation_kind: str
     excitation: dict
     grid: dict
@@ -180,6 +185,7 @@ def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
         range, a bad distribution (the allowed ones and their keys are listed), a
         bad sampling method, or an invalid fixed value.
     """
+    path = None
     if isinstance(source, dict):
         document, where, stem = source, "sweep definition", "sweep"
     else:
@@ -189,7 +195,7 @@ def load_sweep(source: str | Path | Mapping[str, Any]) -> SweepDefinition:
             "sweeps are examples)"))
         where, stem = repr(str(path)), path.stem
     try:
-        return _definition(document, where, stem)
+        return _definition(document, where, stem, path)
     except CountLimitError:  # names its table and key already; keeps its data
         raise
     except ParameterError as error:
@@ -208,8 +214,10 @@ def _check_name(name, kind):
                              f"{', '.join(sorted(ALL_PARAMETERS) + excitation)}.")
 
 
-def _definition(document, where, stem):
+def _definition(document, where, stem, path=None):
     _keys(document, "top level", TABLES)
+    spring = spring_from_table(document["spring"], path) if "spring" in document else None
+    base = IsolatorParameters(spring=spring)
     head = _keys(document.get("sweep", {}), "sweep", SWEEP_KEYS)
     name = str(head.get("name", stem))
     method = head.get("method", "grid")
@@ -231,7 +239,7 @@ def _definition(document, where, stem):
     _keys(excitation, "excitation", EXCITATION_PARAMETERS[kind])
     parameters = dict(_keys(dotted_names(document.get("parameters", {})), "parameters",
                             list(ALL_PARAMETERS)))
-    update_parameters(IsolatorParameters(), ControllerParameters(), parameters)  # values
+    update_parameters(base, ControllerParameters(), parameters)  # values
 
     grid_table = dotted_names(document.get("grid", {}))
     if not isinstance(grid_table, dict):
@@ -252,6 +260,8 @@ def _definition(document, where, stem):
         if (key.split(".", 1)[1] in excitation if key.startswith("excitation.")
                 else key in parameters):
             raise ParameterError(f"{key!r} is both fixed and varied; remove one of them.")
+    registry.check_law_parameters(spring, [k for k in (*grid, *distributions)
+                                           if k in registry.SPRING_PARAMETERS])
     both = sorted(set(grid) & set(distributions))
     if both:
         raise ParameterError(f"{both} appear in both [grid] and [distributions]; keep one.")
@@ -301,7 +311,8 @@ def _definition(document, where, stem):
     outputs = _outputs(document.get("outputs", {}), analysis)
     definition = SweepDefinition(
         name=name, title=str(head.get("title", name)), method=method, samples=samples,
-        seed=seed, batch_size=batch_size, parameters=parameters, excitation_kind=kind,
+        seed=seed, batch_size=batch_size, parameters=parameters, spring=spring,
+        excitation_kind=kind,
         excitation=excitation, grid=grid, distributions=distributions, simulation=simulation,
         analysis=analysis, outputs=outputs, document=document, source=where)
     if not any(k.startswith("excitation.") for k in definition.varied):
