@@ -67,7 +67,7 @@ HEXAPOD_CHANNELS = {
     "relative_position": (C_Z, "leg", "m",
                           "leg relative position z_i = L_i - L_i,home + z_ref (its encoder)"),
     "relative_velocity": (C_V, "leg", "m/s", "leg slip velocity v_i = dL_i/dt (0 when locked)"),
-    "spring_force": (C_FSP, "leg", "N", "MagSpring force along the leg, on the platform"),
+    "spring_force": (C_FSP, "leg", "N", "spring force along the leg, on the platform"),
     "friction_force": (C_FFR, "leg", "N",
                        "friction force along the leg (the holding force when locked)"),
     "stop_force": (C_FST, "leg", "N", "hard-stop force along the leg"),
@@ -82,7 +82,7 @@ HEXAPOD_CHANNELS = {
     "motor_work": (C_WM, None, "J", "work done by the motors"),
     "stop_dissipation": (C_DS, None, "J", "energy dissipated in the hard stops"),
     "kinetic_energy": (C_EK, None, "J", "kinetic energy of the platform (translation + rotation)"),
-    "spring_energy": (C_ESP, None, "J", "energy stored in the six MagSprings"),
+    "spring_energy": (C_ESP, None, "J", "energy stored in the six legs' springs"),
     "gravity_energy": (C_EG, None, "J", "gravitational potential energy m*g*z of the centre of "
                                         "mass (world frame)"),
     "stop_energy": (C_EST, None, "J", "elastic energy stored in the compliant stops"),
