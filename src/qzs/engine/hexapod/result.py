@@ -101,6 +101,18 @@ HEXAPOD_FLAGS = {
 _FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
 
 
+def _per_leg(meta, section, part, legs):
+    """Add each leg's ``{name: (value, unit)}`` (its blocks', its spring law's) to ``meta``:
+    ``<section>.<part><name>`` once when the six agree, else ``<section>.legN.<part><name>``."""
+    same = all(b.keys() == legs[0].keys() and all(
+        np.array_equal(np.asarray(b[k][0]), np.asarray(legs[0][k][0])) for k in b)
+        for b in legs)
+    for leg, parameters in enumerate(legs[:1] if same else legs):
+        prefix = f"{section}." if same else f"{section}.leg{leg + 1}."
+        for name, (value, unit) in parameters.items():
+            meta[f"{prefix}{part}{name}"] = (value, unit)
+
+
 def _attribute(value):
     """A value as a NetCDF-storable attribute (None -> "none", booleans -> 0/1)."""
     if value is None:
@@ -458,14 +470,9 @@ class HexapodResult:
                 values = [getattr(o, field.name) for o in objects]
                 value = values[0] if all(v == values[0] for v in values) else values
                 meta[f"{section}.{field.name}"] = (value, unit_of(field.name))
-        blocks = [block_parameters(c) for c in self.controllers]
-        same = all(b.keys() == blocks[0].keys() and all(
-            np.array_equal(np.asarray(b[k][0]), np.asarray(blocks[0][k][0])) for k in b)
-            for b in blocks)
-        for leg, parameters in enumerate(blocks[:1] if same else blocks):
-            prefix = "controller." if same else f"controller.leg{leg + 1}."
-            for name, (value, unit) in parameters.items():
-                meta[f"{prefix}{name}"] = (value, unit)
+        _per_leg(meta, "controller", "", [block_parameters(c) for c in self.controllers])
+        _per_leg(meta, "isolator", "spring.", [{} if i.spring is None else i.spring.parameters()
+                                               for i in self.isolators])
         for axis, value in self.excitation.items():
             meta[f"excitation.{axis}"] = (type(value).__name__, "")
             for field in dataclasses.fields(value):
