@@ -68,8 +68,8 @@ N_ODE_BLOCKS = N_ODE + LEG_COUNT * N_X
 # its reciprocal pivots, the impulses of the last projection (0 if none), per axis the
 # excitation's phase and its sine and cosine at the start of the step (persistent: carried
 # across kernel calls), the Cartesian loops' errors, PI and damping commands per axis, and
-# where a leg's spring table refused its position in the current step (leg number from 1, 0
-# for none; the position [m] and slip velocity [m/s] there).
+# where a leg's spring table first refused its position (leg number from 1, 0 for none; the
+# position [m] and slip velocity [m/s] there; cleared after a step that ends with a force).
 (W_Y, W_YD, W_YDD, W_RB, W_OM, W_AL, W_VO, W_AO, W_GH, W_OMW, W_ALW, W_RR, W_IBI, W_ACC,
  W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE, W_CART, W_OUTSIDE) = (
     0, 6, 12, 18, 27, 30, 33, 36, 39, 42, 45, 48, 57, 66, 72, 75, 76, 82, 88, 106, 124)

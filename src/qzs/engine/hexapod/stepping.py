@@ -424,8 +424,6 @@ def _run(solver, n_steps, decimation, h, s, plat, models, ex, tables, toff, buf,
     step = counters[CT_STEP]
     control_steps = int(plat[PL_CONTROL_STEPS])
     for _ in range(n_steps):
-        if models is not None:  # a leg's refusing spring table: marked in this step only
-            ww[W_OUTSIDE] = 0.0
         _advance_phases(step * h, step % PHASE_PERIOD == 0, plat, ex, ww)
         sampled = control_steps > 0 and step % control_steps == 0
         if sampled:
@@ -451,6 +449,12 @@ def _run(solver, n_steps, decimation, h, s, plat, models, ex, tables, toff, buf,
             if models is not None and ww[W_OUTSIDE] != 0.0:
                 status = STATUS_OUTSIDE  # the leg and where: ww[W_OUTSIDE:]
             break
+        if models is not None and ww[W_OUTSIDE] != 0.0:
+            # a refusing table's NaN marked in a trial the step did not keep: cleared once the
+            # leg's force at the step's end is a number (else the rate carried to the next
+            # step is NaN, and that step fails with the mark)
+            if not np.isnan(V[V_FSP + int(ww[W_OUTSIDE]) - 1]):
+                ww[W_OUTSIDE] = 0.0
         step += 1
         for i in range(LEG_COUNT):
             z = V[V_Z + i]
