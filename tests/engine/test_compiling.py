@@ -173,7 +173,7 @@ def _timed_stderr(argv, env, timeout):
 #: The kernels only the general path calls (controller blocks, a spring law other than the
 #: tanh): a default run compiles none of them (qzs.engine.kernels.kernel_model).
 GENERAL_PATH = ("block_forces", "block_rates", "sample_blocks", "linear_sample",
-                "sample_linear", "_general_spring", "_general_spring_energy", "_saturated")
+                "sample_linear", "general_spring", "general_spring_energy", "_saturated")
 #: The six legs' kernels only a platform with controller blocks or a spring law other than
 #: the tanh calls (besides the single axis's general kernels): a run without compiles none
 #: of them (``models`` None).

@@ -58,7 +58,7 @@ from qzs.engine.hexapod.layout import (
     V_STOPK, V_TX, V_TY, V_TZ, V_UX, V_UY, V_UZ, V_V, V_VME, V_VR, V_XB, V_Z, V_ZHIGH,
     V_ZLOW, V_ZREF, W_ACC, W_AL, W_ALW, W_AO, W_CART, W_FSUM, W_GH, W_IBI, W_IMPULSE, W_OM,
     W_OMW, W_OUTSIDE, W_PHASE, W_PIVOTS, W_RB, W_RR, W_SOLVE, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.kernels import (M_BLOCKS, M_LINEAR_STEPS, N_X, X_OBSERVER, _general_spring,
+from qzs.engine.kernels import (M_BLOCKS, M_LINEAR_STEPS, N_X, X_OBSERVER, general_spring,
                                 block_forces, block_rates, linear_sample, sample_blocks)
 from qzs.engine.laws import (compliant_stop_law, controller_law, saturation_law,
                              sliding_friction_law, spring_law)
@@ -439,7 +439,7 @@ def _with_blocks(models):
 def _leg_springs(models, ww, V):
     """Each leg's spring force from its own law into row ``FSP`` (docs/model.md §3.1).
 
-    The single axis's general spring (:func:`qzs.engine.kernels._general_spring`, the tanh's
+    The single axis's general spring (:func:`qzs.engine.kernels.general_spring`, the tanh's
     arithmetic bit for bit) on leg ``i``'s packed law (``models[i]`` from ``M_SPRING``) at
     its position (row ``Z``); the padding lanes copy leg 1. A refusing table's NaN outside
     it marks the first such leg in ``ww[W_OUTSIDE:]`` (its number, position and slip
@@ -447,7 +447,7 @@ def _leg_springs(models, ww, V):
     """
     for i in range(LEG_COUNT):
         z = V[V_Z + i]
-        force = _general_spring(models[i], z)
+        force = general_spring(models[i], z)
         if np.isnan(force) and ww[W_OUTSIDE] == 0.0:
             ww[W_OUTSIDE] = i + 1.0
             ww[W_OUTSIDE + 1] = z

@@ -29,7 +29,7 @@ from qzs.engine.hexapod.layout import (
     V_A, V_B, V_DIR, V_EV, V_FDA, V_FFR, V_FMO, V_FPI, V_FSP, V_FST, V_HDA, V_HMO, V_HPI,
     V_MODE, V_STOPK, V_V, V_VME, V_XB, V_Z, V_ZHIGH, V_ZLOW, W_ACC, W_AL, W_ALW, W_FSUM,
     W_GH, W_OM, W_OMW, W_RB, W_RR, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.kernels import (N_X, PHASE_PERIOD, X_OBSERVER, _general_spring_energy, n_stages,
+from qzs.engine.kernels import (N_X, PHASE_PERIOD, X_OBSERVER, general_spring_energy, n_stages,
                                 tableau)
 from qzs.engine.laws import spring_energy_law
 from qzs.engine.stickslip import MODE_STICK, crossed_zero, locate, release_direction, \
@@ -334,7 +334,7 @@ def _record(t, s, plat, models, ww, V, row, marks):
         if models is None:  # the MagSpring's tanh on every leg
             spring += spring_energy_law(V[V_A + i], V[V_B + i], z)
         else:  # each leg's own law (docs/model.md §3.1)
-            spring += _general_spring_energy(models[i], z)
+            spring += general_spring_energy(models[i], z)
         pen = max(V[V_ZLOW + i] - z, 0.0) + max(z - V[V_ZHIGH + i], 0.0)
         stop += 0.5 * V[V_STOPK + i] * pen * pen
         marks[O_LOCKED + i] = V[V_MODE + i] != MODE_SLIP
