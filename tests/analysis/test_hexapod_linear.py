@@ -355,7 +355,7 @@ def test_each_leg_s_stiffness_is_its_own_spring_law_s_slope():
     laws = [None, ObliqueSpringQZS(), PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -2e5),
                                                        center=-0.05),
             TabulatedSpring.from_law(ObliqueSpringQZS(vertical_stiffness=500.0),
-                                     np.linspace(-0.15, 0.03, 37)), None,
+                                     np.linspace(-0.15, 0.03, 38)), None,  # z_ref mid-piece
             ObliqueSpringQZS.quasi_zero()]
     isolators = [IsolatorParameters(spring=law) for law in laws]
     controller = ControllerParameters(pi_kp=40.0)

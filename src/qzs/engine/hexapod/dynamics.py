@@ -420,11 +420,11 @@ def _project(s, plat, ww, V, A, idx, vec):
 
 # ---------------------------------------------------------------- each leg's controller blocks
 # ``models``: each leg's packed blocks and spring law, row ``i`` leg ``i``'s
-# (``qzs.engine.kernels.M_*``), or ``None`` when no leg has blocks or a law (layout.py). Every kernel that reaches the blocks' code takes
-# it as an argument and branches on ``models is not None``: numba prunes that branch by the
-# argument's type before it types the callees, so a run without blocks compiles none of the
-# functions below nor the single axis's block kernels they call (benchmarks/compile_times.py
-# --hexapod). A flag's value (in ``plat``) would not: numba compiles both branches' callees.
+# (``qzs.engine.kernels.M_*``), or ``None`` when no leg has blocks or a law (layout.py). Every
+# kernel that reaches the blocks' code takes it as an argument and branches on ``models is not
+# None``: numba prunes that branch by the argument's type before it types the callees, so a run
+# without blocks or laws compiles none of the functions below nor the single axis's block
+# kernels they call (benchmarks/compile_times.py --hexapod). A flag's value (in ``plat``) would not: numba compiles both branches' callees.
 @njit(**_JIT, inline="always")
 def _with_blocks(models):
     """Whether a leg's packed row holds controller blocks beyond PI + damping (``M_BLOCKS``):
