@@ -346,6 +346,30 @@ def test_decoupled_axes_are_single_axis_isolators(controller, validation):
 
 
 # ---------------------------------------------------------------- inputs and helpers
+def test_each_leg_s_stiffness_is_its_own_spring_law_s_slope():
+    """Legs with their own laws (docs/model.md §3.1): each leg's axial stiffness is its law's
+    ``-dF/dz`` at the setpoint (a central difference of the law's force, an independent
+    reference) plus its ``Kp``; the stiffness matrix is ``J^T diag(k) J``."""
+    from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, TabulatedSpring
+
+    laws = [None, ObliqueSpringQZS(), PolynomialSpring(coefficients=(62.78, -300.0, 0.0, -2e5),
+                                                       center=-0.05),
+            TabulatedSpring.from_law(ObliqueSpringQZS(vertical_stiffness=500.0),
+                                     np.linspace(-0.15, 0.03, 38)), None,  # z_ref mid-piece
+            ObliqueSpringQZS.quasi_zero()]
+    isolators = [IsolatorParameters(spring=law) for law in laws]
+    controller = ControllerParameters(pi_kp=40.0)
+    model = hexapod_linearize(CUBE, OFFSET, isolators, controller, include_preload=False)
+    z, h = controller.position_setpoint, 1e-6
+    slopes = np.array([-(spring_force(z + h, i) - spring_force(z - h, i)) / (2 * h)
+                       for i in isolators])
+    assert np.ptp(slopes) > 100.0  # N/m: the legs differ
+    np.testing.assert_allclose(model.leg_stiffness, slopes + 40.0, rtol=1e-7, atol=1e-6)
+    np.testing.assert_allclose(model.leg_stiffness_matrix,
+                               model.jacobian.T @ np.diag(slopes + 40.0) @ model.jacobian,
+                               rtol=1e-6, atol=1e-6)
+
+
 def test_per_leg_parameters_and_override():
     isolators = [IsolatorParameters(viscous_damping=10.0 * (i + 1)) for i in range(6)]
     controllers = [ControllerParameters(pi_kp=5.0 * i) for i in range(6)]

@@ -173,11 +173,12 @@ def _timed_stderr(argv, env, timeout):
 #: The kernels only the general path calls (controller blocks, a spring law other than the
 #: tanh): a default run compiles none of them (qzs.engine.kernels.kernel_model).
 GENERAL_PATH = ("block_forces", "block_rates", "sample_blocks", "linear_sample",
-                "sample_linear", "_general_spring", "_general_spring_energy", "_saturated")
-#: The six legs' kernels only a platform with controller blocks calls (besides the single
-#: axis's block kernels): a run without blocks compiles none of them (``models`` None).
+                "sample_linear", "general_spring", "general_spring_energy", "_saturated")
+#: The six legs' kernels only a platform with controller blocks or a spring law other than
+#: the tanh calls (besides the single axis's general kernels): a run without compiles none
+#: of them (``models`` None).
 HEXAPOD_BLOCKS = ("_leg_blocks", "_leg_block_rates", "_sample_blocks", "_linear_due",
-                  "_sample_linear")
+                  "_sample_linear", "_leg_springs")
 
 
 def _compiled(cache):
@@ -234,8 +235,9 @@ def test_a_first_run_says_it_compiles_at_once_and_is_never_silent_long(tmp_path)
 
 @pytest.mark.slow
 def test_a_first_six_leg_run_without_blocks_compiles_none_of_the_blocks_code(tmp_path):
-    """A cold six-leg run, PI + damping on every leg: none of the blocks' functions, the six
-    legs' nor the single axis's they call, has a cache index; the six legs' kernels have.
+    """A cold six-leg run, PI + damping on every leg, the tanh: none of the blocks' or the
+    spring laws' functions, the six legs' nor the single axis's they call, has a cache index;
+    the six legs' kernels have.
 
     Failed when the switch was a value in ``plat``: numba compiled the blocks' code into every
     run (35.8 s against 24.2 s of compile CPU, benchmarks/compile_times.py --hexapod).

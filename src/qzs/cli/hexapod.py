@@ -104,6 +104,13 @@ def add_parser(subparsers):
                           help="leg N's own controller file (N from 1 to 6; repeatable, each "
                                "leg once); replaces what the hexapod file or --controller "
                                "gives that leg (`qzs docs hexapod` §9.5a)")
+    simulate.add_argument("--spring", metavar="FILE.toml",
+                          help="spring file for every leg: a [spring] table (law = \"tanh\", "
+                               "\"oblique\", \"polynomial\" or \"table\" and its parameters), "
+                               "as `qzs simulate --spring`")
+    simulate.add_argument("--leg-spring", metavar="N=FILE.toml", action="append", default=[],
+                          help="leg N's own spring file (N from 1 to 6; repeatable, each leg "
+                               "once); replaces what --spring gives that leg")
     simulate.add_argument("--axis", choices=AXES,
                           help="the base axis --excitation drives (replaces the file's table "
                                "for that axis); rotations in [rad]")
@@ -238,6 +245,19 @@ def _controllers(args):
             "names": names}
 
 
+def _with_springs(args, setup):
+    """``--leg-spring`` and ``--spring`` (``simulate``'s) on ``setup``'s legs: every leg
+    number checked before any file is read."""
+    from qzs.iotools.config import load_spring
+    from qzs.workflows.hexapod.setups import read_leg_springs, with_spring_laws
+
+    legs, _ = read_leg_springs(args.leg_spring)
+    spring = load_spring(args.spring) if args.spring else None
+    if spring is None and not legs:
+        return setup
+    return with_spring_laws(setup, spring, legs)
+
+
 def run_linear(args):
     """Run ``qzs hexapod linear`` from parsed arguments; returns the exit code.
 
@@ -301,7 +321,7 @@ def run_simulate(args):
     plot = figure_path(args)
     if plot is not None:
         check_output(args, "--plot", plot, suffixes=(".png", ".svg", ".pdf"))
-    setup = _setup(args)
+    setup = _with_springs(args, _setup(args))
     excitation = None
     if args.axis is not None:
         options = {"kind": args.excitation or "chirp"}

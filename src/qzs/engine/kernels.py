@@ -336,14 +336,42 @@ def linear_sample(M, x, sensors, others, error, ki, f_max):
 # branches a constant ``blocks`` or a ``None`` model rules out, and these copies made a default
 # run's first compile about four times longer (benchmarks/compile_times.py).
 @njit(**_JIT)
-def _general_spring(M, z):
-    """The spring force of the law packed in ``M`` [N] (:func:`spring_general`)."""
+def general_spring(M, z):
+    """The spring force [N] of the law packed in the model row ``M`` (at ``M_SPRING``) at
+    ``z`` [m] (:func:`qzs.engine.laws.spring_general`); the six legs' too.
+
+    Parameters
+    ----------
+    M : ndarray
+        A packed model row (``M_*``).
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Spring force on the payload [N].
+    """
     return spring_general(M, M_SPRING, z)
 
 
 @njit(**_JIT)
-def _general_spring_energy(M, z):
-    """The spring energy of the law packed in ``M`` [J] (:func:`spring_energy_general`)."""
+def general_spring_energy(M, z):
+    """The energy [J] stored in the spring law packed in the model row ``M`` at ``z`` [m]
+    (:func:`qzs.engine.laws.spring_energy_general`); the six legs' too.
+
+    Parameters
+    ----------
+    M : ndarray
+        A packed model row (``M_*``).
+    z : float
+        Relative position [m].
+
+    Returns
+    -------
+    float
+        Stored energy [J].
+    """
     return spring_energy_general(M, M_SPRING, z)
 
 
@@ -376,7 +404,7 @@ def rhs(t, y, yd, ydd, s, x, mode, direction, held, P, M, blocks):
     v = s[S_V] if mode == MODE_SLIP else 0.0
     xd = yd + v
     if blocks:
-        f_spring = _general_spring(M, z)
+        f_spring = general_spring(M, z)
     else:
         f_spring = spring_law(P[P_SPRING_A], P[P_SPRING_B], z)
 
@@ -550,7 +578,7 @@ def energies(y, yd, s, mode, P, M):
     if P[P_PLASTIC] == 0.0:
         pen = max(P[P_Z_LOW] - z, 0.0) + max(z - P[P_Z_HIGH], 0.0)
     if M is not None and M[M_SPRING] != TANH:
-        spring = _general_spring_energy(M, z)
+        spring = general_spring_energy(M, z)
     else:
         spring = spring_energy_law(P[P_SPRING_A], P[P_SPRING_B], z)
     return (0.5 * m * (yd + v) ** 2,

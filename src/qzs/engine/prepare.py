@@ -21,7 +21,8 @@ __all__ = ["PreparedRun", "prepare_run", "pack_model", "stack_models", "check_sp
            "linear_initial_state", "linear_output",
            "run_inputs", "run_duration", "steps_per_sample",
            "divides",
-           "divergence_message", "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
+           "divergence_message", "table_exit_message",
+           "check_resolution", "resolving_step", "MIN_STEPS_PER_PERIOD",
            "check_record", "RECORD_BYTES_PER_POINT"]
 
 #: Fewest integration steps per period of the excitation's highest frequency a run is
@@ -289,7 +290,7 @@ def stack_models(models):
     return out
 
 
-def check_spring(isolator, controller, p):
+def check_spring(isolator, controller, stroke, load=None):
     """Refuse a spring law with no stable equilibrium inside the stroke for the payload.
 
     The MagSpring's tanh (the default, or a TanhSpring) is not checked: on the paper's rig
@@ -306,8 +307,11 @@ def check_spring(isolator, controller, p):
         The plant, its ``spring``.
     controller : ControllerParameters
         The controller (its setpoint and integral gain).
-    p : ndarray
-        The packed parameters (the stops ``K.P_Z_LOW``, ``K.P_Z_HIGH``).
+    stroke : tuple of float
+        The stops ``(low, high)`` [m] (a single run's ``K.P_Z_LOW``, ``K.P_Z_HIGH``).
+    load : float, optional
+        The static force the spring and the motor carry [N] (a platform's leg: its share of
+        the platform's weight along the leg); default the payload's weight ``m g``.
 
     Raises
     ------
@@ -318,7 +322,7 @@ def check_spring(isolator, controller, p):
     law = other_spring_law(isolator)
     if law is None:
         return
-    weight = isolator.mass * isolator.gravity
+    weight = isolator.mass * isolator.gravity if load is None else float(load)
     hold = 0.0
     first, last = law.domain
     if controller.pi_ki > 0.0 and first <= controller.position_setpoint <= last:
@@ -326,11 +330,13 @@ def check_spring(isolator, controller, p):
         if abs(needed) <= isolator.motor_force_max:
             return  # the PI's integral holds the payload at the setpoint
         hold = float(np.clip(needed, -isolator.motor_force_max, isolator.motor_force_max))
-    try:
-        check_equilibrium(law, weight, (float(p[K.P_Z_LOW]), float(p[K.P_Z_HIGH])), hold=hold)
+    try:  # a load pulling on the spring (< 0) is a hold the other way: the same net force
+        check_equilibrium(law, max(weight, 0.0), (float(stroke[0]), float(stroke[1])),
+                          hold=hold - min(weight, 0.0))
     except ParameterError as error:
-        raise ParameterError(f"`spring`: {error} (the stroke from the stops, the weight "
-                             f"m g, the hold the PI's integral preload)",
+        carried = "the weight m g" if load is None else "the static load along the leg"
+        raise ParameterError(f"`spring`: {error} (the stroke from the stops, {carried}, the "
+                             f"hold the PI's integral preload)",
                              ("spring", *error.options)) from None
 
 
@@ -730,12 +736,45 @@ def prepare_run(excitation=None, isolator=None, controller=None, *, duration=Non
         control_steps = steps_per_sample(controller.controller_rate, dt, "controller_rate")
 
     p = _pack_parameters(isolator, controller, dt, control_steps)
-    check_spring(isolator, controller, p)
+    check_spring(isolator, controller, (p[K.P_Z_LOW], p[K.P_Z_HIGH]))
     m = pack_model(isolator, controller, dt)
     packed = excitation.pack()
     s, flags = _initial_state(initial_state, isolator, controller, p, m, excitation, packed)
     return PreparedRun(excitation, isolator, controller, p, m, packed, s, flags, duration,
                        decimation, solver_code, dt, sample_rate)
+
+
+def table_exit_message(model, z, v, t, who="the payload", at="last position inside"):
+    """What a run that left a refusing spring table reports (a SimulationError's message).
+
+    Parameters
+    ----------
+    model : ndarray
+        The packed model row (``K.M_*``) of the table's leg or case.
+    z, v : float
+        A position [m] and the velocity [m/s] there, as ``at`` describes them.
+    t : float
+        Time of the failing step [s].
+    who : str
+        What left the table (``"the payload"``, ``"leg 3"``).
+    at : str
+        Which position ``z`` is: the last one inside the table (a single axis's last finite
+        state), or the one reached outside it (``"reached"``: a platform's leg).
+
+    Returns
+    -------
+    str
+    """
+    n = int(model[K.M_SPRING + TABLE_COUNT])
+    first = float(model[K.M_SPRING + TABLE_POSITIONS])
+    last = float(model[K.M_SPRING + TABLE_POSITIONS + n - 1])
+    end = last if v > 0 or z > 0.5 * (first + last) else first
+    return (f"the run stopped at t = {t:.6g} s: {who} left the spring table "
+            f"[{first:.6g}, {last:.6g}] m past its end at {end:.6g} m ({at} z = {z:.6g} m, "
+            f"moving at v = {v:.6g} m/s), and the TabulatedSpring "
+            "refuses positions outside it (outside='refuse'); measure the curve over the "
+            "whole stroke and a margin for the stops' penetration, or build it with "
+            "outside='extend' (linear beyond the ends).")
 
 
 def divergence_message(state, step, dt, status=K.STATUS_DIVERGED, model=None):
@@ -761,17 +800,7 @@ def divergence_message(state, step, dt, status=K.STATUS_DIVERGED, model=None):
         The message of the :class:`~qzs.errors.SimulationError`.
     """
     if status == K.STATUS_OUTSIDE:
-        n = int(model[K.M_SPRING + TABLE_COUNT])
-        first = float(model[K.M_SPRING + TABLE_POSITIONS])
-        last = float(model[K.M_SPRING + TABLE_POSITIONS + n - 1])
-        z, v = float(state[K.S_Z]), float(state[K.S_V])
-        end = last if v > 0 or z > 0.5 * (first + last) else first
-        return (f"the run stopped at t = {step * dt:.6g} s: the payload left the spring table "
-                f"[{first:.6g}, {last:.6g}] m past its end at {end:.6g} m (last position "
-                f"inside z = {z:.6g} m, moving at v = {v:.6g} m/s), and the TabulatedSpring "
-                "refuses positions outside it (outside='refuse'); measure the curve over the "
-                "whole stroke and a margin for the stops' penetration, or build it with "
-                "outside='extend' (linear beyond the ends).")
+        return table_exit_message(model, float(state[K.S_Z]), float(state[K.S_V]), step * dt)
     controller = ""
     blocks = np.abs(state[K.A_X0:K.A_X0 + K.N_X])
     if np.any(blocks):

@@ -57,9 +57,9 @@ from qzs.engine.hexapod.layout import (
     V_KI, V_KP, V_L, V_LHOME, V_MODE, V_MX, V_MY, V_MZ, V_PB, V_PF, V_PM, V_PS, V_STOPC,
     V_STOPK, V_TX, V_TY, V_TZ, V_UX, V_UY, V_UZ, V_V, V_VME, V_VR, V_XB, V_Z, V_ZHIGH,
     V_ZLOW, V_ZREF, W_ACC, W_AL, W_ALW, W_AO, W_CART, W_FSUM, W_GH, W_IBI, W_IMPULSE, W_OM,
-    W_OMW, W_PHASE, W_PIVOTS, W_RB, W_RR, W_SOLVE, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.kernels import (M_LINEAR_STEPS, N_X, X_OBSERVER, block_forces, block_rates,
-                                linear_sample, sample_blocks)
+    W_OMW, W_OUTSIDE, W_PHASE, W_PIVOTS, W_RB, W_RR, W_SOLVE, W_VO, W_Y, W_YD, W_YDD)
+from qzs.engine.kernels import (M_BLOCKS, M_LINEAR_STEPS, N_X, X_OBSERVER, general_spring,
+                                block_forces, block_rates, linear_sample, sample_blocks)
 from qzs.engine.laws import (compliant_stop_law, controller_law, saturation_law,
                              sliding_friction_law, spring_law)
 from qzs.engine.stickslip import MODE_STICK, hold_margin, slip_event
@@ -419,12 +419,44 @@ def _project(s, plat, ww, V, A, idx, vec):
 
 
 # ---------------------------------------------------------------- each leg's controller blocks
-# ``models``: each leg's packed blocks, row ``i`` leg ``i``'s (``qzs.engine.kernels.M_*``), or
-# ``None`` when no leg has blocks (layout.py). Every kernel that reaches the blocks' code takes
-# it as an argument and branches on ``models is not None``: numba prunes that branch by the
-# argument's type before it types the callees, so a run without blocks compiles none of the
-# functions below nor the single axis's block kernels they call (benchmarks/compile_times.py
-# --hexapod). A flag's value (in ``plat``) would not: numba compiles both branches' callees.
+# ``models``: each leg's packed blocks and spring law, row ``i`` leg ``i``'s
+# (``qzs.engine.kernels.M_*``), or ``None`` when no leg has blocks or a law (layout.py). Every
+# kernel that reaches the blocks' code takes it as an argument and branches on ``models is not
+# None``: numba prunes that branch by the argument's type before it types the callees, so a run
+# without blocks or laws compiles none of the functions below nor the single axis's block
+# kernels they call (benchmarks/compile_times.py --hexapod). A flag's value (in ``plat``) would not: numba compiles both branches' callees.
+@njit(**_JIT, inline="always")
+def _with_blocks(models):
+    """Whether a leg's packed row holds controller blocks beyond PI + damping (``M_BLOCKS``):
+    ``models`` also comes with spring laws alone, which leave the blocks' code out."""
+    for i in range(LEG_COUNT):
+        if models[i, M_BLOCKS] != 0.0:
+            return True
+    return False
+
+
+@njit(**_JIT)
+def _leg_springs(models, ww, V):
+    """Each leg's spring force from its own law into row ``FSP`` (docs/model.md §3.1).
+
+    The single axis's general spring (:func:`qzs.engine.kernels.general_spring`, the tanh's
+    arithmetic bit for bit) on leg ``i``'s packed law (``models[i]`` from ``M_SPRING``) at
+    its position (row ``Z``); the padding lanes copy leg 1. A refusing table's NaN outside
+    it marks the first such leg in ``ww[W_OUTSIDE:]`` (its number, position and slip
+    velocity) for the run's status.
+    """
+    for i in range(LEG_COUNT):
+        z = V[V_Z + i]
+        force = general_spring(models[i], z)
+        if np.isnan(force) and ww[W_OUTSIDE] == 0.0:
+            ww[W_OUTSIDE] = i + 1.0
+            ww[W_OUTSIDE + 1] = z
+            ww[W_OUTSIDE + 2] = V[V_V + i]
+        V[V_FSP + i] = force
+    for pad in range(LEG_COUNT, LANES):
+        V[V_FSP + pad] = V[V_FSP]
+
+
 @njit(**_JIT, inline="always")
 def _leg_state(s, i):
     """Leg ``i``'s blocks' state (``qzs.engine.kernels.X_*``) as a tuple."""
@@ -656,7 +688,8 @@ def _sample(t, plat, models, ww, V, s, h):
     """
     _commands(plat, ww, V)
     if models is not None:  # pruned by type without blocks (see _leg_blocks)
-        _sample_blocks(t, plat, models, V, s, h)
+        if _with_blocks(models):
+            _sample_blocks(t, plat, models, V, s, h)
     for i in range(LANES):
         V[V_HPI + i] = V[V_FPI + i]
         V[V_HDA + i] = V[V_FDA + i]
@@ -763,13 +796,18 @@ def _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, proje
             V[V_DINT + i] = 0.0
     else:
         _commands(plat, ww, V)
-    if models is not None:  # each leg's own blocks (docs/model.md §5.1); pruned by type
-        _leg_blocks(t, s, plat, models, ww, V)
+    if models is not None:  # pruned by type without blocks and spring laws
+        if _with_blocks(models):  # each leg's own blocks (docs/model.md §5.1)
+            _leg_blocks(t, s, plat, models, ww, V)
+        _leg_springs(models, ww, V)  # each leg's own spring law (docs/model.md §3.1)
     for i in range(LANES):
         slipping = V[V_MODE + i] == MODE_SLIP
         v = V[V_V + i]
         z = V[V_Z + i]
-        f_spring = spring_law(V[V_A + i], V[V_B + i], z)
+        if models is None:  # the MagSpring's tanh on every leg
+            f_spring = spring_law(V[V_A + i], V[V_B + i], z)
+        else:
+            f_spring = V[V_FSP + i]
         f_stop, f_elastic = compliant_stop_law(z, v, V[V_ZLOW + i], V[V_ZHIGH + i],
                                                V[V_STOPK + i], V[V_STOPC + i])
         f_motor = V[V_FMO + i]
@@ -873,7 +911,8 @@ def _evaluate(t, s, plat, models, ex, tables, toff, ww, V, A, idx, vec, d, proje
     d[S_WM] = motor_power
     d[S_DS] = stop_loss
     if models is not None:
-        _leg_block_rates(s, plat, models, ww, V, d)
+        if _with_blocks(models):
+            _leg_block_rates(s, plat, models, ww, V, d)
 
 
 # Stale cached kernels of this module are dropped with the others (qzs.engine.arithmetic:

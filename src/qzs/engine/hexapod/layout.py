@@ -45,11 +45,15 @@ N_ROWS = 79 + LEG_COUNT - 1
  PL_CENTRAL, PL_JINV, PL_CKP, PL_CKI, PL_CKD) = (0, 1, 2, 5, 14, 23, 26, 32, 33, 34, 35, 71, 77,
                                                 83)
 N_PLAT = 89
-# The legs' controller blocks beyond PI + damping, ``models``: with blocks on any leg, each
-# leg's packed blocks (``qzs.engine.kernels.M_*``, :func:`qzs.engine.prepare.pack_model`), an
-# array (LEG_COUNT, ``qzs.engine.kernels.N_MODEL``); without, ``None``. The kernels take it as
-# an argument and branch on ``models is not None``, which numba prunes by type before it
-# compiles a callee: a run without blocks compiles none of the blocks' code (dynamics.py).
+# The legs' controller blocks beyond PI + damping and spring laws, ``models``: with blocks on
+# any leg or a leg's spring a law other than the MagSpring's tanh, each leg's packed model row
+# (``qzs.engine.kernels.M_*``, :func:`qzs.engine.prepare.pack_model`: its blocks, then its law
+# at ``M_SPRING``), an array (LEG_COUNT, the widest row; :func:`qzs.engine.prepare.stack_models`);
+# without, ``None``. The kernels take it as an argument and branch on ``models is not None``,
+# which numba prunes by type before it compiles a callee: a run without blocks or laws compiles
+# none of their code (dynamics.py). With ``models``, the blocks' code runs only when a leg has
+# blocks (``M_BLOCKS``, ``dynamics._with_blocks``): a run with laws
+# alone keeps the state and output of a run without blocks.
 
 # ODE state; with blocks, each leg's blocks' state (``qzs.engine.kernels.X_*``: a linear
 # controller's states, the friction observer's estimate) follows: leg ``i``'s at
@@ -63,12 +67,13 @@ N_ODE_BLOCKS = N_ODE + LEG_COUNT * N_X
 # its accelerations, the sum of the leg forces, the state of the locked legs' factorisation,
 # its reciprocal pivots, the impulses of the last projection (0 if none), per axis the
 # excitation's phase and its sine and cosine at the start of the step (persistent: carried
-# across kernel calls), and the Cartesian loops' errors, PI and damping commands per axis.
+# across kernel calls), the Cartesian loops' errors, PI and damping commands per axis, and
+# where a leg's spring table first refused its position (leg number from 1, 0 for none; the
+# position [m] and slip velocity [m/s] there; cleared after a step that ends with a force).
 (W_Y, W_YD, W_YDD, W_RB, W_OM, W_AL, W_VO, W_AO, W_GH, W_OMW, W_ALW, W_RR, W_IBI, W_ACC,
- W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE, W_CART) = (0, 6, 12, 18, 27, 30, 33, 36, 39, 42,
-                                                           45, 48, 57, 66, 72, 75, 76, 82, 88,
-                                                           106)
-N_WORK = 124
+ W_FSUM, W_SOLVE, W_PIVOTS, W_IMPULSE, W_PHASE, W_CART, W_OUTSIDE) = (
+    0, 6, 12, 18, 27, 30, 33, 36, 39, 42, 45, 48, 57, 66, 72, 75, 76, 82, 88, 106, 124)
+N_WORK = 127
 SOLVE_NONE, SOLVE_FACTORED, SOLVE_MIN_NORM = 0.0, 1.0, 2.0
 # Rows of the state buffers ``buf`` (N_BUF, N_ODE).
 B_S, B_K1, B_S1, B_KE, B_TMP, B_K2, B_K3, B_K4, B_TRIAL, B_KT = range(10)
@@ -78,7 +83,9 @@ CT_STEP, CT_EVENTS, CT_STICKS, CT_CONTACTS, CT_IN_CONTACT = 0, 1, 2, 8, 14
 N_COUNTERS = 20
 
 MODE_SLIP, MODE_LOCK = 0.0, 1.0
-STATUS_OK, STATUS_DIVERGED = 0, 1
+#: A run's status: going; diverged; stopped where a leg left a spring table that refuses
+#: positions outside it (its force NaN there), as the single axis's ``STATUS_OUTSIDE``.
+STATUS_OK, STATUS_DIVERGED, STATUS_OUTSIDE = 0, 1, 2
 
 # Output channels: time, poses and motions [6 each], per-leg blocks [6 each], the ledger.
 C_TIME, C_POSE, C_TWIST, C_BASE_POSE, C_BASE_VEL, C_BASE_ACC, C_ACC = 0, 1, 7, 13, 19, 25, 31

@@ -19,17 +19,18 @@ from qzs.engine.hexapod.layout import (
     PL_JINV, PL_MASS, PL_ROTATING, S_C, S_INT, S_Q, S_X, V_A, V_B, V_BX, V_BY, V_BZ, V_CBC, V_CV,
     V_DIR, V_FC, V_FMAX, V_FS, V_HLI, V_HP, V_KD, V_KI, V_KP, V_L, V_LHOME, V_STOPC, V_STOPK,
     V_TX, V_TY, V_TZ, V_YDD, V_ZHIGH, V_ZLOW, V_ZREF)
-from qzs.engine.prepare import (check_record, linear_initial_state, linear_output, pack_model,
-                                steps_per_sample)
+from qzs.engine.prepare import (check_record, check_spring, linear_initial_state, linear_output,
+                                pack_model, stack_models, steps_per_sample)
 from qzs.engine.stability import SOLVERS, largest_stable_step, stability_test
 from qzs.errors import ParameterError, StabilityError
 from qzs.model.controller import ControllerParameters, refuse_blocks
 from qzs.model.excitation import Chirp, DisplacementRecord, RandomExcitation, Sine
 from qzs.model.hexapod import (CartesianController, HexapodGeometry, PlatformParameters,
                                jacobian, static_leg_forces)
-from qzs.model.isolator import IsolatorParameters, refuse_spring_law, spring_force
+from qzs.model.isolator import IsolatorParameters, other_spring_law, spring_force
 
-__all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks"]
+__all__ = ["hexapod_stability_test", "check_hexapod_run", "record_option", "has_blocks",
+           "has_spring_laws"]
 
 _EXCITATIONS = (Chirp, Sine, RandomExcitation, DisplacementRecord)
 
@@ -59,6 +60,21 @@ def has_blocks(controller):
     """
     legs = controller if isinstance(controller, (list, tuple)) else (controller,)
     return any(isinstance(c, ControllerParameters) and c.has_blocks for c in legs)
+
+
+def has_spring_laws(isolators):
+    """Whether a leg's spring is a law other than the MagSpring's tanh.
+
+    Parameters
+    ----------
+    isolators : sequence of IsolatorParameters
+        The six legs.
+
+    Returns
+    -------
+    bool
+    """
+    return any(other_spring_law(iso) is not None for iso in isolators)
 
 
 def _excitations(excitation):
@@ -210,7 +226,7 @@ class _Prepared:
     solver_code: int
     V: np.ndarray
     plat: np.ndarray
-    models: np.ndarray | None  # each leg's packed blocks, None without (layout.py)
+    models: np.ndarray | None  # each leg's blocks and spring law, None without (layout.py)
     ex: np.ndarray
     tables: np.ndarray
     toff: np.ndarray
@@ -268,7 +284,6 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     if not isinstance(progress, (bool, np.bool_)):
         raise ParameterError(f"`progress` must be True or False, got {progress!r}.")
     for leg, (iso, con) in enumerate(zip(isolators, controllers)):
-        refuse_spring_law(iso, "the hexapod", f"leg {leg + 1}: ")
         if iso.stop_model != "compliant":
             raise ParameterError(
                 f"leg {leg + 1}: `stop_model` {iso.stop_model!r} is not supported by the hexapod "
@@ -326,11 +341,19 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     models = []
     for leg, (iso, con) in enumerate(zip(isolators, controllers)):
         try:  # a discrete linear controller's period: a whole number of steps
-            # the blocks' columns (K.N_MODEL): plat holds each leg's blocks, its spring the tanh
-            models.append(pack_model(iso, con, dt)[:K.N_MODEL])
+            models.append(pack_model(iso, con, dt))  # the blocks, then the leg's spring law
         except ParameterError as error:
             raise ParameterError(f"leg {leg + 1}: {error}", error.options) from None
     blocks = has_blocks(controllers)
+    laws = has_spring_laws(isolators)
+    loads = _static_forces(geometry, platform)
+    for leg, (iso, con) in enumerate(zip(isolators, controllers)):
+        center = con.position_setpoint if iso.stop_center is None else iso.stop_center
+        try:  # a law must hold the leg's static load inside its stroke, as the single axis's
+            check_spring(iso, con, (center - iso.stroke_half, center + iso.stroke_half),
+                         load=loads[leg])
+        except ParameterError as error:
+            raise ParameterError(f"leg {leg + 1}: {error}", error.options) from None
     if not hexapod_stability_test(geometry, platform, isolators, controllers, solver)(dt):
         mass = _effective_leg_mass(geometry, platform)
         limit = _stability_limit(geometry, platform, isolators, controllers, solver)
@@ -387,8 +410,9 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     plat[PL_ROTATING] = float(any(axis in moving for axis in AXES[3:]))
     tables = np.ascontiguousarray(np.concatenate(pieces, axis=1))
     toff = np.asarray(offsets, dtype=np.int64)
-    # each leg's blocks, or None: the kernels compile their code only for a run with blocks
-    packed = np.array(models) if blocks else None  # (layout.py: models)
+    # each leg's blocks and spring law, or None: the kernels compile their code only for a
+    # run with blocks or a law other than the tanh (layout.py: models)
+    packed = stack_models(models) if blocks or laws else None
 
     state = np.zeros(N_ODE_BLOCKS if blocks else N_ODE)
     state[S_C:S_C + 3] = platform.center_of_mass  # at home: c = o + R_r c_t, o = 0, R_r = I
@@ -405,7 +429,6 @@ def _prepare(geometry, platform, isolator, controller, excitation, duration, dt,
     # PI preload (docs/model.md §5 for each leg): the motor carries the static leg load the
     # spring does not (stops untouched at the setpoint), the base at rest, less the blocks'
     # output at t = 0 (the linear controller's states first); P and D put out nothing at home.
-    loads = _static_forces(geometry, platform)
     needed = np.zeros(LEG_COUNT)
     for i, (iso, con) in enumerate(zip(isolators, controllers)):
         spring = spring_force(con.position_setpoint, iso)

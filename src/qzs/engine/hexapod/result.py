@@ -67,7 +67,7 @@ HEXAPOD_CHANNELS = {
     "relative_position": (C_Z, "leg", "m",
                           "leg relative position z_i = L_i - L_i,home + z_ref (its encoder)"),
     "relative_velocity": (C_V, "leg", "m/s", "leg slip velocity v_i = dL_i/dt (0 when locked)"),
-    "spring_force": (C_FSP, "leg", "N", "MagSpring force along the leg, on the platform"),
+    "spring_force": (C_FSP, "leg", "N", "spring force along the leg, on the platform"),
     "friction_force": (C_FFR, "leg", "N",
                        "friction force along the leg (the holding force when locked)"),
     "stop_force": (C_FST, "leg", "N", "hard-stop force along the leg"),
@@ -82,7 +82,7 @@ HEXAPOD_CHANNELS = {
     "motor_work": (C_WM, None, "J", "work done by the motors"),
     "stop_dissipation": (C_DS, None, "J", "energy dissipated in the hard stops"),
     "kinetic_energy": (C_EK, None, "J", "kinetic energy of the platform (translation + rotation)"),
-    "spring_energy": (C_ESP, None, "J", "energy stored in the six MagSprings"),
+    "spring_energy": (C_ESP, None, "J", "energy stored in the six legs' springs"),
     "gravity_energy": (C_EG, None, "J", "gravitational potential energy m*g*z of the centre of "
                                         "mass (world frame)"),
     "stop_energy": (C_EST, None, "J", "elastic energy stored in the compliant stops"),
@@ -99,6 +99,18 @@ HEXAPOD_FLAGS = {
     "stop_contact": (O_CONTACT, "leg beyond one of its stops (in contact)"),
 }
 _FLAG_MEANINGS = {"locked": "slipping locked", "stop_contact": "free contact"}
+
+
+def _per_leg(meta, section, part, legs):
+    """Add each leg's ``{name: (value, unit)}`` (its blocks', its spring law's) to ``meta``:
+    ``<section>.<part><name>`` once when the six agree, else ``<section>.legN.<part><name>``."""
+    same = all(b.keys() == legs[0].keys() and all(
+        np.array_equal(np.asarray(b[k][0]), np.asarray(legs[0][k][0])) for k in b)
+        for b in legs)
+    for leg, parameters in enumerate(legs[:1] if same else legs):
+        prefix = f"{section}." if same else f"{section}.leg{leg + 1}."
+        for name, (value, unit) in parameters.items():
+            meta[f"{prefix}{part}{name}"] = (value, unit)
 
 
 def _attribute(value):
@@ -458,14 +470,9 @@ class HexapodResult:
                 values = [getattr(o, field.name) for o in objects]
                 value = values[0] if all(v == values[0] for v in values) else values
                 meta[f"{section}.{field.name}"] = (value, unit_of(field.name))
-        blocks = [block_parameters(c) for c in self.controllers]
-        same = all(b.keys() == blocks[0].keys() and all(
-            np.array_equal(np.asarray(b[k][0]), np.asarray(blocks[0][k][0])) for k in b)
-            for b in blocks)
-        for leg, parameters in enumerate(blocks[:1] if same else blocks):
-            prefix = "controller." if same else f"controller.leg{leg + 1}."
-            for name, (value, unit) in parameters.items():
-                meta[f"{prefix}{name}"] = (value, unit)
+        _per_leg(meta, "controller", "", [block_parameters(c) for c in self.controllers])
+        _per_leg(meta, "isolator", "spring.", [{} if i.spring is None else i.spring.parameters()
+                                               for i in self.isolators])
         for axis, value in self.excitation.items():
             meta[f"excitation.{axis}"] = (type(value).__name__, "")
             for field in dataclasses.fields(value):

@@ -17,9 +17,10 @@ from qzs import defaults
 from qzs._validation import worker_count
 from qzs.engine.hexapod.layout import (CT_CONTACTS, CT_EVENTS, CT_STEP, CT_STICKS, LEG_COUNT,
                                        N_BASE_CHANNELS, N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS,
-                                       N_ODE, N_WORK, S_C, S_V, STATUS_OK, V_Z, V_ZHIGH,
-                                       V_ZLOW)
-from qzs.engine.hexapod.prepare import _prepare
+                                       N_ODE, N_WORK, S_C, S_V, STATUS_OK, STATUS_OUTSIDE,
+                                       V_Z, V_ZHIGH, V_ZLOW, W_OUTSIDE)
+from qzs.engine.hexapod.prepare import _prepare, has_blocks
+from qzs.engine.prepare import table_exit_message
 from qzs.engine.hexapod.result import HexapodResult
 from qzs.engine.hexapod.statistics import _Statistics
 from qzs.engine.hexapod.stepping import _run, _start
@@ -67,7 +68,9 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     isolator : IsolatorParameters or sequence of six, optional
         Each leg's plant; Table 1 defaults if omitted. Its ``mass`` and ``gravity`` are not
         used (the platform's are); ``stroke_half`` must equal the geometry's; compliant stops
-        only.
+        only. Its ``spring`` may be any law (docs/model.md §3.1), each leg its own; a law
+        other than the tanh must hold the leg's static load in its stroke, as the single
+        axis's must hold the payload's weight.
     controller : ControllerParameters or sequence of six, optional
         Each leg's loop (one for every leg, or one per leg); defaults if omitted. Continuous
         (``controller_rate`` 0) or sampled with zero-order hold, every leg at the same rate
@@ -135,7 +138,7 @@ def simulate_hexapod(geometry: HexapodGeometry, platform: PlatformParameters,
     statistics = _Statistics([0.5 * (run.V[V_ZLOW + i] + run.V[V_ZHIGH + i])
                               for i in range(LEG_COUNT)], run.controllers)
     recorder = driver.Recorder(
-        plan, N_CHANNELS if run.models is not None else N_BASE_CHANNELS, N_FLAGS,
+        plan, N_CHANNELS if has_blocks(run.controllers) else N_BASE_CHANNELS, N_FLAGS,
         statistics=statistics.add, sink=sink,
         duration=run.duration, sample_rate=run.sample_rate,
         remedy="stream it to a file instead (`qzs hexapod simulate --out FILE.nc`, "
@@ -181,6 +184,7 @@ class _SixLegs(driver.Stepper):
                      run.V, np.zeros((LEG_COUNT, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64),
                      np.zeros((2, LEG_COUNT)), np.zeros(LEG_COUNT, dtype=np.int64), self.counters)
         self.diverged = False
+        self.status = STATUS_OK
 
     def advance(self, steps, buffer, row0):
         """Advance ``steps`` steps; returns the rows written into ``buffers[buffer]``."""
@@ -188,12 +192,19 @@ class _SixLegs(driver.Stepper):
         status, written = _run(self.run.solver_code, steps, self.run.decimation, self.run.dt,
                                self.s, *self.arrays, *self.work, data, marks, row0)
         self.diverged = status != STATUS_OK
+        self.status = status
         return written
 
     def divergence(self):
         """The :class:`~qzs.errors.SimulationError` of a diverged run (time and last state)."""
         s, V = self.s, self.run.V
         failed = int(self.counters[CT_STEP])
+        if self.status == STATUS_OUTSIDE:  # a leg's refusing spring table, as the single axis
+            ww = self.work[2]
+            leg = int(ww[W_OUTSIDE]) - 1
+            return SimulationError(table_exit_message(
+                self.run.models[leg], ww[W_OUTSIDE + 1], ww[W_OUTSIDE + 2],
+                failed * self.run.dt, who=f"leg {leg + 1}", at="reached"))
         blocks = ""
         if s.size > N_ODE:
             blocks = (f", the controller blocks' largest state {np.max(np.abs(s[N_ODE:])):.6g} "

@@ -16,7 +16,7 @@ from qzs.engine.arithmetic import JIT as _JIT
 from qzs.engine.arithmetic import fma
 from qzs.engine.hexapod.dynamics import (_advance_phases, _commands, _cross, _evaluate,
                                          _inertia_times, _linear_due, _matvec, _rest_frame,
-                                         _sample, _sample_linear)
+                                         _sample, _sample_linear, _with_blocks)
 from qzs.engine.hexapod.layout import (
     B_K1, B_K2, B_KE, B_KT, B_S, B_S1, B_TMP, B_TRIAL, C_ACC, C_BASE_ACC, C_BASE_POSE,
     C_BASE_VEL, C_DF, C_DS, C_EG, C_EK, C_ESP, C_EST, C_FCO, C_FDA, C_FDI, C_FFR, C_FLI,
@@ -25,10 +25,12 @@ from qzs.engine.hexapod.layout import (
     CT_IN_CONTACT, CT_STEP, CT_STICKS, LANES, LEG_COUNT, MODE_LOCK, MODE_SLIP,
     O_CONTACT, O_LOCKED, PL_CONTROL_STEPS, PL_CT, PL_G, PL_HOME, PL_IC, PL_MASS,
     PL_ROTATING, S_C, S_DF, S_DS, S_HP, S_V, S_W, S_WB, S_WM, STATUS_DIVERGED, STATUS_OK,
+    STATUS_OUTSIDE, W_OUTSIDE,
     V_A, V_B, V_DIR, V_EV, V_FDA, V_FFR, V_FMO, V_FPI, V_FSP, V_FST, V_HDA, V_HMO, V_HPI,
     V_MODE, V_STOPK, V_V, V_VME, V_XB, V_Z, V_ZHIGH, V_ZLOW, W_ACC, W_AL, W_ALW, W_FSUM,
     W_GH, W_OM, W_OMW, W_RB, W_RR, W_VO, W_Y, W_YD, W_YDD)
-from qzs.engine.kernels import N_X, PHASE_PERIOD, X_OBSERVER, n_stages, tableau
+from qzs.engine.kernels import (N_X, PHASE_PERIOD, X_OBSERVER, general_spring_energy, n_stages,
+                                tableau)
 from qzs.engine.laws import spring_energy_law
 from qzs.engine.stickslip import MODE_STICK, crossed_zero, locate, release_direction, \
     secant_fraction
@@ -329,17 +331,21 @@ def _record(t, s, plat, models, ww, V, row, marks):
         row[C_FPI + i] = V[V_FPI + i]
         row[C_FDA + i] = V[V_FDA + i]
         row[C_VME + i] = V[V_VME + i]
-        spring += spring_energy_law(V[V_A + i], V[V_B + i], z)
+        if models is None:  # the MagSpring's tanh on every leg
+            spring += spring_energy_law(V[V_A + i], V[V_B + i], z)
+        else:  # each leg's own law (docs/model.md §3.1)
+            spring += general_spring_energy(models[i], z)
         pen = max(V[V_ZLOW + i] - z, 0.0) + max(z - V[V_ZHIGH + i], 0.0)
         stop += 0.5 * V[V_STOPK + i] * pen * pen
         marks[O_LOCKED + i] = V[V_MODE + i] != MODE_SLIP
         marks[O_CONTACT + i] = z < V[V_ZLOW + i] or z > V[V_ZHIGH + i]
-    if models is not None:  # a row without blocks holds N_BASE_CHANNELS
-        for i in range(LEG_COUNT):
-            row[C_FCO + i] = V[V_FCO + i]
-            row[C_FOB + i] = s[S_X + i * N_X + X_OBSERVER]
-            row[C_FDI + i] = V[V_FDI + i]
-            row[C_FLI + i] = V[V_FLI + i]
+    if models is not None:  # pruned by type without blocks and laws
+        if _with_blocks(models):  # a row without blocks holds N_BASE_CHANNELS
+            for i in range(LEG_COUNT):
+                row[C_FCO + i] = V[V_FCO + i]
+                row[C_FOB + i] = s[S_X + i * N_X + X_OBSERVER]
+                row[C_FDI + i] = V[V_FDI + i]
+                row[C_FLI + i] = V[V_FLI + i]
     row[C_WB] = s[S_WB]
     row[C_DF] = s[S_DF]
     row[C_WM] = s[S_WM]
@@ -440,7 +446,15 @@ def _run(solver, n_steps, decimation, h, s, plat, models, ex, tables, toff, buf,
                    newly, counters)
         if not _finite(buf[B_S]):
             status = STATUS_DIVERGED
+            if models is not None and ww[W_OUTSIDE] != 0.0:
+                status = STATUS_OUTSIDE  # the leg and where: ww[W_OUTSIDE:]
             break
+        if models is not None and ww[W_OUTSIDE] != 0.0:
+            # a refusing table's NaN marked in a trial the step did not keep: cleared once the
+            # leg's force at the step's end is a number (else the rate carried to the next
+            # step is NaN, and that step fails with the mark)
+            if not np.isnan(V[V_FSP + int(ww[W_OUTSIDE]) - 1]):
+                ww[W_OUTSIDE] = 0.0
         step += 1
         for i in range(LEG_COUNT):
             z = V[V_Z + i]

@@ -1,5 +1,6 @@
 """Each leg's own controller of a six-axis platform: from a hexapod file's
-``[legs.N.controller]`` tables, from ``--leg-controller N=FILE.toml``, or from Python.
+``[legs.N.controller]`` tables, from ``--leg-controller N=FILE.toml``, or from Python; each
+leg's own spring law from ``--spring FILE.toml`` and ``--leg-spring N=FILE.toml``.
 
 The tables are read by the single axis's reader
 (:func:`qzs.iotools.config.controller_from_table`), blocks included (docs/hexapod.md §9.5a);
@@ -12,9 +13,11 @@ import numpy as np
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters, refuse_blocks
 from qzs.model.hexapod import LEG_COUNT
+from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, update_parameters
+from qzs.model.springs import SpringLaw
 
-__all__ = ["read_leg_controllers"]
+__all__ = ["read_leg_controllers", "read_leg_springs", "with_springs"]
 
 
 def read_leg_controllers(pairs: Sequence[str], argument: str = "--leg-controller"
@@ -46,6 +49,72 @@ def read_leg_controllers(pairs: Sequence[str], argument: str = "--leg-controller
     """
     from qzs.iotools.config import load_controller
 
+    return _read_leg_files(pairs, argument, load_controller)
+
+
+def read_leg_springs(pairs: Sequence[str], argument: str = "--leg-spring"
+                     ) -> tuple[dict[int, SpringLaw], dict[str, str]]:
+    """Each leg's own spring law from ``N=FILE.toml`` pairs (``qzs hexapod simulate
+    --leg-spring``), every leg number checked before any file is read.
+
+    Parameters
+    ----------
+    pairs : sequence of str
+        ``N=FILE.toml``: leg ``N`` (1 to 6) has the law of that spring file
+        (:func:`qzs.iotools.config.load_spring`, a ``[spring]`` table).
+    argument : str
+        How the caller names the option in messages.
+
+    Returns
+    -------
+    legs : dict
+        Leg number -> SpringLaw (:func:`with_springs`'s ``legs``).
+    names : dict
+        ``"legs[N]"`` -> the pair as given, for messages.
+
+    Raises
+    ------
+    ParameterError
+        A pair that is not ``N=FILE``, a leg number outside 1 to 6, a leg given twice, or a
+        file that is not a spring file.
+    """
+    from qzs.iotools.config import load_spring
+
+    return _read_leg_files(pairs, argument, load_spring)
+
+
+def with_springs(isolator: IsolatorParameters, spring: SpringLaw | None = None,
+                 legs: Mapping[int, SpringLaw] | None = None
+                 ) -> IsolatorParameters | tuple[IsolatorParameters, ...]:
+    """Each leg's plant with its spring law: ``spring`` on every leg, ``legs[N]`` on leg N.
+
+    Parameters
+    ----------
+    isolator : IsolatorParameters
+        Every leg's plant.
+    spring : SpringLaw, optional
+        Every leg's law (docs/model.md §3.1); default the plant's own.
+    legs : dict, optional
+        Leg number (1 to 6) -> that leg's own law (:func:`read_leg_springs`).
+
+    Returns
+    -------
+    IsolatorParameters or tuple of six
+        One plant when every leg has the same, else the six.
+    """
+    import dataclasses
+
+    if spring is not None:
+        isolator = dataclasses.replace(isolator, spring=spring)
+    if not legs:
+        return isolator
+    return tuple(dataclasses.replace(isolator, spring=legs[n]) if n in legs else isolator
+                 for n in range(1, LEG_COUNT + 1))
+
+
+def _read_leg_files(pairs, argument, load):
+    """``N=FILE`` pairs read by ``load``: ``({leg: value}, {"legs[N]": pair})``, every leg
+    number checked before any file is read (:func:`read_leg_controllers`)."""
     files: dict[int, str] = {}
     given: dict[int, object] = {}
     for pair in pairs:
@@ -59,7 +128,7 @@ def read_leg_controllers(pairs: Sequence[str], argument: str = "--leg-controller
             raise ParameterError(f"{argument}: leg {number} is given twice ({given[number]!r} "
                                  f"and {pair!r}); give each leg once.", (argument,))
         files[number], given[number] = path.strip(), pair
-    legs = {number: load_controller(path) for number, path in files.items()}
+    legs = {number: load(path) for number, path in files.items()}
     return legs, {f"legs[{n}]": f"{argument} {given[n]}" for n in files}
 
 

@@ -58,7 +58,7 @@ from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import update_parameters
 from qzs.workflows.hexapod.legs import (_checked_legs, _controller, _file_legs, _parameters,
                                         _refuse_central_blocks, _sources, _with_settings,
-                                        read_leg_controllers)
+                                        read_leg_controllers, read_leg_springs, with_springs)
 
 if TYPE_CHECKING:
     from qzs.analysis.hexapod_linear import HexapodLinearModel
@@ -68,7 +68,7 @@ __all__ = ["HexapodSetup", "GEOMETRY_KINDS", "AXES", "load_hexapod", "hexapod_se
            "supported_mass", "default_platform", "default_cube_center_height",
            "linear_record", "linear_text", "plot_linear_transmissibility", "simulate_setup",
            "SHIPPED", "SHIPPED_DEFAULT", "SIMULATION_KEYS", "centralised",
-           "read_leg_controllers"]
+           "read_leg_controllers", "read_leg_springs", "with_spring_laws"]
 
 #: Folder of the shipped hexapod files, inside the package.
 SHIPPED = "workflows/hexapod/hexapod_files"
@@ -120,6 +120,9 @@ class HexapodSetup:
     leg_controllers : tuple of six ControllerParameters or None
         Each leg's own controller where one leg's differs (``[legs.N.controller]``
         tables); None: ``controller`` on every leg.
+    leg_isolators : tuple of six IsolatorParameters or None
+        Each leg's own plant where one leg's spring law differs (:func:`with_spring_laws`); None:
+        ``isolator`` on every leg.
     """
 
     geometry: HexapodGeometry
@@ -132,6 +135,12 @@ class HexapodSetup:
     source: str = ""
     cartesian: CartesianController | None = None
     leg_controllers: tuple[ControllerParameters, ...] | None = None
+    leg_isolators: tuple[IsolatorParameters, ...] | None = None
+
+    @property
+    def isolators(self) -> IsolatorParameters | tuple[IsolatorParameters, ...]:
+        """What the engine takes: ``isolator`` for every leg, or the six ``leg_isolators``."""
+        return self.isolator if self.leg_isolators is None else self.leg_isolators
 
     @property
     def controllers(self) -> ControllerParameters | tuple[ControllerParameters, ...]:
@@ -425,6 +434,35 @@ def centralised(setup: HexapodSetup, *,
     return dataclasses.replace(setup, cartesian=cartesian)
 
 
+def with_spring_laws(setup: HexapodSetup, spring: Any = None,
+            legs: Mapping[int, Any] | None = None) -> HexapodSetup:
+    """The set-up with its legs' spring laws replaced (``--spring``, ``--leg-spring``).
+
+    The platform stays the set-up's (a default one is what the set-up's springs hold at the
+    setpoint; the PI's integral carries what a new law holds less, docs/model.md §5).
+
+    Parameters
+    ----------
+    setup : HexapodSetup
+        The platform.
+    spring : SpringLaw, optional
+        Every leg's law (docs/model.md §3.1); default the set-up's.
+    legs : dict, optional
+        Leg number (1 to 6) -> that leg's own law (:func:`read_leg_springs`).
+
+    Returns
+    -------
+    HexapodSetup
+    """
+    import dataclasses
+
+    plants = with_springs(setup.isolator, spring, legs)
+    if isinstance(plants, IsolatorParameters):
+        return dataclasses.replace(setup, isolator=plants, leg_isolators=None)
+    every = with_springs(setup.isolator, spring)
+    return dataclasses.replace(setup, isolator=every, leg_isolators=plants)
+
+
 def load_hexapod(path: str | Path,
                  settings: Mapping[str, Any] | None = None, *,
                  controller: ControllerParameters | None = None,
@@ -562,7 +600,7 @@ def linear_record(setup: HexapodSetup, *, leg_stiffness: float | None = None,
             raise ParameterError(f"`frame` 'cube_center' needs a cubic geometry, got a "
                                  f"{setup.kind!r} one; use 'center_of_mass', 'origin' or a point.")
         frame = "origin"
-    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolator, setup.controllers,
+    model = hexapod_linearize(setup.geometry, setup.platform, setup.isolators, setup.controllers,
                               leg_stiffness=leg_stiffness, frame=frame,
                               include_preload=include_preload, cartesian=setup.cartesian)
     record = {
@@ -786,7 +824,7 @@ def simulate_setup(setup: HexapodSetup, *,
         check_out()
     try:
         resolved = resolve_hexapod(
-            setup.geometry, setup.platform, setup.isolator, setup.controllers, excitation=built,
+            setup.geometry, setup.platform, setup.isolators, setup.controllers, excitation=built,
             duration=arguments["duration"], dt=dt, tolerance_db=tolerance_db,
             tolerance_state=tolerance_state, sample_rate=arguments["sample_rate"],
             solver=arguments["solver"], cartesian=setup.cartesian, finest=arguments["dt"],
@@ -799,7 +837,7 @@ def simulate_setup(setup: HexapodSetup, *,
     common = dict(cartesian=setup.cartesian, progress=progress, interruptible=interruptible,
                   **resolved.arguments())
     if out is None:
-        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolators,
                                   setup.controllers, **common)
         result.run.update(resolved.step.attributes())
         return result
@@ -808,7 +846,7 @@ def simulate_setup(setup: HexapodSetup, *,
 
     check_out()  # again: the probes took a while
     with HexapodWriter(out, blocks=has_blocks(setup.controllers)) as writer:
-        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolator,
+        result = simulate_hexapod(setup.geometry, setup.platform, setup.isolators,
                                   setup.controllers, sink=writer.append, **common)
         result.run.update(resolved.step.attributes())
         writer.finish(result)
