@@ -25,7 +25,7 @@ INLINE double spring_energy_law(double a, double b, double z) {
     return a / b * (u + log1p(exp(-2.0 * u)) - log(2.0));
 }
 
-/* kernels._general_spring / _general_spring_energy: the law's force [N] (`want`
+/* kernels.general_spring / general_spring_energy: the law's force [N] (`want`
  * QZS_SPRING_FORCE) or energy [J] (QZS_SPRING_ENERGY), NaN outside a refusing table (the run
  * then stops, qzs_failure_status); the tanh's without a law */
 INLINE double spring_of(const QzsPlant *plant, double z, int want) {
