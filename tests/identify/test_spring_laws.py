@@ -211,3 +211,22 @@ def test_non_finite_pairs_refused_for_every_law():
     for law in ("polynomial", "oblique", "table", "best"):
         with pytest.raises(DataError, match="1 force-displacement pairs are not finite"):
             fit_spring(z, force, law=law)
+
+
+def test_a_noisy_mechanism_fits_as_a_mechanism_of_springs_that_exist():
+    """The quasi-zero mechanism measured as the paper's spring study measures (41 points over
+    +-0.1 m, 0.6 N noise, seed 5): an unconstrained search ends at a negative far stiffness
+    (no mechanism: law None); the fit keeps k_v + 2 k_o >= 0 and 2 k_o L0 >= 0, gives a law,
+    and its intervals hold the truth."""
+    law = ObliqueSpringQZS.quasi_zero()
+    rng = np.random.default_rng(5)
+    z = np.linspace(-0.1, 0.1, 41)
+    fit = fit_spring(z, law.force(z) + rng.normal(0.0, 0.6084, z.size), law="oblique")
+    assert fit.law is not None
+    truth = {"center": law.center, "preload": law.preload,
+             "far_stiffness": law.vertical_stiffness + 2 * law.oblique_stiffness,
+             "oblique_force": 2 * law.oblique_stiffness * law.free_length,
+             "horizontal_distance": law.horizontal_distance}
+    for name, value in truth.items():
+        low, high = fit.intervals[name]
+        assert low <= value <= high, (name, low, value, high)

@@ -1,8 +1,8 @@
 """``qzs paper`` and ``qzs study``: the paper's studies, their figures, metrics and report."""
 from pathlib import Path
 
-from qzs.cli.common import (add_frequency_axis_option, add_output_options, check_output, emit,
-                             integer_at_least)
+from qzs.cli.common import (add_frequency_axis_option, add_output_options, add_spring_option,
+                             check_output, emit, integer_at_least)
 from qzs.defaults import ACCURACY
 
 __all__ = ["add_parsers", "run"]
@@ -39,6 +39,7 @@ def add_parsers(subparsers):
         cmd.add_argument("--workers", type=integer_at_least(1), metavar="N",
                          help="worker processes (default: all cores)")
         add_frequency_axis_option(cmd)
+        add_spring_option(cmd)
         if name == "paper":
             out = dict(metavar="DIR", default="results/paper",
                        help="output folder (default results/paper)")
@@ -61,7 +62,8 @@ def run(args):
     int
         The exit code, 0.
     """
-    from qzs.workflows.paper.report import paper_summary, run_paper
+    from qzs.iotools.config import load_spring
+    from qzs.workflows.paper.report import paper_summary, run_paper, spring_statement
     from qzs.workflows.paper.report_step import step_statement
     from qzs.workflows.questions import QUESTIONS
 
@@ -71,16 +73,19 @@ def run(args):
     if args.out is None:  # qzs study: the study's own folder, so that two never share one
         args.out = f"results/{Path(args.definition).stem}"
     check_output(args, "--out", args.out, suffixes=None, directory=True)
+    spring = None if args.spring is None else load_spring(args.spring)
     definitions = None if args.command == "paper" else [args.definition]
     results, verdicts, wall = run_paper(definitions, args.out, quick=args.quick,
                                         workers=args.workers,
                                         progress=not args.quiet and not args.json,
                                         argument="--out", dt=args.dt,
                                         tolerance_db=args.tolerance,
-                                        frequency_scale=args.frequency_axis)
+                                        frequency_scale=args.frequency_axis,
+                                        spring=spring)
     lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"
              for result in results]
     lines.append(f"{'total':<12}    wall {wall:7.1f} s")
+    lines.append(f"spring: {spring_statement(results)}")
     lines.append(step_statement(results))
     lines.extend(f"  [{verdict.label}] {verdict.statement} ({verdict.study})\n"
                  f"      {verdict.evidence}" for verdict in verdicts)
@@ -94,6 +99,12 @@ def run(args):
 def _question(args):
     """``qzs study friction_compensation`` or ``damping_design``: an open question's study."""
     from qzs.errors import ParameterError
+
+    if args.spring is not None:
+        raise ParameterError(f"--spring {args.spring!r} applies to the paper's studies; "
+                             f"{args.definition!r} is one of the paper's open questions, "
+                             "whose study runs the paper's MagSpring: leave --spring out.",
+                             ("--spring",))
     from qzs.workflows.questions import run_question
 
     if args.tolerance is not None:

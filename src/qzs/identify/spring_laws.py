@@ -196,11 +196,14 @@ def fit_oblique(z, f, free_length, confidence):
     low, high = float(z.min()), float(z.max())
     span = high - low
     best = (np.inf, None)
+    # a mechanism of springs: k_v + 2 k_o >= 0 and 2 k_o L0 >= 0 (a curve fitted better by a
+    # negative spring is no mechanism; the search keeps to the springs that exist)
+    floor = (-np.inf, 0.0, 0.0)
     for center in np.linspace(low, high, 41):  # (P, K, A) are linear once (center, d) are set
         u = z - center
         for distance in np.geomspace(span / 100.0, span * 10.0, 31):
             design = np.column_stack([np.ones_like(u), -u, u / np.hypot(u, distance)])
-            linear, *_ = np.linalg.lstsq(design, f, rcond=None)
+            linear = optimize.lsq_linear(design, f, bounds=(floor, np.inf)).x
             cost = float(np.sum((design @ linear - f) ** 2))
             if cost < best[0]:
                 best = (cost, (center, *linear, distance))
@@ -216,7 +219,9 @@ def fit_oblique(z, f, free_length, confidence):
         return np.column_stack([far - amplitude * distance ** 2 / cube, np.ones_like(u), -u,
                                 u / length, -amplitude * u * distance / cube])
 
-    solution = optimize.least_squares(residual, best[1], jac=jacobian, method="lm",
+    start = np.clip(best[1], (-np.inf, -np.inf, 0.0, 0.0, 1e-12), np.inf)
+    solution = optimize.least_squares(residual, start, jac=jacobian, method="trf",
+                                      bounds=((-np.inf, -np.inf, 0.0, 0.0, 1e-12), np.inf),
                                       x_scale="jac", max_nfev=20000)
     if not solution.success:
         raise FitError(f"the oblique-spring fit did not converge ({solution.message}); check "

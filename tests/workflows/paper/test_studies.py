@@ -430,3 +430,70 @@ def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
     statement = step_record([result])["statement"]
     assert "the paper's own: no step met 0.01 dB for any case" in statement
     assert "agrees" not in statement
+
+
+def test_the_studies_run_a_spring_law_and_the_report_says_which(tmp_path):
+    """``run_studies(..., spring=law)`` (``qzs paper --spring``, docs/model.md §3.1): every
+    simulated case is the single run of that law (its transmissibility equal to a
+    ``qzs.simulate`` of the same isolator, bit for bit), the spring study measures and fits
+    that law as its kind (the true coefficients inside the fitted intervals), and the report's
+    metrics.json, HTML and spring curves name the law."""
+    import dataclasses
+
+    import qzs
+    from qzs.analysis.spectral import transmissibility as estimate
+    from qzs.workflows.paper.studies import _case_inputs, _tasks
+
+    law = qzs.PolynomialSpring(coefficients=(62.78, -100.0, 0.0, -5e4), center=-0.06)
+    stiction = load_study("stiction")
+    analysis = {"quick_fft_length": 2048, "quick_n_averages": 6}
+    studies = [load_study("spring"),
+               dataclasses.replace(stiction, analysis={**stiction.analysis, **analysis},
+                                   cases=stiction.cases[1:3])]
+    results = run_studies(studies, quick=True, workers=1, progress=False, dt=1e-3,
+                          spring=law)
+    assert all(r.spring == law for r in results)
+    fit = results[0].cases[0].extra["law_fit"]
+    assert fit.kind == "polynomial" and results[0].cases[0].label == "polynomial"
+    for k, truth in enumerate(law.coefficients):
+        low, high = fit.intervals[f"c{k}"]
+        assert low <= truth <= high, (k, low, truth, high)
+    assert results[0].cases[0].metrics["spring.c1"] == pytest.approx(-100.0, abs=30.0)
+    task = _tasks(studies[1], True, 1e-3, law)[0]
+    isolator, controller, excitation, rate = _case_inputs(task)
+    assert isolator.spring == law
+    run = qzs.simulate(excitation, isolator, controller, sample_rate=rate, dt=1e-3)
+    case = results[1].cases[0]
+    direct = estimate(run.base_acceleration, run.payload_acceleration, rate,
+                      fft_length=task["analysis"]["fft_length"],
+                      n_averages=task["analysis"]["n_averages"])
+    band = (direct.frequency >= case.frequency[0]) & (direct.frequency <= case.frequency[-1])
+    np.testing.assert_array_equal(case.magnitude, direct.magnitude[band])
+    default = run_studies(studies[1:], quick=True, workers=1, progress=False, dt=1e-3)
+    assert not np.array_equal(default[0].cases[0].magnitude, case.magnitude)
+    write_paper_outputs(results, tmp_path, quick=True)
+    document = json.loads((tmp_path / "metrics.json").read_text())
+    assert document["spring"]["law"] == "polynomial"
+    assert document["spring"]["coefficients"] == [[62.78, -100.0, 0.0, -5e4], "N/m^k"]
+    import html as markup
+
+    html = markup.unescape((tmp_path / "report.html").read_text())
+    assert "polynomial spring" in html and "not the paper's MagSpring" in html
+    import xarray as xr
+
+    curves = xr.open_dataset(tmp_path / "spring_curves.nc")
+    assert curves.attrs["spring_kind"] == "polynomial"
+    np.testing.assert_allclose(curves["fitted_force"].values,
+                               fit.law.force(curves["displacement"].values))
+
+
+def test_the_report_of_the_default_spring_names_the_magspring(quick_paper):
+    """Without --spring the report names the MagSpring's tanh, Table 1's numbers."""
+    from qzs.workflows.paper.report import spring_record, spring_statement
+
+    results, _, folder = quick_paper
+    assert json.loads((folder / "metrics.json").read_text())["spring"] == spring_record(results)
+    assert spring_record(results) == {"law": "tanh", "plateau": [60.84, "N"],
+                                      "shape": [78.10, "1/m"]}
+    assert spring_statement(results).startswith("tanh spring (MagSpring)")
+    assert "the paper's, the default" in spring_statement(results)

@@ -25,7 +25,7 @@ from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import ALL_PARAMETERS, unit_of
 
-__all__ = ["curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
+__all__ = ["law_dataset", "curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
            "CURVE_SUFFIXES"]
 
 #: The files :func:`write_curves` writes, by suffix.
@@ -171,6 +171,39 @@ def spring_schema(points):
                                       long_name="measured spring force"),
                              Variable(name="fitted_force", dims=on, units="N",
                                       long_name="fitted law -a tanh(b z) at the points")))
+
+
+def law_dataset(displacement, force, fitted_force, parameters, attrs=None):
+    """A spring law's measured characteristic and its fitted law (docs/model.md §3.1).
+
+    As :func:`spring_dataset`, the fitted force given and the fit's parameters as
+    attributes ``spring_<name>`` with their ``_units`` (CF attribute names: no dots).
+
+    Parameters
+    ----------
+    displacement : array_like
+        Displacements of the points [m].
+    force : array_like
+        Measured forces [N].
+    fitted_force : array_like
+        The fitted law's force at ``displacement`` [N].
+    parameters : dict
+        The fit: name -> ``(value, unit)`` (``kind`` first, unit ``-``).
+    attrs : dict, optional
+        Further global attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    z = np.asarray(displacement, dtype=float)
+    meta = {}
+    for name, (value, unit) in parameters.items():
+        meta[f"spring_{name}"] = value
+        meta[f"spring_{name}_units"] = unit
+    return to_dataset(spring_schema(z.size), {"displacement": z, "force": force,
+                                               "fitted_force": fitted_force},
+                      {**(attrs or {}), **meta})
 
 
 def spring_dataset(displacement, force, spring_force, spring_shape, attrs=None):

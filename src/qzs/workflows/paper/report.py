@@ -36,18 +36,20 @@ from qzs.iotools.files import atomic_path
 from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
+from qzs.model.springs import TanhSpring
 from qzs.model.registry import ALL_PARAMETERS, format_value, unit_of, update_parameters
 from qzs.viz.figures import check_frequency_scale
-from qzs.viz.identify import plot_spring_fit
+from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
-from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset, spring_dataset, write_curves
+from qzs.workflows.paper.curves import (CURVE_SUFFIXES, curves_dataset, law_dataset,
+                                        spring_dataset, write_curves)
 from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
 from qzs.workflows.paper.report_step import step_record, step_statement
 from qzs.workflows.paper.studies import column_unit  # noqa: F401 (the metrics table's units)
 from qzs.workflows.paper.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
                                          run_studies, shipped_studies)
 
-__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
+__all__ = ["spring_statement", "spring_record", "CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
            "curves_of", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
@@ -161,8 +163,8 @@ def _resonance_masked(result):
         raise _Undecidable("needs a case with stiction_force >= 5 N")
     fns = []
     for case in cases:
-        isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
-                                                 case.settings)
+        isolator, controller = update_parameters(IsolatorParameters(spring=result.spring),
+                                                 ControllerParameters(), case.settings)
         fns.append(passive_natural_frequency(isolator, controller.position_setpoint))
     locked = [c.stats["locked_fraction_below_half_hz"] for c in strong]
     _defined(locked, "the fraction of time locked below 0.5 Hz (the chirp never went there)",
@@ -458,6 +460,12 @@ def curves_of(result, *, quick=False):
     attrs = {"title": result.study.title, "study": result.study.name,
              "definition": Path(result.study.source).name if result.study.source else "",
              "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
+    if result.study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
+        fit = result.cases[0].extra["law_fit"]
+        fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
+                                             for name, value in fit.parameters.items()}}
+        return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
+                           attrs)
     if result.study.kind == "spring_characteristic":
         extra = result.cases[0].extra
         return spring_dataset(extra["displacement"], extra["force"],
@@ -481,6 +489,12 @@ def _figures(result, folder, frequency_scale=None):
     import matplotlib.pyplot as plt
 
     study = result.study
+    if study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
+        path = folder / "fig05_spring.png"
+        fig = plot_spring_law_fit(result.cases[0].extra["law_fit"], path=path,
+                                  title=study.title)
+        plt.close(fig)
+        return [("fig05_spring", path, [])]
     if study.kind == "spring_characteristic":
         extra = result.cases[0].extra
         path = folder / "fig05_spring.png"
@@ -677,7 +691,8 @@ def _write_tables(study_results, folder, quick, wall_seconds, verdicts, bar):
                                            "cases": [row for row in rows
                                                      if row["study"] == r.study.name]}
                             for r in study_results},
-                "claims": _claims_record(verdicts), "step": step_record(study_results)}
+                "claims": _claims_record(verdicts), "step": step_record(study_results),
+                "spring": spring_record(study_results)}
     with atomic_path(folder / "metrics.json") as tmp:
         tmp.write_text(json_text(document), encoding="utf-8")
     bar.update(1)
@@ -737,7 +752,8 @@ def paper_summary(study_results: Sequence[StudyResult], verdicts: Sequence[Verdi
     return json_ready({
         "qzs_version": __version__, "quick": quick, "wall_seconds": wall_seconds,
         "claims": _claims_record(verdicts), "studies": studies,
-        "step": step_record(study_results), "outputs": {"report": str(folder / "report.html"),
+        "step": step_record(study_results), "spring": spring_record(study_results),
+        "outputs": {"report": str(folder / "report.html"),
                     "metrics_json": str(folder / "metrics.json"),
                     "metrics_csv": str(folder / "metrics.csv"), "figures": figures,
                     "curves": [str(path) for result in study_results
@@ -773,12 +789,56 @@ _RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample 
              ("base_share_min", "trusted: base power share at least"))
 
 
+def _spring_law(study_results):
+    """The law the studies ran (one for all, :func:`run_studies`): the MagSpring's by default."""
+    law = next((r.spring for r in study_results if r.spring is not None), None)
+    if law is None:
+        iso = IsolatorParameters()
+        law = TanhSpring(plateau=iso.spring_force, shape=iso.spring_shape)
+    return law
+
+
+def spring_statement(study_results):
+    """One sentence: the spring law every case ran (docs/model.md §3, §3.1).
+
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies.
+
+    Returns
+    -------
+    str
+    """
+    law = _spring_law(study_results)
+    default = "the paper's, the default" if isinstance(law, TanhSpring) else (
+        "given with --spring, not the paper's MagSpring: the claims are this law's")
+    return f"{law.describe()} ({default})"
+
+
+def spring_record(study_results):
+    """The spring law every case ran as plain data: ``{"law": kind, field: [value, unit]}``.
+
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies.
+
+    Returns
+    -------
+    dict
+    """
+    return {name: value if name == "law" else [value, unit]
+            for name, (value, unit) in _spring_law(study_results).parameters().items()}
+
+
 def _html(study_results, figures, verdicts, quick, wall_seconds):
     e = html.escape
     parts = [html_head("qzs paper report", _STYLE),
              "<h1>Semi-active QZS isolator: the paper's studies, reproduced</h1>",
              f"<p>qzs {e(__version__)}; {'quick' if quick else 'full-length'} runs"
              + (f"; wall time {wall_seconds:.1f} s" if wall_seconds else "") +
+             f". <b>Spring</b>: {e(spring_statement(study_results))}"
              f". <b>Integration step</b>: {e(step_statement(study_results))}</p><p>"
              "Transmissibility is the amplitude ratio sqrt(S_payload/S_base) of the "
              "accelerations (Welch averages of Hann-windowed segments), shown in dB. Dashed: the "
@@ -876,6 +936,11 @@ _TABLE = (("trusted_from", "trusted from [Hz]"), ("resonance_frequency", "peak o
 
 def _case_table(result):
     e = html.escape
+    if result.study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
+        extra = result.cases[0].extra
+        return (f"<p>The spring's law, measured with noise and fitted as its kind "
+                f"(<code>qzs.fit_spring</code>): true {e(extra['true_law'].describe())}; "
+                f"fitted:</p><pre>{e(extra['law_fit'].summary())}</pre>")
     if result.study.kind == "spring_characteristic":
         fit = result.cases[0].extra["fit"]
         return (f"<p>Fit (model convention, F = -a tanh(b z)): a = {fit['spring_force']:.3f} N "
@@ -905,8 +970,8 @@ def _case_table(result):
         table.append([e(label), *(cell(metrics, reasons, name) for name, _ in _TABLE),
                       e(f"{s['stop_contacts']}"), e(f"{100 * s['locked_fraction']:.1f}"),
                       e(f"{case.linear['undamped_natural_frequency']:.3g}")])
-    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
-                                             result.cases[0].settings)
+    isolator, controller = update_parameters(IsolatorParameters(spring=result.spring),
+                                             ControllerParameters(), result.cases[0].settings)
     rows = [html_table(head, table, cells_html=True)]
     if notes:
         rows.append("<ol class='notes'>" + "".join(f"<li>{e(reason)}</li>" for reason in notes)
@@ -924,7 +989,7 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
               workers: int | None = None, progress: bool = True,
               argument: str = "folder", dt: float | None = None,
               tolerance_db: float | None = None,
-              frequency_scale: str | None = None
+              frequency_scale: str | None = None, spring=None
               ) -> tuple[list[StudyResult], list[Verdict], float]:
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
@@ -952,6 +1017,9 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of every figure (``--frequency-axis``); default each view's own,
         else ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+    spring : SpringLaw, optional
+        The spring law of every case (docs/model.md §3.1; ``--spring``); default the
+        MagSpring's tanh, the paper's.
 
     Returns
     -------
@@ -981,7 +1049,7 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     studies = [load_study(p) for p in paths]
     start = time.perf_counter()
     results = run_studies(studies, quick=quick, workers=workers, progress=progress, dt=dt,
-                          tolerance_db=tolerance_db)
+                          tolerance_db=tolerance_db, spring=spring)
     wall = time.perf_counter() - start
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
                                    workers=workers, frequency_scale=frequency_scale,

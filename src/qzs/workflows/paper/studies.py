@@ -33,6 +33,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -48,8 +49,9 @@ from qzs.identify.spring import fit_spring
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import EXCITATION_OPTIONS, Chirp
-from qzs.model.isolator import IsolatorParameters, spring_force
-from qzs.model.registry import update_parameters
+from qzs.model.isolator import IsolatorParameters, other_spring_law, spring_force
+from qzs.model.springs import PolynomialSpring
+from qzs.model.registry import law_parameters, parameter_value, update_parameters
 
 __all__ = ["CLAIMS", "Study", "StudyResult", "CaseResult", "load_study", "shipped_studies",
            "run_studies", "run_study", "RUN_UNITS", "STATS_UNITS", "column_unit"]
@@ -222,6 +224,8 @@ class StudyResult:
         [s], ``probe_duration`` [s], ``unmet`` (labels of the cases no step met: their
         response depends on the step), ``notes``, ``seconds`` (time of the choice) [s] and
         ``group`` (studies with equal numbers share the choice).
+    spring : SpringLaw or None
+        The spring law every case ran (docs/model.md §3.1); None: the MagSpring's tanh.
     """
 
     study: Study
@@ -229,6 +233,7 @@ class StudyResult:
     quick: bool
     seconds: float = 0.0
     step: dict = field(default_factory=dict)
+    spring: Any = None
 
 
 def shipped_studies():
@@ -307,9 +312,10 @@ def load_study(path):
                  source=str(path))
 
 
-def _tasks(study, quick, dt=None):
+def _tasks(study, quick, dt=None, spring=None):
     """One picklable task per case: everything a worker needs to run it (``dt`` None: the
-    file's, else chosen later by :func:`_choose_steps`)."""
+    file's, else chosen later by :func:`_choose_steps`; ``spring`` the isolator's law, None
+    for the MagSpring's tanh)."""
     analysis = {**ANALYSIS, **study.analysis}
     if quick:
         analysis["fft_length"] = analysis["quick_fft_length"]
@@ -319,14 +325,16 @@ def _tasks(study, quick, dt=None):
         if quick:
             analysis["n_averages"] = min(analysis["n_averages"], analysis["quick_n_averages"])
     if study.kind == "spring_characteristic":
-        return [dict(kind=study.kind, label="MagSpring", settings={}, options=study.options)]
+        return [dict(kind=study.kind, label="MagSpring" if spring is None else spring.kind,
+                     settings={}, options=study.options, spring=spring)]
     return [dict(kind=study.kind, label=case.get("label", f"case {i + 1}"),
                  settings={**study.defaults, **{k: v for k, v in case.items() if k != "label"}},
                  excitation=dict(study.excitation), analysis=analysis,
                  simulation={"dt": None, "solver": SIMULATION["solver"], **study.simulation,
                              **({} if dt is None else {"dt": dt})},
                  step_source="given" if dt is not None else
-                 ("file" if "dt" in study.simulation else "chosen"), options=study.options)
+                 ("file" if "dt" in study.simulation else "chosen"), options=study.options,
+                 spring=spring)
             for i, case in enumerate(study.cases)]
 
 
@@ -344,8 +352,8 @@ def run_case(task):
 def _case_inputs(task):
     """``(isolator, controller, excitation, sample rate [Hz])`` of a simulated case."""
     analysis = task["analysis"]
-    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
-                                             task["settings"])
+    isolator, controller = update_parameters(IsolatorParameters(spring=task["spring"]),
+                                             ControllerParameters(), task["settings"])
     rate = analysis["sample_rate"]
     duration = task["excitation"].get("duration") or required_duration(
         analysis["fft_length"], analysis["n_averages"], rate, analysis["overlap"])
@@ -536,25 +544,47 @@ def _metrics(estimate, keep):
 
 
 def _spring_case(task):
+    """The spring's characteristic: the law measured with noise, and fitted.
+
+    The MagSpring (the paper's Fig. 5): its tanh fitted, ``spring_force`` and
+    ``spring_shape``. Another law (``task["spring"]``, docs/model.md §3.1): measured the
+    same way (noise a share of the MagSpring's plateau force) and fitted as its own kind
+    (:func:`qzs.identify.fit_spring`; a polynomial of its degree about its centre), its
+    fitted parameters by their registry names
+    (``spring.<field>``) and the fit's RMS residual.
+    """
     options = task["options"]
     truth = IsolatorParameters()
+    law = task["spring"]
     rng = np.random.default_rng(int(options.get("seed", 5)))
     z = np.linspace(options.get("displacement_min", -0.1), options.get("displacement_max", 0.1),
                     int(options.get("points", 41)))
-    force = spring_force(z, truth)
+    force = spring_force(z, truth) if law is None else law.force(z)
     measured = force + rng.normal(0.0, float(options.get("noise", 0.01)) * truth.spring_force,
                                   z.size)
-    fit = fit_spring(z, measured)
-    result = CaseResult("MagSpring", {})
-    result.extra = dict(displacement=z, force=measured, fit=dataclasses.asdict(fit),
-                        true_force_amplitude=truth.spring_force,
-                        true_shape=truth.spring_shape)
-    result.metrics = {"spring_force": fit.spring_force, "spring_shape": fit.spring_shape}
+    if law is None:
+        fit = fit_spring(z, measured)
+        result = CaseResult("MagSpring", {})
+        result.extra = dict(displacement=z, force=measured, fit=dataclasses.asdict(fit),
+                            true_force_amplitude=truth.spring_force,
+                            true_shape=truth.spring_shape)
+        result.metrics = {"spring_force": fit.spring_force, "spring_shape": fit.spring_shape}
+        return result
+    shape = ({"degree": max(law.coefficients.size - 1, 1), "center": law.center}
+             if isinstance(law, PolynomialSpring) else {})  # its own powers, about its centre
+    fit = fit_spring(z, measured, law=law.kind, **shape)
+    result = CaseResult(law.kind, {})
+    result.extra = dict(displacement=z, force=measured, law_fit=fit, true_law=law)
+    result.metrics = {"spring_residual_rms": fit.residual_rms}
+    if fit.law is not None:  # else fit.undefined["law"] says why (the report shows it)
+        fitted = IsolatorParameters(spring=fit.law)
+        result.metrics.update({name: parameter_value(fitted, None, name)
+                               for name in law_parameters(fit.law)})
     return result
 
 
 def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True, dt=None,
-                tolerance_db=None):
+                tolerance_db=None, spring=None):
     """Run several studies, all their cases in parallel.
 
     Cases that share their chirp, sample rate, step and solver (the paper's
@@ -583,6 +613,9 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         Tolerance on the transmissibility [dB] the chosen step meets (one step per group
         of cases sharing an excitation, :func:`qzs.engine.accuracy_batch.choose_batch_step`);
         default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
+    spring : SpringLaw, optional
+        The spring law of every case (docs/model.md §3.1); default the MagSpring's tanh (the
+        paper's). The spring study then measures and fits that law.
 
     Returns
     -------
@@ -603,7 +636,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     dt = None if dt is None else positive_real("dt", dt)
     tolerance_db = positive_real("tolerance_db", ACCURACY["tolerance_db"] if tolerance_db is None
                                  else tolerance_db)
-    per_study = [_tasks(study, quick, dt) for study in studies]
+    spring = other_spring_law(IsolatorParameters(spring=spring))  # validated; the tanh: None
+    per_study = [_tasks(study, quick, dt, spring) for study in studies]
     steps = _choose_steps(per_study, tolerance_db, worker_count(workers), progress)
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
              for j, task in enumerate(study_tasks)]
@@ -644,7 +678,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         if pool is not None:
             pool.shutdown(cancel_futures=True)
     elapsed = time.perf_counter() - start
-    return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed, step)
+    return [StudyResult(study, cases, quick, sum(c.seconds for c in cases) or elapsed, step,
+                        spring)
             for study, cases, step in zip(studies, results, steps)]
 
 
@@ -729,7 +764,7 @@ def _step_record(tasks, choices):
 
 #: Units of the metrics table's own columns (:func:`column_unit`).
 _COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
-                 "seconds": "s"}
+                 "seconds": "s", "spring_residual_rms": "N"}
 
 
 def column_unit(name):
