@@ -63,7 +63,8 @@ def run(args):
         The exit code, 0.
     """
     from qzs.iotools.config import load_spring
-    from qzs.workflows.paper.report import paper_summary, run_paper, spring_statement
+    from qzs.workflows.paper.report import paper_summary, run_paper
+    from qzs.workflows.paper.report_spring import spring_statement
     from qzs.workflows.paper.report_step import step_statement
     from qzs.workflows.questions import QUESTIONS
 

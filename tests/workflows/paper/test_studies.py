@@ -489,7 +489,7 @@ def test_the_studies_run_a_spring_law_and_the_report_says_which(tmp_path):
 
 def test_the_report_of_the_default_spring_names_the_magspring(quick_paper):
     """Without --spring the report names the MagSpring's tanh, Table 1's numbers."""
-    from qzs.workflows.paper.report import spring_record, spring_statement
+    from qzs.workflows.paper.report_spring import spring_record, spring_statement
 
     results, _, folder = quick_paper
     assert json.loads((folder / "metrics.json").read_text())["spring"] == spring_record(results)

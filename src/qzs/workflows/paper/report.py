@@ -36,20 +36,19 @@ from qzs.iotools.files import atomic_path
 from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
-from qzs.model.springs import TanhSpring
 from qzs.model.registry import ALL_PARAMETERS, format_value, unit_of, update_parameters
 from qzs.viz.figures import check_frequency_scale
-from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
-from qzs.workflows.paper.curves import (CURVE_SUFFIXES, curves_dataset, law_dataset,
-                                        spring_dataset, write_curves)
+from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset, write_curves
+from qzs.workflows.paper.report_spring import (draw_spring, spring_curves, spring_fit_html,
+                                               spring_record, spring_statement)
 from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
 from qzs.workflows.paper.report_step import step_record, step_statement
 from qzs.workflows.paper.studies import column_unit  # noqa: F401 (the metrics table's units)
 from qzs.workflows.paper.studies import (RUN_UNITS, STATS_UNITS, StudyResult, load_study,
                                          run_studies, shipped_studies)
 
-__all__ = ["spring_statement", "spring_record", "CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
+__all__ = ["CLAIMS", "TREND_CLAIMS", "Verdict", "decide_claims", "damping_changes",
            "curves_of", "paper_summary", "write_paper_outputs", "run_paper"]
 
 #: Free space [bytes] the output folder must have before the studies run: a generous bound
@@ -460,16 +459,8 @@ def curves_of(result, *, quick=False):
     attrs = {"title": result.study.title, "study": result.study.name,
              "definition": Path(result.study.source).name if result.study.source else "",
              "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
-    if result.study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
-        fit = result.cases[0].extra["law_fit"]
-        fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
-                                             for name, value in fit.parameters.items()}}
-        return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
-                           attrs)
     if result.study.kind == "spring_characteristic":
-        extra = result.cases[0].extra
-        return spring_dataset(extra["displacement"], extra["force"],
-                              extra["fit"]["spring_force"], extra["fit"]["spring_shape"], attrs)
+        return spring_curves(result, attrs)
     for key, value in _settings(result).items():
         attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
                       else value)
@@ -489,19 +480,9 @@ def _figures(result, folder, frequency_scale=None):
     import matplotlib.pyplot as plt
 
     study = result.study
-    if study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
-        path = folder / "fig05_spring.png"
-        fig = plot_spring_law_fit(result.cases[0].extra["law_fit"], path=path,
-                                  title=study.title)
-        plt.close(fig)
-        return [("fig05_spring", path, [])]
     if study.kind == "spring_characteristic":
-        extra = result.cases[0].extra
         path = folder / "fig05_spring.png"
-        fig = plot_spring_fit(extra["displacement"], extra["force"],
-                              extra["fit"]["spring_force"], extra["fit"]["spring_shape"],
-                              path=path, title=study.title)
-        plt.close(fig)
+        plt.close(draw_spring(result, path))
         return [("fig05_spring", path, [])]
     drawn = []
     curves = _curves(result)
@@ -789,49 +770,6 @@ _RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample 
              ("base_share_min", "trusted: base power share at least"))
 
 
-def _spring_law(study_results):
-    """The law the studies ran (one for all, :func:`run_studies`): the MagSpring's by default."""
-    law = next((r.spring for r in study_results if r.spring is not None), None)
-    if law is None:
-        iso = IsolatorParameters()
-        law = TanhSpring(plateau=iso.spring_force, shape=iso.spring_shape)
-    return law
-
-
-def spring_statement(study_results):
-    """One sentence: the spring law every case ran (docs/model.md §3, §3.1).
-
-    Parameters
-    ----------
-    study_results : sequence of StudyResult
-        The studies.
-
-    Returns
-    -------
-    str
-    """
-    law = _spring_law(study_results)
-    default = "the paper's, the default" if isinstance(law, TanhSpring) else (
-        "given with --spring, not the paper's MagSpring: the claims are this law's")
-    return f"{law.describe()} ({default})"
-
-
-def spring_record(study_results):
-    """The spring law every case ran as plain data: ``{"law": kind, field: [value, unit]}``.
-
-    Parameters
-    ----------
-    study_results : sequence of StudyResult
-        The studies.
-
-    Returns
-    -------
-    dict
-    """
-    return {name: value if name == "law" else [value, unit]
-            for name, (value, unit) in _spring_law(study_results).parameters().items()}
-
-
 def _html(study_results, figures, verdicts, quick, wall_seconds):
     e = html.escape
     parts = [html_head("qzs paper report", _STYLE),
@@ -936,19 +874,8 @@ _TABLE = (("trusted_from", "trusted from [Hz]"), ("resonance_frequency", "peak o
 
 def _case_table(result):
     e = html.escape
-    if result.study.kind == "spring_characteristic" and "law_fit" in result.cases[0].extra:
-        extra = result.cases[0].extra
-        return (f"<p>The spring's law, measured with noise and fitted as its kind "
-                f"(<code>qzs.fit_spring</code>): true {e(extra['true_law'].describe())}; "
-                f"fitted:</p><pre>{e(extra['law_fit'].summary())}</pre>")
     if result.study.kind == "spring_characteristic":
-        fit = result.cases[0].extra["fit"]
-        return (f"<p>Fit (model convention, F = -a tanh(b z)): a = {fit['spring_force']:.3f} N "
-                f"[{fit['spring_force_interval'][0]:.3f}, {fit['spring_force_interval'][1]:.3f}],"
-                f" b = {fit['spring_shape']:.2f} 1/m [{fit['spring_shape_interval'][0]:.2f}, "
-                f"{fit['spring_shape_interval'][1]:.2f}] (95 %); Table 1: a = 60.84 N, "
-                "b = 78.10 1/m. The paper's Fig. 5 prints a = -60.84 N in the test machine's "
-                "displacement convention.</p>")
+        return spring_fit_html(result)
     notes = {}
 
     def cell(metrics, reasons, name):

@@ -1,0 +1,134 @@
+"""The spring of the paper's studies, as the report states it (docs/workflows/paper.md).
+
+The law every case ran (the MagSpring's tanh, the paper's, by default; another given to
+``qzs paper --spring``, docs/model.md §3.1): as one sentence (:func:`spring_statement`, for
+``report.html`` and the console) and as a record (:func:`spring_record`, for
+``metrics.json``); and the spring study's fit as the report shows it: its figure
+(:func:`draw_spring`), its curves (:func:`spring_curves`) and its paragraph
+(:func:`spring_fit_html`).
+"""
+import html
+
+from qzs.model.isolator import IsolatorParameters
+from qzs.model.springs import TanhSpring
+from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
+from qzs.workflows.paper.curves import law_dataset, spring_dataset
+
+__all__ = ["spring_statement", "spring_record", "draw_spring", "spring_curves",
+           "spring_fit_html"]
+
+
+def _spring_law(study_results):
+    """The law the studies ran (one for all, ``run_studies``): the MagSpring's by default."""
+    law = next((r.spring for r in study_results if r.spring is not None), None)
+    if law is None:
+        iso = IsolatorParameters()
+        law = TanhSpring(plateau=iso.spring_force, shape=iso.spring_shape)
+    return law
+
+
+def spring_statement(study_results):
+    """One sentence: the spring law every case ran (docs/model.md §3, §3.1).
+
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies.
+
+    Returns
+    -------
+    str
+    """
+    law = _spring_law(study_results)
+    default = "the paper's, the default" if isinstance(law, TanhSpring) else (
+        "given with --spring, not the paper's MagSpring: the claims are this law's")
+    return f"{law.describe()} ({default})"
+
+
+def spring_record(study_results):
+    """The spring law every case ran as plain data: ``{"law": kind, field: [value, unit]}``.
+
+    Parameters
+    ----------
+    study_results : sequence of StudyResult
+        The studies.
+
+    Returns
+    -------
+    dict
+    """
+    return {name: value if name == "law" else [value, unit]
+            for name, (value, unit) in _spring_law(study_results).parameters().items()}
+
+
+def draw_spring(result, path):
+    """The spring study's figure (the paper's Fig. 5): the points and the fitted law.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The spring study's result.
+    path : Path
+        The PNG to write (an SVG beside it).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    extra = result.cases[0].extra
+    if "law_fit" in extra:
+        return plot_spring_law_fit(extra["law_fit"], path=path, title=result.study.title)
+    return plot_spring_fit(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
+                           extra["fit"]["spring_shape"], path=path, title=result.study.title)
+
+
+def spring_curves(result, attrs):
+    """The spring study's points and fitted law as a dataset (``spring_curves.nc``).
+
+    Parameters
+    ----------
+    result : StudyResult
+        The spring study's result.
+    attrs : dict
+        Global attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    extra = result.cases[0].extra
+    if "law_fit" in extra:
+        fit = extra["law_fit"]
+        fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
+                                             for name, value in fit.parameters.items()}}
+        return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
+                           attrs)
+    return spring_dataset(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
+                          extra["fit"]["spring_shape"], attrs)
+
+
+def spring_fit_html(result):
+    """The spring study's paragraph in ``report.html``: the fit and what it should find.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The spring study's result.
+
+    Returns
+    -------
+    str
+    """
+    e = html.escape
+    extra = result.cases[0].extra
+    if "law_fit" in extra:
+        return (f"<p>The spring's law, measured with noise and fitted as its kind "
+                f"(<code>qzs.fit_spring</code>): true {e(extra['true_law'].describe())}; "
+                f"fitted:</p><pre>{e(extra['law_fit'].summary())}</pre>")
+    fit = extra["fit"]
+    return (f"<p>Fit (model convention, F = -a tanh(b z)): a = {fit['spring_force']:.3f} N "
+            f"[{fit['spring_force_interval'][0]:.3f}, {fit['spring_force_interval'][1]:.3f}],"
+            f" b = {fit['spring_shape']:.2f} 1/m [{fit['spring_shape_interval'][0]:.2f}, "
+            f"{fit['spring_shape_interval'][1]:.2f}] (95 %); Table 1: a = 60.84 N, "
+            "b = 78.10 1/m. The paper's Fig. 5 prints a = -60.84 N in the test machine's "
+            "displacement convention.</p>")
