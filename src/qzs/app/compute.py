@@ -95,8 +95,12 @@ LINEAR_POINTS = 400
 
 
 def _other_law(spring):
-    """``spring`` unless it is None or the MagSpring's tanh (whose sliders are the fields')."""
-    return None if spring is None or isinstance(spring, TanhSpring) else spring
+    """``spring`` unless it is None or the MagSpring's tanh (whose sliders are the fields');
+    anything but a law is refused."""
+    if spring is not None and not isinstance(spring, SpringLaw):
+        raise ParameterError(f"`spring` must be a spring law (qzs.model.springs) or None for "
+                             f"the MagSpring, got {type(spring).__name__}.", ("spring",))
+    return None if isinstance(spring, TanhSpring) else spring
 
 
 def page_parameters(spring=None):
@@ -130,14 +134,12 @@ def page_parameters(spring=None):
 def _base_isolator(spring):
     """The paper's isolator with the page's spring law: a tanh's numbers in its fields (so
     its sliders are the MagSpring's), another law as ``spring``."""
+    law = _other_law(spring)
+    if law is not None:
+        return IsolatorParameters(spring=law)
     if spring is None:
         return IsolatorParameters()
-    if not isinstance(spring, SpringLaw):
-        raise ParameterError(f"`spring` must be a spring law (qzs.model.springs) or None for "
-                             f"the MagSpring, got {type(spring).__name__}.", ("spring",))
-    if isinstance(spring, TanhSpring):
-        return IsolatorParameters(spring_force=spring.plateau, spring_shape=spring.shape)
-    return IsolatorParameters(spring=spring)
+    return IsolatorParameters(spring_force=spring.plateau, spring_shape=spring.shape)
 
 
 def _unit_scale(unit, isolator):
