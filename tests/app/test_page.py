@@ -4,6 +4,7 @@ The page is built outside a Bokeh server with a synchronous executor, so every r
 computed and delivered before the call returns; the browser tests (test_browser.py)
 drive the same page through Chromium.
 """
+import dataclasses
 import io
 from concurrent.futures import Future
 
@@ -225,8 +226,8 @@ def sidebar_objects(page):
 
 
 def test_a_page_with_a_law_has_its_sliders_and_not_the_magsprings(tmp_path):
-    """`qzs app --spring` with an oblique law: the law's six spring.* sliders (the
-    registry's label and unit, the ranges of law_slider_range, the law's values) where
+    """`qzs app --spring` with an oblique law: the law's six spring.* sliders (the law's
+    field described with the registry's unit, the ranges of law_slider_range, the law's values) where
     spring_force and spring_shape were; a slider redraws the run of the changed law;
     "Reset" returns to the file's law; the TOML export carries the slider values in its
     [spring] table."""
@@ -242,8 +243,8 @@ def test_a_page_with_a_law_has_its_sliders_and_not_the_magsprings(tmp_path):
     shown = sidebar_objects(page)
     for name in names:
         widget = page.widgets[name]
-        info = ALL_PARAMETERS[name]
-        assert label(widget) == f"{info.doc} [{info.unit}]"
+        field = {f.name: f for f in dataclasses.fields(law)}[name.split(".", 1)[1]]
+        assert label(widget) == f"{field.metadata['doc']} [{ALL_PARAMETERS[name].unit}]"
         assert (widget.start, widget.end, widget.step) == law_slider_range(law, name)
         assert widget.value == getattr(law, name.split(".", 1)[1])
         assert widget in shown

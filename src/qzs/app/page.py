@@ -11,6 +11,7 @@ Panel is imported here, never by the layers below; :func:`qzs.app.server.serve` 
 that it is installed before this module is imported.
 """
 import asyncio
+import dataclasses
 import io
 import logging
 import sys
@@ -90,7 +91,12 @@ _WIDGET_WIDTH = 330
 _EXPECTED = (ParameterError, SimulationError, DataError)
 
 
-def _label(name):
+def _label(name, spring=None):
+    """A setting's label, its unit in brackets; a ``spring.*`` parameter described as
+    ``spring``'s own field (the registry's ``spring.center`` speaks of every law)."""
+    fields = {f"spring.{f.name}": f for f in dataclasses.fields(spring)} if spring else {}
+    if name in fields:
+        return f"{fields[name].metadata['doc']} [{ALL_PARAMETERS[name].unit}]"
     if name in ALL_PARAMETERS:
         info = ALL_PARAMETERS[name]
         return f"{info.doc} [{info.unit}]"
@@ -232,7 +238,8 @@ class TuningPage:
             start, end, step = (law_slider_range(self.spring, name)
                                 if name in SPRING_PARAMETERS else SLIDERS[name])
             widgets[name] = _named(
-                pn.widgets.EditableFloatSlider, _label(name), start=start, end=end, step=step,
+                pn.widgets.EditableFloatSlider, _label(name, self.start.isolator.spring),
+                start=start, end=end, step=step,
                 value=float(values[name]), width=_WIDGET_WIDTH)
         widgets["excitation.kind"] = _named(
             pn.widgets.RadioButtonGroup, "excitation",

@@ -238,13 +238,16 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True, spring=
 
     from qzs.app.page import build_page
 
+    def page():  # a function: Panel serves a functools.partial as its text
+        return build_page(spring=spring)
+
     pn.extension(notifications=False)
     shown = f"[{host}]" if ":" in host else host
     print(f"qzs app: serving http://{shown}:{port}/ (Ctrl-C to stop)", file=sys.stderr,
           flush=True)
     previous = signal.getsignal(signal.SIGINT)
     try:
-        pn.serve(functools.partial(build_page, spring=spring), port=port, address=host, websocket_origin=origins,
+        pn.serve(page, port=port, address=host, websocket_origin=origins,
                  show=open_browser, title="qzs tuning page", verbose=False, start=True,
                  threaded=False, admin=False)
     finally:  # Panel stops the server on SIGINT with a handler of its own
