@@ -58,3 +58,16 @@ def test_a_table_of_the_tanh_linearises_as_the_tanh_within_its_interpolation_err
     # each halving of the spacing at least halves it, and two quarter it at least 8-fold
     assert errors[0] / errors[1] > 2 and errors[1] / errors[2] > 2, errors
     assert errors[0] / errors[2] > 8, errors
+
+
+def test_a_negative_loop_stiffness_has_no_undamped_natural_frequency():
+    """A law whose negative stiffness outweighs Kp (the oblique mechanism with a softer
+    vertical spring: k_v + 2 k_o (1 - L0/d) = 120 - 200 = -80 N/m, with Kp = 50 N/m) has no
+    undamped natural frequency: it is NaN, without a RuntimeWarning; the stiffness is the
+    closed form's and the transfer is still the loop's (its unstable pole on the right)."""
+    iso = IsolatorParameters(spring=ObliqueSpringQZS(vertical_stiffness=120.0))
+    model = linearize(iso, CONTROLLER)  # the suite turns a RuntimeWarning into an error
+    assert model.stiffness == pytest.approx(120.0 + 400.0 * (1 - 1.5) + CONTROLLER.pi_kp,
+                                            rel=1e-12)
+    assert np.isnan(model.undamped_natural_frequency)
+    assert np.max(model.poles.real) > 0

@@ -222,3 +222,31 @@ def test_transmissibility_axis_is_logarithmic_with_positive_frequencies(page):
     assert scale == "LogScale"
     for key in ("transmissibility", "linear"):
         assert min(browser.source_data(page, key)["x"]) > 0
+
+
+@pytest.fixture(scope="module")
+def spring_server(chromium, server_log, tmp_path_factory):
+    """`qzs app --spring` with the oblique-spring mechanism, a softer vertical spring."""
+    path = tmp_path_factory.mktemp("spring") / "oblique.toml"
+    path.write_text('[spring]\nlaw = "oblique"\nvertical_stiffness = 180.0\n', encoding="utf-8")
+    with browser.start_server(log=server_log, options=("--spring", str(path))) as url:
+        yield url
+
+
+def test_a_spring_law_page_has_its_sliders_and_one_redraws(context, spring_server, server_log):
+    """The page of `qzs app --spring` shows the law's sliders, not the MagSpring's, and
+    a law's slider released redraws the transmissibility."""
+    page = open_page(context, spring_server, server_log)
+    try:
+        assert page.locator(f".{browser_class('spring_force')}").count() == 0
+        field = page.locator(f".{browser_class('spring.vertical_stiffness')} input").first
+        assert float(field.input_value()) == 180.0
+        page.get_by_text("spring law (--spring): oblique-spring QZS: k_v = 180 N/m").first \
+            .wait_for(timeout=10_000)  # the law, in words
+        before = browser.source_data(page, "transmissibility")
+        browser.drag_slider(page, "spring.vertical_stiffness", 40)
+        changed, drawn = browser.wait_until_changed(page, before["y"])
+        assert float(field.input_value()) > 180.0
+        assert 0 < changed <= drawn < GENEROUS
+    finally:
+        page.close()

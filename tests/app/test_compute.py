@@ -21,11 +21,13 @@ import pytest
 from qzs import ControllerParameters, IsolatorParameters, linearize, simulate, transmissibility
 from qzs.app import compute
 from qzs.app.compute import (LIMITS, MAX_STEPS, PAGE_DEFAULTS, PageRequest, SizeLimitError,
-                             compute_page, config_text, page_request, page_values, welch_length)
+                             compute_page, config_text, law_slider_range, page_parameters,
+                             page_request, page_values, welch_length)
 from qzs.errors import ExcitationError, ParameterError
 from qzs.iotools.config import load_config
 from qzs.model.excitation import build_excitation
-from qzs.model.registry import PARAMETERS
+from qzs.model.registry import PARAMETERS, law_parameters
+from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, TabulatedSpring, TanhSpring
 
 
 @pytest.fixture(scope="module")
@@ -281,3 +283,120 @@ def test_a_stepped_sines_locked_share_is_the_mean_over_its_frequencies(stepped_p
     assert np.ptp(locked) > 0.5
     assert stepped_page.locked_share["excitation"] == pytest.approx(np.mean(locked), rel=1e-12)
 
+
+
+# ---------------------------------------------------------------- a spring law (--spring)
+OBLIQUE = ObliqueSpringQZS()
+POLYNOMIAL = PolynomialSpring(coefficients=[62.78, -150.0, 0.0, -4000.0], center=-0.06)
+TABLE = TabulatedSpring(positions=np.linspace(-0.14, 0.02, 17),
+                        forces=62.78 - 150.0 * (np.linspace(-0.14, 0.02, 17) + 0.06))
+
+
+def test_a_page_request_with_a_law_changes_that_law():
+    """The spring.* values change the page's law, the tanh's fields stay the paper's, and
+    the request's values name the law's parameters and read back to the same request."""
+    request = page_request({"spring.vertical_stiffness": 150.0, "spring.preload": 60.0,
+                            "stiction_force": 6.0}, spring=OBLIQUE)
+    assert request.spring is OBLIQUE
+    assert request.isolator == IsolatorParameters(
+        stiction_force=6.0, spring=dataclasses.replace(OBLIQUE, vertical_stiffness=150.0,
+                                                       preload=60.0))
+    values = page_values(request)
+    assert "spring_force" not in values and "spring_shape" not in values
+    assert [n for n in values if n.startswith("spring.")] == list(law_parameters(OBLIQUE))
+    assert values["spring.vertical_stiffness"] == 150.0 and values["spring.preload"] == 60.0
+    assert page_request(values, spring=OBLIQUE) == request
+    # a polynomial's coefficients, by power
+    poly = page_request({"spring.c1": -120.0}, spring=POLYNOMIAL).isolator.spring
+    np.testing.assert_array_equal(poly.coefficients, [62.78, -120.0, 0.0, -4000.0])
+    # the page's start: the file's law as it is
+    assert page_request(spring=TABLE).isolator.spring == TABLE
+    assert page_parameters(TABLE) == tuple(n for n in compute.MODEL_PARAMETERS
+                                           if n not in compute.TANH_PARAMETERS)
+
+
+def test_a_tanh_law_sets_the_magsprings_sliders():
+    """A TanhSpring file is the MagSpring with its numbers: the page keeps spring_force and
+    spring_shape, starting at the file's values, and runs the tanh of the fields."""
+    request = page_request({"spring_shape": 60.0}, spring=TanhSpring(plateau=55.0, shape=70.0))
+    assert page_parameters(request.spring) == compute.MODEL_PARAMETERS
+    assert request.isolator == IsolatorParameters(spring_force=55.0, spring_shape=60.0)
+    assert page_values(request)["spring_force"] == 55.0
+
+
+@pytest.mark.parametrize("law, values, named", [
+    (OBLIQUE, {"spring.c3": 1.0}, "spring.c3"),            # not the oblique law's
+    (TABLE, {"spring.center": -0.05}, "spring.center"),    # a table has none
+    (OBLIQUE, {"spring_force": 50.0}, "spring_force"),     # the tanh's, with another law
+    (None, {"spring.preload": 60.0}, "spring.preload"),    # no law: the MagSpring's page
+    (OBLIQUE, {"spring.free_length": -0.1}, "spring.free_length"),  # the law's own check
+])
+def test_a_spring_value_the_law_refuses_is_a_page_error_naming_it(law, values, named):
+    with pytest.raises(ParameterError, match=f"`{named}`") as error:
+        page_request(values, spring=law)
+    assert named in error.value.options
+
+
+def test_a_request_whose_law_is_not_the_pages_is_refused():
+    with pytest.raises(ParameterError, match="'tanh' spring law .* 'oblique' law"):
+        PageRequest(isolator=IsolatorParameters(), controller=ControllerParameters(),
+                    spring=OBLIQUE)
+    with pytest.raises(ParameterError, match="`spring` must be a spring law"):
+        page_request(spring="oblique")
+
+
+def test_law_slider_ranges_lie_around_the_laws_values():
+    """[0, 2x] where the law keeps the value >= 0 (the stiffnesses), x +- 50 % else, a zero
+    coefficient +- m*g/h^k; each holds the law's value, its step a 1-2-5 number between a
+    500th and a 200th of the span, its ends whole steps."""
+    paper = IsolatorParameters()
+    weight, h = paper.mass * paper.gravity, paper.stroke_half
+    expected = {(OBLIQUE, "spring.vertical_stiffness"): (0.0, 400.0),
+                (OBLIQUE, "spring.oblique_stiffness"): (0.0, 400.0),
+                (OBLIQUE, "spring.free_length"): (0.09375, 0.28125),
+                (OBLIQUE, "spring.horizontal_distance"): (0.0625, 0.1875),
+                (OBLIQUE, "spring.center"): (-0.09, -0.03),
+                (OBLIQUE, "spring.preload"): (31.39, 94.17),
+                (POLYNOMIAL, "spring.c1"): (-225.0, -75.0),
+                (POLYNOMIAL, "spring.c2"): (-weight / h ** 2, weight / h ** 2),
+                (POLYNOMIAL, "spring.c3"): (-6000.0, -2000.0)}
+    for (law, name), (low, high) in expected.items():
+        start, end, step = law_slider_range(law, name)
+        span = high - low
+        assert span / 500 <= step <= span / 200, name
+        mantissa = step / 10 ** np.floor(np.log10(step))
+        assert min(abs(mantissa - m) for m in (1, 2, 5)) < 1e-9, name
+        assert start <= low < start + step and end - step < high <= end, name
+        value = page_values(page_request(spring=law))[name]
+        assert start <= value <= end, name
+    with pytest.raises(ParameterError, match="`name`"):
+        law_slider_range(TABLE, "spring.center")
+
+
+def test_the_exported_law_reproduces_the_pages_run(tmp_path):
+    """The TOML export with the law's slider values, read by load_config and run by
+    qzs.simulate (as `qzs simulate --config` does), gives the page's transmissibility bit
+    for bit; the linear overlay is the law's linearised loop, not the MagSpring's."""
+    request = page_request({"spring.vertical_stiffness": 180.0, "spring.oblique_stiffness": 210.0,
+                            "excitation.duration": 40.0, "excitation.f1": 10.0}, spring=OBLIQUE)
+    data = compute_page(request)
+    path = tmp_path / "page.toml"
+    path.write_text(config_text(request, data.dt), encoding="utf-8")
+    config = load_config(path)
+    assert config["isolator"] == request.isolator
+    assert config["isolator"].spring.vertical_stiffness == 180.0
+    options = dict(config["excitation"])
+    excitation = build_excitation(options.pop("kind"), options)
+    result = simulate(excitation, config["isolator"], config["controller"],
+                      dt=config["simulation"]["dt"],
+                      sample_rate=config["simulation"]["sample_rate"])
+    estimate = transmissibility(result.base_acceleration, result.payload_acceleration,
+                                request.sample_rate, fft_length=welch_length(len(result)))
+    np.testing.assert_array_equal(data.transmissibility_db,
+                                  20 * np.log10(estimate.magnitude[estimate.trusted]))
+    law_linear = linearize(request.isolator, request.controller).transmissibility(
+        data.linear_frequency)
+    np.testing.assert_allclose(data.linear_db, 20 * np.log10(law_linear), rtol=0, atol=1e-12)
+    tanh_linear = linearize(IsolatorParameters(), request.controller).transmissibility(
+        data.linear_frequency)
+    assert np.max(np.abs(data.linear_db - 20 * np.log10(tanh_linear))) > 0.1  # [dB]

@@ -4,6 +4,7 @@ The page is built outside a Bokeh server with a synchronous executor, so every r
 computed and delivered before the call returns; the browser tests (test_browser.py)
 drive the same page through Chromium.
 """
+import dataclasses
 import io
 from concurrent.futures import Future
 
@@ -211,3 +212,77 @@ def test_frequency_axis_is_log_and_legends_lie_outside_the_frames(page):
         plot = page.plots[name]
         assert not [r for r in plot.center if isinstance(r, Legend)], name
         assert [r for r in getattr(plot, side) if isinstance(r, Legend)], name
+
+
+# ---------------------------------------------------------------- a spring law (--spring)
+def law_page(spring):
+    return page_module.TuningPage(schedule=lambda f: f(), executor=NowExecutor(),
+                                  spring=spring)
+
+
+def sidebar_objects(page):
+    """Every pane and widget of the sidebar (the layout's first column), in order."""
+    return list(page.layout[0].objects)
+
+
+def test_a_page_with_a_law_has_its_sliders_and_not_the_magsprings(tmp_path):
+    """`qzs app --spring` with an oblique law: the law's six spring.* sliders (the law's
+    field described with the registry's unit, the ranges of law_slider_range, the law's values) where
+    spring_force and spring_shape were; a slider redraws the run of the changed law;
+    "Reset" returns to the file's law; the TOML export carries the slider values in its
+    [spring] table."""
+    from qzs.app.compute import law_slider_range, page_parameters
+    from qzs.model.registry import law_parameters
+    from qzs.model.springs import ObliqueSpringQZS
+
+    law = ObliqueSpringQZS()
+    page = law_page(law)
+    names = law_parameters(law)
+    assert "spring_force" not in page.widgets and "spring_shape" not in page.widgets
+    assert [n for n in page.widgets if n.startswith("spring")] == list(names)
+    shown = sidebar_objects(page)
+    for name in names:
+        widget = page.widgets[name]
+        field = {f.name: f for f in dataclasses.fields(law)}[name.split(".", 1)[1]]
+        assert label(widget) == f"{field.metadata['doc']} [{ALL_PARAMETERS[name].unit}]"
+        assert (widget.start, widget.end, widget.step) == law_slider_range(law, name)
+        assert widget.value == getattr(law, name.split(".", 1)[1])
+        assert widget in shown
+    assert page.law_line in shown and law.describe() in page.law_line.object
+    assert page.data.request == page_request(spring=law)
+    assert label(page.reset_button) == "Reset"
+    before = np.array(page.sources["transmissibility"].data["y"])
+    linear = np.array(page.sources["linear"].data["y"])
+    request = set_value(page, "spring.vertical_stiffness", 120.0)
+    assert page.data.request == request
+    assert request.isolator.spring == ObliqueSpringQZS(vertical_stiffness=120.0)
+    assert "k_v = 120 N/m" in page.law_line.object
+    assert not np.array_equal(before, page.sources["transmissibility"].data["y"])
+    assert not np.array_equal(linear, page.sources["linear"].data["y"])  # the law's overlay
+    path = tmp_path / "page.toml"
+    path.write_text(page._toml_file().getvalue(), encoding="utf-8")
+    assert "[spring]" in path.read_text(encoding="utf-8")
+    assert load_config(path)["isolator"] == request.isolator
+    page.reset()
+    assert page.values() == page_values(page_request(spring=law))
+    assert page.data.request.isolator.spring == law
+    assert list(page.values()) == [*page_parameters(law), *list(page.values())[
+        len(page_parameters(law)):]]
+
+
+def test_a_table_law_has_no_slider_and_a_line_describing_it():
+    from qzs.model.springs import TabulatedSpring
+
+    z = np.linspace(-0.14, 0.02, 9)
+    law = TabulatedSpring(positions=z, forces=62.78 - 150.0 * (z + 0.06))
+    page = law_page(law)
+    assert not [n for n in page.widgets if n.startswith("spring")]
+    assert page.law_line in sidebar_objects(page)
+    assert page.law_line.object == f"spring law (--spring): {law.describe()}"
+    assert page.data.request.isolator.spring == law and not page.alert.visible
+
+
+def test_the_magsprings_page_has_no_law_line(page):
+    assert page.law_line not in sidebar_objects(page)
+    assert label(page.reset_button) == "Reset to paper"
+    assert {"spring_force", "spring_shape"} <= set(page.widgets)

@@ -169,3 +169,33 @@ def test_the_warm_up_compiles_every_kernel_a_slider_can_reach():
         grown = {name: (before.get(name, 0), count) for name, count in after.items()
                  if count > before.get(name, 0)}
         assert not grown, f"{values} compiled after the warm-up: {grown}"
+
+
+def test_a_spring_that_is_no_law_fails_before_the_warm_up(monkeypatch):
+    import qzs.app.server as server
+    from qzs.errors import ParameterError
+
+    monkeypatch.setattr(server, "warm_up", lambda **kw: pytest.fail("warmed up before the check"))
+    monkeypatch.setattr(server, "require", lambda *args: None)
+    with pytest.raises(ParameterError, match="`spring` must be a spring law"):
+        server.serve(port=0, open_browser=False, spring="oblique")
+
+
+def test_the_warm_up_runs_the_pages_law(monkeypatch):
+    """`qzs app --spring`: the warm-up runs the page's own runs, with its law (a law is data
+    to the kernels the MagSpring's warm-up compiles, so this is what checks the law on the
+    page's runs before the server listens)."""
+    from qzs.app import compute
+    from qzs.app.server import warm_up
+    from qzs.model.springs import ObliqueSpringQZS
+
+    law, laws = ObliqueSpringQZS(vertical_stiffness=180.0), []
+    real = compute.compute_page
+
+    def recorded(request):
+        laws.append(request.isolator.spring)
+        return real(request)
+
+    monkeypatch.setattr(compute, "compute_page", recorded)
+    warm_up(stream=open("/dev/null", "w"), spring=law)
+    assert laws == [law] * 3

@@ -56,7 +56,9 @@ class LinearModel:
     stiffness : float
         Total stiffness at the setpoint, spring + Kp [N/m].
     undamped_natural_frequency : float
-        ``sqrt(stiffness/m)/(2*pi)`` [Hz]: about 0.08 Hz passive, 0.45 Hz with Kp = 50 N/m.
+        ``sqrt(stiffness/m)/(2*pi)`` [Hz]: about 0.08 Hz passive, 0.45 Hz with Kp = 50 N/m;
+        NaN where the stiffness is negative (a spring law's negative stiffness outweighs Kp:
+        the loop has no undamped oscillation, its static equilibrium is unstable).
     natural_frequency : float
         Natural frequency of the dominant (least-damped oscillatory) pole pair [Hz].
     damping_ratio : float
@@ -159,7 +161,8 @@ def linearize(isolator: IsolatorParameters | None = None,
     dominant = dominant[np.argmin(np.abs(dominant))] if dominant.size else 0j
     wn = abs(dominant)
     zeta = -dominant.real / wn if wn > 0 else 1.0
-    undamped = np.sqrt((k + kp) / m) / (2 * np.pi)
+    # a spring law's negative stiffness beyond Kp: no undamped oscillation (NaN)
+    undamped = np.sqrt((k + kp) / m) / (2 * np.pi) if k + kp >= 0 else np.nan
     return LinearModel(transfer, state_space, k + kp, float(undamped), wn / (2 * np.pi),
                        float(zeta), poles)
 

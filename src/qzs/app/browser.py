@@ -80,7 +80,7 @@ def free_port():
 
 
 @contextlib.contextmanager
-def start_server(port=None, timeout=600.0, log=None):
+def start_server(port=None, timeout=600.0, log=None, options=()):
     """Run ``qzs app --no-browser --port PORT`` as a child process until the block ends.
 
     Parameters
@@ -91,6 +91,8 @@ def start_server(port=None, timeout=600.0, log=None):
         Seconds to wait for the page to answer (the first start compiles the kernels).
     log : file, optional
         Where the server's output goes (default a temporary file, shown if it fails).
+    options : sequence of str
+        More options of ``qzs app`` (``("--spring", "FILE.toml")``).
 
     Yields
     ------
@@ -101,7 +103,8 @@ def start_server(port=None, timeout=600.0, log=None):
     url = f"http://127.0.0.1:{port}/"
     output = log or tempfile.TemporaryFile(mode="w+")
     process = subprocess.Popen([sys.executable, "-m", "qzs", "app", "--no-browser", "--port",
-                                str(port)], stdout=output, stderr=subprocess.STDOUT)
+                                str(port), *options], stdout=output,
+                               stderr=subprocess.STDOUT)
     try:
         deadline = time.monotonic() + timeout
         while True:

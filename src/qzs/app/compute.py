@@ -32,18 +32,23 @@ from qzs.errors import ParameterError, SizeLimitError
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import build_excitation
 from qzs.model.isolator import IsolatorParameters
-from qzs.model.registry import (ALL_PARAMETERS, parameter_info, parameter_value,
-                                update_parameters)
+from qzs.model.registry import (ALL_PARAMETERS, SPRING_PARAMETERS, law_parameters,
+                                parameter_info, parameter_value, update_parameters)
+from qzs.model.springs import SpringLaw, TanhSpring
 
 __all__ = ["PageRequest", "PageData", "SizeLimitError", "page_request", "compute_page",
-           "config_text", "resolve_page_run", "page_values", "LIMITS", "PAGE_DEFAULTS",
-           "MODEL_PARAMETERS", "COMPENSATION", "EXCITATION_KINDS", "SAMPLE_RATES", "CONTROLLER_RATES",
+           "config_text", "resolve_page_run", "page_values", "page_parameters",
+           "law_slider_range", "LIMITS", "PAGE_DEFAULTS", "MODEL_PARAMETERS", "COMPENSATION",
+           "EXCITATION_KINDS", "SAMPLE_RATES", "CONTROLLER_RATES",
            "MAX_STEPS", "TRACE_POINTS"]
 
 #: The model parameters the page sets (registry names), in the order of its panels.
 MODEL_PARAMETERS = ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping",
                     "mass", "spring_force", "spring_shape", "pi_kp", "pi_ki", "damping_gain",
                     "velocity_highpass", "controller_rate", "compensation.fraction")
+#: The MagSpring's tanh parameters among :data:`MODEL_PARAMETERS`: a page started with
+#: another spring law (``qzs app --spring``) shows that law's ``spring.*`` parameters instead.
+TANH_PARAMETERS = ("spring_force", "spring_shape")
 #: The page's friction compensation: a fraction of the friction law [0, 1.5]; 0 (its
 #: default) is no :class:`~qzs.model.controller.FrictionCompensation` block.
 COMPENSATION = "compensation.fraction"
@@ -89,6 +94,128 @@ TRACE_POINTS = 4000
 LINEAR_POINTS = 400
 
 
+def _other_law(spring):
+    """``spring`` unless it is None or the MagSpring's tanh (whose sliders are the fields');
+    anything but a law is refused."""
+    if spring is not None and not isinstance(spring, SpringLaw):
+        raise ParameterError(f"`spring` must be a spring law (qzs.model.springs) or None for "
+                             f"the MagSpring, got {type(spring).__name__}.", ("spring",))
+    return None if isinstance(spring, TanhSpring) else spring
+
+
+def page_parameters(spring=None):
+    """The model parameters of a page started with the spring law ``spring``, in panel order.
+
+    Parameters
+    ----------
+    spring : SpringLaw, optional
+        The page's spring law (``qzs app --spring``); None or a
+        :class:`~qzs.model.springs.TanhSpring`: the MagSpring, whose parameters are
+        ``spring_force`` and ``spring_shape``.
+
+    Returns
+    -------
+    tuple of str
+        :data:`MODEL_PARAMETERS`, the tanh's two replaced by the law's ``spring.*``
+        parameters (:func:`qzs.model.registry.law_parameters`; none for a table).
+    """
+    law = _other_law(spring)
+    if law is None:
+        return MODEL_PARAMETERS
+    names = []
+    for name in MODEL_PARAMETERS:
+        if name == TANH_PARAMETERS[0]:
+            names.extend(law_parameters(law))
+        elif name not in TANH_PARAMETERS:
+            names.append(name)
+    return tuple(names)
+
+
+def _base_isolator(spring):
+    """The paper's isolator with the page's spring law: a tanh's numbers in its fields (so
+    its sliders are the MagSpring's), another law as ``spring``."""
+    law = _other_law(spring)
+    if law is not None:
+        return IsolatorParameters(spring=law)
+    if spring is None:
+        return IsolatorParameters()
+    return IsolatorParameters(spring_force=spring.plateau, spring_shape=spring.shape)
+
+
+def _unit_scale(unit, isolator):
+    """What a zero ``spring.*`` value's slider spans in ``unit``: the payload's weight m*g
+    [N], m*g/h^k [N/m^k] (h the half-stroke), h [m]; None for another unit."""
+    weight, h = isolator.mass * isolator.gravity, isolator.stroke_half
+    if unit == "m":
+        return h
+    if unit == "N":
+        return weight
+    if unit.startswith("N/m"):
+        power = unit[len("N/m"):]
+        return weight / h ** (int(power[1:]) if power.startswith("^") else 1)
+    return None
+
+
+def _accepts(isolator, name, value):
+    try:
+        update_parameters(isolator, ControllerParameters(), {name: value})
+    except ParameterError:
+        return False
+    return True
+
+
+def law_slider_range(spring, name):
+    """The slider of a law's parameter ``name`` around the law's value x: (start, end, step).
+
+    ``[0, 2x]`` where the law keeps the parameter >= 0 (it takes 0 and refuses a negative
+    value: the oblique spring's stiffnesses); ``x +- 50 %`` of ``|x|`` for any other (lengths
+    kept > 0, the centre, the preload, a polynomial's coefficients). A zero value has no
+    scale of its own: it spans ``+-S`` (``[0, S]`` where kept >= 0), ``S`` the scale of the
+    registry's unit on the paper's isolator: its weight ``m*g`` for [N], ``m*g/h^k`` for
+    [N/m^k] (``h`` the half-stroke), ``h`` for [m]. The step is the 1-2-5 number at most a
+    200th of the span; the ends are whole steps around it.
+
+    Parameters
+    ----------
+    spring : SpringLaw
+        The page's law (not the tanh).
+    name : str
+        One of its ``spring.*`` parameters (:func:`qzs.model.registry.law_parameters`).
+
+    Returns
+    -------
+    tuple of float
+        Start, end and step in the registry's unit.
+
+    Raises
+    ------
+    ParameterError
+        ``name`` is no parameter of ``spring``.
+    """
+    isolator = _base_isolator(spring)
+    if name not in law_parameters(isolator.spring):
+        raise ParameterError(f"`name` ({name!r}) is no parameter of the spring law "
+                             f"{spring.describe()}; its parameters are "
+                             f"{', '.join(law_parameters(isolator.spring)) or 'none'}.",
+                             ("name",))
+    value = float(parameter_value(isolator, ControllerParameters(), name))
+    half = abs(value) / 2 if value != 0.0 else (
+        _unit_scale(SPRING_PARAMETERS[name].unit, isolator) or 1.0)
+    kept = _accepts(isolator, name, 0.0) and not _accepts(isolator, name, -half)
+    if value == 0.0:
+        low, high = (0.0, half) if kept else (-half, half)
+    elif kept and value > 0.0:
+        low, high = 0.0, 2 * value
+    else:
+        low, high = value - half, value + half
+    span = high - low
+    exponent = math.floor(math.log10(span / 200))
+    step = max(m * 10.0 ** exponent for m in (1, 2, 5) if m * 10.0 ** exponent <= span / 200)
+    digits = max(0, -exponent)  # a whole step's decimals: no 0.09000000000000001
+    return (round(math.floor(low / step) * step, digits),
+            round(math.ceil(high / step) * step, digits), step)
+
+
 def _bounded(name, value):
     low, high, unit = LIMITS[name]
     if not low <= value <= high:
@@ -124,12 +251,16 @@ class PageRequest:
         Simulated time of that sine run [s] (2 s fade-in included).
     sample_rate : float
         Output rate of the runs [Hz], one of :data:`SAMPLE_RATES`.
+    spring : SpringLaw, optional
+        The spring law the page started with (``qzs app --spring``), before its sliders:
+        it names the page's spring parameters (:func:`page_parameters`); ``isolator.spring``
+        is this law with the sliders' values. None: the MagSpring.
 
     Raises
     ------
     ParameterError
         An invalid value (the API's own checks); :class:`SizeLimitError` for a value
-        outside :data:`LIMITS`.
+        outside :data:`LIMITS`; an isolator whose spring law is not of ``spring``'s kind.
     """
 
     isolator: IsolatorParameters
@@ -143,11 +274,20 @@ class PageRequest:
     sine_frequency: float = PAGE_DEFAULTS["sine.frequency"]
     sine_duration: float = PAGE_DEFAULTS["sine.duration"]
     sample_rate: float = PAGE_DEFAULTS["sample_rate"]
+    spring: SpringLaw | None = None
 
     def __post_init__(self):
         if not isinstance(self.isolator, IsolatorParameters):
             raise ParameterError(f"`isolator` must be an IsolatorParameters, got "
                                  f"{type(self.isolator).__name__}.")
+        base = _base_isolator(self.spring)  # refuses a `spring` that is no law
+        if type(self.isolator.spring) is not type(base.spring):
+            kinds = [getattr(law, "kind", "tanh") for law in (self.isolator.spring, base.spring)]
+            raise ParameterError(
+                f"`isolator` has a {kinds[0]!r} spring law and the page's `spring` is a "
+                f"{kinds[1]!r} law: the page's sliders set the parameters of the law it "
+                "started with; give an isolator with a law of that kind.",
+                ("isolator", "spring"))
         if not isinstance(self.controller, ControllerParameters):
             raise ParameterError(f"`controller` must be a ControllerParameters, got "
                                  f"{type(self.controller).__name__}.")
@@ -228,7 +368,7 @@ def page_values(request=None):
     """
     request = request or page_request()
     values = {name: parameter_value(request.isolator, request.controller, name, 0.0)
-              for name in MODEL_PARAMETERS}
+              for name in page_parameters(request.spring)}
     values.update({"excitation.kind": request.excitation,
                    "excitation.amplitude": request.amplitude,
                    "excitation.f0": request.band[0], "excitation.f1": request.band[1],
@@ -246,7 +386,7 @@ _REQUEST_FIELDS = {"excitation.kind": "excitation", "excitation.amplitude": "amp
                    "sample_rate": "sample_rate"}
 
 
-def page_request(values=None):
+def page_request(values=None, spring=None):
     """A validated :class:`PageRequest` from the page's values.
 
     Parameters
@@ -254,11 +394,17 @@ def page_request(values=None):
     values : dict, optional
         Registry names of model parameters (``stiction_force`` [N], ``pi_kp`` [N/m], ...;
         see ``qzs params``; ``compensation.fraction`` [-] adds a friction compensation,
-        0 none) and the page's own settings: ``excitation.kind`` (``chirp`` or
+        0 none; with a ``spring`` law its ``spring.*`` parameters instead of
+        ``spring_force`` and ``spring_shape``: :func:`page_parameters`) and the page's own
+        settings: ``excitation.kind`` (``chirp`` or
         ``stepped``), ``excitation.amplitude`` [m], ``excitation.f0``, ``excitation.f1``
         [Hz], ``excitation.duration`` [s], ``frequency_count``, ``sine.frequency`` [Hz],
         ``sine.duration`` [s], ``sample_rate`` [Hz]. Missing ones take the paper's
         defaults and :data:`PAGE_DEFAULTS`.
+    spring : SpringLaw, optional
+        The page's spring law (``qzs app --spring``), to which the ``spring.*`` values
+        apply; None: the MagSpring. A :class:`~qzs.model.springs.TanhSpring` gives its
+        numbers to ``spring_force`` and ``spring_shape``.
 
     Returns
     -------
@@ -269,13 +415,22 @@ def page_request(values=None):
     ParameterError
         An unknown name, or an invalid value: the message of the API's own validation
         (:class:`qzs.IsolatorParameters`, :class:`qzs.Chirp`, ...), or a
-        :class:`SizeLimitError`.
+        :class:`SizeLimitError`; a ``spring.*`` name the law has not, or the tanh's
+        ``spring_force``, ``spring_shape`` with another law (the error names it).
     """
     values = dict(values or {})
+    names = page_parameters(spring)
     model = {name: values.pop(name) for name in list(values) if name in ALL_PARAMETERS}
     if not isinstance(model.get(COMPENSATION), str) and model.get(COMPENSATION) == 0:
         del model[COMPENSATION]  # no compensation: no block (the kernels of PI + damping)
-    isolator, controller = update_parameters(IsolatorParameters(), ControllerParameters(),
+    for name in TANH_PARAMETERS:
+        if name in model and name not in names:
+            raise ParameterError(
+                f"`{name}` is a parameter of the MagSpring's tanh, and the page's spring is "
+                f"the {spring.kind!r} law it was started with (qzs app --spring); its "
+                f"parameters are {', '.join(law_parameters(spring)) or 'none (a table)'}.",
+                (name,))
+    isolator, controller = update_parameters(_base_isolator(spring), ControllerParameters(),
                                              model)
     band = (values.pop("excitation.f0", parameter_info("excitation.f0", "chirp").default),
             values.pop("excitation.f1", parameter_info("excitation.f1", "chirp").default))
@@ -284,10 +439,11 @@ def page_request(values=None):
         if key not in _REQUEST_FIELDS:
             others = ["excitation.f0", "excitation.f1", *_REQUEST_FIELDS]
             raise ParameterError(f"unknown page setting {key!r}; the page takes the model "
-                                 f"parameters ({', '.join(MODEL_PARAMETERS)}) and "
+                                 f"parameters ({', '.join(names)}) and "
                                  f"{', '.join(others)}.")
         options[_REQUEST_FIELDS[key]] = values.pop(key)
-    return PageRequest(isolator=isolator, controller=controller, band=band, **options)
+    return PageRequest(isolator=isolator, controller=controller, band=band, spring=spring,
+                       **options)
 
 
 # ---------------------------------------------------------------- the step

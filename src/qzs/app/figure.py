@@ -37,9 +37,10 @@ def describe_request(request):
     else:
         run = (f"stepped sine {request.amplitude * _MM:g} mm, {request.frequency_count} "
                f"frequencies, {request.band[0]:g}-{request.band[1]:g} Hz")
+    law = "" if isolator.spring is None else f"; {isolator.spring.kind} spring law"
     return (f"Fs = {isolator.stiction_force:g} N, Fc = {isolator.coulomb_force:g} N, "
             f"Kp = {controller.pi_kp:g} N/m, Ki = {controller.pi_ki:g} N/(m s), "
-            f"Kd = {controller.damping_gain:g} N s/m; {run}")
+            f"Kd = {controller.damping_gain:g} N s/m; {run}{law}")
 
 
 def page_figure(data, pinned=()):

@@ -11,6 +11,7 @@ Panel is imported here, never by the layers below; :func:`qzs.app.server.serve` 
 that it is installed before this module is imported.
 """
 import asyncio
+import dataclasses
 import io
 import logging
 import sys
@@ -24,13 +25,13 @@ from bokeh.models import (ColumnDataSource, FactorRange, Legend, LogTicker, Nume
 from bokeh.plotting import figure
 
 from qzs._format import markdown_table, number
-from qzs.app.compute import (CONTROLLER_RATES, LIMITS, MODEL_PARAMETERS, SAMPLE_RATES,
-                             compute_page, config_text, page_request, page_values)
+from qzs.app.compute import (CONTROLLER_RATES, LIMITS, SAMPLE_RATES, compute_page, config_text,
+                             law_slider_range, page_parameters, page_request, page_values)
 from qzs.app.figure import PIN_COLORS, describe_request, figure_png
 from qzs.app.platform import PLATFORM_PARAMETERS, compute_platform
 from qzs.app.updates import LatestOnly
 from qzs.errors import DataError, ParameterError, SimulationError
-from qzs.model.registry import ALL_PARAMETERS, PARAMETERS, parameter_info
+from qzs.model.registry import ALL_PARAMETERS, PARAMETERS, SPRING_PARAMETERS, parameter_info
 from qzs.viz.figures import frequency_limits
 
 __all__ = ["TuningPage", "PlatformTab", "build_page", "css_class", "SLIDERS", "SOURCE_NAMES",
@@ -90,7 +91,12 @@ _WIDGET_WIDTH = 330
 _EXPECTED = (ParameterError, SimulationError, DataError)
 
 
-def _label(name):
+def _label(name, spring=None):
+    """A setting's label, its unit in brackets; a ``spring.*`` parameter described as
+    ``spring``'s own field (the registry's ``spring.center`` speaks of every law)."""
+    fields = {f"spring.{f.name}": f for f in dataclasses.fields(spring)} if spring else {}
+    if name in fields:
+        return f"{fields[name].metadata['doc']} [{ALL_PARAMETERS[name].unit}]"
     if name in ALL_PARAMETERS:
         info = ALL_PARAMETERS[name]
         return f"{info.doc} [{info.unit}]"
@@ -179,9 +185,16 @@ class TuningPage:
         the current Bokeh document's ``add_next_tick_callback``, called on that loop.
     executor : concurrent.futures.Executor, optional
         Where computations run; default :data:`EXECUTOR`.
+    spring : SpringLaw, optional
+        The spring law the page starts with (``qzs app --spring``): its ``spring.*``
+        parameters get the sliders of the MagSpring's ``spring_force`` and
+        ``spring_shape`` (ranges :func:`qzs.app.compute.law_slider_range`; a table has
+        none, a line describes it), and "Reset" returns to it. None: the MagSpring.
     """
 
-    def __init__(self, *, schedule=None, executor=None):
+    def __init__(self, *, schedule=None, executor=None, spring=None):
+        self.spring = spring
+        self.start = page_request(spring=spring)  # what "Reset" returns to
         self.document = pn.state.curdoc
         self._loop = _running_loop() if self.document is not None else None
         self.data = None
@@ -198,6 +211,9 @@ class TuningPage:
                                    css_classes=["qzs-error"])
         self.summary = pn.pane.Markdown("", sizing_mode="stretch_width",
                                         css_classes=["qzs-summary"])
+        # the law computed, in words (read-only: a table's law has no slider)
+        self.law_line = pn.pane.Markdown(self._law_text(self.start), width=_WIDGET_WIDTH,
+                                         margin=(0, 5), css_classes=["qzs-spring-law"])
         self.updates = LatestOnly(compute_page, self._deliver,
                                   executor=executor or EXECUTOR,
                                   schedule=schedule or self._schedule, busy=self._busy)
@@ -211,17 +227,19 @@ class TuningPage:
 
     # ------------------------------------------------------------ widgets
     def _make_widgets(self):
-        values = page_values()
+        values = page_values(self.start)
         widgets = {}
-        for name in MODEL_PARAMETERS:
+        for name in page_parameters(self.spring):
             if name == "controller_rate":
                 widgets[name] = _named(
                     pn.widgets.DiscreteSlider, _label(name), options=list(CONTROLLER_RATES),
                     value=values[name], width=_WIDGET_WIDTH)
                 continue
-            start, end, step = SLIDERS[name]
+            start, end, step = (law_slider_range(self.spring, name)
+                                if name in SPRING_PARAMETERS else SLIDERS[name])
             widgets[name] = _named(
-                pn.widgets.EditableFloatSlider, _label(name), start=start, end=end, step=step,
+                pn.widgets.EditableFloatSlider, _label(name, self.start.isolator.spring),
+                start=start, end=end, step=step,
                 value=float(values[name]), width=_WIDGET_WIDTH)
         widgets["excitation.kind"] = _named(
             pn.widgets.RadioButtonGroup, "excitation",
@@ -342,8 +360,8 @@ class TuningPage:
         w = self.widgets
         self.pin_button = _named(pn.widgets.Button, "Pin curve", style="primary", width=95)
         self.clear_button = _named(pn.widgets.Button, "Clear pins", width=95)
-        self.reset_button = _named(pn.widgets.Button, "Reset to paper", style="warning",
-                                   width=110)
+        self.reset_button = _named(pn.widgets.Button, "Reset to paper" if self.start ==
+                                   page_request() else "Reset", style="warning", width=110)
         self.pin_button.on_click(lambda event: self.pin())
         self.clear_button.on_click(lambda event: self.clear_pins())
         self.reset_button.on_click(lambda event: self.reset())
@@ -355,9 +373,14 @@ class TuningPage:
             callback=self._png_file, filename="qzs-figure.png", width=145)
         sidebar = [pn.pane.Markdown("## qzs tuning page", margin=(0, 5)),
                    pn.Row(self.spinner, self.status), self.alert]
+        shown = page_parameters(self.spring)
         for title, names in _GROUPS:
             sidebar.append(pn.pane.Markdown(f"### {title}", margin=(0, 5)))
-            sidebar.extend(w[name] for name in names)
+            # the MagSpring's two, or the page's law's spring.* parameters
+            sidebar.extend(w[name] for name in shown
+                           if name in names or name in SPRING_PARAMETERS and "mass" in names)
+            if "mass" in names and self.start.isolator.spring is not None:
+                sidebar.append(self.law_line)
         sidebar.append(pn.pane.Markdown("### Excitation", margin=(0, 5)))
         sidebar.extend(w[name] for name in ("excitation.kind", "excitation.amplitude", "band",
                                             "excitation.duration", "frequency_count",
@@ -430,7 +453,7 @@ class TuningPage:
         (its result would be for another setting); None is returned then.
         """
         try:
-            request = page_request(self.values())
+            request = page_request(self.values(), spring=self.spring)
         except ParameterError as error:
             self.updates.cancel()
             self._show_error(error)
@@ -462,8 +485,14 @@ class TuningPage:
         self._draw(outcome)
         self.status.object = f"ready (computed in {outcome.elapsed:.2f} s)"
 
+    @staticmethod
+    def _law_text(request):
+        law = request.isolator.spring
+        return "" if law is None else f"spring law (--spring): {law.describe()}"
+
     def _draw(self, data):
         source, request = self.sources, data.request
+        self.law_line.object = self._law_text(request)
         # a log axis draws no bin at or below 0 Hz (the chirp's trusted bins and the
         # linear curve have none; the mask keeps it so)
         shown, linear = data.frequency > 0, data.linear_frequency > 0
@@ -544,8 +573,9 @@ class TuningPage:
             "color": list(PIN_COLORS[:len(self.pins)])}
 
     def reset(self):
-        """Every widget back to the paper's defaults (and the page's), one computation."""
-        values = page_values()
+        """Every widget back to the paper's defaults (and the page's; the spring law's to
+        the page's law), one computation."""
+        values = page_values(self.start)
         self._resetting = True
         try:
             for name, widget in self.widgets.items():
@@ -559,7 +589,7 @@ class TuningPage:
 
     def _toml_file(self):
         try:
-            request = page_request(self.values())
+            request = page_request(self.values(), spring=self.spring)
         except ParameterError as error:
             self._show_error(error)
             return io.StringIO(f"# not exported: {error}\n")
@@ -678,15 +708,20 @@ class PlatformTab:
         self.status.object = "ready"
 
 
-def build_page():
+def build_page(spring=None):
     """A fresh page for one browser session (what the server serves at ``/``): the single
     axis, and the six-axis platform in a second tab.
+
+    Parameters
+    ----------
+    spring : SpringLaw, optional
+        The single axis's spring law (``qzs app --spring``); None: the MagSpring.
 
     Returns
     -------
     panel.viewable.Viewable
     """
-    page = TuningPage()
+    page = TuningPage(spring=spring)
     platform = PlatformTab(schedule=page._schedule)
     tabs = pn.Tabs(("Single axis", page.layout), ("Six-axis platform", platform.layout),
                    dynamic=False, sizing_mode="stretch_width")

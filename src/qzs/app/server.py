@@ -8,6 +8,7 @@ from the address it serves, and reads and writes no file: exports are browser do
 (docs/app.md).
 """
 import errno
+import functools
 import ipaddress
 import signal
 import socket
@@ -141,7 +142,7 @@ def _bind(host, port):
         return probe.getsockname()[1]
 
 
-def warm_up(stream=None):
+def warm_up(stream=None, spring=None):
     """Compile (or load) the kernels and run each computation of the page once: the chirp,
     the stepped sine and a run with the compensation slider's block, so that no setting of
     the page compiles a kernel afterwards.
@@ -150,6 +151,8 @@ def warm_up(stream=None):
     ----------
     stream : file, optional
         Where to say what it does (default stderr).
+    spring : SpringLaw, optional
+        The page's spring law (``qzs app --spring``): the runs take it, as the page's do.
 
     Returns
     -------
@@ -159,23 +162,24 @@ def warm_up(stream=None):
     from qzs.app.compute import compute_page, page_request
     from qzs.app.figure import figure_png
 
+    request = functools.partial(page_request, spring=spring)
     stream = stream or sys.stderr
     start = time.perf_counter()
     print("qzs app: warming the kernels (a few seconds; the first time they compile, and "
           "`qzs: compiling the kernels once` says so) ...", file=stream, flush=True)
-    data = compute_page(page_request())
-    compute_page(page_request({"excitation.kind": "stepped", "frequency_count": 2}))
+    data = compute_page(request())
+    compute_page(request({"excitation.kind": "stepped", "frequency_count": 2}))
     # the compensation slider adds a block: the blocks kernel, compiled here rather than in
     # the first session that moves it (the page has one computing thread for every session)
-    compute_page(page_request({"compensation.fraction": 0.5, "excitation.duration": 10.0,
-                              "excitation.f1": 2.0}))
+    compute_page(request({"compensation.fraction": 0.5, "excitation.duration": 10.0,
+                          "excitation.f1": 2.0}))
     figure_png(data)
     elapsed = time.perf_counter() - start
     print(f"qzs app: warm in {elapsed:.1f} s", file=stream, flush=True)
     return elapsed
 
 
-def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
+def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True, spring=None):
     """Serve the tuning page until Ctrl-C (docs/app.md).
 
     Parameters
@@ -190,6 +194,10 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
         Open the page in the default browser once the server listens.
     warm : bool
         Run :func:`warm_up` before listening.
+    spring : SpringLaw, optional
+        The page's spring law (``qzs app --spring FILE.toml``): its ``spring.*`` parameters
+        get sliders instead of the MagSpring's ``spring_force`` and ``spring_shape``
+        (:class:`qzs.app.page.TuningPage`); checked before the warm-up. None: the MagSpring.
 
     Raises
     ------
@@ -198,7 +206,7 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
     MissingDependencyError
         Panel is not installed (``pip install "qzs[app]"``).
     ParameterError
-        A port outside 0-65535.
+        A port outside 0-65535; a ``spring`` that is no spring law.
     AddressError
         A busy port, or a host that is not this machine's (:func:`check_address`), before
         the warm-up.
@@ -207,6 +215,10 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
         port = integer("port", port, 0, maximum=65535, fix="e.g. 5006")
     port = check_address(host, port)  # a busy port, an address not this machine's: fail now
     require("panel", "the tuning page (qzs app)")
+    if spring is not None:
+        from qzs.app.compute import page_request
+
+        page_request(spring=spring)  # the law checked once, before the warm-up
     if is_loopback(host):
         origins = [f"{name}:{port}" for name in ("127.0.0.1", "localhost")]
     else:
@@ -217,11 +229,17 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
         origins = ["*"] if host in _WILDCARDS else [f"{host}:{port}", f"localhost:{port}",
                                                      f"127.0.0.1:{port}"]
     if warm:
-        warm_up()
+        if spring is None:
+            warm_up()
+        else:
+            warm_up(spring=spring)
 
     import panel as pn
 
     from qzs.app.page import build_page
+
+    def page():  # a function: Panel serves a functools.partial as its text
+        return build_page(spring=spring)
 
     pn.extension(notifications=False)
     shown = f"[{host}]" if ":" in host else host
@@ -229,7 +247,7 @@ def serve(*, port=None, host=DEFAULT_HOST, open_browser=True, warm=True):
           flush=True)
     previous = signal.getsignal(signal.SIGINT)
     try:
-        pn.serve(build_page, port=port, address=host, websocket_origin=origins,
+        pn.serve(page, port=port, address=host, websocket_origin=origins,
                  show=open_browser, title="qzs tuning page", verbose=False, start=True,
                  threaded=False, admin=False)
     finally:  # Panel stops the server on SIGINT with a handler of its own

@@ -4,6 +4,8 @@ It parses and delegates to :func:`qzs.app.server.serve`; it computes nothing.
 """
 import argparse
 
+from qzs.cli.common import add_spring_option
+
 __all__ = ["add_parser", "run"]
 
 
@@ -49,6 +51,7 @@ def add_parser(subparsers):
                              "address is served with a warning: the page has no login)")
     parser.add_argument("--no-browser", action="store_true",
                         help="do not open the page in the default browser")
+    add_spring_option(parser)
     return parser
 
 
@@ -68,4 +71,9 @@ def run(args):
     """
     from qzs.app.server import serve
 
-    return serve(port=args.port, host=args.host, open_browser=not args.no_browser)
+    options = {}
+    if args.spring:  # the page's sliders are then this law's spring.* parameters
+        from qzs.iotools.config import load_spring
+
+        options["spring"] = load_spring(args.spring)
+    return serve(port=args.port, host=args.host, open_browser=not args.no_browser, **options)
