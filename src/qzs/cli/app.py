@@ -51,7 +51,7 @@ def add_parser(subparsers):
                              "address is served with a warning: the page has no login)")
     parser.add_argument("--no-browser", action="store_true",
                         help="do not open the page in the default browser")
-    add_spring_option(parser)
+    add_spring_option(parser, config=False)
     return parser
 
 

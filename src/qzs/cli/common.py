@@ -126,7 +126,7 @@ def add_controller_option(parser):
                              "[controller.linear]); replaces --config's controller")
 
 
-def add_spring_option(parser):
+def add_spring_option(parser, config=True):
     """Add ``--spring FILE.toml`` to ``parser``: a spring file
     (:func:`qzs.iotools.config.load_spring`, a ``[spring]`` table) whose law replaces
     ``--config``'s; ``--set`` applies after it.
@@ -135,11 +135,15 @@ def add_spring_option(parser):
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser.
+    config : bool
+        Whether the subcommand takes ``--config`` too (its help then says which wins).
     """
     parser.add_argument("--spring", metavar="FILE.toml",
                         help="spring file: a [spring] table (law = \"tanh\", \"oblique\", "
                              "\"polynomial\" or \"table\" and its parameters, a table's "
-                             "curve as csv = \"FILE.csv\"); replaces --config's spring")
+                             "curve as csv = \"FILE.csv\")"
+                             + ("; replaces --config's spring" if config else
+                                "; default the MagSpring's tanh"))
 
 
 def add_json_option(parser, help_text=None):

@@ -39,7 +39,7 @@ def add_parsers(subparsers):
         cmd.add_argument("--workers", type=integer_at_least(1), metavar="N",
                          help="worker processes (default: all cores)")
         add_frequency_axis_option(cmd)
-        add_spring_option(cmd)
+        add_spring_option(cmd, config=False)
         if name == "paper":
             out = dict(metavar="DIR", default="results/paper",
                        help="output folder (default results/paper)")
