@@ -460,6 +460,7 @@ def with_spring_laws(setup: HexapodSetup, spring: Any = None,
     if isinstance(plants, IsolatorParameters):
         return dataclasses.replace(setup, isolator=plants, leg_isolators=None)
     every = with_springs(setup.isolator, spring)
+    assert isinstance(every, IsolatorParameters)  # no legs given: one plant for all
     return dataclasses.replace(setup, isolator=every, leg_isolators=plants)
 
 

@@ -37,6 +37,7 @@ from qzs.iotools.writer import write_table
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
 from qzs.model.registry import ALL_PARAMETERS, format_value, unit_of, update_parameters
+from qzs.model.springs import SpringLaw
 from qzs.viz.figures import check_frequency_scale
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
 from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset, write_curves
@@ -916,7 +917,7 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
               workers: int | None = None, progress: bool = True,
               argument: str = "folder", dt: float | None = None,
               tolerance_db: float | None = None,
-              frequency_scale: str | None = None, spring=None
+              frequency_scale: str | None = None, spring: SpringLaw | None = None
               ) -> tuple[list[StudyResult], list[Verdict], float]:
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 

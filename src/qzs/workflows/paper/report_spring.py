@@ -7,18 +7,30 @@ The law every case ran (the MagSpring's tanh, the paper's, by default; another g
 (:func:`draw_spring`), its curves (:func:`spring_curves`) and its paragraph
 (:func:`spring_fit_html`).
 """
+from __future__ import annotations
+
 import html
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.springs import TanhSpring
 from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
 from qzs.workflows.paper.curves import law_dataset, spring_dataset
 
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from qzs.model.springs import SpringLaw
+    from qzs.workflows.paper.studies import StudyResult
+
 __all__ = ["spring_statement", "spring_record", "draw_spring", "spring_curves",
            "spring_fit_html"]
 
 
-def _spring_law(study_results):
+def _spring_law(study_results: Sequence[StudyResult]) -> SpringLaw:
     """The law the studies ran (one for all, ``run_studies``): the MagSpring's by default."""
     law = next((r.spring for r in study_results if r.spring is not None), None)
     if law is None:
@@ -27,7 +39,7 @@ def _spring_law(study_results):
     return law
 
 
-def spring_statement(study_results):
+def spring_statement(study_results: Sequence[StudyResult]) -> str:
     """One sentence: the spring law every case ran (docs/model.md §3, §3.1).
 
     Parameters
@@ -45,7 +57,7 @@ def spring_statement(study_results):
     return f"{law.describe()} ({default})"
 
 
-def spring_record(study_results):
+def spring_record(study_results: Sequence[StudyResult]) -> dict[str, Any]:
     """The spring law every case ran as plain data: ``{"law": kind, field: [value, unit]}``.
 
     Parameters
@@ -61,7 +73,7 @@ def spring_record(study_results):
             for name, (value, unit) in _spring_law(study_results).parameters().items()}
 
 
-def draw_spring(result, path):
+def draw_spring(result: StudyResult, path: Path) -> Figure:
     """The spring study's figure (the paper's Fig. 5): the points and the fitted law.
 
     Parameters
@@ -82,7 +94,7 @@ def draw_spring(result, path):
                            extra["fit"]["spring_shape"], path=path, title=result.study.title)
 
 
-def spring_curves(result, attrs):
+def spring_curves(result: StudyResult, attrs: dict[str, Any]) -> xr.Dataset:
     """The spring study's points and fitted law as a dataset (``spring_curves.nc``).
 
     Parameters
@@ -107,7 +119,7 @@ def spring_curves(result, attrs):
                           extra["fit"]["spring_shape"], attrs)
 
 
-def spring_fit_html(result):
+def spring_fit_html(result: StudyResult) -> str:
     """The spring study's paragraph in ``report.html``: the fit and what it should find.
 
     Parameters
