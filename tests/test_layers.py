@@ -20,15 +20,39 @@ import pytest
 
 SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
 
-#: Layers, lowest first. ``base`` are the top-level modules every layer may use.
-LAYERS = ("base", "model", "iotools", "analysis", "engine", "identify", "viz", "workflows",
-          "export", "app", "cli")
-#: Top-level modules that are the base layer.
+
+
+def _layer_table():
+    """The names of the layer table in ``qzs/__init__.py``'s docstring, in its order."""
+    import re
+
+    text = (SOURCE / "__init__.py").read_text()
+    table = text.split('"""')[1].split("=" * 15)[1:]
+    return re.findall(r"^``([a-z_]+)``", "".join(table), flags=re.MULTILINE)
+
+
+#: Top-level modules that are the base layer (the table's first rows).
 BASE = {"errors", "_validation", "_version", "_optional", "_lazy", "defaults", "_format"}
+#: Layers, lowest first, as the table in ``qzs/__init__.py`` lists them: ``base`` (the
+#: top-level modules every layer may use), then each subpackage.
+LAYERS = ("base", *(name for name in _layer_table() if name not in BASE))
 #: The facade (``qzs/__init__.py``, ``qzs/__main__.py``) may import anything; no module imports it.
 FACADE = {"qzs", "qzs.__main__"}
 #: Methods that may delegate to a higher layer (result objects: ``.plot()``, ``.save()``).
 DELEGATING_METHODS = {"plot", "save"}
+
+
+def test_the_layer_table_in_the_package_docstring_is_every_module_and_package_once():
+    """The table the layers are read from: the base modules first, then every subpackage,
+    each once; nothing in src/qzs outside it."""
+    names = _layer_table()
+    assert len(names) == len(set(names))
+    assert set(names[:len(BASE)]) == BASE
+    packages = {p.name for p in SOURCE.iterdir() if (p / "__init__.py").exists()}
+    modules = {p.stem for p in SOURCE.glob("*.py")} - {"__init__", "__main__"}
+    assert set(names[len(BASE):]) == packages
+    assert modules == BASE
+    assert LAYERS[:4] == ("base", "model", "iotools", "analysis")
 
 
 def module_name(path):

@@ -52,3 +52,17 @@ def test_scipy_signal_is_loaded_by_the_first_estimate_not_by_the_workflows_that_
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120)
     assert done.stdout.split() == ["False", "True"], done.stderr
+
+
+def test_dir_of_qzs_is_its_public_api_and_every_name_resolves():
+    """``dir(qzs)`` lists ``qzs.__all__`` and nothing the package imports to build it
+    (``TYPE_CHECKING``, ``lazy_exports``, ``_LAZY``, the base modules); every listed name is
+    there on first use."""
+    import qzs
+
+    listed = dir(qzs)
+    assert listed == sorted(qzs.__all__)
+    for hidden in ("TYPE_CHECKING", "lazy_exports", "_LAZY", "_lazy", "_validation"):
+        assert hidden not in listed
+    assert all(hasattr(qzs, name) for name in listed)
+    assert "simulate" in listed and "TanhSpring" in listed and "__version__" in listed

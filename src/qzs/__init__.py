@@ -4,8 +4,9 @@ The isolator of Leav et al. (constant-force MagSpring + linear motor, stick-slip
 friction, guide hard stops, PI position loop and active damping), simulated as
 docs/model.md describes, and the tools to judge it by transmissibility.
 
-This module is the flat public API. The top-level modules are the base every layer may
-use; the subpackages are the architecture, each importing only from those listed before it:
+This module is the flat public API (``dir(qzs)`` lists it: ``__all__``). The top-level
+modules are the base every layer may use; the subpackages are the architecture, each importing
+only from those listed before it (``tests/test_layers.py`` reads the layers from this table):
 
 ===============  ====================================================================
 ``errors``       every exception and warning class, each subclassing a built-in
@@ -15,13 +16,13 @@ use; the subpackages are the architecture, each importing only from those listed
 ``_optional``    optional dependencies: imported, or named with the extra to install
 ``_lazy``        names a package exports but imports on first use (PEP 562)
 ``_version``     the installed version
-``model``        parameters, force laws (numpy), excitations, the parameter registry
+``model``        parameters, spring laws, controllers, excitations, the parameter registry
 ``iotools``      the file schema and its streaming writer, config files, rig-log readers
 ``analysis``     spectral estimation and metrics, linearisation, run statistics
-``engine``       numba kernels, single and lockstep drivers, simulate, batch, results
+``engine``       numba kernels, single, lockstep and six-leg drivers, simulate, results
 ``identify``     spring, friction and transmissibility fits
 ``viz``          every figure
-``workflows``    studies and report, experiments, sweeps, response, design, hexapod studies
+``workflows``    paper studies, experiments, sweeps, response, design, design space, six axes
 ``export``       the isolator and its controller as C, and as an FMU (FMI 2.0 / 3.0)
 ``app``          the interactive tuning page (``qzs app``; Panel, optional)
 ``cli``          the ``qzs`` command
@@ -130,4 +131,4 @@ __all__ = [
     *_LAZY,
 ]
 
-__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, public=__all__)

@@ -6,7 +6,7 @@ import threading
 __all__ = ["lazy_exports", "import_in_background"]
 
 
-def lazy_exports(package, exports):
+def lazy_exports(package, exports, public=None):
     """Module-level ``__getattr__`` and ``__dir__`` for a package with lazily loaded names.
 
     Parameters
@@ -16,6 +16,10 @@ def lazy_exports(package, exports):
     exports : dict
         Exported name -> the module that defines it (the layer test reads these as
         imports of the package).
+    public : sequence of str, optional
+        What ``dir(package)`` lists (its ``__all__``: the public API, none of the names the
+        package itself imports to build it); default everything the package holds and
+        ``exports``.
 
     Returns
     -------
@@ -32,6 +36,8 @@ def lazy_exports(package, exports):
         raise AttributeError(f"module {package!r} has no attribute {name!r}")
 
     def __dir__():
+        if public is not None:
+            return sorted(public)
         return sorted(set(namespace) | set(exports))
 
     return __getattr__, __dir__
