@@ -49,7 +49,7 @@ from qzs.identify.spring import fit_spring
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import EXCITATION_OPTIONS, Chirp
-from qzs.model.isolator import IsolatorParameters, other_spring_law, spring_force
+from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.springs import PolynomialSpring
 from qzs.model.registry import law_parameters, parameter_value, update_parameters
 
@@ -576,7 +576,9 @@ def _spring_case(task):
     result = CaseResult(law.kind, {})
     result.extra = dict(displacement=z, force=measured, law_fit=fit, true_law=law)
     result.metrics = {"spring_residual_rms": fit.residual_rms}
-    if fit.law is not None:  # else fit.undefined["law"] says why (the report shows it)
+    if fit.kind == "tanh":  # another MagSpring: its a and b, as the paper's
+        result.metrics.update(spring_force=fit.spring_force, spring_shape=fit.spring_shape)
+    elif fit.law is not None:  # else fit.undefined["law"] says why (the report shows it)
         fitted = IsolatorParameters(spring=fit.law)
         result.metrics.update({name: parameter_value(fitted, None, name)
                                for name in law_parameters(fit.law)})
@@ -615,7 +617,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
     spring : SpringLaw, optional
         The spring law of every case (docs/model.md §3.1); default the MagSpring's tanh (the
-        paper's). The spring study then measures and fits that law.
+        paper's: a ``TanhSpring`` of Table 1's numbers is the default, another tanh runs
+        with its own). The spring study then measures and fits that law.
 
     Returns
     -------
@@ -636,7 +639,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     dt = None if dt is None else positive_real("dt", dt)
     tolerance_db = positive_real("tolerance_db", ACCURACY["tolerance_db"] if tolerance_db is None
                                  else tolerance_db)
-    spring = other_spring_law(IsolatorParameters(spring=spring))  # validated; the tanh: None
+    given = IsolatorParameters(spring=spring).spring_law  # validated
+    spring = None if given == IsolatorParameters().spring_law else given  # the MagSpring: None
     per_study = [_tasks(study, quick, dt, spring) for study in studies]
     steps = _choose_steps(per_study, tolerance_db, worker_count(workers), progress)
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
