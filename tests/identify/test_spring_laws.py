@@ -230,3 +230,89 @@ def test_a_noisy_mechanism_fits_as_a_mechanism_of_springs_that_exist():
     for name, value in truth.items():
         low, high = fit.intervals[name]
         assert low <= value <= high, (name, low, value, high)
+
+
+def _numerical_covariance(values, z, f):
+    """``s^2 (J^T J)^-1`` of the mechanism's five numbers with J by central differences of
+    ``oblique_force``: an independent reference for the fit's analytic Jacobian."""
+    from qzs.identify.spring_laws import oblique_force
+
+    def model(x):
+        return oblique_force(z - x[0], *x[1:])
+
+    steps = 1e-6 * np.maximum(np.abs(values), 1e-3)
+    unit = np.eye(5)
+    jacobian = np.column_stack([(model(values + unit[i] * h) - model(values - unit[i] * h))
+                                / (2 * h) for i, h in enumerate(steps)])
+    residual = model(values) - f
+    return residual @ residual / (z.size - 5) * np.linalg.inv(jacobian.T @ jacobian)
+
+
+def test_oblique_intervals_are_the_least_squares_covariance_of_the_mechanism():
+    """The five numbers' intervals are ``t s sqrt(diag (J^T J)^-1)`` (docs/model.md §3.1), J
+    the force's derivatives at the fit: checked against J by finite differences; with the free
+    length given, k_o = A / (2 L0) and k_v = K - A / L0 carry that covariance linearly."""
+    from qzs.identify.spring_laws import OBLIQUE_FITTED
+
+    z = np.linspace(-0.14, 0.02, 201)
+    f = noisy(OBLIQUE, z, 0.05, 4)
+    fit = fit_spring(z, f, law="oblique", free_length=0.1875)
+    names = list(OBLIQUE_FITTED)
+    values = np.array([fit.parameters[n] for n in names])
+    covariance = _numerical_covariance(values, z, f)
+    t = stats.t.ppf(0.975, z.size - 5)
+    for i, name in enumerate(names):
+        low, high = fit.intervals[name]
+        assert (high - low) / 2 == pytest.approx(t * math.sqrt(covariance[i, i]), rel=1e-4), name
+    length = 0.1875
+    derived = np.array([[1.0, -1.0 / length], [0.0, 0.5 / length]])  # (k_v, k_o) from (K, A)
+    spread = derived @ covariance[2:4, 2:4] @ derived.T
+    for i, name in enumerate(("vertical_stiffness", "oblique_stiffness")):
+        low, high = fit.intervals[name]
+        assert (high - low) / 2 == pytest.approx(t * math.sqrt(spread[i, i]), rel=1e-4), name
+        assert (low + high) / 2 == pytest.approx(fit.parameters[name], rel=1e-12)
+
+
+def test_table_smoothing_minimises_the_corrected_akaike_criterion():
+    """``smoothing="aicc"`` picks the ``lam`` of least AICc = ln(RSS/n) + 1 + 2 (tr H + 1) /
+    (n - tr H - 2) (Hurvich, Simonoff & Tsai; docs/model.md §3.1), here recomputed with the
+    hat matrix H built column by column; few points, where the correction weighs most."""
+    from scipy.interpolate import make_smoothing_spline
+
+    z = np.linspace(-0.14, 0.02, 12)
+    f = noisy(OBLIQUE, z, 0.3, 5)
+    s = (z - z[0]) / (z[-1] - z[0])
+
+    def aicc(log_lam):
+        hat = np.column_stack([make_smoothing_spline(s, e, lam=10.0 ** log_lam)(s)
+                               for e in np.eye(z.size)])
+        rss, trace = float(np.sum((hat @ f - f) ** 2)), float(np.trace(hat))
+        return math.log(rss / z.size) + 1.0 + 2.0 * (trace + 1.0) / (z.size - trace - 2.0)
+
+    fit = fit_spring(z, f, law="table")
+    chosen = math.log10(fit.parameters["smoothing"])
+    grid = np.linspace(chosen - 0.5, chosen + 0.5, 101)
+    best = grid[int(np.argmin([aicc(x) for x in grid]))]
+    assert abs(best - chosen) <= 0.025
+    assert fit.n_parameters == pytest.approx(
+        np.trace(np.column_stack([make_smoothing_spline(s, e, lam=10.0 ** chosen)(s)
+                                  for e in np.eye(z.size)])), rel=1e-9)
+
+
+def test_a_test_machine_s_curve_of_a_law_that_is_not_odd_fits_the_model_s_law():
+    """``convention="test_machine"`` reads the positions with the opposite sign, the forces as
+    given (docs/model.md §3): a cubic with even terms measured so fits back to itself."""
+    z = np.linspace(-0.1, 0.1, 101)
+    fit = fit_spring(-z, noisy(CUBIC, z, 1e-3, 6), law="polynomial", degree=3, center=0.0,
+                     convention="test_machine")
+    np.testing.assert_allclose(fit.law.coefficients, CUBIC.coefficients, rtol=1e-2, atol=0.01)
+    np.testing.assert_allclose(fit.predict(z), CUBIC.force(z), atol=2e-3)
+
+
+def test_a_table_fit_has_table_points_evenly_over_the_data_s_range():
+    """``table_points`` positions, evenly spaced from the least to the greatest position; the
+    forces there are the smoother's (within the noise of the truth)."""
+    z = np.random.default_rng(8).uniform(-0.14, 0.02, 90)
+    fit = fit_spring(z, noisy(OBLIQUE, z, 0.02, 8), law="table", table_points=37)
+    np.testing.assert_array_equal(fit.law.positions, np.linspace(z.min(), z.max(), 37))
+    np.testing.assert_allclose(fit.law.forces, OBLIQUE.force(fit.law.positions), atol=0.1)

@@ -191,3 +191,29 @@ def test_a_bad_spring_parameter_is_named_with_its_fix(isolator, settings, names,
     with pytest.raises(ParameterError, match=message) as caught:
         update_parameters(isolator, qzs.ControllerParameters(), settings)
     assert caught.value.options == names
+
+
+def test_a_polynomial_takes_its_next_power_and_any_up_to_the_highest():
+    """``spring.c<k>`` for k at and above the polynomial's length pads with zeros (docs/model.md
+    §3.1): a linear law (c0, c1) takes c2, the very next power, and c7, the highest; c8 is
+    no parameter."""
+    from qzs.model.registry import SPRING_POWERS, check_law_parameters
+
+    linear = qzs.IsolatorParameters(spring=qzs.PolynomialSpring(coefficients=(60.0, -100.0)))
+    quadratic, _ = update_parameters(linear, qzs.ControllerParameters(), {"spring.c2": 3e3})
+    assert quadratic.spring.coefficients.tolist() == [60.0, -100.0, 3e3]
+    # the force is the polynomial's: c0 + c1 z + c2 z^2 about the centre 0
+    assert quadratic.spring.force(0.01) == pytest.approx(60.0 - 1.0 + 0.3, rel=1e-14)
+    check_law_parameters(linear.spring, [f"spring.c{k}" for k in range(SPRING_POWERS + 1)])
+    with pytest.raises(ParameterError) as caught:
+        check_law_parameters(linear.spring, [f"spring.c{SPRING_POWERS + 1}"])
+    assert caught.value.options == (f"spring.c{SPRING_POWERS + 1}",)
+
+
+def test_a_spring_parameter_on_an_explicit_tanh_law_names_the_fix():
+    """An isolator whose law is a TanhSpring given explicitly (not None) has no ``spring.*``
+    parameter either; the refusal names its own parameters and the fix, as for None."""
+    tanh = qzs.IsolatorParameters(spring=qzs.TanhSpring())
+    with pytest.raises(ParameterError, match="MagSpring's tanh.*`spring_force`") as caught:
+        update_parameters(tanh, qzs.ControllerParameters(), {"spring.preload": 60.0})
+    assert caught.value.options == ("spring.preload",)

@@ -39,6 +39,7 @@ def test_the_tanh_stays_the_fields_and_a_tanh_law_is_the_same_model():
 
 @pytest.mark.parametrize("law, names", [
     (TanhSpring(plateau=50.0), ("spring_law", "spring_force", "spring_shape")),
+    (TanhSpring(shape=70.0), ("spring_law", "spring_force", "spring_shape")),  # shape alone
     ("oblique", ("spring_law",)),
 ])
 def test_a_law_that_is_none_or_disagrees_with_the_fields_is_refused(law, names):

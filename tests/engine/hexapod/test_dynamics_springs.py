@@ -109,3 +109,19 @@ def test_a_refusing_table_left_mid_run_stops_naming_the_leg_and_the_range():
     v = float(text.split("moving at v = ")[1].split(" m/s")[0])
     assert end in (-0.14, 0.021)
     assert 0 < (z - end) * np.sign(v) < 1e-3  # just past the end, moving outwards
+
+
+def test_the_leg_that_leaves_its_refusing_table_is_the_one_named():
+    """Leg 4 alone refuses positions outside its table, the other five extend the same table
+    beyond its ends: the legs move alike, only leg 4 leaves a table, and the run's error names
+    leg 4 (legs are numbered from 1)."""
+    positions = np.linspace(-0.14, 0.021, 162)
+    refusing = IsolatorParameters(spring=TabulatedSpring.from_law(ObliqueSpringQZS(), positions))
+    extending = IsolatorParameters(spring=TabulatedSpring.from_law(ObliqueSpringQZS(), positions,
+                                                                   outside="extend"))
+    legs = [extending] * 3 + [refusing] + [extending] * 2
+    with pytest.raises(SimulationError, match=r"leg 4 left the spring table \[-0\.14, 0\.021\] "
+                                              r"m past its end at "):
+        simulate_hexapod(vertical_legs(), _six_masses(refusing), legs,
+                         excitation={"z": Sine(amplitude=0.1, frequency=2.0, fade_in=0.0)},
+                         duration=1.0)

@@ -53,3 +53,46 @@ def test_a_refusing_table_narrower_than_the_stroke_is_refused_without_an_integra
                 check_hexapod_run(GEOMETRY, PLATFORM, legs, NO_INTEGRAL, duration=1.0)
         else:
             check_hexapod_run(GEOMETRY, PLATFORM, legs, NO_INTEGRAL, duration=1.0)
+
+
+OFF_CENTRE = PlatformParameters(mass=22.0, inertia=np.diag([0.5, 0.5, 0.5]),
+                                center_of_mass=(0.05, 0.0, 0.0))
+
+
+def test_each_leg_s_law_is_checked_against_its_own_load():
+    """A centre of mass off the axis loads the legs unequally (about 88, 62 and 37 N): a law
+    holding leg 4's 37 N near the setpoint is taken there, and refused on leg 3, whose 62 N
+    would put its equilibrium 0.25 m below, naming leg 3."""
+    loads = static_leg_forces(GEOMETRY, OFF_CENTRE)
+    assert loads[3] < loads[2] - 20.0 and loads[2] < loads[0] - 20.0
+    light = PolynomialSpring(coefficients=(loads[3] + 1.0, -100.0), center=-0.06)
+    legs = [IsolatorParameters()] * 6
+    check_hexapod_run(GEOMETRY, OFF_CENTRE, legs[:3] + [IsolatorParameters(spring=light)]
+                      + legs[4:], NO_INTEGRAL, duration=1.0)
+    with pytest.raises(ParameterError, match=r"leg 3: `spring`: .*static load along the leg"):
+        check_hexapod_run(GEOMETRY, OFF_CENTRE, legs[:2] + [IsolatorParameters(spring=light)]
+                          + legs[3:], NO_INTEGRAL, duration=1.0)
+
+
+def test_each_leg_s_pi_preload_is_its_load_less_its_own_spring_at_the_setpoint():
+    """docs/model.md §5 per leg: the PI integral starts with the leg's static load less what
+    that leg's own law gives at the setpoint (a polynomial 7 N above the tanh's there on leg
+    3, the oblique QZS on leg 5), so each motor starts at its own share, the base at rest."""
+    from qzs import Sine
+    from qzs.engine.hexapod import simulate_hexapod
+    from qzs.model.isolator import spring_force
+
+    controller = ControllerParameters(pi_kp=2000.0, pi_ki=800.0, damping_gain=20.0)
+    tanh = IsolatorParameters()
+    above = float(spring_force(controller.position_setpoint, tanh)) + 7.0
+    legs = [tanh, tanh, IsolatorParameters(spring=PolynomialSpring(coefficients=(above, -200.0),
+                                                                   center=-0.06)),
+            tanh, IsolatorParameters(spring=ObliqueSpringQZS()), tanh]
+    result = simulate_hexapod(GEOMETRY, OFF_CENTRE, legs, controller,
+                              excitation={"z": Sine(amplitude=0.001, frequency=2.0)},
+                              duration=0.01)
+    loads = static_leg_forces(GEOMETRY, OFF_CENTRE)
+    springs = [float(spring_force(controller.position_setpoint, leg)) for leg in legs]
+    assert springs[2] == pytest.approx(springs[0] + 7.0, rel=1e-12)
+    np.testing.assert_allclose(result["pi_force"][0], loads - springs, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(result["spring_force"][0], springs, rtol=1e-12)

@@ -260,3 +260,33 @@ def test_a_spring_variable_the_law_cannot_take_is_refused_naming_it(spring, vari
     with pytest.raises(ProblemError, match=fix) as error:
         load_problem(document)
     assert error.value.table in ("variables", "spring")
+
+
+def test_an_uncertain_spring_parameter_the_law_lacks_is_refused_in_its_table():
+    """[uncertain] names ``spring.*`` as [variables] does (docs/model.md §3.1): the MagSpring's
+    tanh has none, so an uncertain ``spring.preload`` is refused in [uncertain], naming it."""
+    document = changed(uncertain={"spring.preload": {"distribution": "uniform",
+                                                     "low": 55.0, "high": 65.0}})
+    with pytest.raises(ProblemError, match="MagSpring's tanh") as error:
+        load_problem(document)
+    assert (error.value.table, error.value.key) == ("uncertain", "spring.preload")
+
+
+def test_a_table_law_s_csv_is_read_beside_the_problem_file(tmp_path, monkeypatch):
+    """A [spring] table law's ``csv`` is relative to the problem file wherever it is read
+    from; the problem's sweep carries that law."""
+    import qzs
+
+    folder = tmp_path / "design"
+    folder.mkdir()
+    (folder / "curve.csv").write_text("position [m],force [N]\n-0.1,40.0\n-0.05,62.0\n0.0,80.0\n")
+    path = folder / "table.toml"
+    path.write_text('[problem]\nname = "table"\n'
+                    '[spring]\nlaw = "table"\ncsv = "curve.csv"\noutside = "extend"\n'
+                    '[variables]\npi_kp = { low = 20.0, high = 80.0 }\n'
+                    '[[objectives]]\nmetric = "motor_force_rms"\n')
+    monkeypatch.chdir(tmp_path)
+    problem = load_problem(path)
+    assert problem.sweep.spring == qzs.TabulatedSpring(positions=(-0.1, -0.05, 0.0),
+                                                       forces=(40.0, 62.0, 80.0),
+                                                       outside="extend")

@@ -277,3 +277,50 @@ def test_a_varied_spring_parameter_the_law_lacks_is_refused_before_any_run(sprin
                 **({"spring": spring} if spring else {})}
     with pytest.raises(ParameterError, match=message):
         load_sweep(document)
+
+
+
+def test_a_fixed_spring_parameter_applies_to_the_sweep_s_law_and_is_checked_on_reading():
+    """[parameters] may fix a ``spring.*`` of the [spring] law (docs/model.md §3.1): the file
+    reads, a case's isolator has the law with that value, and a value the law refuses is
+    refused on reading, naming it."""
+    import dataclasses
+
+    import qzs
+    from qzs.workflows.sweeps.cases import build_model
+
+    spring = {"law": "oblique", "vertical_stiffness": "quasi-zero"}
+    sweep = load_sweep(definition(spring=spring, parameters={"spring.preload": 61.0},
+                                  grid={"mass": [6.0, 7.0]}))
+    isolator, _ = build_model(sweep, {"mass": 7.0})
+    assert isolator.mass == 7.0
+    assert isolator.spring == dataclasses.replace(qzs.ObliqueSpringQZS.quasi_zero(),
+                                                  preload=61.0)
+    raises(definition(spring=spring, parameters={"spring.free_length": -1.0},
+                      grid={"mass": [6.0, 7.0]}), "`spring.free_length` must be positive")
+
+
+def test_a_spring_parameter_drawn_from_a_distribution_the_law_lacks_is_refused_on_reading():
+    """[distributions] names ``spring.*`` as [grid] does: the MagSpring's tanh has none, so a
+    random sweep over ``spring.preload`` without a [spring] law is refused on reading."""
+    document = definition(sweep={"method": "random", "samples": 4, "seed": 1},
+                          distributions={"spring.preload": {"distribution": "uniform",
+                                                            "low": 55.0, "high": 65.0}})
+    raises(document, "`spring.preload`", "MagSpring's tanh")
+
+
+def test_a_table_law_s_csv_is_read_beside_the_sweep_file(tmp_path, monkeypatch):
+    """A [spring] table law's ``csv`` is relative to the sweep file, wherever the sweep is
+    read from (docs/model.md §3.1)."""
+    import qzs
+
+    folder = tmp_path / "study"
+    folder.mkdir()
+    (folder / "curve.csv").write_text("position [m],force [N]\n-0.1,40.0\n-0.05,62.0\n0.0,80.0\n")
+    path = folder / "sweep.toml"
+    path.write_text('[sweep]\nname = "t"\n[spring]\nlaw = "table"\ncsv = "curve.csv"\n'
+                    '[grid]\nmass = [6.0, 7.0]\n')
+    monkeypatch.chdir(tmp_path)
+    sweep = load_sweep(path)
+    assert sweep.spring == qzs.TabulatedSpring(positions=(-0.1, -0.05, 0.0),
+                                               forces=(40.0, 62.0, 80.0))
