@@ -530,10 +530,6 @@ def test_an_explicit_tanh_spring_is_the_paper_s_magspring():
     assert set(default[0].cases[0].metrics) == {"spring_force", "spring_shape"}
 
 
-@pytest.mark.xfail(strict=True, reason="BUG found in mutation round 41: run_studies maps every "
-                   "TanhSpring to None (other_spring_law), so a tanh other than the paper's "
-                   "(`qzs study spring --spring` a file with law = \"tanh\", plateau = 40) runs "
-                   "and reports the paper's MagSpring (60.84 N, 78.1 1/m), exit 0")
 def test_a_tanh_other_than_the_paper_s_is_run_or_refused_never_swapped_for_the_magspring():
     """A tanh law with other numbers than Table 1's is either the law every case runs (the
     report states and records it, the spring study measures it) or refused naming `spring`;
