@@ -176,3 +176,32 @@ def test_the_c_stiffness_peak_is_the_step_checks(name):
     got = _library().qzs_spring_stiffness_peak(_pointer(packed), center - isolator.stroke_half,
                                                center + isolator.stroke_half)
     assert got == pytest.approx(spring_stiffness_peak(isolator, controller), rel=1e-12)
+
+
+@pytest.mark.parametrize("forces", [(0.0, 1.0, -1.0, 0.0), (0.0, 1.0, -3.0, 0.0)],
+                         ids=["kept", "limited"])
+def test_the_c_table_s_end_slopes_are_scipy_s_pchip_ends(forces):
+    """An end whose neighbouring secant turns back (PCHIP's shape-preserving end rule, Moler's
+    ``pchip``): the three-point slope is kept while within three times the end secant (25
+    for secants 10 and -20: kept; 35 for 10 and -40: limited to 30). The C's end slopes and
+    forces are scipy.interpolate.PchipInterpolator's, an independent implementation."""
+    from scipy.interpolate import PchipInterpolator
+
+    from qzs.model.springs import TABLE_END_SLOPE, TABLE_POSITIONS
+
+    x = np.array([0.0, 0.1, 0.2, 0.3])
+    y = np.array(forces)
+    n = x.size
+    library = _library()
+    got = np.full(TabulatedSpring(positions=x, forces=y).pack().size, np.nan)
+    library.qzs_spring_table(_pointer(got), n, _pointer(x), _pointer(y), 0)
+    reference = PchipInterpolator(x, y)
+    ends = reference.derivative()(x[[0, -1]])
+    assert ends[0] == pytest.approx(25.0 if forces[2] == -1.0 else 30.0, rel=1e-12)
+    first_piece = got[TABLE_POSITIONS + n:TABLE_POSITIONS + n + 4]
+    assert first_piece[1] == pytest.approx(ends[0], rel=1e-12)
+    assert got[TABLE_END_SLOPE] == pytest.approx(ends[1], rel=1e-12)
+    values = Values()
+    for z in np.linspace(0.0, 0.3, 31):
+        library.qzs_spring_evaluate(_pointer(got), z, 7, ctypes.byref(values))
+        assert values.force == pytest.approx(float(reference(z)), rel=1e-12, abs=1e-12)

@@ -185,3 +185,32 @@ def test_an_oblique_spring_out_of_its_range_is_refused_at_initialisation(fmu_fol
     message = fmu.failing(fmu.fmu.exitInitializationMode)
     assert "`spring.free_length` = 0 must be positive [m]" in message
     fmu.free()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_the_step_is_checked_against_the_law_s_stiffness(fmu_folder, version):
+    """A stiff law (a polynomial of 1e5 N/m) lowers the largest stable step below the tanh's:
+    the FMU refuses a step a thousandth above the law's limit, naming the limit qzs computes
+    for that isolator (qzs.engine.stability, the law's stiffness peak over the stroke), as
+    qzs.simulate refuses it, and takes one a thousandth below."""
+    from qzs.engine.stability import largest_stable_step
+
+    law = qzs.PolynomialSpring(coefficients=(62.784, -1e5), center=-0.06)
+    isolator = qzs.IsolatorParameters(spring=law)
+    limit = largest_stable_step(isolator, qzs.ControllerParameters(), "ode3")
+    assert limit < 0.97 * largest_stable_step()  # the law's stiffness sets it, not the stops
+    with pytest.raises(qzs.StabilityError):
+        qzs.simulate(EXPORT_SPRING_SINE, isolator, duration=0.1, dt=limit * 1.001,
+                     sample_rate=1.0 / (limit * 1.001))
+    path = _fmu(fmu_folder, "stiff polynomial", version, law)
+    fmu = Logged(path, version)
+    fmu.enter(stop_time=DURATION)
+    fmu.set(step_size=limit * 1.001)
+    message = fmu.failing(fmu.fmu.exitInitializationMode)
+    assert "largest stable step is %.3g s" % limit in message and "step_size" in message
+    fmu.free()
+    fmu = Logged(path, version)
+    fmu.enter(stop_time=DURATION)
+    fmu.set(step_size=limit * 0.999)
+    fmu.fmu.exitInitializationMode()
+    fmu.free()
