@@ -53,7 +53,7 @@ OBLIQUE_FITTED = {"center": ("m", "position where the oblique springs are horizo
                   "far_stiffness": ("N/m", "k_v + 2 k_o, the stiffness far from the centre"),
                   "oblique_force": ("N", "2 k_o L0, the oblique springs' force scale"),
                   "horizontal_distance": ("m", "distance to the hinges, d")}
-#: The range of ``log10 lam`` the table's generalised cross-validation searches.
+#: The range of ``log10 lam`` the table's smoothing searches for the least AICc.
 TABLE_LAMBDA_RANGE = (-12.0, 3.0)
 #: Columns of the identity solved at once for the trace of the smoothing spline's hat matrix.
 _TRACE_BLOCK = 256

@@ -658,8 +658,7 @@ def _spring(document, path):
     try:
         return spring_from_table(document["spring"], path)
     except ParameterError as error:
-        raise ProblemError("spring", (error.options or ("",))[0], document["spring"],
-                           str(error)) from None
+        raise ProblemError("spring", "", None, str(error)) from None  # it names the key
 
 
 def _problem(document, where, stem, path=None):
