@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from qzs.model.isolator import IsolatorParameters
-from qzs.model.springs import TanhSpring
 from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
 from qzs.workflows.paper.curves import law_dataset, spring_dataset
 
@@ -33,10 +32,7 @@ __all__ = ["spring_statement", "spring_record", "draw_spring", "spring_curves",
 def _spring_law(study_results: Sequence[StudyResult]) -> SpringLaw:
     """The law the studies ran (one for all, ``run_studies``): the MagSpring's by default."""
     law = next((r.spring for r in study_results if r.spring is not None), None)
-    if law is None:
-        iso = IsolatorParameters()
-        law = TanhSpring(plateau=iso.spring_force, shape=iso.spring_shape)
-    return law
+    return IsolatorParameters(spring=law).spring_law
 
 
 def spring_statement(study_results: Sequence[StudyResult]) -> str:
