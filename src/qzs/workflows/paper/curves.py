@@ -234,9 +234,6 @@ def spring_dataset(displacement, force, spring_force, spring_shape, attrs=None):
     z = np.asarray(displacement, dtype=float)
     fitted = law(z, dataclasses.replace(IsolatorParameters(), spring_force=spring_force,
                                         spring_shape=spring_shape))
-    return to_dataset(spring_schema(z.size), {"displacement": z, "force": force,
-                                               "fitted_force": fitted},
-                      {**(attrs or {}), "spring_force": float(spring_force),
-                       "spring_force_units": unit_of("spring_force"),
-                       "spring_shape": float(spring_shape),
-                       "spring_shape_units": unit_of("spring_shape")})
+    return law_dataset(z, force, fitted, {  # attributes spring_force, spring_shape
+        "force": (float(spring_force), unit_of("spring_force")),
+        "shape": (float(spring_shape), unit_of("spring_shape"))}, attrs)
