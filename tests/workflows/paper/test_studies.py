@@ -483,6 +483,10 @@ def test_the_studies_run_a_spring_law_and_the_report_says_which(tmp_path):
 
     curves = xr.open_dataset(tmp_path / "spring_curves.nc")
     assert curves.attrs["spring_kind"] == "polynomial"
+    # the file's labels name the law it holds, not the MagSpring's tanh
+    assert "tanh" not in curves["fitted_force"].attrs["long_name"]
+    assert "polynomial" in curves["fitted_force"].attrs["long_name"]
+    assert "MagSpring" not in curves["displacement"].attrs["long_name"]
     np.testing.assert_allclose(curves["fitted_force"].values,
                                fit.law.force(curves["displacement"].values))
 

@@ -151,29 +151,33 @@ def write_curves(dataset, folder, name):
             for suffix in CURVE_SUFFIXES]
 
 
-def spring_schema(points):
+def spring_schema(points, law=None):
     """The CF-1.10 layout of the spring's characteristic: the points and the fitted law.
 
     Parameters
     ----------
     points : int
         Number of measured points.
+    law : str, optional
+        The fitted law's kind (``"polynomial"``, ...); default the MagSpring's tanh.
 
     Returns
     -------
     Schema
     """
     on = ("point",)
+    spring, fitted = (("the MagSpring", "-a tanh(b z)") if law is None
+                      else ("the spring", f"{law}"))
     return Schema(kind="the spring's characteristic", dimensions={"point": int(points)},
                   coordinates=(Variable(name="displacement", dims=on, units="m",
-                                        long_name="displacement z of the MagSpring"),),
+                                        long_name=f"displacement z of {spring}"),),
                   variables=(Variable(name="force", dims=on, units="N",
                                       long_name="measured spring force"),
                              Variable(name="fitted_force", dims=on, units="N",
-                                      long_name="fitted law -a tanh(b z) at the points")))
+                                      long_name=f"fitted law {fitted} at the points")))
 
 
-def law_dataset(displacement, force, fitted_force, parameters, attrs=None):
+def law_dataset(displacement, force, fitted_force, parameters, attrs=None, law=None):
     """A spring law's measured characteristic and its fitted law (docs/model.md §3.1).
 
     As :func:`spring_dataset`, the fitted force given and the fit's parameters as
@@ -191,6 +195,8 @@ def law_dataset(displacement, force, fitted_force, parameters, attrs=None):
         The fit: name -> ``(value, unit)`` (``kind`` first, unit ``-``).
     attrs : dict, optional
         Further global attributes.
+    law : str, optional
+        The fitted law's kind, for the labels (:func:`spring_schema`); default the tanh.
 
     Returns
     -------
@@ -201,8 +207,8 @@ def law_dataset(displacement, force, fitted_force, parameters, attrs=None):
     for name, (value, unit) in parameters.items():
         meta[f"spring_{name}"] = value
         meta[f"spring_{name}_units"] = unit
-    return to_dataset(spring_schema(z.size), {"displacement": z, "force": force,
-                                               "fitted_force": fitted_force},
+    return to_dataset(spring_schema(z.size, law), {"displacement": z, "force": force,
+                                                    "fitted_force": fitted_force},
                       {**(attrs or {}), **meta})
 
 

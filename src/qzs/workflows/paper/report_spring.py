@@ -111,7 +111,7 @@ def spring_curves(result: StudyResult, attrs: dict[str, Any]) -> xr.Dataset:
         fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
                                              for name, value in fit.parameters.items()}}
         return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
-                           attrs)
+                           attrs, law=fit.kind)
     return spring_dataset(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
                           extra["fit"]["spring_shape"], attrs)
 
