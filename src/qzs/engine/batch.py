@@ -142,15 +142,20 @@ class BatchResult:
 
 def _parameter_values(cases, n):
     """Every registry parameter's value in each case: name -> list (none if ``cases`` is not
-    one pair per case); a block's parameters where a case has that block (None in the
-    others)."""
+    one pair per case); a block's parameters where a case has that block, a spring law's
+    where a case's law has it (None in the others)."""
     if len(cases) != n:
         return {}
     blocks = {name for pair in cases for name in BLOCKS if getattr(pair[1], name) is not None}
     laws = {name for pair in cases for name in law_parameters(pair[0].spring)}
+
+    def recorded(name):  # a law's parameter where a case's law has it, a block's likewise
+        if name in SPRING_PARAMETERS:
+            return name in laws
+        return name not in BLOCK_PARAMETERS or name.split(".", 1)[0] in blocks
+
     return {name: [parameter_value(*pair, name) for pair in cases]
-            for name in ALL_PARAMETERS if name in laws or name not in BLOCK_PARAMETERS
-            and name not in SPRING_PARAMETERS or name.split(".", 1)[0] in blocks}
+            for name in ALL_PARAMETERS if recorded(name)}
 
 
 def batch_schema(batch):
