@@ -49,18 +49,21 @@ def controllers():
             "+ all three": base + compensation + dither + linear}
 
 
-def single_rate(controller, duration, repeats):
+def single_rate(isolator, controller, duration, repeats):
     """Best steps per second of one run [1/s]."""
     excitation = qzs.Sine(amplitude=0.01, frequency=3.0)
-    return max(qzs.simulate(excitation, controller=controller, duration=duration, dt=1e-4,
+    return max(qzs.simulate(excitation, isolator, controller, duration=duration, dt=1e-4,
                             sample_rate=1000.0).steps_per_second for _ in range(repeats))
 
 
-def lanes_rate(controller, cases, duration, repeats):
-    """Best steps per second of ``cases`` lanes, summed over the cases [1/s]."""
+def lanes_rate(isolator, controller, cases, duration, repeats):
+    """Best steps per second of ``cases`` lanes (stiction 8-12 N), summed over the cases
+    [1/s]."""
+    import dataclasses
+
     excitation = qzs.Sine(amplitude=0.01, frequency=3.0)
-    stiction = np.linspace(8.0, 12.0, cases)
-    pairs = [(qzs.IsolatorParameters(stiction_force=float(fs)), controller) for fs in stiction]
+    pairs = [(dataclasses.replace(isolator, stiction_force=float(fs)), controller)
+             for fs in np.linspace(8.0, 12.0, cases)]
     best = 0.0
     for _ in range(repeats):
         batch = simulate_batch(pairs, excitation, duration=duration, dt=1e-4, sample_rate=100.0,
@@ -69,36 +72,46 @@ def lanes_rate(controller, cases, duration, repeats):
     return best
 
 
+def compare(name, heading, rows, quick, repeats, target_row, target, sentence):
+    """Measure every row against the first, print the table and the target's verdicts.
+
+    ``heading``: what a row is; ``rows``: label -> ``(isolator, controller)``, the baseline
+    first; ``target_row``: the
+    label's start of the row the target is on; ``sentence``: the target, as printed.
+    """
+    duration, lanes_duration, cases = (5.0, 0.5, 16) if quick else (20.0, 2.0, 64)
+    print(f"# {name}  {time.strftime('%Y-%m-%d %H:%M')}  python {platform.python_version()}")
+    for isolator, controller in rows.values():  # compile or load every kernel first
+        single_rate(isolator, controller, 0.1, 1)
+        lanes_rate(isolator, controller, 2, 0.05, 1)
+    print(f"{heading:32s} {'single [M steps/s]':>19s} {'ratio':>6s} "
+          f"{'lanes, 1 thread [M steps/s]':>28s} {'ratio':>6s}")
+    base_single = base_lanes = None
+    verdicts = []
+    for label, (isolator, controller) in rows.items():
+        single = single_rate(isolator, controller, duration, repeats)
+        lanes = lanes_rate(isolator, controller, cases, lanes_duration, repeats)
+        base_single = base_single or single
+        base_lanes = base_lanes or lanes
+        ratio_single, ratio_lanes = base_single / single, base_lanes / lanes
+        print(f"{label:32s} {single / 1e6:19.2f} {ratio_single:6.2f} {lanes / 1e6:28.2f} "
+              f"{ratio_lanes:6.2f}")
+        if label.startswith(target_row):
+            verdicts = [("single", ratio_single), ("lanes", ratio_lanes)]
+    for where, ratio in verdicts:
+        verdict = "met" if ratio <= target else "NOT met"
+        print(f"target: {sentence} ({where}): {ratio:.2f} x, {verdict}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter runs")
     parser.add_argument("--repeats", type=int, default=5, help="best of this many runs")
     args = parser.parse_args()
-    duration, lanes_duration, cases = (5.0, 0.5, 16) if args.quick else (20.0, 2.0, 64)
-    print(f"# bench_controller  {time.strftime('%Y-%m-%d %H:%M')}  python "
-          f"{platform.python_version()}")
-    rows = controllers()
-    for controller in rows.values():  # compile or load every kernel first
-        single_rate(controller, 0.1, 1)
-        lanes_rate(controller, 2, 0.05, 1)
-    print(f"{'controller':32s} {'single [M steps/s]':>19s} {'ratio':>6s} "
-          f"{'lanes, 1 thread [M steps/s]':>28s} {'ratio':>6s}")
-    base_single = base_lanes = None
-    verdicts = []
-    for name, controller in rows.items():
-        single = single_rate(controller, duration, args.repeats)
-        lanes = lanes_rate(controller, cases, lanes_duration, args.repeats)
-        base_single = base_single or single
-        base_lanes = base_lanes or lanes
-        ratio_single, ratio_lanes = base_single / single, base_lanes / lanes
-        print(f"{name:32s} {single / 1e6:19.2f} {ratio_single:6.2f} {lanes / 1e6:28.2f} "
-              f"{ratio_lanes:6.2f}")
-        if name.startswith("+ 4-state"):
-            verdicts = [("single", ratio_single), ("lanes", ratio_lanes)]
-    for where, ratio in verdicts:
-        verdict = "met" if ratio <= TARGET_LTI4 else "NOT met"
-        print(f"target: 4-state linear controller per step <= {TARGET_LTI4:.2f} x PI + damping "
-              f"({where}): {ratio:.2f} x, {verdict}")
+    rows = {name: (qzs.IsolatorParameters(), controller)
+            for name, controller in controllers().items()}
+    compare("bench_controller", "controller", rows, args.quick, args.repeats, "+ 4-state", TARGET_LTI4,
+            f"4-state linear controller per step <= {TARGET_LTI4:.2f} x PI + damping")
 
 
 if __name__ == "__main__":

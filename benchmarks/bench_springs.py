@@ -15,13 +15,15 @@ condition; for the lanes, 64 cases of each (stiction 8-12 N). The ratio is the t
 against the baseline's. Exits 0: a benchmark reports.
 """
 import argparse
-import platform
-import time
+import sys
+from pathlib import Path
 
 import numpy as np
 
 import qzs
-from qzs.engine.batch import simulate_batch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_controller import compare  # noqa: E402  the same measurement and table
 
 TARGET_TABLE = 1.15  # time per step of a 200-point table / the tanh's
 TABLE_POINTS = 200
@@ -43,57 +45,15 @@ def laws():
             "oblique, quasi-zero": qzs.ObliqueSpringQZS.quasi_zero()}
 
 
-def single_rate(law, duration, repeats):
-    """Best steps per second of one run [1/s]."""
-    excitation = qzs.Sine(amplitude=0.01, frequency=3.0)
-    iso = qzs.IsolatorParameters(spring=law)
-    return max(qzs.simulate(excitation, iso, duration=duration, dt=1e-4,
-                            sample_rate=1000.0).steps_per_second for _ in range(repeats))
-
-
-def lanes_rate(law, cases, duration, repeats):
-    """Best steps per second of ``cases`` lanes, summed over the cases [1/s]."""
-    excitation = qzs.Sine(amplitude=0.01, frequency=3.0)
-    pairs = [(qzs.IsolatorParameters(stiction_force=float(fs), spring=law),
-              qzs.ControllerParameters()) for fs in np.linspace(8.0, 12.0, cases)]
-    best = 0.0
-    for _ in range(repeats):
-        batch = simulate_batch(pairs, excitation, duration=duration, dt=1e-4, sample_rate=100.0,
-                               channels=(), workers=1)
-        best = max(best, cases * duration / 1e-4 / batch.elapsed)
-    return best
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter runs")
     parser.add_argument("--repeats", type=int, default=5, help="best of this many runs")
     args = parser.parse_args()
-    duration, lanes_duration, cases = (5.0, 0.5, 16) if args.quick else (20.0, 2.0, 64)
-    print(f"# bench_springs  {time.strftime('%Y-%m-%d %H:%M')}  python "
-          f"{platform.python_version()}")
-    rows = laws()
-    for law in rows.values():  # compile or load every kernel first
-        single_rate(law, 0.1, 1)
-        lanes_rate(law, 2, 0.05, 1)
-    print(f"{'spring law':32s} {'single [M steps/s]':>19s} {'ratio':>6s} "
-          f"{'lanes, 1 thread [M steps/s]':>28s} {'ratio':>6s}")
-    base_single = base_lanes = None
-    verdicts = []
-    for name, law in rows.items():
-        single = single_rate(law, duration, args.repeats)
-        lanes = lanes_rate(law, cases, lanes_duration, args.repeats)
-        base_single = base_single or single
-        base_lanes = base_lanes or lanes
-        ratio_single, ratio_lanes = base_single / single, base_lanes / lanes
-        print(f"{name:32s} {single / 1e6:19.2f} {ratio_single:6.2f} {lanes / 1e6:28.2f} "
-              f"{ratio_lanes:6.2f}")
-        if name.startswith("table"):
-            verdicts = [("single", ratio_single), ("lanes", ratio_lanes)]
-    for where, ratio in verdicts:
-        verdict = "met" if ratio <= TARGET_TABLE else "NOT met"
-        print(f"target: {TABLE_POINTS}-point table per step <= {TARGET_TABLE:.2f} x the tanh "
-              f"({where}): {ratio:.2f} x, {verdict}")
+    rows = {name: (qzs.IsolatorParameters(spring=law), qzs.ControllerParameters())
+            for name, law in laws().items()}
+    compare("bench_springs", "spring law", rows, args.quick, args.repeats, "table", TARGET_TABLE,
+            f"{TABLE_POINTS}-point table per step <= {TARGET_TABLE:.2f} x the tanh")
 
 
 if __name__ == "__main__":
