@@ -265,6 +265,92 @@ def paper(folder):
           flush=True)
 
 
+_TIMING = re.compile(r"(second|elapsed|wall|generated|version|created|date|timestamp|"
+                     r"steps_per_second|path|folder|file|store|out|command)", re.I)
+
+
+def _clean(value):
+    """A JSON summary without what differs from run to run (times, paths, versions)."""
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items() if not _TIMING.search(k)}
+    if isinstance(value, list):
+        return [_clean(v) for v in value]
+    if isinstance(value, str):
+        value = re.sub(r"[0-9.]+ s to choose", "(time) to choose", value)
+        value = re.sub(r", [0-9.]+ s\)", ", (time))", value)
+        return re.sub(r"/tmp/[^ ,;'\"]+", "(path)", value)
+    return value
+
+
+def cli_json(name, folder, *args, suffix=""):
+    """Hash of the cleaned ``--json`` summary of ``qzs ARGS --json --quiet``."""
+    out = os.path.join(folder, name.replace("/", "_") + suffix)
+    done = subprocess.run([sys.executable, "-m", "qzs", *args, "--out", out, "--json",
+                           "--quiet"], check=True, capture_output=True, text=True)
+    text = json.dumps(_clean(json.loads(done.stdout)), sort_keys=True)
+    print(f"{name:40s} {hashlib.sha256(text.encode()).hexdigest()[:16]}", flush=True)
+    import xarray as xr
+    files = [out] if out.endswith(".nc") else sorted(
+        os.path.join(out, f) for f in os.listdir(out) if f.endswith(".nc"))
+    for path in files:
+        with xr.open_dataset(path) as data:
+            line(f"{name}/{os.path.basename(path)}",
+                 *[data[k].values for k in sorted(data.data_vars)
+                   if data[k].dtype.kind in "fiub" and not _TIMING.search(k)])
+
+
+SWEEP = """
+[sweep]
+name = "fingerprint"
+method = "grid"
+batch_size = 4
+[grid]
+pi_kp = [5.0, 50.0]
+stiction_force = [5.0, 15.0]
+[excitation]
+kind = "chirp"
+amplitude = 0.010
+f0 = 0.0
+f1 = 20.0
+[simulation]
+solver = "ode3"
+tolerance_db = 0.05
+[analysis]
+sample_rate = 1000.0
+fft_length = 4096
+n_averages = 3
+band = [0.0, 20.0]
+at_frequencies = [2.0, 12.0]
+[outputs]
+stats = ["peak_stroke", "steps"]
+metrics = ["resonance_frequency", "transmissibility_at_2_hz"]
+transmissibility = true
+"""
+
+
+def workflows(folder):
+    """The walks above the engine: a six-axis study, an optimisation, the gain design, a
+    response sweep and a sweep whose steps are chosen for a tolerance, a study with one."""
+    cli_json("cli/hexapod-study", folder, "hexapod", "study", "--quick")
+    cli_json("cli/optimize", folder, "optimize", "isolation_vs_effort", "--generations", "2",
+             "--population", "6")
+    cli_json("cli/response", folder, "response", "--range", "1,6,4", "--tolerance", "0.02",
+             "--compare-chirp", suffix=".nc")
+    cli_json("cli/study-stiction", folder, "study", "stiction", "--quick", "--tolerance",
+             "0.05")
+    sweep = os.path.join(folder, "fingerprint.toml")
+    with open(sweep, "w", encoding="utf-8") as handle:
+        handle.write(SWEEP)
+    out = os.path.join(folder, "sweep.zarr")
+    subprocess.run([sys.executable, "-m", "qzs", "sweep", sweep, "--out", out, "--quiet"],
+                   check=True, capture_output=True)
+    import xarray as xr
+    data = xr.open_zarr(out).load()
+    line("cli/sweep", *[data[k].values for k in sorted(data.data_vars)
+                        if data[k].dtype.kind in "fiub" and not _TIMING.search(k)])
+    cli_json("cli/design", folder, "design", "--quick")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-paper", action="store_true")
@@ -275,6 +361,7 @@ def main():
                  balance=balance)
     with tempfile.TemporaryDirectory() as folder:
         parts["streamed"] = lambda: streamed_run(folder)
+        parts["workflows"] = lambda: workflows(folder)
         if not args.skip_paper:
             parts["paper"] = lambda: paper(folder)
         only = [p for p in args.only.split(",") if p]
