@@ -8,7 +8,7 @@ walk of a compile is numba's, not ours)::
     .venv/bin/python benchmarks/walk.py simulate --duration 5
     .venv/bin/python benchmarks/walk.py optimize isolation_vs_effort --generations 1 --population 4
 
-Every Python call is recorded (``sys.setprofile``; a compiled kernel's steps are not
+Every Python call is recorded (``sys.setprofile``, in every thread; a compiled kernel's steps are not
 Python calls and are not seen) and mapped to its file under ``src/qzs`` and that file's
 layer (the table in ``qzs/__init__.py``, as ``tests/test_layers.py`` reads it). Printed:
 
@@ -19,7 +19,10 @@ layer (the table in ``qzs/__init__.py``, as ``tests/test_layers.py`` reads it). 
   (a value flowing up to be handed down again, or a callback);
 - ``callbacks``: calls made from a lower layer's frame into a higher layer's function.
 
-The command's output goes to a temporary folder (``--out`` is added unless given).
+The command's output goes to a temporary folder (``--out`` is added unless given), and so
+does the step cache (``QZS_CACHE_DIR``): a chosen step is chosen, not read back. The jobs a
+command hands to a forked helper (:mod:`qzs.workflows.forked`: ``simulate``'s step choice,
+its figure) run in this process, so that they are walked too.
 """
 import os
 import sys
@@ -53,10 +56,14 @@ def main(argv):
     order, table = layers()
     folder = tempfile.mkdtemp(prefix="qzs-walk-")
     os.chdir(folder)  # a figure written by default lands here, not in the checkout
+    os.environ["QZS_CACHE_DIR"] = folder  # an empty step cache: the choice is walked
     if "--out" not in argv and argv and argv[0] in ("simulate", "optimize"):
         argv = [*argv, "--out", os.path.join(folder, "run.nc" if argv[0] == "simulate"
                                               else "out")]
     from qzs.cli import main as cli_main
+    from qzs.workflows import forked
+
+    forked.available = lambda: False  # the jobs a command forks (its step choice) run here
 
     calls = []
 
@@ -70,6 +77,9 @@ def main(argv):
         from_path = caller.f_code.co_filename if caller is not None else ""
         calls.append((path, from_path if from_path.startswith(ROOT) else None))
 
+    import threading
+
+    threading.setprofile(profile)  # the threads a command starts (a probe, a batch) too
     sys.setprofile(profile)
     try:
         code = cli_main(argv)
@@ -77,6 +87,7 @@ def main(argv):
         code = stop.code
     finally:
         sys.setprofile(None)
+        threading.setprofile(None)
     files = {path for path, _ in calls}
     changes = up = callbacks = 0
     previous = None
