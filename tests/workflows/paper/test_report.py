@@ -15,7 +15,7 @@ from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp
 from qzs.workflows.paper.report import CLAIMS, TREND_CLAIMS, decide_claims
 from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
-from qzs.workflows.paper.studies import CaseResult, Study, StudyResult, _locked_below, load_study
+from qzs.workflows.paper.studies import CaseResult, Study, StudyResult, load_study
 
 FREQUENCY = np.round(np.arange(0.0, 20.0 + 1e-9, 0.05), 10)  # [Hz]
 
@@ -101,18 +101,6 @@ def test_resonance_masked_flips_on_a_trusted_low_frequency_peak():
 def test_resonance_masked_is_not_decidable_without_strong_stiction():
     weak = study("s", ["resonance_masked"], masked_cases()[:1])
     assert verdict(weak, "resonance_masked").label == "not decidable"
-
-
-def test_locked_fraction_is_taken_below_the_frequency():
-    """The chirp is below 0.5 Hz for its first 2.5 s; only then is the payload locked."""
-    chirp = Chirp(amplitude=0.01, f0=0.0, f1=20.0, duration=100.0)
-    time = np.arange(0.0, 100.0, 0.01)
-    run = types.SimpleNamespace(time=time, locked=time < 2.5)
-    assert _locked_below(run, chirp, 0.5) == pytest.approx(1.0)
-    run = types.SimpleNamespace(time=time, locked=time >= 2.5)
-    assert _locked_below(run, chirp, 0.5) == pytest.approx(0.0)
-    run = types.SimpleNamespace(time=time, locked=time < 1.25)
-    assert _locked_below(run, chirp, 0.5) == pytest.approx(0.5)
 
 
 # ---------------------------------------------------------------- pi_resonance_range
