@@ -151,7 +151,17 @@ class CaseResult:
 
 
 def run_case(case):
-    """Run one :class:`StudyCase` (its step chosen); top-level so process pools can call it."""
+    """Run one :class:`StudyCase` (its step chosen); top-level so process pools can call it.
+
+    Parameters
+    ----------
+    case : StudyCase
+        A simulated case with its step.
+
+    Returns
+    -------
+    CaseResult
+    """
     start = time.perf_counter()
     if not case.simulated:
         result = _spring_case(case)
@@ -162,7 +172,17 @@ def run_case(case):
 
 
 def case_inputs(case):
-    """``(isolator, controller, excitation, sample rate [Hz])`` of a simulated case."""
+    """``(isolator, controller, excitation, sample rate [Hz])`` of a simulated case.
+
+    Parameters
+    ----------
+    case : StudyCase
+        A simulated case.
+
+    Returns
+    -------
+    tuple
+    """
     analysis = case.analysis
     isolator, controller = update_parameters(IsolatorParameters(spring=case.spring),
                                              ControllerParameters(), case.settings)
@@ -252,7 +272,17 @@ class _LockstepRun:
 
 
 def lockstep_key(case):
-    """Cases with equal keys share every step of their runs: same chirp, rate, step, solver."""
+    """Cases with equal keys share every step of their runs: same chirp, rate, step, solver.
+
+    Parameters
+    ----------
+    case : StudyCase
+        A simulated case with its step.
+
+    Returns
+    -------
+    tuple
+    """
     _, _, excitation, rate = case_inputs(case)
     return excitation, float(rate), float(case.dt), case.solver
 

@@ -341,8 +341,18 @@ def plan_studies(studies, *, quick=False, workers=None, progress=True, dt=None,
     ----------
     studies : sequence of Study
         The definitions (:func:`load_study`).
-    quick, workers, progress, dt, tolerance_db, spring
-        As for :func:`run_studies` (``workers`` and ``progress`` serve the step's choice).
+    quick : bool
+        Shorter runs (fewer, shorter Welch segments).
+    workers : int, optional
+        Cores for the step's choice; default all.
+    progress : bool
+        Show the step choice's progress.
+    dt : float, optional
+        Integration step [s] of every case; default a file's, else chosen.
+    tolerance_db : float, optional
+        Tolerance on the transmissibility [dB] the chosen step meets; not with ``dt``.
+    spring : SpringLaw, optional
+        The spring law of every case; default the MagSpring's tanh.
 
     Returns
     -------
@@ -376,8 +386,12 @@ def run_plan(plan, *, workers=None, progress=True, lockstep=True):
     ----------
     plan : StudyPlan
         The studies, their cases and steps.
-    workers, progress, lockstep
-        As for :func:`run_studies`.
+    workers : int, optional
+        Cores, as for :func:`run_studies`.
+    progress : bool
+        Show a progress bar over cases.
+    lockstep : bool
+        Share steps between cases through the batch kernel.
 
     Returns
     -------
