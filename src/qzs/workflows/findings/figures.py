@@ -15,6 +15,7 @@ from qzs.workflows.findings.verdicts import case_value
 __all__ = ["figure_curves", "curves_of", "draw_views", "draw_studies", "curve_files",
            "figure_names"]
 
+
 def figure_curves(result):
     """The curves a study's figures draw, each with its case's ``parameters`` and ``phase``.
 
@@ -150,7 +151,6 @@ def curve_files(result, folder):
 
 def figure_names(result):
     """The file stems of a study's figures.
-
 
     Parameters
     ----------

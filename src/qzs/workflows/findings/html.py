@@ -48,7 +48,6 @@ _RUN_ROWS = (("solver", "solver"), ("dt", "time step"), ("sample_rate", "sample 
 def paper_html(study_results, figures, verdicts, quick, wall_seconds):
     """The paper's ``report.html``: claims, then per study its settings, figures, verdicts, table.
 
-
     Parameters
     ----------
     study_results : sequence of StudyResult
@@ -141,7 +140,6 @@ def _duration_note(settings):
 def settings_table(result):
     """A study's run settings and its cases' parameters, as HTML tables.
 
-
     Parameters
     ----------
     result : StudyResult
@@ -182,7 +180,6 @@ _TABLE = (("trusted_from", "trusted from [Hz]"), ("resonance_frequency", "peak o
 
 def case_table(result):
     """A study's metrics per case, a dash and a note where undefined, as HTML.
-
 
     Parameters
     ----------

@@ -12,6 +12,7 @@ from qzs.iotools.files import atomic_path
 __all__ = ["with_reasons", "metric_rows", "claims_record", "run_settings", "document_head",
            "metric_cell", "significant", "write_text"]
 
+
 def with_reasons(metrics, reasons, prefix=""):
     """Metric values with ``<name>_reason`` beside each NaN one.
 
@@ -38,7 +39,6 @@ def with_reasons(metrics, reasons, prefix=""):
 
 def metric_rows(study_results):
     """The rows of ``metrics.csv``: one per study and case, a reason beside each NaN metric.
-
 
     Parameters
     ----------
@@ -70,7 +70,6 @@ def metric_rows(study_results):
 
 def claims_record(verdicts):
     """The claims' verdicts as data (``metrics.json``, ``--json``).
-
 
     Parameters
     ----------
@@ -106,7 +105,6 @@ def run_settings(result):
     return {k: v[0] if len(v) == 1 else v for k, v in out.items()}
 
 
-#: A number in a findings table or sentence: three significant digits, a dash if undefined.
 def significant(value):
     """``value`` with three significant digits (:func:`qzs._format.number`), "—" if undefined.
 
