@@ -5,8 +5,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from qzs._validation import (Structured, choice, finite_rows, integer, interval, non_negative_real,
-                             optional, positive_real, real)
+from qzs._validation import (Structured, choice, finite_rows, integer, interval, known_keys,
+                             non_negative_real, optional, positive_real, real)
 from qzs.errors import DataError, ParameterError, ProblemError
 
 NOT_NUMBERS = [True, np.True_, "1.0", None, [1.0], 1 + 2j]
@@ -182,3 +182,36 @@ def test_a_seed_comes_back_as_an_int(value):
     from qzs._validation import seed
 
     assert seed("seed", value) == value and type(seed("seed", value)) is int
+
+
+def test_known_keys_names_the_table_the_unknown_keys_and_the_allowed_ones():
+    table = {"a": 1, "b": 3}
+    assert known_keys(table, ("a", "b"), "[t]", required=("a",)) is table
+    with pytest.raises(ParameterError) as info:
+        known_keys({"a": 1, "zz": 2, "yy": 3}, ("b", "a"), "[t]", "'f.toml': ",
+                   options=("t",), fix="drop them")
+    assert str(info.value) == ("'f.toml': unknown key(s) ['yy', 'zz'] in [t]; allowed are "
+                               "['a', 'b']; drop them.")
+    assert info.value.options == ("t",)
+
+
+def test_known_keys_names_a_missing_required_key_and_refuses_a_non_table():
+    with pytest.raises(ParameterError, match=r"^missing axis\(s\) \['y'\] in `e`; required are "
+                                             r"\['x', 'y'\], allowed are \['x', 'y', 'z'\]\.$"):
+        known_keys({"x": 1}, ("z",), "`e`", required=("x", "y"), noun="axis")
+    with pytest.raises(ParameterError, match=r"^\[t\] must be a table, got 3\.$"):
+        known_keys(3, ("a",), "[t]")
+
+
+def test_known_keys_raises_the_error_asked_for():
+    from qzs.errors import ExcitationError
+
+    with pytest.raises(ExcitationError) as info:
+        known_keys({"f0": 1.0}, ("frequency",), "a sine", noun="option", error=ExcitationError,
+                   options=("f0",))
+    assert info.value.options == ("f0",)
+    build = Structured(build=lambda key, value, reason: ProblemError("t", key, value, reason))
+    with pytest.raises(ProblemError) as info:
+        known_keys({"a": 1, "q": 7}, ("a",), "[t]", error=build)
+    assert (info.value.table, info.value.key, info.value.value) == ("t", "q", 7)
+    assert info.value.fix == "unknown key(s) ['q'] in [t]; allowed are ['a']"

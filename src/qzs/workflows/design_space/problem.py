@@ -56,13 +56,14 @@ import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from qzs._format import unit_label, with_unit
-from qzs._validation import Structured, integer, read_toml, real
+from qzs._validation import Structured, integer, known_keys, read_toml, real
 from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.iotools.shipped import resolve_shipped, shipped_files
@@ -420,10 +421,7 @@ def _table(document, name, kind=dict):
 
 
 def _known(table, name, allowed):
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        _fail(name, unknown[0], table[unknown[0]],
-              f"unknown key in [{name}]; allowed are: {', '.join(allowed)}")
+    known_keys(table, allowed, f"[{name}]", error=Structured(build=partial(ProblemError, name)))
 
 
 def _parameter_name(table, name, kind):

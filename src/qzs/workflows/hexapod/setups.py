@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from qzs._format import number
-from qzs._validation import read_toml, real
+from qzs._validation import known_keys, read_toml, real
 from qzs.defaults import AXES, HEXAPOD
 from qzs.errors import ParameterError
 from qzs.iotools.shipped import resolve_shipped
@@ -260,12 +260,7 @@ def _geometry(table, where):
         raise ParameterError(f"{where}[geometry] `kind` must be one of {sorted(GEOMETRY_KINDS)}, "
                              f"got {kind!r}.")
     required, optional = GEOMETRY_KINDS[kind]
-    missing = [k for k in required if k not in table]
-    unknown = sorted(set(table) - set(required) - set(optional))
-    if missing or unknown:
-        raise ParameterError(f"{where}[geometry] of kind {kind!r} needs {list(required)} and "
-                             f"may have {list(optional)}; "
-                             + (f"missing {missing}" if missing else f"unknown {unknown}") + ".")
+    known_keys(table, optional, f"[geometry] (kind = {kind!r})", where, required=required)
     if kind == "cubic":
         table.setdefault("cube_center_height", default_cube_center_height(table["cube_edge"]))
         return cubic_geometry(**table), kind
@@ -278,10 +273,7 @@ def _geometry(table, where):
 
 def _platform(table, geometry, isolator, controller, where):
     table = _numbers(table, "platform", where)
-    unknown = sorted(set(table) - set(_PLATFORM_KEYS))
-    if unknown:
-        raise ParameterError(f"{where}[platform]: unknown key(s) {unknown}; allowed are "
-                             f"{list(_PLATFORM_KEYS)}.")
+    known_keys(table, _PLATFORM_KEYS, "[platform]", where)
     if "inertia" in table and "principal_inertia" in table:
         raise ParameterError(f"{where}[platform]: give `inertia` (3 x 3) or `principal_inertia` "
                              "(3), not both.")
@@ -313,10 +305,7 @@ _CARTESIAN_KEYS = ("point", "position_gain", "integral_gain", "damping_gain")
 
 def _cartesian(table, geometry, platform, controller, where):
     """A ``[cartesian]`` table as a CartesianController (gains left out: the legs' loops')."""
-    unknown = sorted(set(table) - set(_CARTESIAN_KEYS))
-    if unknown:
-        raise ParameterError(f"{where}[cartesian]: unknown key(s) {unknown}; allowed are "
-                             f"{list(_CARTESIAN_KEYS)}.")
+    known_keys(table, _CARTESIAN_KEYS, "[cartesian]", where)
     point = table.get("point", "origin")
     legs = CartesianController.from_legs(geometry, controller, platform=platform, point=point)
     return CartesianController(**{name: table.get(name, getattr(legs, name))
@@ -509,9 +498,7 @@ def load_hexapod(path: str | Path,
     where = f"{str(path)!r}: "
     allowed = {"geometry", "platform", "leg", "controller", "excitation", "simulation",
                "cartesian", "legs"}
-    unknown = sorted(set(document) - allowed)
-    if unknown:
-        raise ParameterError(f"{where}unknown table(s) {unknown}; allowed are {sorted(allowed)}.")
+    known_keys(document, allowed, "the hexapod file", where, noun="table")
     if "geometry" not in document:
         raise ParameterError(f"{where}a [geometry] table is needed (kind = 'cubic', 'radial' "
                              "or 'joints').")
@@ -535,15 +522,10 @@ def load_hexapod(path: str | Path,
     geometry, kind = _geometry(document["geometry"], where)
     platform = _platform(document.get("platform", {}), geometry, isolator, controller, where)
     excitation = document.get("excitation", {})
-    wrong = sorted(set(excitation) - set(AXES))
-    if wrong:
-        raise ParameterError(f"{where}[excitation.<axis>] axes must be among {list(AXES)}, got "
-                             f"{wrong}.")
-    simulation = dict(document.get("simulation", {}))
-    wrong = sorted(set(simulation) - set(SIMULATION_KEYS))
-    if wrong:
-        raise ParameterError(f"{where}[simulation]: unknown key(s) {wrong}; allowed are "
-                             f"{list(SIMULATION_KEYS)}.")
+    known_keys(excitation, AXES, "[excitation]", where, noun="axis name",
+               fix="write [excitation.<axis>] tables")
+    simulation = dict(known_keys(document.get("simulation", {}), SIMULATION_KEYS, "[simulation]",
+                                 where))
     for axis, options in excitation.items():
         if not isinstance(options, dict) or "kind" not in options:
             raise ParameterError(f"{where}[excitation.{axis}] needs a `kind` (chirp, sine, "
