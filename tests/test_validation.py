@@ -1,6 +1,8 @@
 """The shared argument checks of :mod:`qzs._validation`: what they accept, return and say."""
+import ast
 import math
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -215,3 +217,57 @@ def test_known_keys_raises_the_error_asked_for():
         known_keys({"a": 1, "q": 7}, ("a",), "[t]", error=build)
     assert (info.value.table, info.value.key, info.value.value) == ("t", "q", 7)
     assert info.value.fix == "unknown key(s) ['q'] in [t]; allowed are ['a']"
+
+
+#: The package's sources, and the one module that may compare a table's keys with the
+#: allowed ones by hand (:func:`known_keys`).
+SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
+KEY_CHECK_HOME = SOURCE / "_validation.py"
+
+
+def _is_set_of_a_table(node):
+    """``set(name)``, ``set(a.b)`` or ``name.keys()``: the keys of a table."""
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+            and node.func.id in ("set", "frozenset") and len(node.args) == 1:
+        return isinstance(node.args[0], (ast.Name, ast.Attribute, ast.Subscript))
+    return (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+            and node.func.attr == "keys" and not node.args)
+
+
+def hand_written_key_checks(tree):
+    """The lines of ``tree`` that take a table's keys minus others: ``set(table) - allowed``,
+    ``table.keys() - allowed``, ``set(table).difference(allowed)``."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Sub) \
+                and _is_set_of_a_table(node.left):
+            found.append(node.lineno)
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                and node.func.attr == "difference" and _is_set_of_a_table(node.func.value):
+            found.append(node.lineno)
+    return found
+
+
+@pytest.mark.parametrize("text, count", [
+    ("unknown = sorted(set(table) - set(ALLOWED))", 1),
+    ("extra = set(self.options) - {'a'}", 1),
+    ("extra = options.keys() - ALLOWED", 1),
+    ("extra = set(spec['x']).difference(ALLOWED)", 1),
+    ("unmet = set(range(cases)) - set(met)", 0),  # not a table's keys: the indices of cases
+    ("missing = {'done', 'status'} - set(dataset.variables)", 0),  # what must be there
+])
+def test_the_detector_sees_a_hand_written_key_check(text, count):
+    assert len(hand_written_key_checks(ast.parse(text))) == count
+
+
+def test_no_module_but_validation_checks_a_tables_keys_by_hand():
+    """Each check once: an unknown-key check goes through ``known_keys`` (its one message
+    format, naming the table, the unknown keys and the allowed ones)."""
+    found = {}
+    for path in sorted(SOURCE.rglob("*.py")):
+        if path == KEY_CHECK_HOME:
+            continue
+        lines = hand_written_key_checks(ast.parse(path.read_text(encoding="utf-8")))
+        if lines:
+            found[str(path.relative_to(SOURCE))] = lines
+    assert not found, f"use qzs._validation.known_keys at {found}"
