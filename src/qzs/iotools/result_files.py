@@ -1,0 +1,120 @@
+"""A result object's ``save(path)``: the format chosen by the file's extension (issue 42).
+
+Every result class delegates its ``save`` here with what it has: a dataset (``.nc``,
+``.csv``, ``.mat`` through :func:`qzs.iotools.writer.write_dataset`), a plain record
+(``.json``) and, for a format of its own, a writer by extension. The extension is checked
+before anything is computed or written (:func:`qzs.iotools.paths.check_output_path`: an
+:class:`~qzs.errors.OutputPathError` naming ``path``, its extension and the accepted ones);
+every file is written atomically (:func:`qzs.iotools.files.atomic_path`).
+"""
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+from qzs._format import json_text
+from qzs.iotools.files import _write_error, atomic_path
+from qzs.iotools.paths import check_output_path
+
+__all__ = ["DATASET_SUFFIXES", "RECORD_SUFFIXES", "save_by_extension", "suffixes_of",
+           "write_json"]
+
+#: The files a result with arrays writes (:func:`qzs.iotools.writer.write_dataset`).
+DATASET_SUFFIXES = (".nc", ".csv", ".mat")
+#: The file a result with a plain record writes (:func:`write_json`).
+RECORD_SUFFIXES = (".json",)
+
+
+def write_json(record: Mapping[str, Any], path: str | Path) -> Path:
+    """Write ``record`` as strict JSON (NaN and inf as null), atomically.
+
+    Parameters
+    ----------
+    record : mapping
+        Plain data (:func:`qzs._format.json_text` converts arrays and numbers).
+    path : str or Path
+        The ``.json`` file; its folder is created if missing.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    text = json_text(record) + "\n"
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
+
+
+def save_by_extension(path: str | Path, *, dataset: Callable[[], Any] | None = None,
+                      record: Callable[[], Mapping[str, Any]] | None = None,
+                      writers: Mapping[str, Callable[[Path], Path]] | None = None) -> Path:
+    """Write a result to ``path`` in the format its extension names, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file; its extension (case-insensitive) chooses the format.
+    dataset : callable, optional
+        Returns the result's ``xarray.Dataset`` (CF attributes, :func:`qzs.iotools.schema.
+        to_dataset`); given, ``.nc``, ``.csv`` and ``.mat`` are accepted.
+    record : callable, optional
+        Returns the result as plain data; given, ``.json`` is accepted.
+    writers : mapping of str to callable, optional
+        Extension -> a writer of its own, called with the checked path (e.g. a spring
+        fit's ``.toml``); it writes atomically and returns the path.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    OutputPathError
+        An extension the result cannot be written as (naming ``path``, the extension and
+        the accepted ones), or a path that cannot be written; raised before any work.
+    WriteError
+        Writing failed; nothing is left behind.
+    """
+    writers = {suffix.lower(): write for suffix, write in (writers or {}).items()}
+    accepted = [*(DATASET_SUFFIXES if dataset is not None else ()),
+                *(RECORD_SUFFIXES if record is not None else ()), *writers]
+    path = check_output_path(path, argument="path", suffixes=accepted)
+    suffix = path.suffix.lower()
+    if suffix in writers:
+        return writers[suffix](path)
+    if suffix in RECORD_SUFFIXES:
+        return write_json(record(), path)  # type: ignore[misc]  # accepted only with it
+    from qzs.iotools.writer import write_dataset
+
+    return write_dataset(dataset(), path)  # type: ignore[misc]  # accepted only with it
+
+
+def suffixes_of(*, dataset: bool = False, record: bool = False,
+                others: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The extensions :func:`save_by_extension` accepts with these arguments.
+
+    Parameters
+    ----------
+    dataset, record : bool
+        Is a dataset, a record given?
+    others : tuple of str
+        The extensions of the ``writers`` given.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return (*(DATASET_SUFFIXES if dataset else ()), *(RECORD_SUFFIXES if record else ()),
+            *others)
+
+
