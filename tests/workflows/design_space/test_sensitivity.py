@@ -57,7 +57,7 @@ def test_ishigami_analytic_indices_lie_in_the_reported_intervals(ishigami_sobol,
     assert result.method == "sobol" and result.parameters == ISHIGAMI_NAMES
     assert result.samples == 2 ** 12 and result.evaluations == 2 ** 12 * (3 + 2)
     for name, exact in (("first_order", first), ("total_order", total)):
-        interval = getattr(result, f"{name}_interval")[0]
+        interval = np.stack(result.intervals[name], axis=-1)[0]
         assert np.all(interval[:, 0] <= exact) and np.all(exact <= interval[:, 1]), (
             name, exact, interval)
         width = interval[:, 1] - interval[:, 0]
@@ -78,7 +78,7 @@ def test_morris_sees_ishigami_x3_act_only_through_interaction(ishigami_sobol):
     assert result.method == "morris" and result.evaluations == 40 * (3 + 1)
     assert result.first_order is None and result.mu_star.shape == (1, 3)
     mu_star, sigma = result.mu_star[0], result.sigma[0]
-    low = result.mu_star_interval[0, :, 0]
+    low = result.intervals["mu_star"][0][0]
     assert np.all(low > 0)  # each parameter matters: x3 too, though S1(x3) = 0
     assert abs(ishigami_sobol.first_order[0, 2]) < 0.05
     assert sigma[2] > mu_star[2] / 2  # x3 acts through its interaction with x1
@@ -89,7 +89,7 @@ def test_the_same_seed_gives_the_same_indices():
     one = sensitivity(ishigami_problem(samples=64, seed=3), evaluate=ishigami, progress=False)
     two = sensitivity(ishigami_problem(samples=64), seed=3, evaluate=ishigami, progress=False)
     assert np.array_equal(one.total_order, two.total_order)
-    assert np.array_equal(one.first_order_interval, two.first_order_interval)
+    assert np.array_equal(one.intervals["first_order"], two.intervals["first_order"])
 
 
 # ---------------------------------------------------------------- linearised isolator
@@ -147,7 +147,7 @@ def test_linear_isolator_ranking_agrees_with_the_derivative_based_one(linear_sob
     assert result.ranking() == expected == ("damping_gain", "viscous_damping", "mass",
                                             "pi_kp")
     # the bound holds: every total index's interval starts below its DGSM bound
-    lower = result.total_order_interval[0, :, 0]
+    lower = result.intervals["total_order"][0][0]
     for j, name in enumerate(result.parameters):
         assert lower[j] <= bounds[name] + 1e-9, (name, lower[j], bounds[name])
     # and the qzs path evaluates exactly the closed form (no simulation)
@@ -166,7 +166,7 @@ def test_a_failed_case_leaves_the_indices_undefined_with_the_reason():
     problem["variables"]["coulomb_force"] = {"low": 0.5, "high": 15.0}  # stiction 10 N
     result = sensitivity(problem, progress=False)
     assert result.failed > 0
-    assert np.isnan(result.total_order).all() and np.isnan(result.first_order_interval).all()
+    assert np.isnan(result.total_order).all() and np.isnan(result.intervals["first_order"]).all()
     assert "cases gave NaN" in result.reasons[0] and "coulomb" in result.reasons[0].lower()
     with pytest.raises(ParameterError, match="undefined"):
         result.ranking()
@@ -335,9 +335,9 @@ def test_the_result_round_trips_through_its_files(ishigami_sobol, tmp_path):
         for name in ("first_order", "total_order"):
             assert np.array_equal(back[name].values, getattr(result, name))
             assert np.array_equal(back[f"{name}_lower"].values,
-                                  getattr(result, f"{name}_interval")[..., 0])
+                                  result.intervals[name][0])
             assert np.array_equal(back[f"{name}_upper"].values,
-                                  getattr(result, f"{name}_interval")[..., 1])
+                                  result.intervals[name][1])
         assert list(back["parameter"].values) == list(result.parameters)
         assert back.attrs["method"] == "sobol"
 
@@ -352,7 +352,7 @@ def test_the_result_round_trips_through_its_files(ishigami_sobol, tmp_path):
     assert np.allclose(np.array(column["total_order"], float), result.total_order[0],
                        rtol=1e-9)
     assert np.allclose(np.array(column["first_order_lower"], float),
-                       result.first_order_interval[0, :, 0], rtol=1e-9)
+                       result.intervals["first_order"][0][0], rtol=1e-9)
 
     mat = scipy.io.loadmat(result.save(tmp_path / "ishigami.mat"))
     assert np.array_equal(np.asarray(mat["total_order"], float).reshape(1, 3),
@@ -382,3 +382,19 @@ def test_summary_and_ranking(ishigami_sobol):
     with pytest.raises(ParameterError, match="`metric` must be one of"):
         ishigami_sobol.ranking("peak_stroke")
     assert isinstance(ishigami_sobol, SensitivityResult)
+
+
+def test_intervals_are_one_mapping_and_the_old_names_warn(ishigami_sobol):
+    """``intervals``: each estimated index -> (low, high) about it; ``<index>_interval``
+    (deprecated, one release) warns with the new name and gives the same numbers."""
+    result = ishigami_sobol
+    assert set(result.intervals) == {"first_order", "total_order"} and result.confidence == 0.95
+    for name, (low, high) in result.intervals.items():
+        estimate = getattr(result, name)
+        assert low.shape == high.shape == estimate.shape
+        assert np.all(low <= estimate) and np.all(estimate <= high) and np.all(low < high)
+        with pytest.warns(DeprecationWarning, match=rf"use `intervals\['{name}'\]`"):
+            old = getattr(result, f"{name}_interval")
+        assert np.array_equal(old, np.stack([low, high], axis=-1))
+    with pytest.warns(DeprecationWarning):
+        assert result.mu_star_interval is None  # a Sobol result has no Morris interval

@@ -55,6 +55,7 @@ from qzs._format import unit_label
 from qzs._optional import require
 from qzs._validation import seed as checked_seed
 from qzs.errors import CountLimitError, ParameterError, ProblemError
+from qzs.identify._protocol import deprecated_alias
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.workflows.design_space.evaluation import cases_per_batch, evaluate_cases
 from qzs.workflows.design_space.metrics import METRICS
@@ -91,12 +92,17 @@ _INDICES = {"sobol": ("first_order", "total_order"), "morris": ("mu_star", "mu",
 _INTERVALS = {"sobol": ("first_order", "total_order"), "morris": ("mu_star",)}
 
 
+def _stacked(result, name):
+    """An interval as the old ``<index>_interval`` array ``(metric, parameter, 2)``, or None."""
+    return np.stack(result.intervals[name], axis=-1) if name in result.intervals else None
+
+
 @dataclass(frozen=True, kw_only=True, eq=False)
 class SensitivityResult:
     """Global sensitivity indices of a problem's metrics (:func:`sensitivity`).
 
-    Arrays are ``(metric, parameter)``; intervals ``(metric, parameter, 2)`` with the
-    lower and upper end at ``confidence``. The indices of the other method are None. A
+    Arrays are ``(metric, parameter)``; ``intervals`` maps each estimated index to its
+    ``(low, high)`` arrays at ``confidence``. The indices of the other method are None. A
     metric whose indices are undefined (a failed case, a metric that never varies) has NaN
     indices and its reason in ``reasons``. The object holds data; its methods delegate
     to this module's functions, :mod:`qzs.viz.sensitivity` and
@@ -118,13 +124,14 @@ class SensitivityResult:
         Their units.
     first_order, total_order : ndarray or None
         Sobol: first-order and total indices [-].
-    first_order_interval, total_order_interval : ndarray or None
-        Their confidence intervals [-] (bootstrap, :data:`NUM_RESAMPLES` resamples).
     mu_star, mu, sigma : ndarray or None
         Morris: mean absolute, mean and standard deviation of the elementary effects
         [the metric's unit].
-    mu_star_interval : ndarray or None
-        The confidence interval of ``mu_star`` [the metric's unit].
+    intervals : Mapping[str, tuple of ndarray]
+        Index name (Sobol: ``first_order``, ``total_order``; Morris: ``mu_star``) -> its
+        ``(low, high)`` confidence interval at ``confidence``, each ``(metric, parameter)``
+        [the index's unit] (bootstrap, :data:`NUM_RESAMPLES` resamples). The old
+        ``<index>_interval`` arrays ``(metric, parameter, 2)`` are deprecated aliases.
     confidence : float
         The intervals' confidence level [-] (0.95).
     samples : int
@@ -157,13 +164,11 @@ class SensitivityResult:
     metrics: tuple
     metric_units: tuple
     first_order: np.ndarray | None = None
-    first_order_interval: np.ndarray | None = None
     total_order: np.ndarray | None = None
-    total_order_interval: np.ndarray | None = None
     mu_star: np.ndarray | None = None
-    mu_star_interval: np.ndarray | None = None
     mu: np.ndarray | None = None
     sigma: np.ndarray | None = None
+    intervals: Mapping[str, tuple] = field(default_factory=lambda: MappingProxyType({}))
     confidence: float = 0.95
     samples: int = 0
     levels: int = 0
@@ -186,15 +191,12 @@ class SensitivityResult:
         """
         return {name: getattr(self, name) for name in _INDICES[self.method]}
 
-    @property
-    def intervals(self) -> dict[str, np.ndarray]:
-        """The confidence intervals by index name, shape (n_metrics, n_parameters, 2).
-
-        Returns
-        -------
-        dict of str to ndarray
-        """
-        return {name: getattr(self, f"{name}_interval") for name in _INTERVALS[self.method]}
+    first_order_interval = deprecated_alias("first_order_interval", "intervals['first_order']",
+                                            lambda result: _stacked(result, "first_order"))
+    total_order_interval = deprecated_alias("total_order_interval", "intervals['total_order']",
+                                            lambda result: _stacked(result, "total_order"))
+    mu_star_interval = deprecated_alias("mu_star_interval", "intervals['mu_star']",
+                                        lambda result: _stacked(result, "mu_star"))
 
     def ranking(self, metric: str | None = None) -> tuple[str, ...]:
         """The parameters, most influential first (:func:`parameter_ranking`).
@@ -558,7 +560,8 @@ def _analyse(salib, plan, unit_samples, values, messages):
                 intervals[name][i] = np.column_stack([out[name][i] - half,
                                                       out[name][i] + half])
     result = dict(out)
-    result.update({f"{name}_interval": interval for name, interval in intervals.items()})
+    result["intervals"] = MappingProxyType({name: (interval[..., 0], interval[..., 1])
+                                            for name, interval in intervals.items()})
     return result, reasons
 
 
@@ -647,7 +650,7 @@ def sensitivity_summary(result: SensitivityResult) -> str:
             label = _label(name, result.parameter_units[j])
             if result.parameter_kinds[j] == "uncertain":
                 label += " ~"
-            half = {name: np.diff(interval[i, j])[0] / 2 for name, interval in intervals.items()}
+            half = {name: (high[i, j] - low[i, j]) / 2 for name, (low, high) in intervals.items()}
             if result.method == "sobol":
                 s1, st = indices["first_order"][i, j], indices["total_order"][i, j]
                 lines.append(f"  {label:<32} {s1:8.3f} {half['first_order']:7.3f} {st:8.3f} "
@@ -737,8 +740,7 @@ def sensitivity_dataset(result: SensitivityResult) -> xr.Dataset:
     for name in _INDICES[result.method]:
         values[name] = getattr(result, name)
         if name in _INTERVALS[result.method]:
-            interval = getattr(result, f"{name}_interval")
-            values[f"{name}_lower"], values[f"{name}_upper"] = interval[..., 0], interval[..., 1]
+            values[f"{name}_lower"], values[f"{name}_upper"] = result.intervals[name]
     method = ("Sobol indices, Saltelli's scheme (SALib)" if result.method == "sobol"
               else "Morris elementary effects (SALib)")
     attrs = {"title": f"global sensitivity of {result.title}",
