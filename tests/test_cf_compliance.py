@@ -5,8 +5,8 @@ a test dependency) must find no error (its high-priority failures) and no warnin
 medium-priority ones) in: a single run (``qzs simulate --out``), a batch's and a sweep's
 dataset, a six-axis run (``qzs hexapod simulate --out``), a steady-state response
 (``qzs response --out``), an experiment's transmissibility, a study's curves, an
-optimisation's and a sensitivity analysis's results, and a six-axis transmissibility
-matrix. How qzs encodes what CF has no home for: docs/model.md, decision 34.
+optimisation's and a sensitivity analysis's results, a six-axis transmissibility
+matrix, and a fit's data (a friction fit's ``save``). How qzs encodes what CF has no home for: docs/model.md, decision 34.
 
 Run as a script (``python tests/test_cf_compliance.py FOLDER``) it writes each kind into
 FOLDER and prints the checker's counts per file.
@@ -68,14 +68,13 @@ def streamed_run(folder):
 
 def batch(folder):
     import qzs
-    from qzs.iotools.writer import write_dataset
 
     cases = [(qzs.IsolatorParameters(stiction_force=f), qzs.ControllerParameters())
              for f in (5.0, 10.0)]
     result = qzs.simulate_batch(cases, qzs.Sine(amplitude=0.002, frequency=3.0), duration=0.2,
                                 sample_rate=200.0, channels=("relative_position", "locked"),
                                 workers=1)
-    return write_dataset(result.to_xarray(), folder / "batch.nc")
+    return result.save(folder / "batch.nc")  # BatchResult.save: write_dataset of to_xarray
 
 
 def sweep(folder):
@@ -109,14 +108,13 @@ def response(folder):
 
 def experiment(folder):
     import qzs
-    from qzs.iotools.writer import write_dataset
     from qzs.workflows.experiment.process import process_experiment
 
     recording = qzs.read_recording(ROOT / "examples" / "data" / "experiment.csv",
                                    ROOT / "examples" / "data" / "experiment_map.toml")
     result = process_experiment(recording, fft_length=1024, n_averages=None,
                                 simulate_match=False)
-    return write_dataset(result.to_xarray(), folder / "experiment.nc")
+    return result.save(folder / "experiment.nc")
 
 
 def curves(folder):
@@ -162,6 +160,22 @@ def sensitivity(folder):
                "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
                "sensitivity": {"samples": 8}}
     return analyse(problem, progress=False).save(folder / "sensitivity.nc")
+
+
+def friction_fit(folder):
+    """A fit's dataset (qzs.identify's FitProtocol.save): the test on ``time``, the
+    estimates and their intervals as global attributes."""
+    import qzs
+
+    truth = qzs.IsolatorParameters()
+    time = np.arange(0.0, 8.0, 1e-3)
+    omega = 2 * np.pi * 0.5
+    z = -0.060 + 0.030 * np.sin(omega * time)
+    v, a = 0.030 * omega * np.cos(omega * time), -0.030 * omega ** 2 * np.sin(omega * time)
+    force = (truth.mass * a - qzs.spring_force(z, truth) - qzs.friction_force(v, truth) + 3.0
+             + np.random.default_rng(0).normal(0.0, 0.2, time.size))
+    fit = qzs.fit_friction(time, z, force, spring=truth, mass=truth.mass)
+    return fit.save(folder / "friction_fit.nc")
 
 
 def hexapod_transmissibility(folder):
@@ -211,7 +225,8 @@ KINDS = {"single_run": single_run, "run_with_blocks": run_with_blocks,
          "streamed_run": streamed_run, "batch": batch,
          "sweep": sweep, "hexapod_run": hexapod_run, "response": response,
          "experiment": experiment, "curves": curves, "optimisation": optimisation,
-         "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility}
+         "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility,
+         "friction_fit": friction_fit}
 
 
 @pytest.fixture(scope="module")

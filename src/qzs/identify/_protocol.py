@@ -19,7 +19,42 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-__all__ = ["FitProtocol", "deprecated_alias", "interval_attributes"]
+__all__ = ["FitProtocol", "deprecated_alias", "interval_attributes", "plot_doc",
+           "FREQUENCY_SCALE_OPTION"]
+
+_PLOT_DOC = """The fitted data and the fit, with the residuals (:mod:`qzs.viz.identify`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (format from the suffix; a .png also as .svg).
+        title : str, optional
+            Figure title; default none.{options}
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Its axes labelled with their units.
+        """
+#: The option of a fit's figure with a frequency axis.
+FREQUENCY_SCALE_OPTION = """
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log)."""
+
+
+def plot_doc(options: str = "") -> str:
+    """The docstring every fit's ``plot`` shares, with the figure's own options.
+
+    Parameters
+    ----------
+    options : str
+        Numpydoc entries of the options after ``title`` (e.g. :data:`FREQUENCY_SCALE_OPTION`).
+
+    Returns
+    -------
+    str
+    """
+    return _PLOT_DOC.format(options=options)
 
 
 def deprecated_alias(old: str, new: str, value: Callable[[Any], Any]) -> property:
@@ -102,28 +137,12 @@ class FitProtocol:
         """Writers of formats of the fit's own, by extension (none by default)."""
         return {}
 
-    def plot(self, path: str | Path | None = None, *, title: str | None = None,
-             **options: Any) -> "Figure":
-        """The fitted data and the fit, with the residuals (:mod:`qzs.viz.identify`).
-
-        Parameters
-        ----------
-        path : str or Path, optional
-            Write the figure there, atomically (format from the suffix; a .png also as .svg).
-        title : str, optional
-            Figure title; default none.
-        **options
-            The figure function's own options (a transmissibility fit's
-            ``frequency_scale``: ``"log"`` or ``"linear"`` [-]).
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-            Axes labelled with their units.
-        """
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
         from qzs.viz import identify
 
-        return getattr(identify, self._figure)(self, path=path, title=title or "", **options)
+        return getattr(identify, self._figure)(self, path=path, title=title or "")
+
+    plot.__doc__ = plot_doc()
 
     def save(self, path: str | Path) -> Path:
         """Write the fit atomically, the format chosen by the extension.

@@ -3,6 +3,7 @@ import dataclasses
 import time as _time
 from dataclasses import dataclass
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -16,7 +17,8 @@ from qzs.defaults import EXCITATION
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
 from qzs.errors import DataError, FitError, ParameterError, SimulationError
-from qzs.identify._protocol import FitProtocol, interval_attributes
+from qzs.identify._protocol import (FREQUENCY_SCALE_OPTION, FitProtocol, interval_attributes,
+                                   plot_doc)
 from qzs.identify._statistics import (fit_covariance, finite_samples, profile_threshold,
                                       student_quantile)
 from qzs.model.controller import ControllerParameters
@@ -26,6 +28,7 @@ from qzs.model.registry import PARAMETERS, numeric_parameters
 
 if TYPE_CHECKING:
     import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = ["TransmissibilityFit", "fit_transmissibility"]
 
@@ -73,7 +76,14 @@ class TransmissibilityFit(FitProtocol):
     n_simulations: int
     elapsed: float
 
-    _figure = "plot_transmissibility_fit"
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
+        from qzs.viz.identify import plot_transmissibility_fit
+
+        return plot_transmissibility_fit(self, path=path, title=title or "",
+                                         frequency_scale=frequency_scale)
+
+    plot.__doc__ = plot_doc(FREQUENCY_SCALE_OPTION)
 
     def estimates(self) -> dict[str, float]:
         """The fitted values by name (the keys of ``intervals``; units: the registry's).

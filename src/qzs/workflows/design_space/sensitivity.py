@@ -231,6 +231,9 @@ class SensitivityResult:
         """
         return sensitivity_dataset(self)
 
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = SENSITIVITY_SUFFIXES
+
     def save(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` atomically: ``.nc`` (NetCDF), ``.csv`` (one row per
         metric and parameter) or ``.mat`` (MATLAB).
@@ -245,9 +248,9 @@ class SensitivityResult:
         Path
             ``path``.
         """
-        from qzs.iotools.writer import write_dataset
+        from qzs.iotools.result_files import save_by_extension
 
-        return write_dataset(self.to_xarray(), path)
+        return save_by_extension(path, dataset=self.to_xarray)
 
     def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
         """Bars of the indices with their intervals, one panel per metric
