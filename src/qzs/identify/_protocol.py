@@ -73,7 +73,7 @@ def deprecated_alias(old: str, new: str, value: Callable[[Any], Any]) -> propert
     -------
     property
     """
-    def get(self):
+    def get(self: Any) -> Any:
         warnings.warn(f"`{type(self).__name__}.{old}` is deprecated and will be removed in "
                       f"the next release; use `{new}`.", DeprecationWarning, stacklevel=2)
         return value(self)
