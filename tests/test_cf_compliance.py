@@ -21,6 +21,8 @@ checker = pytest.importorskip("compliance_checker.runner",
                               reason="compliance-checker is in the test extra: "
                                      "pip install -e '.[test]'")
 
+from helpers import LINEAR_PROBLEM, SENSITIVITY_PROBLEM, instron_test
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -131,17 +133,6 @@ def curves(folder):
     return write_curves(dataset, folder, "damping")[0]
 
 
-LINEAR_PROBLEM = {
-    "problem": {"name": "linear", "title": "linear trade-off"},
-    "variables": {"damping_gain": {"low": 0.0, "high": 300.0},
-                  "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
-    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
-                   {"metric": "hunting_amplitude"}],
-    "constraints": [{"metric": "linear_transmissibility_at", "frequency": 5.0, "max": 0.9}],
-    "optimizer": {"population": 4, "generations": 2, "seed": 4},
-}
-
-
 def optimisation(folder):
     pytest.importorskip("pymoo")
     from qzs.workflows.design_space.optimizer import optimize
@@ -154,12 +145,7 @@ def sensitivity(folder):
     pytest.importorskip("SALib")
     from qzs.workflows.design_space.sensitivity import sensitivity as analyse
 
-    problem = {"problem": {"name": "linear", "title": "Linearised isolator at 3 Hz"},
-               "variables": {"pi_kp": {"low": 1.0, "high": 100.0},
-                             "mass": {"low": 5.0, "high": 8.0}},
-               "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
-               "sensitivity": {"samples": 8}}
-    return analyse(problem, progress=False).save(folder / "sensitivity.nc")
+    return analyse(SENSITIVITY_PROBLEM, progress=False).save(folder / "sensitivity.nc")
 
 
 def friction_fit(folder):
@@ -168,13 +154,7 @@ def friction_fit(folder):
     import qzs
 
     truth = qzs.IsolatorParameters()
-    time = np.arange(0.0, 8.0, 1e-3)
-    omega = 2 * np.pi * 0.5
-    z = -0.060 + 0.030 * np.sin(omega * time)
-    v, a = 0.030 * omega * np.cos(omega * time), -0.030 * omega ** 2 * np.sin(omega * time)
-    force = (truth.mass * a - qzs.spring_force(z, truth) - qzs.friction_force(v, truth) + 3.0
-             + np.random.default_rng(0).normal(0.0, 0.2, time.size))
-    fit = qzs.fit_friction(time, z, force, spring=truth, mass=truth.mass)
+    fit = qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
     return fit.save(folder / "friction_fit.nc")
 
 

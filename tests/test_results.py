@@ -47,6 +47,8 @@ import pytest
 import qzs
 from qzs.errors import OutputPathError
 
+from helpers import LINEAR_PROBLEM, SENSITIVITY_PROBLEM, instron_test
+
 ROOT = Path(__file__).resolve().parents[1]
 #: How a result class's name ends (the rule of the module docstring).
 RESULT_ENDINGS = ("Result", "Fit", "Response", "Transmissibility", "Estimate", "Curve",
@@ -120,23 +122,12 @@ def _design():
 
 def _optimisation(folder):
     pytest.importorskip("pymoo")
-    problem = {"problem": {"name": "linear", "title": "linear trade-off"},
-               "variables": {"damping_gain": {"low": 0.0, "high": 300.0},
-                             "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
-               "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
-                              {"metric": "hunting_amplitude"}],
-               "optimizer": {"population": 4, "generations": 2, "seed": 4}}
-    return qzs.optimize(problem, folder / "linear.zarr", progress=False)
+    return qzs.optimize(LINEAR_PROBLEM, folder / "linear.zarr", progress=False)
 
 
 def _sensitivity():
     pytest.importorskip("SALib")
-    problem = {"problem": {"name": "linear", "title": "Linearised isolator at 3 Hz"},
-               "variables": {"pi_kp": {"low": 1.0, "high": 100.0},
-                             "mass": {"low": 5.0, "high": 8.0}},
-               "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
-               "sensitivity": {"samples": 8}}
-    return qzs.sensitivity(problem, progress=False)
+    return qzs.sensitivity(SENSITIVITY_PROBLEM, progress=False)
 
 
 def _response():
@@ -167,14 +158,7 @@ def _spring_fit():
 
 def _friction_fit():
     truth = qzs.IsolatorParameters()
-    rng = np.random.default_rng(0)
-    time = np.arange(0.0, 8.0, 1e-3)
-    omega = 2 * np.pi * 0.5
-    z = -0.060 + 0.030 * np.sin(omega * time)
-    v, a = 0.030 * omega * np.cos(omega * time), -0.030 * omega ** 2 * np.sin(omega * time)
-    force = (truth.mass * a - qzs.spring_force(z, truth) - qzs.friction_force(v, truth) + 3.0
-             + rng.normal(0.0, 0.2, time.size))
-    return qzs.fit_friction(time, z, force, spring=truth, mass=truth.mass)
+    return qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
 
 
 def _transmissibility_fit():

@@ -30,7 +30,7 @@ from qzs.engine.channels import (BLOCK_CHANNELS, FLAGS, run_channels, sample_byt
                                  simulation_schema, unrecorded)
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
-from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.controller import BLOCKS
 from qzs.model.registry import (ALL_PARAMETERS, BLOCK_PARAMETERS, SPRING_PARAMETERS,
@@ -145,26 +145,10 @@ class BatchResult:
         return plot_batch(self, path=path, title=title)
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` atomically: ``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row
-        per case and sample) or ``.mat`` (MATLAB) (:func:`qzs.iotools.writer.write_dataset`).
-
-        Parameters
-        ----------
-        path : str or Path
-            The file; its extension is one of :attr:`save_suffixes`.
-
-        Returns
-        -------
-        Path
-            ``path``.
-
-        Raises
-        ------
-        OutputPathError
-            Another extension (naming ``path``, its extension and the accepted ones),
-            raised before anything is written.
-        """
         return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per case and "
+                            "sample) or ``.mat`` (MATLAB) of :meth:`to_xarray`")
 
     def to_xarray(self) -> xr.Dataset:
         """The batch as an ``xarray.Dataset`` on dimensions ``case`` and ``time``, CF-1.10.

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from qzs.iotools.result_files import save_by_extension, suffixes_of
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -145,28 +145,11 @@ class FitProtocol:
     plot.__doc__ = plot_doc()
 
     def save(self, path: str | Path) -> Path:
-        """Write the fit atomically, the format chosen by the extension.
-
-        ``.json``: :meth:`to_record` (estimates, ``intervals``, ``confidence``, units,
-        residual); ``.nc``, ``.csv``, ``.mat``: :meth:`to_xarray` (the fitted data [SI
-        units], the estimates and intervals as global attributes); a spring fit also writes
-        ``.toml`` (its law as a ``[spring]`` table).
-
-        Parameters
-        ----------
-        path : str or Path
-            The file; its extension is one of ``save_suffixes``.
-
-        Returns
-        -------
-        Path
-            ``path``.
-
-        Raises
-        ------
-        OutputPathError
-            Another extension (the error names ``path``, its extension and the accepted
-            ones), raised before anything is written.
-        """
         return save_by_extension(path, dataset=self.to_xarray, record=self.to_record,
                                  writers=self._writers())
+
+    save.__doc__ = save_doc("``.json`` (:meth:`to_record`: the estimates, ``intervals``, "
+                            "``confidence``, units, residual); ``.nc``, ``.csv``, ``.mat`` "
+                            "(:meth:`to_xarray`: the fitted data [SI units], the estimates "
+                            "and intervals as global attributes); a spring fit also ``.toml`` "
+                            "(its law as a ``[spring]`` table)")

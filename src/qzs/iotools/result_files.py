@@ -15,8 +15,8 @@ from qzs._format import json_text
 from qzs.iotools.files import _write_error, atomic_path
 from qzs.iotools.paths import check_output_path
 
-__all__ = ["DATASET_SUFFIXES", "RECORD_SUFFIXES", "save_by_extension", "suffixes_of",
-           "write_json"]
+__all__ = ["DATASET_SUFFIXES", "RECORD_SUFFIXES", "save_by_extension", "save_doc",
+           "suffixes_of", "write_json"]
 
 #: The files a result with arrays writes (:func:`qzs.iotools.writer.write_dataset`).
 DATASET_SUFFIXES = (".nc", ".csv", ".mat")
@@ -97,6 +97,46 @@ def save_by_extension(path: str | Path, *, dataset: Callable[[], Any] | None = N
     from qzs.iotools.writer import write_dataset
 
     return write_dataset(dataset(), path)  # type: ignore[misc]  # accepted only with it
+
+
+def save_doc(formats: str) -> str:
+    """The docstring every result's ``save`` shares, with what its extensions write.
+
+    Parameters
+    ----------
+    formats : str
+        What each extension writes (``"``.nc``, ``.csv``, ``.mat``: :meth:`to_xarray`"``),
+        wrapped into the docstring's first paragraph.
+
+    Returns
+    -------
+    str
+    """
+    import textwrap
+
+    head = textwrap.fill(f"Write the result atomically, the format chosen by the extension: "
+                         f"{formats}.", width=88, subsequent_indent=" " * 8)
+    return head + _SAVE_DOC
+
+
+_SAVE_DOC = """
+
+        Parameters
+        ----------
+        path : str or Path
+            The file; its extension is one of ``save_suffixes``.
+
+        Returns
+        -------
+        Path
+            ``path``.
+
+        Raises
+        ------
+        OutputPathError
+            Another extension (naming ``path``, its extension and the accepted ones),
+            raised before anything is computed or written.
+        """
 
 
 def suffixes_of(*, dataset: bool = False, record: bool = False,

@@ -40,7 +40,7 @@ from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
-from qzs.iotools.result_files import save_by_extension, suffixes_of
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.iotools.rig import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
@@ -307,27 +307,11 @@ class ExperimentResult:
     save_suffixes = suffixes_of(dataset=True, record=True)
 
     def save(self, path: str | Path) -> Path:
-        """Write the experiment atomically, the format chosen by the extension: ``.nc``,
-        ``.csv``, ``.mat`` (:meth:`to_xarray`: the transmissibility [1] on frequency [Hz])
-        or ``.json`` (:meth:`to_record`).
-
-        Parameters
-        ----------
-        path : str or Path
-            The file; its extension is one of :attr:`save_suffixes`.
-
-        Returns
-        -------
-        Path
-            ``path``.
-
-        Raises
-        ------
-        OutputPathError
-            Another extension (naming ``path``, its extension and the accepted ones),
-            raised before anything is written.
-        """
         return save_by_extension(path, dataset=self.to_xarray, record=self.to_record)
+
+    save.__doc__ = save_doc("``.nc``, ``.csv``, ``.mat`` (:meth:`to_xarray`: the "
+                            "transmissibility [1] on frequency [Hz]) or ``.json`` "
+                            "(:meth:`to_record`)")
 
     def write_report(self, folder: str | Path,
                      frequency_scale: str | None = None) -> dict[str, Path]:

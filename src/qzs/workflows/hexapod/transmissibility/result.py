@@ -12,7 +12,7 @@ import numpy as np
 from qzs._format import number
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
-from qzs.iotools.result_files import DATASET_SUFFIXES
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
 from qzs.iotools.schema import Schema, Variable, to_dataset
 
 if TYPE_CHECKING:
@@ -157,29 +157,10 @@ class HexapodTransmissibility:
     save_suffixes = DATASET_SUFFIXES
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` atomically: ``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row
-        per frequency and entry) or ``.mat`` (MATLAB) (:func:`qzs.iotools.writer.
-        write_dataset`).
-
-        Parameters
-        ----------
-        path : str or Path
-            The file; its extension is one of :attr:`save_suffixes`.
-
-        Returns
-        -------
-        Path
-            ``path``.
-
-        Raises
-        ------
-        OutputPathError
-            Another extension (naming ``path``, its extension and the accepted ones),
-            raised before anything is written.
-        """
-        from qzs.iotools.result_files import save_by_extension
-
         return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per frequency and "
+                            "entry) or ``.mat`` (MATLAB) of :meth:`to_xarray`")
 
     def summary(self) -> str:
         """One-screen text (:func:`transmissibility_summary`).
