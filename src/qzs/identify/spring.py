@@ -257,7 +257,7 @@ class SpringFit(FitProtocol):
 
     def _write_toml(self, path: Path) -> Path:
         from qzs.iotools.config import spring_text
-        from qzs.iotools.files import atomic_path
+        from qzs.iotools.files import write_text
 
         if self.law is None:
             raise ParameterError(f"`path` {str(path)!r}: this {self.kind} fit made no law "
@@ -265,9 +265,7 @@ class SpringFit(FitProtocol):
                                  "[spring] table to write; save it as .json.", ("path",))
         text = spring_text(self.law, note=f"fitted by qzs.fit_spring to {self.n_points} "
                            f"points, residual rms {self.residual_rms:.4g} N")
-        with atomic_path(path) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
-        return path
+        return write_text(path, text)
 
 
 def _tanh(z, f, confidence):

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from qzs._format import json_text
-from qzs.iotools.files import _write_error, atomic_path
+from qzs.iotools.files import write_text
 from qzs.iotools.paths import check_output_path
 
 __all__ = ["DATASET_SUFFIXES", "RECORD_SUFFIXES", "save_by_extension", "save_doc",
@@ -44,14 +44,7 @@ def write_json(record: Mapping[str, Any], path: str | Path) -> Path:
     WriteError
         Writing failed (disk full, permissions); nothing is left behind.
     """
-    path = Path(path)
-    text = json_text(record) + "\n"
-    try:
-        with atomic_path(path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    except OSError as error:
-        raise _write_error(path, error) from None
-    return path
+    return write_text(path, json_text(record) + "\n")
 
 
 def save_by_extension(path: str | Path, *, dataset: Callable[[], Any] | None = None,
