@@ -65,7 +65,6 @@ LEFT = {
                           "its instance also takes minutes (60 s chirps on every axis)",
     "StepChoice": "the step choice becomes one call in issue 42 part 1 "
                   "(engine/step_search.py, owned there)",
-    "TransmissibilityEstimate": "has to_xarray only: summary, plot and save not written yet",
     "FrequencyResponseCurve": "harmonic balance curve: the protocol not written yet",
     "HarmonicBalanceSolution": "one harmonic balance point: the protocol not written yet",
     "CaseCurve": "one curve of a question's answer: the protocol not written yet",
@@ -161,14 +160,22 @@ def _friction_fit():
     return qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
 
 
-def _transmissibility_fit():
-    chirp = qzs.Chirp(amplitude=0.010, f0=0.0, f1=20.0, duration=20.0)
-    run = qzs.simulate(chirp, qzs.IsolatorParameters(viscous_damping=60.0), dt=5e-4,
+#: The chirp of the small transmissibility estimate and fit.
+CHIRP = qzs.Chirp(amplitude=0.010, f0=0.0, f1=20.0, duration=20.0)
+
+
+@cache
+def _estimate():
+    run = qzs.simulate(CHIRP, qzs.IsolatorParameters(viscous_damping=60.0), dt=5e-4,
                        sample_rate=100.0)
-    estimate = qzs.transmissibility(run.base_acceleration, run.payload_acceleration, 100.0,
-                                    fft_length=512)
+    return qzs.transmissibility(run.base_acceleration, run.payload_acceleration, 100.0,
+                                fft_length=512)
+
+
+def _transmissibility_fit():
+    estimate = _estimate()
     return qzs.fit_transmissibility(estimate.frequency, estimate.magnitude,
-                                    ("viscous_damping",), excitation=chirp)
+                                    ("viscous_damping",), excitation=CHIRP)
 
 
 #: Class name -> (how to build a small instance from a folder, a number its summary shows).
@@ -185,6 +192,8 @@ FACTORIES = {
     "ExperimentResult": (lambda folder: _experiment(), lambda r: r.band[1]),
     "SpringFit": (lambda folder: _spring_fit(), lambda r: r.parameters["plateau"]),
     "FrictionFit": (lambda folder: _friction_fit(), lambda r: r.stiction_force),
+    "TransmissibilityEstimate": (lambda folder: _estimate(),
+                                 lambda r: float(np.max(r.magnitude[r.trusted]))),
     "TransmissibilityFit": (lambda folder: _transmissibility_fit(),
                             lambda r: r.parameters["viscous_damping"]),
 }
