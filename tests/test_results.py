@@ -65,7 +65,6 @@ LEFT = {
                           "its instance also takes minutes (60 s chirps on every axis)",
     "StepChoice": "the step choice becomes one call in issue 42 part 1 "
                   "(engine/step_search.py, owned there)",
-    "FrequencyResponseCurve": "harmonic balance curve: the protocol not written yet",
     "HarmonicBalanceSolution": "one harmonic balance point: the protocol not written yet",
     "CaseCurve": "one curve of a question's answer: the protocol not written yet",
     "LawFit": "one law's fit inside SpringFit (which has the protocol): not written yet",
@@ -178,6 +177,14 @@ def _transmissibility_fit():
                                     ("viscous_damping",), excitation=CHIRP)
 
 
+def _balance():
+    from qzs.analysis.harmonic_balance import SmoothModel, frequency_response_curve
+
+    model = SmoothModel.from_parameters(qzs.IsolatorParameters(), qzs.ControllerParameters(),
+                                        amplitude=0.002)
+    return frequency_response_curve(model, (1.0, 6.0), harmonics=3, max_points=60)
+
+
 #: Class name -> (how to build a small instance from a folder, a number its summary shows).
 FACTORIES = {
     "SimulationResult": (lambda folder: _simulation(), lambda r: r["time"][-1]),
@@ -192,6 +199,8 @@ FACTORIES = {
     "ExperimentResult": (lambda folder: _experiment(), lambda r: r.band[1]),
     "SpringFit": (lambda folder: _spring_fit(), lambda r: r.parameters["plateau"]),
     "FrictionFit": (lambda folder: _friction_fit(), lambda r: r.stiction_force),
+    "FrequencyResponseCurve": (lambda folder: _balance(),
+                               lambda r: float(np.max(r.transmissibility[r.stable & r.valid]))),
     "TransmissibilityEstimate": (lambda folder: _estimate(),
                                  lambda r: float(np.max(r.magnitude[r.trusted]))),
     "TransmissibilityFit": (lambda folder: _transmissibility_fit(),

@@ -11,7 +11,7 @@ from qzs._format import decibels
 from qzs.defaults import FIGURES
 from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure, save_figure
 
-__all__ = ["plot_response"]
+__all__ = ["plot_response", "plot_balance"]
 
 _FLOOR = FIGURES["magnitude_floor"]  # amplitude ratio drawn for 0 [-]
 _SWEEPS = {"up": ("C0", "^", "stepped sine, sweep up"),
@@ -162,6 +162,48 @@ def plot_response(response, path=None, title=None, frequency_scale=None):
                           f"(it peaks at {model.peak_friction:.3g} N; Fs = "
                           f"{model.stiction_force:g} N)")
     ax_t.set_title(title, fontsize=9)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_balance(curve, path=None, title=None, frequency_scale=None):
+    """Draw a harmonic balance :class:`~qzs.analysis.harmonic_balance.FrequencyResponseCurve`.
+
+    Parameters
+    ----------
+    curve : FrequencyResponseCurve
+        The curve (:func:`qzs.analysis.harmonic_balance.frequency_response_curve`).
+    path : str or Path, optional
+        Write the figure there (format from the extension; a .png also as .svg).
+    title : str, optional
+        Figure title; default names the harmonics.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (ax_t, ax_z) = new_figure(2, height=2.4, height_ratios=(1.4, 1.0))
+    scale = check_frequency_scale(frequency_scale)
+    _draw_balance(ax_t, curve, decibels(curve.transmissibility, _FLOOR))
+    _draw_balance(ax_z, curve, curve.relative_amplitude, scale=1e3)
+    for fold in curve.folds:
+        for ax in (ax_t, ax_z):
+            ax.axvline(fold, color="0.3", lw=0.6, ls="-.", zorder=0)
+    ax_t.set_ylabel("fundamental transmissibility\n|X1/Y1| [dB]")
+    ax_z.set_ylabel("relative amplitude\n|Z1| [mm]")
+    ax_z.set_xlabel("frequency [Hz]")
+    f = curve.frequency
+    frequency_axis(ax_t, (float(np.min(f)) * 0.95, float(np.max(f)) * 1.05),
+                   frequency_scale=scale)
+    for ax in (ax_t, ax_z):
+        ax.grid(True, which="both", alpha=0.25)
+    ax_t.legend(fontsize=7, loc="best")
+    ax_t.set_title(title if title is not None else
+                   f"harmonic balance of the smooth model, {curve.harmonics} harmonics",
+                   fontsize=9)
     if path is not None:
         save_figure(fig, path)
     return fig
