@@ -32,11 +32,11 @@ def main(argv=None):
     displacement, force = static[:, 0] * 1e-3, static[:, 1]  # [mm] -> [m]
     spring = fit_spring(displacement, force, convention="test_machine")
     print(f"MagSpring ({spring.convention} convention in, model convention out):")
-    print(f"  a = {spring.spring_force:.2f} N   95 % CI {spring.spring_force_interval[0]:.2f} .. "
-          f"{spring.spring_force_interval[1]:.2f}   (the paper's Fig. 5 prints "
+    print(f"  a = {spring.spring_force:.2f} N   95 % CI {spring.intervals['plateau'][0]:.2f} .. "
+          f"{spring.intervals['plateau'][1]:.2f}   (the paper's Fig. 5 prints "
           f"a = {spring.as_paper_reports()[0]:.2f} N)")
-    print(f"  b = {spring.spring_shape:.2f} 1/m 95 % CI {spring.spring_shape_interval[0]:.2f} .. "
-          f"{spring.spring_shape_interval[1]:.2f}   residual rms {spring.residual_rms:.2f} N")
+    print(f"  b = {spring.spring_shape:.2f} 1/m 95 % CI {spring.intervals['shape'][0]:.2f} .. "
+          f"{spring.intervals['shape'][1]:.2f}   residual rms {spring.residual_rms:.2f} N")
     plt.close(plot_spring_fit(-displacement, force, spring.spring_force, spring.spring_shape,
                               path=args.out / "spring_fit.png", title="MagSpring static test"))
 

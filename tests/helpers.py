@@ -427,3 +427,38 @@ def duffing_harmonic_bound(frequency, k3, relative, third):
     dynamic = np.hypot(detuning, c * w)
     slope = dynamic + relative * detuning * 1.5 * k3 * relative / dynamic
     return 2 * 0.75 * abs(k3) * relative ** 2 * third / abs(slope)
+
+
+def instron_test(seed=0, isolator=None, offset=3.0, noise=0.2, rate=1000.0, cycles=4,
+                 amplitude=0.030, frequency=0.5):
+    """Imposed sine about the operating point, force the machine applies (model law + noise):
+    ``(time [s], displacement [m], force [N])`` of a friction test (``qzs.fit_friction``)."""
+    isolator = isolator or IsolatorParameters()
+    rng = np.random.default_rng(seed)
+    time = np.arange(0.0, cycles / frequency, 1.0 / rate)
+    omega = 2 * np.pi * frequency
+    z = -0.060 + amplitude * np.sin(omega * time)
+    v = amplitude * omega * np.cos(omega * time)
+    a = -amplitude * omega ** 2 * np.sin(omega * time)
+    force = (isolator.mass * a - qzs.spring_force(z, isolator) - qzs.friction_force(v, isolator)
+             + offset + rng.normal(0.0, noise, time.size))
+    return time, z + rng.normal(0.0, 2e-6, time.size), force
+
+
+#: A small two-objective problem of the linearised isolator (``qzs.optimize``): a stiffer
+#: position loop hunts less but isolates less at 1 Hz.
+LINEAR_PROBLEM = {
+    "problem": {"name": "linear", "title": "linear trade-off"},
+    "variables": {"damping_gain": {"low": 0.0, "high": 300.0},
+                  "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
+    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
+                   {"metric": "hunting_amplitude"}],
+    "constraints": [{"metric": "linear_transmissibility_at", "frequency": 5.0, "max": 0.9}],
+    "optimizer": {"population": 4, "generations": 2, "seed": 4},
+}
+#: A small sensitivity problem of the linearised isolator (``qzs.sensitivity``, 8 samples).
+SENSITIVITY_PROBLEM = {
+    "problem": {"name": "linear", "title": "Linearised isolator at 3 Hz"},
+    "variables": {"pi_kp": {"low": 1.0, "high": 100.0}, "mass": {"low": 5.0, "high": 8.0}},
+    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
+    "sensitivity": {"samples": 8}}

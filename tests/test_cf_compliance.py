@@ -5,8 +5,8 @@ a test dependency) must find no error (its high-priority failures) and no warnin
 medium-priority ones) in: a single run (``qzs simulate --out``), a batch's and a sweep's
 dataset, a six-axis run (``qzs hexapod simulate --out``), a steady-state response
 (``qzs response --out``), an experiment's transmissibility, a study's curves, an
-optimisation's and a sensitivity analysis's results, and a six-axis transmissibility
-matrix. How qzs encodes what CF has no home for: docs/model.md, decision 34.
+optimisation's and a sensitivity analysis's results, a six-axis transmissibility
+matrix, and a fit's data (a friction fit's ``save``). How qzs encodes what CF has no home for: docs/model.md, decision 34.
 
 Run as a script (``python tests/test_cf_compliance.py FOLDER``) it writes each kind into
 FOLDER and prints the checker's counts per file.
@@ -20,6 +20,8 @@ import pytest
 checker = pytest.importorskip("compliance_checker.runner",
                               reason="compliance-checker is in the test extra: "
                                      "pip install -e '.[test]'")
+
+from helpers import LINEAR_PROBLEM, SENSITIVITY_PROBLEM, instron_test
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -68,14 +70,13 @@ def streamed_run(folder):
 
 def batch(folder):
     import qzs
-    from qzs.iotools.writer import write_dataset
 
     cases = [(qzs.IsolatorParameters(stiction_force=f), qzs.ControllerParameters())
              for f in (5.0, 10.0)]
     result = qzs.simulate_batch(cases, qzs.Sine(amplitude=0.002, frequency=3.0), duration=0.2,
                                 sample_rate=200.0, channels=("relative_position", "locked"),
                                 workers=1)
-    return write_dataset(result.to_xarray(), folder / "batch.nc")
+    return result.save(folder / "batch.nc")  # BatchResult.save: write_dataset of to_xarray
 
 
 def sweep(folder):
@@ -109,14 +110,13 @@ def response(folder):
 
 def experiment(folder):
     import qzs
-    from qzs.iotools.writer import write_dataset
     from qzs.workflows.experiment.process import process_experiment
 
     recording = qzs.read_recording(ROOT / "examples" / "data" / "experiment.csv",
                                    ROOT / "examples" / "data" / "experiment_map.toml")
     result = process_experiment(recording, fft_length=1024, n_averages=None,
                                 simulate_match=False)
-    return write_dataset(result.to_xarray(), folder / "experiment.nc")
+    return result.save(folder / "experiment.nc")
 
 
 def curves(folder):
@@ -133,17 +133,6 @@ def curves(folder):
     return write_curves(dataset, folder, "damping")[0]
 
 
-LINEAR_PROBLEM = {
-    "problem": {"name": "linear", "title": "linear trade-off"},
-    "variables": {"damping_gain": {"low": 0.0, "high": 300.0},
-                  "pi_kp": {"low": 1.0, "high": 1000.0, "scale": "log"}},
-    "objectives": [{"metric": "linear_transmissibility_at", "frequency": 1.0},
-                   {"metric": "hunting_amplitude"}],
-    "constraints": [{"metric": "linear_transmissibility_at", "frequency": 5.0, "max": 0.9}],
-    "optimizer": {"population": 4, "generations": 2, "seed": 4},
-}
-
-
 def optimisation(folder):
     pytest.importorskip("pymoo")
     from qzs.workflows.design_space.optimizer import optimize
@@ -156,12 +145,17 @@ def sensitivity(folder):
     pytest.importorskip("SALib")
     from qzs.workflows.design_space.sensitivity import sensitivity as analyse
 
-    problem = {"problem": {"name": "linear", "title": "Linearised isolator at 3 Hz"},
-               "variables": {"pi_kp": {"low": 1.0, "high": 100.0},
-                             "mass": {"low": 5.0, "high": 8.0}},
-               "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
-               "sensitivity": {"samples": 8}}
-    return analyse(problem, progress=False).save(folder / "sensitivity.nc")
+    return analyse(SENSITIVITY_PROBLEM, progress=False).save(folder / "sensitivity.nc")
+
+
+def friction_fit(folder):
+    """A fit's dataset (qzs.identify's FitProtocol.save): the test on ``time``, the
+    estimates and their intervals as global attributes."""
+    import qzs
+
+    truth = qzs.IsolatorParameters()
+    fit = qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
+    return fit.save(folder / "friction_fit.nc")
 
 
 def hexapod_transmissibility(folder):
@@ -211,7 +205,8 @@ KINDS = {"single_run": single_run, "run_with_blocks": run_with_blocks,
          "streamed_run": streamed_run, "batch": batch,
          "sweep": sweep, "hexapod_run": hexapod_run, "response": response,
          "experiment": experiment, "curves": curves, "optimisation": optimisation,
-         "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility}
+         "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility,
+         "friction_fit": friction_fit}
 
 
 @pytest.fixture(scope="module")

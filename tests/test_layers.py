@@ -337,6 +337,8 @@ CROSS_CUTTING = {
                 "order in one fresh folder, with the outputs they state",
     "bad_inputs": "inputs that used to end in a traceback, through the API and every command",
     "result_api": "every result class's plot() and save(), one signature",
+    "results": "every public result class, found by introspection, built and walked: "
+               "summary, plot, save by extension, to_xarray, intervals",
     "trust": "the trusted-bins rule every metric obeys (its check is imported by the studies' "
              "and the experiment's tests)",
     "benchmark_reference": "the benchmarks' C reference model against qzs",

@@ -10,23 +10,11 @@ from qzs.errors import FitError
 from qzs.identify import fit_friction
 from qzs.viz.identify import plot_friction_fit
 
+from helpers import instron_test
+
 TRUTH = qzs.IsolatorParameters()
 NAMES = ("stiction_force", "coulomb_force", "stribeck_decay", "viscous_damping")
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "data"
-
-
-def instron_test(seed=0, isolator=TRUTH, offset=3.0, noise=0.2, rate=1000.0, cycles=4,
-                 amplitude=0.030, frequency=0.5):
-    """Imposed sine about the operating point, force the machine applies (model law + noise)."""
-    rng = np.random.default_rng(seed)
-    time = np.arange(0.0, cycles / frequency, 1.0 / rate)
-    omega = 2 * np.pi * frequency
-    z = -0.060 + amplitude * np.sin(omega * time)
-    v = amplitude * omega * np.cos(omega * time)
-    a = -amplitude * omega ** 2 * np.sin(omega * time)
-    force = (isolator.mass * a - qzs.spring_force(z, isolator) - qzs.friction_force(v, isolator)
-             + offset + rng.normal(0.0, noise, time.size))
-    return time, z + rng.normal(0.0, 2e-6, time.size), force
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -17,12 +17,12 @@ def synthetic(a=60.84, b=78.10, noise=0.3, n=41, seed=1):
 def test_round_trip_within_confidence_interval(seed, validation):
     z, f = synthetic(seed=seed)
     fit = fit_spring(z, f)
-    assert fit.spring_force_interval[0] <= 60.84 <= fit.spring_force_interval[1]
-    assert fit.spring_shape_interval[0] <= 78.10 <= fit.spring_shape_interval[1]
+    assert fit.intervals["plateau"][0] <= 60.84 <= fit.intervals["plateau"][1]
+    assert fit.intervals["shape"][0] <= 78.10 <= fit.intervals["shape"][1]
     assert fit.residual_rms == pytest.approx(0.3, rel=0.3)
     share = max(abs(value - truth) / (np.diff(interval)[0] / 2) for value, truth, interval in (
-        (fit.spring_force, 60.84, fit.spring_force_interval),
-        (fit.spring_shape, 78.10, fit.spring_shape_interval)))
+        (fit.spring_force, 60.84, fit.intervals["plateau"]),
+        (fit.spring_shape, 78.10, fit.intervals["shape"])))
     validation(f"MagSpring fit round trip (seed {seed}, 0.3 N noise)",
                "a = 60.84 N, b = 78.10 1/m (Table 1, the paper's Fig. 5 fit) inside the 95 % "
                "intervals",

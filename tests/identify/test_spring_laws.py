@@ -99,7 +99,8 @@ def test_a_tanh_pushing_away_makes_no_law_and_says_why():
     assert "convention='test_machine'" in fit.undefined["law"]
     good = fit_spring(-z, noisy(TANH, z, 0.1, 0), convention="test_machine")
     assert good.law == TanhSpring(plateau=good.spring_force, shape=good.spring_shape)
-    assert good.intervals["plateau"] == good.spring_force_interval
+    with pytest.warns(DeprecationWarning, match=r"use `intervals\['plateau'\]`"):
+        assert good.spring_force_interval == good.intervals["plateau"]  # the old name, one release
     assert good.parameters == {"plateau": good.spring_force, "shape": good.spring_shape}
 
 

@@ -52,7 +52,7 @@ def test_spring_fit_half_width(validation):
     dof = z.size - 2
     covariance = residual @ residual / dof * np.linalg.inv(jacobian.T @ jacobian)
     expected = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(covariance))
-    got = [np.diff(fit.spring_force_interval)[0] / 2, np.diff(fit.spring_shape_interval)[0] / 2]
+    got = [np.diff(fit.intervals["plateau"])[0] / 2, np.diff(fit.intervals["shape"])[0] / 2]
     np.testing.assert_allclose(got, expected, rtol=1e-3)
     validation("MagSpring fit: 95 % half-widths of a and b", "t(0.975, dof) sqrt(diag(s^2 "
                "(J^T J)^-1)), analytic Jacobian of a tanh(b z)",

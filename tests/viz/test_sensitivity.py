@@ -16,13 +16,14 @@ UNITS = ("N/m", "kg", "N")
 def sobol_result(reasons=("", "")):
     first = np.array([[0.05, 0.60, 0.20], [0.30, 0.01, 0.40]])
     total = np.array([[0.10, 0.70, 0.25], [0.45, 0.02, 0.50]])
-    interval = lambda values, below, above: np.stack([values - below, values + above], -1)
+    interval = lambda values, below, above: (values - below, values + above)
     return SensitivityResult(
         method="sobol", parameters=PARAMETERS, parameter_units=UNITS,
         parameter_kinds=("variable", "variable", "uncertain"),
         metrics=("transmissibility_at_12_hz", "peak_stroke"), metric_units=("1", "m"),
-        first_order=first, first_order_interval=interval(first, 0.03, 0.04),
-        total_order=total, total_order_interval=interval(total, 0.02, 0.05),
+        first_order=first, total_order=total,
+        intervals={"first_order": interval(first, 0.03, 0.04),
+                   "total_order": interval(total, 0.02, 0.05)},
         confidence=0.9, samples=256, evaluations=256 * 5, reasons=reasons, problem="toy",
         title="A toy problem", settings=MappingProxyType({}))
 
@@ -33,7 +34,7 @@ def morris_result():
         method="morris", parameters=PARAMETERS, parameter_units=UNITS,
         parameter_kinds=("variable", "variable", "uncertain"), metrics=("peak_stroke",),
         metric_units=("m",), mu_star=mu_star,
-        mu_star_interval=np.stack([mu_star - 0.1, mu_star + 0.15], -1),
+        intervals={"mu_star": (mu_star - 0.1, mu_star + 0.15)},
         mu=mu_star * 0.5, sigma=np.array([[0.05, 0.3, 0.6]]), confidence=0.95, samples=10,
         levels=4, evaluations=40, reasons=("",), problem="toy", title="A toy problem")
 
@@ -65,11 +66,11 @@ def test_sobol_bars_and_error_bars_are_the_indices_and_their_intervals():
         drawn = bars(ax)
         for name in ("first_order", "total_order"):
             label = SERIES["sobol"][name][0]
-            values, interval = getattr(result, name)[i], getattr(result, f"{name}_interval")[i]
+            values, (lows, highs) = getattr(result, name)[i], result.intervals[name]
             for j, parameter in enumerate(PARAMETERS):
                 value, (low, high) = drawn[label][parameter]
                 assert value == pytest.approx(values[j])
-                assert (low, high) == pytest.approx(tuple(interval[j]))
+                assert (low, high) == pytest.approx((lows[i, j], highs[i, j]))
         # ranked by the total index, the largest on top
         ticks = sorted(ax.get_yticklabels(), key=lambda t: -t.get_position()[1])
         order = [t.get_text().split(" [")[0] for t in ticks]
@@ -92,7 +93,7 @@ def test_morris_bars_are_mu_star_with_sigma_as_markers():
     for j, parameter in enumerate(PARAMETERS):
         value, interval = drawn[parameter]
         assert value == pytest.approx(result.mu_star[0, j])
-        assert interval == pytest.approx(tuple(result.mu_star_interval[0, j]))
+        assert interval == pytest.approx(tuple(end[0, j] for end in result.intervals["mu_star"]))
     (sigma,) = [line for line in ax.get_lines()
                 if line.get_label() == SERIES["morris"]["sigma"][0]]
     order = np.argsort(-result.mu_star[0])

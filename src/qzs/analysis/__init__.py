@@ -10,6 +10,7 @@
 ``harmonic_balance``  periodic responses of the smooth model: AFT, continuation, Hill stability
 ``statistics``        run statistics (stroke, time locked, motor effort)
 ``summary``           the one-screen text summary of a run
+``estimate_views``    a transmissibility estimate's summary, figure and files (the result protocol)
 ====================  =============================================================================
 """
 from qzs._lazy import lazy_exports

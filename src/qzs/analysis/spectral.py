@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from qzs._format import UndefinedValue, decibels
 from qzs._validation import finite_rows, finite_series, integer, optional, positive_real
+from qzs.analysis.estimate_views import EstimateProtocol
 from qzs.analysis.welch import transmissibility_arrays
 from qzs.defaults import ANALYSIS, REPORTED_FREQUENCIES
 from qzs.errors import DataError, DataWarning, ParameterError
@@ -254,7 +255,7 @@ def required_duration(fft_length, n_averages, sample_rate, overlap=0.5):
 
 # ---------------------------------------------------------------- estimation
 @dataclass(frozen=True, eq=False)
-class TransmissibilityEstimate:
+class TransmissibilityEstimate(EstimateProtocol):
     """Transmissibility from base to payload acceleration, one value per frequency bin.
 
     Attributes

@@ -3,8 +3,10 @@
 The numbers come from :attr:`SimulationResult.statistics` (every sample, also of a
 run streamed to a file); the warnings from :func:`run_warnings`.
 """
+import numpy as np
+
 __all__ = ["summary_text", "summary_record", "run_title", "run_warnings", "excitation_part",
-           "block_lines", "WARNING_LIMITS"]
+           "block_lines", "batch_text", "WARNING_LIMITS"]
 
 #: Where the summary starts to warn: the output rate per excitation frequency [-], the
 #: integration steps per period [-], the energy-ledger residual per unit of base work [-].
@@ -264,4 +266,32 @@ def summary_text(result):
     lines.append(f"  time span        {stats['time_first']:g} .. {stats['time_last']:g} s")
     lines += [f"  WARNING          {message}" for code, message in run_warnings(result)
               if code != "interrupted"]
+    return "\n".join(lines)
+
+
+def batch_text(result, statistics):
+    """A batch of runs as text: its size, its failures, each case's statistics.
+
+    Parameters
+    ----------
+    result : BatchResult
+        The batch (:func:`qzs.engine.batch.simulate_batch`).
+    statistics : mapping of str to (str, str)
+        Statistic name -> (unit, description) (``qzs.engine.batch.STATS``).
+
+    Returns
+    -------
+    str
+    """
+    n = len(result.status)
+    failed = int(np.sum(result.status))
+    lines = [f"batch of {n} simulation(s) of {result.time[-1]:.6g} s, {len(result.time)} "
+             f"samples each; {failed} failed; {result.elapsed:.3g} s wall time"]
+    shown = [name for name in statistics if name in result.stats and name != "steps"]
+    for i in range(n):
+        values = ", ".join(f"{name} {result.stats[name][i]:.4g}"
+                           + (f" {statistics[name][0]}" if statistics[name][0] != "1" else "")
+                           for name in shown)
+        state = f"failed: {result.messages[i]}" if result.status[i] else values
+        lines.append(f"  case {i}: {state}")
     return "\n".join(lines)

@@ -14,6 +14,7 @@ import dataclasses
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -29,6 +30,7 @@ from qzs.engine.channels import (BLOCK_CHANNELS, FLAGS, run_channels, sample_byt
                                  simulation_schema, unrecorded)
 from qzs.engine.metadata import _now
 from qzs.errors import CaseError, ParameterError
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.model.controller import BLOCKS
 from qzs.model.registry import (ALL_PARAMETERS, BLOCK_PARAMETERS, SPRING_PARAMETERS,
@@ -36,6 +38,7 @@ from qzs.model.registry import (ALL_PARAMETERS, BLOCK_PARAMETERS, SPRING_PARAMET
 
 if TYPE_CHECKING:
     import xarray as xr
+    from matplotlib.figure import Figure
 
     from qzs.model.controller import ControllerParameters
     from qzs.model.excitation import Excitation
@@ -106,6 +109,46 @@ class BatchResult:
     def steps_per_second(self) -> float:
         """Simulated steps per second over all cases [steps/s]."""
         return float(self.stats["steps"].sum()) / max(self.elapsed, 1e-12)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
+    def summary(self) -> str:
+        """The batch as text: its size, its failures, each case's statistics
+        (:func:`qzs.analysis.summary.batch_text`).
+
+        Returns
+        -------
+        str
+        """
+        from qzs.analysis.summary import batch_text
+
+        return batch_text(self, STATS)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
+        """The kept channels against time, one line per case
+        (:func:`qzs.viz.simulation.plot_batch`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there too, atomically (format from the suffix).
+        title : str, optional
+            Figure title; default one naming the cases and the failures.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.simulation import plot_batch
+
+        return plot_batch(self, path=path, title=title)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per case and "
+                            "sample) or ``.mat`` (MATLAB) of :meth:`to_xarray`")
 
     def to_xarray(self) -> xr.Dataset:
         """The batch as an ``xarray.Dataset`` on dimensions ``case`` and ``time``, CF-1.10.

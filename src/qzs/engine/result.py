@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from qzs.engine.channels import CHANNELS, FLAGS, named_block, run_channels, simulation_schema
 from qzs.engine.metadata import file_attributes, parameter_metadata, run_metadata
-from qzs.engine.result_file import save_result
+from qzs.engine.result_file import RESULT_SUFFIXES, save_result
 from qzs.iotools.schema import to_dataset
 
 if TYPE_CHECKING:
@@ -189,6 +189,9 @@ class SimulationResult:
         from qzs.viz.simulation import plot_simulation
 
         return plot_simulation(self, path=path, title=title)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = tuple(RESULT_SUFFIXES)
 
     def save(self, path: str | Path) -> Path:
         """Write the run atomically to NetCDF (``.nc``), CSV (``.csv``) or MATLAB (``.mat``).

@@ -15,6 +15,7 @@ from qzs.engine.channels import FLAGS, channel_count, run_channels, simulation_s
 from qzs.engine.metadata import controller_from_attributes, file_attributes
 from qzs.errors import DataError, ParameterError
 from qzs.iotools import files
+from qzs.iotools.paths import check_output_path
 from qzs.iotools.writer import StreamWriter, estimated_file_size
 
 if TYPE_CHECKING:
@@ -162,11 +163,14 @@ def save_result(result, path):
     Raises
     ------
     ParameterError
-        Any other suffix, or a preview of a streamed run (``run["preview_every"] > 1``).
+        Any other suffix (an :class:`~qzs.errors.OutputPathError` naming ``path``, its
+        extension and the accepted ones, before anything is written), or a preview of a
+        streamed run (``run["preview_every"] > 1``).
     WriteError
         Writing failed (disk full, permissions; attributes ``path`` and ``reason``);
         nothing is left behind.
     """
+    check_output_path(path, argument="path", suffixes=tuple(RESULT_SUFFIXES))
     every = result.run.get("preview_every", 1)
     if every != 1:
         raise ParameterError(f"this result keeps only every {every}th sample of a run streamed "

@@ -12,6 +12,7 @@
 ``transmissibility``  :func:`fit_transmissibility`: chosen model parameters fitted to a measured
                       transmissibility curve through the simulator
 ``_statistics``       the fits' covariance, Student-t quantile and profile threshold
+``_protocol``         what every fit shares: summary, plot, save by extension, to_xarray, intervals
 ====================  =============================================================================
 
 All intervals are Student-t intervals on the covariance ``s^2 (J^T J)^-1`` of the

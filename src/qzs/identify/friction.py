@@ -1,9 +1,9 @@
 """Friction law fitted to an imposed-motion test (the paper's Instron tests, eq. 3)."""
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -11,11 +11,13 @@ from scipy import optimize
 
 from qzs._validation import integer, non_negative_real, positive_real, strictly_increasing
 from qzs.errors import DataError, FitError, ParameterError
+from qzs.identify._protocol import FitProtocol, interval_attributes
 from qzs.identify._statistics import fit_covariance, finite_samples, student_quantile
 from qzs.model.isolator import IsolatorParameters, friction_force
+from qzs.model.registry import unit_of
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+    import xarray as xr
 
 __all__ = ["FrictionFit", "fit_friction", "FRICTION_PARAMETERS", "FORCE_SIGNS"]
 
@@ -25,8 +27,23 @@ FRICTION_PARAMETERS = ("stiction_force", "coulomb_force", "stribeck_decay", "vis
 FORCE_SIGNS = ("auto", "applied", "reaction")
 
 
+def friction_unit(name: str) -> str:
+    """The unit of an estimate of :data:`FRICTION_PARAMETERS` (the offset's: N).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`FRICTION_PARAMETERS`.
+
+    Returns
+    -------
+    str
+    """
+    return "N" if name == "offset" else unit_of(name)
+
+
 @dataclass(frozen=True, eq=False)
-class FrictionFit:
+class FrictionFit(FitProtocol):
     """Result of :func:`fit_friction`: eq. (3) parameters with confidence intervals.
 
     Attributes
@@ -39,10 +56,11 @@ class FrictionFit:
         Cv [N*s/m].
     offset : float
         Constant force [N] (load-cell zero, weight not carried by the spring); 0 if not fitted.
-    intervals : Mapping[str, tuple]
-        Parameter name -> (low, high) confidence interval at ``confidence``.
+    intervals : Mapping[str, tuple of float]
+        Each estimate of :data:`FRICTION_PARAMETERS` -> its (low, high) confidence interval
+        at ``confidence``, in its unit (``(0, 0)`` for an offset not fitted).
     confidence : float
-        Level of the intervals.
+        Level of the intervals [-] (0.95).
     force_sign : {"applied", "reaction"}
         How the force was read: the force the machine applies to the carriage along the
         displacement (``"applied"``) or its opposite (``"reaction"``).
@@ -63,7 +81,7 @@ class FrictionFit:
     stribeck_decay: float
     viscous_damping: float
     offset: float
-    intervals: object
+    intervals: Mapping[str, tuple]
     confidence: float
     force_sign: str
     residual_rms: float
@@ -108,23 +126,80 @@ class FrictionFit:
         return dataclasses.replace(isolator or IsolatorParameters(),
                                    **{n: getattr(self, n) for n in FRICTION_PARAMETERS[:4]})
 
-    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
-        """Friction against velocity with the fit, and residuals (:func:`qzs.viz.identify.plot_friction_fit`).
+    _figure = "plot_friction_fit"
 
-        Parameters
-        ----------
-        path : str or Path, optional
-            Write the figure there (a .png also as .svg).
-        title : str, optional
-            Figure title; default none.
+    def estimates(self) -> dict[str, float]:
+        """The estimates of :data:`FRICTION_PARAMETERS` by name (the keys of ``intervals``).
 
         Returns
         -------
-        matplotlib.figure.Figure
+        dict of str to float
+            Forces [N], ``stribeck_decay`` [s/m], ``viscous_damping`` [N*s/m].
         """
-        from qzs.viz.identify import plot_friction_fit
+        return {name: getattr(self, name) for name in FRICTION_PARAMETERS}
 
-        return plot_friction_fit(self, path=path, title=title or "")
+    def summary(self) -> str:
+        """The fit as text: each estimate with its interval, the residual, the samples.
+
+        Returns
+        -------
+        str
+        """
+        lines = [f"friction fit (eq. 3): {self.n_used} samples used, {self.n_excluded} "
+                 f"excluded as stick; force read as {self.force_sign}"]
+        for name, value in self.estimates().items():
+            low, high = self.intervals[name]
+            unit = friction_unit(name)
+            lines.append(f"  {name} = {value:.6g} {unit}  [{low:.4g}, {high:.4g}] {unit} "
+                         f"({100 * self.confidence:g} %)")
+        lines.append(f"  residual rms {self.residual_rms:.4g} N")
+        return "\n".join(lines)
+
+    def to_record(self) -> dict[str, Any]:
+        """The fit as plain data (what :meth:`save` writes as JSON; NaN as null).
+
+        Returns
+        -------
+        dict
+        """
+        return {"kind": "friction", "parameters": self.estimates(),
+                "intervals": {k: list(v) for k, v in self.intervals.items()},
+                "units": {name: friction_unit(name) for name in FRICTION_PARAMETERS},
+                "confidence": self.confidence, "force_sign": self.force_sign,
+                "residual_rms": self.residual_rms, "residual_rms_units": "N",
+                "n_used": self.n_used, "n_excluded": self.n_excluded}
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The test as an ``xarray.Dataset`` on ``time`` (CF-1.10, units on every variable).
+
+        ``velocity`` [m/s], ``friction`` and ``residual`` [N], the ``used`` flag; the
+        estimates, their intervals (``<name>_lower``, ``<name>_upper``) and units, and
+        ``confidence_level`` as global attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.iotools.schema import Schema, Variable, time_coordinate, to_dataset
+
+        schema = Schema(kind="a friction fit", dimensions={"time": None},
+                        coordinates=(time_coordinate(),), variables=(
+            Variable(name="velocity", dims=("time",), units="m/s",
+                     long_name="smoothed velocity of the carriage"),
+            Variable(name="friction", dims=("time",), units="N",
+                     long_name="measured force spent on friction (-F_friction)"),
+            Variable(name="residual", dims=("time",), units="N",
+                     long_name="measured minus fitted friction force"),
+            Variable(name="used", dims=("time",), units="1", dtype="int8",
+                     flag_meanings="excluded used",
+                     long_name="1 where the sample is fitted (faster than the threshold)",
+                     order=("units", "flag_values", "flag_meanings", "long_name"))))
+        values = {"time": self.time, "velocity": self.velocity, "friction": self.friction,
+                  "residual": self.residual, "used": self.used}
+        attrs = {"title": "friction fit (qzs.fit_friction, eq. 3)",
+                 "force_sign": self.force_sign, "residual_rms": self.residual_rms,
+                 "residual_rms_units": "N", **interval_attributes(self, friction_unit)}
+        return to_dataset(schema, values, attrs)
 
 
 def _smoothed_derivatives(time, displacement, window, polyorder, tolerance):

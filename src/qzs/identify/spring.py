@@ -23,16 +23,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from qzs._format import json_text, number
+from qzs._format import number
 from qzs._validation import choice, integer, positive_real, real
 from qzs.errors import DataError, FitError, ParameterError
+from qzs.identify._protocol import FitProtocol, deprecated_alias, interval_attributes
 from qzs.identify._statistics import student_quantile
 from qzs.identify.spring_laws import (LawFit, fit_oblique, fit_polynomial, fit_table,
                                       oblique_force)
 from qzs.model.springs import TABLE_MIN_POINTS, SpringLaw, TanhSpring
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+    import xarray as xr
 
 __all__ = ["SpringFit", "fit_spring", "CONVENTIONS", "LAWS", "CRITERION"]
 
@@ -42,11 +43,12 @@ LAWS = ("tanh", "polynomial", "oblique", "table", "best")
 #: The criterion ``law="best"`` chooses by (module docstring).
 CRITERION = "BIC = n ln(RSS/n) + k ln n"
 #: Files :meth:`SpringFit.save` writes.
-SPRING_FIT_SUFFIXES = (".json", ".toml")
+SPRING_FIT_SUFFIXES = (*FitProtocol.save_suffixes, ".toml")
+_NAN_PAIR = (math.nan, math.nan)
 
 
 @dataclass(frozen=True, eq=False)
-class SpringFit:
+class SpringFit(FitProtocol):
     """Result of :func:`fit_spring`.
 
     Every number is in the model's convention and SI units; a number that does not apply is
@@ -57,10 +59,8 @@ class SpringFit:
     spring_force, spring_shape : float
         ``a`` [N] and ``b`` [1/m] in the model's convention (docs/model.md §3: ``F = -a*tanh(b*z)``,
         z upward, a > 0 for a restoring spring). NaN when another law was fitted.
-    spring_force_interval, spring_shape_interval : tuple of float
-        Confidence intervals at ``confidence`` (NaN when another law was fitted).
     confidence : float
-        Confidence level of the intervals.
+        Confidence level of the intervals [-] (0.95).
     convention : str
         Displacement convention of the input data: ``"model"`` (z = x - y, the spring
         pushes up when compressed, as docs/model.md §1) or ``"test_machine"`` (displacement
@@ -82,10 +82,12 @@ class SpringFit:
         ``horizontal_distance``, and with ``free_length`` given ``vertical_stiffness``,
         ``oblique_stiffness``, ``free_length``; the table: ``smoothing`` and
         ``effective_parameters``).
-    intervals : Mapping[str, tuple]
-        Parameter name -> (low, high) confidence interval at ``confidence`` (Student t on the
-        linearised covariance; infinite where the data do not determine it). A parameter
-        without one is named in ``undefined``.
+    intervals : Mapping[str, tuple of float]
+        Parameter name -> (low, high) confidence interval at ``confidence``, in its unit
+        (Student t on the linearised covariance; infinite where the data do not determine
+        it). A parameter without one is named in ``undefined``. (``spring_force_interval``
+        and ``spring_shape_interval``, deprecated, are ``intervals["plateau"]`` and
+        ``intervals["shape"]`` of the tanh.)
     units : Mapping[str, str]
         Parameter name -> unit.
     undefined : Mapping[str, str]
@@ -109,8 +111,6 @@ class SpringFit:
 
     spring_force: float
     spring_shape: float
-    spring_force_interval: tuple
-    spring_shape_interval: tuple
     confidence: float
     convention: str
     residual_rms: float
@@ -129,6 +129,15 @@ class SpringFit:
     displacement: np.ndarray = dataclasses.field(repr=False)
     force: np.ndarray = dataclasses.field(repr=False)
     residual: np.ndarray = dataclasses.field(repr=False)
+
+    _figure = "plot_spring_law_fit"
+    save_suffixes = SPRING_FIT_SUFFIXES
+    spring_force_interval = deprecated_alias(
+        "spring_force_interval", "intervals['plateau']",
+        lambda fit: fit.intervals.get("plateau", _NAN_PAIR) if fit.kind == "tanh" else _NAN_PAIR)
+    spring_shape_interval = deprecated_alias(
+        "spring_shape_interval", "intervals['shape']",
+        lambda fit: fit.intervals.get("shape", _NAN_PAIR) if fit.kind == "tanh" else _NAN_PAIR)
 
     def as_paper_reports(self) -> tuple[float, float]:
         """``(a, b)`` as the test machine's convention would print them (paper Fig. 5)."""
@@ -205,55 +214,58 @@ class SpringFit:
                                for k, f in self.candidates.items()},
                 "rejected": dict(self.rejected)}
 
-    def save(self, path: str | Path) -> Path:
-        """Write the fit atomically: ``.json`` (:meth:`to_record`) or ``.toml`` (the law as a
-        ``[spring]`` table, what ``qzs simulate --spring FILE.toml`` reads).
-
-        Parameters
-        ----------
-        path : str or Path
-            The file; its extension chooses the format.
+    def estimates(self) -> dict[str, float]:
+        """The fitted parameters by name (:attr:`parameters`; those with an interval are the
+        keys of ``intervals``).
 
         Returns
         -------
-        Path
+        dict of str to float
         """
+        return dict(self.parameters)
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The pairs fitted as an ``xarray.Dataset`` on ``point`` (CF-1.10, units on each).
+
+        ``displacement`` [m] (model convention), ``force`` and ``residual`` [N]; the law, its
+        parameters, their intervals (``<name>_lower``, ``<name>_upper``) and units, and
+        ``confidence_level`` as global attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.iotools.schema import Schema, Variable, to_dataset
+
+        schema = Schema(kind="a spring fit", dimensions={"point": None}, variables=(
+            Variable(name="displacement", dims=("point",), units="m",
+                     long_name="relative position z (model convention)"),
+            Variable(name="force", dims=("point",), units="N",
+                     long_name="measured spring force on the payload"),
+            Variable(name="residual", dims=("point",), units="N",
+                     long_name="measured minus fitted force")))
+        attrs = {"title": f"spring fit (qzs.fit_spring): {self.kind} law",
+                 "law": self.kind, "convention": self.convention,
+                 "residual_rms": self.residual_rms, "residual_rms_units": "N",
+                 **interval_attributes(self, lambda name: self.units.get(name, ""))}
+        return to_dataset(schema, {"displacement": self.displacement, "force": self.force,
+                                   "residual": self.residual}, attrs)
+
+    def _writers(self) -> dict[str, Any]:
+        """``.toml``: the law as a ``[spring]`` table, what ``qzs simulate --spring`` reads."""
+        return {".toml": self._write_toml}
+
+    def _write_toml(self, path: Path) -> Path:
         from qzs.iotools.config import spring_text
-        from qzs.iotools.files import atomic_path
-        from qzs.iotools.paths import check_output_path
+        from qzs.iotools.files import write_text
 
-        path = check_output_path(path, argument="path", suffixes=SPRING_FIT_SUFFIXES)
-        if path.suffix.lower() == ".toml":
-            if self.law is None:
-                raise ParameterError(f"`path` {str(path)!r}: this {self.kind} fit made no law "
-                                     f"({self.undefined.get('law', '')}), so there is no "
-                                     "[spring] table to write; save it as .json.", ("path",))
-            text = spring_text(self.law, note=f"fitted by qzs.fit_spring to {self.n_points} "
-                               f"points, residual rms {self.residual_rms:.4g} N")
-        else:
-            text = json_text(self.to_record()) + "\n"
-        with atomic_path(path) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
-        return path
-
-    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
-        """Force against displacement with the fitted law (and the other candidates), and the
-        residuals (:func:`qzs.viz.identify.plot_spring_law_fit`).
-
-        Parameters
-        ----------
-        path : str or Path, optional
-            Write the figure there (a .png also as .svg).
-        title : str, optional
-            Figure title; default none.
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-        """
-        from qzs.viz.identify import plot_spring_law_fit
-
-        return plot_spring_law_fit(self, path=path, title=title or "")
+        if self.law is None:
+            raise ParameterError(f"`path` {str(path)!r}: this {self.kind} fit made no law "
+                                 f"({self.undefined.get('law', '')}), so there is no "
+                                 "[spring] table to write; save it as .json.", ("path",))
+        text = spring_text(self.law, note=f"fitted by qzs.fit_spring to {self.n_points} "
+                           f"points, residual rms {self.residual_rms:.4g} N")
+        return write_text(path, text)
 
 
 def _tanh(z, f, confidence):
@@ -310,12 +322,11 @@ def _fit_one(kind, z, f, convention, confidence, degree, center, smoothing, free
              table_points):
     """One law fitted: a :class:`SpringFit` with its criterion."""
     _check_points((kind,), z.size, degree)
-    nan_pair, old = (math.nan, math.nan), {}
+    old = {}
     if kind == "tanh":
-        a, b, a_interval, b_interval, fitted = _tanh(z, f, confidence)
+        a, b, _, _, fitted = _tanh(z, f, confidence)
     else:
         a = b = math.nan
-        a_interval = b_interval = nan_pair
         old = {name: f"the fitted law is {kind!r}, not the tanh: see `law` and `parameters`"
                for name in ("spring_force", "spring_shape")}
         if kind == "polynomial":
@@ -340,7 +351,7 @@ def _fit_one(kind, z, f, convention, confidence, degree, center, smoothing, free
         criterion = n * math.log(rss / n) + fitted.n_parameters * math.log(n)
     scale = 1.4826 * np.median(np.abs(residual - np.median(residual)))
     outliers = tuple(int(i) for i in np.flatnonzero(np.abs(residual) > 4 * max(scale, 1e-300)))
-    return SpringFit(a, b, a_interval, b_interval, confidence, convention,
+    return SpringFit(a, b, confidence, convention,
                      float(np.sqrt(np.mean(residual ** 2))), outliers, kind, fitted.law,
                      dict(fitted.parameters), dict(fitted.intervals), dict(fitted.units),
                      undefined, criterion, n, fitted.n_parameters, {}, {}, z, f, residual)

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,6 +17,8 @@ from qzs.defaults import EXCITATION
 from qzs.engine.prepare import steps_per_sample
 from qzs.engine.simulate import simulate
 from qzs.errors import DataError, FitError, ParameterError, SimulationError
+from qzs.identify._protocol import (FREQUENCY_SCALE_OPTION, FitProtocol, interval_attributes,
+                                   plot_doc)
 from qzs.identify._statistics import (fit_covariance, finite_samples, profile_threshold,
                                       student_quantile)
 from qzs.model.controller import ControllerParameters
@@ -25,6 +27,7 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import PARAMETERS, numeric_parameters
 
 if TYPE_CHECKING:
+    import xarray as xr
     from matplotlib.figure import Figure
 
 __all__ = ["TransmissibilityFit", "fit_transmissibility"]
@@ -33,18 +36,19 @@ _JITTER_SIZE = 0.02  # relative parameter change that redraws the stick-slip pat
 
 
 @dataclass(frozen=True, eq=False)
-class TransmissibilityFit:
+class TransmissibilityFit(FitProtocol):
     """Result of :func:`fit_transmissibility`.
 
     Attributes
     ----------
     parameters : Mapping[str, float]
         Fitted values of the free parameters (registry names and SI units, docs/model.md §11).
-    intervals : Mapping[str, tuple]
-        Name -> (low, high) confidence interval (fitted in log space, so asymmetric),
-        measurement noise and stick-slip jumps included (see :func:`fit_transmissibility`).
+    intervals : Mapping[str, tuple of float]
+        Each fitted name -> its (low, high) confidence interval at ``confidence``, in its
+        unit (fitted in log space, so asymmetric), measurement noise and stick-slip jumps
+        included (see :func:`fit_transmissibility`).
     confidence : float
-        Level of the intervals.
+        Level of the intervals [-] (0.95).
     isolator, controller : IsolatorParameters, ControllerParameters
         The full parameter sets with the fitted values.
     excitation : Chirp
@@ -59,12 +63,12 @@ class TransmissibilityFit:
         Wall time of the fit [s].
     """
 
-    parameters: object
-    intervals: object
+    parameters: Mapping[str, float]
+    intervals: Mapping[str, tuple]
     confidence: float
-    isolator: object
-    controller: object
-    excitation: object
+    isolator: IsolatorParameters
+    controller: ControllerParameters
+    excitation: Chirp
     frequency: np.ndarray
     measured: np.ndarray
     fitted: np.ndarray
@@ -74,25 +78,80 @@ class TransmissibilityFit:
 
     def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> "Figure":
-        """Measured and fitted curves (:func:`qzs.viz.identify.plot_transmissibility_fit`).
-
-        Parameters
-        ----------
-        path : str or Path, optional
-            Write the figure there (a .png also as .svg).
-        title : str, optional
-            Figure title; default none.
-        frequency_scale : {"log", "linear"}, optional
-            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-        """
         from qzs.viz.identify import plot_transmissibility_fit
 
         return plot_transmissibility_fit(self, path=path, title=title or "",
                                          frequency_scale=frequency_scale)
+
+    plot.__doc__ = plot_doc(FREQUENCY_SCALE_OPTION)
+
+    def estimates(self) -> dict[str, float]:
+        """The fitted values by name (the keys of ``intervals``; units: the registry's).
+
+        Returns
+        -------
+        dict of str to float
+        """
+        return dict(self.parameters)
+
+    def summary(self) -> str:
+        """The fit as text: each fitted value with its interval, the residual, the cost.
+
+        Returns
+        -------
+        str
+        """
+        lines = [f"transmissibility fit: {len(self.parameters)} parameter(s) over "
+                 f"{self.frequency[0]:.4g}-{self.frequency[-1]:.4g} Hz, {self.n_simulations} "
+                 f"simulations, {self.elapsed:.3g} s"]
+        for name, value in self.parameters.items():
+            low, high = self.intervals[name]
+            unit = PARAMETERS[name].unit
+            lines.append(f"  {name} = {value:.6g} {unit}  [{low:.4g}, {high:.4g}] {unit} "
+                         f"({100 * self.confidence:g} %)")
+        lines.append(f"  residual rms of ln(fitted/measured) {self.residual_rms:.4g}")
+        return "\n".join(lines)
+
+    def to_record(self) -> dict[str, Any]:
+        """The fit as plain data (what :meth:`save` writes as JSON; NaN as null).
+
+        Returns
+        -------
+        dict
+        """
+        return {"kind": "transmissibility", "parameters": self.estimates(),
+                "intervals": {k: list(v) for k, v in self.intervals.items()},
+                "units": {name: PARAMETERS[name].unit for name in self.parameters},
+                "confidence": self.confidence, "residual_rms": self.residual_rms,
+                "n_simulations": self.n_simulations, "elapsed": self.elapsed,
+                "elapsed_units": "s"}
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The curves as an ``xarray.Dataset`` on ``frequency`` (CF-1.10, units on each).
+
+        ``measured`` and ``fitted`` amplitude ratios [1] on ``frequency`` [Hz]; the fitted
+        values, their intervals (``<name>_lower``, ``<name>_upper``) and units, and
+        ``confidence_level`` as global attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.iotools.schema import Schema, Variable, to_dataset
+
+        schema = Schema(kind="a transmissibility fit", dimensions={"frequency": None},
+                        coordinates=(Variable(name="frequency", dims=("frequency",),
+                                              units="Hz", long_name="frequency"),),
+                        variables=(
+            Variable(name="measured", dims=("frequency",), units="1",
+                     long_name="measured transmissibility (amplitude ratio)"),
+            Variable(name="fitted", dims=("frequency",), units="1",
+                     long_name="the fitted model's transmissibility (amplitude ratio)")))
+        attrs = {"title": "transmissibility fit (qzs.fit_transmissibility)",
+                 "residual_rms": self.residual_rms, "n_simulations": self.n_simulations,
+                 **interval_attributes(self, lambda name: PARAMETERS[name].unit)}
+        return to_dataset(schema, {"frequency": self.frequency, "measured": self.measured,
+                                   "fitted": self.fitted}, attrs)
 
 
 def _free_parameters(free, isolator, controller, initial):

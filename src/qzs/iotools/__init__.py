@@ -9,6 +9,7 @@ This layer knows no result type: each declares its own schema beside its class
 ``writer``     the atomic CF writer of a schema: streamed (NetCDF, CSV, MATLAB), whole datasets, tables
 ``matfile``    MATLAB files (MAT 5, MAT 7.3) of a dataset or a streamed schema
 ``files``      atomic writes; result files read back
+``result_files``  a result's ``save``: the format chosen by the extension (.nc, .csv, .mat, .json)
 ``paths``      output paths checked before the work starts
 ``config``     run configurations (TOML)
 ``rig``        subpackage: test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map

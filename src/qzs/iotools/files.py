@@ -19,7 +19,7 @@ from qzs.iotools.schema import NONE_VALUE
 from qzs.model.excitation import read_displacement_csv
 from qzs.model.registry import parse_value
 
-__all__ = ["atomic_path", "read_result", "read_displacement_csv", "RESULT_SUFFIXES",
+__all__ = ["atomic_path", "write_text", "read_result", "read_displacement_csv", "RESULT_SUFFIXES",
            "is_units_row"]
 
 #: File formats of a result streamed to a file: suffix -> name.
@@ -53,6 +53,35 @@ def atomic_path(path):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def write_text(path, text):
+    """Write ``text`` (UTF-8) to ``path`` atomically (:func:`atomic_path`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file; its folder is created if missing.
+    text : str
+        Its whole content.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    WriteError
+        Writing failed (disk full, permissions); nothing is left behind.
+    """
+    path = Path(path)
+    try:
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise _write_error(path, error) from None
+    return path
 
 
 def _umask():

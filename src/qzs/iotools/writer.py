@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from qzs.errors import ParameterError
-from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error, atomic_path
+from qzs.iotools.files import RESULT_SUFFIXES, _umask, _write_error, atomic_path, write_text
 from qzs.iotools.matfile import MatStream
 from qzs.iotools.cf_layout import (container_attributes, container_long_name, file_schema,
                                    to_file_layout)
@@ -673,12 +673,7 @@ def write_table(rows, path, *, units, attrs=None):
         writer.writerow(["" if row.get(key) is None else _cell(row[key], repr)
                          for key in columns])
     text = _csv_head(attrs or {}, columns, [units(key) or "" for key in columns])
-    try:
-        with atomic_path(path) as tmp:
-            tmp.write_text(text + body.getvalue(), encoding="utf-8")
-    except OSError as error:
-        raise _write_error(path, error) from None
-    return path
+    return write_text(path, text + body.getvalue())
 
 
 def _table_text(dataset):

@@ -11,7 +11,7 @@ from qzs._format import decibels
 from qzs.defaults import FIGURES
 from qzs.viz.figures import check_frequency_scale, drawn, frequency_axis, new_figure, save_figure
 
-__all__ = ["plot_response"]
+__all__ = ["plot_response", "plot_balance", "plot_period"]
 
 _FLOOR = FIGURES["magnitude_floor"]  # amplitude ratio drawn for 0 [-]
 _SWEEPS = {"up": ("C0", "^", "stepped sine, sweep up"),
@@ -162,6 +162,83 @@ def plot_response(response, path=None, title=None, frequency_scale=None):
                           f"(it peaks at {model.peak_friction:.3g} N; Fs = "
                           f"{model.stiction_force:g} N)")
     ax_t.set_title(title, fontsize=9)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_balance(curve, path=None, title=None, frequency_scale=None):
+    """Draw a harmonic balance :class:`~qzs.analysis.harmonic_balance.FrequencyResponseCurve`.
+
+    Parameters
+    ----------
+    curve : FrequencyResponseCurve
+        The curve (:func:`qzs.analysis.harmonic_balance.frequency_response_curve`).
+    path : str or Path, optional
+        Write the figure there (format from the extension; a .png also as .svg).
+    title : str, optional
+        Figure title; default names the harmonics.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (ax_t, ax_z) = new_figure(2, height=2.4, height_ratios=(1.4, 1.0))
+    scale = check_frequency_scale(frequency_scale)
+    _draw_balance(ax_t, curve, decibels(curve.transmissibility, _FLOOR))
+    _draw_balance(ax_z, curve, curve.relative_amplitude, scale=1e3)
+    for fold in curve.folds:
+        for ax in (ax_t, ax_z):
+            ax.axvline(fold, color="0.3", lw=0.6, ls="-.", zorder=0)
+    ax_t.set_ylabel("fundamental transmissibility\n|X1/Y1| [dB]")
+    ax_z.set_ylabel("relative amplitude\n|Z1| [mm]")
+    ax_z.set_xlabel("frequency [Hz]")
+    f = curve.frequency
+    frequency_axis(ax_t, (float(np.min(f)) * 0.95, float(np.max(f)) * 1.05),
+                   frequency_scale=scale)
+    for ax in (ax_t, ax_z):
+        ax.grid(True, which="both", alpha=0.25)
+    ax_t.legend(fontsize=7, loc="best")
+    ax_t.set_title(title if title is not None else
+                   f"harmonic balance of the smooth model, {curve.harmonics} harmonics",
+                   fontsize=9)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_period(solution, path=None, title=None):
+    """One period of a :class:`~qzs.analysis.harmonic_balance.HarmonicBalanceSolution`.
+
+    Parameters
+    ----------
+    solution : HarmonicBalanceSolution
+        The periodic response (:func:`qzs.analysis.harmonic_balance.periodic_response`).
+    path : str or Path, optional
+        Write the figure there (format from the extension; a .png also as .svg).
+    title : str, optional
+        Figure title; default names the frequency and the harmonics.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    series = solution.time_series()
+    fig, axes = new_figure(3, height=1.8)
+    for ax, (name, scale, label) in zip(axes, (
+            ("relative_position", 1e3, "relative position z [mm]"),
+            ("motor_force", 1.0, "motor command [N]"),
+            ("payload_acceleration", 1.0, "payload acceleration [m/s$^2$]"))):
+        ax.plot(series["time"], series[name] * scale, color="C0", lw=1.0)
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time from the base's crest [s]")
+    axes[0].set_title(title if title is not None else
+                      f"periodic response at {solution.frequency:.4g} Hz, "
+                      f"{solution.harmonics} harmonics (|X1/Y1| = "
+                      f"{solution.transmissibility:.4g})", fontsize=9)
     if path is not None:
         save_figure(fig, path)
     return fig

@@ -40,9 +40,9 @@ def _default_title(result):
     return f"{result.title}\n{how}{failed}"
 
 
-def _errors(values, interval):
+def _errors(values, low, high):
     """Asymmetric error-bar lengths ``(below, above)`` of ``values`` from their interval."""
-    return np.vstack([values - interval[:, 0], interval[:, 1] - values])
+    return np.vstack([values - low, high - values])
 
 
 def plot_sensitivity(result, path=None, title=None):
@@ -100,19 +100,20 @@ def _panel(ax, result, i, unit):
         for shift, name in zip((_HEIGHT / 2, -_HEIGHT / 2), ("first_order", "total_order")):
             label, colour = series[name]
             values = getattr(result, name)[i, order]
-            interval = getattr(result, f"{name}_interval")[i, order]
+            low, high = result.intervals[name]
             ax.barh(rows + shift, values, height=_HEIGHT, color=colour, alpha=0.85,
-                    xerr=_errors(values, interval), capsize=3, label=label,
+                    xerr=_errors(values, low[i, order], high[i, order]), capsize=3, label=label,
                     error_kw={"elinewidth": 1.0, "ecolor": "0.15"})
-        top = max(1.0, float(np.nanmax(result.total_order_interval[i])))
-        low = min(0.0, float(np.nanmin(result.first_order_interval[i])))
+        top = max(1.0, float(np.nanmax(np.stack(result.intervals["total_order"])[:, i])))
+        low = min(0.0, float(np.nanmin(np.stack(result.intervals["first_order"])[:, i])))
         ax.set_xlim(low - 0.02, top + 0.02)
         ax.set_xlabel("Sobol index [-] (share of the metric's variance)")
     else:
         label, colour = series["mu_star"]
         values = result.mu_star[i, order]
         ax.barh(rows, values, height=1.6 * _HEIGHT, color=colour, alpha=0.85,
-                xerr=_errors(values, result.mu_star_interval[i, order]), capsize=3,
+                xerr=_errors(values, *(end[i, order] for end in result.intervals["mu_star"])),
+                capsize=3,
                 label=label, error_kw={"elinewidth": 1.0, "ecolor": "0.15"})
         label, colour = series["sigma"]
         ax.plot(result.sigma[i, order], rows, "D", color=colour, ms=5, label=label)

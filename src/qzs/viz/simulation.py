@@ -2,7 +2,7 @@
 from qzs.analysis.summary import run_title
 from qzs.viz.figures import envelope, new_figure, save_figure
 
-__all__ = ["plot_simulation", "plot_energy"]
+__all__ = ["plot_simulation", "plot_energy", "plot_batch"]
 
 
 def plot_simulation(result, path=None, title=None):
@@ -92,6 +92,49 @@ def plot_energy(result, path=None):
     for ax in axes:
         ax.grid(True, alpha=0.3)
     fig.suptitle("Energy ledger: dE = W_base + W_motor - D_friction - D_stop")
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_batch(result, path=None, title=None, max_panels=4, max_labels=8):
+    """The kept channels of a batch of runs, one panel per channel, one line per case.
+
+    Parameters
+    ----------
+    result : BatchResult
+        The batch (:func:`qzs.engine.batch.simulate_batch`).
+    path : str or Path, optional
+        If given, the figure is also written there, atomically (format from the suffix).
+    title : str, optional
+        Figure title; default one naming the cases and the failures.
+    max_panels : int
+        The first channels drawn (a flag is not drawn).
+    max_labels : int
+        Cases named in the legend (the first ones).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from qzs.engine.channels import CHANNELS
+
+    names = [name for name in result.channels if name in CHANNELS][:max_panels]
+    fig, axes = new_figure(max(len(names), 1))
+    n = len(result.status)
+    for ax, name in zip(axes, names):
+        unit = CHANNELS[name][1]
+        for i in range(n):
+            tt, vv = envelope(result.time, result.channels[name][i])
+            ax.plot(tt, vv, lw=0.7, label=f"case {i}" if i < max_labels else None)
+        ax.set_ylabel(f"{name} [{unit}]")
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    if names:
+        axes[0].legend(loc="upper right", fontsize="small", ncols=4)
+    failed = int(sum(result.status))
+    fig.suptitle(title if title is not None else f"batch of {n} runs"
+                 + (f", {failed} failed" if failed else ""))
     if path is not None:
         save_figure(fig, path)
     return fig

@@ -196,3 +196,29 @@ def test_stability_changes_at_the_folds_between_the_same_two_points(softening_cu
             largest = np.abs(np.linalg.eigvals(phi[:2, :2])).max()
             assert (largest < 1.0) == curve.stable[j], (j, largest)
 
+
+
+def test_the_softening_curves_summary_dataset_and_figure(softening_curve, tmp_path):
+    """The protocol on a curve that folds: the summary names the folds and the stable peak,
+    the dataset keeps every point in arclength order with units, the figure marks the folds."""
+    import matplotlib.pyplot as plt
+
+    curve = softening_curve
+    assert len(curve.folds) == 2
+    text = curve.summary()
+    assert all(f"{fold:.4g}" in text for fold in curve.folds)
+    usable = curve.stable & curve.valid
+    assert f"{np.max(curve.transmissibility[usable]):.4g}" in text
+    data = curve.to_xarray()
+    assert np.array_equal(data["frequency"].values, curve.frequency)  # folds go back: kept
+    assert np.array_equal(data["stable"].values.astype(bool), curve.stable)
+    assert np.array_equal(data["relative_max"].values, curve.relative_range[:, 1])
+    assert data["largest_exponent"].attrs["units"] == "1/s"
+    assert list(data.attrs["folds"]) == list(curve.folds)
+    figure = curve.plot(tmp_path / "curve.png", frequency_scale="linear")
+    try:
+        folds = [line.get_xdata()[0] for line in figure.axes[0].lines
+                 if line.get_linestyle() == "-."]
+        assert folds == pytest.approx(list(curve.folds))
+    finally:
+        plt.close(figure)

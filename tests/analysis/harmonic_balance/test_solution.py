@@ -121,3 +121,25 @@ def test_bad_input_is_refused(call, name):
     model = SmoothModel.from_parameters(amplitude=0.01)
     with pytest.raises(ParameterError, match=name):
         call(model)
+
+
+def test_one_period_as_text_dataset_and_figure(softening_curve, tmp_path):
+    """The protocol of a solution: its summary names its fundamental, its dataset is one
+    period of its time series with units, its figure draws that period."""
+    import matplotlib.pyplot as plt
+
+    solution = softening_curve.solution(3)
+    text = solution.summary()
+    assert f"{solution.transmissibility:.6g}" in text and f"{solution.frequency:.6g} Hz" in text
+    data = solution.to_xarray()
+    series = solution.time_series()
+    assert np.array_equal(data["time"].values, series["time"])
+    assert np.array_equal(data["motor_force"].values, series["motor_force"])
+    assert data["time"].values[-1] < 1.0 / solution.frequency  # one period, its end left out
+    assert data["pi_integral"].attrs["units"] == "m*s"
+    figure = solution.plot(tmp_path / "period.png")
+    try:
+        (line,) = figure.axes[0].lines
+        assert np.allclose(line.get_ydata(), series["relative_position"] * 1e3)
+    finally:
+        plt.close(figure)

@@ -23,7 +23,7 @@ def test_ishigami_analytic_indices_lie_in_the_reported_intervals(ishigami_sobol,
     assert result.method == "sobol" and result.parameters == ISHIGAMI_NAMES
     assert result.samples == 2 ** 12 and result.evaluations == 2 ** 12 * (3 + 2)
     for name, exact in (("first_order", first), ("total_order", total)):
-        interval = getattr(result, f"{name}_interval")[0]
+        interval = np.stack(result.intervals[name], axis=-1)[0]
         assert np.all(interval[:, 0] <= exact) and np.all(exact <= interval[:, 1]), (
             name, exact, interval)
         width = interval[:, 1] - interval[:, 0]
@@ -44,7 +44,7 @@ def test_morris_sees_ishigami_x3_act_only_through_interaction(ishigami_sobol):
     assert result.method == "morris" and result.evaluations == 40 * (3 + 1)
     assert result.first_order is None and result.mu_star.shape == (1, 3)
     mu_star, sigma = result.mu_star[0], result.sigma[0]
-    low = result.mu_star_interval[0, :, 0]
+    low = result.intervals["mu_star"][0][0]
     assert np.all(low > 0)  # each parameter matters: x3 too, though S1(x3) = 0
     assert abs(ishigami_sobol.first_order[0, 2]) < 0.05
     assert sigma[2] > mu_star[2] / 2  # x3 acts through its interaction with x1
@@ -55,7 +55,7 @@ def test_the_same_seed_gives_the_same_indices():
     one = sensitivity(ishigami_problem(samples=64, seed=3), evaluate=ishigami, progress=False)
     two = sensitivity(ishigami_problem(samples=64), seed=3, evaluate=ishigami, progress=False)
     assert np.array_equal(one.total_order, two.total_order)
-    assert np.array_equal(one.first_order_interval, two.first_order_interval)
+    assert np.array_equal(one.intervals["first_order"], two.intervals["first_order"])
 
 
 # ---------------------------------------------------------------- linearised isolator
@@ -113,7 +113,7 @@ def test_linear_isolator_ranking_agrees_with_the_derivative_based_one(linear_sob
     assert result.ranking() == expected == ("damping_gain", "viscous_damping", "mass",
                                             "pi_kp")
     # the bound holds: every total index's interval starts below its DGSM bound
-    lower = result.total_order_interval[0, :, 0]
+    lower = result.intervals["total_order"][0][0]
     for j, name in enumerate(result.parameters):
         assert lower[j] <= bounds[name] + 1e-9, (name, lower[j], bounds[name])
     # and the qzs path evaluates exactly the closed form (no simulation)
@@ -132,7 +132,7 @@ def test_a_failed_case_leaves_the_indices_undefined_with_the_reason():
     problem["variables"]["coulomb_force"] = {"low": 0.5, "high": 15.0}  # stiction 10 N
     result = sensitivity(problem, progress=False)
     assert result.failed > 0
-    assert np.isnan(result.total_order).all() and np.isnan(result.first_order_interval).all()
+    assert np.isnan(result.total_order).all() and np.isnan(result.intervals["first_order"]).all()
     assert "cases gave NaN" in result.reasons[0] and "coulomb" in result.reasons[0].lower()
     with pytest.raises(ParameterError, match="undefined"):
         result.ranking()

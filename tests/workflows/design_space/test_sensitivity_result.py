@@ -38,9 +38,9 @@ def test_the_result_round_trips_through_its_files(ishigami_sobol, tmp_path):
         for name in ("first_order", "total_order"):
             assert np.array_equal(back[name].values, getattr(result, name))
             assert np.array_equal(back[f"{name}_lower"].values,
-                                  getattr(result, f"{name}_interval")[..., 0])
+                                  result.intervals[name][0])
             assert np.array_equal(back[f"{name}_upper"].values,
-                                  getattr(result, f"{name}_interval")[..., 1])
+                                  result.intervals[name][1])
         assert list(back["parameter"].values) == list(result.parameters)
         assert back.attrs["method"] == "sobol"
 
@@ -55,7 +55,7 @@ def test_the_result_round_trips_through_its_files(ishigami_sobol, tmp_path):
     assert np.allclose(np.array(column["total_order"], float), result.total_order[0],
                        rtol=1e-9)
     assert np.allclose(np.array(column["first_order_lower"], float),
-                       result.first_order_interval[0, :, 0], rtol=1e-9)
+                       result.intervals["first_order"][0][0], rtol=1e-9)
 
     mat = scipy.io.loadmat(result.save(tmp_path / "ishigami.mat"))
     assert np.array_equal(np.asarray(mat["total_order"], float).reshape(1, 3),
@@ -85,3 +85,19 @@ def test_summary_and_ranking(ishigami_sobol):
     with pytest.raises(ParameterError, match="`metric` must be one of"):
         ishigami_sobol.ranking("peak_stroke")
     assert isinstance(ishigami_sobol, SensitivityResult)
+
+
+def test_intervals_are_one_mapping_and_the_old_names_warn(ishigami_sobol):
+    """``intervals``: each estimated index -> (low, high) about it; ``<index>_interval``
+    (deprecated, one release) warns with the new name and gives the same numbers."""
+    result = ishigami_sobol
+    assert set(result.intervals) == {"first_order", "total_order"} and result.confidence == 0.95
+    for name, (low, high) in result.intervals.items():
+        estimate = getattr(result, name)
+        assert low.shape == high.shape == estimate.shape
+        assert np.all(low <= estimate) and np.all(estimate <= high) and np.all(low < high)
+        with pytest.warns(DeprecationWarning, match=rf"use `intervals\['{name}'\]`"):
+            old = getattr(result, f"{name}_interval")
+        assert np.array_equal(old, np.stack([low, high], axis=-1))
+    with pytest.warns(DeprecationWarning):
+        assert result.mu_star_interval is None  # a Sobol result has no Morris interval

@@ -1,12 +1,19 @@
 """The frequency-response curve: a branch of periodic responses with stability and folds."""
 from dataclasses import dataclass, field
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from qzs.analysis.harmonic_balance.smooth_model import SmoothModel
 from qzs.analysis.harmonic_balance.solution import HarmonicBalanceSolution
 from qzs.analysis.harmonic_balance.stability import _is_stable, floquet_exponents
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
+from qzs.iotools.schema import Schema, Variable, to_dataset
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = ["FrequencyResponseCurve"]
 
@@ -88,6 +95,119 @@ class FrequencyResponseCurve:
                                        np.array(self.coefficients[index]),
                                        float(self.integral_mean[index]), self.model, True, 0,
                                        0.0)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
+    def summary(self) -> str:
+        """The curve as text: its points, its stable peak, its folds and notes.
+
+        Returns
+        -------
+        str
+        """
+        f = self.frequency
+        lines = [f"harmonic balance, {self.harmonics} harmonics: {f.size} points "
+                 f"{np.min(f):.4g}-{np.max(f):.4g} Hz, {int(np.sum(self.stable))} stable, "
+                 f"{int(np.sum(~self.valid))} beyond the stops or saturation"]
+        usable = np.flatnonzero(self.stable & self.valid)
+        if usable.size:
+            k = usable[np.argmax(self.transmissibility[usable])]
+            lines.append(f"  stable peak |X1/Y1| {self.transmissibility[k]:.4g} at "
+                         f"{f[k]:.4g} Hz, relative amplitude "
+                         f"{self.relative_amplitude[k] * 1e3:.4g} mm")
+        else:
+            lines.append("  no stable point within the stops and the motor's limit")
+        if self.folds:
+            lines.append("  folds at " + ", ".join(f"{fold:.4g}" for fold in self.folds)
+                         + " Hz")
+        lines.extend(f"  note: {note}" for note in self.notes)
+        return "\n".join(lines)
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The curve as an ``xarray.Dataset`` on ``point`` (arclength order), CF-1.10.
+
+        ``frequency`` [Hz], ``transmissibility`` [1], ``phase`` [rad],
+        ``relative_amplitude``, ``relative_min``, ``relative_max`` [m],
+        ``motor_force_peak`` [N], ``largest_exponent`` [1/s], the ``stable`` and ``valid``
+        flags, ``harmonic_ratio`` [1] on ``(point, harmonic)``; ``folds`` [Hz] and
+        ``harmonics`` as global attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        def flag(name, meanings, what):
+            return Variable(name=name, dims=("point",), units="1", dtype="int8",
+                            flag_meanings=meanings, long_name=what,
+                            order=("units", "flag_values", "flag_meanings", "long_name"))
+
+        per_point = {"frequency": ("Hz", "excitation frequency"),
+                     "transmissibility": ("1", "fundamental amplitude ratio of payload to "
+                                               "base acceleration"),
+                     "phase": ("rad", "phase of the payload's fundamental"),
+                     "relative_amplitude": ("m", "fundamental amplitude of the relative "
+                                                 "position"),
+                     "relative_min": ("m", "least relative position over the period"),
+                     "relative_max": ("m", "greatest relative position over the period"),
+                     "motor_force_peak": ("N", "largest unsaturated motor command"),
+                     "largest_exponent": ("1/s", "largest real part of the Floquet "
+                                                 "exponents")}
+        schema = Schema(
+            kind="a harmonic balance curve", dimensions={"point": None, "harmonic": 4},
+            coordinates=(Variable(name="harmonic", dims=("harmonic",), units="1",
+                                  dtype="int64", long_name="harmonic order"),),
+            variables=(*(Variable(name=name, dims=("point",), units=unit, long_name=what)
+                         for name, (unit, what) in per_point.items()),
+                       Variable(name="harmonic_ratio", dims=("point", "harmonic"), units="1",
+                                long_name="payload acceleration at the harmonic over the "
+                                          "base's fundamental"),
+                       flag("stable", "unstable stable", "1 where every Floquet exponent "
+                                                         "decays"),
+                       flag("valid", "beyond within", "1 within the stops and the motor's "
+                                                      "limit")))
+        values = {"harmonic": np.arange(2, 6), "frequency": self.frequency,
+                  "transmissibility": self.transmissibility, "phase": self.phase,
+                  "relative_amplitude": self.relative_amplitude,
+                  "relative_min": self.relative_range[:, 0],
+                  "relative_max": self.relative_range[:, 1],
+                  "motor_force_peak": self.motor_force_peak,
+                  "largest_exponent": self.largest_exponent,
+                  "harmonic_ratio": self.harmonic_ratios, "stable": self.stable,
+                  "valid": self.valid}
+        attrs = {"title": "frequency-response curve of the smooth model (harmonic balance)",
+                 "harmonics": self.harmonics, "folds": np.asarray(self.folds, float),
+                 "folds_units": "Hz", "friction_velocity": self.model.friction_velocity,
+                 "friction_velocity_units": "m/s"}
+        return to_dataset(schema, values, attrs)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
+        """The transmissibility [dB] and relative amplitude [mm] over frequency, stable
+        solid, unstable dashed, folds marked (:func:`qzs.viz.response.plot_balance`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (a .png also as .svg).
+        title : str, optional
+            Figure title; default one naming the harmonics.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.response import plot_balance
+
+        return plot_balance(self, path=path, title=title, frequency_scale=frequency_scale)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per point and "
+                            "harmonic) or ``.mat`` (MATLAB) of :meth:`to_xarray`")
 
     def to_dict(self) -> dict[str, Any]:
         """The curve as plain lists (NaN kept), for JSON.

@@ -5,6 +5,8 @@ describing-function response or a given solution; :class:`HarmonicBalanceSolutio
 coefficients and derives the transmissibility, the harmonics and the time series.
 """
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,9 +18,24 @@ from qzs.analysis.harmonic_balance.residual import (_force_scale, _linear_terms,
                                                     _relative_coefficients, _residual, _scales)
 from qzs.analysis.harmonic_balance.smooth_model import SmoothModel
 from qzs.errors import ParameterError
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
+from qzs.iotools.schema import Schema, Variable, time_coordinate, to_dataset
 from qzs.model.isolator import friction_level, friction_slope
 
-__all__ = ["HarmonicBalanceSolution", "periodic_response"]
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+__all__ = ["HarmonicBalanceSolution", "periodic_response", "PERIOD_CHANNELS"]
+
+#: The time series of one period (:meth:`HarmonicBalanceSolution.time_series`): unit, meaning.
+PERIOD_CHANNELS = {
+    "relative_position": ("m", "relative position z"),
+    "relative_velocity": ("m/s", "relative velocity"),
+    "highpass_state": ("m/s", "state of the damping loop's high-pass"),
+    "pi_integral": ("m*s", "integral of the position error (PI)"),
+    "motor_force": ("N", "unsaturated motor command"),
+    "payload_acceleration": ("m/s^2", "payload acceleration")}
 
 #: Newton stops when the largest scaled update is below this [-].
 NEWTON_TOLERANCE = 1e-10
@@ -180,6 +197,72 @@ class HarmonicBalanceSolution:
         return {"time": basis.tau / omega, "relative_position": z, "relative_velocity": v,
                 "highpass_state": w, "pi_integral": integral, "motor_force": motor,
                 "payload_acceleration": synth(s * xd_k)}
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
+    def summary(self) -> str:
+        """The solution as text: its fundamental, its harmonics kept, Newton's outcome.
+
+        Returns
+        -------
+        str
+        """
+        state = (f"converged in {self.iterations} Newton iterations" if self.converged else
+                 f"NOT converged after {self.iterations} Newton iterations")
+        return (f"periodic response at {self.frequency:.6g} Hz, {self.harmonics} harmonics, "
+                f"base amplitude {self.model.amplitude * 1e3:.4g} mm\n"
+                f"  |X1/Y1| {self.transmissibility:.6g}, phase {self.phase:.4g} rad, "
+                f"relative amplitude {self.relative_amplitude * 1e3:.4g} mm\n"
+                f"  {state}, residual {self.residual:.3g} of the force scale")
+
+    def to_xarray(self) -> "xr.Dataset":
+        """One period of the response (:meth:`time_series`) on ``time`` [s], CF-1.10.
+
+        The channels of :data:`PERIOD_CHANNELS` with their units; ``frequency`` [Hz],
+        ``transmissibility`` [1], ``phase`` [rad], ``harmonics``, ``converged`` and
+        ``residual`` as global attributes.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        schema = Schema(kind="a periodic response", dimensions={"time": None},
+                        coordinates=(time_coordinate(),),
+                        variables=tuple(Variable(name=name, dims=("time",), units=unit,
+                                                 long_name=what)
+                                        for name, (unit, what) in PERIOD_CHANNELS.items()))
+        attrs = {"title": "one period of the smooth model's response (harmonic balance)",
+                 "frequency": self.frequency, "frequency_units": "Hz",
+                 "transmissibility": self.transmissibility, "transmissibility_units": "1",
+                 "phase": self.phase, "phase_units": "rad", "harmonics": self.harmonics,
+                 "converged": int(self.converged), "residual": self.residual}
+        return to_dataset(schema, self.time_series(), attrs)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> "Figure":
+        """One period: relative position [mm], motor force [N] and payload acceleration
+        [m/s^2] against time [s] (:func:`qzs.viz.response.plot_period`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (a .png also as .svg).
+        title : str, optional
+            Figure title; default one naming the frequency and the harmonics.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.response import plot_period
+
+        return plot_period(self, path=path, title=title)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per sample) or "
+                            "``.mat`` (MATLAB) of :meth:`to_xarray`: one period")
 
     def state_at_start(self):
         """State ``(z, v, w, I)`` at phase 0, for :func:`smooth_right_hand_side`.

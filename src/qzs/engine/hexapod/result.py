@@ -532,6 +532,9 @@ class HexapodResult:
         """One-screen text summary: per leg stroke used, contacts, time locked, motor RMS."""
         return _summary_text(self)
 
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = HEXAPOD_SUFFIXES
+
     def save(self, path: str | Path) -> Path:
         """Write the run to NetCDF or MATLAB (:func:`save_hexapod_result`).
 

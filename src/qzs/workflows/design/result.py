@@ -9,7 +9,9 @@ import numpy as np
 
 from qzs._format import json_ready, json_text
 from qzs._version import __version__
+from qzs.errors import DataError
 from qzs.iotools.files import atomic_path
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension
 from qzs.workflows.paper.curves import curves_dataset, write_curves
 from qzs.workflows.design.report import _html, design_text
 
@@ -167,18 +169,42 @@ class DesignResult:
             attrs.update({"band": np.asarray(band, dtype=float), "band_units": "Hz"})
         return curves_dataset(curves, attrs)
 
+    def to_xarray(self) -> xr.Dataset | None:
+        """The damping search's curves (:meth:`curves`): transmissibility [1] on ``case`` and
+        ``frequency`` [Hz], the gains as coordinates with their units.
+
+        Returns
+        -------
+        xarray.Dataset or None
+            None when the search ran no simulation.
+        """
+        return self.curves()
+
+    def _curves_to_save(self) -> xr.Dataset:
+        curves = self.curves()
+        if curves is None:
+            raise DataError("this design's damping search ran no simulation (no admissible "
+                            "damping gain), so it has no curves to write as .nc, .csv or "
+                            ".mat; save it as .json or into a folder.")
+        return curves
+
+    #: The extensions :meth:`save` accepts (a path without one is a folder).
+    save_suffixes = (".json", *DATASET_SUFFIXES)
+
     def save(self, path: str | Path, *, frequency_scale: str | None = None,
              progress: bool = False) -> Path:
-        """Write ``report.html``, ``design.json``, the figures (PNG and SVG) and the damping
-        search's curves (``damping_curves.nc``, ``.csv`` and ``.mat``, :meth:`curves`) into
-        the folder ``path``.
+        """Write the design atomically: ``.json`` (:meth:`to_dict`), ``.nc``, ``.csv`` or
+        ``.mat`` (the damping search's curves, :meth:`curves`), or, for a path without an
+        extension, the folder of ``report.html``, ``design.json``, the figures (PNG and
+        SVG) and the curves (``damping_curves.nc``, ``.csv`` and ``.mat``).
 
         Each file is written atomically (a temporary file renamed onto it).
 
         Parameters
         ----------
         path : str or Path
-            The output folder, created if missing.
+            A file of :attr:`save_suffixes`, or the output folder (no extension; created
+            if missing).
         frequency_scale : {"log", "linear"}, optional
             Frequency axis of the transmissibility figure; default
             ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
@@ -190,6 +216,8 @@ class DesignResult:
         Path
             The folder (:func:`write_design` says which file is which).
         """
+        if Path(path).suffix and not Path(path).is_dir():
+            return save_by_extension(path, dataset=self._curves_to_save, record=self.to_dict)
         return write_design(self, path, frequency_scale=frequency_scale,
                             progress=progress)["report"].parent
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from qzs._format import with_unit
 from qzs._version import __version__
+from qzs.iotools.result_files import DATASET_SUFFIXES
 from qzs.errors import HelperProcessError, ParameterError
 from qzs.workflows.design_space.metrics import goal_values
 from qzs.workflows.design_space.problem import DesignProblem, _spread_text, _unit
@@ -300,6 +301,9 @@ class OptimizationResult:
                                                                  "design in the store"})},
                           attrs=attrs)
 
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
     def save(self, path: str | Path, *, pareto_only: bool = True) -> Path:
         """Write the Pareto set (or every design) to NetCDF, CSV or MATLAB, atomically.
 
@@ -314,9 +318,9 @@ class OptimizationResult:
         -------
         Path
         """
-        from qzs.iotools.writer import write_dataset
+        from qzs.iotools.result_files import save_by_extension
 
-        return write_dataset(self.to_xarray(pareto_only=pareto_only), path)
+        return save_by_extension(path, dataset=lambda: self.to_xarray(pareto_only=pareto_only))
 
     def config_text(self, index: int | None = None) -> str:
         """The chosen design (or design ``index``) as a run configuration's TOML text.

@@ -367,7 +367,8 @@ def _analyse(salib, plan, unit_samples, values, messages):
                 intervals[name][i] = np.column_stack([out[name][i] - half,
                                                       out[name][i] + half])
     result = dict(out)
-    result.update({f"{name}_interval": interval for name, interval in intervals.items()})
+    result["intervals"] = MappingProxyType({name: (interval[..., 0], interval[..., 1])
+                                            for name, interval in intervals.items()})
     return result, reasons
 
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from qzs._format import unit_label
 from qzs.errors import ParameterError
+from qzs.identify._protocol import deprecated_alias
 from qzs.iotools.schema import Schema, Variable, to_dataset
 
 if TYPE_CHECKING:
@@ -47,13 +48,18 @@ _INDICES = {"sobol": ("first_order", "total_order"), "morris": ("mu_star", "mu",
 _INTERVALS = {"sobol": ("first_order", "total_order"), "morris": ("mu_star",)}
 
 
+def _stacked(result, name):
+    """An interval as the old ``<index>_interval`` array ``(metric, parameter, 2)``, or None."""
+    return np.stack(result.intervals[name], axis=-1) if name in result.intervals else None
+
+
 @dataclass(frozen=True, kw_only=True, eq=False)
 class SensitivityResult:
     """Global sensitivity indices of a problem's metrics
     (:func:`~qzs.workflows.design_space.sensitivity.sensitivity`).
 
-    Arrays are ``(metric, parameter)``; intervals ``(metric, parameter, 2)`` with the
-    lower and upper end at ``confidence``. The indices of the other method are None. A
+    Arrays are ``(metric, parameter)``; ``intervals`` maps each estimated index to its
+    ``(low, high)`` arrays at ``confidence``. The indices of the other method are None. A
     metric whose indices are undefined (a failed case, a metric that never varies) has NaN
     indices and its reason in ``reasons``. The object holds data; its methods delegate
     to this module's functions, :mod:`qzs.viz.sensitivity` and
@@ -75,13 +81,14 @@ class SensitivityResult:
         Their units.
     first_order, total_order : ndarray or None
         Sobol: first-order and total indices [-].
-    first_order_interval, total_order_interval : ndarray or None
-        Their confidence intervals [-] (bootstrap, :data:`NUM_RESAMPLES` resamples).
     mu_star, mu, sigma : ndarray or None
         Morris: mean absolute, mean and standard deviation of the elementary effects
         [the metric's unit].
-    mu_star_interval : ndarray or None
-        The confidence interval of ``mu_star`` [the metric's unit].
+    intervals : Mapping[str, tuple of ndarray]
+        Index name (Sobol: ``first_order``, ``total_order``; Morris: ``mu_star``) -> its
+        ``(low, high)`` confidence interval at ``confidence``, each ``(metric, parameter)``
+        [the index's unit] (bootstrap, :data:`NUM_RESAMPLES` resamples). The old
+        ``<index>_interval`` arrays ``(metric, parameter, 2)`` are deprecated aliases.
     confidence : float
         The intervals' confidence level [-] (0.95).
     samples : int
@@ -114,13 +121,11 @@ class SensitivityResult:
     metrics: tuple
     metric_units: tuple
     first_order: np.ndarray | None = None
-    first_order_interval: np.ndarray | None = None
     total_order: np.ndarray | None = None
-    total_order_interval: np.ndarray | None = None
     mu_star: np.ndarray | None = None
-    mu_star_interval: np.ndarray | None = None
     mu: np.ndarray | None = None
     sigma: np.ndarray | None = None
+    intervals: Mapping[str, tuple] = field(default_factory=lambda: MappingProxyType({}))
     confidence: float = 0.95
     samples: int = 0
     levels: int = 0
@@ -143,15 +148,12 @@ class SensitivityResult:
         """
         return {name: getattr(self, name) for name in _INDICES[self.method]}
 
-    @property
-    def intervals(self) -> dict[str, np.ndarray]:
-        """The confidence intervals by index name, shape (n_metrics, n_parameters, 2).
-
-        Returns
-        -------
-        dict of str to ndarray
-        """
-        return {name: getattr(self, f"{name}_interval") for name in _INTERVALS[self.method]}
+    first_order_interval = deprecated_alias("first_order_interval", "intervals['first_order']",
+                                            lambda result: _stacked(result, "first_order"))
+    total_order_interval = deprecated_alias("total_order_interval", "intervals['total_order']",
+                                            lambda result: _stacked(result, "total_order"))
+    mu_star_interval = deprecated_alias("mu_star_interval", "intervals['mu_star']",
+                                        lambda result: _stacked(result, "mu_star"))
 
     def ranking(self, metric: str | None = None) -> tuple[str, ...]:
         """The parameters, most influential first (:func:`parameter_ranking`).
@@ -186,6 +188,9 @@ class SensitivityResult:
         """
         return sensitivity_dataset(self)
 
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = SENSITIVITY_SUFFIXES
+
     def save(self, path: str | Path) -> Path:
         """Write :meth:`to_xarray` atomically: ``.nc`` (NetCDF), ``.csv`` (one row per
         metric and parameter) or ``.mat`` (MATLAB).
@@ -200,9 +205,9 @@ class SensitivityResult:
         Path
             ``path``.
         """
-        from qzs.iotools.writer import write_dataset
+        from qzs.iotools.result_files import save_by_extension
 
-        return write_dataset(self.to_xarray(), path)
+        return save_by_extension(path, dataset=self.to_xarray)
 
     def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
         """Bars of the indices with their intervals, one panel per metric
@@ -305,7 +310,7 @@ def sensitivity_summary(result: SensitivityResult) -> str:
             label = _label(name, result.parameter_units[j])
             if result.parameter_kinds[j] == "uncertain":
                 label += " ~"
-            half = {name: np.diff(interval[i, j])[0] / 2 for name, interval in intervals.items()}
+            half = {name: (high[i, j] - low[i, j]) / 2 for name, (low, high) in intervals.items()}
             if result.method == "sobol":
                 s1, st = indices["first_order"][i, j], indices["total_order"][i, j]
                 lines.append(f"  {label:<32} {s1:8.3f} {half['first_order']:7.3f} {st:8.3f} "
@@ -395,8 +400,7 @@ def sensitivity_dataset(result: SensitivityResult) -> xr.Dataset:
     for name in _INDICES[result.method]:
         values[name] = getattr(result, name)
         if name in _INTERVALS[result.method]:
-            interval = getattr(result, f"{name}_interval")
-            values[f"{name}_lower"], values[f"{name}_upper"] = interval[..., 0], interval[..., 1]
+            values[f"{name}_lower"], values[f"{name}_upper"] = result.intervals[name]
     method = ("Sobol indices, Saltelli's scheme (SALib)" if result.method == "sobol"
               else "Morris elementary effects (SALib)")
     attrs = {"title": f"global sensitivity of {result.title}",

@@ -40,6 +40,7 @@ from qzs.errors import DataError, DataWarning, ParameterError
 from qzs.iotools.config import load_config
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.iotools.rig import Recording, load_channel_map, read_recording
 from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
@@ -301,6 +302,16 @@ class ExperimentResult:
                                   if self.simulated_metrics is not None else None),
             "discrepancy_db": self.discrepancy_db(),
             "simulation_seconds": self.simulation_seconds, "notes": list(self.notes)}
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = suffixes_of(dataset=True, record=True)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_record)
+
+    save.__doc__ = save_doc("``.nc``, ``.csv``, ``.mat`` (:meth:`to_xarray`: the "
+                            "transmissibility [1] on frequency [Hz]) or ``.json`` "
+                            "(:meth:`to_record`)")
 
     def write_report(self, folder: str | Path,
                      frequency_scale: str | None = None) -> dict[str, Path]:

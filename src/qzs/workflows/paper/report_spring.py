@@ -135,9 +135,9 @@ def spring_fit_html(result: StudyResult) -> str:
                 f"(<code>qzs.fit_spring</code>): true {e(extra['true_law'].describe())}; "
                 f"fitted:</p><pre>{e(extra['law_fit'].summary())}</pre>")
     fit = extra["fit"]
+    (a_low, a_high), (b_low, b_high) = (fit["intervals"][name] for name in ("plateau", "shape"))
     return (f"<p>Fit (model convention, F = -a tanh(b z)): a = {fit['spring_force']:.3f} N "
-            f"[{fit['spring_force_interval'][0]:.3f}, {fit['spring_force_interval'][1]:.3f}],"
-            f" b = {fit['spring_shape']:.2f} 1/m [{fit['spring_shape_interval'][0]:.2f}, "
-            f"{fit['spring_shape_interval'][1]:.2f}] (95 %); Table 1: a = 60.84 N, "
+            f"[{a_low:.3f}, {a_high:.3f}], b = {fit['spring_shape']:.2f} 1/m [{b_low:.2f}, "
+            f"{b_high:.2f}] (95 %); Table 1: a = 60.84 N, "
             "b = 78.10 1/m. The paper's Fig. 5 prints a = -60.84 N in the test machine's "
             "displacement convention.</p>")

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from qzs._format import decibels
 from qzs._validation import choice
-from qzs.workflows.response.files import POINT_FIELDS, response_dataset
+from qzs.workflows.response.files import POINT_FIELDS, RESPONSE_SUFFIXES, response_dataset
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -410,6 +410,9 @@ class SteadyStateResponse:
         from qzs.viz.response import plot_response
 
         return plot_response(self, path=path, title=title, frequency_scale=frequency_scale)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = RESPONSE_SUFFIXES
 
     def save(self, path: str | Path) -> Path:
         """Write the response atomically: ``.nc`` (NetCDF), ``.csv`` (one row per point),

@@ -12,7 +12,7 @@ import numpy as np
 from qzs._format import number
 from qzs.analysis.hexapod_linear import entry_unit
 from qzs.defaults import AXES, AXIS_UNITS
-from qzs.errors import ParameterError
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
 from qzs.iotools.schema import Schema, Variable, to_dataset
 
 if TYPE_CHECKING:
@@ -153,28 +153,14 @@ class HexapodTransmissibility:
             linear_label=None if self.linear_stable else "linear model (UNSTABLE loop)",
             untrusted_below=self.settings["trusted_from"], frequency_scale=frequency_scale)
 
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_xarray` as NetCDF (h5netcdf), atomically.
+        return save_by_extension(path, dataset=self.to_xarray)
 
-        Parameters
-        ----------
-        path : str or Path
-            The file; must end in ``.nc``.
-
-        Returns
-        -------
-        Path
-            ``path``.
-        """
-        from qzs.iotools.files import atomic_path
-        from qzs.iotools.writer import write_netcdf
-
-        path = Path(path)
-        if path.suffix.lower() != ".nc":
-            raise ParameterError(f"`path` must end in .nc (NetCDF), got {str(path)!r}.")
-        with atomic_path(path) as tmp:
-            write_netcdf(self.to_xarray(), tmp)
-        return path
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per frequency and "
+                            "entry) or ``.mat`` (MATLAB) of :meth:`to_xarray`")
 
     def summary(self) -> str:
         """One-screen text (:func:`transmissibility_summary`).
