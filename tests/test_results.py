@@ -66,7 +66,6 @@ LEFT = {
     "StepChoice": "the step choice becomes one call in issue 42 part 1 "
                   "(engine/step_search.py, owned there)",
     "CaseCurve": "one curve of a question's answer: the protocol not written yet",
-    "LawFit": "one law's fit inside SpringFit (which has the protocol): not written yet",
 }
 
 
@@ -153,6 +152,15 @@ def _spring_fit():
     return qzs.fit_spring(z, qzs.spring_force(z, qzs.IsolatorParameters()) + noise)
 
 
+def _law_fit():
+    from qzs.identify.spring_laws import fit_polynomial
+
+    z = np.linspace(-0.1, 0.1, 41)
+    noise = np.random.default_rng(1).normal(0.0, 0.5, z.size)
+    return fit_polynomial(z, qzs.spring_force(z, qzs.IsolatorParameters()) + noise, 3, None,
+                          0.95)
+
+
 def _friction_fit():
     truth = qzs.IsolatorParameters()
     return qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
@@ -206,6 +214,7 @@ FACTORIES = {
                                 lambda r: r.setup.platform.mass),
     "ExperimentResult": (lambda folder: _experiment(), lambda r: r.band[1]),
     "SpringFit": (lambda folder: _spring_fit(), lambda r: r.parameters["plateau"]),
+    "LawFit": (lambda folder: _law_fit(), lambda r: r.parameters["c1"]),
     "FrictionFit": (lambda folder: _friction_fit(), lambda r: r.stiction_force),
     "FrequencyResponseCurve": (lambda folder: _balance(),
                                lambda r: float(np.max(r.transmissibility[r.stable & r.valid]))),

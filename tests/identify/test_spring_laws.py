@@ -317,3 +317,43 @@ def test_a_table_fit_has_table_points_evenly_over_the_data_s_range():
     fit = fit_spring(z, noisy(OBLIQUE, z, 0.02, 8), law="table", table_points=37)
     np.testing.assert_array_equal(fit.law.positions, np.linspace(z.min(), z.max(), 37))
     np.testing.assert_allclose(fit.law.forces, OBLIQUE.force(fit.law.positions), atol=0.1)
+
+
+@pytest.mark.parametrize("law", ["polynomial", "oblique", "table"])
+def test_one_law_s_fit_is_the_spring_fit_of_that_law(law, tmp_path):
+    """A LawFit (one law, what fit_spring makes its SpringFit of) states the same numbers as
+    the SpringFit of that law: criterion (BIC from the residuals), residual, prediction; its
+    saved pairs read back; its text names its parameters."""
+    import xarray as xr
+
+    from qzs.identify.spring_laws import fit_oblique, fit_polynomial, fit_table
+
+    z = np.linspace(-0.1, 0.1, 61)
+    f = noisy(OBLIQUE if law == "oblique" else CUBIC, z, 0.2, 4)
+    one = {"polynomial": lambda: fit_polynomial(z, f, 3, None, 0.95),
+           "oblique": lambda: fit_oblique(z, f, None, 0.95),
+           "table": lambda: fit_table(z, f, "aicc", 101, 0.95)}[law]()
+    spring = fit_spring(z, f, law=law)
+    assert one.kind == spring.kind == law and one.n_points == z.size
+    assert one.criterion == spring.criterion
+    rss = float(np.sum((f - one.predict(z)) ** 2))
+    assert one.criterion == pytest.approx(z.size * math.log(rss / z.size)
+                                          + one.n_parameters * math.log(z.size), rel=1e-12)
+    assert one.residual_rms == spring.residual_rms
+    np.testing.assert_array_equal(one.residual, spring.residual)
+    np.testing.assert_array_equal(one.predict(z), spring.predict(z))
+    text = one.summary()
+    assert all(name in text for name in one.parameters)
+    with xr.open_dataset(one.save(tmp_path / "law.nc")) as back:
+        np.testing.assert_array_equal(back["force"].values, f)
+        np.testing.assert_array_equal(back["residual"].values, one.residual)
+        assert back.attrs["law"] == law and back["displacement"].attrs["units"] == "m"
+
+
+def test_a_law_fit_s_criterion_is_undefined_with_its_reason_on_exact_data():
+    from qzs.identify.spring_laws import fit_polynomial
+
+    z = np.linspace(-0.1, 0.1, 9)
+    one = fit_polynomial(z, CUBIC.force(z) * 0.0 + 3.0, 1, 0.0, 0.95)  # a constant: exact
+    value, why = one.bic()
+    assert math.isnan(value) and "residuals are all zero" in why

@@ -26,10 +26,10 @@ from scipy import optimize
 from qzs._format import number
 from qzs._validation import choice, integer, positive_real, real
 from qzs.errors import DataError, FitError, ParameterError
-from qzs.identify._protocol import FitProtocol, deprecated_alias, interval_attributes
+from qzs.identify._protocol import FitProtocol, deprecated_alias
 from qzs.identify._statistics import student_quantile
-from qzs.identify.spring_laws import (LawFit, fit_oblique, fit_polynomial, fit_table,
-                                      oblique_force)
+from qzs.identify.spring_laws import (CRITERION, LawFit, fit_oblique, fit_polynomial,
+                                      fit_table, law_force, pairs_dataset, parameter_lines)
 from qzs.model.springs import TABLE_MIN_POINTS, SpringLaw, TanhSpring
 
 if TYPE_CHECKING:
@@ -40,8 +40,6 @@ __all__ = ["SpringFit", "fit_spring", "CONVENTIONS", "LAWS", "CRITERION"]
 CONVENTIONS = ("model", "test_machine")
 #: What ``fit_spring(law=...)`` fits: a law by its name, or ``"best"`` of them all.
 LAWS = ("tanh", "polynomial", "oblique", "table", "best")
-#: The criterion ``law="best"`` chooses by (module docstring).
-CRITERION = "BIC = n ln(RSS/n) + k ln n"
 #: Files :meth:`SpringFit.save` writes.
 SPRING_FIT_SUFFIXES = (*FitProtocol.save_suffixes, ".toml")
 _NAN_PAIR = (math.nan, math.nan)
@@ -156,26 +154,12 @@ class SpringFit(FitProtocol):
         ndarray
             Force on the payload [N].
         """
-        z = np.asarray(displacement, dtype=float)
-        if self.law is not None:
-            return self.law.force(z)
-        if self.kind == "tanh":
-            return -self.spring_force * np.tanh(self.spring_shape * z)
-        p = self.parameters
-        return oblique_force(z - p["center"], p["preload"], p["far_stiffness"],
-                             p["oblique_force"], p["horizontal_distance"])
+        return law_force(self.kind, self.law, self.parameters, displacement)
 
     def summary(self) -> str:
         """The fit as text: law, parameters with intervals, residual, criterion, candidates."""
-        percent = f"{100 * self.confidence:g} %"
         lines = [f"spring fit: {self.kind} law, {self.n_points} points ({self.convention} "
-                 f"convention, reported in the model's)"]
-        for name, value in self.parameters.items():
-            unit = self.units.get(name, "")
-            low, high = self.intervals.get(name, (None, None))
-            where = (f"  [{number(low, 4)}, {number(high, 4)}] {unit} ({percent})"
-                     if name in self.intervals else "")
-            lines.append(f"  {name} = {number(value, 6, unit)}{where}")
+                 f"convention, reported in the model's)", *parameter_lines(self)]
         lines.append(f"  residual rms {number(self.residual_rms, 4, 'N')}; BIC "
                      f"{number(self.criterion, 6)} (k = {self.n_parameters:.4g})")
         lines.append("  outliers (|residual| > 4 robust sd): "
@@ -235,21 +219,8 @@ class SpringFit(FitProtocol):
         -------
         xarray.Dataset
         """
-        from qzs.iotools.schema import Schema, Variable, to_dataset
-
-        schema = Schema(kind="a spring fit", dimensions={"point": None}, variables=(
-            Variable(name="displacement", dims=("point",), units="m",
-                     long_name="relative position z (model convention)"),
-            Variable(name="force", dims=("point",), units="N",
-                     long_name="measured spring force on the payload"),
-            Variable(name="residual", dims=("point",), units="N",
-                     long_name="measured minus fitted force")))
-        attrs = {"title": f"spring fit (qzs.fit_spring): {self.kind} law",
-                 "law": self.kind, "convention": self.convention,
-                 "residual_rms": self.residual_rms, "residual_rms_units": "N",
-                 **interval_attributes(self, lambda name: self.units.get(name, ""))}
-        return to_dataset(schema, {"displacement": self.displacement, "force": self.force,
-                                   "residual": self.residual}, attrs)
+        return pairs_dataset(self, f"spring fit (qzs.fit_spring): {self.kind} law",
+                             convention=self.convention)
 
     def _writers(self) -> dict[str, Any]:
         """``.toml``: the law as a ``[spring]`` table, what ``qzs simulate --spring`` reads."""
@@ -297,7 +268,8 @@ def _tanh(z, f, confidence):
                             "convention='test_machine'")
     fitted = LawFit(law, {"plateau": float(a), "shape": float(b)},
                     {"plateau": a_interval, "shape": b_interval},
-                    {"plateau": "N", "shape": "1/m"}, undefined, model(z, *params), 2.0)
+                    {"plateau": "N", "shape": "1/m"}, undefined, model(z, *params), 2.0,
+                    kind="tanh", displacement=z, force=f, confidence=confidence)
     return float(a), float(b), a_interval, b_interval, fitted
 
 
@@ -334,25 +306,16 @@ def _fit_one(kind, z, f, convention, confidence, degree, center, smoothing, free
         elif kind == "oblique":
             fitted = fit_oblique(z, f, free_length, confidence)
         else:
-            fitted = fit_table(z, f, smoothing, table_points)
-    residual = f - fitted.predicted
-    rss = float(residual @ residual)
+            fitted = fit_table(z, f, smoothing, table_points, confidence)
+    residual = fitted.residual
     n = z.size
     undefined = {**old, **fitted.undefined}
-    criterion = math.nan
-    if n - fitted.n_parameters < 1.0:
-        undefined["criterion"] = (f"the law has {fitted.n_parameters:.4g} parameters for {n} "
-                                  "points: it follows the noise, and RSS/n no longer "
-                                  "estimates its variance (smooth the table more)")
-    elif rss <= 0.0:
-        undefined["criterion"] = ("the residuals are all zero (the data lie exactly on the "
-                                  "law): n ln(RSS/n) is -inf")
-    else:
-        criterion = n * math.log(rss / n) + fitted.n_parameters * math.log(n)
+    criterion, why = fitted.bic()
+    if why is not None:
+        undefined["criterion"] = why
     scale = 1.4826 * np.median(np.abs(residual - np.median(residual)))
     outliers = tuple(int(i) for i in np.flatnonzero(np.abs(residual) > 4 * max(scale, 1e-300)))
-    return SpringFit(a, b, confidence, convention,
-                     float(np.sqrt(np.mean(residual ** 2))), outliers, kind, fitted.law,
+    return SpringFit(a, b, confidence, convention, fitted.residual_rms, outliers, kind, fitted.law,
                      dict(fitted.parameters), dict(fitted.intervals), dict(fitted.units),
                      undefined, criterion, n, fitted.n_parameters, {}, {}, z, f, residual)
 

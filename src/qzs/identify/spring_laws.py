@@ -34,18 +34,29 @@ table          a cubic smoothing spline (``scipy.interpolate.make_smoothing_spli
 =============  ===========================================================================
 """
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 from scipy.interpolate import make_smoothing_spline
 
+from qzs._format import number
 from qzs.errors import DataError, FitError
+from qzs.identify._protocol import FitProtocol, interval_attributes
 from qzs.identify._statistics import fit_covariance, student_quantile
 from qzs.model.springs import ObliqueSpringQZS, PolynomialSpring, SpringLaw, TabulatedSpring
 
+if TYPE_CHECKING:
+    import xarray as xr
+
 __all__ = ["LawFit", "fit_polynomial", "fit_oblique", "fit_table", "oblique_force",
-           "OBLIQUE_FITTED", "TABLE_LAMBDA_RANGE"]
+           "law_force", "parameter_lines", "pairs_dataset", "CRITERION", "OBLIQUE_FITTED",
+           "TABLE_LAMBDA_RANGE"]
+
+#: The criterion a fit is compared by (:meth:`LawFit.bic`; ``fit_spring(law="best")``).
+CRITERION = "BIC = n ln(RSS/n) + k ln n"
 
 #: The oblique law's fitted parameters, their units, and what each is.
 OBLIQUE_FITTED = {"center": ("m", "position where the oblique springs are horizontal"),
@@ -63,9 +74,10 @@ _SPLIT = ("a force curve determines only k_v + 2 k_o and 2 k_o L0 (k_o and L0 en
           "the same force at every z; give free_length = L0 [m] to determine the three")
 
 
-@dataclass(frozen=True)
-class LawFit:
-    """One law fitted (internal to :func:`qzs.identify.fit_spring`).
+@dataclass(frozen=True, eq=False)
+class LawFit(FitProtocol):
+    """One law fitted to force-displacement pairs (what :func:`qzs.identify.fit_spring` makes
+    its :class:`~qzs.identify.SpringFit` of).
 
     Attributes
     ----------
@@ -74,7 +86,7 @@ class LawFit:
     parameters : dict of str to float
         Fitted (or derived) parameters.
     intervals : dict of str to tuple of float
-        Their confidence intervals.
+        Their confidence intervals at ``confidence``: name -> ``(low, high)``.
     units : dict of str to str
         Their units.
     undefined : dict of str to str
@@ -83,6 +95,12 @@ class LawFit:
         The fitted force at the data [N].
     n_parameters : float
         Parameters the criterion counts (a table's effective degrees of freedom).
+    kind : str
+        The law fitted: ``"tanh"``, ``"polynomial"``, ``"oblique"`` or ``"table"``.
+    displacement, force : ndarray
+        The pairs fitted: relative position [m] (model convention), force on the payload [N].
+    confidence : float
+        Level of the intervals [-].
     """
 
     law: SpringLaw | None
@@ -90,8 +108,208 @@ class LawFit:
     intervals: dict
     units: dict
     undefined: dict
-    predicted: np.ndarray
+    predicted: np.ndarray = field(repr=False)
     n_parameters: float
+    kind: str = field(kw_only=True)
+    displacement: np.ndarray = field(kw_only=True, repr=False)
+    force: np.ndarray = field(kw_only=True, repr=False)
+    confidence: float = field(kw_only=True)
+
+    _figure = "plot_spring_law_fit"
+
+    @property
+    def n_points(self) -> int:
+        """Pairs fitted."""
+        return int(self.displacement.size)
+
+    @property
+    def residual(self) -> np.ndarray:
+        """Measured minus fitted force at the data [N]."""
+        return self.force - self.predicted
+
+    @property
+    def residual_rms(self) -> float:
+        """RMS of :attr:`residual` [N]."""
+        return float(np.sqrt(np.mean(self.residual ** 2)))
+
+    def bic(self) -> tuple[float, str | None]:
+        """The fit's :data:`CRITERION` [-], NaN with the reason where it is undefined.
+
+        Returns
+        -------
+        value : float
+        reason : str or None
+            Why ``value`` is NaN; None when it is defined.
+        """
+        residual = self.residual
+        rss = float(residual @ residual)
+        n = self.displacement.size
+        if n - self.n_parameters < 1.0:
+            return math.nan, (f"the law has {self.n_parameters:.4g} parameters for {n} "
+                              "points: it follows the noise, and RSS/n no longer "
+                              "estimates its variance (smooth the table more)")
+        if rss <= 0.0:
+            return math.nan, ("the residuals are all zero (the data lie exactly on the "
+                              "law): n ln(RSS/n) is -inf")
+        return n * math.log(rss / n) + self.n_parameters * math.log(n), None
+
+    @property
+    def criterion(self) -> float:
+        """:meth:`bic`'s value [-] (NaN where undefined)."""
+        return self.bic()[0]
+
+    def predict(self, displacement: ArrayLike) -> NDArray[np.float64]:
+        """The fitted force at ``displacement`` [N], even when ``law`` is None
+        (:func:`law_force`).
+
+        Parameters
+        ----------
+        displacement : float or array_like
+            Relative position [m], model convention.
+
+        Returns
+        -------
+        ndarray
+        """
+        return law_force(self.kind, self.law, self.parameters, displacement)
+
+    def estimates(self) -> dict[str, float]:
+        """The fitted parameters by name (those with an interval are its keys).
+
+        Returns
+        -------
+        dict of str to float
+        """
+        return dict(self.parameters)
+
+    def summary(self) -> str:
+        """The fit as text: its law, parameters with intervals, residual and criterion.
+
+        Returns
+        -------
+        str
+        """
+        lines = [f"{self.kind} law fitted to {self.n_points} points (model convention)",
+                 *parameter_lines(self),
+                 f"  residual rms {number(self.residual_rms, 4, 'N')}; BIC "
+                 f"{number(self.criterion, 6)} (k = {self.n_parameters:.4g})",
+                 "  law: " + (self.law.describe() if self.law is not None else "none")]
+        lines += [f"  {name} undefined: {why}" for name, why in self.undefined.items()]
+        return "\n".join(lines)
+
+    def to_record(self) -> dict[str, Any]:
+        """The fit as plain data (what :meth:`save` writes as JSON; NaN as None).
+
+        Returns
+        -------
+        dict
+        """
+        return {"kind": self.kind, "law": None if self.law is None else self.law.to_dict(),
+                "parameters": dict(self.parameters),
+                "intervals": {k: list(v) for k, v in self.intervals.items()},
+                "units": dict(self.units), "undefined": dict(self.undefined),
+                "confidence": self.confidence, "residual_rms": self.residual_rms,
+                "criterion": {"name": CRITERION, "value": self.criterion,
+                              "n_points": self.n_points, "n_parameters": self.n_parameters}}
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The pairs fitted on ``point`` (:func:`pairs_dataset`, CF-1.10, units on each).
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        return pairs_dataset(self, f"{self.kind} law fitted (qzs.identify.spring_laws)")
+
+
+def law_force(kind: str, law: SpringLaw | None, parameters: dict,
+              displacement: ArrayLike) -> NDArray[np.float64]:
+    """A fitted law's force at ``displacement`` [N]: the law's, or, where the fitted numbers
+    made none, the tanh's or the mechanism's formula of its parameters.
+
+    Parameters
+    ----------
+    kind : str
+        The law fitted.
+    law : SpringLaw or None
+        The law made of the fit.
+    parameters : dict
+        The fitted parameters (the tanh's ``plateau``, ``shape``; the mechanism's).
+    displacement : float or array_like
+        Relative position [m], model convention.
+
+    Returns
+    -------
+    ndarray
+        Force on the payload [N].
+    """
+    z = np.asarray(displacement, dtype=float)
+    if law is not None:
+        return law.force(z)
+    if kind == "tanh":
+        return -parameters["plateau"] * np.tanh(parameters["shape"] * z)
+    p = parameters
+    return oblique_force(z - p["center"], p["preload"], p["far_stiffness"],
+                         p["oblique_force"], p["horizontal_distance"])
+
+
+def parameter_lines(fit: Any) -> list[str]:
+    """A fit's parameters as text lines, each with its unit and interval.
+
+    Parameters
+    ----------
+    fit : LawFit or SpringFit
+        The fit (``parameters``, ``units``, ``intervals``, ``confidence``).
+
+    Returns
+    -------
+    list of str
+    """
+    percent = f"{100 * fit.confidence:g} %"
+    lines = []
+    for name, value in fit.parameters.items():
+        unit = fit.units.get(name, "")
+        low, high = fit.intervals.get(name, (None, None))
+        where = (f"  [{number(low, 4)}, {number(high, 4)}] {unit} ({percent})"
+                 if name in fit.intervals else "")
+        lines.append(f"  {name} = {number(value, 6, unit)}{where}")
+    return lines
+
+
+def pairs_dataset(fit: Any, title: str, **attrs: Any) -> "xr.Dataset":
+    """A spring fit's pairs as an ``xarray.Dataset`` on ``point`` (CF-1.10, units on each).
+
+    ``displacement`` [m] (model convention), ``force`` and ``residual`` [N]; the law,
+    ``attrs``, the residual's RMS, the parameters, their intervals (``<name>_lower``,
+    ``<name>_upper``) and units, and ``confidence_level`` as global attributes.
+
+    Parameters
+    ----------
+    fit : LawFit or SpringFit
+        The fit.
+    title : str
+        The dataset's title.
+    **attrs
+        Further global attributes, after the law's.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    from qzs.iotools.schema import Schema, Variable, to_dataset
+
+    schema = Schema(kind="a spring fit", dimensions={"point": None}, variables=(
+        Variable(name="displacement", dims=("point",), units="m",
+                 long_name="relative position z (model convention)"),
+        Variable(name="force", dims=("point",), units="N",
+                 long_name="measured spring force on the payload"),
+        Variable(name="residual", dims=("point",), units="N",
+                 long_name="measured minus fitted force")))
+    head = {"title": title, "law": fit.kind, **attrs,
+            "residual_rms": fit.residual_rms, "residual_rms_units": "N",
+            **interval_attributes(fit, lambda name: fit.units.get(name, ""))}
+    return to_dataset(schema, {"displacement": fit.displacement, "force": fit.force,
+                               "residual": fit.residual}, head)
 
 
 def _intervals(names, values, covariance, confidence, dof):
@@ -147,7 +365,8 @@ def fit_polynomial(z, f, degree, center, confidence):
     return LawFit(PolynomialSpring(coefficients=coefficients, center=center), parameters,
                   _intervals(names, coefficients, covariance, confidence, dof), units,
                   {"center": "chosen, not fitted: the position the powers are taken about"},
-                  predicted, float(k))
+                  predicted, float(k), kind="polynomial", displacement=z, force=f,
+                  confidence=confidence)
 
 
 def oblique_force(u, preload, far, amplitude, distance):
@@ -264,7 +483,8 @@ def fit_oblique(z, f, free_length, confidence):
                                    center=center, preload=preload)
     if law is None:
         undefined["law"] = _oblique_refusal(far, amplitude, free_length)
-    return LawFit(law, parameters, intervals, units, undefined, predicted, 5.0)
+    return LawFit(law, parameters, intervals, units, undefined, predicted, 5.0, kind="oblique",
+                  displacement=z, force=f, confidence=confidence)
 
 
 def _oblique_refusal(far, amplitude, free_length):
@@ -294,7 +514,7 @@ def _hat_trace(s, weights, lam):
     return total
 
 
-def fit_table(z, f, smoothing, points):
+def fit_table(z, f, smoothing, points, confidence=0.95):
     """A smoothing spline's forces at ``points`` positions: a :class:`TabulatedSpring`.
 
     Parameters
@@ -308,6 +528,8 @@ def fit_table(z, f, smoothing, points):
         (module docstring).
     points : int
         Positions of the table, evenly spaced over the data's range.
+    confidence : float
+        The level a fit states [-] (a table has no parameter intervals).
 
     Returns
     -------
@@ -349,4 +571,5 @@ def fit_table(z, f, smoothing, points):
     units = {"smoothing": "-", "effective_parameters": "-"}
     undefined = {"intervals": "a smoothed table has no parameter intervals: its forces are a "
                               "smoother's output, biased by the smoothing"}
-    return LawFit(law, parameters, {}, units, undefined, law.force(z), trace)
+    return LawFit(law, parameters, {}, units, undefined, law.force(z), trace, kind="table",
+                  displacement=z, force=f, confidence=confidence)

@@ -52,8 +52,9 @@ def plot_spring_law_fit(fit, *, path=None, title=""):
 
     Parameters
     ----------
-    fit : SpringFit
-        The fit (:func:`qzs.identify.fit_spring`).
+    fit : SpringFit or LawFit
+        The fit (:func:`qzs.identify.fit_spring`, or one law of it: a
+        :class:`~qzs.identify.spring_laws.LawFit`, which has no candidates).
     path : str or Path, optional
         Write the figure there (a .png also as .svg).
     title : str
@@ -69,11 +70,12 @@ def plot_spring_law_fit(fit, *, path=None, title=""):
     grid = np.linspace(z.min(), z.max(), 801)
     top.plot(z * 1e3, force, "o", ms=3.5, mfc="none", color="0.35", zorder=3,
              label=f"measured ({fit.n_points})")
-    for kind, other in fit.candidates.items():
+    candidates = getattr(fit, "candidates", {})
+    for kind, other in candidates.items():
         if kind != fit.kind:
             top.plot(grid * 1e3, other.predict(grid), "--", lw=1.0,
                      label=f"{kind}: BIC {other.criterion:.1f}")
-    chosen = f", BIC {fit.criterion:.1f}" + (" (chosen)" if fit.candidates else "")
+    chosen = f", BIC {fit.criterion:.1f}" + (" (chosen)" if candidates else "")
     top.plot(grid * 1e3, fit.predict(grid), "-", color="C3", lw=1.4,
              label=f"{fit.kind} fit: rms residual {fit.residual_rms:.3g} N{chosen}")
     margin = 0.15 * max(np.ptp(force), 1e-9)  # a far-off candidate does not squash the data
