@@ -65,7 +65,6 @@ LEFT = {
                           "its instance also takes minutes (60 s chirps on every axis)",
     "StepChoice": "the step choice becomes one call in issue 42 part 1 "
                   "(engine/step_search.py, owned there)",
-    "CaseCurve": "one curve of a question's answer: the protocol not written yet",
 }
 
 
@@ -161,6 +160,16 @@ def _law_fit():
                           0.95)
 
 
+def _case_curve():
+    from qzs.workflows.questions.common import ChirpPlan, run_chirp_cases
+
+    (curve,) = run_chirp_cases(["viscous 60 N*s/m"],
+                               [(qzs.IsolatorParameters(viscous_damping=60.0),
+                                 qzs.ControllerParameters())],
+                               ChirpPlan(CHIRP, 100.0, 512, 5e-4), workers=1)
+    return curve
+
+
 def _friction_fit():
     truth = qzs.IsolatorParameters()
     return qzs.fit_friction(*instron_test(), spring=truth, mass=truth.mass)
@@ -215,6 +224,7 @@ FACTORIES = {
     "ExperimentResult": (lambda folder: _experiment(), lambda r: r.band[1]),
     "SpringFit": (lambda folder: _spring_fit(), lambda r: r.parameters["plateau"]),
     "LawFit": (lambda folder: _law_fit(), lambda r: r.parameters["c1"]),
+    "CaseCurve": (lambda folder: _case_curve(), lambda r: r.metrics["isolation_onset"]),
     "FrictionFit": (lambda folder: _friction_fit(), lambda r: r.stiction_force),
     "FrequencyResponseCurve": (lambda folder: _balance(),
                                lambda r: float(np.max(r.transmissibility[r.stable & r.valid]))),

@@ -7,13 +7,22 @@ last bit), under one chirp, and is reduced to its transmissibility curve over it
 """
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from qzs._format import decibels, number
 from qzs.analysis.damping import band_rms
-from qzs.analysis.spectral import band_mask, transmissibility, transmissibility_metrics
+from qzs.analysis.spectral import (band_mask, metric_unit, transmissibility,
+                                   transmissibility_metrics)
 from qzs.defaults import ANALYSIS
 from qzs.errors import ParameterError, SimulationError
+from qzs.iotools.result_files import DATASET_SUFFIXES, save_by_extension, save_doc
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = ["Answer", "ChirpPlan", "CaseCurve", "run_chirp_cases", "band_transmissibility"]
 
@@ -105,6 +114,105 @@ class CaseCurve:
     metrics: dict = field(default_factory=dict)
     reasons: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = DATASET_SUFFIXES
+
+    def summary(self) -> str:
+        """The case as text: its bins, its trusted peak, its metrics and statistics.
+
+        Returns
+        -------
+        str
+        """
+        f, trusted = self.frequency, np.flatnonzero(self.trusted)
+        lines = [f"{self.label}: transmissibility over {f.size} bins up to {f[-1]:.4g} Hz, "
+                 f"{trusted.size} trusted"]
+        if trusted.size:
+            k = trusted[np.argmax(self.magnitude[trusted])]
+            lines.append(f"  trusted peak |T| {self.magnitude[k]:.4g} "
+                         f"({decibels(self.magnitude[k]):.3g} dB) at {f[k]:.4g} Hz")
+        for name, value in self.metrics.items():
+            why = f" ({self.reasons[name]})" if name in self.reasons else ""
+            lines.append(f"  {name} = {_shown(name, value)}{why}")
+        lines.append("  run: " + ", ".join(f"{name} {_shown(name, value)}"
+                                           for name, value in self.stats.items()))
+        return "\n".join(lines)
+
+    def curve(self) -> dict[str, Any]:
+        """The curve as the figures and the curves' files take it (``label``,
+        ``frequency`` [Hz], ``magnitude`` [1], ``trusted``).
+
+        Returns
+        -------
+        dict
+        """
+        return {"label": self.label, "frequency": self.frequency, "magnitude": self.magnitude,
+                "trusted": self.trusted}
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The curve as the paper's curves files lay it out
+        (:func:`qzs.workflows.paper.curves.curves_dataset`: ``magnitude`` [1] and the
+        ``trusted`` flag on ``case`` and ``frequency`` [Hz]); its metrics and statistics as
+        global attributes with their ``_units``.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.workflows.paper.curves import curves_dataset
+
+        attrs: dict[str, Any] = {"title": f"transmissibility of {self.label}"}
+        for name, value in (*self.metrics.items(), *self.stats.items()):
+            attrs[name] = value
+            if _unit(name):
+                attrs[f"{name}_units"] = _unit(name)
+        return curves_dataset([self.curve()], attrs)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
+        """The curve in dB against frequency, trusted bins solid
+        (:func:`qzs.viz.transmissibility.plot_transmissibility`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (a .png also as .svg).
+        title : str, optional
+            Figure title; default the case's label.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.transmissibility import plot_transmissibility
+
+        return plot_transmissibility([self.curve()],
+                                     frequency_range=(0.0, float(self.frequency[-1])),
+                                     frequency_scale=frequency_scale,
+                                     title=self.label if title is None else title, path=path)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray)
+
+    save.__doc__ = save_doc("``.nc`` (NetCDF, CF-1.10), ``.csv`` (one row per bin) or "
+                            "``.mat`` (MATLAB) of :meth:`to_xarray`: the curve, its metrics "
+                            "and statistics")
+
+
+def _unit(name):
+    """The unit of a case's metric or statistic ("1" a ratio or a count), "" if none."""
+    from qzs.engine.batch import STATS
+
+    return metric_unit(name) or STATS.get(name, ("",))[0]
+
+
+def _shown(name, value):
+    """A metric or statistic as text with its unit (none for a ratio or a count)."""
+    unit = _unit(name)
+    return number(value, 4, "" if unit == "1" else unit)
 
 
 def band_transmissibility(curve, band):
