@@ -307,7 +307,7 @@ def test_study_physics_is_sensible(quick_paper):
     results, _, _ = quick_paper
     by_name = {r.study.name: r for r in results}
     fit = by_name["spring"].cases[0].extra["fit"]
-    assert fit["spring_force_interval"][0] <= 60.84 <= fit["spring_force_interval"][1]
+    assert fit["intervals"]["plateau"][0] <= 60.84 <= fit["intervals"]["plateau"][1]
     for case in by_name["viscous"].cases:
         # above the stick-slip band the nonlinear curve follows the linearised model
         keep = (case.frequency > 6) & (case.frequency < 18)

@@ -12,8 +12,8 @@ from qzs.workflows.paper.studies import RUN_UNITS
 from qzs.workflows.findings.tables import run_settings
 from qzs.workflows.findings.verdicts import case_value
 
-__all__ = ["figure_curves", "curves_of", "draw_views", "draw_studies", "curve_files",
-           "figure_names"]
+__all__ = ["figure_curves", "case_curves", "curves_of", "case_dataset", "view_figure",
+           "case_figure", "draw_views", "draw_studies", "curve_files", "figure_names"]
 
 
 def figure_curves(result):
@@ -30,25 +30,42 @@ def figure_curves(result):
     """
     cases = result.cases
     names = list(dict.fromkeys(k for c in cases for k in c.settings))
-
-    def parameters(case):
-        return {name: case_value(case, name) for name in names}
-
     if result.study.kind == "processing":
-        case = cases[0]
+        return case_curves(cases[0], names)
+    return [curve for case in cases for curve in case_curves(case, names)]
+
+
+def case_curves(case, names=None):
+    """The curves of one case as the figures draw them: its own and, processed like the
+    experiment (a ``processing`` study's), the experiment-style one.
+
+    Parameters
+    ----------
+    case : CaseResult
+        A simulated case.
+    names : sequence of str, optional
+        The parameters each curve carries; default the case's own settings.
+
+    Returns
+    -------
+    list of dict
+    """
+    parameters = {name: case_value(case, name)
+                  for name in (case.settings if names is None else names)}
+    if "highpass" in case.extra:  # processed like the experiment
         return [dict(label=f"ideal: accelerations, {case.stats['n_averages']} averages",
                      frequency=case.frequency, magnitude=case.magnitude, trusted=case.trusted,
                      coherence=case.coherence, linear=case.linear.get("magnitude"),
-                     phase=case.phase, parameters=parameters(case)),
+                     phase=case.phase, parameters=parameters),
                 dict(label=f"experiment-style: velocities through the "
                            f"{case.extra['highpass']:g} Hz high-pass, "
                            f"{case.extra['n_averages']} averages",
                      frequency=case.extra["frequency"], magnitude=case.extra["magnitude"],
                      trusted=case.extra.get("trusted"), coherence=case.extra.get("coherence"),
-                     phase=case.extra.get("phase"), parameters=parameters(case))]
-    return [dict(label=c.label, frequency=c.frequency, magnitude=c.magnitude, trusted=c.trusted,
-                 coherence=c.coherence, linear=c.linear.get("magnitude"), phase=c.phase,
-                 parameters=parameters(c)) for c in cases]
+                     phase=case.extra.get("phase"), parameters=parameters)]
+    return [dict(label=case.label, frequency=case.frequency, magnitude=case.magnitude,
+                 trusted=case.trusted, coherence=case.coherence,
+                 linear=case.linear.get("magnitude"), phase=case.phase, parameters=parameters)]
 
 
 def curves_of(result, *, quick=False):
@@ -74,13 +91,107 @@ def curves_of(result, *, quick=False):
              "definition": Path(result.study.source).name if result.study.source else "",
              "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
     if result.study.kind == "spring_characteristic":
-        return spring_curves(result, attrs)
-    for key, value in run_settings(result).items():
+        return spring_curves(result.cases[0], attrs)
+    return curves_dataset(figure_curves(result), _run_attributes(attrs, run_settings(result)))
+
+
+def _run_attributes(attrs, settings):
+    """``attrs`` with the run settings and their ``<key>_units`` (values joined if several)."""
+    for key, value in settings.items():
         attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
                       else value)
         if RUN_UNITS.get(key):
             attrs[f"{key}_units"] = RUN_UNITS[key]
-    return curves_dataset(figure_curves(result), attrs)
+    return attrs
+
+
+def case_dataset(case):
+    """One case's curves (:func:`case_curves`) as a curves dataset with its run settings, or
+    a spring case's points and fitted law (:func:`curves_of`'s layouts).
+
+    Parameters
+    ----------
+    case : CaseResult
+        The case.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    attrs = {"title": case.label, "source": f"qzs {__version__} (a case of qzs paper / qzs "
+                                            "study)"}
+    if case.frequency is None:
+        return spring_curves(case, attrs)
+    return curves_dataset(case_curves(case), _run_attributes(attrs, dict(case.run)))
+
+
+def view_figure(result, view=None, path=None, frequency_scale=None, title=None):
+    """One view of a study (its first by default; the spring's figure for the spring study).
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study.
+    view : dict, optional
+        One of ``result.study.views``; default the first (the band analysed if none).
+    path : str or Path, optional
+        Write the figure there (PNG and SVG).
+    frequency_scale : {"log", "linear"}, optional
+        Overrides the view's own; else the view's or the default (log).
+    title : str, optional
+        Default the study's title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    study = result.study
+    title = study.title if title is None else title
+    if study.kind == "spring_characteristic":
+        return draw_spring(result.cases[0], path, title)
+    first = result.cases[0]
+    if view is None:
+        view = (study.views[0] if study.views else
+                {"frequency_range": (0.0, float(first.frequency[-1]))})
+    untrusted = None
+    if study.kind == "processing":
+        untrusted = first.extra.get("untrusted_below", 1.5 * first.extra["highpass"])
+    coherence_min = first.run.get("coherence_min") if first.run else None
+    options = {} if coherence_min is None else {"coherence_min": coherence_min}
+    return plot_transmissibility(figure_curves(result),
+                                 frequency_range=tuple(view["frequency_range"]),
+                                 frequency_scale=frequency_scale or view.get("frequency_scale"),
+                                 title=title, path=path, untrusted_below=untrusted, **options)
+
+
+def case_figure(case, path=None, frequency_scale=None, title=None):
+    """One case's curves (:func:`case_curves`) over its band, or a spring case's figure.
+
+    Parameters
+    ----------
+    case : CaseResult
+        The case.
+    path : str or Path, optional
+        Write the figure there (PNG and SVG).
+    frequency_scale : {"log", "linear"}, optional
+        Default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+    title : str, optional
+        Default the case's label.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    title = case.label if title is None else title
+    if case.frequency is None:
+        return draw_spring(case, path, title)
+    options = {"coherence_min": case.run["coherence_min"]} if "coherence_min" in case.run \
+        else {}
+    untrusted = (case.extra.get("untrusted_below", 1.5 * case.extra["highpass"])
+                 if "highpass" in case.extra else None)
+    return plot_transmissibility(case_curves(case), frequency_range=(0.0, float(
+        case.frequency[-1])), frequency_scale=frequency_scale, title=title, path=path,
+        untrusted_below=untrusted, **options)
 
 
 def draw_views(result, folder, frequency_scale=None):
@@ -109,26 +220,15 @@ def draw_views(result, folder, frequency_scale=None):
     study = result.study
     if study.kind == "spring_characteristic":
         path = folder / "fig05_spring.png"
-        plt.close(draw_spring(result, path))
+        plt.close(view_figure(result, path=path))
         return [("fig05_spring", path, [])]
     drawn = []
     curves = figure_curves(result)
-    coherence_min = result.cases[0].run.get("coherence_min") if result.cases[0].run else None
     for view in study.views:
-        untrusted = None
-        if study.kind == "processing":
-            untrusted = result.cases[0].extra.get("untrusted_below",
-                                                  1.5 * result.cases[0].extra["highpass"])
-        span = tuple(view["frequency_range"])
         path = folder / f"{view['figure']}.png"
-        options = {} if coherence_min is None else {"coherence_min": coherence_min}
-        fig = plot_transmissibility(curves, frequency_range=span,
-                                    frequency_scale=frequency_scale or view.get(
-                                        "frequency_scale"),
-                                    title=study.title, path=path, untrusted_below=untrusted,
-                                    **options)
-        plt.close(fig)
-        drawn.append((view["figure"], path, overlap_notes(curves, frequency_range=span)))
+        plt.close(view_figure(result, view, path, frequency_scale))
+        drawn.append((view["figure"], path,
+                      overlap_notes(curves, frequency_range=tuple(view["frequency_range"]))))
     return drawn
 
 

@@ -9,8 +9,9 @@ from qzs._format import footnoted, number
 from qzs._version import __version__
 from qzs.iotools.files import atomic_path
 
-__all__ = ["with_reasons", "metric_rows", "claims_record", "run_settings", "document_head",
-           "metric_cell", "significant", "write_text"]
+__all__ = ["with_reasons", "metric_rows", "case_row", "study_record", "case_text",
+           "claims_record", "run_settings", "document_head", "metric_cell", "significant",
+           "write_text"]
 
 
 def with_reasons(metrics, reasons, prefix=""):
@@ -49,23 +50,91 @@ def metric_rows(study_results):
     -------
     list of dict
     """
-    rows = []
-    for result in study_results:
-        for case in result.cases:
-            row = {"study": result.study.name, "case": case.label}
-            row.update({f"param.{k}": v for k, v in case.settings.items()})
-            row.update(with_reasons(case.metrics, case.reasons))
-            if "metrics" in case.extra:
-                row.update(with_reasons(case.extra["metrics"], case.extra.get("reasons", {}),
-                                         prefix="processed."))
-            row.update(case.stats)
-            row.update({f"run.{k}": v for k, v in case.run.items()})
-            if case.linear:
-                row["linear_undamped_natural_frequency"] = case.linear[
-                    "undamped_natural_frequency"]
-            row["seconds"] = case.seconds
-            rows.append(row)
-    return rows
+    return [{"study": result.study.name, **case_row(case)} for result in study_results
+            for case in result.cases]
+
+
+def case_row(case):
+    """One case's row of ``metrics.csv`` without its study: label, parameters, metrics
+    with reasons, statistics, run settings, the linear model's frequency, time.
+
+    Parameters
+    ----------
+    case : CaseResult
+        The case.
+
+    Returns
+    -------
+    dict
+    """
+    row = {"case": case.label}
+    row.update({f"param.{k}": v for k, v in case.settings.items()})
+    row.update(with_reasons(case.metrics, case.reasons))
+    if "metrics" in case.extra:
+        row.update(with_reasons(case.extra["metrics"], case.extra.get("reasons", {}),
+                                prefix="processed."))
+    row.update(case.stats)
+    row.update({f"run.{k}": v for k, v in case.run.items()})
+    if case.linear:
+        row["linear_undamped_natural_frequency"] = case.linear["undamped_natural_frequency"]
+    row["seconds"] = case.seconds
+    return row
+
+
+def study_record(result):
+    """A study as ``metrics.json`` holds it: title, time [s], run settings, case rows.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The study.
+
+    Returns
+    -------
+    dict
+    """
+    return {"title": result.study.title, "seconds": result.seconds,
+            "settings": run_settings(result), "cases": metric_rows([result])}
+
+
+def case_text(case, unit):
+    """A case's curve, metrics and statistics as text (a paper study's case, a question's).
+
+    Parameters
+    ----------
+    case : CaseResult or CaseCurve
+        The case (``label``, ``frequency`` [Hz] or None, ``magnitude``, ``trusted``,
+        ``metrics``, ``reasons``, ``stats``).
+    unit : callable
+        Metric or statistic name -> its unit ("1" or "" shown as none).
+
+    Returns
+    -------
+    str
+    """
+    from qzs._format import decibels
+
+    def shown(name, value):
+        return number(value, 4, "" if unit(name) in ("1", None) else unit(name))
+
+    f = case.frequency
+    if f is None:
+        lines = [f"{case.label}: no transmissibility curve"]
+    else:
+        trusted = np.flatnonzero(case.trusted)
+        lines = [f"{case.label}: transmissibility over {f.size} bins "
+                 f"{f[0]:.4g}-{f[-1]:.4g} Hz, {trusted.size} trusted"]
+        if trusted.size:
+            k = trusted[np.argmax(case.magnitude[trusted])]
+            lines.append(f"  trusted peak |T| {case.magnitude[k]:.4g} "
+                         f"({decibels(case.magnitude[k]):.3g} dB) at {f[k]:.4g} Hz")
+    for name, value in case.metrics.items():
+        why = f" ({case.reasons[name]})" if name in case.reasons else ""
+        lines.append(f"  {name} = {shown(name, value)}{why}")
+    if case.stats:
+        lines.append("  run: " + ", ".join(f"{name} {shown(name, value)}"
+                                           for name, value in case.stats.items()))
+    return "\n".join(lines)
 
 
 def claims_record(verdicts):

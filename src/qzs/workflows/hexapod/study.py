@@ -42,6 +42,7 @@ from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.viz.figures import check_frequency_scale
 from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod.transmissibility import hexapod_transmissibility
@@ -49,10 +50,11 @@ from qzs.workflows.findings.markdown import study_markdown, study_summary
 from qzs.workflows.findings.tables import document_head, significant, write_text
 
 if TYPE_CHECKING:
+    import xarray as xr
     from matplotlib.figure import Figure
 
 __all__ = ["CASES", "RUNS", "STUDY_AXES", "HexapodStudyResult", "run_hexapod_study",
-           "comparison_figure", "study_steps",
+           "study_result", "study_document", "comparison_figure", "study_steps",
            "write_study_outputs"]
 
 #: The study's cases: label -> (what it means, registry overrides of every leg's loop).
@@ -141,6 +143,43 @@ class HexapodStudyResult:
         """
         return comparison_figure(self.cases, out=path, frequency_scale=frequency_scale,
                                  title=title)
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = suffixes_of(dataset=True, record=True)
+
+    def to_record(self) -> dict[str, Any]:
+        """The study as its ``metrics.json`` holds it (:func:`study_document`), with the
+        whole's wall time.
+
+        Returns
+        -------
+        dict
+        """
+        return study_document(self.cases, self.rows, self.findings, self.quick,
+                              self.wall_seconds)
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The cases' matrices, as each ``hexapod_matrix_<case>.nc`` holds its own
+        (:meth:`HexapodTransmissibility.to_xarray`), stacked on ``case``; the attributes
+        every case shares kept.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        import xarray as xr
+
+        return xr.concat([result.to_xarray() for result in self.cases.values()],
+                         dim="case", data_vars="different", coords="minimal", compat="equals",
+                         join="outer", combine_attrs="drop_conflicts").assign_coords(
+            case=list(self.cases))
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_record)
+
+    save.__doc__ = save_doc("``.nc``, ``.csv``, ``.mat`` (:meth:`to_xarray`: every case's "
+                            "matrix on ``case``) or ``.json`` (:meth:`to_record`: what "
+                            "``metrics.json`` holds)")
 
 
 # ---------------------------------------------------------------- metrics
@@ -418,16 +457,46 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
                                                 dt=dt, tolerance_db=tolerance_db,
                                                 workers=workers,
                                                 progress=progress)
-    wall = time.perf_counter() - start
+    return study_result(cases, folder, quick=quick, run_seconds=time.perf_counter() - start,
+                        frequency_scale=frequency_scale, progress=progress)
+
+
+def study_result(cases: Mapping[str, Any], folder: str | Path, *, quick: bool = False,
+                 run_seconds: float | None = None, frequency_scale: str | None = None,
+                 progress: bool = False) -> HexapodStudyResult:
+    """The study from its cases' matrices: the metrics rows, the findings, the files written.
+
+    Parameters
+    ----------
+    cases : mapping
+        Case label (of :data:`CASES`) -> its :class:`~qzs.workflows.hexapod.
+        transmissibility.HexapodTransmissibility` over :data:`STUDY_AXES`.
+    folder : str or Path
+        Output folder, created if missing.
+    quick : bool
+        Whether the runs were the quick ones.
+    run_seconds : float, optional
+        Wall time of the runs [s], recorded in the files.
+    frequency_scale : {"log", "linear"}, optional
+        Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``.
+    progress : bool
+        Show a progress bar over the figures and files.
+
+    Returns
+    -------
+    HexapodStudyResult
+    """
+    start = time.perf_counter()
     rows = tuple(_metrics_row(label, result, axis) for label, result in cases.items()
                  for axis in STUDY_AXES)
     findings = _findings(cases, rows)
-    files = write_study_outputs(cases, rows, findings, folder, quick=quick, wall_seconds=wall,
-                                frequency_scale=frequency_scale, progress=progress)
-    return HexapodStudyResult(cases=MappingProxyType(cases), rows=rows, findings=findings,
-                              quick=quick, wall_seconds=time.perf_counter() - start,
-                              folder=Path(folder),
-                              files=MappingProxyType(files))
+    files = write_study_outputs(cases, rows, findings, folder, quick=quick,
+                                wall_seconds=run_seconds, frequency_scale=frequency_scale,
+                                progress=progress)
+    wall = (run_seconds or 0.0) + time.perf_counter() - start
+    return HexapodStudyResult(cases=MappingProxyType(dict(cases)), rows=rows,
+                              findings=findings, quick=quick, wall_seconds=wall,
+                              folder=Path(folder), files=MappingProxyType(files))
 
 
 def study_steps(study: HexapodStudyResult) -> dict[str, dict[str, dict[str, Any]]]:
@@ -452,6 +521,45 @@ def study_steps(study: HexapodStudyResult) -> dict[str, dict[str, dict[str, Any]
 
 
 # ---------------------------------------------------------------- outputs
+def study_document(cases, rows, findings, quick, wall_seconds):
+    """The study as ``metrics.json`` holds it: the head, each case's meaning, linear model,
+    settings and steps, the metrics rows and the findings.
+
+    Parameters
+    ----------
+    cases : mapping
+        Case label -> HexapodTransmissibility.
+    rows : sequence of dict
+        The metrics rows.
+    findings : sequence of str
+        The findings' sentences.
+    quick : bool
+        Whether the runs were the quick ones.
+    wall_seconds : float or None
+        Wall time of the runs [s].
+
+    Returns
+    -------
+    dict
+    """
+    from qzs.workflows.hexapod.transmissibility.result import run_steps
+
+    return {**document_head(quick, wall_seconds), "setup": SHIPPED_DEFAULT,
+            "axes": list(STUDY_AXES),
+            "cases": {label: {"meaning": CASES[label][0], "overrides": CASES[label][1],
+                              "linear_stable": result.linear_stable,
+                              "linear_natural_frequencies_hz":
+                                  result.linear_natural_frequencies,
+                              "settings": dict(result.settings),
+                              "steps": {a: {"dt_s": r["dt"], "step": r["step"],
+                                            "error_db": r["error_db"],
+                                            "tolerance_db": r["tolerance_db"],
+                                            "reason": r["reason"]}
+                                        for a, r in run_steps(result).items()}}
+                      for label, result in cases.items()},
+            "rows": list(rows), "findings": list(findings)}
+
+
 def _slug(label):
     return label.lower().replace(" ", "_")
 
@@ -568,21 +676,8 @@ def _write_outputs(cases, rows, findings, folder, quick, wall_seconds, frequency
 
     files["metrics.csv"] = write_text(folder / "metrics.csv", csv_text(rows))
     bar.update(1)
-    document = {**document_head(quick, wall_seconds), "setup": SHIPPED_DEFAULT, "axes": list(STUDY_AXES),
-                "cases": {label: {"meaning": CASES[label][0], "overrides": CASES[label][1],
-                                  "linear_stable": result.linear_stable,
-                                  "linear_natural_frequencies_hz":
-                                      result.linear_natural_frequencies,
-                                  "settings": dict(result.settings),
-                                  "steps": {a: {"dt_s": r["dt"], "step": r["step"],
-                                                "error_db": r["step_error_db"],
-                                                "tolerance_db":
-                                                    result.settings["tolerance_db"],
-                                                "reason": r["step_reason"]}
-                                            for a, r in result.runs.items()}}
-                          for label, result in cases.items()},
-                "rows": list(rows), "findings": list(findings)}
-    files["metrics.json"] = write_text(folder / "metrics.json", json_text(document))
+    files["metrics.json"] = write_text(folder / "metrics.json", json_text(
+        study_document(cases, rows, findings, quick, wall_seconds)))
     bar.update(1)
     files["report.md"] = write_text(folder / "report.md", study_markdown(
         cases, rows, findings, files, quick, wall_seconds,

@@ -9,8 +9,9 @@ measured and fitted instead (docs/model.md §3.1, §10).
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,14 +22,19 @@ from qzs.analysis.statistics import run_statistics
 from qzs.defaults import REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
 from qzs.identify.spring import fit_spring
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import Chirp
 from qzs.model.isolator import IsolatorParameters, spring_force
 from qzs.model.registry import law_parameters, parameter_value, update_parameters
 from qzs.model.springs import PolynomialSpring
 
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
 __all__ = ["StudyCase", "CaseResult", "RUN_UNITS", "STATS_UNITS", "run_case", "case_inputs",
-           "lockstep_key", "run_lockstep"]
+           "case_unit", "lockstep_key", "run_lockstep"]
 
 #: The unit of each entry of :attr:`CaseResult.run` (None: a word, no unit; "1": a count or
 #: a ratio).
@@ -148,6 +154,96 @@ class CaseResult:
     extra: dict = field(default_factory=dict)
     seconds: float = 0.0
     phase: np.ndarray | None = None
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = suffixes_of(dataset=True, record=True)
+
+    def summary(self) -> str:
+        """The case as text: its curve's bins and trusted peak, metrics (with the reason
+        of each undefined one) and statistics, with units
+        (:func:`qzs.workflows.findings.tables.case_text`).
+
+        Returns
+        -------
+        str
+        """
+        from qzs.workflows.findings.tables import case_text
+
+        return case_text(self, case_unit)
+
+    def to_record(self) -> dict[str, Any]:
+        """The case's row of ``metrics.json`` (:func:`qzs.workflows.findings.tables.case_row`).
+
+        Returns
+        -------
+        dict
+        """
+        from qzs.workflows.findings.tables import case_row
+
+        return case_row(self)
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The case's curves as the study's ``<study>_curves.nc`` lays them out (on ``case``
+        and ``frequency`` [Hz], its parameters and run settings with units), or the spring
+        case's points and fitted law (:func:`qzs.workflows.findings.figures.case_dataset`).
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.workflows.findings.figures import case_dataset
+
+        return case_dataset(self)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
+        """The case's transmissibility [dB] against frequency [Hz] with its coherence, or the
+        spring case's points and fitted law (:func:`qzs.workflows.findings.figures.
+        case_figure`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (a .png also as .svg).
+        title : str, optional
+            Figure title; default the case's label.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.workflows.findings.figures import case_figure
+
+        return case_figure(self, path, frequency_scale, title)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_record)
+
+    save.__doc__ = save_doc("``.nc``, ``.csv``, ``.mat`` (:meth:`to_xarray`: the curves "
+                            "files' layout) or ``.json`` (:meth:`to_record`: the case's row "
+                            "of ``metrics.json``)")
+
+
+def case_unit(name):
+    """The unit of a case's metric, statistic or run setting (``metrics.csv``'s), "" if none.
+
+    Parameters
+    ----------
+    name : str
+        The name.
+
+    Returns
+    -------
+    str
+    """
+    from qzs.workflows.paper.studies import column_unit
+
+    try:
+        return column_unit(name)
+    except KeyError:
+        return ""
 
 
 def run_case(case):

@@ -30,7 +30,8 @@ from qzs.viz.figures import check_frequency_scale
 from qzs.workflows.findings.figures import curve_files, curves_of, draw_studies, figure_names
 from qzs.workflows.findings.html import paper_html
 from qzs.workflows.findings.tables import (claims_record, document_head, metric_rows,
-                                           run_settings, with_reasons, write_text)
+                                           run_settings, study_record, with_reasons,
+                                           write_text)
 from qzs.workflows.findings.verdicts import (CLAIMS, TREND_CLAIMS, Verdict, damping_changes,
                                              decide_claims)
 from qzs.workflows.paper.curves import write_curves
@@ -113,11 +114,7 @@ def _write_tables(study_results, folder, quick, wall_seconds, verdicts, bar):
     """``metrics.json``, ``metrics.csv`` and each study's curves, advancing ``bar``."""
     rows = metric_rows(study_results)
     document = {**document_head(quick, wall_seconds),
-                "studies": {r.study.name: {"title": r.study.title, "seconds": r.seconds,
-                                           "settings": run_settings(r),
-                                           "cases": [row for row in rows
-                                                     if row["study"] == r.study.name]}
-                            for r in study_results},
+                "studies": {r.study.name: study_record(r) for r in study_results},
                 "claims": claims_record(verdicts), "step": step_record(study_results),
                 "spring": spring_record(study_results)}
     write_text(folder / "metrics.json", json_text(document))

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from qzs.model.springs import SpringLaw
+    from qzs.workflows.paper.cases import CaseResult
     from qzs.workflows.paper.studies import StudyResult
 
 __all__ = ["spring_statement", "spring_record", "draw_spring", "spring_curves",
@@ -70,34 +71,36 @@ def spring_record(study_results: Sequence[StudyResult]) -> dict[str, Any]:
             for name, (value, unit) in _spring_law(study_results).parameters().items()}
 
 
-def draw_spring(result: StudyResult, path: Path) -> Figure:
+def draw_spring(case: CaseResult, path: Path | None, title: str) -> Figure:
     """The spring study's figure (the paper's Fig. 5): the points and the fitted law.
 
     Parameters
     ----------
-    result : StudyResult
-        The spring study's result.
-    path : Path
-        The PNG to write (an SVG beside it).
+    case : CaseResult
+        The spring study's case.
+    path : Path or None
+        The PNG to write (an SVG beside it); None: none.
+    title : str
+        The figure's title (the study's).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    extra = result.cases[0].extra
+    extra = case.extra
     if "law_fit" in extra:
-        return plot_spring_law_fit(extra["law_fit"], path=path, title=result.study.title)
+        return plot_spring_law_fit(extra["law_fit"], path=path, title=title)
     return plot_spring_fit(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
-                           extra["fit"]["spring_shape"], path=path, title=result.study.title)
+                           extra["fit"]["spring_shape"], path=path, title=title)
 
 
-def spring_curves(result: StudyResult, attrs: dict[str, Any]) -> xr.Dataset:
+def spring_curves(case: CaseResult, attrs: dict[str, Any]) -> xr.Dataset:
     """The spring study's points and fitted law as a dataset (``spring_curves.nc``).
 
     Parameters
     ----------
-    result : StudyResult
-        The spring study's result.
+    case : CaseResult
+        The spring study's case.
     attrs : dict
         Global attributes.
 
@@ -105,7 +108,7 @@ def spring_curves(result: StudyResult, attrs: dict[str, Any]) -> xr.Dataset:
     -------
     xarray.Dataset
     """
-    extra = result.cases[0].extra
+    extra = case.extra
     if "law_fit" in extra:
         fit = extra["law_fit"]
         fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))

@@ -32,12 +32,14 @@ import dataclasses
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from qzs._validation import known_keys, read_toml, worker_count
 from qzs.defaults import ACCURACY, ANALYSIS, FREQUENCY_SCALES, SIMULATION
 from qzs.errors import ParameterError
+from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.iotools.shipped import resolve_shipped, shipped_files
 from qzs.model.controller import ControllerParameters
 from qzs.model.excitation import EXCITATION_OPTIONS
@@ -45,6 +47,10 @@ from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 from qzs.workflows.paper.cases import (RUN_UNITS, STATS_UNITS, CaseResult, StudyCase,
                                        case_inputs, lockstep_key, run_case, run_lockstep)
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = ["CLAIMS", "Study", "StudyCase", "StudyPlan", "StudyResult", "CaseResult",
            "load_study", "shipped_studies", "plan_studies", "run_plan", "run_studies",
@@ -155,6 +161,79 @@ class StudyResult:
     seconds: float = 0.0
     step: dict = field(default_factory=dict)
     spring: Any = None
+
+    #: The extensions :meth:`save` accepts.
+    save_suffixes = suffixes_of(dataset=True, record=True)
+
+    def summary(self) -> str:
+        """The study as text: its kind, its step, then each case (:meth:`CaseResult.summary`).
+
+        Returns
+        -------
+        str
+        """
+        head = [f"study {self.study.name!r} ({self.study.kind}{', quick' if self.quick else ''}"
+                f"): {self.study.title}; {len(self.cases)} cases, {self.seconds:.3g} s"]
+        if self.step:
+            head.append(f"  step dt = {self.step['dt']:.6g} s ({self.step['source']})")
+        return "\n".join([*head, *(case.summary() for case in self.cases)])
+
+    def to_record(self) -> dict[str, Any]:
+        """The study as ``metrics.json`` holds it: title, time [s], run settings, the cases'
+        rows (:func:`qzs.workflows.findings.tables.study_record`).
+
+        Returns
+        -------
+        dict
+        """
+        from qzs.workflows.findings.tables import study_record
+
+        return study_record(self)
+
+    def to_xarray(self) -> "xr.Dataset":
+        """The curves its figures draw, as ``<study>_curves.nc`` holds them
+        (:func:`qzs.workflows.findings.figures.curves_of`: on ``case`` and ``frequency``
+        [Hz], with the cases' parameters and the run settings with units), or the spring
+        study's points and fitted law.
+
+        Returns
+        -------
+        xarray.Dataset
+        """
+        from qzs.workflows.findings.figures import curves_of
+
+        return curves_of(self, quick=self.quick)
+
+    def plot(self, path: str | Path | None = None, *, title: str | None = None,
+             frequency_scale: str | None = None) -> "Figure":
+        """The study's first figure (:func:`qzs.workflows.findings.figures.view_figure`):
+        its cases' transmissibility [dB] against frequency [Hz], or the spring's
+        characteristic.
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (a .png also as .svg).
+        title : str, optional
+            Figure title; default the study's.
+        frequency_scale : {"log", "linear"}, optional
+            Frequency axis; default the view's own, else
+            ``qzs.defaults.FIGURES["frequency_scale"]`` (log).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.workflows.findings.figures import view_figure
+
+        return view_figure(self, None, path, frequency_scale, title)
+
+    def save(self, path: str | Path) -> Path:
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_record)
+
+    save.__doc__ = save_doc("``.nc``, ``.csv``, ``.mat`` (:meth:`to_xarray`: the study's "
+                            "curves, as ``qzs paper`` writes them) or ``.json`` "
+                            "(:meth:`to_record`: the study's entry of ``metrics.json``)")
 
 
 @dataclass(frozen=True, kw_only=True)

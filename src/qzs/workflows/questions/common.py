@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from qzs._format import decibels, number
 from qzs.analysis.damping import band_rms
 from qzs.analysis.spectral import (band_mask, metric_unit, transmissibility,
                                    transmissibility_metrics)
@@ -125,19 +124,9 @@ class CaseCurve:
         -------
         str
         """
-        f, trusted = self.frequency, np.flatnonzero(self.trusted)
-        lines = [f"{self.label}: transmissibility over {f.size} bins up to {f[-1]:.4g} Hz, "
-                 f"{trusted.size} trusted"]
-        if trusted.size:
-            k = trusted[np.argmax(self.magnitude[trusted])]
-            lines.append(f"  trusted peak |T| {self.magnitude[k]:.4g} "
-                         f"({decibels(self.magnitude[k]):.3g} dB) at {f[k]:.4g} Hz")
-        for name, value in self.metrics.items():
-            why = f" ({self.reasons[name]})" if name in self.reasons else ""
-            lines.append(f"  {name} = {_shown(name, value)}{why}")
-        lines.append("  run: " + ", ".join(f"{name} {_shown(name, value)}"
-                                           for name, value in self.stats.items()))
-        return "\n".join(lines)
+        from qzs.workflows.findings.tables import case_text
+
+        return case_text(self, _unit)
 
     def curve(self) -> dict[str, Any]:
         """The curve as the figures and the curves' files take it (``label``,
@@ -207,12 +196,6 @@ def _unit(name):
     from qzs.engine.batch import STATS
 
     return metric_unit(name) or STATS.get(name, ("",))[0]
-
-
-def _shown(name, value):
-    """A metric or statistic as text with its unit (none for a ratio or a count)."""
-    unit = _unit(name)
-    return number(value, 4, "" if unit == "1" else unit)
 
 
 def band_transmissibility(curve, band):
