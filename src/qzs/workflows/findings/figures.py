@@ -1,80 +1,21 @@
-"""The report's figures: each study's views drawn from its curves, and the curves as data."""
+"""The report's figures: each study's views drawn from its curves, and the curves as data
+(:mod:`qzs.workflows.paper.curves`)."""
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-
-from qzs._version import __version__
-from qzs.model.registry import format_value
 from qzs.viz.transmissibility import overlap_notes, plot_transmissibility
-from qzs.workflows.paper.curves import CURVE_SUFFIXES, curves_dataset
-from qzs.workflows.paper.report_spring import draw_spring, spring_curves
+from qzs.workflows.paper.curves import (CURVE_SUFFIXES, case_curves, figure_curves,
+                                        study_dataset)
+from qzs.workflows.paper.report_spring import draw_spring
 from qzs.workflows.paper.studies import RUN_UNITS
-from qzs.workflows.findings.tables import run_settings
-from qzs.workflows.findings.verdicts import case_value
 
-__all__ = ["figure_curves", "case_curves", "curves_of", "case_dataset", "view_figure",
-           "case_figure", "draw_views", "draw_studies", "curve_files", "figure_names"]
-
-
-def figure_curves(result):
-    """The curves a study's figures draw, each with its case's ``parameters`` and ``phase``.
-
-    Parameters
-    ----------
-    result : StudyResult
-        A study.
-
-    Returns
-    -------
-    list of dict
-    """
-    cases = result.cases
-    names = list(dict.fromkeys(k for c in cases for k in c.settings))
-    if result.study.kind == "processing":
-        return case_curves(cases[0], names)
-    return [curve for case in cases for curve in case_curves(case, names)]
-
-
-def case_curves(case, names=None):
-    """The curves of one case as the figures draw them: its own and, processed like the
-    experiment (a ``processing`` study's), the experiment-style one.
-
-    Parameters
-    ----------
-    case : CaseResult
-        A simulated case.
-    names : sequence of str, optional
-        The parameters each curve carries; default the case's own settings.
-
-    Returns
-    -------
-    list of dict
-    """
-    parameters = {name: case_value(case, name)
-                  for name in (case.settings if names is None else names)}
-    if "highpass" in case.extra:  # processed like the experiment
-        return [dict(label=f"ideal: accelerations, {case.stats['n_averages']} averages",
-                     frequency=case.frequency, magnitude=case.magnitude, trusted=case.trusted,
-                     coherence=case.coherence, linear=case.linear.get("magnitude"),
-                     phase=case.phase, parameters=parameters),
-                dict(label=f"experiment-style: velocities through the "
-                           f"{case.extra['highpass']:g} Hz high-pass, "
-                           f"{case.extra['n_averages']} averages",
-                     frequency=case.extra["frequency"], magnitude=case.extra["magnitude"],
-                     trusted=case.extra.get("trusted"), coherence=case.extra.get("coherence"),
-                     phase=case.extra.get("phase"), parameters=parameters)]
-    return [dict(label=case.label, frequency=case.frequency, magnitude=case.magnitude,
-                 trusted=case.trusted, coherence=case.coherence,
-                 linear=case.linear.get("magnitude"), phase=case.phase, parameters=parameters)]
+__all__ = ["figure_curves", "case_curves", "curves_of", "view_figure", "case_figure",
+           "draw_views", "draw_studies", "curve_files", "figure_names"]
 
 
 def curves_of(result, *, quick=False):
-    """A study's curves as a dataset (:func:`qzs.workflows.paper.curves.curves_dataset`).
-
-    The curves its figures draw, on ``case`` and ``frequency``, with each case's
-    parameters as coordinates and the run settings, study and definition as attributes;
-    for the spring's characteristic, its points and fitted law
-    (:func:`qzs.workflows.paper.curves.spring_dataset`).
+    """A study's curves as a dataset (:func:`qzs.workflows.paper.curves.study_dataset`, the
+    run settings' units :data:`qzs.workflows.paper.cases.RUN_UNITS`).
 
     Parameters
     ----------
@@ -87,42 +28,7 @@ def curves_of(result, *, quick=False):
     -------
     xarray.Dataset
     """
-    attrs = {"title": result.study.title, "study": result.study.name,
-             "definition": Path(result.study.source).name if result.study.source else "",
-             "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
-    if result.study.kind == "spring_characteristic":
-        return spring_curves(result.cases[0], attrs)
-    return curves_dataset(figure_curves(result), _run_attributes(attrs, run_settings(result)))
-
-
-def _run_attributes(attrs, settings):
-    """``attrs`` with the run settings and their ``<key>_units`` (values joined if several)."""
-    for key, value in settings.items():
-        attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
-                      else value)
-        if RUN_UNITS.get(key):
-            attrs[f"{key}_units"] = RUN_UNITS[key]
-    return attrs
-
-
-def case_dataset(case):
-    """One case's curves (:func:`case_curves`) as a curves dataset with its run settings, or
-    a spring case's points and fitted law (:func:`curves_of`'s layouts).
-
-    Parameters
-    ----------
-    case : CaseResult
-        The case.
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    attrs = {"title": case.label, "source": f"qzs {__version__} (a case of qzs paper / qzs "
-                                            "study)"}
-    if case.frequency is None:
-        return spring_curves(case, attrs)
-    return curves_dataset(case_curves(case), _run_attributes(attrs, dict(case.run)))
+    return study_dataset(result, quick=quick, run_units=RUN_UNITS)
 
 
 def view_figure(result, view=None, path=None, frequency_scale=None, title=None):

@@ -15,7 +15,8 @@ from qzs.analysis.spectral import band_mask, rolloff_slope, transmissibility_at
 from qzs.defaults import DAMPING_CLAIM
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, passive_natural_frequency
-from qzs.model.registry import ALL_PARAMETERS, format_value, unit_of, update_parameters
+from qzs.model.registry import format_value, unit_of, update_parameters
+from qzs.workflows.paper.curves import case_value
 from qzs.workflows.paper.studies import CLAIMS as STATEMENTS
 
 __all__ = ["CLAIMS", "TREND_CASES", "TREND_CLAIMS", "Verdict", "case_value", "decide_claims",
@@ -71,23 +72,6 @@ class _Undecidable(Exception):
 
 
 # ---------------------------------------------------------------- reading cases
-def case_value(case, name):
-    """A case's value of model parameter ``name``: its override, else the default.
-
-    Parameters
-    ----------
-    case : CaseResult
-        The case.
-    name : str
-        A model parameter's registry name.
-
-    Returns
-    -------
-    float
-    """
-    return case.settings.get(name, ALL_PARAMETERS[name].default)
-
-
 def _ordered(result, name, needed=TREND_CASES):
     """The study's cases ordered by parameter ``name``; a trend needs ``needed`` distinct values."""
     cases = sorted(result.cases, key=lambda c: case_value(c, name))

@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["StudyCase", "CaseResult", "RUN_UNITS", "STATS_UNITS", "run_case", "case_inputs",
-           "case_unit", "lockstep_key", "run_lockstep"]
+           "case_unit", "column_unit", "lockstep_key", "run_lockstep"]
 
 #: The unit of each entry of :attr:`CaseResult.run` (None: a word, no unit; "1": a count or
 #: a ratio).
@@ -185,15 +185,15 @@ class CaseResult:
     def to_xarray(self) -> "xr.Dataset":
         """The case's curves as the study's ``<study>_curves.nc`` lays them out (on ``case``
         and ``frequency`` [Hz], its parameters and run settings with units), or the spring
-        case's points and fitted law (:func:`qzs.workflows.findings.figures.case_dataset`).
+        case's points and fitted law (:func:`qzs.workflows.paper.curves.case_dataset`).
 
         Returns
         -------
         xarray.Dataset
         """
-        from qzs.workflows.findings.figures import case_dataset
+        from qzs.workflows.paper.curves import case_dataset
 
-        return case_dataset(self)
+        return case_dataset(self, RUN_UNITS)
 
     def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> "Figure":
@@ -238,12 +238,59 @@ def case_unit(name):
     -------
     str
     """
-    from qzs.workflows.paper.studies import column_unit
-
     try:
         return column_unit(name)
     except KeyError:
         return ""
+
+
+#: Units of the metrics table's own columns (:func:`column_unit`).
+_COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
+                 "seconds": "s", "spring_residual_rms": "N"}
+
+
+def column_unit(name):
+    """The unit of a column of ``metrics.csv`` (its units row), from where it is defined.
+
+    Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
+    :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
+    ``spring_shape`` from the registry), statistics and run settings from
+    :data:`STATS_UNITS` and :data:`RUN_UNITS`.
+
+    Parameters
+    ----------
+    name : str
+        The column's name.
+
+    Returns
+    -------
+    str
+        The unit; ``""`` for a text column (labels, reasons, the solver's name).
+
+    Raises
+    ------
+    KeyError
+        A column no definition gives a unit for (a programming error).
+    """
+    if name.endswith("_reason") or name in _COLUMN_UNITS:
+        return _COLUMN_UNITS.get(name, "")
+    from qzs.model.registry import unit_of
+
+    for prefix, units in (("run.", RUN_UNITS), ("param.", None), ("processed.", None)):
+        if name.startswith(prefix):
+            key = name[len(prefix):]
+            if units is not None:
+                return units[key] or ""
+            return unit_of(key) if prefix == "param." else column_unit(key)
+    from qzs.analysis.spectral import metric_unit
+    from qzs.model.registry import ALL_PARAMETERS, unit_of
+
+    unit = metric_unit(name) or STATS_UNITS.get(name)
+    if unit is None and name in ALL_PARAMETERS:
+        unit = unit_of(name)
+    if unit is None:
+        raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")
+    return unit
 
 
 def run_case(case):

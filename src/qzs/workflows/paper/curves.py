@@ -25,8 +25,9 @@ from qzs.iotools.schema import Schema, Variable, to_dataset
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import ALL_PARAMETERS, unit_of
 
-__all__ = ["law_dataset", "curves_schema", "curves_dataset", "spring_schema", "spring_dataset", "write_curves",
-           "CURVE_SUFFIXES"]
+__all__ = ["law_dataset", "curves_schema", "curves_dataset", "spring_schema", "spring_dataset",
+           "write_curves", "case_value", "figure_curves", "case_curves", "study_dataset",
+           "case_dataset", "spring_curves", "CURVE_SUFFIXES"]
 
 #: The files :func:`write_curves` writes, by suffix.
 CURVE_SUFFIXES = (".nc", ".csv", ".mat")
@@ -243,3 +244,168 @@ def spring_dataset(displacement, force, spring_force, spring_shape, attrs=None):
     return law_dataset(z, force, fitted, {  # attributes spring_force, spring_shape
         "force": (float(spring_force), unit_of("spring_force")),
         "shape": (float(spring_shape), unit_of("spring_shape"))}, attrs)
+
+
+def case_value(case, name):
+    """A case's value of model parameter ``name``: its override, else the default.
+
+    Parameters
+    ----------
+    case : CaseResult
+        The case.
+    name : str
+        A model parameter's registry name.
+
+    Returns
+    -------
+    float
+    """
+    return case.settings.get(name, ALL_PARAMETERS[name].default)
+
+
+def figure_curves(result):
+    """The curves a study's figures draw, each with its case's ``parameters`` and ``phase``.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study.
+
+    Returns
+    -------
+    list of dict
+    """
+    cases = result.cases
+    names = list(dict.fromkeys(k for c in cases for k in c.settings))
+    if result.study.kind == "processing":
+        return case_curves(cases[0], names)
+    return [curve for case in cases for curve in case_curves(case, names)]
+
+
+def case_curves(case, names=None):
+    """The curves of one case as the figures draw them: its own and, processed like the
+    experiment (a ``processing`` study's), the experiment-style one.
+
+    Parameters
+    ----------
+    case : CaseResult
+        A simulated case.
+    names : sequence of str, optional
+        The parameters each curve carries; default the case's own settings.
+
+    Returns
+    -------
+    list of dict
+    """
+    parameters = {name: case_value(case, name)
+                  for name in (case.settings if names is None else names)}
+    if "highpass" in case.extra:  # processed like the experiment
+        return [dict(label=f"ideal: accelerations, {case.stats['n_averages']} averages",
+                     frequency=case.frequency, magnitude=case.magnitude, trusted=case.trusted,
+                     coherence=case.coherence, linear=case.linear.get("magnitude"),
+                     phase=case.phase, parameters=parameters),
+                dict(label=f"experiment-style: velocities through the "
+                           f"{case.extra['highpass']:g} Hz high-pass, "
+                           f"{case.extra['n_averages']} averages",
+                     frequency=case.extra["frequency"], magnitude=case.extra["magnitude"],
+                     trusted=case.extra.get("trusted"), coherence=case.extra.get("coherence"),
+                     phase=case.extra.get("phase"), parameters=parameters)]
+    return [dict(label=case.label, frequency=case.frequency, magnitude=case.magnitude,
+                 trusted=case.trusted, coherence=case.coherence,
+                 linear=case.linear.get("magnitude"), phase=case.phase, parameters=parameters)]
+
+
+def _run_attributes(attrs, settings, run_units):
+    """``attrs`` with the run settings and their ``<key>_units`` (values joined if several)."""
+    from qzs.model.registry import format_value
+
+    for key, value in settings.items():
+        attrs[key] = (", ".join(format_value(v) for v in value) if isinstance(value, list)
+                      else value)
+        if run_units.get(key):
+            attrs[f"{key}_units"] = run_units[key]
+    return attrs
+
+
+def study_dataset(result, *, quick, run_units):
+    """A study's curves as a dataset (:func:`curves_dataset`): ``<study>_curves.nc``.
+
+    The curves its figures draw (:func:`figure_curves`), on ``case`` and ``frequency``, with
+    each case's parameters as coordinates and the run settings, study and definition as
+    attributes; for the spring's characteristic, its points and fitted law
+    (:func:`spring_curves`).
+
+    Parameters
+    ----------
+    result : StudyResult
+        A study.
+    quick : bool
+        Whether the runs were the quick ones (an attribute).
+    run_units : mapping of str to str
+        The unit of each run setting (:data:`qzs.workflows.paper.cases.RUN_UNITS`).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    from pathlib import Path
+
+    from qzs._version import __version__
+    from qzs.workflows.findings.tables import run_settings
+
+    attrs = {"title": result.study.title, "study": result.study.name,
+             "definition": Path(result.study.source).name if result.study.source else "",
+             "quick": int(bool(quick)), "source": f"qzs {__version__} (qzs paper / qzs study)"}
+    if result.study.kind == "spring_characteristic":
+        return spring_curves(result.cases[0], attrs)
+    return curves_dataset(figure_curves(result),
+                          _run_attributes(attrs, run_settings(result), run_units))
+
+
+def case_dataset(case, run_units):
+    """One case's curves (:func:`case_curves`) as a curves dataset with its run settings, or
+    a spring case's points and fitted law (:func:`study_dataset`'s layouts).
+
+    Parameters
+    ----------
+    case : CaseResult
+        The case.
+    run_units : mapping of str to str
+        The unit of each run setting (:data:`qzs.workflows.paper.cases.RUN_UNITS`).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    from qzs._version import __version__
+
+    attrs = {"title": case.label, "source": f"qzs {__version__} (a case of qzs paper / qzs "
+                                            "study)"}
+    if case.frequency is None:
+        return spring_curves(case, attrs)
+    return curves_dataset(case_curves(case), _run_attributes(attrs, dict(case.run), run_units))
+
+
+def spring_curves(case, attrs):
+    """The spring study's points and fitted law as a dataset (``spring_curves.nc``).
+
+    Parameters
+    ----------
+    case : CaseResult
+        The spring study's case.
+    attrs : dict
+        Global attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    extra = case.extra
+    if "law_fit" in extra:
+        fit = extra["law_fit"]
+        fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
+                                             for name, value in fit.parameters.items()}}
+        return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
+                           attrs, law=fit.kind)
+    return spring_dataset(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
+                          extra["fit"]["spring_shape"], attrs)

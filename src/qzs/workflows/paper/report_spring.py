@@ -4,8 +4,8 @@ The law every case ran (the MagSpring's tanh, the paper's, by default; another g
 ``qzs paper --spring``, docs/model.md §3.1): as one sentence (:func:`spring_statement`, for
 ``report.html`` and the console) and as a record (:func:`spring_record`, for
 ``metrics.json``); and the spring study's fit as the report shows it: its figure
-(:func:`draw_spring`), its curves (:func:`spring_curves`) and its paragraph
-(:func:`spring_fit_html`).
+(:func:`draw_spring`) and its paragraph (:func:`spring_fit_html`); its curves are
+:func:`qzs.workflows.paper.curves.spring_curves`.
 """
 from __future__ import annotations
 
@@ -16,10 +16,9 @@ from typing import TYPE_CHECKING, Any
 
 from qzs.model.isolator import IsolatorParameters
 from qzs.viz.identify import plot_spring_fit, plot_spring_law_fit
-from qzs.workflows.paper.curves import law_dataset, spring_dataset
+from qzs.workflows.paper.curves import spring_curves  # noqa: F401  (its room before)
 
 if TYPE_CHECKING:
-    import xarray as xr
     from matplotlib.figure import Figure
 
     from qzs.model.springs import SpringLaw
@@ -92,31 +91,6 @@ def draw_spring(case: CaseResult, path: Path | None, title: str) -> Figure:
         return plot_spring_law_fit(extra["law_fit"], path=path, title=title)
     return plot_spring_fit(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
                            extra["fit"]["spring_shape"], path=path, title=title)
-
-
-def spring_curves(case: CaseResult, attrs: dict[str, Any]) -> xr.Dataset:
-    """The spring study's points and fitted law as a dataset (``spring_curves.nc``).
-
-    Parameters
-    ----------
-    case : CaseResult
-        The spring study's case.
-    attrs : dict
-        Global attributes.
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    extra = case.extra
-    if "law_fit" in extra:
-        fit = extra["law_fit"]
-        fitted = {"kind": (fit.kind, "-"), **{name: (value, fit.units.get(name, ""))
-                                             for name, value in fit.parameters.items()}}
-        return law_dataset(fit.displacement, fit.force, fit.predict(fit.displacement), fitted,
-                           attrs, law=fit.kind)
-    return spring_dataset(extra["displacement"], extra["force"], extra["fit"]["spring_force"],
-                          extra["fit"]["spring_shape"], attrs)
 
 
 def spring_fit_html(result: StudyResult) -> str:

@@ -46,7 +46,8 @@ from qzs.model.excitation import EXCITATION_OPTIONS
 from qzs.model.isolator import IsolatorParameters
 from qzs.model.registry import update_parameters
 from qzs.workflows.paper.cases import (RUN_UNITS, STATS_UNITS, CaseResult, StudyCase,
-                                       case_inputs, lockstep_key, run_case, run_lockstep)
+                                       case_inputs, column_unit, lockstep_key, run_case,
+                                       run_lockstep)
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -192,7 +193,7 @@ class StudyResult:
 
     def to_xarray(self) -> "xr.Dataset":
         """The curves its figures draw, as ``<study>_curves.nc`` holds them
-        (:func:`qzs.workflows.findings.figures.curves_of`: on ``case`` and ``frequency``
+        (:func:`qzs.workflows.paper.curves.study_dataset`: on ``case`` and ``frequency``
         [Hz], with the cases' parameters and the run settings with units), or the spring
         study's points and fitted law.
 
@@ -200,9 +201,9 @@ class StudyResult:
         -------
         xarray.Dataset
         """
-        from qzs.workflows.findings.figures import curves_of
+        from qzs.workflows.paper.curves import study_dataset
 
-        return curves_of(self, quick=self.quick)
+        return study_dataset(self, quick=self.quick, run_units=RUN_UNITS)
 
     def plot(self, path: str | Path | None = None, *, title: str | None = None,
              frequency_scale: str | None = None) -> "Figure":
@@ -608,52 +609,3 @@ def _step_record(cases, choices):
                       notes=list(choice.notes), seconds=seconds, group=group,
                       cached=choice.cached)
     return record
-
-
-#: Units of the metrics table's own columns (:func:`column_unit`).
-_COLUMN_UNITS = {"study": "", "case": "", "linear_undamped_natural_frequency": "Hz",
-                 "seconds": "s", "spring_residual_rms": "N"}
-
-
-def column_unit(name):
-    """The unit of a column of ``metrics.csv`` (its units row), from where it is defined.
-
-    Parameters come from :mod:`qzs.model.registry` (``param.<name>``), metrics from
-    :func:`qzs.analysis.spectral.metric_unit` (the spring's fitted ``spring_force`` and
-    ``spring_shape`` from the registry), statistics and run settings from
-    :data:`STATS_UNITS` and :data:`RUN_UNITS`.
-
-    Parameters
-    ----------
-    name : str
-        The column's name.
-
-    Returns
-    -------
-    str
-        The unit; ``""`` for a text column (labels, reasons, the solver's name).
-
-    Raises
-    ------
-    KeyError
-        A column no definition gives a unit for (a programming error).
-    """
-    if name.endswith("_reason") or name in _COLUMN_UNITS:
-        return _COLUMN_UNITS.get(name, "")
-    from qzs.model.registry import unit_of
-
-    for prefix, units in (("run.", RUN_UNITS), ("param.", None), ("processed.", None)):
-        if name.startswith(prefix):
-            key = name[len(prefix):]
-            if units is not None:
-                return units[key] or ""
-            return unit_of(key) if prefix == "param." else column_unit(key)
-    from qzs.analysis.spectral import metric_unit
-    from qzs.model.registry import ALL_PARAMETERS, unit_of
-
-    unit = metric_unit(name) or STATS_UNITS.get(name)
-    if unit is None and name in ALL_PARAMETERS:
-        unit = unit_of(name)
-    if unit is None:
-        raise KeyError(f"metrics.csv column {name!r} has no unit in any definition.")
-    return unit
