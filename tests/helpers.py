@@ -462,3 +462,48 @@ SENSITIVITY_PROBLEM = {
     "variables": {"pi_kp": {"low": 1.0, "high": 100.0}, "mass": {"low": 5.0, "high": 8.0}},
     "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
     "sensitivity": {"samples": 8}}
+
+
+#: A small study of the paper's kind: two cases of the viscous study, short chirps, a given step.
+SMALL_STUDY = """
+[study]
+name = "small"
+title = "Passive isolator, two viscous frictions (small)"
+kind = "transmissibility"
+[[study.view]]
+figure = "small"
+frequency_range = [0.0, 20.0]
+[defaults]
+pi_kp = 5.0
+pi_ki = 2.0
+[[case]]
+label = "Cv = 60 N s/m"
+viscous_damping = 60.0
+[[case]]
+label = "Cv = 120 N s/m"
+viscous_damping = 120.0
+[excitation]
+amplitude = 0.010
+f0 = 0.0
+f1 = 20.0
+duration = 20.0
+[analysis]
+sample_rate = 100.0
+fft_length = 512
+[simulation]
+dt = 5e-4
+"""
+
+
+def tiny_hexapod_study(folder):
+    """The six-axis study's result (``qzs hexapod study``) from a tiny real run of its three
+    cases: 4 s chirps at a given dt = 1 ms (its own quick run is 60 s chirps, minutes)."""
+    import qzs
+    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
+    from qzs.workflows.hexapod.study import CASES, STUDY_AXES, study_result
+
+    cases = {label: qzs.hexapod_transmissibility(load_hexapod(SHIPPED_DEFAULT, overrides),
+                                                 axes=STUDY_AXES, duration=4.0, dt=1e-3,
+                                                 fft_length=512, workers=1, progress=False)
+             for label, (_, overrides) in CASES.items()}
+    return study_result(cases, folder, quick=True, run_seconds=1.5)

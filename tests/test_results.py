@@ -47,7 +47,8 @@ import pytest
 import qzs
 from qzs.errors import OutputPathError
 
-from helpers import LINEAR_PROBLEM, SENSITIVITY_PROBLEM, instron_test
+from helpers import (LINEAR_PROBLEM, SENSITIVITY_PROBLEM, SMALL_STUDY, instron_test,
+                     tiny_hexapod_study)
 
 ROOT = Path(__file__).resolve().parents[1]
 #: How a result class's name ends (the rule of the module docstring).
@@ -130,19 +131,6 @@ def _hexapod_matrix():
                                         duration=4.0, dt=1e-3, fft_length=512, workers=1)
 
 
-def _hexapod_study(folder):
-    """The six-axis study's result from a tiny real run of its cases (4 s chirps at 1 ms; the
-    study's own quick run is 60 s chirps on every axis, minutes)."""
-    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
-    from qzs.workflows.hexapod.study import CASES, STUDY_AXES, study_result
-
-    cases = {label: qzs.hexapod_transmissibility(load_hexapod(SHIPPED_DEFAULT, overrides),
-                                                 axes=STUDY_AXES, duration=4.0, dt=1e-3,
-                                                 fft_length=512, workers=1, progress=False)
-             for label, (_, overrides) in CASES.items()}
-    return study_result(cases, folder / "hexapod_study", quick=True)
-
-
 def _experiment():
     from qzs.workflows.experiment.process import process_experiment
 
@@ -175,37 +163,6 @@ def _case_curve():
                                  qzs.ControllerParameters())],
                                ChirpPlan(CHIRP, 100.0, 512, 5e-4), workers=1)
     return curve
-
-
-#: A small study of the paper's kind: two cases of the viscous study, short chirps, a given step.
-SMALL_STUDY = """
-[study]
-name = "small"
-title = "Passive isolator, two viscous frictions (small)"
-kind = "transmissibility"
-[[study.view]]
-figure = "small"
-frequency_range = [0.0, 20.0]
-[defaults]
-pi_kp = 5.0
-pi_ki = 2.0
-[[case]]
-label = "Cv = 60 N s/m"
-viscous_damping = 60.0
-[[case]]
-label = "Cv = 120 N s/m"
-viscous_damping = 120.0
-[excitation]
-amplitude = 0.010
-f0 = 0.0
-f1 = 20.0
-duration = 20.0
-[analysis]
-sample_rate = 100.0
-fft_length = 512
-[simulation]
-dt = 5e-4
-"""
 
 
 @cache
@@ -267,7 +224,8 @@ FACTORIES = {
     "SteadyStateResponse": (lambda folder: _response(), lambda r: r.dt),
     "HexapodTransmissibility": (lambda folder: _hexapod_matrix(),
                                 lambda r: r.setup.platform.mass),
-    "HexapodStudyResult": (_hexapod_study, lambda r: r.rows[0]["T_at_16_hz"]),
+    "HexapodStudyResult": (lambda folder: tiny_hexapod_study(folder / "hexapod_study"),
+                           lambda r: r.rows[0]["T_at_16_hz"]),
     "ExperimentResult": (lambda folder: _experiment(), lambda r: r.band[1]),
     "SpringFit": (lambda folder: _spring_fit(), lambda r: r.parameters["plateau"]),
     "LawFit": (lambda folder: _law_fit(), lambda r: r.parameters["c1"]),

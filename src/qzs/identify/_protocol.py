@@ -111,9 +111,9 @@ class FitProtocol:
     """The result protocol of a fit: ``summary``, ``plot``, ``save``, ``to_xarray``.
 
     A subclass (a frozen dataclass) names its figure function (``_figure``, in
-    :mod:`qzs.viz.identify`) and defines ``summary``, ``estimates``, ``to_record`` and
-    ``to_xarray``; it has ``intervals`` (estimated name -> ``(low, high)``) and
-    ``confidence`` (their level [-]).
+    :mod:`qzs.viz.identify`) and defines ``summary``, ``to_record``, ``to_xarray`` and,
+    without ``parameters``, ``estimates``; it has ``intervals`` (estimated name ->
+    ``(low, high)``) and ``confidence`` (their level [-]).
     """
 
     #: The function of :mod:`qzs.viz.identify` that draws the fit.
@@ -121,9 +121,15 @@ class FitProtocol:
     #: The extensions :meth:`save` accepts.
     save_suffixes = suffixes_of(dataset=True, record=True)
 
-    def estimates(self) -> dict[str, float]:  # pragma: no cover - each fit defines it
-        """The estimated values by name (the keys of ``intervals``)."""
-        raise NotImplementedError
+    def estimates(self) -> dict[str, float]:
+        """The estimated values by name (those with an interval are the keys of
+        ``intervals``): the fit's ``parameters`` unless it says otherwise.
+
+        Returns
+        -------
+        dict of str to float
+        """
+        return dict(self.parameters)  # type: ignore[attr-defined]
 
     def to_record(self) -> dict[str, Any]:  # pragma: no cover - each fit defines it
         """The fit as plain data (what :meth:`save` writes as JSON)."""

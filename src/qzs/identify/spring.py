@@ -28,8 +28,9 @@ from qzs._validation import choice, integer, positive_real, real
 from qzs.errors import DataError, FitError, ParameterError
 from qzs.identify._protocol import FitProtocol, deprecated_alias
 from qzs.identify._statistics import student_quantile
-from qzs.identify.spring_laws import (CRITERION, LawFit, fit_oblique, fit_polynomial,
-                                      fit_table, law_force, pairs_dataset, parameter_lines)
+from qzs.identify.spring_laws import (CRITERION, LawFit, criterion_record, fit_oblique,
+                                      fit_polynomial, fit_table, law_force, pairs_dataset,
+                                      parameter_lines, record_head)
 from qzs.model.springs import TABLE_MIN_POINTS, SpringLaw, TanhSpring
 
 if TYPE_CHECKING:
@@ -185,28 +186,13 @@ class SpringFit(FitProtocol):
         -------
         dict
         """
-        return {"kind": self.kind, "law": None if self.law is None else self.law.to_dict(),
-                "parameters": dict(self.parameters),
-                "intervals": {k: list(v) for k, v in self.intervals.items()},
-                "units": dict(self.units), "undefined": dict(self.undefined),
-                "confidence": self.confidence, "convention": self.convention,
+        return {**record_head(self), "convention": self.convention,
                 "residual_rms": self.residual_rms, "outliers": list(self.outliers),
-                "criterion": {"name": CRITERION, "value": self.criterion,
-                              "n_points": self.n_points, "n_parameters": self.n_parameters},
+                "criterion": criterion_record(self),
                 "candidates": {k: {"criterion": f.criterion, "n_parameters": f.n_parameters,
                                    "residual_rms": f.residual_rms}
                                for k, f in self.candidates.items()},
                 "rejected": dict(self.rejected)}
-
-    def estimates(self) -> dict[str, float]:
-        """The fitted parameters by name (:attr:`parameters`; those with an interval are the
-        keys of ``intervals``).
-
-        Returns
-        -------
-        dict of str to float
-        """
-        return dict(self.parameters)
 
     def to_xarray(self) -> "xr.Dataset":
         """The pairs fitted as an ``xarray.Dataset`` on ``point`` (CF-1.10, units on each).

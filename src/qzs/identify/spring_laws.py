@@ -52,7 +52,8 @@ if TYPE_CHECKING:
     import xarray as xr
 
 __all__ = ["LawFit", "fit_polynomial", "fit_oblique", "fit_table", "oblique_force",
-           "law_force", "parameter_lines", "pairs_dataset", "CRITERION", "OBLIQUE_FITTED",
+           "law_force", "parameter_lines", "pairs_dataset", "record_head", "criterion_record",
+           "CRITERION", "OBLIQUE_FITTED",
            "TABLE_LAMBDA_RANGE"]
 
 #: The criterion a fit is compared by (:meth:`LawFit.bic`; ``fit_spring(law="best")``).
@@ -173,15 +174,6 @@ class LawFit(FitProtocol):
         """
         return law_force(self.kind, self.law, self.parameters, displacement)
 
-    def estimates(self) -> dict[str, float]:
-        """The fitted parameters by name (those with an interval are its keys).
-
-        Returns
-        -------
-        dict of str to float
-        """
-        return dict(self.parameters)
-
     def summary(self) -> str:
         """The fit as text: its law, parameters with intervals, residual and criterion.
 
@@ -204,13 +196,8 @@ class LawFit(FitProtocol):
         -------
         dict
         """
-        return {"kind": self.kind, "law": None if self.law is None else self.law.to_dict(),
-                "parameters": dict(self.parameters),
-                "intervals": {k: list(v) for k, v in self.intervals.items()},
-                "units": dict(self.units), "undefined": dict(self.undefined),
-                "confidence": self.confidence, "residual_rms": self.residual_rms,
-                "criterion": {"name": CRITERION, "value": self.criterion,
-                              "n_points": self.n_points, "n_parameters": self.n_parameters}}
+        return {**record_head(self), "residual_rms": self.residual_rms,
+                "criterion": criterion_record(self)}
 
     def to_xarray(self) -> "xr.Dataset":
         """The pairs fitted on ``point`` (:func:`pairs_dataset`, CF-1.10, units on each).
@@ -220,6 +207,42 @@ class LawFit(FitProtocol):
         xarray.Dataset
         """
         return pairs_dataset(self, f"{self.kind} law fitted (qzs.identify.spring_laws)")
+
+
+def record_head(fit: Any) -> dict[str, Any]:
+    """The head of a spring fit's record: kind, law, parameters, intervals, units, what is
+    undefined, the confidence level.
+
+    Parameters
+    ----------
+    fit : LawFit or SpringFit
+        The fit.
+
+    Returns
+    -------
+    dict
+    """
+    return {"kind": fit.kind, "law": None if fit.law is None else fit.law.to_dict(),
+            "parameters": dict(fit.parameters),
+            "intervals": {k: list(v) for k, v in fit.intervals.items()},
+            "units": dict(fit.units), "undefined": dict(fit.undefined),
+            "confidence": fit.confidence}
+
+
+def criterion_record(fit: Any) -> dict[str, Any]:
+    """A spring fit's criterion as plain data: name, value [-], points and parameters.
+
+    Parameters
+    ----------
+    fit : LawFit or SpringFit
+        The fit.
+
+    Returns
+    -------
+    dict
+    """
+    return {"name": CRITERION, "value": fit.criterion, "n_points": fit.n_points,
+            "n_parameters": fit.n_parameters}
 
 
 def law_force(kind: str, law: SpringLaw | None, parameters: dict,

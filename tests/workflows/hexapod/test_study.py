@@ -86,19 +86,6 @@ def test_writing_the_study_advances_a_progress_bar_file_by_file(tmp_path, monkey
     assert all("report.md" not in files for _, files in steps[:-1])
 
 
-def tiny_study(folder):
-    """The study's three cases from a tiny real run: 4 s chirps at a given dt = 1 ms."""
-    import qzs
-    from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
-    from qzs.workflows.hexapod.study import CASES, STUDY_AXES, study_result
-
-    cases = {label: qzs.hexapod_transmissibility(load_hexapod(SHIPPED_DEFAULT, overrides),
-                                                 axes=STUDY_AXES, duration=4.0, dt=1e-3,
-                                                 fft_length=512, workers=1, progress=False)
-             for label, (_, overrides) in CASES.items()}
-    return study_result(cases, folder, quick=True, run_seconds=1.5)
-
-
 def test_a_study_at_a_given_step_writes_its_steps_and_saves_its_matrices(tmp_path):
     """With a given dt the runs have no step search: metrics.json says so (it raised a
     KeyError on 'step_error_db'); the saved study is its metrics.json and its cases'
@@ -108,7 +95,9 @@ def test_a_study_at_a_given_step_writes_its_steps_and_saves_its_matrices(tmp_pat
 
     from qzs.iotools.files import read_result
 
-    study = tiny_study(tmp_path / "out")
+    from helpers import tiny_hexapod_study
+
+    study = tiny_hexapod_study(tmp_path / "out")
     written = json.loads((tmp_path / "out" / "metrics.json").read_text(encoding="utf-8"))
     step = written["cases"]["PI"]["steps"]["z"]
     assert step["dt_s"] == 1e-3 and step["error_db"] is None

@@ -12,40 +12,13 @@ from qzs.workflows.findings.figures import curves_of
 from qzs.workflows.findings.tables import metric_rows
 from qzs.workflows.paper.studies import run_study
 
-SMALL = """
-[study]
-name = "small"
-title = "two viscous frictions"
-kind = "transmissibility"
-[[study.view]]
-figure = "small"
-frequency_range = [0.0, 20.0]
-[defaults]
-pi_kp = 5.0
-pi_ki = 2.0
-[[case]]
-label = "Cv = 60 N s/m"
-viscous_damping = 60.0
-[[case]]
-label = "Cv = 120 N s/m"
-viscous_damping = 120.0
-[excitation]
-amplitude = 0.010
-f0 = 0.0
-f1 = 20.0
-duration = 20.0
-[analysis]
-sample_rate = 100.0
-fft_length = 512
-[simulation]
-dt = 5e-4
-"""
+from helpers import SMALL_STUDY
 
 
 @pytest.fixture(scope="module")
 def small(tmp_path_factory):
     path = tmp_path_factory.mktemp("study") / "small.toml"
-    path.write_text(SMALL, encoding="utf-8")
+    path.write_text(SMALL_STUDY, encoding="utf-8")
     return run_study(path, workers=1, progress=False)
 
 
@@ -77,7 +50,7 @@ def test_a_saved_study_s_curves_are_its_cases_curves(small, tmp_path):
 
 def test_a_saved_study_s_record_is_its_entry_of_metrics_json(small, tmp_path):
     read = json.loads(small.save(tmp_path / "small.json").read_text(encoding="utf-8"))
-    assert read["title"] == "two viscous frictions" and read["settings"]["dt"] == 5e-4
+    assert read["title"] == "Passive isolator, two viscous frictions (small)" and read["settings"]["dt"] == 5e-4
     rows = metric_rows([small])
     assert [row["case"] for row in read["cases"]] == [row["case"] for row in rows]
     for row, case in zip(read["cases"], small.cases):
