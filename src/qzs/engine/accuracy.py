@@ -7,11 +7,13 @@ step halving on a short representative stretch of the excitation (the *probe*):
 
 >>> from qzs import Chirp
 >>> from qzs.engine.accuracy import choose_step
->>> choice = choose_step(Chirp(), tolerance_db=0.01)  # doctest: +SKIP
+>>> choice = choose_step(Chirp(), tolerance=0.01)  # doctest: +SKIP
 >>> choice.dt, choice.error  # doctest: +SKIP
 (0.001, 0.0004...)
 """
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -21,15 +23,14 @@ from qzs._lazy import import_in_background
 from qzs._validation import choice as _choice
 from qzs.engine.step_search import (ADMISSIBLE_REFINEMENT, MAX_HALVINGS, MEASURE_UNITS,
                                     RATE_REFINEMENT_MAX, SAFETY, StepChoice, admissible_step,
-                                    bound_notes, halving_search, search_step,
-                                    tolerance_measure)
+                                    halving_search)
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
 __all__ = ["StepChoice", "choose_step", "default_tolerance", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings", "spectral_beside_probes"]
+           "probe_settings", "spectral_beside_probes", "single_probe", "SingleProbe"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -307,11 +308,118 @@ def spectral_beside_probes(measure):
         import_in_background("scipy.signal", "qzs.analysis.spectral")
 
 
-def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db=None,
+@dataclass(frozen=True, kw_only=True)
+class SingleProbe:
+    """The probe builder of one axis (:func:`single_probe`): its inputs, nothing computed.
+
+    :func:`qzs.engine.step_choice.choose` calls :meth:`build` only for a chosen step.
+    """
+
+    excitation: Any = None
+    isolator: Any = None
+    controller: Any = None
+    solver: str = defaults.SIMULATION["solver"]
+    sample_rate: float = defaults.SIMULATION["sample_rate"]
+    band: tuple | None = None
+    probe_duration: float | None = None
+    fft_length: int | None = None
+    initial_state: Any = None
+    max_halvings: int = MAX_HALVINGS
+    safety: float = SAFETY
+
+    @property
+    def default_measure(self) -> str:
+        """The default request's measure: the state for a sine (no band), else the
+        transmissibility."""
+        return "state_m" if isinstance(self.excitation, Sine) else "transmissibility_db"
+
+    def build(self, measure):
+        """The probe for ``measure``: inputs checked, the probe's excitation made.
+
+        Parameters
+        ----------
+        measure : str
+            The accuracy measure.
+
+        Returns
+        -------
+        Probe
+        """
+        from qzs.engine.prepare import run_inputs
+        from qzs.engine.step_choice import Probe
+
+        excitation, isolator, controller = run_inputs(self.excitation, self.isolator,
+                                                      self.controller)
+        order, sample_rate, band, probe, duration = probe_settings(
+            excitation, measure, self.solver, self.sample_rate, self.band, self.probe_duration,
+            self.fft_length, self.safety, self.max_halvings)
+        solver, initial_state, fft_length = self.solver, self.initial_state, self.fft_length
+
+        def run(dt, cases):
+            from qzs.engine.single import integrate
+
+            return [integrate(probe, isolator, controller, duration=duration, dt=dt,
+                              sample_rate=sample_rate, solver=solver,
+                              initial_state=initial_state)]
+
+        return Probe(
+            measure=measure, order=order, sample_rate=sample_rate, solver=solver,
+            excitation=probe, duration=duration, band=band,
+            shortened=probe is not excitation,
+            start=lambda: _single_start(probe, duration, isolator, controller, solver,
+                                        sample_rate),
+            run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
+                                                             fft_length=fft_length),
+            key=dict(excitation=excitation, isolator=isolator, controller=controller,
+                     initial_state=initial_state, solver=solver, sample_rate=sample_rate,
+                     band=band, probe_duration=self.probe_duration, fft_length=fft_length),
+            max_halvings=self.max_halvings, safety=self.safety)
+
+
+def single_probe(excitation=None, isolator=None, controller=None, *,
+                 solver=defaults.SIMULATION["solver"],
+                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
+                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS, safety=SAFETY):
+    """The probe of one axis for :func:`qzs.engine.step_choice.choose` (nothing computed yet).
+
+    Parameters are those of :func:`choose_step` (the model, the run's output and the probe's
+    settings).
+
+    Returns
+    -------
+    SingleProbe
+    """
+    return SingleProbe(excitation=excitation, isolator=isolator, controller=controller,
+                       solver=solver, sample_rate=sample_rate, band=band,
+                       probe_duration=probe_duration, fft_length=fft_length,
+                       initial_state=initial_state, max_halvings=max_halvings, safety=safety)
+
+
+def _single_start(probe, duration, isolator, controller, solver, sample_rate):
+    """One axis's stability limit, resolving step and admissible start (``Probe.start``)."""
+    from qzs.engine.prepare import check_resolution, divides, resolving_step
+    from qzs.engine.stability import largest_stable_step, stability_test
+
+    stable = stability_test(isolator, controller, solver)
+    limit = largest_stable_step(isolator, controller, solver)
+    resolving = resolving_step(probe, duration)  # the step must follow the base motion too
+    # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
+    # step follows is refused as a literal step too coarse for it would be, naming it
+    check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
+    rates = controller.sample_rates  # each sampled period a whole number of steps
+    single = rates[0] if len(rates) == 1 else 0.0
+    dt0, k0 = admissible_step(sample_rate, single,
+                              lambda dt: dt <= resolving and stable(dt)
+                              and (single or all(divides(rate, dt) for rate in rates)))
+    return limit, resolving, dt0, k0
+
+
+def choose_step(excitation=None, isolator=None, controller=None, *, tolerance=None,
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS,
-                safety=SAFETY, finest=None, fallback=False, progress=False, cache=False):
+                safety=SAFETY, finest=None, fallback=False, progress=False, cache=False,
+                tolerance_db=None):
     """The largest fixed step whose error stays within a tolerance (docs/model.md §7).
 
     Candidates are ``dt_j = dt_0 / 2**j`` with ``dt_0 = 1/(sample_rate*k)`` the largest
@@ -322,7 +430,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     asymptotic range; stick-slip events lower it), capped at the scheme's ``2**order``,
     extrapolates the error of ``dt_j`` Richardson-style: ``d_j * r_j/(r_j - 1)``. Where the
     differences do not shrink (``r_j <= 1``) there is no estimate. The chosen step is the
-    coarsest whose estimate times ``safety`` meets the tolerance.
+    coarsest whose estimate times ``safety`` meets the tolerance. The one call
+    :func:`qzs.engine.step_choice.choose` on :func:`single_probe`.
 
     Parameters
     ----------
@@ -332,7 +441,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
         PI and damping loops; defaults if omitted.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance on the transmissibility [dB]: max ``|20 log10(T_dt/T_ref)|`` over the
         trusted bins of ``band``.
     tolerance_state : float, optional
@@ -363,8 +472,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         The finest candidate [s]: halvings stop above it; the fallback step too.
     fallback : bool
         Where no candidate meets the tolerance (or no bin of the band is trusted on the
-        probe), return the fallback of :func:`~qzs.engine.step_search.search_step` (``finest``,
-        default the paper's step; ``met`` False, ``error`` NaN, a note why) instead of
+        probe), return the one fallback (:mod:`qzs.engine.step_choice`: ``finest``, default
+        the paper's step; ``met`` False, ``error`` NaN, the unmet sentence) instead of
         raising: what a run that must go on asks for.
     progress : bool
         Show a progress bar over the probe runs.
@@ -372,6 +481,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Read the choice from, and keep it in, the step cache on disk
         (:mod:`qzs.engine.step_cache`, keyed by every input above and by the code that
         chooses): a repeated command skips the probe. The command line uses it.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -383,61 +494,22 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import check_resolution, divides, resolving_step, run_inputs
-    from qzs.engine.single import integrate
-    from qzs.engine.stability import largest_stable_step, stability_test
+    from qzs.engine.step_choice import choose
 
-    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
-    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    order, sample_rate, band, probe, duration = probe_settings(
-        excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
-        max_halvings)
+    request = _tolerance_request(tolerance, tolerance_state, tolerance_db)
+    return choose(request, single_probe(
+        excitation, isolator, controller, solver=solver, sample_rate=sample_rate, band=band,
+        probe_duration=probe_duration, fft_length=fft_length, initial_state=initial_state,
+        max_halvings=max_halvings, safety=safety),
+        fallback=fallback, finest=finest, progress=progress, cache=cache)
 
-    key = None
-    if cache:
-        from qzs.engine import step_cache
 
-        key = step_cache.cache_key(
-            excitation=excitation, isolator=isolator, controller=controller,
-            initial_state=initial_state, measure=measure, tolerance=tolerance, solver=solver,
-            sample_rate=sample_rate, band=band, probe_duration=probe_duration,
-            fft_length=fft_length, max_halvings=max_halvings, safety=safety,
-            **({"finest": finest, "fallback": True} if fallback else {}))
-        hit = step_cache.load_choice(key, probe, duration)
-        if hit is not None:
-            return hit
-    spectral_beside_probes(measure)
+def _tolerance_request(tolerance, tolerance_state, tolerance_db):
+    """The request of a chooser's tolerance keywords: exactly one tolerance (no default)."""
+    from qzs.engine.step_choice import step_request
 
-    stable = stability_test(isolator, controller, solver)
-    limit = largest_stable_step(isolator, controller, solver)
-    resolving = resolving_step(probe, duration)  # the step must follow the base motion too
-    # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
-    # step follows is refused as a literal step too coarse for it would be, naming it
-    check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
-    rates = controller.sample_rates  # each sampled period a whole number of steps
-    single = rates[0] if len(rates) == 1 else 0.0
-    dt0, k0 = admissible_step(sample_rate, single,
-                              lambda dt: dt <= resolving and stable(dt)
-                              and (single or all(divides(rate, dt) for rate in rates)))
-
-    def run(dt, cases):
-        return [integrate(probe, isolator, controller, duration=duration, dt=dt,
-                          sample_rate=sample_rate, solver=solver, initial_state=initial_state)]
-
-    choice = search_step(
-        run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
-                                                         fft_length=fft_length),
-        dt0=dt0, order=order, measure=measure, tolerance=tolerance, sample_rate=sample_rate,
-        solver=solver, probe=probe, probe_duration=duration, band=band,
-        notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
-                          probe is not excitation),
-        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
-        fallback=fallback, progress=progress)
-    if key is not None:
-        from qzs.engine import step_cache
-
-        step_cache.store_choice(key, choice)
-    return choice
+    return step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                        tolerance_db=tolerance_db, required=True, stacklevel=5)
 
 
 def default_tolerance(excitation):
@@ -446,7 +518,8 @@ def default_tolerance(excitation):
     The transmissibility within ``defaults.ACCURACY["tolerance_db"]`` where the excitation
     has a band to estimate it over (a chirp, a random excitation, a record); a sine has one
     frequency and no Welch estimate, so its relative position within
-    ``defaults.ACCURACY["tolerance_state"]``.
+    ``defaults.ACCURACY["tolerance_state"]`` (the default :class:`~qzs.engine.step_choice.
+    StepRequest` resolved on :func:`single_probe`).
 
     Parameters
     ----------
@@ -456,12 +529,13 @@ def default_tolerance(excitation):
     Returns
     -------
     dict
-        One keyword of :func:`choose_step`: ``{"tolerance_db": ...}`` [dB] or
+        One keyword of :func:`choose_step`: ``{"tolerance": ...}`` [dB] or
         ``{"tolerance_state": ...}`` [m].
     """
-    if isinstance(excitation, Sine):
-        return {"tolerance_state": float(defaults.ACCURACY["tolerance_state"])}
-    return {"tolerance_db": float(defaults.ACCURACY["tolerance_db"])}
+    from qzs.engine.step_choice import StepRequest
+
+    measure, value = StepRequest().resolved(single_probe(excitation).default_measure)
+    return {"state_m": {"tolerance_state": value}}.get(measure, {"tolerance": value})
 
 
 # ---------------------------------------------------------------- shared by the searches

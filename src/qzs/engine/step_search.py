@@ -30,12 +30,12 @@ from typing import Any
 
 import numpy as np
 
-from qzs import _validation, defaults
+from qzs import defaults
 from qzs._format import STEP_RECORD_UNITS as RECORD_UNITS
 from qzs._format import step_line as record_line
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 
-__all__ = ["StepChoice", "search_step", "halving_search", "admissible_step", "tolerance_measure",
+__all__ = ["StepChoice", "search_step", "halving_search", "admissible_step",
            "bound_notes", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
            "ADMISSIBLE_REFINEMENT"]
 
@@ -163,6 +163,15 @@ class StepChoice:
         return MEASURE_UNITS.get(self.measure, "")
 
     @property
+    def unmet_note(self) -> str:
+        """The one sentence every caller shows for an unmet tolerance; '' where it was met.
+
+        Made by :func:`qzs.engine.step_choice.unmet_sentence` (the fallback's reason and
+        step); a literal step has no tolerance to miss.
+        """
+        return "" if self.met or not self.chosen else (self.notes[-1] if self.notes else "")
+
+    @property
     def steps_per_sample(self) -> int:
         """Integration steps per output sample [-]."""
         return int(round(1.0 / (self.sample_rate * self.dt)))
@@ -240,7 +249,7 @@ class StepChoice:
             reason = (f"estimated error {self.error:.2g} {self.unit} <= {self.tolerance:g} "
                       f"{self.unit} / safety on a {self.probe_duration:g} s probe")
         else:
-            reason = self.notes[-1] if self.notes else "no step tried met the tolerance"
+            reason = self.unmet_note or "no step tried met the tolerance"
         band = {} if self.band is None else {"step_band_low": float(self.band[0]),
                                              "step_band_high": float(self.band[1])}
         return {"step": "accuracy-driven" if self.met else "fallback",
@@ -250,41 +259,7 @@ class StepChoice:
                 "step_probe_duration": float(self.probe_duration), "step_reason": reason}
 
 
-# ---------------------------------------------------------------- shared validation
-def tolerance_measure(tolerance_db, tolerance_state):
-    """The measure and value of exactly one tolerance: ``(measure, tolerance)``.
-
-    Parameters
-    ----------
-    tolerance_db : float or None
-        On the transmissibility [dB].
-    tolerance_state : float or None
-        On the state [m].
-
-    Returns
-    -------
-    measure : str
-        ``"transmissibility_db"`` or ``"state_m"``.
-    tolerance : float
-        The positive tolerance, in the measure's unit.
-
-    Raises
-    ------
-    ParameterError
-        Both, neither, or a tolerance that is not a positive finite number.
-    """
-    given = [(name, value) for name, value in (("tolerance_db", tolerance_db),
-                                               ("tolerance_state", tolerance_state))
-             if value is not None]
-    if len(given) != 1:
-        raise ParameterError(
-            "give exactly one of `tolerance_db` (transmissibility, dB) and `tolerance_state` "
-            f"(relative position, m); got {' and '.join(n for n, _ in given) or 'neither'}.")
-    name, value = given[0]
-    measure = "transmissibility_db" if name == "tolerance_db" else "state_m"
-    return measure, _validation.positive_real(name, value)
-
-
+# ---------------------------------------------------------------- the admissible start
 def admissible_step(sample_rate, controller_rate, stable):
     """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
     divides the controller's period too.
@@ -616,11 +591,12 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
             reason = (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
                       f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
                       "redraw the response at every step)")
-        dt = float(finest if finest is not None else defaults.SIMULATION["dt"])
+        from qzs.engine.step_choice import fallback_step, unmet_sentence
+
+        dt = fallback_step(finest)
         return StepChoice(dt=dt, error=math.nan,
                           reference_dt=min(integrated, default=math.nan),
-                          notes=tuple(notes + [f"{reason}; running at dt = {dt:.3g} s, whose "
-                                               "error is not estimated"]), met=False,
+                          notes=tuple(notes + [unmet_sentence(reason, dt)]), met=False,
                           case_errors=(math.nan,) * cases if several else (),
                           case_steps=(math.nan,) * cases if several else (),
                           unmet=tuple(range(cases)) if several else (), **record)

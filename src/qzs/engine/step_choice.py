@@ -1,0 +1,336 @@
+"""Step choice as one call: what is asked (:class:`StepRequest`), of what (:class:`Probe`), by
+:func:`choose` (docs/model.md §7).
+
+Every step of qzs that is not given literally is chosen here: a request (a literal ``dt``
+[s], a ``tolerance`` on the transmissibility [dB] or on the state [m], or the default of
+:data:`qzs.defaults.ACCURACY`) and a probe of a model (one axis,
+:func:`qzs.engine.accuracy.single_probe`; lanes of a lockstep batch,
+:func:`qzs.engine.accuracy_batch.batch_probe`; the six legs,
+:func:`qzs.engine.hexapod.accuracy.hexapod_step_probe`) go to :func:`choose`, which owns the
+step cache (:mod:`qzs.engine.step_cache`), the one search
+(:func:`qzs.engine.step_search.search_step`), the one fallback step (:func:`fallback_step`)
+and the one meaning of an unmet tolerance (:func:`unmet_sentence`, shown by every caller as
+:attr:`~qzs.engine.step_search.StepChoice.unmet_note`).
+
+>>> from qzs import Chirp
+>>> from qzs.engine.accuracy import single_probe
+>>> from qzs.engine.step_choice import StepRequest, choose
+>>> choice = choose(StepRequest(tolerance=0.01), single_probe(Chirp()))  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from qzs import _validation, defaults
+from qzs.errors import ParameterError
+
+__all__ = ["StepRequest", "Probe", "choose", "fallback_step", "unmet_sentence",
+           "DEFAULT_KEYS", "step_request"]
+
+#: Each measure's key of its default tolerance in :data:`qzs.defaults.ACCURACY`.
+DEFAULT_KEYS = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}
+
+
+# ---------------------------------------------------------------- the one unmet meaning
+def fallback_step(finest=None):
+    """The step [s] a run that must go on gets where no step tried meets its tolerance.
+
+    Parameters
+    ----------
+    finest : float, optional
+        The finest step the caller allows [s]; default the paper's ``SIMULATION["dt"]``.
+
+    Returns
+    -------
+    float
+    """
+    return float(finest if finest is not None else defaults.SIMULATION["dt"])
+
+
+def unmet_sentence(reason, dt):
+    """The one sentence every caller shows for an unmet tolerance (the record's last note).
+
+    Parameters
+    ----------
+    reason : str
+        Why no step met it (from :func:`~qzs.engine.step_search.search_step`).
+    dt : float
+        The fallback step the run goes on at [s] (:func:`fallback_step`).
+
+    Returns
+    -------
+    str
+    """
+    return f"{reason}; running at dt = {dt:.3g} s, whose error is not estimated"
+
+
+# ---------------------------------------------------------------- the request
+@dataclass(frozen=True, kw_only=True)
+class StepRequest:
+    """What a run asks of its step: a literal ``dt``, a ``tolerance``, or the default.
+
+    Checked once, here: a bad request is a :class:`~qzs.errors.ParameterError` naming the
+    argument, its value and the fix, before any probe.
+
+    Attributes
+    ----------
+    dt : float, optional
+        A literal step [s]: nothing is chosen, nothing probed.
+    tolerance : float, optional
+        The tolerance, in the unit of ``measure``.
+    measure : {"transmissibility_db", "state_m"}, optional
+        What ``tolerance`` bounds: the transmissibility [dB] (the default with a tolerance) or
+        the relative position [m]. Neither ``dt`` nor ``tolerance``: the default tolerance
+        of this measure (of the probe's default measure if None too).
+    """
+
+    dt: float | None = None
+    tolerance: float | None = None
+    measure: str | None = None
+
+    def __post_init__(self):
+        if self.dt is not None and (self.tolerance is not None or self.measure is not None):
+            raise ParameterError(
+                f"give a literal `dt` ({self.dt!r} s) or a `tolerance` "
+                f"({self.tolerance!r}, measure {self.measure!r}), not both: a literal step has "
+                "no tolerance to meet; drop one.", ("dt", "tolerance"))
+        if self.dt is not None:
+            _validation.positive_real("dt", self.dt, fix="in seconds, e.g. 1e-3")
+        if self.measure is not None:
+            _validation.choice("measure", self.measure, tuple(DEFAULT_KEYS))
+        if self.tolerance is not None:
+            name = "tolerance_state" if self.measure == "state_m" else "tolerance"
+            unit = "m" if self.measure == "state_m" else "dB"
+            _validation.positive_real(name, self.tolerance, fix=f"in {unit}, e.g. "
+                                      + ("1e-5" if unit == "m" else "0.01"))
+
+    @property
+    def literal(self) -> bool:
+        """Whether the step is given literally (nothing to choose)."""
+        return self.dt is not None
+
+    def resolved(self, default_measure: str) -> tuple[str, float]:
+        """The measure and tolerance asked: ``(measure, tolerance)``.
+
+        Parameters
+        ----------
+        default_measure : str
+            The probe's measure where the request names none (:meth:`Probe`'s builder).
+
+        Returns
+        -------
+        measure : str
+        tolerance : float
+            In the measure's unit; the default is ``qzs.defaults.ACCURACY``'s.
+        """
+        measure = self.measure or ("transmissibility_db" if self.tolerance is not None
+                                   else default_measure)
+        if self.tolerance is not None:
+            return measure, float(self.tolerance)
+        return measure, float(defaults.ACCURACY[DEFAULT_KEYS[measure]])
+
+
+def step_request(*, dt=None, tolerance=None, tolerance_state=None, tolerance_db=None,
+                 required=False, stacklevel=4):
+    """The :class:`StepRequest` of the API's keywords (one spelling: ``tolerance`` [dB]).
+
+    Parameters
+    ----------
+    dt : float, optional
+        A literal step [s].
+    tolerance : float, optional
+        On the transmissibility [dB].
+    tolerance_state : float, optional
+        On the relative position (or pose) [m].
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns).
+    required : bool
+        Exactly one tolerance must be given (a chooser's call): neither is refused too.
+    stacklevel : int
+        Where the deprecation warning points.
+
+    Returns
+    -------
+    StepRequest
+
+    Raises
+    ------
+    ParameterError
+        Both tolerances (or neither where ``required``), a tolerance and a ``dt``, or a
+        non-positive value.
+    """
+    tolerance = _validation.renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db,
+                                            stacklevel=stacklevel)
+    given = [name for name, value in (("tolerance", tolerance),
+                                      ("tolerance_state", tolerance_state)) if value is not None]
+    if len(given) == 2 or (required and not given):
+        raise ParameterError(
+            "give exactly one of `tolerance` (transmissibility, dB) and `tolerance_state` "
+            f"(relative position, m); got {' and '.join(given) or 'neither'}.",
+            ("tolerance", "tolerance_state"))
+    if tolerance_state is not None:
+        return StepRequest(dt=dt, tolerance=tolerance_state, measure="state_m")
+    return StepRequest(dt=dt, tolerance=tolerance,
+                       measure=None if tolerance is None else "transmissibility_db")
+
+
+# ---------------------------------------------------------------- the probe
+@dataclass(frozen=True, kw_only=True)
+class Probe:
+    """A model's probe, built for one measure: what :func:`choose` needs to search a step.
+
+    The probe is built only for a chosen step (a literal request builds none); its
+    stability limit and admissible start (:attr:`start`) are computed only where the
+    step cache has no answer.
+
+    Attributes
+    ----------
+    measure : str
+        The accuracy measure.
+    order : int
+        The scheme's order [-].
+    sample_rate : float
+        Output rate [Hz].
+    solver : str
+        The integrator.
+    excitation : object
+        The probe's excitation (for the record).
+    duration : float
+        The probe's length [s].
+    band : tuple of float or None
+        The transmissibility measure's band [Hz].
+    shortened : bool
+        Whether the probe is a shortened stand-in for the run's excitation.
+    start : callable
+        ``start()``: ``(stability_limit [s], resolving step [s], dt0 [s], k0 [-])``, the
+        largest stable step, the largest resolving the base motion, and the admissible start
+        (:func:`~qzs.engine.step_search.admissible_step`).
+    run : callable
+        ``run(dt, members)``: one probe run per listed case at step ``dt`` [s].
+    compare : callable
+        ``compare(coarse, fine)``: their difference in the measure's unit (NaN: none).
+    cases : int
+        Cases (lanes) sharing the step [-].
+    labels : tuple of str or None
+        Their names in the notes.
+    key : mapping or None
+        The cache-key parts (the model, the probe's settings); None: not cached.
+    max_halvings : int
+        Halvings of ``dt0`` tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    search : mapping
+        Further keywords of :func:`~qzs.engine.step_search.search_step` (``give_up_early``,
+        ``per_case``, ``unit_name``).
+    """
+
+    measure: str
+    order: int
+    sample_rate: float
+    solver: str
+    excitation: Any
+    duration: float
+    band: tuple | None
+    shortened: bool
+    start: Callable[[], tuple]
+    run: Callable
+    compare: Callable
+    cases: int = 1
+    labels: tuple | None = None
+    key: Mapping | None = None
+    max_halvings: int = 8
+    safety: float = 2.0
+    search: Mapping = field(default_factory=dict)
+
+
+# ---------------------------------------------------------------- the one call
+def choose(request, probe, *, fallback=False, finest=None, progress=False, cache=False):
+    """The step of a request on a probe: literal, from the cache, or searched.
+
+    Parameters
+    ----------
+    request : StepRequest
+        What is asked.
+    probe : object
+        A probe builder (:func:`qzs.engine.accuracy.single_probe`,
+        :func:`qzs.engine.accuracy_batch.batch_probe`,
+        :func:`qzs.engine.hexapod.accuracy.hexapod_step_probe`): ``sample_rate``,
+        ``solver``, ``default_measure`` and ``build(measure)`` -> :class:`Probe`.
+    fallback : bool
+        Where no candidate meets the tolerance (or no bin is trusted), return the fallback
+        (:func:`fallback_step`, ``met`` False, :func:`unmet_sentence` as the last note)
+        instead of raising.
+    finest : float, optional
+        The finest candidate [s]: halvings stop above it; the fallback step too.
+    progress : bool
+        Show a progress bar over the probe runs.
+    cache : bool
+        Read the choice from, and keep it in, the step cache (probes with cache-key parts).
+
+    Returns
+    -------
+    StepChoice
+        ``chosen`` False for a literal request (no probe work at all).
+
+    Raises
+    ------
+    ParameterError
+        A bad ``finest``, or as the probe's build and the search raise.
+    ToleranceNotMetError
+        No candidate meets the tolerance (without ``fallback``).
+    """
+    from qzs.engine.step_search import StepChoice
+
+    if request.literal:
+        return StepChoice.literal(request.dt, sample_rate=probe.sample_rate, solver=probe.solver)
+    if finest is not None:
+        _validation.positive_real("finest", finest)
+    measure, tolerance = request.resolved(probe.default_measure)
+    legs = probe.build(measure)
+    key = _cache_key(legs, tolerance, finest, fallback) if cache else None
+    if key is not None:
+        from qzs.engine import step_cache
+
+        hit = step_cache.load_choice(key, legs.excitation, legs.duration,
+                                     cases=legs.cases if legs.search.get("per_case") else None)
+        if hit is not None:
+            return hit
+    choice = _search(legs, tolerance, fallback, finest, progress)
+    if key is not None:
+        from qzs.engine import step_cache
+
+        step_cache.store_choice(key, choice)
+    return choice
+
+
+def _cache_key(legs, tolerance, finest, fallback):
+    """The step cache's key of a choice (None: the probe is not cached)."""
+    if legs.key is None:
+        return None
+    from qzs.engine import step_cache
+
+    return step_cache.cache_key(**legs.key, measure=legs.measure, tolerance=tolerance,
+                                max_halvings=legs.max_halvings, safety=legs.safety,
+                                finest=finest, fallback=bool(fallback))
+
+
+def _search(legs, tolerance, fallback, finest, progress):
+    """The one search on a built probe (:func:`~qzs.engine.step_search.search_step`)."""
+    from qzs.engine.accuracy import spectral_beside_probes
+    from qzs.engine.step_search import bound_notes, search_step
+
+    spectral_beside_probes(legs.measure)
+    limit, resolving, dt0, k0 = legs.start()
+    return search_step(
+        run=legs.run, compare=legs.compare, cases=legs.cases, dt0=dt0, order=legs.order,
+        measure=legs.measure, tolerance=tolerance, sample_rate=legs.sample_rate,
+        solver=legs.solver, probe=legs.excitation, probe_duration=legs.duration, band=legs.band,
+        notes=bound_notes(dt0, k0, legs.sample_rate, limit, resolving, legs.measure,
+                          legs.shortened),
+        stability_limit=limit, max_halvings=legs.max_halvings, safety=legs.safety,
+        finest=finest, fallback=fallback, labels=legs.labels, progress=progress,
+        **legs.search)
+
