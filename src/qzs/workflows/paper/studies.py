@@ -24,7 +24,7 @@ its bins are trusted (docs/model.md §10), and every metric comes from those bin
 The integration step: a ``[simulation] dt`` in the file, or ``dt`` given to
 :func:`run_studies` (``qzs paper --dt``), is used as it is; otherwise the cases that share
 an excitation get one step, the coarsest that keeps every one's transmissibility within
-``tolerance_db`` (default :data:`qzs.defaults.ACCURACY`), chosen by
+``tolerance`` (default :data:`qzs.defaults.ACCURACY`), chosen by
 :func:`qzs.engine.accuracy_batch.choose_batch_step` on one lockstep probe of them all
 (docs/model.md §7).
 """
@@ -586,7 +586,7 @@ def _spring_case(task):
 
 
 def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True, dt=None,
-                tolerance_db=None, spring=None):
+                tolerance=None, spring=None, tolerance_db=None):
     """Run several studies, all their cases in parallel.
 
     Cases that share their chirp, sample rate, step and solver (the paper's
@@ -610,8 +610,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         through the one-case driver, one per process (the same numbers, slower).
     dt : float, optional
         Integration step [s] of every case (the paper's: 1e-4); default a file's
-        ``[simulation] dt``, else chosen for ``tolerance_db``.
-    tolerance_db : float, optional
+        ``[simulation] dt``, else chosen for ``tolerance``.
+    tolerance : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets (one step per group
         of cases sharing an excitation, :func:`qzs.engine.accuracy_batch.choose_batch_step`);
         default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
@@ -619,6 +619,8 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         The spring law of every case (docs/model.md §3.1); default the MagSpring's tanh (the
         paper's: a ``TanhSpring`` of Table 1's numbers is the default, another tanh runs
         with its own). The spring study then measures and fits that law.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -627,22 +629,17 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     Raises
     ------
     ParameterError
-        Both ``dt`` and ``tolerance_db``, or a non-positive one.
+        Both ``dt`` and ``tolerance``, or a non-positive one.
     """
     from qzs.engine.progress import progress_bar
+    from qzs.engine.step_choice import step_request
 
-    from qzs._validation import positive_real
-
-    if dt is not None and tolerance_db is not None:
-        raise ParameterError("give `dt` (a literal step [s]) or `tolerance_db` (the accuracy "
-                             "the step is chosen for [dB]), not both.")
-    dt = None if dt is None else positive_real("dt", dt)
-    tolerance_db = positive_real("tolerance_db", ACCURACY["tolerance_db"] if tolerance_db is None
-                                 else tolerance_db)
+    request = step_request(dt=dt, tolerance=tolerance, tolerance_db=tolerance_db)
+    dt = request.dt
     given = IsolatorParameters(spring=spring).spring_law  # validated
     spring = None if given == IsolatorParameters().spring_law else given  # the MagSpring: None
     per_study = [_tasks(study, quick, dt, spring) for study in studies]
-    steps = _choose_steps(per_study, tolerance_db, worker_count(workers), progress)
+    steps = _choose_steps(per_study, request, worker_count(workers), progress)
     tasks = [(i, j, task) for i, study_tasks in enumerate(per_study)
              for j, task in enumerate(study_tasks)]
     results = [[None] * len(study_tasks) for study_tasks in per_study]
@@ -706,13 +703,16 @@ def run_study(study, **options):
     return run_studies([study], **options)[0]
 
 
-def _choose_steps(per_study, tolerance_db, workers, progress):
+def _choose_steps(per_study, request, workers, progress):
     """Fill in the step of every task without one; returns each study's :func:`_step_record`.
 
     The tasks that share their chirp, sample rate and solver (a lockstep batch) get one
-    step: :func:`qzs.engine.accuracy_batch.choose_batch_step` over their distinct cases.
+    step: :func:`qzs.engine.step_choice.choose` of ``request`` (a
+    :class:`~qzs.engine.step_choice.StepRequest`; its tolerance, else the default) on a batch
+    probe of their distinct cases.
     """
-    from qzs.engine.accuracy_batch import choose_batch_step
+    from qzs.engine.accuracy_batch import batch_probe
+    from qzs.engine.step_choice import choose
 
     groups = {}
     for tasks in per_study:
@@ -728,11 +728,10 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
         for task in tasks:
             isolator, controller, _, _ = _case_inputs(task)
             index.setdefault((isolator, controller), []).append(task)
-        # no step meeting the tolerance for any case: the one fallback (the paper's step)
-        choice = choose_batch_step(
-            list(index), excitation, tolerance_db=tolerance_db, solver=solver,
-            sample_rate=rate, fallback=True, workers=workers, progress=progress,
-            labels=[members[0]["label"] for members in index.values()], cache=True)
+        choice = choose(request, batch_probe(
+            list(index), excitation, solver=solver, sample_rate=rate, workers=workers,
+            labels=[members[0]["label"] for members in index.values()]),
+            fallback=True, progress=progress, cache=True)
         seconds = time.perf_counter() - start
         for c, members in enumerate(index.values()):
             for task in members:
@@ -750,7 +749,7 @@ def _step_record(tasks, choices):
     record = {"dt": float(first["simulation"]["dt"]), "source": first["step_source"]}
     if id(first) in choices and not choices[id(first)][0].met:
         choice, _, seconds, group = choices[id(first)]
-        record.update(source="fallback", tolerance_db=choice.tolerance, notes=[choice.notes[-1]],
+        record.update(source="fallback", tolerance_db=choice.tolerance, notes=[choice.unmet_note],
                       unmet=[task["label"] for task in simulated], seconds=seconds,
                       group=group)
     elif id(first) in choices:
