@@ -331,11 +331,11 @@ def test_a_step_choice_loads_scipy_signal_beside_its_first_probe_runs(monkeypatc
     """scipy.signal (0.9 s of imports) is loaded by the first estimate, not by importing the
     spectral module: the choice starts loading it in a thread before its probes integrate,
     so that the import overlaps them (a first run's choice took 0.2-0.4 s longer without)."""
-    import qzs.engine.accuracy as accuracy
     import qzs.engine.single as single
+    import qzs.engine.step_choice as step_choice
 
     order = []
-    monkeypatch.setattr(accuracy, "import_in_background",
+    monkeypatch.setattr(step_choice, "import_in_background",
                         lambda *modules: order.append(("import", modules)))
     integrate = single.integrate
     monkeypatch.setattr(single, "integrate",

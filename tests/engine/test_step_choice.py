@@ -9,8 +9,8 @@ import pytest
 
 from qzs import Chirp, Sine
 from qzs.defaults import ACCURACY, SIMULATION
-from qzs.engine.accuracy import choose_step, single_probe
-from qzs.engine.accuracy_batch import batch_probe, choose_batch_step
+from qzs.engine.accuracy import SingleProbe, choose_step
+from qzs.engine.accuracy_batch import BatchProbe, choose_batch_step
 from qzs.engine.step_choice import (StepRequest, choose, fallback_step, step_request,
                                     unmet_sentence)
 from qzs.engine.step_search import StepChoice, search_step
@@ -62,9 +62,9 @@ def test_the_default_request_is_the_defaults_accuracy_in_the_probes_measure():
     assert StepRequest(measure="state_m").resolved("transmissibility_db") == (
         "state_m", ACCURACY["tolerance_state"])
     # the probes' default measures: a sine has no band, so its state; a chirp its dB
-    assert single_probe(Sine(frequency=2.0)).default_measure == "state_m"
-    assert single_probe(CHIRP).default_measure == "transmissibility_db"
-    assert batch_probe([], Sine(frequency=2.0)).default_measure == "state_m"
+    assert SingleProbe(excitation=Sine(frequency=2.0)).default_measure == "state_m"
+    assert SingleProbe(excitation=CHIRP).default_measure == "transmissibility_db"
+    assert BatchProbe(cases=[], excitation=Sine(frequency=2.0)).default_measure == "state_m"
 
 
 def test_the_api_keywords_make_one_request():
@@ -144,8 +144,9 @@ def test_a_batch_probe_of_one_case_chooses_what_the_single_axis_probe_chooses():
     estimate, history and notes (the batch adds only its per-case entries)."""
     pair = (IsolatorParameters(), ControllerParameters())
     request = StepRequest(tolerance=0.05)
-    single = choose(request, single_probe(CHIRP, *pair, max_halvings=5))
-    batch = choose(request, batch_probe([pair], CHIRP, max_halvings=5))
+    single = choose(request, SingleProbe(excitation=CHIRP, isolator=pair[0], controller=pair[1],
+                                             max_halvings=5))
+    batch = choose(request, BatchProbe(cases=[pair], excitation=CHIRP, max_halvings=5))
     assert single.met and batch.met
     assert (batch.dt, batch.error, batch.history, batch.notes) == (
         single.dt, single.error, single.history, single.notes)
@@ -158,7 +159,7 @@ def test_a_cache_hit_is_the_choice_the_search_made(monkeypatch, tmp_path):
     import qzs.engine.single as single_module
 
     monkeypatch.setenv("QZS_CACHE_DIR", str(tmp_path))
-    probe = single_probe(CHIRP, max_halvings=5)
+    probe = SingleProbe(excitation=CHIRP, max_halvings=5)
     fresh = choose(StepRequest(tolerance=0.05), probe, fallback=True, cache=True)
 
     def no_run(*args, **kwargs):

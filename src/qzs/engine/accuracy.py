@@ -19,18 +19,18 @@ import numpy as np
 
 from qzs import _validation, defaults
 from qzs._format import decibels
-from qzs._lazy import import_in_background
 from qzs._validation import choice as _choice
 from qzs.engine.step_search import (ADMISSIBLE_REFINEMENT, MAX_HALVINGS, MEASURE_UNITS,
                                     RATE_REFINEMENT_MAX, SAFETY, StepChoice, admissible_step,
                                     halving_search)
+from qzs.engine.step_choice import spectral_beside_probes  # noqa: F401 (kept importable here)
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
-__all__ = ["StepChoice", "choose_step", "default_tolerance", "probe_excitation", "step_error",
+__all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings", "spectral_beside_probes", "single_probe", "SingleProbe"]
+           "probe_settings", "spectral_beside_probes", "SingleProbe", "excitation_measure"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -291,28 +291,53 @@ def check_band(band, excitation, sample_rate):
     return (low, high)
 
 
-def spectral_beside_probes(measure):
-    """Start loading what a step choice's estimates need, beside its first probe runs.
-
-    For ``measure`` ``"transmissibility_db"``: the spectral analysis and scipy.signal (0.9 s
-    of imports, loaded by the first estimate, not by :mod:`qzs.analysis.spectral` itself)
-    load in a thread while the probe's first runs integrate in a kernel that holds no GIL.
-    Called once a choice is known to need its probes (not read from the step cache).
+def excitation_measure(excitation):
+    """The measure a run of ``excitation`` is judged by when it asks for no tolerance.
 
     Parameters
     ----------
-    measure : str
-        The choice's measure, a key of :data:`MEASURE_UNITS`.
+    excitation : Chirp, Sine, RandomExcitation, DisplacementRecord or None
+        The run's excitation (None: the paper's chirp).
+
+    Returns
+    -------
+    str
+        ``"state_m"`` for a sine (one frequency, no band to estimate a transmissibility
+        over), else ``"transmissibility_db"``.
     """
-    if measure == "transmissibility_db":
-        import_in_background("scipy.signal", "qzs.analysis.spectral")
+    return "state_m" if isinstance(excitation, Sine) else "transmissibility_db"
 
 
 @dataclass(frozen=True, kw_only=True)
 class SingleProbe:
-    """The probe builder of one axis (:func:`single_probe`): its inputs, nothing computed.
+    """The probe of one axis: the inputs of :func:`choose_step` but the tolerance; nothing
+    computed until :meth:`build`, which :func:`qzs.engine.step_choice.choose` calls only for
+    a chosen step.
 
-    :func:`qzs.engine.step_choice.choose` calls :meth:`build` only for a chosen step.
+    Attributes
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord or None
+        The run's excitation (None: the paper's chirp).
+    isolator : IsolatorParameters or None
+        Plant parameters (None: Table 1's).
+    controller : ControllerParameters or None
+        PI and damping loops (None: the defaults).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    fft_length : int or None
+        Welch segment length [samples] of the probe's transmissibility.
+    initial_state : InitialState or None
+        As for :func:`qzs.simulate`.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
     """
 
     excitation: Any = None
@@ -329,9 +354,8 @@ class SingleProbe:
 
     @property
     def default_measure(self) -> str:
-        """The default request's measure: the state for a sine (no band), else the
-        transmissibility."""
-        return "state_m" if isinstance(self.excitation, Sine) else "transmissibility_db"
+        """The default request's measure (:func:`excitation_measure`)."""
+        return excitation_measure(self.excitation)
 
     def build(self, measure):
         """The probe for ``measure``: inputs checked, the probe's excitation made.
@@ -376,25 +400,6 @@ class SingleProbe:
             max_halvings=self.max_halvings, safety=self.safety)
 
 
-def single_probe(excitation=None, isolator=None, controller=None, *,
-                 solver=defaults.SIMULATION["solver"],
-                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
-                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS, safety=SAFETY):
-    """The probe of one axis for :func:`qzs.engine.step_choice.choose` (nothing computed yet).
-
-    Parameters are those of :func:`choose_step` (the model, the run's output and the probe's
-    settings).
-
-    Returns
-    -------
-    SingleProbe
-    """
-    return SingleProbe(excitation=excitation, isolator=isolator, controller=controller,
-                       solver=solver, sample_rate=sample_rate, band=band,
-                       probe_duration=probe_duration, fft_length=fft_length,
-                       initial_state=initial_state, max_halvings=max_halvings, safety=safety)
-
-
 def _single_start(probe, duration, isolator, controller, solver, sample_rate):
     """One axis's stability limit, resolving step and admissible start (``Probe.start``)."""
     from qzs.engine.prepare import check_resolution, divides, resolving_step
@@ -431,7 +436,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance=No
     extrapolates the error of ``dt_j`` Richardson-style: ``d_j * r_j/(r_j - 1)``. Where the
     differences do not shrink (``r_j <= 1``) there is no estimate. The chosen step is the
     coarsest whose estimate times ``safety`` meets the tolerance. The one call
-    :func:`qzs.engine.step_choice.choose` on :func:`single_probe`.
+    :func:`qzs.engine.step_choice.choose` on a :class:`SingleProbe`.
 
     Parameters
     ----------
@@ -494,48 +499,16 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance=No
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.step_choice import choose
+    from qzs.engine.step_choice import choose, step_request
 
-    request = _tolerance_request(tolerance, tolerance_state, tolerance_db)
-    return choose(request, single_probe(
-        excitation, isolator, controller, solver=solver, sample_rate=sample_rate, band=band,
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, SingleProbe(
+        excitation=excitation, isolator=isolator, controller=controller, solver=solver,
+        sample_rate=sample_rate, band=band,
         probe_duration=probe_duration, fft_length=fft_length, initial_state=initial_state,
         max_halvings=max_halvings, safety=safety),
         fallback=fallback, finest=finest, progress=progress, cache=cache)
-
-
-def _tolerance_request(tolerance, tolerance_state, tolerance_db):
-    """The request of a chooser's tolerance keywords: exactly one tolerance (no default)."""
-    from qzs.engine.step_choice import step_request
-
-    return step_request(tolerance=tolerance, tolerance_state=tolerance_state,
-                        tolerance_db=tolerance_db, required=True, stacklevel=5)
-
-
-def default_tolerance(excitation):
-    """The accuracy a command asks for when given no step and no tolerance.
-
-    The transmissibility within ``defaults.ACCURACY["tolerance_db"]`` where the excitation
-    has a band to estimate it over (a chirp, a random excitation, a record); a sine has one
-    frequency and no Welch estimate, so its relative position within
-    ``defaults.ACCURACY["tolerance_state"]`` (the default :class:`~qzs.engine.step_choice.
-    StepRequest` resolved on :func:`single_probe`).
-
-    Parameters
-    ----------
-    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
-        The run's excitation.
-
-    Returns
-    -------
-    dict
-        One keyword of :func:`choose_step`: ``{"tolerance": ...}`` [dB] or
-        ``{"tolerance_state": ...}`` [m].
-    """
-    from qzs.engine.step_choice import StepRequest
-
-    measure, value = StepRequest().resolved(single_probe(excitation).default_measure)
-    return {"state_m": {"tolerance_state": value}}.get(measure, {"tolerance": value})
 
 
 # ---------------------------------------------------------------- shared by the searches

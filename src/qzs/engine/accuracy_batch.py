@@ -11,13 +11,11 @@ from typing import Any
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import _tolerance_request, probe_settings, step_error
+from qzs.engine.accuracy import excitation_measure, probe_settings, step_error
 from qzs.engine.step_search import SAFETY, StepChoice, admissible_step
 from qzs.errors import ParameterError
-from qzs.model.excitation import Sine
 
-__all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step", "batch_probe",
-           "BatchProbe"]
+__all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step", "BatchProbe"]
 
 #: The record of a batch's step: the one record, :class:`~qzs.engine.step_search.StepChoice`
 #: (its ``case_errors``, ``case_steps`` and ``unmet`` filled in).
@@ -121,11 +119,12 @@ def choose_batch_step(cases, excitation=None, *, tolerance=None, tolerance_state
     SimulationError
         A case diverges on the probe.
     """
-    from qzs.engine.step_choice import choose
+    from qzs.engine.step_choice import choose, step_request
 
-    request = _tolerance_request(tolerance, tolerance_state, tolerance_db)
-    return choose(request, batch_probe(
-        cases, excitation, solver=solver, sample_rate=sample_rate, band=band,
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, BatchProbe(
+        cases=cases, excitation=excitation, solver=solver, sample_rate=sample_rate, band=band,
         probe_duration=probe_duration, fft_length=fft_length, max_halvings=max_halvings,
         safety=safety, workers=workers, labels=labels),
         fallback=fallback, finest=finest, progress=progress, cache=cache)
@@ -133,8 +132,35 @@ def choose_batch_step(cases, excitation=None, *, tolerance=None, tolerance_state
 
 @dataclass(frozen=True, kw_only=True)
 class BatchProbe:
-    """The probe builder of a lockstep batch (:func:`batch_probe`): its inputs, nothing
-    computed; :func:`qzs.engine.step_choice.choose` calls :meth:`build` for a chosen step."""
+    """The probe of a lockstep batch: the inputs of :func:`choose_batch_step` but the
+    tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
+    :meth:`build` for a chosen step.
+
+    Attributes
+    ----------
+    cases : sequence of (IsolatorParameters, ControllerParameters)
+        The lanes sharing the step.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord or None
+        Their shared excitation (None: the paper's chirp).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    fft_length : int or None
+        Welch segment length [samples] of the probe's transmissibility.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    workers : int or None
+        Threads of the batch kernel (None: all cores).
+    labels : sequence of str or None
+        The cases' names in the notes.
+    """
 
     cases: Any
     excitation: Any = None
@@ -150,8 +176,8 @@ class BatchProbe:
 
     @property
     def default_measure(self) -> str:
-        """The default request's measure: the state for a sine, else the transmissibility."""
-        return "state_m" if isinstance(self.excitation, Sine) else "transmissibility_db"
+        """The default request's measure (:func:`~qzs.engine.accuracy.excitation_measure`)."""
+        return excitation_measure(self.excitation)
 
     def build(self, measure):
         """The probe for ``measure``: the cases and settings checked, the probe made.
@@ -193,26 +219,6 @@ class BatchProbe:
                      fft_length=fft_length, labels=labels),
             max_halvings=self.max_halvings, safety=self.safety,
             search=dict(give_up_early=True, per_case=True, unit_name="batch"))
-
-
-def batch_probe(cases, excitation=None, *, solver=defaults.SIMULATION["solver"],
-                sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
-                fft_length=None, max_halvings=BATCH_MAX_HALVINGS, safety=SAFETY, workers=None,
-                labels=None):
-    """The probe of a lockstep batch for :func:`qzs.engine.step_choice.choose` (nothing
-    computed yet).
-
-    Parameters are those of :func:`choose_batch_step` (the cases, their shared excitation,
-    the run's output and the probe's settings).
-
-    Returns
-    -------
-    BatchProbe
-    """
-    return BatchProbe(cases=cases, excitation=excitation, solver=solver,
-                      sample_rate=sample_rate, band=band, probe_duration=probe_duration,
-                      fft_length=fft_length, max_halvings=max_halvings, safety=safety,
-                      workers=workers, labels=labels)
 
 
 def _batch_start(cases, probe, duration, solver, sample_rate):

@@ -184,7 +184,7 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
         An invalid input (named with its value and the fix), both a ``dt`` and a
         tolerance, a transmissibility tolerance for a sine; as :func:`qzs.simulate`.
     """
-    from qzs.engine.accuracy import excitation_over, probe_excitation, single_probe
+    from qzs.engine.accuracy import SingleProbe, excitation_over, probe_excitation
     from qzs.engine.prepare import pack_model, run_duration, run_inputs
     from qzs.engine.step_choice import choose, step_request
     from qzs.model.excitation import Sine
@@ -216,10 +216,10 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
         # a stationary excitation's probe is its start: never longer than the run
         default = probe_excitation(covered, (0.0, 0.0))[1]
         probe_duration = duration if duration < default else None
-    choice = choose(request, single_probe(covered, isolator, controller, solver=solver,
-                                          sample_rate=sample_rate,
-                                          probe_duration=probe_duration,
-                                          initial_state=initial_state),
+    choice = choose(request, SingleProbe(excitation=covered, isolator=isolator,
+                                         controller=controller, solver=solver,
+                                         sample_rate=sample_rate, probe_duration=probe_duration,
+                                         initial_state=initial_state),
                     fallback=True, progress=progress, cache=cache)
     if request.literal:
         pack_model(isolator, controller, choice.dt)  # a discrete linear controller's steps
@@ -410,7 +410,7 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
     ParameterError
         Invalid settings (before any probe), both a ``dt`` and a tolerance.
     """
-    from qzs.engine.hexapod.accuracy import hexapod_step_probe
+    from qzs.engine.hexapod.accuracy import HexapodProbe
     from qzs.engine.hexapod.prepare import check_hexapod_run
     from qzs.engine.step_choice import choose, step_request
 
@@ -426,8 +426,9 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
                       duration=duration, dt=finest if dt is None else dt,
                       sample_rate=sample_rate, solver=solver, cartesian=cartesian)
     request = step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
-    choice = choose(request, hexapod_step_probe(
-        geometry, platform, isolator, controller, excitation=excitation, solver=solver,
+    choice = choose(request, HexapodProbe(
+        geometry=geometry, platform=platform, isolator=isolator, controller=controller,
+        excitation=excitation, solver=solver,
         sample_rate=sample_rate, duration=duration, cartesian=cartesian),
         finest=None if request.literal else finest, fallback=True, progress=progress)
     return ResolvedHexapodRun(excitation=excitation, duration=duration, dt=choice.dt,

@@ -4,67 +4,37 @@
 Every step of qzs that is not given literally is chosen here: a request (a literal ``dt``
 [s], a ``tolerance`` on the transmissibility [dB] or on the state [m], or the default of
 :data:`qzs.defaults.ACCURACY`) and a probe of a model (one axis,
-:func:`qzs.engine.accuracy.single_probe`; lanes of a lockstep batch,
-:func:`qzs.engine.accuracy_batch.batch_probe`; the six legs,
-:func:`qzs.engine.hexapod.accuracy.hexapod_step_probe`) go to :func:`choose`, which owns the
+:class:`qzs.engine.accuracy.SingleProbe`; lanes of a lockstep batch,
+:class:`qzs.engine.accuracy_batch.BatchProbe`; the six legs,
+:class:`qzs.engine.hexapod.accuracy.HexapodProbe`) go to :func:`choose`, which owns the
 step cache (:mod:`qzs.engine.step_cache`), the one search
 (:func:`qzs.engine.step_search.search_step`), the one fallback step (:func:`fallback_step`)
 and the one meaning of an unmet tolerance (:func:`unmet_sentence`, shown by every caller as
-:attr:`~qzs.engine.step_search.StepChoice.unmet_note`).
+:attr:`~qzs.engine.step_search.StepChoice.unmet_note`); those two are written beside the
+record, in :mod:`qzs.engine.step_search`, and read here.
 
 >>> from qzs import Chirp
->>> from qzs.engine.accuracy import single_probe
+>>> from qzs.engine.accuracy import SingleProbe
 >>> from qzs.engine.step_choice import StepRequest, choose
->>> choice = choose(StepRequest(tolerance=0.01), single_probe(Chirp()))  # doctest: +SKIP
+>>> choice = choose(StepRequest(tolerance=0.01), SingleProbe(excitation=Chirp()))  # doctest: +SKIP
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from qzs import _validation, defaults
+from qzs._lazy import import_in_background
+from qzs.engine.step_search import (StepChoice, bound_notes, fallback_step, search_step,
+                                    unmet_sentence)
 from qzs.errors import ParameterError
 
 __all__ = ["StepRequest", "Probe", "choose", "fallback_step", "unmet_sentence",
-           "DEFAULT_KEYS", "step_request"]
+           "DEFAULT_KEYS", "step_request", "spectral_beside_probes"]
 
 #: Each measure's key of its default tolerance in :data:`qzs.defaults.ACCURACY`.
 DEFAULT_KEYS = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}
-
-
-# ---------------------------------------------------------------- the one unmet meaning
-def fallback_step(finest=None):
-    """The step [s] a run that must go on gets where no step tried meets its tolerance.
-
-    Parameters
-    ----------
-    finest : float, optional
-        The finest step the caller allows [s]; default the paper's ``SIMULATION["dt"]``.
-
-    Returns
-    -------
-    float
-    """
-    return float(finest if finest is not None else defaults.SIMULATION["dt"])
-
-
-def unmet_sentence(reason, dt):
-    """The one sentence every caller shows for an unmet tolerance (the record's last note).
-
-    Parameters
-    ----------
-    reason : str
-        Why no step met it (from :func:`~qzs.engine.step_search.search_step`).
-    dt : float
-        The fallback step the run goes on at [s] (:func:`fallback_step`).
-
-    Returns
-    -------
-    str
-    """
-    return f"{reason}; running at dt = {dt:.3g} s, whose error is not estimated"
 
 
 # ---------------------------------------------------------------- the request
@@ -255,9 +225,9 @@ def choose(request, probe, *, fallback=False, finest=None, progress=False, cache
     request : StepRequest
         What is asked.
     probe : object
-        A probe builder (:func:`qzs.engine.accuracy.single_probe`,
-        :func:`qzs.engine.accuracy_batch.batch_probe`,
-        :func:`qzs.engine.hexapod.accuracy.hexapod_step_probe`): ``sample_rate``,
+        A model's probe (:class:`qzs.engine.accuracy.SingleProbe`,
+        :class:`qzs.engine.accuracy_batch.BatchProbe`,
+        :class:`qzs.engine.hexapod.accuracy.HexapodProbe`): ``sample_rate``,
         ``solver``, ``default_measure`` and ``build(measure)`` -> :class:`Probe`.
     fallback : bool
         Where no candidate meets the tolerance (or no bin is trusted), return the fallback
@@ -282,8 +252,6 @@ def choose(request, probe, *, fallback=False, finest=None, progress=False, cache
     ToleranceNotMetError
         No candidate meets the tolerance (without ``fallback``).
     """
-    from qzs.engine.step_search import StepChoice
-
     if request.literal:
         return StepChoice.literal(request.dt, sample_rate=probe.sample_rate, solver=probe.solver)
     if finest is not None:
@@ -317,11 +285,25 @@ def _cache_key(legs, tolerance, finest, fallback):
                                 finest=finest, fallback=bool(fallback))
 
 
+def spectral_beside_probes(measure):
+    """Start loading what a step choice's estimates need, beside its first probe runs.
+
+    For ``measure`` ``"transmissibility_db"``: the spectral analysis and scipy.signal (0.9 s
+    of imports, loaded by the first estimate, not by :mod:`qzs.analysis.spectral` itself)
+    load in a thread while the probe's first runs integrate in a kernel that holds no GIL.
+    Called once a choice is known to need its probes (not read from the step cache).
+
+    Parameters
+    ----------
+    measure : str
+        The choice's measure, a key of :data:`DEFAULT_KEYS`.
+    """
+    if measure == "transmissibility_db":
+        import_in_background("scipy.signal", "qzs.analysis.spectral")
+
+
 def _search(legs, tolerance, fallback, finest, progress):
     """The one search on a built probe (:func:`~qzs.engine.step_search.search_step`)."""
-    from qzs.engine.accuracy import spectral_beside_probes
-    from qzs.engine.step_search import bound_notes, search_step
-
     spectral_beside_probes(legs.measure)
     limit, resolving, dt0, k0 = legs.start()
     return search_step(

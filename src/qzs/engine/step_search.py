@@ -36,7 +36,7 @@ from qzs._format import step_line as record_line
 from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
 
 __all__ = ["StepChoice", "search_step", "halving_search", "admissible_step",
-           "bound_notes", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
+           "bound_notes", "fallback_step", "unmet_sentence", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
            "ADMISSIBLE_REFINEMENT"]
 
 #: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
@@ -52,6 +52,40 @@ MAX_HALVINGS = 8
 RATE_REFINEMENT_MAX = 32
 #: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
 ADMISSIBLE_REFINEMENT = 1_000_000
+
+
+# ---------------------------------------------------------------- the one unmet meaning
+# (changing the fallback step or the sentence every caller shows is an edit here)
+def fallback_step(finest=None):
+    """The step [s] a run that must go on gets where no step tried meets its tolerance.
+
+    Parameters
+    ----------
+    finest : float, optional
+        The finest step the caller allows [s]; default the paper's ``SIMULATION["dt"]``.
+
+    Returns
+    -------
+    float
+    """
+    return float(finest if finest is not None else defaults.SIMULATION["dt"])
+
+
+def unmet_sentence(reason, dt):
+    """The one sentence every caller shows for an unmet tolerance (the record's last note).
+
+    Parameters
+    ----------
+    reason : str
+        Why no step met it (from :func:`~qzs.engine.step_search.search_step`).
+    dt : float
+        The fallback step the run goes on at [s] (:func:`fallback_step`).
+
+    Returns
+    -------
+    str
+    """
+    return f"{reason}; running at dt = {dt:.3g} s, whose error is not estimated"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -166,8 +200,8 @@ class StepChoice:
     def unmet_note(self) -> str:
         """The one sentence every caller shows for an unmet tolerance; '' where it was met.
 
-        Made by :func:`qzs.engine.step_choice.unmet_sentence` (the fallback's reason and
-        step); a literal step has no tolerance to miss.
+        Made by :func:`unmet_sentence` (the fallback's reason and step); a literal step has
+        no tolerance to miss.
         """
         return "" if self.met or not self.chosen else (self.notes[-1] if self.notes else "")
 
@@ -534,17 +568,63 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     labels = [f"case {c}" for c in range(cases)] if labels is None else [str(x) for x in labels]
     if len(labels) != cases:
         raise ParameterError(f"`labels` must name each of the {cases} cases, got {len(labels)}.")
-    unit = MEASURE_UNITS[measure]
     notes = list(notes)
-    bar = None
-    if progress:
-        from qzs.engine.progress import progress_bar
+    bar = _progress_bar(progress, max_halvings + 1, unit_name)
+    differences, integrated = {}, []
+    before, after, difference = _probe_runs(run, compare, dt0, bar, differences, integrated)
+    try:
+        met, best, history, untrusted, failed = _loop(
+            difference, cases, order, tolerance, dt0, max_halvings, safety, give_up_early,
+            before=before, after=after)
+    finally:
+        if bar is not None:
+            bar.close()
+    several = cases > 1 or per_case
+    record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
+                  sample_rate=float(sample_rate), solver=solver, probe=probe,
+                  probe_duration=float(probe_duration), band=band, history=tuple(history))
+    if not met:
+        reason = _unmet_reason(best, untrusted, cases, fallback, dt0, max_halvings, safety,
+                               record)
+        dt = fallback_step(finest)
+        return StepChoice(dt=dt, error=math.nan,
+                          reference_dt=min(integrated, default=math.nan),
+                          notes=tuple(notes + [unmet_sentence(reason, dt)]), met=False,
+                          case_errors=(math.nan,) * cases if several else (),
+                          case_steps=(math.nan,) * cases if several else (),
+                          unmet=tuple(range(cases)) if several else (), **record)
+    j = max(level for level, _ in met.values())
+    deciding = min(c for c, (level, _) in met.items() if level == j)
+    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
+    notes += _case_notes(labels, failed, untrusted, best, dt0 / 2 ** (max_halvings - 2), record)
+    entries = {}
+    if several:
+        entries = dict(
+            case_errors=tuple(float(met[c][1]) if c in met else
+                              (math.nan if c in untrusted else math.inf) for c in range(cases)),
+            case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
+                             for c in range(cases)),
+            unmet=tuple(sorted(set(range(cases)) - set(met))))
+    return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
+                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **entries, **record)
 
-        # shown after half a second: a cached or quick choice draws nothing, and a first run's
-        # compile notice (qzs.engine.compiling) comes before the bar
-        bar = progress_bar(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
-                           delay=0.5)
-    runs, differences, integrated = {}, {}, []
+
+def _progress_bar(progress, total, unit_name):
+    """The search's progress bar over probe runs (None without ``progress``)."""
+    if not progress:
+        return None
+    from qzs.engine.progress import progress_bar
+
+    # shown after half a second: a cached or quick choice draws nothing, and a first run's
+    # compile notice (qzs.engine.compiling) comes before the bar
+    return progress_bar(total=total, unit=unit_name, desc="choosing dt", leave=False, delay=0.5)
+
+
+def _probe_runs(run, compare, dt0, bar, differences, integrated):
+    """The loop's ``before``, ``after`` and ``difference`` over the probe's runs: each
+    candidate integrated once per case, kept while a comparison needs it; ``differences``
+    memoises the comparisons and ``integrated`` lists the steps run."""
+    runs = {}
 
     def integrate(j, members):
         kept = runs.setdefault(j, {})
@@ -564,49 +644,40 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
             differences[j, c] = compare(runs[j][c], runs[j + 1][c])
         return differences[j, c]
 
-    try:
-        met, best, history, untrusted, failed = _loop(
-            difference, cases, order, tolerance, dt0, max_halvings, safety, give_up_early,
-            before=before, after=lambda j: runs.pop(j, None))
-    finally:
-        if bar is not None:
-            bar.close()
-    several = cases > 1 or per_case
-    record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
-                  sample_rate=float(sample_rate), solver=solver, probe=probe,
-                  probe_duration=float(probe_duration), band=band, history=tuple(history))
-    if not met:
-        # the finest candidate whose error was estimated (compared with two finer ones)
-        finest_tried = dt0 / 2 ** max(max_halvings - 2, 0)
-        if untrusted and len(untrusted) == cases:
-            reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
-                      f"{probe_duration:g} s probe, so no error is measured")
-            if not fallback:
-                raise ParameterError(reason.replace(", so no error is measured", "")
-                                     + "; lengthen `probe_duration` or narrow the band.")
-        else:
-            smallest = min(best.values(), default=math.inf)
-            if not fallback:
-                raise ToleranceNotMetError(tolerance, unit, finest_tried, smallest, safety)
-            reason = (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
-                      f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
-                      "redraw the response at every step)")
-        from qzs.engine.step_choice import fallback_step, unmet_sentence
+    return before, lambda j: runs.pop(j, None), difference
 
-        dt = fallback_step(finest)
-        return StepChoice(dt=dt, error=math.nan,
-                          reference_dt=min(integrated, default=math.nan),
-                          notes=tuple(notes + [unmet_sentence(reason, dt)]), met=False,
-                          case_errors=(math.nan,) * cases if several else (),
-                          case_steps=(math.nan,) * cases if several else (),
-                          unmet=tuple(range(cases)) if several else (), **record)
-    j = max(level for level, _ in met.values())
-    deciding = min(c for c, (level, _) in met.items() if level == j)
-    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
+
+def _unmet_reason(best, untrusted, cases, fallback, dt0, max_halvings, safety, record):
+    """Why no candidate met the tolerance, for the fallback's sentence; without
+    ``fallback`` the error that says so is raised instead."""
+    tolerance, band, length = record["tolerance"], record["band"], record["probe_duration"]
+    unit = MEASURE_UNITS[record["measure"]]
+    # the finest candidate whose error was estimated (compared with two finer ones)
+    finest_tried = dt0 / 2 ** max(max_halvings - 2, 0)
+    if untrusted and len(untrusted) == cases:
+        reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
+                  f"{length:g} s probe, so no error is measured")
+        if not fallback:
+            raise ParameterError(reason.replace(", so no error is measured", "")
+                                 + "; lengthen `probe_duration` or narrow the band.")
+        return reason
+    smallest = min(best.values(), default=math.inf)
+    if not fallback:
+        raise ToleranceNotMetError(tolerance, unit, finest_tried, smallest, safety)
+    return (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
+            f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
+            "redraw the response at every step)")
+
+
+def _case_notes(labels, failed, untrusted, best, finest_tried, record):
+    """The notes on the cases that did not set the step: none met it, or none was measured."""
+    tolerance, band, length = record["tolerance"], record["band"], record["probe_duration"]
+    unit = MEASURE_UNITS[record["measure"]]
+    notes = []
     if failed:
         notes.append(
             f"{'; '.join(labels[c] for c in failed)}: no step down to "
-            f"{dt0 / 2 ** (max_halvings - 2):.3g} s meets {tolerance:g} {unit} (best estimate "
+            f"{finest_tried:.3g} s meets {tolerance:g} {unit} (best estimate "
             + ", ".join(f"{best.get(c, math.inf):.2g} {unit}" for c in failed)
             + "; an estimate that even the scheme's order could not bring within the tolerance "
             "by the finest candidate ends the search early): their response depends on the step "
@@ -615,15 +686,6 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     if untrusted:
         notes.append(f"{'; '.join(labels[c] for c in untrusted)}: no bin of "
                      f"the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
-                     f"{probe_duration:g} s probe, so no error is measured; the step is the "
+                     f"{length:g} s probe, so no error is measured; the step is the "
                      "other cases'")
-    entries = {}
-    if several:
-        entries = dict(
-            case_errors=tuple(float(met[c][1]) if c in met else
-                              (math.nan if c in untrusted else math.inf) for c in range(cases)),
-            case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
-                             for c in range(cases)),
-            unmet=tuple(sorted(set(range(cases)) - set(met))))
-    return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
-                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **entries, **record)
+    return notes

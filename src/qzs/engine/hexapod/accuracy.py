@@ -42,8 +42,7 @@ from qzs.engine.accuracy import (PROBE_DURATION, check_band, estimate_difference
 from qzs.engine.step_search import MAX_HALVINGS, MEASURE_UNITS, SAFETY, admissible_step
 from qzs.errors import ParameterError
 
-__all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error", "hexapod_step_probe",
-           "HexapodProbe"]
+__all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error", "HexapodProbe"]
 
 
 def hexapod_probe(excitation, band=None, probe_duration=None, duration=None,
@@ -226,12 +225,13 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     ToleranceNotMetError
         No candidate meets the tolerance and no ``fallback`` was given.
     """
-    from qzs.engine.accuracy import _tolerance_request
-    from qzs.engine.step_choice import choose
+    from qzs.engine.step_choice import choose, step_request
 
-    request = _tolerance_request(tolerance, tolerance_state, tolerance_db)
-    return choose(request, hexapod_step_probe(
-        geometry, platform, isolator, controller, excitation=excitation, solver=solver,
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, HexapodProbe(
+        geometry=geometry, platform=platform, isolator=isolator, controller=controller,
+        excitation=excitation, solver=solver,
         sample_rate=sample_rate, band=band, duration=duration, probe_duration=probe_duration,
         cartesian=cartesian, max_halvings=max_halvings, safety=safety),
         fallback=fallback, finest=finest, progress=progress)
@@ -239,9 +239,39 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
 
 @dataclass(frozen=True, kw_only=True)
 class HexapodProbe:
-    """The probe builder of the six-leg platform (:func:`hexapod_step_probe`): its inputs,
-    nothing computed; :func:`qzs.engine.step_choice.choose` calls :meth:`build` for a chosen
-    step. Not cached (no key)."""
+    """The probe of the six-leg platform: the inputs of :func:`choose_hexapod_step` but the
+    tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
+    :meth:`build` for a chosen step. Not cached (no key).
+
+    Attributes
+    ----------
+    geometry : HexapodGeometry
+        The platform's joints.
+    platform : PlatformParameters
+        Its mass and inertia.
+    isolator : IsolatorParameters or sequence of six or None
+        The legs' plants (None: the defaults).
+    controller : ControllerParameters or sequence of six or None
+        The legs' loops (None: the defaults).
+    excitation : dict
+        Axis name -> excitation (the moving axes).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    duration : float or None
+        The run's length [s]; a probe of a stationary excitation is not longer.
+    cartesian : CartesianController or None
+        Centralised loops.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    """
 
     geometry: Any
     platform: Any
@@ -379,25 +409,3 @@ def _probe_run(probe_of, isolators, controllers, probe, length, dt, sample_rate)
     return simulate_hexapod(probe_of.geometry, probe_of.platform, isolators, controllers,
                             excitation=probe, duration=length, dt=dt, sample_rate=sample_rate,
                             solver=probe_of.solver, cartesian=probe_of.cartesian)
-
-
-def hexapod_step_probe(geometry, platform, isolator=None, controller=None, *, excitation,
-                       solver=defaults.SIMULATION["solver"],
-                       sample_rate=defaults.SIMULATION["sample_rate"], band=None, duration=None,
-                       probe_duration=None, cartesian=None, max_halvings=MAX_HALVINGS,
-                       safety=SAFETY):
-    """The six-leg platform's probe for :func:`qzs.engine.step_choice.choose` (nothing
-    computed yet).
-
-    Parameters are those of :func:`choose_hexapod_step` (the platform, its legs, the
-    excitation, the run's output and the probe's settings).
-
-    Returns
-    -------
-    HexapodProbe
-    """
-    return HexapodProbe(geometry=geometry, platform=platform, isolator=isolator,
-                        controller=controller, excitation=excitation, solver=solver,
-                        sample_rate=sample_rate, band=band, duration=duration,
-                        probe_duration=probe_duration, cartesian=cartesian,
-                        max_halvings=max_halvings, safety=safety)

@@ -56,7 +56,7 @@ def choose_dt(settings, kp_probe):
     note : str
         How it was chosen.
     """
-    from qzs.engine.accuracy_batch import batch_probe
+    from qzs.engine.accuracy_batch import BatchProbe
     from qzs.engine.step_choice import StepRequest, choose
 
     probes = [(dataclasses.replace(settings.isolator, stiction_force=settings.stiction_range[1]),
@@ -64,10 +64,10 @@ def choose_dt(settings, kp_probe):
               (settings.isolator, settings.controller_at(kp_probe, settings.damping_gain_max))]
     labels = [f"Kd = {controller.damping_gain:g} N*s/m, Fs = {isolator.stiction_force:g} N"
               for isolator, controller in probes]
-    choice = choose(StepRequest(), batch_probe(probes, settings.excitation,
-                                               sample_rate=settings.sample_rate,
-                                               band=settings.band, max_halvings=MAX_HALVINGS,
-                                               labels=labels),
+    choice = choose(StepRequest(), BatchProbe(cases=probes, excitation=settings.excitation,
+                                              sample_rate=settings.sample_rate,
+                                              band=settings.band, max_halvings=MAX_HALVINGS,
+                                              labels=labels),
                     fallback=True, cache=True)
     if not choice.met:
         return choice.dt, f"no probed case meets the tolerance: {choice.unmet_note}"

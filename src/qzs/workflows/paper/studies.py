@@ -42,7 +42,7 @@ from qzs.analysis.linear import linearize
 from qzs.analysis.spectral import (band_mask, highpass, required_duration, transmissibility,
                                    transmissibility_metrics)
 from qzs.analysis.statistics import run_statistics
-from qzs.defaults import ACCURACY, ANALYSIS, FREQUENCY_SCALES, REPORTED_FREQUENCIES, SIMULATION
+from qzs.defaults import ANALYSIS, FREQUENCY_SCALES, REPORTED_FREQUENCIES, SIMULATION
 from qzs.engine.simulate import simulate
 from qzs.errors import ParameterError
 from qzs.identify.spring import fit_spring
@@ -711,7 +711,7 @@ def _choose_steps(per_study, request, workers, progress):
     :class:`~qzs.engine.step_choice.StepRequest`; its tolerance, else the default) on a batch
     probe of their distinct cases.
     """
-    from qzs.engine.accuracy_batch import batch_probe
+    from qzs.engine.accuracy_batch import BatchProbe
     from qzs.engine.step_choice import choose
 
     groups = {}
@@ -728,9 +728,9 @@ def _choose_steps(per_study, request, workers, progress):
         for task in tasks:
             isolator, controller, _, _ = _case_inputs(task)
             index.setdefault((isolator, controller), []).append(task)
-        choice = choose(request, batch_probe(
-            list(index), excitation, solver=solver, sample_rate=rate, workers=workers,
-            labels=[members[0]["label"] for members in index.values()]),
+        choice = choose(request, BatchProbe(
+            cases=list(index), excitation=excitation, solver=solver, sample_rate=rate,
+            workers=workers, labels=[members[0]["label"] for members in index.values()]),
             fallback=True, progress=progress, cache=True)
         seconds = time.perf_counter() - start
         for c, members in enumerate(index.values()):

@@ -200,7 +200,7 @@ def response_step(frequencies, amplitude, isolator, controller, *, solver, toler
     StepChoice
         The record (``met`` False, ``error`` NaN and the unmet sentence for the fallback).
     """
-    from qzs.engine.accuracy import single_probe
+    from qzs.engine.accuracy import SingleProbe
     from qzs.engine.step_choice import choose, step_request
 
     request = step_request(tolerance=tolerance, tolerance_db=tolerance_db)
@@ -211,8 +211,9 @@ def response_step(frequencies, amplitude, isolator, controller, *, solver, toler
         low = 0.8 * high
     probe = Chirp(amplitude=amplitude, f0=low, f1=high, duration=60.0,
                   fade_in=min(2.0 / low, 15.0))
-    return choose(request, single_probe(probe, isolator, controller, solver=solver,
-                                        sample_rate=sample_rate, band=(low, high)),
+    return choose(request, SingleProbe(excitation=probe, isolator=isolator,
+                                       controller=controller, solver=solver,
+                                       sample_rate=sample_rate, band=(low, high)),
                   fallback=True, progress=progress, cache=True)
 
 

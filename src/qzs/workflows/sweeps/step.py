@@ -105,13 +105,13 @@ def choose_sweep_step(definition, settings, *, progress=False):
 
 def _choose(definition, excitation, members, labels, progress):
     """The one call on a batch probe of the probed cases sharing ``excitation``."""
-    from qzs.engine.accuracy_batch import batch_probe
+    from qzs.engine.accuracy_batch import BatchProbe
     from qzs.engine.step_choice import StepRequest, choose
     from qzs.engine.step_search import MAX_HALVINGS
 
     request = StepRequest(tolerance=definition.simulation["tolerance_db"])
-    return choose(request, batch_probe([pair for _, pair in members], excitation,
-                                       solver=definition.simulation["solver"],
-                                       sample_rate=definition.analysis["sample_rate"],
-                                       max_halvings=MAX_HALVINGS, labels=labels),
+    return choose(request, BatchProbe(cases=[pair for _, pair in members], excitation=excitation,
+                                      solver=definition.simulation["solver"],
+                                      sample_rate=definition.analysis["sample_rate"],
+                                      max_halvings=MAX_HALVINGS, labels=labels),
                   fallback=True, progress=progress, cache=True)

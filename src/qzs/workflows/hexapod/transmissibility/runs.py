@@ -56,14 +56,14 @@ def axis_step(task):
         ``step_probe_duration``, ``step_reason``) and ``step_history`` (``(dt [s],
         difference to the next finer step [dB])`` per step compared).
     """
-    from qzs.engine.hexapod.accuracy import hexapod_step_probe
+    from qzs.engine.hexapod.accuracy import HexapodProbe
     from qzs.engine.step_choice import StepRequest, choose
 
     f0, f1 = task["f0"], task["f1"]
-    probe = hexapod_step_probe(
-        task["geometry"], task["platform"], task["isolator"], task["controller"],
-        excitation={task["axis"]: task["excitation"]}, solver=task["solver"],
-        sample_rate=task["sample_rate"], band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1),
+    probe = HexapodProbe(
+        geometry=task["geometry"], platform=task["platform"], isolator=task["isolator"],
+        controller=task["controller"], excitation={task["axis"]: task["excitation"]},
+        solver=task["solver"], sample_rate=task["sample_rate"], band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1),
         **_control(task))
     choice = choose(StepRequest(tolerance=task["tolerance_db"]), probe,
                     finest=task["setup_dt"], fallback=True)
