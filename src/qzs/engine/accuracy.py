@@ -20,10 +20,10 @@ import numpy as np
 from qzs import _validation, defaults
 from qzs._format import decibels
 from qzs._validation import choice as _choice
-from qzs.engine.step_search import (ADMISSIBLE_REFINEMENT, MAX_HALVINGS, MEASURE_UNITS,
-                                    RATE_REFINEMENT_MAX, SAFETY, StepChoice, admissible_step,
+from qzs.engine.step_choice import (ADMISSIBLE_REFINEMENT, RATE_REFINEMENT_MAX,  # noqa: F401
+                                    admissible_step, spectral_beside_probes)
+from qzs.engine.step_search import (MAX_HALVINGS, MEASURE_UNITS, SAFETY, StepChoice,
                                     halving_search)
-from qzs.engine.step_choice import spectral_beside_probes  # noqa: F401 (kept importable here)
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 

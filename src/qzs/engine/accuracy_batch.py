@@ -12,7 +12,8 @@ import numpy as np
 
 from qzs import defaults
 from qzs.engine.accuracy import excitation_measure, probe_settings, step_error
-from qzs.engine.step_search import SAFETY, StepChoice, admissible_step
+from qzs.engine.step_choice import admissible_step
+from qzs.engine.step_search import SAFETY, StepChoice
 from qzs.errors import ParameterError
 
 __all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step", "BatchProbe"]

@@ -26,15 +26,120 @@ from typing import Any
 
 from qzs import _validation, defaults
 from qzs._lazy import import_in_background
-from qzs.engine.step_search import (StepChoice, bound_notes, fallback_step, search_step,
-                                    unmet_sentence)
-from qzs.errors import ParameterError
+from qzs.engine.step_search import StepChoice, fallback_step, search_step, unmet_sentence
+from qzs.errors import ControllerRateError, ParameterError
 
 __all__ = ["StepRequest", "Probe", "choose", "fallback_step", "unmet_sentence",
-           "DEFAULT_KEYS", "step_request", "spectral_beside_probes"]
+           "DEFAULT_KEYS", "step_request", "spectral_beside_probes", "admissible_step",
+           "bound_notes", "RATE_REFINEMENT_MAX", "ADMISSIBLE_REFINEMENT"]
 
 #: Each measure's key of its default tolerance in :data:`qzs.defaults.ACCURACY`.
 DEFAULT_KEYS = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}
+
+
+#: A sampled controller may make the step at most this much finer than the largest stable
+#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
+#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
+#: of times longer (:class:`~qzs.errors.ControllerRateError`).
+RATE_REFINEMENT_MAX = 32
+#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
+ADMISSIBLE_REFINEMENT = 1_000_000
+
+
+# ---------------------------------------------------------------- the admissible start
+def admissible_step(sample_rate, controller_rate, stable):
+    """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
+    divides the controller's period too.
+
+    Parameters
+    ----------
+    sample_rate : float
+        Output rate [Hz]; the step divides its period.
+    controller_rate : float
+        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
+    stable : callable
+        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
+
+    Returns
+    -------
+    dt : float
+        The step [s].
+    k : int
+        Steps per output sample [-].
+
+    Raises
+    ------
+    ControllerRateError
+        The controller's period is a whole number of steps only at a step more than
+        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
+    """
+    from qzs.engine.prepare import steps_per_sample
+
+    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
+                  if stable(1.0 / (sample_rate * k))), None)
+    if first is None:
+        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
+                             "is stable; check the model's stiffness and the `sample_rate`.")
+    if controller_rate <= 0:
+        return 1.0 / (sample_rate * first), first
+    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
+        dt = 1.0 / (sample_rate * k)
+        if not stable(dt):
+            continue
+        try:
+            steps_per_sample(controller_rate, dt, "controller_rate")
+        except ParameterError:
+            continue
+        return dt, k
+    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
+    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
+    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
+                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
+                              suggestions=sorted(near))
+
+
+def bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
+    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people.
+
+    Parameters
+    ----------
+    dt0 : float
+        The coarsest candidate [s].
+    k0 : int
+        Its steps per output sample [-].
+    sample_rate : float
+        Output rate [Hz].
+    limit : float
+        The solver's largest stable step [s].
+    resolving : float
+        The largest step that resolves the base motion [s].
+    measure : str
+        The accuracy measure.
+    shortened : bool
+        Whether the probe is a shortened stand-in for the run's excitation.
+
+    Returns
+    -------
+    list of str
+    """
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
+
+    notes = []
+    if k0 == 1:
+        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
+                     f"(a lower sample_rate would allow larger steps; stability allows "
+                     f"{limit:.3g} s)")
+    elif resolving < limit:
+        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
+                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
+                     f"of its highest frequency (stability allows {limit:.3g} s)")
+    else:
+        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
+                     f"<= {limit:.3g} s")
+    if measure == "state_m" and shortened:
+        notes.append("the state error is measured on a shortened chirp; on the full sweep "
+                     "phase errors accumulate over a longer time")
+    return notes
 
 
 # ---------------------------------------------------------------- the request
@@ -177,7 +282,7 @@ class Probe:
     start : callable
         ``start()``: ``(stability_limit [s], resolving step [s], dt0 [s], k0 [-])``, the
         largest stable step, the largest resolving the base motion, and the admissible start
-        (:func:`~qzs.engine.step_search.admissible_step`).
+        (:func:`admissible_step`).
     run : callable
         ``run(dt, members)``: one probe run per listed case at step ``dt`` [s].
     compare : callable

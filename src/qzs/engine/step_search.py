@@ -9,7 +9,7 @@ halving, its memo, its progress bar, the Richardson estimate, the one fallback p
 one record (:class:`StepChoice`) are written here once.
 
 The method: candidates ``dt_j = dt_0 / 2**j`` from the largest admissible step ``dt_0``
-(:func:`admissible_step`); each is integrated on the probe and compared with the next finer
+(:func:`qzs.engine.step_choice.admissible_step`); each is integrated on the probe and compared with the next finer
 one: the difference ``d_j`` is measured, and the observed ratio ``r_j = d_j/d_{j+1}``
 (``2**order`` in the asymptotic range; stick-slip events lower it), capped at ``2**order``,
 extrapolates the error of ``dt_j`` as ``d_j r_j/(r_j - 1)``. The chosen step is the coarsest
@@ -33,11 +33,10 @@ import numpy as np
 from qzs import defaults
 from qzs._format import STEP_RECORD_UNITS as RECORD_UNITS
 from qzs._format import step_line as record_line
-from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
+from qzs.errors import ParameterError, ToleranceNotMetError
 
-__all__ = ["StepChoice", "search_step", "halving_search", "admissible_step",
-           "bound_notes", "fallback_step", "unmet_sentence", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
-           "ADMISSIBLE_REFINEMENT"]
+__all__ = ["StepChoice", "search_step", "halving_search", "fallback_step", "unmet_sentence",
+           "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS"]
 
 #: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
 MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
@@ -45,13 +44,6 @@ MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
 SAFETY = 2.0
 #: Halvings below the largest admissible step tried at most before giving up.
 MAX_HALVINGS = 8
-#: A sampled controller may make the step at most this much finer than the largest stable
-#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
-#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
-#: of times longer (:class:`~qzs.errors.ControllerRateError`).
-RATE_REFINEMENT_MAX = 32
-#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
-ADMISSIBLE_REFINEMENT = 1_000_000
 
 
 # ---------------------------------------------------------------- the one unmet meaning
@@ -293,102 +285,6 @@ class StepChoice:
                 "step_probe_duration": float(self.probe_duration), "step_reason": reason}
 
 
-# ---------------------------------------------------------------- the admissible start
-def admissible_step(sample_rate, controller_rate, stable):
-    """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
-    divides the controller's period too.
-
-    Parameters
-    ----------
-    sample_rate : float
-        Output rate [Hz]; the step divides its period.
-    controller_rate : float
-        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
-    stable : callable
-        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
-
-    Returns
-    -------
-    dt : float
-        The step [s].
-    k : int
-        Steps per output sample [-].
-
-    Raises
-    ------
-    ControllerRateError
-        The controller's period is a whole number of steps only at a step more than
-        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
-    """
-    from qzs.engine.prepare import steps_per_sample
-
-    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
-                  if stable(1.0 / (sample_rate * k))), None)
-    if first is None:
-        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
-                             "is stable; check the model's stiffness and the `sample_rate`.")
-    if controller_rate <= 0:
-        return 1.0 / (sample_rate * first), first
-    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
-        dt = 1.0 / (sample_rate * k)
-        if not stable(dt):
-            continue
-        try:
-            steps_per_sample(controller_rate, dt, "controller_rate")
-        except ParameterError:
-            continue
-        return dt, k
-    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
-    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
-    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
-                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
-                              suggestions=sorted(near))
-
-
-def bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
-    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people.
-
-    Parameters
-    ----------
-    dt0 : float
-        The coarsest candidate [s].
-    k0 : int
-        Its steps per output sample [-].
-    sample_rate : float
-        Output rate [Hz].
-    limit : float
-        The solver's largest stable step [s].
-    resolving : float
-        The largest step that resolves the base motion [s].
-    measure : str
-        The accuracy measure.
-    shortened : bool
-        Whether the probe is a shortened stand-in for the run's excitation.
-
-    Returns
-    -------
-    list of str
-    """
-    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
-
-    notes = []
-    if k0 == 1:
-        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
-                     f"(a lower sample_rate would allow larger steps; stability allows "
-                     f"{limit:.3g} s)")
-    elif resolving < limit:
-        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
-                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
-                     f"of its highest frequency (stability allows {limit:.3g} s)")
-    else:
-        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
-                     f"<= {limit:.3g} s")
-    if measure == "state_m" and shortened:
-        notes.append("the state error is measured on a shortened chirp; on the full sweep "
-                     "phase errors accumulate over a longer time")
-    return notes
-
-
 # ---------------------------------------------------------------- the search
 def _estimate(d, d_next, order):
     """The Richardson estimate of the error of ``dt_j`` from ``d_j`` and ``d_{j+1}``:
@@ -507,7 +403,7 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     cases : int
         How many cases share the step [-].
     dt0 : float
-        The coarsest candidate [s] (:func:`admissible_step`).
+        The coarsest candidate [s] (:func:`~qzs.engine.step_choice.admissible_step`).
     order : int
         The scheme's order of accuracy [-].
     measure : {"transmissibility_db", "state_m"}
@@ -525,7 +421,7 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     band : tuple of float or None
         The transmissibility measure's band [Hz].
     notes : sequence of str
-        What bounds ``dt0`` (:func:`bound_notes`).
+        What bounds ``dt0`` (:func:`~qzs.engine.step_choice.bound_notes`).
     stability_limit : float
         The largest stable step [s] (for the record).
     max_halvings : int

@@ -39,7 +39,8 @@ from qzs import _validation, defaults
 from qzs._validation import choice as _choice
 from qzs.engine.accuracy import (PROBE_DURATION, check_band, estimate_difference_db,
                                  frequency_range, probe_excitation, probe_fft_length)
-from qzs.engine.step_search import MAX_HALVINGS, MEASURE_UNITS, SAFETY, admissible_step
+from qzs.engine.step_choice import admissible_step
+from qzs.engine.step_search import MAX_HALVINGS, MEASURE_UNITS, SAFETY
 from qzs.errors import ParameterError
 
 __all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error", "HexapodProbe"]

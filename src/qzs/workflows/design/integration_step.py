@@ -13,12 +13,12 @@ def _stroke_step(settings):
     transmissibility: measured on the quick design's 16 cases at three gain sets, the band's
     use agreed within 0.9 % of the band between 0.625 ms and 2.5 ms (docs/design.md). So no
     halving: the step is the admissible start of the step search
-    (:func:`~qzs.engine.step_search.admissible_step`, the one search's first candidate) on the
+    (:func:`~qzs.engine.step_choice.admissible_step`, the one search's first candidate) on the
     stiffest, lightest case, with STROKE_STEP_MAX as its resolving step; never finer than the
     accuracy-driven ``settings.dt`` (that step too where no such start exists).
     """
     from qzs.engine.stability import stability_test
-    from qzs.engine.step_search import admissible_step
+    from qzs.engine.step_choice import admissible_step
     from qzs.errors import ParameterError
 
     stiffest = settings.controller_at(max(KP_GRID[settings.quick]),
