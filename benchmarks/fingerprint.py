@@ -286,7 +286,8 @@ def cli_json(name, folder, *args, suffix=""):
     """Hash of the cleaned ``--json`` summary of ``qzs ARGS --json --quiet``."""
     out = os.path.join(folder, name.replace("/", "_") + suffix)
     done = subprocess.run([sys.executable, "-m", "qzs", *args, "--out", out, "--json",
-                           "--quiet"], check=True, capture_output=True, text=True)
+                           "--quiet"], check=True, capture_output=True, text=True,
+                          cwd=folder)  # a default figure lands there, not in the checkout
     text = json.dumps(_clean(json.loads(done.stdout)), sort_keys=True)
     print(f"{name:40s} {hashlib.sha256(text.encode()).hexdigest()[:16]}", flush=True)
     import xarray as xr

@@ -54,10 +54,10 @@ def _design():
 
 def _paper():
     from qzs.engine.step_choice import StepRequest
-    from qzs.workflows.paper.studies import _choose_steps, _tasks, load_study
+    from qzs.workflows.paper.studies import _choose_steps, _study_cases, load_study
 
-    tasks = _tasks(load_study("stiction"), True)
-    record, = _choose_steps([tasks], StepRequest(), 1, False)
+    cases = _study_cases(load_study("stiction"), True)
+    _, (record,) = _choose_steps([cases], StepRequest(), 1, False)
     assert record["source"] == "fallback"
     return "; ".join(record["notes"])
 

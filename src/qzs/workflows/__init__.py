@@ -21,5 +21,7 @@
                     transmissibility, the six-leg study
 ``questions``       ``qzs study friction_compensation``, ``damping_design``: the paper's two
                     open questions answered, each with one verdict
+``findings``        verdicts, tables, figures, HTML and Markdown: the findings and report rooms
+                    the paper and the six-axis study share
 ==================  ==========================================================================
 """

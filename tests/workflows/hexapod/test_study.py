@@ -76,7 +76,7 @@ def test_writing_the_study_advances_a_progress_bar_file_by_file(tmp_path, monkey
 
     monkeypatch.setattr(progress, "progress_bar", bar)
     monkeypatch.setattr(study, "comparison_figure", lambda cases, out, **_: figure_to(out))
-    monkeypatch.setattr(study, "_markdown", lambda *_: "report")
+    monkeypatch.setattr(study, "study_markdown", lambda *_, **__: "report")
     monkeypatch.setattr(study, "CASES", {"PI": ("with PI", {}), "no PI": ("without", {})})
     study.write_study_outputs({"PI": case(), "no PI": case()}, [], [], tmp_path, progress=True)
     (recorder,) = bars

@@ -11,6 +11,7 @@ import xarray as xr
 
 from qzs.iotools.writer import write_dataset
 from qzs.model.registry import unit_of
+from qzs.workflows.findings import figures
 from qzs.workflows.paper import report
 from qzs.workflows.paper.curves import curves_dataset, curves_schema, spring_dataset, write_curves
 from qzs.workflows.paper.studies import CaseResult, Study, StudyResult
@@ -44,13 +45,13 @@ def damping_study():
 def drawn(monkeypatch):
     """The curves each figure was drawn from, by figure file name."""
     seen = {}
-    original = report.plot_transmissibility
+    original = figures.plot_transmissibility
 
     def keep(curves, **options):
         seen[options["path"].stem] = [dict(c) for c in curves]
         return original(curves, **options)
 
-    monkeypatch.setattr(report, "plot_transmissibility", keep)
+    monkeypatch.setattr(figures, "plot_transmissibility", keep)
     return seen
 
 

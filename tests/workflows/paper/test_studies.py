@@ -445,7 +445,8 @@ def test_the_studies_run_a_spring_law_and_the_report_says_which(tmp_path):
 
     import qzs
     from qzs.analysis.spectral import transmissibility as estimate
-    from qzs.workflows.paper.studies import _case_inputs, _tasks
+    from qzs.workflows.paper.cases import case_inputs
+    from qzs.workflows.paper.studies import _study_cases
 
     law = qzs.PolynomialSpring(coefficients=(62.78, -100.0, 0.0, -5e4), center=-0.06)
     stiction = load_study("stiction")
@@ -462,14 +463,14 @@ def test_the_studies_run_a_spring_law_and_the_report_says_which(tmp_path):
         low, high = fit.intervals[f"c{k}"]
         assert low <= truth <= high, (k, low, truth, high)
     assert results[0].cases[0].metrics["spring.c1"] == pytest.approx(-100.0, abs=30.0)
-    task = _tasks(studies[1], True, 1e-3, law)[0]
-    isolator, controller, excitation, rate = _case_inputs(task)
+    task = _study_cases(studies[1], True, 1e-3, law)[0]
+    isolator, controller, excitation, rate = case_inputs(task)
     assert isolator.spring == law
     run = qzs.simulate(excitation, isolator, controller, sample_rate=rate, dt=1e-3)
     case = results[1].cases[0]
     direct = estimate(run.base_acceleration, run.payload_acceleration, rate,
-                      fft_length=task["analysis"]["fft_length"],
-                      n_averages=task["analysis"]["n_averages"])
+                      fft_length=task.analysis["fft_length"],
+                      n_averages=task.analysis["n_averages"])
     band = (direct.frequency >= case.frequency[0]) & (direct.frequency <= case.frequency[-1])
     np.testing.assert_array_equal(case.magnitude, direct.magnitude[band])
     default = run_studies(studies[1:], quick=True, workers=1, progress=False, dt=1e-3)
@@ -506,23 +507,6 @@ def test_the_report_of_the_default_spring_names_the_magspring(quick_paper):
     assert "the paper's, the default" in spring_statement(results)
 
 
-def test_the_spring_study_reports_the_fitted_law_s_parameters_not_the_true_ones():
-    """The spring study's metrics of another law are the fit's numbers by their registry names
-    (``spring.c<k>``, docs/model.md §3.1), which the noise moves off the law measured."""
-    import qzs
-    from qzs.workflows.paper.studies import _spring_case, _tasks
-
-    law = qzs.PolynomialSpring(coefficients=(62.78, -100.0, 0.0, -5e4), center=-0.06)
-    task = _tasks(load_study("spring"), True, None, law)[0]
-    result = _spring_case(task)
-    fit = result.extra["law_fit"]
-    for k, truth in enumerate(law.coefficients):
-        assert result.metrics[f"spring.c{k}"] == fit.parameters[f"c{k}"]
-        assert result.metrics[f"spring.c{k}"] != truth
-    assert result.metrics["spring.center"] == -0.06
-    assert result.metrics["spring_residual_rms"] == fit.residual_rms
-
-
 def test_an_explicit_tanh_spring_is_the_paper_s_magspring():
     """``run_studies(..., spring=TanhSpring())`` is the default: the spring study fits the
     MagSpring's tanh (``spring_force``, ``spring_shape``) under the MagSpring's label."""
@@ -557,3 +541,47 @@ def test_a_tanh_other_than_the_paper_s_is_run_or_refused_never_swapped_for_the_m
     fitted = results[0].cases[0].metrics
     assert fitted.get("spring_force", fitted.get("spring.plateau")) == pytest.approx(40.0,
                                                                                    rel=0.05)
+
+
+def test_a_plan_carries_each_chosen_step_in_new_cases_and_mutates_none(monkeypatch):
+    """plan_studies resolves once: the step the (here stubbed) batch choice returns is in
+    every simulated case of the plan, made by dataclasses.replace, while the cases it was
+    chosen for keep dt None; the spring study's case has no step; the record says which
+    case the choice did not meet. The cases are frozen: nothing can write a step into them."""
+    import dataclasses
+    import types
+
+    import qzs.engine.step_choice as step_choice
+    from qzs.engine.step_choice import StepRequest
+    from qzs.workflows.paper.studies import StudyCase, _choose_steps, _study_cases, plan_studies
+
+    seen = {}
+
+    def choose(request, probe, **options):
+        seen["labels"] = probe.labels
+        cases = probe.cases
+        return types.SimpleNamespace(dt=2.5e-4, met=True, tolerance=request.tolerance,
+                                     case_errors=[0.01 * (c + 1) for c in range(len(cases))],
+                                     unmet=(1,), reference_dt=1.25e-4, probe_duration=5.0,
+                                     notes=("probed",), cached=False)
+
+    monkeypatch.setattr(step_choice, "choose", choose)
+    stiction, spring = load_study("stiction"), load_study("spring")
+    per_study = [_study_cases(stiction, True), _study_cases(spring, True)]
+    assert all(case.dt is None for case in per_study[0])
+    cases, steps = _choose_steps(per_study, StepRequest(tolerance=0.05), 1, False)
+    assert all(case.dt is None for case in per_study[0])  # not written into
+    assert [case.dt for case in cases[0]] == [2.5e-4] * len(stiction.cases)
+    assert cases[0][0] == dataclasses.replace(per_study[0][0], dt=2.5e-4)
+    assert cases[1] == per_study[1] and cases[1][0].dt is None and steps[1] == {}
+    assert seen["labels"] == [case.label for case in per_study[0]]
+    assert steps[0]["dt"] == 2.5e-4 and steps[0]["source"] == "chosen"
+    assert steps[0]["unmet"] == [per_study[0][1].label]
+    assert steps[0]["estimated_error_db"] == max(0.01 * (c + 1) for c in range(len(cases[0]))
+                                                 if c != 1)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cases[0][0].dt = 1e-4
+    plan = plan_studies([stiction, spring], quick=True, workers=1, progress=False, dt=1e-3)
+    assert isinstance(plan.cases[0][0], StudyCase)
+    assert {(case.dt, case.step_source) for case in plan.cases[0]} == {(1e-3, "given")}
+    assert plan.steps[0] == {"dt": 1e-3, "source": "given"}

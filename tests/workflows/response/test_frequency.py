@@ -228,6 +228,36 @@ def test_frictionless_steady_state_is_the_linear_closed_loop(validation):
                                np.abs(expected), rtol=1e-12)
 
 
+def test_a_frequency_run_is_the_sweep_s_point_and_carries_its_state_to_the_next():
+    """A sweep's frequency is the frozen plan at that frequency: run alone from rest it gives
+    the sweep's own point, bit for bit (the plan carries every setting down); started from
+    its final state it is continued, settles sooner, and agrees within the periodicity
+    tolerance."""
+    import dataclasses
+
+    from qzs.workflows.response.frequency import FrequencyRun, SweepPlan, _run_frequency
+
+    isolator = IsolatorParameters(stiction_force=0.0, coulomb_force=0.0)
+    controller = ControllerParameters(damping_gain=30.0)
+    sweep = run([1.0], 0.001, isolator, controller)
+    plan = SweepPlan(amplitude=0.001, isolator=isolator, controller=controller, dt=1e-3,
+                     solver="ode3", periodic_tolerance=sweep.settings["periodic_tolerance"],
+                     max_periods=sweep.settings["max_periods"],
+                     max_time=sweep.settings["max_time"], fade_in=sweep.settings["fade_in"],
+                     harmonics=sweep.settings["harmonics"])
+    first = plan.at("up", 1.0)
+    assert first == FrequencyRun(plan=plan, direction="up", frequency=1.0, carried=None)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        first.frequency = 2.0
+    point, carried = _run_frequency(first)
+    expected = dataclasses.replace(sweep.points[0], seconds=point.seconds)
+    assert point == expected and point.start == "rest"
+    again, _ = _run_frequency(plan.at("up", 1.0, carried))
+    assert again.start == "continued" and again.periods < point.periods
+    assert again.transmissibility == pytest.approx(point.transmissibility,
+                                                   rel=plan.periodic_tolerance)
+
+
 # ---------------------------------------------------------------- sub-harmonics
 def impact_oscillator():
     k, shape = MASS * (2 * math.pi * 2.0) ** 2, 1e-3

@@ -9,6 +9,8 @@ DFT per harmonic of the output samples (§2).
 import math
 import time
 from collections import deque
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -16,7 +18,7 @@ from qzs.model.excitation import Sine
 from qzs.workflows.response.result import ResponsePoint
 
 __all__ = ["steps_for", "SAMPLES_PER_PERIOD", "PERIODIC_TOLERANCE", "CONSECUTIVE_PERIODS",
-           "MAX_PERIOD_MULTIPLE"]
+           "MAX_PERIOD_MULTIPLE", "SweepPlan", "FrequencyRun"]
 
 #: Output samples per period [-]: the DFT's length per period. A multiple of the kernels'
 #: exact-sine period (256 steps), so a period is a whole number of kernel chunks and the
@@ -34,6 +36,88 @@ MAX_PERIOD_MULTIPLE = 3
 SUBHARMONIC_SEPARATION = 1000.0
 #: Scaled state changes below this are round-off: the response repeats exactly [-].
 ROUND_OFF = 1e-11
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepPlan:
+    """What every frequency of a steady-state sweep shares, resolved (its step chosen).
+
+    Attributes
+    ----------
+    amplitude : float
+        The base's displacement amplitude [m].
+    isolator : IsolatorParameters
+        The isolator.
+    controller : ControllerParameters
+        Its controller.
+    dt : float
+        The largest integration step [s] (each frequency's divides its period).
+    solver : str
+        The integration scheme.
+    periodic_tolerance : float
+        Periodicity tolerance [-]: scaled state change per period.
+    max_periods : int
+        Most periods simulated per frequency.
+    max_time : float
+        Most simulated time per frequency [s].
+    fade_in : float
+        Fade-in of a start from rest [s].
+    harmonics : int
+        Harmonics of the output read [-].
+    """
+
+    amplitude: float
+    isolator: Any
+    controller: Any
+    dt: float
+    solver: str
+    periodic_tolerance: float
+    max_periods: int
+    max_time: float
+    fade_in: float
+    harmonics: int
+
+    def at(self, direction, frequency, carried=None):
+        """The run of one frequency of a sweep.
+
+        Parameters
+        ----------
+        direction : {"up", "down"}
+            The sweep it belongs to.
+        frequency : float
+            The excitation's frequency [Hz].
+        carried : CarriedState, optional
+            The previous frequency's final state; None: start from rest.
+
+        Returns
+        -------
+        FrequencyRun
+        """
+        return FrequencyRun(plan=self, direction=direction, frequency=frequency,
+                            carried=carried)
+
+
+@dataclass(frozen=True, kw_only=True)
+class FrequencyRun:
+    """One frequency of a sweep: the plan, the sweep's direction, where it starts.
+
+    Attributes
+    ----------
+    plan : SweepPlan
+        What every frequency shares.
+    direction : {"up", "down"}
+        The sweep it belongs to.
+    frequency : float
+        The excitation's frequency [Hz].
+    carried : CarriedState or None
+        The previous frequency's final state (:class:`~qzs.engine.periodic.CarriedState`);
+        None: start from rest.
+    """
+
+    plan: SweepPlan
+    direction: str
+    frequency: float
+    carried: Any = None
 
 
 def steps_for(frequency, dt):
@@ -187,37 +271,35 @@ def _nan_values(harmonic_count):
 def _run_frequency(task):
     """Simulate one frequency until periodic (runs in a worker process or inline).
 
-    ``task``: ``frequency`` [Hz], ``amplitude`` [m], ``isolator``, ``controller``, ``dt``
-    (largest step [s]), ``solver``, ``carried`` (None, or the previous frequency's final
-    :class:`~qzs.engine.periodic.CarriedState`), ``direction`` and the settings. Returns
-    ``(point, carried)``: the :class:`~qzs.workflows.response.result.ResponsePoint` and the
-    final state to start the next frequency from (None after a divergence).
+    ``task``: a :class:`FrequencyRun`. Returns ``(point, carried)``: the
+    :class:`~qzs.workflows.response.result.ResponsePoint` and the final state to start the
+    next frequency from (None after a divergence).
     """
     from qzs.engine.periodic import PeriodicRun
     from qzs.engine.channels import CHANNELS, FLAGS
 
     started = time.perf_counter()
-    frequency, amplitude = task["frequency"], task["amplitude"]
-    settings = task["settings"]
+    plan = task.plan
+    frequency, amplitude = task.frequency, plan.amplitude
     period = 1.0 / frequency
-    steps = steps_for(frequency, task["dt"])
+    steps = steps_for(frequency, plan.dt)
     dt = period / steps
-    carried = task["carried"]
-    fade_periods = 0 if carried is not None else math.ceil(settings["fade_in"] * frequency - 1e-9)
+    carried = task.carried
+    fade_periods = 0 if carried is not None else math.ceil(plan.fade_in * frequency - 1e-9)
     # base y = A sin(w t + pi/2) = A cos(w t): every period starts at the crest, where the
     # base velocity is zero, so a state carried from another frequency starts with the same
     # base displacement and velocity as it ended with (docs/response.md §4)
     excitation = Sine(amplitude=amplitude, frequency=frequency, phase=0.5 * math.pi,
                       fade_in=fade_periods * period)
-    run = PeriodicRun(excitation, task["isolator"], task["controller"], period=period, dt=dt,
-                      sample_rate=frequency * SAMPLES_PER_PERIOD, solver=task["solver"],
+    run = PeriodicRun(excitation, plan.isolator, plan.controller, period=period, dt=dt,
+                      sample_rate=frequency * SAMPLES_PER_PERIOD, solver=plan.solver,
                       carried=carried)
-    harmonic_count = settings["harmonics"]
+    harmonic_count = plan.harmonics
     omega = 2 * math.pi * frequency
     # the states that act on the motion: z and v; the high-pass state where the damping
     # loop feeds it back; the PI integral where Ki > 0 (without its gain the integral of a
     # payload held off the setpoint grows for ever, and the motion is periodic all the same)
-    controller = task["controller"]
+    controller = plan.controller
     state_names = ["relative_position", "relative_velocity"]
     scale = [amplitude, amplitude * omega]
     if controller.damping_gain > 0 and controller.velocity_highpass > 0:
@@ -232,16 +314,16 @@ def _run_frequency(task):
     boundaries = deque(maxlen=MAX_PERIOD_MULTIPLE + 1)
     contacts = deque(maxlen=MAX_PERIOD_MULTIPLE + 1)
     changes = {m: deque(maxlen=CONSECUTIVE_PERIODS) for m in range(1, MAX_PERIOD_MULTIPLE + 1)}
-    tolerance = settings["periodic_tolerance"]
-    motor_force_max = task["isolator"].motor_force_max
+    tolerance = plan.periodic_tolerance
+    motor_force_max = plan.isolator.motor_force_max
     multiple, periods, residual, reason = 0, 0, math.inf, ""
-    cap = max(min(settings["max_periods"], math.floor(settings["max_time"] * frequency)),
+    cap = max(min(plan.max_periods, math.floor(plan.max_time * frequency)),
               fade_periods + CONSECUTIVE_PERIODS + MAX_PERIOD_MULTIPLE + 1)
     for periods in range(1, cap + 1):
         slot = periods % keep
         if run.advance(rows[slot], marks[slot]):
             reason = "diverged: " + run.divergence()
-            point = ResponsePoint(direction=task["direction"], frequency=frequency,
+            point = ResponsePoint(direction=task.direction, frequency=frequency,
                                   **_nan_values(harmonic_count), period_multiple=0,
                                   periods=periods, settle_time=periods * period,
                                   residual=math.nan, converged=False, reason=reason,
@@ -280,7 +362,7 @@ def _run_frequency(task):
                   f"time, its mean "
                   f"{1e3 * offset:+.3g} mm from the setpoint); raise `max_periods` or "
                   "`max_time`, or the response is quasi-periodic or chaotic")
-    point = ResponsePoint(direction=task["direction"], frequency=frequency, **values,
+    point = ResponsePoint(direction=task.direction, frequency=frequency, **values,
                           period_multiple=multiple, periods=periods,
                           settle_time=periods * period, residual=float(residual),
                           converged=bool(multiple), reason=reason, start=start, dt=dt,

@@ -7,13 +7,10 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from qzs.workflows.response.frequency import _run_frequency
 
 
-def _task(base, direction, frequency, carried):
-    return dict(base, direction=direction, frequency=frequency, carried=carried)
-
-
 def _run_chains(chains, base, extra, workers, progress):
-    """Run the sweeps (each a chain of frequencies) and the extra tasks; returns
-    ``(points in sweep order, {name: outcome})``."""
+    """Run the sweeps (each a chain of frequencies of the :class:`~qzs.workflows.response.
+    frequency.SweepPlan` ``base``) and the extra tasks; returns ``(points in sweep order,
+    {name: outcome})``."""
     from qzs.engine.progress import progress_bar
 
     total = sum(len(c) for c in chains.values())
@@ -28,7 +25,7 @@ def _run_chains(chains, base, extra, workers, progress):
             for d, chain in chains.items():
                 carried = None
                 for frequency in chain:
-                    point, carried = _run_frequency(_task(base, d, frequency, carried))
+                    point, carried = _run_frequency(base.at(d, frequency, carried))
                     points[d].append(point)
                     bar.update()
         else:
@@ -46,7 +43,7 @@ def _run_pool(chains, base, extra, workers, points, outcomes, bar):
         for name, (function, task) in extra.items():
             pending[pool.submit(function, task)] = ("extra", name, None)
         for d, chain in chains.items():
-            pending[pool.submit(_run_frequency, _task(base, d, chain[0], None))] = ("chain", d, 0)
+            pending[pool.submit(_run_frequency, base.at(d, chain[0]))] = ("chain", d, 0)
         while pending:
             done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
             for future in done:
@@ -58,7 +55,7 @@ def _run_pool(chains, base, extra, workers, points, outcomes, bar):
                 points[name].append(point)
                 bar.update()
                 if index + 1 < len(chains[name]):
-                    task = _task(base, name, chains[name][index + 1], carried)
+                    task = base.at(name, chains[name][index + 1], carried)
                     pending[pool.submit(_run_frequency, task)] = ("chain", name, index + 1)
         finished = True
     finally:

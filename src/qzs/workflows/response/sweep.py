@@ -20,7 +20,7 @@ from qzs.errors import CountLimitError, ParameterError
 from qzs.model.excitation import Chirp
 from qzs.workflows.response.chirp import _run_chirp
 from qzs.workflows.response.frequency import (CONSECUTIVE_PERIODS, MAX_PERIOD_MULTIPLE,
-                                              PERIODIC_TOLERANCE, SAMPLES_PER_PERIOD)
+                                              PERIODIC_TOLERANCE, SAMPLES_PER_PERIOD, SweepPlan)
 from qzs.workflows.response.pool import _run_chains
 from qzs.workflows.response.result import SteadyStateResponse
 
@@ -376,14 +376,12 @@ def steady_state_response(frequencies: ArrayLike,
     _check_step(dt, frequencies, isolator, controller, solver)
     if max_time is None:
         max_time = settle_time_cap(isolator, controller)
-    settings = {"periodic_tolerance": periodic_tolerance, "max_periods": max_periods,
-                "max_time": max_time, "samples_per_period": SAMPLES_PER_PERIOD, "fade_in": fade_in,
-                "harmonics": harmonics}
-
     chains = {"up": list(frequencies), "down": list(frequencies[::-1])}
     chains = {d: chains[d] for d in (("up", "down") if direction == "both" else (direction,))}
-    base = dict(amplitude=amplitude, isolator=isolator, controller=controller, dt=dt,
-                solver=solver, settings=settings)
+    base = SweepPlan(amplitude=amplitude, isolator=isolator, controller=controller, dt=dt,
+                     solver=solver, periodic_tolerance=periodic_tolerance,
+                     max_periods=max_periods, max_time=max_time, fade_in=fade_in,
+                     harmonics=harmonics)
     extra = {}
     if harmonic_balance:
         low, high = float(frequencies[0]), float(frequencies[-1])
@@ -400,7 +398,9 @@ def steady_state_response(frequencies: ArrayLike,
     concurrent = len(chains) + len(extra)
     if workers is None:  # an explicit count is the user's; the default, no more than there is to do
         workers = worker_count(None, concurrent)
-    settings["workers"] = workers
+    settings = {"periodic_tolerance": periodic_tolerance, "max_periods": max_periods,
+                "max_time": max_time, "samples_per_period": SAMPLES_PER_PERIOD, "fade_in": fade_in,
+                "harmonics": harmonics, "workers": workers}
     points, outcomes = _run_chains(chains, base, extra, workers, progress)
     balance, note = outcomes.get("balance", (None, ""))
     if note:

@@ -1,4 +1,7 @@
 """One run's column: the Welch estimate of every platform axis per the excited base axis."""
+import dataclasses
+import types
+
 import numpy as np
 import pytest
 
@@ -15,11 +18,37 @@ def test_a_platform_moving_half_the_base_gives_half_on_every_trusted_bin():
     twist = np.zeros((n, 6))
     twist[:, 2] = 0.5 * base[:, 2]
     twist[:, 0] = 1e-3 * rng.normal(size=n)  # uncorrelated with the base
-    task = dict(sample_rate=rate, fft_length=4096, overlap=0.5, estimator="h1",
-                coherence_min=0.9, base_share_min=1e-10)
-    estimates = _estimate({"base_velocity": base, "platform_twist": twist}, "z", task)
+    run = types.SimpleNamespace(sample_rate=rate, fft_length=4096, overlap=0.5, estimator="h1",
+                                coherence_min=0.9, base_share_min=1e-10)
+    estimates = _estimate({"base_velocity": base, "platform_twist": twist}, "z", run)
     z = estimates[2]
     assert np.any(z.trusted)
     np.testing.assert_allclose(z.magnitude[z.trusted], 0.5, rtol=1e-12)
     np.testing.assert_allclose(z.phase[z.trusted], 0.0, atol=1e-12)
     assert not np.any(estimates[0].trusted)  # no coherence with the base
+
+
+def test_the_plan_gives_one_frozen_run_per_axis_with_the_common_settings():
+    """Each excited axis is one AxisRun, in the order of AXES, carrying its own chirp and the
+    runs' common settings; nothing can be written into it (a chosen step is returned by
+    axis_step, not stored); the centralised controller keyword only where there is one."""
+    from qzs.workflows.hexapod.setups import hexapod_setup
+    from qzs.workflows.hexapod.transmissibility import plan
+    from qzs.workflows.hexapod.transmissibility.runs import AxisRun
+
+    setup = hexapod_setup()
+    _, amplitudes, common, runs, _ = plan._plan(
+        setup, ("x", "z"), None, 0.0, 20.0, 60.0, None, None, None, None, "h1", -100.0, 1,
+        False)
+    assert [run.axis for run in runs] == ["x", "z"]  # the order of AXES, not the argument's
+    for run in runs:
+        assert isinstance(run, AxisRun)
+        assert run.excitation.amplitude == amplitudes[run.axis]
+        assert run.dt is None and run.tolerance_db == common["tolerance_db"]
+        for name in ("f0", "f1", "duration", "sample_rate", "solver", "fft_length",
+                     "setup_dt"):
+            assert getattr(run, name) == common[name]
+        assert run.control == {}
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        runs[0].dt = 1e-3
+    assert dataclasses.replace(runs[0], cartesian="c").control == {"cartesian": "c"}

@@ -101,25 +101,25 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     from qzs._validation import renamed_keyword
 
     tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
-    axes, amplitudes, common, tasks, workers = _plan(
+    axes, amplitudes, common, runs, workers = _plan(
         setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
         estimator, floor_db, workers, progress, tolerance)
     from qzs.engine.progress import progress_bar
 
-    _dry_run(tasks[0])
-    workers = worker_count(workers, len(tasks))
+    _dry_run(runs[0])
+    workers = worker_count(workers, len(runs))
     columns = {}
-    bar = progress_bar(total=len(tasks), unit="run", desc="hexapod chirps", disable=not progress)
+    bar = progress_bar(total=len(runs), unit="run", desc="hexapod chirps", disable=not progress)
     try:
         if workers == 1:
-            for task in tasks:
-                columns[task["axis"]] = run_axis(task)
+            for run in runs:
+                columns[run.axis] = run_axis(run)
                 bar.update()
         else:
             from concurrent.futures import ProcessPoolExecutor, as_completed
 
             with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = [pool.submit(run_axis, task) for task in tasks]
+                futures = [pool.submit(run_axis, run) for run in runs]
                 try:
                     for future in as_completed(futures):
                         column = future.result()

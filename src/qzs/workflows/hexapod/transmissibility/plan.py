@@ -7,6 +7,7 @@ from qzs import defaults
 from qzs._validation import choice, integer, positive_real, real
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
+from qzs.workflows.hexapod.transmissibility.runs import AxisRun
 from qzs.workflows.hexapod.transmissibility.settings import (AMPLITUDE, ESTIMATORS,
                                                              MIN_SEGMENTS, platform_size)
 
@@ -122,7 +123,7 @@ def sweep_trusted_from(f0, f1, duration, fft_length, sample_rate):
 
 def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
           estimator, floor_db, workers, progress, tolerance_db=None):
-    """Check every argument; the runs' common settings and one task per axis."""
+    """Check every argument; the runs' common settings and one :class:`AxisRun` per axis."""
     from qzs.model.excitation import Chirp
     from qzs.workflows.hexapod.setups import HexapodSetup
 
@@ -208,24 +209,24 @@ def _plan(setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft
                   trusted_from=sweep_trusted_from(f0, f1, duration, fft_length, sample_rate),
                   tolerance_db=tolerance_db, setup_dt=setup_dt,
                   dt=dt, frame="top frame origin (the cube's centre of a cubic geometry)")
-    tasks = [dict(axis=axis, excitation=chirps[axis], geometry=setup.geometry,
-                  platform=setup.platform, isolator=setup.isolator,
-                  controller=controllers, cartesian=getattr(setup, "cartesian", None),
-                  **common) for axis in axes]
-    return axes, amplitudes, common, tasks, workers
+    fields = {name: common[name] for name in _RUN_SETTINGS}
+    runs = [AxisRun(axis=axis, excitation=chirps[axis], geometry=setup.geometry,
+                    platform=setup.platform, isolator=setup.isolator, controller=controllers,
+                    cartesian=getattr(setup, "cartesian", None), **fields) for axis in axes]
+    return axes, amplitudes, common, runs, workers
 
 
-def _dry_run(task):
+#: The runs' common settings each :class:`AxisRun` carries.
+_RUN_SETTINGS = ("f0", "f1", "duration", "sample_rate", "solver", "fft_length", "overlap",
+                 "estimator", "coherence_min", "base_share_min", "tolerance_db", "setup_dt",
+                 "dt")
+
+
+def _dry_run(run):
     """One step of the first run: the engine checks the set-up before any long run."""
     from qzs.engine.hexapod import simulate_hexapod
 
-    step = task["dt"] or task["setup_dt"]
-    simulate_hexapod(task["geometry"], task["platform"], task["isolator"], task["controller"],
-                     excitation={task["axis"]: task["excitation"]}, duration=step, dt=step,
-                     sample_rate=task["sample_rate"], solver=task["solver"],
-                     **_control(task))
-
-
-def _control(task):
-    """The centralised controller keyword, where the set-up has one."""
-    return {} if task.get("cartesian") is None else {"cartesian": task["cartesian"]}
+    step = run.dt or run.setup_dt
+    simulate_hexapod(run.geometry, run.platform, run.isolator, run.controller,
+                     excitation={run.axis: run.excitation}, duration=step, dt=step,
+                     sample_rate=run.sample_rate, solver=run.solver, **run.control)
