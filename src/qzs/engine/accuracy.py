@@ -21,7 +21,7 @@ from qzs import _validation, defaults
 from qzs._format import decibels
 from qzs._validation import choice as _choice
 from qzs.engine.step_choice import (ADMISSIBLE_REFINEMENT, RATE_REFINEMENT_MAX,  # noqa: F401
-                                    admissible_step, spectral_beside_probes)
+                                    ProbeSettings, admissible_step, spectral_beside_probes)
 from qzs.engine.step_search import (MAX_HALVINGS, MEASURE_UNITS, SAFETY, StepChoice,
                                     halving_search)
 from qzs.errors import ParameterError
@@ -30,7 +30,7 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings", "spectral_beside_probes", "SingleProbe", "excitation_measure"]
+           "probe_settings", "spectral_beside_probes", "SingleProbe"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -291,25 +291,8 @@ def check_band(band, excitation, sample_rate):
     return (low, high)
 
 
-def excitation_measure(excitation):
-    """The measure a run of ``excitation`` is judged by when it asks for no tolerance.
-
-    Parameters
-    ----------
-    excitation : Chirp, Sine, RandomExcitation, DisplacementRecord or None
-        The run's excitation (None: the paper's chirp).
-
-    Returns
-    -------
-    str
-        ``"state_m"`` for a sine (one frequency, no band to estimate a transmissibility
-        over), else ``"transmissibility_db"``.
-    """
-    return "state_m" if isinstance(excitation, Sine) else "transmissibility_db"
-
-
 @dataclass(frozen=True, kw_only=True)
-class SingleProbe:
+class SingleProbe(ProbeSettings):
     """The probe of one axis: the inputs of :func:`choose_step` but the tolerance; nothing
     computed until :meth:`build`, which :func:`qzs.engine.step_choice.choose` calls only for
     a chosen step.
@@ -340,35 +323,12 @@ class SingleProbe:
         Factor [-] between the estimate and the tolerance.
     """
 
-    excitation: Any = None
     isolator: Any = None
     controller: Any = None
-    solver: str = defaults.SIMULATION["solver"]
-    sample_rate: float = defaults.SIMULATION["sample_rate"]
-    band: tuple | None = None
-    probe_duration: float | None = None
     fft_length: int | None = None
     initial_state: Any = None
-    max_halvings: int = MAX_HALVINGS
-    safety: float = SAFETY
 
-    @property
-    def default_measure(self) -> str:
-        """The default request's measure (:func:`excitation_measure`)."""
-        return excitation_measure(self.excitation)
-
-    def build(self, measure):
-        """The probe for ``measure``: inputs checked, the probe's excitation made.
-
-        Parameters
-        ----------
-        measure : str
-            The accuracy measure.
-
-        Returns
-        -------
-        Probe
-        """
+    def _build(self, measure):
         from qzs.engine.prepare import run_inputs
         from qzs.engine.step_choice import Probe
 

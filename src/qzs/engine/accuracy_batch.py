@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import excitation_measure, probe_settings, step_error
-from qzs.engine.step_choice import admissible_step
+from qzs.engine.accuracy import probe_settings, step_error
+from qzs.engine.step_choice import ProbeSettings, admissible_step
 from qzs.engine.step_search import SAFETY, StepChoice
 from qzs.errors import ParameterError
 
@@ -132,7 +132,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance=None, tolerance_state
 
 
 @dataclass(frozen=True, kw_only=True)
-class BatchProbe:
+class BatchProbe(ProbeSettings):
     """The probe of a lockstep batch: the inputs of :func:`choose_batch_step` but the
     tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
     :meth:`build` for a chosen step.
@@ -164,34 +164,12 @@ class BatchProbe:
     """
 
     cases: Any
-    excitation: Any = None
-    solver: str = defaults.SIMULATION["solver"]
-    sample_rate: float = defaults.SIMULATION["sample_rate"]
-    band: tuple | None = None
-    probe_duration: float | None = None
     fft_length: int | None = None
     max_halvings: int = BATCH_MAX_HALVINGS
-    safety: float = SAFETY
     workers: int | None = None
     labels: Any = None
 
-    @property
-    def default_measure(self) -> str:
-        """The default request's measure (:func:`~qzs.engine.accuracy.excitation_measure`)."""
-        return excitation_measure(self.excitation)
-
-    def build(self, measure):
-        """The probe for ``measure``: the cases and settings checked, the probe made.
-
-        Parameters
-        ----------
-        measure : str
-            The accuracy measure.
-
-        Returns
-        -------
-        Probe
-        """
+    def _build(self, measure):
         from qzs.engine.prepare import run_inputs
         from qzs.engine.step_choice import Probe
 

@@ -26,12 +26,14 @@ from typing import Any
 
 from qzs import _validation, defaults
 from qzs._lazy import import_in_background
-from qzs.engine.step_search import StepChoice, fallback_step, search_step, unmet_sentence
+from qzs.engine.step_search import (MAX_HALVINGS, SAFETY, StepChoice, fallback_step,
+                                    search_step, unmet_sentence)
 from qzs.errors import ControllerRateError, ParameterError
 
 __all__ = ["StepRequest", "Probe", "choose", "fallback_step", "unmet_sentence",
            "DEFAULT_KEYS", "step_request", "spectral_beside_probes", "admissible_step",
-           "bound_notes", "RATE_REFINEMENT_MAX", "ADMISSIBLE_REFINEMENT"]
+           "bound_notes", "RATE_REFINEMENT_MAX", "ADMISSIBLE_REFINEMENT", "ProbeSettings",
+           "excitation_measure"]
 
 #: Each measure's key of its default tolerance in :data:`qzs.defaults.ACCURACY`.
 DEFAULT_KEYS = {"transmissibility_db": "tolerance_db", "state_m": "tolerance_state"}
@@ -253,6 +255,81 @@ def step_request(*, dt=None, tolerance=None, tolerance_state=None, tolerance_db=
 
 
 # ---------------------------------------------------------------- the probe
+def excitation_measure(excitation):
+    """The measure a run of ``excitation`` is judged by when it asks for no tolerance.
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation, DisplacementRecord or None
+        The run's excitation (None: the paper's chirp).
+
+    Returns
+    -------
+    str
+        ``"state_m"`` for a sine (one frequency, no band to estimate a transmissibility
+        over), else ``"transmissibility_db"``.
+    """
+    from qzs.model.excitation import Sine
+
+    return "state_m" if isinstance(excitation, Sine) else "transmissibility_db"
+
+
+@dataclass(frozen=True, kw_only=True)
+class ProbeSettings:
+    """What every model's probe is given besides its model: the base of
+    :class:`~qzs.engine.accuracy.SingleProbe`, :class:`~qzs.engine.accuracy_batch.BatchProbe`
+    and :class:`~qzs.engine.hexapod.accuracy.HexapodProbe`. Nothing is computed until
+    :meth:`build`, which :func:`choose` calls only for a chosen step.
+
+    Attributes
+    ----------
+    excitation : object
+        The run's excitation (None: the paper's chirp; the six legs: axis name -> excitation).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    """
+
+    excitation: Any = None
+    solver: str = defaults.SIMULATION["solver"]
+    sample_rate: float = defaults.SIMULATION["sample_rate"]
+    band: tuple | None = None
+    probe_duration: float | None = None
+    max_halvings: int = MAX_HALVINGS
+    safety: float = SAFETY
+
+    @property
+    def default_measure(self) -> str:
+        """The default request's measure (:func:`excitation_measure`)."""
+        return excitation_measure(self.excitation)
+
+    def build(self, measure):
+        """The probe for ``measure``: the inputs checked, the probe's excitation made.
+
+        Parameters
+        ----------
+        measure : str
+            The accuracy measure.
+
+        Returns
+        -------
+        Probe
+        """
+        return self._build(measure)
+
+    def _build(self, measure):
+        raise NotImplementedError
+
+
 @dataclass(frozen=True, kw_only=True)
 class Probe:
     """A model's probe, built for one measure: what :func:`choose` needs to search a step.
@@ -316,8 +393,8 @@ class Probe:
     cases: int = 1
     labels: tuple | None = None
     key: Mapping | None = None
-    max_halvings: int = 8
-    safety: float = 2.0
+    max_halvings: int = MAX_HALVINGS
+    safety: float = SAFETY
     search: Mapping = field(default_factory=dict)
 
 

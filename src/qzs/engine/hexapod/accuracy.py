@@ -39,7 +39,7 @@ from qzs import _validation, defaults
 from qzs._validation import choice as _choice
 from qzs.engine.accuracy import (PROBE_DURATION, check_band, estimate_difference_db,
                                  frequency_range, probe_excitation, probe_fft_length)
-from qzs.engine.step_choice import admissible_step
+from qzs.engine.step_choice import ProbeSettings, admissible_step
 from qzs.engine.step_search import MAX_HALVINGS, MEASURE_UNITS, SAFETY
 from qzs.errors import ParameterError
 
@@ -239,7 +239,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
 
 
 @dataclass(frozen=True, kw_only=True)
-class HexapodProbe:
+class HexapodProbe(ProbeSettings):
     """The probe of the six-leg platform: the inputs of :func:`choose_hexapod_step` but the
     tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
     :meth:`build` for a chosen step. Not cached (no key).
@@ -278,15 +278,8 @@ class HexapodProbe:
     platform: Any
     isolator: Any = None
     controller: Any = None
-    excitation: Any = None
-    solver: str = defaults.SIMULATION["solver"]
-    sample_rate: float = defaults.SIMULATION["sample_rate"]
-    band: tuple | None = None
     duration: float | None = None
-    probe_duration: float | None = None
     cartesian: Any = None
-    max_halvings: int = MAX_HALVINGS
-    safety: float = SAFETY
 
     @property
     def default_measure(self) -> str:
@@ -298,18 +291,7 @@ class HexapodProbe:
         one_chirp = len(moving) == 1 and isinstance(next(iter(moving.values())), Chirp)
         return "transmissibility_db" if one_chirp else "state_m"
 
-    def build(self, measure):
-        """The probe for ``measure``: the settings checked, the legs and the probe made.
-
-        Parameters
-        ----------
-        measure : str
-            The accuracy measure.
-
-        Returns
-        -------
-        Probe
-        """
+    def _build(self, measure):
         from qzs.engine.hexapod.prepare import _excitations
         from qzs.engine.step_choice import Probe
         from qzs.model.hexapod import platform_size
