@@ -266,7 +266,7 @@ def paper(folder):
 
 
 _TIMING = re.compile(r"(second|elapsed|wall|generated|version|created|date|timestamp|"
-                     r"steps_per_second|path|folder|file|store|out|command)", re.I)
+                     r"steps_per_second|path|folder|file|store|out|command|cached)", re.I)
 
 
 def _clean(value):
@@ -287,7 +287,8 @@ def cli_json(name, folder, *args, suffix=""):
     out = os.path.join(folder, name.replace("/", "_") + suffix)
     done = subprocess.run([sys.executable, "-m", "qzs", *args, "--out", out, "--json",
                            "--quiet"], check=True, capture_output=True, text=True,
-                          cwd=folder)  # a default figure lands there, not in the checkout
+                          cwd=folder,  # a default figure lands there, not in the checkout
+                          env={**os.environ, "QZS_CACHE_DIR": folder})  # steps chosen anew
     text = json.dumps(_clean(json.loads(done.stdout)), sort_keys=True)
     print(f"{name:40s} {hashlib.sha256(text.encode()).hexdigest()[:16]}", flush=True)
     import xarray as xr
@@ -344,7 +345,8 @@ def workflows(folder):
         handle.write(SWEEP)
     out = os.path.join(folder, "sweep.zarr")
     subprocess.run([sys.executable, "-m", "qzs", "sweep", sweep, "--out", out, "--quiet"],
-                   check=True, capture_output=True)
+                   check=True, capture_output=True, cwd=folder,
+                   env={**os.environ, "QZS_CACHE_DIR": folder})
     import xarray as xr
     data = xr.open_zarr(out).load()
     line("cli/sweep", *[data[k].values for k in sorted(data.data_vars)

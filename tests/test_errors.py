@@ -40,6 +40,8 @@ CARRIERS = [
     (errors.Terminated(15), {"signum": 15, "exit_code": 143}),
     (errors.HelperProcessError("qzs-figure", -9), {"name": "qzs-figure", "exitcode": -9}),
     (errors.CompilerError("gcc", "was not found"), {"compiler": "gcc", "reason": "was not found"}),
+    (errors.CModelMismatchError([("QZS_P_VREG", 21, "kernels.P_VREG = 22")]),
+     {"mismatches": (("QZS_P_VREG", 21, "kernels.P_VREG = 22"),)}),
     (errors.ExcitationError("`f_low` must be below `f_high`", ("f_low", "f_high")),
      {"options": ("f_low", "f_high")}),
     (errors.UnresolvedExcitationError(frequency=4000.0, dt=1e-4, minimum=10),
@@ -64,7 +66,8 @@ def test_each_error_is_caught_by_its_built_in():
     ``except ImportError`` a missing extra; SIGTERM is not swallowed by ``except Exception``."""
     expected = {"ParameterError": ValueError, "DataError": ValueError,
                 "SimulationError": RuntimeError, "FitError": RuntimeError,
-                "CompilerError": RuntimeError, "HelperProcessError": ChildProcessError,
+                "CompilerError": RuntimeError, "CModelMismatchError": RuntimeError,
+                "HelperProcessError": ChildProcessError,
                 "MissingDependencyError": ImportError, "DataWarning": UserWarning}
     for name, base in expected.items():
         assert issubclass(getattr(errors, name), base), name

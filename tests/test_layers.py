@@ -347,6 +347,8 @@ CROSS_CUTTING = {
 }
 #: The longest a source file of qzs may be [lines] (one concept per module).
 MAX_LINES = 1000
+#: The longest a module of ``workflows/`` may be [lines] (issue 42: rooms of one concept).
+WORKFLOW_MAX_LINES = 800
 
 
 def source_modules():
@@ -444,6 +446,14 @@ def test_no_source_file_is_over_the_line_limit():
     over = [f"src/qzs/{path}: {count} lines" for path, count in lengths.items()
             if count > MAX_LINES]
     assert not over, f"over {MAX_LINES} lines (split by concept):\n" + "\n".join(over)
+
+
+def test_no_workflow_module_is_over_its_line_limit():
+    over = [f"src/qzs/{path.relative_to(SOURCE)}: {count} lines"
+            for path in sorted((SOURCE / "workflows").rglob("*.py"))
+            if (count := len(path.read_text().splitlines())) > WORKFLOW_MAX_LINES]
+    assert not over, (f"over {WORKFLOW_MAX_LINES} lines in workflows/ (split by concept):\n"
+                      + "\n".join(over))
 
 
 def test_the_docstring_reader_sees_only_the_table():

@@ -1,12 +1,14 @@
 """The shared argument checks of :mod:`qzs._validation`: what they accept, return and say."""
+import ast
 import math
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from qzs._validation import (Structured, choice, finite_rows, integer, interval, non_negative_real,
-                             optional, positive_real, real)
+from qzs._validation import (Structured, choice, finite_rows, integer, interval, known_keys,
+                             non_negative_real, optional, positive_real, real)
 from qzs.errors import DataError, ParameterError, ProblemError
 
 NOT_NUMBERS = [True, np.True_, "1.0", None, [1.0], 1 + 2j]
@@ -182,3 +184,90 @@ def test_a_seed_comes_back_as_an_int(value):
     from qzs._validation import seed
 
     assert seed("seed", value) == value and type(seed("seed", value)) is int
+
+
+def test_known_keys_names_the_table_the_unknown_keys_and_the_allowed_ones():
+    table = {"a": 1, "b": 3}
+    assert known_keys(table, ("a", "b"), "[t]", required=("a",)) is table
+    with pytest.raises(ParameterError) as info:
+        known_keys({"a": 1, "zz": 2, "yy": 3}, ("b", "a"), "[t]", "'f.toml': ",
+                   options=("t",), fix="drop them")
+    assert str(info.value) == ("'f.toml': unknown key(s) ['yy', 'zz'] in [t]; allowed are "
+                               "['a', 'b']; drop them.")
+    assert info.value.options == ("t",)
+
+
+def test_known_keys_names_a_missing_required_key_and_refuses_a_non_table():
+    with pytest.raises(ParameterError, match=r"^missing axis\(s\) \['y'\] in `e`; required are "
+                                             r"\['x', 'y'\], allowed are \['x', 'y', 'z'\]\.$"):
+        known_keys({"x": 1}, ("z",), "`e`", required=("x", "y"), noun="axis")
+    with pytest.raises(ParameterError, match=r"^\[t\] must be a table, got 3\.$"):
+        known_keys(3, ("a",), "[t]")
+
+
+def test_known_keys_raises_the_error_asked_for():
+    from qzs.errors import ExcitationError
+
+    with pytest.raises(ExcitationError) as info:
+        known_keys({"f0": 1.0}, ("frequency",), "a sine", noun="option", error=ExcitationError,
+                   options=("f0",))
+    assert info.value.options == ("f0",)
+    build = Structured(build=lambda key, value, reason: ProblemError("t", key, value, reason))
+    with pytest.raises(ProblemError) as info:
+        known_keys({"a": 1, "q": 7}, ("a",), "[t]", error=build)
+    assert (info.value.table, info.value.key, info.value.value) == ("t", "q", 7)
+    assert info.value.fix == "unknown key(s) ['q'] in [t]; allowed are ['a']"
+
+
+#: The package's sources, and the one module that may compare a table's keys with the
+#: allowed ones by hand (:func:`known_keys`).
+SOURCE = Path(__file__).resolve().parents[1] / "src" / "qzs"
+KEY_CHECK_HOME = SOURCE / "_validation.py"
+
+
+def _is_set_of_a_table(node):
+    """``set(name)``, ``set(a.b)`` or ``name.keys()``: the keys of a table."""
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+            and node.func.id in ("set", "frozenset") and len(node.args) == 1:
+        return isinstance(node.args[0], (ast.Name, ast.Attribute, ast.Subscript))
+    return (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+            and node.func.attr == "keys" and not node.args)
+
+
+def hand_written_key_checks(tree):
+    """The lines of ``tree`` that take a table's keys minus others: ``set(table) - allowed``,
+    ``table.keys() - allowed``, ``set(table).difference(allowed)``."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Sub) \
+                and _is_set_of_a_table(node.left):
+            found.append(node.lineno)
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                and node.func.attr == "difference" and _is_set_of_a_table(node.func.value):
+            found.append(node.lineno)
+    return found
+
+
+@pytest.mark.parametrize("text, count", [
+    ("unknown = sorted(set(table) - set(ALLOWED))", 1),
+    ("extra = set(self.options) - {'a'}", 1),
+    ("extra = options.keys() - ALLOWED", 1),
+    ("extra = set(spec['x']).difference(ALLOWED)", 1),
+    ("unmet = set(range(cases)) - set(met)", 0),  # not a table's keys: the indices of cases
+    ("missing = {'done', 'status'} - set(dataset.variables)", 0),  # what must be there
+])
+def test_the_detector_sees_a_hand_written_key_check(text, count):
+    assert len(hand_written_key_checks(ast.parse(text))) == count
+
+
+def test_no_module_but_validation_checks_a_tables_keys_by_hand():
+    """Each check once: an unknown-key check goes through ``known_keys`` (its one message
+    format, naming the table, the unknown keys and the allowed ones)."""
+    found = {}
+    for path in sorted(SOURCE.rglob("*.py")):
+        if path == KEY_CHECK_HOME:
+            continue
+        lines = hand_written_key_checks(ast.parse(path.read_text(encoding="utf-8")))
+        if lines:
+            found[str(path.relative_to(SOURCE))] = lines
+    assert not found, f"use qzs._validation.known_keys at {found}"

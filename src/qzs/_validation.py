@@ -372,19 +372,70 @@ def strictly_increasing(name, time, error, fix="sort it and drop duplicates firs
                     f"{int(np.count_nonzero(steps <= 0))} such steps); {fix}.")
 
 
-def known_keys(table, allowed, where, prefix="", options=()):
-    """Return ``table`` if it is a dict whose keys are all in ``allowed``, else raise.
+def known_keys(table, allowed, where, prefix="", options=(), *, required=(), noun="key",
+               fix="", error=ParameterError):
+    """Return ``table`` if it is a dict whose keys are all in ``allowed`` and that has every
+    ``required`` key, else raise: the one check of a table's (a dict's) keys.
 
-    ``where`` names the table in the message (e.g. ``[analysis]``); ``prefix`` the file;
-    ``options`` the arguments the error is about (:attr:`ParameterError.options`).
+    Its messages, one format: ``"{prefix}unknown key(s) ['x'] in {where}; allowed are
+    ['a', 'b']."``, ``"{prefix}missing key(s) ['a'] in {where}; required are ['a'], allowed
+    are ['a', 'b']."`` and ``"{prefix}{where} must be a table, got 3."``, each ended by
+    ``"; {fix}"`` when ``fix`` is given.
+
+    Parameters
+    ----------
+    table : object
+        The table (a dict) read.
+    allowed : iterable of str
+        Its keys that may be given (the ``required`` ones need not be repeated).
+    where : str
+        The table or argument, as the user wrote it (``[analysis]``, ```settings```).
+    prefix : str
+        Put before the message (the file: ``"'run.toml': "``).
+    options : tuple of str
+        The arguments the error is about (:attr:`ParameterError.options`).
+    required : sequence of str
+        Keys that must be given.
+    noun : str
+        What a key is (``"key"``, ``"table"``, ``"axis"``, ``"option"``), in the message.
+    fix : str
+        What to do, ending the message ('' for nothing).
+    error : type or Structured
+        What to raise: an exception class called with the message (and ``options`` for a
+        :class:`ParameterError`), or a :class:`Structured` builder called with the first
+        wrong key, its value and the message without ``prefix`` (the reason).
+
+    Returns
+    -------
+    dict
+        ``table``.
     """
     if not isinstance(table, dict):
-        raise ParameterError(f"{prefix}{where} must be a table, got {table!r}.", options)
-    unknown = sorted(set(table) - set(allowed))
+        raise _table_refusal(error, prefix, options, "", table,
+                             f"{where} must be a table, got {table!r}", fix)
+    allowed = sorted({*allowed, *required}, key=str)
+    missing = [key for key in required if key not in table]
+    unknown = sorted(set(table) - set(allowed), key=str)
     if unknown:
-        raise ParameterError(f"{prefix}unknown key(s) {unknown} in {where}; allowed are "
-                             f"{sorted(allowed)}.", options)
-    return table
+        reason = f"unknown {noun}(s) {unknown} in {where}; allowed are {allowed}"
+    elif missing:
+        reason = (f"missing {noun}(s) {missing} in {where}; required are {list(required)}, "
+                  f"allowed are {allowed}")
+    else:
+        return table
+    key = (unknown or missing)[0]
+    raise _table_refusal(error, prefix, options, key, table.get(key), reason, fix)
+
+
+def _table_refusal(error, prefix, options, key, value, reason, fix):
+    """:func:`known_keys`'s exception: ``reason`` (and ``fix``) about ``key``."""
+    reason += f"; {fix}" if fix else ""
+    if isinstance(error, Structured):
+        return error.build(key, value, reason)
+    if isinstance(error, type) and issubclass(error, ParameterError) \
+            and error.__init__ is ParameterError.__init__:
+        return error(f"{prefix}{reason}.", options)
+    return error(f"{prefix}{reason}.")
 
 
 def renamed_keyword(new, value, old, old_value, *, stacklevel=3):

@@ -14,7 +14,8 @@ __all__ = ["ParameterError", "ExcitationError", "StabilityError", "CaseError",
            "OutputPathError", "ResumeMismatchError", "ResultTooLargeError", "WriteError", "ToleranceNotMetError",
            "SizeLimitError", "RunTooLongError", "UnresolvedExcitationError",
            "ControllerRateError", "CountLimitError", "InvalidCasesError",
-           "SchedulerError", "AddressError", "ProblemError", "CompilerError", "Terminated",
+           "SchedulerError", "AddressError", "ProblemError", "CompilerError",
+           "CModelMismatchError", "Terminated",
            "HelperProcessError",
            "DataWarning", "FitWarning"]
 
@@ -627,6 +628,38 @@ class CompilerError(RuntimeError):
 
     def __reduce__(self):
         return type(self), (self.compiler, self.reason, self.fix)
+
+
+class CModelMismatchError(RuntimeError):
+    """qzs's C model (``qzs/export/csrc``) is not the numba side it copies: a packed index
+    (``QZS_P_*``, ``QZS_S_*``, ...) with another value or on one side only, or a registry
+    parameter that ``qzs_fmu.c`` does not read or checks with another bound. Raised before
+    anything is exported (:func:`qzs.export.clayout.check_c_model`).
+
+    Parameters
+    ----------
+    mismatches : tuple of (str, object, object)
+        Each difference: the index or parameter (``QZS_P_VREG``, ``isolator.mass``), the C
+        side (its value; None where C has none) and the Python side (None where it has none).
+
+    Attributes
+    ----------
+    mismatches : tuple of (str, object, object)
+        As given.
+    """
+
+    def __init__(self, mismatches) -> None:
+        self.mismatches = tuple(tuple(m) for m in mismatches)
+        shown = "; ".join(f"{name}: C {'has none' if c is None else repr(c)}, Python "
+                          f"{'has none' if py is None else py}"
+                          for name, c, py in self.mismatches)
+        super().__init__(f"qzs's C model does not match the Python side it copies ({shown}); "
+                         "make src/qzs/export/csrc (its headers' indices, qzs_fmu.c's packing "
+                         "and REQUIRE checks) say what the Python side says, then run "
+                         "tests/export.")
+
+    def __reduce__(self):
+        return type(self), (self.mismatches,)
 
 
 class Terminated(BaseException):

@@ -123,17 +123,17 @@ def test_hexapod_file(tmp_path, capsys):
 
 @pytest.mark.parametrize("text, match", [
     ("[geometry]\nkind = 'square'\n", "`kind` must be one of"),
-    ("[geometry]\nkind = 'cubic'\n", "missing \\['cube_edge'\\]"),
-    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\nwidth = 2\n", "unknown \\['width'\\]"),
+    ("[geometry]\nkind = 'cubic'\n", "missing key\\(s\\) \\['cube_edge'\\]"),
+    ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\nwidth = 2\n", "unknown key\\(s\\) \\['width'\\]"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[leg]\npi_kp = 3.0\n",
      "`pi_kp` is not an isolator parameter"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[platform]\nmass = 3.0\n"
      "inertia = [[1,0,0],[0,1,0],[0,0,1]]\nprincipal_inertia = [1, 1, 1]\n", "not both"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[excitation.w]\nkind = 'sine'\n",
-     "axes must be among"),
+     "unknown axis name\\(s\\) \\['w'\\] in \\[excitation\\]"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[wheels]\n", "unknown table"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\ngain = 3\n",
-     "\\[cartesian\\]: unknown key"),
+     "unknown key\\(s\\) \\['gain'\\] in \\[cartesian\\]"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\nposition_gain = [1, 2]\n",
      "position_gain"),
     ("[geometry]\nkind = 'cubic'\ncube_edge = 0.1\n[cartesian]\npoint = 'centre'\n", "point"),

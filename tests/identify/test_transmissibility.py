@@ -72,8 +72,11 @@ def test_bad_input(curve):
     with pytest.raises(ParameterError, match="`bounds` for 'viscous_damping'"):
         fit_transmissibility(frequency, magnitude, ("viscous_damping",), bounds={
             "viscous_damping": (200, 300)})
-    with pytest.raises(ParameterError, match="`initial` names"):
+    with pytest.raises(ParameterError, match=r"unknown parameter\(s\) \['mass'\] in `initial`"):
         fit_transmissibility(frequency, magnitude, ("viscous_damping",), initial={"mass": 6})
+    with pytest.raises(ParameterError, match=r"unknown parameter\(s\) \['mass'\] in `bounds`"):
+        fit_transmissibility(frequency, magnitude, ("viscous_damping",),
+                             bounds={"mass": (1, 9)})
     with pytest.raises(DataError, match="only 1 points of the curve lie in the band"):
         fit_transmissibility(frequency[:12], magnitude[:12], ("viscous_damping", "mass"))
     with pytest.raises(DataError, match="`magnitude` has 1 non-finite"):

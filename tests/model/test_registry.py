@@ -37,7 +37,7 @@ def test_every_excitation_option_has_a_unit_and_builds_its_kind():
 
 @pytest.mark.parametrize("kind, options, message", [
     ("square", {}, "`kind` must be one of"),
-    ("sine", {"f0": 1.0}, "takes no option(s) ['f0']"),
+    ("sine", {"f0": 1.0}, "unknown option(s) ['f0'] in a sine excitation"),
     ("file", {}, "needs `record`"),
     ("chirp", {"amplitude": -1.0}, "`amplitude` must be non-negative"),
 ])

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qzs.errors import ParameterError
+from qzs._validation import known_keys
 
 __all__ = ["PlatformData", "compute_platform", "PLATFORM_PARAMETERS", "GRID_RANGE"]
 
@@ -83,11 +83,8 @@ def compute_platform(settings=None, dpi=75):
     from qzs.viz.hexapod_matrix import plot_transmissibility_matrix
     from qzs.workflows.hexapod.setups import AXES, SHIPPED_DEFAULT, linear_record, load_hexapod
 
-    settings = dict(settings or {})
-    unknown = sorted(set(settings) - set(PLATFORM_PARAMETERS))
-    if unknown:
-        raise ParameterError(f"unknown platform setting(s) {unknown}; the tab sets "
-                             f"{', '.join(PLATFORM_PARAMETERS)}.")
+    settings = known_keys(dict(settings or {}), PLATFORM_PARAMETERS, "`settings`",
+                          noun="platform setting", options=("settings",))
     setup = load_hexapod(SHIPPED_DEFAULT, settings)
     model, record = linear_record(setup)
     frequency = np.geomspace(*GRID_RANGE, GRID_POINTS)

@@ -6,7 +6,8 @@ Exit codes (:data:`EXIT_CODES`), the same for every subcommand:
 - 1: the run started and failed (:class:`~qzs.errors.SimulationError`,
   :class:`~qzs.errors.FitError`, an I/O error while writing such as a full disk
   (:class:`~qzs.errors.WriteError`), out of memory, no working C compiler for an export
-  (:class:`~qzs.errors.CompilerError`)).
+  (:class:`~qzs.errors.CompilerError`), a C model that is not the Python side's
+  (:class:`~qzs.errors.CModelMismatchError`)).
 - 2: bad input or usage (:class:`~qzs.errors.ParameterError` and its subclasses, such as
   :class:`~qzs.errors.CaseError` for an invalid case of a batch, found before the batch
   runs; :class:`~qzs.errors.DataError`, :class:`~qzs.errors.MissingDependencyError`;
@@ -28,8 +29,9 @@ from pathlib import Path
 from qzs._format import json_ready
 from qzs.defaults import FIGURES, FREQUENCY_SCALES
 from qzs.engine.progress import show_warning
-from qzs.errors import (CompilerError, DataError, FitError, MissingDependencyError,
-                        ParameterError, SimulationError, Terminated, WriteError)
+from qzs.errors import (CModelMismatchError, CompilerError, DataError, FitError,
+                        MissingDependencyError, ParameterError, SimulationError, Terminated,
+                        WriteError)
 from qzs.iotools.config import load_config, load_controller, load_spring
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -556,7 +558,8 @@ def run_handler(handler, args):
     -------
     int
         The handler's exit code; 1 after a failed run (:class:`SimulationError`,
-        :class:`FitError`, :class:`WriteError`, :class:`CompilerError`, an ``OSError`` or
+        :class:`FitError`, :class:`WriteError`, :class:`CompilerError`,
+        :class:`CModelMismatchError`, an ``OSError`` or
         ``MemoryError``); 2 after
         bad input (:class:`ParameterError` and subclasses such as :class:`CaseError`,
         :class:`DataError`, :class:`MissingDependencyError`); 130 after Ctrl-C; 143 after SIGTERM
@@ -574,7 +577,8 @@ def run_handler(handler, args):
 
             with compile_notice(families, ticking=not quiet):
                 return handler(args)
-    except (SimulationError, FitError, WriteError, CompilerError) as error:  # before DataError
+    except (SimulationError, FitError, WriteError, CompilerError,
+            CModelMismatchError) as error:  # before DataError
         return _fail(error, 1)
     except (ParameterError, DataError, MissingDependencyError) as error:
         return _fail(error, 2)

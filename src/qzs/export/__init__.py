@@ -7,6 +7,7 @@ compiler:
 
 =================  ================================================================
 ``csource``        the shipped C sources, the system compiler, compile and load (ctypes)
+``clayout``        the C model's packed indices and parameter checks, asserted against Python
 ``cmodel``         run a case through the C model as :func:`qzs.simulate` would
 ``controller``     the sampled controller as one dependency-free C file (``qzs export``)
 ``fmu``            ``qzs.export_fmu``: the isolator as an FMI 2.0 / 3.0 co-simulation FMU

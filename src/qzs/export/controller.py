@@ -32,6 +32,7 @@ from qzs._version import __version__
 from qzs.engine import kernels as K
 from qzs.engine.prepare import prepare_run
 from qzs.errors import ParameterError
+from qzs.export.clayout import check_c_model
 from qzs.export.csource import source_text
 from qzs.iotools.files import atomic_path
 from qzs.iotools.paths import check_output_path
@@ -177,7 +178,14 @@ def controller_source(controller=None, isolator=None, *, dt=defaults.SIMULATION[
     -------
     str
         C99 source (links with libm).
+
+    Raises
+    ------
+    CModelMismatchError
+        The shipped C model's indices or checks are not the Python side's
+        (:func:`qzs.export.clayout.check_c_model`).
     """
+    check_c_model()  # qzs_controller.h's block indices are the kernels' M_*
     parameters, preload = exported_parameters(controller, isolator, dt=dt)
     regularisation, model, states, held = exported_blocks(controller, isolator, dt=dt)
     header = source_text("qzs_controller.h")

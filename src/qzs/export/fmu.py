@@ -28,6 +28,7 @@ from qzs.engine.run_spec import resolve
 from qzs.engine.stability import SOLVERS
 from qzs.errors import (ControllerRateError, ParameterError, StabilityError,
                         UnresolvedExcitationError)
+from qzs.export.clayout import check_c_model
 from qzs.export.csource import CFLAGS, compile_shared, source_folder
 from qzs.export.fmu_variables import BASE_MOTIONS, MODES, fmu_variables, variables_header
 from qzs.export.fmu_xml import build_description, model_description
@@ -269,9 +270,13 @@ def export_fmu(path: str | Path, excitation: Chirp | Sine | None = None,
         FMPy (the FMI headers) is not installed.
     CompilerError
         No C compiler, or it failed.
+    CModelMismatchError
+        The shipped C model's indices or checks are not the Python side's
+        (:func:`qzs.export.clayout.check_c_model`).
     """
     path = check_output_path(path, argument=argument, suffixes=(".fmu",))
     _check_choices(fmi_version, mode, base_motion, model_identifier)
+    check_c_model()  # the C sources copied below are the Python side's, index for index
     excitation = _check_excitation(excitation, base_motion)
     probe: Chirp | Sine = (excitation if excitation is not None
                            else Sine(amplitude=0.0, fade_in=0.0))

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import optimize
 
-from qzs._validation import integer
+from qzs._validation import integer, known_keys
 from qzs.analysis.spectral import transmissibility
 from qzs.defaults import EXCITATION
 from qzs.engine.prepare import steps_per_sample
@@ -109,9 +109,8 @@ def _free_parameters(free, isolator, controller, initial):
         raise ParameterError(f"`free` has unknown or non-numeric parameter(s) {unknown}; "
                              f"choose from {sorted(owners)}.")
     initial = dict(initial or {})
-    extra = sorted(set(initial) - set(free))
-    if extra:
-        raise ParameterError(f"`initial` names {extra}, which are not in `free` {free}.")
+    known_keys(initial, free, "`initial`", noun="parameter", options=("initial",),
+               fix="give a start only for the parameters in `free`")
     start = {name: float(initial.get(name, getattr(owners[name], name))) for name in free}
     for name, value in start.items():
         if not value > 0:
@@ -122,9 +121,8 @@ def _free_parameters(free, isolator, controller, initial):
 
 def _bounds(free, start, bounds, isolator):
     bounds = dict(bounds or {})
-    extra = sorted(set(bounds) - set(free))
-    if extra:
-        raise ParameterError(f"`bounds` names {extra}, which are not in `free` {free}.")
+    known_keys(bounds, free, "`bounds`", noun="parameter", options=("bounds",),
+               fix="give bounds only for the parameters in `free`")
     low, high = [], []
     for name in free:
         lo, hi = bounds.get(name, (start[name] / 20.0, start[name] * 20.0))

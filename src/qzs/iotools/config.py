@@ -72,10 +72,7 @@ def load_config(path: str | Path) -> dict[str, Any]:
     path = Path(path)
     document = read_toml(path, "config file", empty=EMPTY_CONFIG)
     allowed = {"isolator", "controller", "excitation", "simulation", "spring"}
-    unknown = set(document) - allowed
-    if unknown:
-        raise ParameterError(f"{str(path)!r}: unknown table(s) {sorted(unknown)}; "
-                             f"allowed are {sorted(allowed)}.")
+    known_keys(document, allowed, "the config file", f"{str(path)!r}: ", noun="table")
     isolator_table = document.get("isolator", {})
     if not isinstance(isolator_table, dict):
         raise ParameterError(f"{str(path)!r}: [isolator] must be a table, got "
@@ -126,13 +123,11 @@ def load_controller(path: str | Path) -> ControllerParameters:
     path = Path(path)
     document = read_toml(path, "controller file", empty=(
         "write a [controller] table into it (`qzs params --toml` shows one)"))
-    others = sorted(set(document) - {"controller"})
-    if others or "controller" not in document:
-        raise ParameterError(
-            f"controller file {str(path)!r} must hold a [controller] table (and its "
-            f"[controller.<block>] tables) and nothing else; it has {sorted(document)}: put "
-            "[isolator], [excitation] and [simulation] in a config file (--config).",
-            ("controller",))
+    known_keys(document, (), f"controller file {str(path)!r}", required=("controller",),
+               noun="table", options=("controller",),
+               fix="it must hold a [controller] table (and its [controller.<block>] tables) "
+                   "and nothing else: put [isolator], [excitation] and [simulation] in a "
+                   "config file (--config)")
     return controller_from_table(document["controller"], path)
 
 
@@ -161,12 +156,9 @@ def load_spring(path: str | Path):
     path = Path(path)
     document = read_toml(path, "spring file", empty=(
         'write a [spring] table into it, e.g. law = "oblique"'))
-    others = sorted(set(document) - {"spring"})
-    if others or "spring" not in document:
-        raise ParameterError(
-            f"spring file {str(path)!r} must hold a [spring] table and nothing else; it has "
-            f"{sorted(document)}: put the other tables in a config file (--config).",
-            ("spring",))
+    known_keys(document, (), f"spring file {str(path)!r}", required=("spring",), noun="table",
+               options=("spring",), fix="it must hold a [spring] table and nothing else: put "
+                                         "the other tables in a config file (--config)")
     return spring_from_table(document["spring"], path)
 
 

@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from qzs._validation import (choice, non_negative_real, parameter, positive_real, read_csv_table,
-                             real, strictly_increasing, validate_fields)
+from qzs._validation import (choice, known_keys, non_negative_real, parameter, positive_real,
+                             read_csv_table, real, strictly_increasing, validate_fields)
 from qzs._validation import seed as checked_seed
 from qzs.defaults import EXCITATION
 from qzs.errors import DataError, ExcitationError
@@ -490,10 +490,8 @@ def _build(kind, options):
     if kind not in EXCITATION_KINDS:
         raise ExcitationError(f"excitation `kind` must be one of {tuple(EXCITATION_KINDS)}, "
                               f"got {kind!r}.")
-    unknown = sorted(set(options) - set(EXCITATION_OPTIONS[kind]))
-    if unknown:
-        raise ExcitationError(f"a {kind} excitation takes no option(s) {unknown}; its options "
-                              f"are {list(EXCITATION_OPTIONS[kind])}.")
+    known_keys(options, EXCITATION_OPTIONS[kind], f"a {kind} excitation", noun="option",
+               error=ExcitationError)
     if kind == "file":
         if "record" not in options:
             raise ExcitationError("a `file` excitation needs `record`, the path of a CSV file "

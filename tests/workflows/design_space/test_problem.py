@@ -68,29 +68,6 @@ def test_a_list_of_values_is_drawn_in_equal_shares():
     assert values.tolist() == [6.0, 6.4, 6.8] and counts.tolist() == [3, 3, 3]
 
 
-@pytest.mark.parametrize("statistic, sense, expected", [
-    ("mean", "minimize", [2.0, 5.0]), ("worst", "minimize", [3.0, 9.0]),
-    ("worst", "maximize", [1.0, 1.0])])
-def test_a_goal_combines_the_draws_of_each_design(statistic, sense, expected):
-    from qzs.workflows.design_space.problem import Goal
-
-    goal = Goal(metric="peak_stroke", column="peak_stroke", options={}, statistic=statistic,
-                sense=sense)
-    assert goal.aggregate([[1.0, 2.0, 3.0], [1.0, 5.0, 9.0]]).tolist() == expected
-
-
-def test_a_quantile_is_taken_from_the_bad_side_of_a_maximised_metric():
-    from qzs.workflows.design_space.problem import Goal
-
-    values = np.arange(101.0)[None, :]
-    low = Goal(metric="phase_margin", column="phase_margin", options={},
-               statistic="quantile", quantile=0.9, sense="maximize")
-    high = Goal(metric="peak_stroke", column="peak_stroke", options={},
-                statistic="quantile", quantile=0.9, sense="minimize")
-    assert low.aggregate(values)[0] == pytest.approx(10.0)
-    assert high.aggregate(values)[0] == pytest.approx(90.0)
-
-
 BAD = [
     ("unknown parameter", {"variables": {"pi_kpp": {"low": 1.0, "high": 2.0}}},
      "variables", "pi_kpp", "not a parameter"),

@@ -9,46 +9,12 @@ from qzs.errors import CountLimitError, ParameterError, ProblemError
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters, spring_stiffness
 from qzs.workflows.design_space.problem import load_problem
-from qzs.workflows.design_space.sensitivity import (SensitivityResult, parameter_ranking,
-                                                    sensitivity)
+from qzs.workflows.design_space.sensitivity import sensitivity
+
+from workflows.design_space.ishigami import (ISHIGAMI_COLUMN, ISHIGAMI_NAMES, ishigami,
+                                             ishigami_indices, ishigami_problem)
 
 # ---------------------------------------------------------------- Ishigami
-#: Three registry parameters stand for Ishigami's x1, x2, x3 (each uniform on [-pi, pi]):
-#: the problem only checks that low < high, and ``evaluate=`` replaces the simulator.
-ISHIGAMI_NAMES = ("pi_kp", "pi_ki", "damping_gain")
-ISHIGAMI_COLUMN = "linear_transmissibility_at_3_hz"
-A, B = 7.0, 0.1
-
-
-def ishigami_indices():
-    """Analytic first-order and total indices (Ishigami & Homma 1990; Sobol' 1999)."""
-    v1 = 0.5 * (1 + B * math.pi ** 4 / 5) ** 2
-    v2 = A ** 2 / 8
-    v13 = B ** 2 * math.pi ** 8 * (1 / 18 - 1 / 50)
-    v = v1 + v2 + v13
-    return np.array([v1, v2, 0.0]) / v, np.array([v1 + v13, v2, v13]) / v
-
-
-def ishigami_problem(**sensitivity_table):
-    return {"problem": {"name": "ishigami", "title": "Ishigami function"},
-            # the gains cannot be negative: searched on [0, 2 pi], shifted by -pi below
-            "variables": {n: {"low": 0.0, "high": 2 * math.pi} for n in ISHIGAMI_NAMES},
-            "objectives": [{"metric": "linear_transmissibility_at", "frequency": 3.0}],
-            "sensitivity": sensitivity_table}
-
-
-def ishigami(settings):
-    """The evaluator put in place of qzs: the same cases, Ishigami's function of them."""
-    x = np.array([[case[name] for name in ISHIGAMI_NAMES] for case in settings]) - math.pi
-    y = np.sin(x[:, 0]) + A * np.sin(x[:, 1]) ** 2 + B * x[:, 2] ** 4 * np.sin(x[:, 0])
-    return {ISHIGAMI_COLUMN: y}
-
-
-@pytest.fixture(scope="module")
-def ishigami_sobol():
-    return sensitivity(ishigami_problem(samples=2 ** 12), evaluate=ishigami, progress=False)
-
-
 def test_ishigami_analytic_indices_lie_in_the_reported_intervals(ishigami_sobol, validation):
     result = ishigami_sobol
     first, total = ishigami_indices()
@@ -316,69 +282,3 @@ def test_an_evaluator_must_return_every_metric_per_case():
                     evaluate=lambda s: {ISHIGAMI_COLUMN: np.zeros(3)})
     with pytest.raises(ParameterError, match="`evaluate` must be a callable"):
         sensitivity(ishigami_problem(samples=4), evaluate=3, progress=False)
-
-
-# ---------------------------------------------------------------- the result's views
-def test_the_result_round_trips_through_its_files(ishigami_sobol, tmp_path):
-    import scipy.io
-    import xarray as xr
-
-    result = ishigami_sobol
-    dataset = result.to_xarray()
-    assert dataset["first_order"].dims == ("metric", "parameter")
-    assert dataset["total_order"].attrs["units"] == "1"
-    assert list(dataset["parameter_unit"].values) == ["N/m", "N/(m*s)", "N*s/m"]
-    assert dataset.attrs["Conventions"] == "CF-1.10"
-    assert dataset.attrs["samples"] == 4096 and dataset.attrs["confidence_level"] == 0.95
-
-    with xr.open_dataset(result.save(tmp_path / "ishigami.nc"), engine="h5netcdf") as back:
-        for name in ("first_order", "total_order"):
-            assert np.array_equal(back[name].values, getattr(result, name))
-            assert np.array_equal(back[f"{name}_lower"].values,
-                                  getattr(result, f"{name}_interval")[..., 0])
-            assert np.array_equal(back[f"{name}_upper"].values,
-                                  getattr(result, f"{name}_interval")[..., 1])
-        assert list(back["parameter"].values) == list(result.parameters)
-        assert back.attrs["method"] == "sobol"
-
-    import csv
-
-    text = result.save(tmp_path / "ishigami.csv").read_text()
-    names, units, *rows = csv.reader(line for line in text.splitlines()
-                                     if not line.startswith("#"))
-    column = {name: [row[k] for row in rows] for k, name in enumerate(names)}
-    assert column["parameter"] == list(result.parameters)
-    assert units[names.index("total_order")] == "1"
-    assert np.allclose(np.array(column["total_order"], float), result.total_order[0],
-                       rtol=1e-9)
-    assert np.allclose(np.array(column["first_order_lower"], float),
-                       result.first_order_interval[0, :, 0], rtol=1e-9)
-
-    mat = scipy.io.loadmat(result.save(tmp_path / "ishigami.mat"))
-    assert np.array_equal(np.asarray(mat["total_order"], float).reshape(1, 3),
-                          result.total_order)
-    with pytest.raises(ParameterError):
-        result.save(tmp_path / "ishigami.json")
-
-
-def test_morris_units_are_the_metrics_own(tmp_path):
-    result = sensitivity(ishigami_problem(method="morris", trajectories=4), evaluate=ishigami,
-                         progress=False)
-    dataset = result.to_xarray()
-    assert set(dataset.data_vars) == {"mu_star", "mu_star_lower", "mu_star_upper", "mu",
-                                      "sigma", "reason"}
-    assert dataset["mu_star"].attrs["units"] == "1"  # the metric's (an amplitude ratio)
-    assert dataset.attrs["levels"] == 4
-    assert "mu*" in result.summary()
-
-
-def test_summary_and_ranking(ishigami_sobol):
-    text = ishigami_sobol.summary()
-    assert "4096 base samples, 20480 cases" in text
-    rows = [line.split()[0] for line in text.splitlines() if line.startswith("  pi_")
-            or line.startswith("  damping")]
-    assert rows == list(ishigami_sobol.ranking())
-    assert parameter_ranking(ishigami_sobol, ISHIGAMI_COLUMN) == ishigami_sobol.ranking()
-    with pytest.raises(ParameterError, match="`metric` must be one of"):
-        ishigami_sobol.ranking("peak_stroke")
-    assert isinstance(ishigami_sobol, SensitivityResult)

@@ -85,7 +85,7 @@ def test_bad_distribution_names_the_allowed_ones_and_their_keys():
                      "lognormal", "loguniform")
     assert "median" in message and "std" in message
     raises({**definition(distributions={"mass": {"distribution": "normal", "mean": 6.4}}),
-            **sample}, "takes keys ['mean', 'std']", "missing ['std']")
+            **sample}, "required are ['mean', 'std']", "missing key(s) ['std']")
     raises({**definition(distributions={"mass": {"distribution": "uniform", "low": 7.0,
                                                  "high": 6.0}}), **sample}, "`low` < `high`")
     raises({**definition(distributions={"mass": {"distribution": "lognormal", "median": 6.4,

@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import choice, positive_real
+from qzs._validation import choice, known_keys, positive_real
 from qzs.engine import driver
 from qzs.engine import kernels as K
 from qzs.engine.hexapod.dynamics import _advance_phases, _evaluate, _rest_frame
@@ -86,10 +86,8 @@ def _excitations(excitation):
             f"`excitation` must be a dict from axis names {AXES} to excitations (Chirp, Sine, "
             f"RandomExcitation, DisplacementRecord) or None, got {type(excitation).__name__}; "
             "e.g. excitation={'z': Chirp(duration=20.0)}.")
-    unknown = [key for key in excitation if key not in AXES]
-    if unknown:
-        raise ParameterError(f"`excitation` has unknown axis name(s) {unknown!r}; the axes are "
-                             f"{AXES} (translations [m], rotation angles [rad]).")
+    known_keys(excitation, AXES, "`excitation`", noun="axis name", options=("excitation",),
+               fix="the axes are translations [m] and rotation angles [rad]")
     moving = {}
     for axis in AXES:
         value = excitation.get(axis)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from qzs import defaults
-from qzs._validation import worker_count
+from qzs._validation import known_keys, worker_count
 from qzs.engine.hexapod.layout import (CT_CONTACTS, CT_EVENTS, CT_STEP, CT_STICKS, LEG_COUNT,
                                        N_BASE_CHANNELS, N_BUF, N_CHANNELS, N_COUNTERS, N_FLAGS,
                                        N_ODE, N_WORK, S_C, S_V, STATUS_OK, STATUS_OUTSIDE,
@@ -263,10 +263,8 @@ def simulate_hexapods(runs: Sequence[Mapping[str, Any]], *, workers: int | None 
         if not isinstance(arguments, dict):
             raise ParameterError(f"`runs[{i}]` must be a dict of simulate_hexapod arguments, "
                                  f"got {type(arguments).__name__}.")
-        unknown = sorted(set(arguments) - set(names))
-        if unknown or "geometry" not in arguments or "platform" not in arguments:
-            raise ParameterError(f"`runs[{i}]` needs `geometry` and `platform` and may have "
-                                 f"{list(names[2:])}; got {sorted(arguments)}.")
+        known_keys(arguments, names, f"`runs[{i}]`", required=names[:2], noun="argument",
+                   fix="give simulate_hexapod's arguments")
         try:  # every run checked before any integration (it packs again when it starts: cheap)
             _prepare(arguments["geometry"], arguments["platform"], arguments.get("isolator"),
                      arguments.get("controller"), arguments.get("excitation"),

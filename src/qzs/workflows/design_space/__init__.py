@@ -8,15 +8,17 @@ every evaluated design in a resumable Zarr store (:mod:`.store`); ``qzs sensitiv
 ranks the parameters by Sobol or Morris indices (:mod:`.sensitivity`). The guide is
 ``qzs docs design-space``.
 
-===============  ================================================================
-``problem``      problem files: variables, uncertainty, objectives, constraints
-``metrics``      the metrics, and how a design's draws combine
-``evaluation``   a population evaluated, each batch one task: runs, estimates, linear metrics
-``optimizer``    NSGA-II over the problem, generation by generation (pymoo)
-``store``        the Zarr store of every evaluated design: resume, replay
-``result``       the Pareto set: files, figure, chosen design, report
-``sensitivity``  Sobol and Morris indices of the metrics (SALib)
-===============  ================================================================
+======================  ================================================================
+``problem``             problem files: variables, uncertainty, objectives, constraints
+``problem_types``       the validated problem: its variables, uncertainty and goals
+``metrics``             the metrics, and how a design's draws combine
+``evaluation``          a population evaluated, a batch per task: runs, estimates, linear metrics
+``optimizer``           NSGA-II over the problem, generation by generation (pymoo)
+``store``               the Zarr store of every evaluated design: resume, replay
+``result``              the Pareto set: files, figure, chosen design, report
+``sensitivity``         Sobol and Morris indices of the metrics (SALib)
+``sensitivity_result``  the indices as a result: ranking, table, dataset, files
+======================  ================================================================
 """
 from qzs.workflows.design_space.evaluation import Evaluation, evaluate
 from qzs.workflows.design_space.metrics import METRICS

@@ -7,8 +7,9 @@ simulated 6x6 transmissibility runs one chirp per excited base axis
 side by side (:mod:`.study`). The model is described in docs/hexapod.md.
 
 =====================  ================================================================
-``setups``             set-ups: hexapod files, defaults, the linear and simulated
-                       reports behind ``qzs hexapod``
+``setups``             set-ups from hexapod files, and a set-up's simulated run
+``platform_setup``     the set-up object, the default platform, set-ups from objects
+``linear_report``      the linear analysis as data, text and the 6x6 grid (``linear``)
 ``legs``               each leg's own controller: ``[legs.N.controller]`` tables,
                        ``--leg-controller N=FILE.toml``
 ``transmissibility``   the simulated 6x6 transmissibility of a platform, chirp per axis

@@ -211,10 +211,7 @@ def load_study(path):
         "qzs/workflows/paper/study_files and edit it)"))
     allowed = {"study", "defaults", "case", "excitation", "analysis", "simulation", "spring",
                "processing"}
-    unknown = set(document) - allowed
-    if unknown:
-        raise ParameterError(f"{str(path)!r}: unknown table(s) {sorted(unknown)}; allowed are "
-                             f"{sorted(allowed)}.")
+    known_keys(document, allowed, "the study file", f"{str(path)!r}: ", noun="table")
     head = document.get("study")
     if not isinstance(head, dict) or "name" not in head or "kind" not in head:
         raise ParameterError(f"{str(path)!r} needs a [study] table with `name` and `kind`.")

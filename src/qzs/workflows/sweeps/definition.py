@@ -446,14 +446,8 @@ def parse_distribution(name, spec):
         raise ParameterError(f"unknown distribution {kind!r} for {name!r}; allowed are: "
                              f"{allowed}.")
     required, optional = DISTRIBUTIONS[kind]
-    keys = {k: v for k, v in spec.items() if k != "distribution"}
-    missing = [k for k in required if k not in keys]
-    extra = sorted(set(keys) - set(required) - set(optional))
-    if missing or extra:
-        takes = f"{list(required)}" + (f" (optional {list(optional)})" if optional else "")
-        wrong = "; ".join(part for part in (f"missing {missing}" if missing else "",
-                                            f"unknown {extra}" if extra else "") if part)
-        raise ParameterError(f"distribution {kind!r} of {name!r} takes keys {takes}; {wrong}.")
+    keys = known_keys({k: v for k, v in spec.items() if k != "distribution"}, optional,
+                      f"distribution {kind!r} of {name!r}", required=required)
     values = {k: real(f"{name}.{k}", v) for k, v in keys.items()}
     for key in ("std", "sigma", "median"):
         if key in values and values[key] <= 0:
