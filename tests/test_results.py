@@ -63,8 +63,6 @@ LEFT = {
     "HexapodStudyResult": "the six-axis study moves to the shared findings-and-report module "
                           "in issue 42 part 2 (workflows/hexapod/study.py, owned there); "
                           "its instance also takes minutes (60 s chirps on every axis)",
-    "StepChoice": "the step choice becomes one call in issue 42 part 1 "
-                  "(engine/step_search.py, owned there)",
     "CaseCurve": "one curve of a question's answer: the protocol not written yet",
     "LawFit": "one law's fit inside SpringFit (which has the protocol): not written yet",
 }
@@ -193,8 +191,15 @@ def _balance():
     return frequency_response_curve(model, (1.0, 6.0), harmonics=3, max_points=60)
 
 
+def _step_choice():
+    from qzs.engine.accuracy import choose_step
+
+    return choose_step(qzs.Chirp(duration=20.0, f1=20.0), tolerance=1e-4)
+
+
 #: Class name -> (how to build a small instance from a folder, a number its summary shows).
 FACTORIES = {
+    "StepChoice": (lambda folder: _step_choice(), lambda r: r.error),
     "SimulationResult": (lambda folder: _simulation(), lambda r: r["time"][-1]),
     "BatchResult": (lambda folder: _batch(), lambda r: r.stats["motor_force_rms"][0]),
     "HexapodResult": (lambda folder: _hexapod(), lambda r: r.time[-1]),

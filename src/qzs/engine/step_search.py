@@ -255,6 +255,60 @@ class StepChoice:
                           unmet=list(self.unmet))
         return record
 
+    #: The extensions :meth:`save` accepts: the candidates (.nc, .csv, .mat), the record (.json).
+    save_suffixes = (".nc", ".csv", ".mat", ".json")
+
+    def to_xarray(self):
+        """The candidates tried, with the record as attributes
+        (:func:`qzs.engine.step_views.step_dataset`).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``step`` [s], ``difference`` and ``estimated_error`` (in the measure's unit) per
+            candidate, coarsest first.
+        """
+        from qzs.engine.step_views import step_dataset
+
+        return step_dataset(self)
+
+    def plot(self, path=None, *, title=None):
+        """Each candidate's estimated error against its step, the tolerance and the chosen
+        step (:func:`qzs.viz.step.plot_step_choice`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (format from the suffix).
+        title : str, optional
+            Figure title; default the step and how it was chosen.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.step import plot_step_choice
+
+        return plot_step_choice(self, path=path, title=title)
+
+    def save(self, path):
+        """Write the choice by the extension of ``path``, atomically: the candidates as .nc,
+        .csv or .mat (:meth:`to_xarray`), the record as .json (:meth:`to_dict`).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file; its extension is one of ``save_suffixes``.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
+        from qzs.iotools.result_files import save_by_extension
+
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_dict)
+
     def attributes(self) -> dict[str, Any]:
         """The record as a run's entries and file attributes give it (``run.step*``).
 
