@@ -235,9 +235,9 @@ def _same(a, b):
 
 def _synthetic_choice(constant, cases=1, **options):
     """The search on runs ``C * dt**3`` (no probe integrated): a choice in a millisecond."""
-    from qzs.engine.step_search import search_step
+    from engine.search_probe import search
 
-    return search_step(run=lambda dt, members: [constant * dt ** 3 for _ in members],
+    return search(run=lambda dt, members: [constant * dt ** 3 for _ in members],
                        compare=lambda coarse, fine: abs(coarse - fine), cases=cases, dt0=1e-3,
                        order=3, measure="transmissibility_db", tolerance=1e-3,
                        sample_rate=1000.0, solver="ode3", probe=CHIRP, probe_duration=PROBE,

@@ -13,7 +13,8 @@ from qzs.engine.accuracy import SingleProbe, choose_step
 from qzs.engine.accuracy_batch import BatchProbe, choose_batch_step
 from qzs.engine.step_choice import (StepRequest, choose, fallback_step, step_request,
                                     unmet_sentence)
-from qzs.engine.step_search import StepChoice, search_step
+from engine.search_probe import search
+from qzs.engine.step_search import StepChoice
 from qzs.errors import ParameterError
 from qzs.model.controller import ControllerParameters
 from qzs.model.isolator import IsolatorParameters
@@ -176,7 +177,7 @@ def test_a_cache_hit_is_the_choice_the_search_made(monkeypatch, tmp_path):
 def test_an_unmet_tolerance_falls_back_with_the_one_sentence():
     """Differences that never shrink: no candidate meets the tolerance; the record runs at
     the one fallback step and its last note is the one sentence."""
-    choice = search_step(run=lambda dt, cases: [dt] * len(cases),
+    choice = search(run=lambda dt, cases: [dt] * len(cases),
                          compare=lambda coarse, fine: 1.0, dt0=1e-3, order=3,
                          measure="transmissibility_db", tolerance=0.01, sample_rate=1000.0,
                          solver="ode3", probe=None, probe_duration=10.0, band=(1.0, 5.0),

@@ -6,7 +6,7 @@ import warnings
 import pytest
 
 from qzs import Chirp
-from qzs.engine.step_search import search_step
+from engine.search_probe import search
 from qzs.errors import DataWarning
 
 
@@ -16,7 +16,7 @@ def unmet(monkeypatch):
     shrink), returned by every call of ``choose``."""
     import qzs.engine.step_choice as step_choice
 
-    choice = search_step(run=lambda dt, cases: [dt] * len(cases),
+    choice = search(run=lambda dt, cases: [dt] * len(cases),
                          compare=lambda coarse, fine: 1.0, cases=2, dt0=1e-3, order=3,
                          measure="transmissibility_db", tolerance=0.01, sample_rate=1000.0,
                          solver="ode3", probe=Chirp(f1=5.0, duration=20.0), probe_duration=20.0,
@@ -82,7 +82,7 @@ def test_a_met_or_literal_step_shows_no_unmet_sentence():
     assert _step_note(StepChoice.literal(1e-3)) == ""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        met = search_step(run=lambda dt, cases: [dt] * len(cases),
+        met = search(run=lambda dt, cases: [dt] * len(cases),
                           compare=lambda coarse, fine: 1e-3 * coarse, dt0=1e-3, order=3,
                           measure="state_m", tolerance=1.0, sample_rate=1000.0, solver="ode3",
                           probe=None, probe_duration=1.0, band=None, stability_limit=2e-3)

@@ -375,8 +375,8 @@ class Probe:
     safety : float
         Factor [-] between the estimate and the tolerance.
     search : mapping
-        Further keywords of :func:`~qzs.engine.step_search.search_step` (``give_up_early``,
-        ``per_case``, ``unit_name``).
+        How :func:`~qzs.engine.step_search.search_step` treats the cases:
+        ``give_up_early``, ``per_case``, ``unit_name`` (each optional).
     """
 
     measure: str
@@ -489,12 +489,8 @@ def _search(legs, tolerance, fallback, finest, progress):
     spectral_beside_probes(legs.measure)
     limit, resolving, dt0, k0 = legs.start()
     return search_step(
-        run=legs.run, compare=legs.compare, cases=legs.cases, dt0=dt0, order=legs.order,
-        measure=legs.measure, tolerance=tolerance, sample_rate=legs.sample_rate,
-        solver=legs.solver, probe=legs.excitation, probe_duration=legs.duration, band=legs.band,
+        legs, tolerance=tolerance, dt0=dt0, stability_limit=limit,
         notes=bound_notes(dt0, k0, legs.sample_rate, limit, resolving, legs.measure,
                           legs.shortened),
-        stability_limit=limit, max_halvings=legs.max_halvings, safety=legs.safety,
-        finest=finest, fallback=fallback, labels=legs.labels, progress=progress,
-        **legs.search)
+        finest=finest, fallback=fallback, progress=progress)
 

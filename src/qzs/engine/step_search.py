@@ -437,69 +437,41 @@ def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFET
     return (met[0][0] if met else None), history
 
 
-def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample_rate,
-                solver, probe, probe_duration, band, notes=(), stability_limit,
-                max_halvings=MAX_HALVINGS, safety=SAFETY, finest=None, fallback=False,
-                give_up_early=False, labels=None, per_case=False, progress=False,
-                unit_name="run"):
+def search_step(probe, *, tolerance, dt0, stability_limit, notes=(), finest=None,
+                fallback=False, progress=False):
     """The coarsest candidate ``dt_0 / 2**j`` whose estimated error meets a tolerance.
 
-    The one search of qzs (module docstring); the callers give what differs.
+    The one search of qzs (module docstring), on a built probe: the probe says what differs
+    between the models (how to run a candidate and compare two, the cases, the measure).
 
     Parameters
     ----------
-    run : callable
-        ``run(dt, cases)``: integrate the probe at step ``dt`` [s] for the listed case
-        indices; returns one run per case, in that order.
-    compare : callable
-        ``compare(coarse, fine)``: the difference of two runs of one case in the measure's
-        unit (NaN: no measure, e.g. no trusted bin in the band).
-    cases : int
-        How many cases share the step [-].
-    dt0 : float
-        The coarsest candidate [s] (:func:`~qzs.engine.step_choice.admissible_step`).
-    order : int
-        The scheme's order of accuracy [-].
-    measure : {"transmissibility_db", "state_m"}
-        The accuracy measure.
+    probe : Probe
+        The built probe (:class:`qzs.engine.step_choice.Probe`): ``run(dt, cases)`` (one
+        probe run per listed case at step ``dt`` [s]), ``compare(coarse, fine)`` (their
+        difference in the measure's unit; NaN: none), ``cases`` [-] and their ``labels``,
+        the scheme's ``order`` [-], the ``measure``, ``sample_rate`` [Hz], ``solver``, the
+        probe's ``excitation``, ``duration`` [s] and ``band`` [Hz] (for the record),
+        ``max_halvings`` [-], ``safety`` [-] (>= 1, between the estimate and the tolerance),
+        and ``search``: ``give_up_early`` (a case leaves, unmet, once its estimate exceeds
+        the tolerance by more than the order could close), ``per_case`` (the record's
+        per-case entries even for one case), ``unit_name`` (a probe run on the bar).
     tolerance : float
         The tolerance, in the measure's unit.
-    sample_rate : float
-        Output rate [Hz].
-    solver : str
-        The integrator.
-    probe : object
-        The excitation integrated (for the record).
-    probe_duration : float
-        Its length [s].
-    band : tuple of float or None
-        The transmissibility measure's band [Hz].
-    notes : sequence of str
-        What bounds ``dt0`` (:func:`~qzs.engine.step_choice.bound_notes`).
+    dt0 : float
+        The coarsest candidate [s] (:func:`~qzs.engine.step_choice.admissible_step`).
     stability_limit : float
         The largest stable step [s] (for the record).
-    max_halvings : int
-        Halvings of ``dt0`` tried at most [-].
-    safety : float
-        Factor [-] (>= 1) between the estimate and the tolerance.
+    notes : sequence of str
+        What bounds ``dt0`` (:func:`~qzs.engine.step_choice.bound_notes`).
     finest : float, optional
         The finest candidate [s]: halvings stop above it; also the fallback step.
     fallback : bool
         Where no candidate meets the tolerance, or no bin of the band is trusted: return
         the fallback (``finest``, default the paper's step) with ``met`` False instead of
         raising.
-    give_up_early : bool
-        Let a case leave the search, unmet, as soon as its estimate exceeds the tolerance by
-        more than the scheme's order could close by the finest candidate.
-    labels : sequence of str, optional
-        The cases' names in the notes (default ``case 0``, ...).
-    per_case : bool
-        Fill the record's ``case_errors``, ``case_steps`` and ``unmet`` even for one case
-        (always for several).
     progress : bool
         Show a progress bar over the probe runs.
-    unit_name : str
-        What one probe run is called on the bar (``run``, ``batch``).
 
     Returns
     -------
@@ -512,27 +484,42 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     ParameterError
         No bin of the band is trusted on the probe for any case (without ``fallback``).
     """
+    cases, max_halvings = probe.cases, probe.max_halvings
     if finest is not None:
         count = sum(1 for j in range(64) if dt0 / 2 ** j >= finest * (1 - 1e-9))
         max_halvings = min(max_halvings, count - 1)
-    labels = [f"case {c}" for c in range(cases)] if labels is None else [str(x) for x in labels]
+    labels = ([f"case {c}" for c in range(cases)] if probe.labels is None
+              else [str(x) for x in probe.labels])
     if len(labels) != cases:
         raise ParameterError(f"`labels` must name each of the {cases} cases, got {len(labels)}.")
     notes = list(notes)
-    bar = _progress_bar(progress, max_halvings + 1, unit_name)
+    bar = _progress_bar(progress, max_halvings + 1, probe.search.get("unit_name", "run"))
     differences, integrated = {}, []
-    before, after, difference = _probe_runs(run, compare, dt0, bar, differences, integrated)
+    before, after, difference = _probe_runs(probe.run, probe.compare, dt0, bar, differences,
+                                            integrated)
     try:
         met, best, history, untrusted, failed = _loop(
-            difference, cases, order, tolerance, dt0, max_halvings, safety, give_up_early,
-            before=before, after=after)
+            difference, cases, probe.order, tolerance, dt0, max_halvings, probe.safety,
+            probe.search.get("give_up_early", False), before=before, after=after)
     finally:
         if bar is not None:
             bar.close()
-    several = cases > 1 or per_case
-    record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
-                  sample_rate=float(sample_rate), solver=solver, probe=probe,
-                  probe_duration=float(probe_duration), band=band, history=tuple(history))
+    record = dict(measure=probe.measure, tolerance=float(tolerance),
+                  stability_limit=float(stability_limit), sample_rate=float(probe.sample_rate),
+                  solver=probe.solver, probe=probe.excitation,
+                  probe_duration=float(probe.duration), band=probe.band, history=tuple(history))
+    outcome = dict(met=met, best=best, untrusted=untrusted, failed=failed,
+                   differences=differences, integrated=integrated)
+    return _choice(probe, outcome, record, notes, labels, dt0, max_halvings, finest, fallback)
+
+
+def _choice(probe, outcome, record, notes, labels, dt0, max_halvings, finest, fallback):
+    """The record of a finished search: the chosen step and each case's, or the fallback."""
+    cases, order, safety = probe.cases, probe.order, probe.safety
+    several = cases > 1 or probe.search.get("per_case", False)
+    met, best, untrusted, failed, differences, integrated = (
+        outcome[key] for key in ("met", "best", "untrusted", "failed", "differences",
+                                 "integrated"))
     if not met:
         reason = _unmet_reason(best, untrusted, cases, fallback, dt0, max_halvings, safety,
                                record)
