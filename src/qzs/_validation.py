@@ -479,3 +479,30 @@ def renamed_keyword(new, value, old, old_value, *, stacklevel=3):
     warnings.warn(f"`{old}` is deprecated and will be removed in the next release; use "
                   f"`{new}` (the same value and unit).", DeprecationWarning, stacklevel=stacklevel)
     return old_value
+
+
+def deprecated_alias(old, new, value):
+    """A property ``old`` that warns (DeprecationWarning naming ``new``) and returns ``value``:
+    an attribute's old spelling kept one release (:func:`renamed_keyword` for a keyword).
+
+    Parameters
+    ----------
+    old : str
+        The deprecated attribute's name.
+    new : str
+        What to use instead, as the warning shows it (``"intervals['plateau']"``).
+    value : callable
+        The object -> the value (the same numbers as ``new``).
+
+    Returns
+    -------
+    property
+    """
+    def get(self):
+        import warnings
+
+        warnings.warn(f"`{type(self).__name__}.{old}` is deprecated and will be removed in "
+                      f"the next release; use `{new}`.", DeprecationWarning, stacklevel=2)
+        return value(self)
+
+    return property(get, doc=f"Deprecated (one release): use ``{new}``.")

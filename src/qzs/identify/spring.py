@@ -26,7 +26,8 @@ from scipy import optimize
 from qzs._format import number
 from qzs._validation import choice, integer, positive_real, real
 from qzs.errors import DataError, FitError, ParameterError
-from qzs.identify._protocol import FitProtocol, deprecated_alias, interval_attributes
+from qzs._validation import deprecated_alias
+from qzs.identify._protocol import FitProtocol, interval_attributes
 from qzs.identify._statistics import student_quantile
 from qzs.identify.spring_laws import (LawFit, fit_oblique, fit_polynomial, fit_table,
                                       oblique_force)

@@ -123,7 +123,7 @@ def test_the_tolerance_key_and_its_deprecated_name_tolerance_db():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         new = load_sweep(definition(grid=grid, simulation={"tolerance": 0.2}))
-    with pytest.warns(DeprecationWarning, match="`tolerance_db` is deprecated.*write `tolerance`"):
+    with pytest.warns(DeprecationWarning, match="`tolerance_db` is deprecated.*use `tolerance`"):
         old = load_sweep(definition(grid=grid, simulation={"tolerance_db": 0.2}))
     assert new.simulation["tolerance_db"] == old.simulation["tolerance_db"] == 0.2
     assert new.simulation["dt"] is old.simulation["dt"] is None

@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import Any
 import numpy as np
 
-from qzs._validation import integer, known_keys, positive_real, read_toml, real
+from qzs._validation import (integer, known_keys, positive_real, read_toml, real,
+                             renamed_keyword)
 from qzs._validation import seed as checked_seed
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
@@ -211,21 +212,14 @@ def _simulation_table(table):
     """``[simulation]`` with its tolerance under the records' key ``tolerance_db`` [dB].
 
     The file writes ``tolerance`` (the one spelling); ``tolerance_db`` is its deprecated
-    name, read one release more with a :class:`DeprecationWarning`.
+    name, read one release more with a :class:`DeprecationWarning`
+    (:func:`qzs._validation.renamed_keyword`).
     """
-    import warnings
-
     table = dict(_keys(table, "simulation", (*SIMULATION_DEFAULTS, "tolerance")))
-    if "tolerance_db" in table:
-        if "tolerance" in table:
-            raise ParameterError("give `tolerance` only in [simulation], got both `tolerance` "
-                                 "and its deprecated name `tolerance_db`; drop `tolerance_db`.",
-                                 ("tolerance", "tolerance_db"))
-        warnings.warn("[simulation] `tolerance_db` is deprecated and will be removed in the next "
-                      "release; write `tolerance` (the same value, dB).", DeprecationWarning,
-                      stacklevel=2)
-    elif "tolerance" in table:
-        table["tolerance_db"] = table.pop("tolerance")
+    tolerance = renamed_keyword("tolerance", table.pop("tolerance", None), "tolerance_db",
+                                table.pop("tolerance_db", None), stacklevel=4)
+    if tolerance is not None:
+        table["tolerance_db"] = tolerance
     return table
 
 
