@@ -9,7 +9,7 @@ Run from the repository root with the project's interpreter::
 
 For each tolerance on the transmissibility (dB over the band, default 1-20 Hz):
 
-1. ``qzs.engine.choose_step(chirp, tolerance_db=tol, band=band)`` picks the step on its
+1. ``qzs.engine.choose_step(chirp, tolerance=tol, band=band)`` picks the step on its
    60 s probe (its own wall time is reported: it is paid once per model);
 2. the full chirp is integrated at the chosen step and at the paper's dt = 1e-4 s (ode3,
    1 kHz output), best of ``--repeats`` wall times of ``qzs.simulate`` each, taking turns;
@@ -76,7 +76,7 @@ def main(argv=None):
     choices = []
     for tol in args.tolerance:
         start = time.perf_counter()
-        choice = choose_step(chirp, tolerance_db=tol, band=band, sample_rate=RATE)
+        choice = choose_step(chirp, tolerance=tol, band=band, sample_rate=RATE)
         choices.append((tol, choice, time.perf_counter() - start))
     _, reference = _estimate(chirp, REFERENCE_DT, fft_length)
 

@@ -245,11 +245,12 @@ def balance():
 def paper(folder):
     out = os.path.join(folder, "paper")
     subprocess.run([sys.executable, "-m", "qzs", "paper", "--quick", "--out", out],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                   env={**os.environ, "QZS_CACHE_DIR": folder})  # steps chosen anew
     with open(os.path.join(out, "metrics.json"), encoding="utf-8") as handle:
         metrics = json.load(handle)
     drop = {"wall_seconds", "generated", "elapsed", "seconds", "version", "qzs_version",
-            "created", "date", "timestamp", "runs_seconds", "steps_per_second"}
+            "created", "date", "timestamp", "runs_seconds", "steps_per_second", "cached"}
 
     def clean(value):
         if isinstance(value, dict):

@@ -579,7 +579,7 @@ import qzs
 from qzs.engine.accuracy import choose_step
 qzs.simulate(qzs.Chirp(), duration=1e-3, dt=1e-3)  # kernels loaded (start-up, not the choice)
 start = time.perf_counter()
-choice = choose_step(qzs.Chirp(duration={duration!r}), tolerance_db=0.01, cache={cache})
+choice = choose_step(qzs.Chirp(duration={duration!r}), tolerance=0.01, cache={cache})
 print(time.perf_counter() - start, choice.dt)
 """
 

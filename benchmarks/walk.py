@@ -106,6 +106,9 @@ def main(argv):
     print(f"  file changes     {changes}")
     print(f"  moves back up    {up}")
     print(f"  callbacks        {callbacks}")
+    if os.environ.get("QZS_WALK_FILES"):  # the files themselves, one per line
+        for path in sorted(files):
+            print("   ", os.path.relpath(path, ROOT))
 
 
 if __name__ == "__main__":

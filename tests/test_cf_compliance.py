@@ -199,6 +199,15 @@ def batch_with_blocks(folder):
     return write_dataset(result.to_xarray(), folder / "batch_blocks.nc")
 
 
+def step_choice(folder):
+    """A step choice's candidates (StepChoice.save)."""
+    import qzs
+    from qzs.engine.accuracy import choose_step
+
+    return choose_step(qzs.Chirp(duration=20.0, f1=20.0), tolerance=1e-4).save(
+        folder / "step_choice.nc")
+
+
 #: Every kind of NetCDF file qzs writes: name -> writer of one small file into a folder.
 KINDS = {"single_run": single_run, "run_with_blocks": run_with_blocks,
          "batch_with_blocks": batch_with_blocks,
@@ -206,7 +215,7 @@ KINDS = {"single_run": single_run, "run_with_blocks": run_with_blocks,
          "sweep": sweep, "hexapod_run": hexapod_run, "response": response,
          "experiment": experiment, "curves": curves, "optimisation": optimisation,
          "sensitivity": sensitivity, "hexapod_transmissibility": hexapod_transmissibility,
-         "friction_fit": friction_fit}
+         "friction_fit": friction_fit, "step_choice": step_choice}
 
 
 @pytest.fixture(scope="module")

@@ -436,3 +436,73 @@ def _table_refusal(error, prefix, options, key, value, reason, fix):
             and error.__init__ is ParameterError.__init__:
         return error(f"{prefix}{reason}.", options)
     return error(f"{prefix}{reason}.")
+
+
+def renamed_keyword(new, value, old, old_value, *, stacklevel=3):
+    """A keyword's value under its new name, its old name kept one release with a warning.
+
+    Parameters
+    ----------
+    new : str
+        The keyword's name now (``"tolerance"``).
+    value : object
+        Its value (None: not given).
+    old : str
+        The deprecated name (``"tolerance_db"``).
+    old_value : object
+        The value given under the old name (None: not given).
+    stacklevel : int
+        Where the warning points (3: the caller of the function that calls this).
+
+    Returns
+    -------
+    object
+        ``value``, else ``old_value``.
+
+    Raises
+    ------
+    ParameterError
+        Both names given.
+
+    Warns
+    -----
+    DeprecationWarning
+        The old name given: it says the new one.
+    """
+    if old_value is None:
+        return value
+    import warnings
+
+    if value is not None:
+        raise ParameterError(f"give `{new}` only, got both `{new}` ({value!r}) and its "
+                             f"deprecated name `{old}` ({old_value!r}); drop `{old}`.", (new, old))
+    warnings.warn(f"`{old}` is deprecated and will be removed in the next release; use "
+                  f"`{new}` (the same value and unit).", DeprecationWarning, stacklevel=stacklevel)
+    return old_value
+
+
+def deprecated_alias(old, new, value):
+    """A property ``old`` that warns (DeprecationWarning naming ``new``) and returns ``value``:
+    an attribute's old spelling kept one release (:func:`renamed_keyword` for a keyword).
+
+    Parameters
+    ----------
+    old : str
+        The deprecated attribute's name.
+    new : str
+        What to use instead, as the warning shows it (``"intervals['plateau']"``).
+    value : callable
+        The object -> the value (the same numbers as ``new``).
+
+    Returns
+    -------
+    property
+    """
+    def get(self):
+        import warnings
+
+        warnings.warn(f"`{type(self).__name__}.{old}` is deprecated and will be removed in "
+                      f"the next release; use `{new}`.", DeprecationWarning, stacklevel=2)
+        return value(self)
+
+    return property(get, doc=f"Deprecated (one release): use ``{new}``.")

@@ -7,7 +7,8 @@ from qzs.cli import main
 from qzs.cli.design import parse_list, parse_pair
 from qzs.errors import ParameterError
 from qzs.workflows import design as D
-from qzs.workflows.design import hunting, integration_step, proportional_search
+from qzs.engine import step_choice
+from qzs.workflows.design import hunting, proportional_search
 from qzs.workflows.design import cost
 
 
@@ -84,7 +85,7 @@ def test_cli_bad_input_is_exit_2_before_any_work(argv, words, monkeypatch, capsy
     for module, name in [(proportional_search, "simulate"),
                          (proportional_search, "simulate_batch"),
                          (cost, "simulate_batch"), (hunting, "simulate"),
-                         (integration_step, "choose_batch_step")]:
+                         (step_choice, "choose")]:
         monkeypatch.setattr(module, name, forbidden)
     assert main(argv + ["--quiet", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err

@@ -223,7 +223,7 @@ def test_tolerance_chooses_the_step_the_run_uses(capsys):
     assert main(["simulate", "--excitation-duration", "100", "--duration", "20",
                  "--tolerance", "0.05", "--sample-rate", "500", "--plot", "none", "--json"]) == 0
     record = json.loads(capsys.readouterr().out)
-    expected = choose_step(excitation_over(Chirp(duration=100.0), 20.0), tolerance_db=0.05,
+    expected = choose_step(excitation_over(Chirp(duration=100.0), 20.0), tolerance=0.05,
                            sample_rate=500.0)
     assert record["step"]["dt"] == record["run"]["dt"] == expected.dt
     assert record["step"]["chosen"] and record["step"]["unit"] == "dB"
@@ -243,7 +243,7 @@ def test_without_a_step_the_default_tolerance_chooses_it_and_dt_stays_literal(ca
     assert main(["simulate", *common, "--json"]) == 0
     record = json.loads(capsys.readouterr().out)
     expected = choose_step(excitation_over(Chirp(duration=100.0), 40.0),
-                           tolerance_db=ACCURACY["tolerance_db"], sample_rate=500.0)
+                           tolerance=ACCURACY["tolerance_db"], sample_rate=500.0)
     assert record["run"]["dt"] == expected.dt > 1e-4
     assert record["step"]["tolerance"] == ACCURACY["tolerance_db"]
     assert main(["simulate", *common, "--quiet"]) == 0

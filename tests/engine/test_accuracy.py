@@ -41,7 +41,7 @@ def _check_against_fine(choice, measure, factor=64, isolator=None, controller=No
 
 @pytest.mark.parametrize("tolerance", [1e-3, 1e-4])
 def test_chosen_step_meets_a_db_tolerance_against_a_much_finer_reference(tolerance):
-    choice = choose_step(CHIRP, tolerance_db=tolerance, band=(1.0, 20.0), probe_duration=PROBE)
+    choice = choose_step(CHIRP, tolerance=tolerance, band=(1.0, 20.0), probe_duration=PROBE)
     assert isinstance(choice, StepChoice)
     assert choice.measure == "transmissibility_db" and 2 * choice.error <= tolerance
     actual = _check_against_fine(choice, "transmissibility_db")
@@ -67,7 +67,7 @@ def test_a_tighter_tolerance_never_gives_a_larger_step():
              for tol in (1e-4, 1e-5, 1e-6, 1e-7)]
     assert all(later <= earlier for earlier, later in zip(steps, steps[1:]))
     assert steps[-1] < steps[0]
-    db = [choose_step(CHIRP, tolerance_db=tol, probe_duration=PROBE).dt
+    db = [choose_step(CHIRP, tolerance=tol, probe_duration=PROBE).dt
           for tol in (1e-2, 1e-4, 2e-5)]
     assert all(later <= earlier for earlier, later in zip(db, db[1:]))
 
@@ -76,7 +76,7 @@ def test_a_tighter_tolerance_never_gives_a_larger_step():
                                                           (50.0, 0.0)])
 def test_the_step_respects_stability_and_divides_the_output_period(sample_rate, controller_rate):
     controller = ControllerParameters(controller_rate=controller_rate)
-    choice = choose_step(CHIRP, controller=controller, tolerance_db=0.5,
+    choice = choose_step(CHIRP, controller=controller, tolerance=0.5,
                          sample_rate=sample_rate, probe_duration=PROBE)
     limit = largest_stable_step(IsolatorParameters(), controller, "ode3")
     assert choice.stability_limit == pytest.approx(limit)
@@ -101,7 +101,7 @@ def test_stiff_stops_lower_the_step():
     stiff = IsolatorParameters(stop_stiffness=1e8)
     limit = largest_stable_step(stiff, None, "ode3")
     assert limit < 1e-3
-    choice = choose_step(CHIRP, stiff, tolerance_db=0.5, probe_duration=PROBE)
+    choice = choose_step(CHIRP, stiff, tolerance=0.5, probe_duration=PROBE)
     assert choice.dt <= limit
     steps_per_sample(1000.0, choice.dt)
 
@@ -112,21 +112,21 @@ def _refuse_to_simulate(*args, **kwargs):
 
 @pytest.mark.parametrize("kwargs, match", [
     (dict(), "exactly one"),
-    (dict(tolerance_db=0.1, tolerance_state=1e-6), "exactly one"),
-    (dict(tolerance_db=0.0), "positive"),
-    (dict(tolerance_db=-0.1), "positive"),
+    (dict(tolerance=0.1, tolerance_state=1e-6), "exactly one"),
+    (dict(tolerance=0.0), "positive"),
+    (dict(tolerance=-0.1), "positive"),
     (dict(tolerance_state=math.nan), "`tolerance_state` must be finite, got nan"),
-    (dict(tolerance_db=True), "`tolerance_db` must be a number, got the boolean True"),
-    (dict(tolerance_db=0.1, band=(1.0, 30.0)), "outside the excitation"),
-    (dict(tolerance_db=0.1, band=(5.0, 1.0)), "low <= high"),
-    (dict(tolerance_db=0.1, band=(1.0, 20.0), sample_rate=30.0), "Nyquist"),
-    (dict(tolerance_db=0.1, band="wide"), "two frequencies"),
-    (dict(tolerance_db=0.1, solver="rk45"), "solver"),
-    (dict(tolerance_db=0.1, sample_rate=-1.0), "sample_rate"),
-    (dict(tolerance_db=0.1, probe_duration=0.0), "probe_duration"),
-    (dict(tolerance_db=0.1, fft_length=10 ** 9), "fft_length"),
-    (dict(tolerance_db=0.1, max_halvings=1), "max_halvings"),
-    (dict(tolerance_db=0.1, safety=0.5), "safety"),
+    (dict(tolerance=True), "`tolerance` must be a number, got the boolean True"),
+    (dict(tolerance=0.1, band=(1.0, 30.0)), "outside the excitation"),
+    (dict(tolerance=0.1, band=(5.0, 1.0)), "low <= high"),
+    (dict(tolerance=0.1, band=(1.0, 20.0), sample_rate=30.0), "Nyquist"),
+    (dict(tolerance=0.1, band="wide"), "two frequencies"),
+    (dict(tolerance=0.1, solver="rk45"), "solver"),
+    (dict(tolerance=0.1, sample_rate=-1.0), "sample_rate"),
+    (dict(tolerance=0.1, probe_duration=0.0), "probe_duration"),
+    (dict(tolerance=0.1, fft_length=10 ** 9), "fft_length"),
+    (dict(tolerance=0.1, max_halvings=1), "max_halvings"),
+    (dict(tolerance=0.1, safety=0.5), "safety"),
 ])
 def test_bad_arguments_raise_before_any_simulation(monkeypatch, kwargs, match):
     monkeypatch.setattr(simulate_module, "integrate", _refuse_to_simulate)
@@ -137,11 +137,11 @@ def test_bad_arguments_raise_before_any_simulation(monkeypatch, kwargs, match):
 def test_bad_models_and_excitations_are_refused(monkeypatch):
     monkeypatch.setattr(simulate_module, "integrate", _refuse_to_simulate)
     with pytest.raises(ParameterError, match="excitation"):
-        choose_step("chirp", tolerance_db=0.1)
+        choose_step("chirp", tolerance=0.1)
     with pytest.raises(ParameterError, match="isolator"):
-        choose_step(CHIRP, ControllerParameters(), tolerance_db=0.1)
+        choose_step(CHIRP, ControllerParameters(), tolerance=0.1)
     with pytest.raises(ParameterError, match="band"):  # a sine's band is its frequency
-        choose_step(Sine(frequency=3.0), tolerance_db=0.1, band=(1.0, 20.0))
+        choose_step(Sine(frequency=3.0), tolerance=0.1, band=(1.0, 20.0))
 
 
 def test_an_unreachable_tolerance_is_an_error_not_a_silent_step():
@@ -188,7 +188,7 @@ def test_the_probe_of_a_chirp_covers_the_band_and_is_short():
 
 
 def test_summary_names_the_step_and_the_binding_limit():
-    choice = choose_step(CHIRP, tolerance_db=0.1, probe_duration=PROBE, progress=False)
+    choice = choose_step(CHIRP, tolerance=0.1, probe_duration=PROBE, progress=False)
     text = choice.summary()
     assert "dt = 0.001 s" in text and "dB" in text and "output rate bounds" in text
     with pytest.raises(AttributeError):
@@ -276,7 +276,7 @@ def test_the_chosen_step_is_the_largest_whose_db_error_meets_the_tolerance():
     dt0, errors = _candidate_errors(probe, isolator, controller, "transmissibility_db", run, 2,
                                     7, band)
     tolerance = SAFETY * math.sqrt(errors[0] * errors[1])
-    choice = choose_step(Chirp(duration=20.0), isolator, controller, tolerance_db=tolerance,
+    choice = choose_step(Chirp(duration=20.0), isolator, controller, tolerance=tolerance,
                          band=band, probe_duration=20.0)
     assert choice.probe == probe
     assert choice.dt == dt0 / 2
@@ -303,7 +303,7 @@ def test_a_controller_rate_that_shares_no_step_with_the_output_is_refused_at_onc
     assert admissible_step(1000.0, 3000.0, stable) == (pytest.approx(1 / 6000), 6)
     with pytest.raises(ControllerRateError):
         choose_step(CHIRP, controller=ControllerParameters(controller_rate=333.0),
-                    tolerance_db=0.5, probe_duration=PROBE)
+                    tolerance=0.5, probe_duration=PROBE)
 
 
 def test_a_sine_probe_of_a_fraction_of_an_output_period_is_compared_sample_for_sample():
@@ -331,15 +331,15 @@ def test_a_step_choice_loads_scipy_signal_beside_its_first_probe_runs(monkeypatc
     """scipy.signal (0.9 s of imports) is loaded by the first estimate, not by importing the
     spectral module: the choice starts loading it in a thread before its probes integrate,
     so that the import overlaps them (a first run's choice took 0.2-0.4 s longer without)."""
-    import qzs.engine.accuracy as accuracy
     import qzs.engine.single as single
+    import qzs.engine.step_choice as step_choice
 
     order = []
-    monkeypatch.setattr(accuracy, "import_in_background",
+    monkeypatch.setattr(step_choice, "import_in_background",
                         lambda *modules: order.append(("import", modules)))
     integrate = single.integrate
     monkeypatch.setattr(single, "integrate",
                         lambda *a, **k: order.append(("probe",)) or integrate(*a, **k))
-    choose_step(Chirp(duration=100.0, f1=5.0), tolerance_db=0.05, probe_duration=12.0)
+    choose_step(Chirp(duration=100.0, f1=5.0), tolerance=0.05, probe_duration=12.0)
     assert order[0][0] == "import" and "scipy.signal" in order[0][1]
     assert ("probe",) in order[1:]

@@ -4,7 +4,6 @@ import pytest
 
 from qzs.engine.accuracy import check_band as error_band
 from qzs.engine.accuracy import frequency_range as excitation_range
-from qzs.engine.step_search import tolerance_measure
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, Sine
 
@@ -23,12 +22,3 @@ def test_the_band_is_the_excitations_from_one_hertz_or_a_band_inside_it():
         error_band((5.0, 2.0), chirp, 1000.0)
 
 
-def test_exactly_one_tolerance_is_given():
-    assert tolerance_measure(0.01, None) == ("transmissibility_db", 0.01)
-    assert tolerance_measure(None, 1e-6) == ("state_m", 1e-6)
-    with pytest.raises(ParameterError, match="got tolerance_db and tolerance_state"):
-        tolerance_measure(0.01, 1e-6)
-    with pytest.raises(ParameterError, match="got neither"):
-        tolerance_measure(None, None)
-    with pytest.raises(ParameterError, match="tolerance_db"):
-        tolerance_measure(-1.0, None)

@@ -27,10 +27,10 @@ CASES = [(IsolatorParameters(), ControllerParameters()),
 
 def test_each_case_gets_its_own_choice_and_the_batch_the_finest_step():
     tolerance = 1e-3
-    batch = choose_batch_step(CASES, CHIRP, tolerance_db=tolerance, probe_duration=PROBE,
+    batch = choose_batch_step(CASES, CHIRP, tolerance=tolerance, probe_duration=PROBE,
                               labels=["table 1", "Cv = 400", "Fs = 15", "no PI"])
     assert isinstance(batch, BatchStepChoice)
-    alone = [choose_step(CHIRP, *case, tolerance_db=tolerance, probe_duration=PROBE)
+    alone = [choose_step(CHIRP, *case, tolerance=tolerance, probe_duration=PROBE)
              for case in CASES[:3]]
     # the lockstep probe is the one-case probe, bit for bit: the same steps and estimates
     assert list(batch.case_steps[:3]) == [choice.dt for choice in alone]
@@ -41,7 +41,7 @@ def test_each_case_gets_its_own_choice_and_the_batch_the_finest_step():
     assert batch.reference_dt == batch.dt / 4
     # the case without PI: no step meets it, alone an error, in the batch a note
     with pytest.raises(ToleranceNotMetError):
-        choose_step(CHIRP, *NO_PI, tolerance_db=tolerance, probe_duration=PROBE)
+        choose_step(CHIRP, *NO_PI, tolerance=tolerance, probe_duration=PROBE)
     assert batch.unmet == (3,)
     assert math.isinf(batch.case_errors[3]) and math.isnan(batch.case_steps[3])
     assert any(note.startswith("no PI: no step down to") for note in batch.notes)
@@ -67,7 +67,7 @@ def test_no_case_meeting_the_tolerance_is_an_error_and_a_hopeless_case_is_probed
 
     monkeypatch.setattr(batch_module, "simulate_batch", counted)
     with pytest.raises(ToleranceNotMetError, match="no step down to") as caught:
-        choose_batch_step([NO_PI], CHIRP, tolerance_db=1e-3, probe_duration=PROBE)
+        choose_batch_step([NO_PI], CHIRP, tolerance=1e-3, probe_duration=PROBE)
     error, order = caught.value, SOLVERS[defaults.SIMULATION["solver"]][1]
     assert error.safety * error.smallest_error > error.tolerance * 2.0 ** (
         order * (BATCH_MAX_HALVINGS - 2))
@@ -75,12 +75,12 @@ def test_no_case_meeting_the_tolerance_is_an_error_and_a_hopeless_case_is_probed
 
 
 @pytest.mark.parametrize("cases, options, match", [
-    ([], {"tolerance_db": 0.01}, "at least one"),
+    ([], {"tolerance": 0.01}, "at least one"),
     (CASES[:1], {}, "exactly one of"),
-    (CASES[:1], {"tolerance_db": 0.01, "tolerance_state": 1e-6}, "exactly one of"),
-    (CASES[:1], {"tolerance_db": -1.0}, "tolerance_db"),
-    (CASES[:1], {"tolerance_db": 0.01, "labels": ["a", "b"]}, "labels"),
-    (CASES[:1], {"tolerance_db": 0.01, "band": (1.0, 50.0)}, "band"),
+    (CASES[:1], {"tolerance": 0.01, "tolerance_state": 1e-6}, "exactly one of"),
+    (CASES[:1], {"tolerance": -1.0}, "tolerance"),
+    (CASES[:1], {"tolerance": 0.01, "labels": ["a", "b"]}, "labels"),
+    (CASES[:1], {"tolerance": 0.01, "band": (1.0, 50.0)}, "band"),
 ])
 def test_bad_arguments_raise_before_any_simulation(monkeypatch, cases, options, match):
     import qzs.engine.batch

@@ -116,12 +116,12 @@ def test_a_literal_step_is_a_record_and_the_python_default_is_the_papers_step():
 ])
 def test_inconsistent_or_impossible_requests_are_refused_before_any_run(options, match,
                                                                         monkeypatch):
-    import qzs.engine.accuracy as accuracy
+    import qzs.engine.step_choice as step_choice
 
     def no_search(*args, **kwargs):
         raise AssertionError("a step was searched")
 
-    monkeypatch.setattr(accuracy, "choose_step", no_search)
+    monkeypatch.setattr(step_choice, "choose", no_search)
     with pytest.raises(ParameterError, match=match):
         qzs.resolve(**{"excitation": Chirp(), **options})
 

@@ -72,11 +72,11 @@ from qzs import Chirp, ControllerParameters, IsolatorParameters
 from qzs.engine.accuracy import choose_step
 from qzs.engine.accuracy_batch import choose_batch_step
 chirp = Chirp(duration=30.0, f1=5.0)
-choose_step(chirp, tolerance_db=0.05, probe_duration=8.0, cache=True)
+choose_step(chirp, tolerance=0.05, probe_duration=8.0, cache=True)
 choose_step(chirp, tolerance_state=1e-15, probe_duration=2.0, max_halvings=2, fallback=True,
             cache=True)
 cases = [(IsolatorParameters(), ControllerParameters(pi_kp=p)) for p in (50.0, 80.0)]
-choose_batch_step(cases, chirp, tolerance_db=0.05, probe_duration=8.0, cache=True, workers=2)
+choose_batch_step(cases, chirp, tolerance=0.05, probe_duration=8.0, cache=True, workers=2)
 sys.setprofile(None)
 threading.setprofile(None)
 print(json.dumps(sorted(ran)))
@@ -183,7 +183,7 @@ def test_text_moved_across_the_boundary_of_two_sources_changes_the_key(tmp_path)
 
 
 def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch):
-    first = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    first = choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True)
     assert not first.cached and len(list(cache.glob("*.json"))) == 1
 
     def no_run(*args, **kwargs):
@@ -191,7 +191,7 @@ def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch
 
     import qzs.engine.single as simulate_module
     monkeypatch.setattr(simulate_module, "integrate", no_run)
-    again = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    again = choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True)
     assert again.cached
     for field in dataclasses.fields(first):
         if field.name not in ("cached", "probe"):
@@ -199,28 +199,28 @@ def test_a_repeated_choice_is_read_back_whole_without_a_probe(cache, monkeypatch
     assert again.probe == first.probe
     # another tolerance is another question: it needs the probe (and so fails here)
     with pytest.raises(AssertionError, match="ran a probe"):
-        choose_step(CHIRP, tolerance_db=0.04, probe_duration=PROBE, cache=True)
+        choose_step(CHIRP, tolerance=0.04, probe_duration=PROBE, cache=True)
     # without cache=True the disk is neither read nor written
     with pytest.raises(AssertionError, match="ran a probe"):
-        choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE)
+        choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE)
 
 
 def test_a_damaged_record_or_an_unwritable_folder_costs_a_new_choice(cache, tmp_path,
                                                                       monkeypatch):
-    first = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    first = choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True)
     (record,) = cache.glob("*.json")
     record.write_text('{"format": 1, "dt": "not a step"')
-    again = choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True)
+    again = choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True)
     assert not again.cached and again.dt == first.dt
     record.write_text('{"format": 1, "dt": -1.0}')
     assert step_cache.load(record.stem) is not None
-    assert not choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True).cached
+    assert not choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True).cached
     # a file where the folder should be: nothing is written, the choice is still made
     blocked = tmp_path / "blocked"
     blocked.write_text("")
     monkeypatch.setenv(step_cache.CACHE_ENV, str(blocked))
     assert not step_cache.store("k", {"dt": 1.0})
-    assert choose_step(CHIRP, tolerance_db=0.05, probe_duration=PROBE, cache=True).dt == first.dt
+    assert choose_step(CHIRP, tolerance=0.05, probe_duration=PROBE, cache=True).dt == first.dt
     assert not list(cache.glob("*.part")) and not list(cache.glob(".*"))
 
 
@@ -235,9 +235,9 @@ def _same(a, b):
 
 def _synthetic_choice(constant, cases=1, **options):
     """The search on runs ``C * dt**3`` (no probe integrated): a choice in a millisecond."""
-    from qzs.engine.step_search import search_step
+    from engine.search_probe import search
 
-    return search_step(run=lambda dt, members: [constant * dt ** 3 for _ in members],
+    return search(run=lambda dt, members: [constant * dt ** 3 for _ in members],
                        compare=lambda coarse, fine: abs(coarse - fine), cases=cases, dt0=1e-3,
                        order=3, measure="transmissibility_db", tolerance=1e-3,
                        sample_rate=1000.0, solver="ode3", probe=CHIRP, probe_duration=PROBE,
@@ -314,7 +314,7 @@ def test_a_repeated_batch_choice_is_read_back_whole_without_a_probe(cache, monke
 
     cases = [(IsolatorParameters(), ControllerParameters()),
              (IsolatorParameters(), ControllerParameters(pi_kp=0.0, pi_ki=0.0))]
-    options = dict(tolerance_db=1e-3, probe_duration=PROBE, fallback=True,
+    options = dict(tolerance=1e-3, probe_duration=PROBE, fallback=True,
                    labels=["table 1", "no PI"])
     first = choose_batch_step(cases, CHIRP, cache=True, **options)
     assert not first.cached and first.unmet == (1,) and len(list(cache.glob("*.json"))) == 1
@@ -330,7 +330,7 @@ def test_a_repeated_batch_choice_is_read_back_whole_without_a_probe(cache, monke
             assert getattr(again, field.name) == getattr(first, field.name) or (
                 field.name == "case_steps" and np.array_equal(
                     again.case_steps, first.case_steps, equal_nan=True)), field.name
-    for other in (dict(options, labels=["a", "b"]), dict(options, tolerance_db=2e-3)):
+    for other in (dict(options, labels=["a", "b"]), dict(options, tolerance=2e-3)):
         with pytest.raises(AssertionError, match="ran a probe"):
             choose_batch_step(cases, CHIRP, cache=True, **other)
     with pytest.raises(AssertionError, match="ran a probe"):

@@ -18,8 +18,9 @@ import math
 import pytest
 
 from qzs import defaults
+from engine.search_probe import search
 from qzs.engine.step_search import (MAX_HALVINGS, SAFETY, StepChoice, halving_search,
-                                    record_line, search_step)
+                                    record_line)
 from qzs.errors import ParameterError, ToleranceNotMetError
 
 ORDER = 3
@@ -34,7 +35,7 @@ def _search(constants, tolerance, **options):
         calls.extend((dt, c) for c in cases)
         return [constants[c] * dt ** ORDER for c in cases]
 
-    choice = search_step(run=run, compare=lambda coarse, fine: abs(coarse - fine),
+    choice = search(run=run, compare=lambda coarse, fine: abs(coarse - fine),
                          cases=len(constants), dt0=DT0, order=ORDER,
                          measure="transmissibility_db", tolerance=tolerance, sample_rate=1000.0,
                          solver="ode3", probe=None, probe_duration=10.0, band=(1.0, 20.0),
@@ -76,7 +77,7 @@ def test_several_cases_share_the_finest_of_their_steps_and_an_unmet_case_is_name
         return [1e3 * dt ** ORDER if c == 0 else (stuck.__setitem__(0, stuck[0] + 1) or stuck[0])
                 for c in cases]
 
-    mixed = search_step(run=run, compare=lambda a, b: abs(a - b), cases=2, dt0=DT0,
+    mixed = search(run=run, compare=lambda a, b: abs(a - b), cases=2, dt0=DT0,
                         order=ORDER, measure="transmissibility_db", tolerance=tolerance,
                         sample_rate=1000.0, solver="ode3", probe=None, probe_duration=10.0,
                         band=(1.0, 20.0), stability_limit=0.005, labels=["ok", "stuck"])
@@ -133,8 +134,8 @@ def test_no_trusted_bin_is_an_error_or_the_fallback():
                    solver="ode3", probe=None, probe_duration=10.0, band=(1.0, 20.0),
                    stability_limit=0.005)
     with pytest.raises(ParameterError, match="no bin of the band"):
-        search_step(**options)
-    choice = search_step(**options, fallback=True)
+        search(**options)
+    choice = search(**options, fallback=True)
     assert not choice.met and "no bin of the band" in choice.notes[-1]
 
 

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from qzs.identify import FrictionFit, SpringFit, TransmissibilityFit
-from qzs.identify._protocol import (FREQUENCY_SCALE_OPTION, FitProtocol, deprecated_alias,
-                                    interval_attributes, plot_doc)
+from qzs._validation import deprecated_alias
+from qzs.identify._protocol import (FREQUENCY_SCALE_OPTION, FitProtocol, interval_attributes,
+                                    plot_doc)
 
 
 @dataclass(frozen=True)

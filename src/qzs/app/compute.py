@@ -489,8 +489,8 @@ def _resolved(excitation, isolator, controller, sample_rate, duration, tolerance
 
 
 def _step_note(step):
-    """The fallback's reason, for the page's notes (empty where the step met its tolerance)."""
-    return "" if step.met else step.notes[-1]
+    """The unmet tolerance's one sentence, for the page's notes (empty where it was met)."""
+    return step.unmet_note
 
 
 @functools.lru_cache(maxsize=64)
@@ -498,8 +498,7 @@ def _response_step(frequencies, amplitude, isolator, controller, sample_rate):
     from qzs.workflows.response import response_step
 
     return response_step(np.asarray(frequencies), amplitude, isolator, controller,
-                         solver=defaults.SIMULATION["solver"],
-                         tolerance_db=defaults.ACCURACY["tolerance_db"], sample_rate=sample_rate)
+                         solver=defaults.SIMULATION["solver"], sample_rate=sample_rate)
 
 
 def _check_steps(name, simulated_time, dt):

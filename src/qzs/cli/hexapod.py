@@ -331,7 +331,7 @@ def run_simulate(args):
             options["duration"] = args.excitation_duration
         excitation = {args.axis: options}
     result = simulate_setup(setup, excitation=excitation, duration=args.duration, dt=args.dt,
-                            tolerance_db=args.tolerance, tolerance_state=args.tolerance_state,
+                            tolerance=args.tolerance, tolerance_state=args.tolerance_state,
                             sample_rate=args.sample_rate, solver=args.solver,
                             progress=not args.quiet and not args.json, out=args.out or None,
                             interruptible=True, argument="--out",
@@ -399,7 +399,7 @@ def run_transmissibility(args):
                if getattr(args, name) is not None}
     result = hexapod_transmissibility(
         setup, axes=args.axes, amplitude=_amplitude(args.amplitude),
-        **{**dict(CHIRP), **options}, dt=args.dt, tolerance_db=args.tolerance,
+        **{**dict(CHIRP), **options}, dt=args.dt, tolerance=args.tolerance,
         sample_rate=args.sample_rate,
         workers=args.workers, progress=not args.quiet and not args.json)
     folder = Path(args.out)
@@ -432,7 +432,7 @@ def run_study(args):
 
     check_output(args, "--out", args.out, suffixes=None, directory=True)
     result = run_hexapod_study(args.out, quick=args.quick, dt=args.dt,
-                               tolerance_db=args.tolerance, workers=args.workers,
+                               tolerance=args.tolerance, workers=args.workers,
                                progress=not args.quiet and not args.json,
                                frequency_scale=args.frequency_axis)
     record = {"quick": result.quick, "wall_seconds": result.wall_seconds,

@@ -214,7 +214,7 @@ def run(args):
     if args.dt is not None:
         options["dt"] = args.dt
     elif args.tolerance is not None:
-        options["tolerance_db"] = args.tolerance
+        options["tolerance"] = args.tolerance
     elif "dt" in simulation:
         options["dt"] = simulation["dt"]
     if args.solver or "solver" in simulation:

@@ -80,7 +80,7 @@ def run(args):
                                         workers=args.workers,
                                         progress=not args.quiet and not args.json,
                                         argument="--out", dt=args.dt,
-                                        tolerance_db=args.tolerance,
+                                        tolerance=args.tolerance,
                                         frequency_scale=args.frequency_axis,
                                         spring=spring)
     lines = [f"{result.study.name:<12} {len(result.cases):>2} case(s) {result.seconds:7.1f} s"

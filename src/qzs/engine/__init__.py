@@ -17,6 +17,8 @@
 ``result``          :class:`SimulationResult`
 ``result_file``     a run's file: :class:`~qzs.engine.result_file.ResultWriter`, save, read, size
 ``step_search``     the one step search, its fallback and its record (:class:`StepChoice`)
+``step_choice``     :func:`~qzs.engine.step_choice.choose`: a request and a probe, one call
+``step_views``      a step choice's candidates as a dataset (its ``to_xarray``, ``save``)
 ``accuracy``        :func:`choose_step`, the step of one axis: its probe and measures
 ``accuracy_batch``  :func:`~qzs.engine.accuracy_batch.choose_batch_step`, one step for a batch
 ``run_spec``        :func:`resolve`, a run resolved once: inputs, duration, step and record

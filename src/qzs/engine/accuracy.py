@@ -7,29 +7,30 @@ step halving on a short representative stretch of the excitation (the *probe*):
 
 >>> from qzs import Chirp
 >>> from qzs.engine.accuracy import choose_step
->>> choice = choose_step(Chirp(), tolerance_db=0.01)  # doctest: +SKIP
+>>> choice = choose_step(Chirp(), tolerance=0.01)  # doctest: +SKIP
 >>> choice.dt, choice.error  # doctest: +SKIP
 (0.001, 0.0004...)
 """
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from qzs import _validation, defaults
 from qzs._format import decibels
-from qzs._lazy import import_in_background
 from qzs._validation import choice as _choice
-from qzs.engine.step_search import (ADMISSIBLE_REFINEMENT, MAX_HALVINGS, MEASURE_UNITS,
-                                    RATE_REFINEMENT_MAX, SAFETY, StepChoice, admissible_step,
-                                    bound_notes, halving_search, search_step,
-                                    tolerance_measure)
+from qzs.engine.step_choice import (ADMISSIBLE_REFINEMENT, RATE_REFINEMENT_MAX,  # noqa: F401
+                                    ProbeSettings, admissible_step, spectral_beside_probes)
+from qzs.engine.step_search import (MAX_HALVINGS, MEASURE_UNITS, SAFETY, StepChoice,
+                                    halving_search)
 from qzs.errors import ParameterError
 from qzs.model.excitation import Chirp, RandomExcitation, Sine
 
-__all__ = ["StepChoice", "choose_step", "default_tolerance", "probe_excitation", "step_error",
+__all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings", "spectral_beside_probes"]
+           "probe_settings", "spectral_beside_probes", "SingleProbe"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -290,28 +291,100 @@ def check_band(band, excitation, sample_rate):
     return (low, high)
 
 
-def spectral_beside_probes(measure):
-    """Start loading what a step choice's estimates need, beside its first probe runs.
+@dataclass(frozen=True, kw_only=True)
+class SingleProbe(ProbeSettings):
+    """The probe of one axis: the inputs of :func:`choose_step` but the tolerance; nothing
+    computed until :meth:`build`, which :func:`qzs.engine.step_choice.choose` calls only for
+    a chosen step.
 
-    For ``measure`` ``"transmissibility_db"``: the spectral analysis and scipy.signal (0.9 s
-    of imports, loaded by the first estimate, not by :mod:`qzs.analysis.spectral` itself)
-    load in a thread while the probe's first runs integrate in a kernel that holds no GIL.
-    Called once a choice is known to need its probes (not read from the step cache).
-
-    Parameters
+    Attributes
     ----------
-    measure : str
-        The choice's measure, a key of :data:`MEASURE_UNITS`.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord or None
+        The run's excitation (None: the paper's chirp).
+    isolator : IsolatorParameters or None
+        Plant parameters (None: Table 1's).
+    controller : ControllerParameters or None
+        PI and damping loops (None: the defaults).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    fft_length : int or None
+        Welch segment length [samples] of the probe's transmissibility.
+    initial_state : InitialState or None
+        As for :func:`qzs.simulate`.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
     """
-    if measure == "transmissibility_db":
-        import_in_background("scipy.signal", "qzs.analysis.spectral")
+
+    isolator: Any = None
+    controller: Any = None
+    fft_length: int | None = None
+    initial_state: Any = None
+
+    def _build(self, measure):
+        from qzs.engine.prepare import run_inputs
+        from qzs.engine.step_choice import Probe
+
+        excitation, isolator, controller = run_inputs(self.excitation, self.isolator,
+                                                      self.controller)
+        order, sample_rate, band, probe, duration = probe_settings(
+            excitation, measure, self.solver, self.sample_rate, self.band, self.probe_duration,
+            self.fft_length, self.safety, self.max_halvings)
+        solver, initial_state, fft_length = self.solver, self.initial_state, self.fft_length
+
+        def run(dt, cases):
+            from qzs.engine.single import integrate
+
+            return [integrate(probe, isolator, controller, duration=duration, dt=dt,
+                              sample_rate=sample_rate, solver=solver,
+                              initial_state=initial_state)]
+
+        return Probe(
+            measure=measure, order=order, sample_rate=sample_rate, solver=solver,
+            excitation=probe, duration=duration, band=band,
+            shortened=probe is not excitation,
+            start=lambda: _single_start(probe, duration, isolator, controller, solver,
+                                        sample_rate),
+            run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
+                                                             fft_length=fft_length),
+            key=dict(excitation=excitation, isolator=isolator, controller=controller,
+                     initial_state=initial_state, solver=solver, sample_rate=sample_rate,
+                     band=band, probe_duration=self.probe_duration, fft_length=fft_length),
+            max_halvings=self.max_halvings, safety=self.safety)
 
 
-def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db=None,
+def _single_start(probe, duration, isolator, controller, solver, sample_rate):
+    """One axis's stability limit, resolving step and admissible start (``Probe.start``)."""
+    from qzs.engine.prepare import check_resolution, divides, resolving_step
+    from qzs.engine.stability import largest_stable_step, stability_test
+
+    stable = stability_test(isolator, controller, solver)
+    limit = largest_stable_step(isolator, controller, solver)
+    resolving = resolving_step(probe, duration)  # the step must follow the base motion too
+    # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
+    # step follows is refused as a literal step too coarse for it would be, naming it
+    check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
+    rates = controller.sample_rates  # each sampled period a whole number of steps
+    single = rates[0] if len(rates) == 1 else 0.0
+    dt0, k0 = admissible_step(sample_rate, single,
+                              lambda dt: dt <= resolving and stable(dt)
+                              and (single or all(divides(rate, dt) for rate in rates)))
+    return limit, resolving, dt0, k0
+
+
+def choose_step(excitation=None, isolator=None, controller=None, *, tolerance=None,
                 tolerance_state=None, solver=defaults.SIMULATION["solver"],
                 sample_rate=defaults.SIMULATION["sample_rate"], band=None, probe_duration=None,
                 fft_length=None, initial_state=None, max_halvings=MAX_HALVINGS,
-                safety=SAFETY, finest=None, fallback=False, progress=False, cache=False):
+                safety=SAFETY, finest=None, fallback=False, progress=False, cache=False,
+                tolerance_db=None):
     """The largest fixed step whose error stays within a tolerance (docs/model.md §7).
 
     Candidates are ``dt_j = dt_0 / 2**j`` with ``dt_0 = 1/(sample_rate*k)`` the largest
@@ -322,7 +395,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
     asymptotic range; stick-slip events lower it), capped at the scheme's ``2**order``,
     extrapolates the error of ``dt_j`` Richardson-style: ``d_j * r_j/(r_j - 1)``. Where the
     differences do not shrink (``r_j <= 1``) there is no estimate. The chosen step is the
-    coarsest whose estimate times ``safety`` meets the tolerance.
+    coarsest whose estimate times ``safety`` meets the tolerance. The one call
+    :func:`qzs.engine.step_choice.choose` on a :class:`SingleProbe`.
 
     Parameters
     ----------
@@ -332,7 +406,7 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Plant parameters; Table 1 defaults if omitted.
     controller : ControllerParameters, optional
         PI and damping loops; defaults if omitted.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance on the transmissibility [dB]: max ``|20 log10(T_dt/T_ref)|`` over the
         trusted bins of ``band``.
     tolerance_state : float, optional
@@ -363,8 +437,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         The finest candidate [s]: halvings stop above it; the fallback step too.
     fallback : bool
         Where no candidate meets the tolerance (or no bin of the band is trusted on the
-        probe), return the fallback of :func:`~qzs.engine.step_search.search_step` (``finest``,
-        default the paper's step; ``met`` False, ``error`` NaN, a note why) instead of
+        probe), return the one fallback (:mod:`qzs.engine.step_choice`: ``finest``, default
+        the paper's step; ``met`` False, ``error`` NaN, the unmet sentence) instead of
         raising: what a run that must go on asks for.
     progress : bool
         Show a progress bar over the probe runs.
@@ -372,6 +446,8 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Read the choice from, and keep it in, the step cache on disk
         (:mod:`qzs.engine.step_cache`, keyed by every input above and by the code that
         chooses): a repeated command skips the probe. The command line uses it.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -383,85 +459,16 @@ def choose_step(excitation=None, isolator=None, controller=None, *, tolerance_db
         Both or neither tolerance, a non-positive one, a band outside the excitation, no
         trusted bin in the band on the probe, or a tolerance no candidate meets.
     """
-    from qzs.engine.prepare import check_resolution, divides, resolving_step, run_inputs
-    from qzs.engine.single import integrate
-    from qzs.engine.stability import largest_stable_step, stability_test
+    from qzs.engine.step_choice import choose, step_request
 
-    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
-    excitation, isolator, controller = run_inputs(excitation, isolator, controller)
-    order, sample_rate, band, probe, duration = probe_settings(
-        excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
-        max_halvings)
-
-    key = None
-    if cache:
-        from qzs.engine import step_cache
-
-        key = step_cache.cache_key(
-            excitation=excitation, isolator=isolator, controller=controller,
-            initial_state=initial_state, measure=measure, tolerance=tolerance, solver=solver,
-            sample_rate=sample_rate, band=band, probe_duration=probe_duration,
-            fft_length=fft_length, max_halvings=max_halvings, safety=safety,
-            **({"finest": finest, "fallback": True} if fallback else {}))
-        hit = step_cache.load_choice(key, probe, duration)
-        if hit is not None:
-            return hit
-    spectral_beside_probes(measure)
-
-    stable = stability_test(isolator, controller, solver)
-    limit = largest_stable_step(isolator, controller, solver)
-    resolving = resolving_step(probe, duration)  # the step must follow the base motion too
-    # no candidate below 1/(sample_rate * ADMISSIBLE_REFINEMENT): an excitation only a finer
-    # step follows is refused as a literal step too coarse for it would be, naming it
-    check_resolution(probe, 1.0 / (sample_rate * ADMISSIBLE_REFINEMENT), duration)
-    rates = controller.sample_rates  # each sampled period a whole number of steps
-    single = rates[0] if len(rates) == 1 else 0.0
-    dt0, k0 = admissible_step(sample_rate, single,
-                              lambda dt: dt <= resolving and stable(dt)
-                              and (single or all(divides(rate, dt) for rate in rates)))
-
-    def run(dt, cases):
-        return [integrate(probe, isolator, controller, duration=duration, dt=dt,
-                          sample_rate=sample_rate, solver=solver, initial_state=initial_state)]
-
-    choice = search_step(
-        run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
-                                                         fft_length=fft_length),
-        dt0=dt0, order=order, measure=measure, tolerance=tolerance, sample_rate=sample_rate,
-        solver=solver, probe=probe, probe_duration=duration, band=band,
-        notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
-                          probe is not excitation),
-        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
-        fallback=fallback, progress=progress)
-    if key is not None:
-        from qzs.engine import step_cache
-
-        step_cache.store_choice(key, choice)
-    return choice
-
-
-def default_tolerance(excitation):
-    """The accuracy a command asks for when given no step and no tolerance.
-
-    The transmissibility within ``defaults.ACCURACY["tolerance_db"]`` where the excitation
-    has a band to estimate it over (a chirp, a random excitation, a record); a sine has one
-    frequency and no Welch estimate, so its relative position within
-    ``defaults.ACCURACY["tolerance_state"]``.
-
-    Parameters
-    ----------
-    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
-        The run's excitation.
-
-    Returns
-    -------
-    dict
-        One keyword of :func:`choose_step`: ``{"tolerance_db": ...}`` [dB] or
-        ``{"tolerance_state": ...}`` [m].
-    """
-    if isinstance(excitation, Sine):
-        return {"tolerance_state": float(defaults.ACCURACY["tolerance_state"])}
-    return {"tolerance_db": float(defaults.ACCURACY["tolerance_db"])}
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, SingleProbe(
+        excitation=excitation, isolator=isolator, controller=controller, solver=solver,
+        sample_rate=sample_rate, band=band,
+        probe_duration=probe_duration, fft_length=fft_length, initial_state=initial_state,
+        max_halvings=max_halvings, safety=safety),
+        fallback=fallback, finest=finest, progress=progress, cache=cache)
 
 
 # ---------------------------------------------------------------- shared by the searches

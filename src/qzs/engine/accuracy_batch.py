@@ -6,16 +6,17 @@ one lockstep batch of the cases still searched; the paper's studies and sweeps t
 step from it.
 """
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import probe_settings, spectral_beside_probes, step_error
-from qzs.engine.step_search import (SAFETY, StepChoice, admissible_step, bound_notes,
-                                    search_step, tolerance_measure)
+from qzs.engine.accuracy import probe_settings, step_error
+from qzs.engine.step_choice import ProbeSettings, admissible_step
+from qzs.engine.step_search import SAFETY, StepChoice
 from qzs.errors import ParameterError
 
-__all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step"]
+__all__ = ["BATCH_MAX_HALVINGS", "BatchStepChoice", "choose_batch_step", "BatchProbe"]
 
 #: The record of a batch's step: the one record, :class:`~qzs.engine.step_search.StepChoice`
 #: (its ``case_errors``, ``case_steps`` and ``unmet`` filled in).
@@ -38,12 +39,12 @@ class _ProbeRun:
     estimates: dict = field(default_factory=dict)  # fft length -> its transmissibility
 
 
-def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_state=None,
+def choose_batch_step(cases, excitation=None, *, tolerance=None, tolerance_state=None,
                       solver=defaults.SIMULATION["solver"],
                       sample_rate=defaults.SIMULATION["sample_rate"], band=None,
                       probe_duration=None, fft_length=None, max_halvings=BATCH_MAX_HALVINGS,
                       safety=SAFETY, finest=None, fallback=False, workers=None, progress=False,
-                      labels=None, cache=False):
+                      labels=None, cache=False, tolerance_db=None):
     """One step for many cases sharing an excitation: the coarsest meeting the tolerance
     for every case (docs/model.md §7).
 
@@ -66,7 +67,7 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         The parameter sets, as for :func:`~qzs.engine.batch.simulate_batch`.
     excitation : Chirp, Sine, RandomExcitation or DisplacementRecord, optional
         The full runs' shared excitation; default the paper's chirp.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance on the transmissibility [dB], as for :func:`choose_step`.
     tolerance_state : float, optional
         Tolerance on the relative position [m], as for :func:`choose_step`. Give exactly
@@ -102,6 +103,8 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         ``progress``, which change no bit of it, and by the code that chooses): a repeated
         ``qzs paper`` skips its probes (1.2 s of the paper's 12 s). The studies and sweeps
         use it.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -117,19 +120,91 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
     SimulationError
         A case diverges on the probe.
     """
-    from qzs.engine.batch import simulate_batch
-    from qzs.engine.prepare import divides, resolving_step, run_inputs
-    from qzs.engine.stability import largest_stable_step, stability_test
-    from qzs.errors import SimulationError
+    from qzs.engine.step_choice import choose, step_request
 
-    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
-    cases = [run_inputs(None, *pair)[1:] for pair in cases]
-    if not cases:
-        raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
-    excitation = run_inputs(excitation)[0]
-    order, sample_rate, band, probe, duration = probe_settings(
-        excitation, measure, solver, sample_rate, band, probe_duration, fft_length, safety,
-        max_halvings)
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, BatchProbe(
+        cases=cases, excitation=excitation, solver=solver, sample_rate=sample_rate, band=band,
+        probe_duration=probe_duration, fft_length=fft_length, max_halvings=max_halvings,
+        safety=safety, workers=workers, labels=labels),
+        fallback=fallback, finest=finest, progress=progress, cache=cache)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BatchProbe(ProbeSettings):
+    """The probe of a lockstep batch: the inputs of :func:`choose_batch_step` but the
+    tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
+    :meth:`build` for a chosen step.
+
+    Attributes
+    ----------
+    cases : sequence of (IsolatorParameters, ControllerParameters)
+        The lanes sharing the step.
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord or None
+        Their shared excitation (None: the paper's chirp).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    fft_length : int or None
+        Welch segment length [samples] of the probe's transmissibility.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    workers : int or None
+        Threads of the batch kernel (None: all cores).
+    labels : sequence of str or None
+        The cases' names in the notes.
+    """
+
+    cases: Any
+    fft_length: int | None = None
+    max_halvings: int = BATCH_MAX_HALVINGS
+    workers: int | None = None
+    labels: Any = None
+
+    def _build(self, measure):
+        from qzs.engine.prepare import run_inputs
+        from qzs.engine.step_choice import Probe
+
+        cases = [run_inputs(None, *pair)[1:] for pair in self.cases]
+        if not cases:
+            raise ParameterError("`cases` must hold at least one (isolator, controller) pair.")
+        excitation = run_inputs(self.excitation)[0]
+        order, sample_rate, band, probe, duration = probe_settings(
+            excitation, measure, self.solver, self.sample_rate, self.band, self.probe_duration,
+            self.fft_length, self.safety, self.max_halvings)
+        n = len(cases)
+        labels = ([f"case {c}" for c in range(n)] if self.labels is None
+                  else [str(x) for x in self.labels])
+        fft_length = self.fft_length
+        return Probe(
+            measure=measure, order=order, sample_rate=sample_rate, solver=self.solver,
+            excitation=probe, duration=duration, band=band, shortened=probe is not excitation,
+            start=lambda: _batch_start(cases, probe, duration, self.solver, sample_rate),
+            run=_batch_run(cases, probe, duration, sample_rate, self.solver, self.workers,
+                           labels),
+            compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
+                                                    fft_length=fft_length),
+            cases=n, labels=labels,
+            key=dict(batch=True, cases=cases, excitation=excitation, solver=self.solver,
+                     sample_rate=sample_rate, band=band, probe_duration=self.probe_duration,
+                     fft_length=fft_length, labels=labels),
+            max_halvings=self.max_halvings, safety=self.safety,
+            search=dict(give_up_early=True, per_case=True, unit_name="batch"))
+
+
+def _batch_start(cases, probe, duration, solver, sample_rate):
+    """The batch's stability limit, resolving step and admissible start (``Probe.start``):
+    the largest step admissible for every case."""
+    from qzs.engine.prepare import divides, resolving_step
+    from qzs.engine.stability import largest_stable_step, stability_test
 
     tests = [stability_test(isolator, controller, solver) for isolator, controller in cases]
     limit = min(largest_stable_step(isolator, controller, solver)
@@ -148,21 +223,14 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         dt0, k0 = admissible_step(sample_rate, rates[0], stable)
     else:
         dt0, k0 = admissible_step(sample_rate, 0.0, lambda dt: stable(dt) and divides_all(dt))
-    n = len(cases)
-    labels = [f"case {c}" for c in range(n)] if labels is None else [str(x) for x in labels]
-    key = None
-    if cache:
-        from qzs.engine import step_cache
+    return limit, resolving, dt0, k0
 
-        key = step_cache.cache_key(
-            batch=True, cases=cases, excitation=excitation, measure=measure,
-            tolerance=tolerance, solver=solver, sample_rate=sample_rate, band=band,
-            probe_duration=probe_duration, fft_length=fft_length, max_halvings=max_halvings,
-            safety=safety, finest=finest, fallback=fallback, labels=labels)
-        hit = step_cache.load_choice(key, probe, duration, cases=n)
-        if hit is not None:
-            return hit
-    spectral_beside_probes(measure)
+
+def _batch_run(cases, probe, duration, sample_rate, solver, workers, labels):
+    """``Probe.run`` of a batch: one lockstep batch of the listed cases at a step."""
+    from qzs.engine.batch import simulate_batch
+    from qzs.errors import SimulationError
+
     names = ("base_acceleration", "payload_acceleration", "relative_position")
 
     def run(dt, members):
@@ -176,18 +244,4 @@ def choose_batch_step(cases, excitation=None, *, tolerance_db=None, tolerance_st
         return [_ProbeRun(**{name: batch.channels[name][row] for name in names},
                           run={"sample_rate": sample_rate}) for row in range(len(members))]
 
-    choice = search_step(
-        run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,
-                                                         fft_length=fft_length),
-        cases=n, dt0=dt0, order=order, measure=measure, tolerance=tolerance,
-        sample_rate=sample_rate, solver=solver, probe=probe, probe_duration=duration,
-        band=band, notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure,
-                                     probe is not excitation),
-        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
-        fallback=fallback, give_up_early=True, labels=labels, per_case=True, progress=progress,
-        unit_name="batch")
-    if key is not None:
-        from qzs.engine import step_cache
-
-        step_cache.store_choice(key, choice)
-    return choice
+    return run

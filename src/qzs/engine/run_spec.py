@@ -184,10 +184,9 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
         An invalid input (named with its value and the fix), both a ``dt`` and a
         tolerance, a transmissibility tolerance for a sine; as :func:`qzs.simulate`.
     """
-    from qzs.engine.accuracy import (choose_step, default_tolerance, excitation_over,
-                                     probe_excitation)
+    from qzs.engine.accuracy import SingleProbe, excitation_over, probe_excitation
     from qzs.engine.prepare import pack_model, run_duration, run_inputs
-    from qzs.engine.step_search import StepChoice
+    from qzs.engine.step_choice import choose, step_request
     from qzs.model.excitation import Sine
 
     excitation, isolator, controller = run_inputs(excitation, isolator, controller)
@@ -205,32 +204,25 @@ def resolve(excitation: Excitation | None = None, isolator: IsolatorParameters |
         dt = defaults.SIMULATION["dt"]
     check_length(duration, sample_rate, None if dt is None else
                  _validation.positive_real("dt", dt))
-    if dt is not None:
-        choice = StepChoice.literal(_validation.positive_real("dt", dt), sample_rate=sample_rate,
-                                    solver=solver)
+    if tolerance is not None and isinstance(excitation, Sine):
+        raise ParameterError(
+            f"`tolerance` ({tolerance!r} dB) is on the transmissibility, which a sine "
+            "has no band to estimate; give `tolerance_state` [m] or a literal `dt`.",
+            ("tolerance", "tolerance_state", "dt"))
+    request = step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
+    covered = excitation_over(excitation, duration)
+    probe_duration = None
+    if not request.literal and not math.isclose(duration, covered.duration or math.inf):
+        # a stationary excitation's probe is its start: never longer than the run
+        default = probe_excitation(covered, (0.0, 0.0))[1]
+        probe_duration = duration if duration < default else None
+    choice = choose(request, SingleProbe(excitation=covered, isolator=isolator,
+                                         controller=controller, solver=solver,
+                                         sample_rate=sample_rate, probe_duration=probe_duration,
+                                         initial_state=initial_state),
+                    fallback=True, progress=progress, cache=cache)
+    if request.literal:
         pack_model(isolator, controller, choice.dt)  # a discrete linear controller's steps
-    else:
-        if tolerance is not None:
-            if isinstance(excitation, Sine):
-                raise ParameterError(
-                    f"`tolerance` ({tolerance!r} dB) is on the transmissibility, which a sine "
-                    "has no band to estimate; give `tolerance_state` [m] or a literal `dt`.",
-                    ("tolerance", "tolerance_state", "dt"))
-            asked = {"tolerance_db": tolerance}
-        elif tolerance_state is not None:
-            asked = {"tolerance_state": tolerance_state}
-        else:
-            asked = default_tolerance(excitation)
-        covered = excitation_over(excitation, duration)
-        probe_duration = None
-        if not math.isclose(duration, covered.duration or math.inf):
-            # a stationary excitation's probe is its start: never longer than the run
-            default = probe_excitation(covered, (0.0, 0.0))[1]
-            probe_duration = duration if duration < default else None
-        choice = choose_step(covered, isolator, controller, **asked, solver=solver,
-                           sample_rate=sample_rate, probe_duration=probe_duration,
-                           initial_state=initial_state, fallback=True, progress=progress,
-                           cache=cache)
     return ResolvedRun(excitation=excitation, isolator=isolator, controller=controller,
                        initial_state=initial_state, duration=duration, dt=choice.dt,
                        sample_rate=sample_rate, solver=solver, step=choice)
@@ -364,15 +356,15 @@ class ResolvedHexapodRun:
 
 
 def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excitation,
-                    duration=None, dt=None, tolerance_db=None, tolerance_state=None,
+                    duration=None, dt=None, tolerance=None, tolerance_state=None,
                     sample_rate=defaults.SIMULATION["sample_rate"],
                     solver=defaults.SIMULATION["solver"], cartesian=None, finest=None,
-                    step="literal", progress=False):
+                    step="literal", progress=False, tolerance_db=None):
     """Resolve a six-leg platform run once: validate its settings, choose its step.
 
     The step is literal (``dt``), or the largest meeting a tolerance
     (:func:`qzs.engine.hexapod.accuracy.choose_hexapod_step`, with the one fallback): the
-    driven axis's transmissibility within ``tolerance_db`` [dB] (one moving axis), or the pose
+    driven axis's transmissibility within ``tolerance`` [dB] (one moving axis), or the pose
     within ``tolerance_state`` [m]; given neither, ``step`` decides as for :func:`resolve`
     (``"chosen"``: ``defaults.ACCURACY``, the transmissibility for one chirp, else the pose).
 
@@ -390,7 +382,7 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
         Simulated time [s].
     dt : float, optional
         A literal step [s].
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance [dB] on the driven axis's column of the transmissibility.
     tolerance_state : float, optional
         Tolerance [m] on the pose.
@@ -406,6 +398,8 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
         The step given neither ``dt`` nor a tolerance, as for :func:`resolve`.
     progress : bool
         Show the probes' progress.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -416,14 +410,14 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
     ParameterError
         Invalid settings (before any probe), both a ``dt`` and a tolerance.
     """
-    from qzs.engine.hexapod.accuracy import choose_hexapod_step
+    from qzs.engine.hexapod.accuracy import HexapodProbe
     from qzs.engine.hexapod.prepare import check_hexapod_run
-    from qzs.engine.step_search import StepChoice
-    from qzs.model.excitation import Chirp
+    from qzs.engine.step_choice import choose, step_request
 
     _validation.choice("step", step, ("literal", "chosen"))
-    given = _one_step_request(dt=dt, tolerance_db=tolerance_db,
-                              tolerance_state=tolerance_state)
+    tolerance = _validation.renamed_keyword("tolerance", tolerance, "tolerance_db",
+                                            tolerance_db)
+    given = _one_step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
     finest = defaults.SIMULATION["dt"] if finest is None else finest
     if dt is None and not given and step == "literal":
         dt = finest
@@ -431,20 +425,11 @@ def resolve_hexapod(geometry, platform, isolator=None, controller=None, *, excit
     check_hexapod_run(geometry, platform, isolator, controller, excitation=excitation,
                       duration=duration, dt=finest if dt is None else dt,
                       sample_rate=sample_rate, solver=solver, cartesian=cartesian)
-    if dt is not None:
-        choice = StepChoice.literal(dt, sample_rate=sample_rate, solver=solver)
-    else:
-        if tolerance_db is not None:
-            asked = {"tolerance_db": tolerance_db}
-        elif tolerance_state is not None:
-            asked = {"tolerance_state": tolerance_state}
-        elif len(excitation) == 1 and isinstance(next(iter(excitation.values())), Chirp):
-            asked = {"tolerance_db": defaults.ACCURACY["tolerance_db"]}
-        else:
-            asked = {"tolerance_state": defaults.ACCURACY["tolerance_state"]}
-        choice = choose_hexapod_step(geometry, platform, isolator, controller,
-                                     excitation=excitation, **asked, solver=solver,
-                                     sample_rate=sample_rate, duration=duration, finest=finest,
-                                     fallback=True, cartesian=cartesian, progress=progress)
+    request = step_request(dt=dt, tolerance=tolerance, tolerance_state=tolerance_state)
+    choice = choose(request, HexapodProbe(
+        geometry=geometry, platform=platform, isolator=isolator, controller=controller,
+        excitation=excitation, solver=solver,
+        sample_rate=sample_rate, duration=duration, cartesian=cartesian),
+        finest=None if request.literal else finest, fallback=True, progress=progress)
     return ResolvedHexapodRun(excitation=excitation, duration=duration, dt=choice.dt,
                               sample_rate=sample_rate, solver=solver, step=choice)

@@ -9,7 +9,7 @@ halving, its memo, its progress bar, the Richardson estimate, the one fallback p
 one record (:class:`StepChoice`) are written here once.
 
 The method: candidates ``dt_j = dt_0 / 2**j`` from the largest admissible step ``dt_0``
-(:func:`admissible_step`); each is integrated on the probe and compared with the next finer
+(:func:`qzs.engine.step_choice.admissible_step`); each is integrated on the probe and compared with the next finer
 one: the difference ``d_j`` is measured, and the observed ratio ``r_j = d_j/d_{j+1}``
 (``2**order`` in the asymptotic range; stick-slip events lower it), capped at ``2**order``,
 extrapolates the error of ``dt_j`` as ``d_j r_j/(r_j - 1)``. The chosen step is the coarsest
@@ -30,14 +30,13 @@ from typing import Any
 
 import numpy as np
 
-from qzs import _validation, defaults
+from qzs import defaults
 from qzs._format import STEP_RECORD_UNITS as RECORD_UNITS
 from qzs._format import step_line as record_line
-from qzs.errors import ControllerRateError, ParameterError, ToleranceNotMetError
+from qzs.errors import ParameterError, ToleranceNotMetError
 
-__all__ = ["StepChoice", "search_step", "halving_search", "admissible_step", "tolerance_measure",
-           "bound_notes", "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS", "RATE_REFINEMENT_MAX",
-           "ADMISSIBLE_REFINEMENT"]
+__all__ = ["StepChoice", "search_step", "halving_search", "fallback_step", "unmet_sentence",
+           "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS"]
 
 #: The measures of a step's accuracy and their units: the transmissibility [dB], the state [m].
 MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
@@ -45,13 +44,40 @@ MEASURE_UNITS = {"transmissibility_db": "dB", "state_m": "m"}
 SAFETY = 2.0
 #: Halvings below the largest admissible step tried at most before giving up.
 MAX_HALVINGS = 8
-#: A sampled controller may make the step at most this much finer than the largest stable
-#: one [-]: its period and the output's must both be whole numbers of steps, and a rate
-#: such as 333 Hz against a 1000 Hz output meets that only at 1/333000 s, a run hundreds
-#: of times longer (:class:`~qzs.errors.ControllerRateError`).
-RATE_REFINEMENT_MAX = 32
-#: Steps per output sample a candidate takes at most [-] (:func:`admissible_step`).
-ADMISSIBLE_REFINEMENT = 1_000_000
+
+
+# ---------------------------------------------------------------- the one unmet meaning
+# (changing the fallback step or the sentence every caller shows is an edit here)
+def fallback_step(finest=None):
+    """The step [s] a run that must go on gets where no step tried meets its tolerance.
+
+    Parameters
+    ----------
+    finest : float, optional
+        The finest step the caller allows [s]; default the paper's ``SIMULATION["dt"]``.
+
+    Returns
+    -------
+    float
+    """
+    return float(finest if finest is not None else defaults.SIMULATION["dt"])
+
+
+def unmet_sentence(reason, dt):
+    """The one sentence every caller shows for an unmet tolerance (the record's last note).
+
+    Parameters
+    ----------
+    reason : str
+        Why no step met it (from :func:`~qzs.engine.step_search.search_step`).
+    dt : float
+        The fallback step the run goes on at [s] (:func:`fallback_step`).
+
+    Returns
+    -------
+    str
+    """
+    return f"{reason}; running at dt = {dt:.3g} s, whose error is not estimated"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -163,6 +189,15 @@ class StepChoice:
         return MEASURE_UNITS.get(self.measure, "")
 
     @property
+    def unmet_note(self) -> str:
+        """The one sentence every caller shows for an unmet tolerance; '' where it was met.
+
+        Made by :func:`unmet_sentence` (the fallback's reason and step); a literal step has
+        no tolerance to miss.
+        """
+        return "" if self.met or not self.chosen else (self.notes[-1] if self.notes else "")
+
+    @property
     def steps_per_sample(self) -> int:
         """Integration steps per output sample [-]."""
         return int(round(1.0 / (self.sample_rate * self.dt)))
@@ -220,6 +255,60 @@ class StepChoice:
                           unmet=list(self.unmet))
         return record
 
+    #: The extensions :meth:`save` accepts: the candidates (.nc, .csv, .mat), the record (.json).
+    save_suffixes = (".nc", ".csv", ".mat", ".json")
+
+    def to_xarray(self):
+        """The candidates tried, with the record as attributes
+        (:func:`qzs.engine.step_views.step_dataset`).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``step`` [s], ``difference`` and ``estimated_error`` (in the measure's unit) per
+            candidate, coarsest first.
+        """
+        from qzs.engine.step_views import step_dataset
+
+        return step_dataset(self)
+
+    def plot(self, path=None, *, title=None):
+        """Each candidate's estimated error against its step, the tolerance and the chosen
+        step (:func:`qzs.viz.step.plot_step_choice`).
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            Write the figure there, atomically (format from the suffix).
+        title : str, optional
+            Figure title; default the step and how it was chosen.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from qzs.viz.step import plot_step_choice
+
+        return plot_step_choice(self, path=path, title=title)
+
+    def save(self, path):
+        """Write the choice by the extension of ``path``, atomically: the candidates as .nc,
+        .csv or .mat (:meth:`to_xarray`), the record as .json (:meth:`to_dict`).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file; its extension is one of ``save_suffixes``.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
+        from qzs.iotools.result_files import save_by_extension
+
+        return save_by_extension(path, dataset=self.to_xarray, record=self.to_dict)
+
     def attributes(self) -> dict[str, Any]:
         """The record as a run's entries and file attributes give it (``run.step*``).
 
@@ -240,7 +329,7 @@ class StepChoice:
             reason = (f"estimated error {self.error:.2g} {self.unit} <= {self.tolerance:g} "
                       f"{self.unit} / safety on a {self.probe_duration:g} s probe")
         else:
-            reason = self.notes[-1] if self.notes else "no step tried met the tolerance"
+            reason = self.unmet_note or "no step tried met the tolerance"
         band = {} if self.band is None else {"step_band_low": float(self.band[0]),
                                              "step_band_high": float(self.band[1])}
         return {"step": "accuracy-driven" if self.met else "fallback",
@@ -248,136 +337,6 @@ class StepChoice:
                 f"step_error_{suffix}": float(self.error),
                 "step_reference_dt": float(self.reference_dt),
                 "step_probe_duration": float(self.probe_duration), "step_reason": reason}
-
-
-# ---------------------------------------------------------------- shared validation
-def tolerance_measure(tolerance_db, tolerance_state):
-    """The measure and value of exactly one tolerance: ``(measure, tolerance)``.
-
-    Parameters
-    ----------
-    tolerance_db : float or None
-        On the transmissibility [dB].
-    tolerance_state : float or None
-        On the state [m].
-
-    Returns
-    -------
-    measure : str
-        ``"transmissibility_db"`` or ``"state_m"``.
-    tolerance : float
-        The positive tolerance, in the measure's unit.
-
-    Raises
-    ------
-    ParameterError
-        Both, neither, or a tolerance that is not a positive finite number.
-    """
-    given = [(name, value) for name, value in (("tolerance_db", tolerance_db),
-                                               ("tolerance_state", tolerance_state))
-             if value is not None]
-    if len(given) != 1:
-        raise ParameterError(
-            "give exactly one of `tolerance_db` (transmissibility, dB) and `tolerance_state` "
-            f"(relative position, m); got {' and '.join(n for n, _ in given) or 'neither'}.")
-    name, value = given[0]
-    measure = "transmissibility_db" if name == "tolerance_db" else "state_m"
-    return measure, _validation.positive_real(name, value)
-
-
-def admissible_step(sample_rate, controller_rate, stable):
-    """The largest admissible step: ``1/(sample_rate*k)``, smallest k that is stable and
-    divides the controller's period too.
-
-    Parameters
-    ----------
-    sample_rate : float
-        Output rate [Hz]; the step divides its period.
-    controller_rate : float
-        A sampled controller's rate [Hz] (0: continuous); the step divides its period too.
-    stable : callable
-        ``stable(dt)``: whether the step ``dt`` [s] is linearly stable.
-
-    Returns
-    -------
-    dt : float
-        The step [s].
-    k : int
-        Steps per output sample [-].
-
-    Raises
-    ------
-    ControllerRateError
-        The controller's period is a whole number of steps only at a step more than
-        :data:`RATE_REFINEMENT_MAX` times finer than the stable one (before any run).
-    """
-    from qzs.engine.prepare import steps_per_sample
-
-    first = next((k for k in range(1, ADMISSIBLE_REFINEMENT)
-                  if stable(1.0 / (sample_rate * k))), None)
-    if first is None:
-        raise ParameterError(f"no step 1/(sample_rate*k) with k < {ADMISSIBLE_REFINEMENT:.0e} "
-                             "is stable; check the model's stiffness and the `sample_rate`.")
-    if controller_rate <= 0:
-        return 1.0 / (sample_rate * first), first
-    for k in range(first, RATE_REFINEMENT_MAX * first + 1):
-        dt = 1.0 / (sample_rate * k)
-        if not stable(dt):
-            continue
-        try:
-            steps_per_sample(controller_rate, dt, "controller_rate")
-        except ParameterError:
-            continue
-        return dt, k
-    multiples = [sample_rate * n for n in range(1, 9)] + [sample_rate / n for n in range(2, 9)]
-    near = sorted(multiples, key=lambda f: abs(f - controller_rate))[:2]
-    raise ControllerRateError(controller_rate=controller_rate, sample_rate=sample_rate,
-                              step=1.0 / (sample_rate * first), refinement=RATE_REFINEMENT_MAX,
-                              suggestions=sorted(near))
-
-
-def bound_notes(dt0, k0, sample_rate, limit, resolving, measure, shortened):
-    """What bounds the coarsest candidate ``dt0 = 1/(sample_rate*k0)`` [s], for people.
-
-    Parameters
-    ----------
-    dt0 : float
-        The coarsest candidate [s].
-    k0 : int
-        Its steps per output sample [-].
-    sample_rate : float
-        Output rate [Hz].
-    limit : float
-        The solver's largest stable step [s].
-    resolving : float
-        The largest step that resolves the base motion [s].
-    measure : str
-        The accuracy measure.
-    shortened : bool
-        Whether the probe is a shortened stand-in for the run's excitation.
-
-    Returns
-    -------
-    list of str
-    """
-    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
-
-    notes = []
-    if k0 == 1:
-        notes.append(f"the output rate bounds the step: dt_0 = 1/sample_rate = {dt0:.3g} s "
-                     f"(a lower sample_rate would allow larger steps; stability allows "
-                     f"{limit:.3g} s)")
-    elif resolving < limit:
-        notes.append(f"the base motion bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = "
-                     f"{dt0:.3g} s <= {resolving:.3g} s, {MIN_STEPS_PER_PERIOD} steps per period "
-                     f"of its highest frequency (stability allows {limit:.3g} s)")
-    else:
-        notes.append(f"stability bounds the step: dt_0 = 1/({sample_rate:g}*{k0}) = {dt0:.3g} s "
-                     f"<= {limit:.3g} s")
-    if measure == "state_m" and shortened:
-        notes.append("the state error is measured on a shortened chirp; on the full sweep "
-                     "phase errors accumulate over a longer time")
-    return notes
 
 
 # ---------------------------------------------------------------- the search
@@ -478,69 +437,41 @@ def halving_search(difference, order, tolerance, dt0, max_halvings, safety=SAFET
     return (met[0][0] if met else None), history
 
 
-def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample_rate,
-                solver, probe, probe_duration, band, notes=(), stability_limit,
-                max_halvings=MAX_HALVINGS, safety=SAFETY, finest=None, fallback=False,
-                give_up_early=False, labels=None, per_case=False, progress=False,
-                unit_name="run"):
+def search_step(probe, *, tolerance, dt0, stability_limit, notes=(), finest=None,
+                fallback=False, progress=False):
     """The coarsest candidate ``dt_0 / 2**j`` whose estimated error meets a tolerance.
 
-    The one search of qzs (module docstring); the callers give what differs.
+    The one search of qzs (module docstring), on a built probe: the probe says what differs
+    between the models (how to run a candidate and compare two, the cases, the measure).
 
     Parameters
     ----------
-    run : callable
-        ``run(dt, cases)``: integrate the probe at step ``dt`` [s] for the listed case
-        indices; returns one run per case, in that order.
-    compare : callable
-        ``compare(coarse, fine)``: the difference of two runs of one case in the measure's
-        unit (NaN: no measure, e.g. no trusted bin in the band).
-    cases : int
-        How many cases share the step [-].
-    dt0 : float
-        The coarsest candidate [s] (:func:`admissible_step`).
-    order : int
-        The scheme's order of accuracy [-].
-    measure : {"transmissibility_db", "state_m"}
-        The accuracy measure.
+    probe : Probe
+        The built probe (:class:`qzs.engine.step_choice.Probe`): ``run(dt, cases)`` (one
+        probe run per listed case at step ``dt`` [s]), ``compare(coarse, fine)`` (their
+        difference in the measure's unit; NaN: none), ``cases`` [-] and their ``labels``,
+        the scheme's ``order`` [-], the ``measure``, ``sample_rate`` [Hz], ``solver``, the
+        probe's ``excitation``, ``duration`` [s] and ``band`` [Hz] (for the record),
+        ``max_halvings`` [-], ``safety`` [-] (>= 1, between the estimate and the tolerance),
+        and ``search``: ``give_up_early`` (a case leaves, unmet, once its estimate exceeds
+        the tolerance by more than the order could close), ``per_case`` (the record's
+        per-case entries even for one case), ``unit_name`` (a probe run on the bar).
     tolerance : float
         The tolerance, in the measure's unit.
-    sample_rate : float
-        Output rate [Hz].
-    solver : str
-        The integrator.
-    probe : object
-        The excitation integrated (for the record).
-    probe_duration : float
-        Its length [s].
-    band : tuple of float or None
-        The transmissibility measure's band [Hz].
-    notes : sequence of str
-        What bounds ``dt0`` (:func:`bound_notes`).
+    dt0 : float
+        The coarsest candidate [s] (:func:`~qzs.engine.step_choice.admissible_step`).
     stability_limit : float
         The largest stable step [s] (for the record).
-    max_halvings : int
-        Halvings of ``dt0`` tried at most [-].
-    safety : float
-        Factor [-] (>= 1) between the estimate and the tolerance.
+    notes : sequence of str
+        What bounds ``dt0`` (:func:`~qzs.engine.step_choice.bound_notes`).
     finest : float, optional
         The finest candidate [s]: halvings stop above it; also the fallback step.
     fallback : bool
         Where no candidate meets the tolerance, or no bin of the band is trusted: return
         the fallback (``finest``, default the paper's step) with ``met`` False instead of
         raising.
-    give_up_early : bool
-        Let a case leave the search, unmet, as soon as its estimate exceeds the tolerance by
-        more than the scheme's order could close by the finest candidate.
-    labels : sequence of str, optional
-        The cases' names in the notes (default ``case 0``, ...).
-    per_case : bool
-        Fill the record's ``case_errors``, ``case_steps`` and ``unmet`` even for one case
-        (always for several).
     progress : bool
         Show a progress bar over the probe runs.
-    unit_name : str
-        What one probe run is called on the bar (``run``, ``batch``).
 
     Returns
     -------
@@ -553,23 +484,84 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     ParameterError
         No bin of the band is trusted on the probe for any case (without ``fallback``).
     """
+    cases, max_halvings = probe.cases, probe.max_halvings
     if finest is not None:
         count = sum(1 for j in range(64) if dt0 / 2 ** j >= finest * (1 - 1e-9))
         max_halvings = min(max_halvings, count - 1)
-    labels = [f"case {c}" for c in range(cases)] if labels is None else [str(x) for x in labels]
+    labels = ([f"case {c}" for c in range(cases)] if probe.labels is None
+              else [str(x) for x in probe.labels])
     if len(labels) != cases:
         raise ParameterError(f"`labels` must name each of the {cases} cases, got {len(labels)}.")
-    unit = MEASURE_UNITS[measure]
     notes = list(notes)
-    bar = None
-    if progress:
-        from qzs.engine.progress import progress_bar
+    bar = _progress_bar(progress, max_halvings + 1, probe.search.get("unit_name", "run"))
+    differences, integrated = {}, []
+    before, after, difference = _probe_runs(probe.run, probe.compare, dt0, bar, differences,
+                                            integrated)
+    try:
+        met, best, history, untrusted, failed = _loop(
+            difference, cases, probe.order, tolerance, dt0, max_halvings, probe.safety,
+            probe.search.get("give_up_early", False), before=before, after=after)
+    finally:
+        if bar is not None:
+            bar.close()
+    record = dict(measure=probe.measure, tolerance=float(tolerance),
+                  stability_limit=float(stability_limit), sample_rate=float(probe.sample_rate),
+                  solver=probe.solver, probe=probe.excitation,
+                  probe_duration=float(probe.duration), band=probe.band, history=tuple(history))
+    outcome = dict(met=met, best=best, untrusted=untrusted, failed=failed,
+                   differences=differences, integrated=integrated)
+    return _choice(probe, outcome, record, notes, labels, dt0, max_halvings, finest, fallback)
 
-        # shown after half a second: a cached or quick choice draws nothing, and a first run's
-        # compile notice (qzs.engine.compiling) comes before the bar
-        bar = progress_bar(total=max_halvings + 1, unit=unit_name, desc="choosing dt", leave=False,
-                           delay=0.5)
-    runs, differences, integrated = {}, {}, []
+
+def _choice(probe, outcome, record, notes, labels, dt0, max_halvings, finest, fallback):
+    """The record of a finished search: the chosen step and each case's, or the fallback."""
+    cases, order, safety = probe.cases, probe.order, probe.safety
+    several = cases > 1 or probe.search.get("per_case", False)
+    met, best, untrusted, failed, differences, integrated = (
+        outcome[key] for key in ("met", "best", "untrusted", "failed", "differences",
+                                 "integrated"))
+    if not met:
+        reason = _unmet_reason(best, untrusted, cases, fallback, dt0, max_halvings, safety,
+                               record)
+        dt = fallback_step(finest)
+        return StepChoice(dt=dt, error=math.nan,
+                          reference_dt=min(integrated, default=math.nan),
+                          notes=tuple(notes + [unmet_sentence(reason, dt)]), met=False,
+                          case_errors=(math.nan,) * cases if several else (),
+                          case_steps=(math.nan,) * cases if several else (),
+                          unmet=tuple(range(cases)) if several else (), **record)
+    j = max(level for level, _ in met.values())
+    deciding = min(c for c, (level, _) in met.items() if level == j)
+    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
+    notes += _case_notes(labels, failed, untrusted, best, dt0 / 2 ** (max_halvings - 2), record)
+    entries = {}
+    if several:
+        entries = dict(
+            case_errors=tuple(float(met[c][1]) if c in met else
+                              (math.nan if c in untrusted else math.inf) for c in range(cases)),
+            case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
+                             for c in range(cases)),
+            unmet=tuple(sorted(set(range(cases)) - set(met))))
+    return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
+                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **entries, **record)
+
+
+def _progress_bar(progress, total, unit_name):
+    """The search's progress bar over probe runs (None without ``progress``)."""
+    if not progress:
+        return None
+    from qzs.engine.progress import progress_bar
+
+    # shown after half a second: a cached or quick choice draws nothing, and a first run's
+    # compile notice (qzs.engine.compiling) comes before the bar
+    return progress_bar(total=total, unit=unit_name, desc="choosing dt", leave=False, delay=0.5)
+
+
+def _probe_runs(run, compare, dt0, bar, differences, integrated):
+    """The loop's ``before``, ``after`` and ``difference`` over the probe's runs: each
+    candidate integrated once per case, kept while a comparison needs it; ``differences``
+    memoises the comparisons and ``integrated`` lists the steps run."""
+    runs = {}
 
     def integrate(j, members):
         kept = runs.setdefault(j, {})
@@ -589,48 +581,40 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
             differences[j, c] = compare(runs[j][c], runs[j + 1][c])
         return differences[j, c]
 
-    try:
-        met, best, history, untrusted, failed = _loop(
-            difference, cases, order, tolerance, dt0, max_halvings, safety, give_up_early,
-            before=before, after=lambda j: runs.pop(j, None))
-    finally:
-        if bar is not None:
-            bar.close()
-    several = cases > 1 or per_case
-    record = dict(measure=measure, tolerance=float(tolerance), stability_limit=float(stability_limit),
-                  sample_rate=float(sample_rate), solver=solver, probe=probe,
-                  probe_duration=float(probe_duration), band=band, history=tuple(history))
-    if not met:
-        # the finest candidate whose error was estimated (compared with two finer ones)
-        finest_tried = dt0 / 2 ** max(max_halvings - 2, 0)
-        if untrusted and len(untrusted) == cases:
-            reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
-                      f"{probe_duration:g} s probe, so no error is measured")
-            if not fallback:
-                raise ParameterError(reason.replace(", so no error is measured", "")
-                                     + "; lengthen `probe_duration` or narrow the band.")
-        else:
-            smallest = min(best.values(), default=math.inf)
-            if not fallback:
-                raise ToleranceNotMetError(tolerance, unit, finest_tried, smallest, safety)
-            reason = (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
-                      f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
-                      "redraw the response at every step)")
-        dt = float(finest if finest is not None else defaults.SIMULATION["dt"])
-        return StepChoice(dt=dt, error=math.nan,
-                          reference_dt=min(integrated, default=math.nan),
-                          notes=tuple(notes + [f"{reason}; running at dt = {dt:.3g} s, whose "
-                                               "error is not estimated"]), met=False,
-                          case_errors=(math.nan,) * cases if several else (),
-                          case_steps=(math.nan,) * cases if several else (),
-                          unmet=tuple(range(cases)) if several else (), **record)
-    j = max(level for level, _ in met.values())
-    deciding = min(c for c, (level, _) in met.items() if level == j)
-    notes += _order_notes(differences[j, deciding], differences[j + 1, deciding], order)
+    return before, lambda j: runs.pop(j, None), difference
+
+
+def _unmet_reason(best, untrusted, cases, fallback, dt0, max_halvings, safety, record):
+    """Why no candidate met the tolerance, for the fallback's sentence; without
+    ``fallback`` the error that says so is raised instead."""
+    tolerance, band, length = record["tolerance"], record["band"], record["probe_duration"]
+    unit = MEASURE_UNITS[record["measure"]]
+    # the finest candidate whose error was estimated (compared with two finer ones)
+    finest_tried = dt0 / 2 ** max(max_halvings - 2, 0)
+    if untrusted and len(untrusted) == cases:
+        reason = (f"no bin of the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
+                  f"{length:g} s probe, so no error is measured")
+        if not fallback:
+            raise ParameterError(reason.replace(", so no error is measured", "")
+                                 + "; lengthen `probe_duration` or narrow the band.")
+        return reason
+    smallest = min(best.values(), default=math.inf)
+    if not fallback:
+        raise ToleranceNotMetError(tolerance, unit, finest_tried, smallest, safety)
+    return (f"no step down to {finest_tried:.3g} s met {tolerance:g} {unit} "
+            f"(smallest estimate {smallest:.3g} {unit}: stick-slip or stop contacts "
+            "redraw the response at every step)")
+
+
+def _case_notes(labels, failed, untrusted, best, finest_tried, record):
+    """The notes on the cases that did not set the step: none met it, or none was measured."""
+    tolerance, band, length = record["tolerance"], record["band"], record["probe_duration"]
+    unit = MEASURE_UNITS[record["measure"]]
+    notes = []
     if failed:
         notes.append(
             f"{'; '.join(labels[c] for c in failed)}: no step down to "
-            f"{dt0 / 2 ** (max_halvings - 2):.3g} s meets {tolerance:g} {unit} (best estimate "
+            f"{finest_tried:.3g} s meets {tolerance:g} {unit} (best estimate "
             + ", ".join(f"{best.get(c, math.inf):.2g} {unit}" for c in failed)
             + "; an estimate that even the scheme's order could not bring within the tolerance "
             "by the finest candidate ends the search early): their response depends on the step "
@@ -639,15 +623,6 @@ def search_step(*, run, compare, cases=1, dt0, order, measure, tolerance, sample
     if untrusted:
         notes.append(f"{'; '.join(labels[c] for c in untrusted)}: no bin of "
                      f"the band ({band[0]:g}, {band[1]:g}) Hz is trusted on the "
-                     f"{probe_duration:g} s probe, so no error is measured; the step is the "
+                     f"{length:g} s probe, so no error is measured; the step is the "
                      "other cases'")
-    entries = {}
-    if several:
-        entries = dict(
-            case_errors=tuple(float(met[c][1]) if c in met else
-                              (math.nan if c in untrusted else math.inf) for c in range(cases)),
-            case_steps=tuple(dt0 / 2 ** met[c][0] if c in met else math.nan
-                             for c in range(cases)),
-            unmet=tuple(sorted(set(range(cases)) - set(met))))
-    return StepChoice(dt=dt0 / 2 ** j, error=float(max(e for _, e in met.values())),
-                      reference_dt=dt0 / 2 ** (j + 2), notes=tuple(notes), **entries, **record)
+    return notes

@@ -6,7 +6,6 @@ A fit holds its numbers; :class:`FitProtocol` gives it the result protocol by de
 ``.nc``/``.csv``/``.mat`` of :meth:`to_xarray`), ``to_xarray`` to
 :func:`qzs.iotools.schema.to_dataset` of the fit's own schema. Its confidence intervals
 are spelled once: ``intervals``, estimated name -> ``(low, high)`` at ``confidence``.
-:func:`deprecated_alias` keeps an old spelling one release, warning with the new one.
 """
 import warnings
 from collections.abc import Callable
@@ -19,7 +18,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
-__all__ = ["FitProtocol", "deprecated_alias", "interval_attributes", "plot_doc",
+__all__ = ["FitProtocol", "interval_attributes", "plot_doc",
            "FREQUENCY_SCALE_OPTION"]
 
 _PLOT_DOC = """The fitted data and the fit, with the residuals (:mod:`qzs.viz.identify`).
@@ -55,30 +54,6 @@ def plot_doc(options: str = "") -> str:
     str
     """
     return _PLOT_DOC.format(options=options)
-
-
-def deprecated_alias(old: str, new: str, value: Callable[[Any], Any]) -> property:
-    """A property ``old`` that warns (DeprecationWarning naming ``new``) and returns ``value``.
-
-    Parameters
-    ----------
-    old : str
-        The deprecated attribute's name.
-    new : str
-        What to use instead, as the warning shows it (``"intervals['plateau']"``).
-    value : callable
-        The object -> the value (the same numbers as ``new``).
-
-    Returns
-    -------
-    property
-    """
-    def get(self: Any) -> Any:
-        warnings.warn(f"`{type(self).__name__}.{old}` is deprecated and will be removed in "
-                      f"the next release; use `{new}`.", DeprecationWarning, stacklevel=2)
-        return value(self)
-
-    return property(get, doc=f"Deprecated (one release): use ``{new}``.")
 
 
 def interval_attributes(fit: Any, units: Any) -> dict[str, Any]:

@@ -26,7 +26,8 @@ from scipy import optimize
 from qzs._format import number
 from qzs._validation import choice, integer, positive_real, real
 from qzs.errors import DataError, FitError, ParameterError
-from qzs.identify._protocol import FitProtocol, deprecated_alias
+from qzs._validation import deprecated_alias
+from qzs.identify._protocol import FitProtocol
 from qzs.identify._statistics import student_quantile
 from qzs.identify.spring_laws import (CRITERION, LawFit, criterion_record, fit_oblique,
                                       fit_polynomial, fit_table, law_force, pairs_dataset,

@@ -15,6 +15,7 @@
 ``hexapod_study``     the hexapod study's cases side by side
 ``sensitivity``       Sobol and Morris indices as bars with their intervals
 ``questions``         the paper's open questions: compensation fraction, damping loops
+``step``              a step choice: each candidate's estimated error and the tolerance
 ====================  ================================================================
 """
 from qzs.viz.figures import envelope, new_figure, save_figure

@@ -30,7 +30,7 @@ def _probe_run(setup, choice, dt):
 
 
 @pytest.mark.parametrize("excitation, measure", [
-    ({"x": Chirp(amplitude=0.002, f0=0.0, f1=8.0, duration=20.0)}, "tolerance_db"),
+    ({"x": Chirp(amplitude=0.002, f0=0.0, f1=8.0, duration=20.0)}, "tolerance"),
     ({"x": RandomExcitation(amplitude=0.002, f_low=0.5, f_high=8.0, duration=5.0, seed=1)},
      "tolerance_state")])
 def test_the_chosen_step_is_the_largest_meeting_the_tolerance_against_a_finer_run(
@@ -51,7 +51,7 @@ def test_the_chosen_step_is_the_largest_meeting_the_tolerance_against_a_finer_ru
     assert choice.dt == choice.history[-1][0]
     assert all(SAFETY * estimate > tolerance for _, _, estimate in choice.history[:-1])
     assert SAFETY * choice.error <= tolerance
-    kind = "transmissibility_db" if measure == "tolerance_db" else "state_m"
+    kind = "transmissibility_db" if measure == "tolerance" else "state_m"
     assert choice.measure == kind and choice.tolerance == tolerance
     chosen, finer = (_probe_run(setup, choice, dt) for dt in (choice.dt, choice.dt / 8))
     actual = hexapod_step_error(chosen, finer, kind, axis="x", band=choice.band)
@@ -79,16 +79,16 @@ def test_the_state_measure_counts_a_rotation_as_the_arc_at_the_platforms_size(se
 
 
 @pytest.mark.parametrize("options, match", [
-    (dict(tolerance_db=0.0), "`tolerance_db`.*0"),
-    (dict(tolerance_db=-0.01), "`tolerance_db`.*-0.01"),
-    (dict(tolerance_db=float("nan")), "`tolerance_db`.*nan"),
+    (dict(tolerance=0.0), "`tolerance`.*0"),
+    (dict(tolerance=-0.01), "`tolerance`.*-0.01"),
+    (dict(tolerance=float("nan")), "`tolerance`.*nan"),
     (dict(tolerance_state="small"), "`tolerance_state`.*small"),
-    (dict(), "exactly one of `tolerance_db`.*neither"),
-    (dict(tolerance_db=0.01, tolerance_state=1e-5), "tolerance_db and tolerance_state"),
-    (dict(tolerance_db=0.01, excitation={"x": Chirp(duration=20.0), "z": Chirp(duration=20.0)}),
+    (dict(), "exactly one of `tolerance`.*neither"),
+    (dict(tolerance=0.01, tolerance_state=1e-5), "tolerance and tolerance_state"),
+    (dict(tolerance=0.01, excitation={"x": Chirp(duration=20.0), "z": Chirp(duration=20.0)}),
      "one axis.*Give `tolerance_state`"),
-    (dict(tolerance_db=0.01, excitation={}), "moves no base axis"),
-    (dict(tolerance_db=0.01, band=(1.0, 50.0)), "`band`.*outside"),
+    (dict(tolerance=0.01, excitation={}), "moves no base axis"),
+    (dict(tolerance=0.01, band=(1.0, 50.0)), "`band`.*outside"),
 ])
 def test_bad_tolerances_are_refused_before_any_run(setup, monkeypatch, options, match):
     import qzs.engine.hexapod.simulate as simulate

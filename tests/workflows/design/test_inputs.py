@@ -4,13 +4,14 @@ import pytest
 import qzs
 from qzs import Chirp, ControllerParameters, ParameterError
 from qzs.workflows import design as D
-from qzs.workflows.design import hunting, integration_step, proportional_search
+from qzs.workflows.design import hunting, proportional_search
+from qzs.engine import step_choice
 from qzs.workflows.design import cost
 
 #: Where the design simulates: (module, name) of every simulating function it calls.
 SIMULATORS = [(proportional_search, "simulate"), (proportional_search, "simulate_batch"),
               (cost, "simulate_batch"), (hunting, "simulate"),
-              (integration_step, "choose_batch_step")]
+              (step_choice, "choose")]
 
 
 def forbid_simulation(monkeypatch):

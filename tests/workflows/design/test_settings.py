@@ -23,3 +23,19 @@ def test_the_gains_a_stage_tries_keep_the_ratio_and_the_rate(design_options):
     assert (trial.pi_kp, trial.damping_gain, trial.controller_rate) == (300.0, 25.0, 500.0)
     assert trial.pi_ki == pytest.approx(0.4 * 300.0, rel=1e-15)
     assert settings.controller_at(10.0).damping_gain == settings.controller.damping_gain
+
+
+def test_the_plan_is_resolved_once_with_its_steps_and_never_changed(design_options):
+    """The settings are a frozen plan: the steps are in it when it is made (a given dt is
+    the cost's step and the PI search's), and a stage cannot write a step into it."""
+    import dataclasses
+
+    from qzs.workflows.design.inputs import _design_settings
+
+    arguments = dict(design_options, stiction_range=(8.0, 12.0), cost="rms",
+                     controller_rate=None, delay=0.0, gain_margin_min=6.0,
+                     phase_margin_min=30.0, workers=1, progress=False, dt=5e-4)
+    settings = _design_settings(None, None, **arguments)
+    assert (settings.dt, settings.stroke_dt, settings.dt_note) == (5e-4, 5e-4, "given")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        settings.dt = 1e-3

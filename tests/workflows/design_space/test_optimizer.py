@@ -183,7 +183,7 @@ def test_a_simulated_search_runs_each_generation_as_one_task(tmp_path, monkeypat
 
 def test_the_step_is_chosen_on_the_corners_and_centre_when_the_file_gives_none():
     document = copy.deepcopy(SIMULATED)
-    document["simulation"] = {"tolerance_db": 0.05}
+    document["simulation"] = {"tolerance": 0.05}
     problem = load_problem(document)
     corners = probe_designs(problem)
     assert corners[:, 1].tolist() == pytest.approx([1.0, 10 ** 1.5, 1000.0])

@@ -382,7 +382,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
     """No ``dt``: one step for the batch, chosen for the tolerance and recorded with its
     estimate; ``dt`` given: used as given, nothing probed, over a file's; a file's
     ``[simulation] dt``: used as written; ``dt`` and a tolerance both: refused at once."""
-    import qzs.engine.accuracy_batch
+    import qzs.engine.step_choice
     from qzs.engine.accuracy import SAFETY
 
     text = ("[study]\nname = 'tiny'\nkind = 'transmissibility'\n"
@@ -400,7 +400,7 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
     def refuse(*args, **kwargs):
         raise AssertionError("a step was chosen where one was given")
 
-    monkeypatch.setattr(qzs.engine.accuracy_batch, "choose_batch_step", refuse)
+    monkeypatch.setattr(qzs.engine.step_choice, "choose", refuse)
     path.write_text(text + "[simulation]\ndt = 5e-4\n")
     from_file = run_studies([load_study(path)], quick=True, workers=1, progress=False)[0]
     assert from_file.step == {"dt": 5e-4, "source": "file"}
@@ -409,9 +409,12 @@ def test_the_step_is_chosen_for_the_tolerance_or_given_or_the_files(tmp_path, mo
     assert given.step == {"dt": 2.5e-4, "source": "given"}
     assert [case.run["dt"] for case in given.cases] == [2.5e-4] * 2
     with pytest.raises(ParameterError, match="not both"):
-        run_studies([study], dt=1e-3, tolerance_db=0.01)
-    with pytest.raises(ParameterError, match="tolerance_db"):
-        run_studies([study], tolerance_db=-1.0)
+        run_studies([study], dt=1e-3, tolerance=0.01)
+    with pytest.raises(ParameterError, match="`tolerance`"):
+        run_studies([study], tolerance=-1.0)
+    with pytest.warns(DeprecationWarning, match="use `tolerance`"), \
+            pytest.raises(ParameterError, match="not both"):
+        run_studies([study], dt=1e-3, tolerance_db=0.01)  # the deprecated name, one release
 
 
 def test_a_batch_no_step_settles_runs_at_the_papers_step_and_says_so(tmp_path):
@@ -548,23 +551,25 @@ def test_a_plan_carries_each_chosen_step_in_new_cases_and_mutates_none(monkeypat
     import dataclasses
     import types
 
-    import qzs.engine.accuracy_batch as accuracy_batch
+    import qzs.engine.step_choice as step_choice
+    from qzs.engine.step_choice import StepRequest
     from qzs.workflows.paper.studies import StudyCase, _choose_steps, _study_cases, plan_studies
 
     seen = {}
 
-    def choose(cases, excitation, **options):
-        seen["labels"] = options["labels"]
-        return types.SimpleNamespace(dt=2.5e-4, met=True, tolerance=options["tolerance_db"],
+    def choose(request, probe, **options):
+        seen["labels"] = probe.labels
+        cases = probe.cases
+        return types.SimpleNamespace(dt=2.5e-4, met=True, tolerance=request.tolerance,
                                      case_errors=[0.01 * (c + 1) for c in range(len(cases))],
                                      unmet=(1,), reference_dt=1.25e-4, probe_duration=5.0,
                                      notes=("probed",), cached=False)
 
-    monkeypatch.setattr(accuracy_batch, "choose_batch_step", choose)
+    monkeypatch.setattr(step_choice, "choose", choose)
     stiction, spring = load_study("stiction"), load_study("spring")
     per_study = [_study_cases(stiction, True), _study_cases(spring, True)]
     assert all(case.dt is None for case in per_study[0])
-    cases, steps = _choose_steps(per_study, 0.05, 1, False)
+    cases, steps = _choose_steps(per_study, StepRequest(tolerance=0.05), 1, False)
     assert all(case.dt is None for case in per_study[0])  # not written into
     assert [case.dt for case in cases[0]] == [2.5e-4] * len(stiction.cases)
     assert cases[0][0] == dataclasses.replace(per_study[0][0], dt=2.5e-4)

@@ -12,7 +12,7 @@ from qzs.workflows.response import SAMPLES_PER_PERIOD, steady_state_response
     (([],), {}, "frequencies"),
     (([2.0], 0.0), {}, "amplitude"),
     (([2.0],), {"direction": "sideways"}, "direction"),
-    (([2.0],), {"dt": 1e-3, "tolerance_db": 0.01}, "dt"),
+    (([2.0],), {"dt": 1e-3, "tolerance": 0.01}, "dt"),
     (([2.0],), {"dt": 0.05}, "dt"),
     (([60.0],), {"dt": 1e-3}, "frequencies"),
     (([2.0],), {"harmonics": 100}, "harmonics"),
@@ -55,3 +55,13 @@ def test_1e8_frequencies_fail_at_once():
         steady_state_response(frequencies)
     assert time.perf_counter() - began < 2.0
     assert (caught.value.count, caught.value.limit) == (10 ** 8, MAX_FREQUENCIES)
+
+
+def test_tolerance_db_is_the_deprecated_name_of_tolerance():
+    """One release more: it warns with the new name, and means what ``tolerance`` means (so
+    with a ``dt`` it is refused as ``tolerance`` is)."""
+    with pytest.warns(DeprecationWarning, match="use `tolerance`"), \
+            pytest.raises(ParameterError, match="`dt`.*`tolerance`.*not both"):
+        steady_state_response([2.0], dt=1e-3, tolerance_db=0.01)
+    with pytest.raises(ParameterError, match="give `tolerance` only"):
+        steady_state_response([2.0], tolerance=0.01, tolerance_db=0.01)

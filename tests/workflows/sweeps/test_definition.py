@@ -114,13 +114,32 @@ def test_fixed_and_varied_conflicts_and_invalid_fixed_values():
     raises(definition(excitation={"frequency": 2.0}, grid={"pi_kp": [1.0]}), "[excitation]")
 
 
+def test_the_tolerance_key_and_its_deprecated_name_tolerance_db():
+    """[simulation] writes `tolerance` [dB]; `tolerance_db` is read one release more, with a
+    DeprecationWarning naming `tolerance`; the store keeps its `tolerance_db` (the schema)."""
+    import warnings
+
+    grid = {"pi_kp": [1.0]}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        new = load_sweep(definition(grid=grid, simulation={"tolerance": 0.2}))
+    with pytest.warns(DeprecationWarning, match="`tolerance_db` is deprecated.*use `tolerance`"):
+        old = load_sweep(definition(grid=grid, simulation={"tolerance_db": 0.2}))
+    assert new.simulation["tolerance_db"] == old.simulation["tolerance_db"] == 0.2
+    assert new.simulation["dt"] is old.simulation["dt"] is None
+    raises(definition(grid=grid, simulation={"tolerance": 0.2, "tolerance_db": 0.2}),
+           "give `tolerance` only")
+    for path in shipped_sweeps():  # the shipped files say `tolerance`
+        assert "tolerance_db" not in path.read_text(encoding="utf-8"), path
+
+
 def test_analysis_and_simulation_checks():
     raises(definition(grid={"pi_kp": [1.0]}, analysis={"sample_rate": 3000.0},
                       simulation={"dt": 1e-4}), "`sample_rate` (3000.0 Hz) must divide")
-    raises(definition(grid={"pi_kp": [1.0]}, simulation={"dt": 1e-4, "tolerance_db": 0.1}),
-           "either `dt`", "`tolerance_db`")
-    raises(definition(grid={"pi_kp": [1.0]}, simulation={"tolerance_db": -1.0}),
-           "`tolerance_db`")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"dt": 1e-4, "tolerance": 0.1}),
+           "either `dt`", "`tolerance`")
+    raises(definition(grid={"pi_kp": [1.0]}, simulation={"tolerance": -1.0}),
+           "`tolerance`")
     raises(definition(grid={"pi_kp": [1.0]}, simulation={"solver": "rk45"}), "`solver`")
     raises(definition(grid={"pi_kp": [1.0]}, analysis={"duration": 10.0}),
            "either `n_averages` or `duration`")

@@ -24,14 +24,14 @@ def test_without_dt_the_step_is_chosen_for_the_tolerance_before_any_case_runs():
 
     document = definition(grid={"stiction_force": [2.0, 15.0]},
                           analysis={"fft_length": 2048, "n_averages": 6},
-                          simulation={"tolerance_db": 0.05})
+                          simulation={"tolerance": 0.05})
     sweep = load_sweep(document)
     assert sweep.simulation["dt"] is None and "chosen at run time" in plan_text(sweep)
     settings = case_settings(sweep, sample_cases(sweep))
     chosen, choices = choose_sweep_step(sweep, settings)
     assert [i for i, _ in choices] == [0, 1]
     isolator, controller, (excitation, _), _ = build_case(sweep, settings[1])
-    direct = choose_step(excitation, isolator, controller, tolerance_db=0.05)
+    direct = choose_step(excitation, isolator, controller, tolerance=0.05)
     assert chosen.simulation["dt"] == min(c.dt for _, c in choices) <= direct.dt
     from qzs.engine.accuracy import SAFETY
 

@@ -25,11 +25,13 @@ compared with the next finer one, the error extrapolated Richardson-style
 
 >>> from qzs.engine.hexapod.accuracy import choose_hexapod_step
 >>> choice = choose_hexapod_step(geometry, platform, excitation={"x": Chirp(
-...     amplitude=0.002, duration=200.0)}, tolerance_db=0.01)  # doctest: +SKIP
+...     amplitude=0.002, duration=200.0)}, tolerance=0.01)  # doctest: +SKIP
 >>> choice.dt, choice.error  # doctest: +SKIP
 (0.001, 0.0008...)
 """
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -37,12 +39,11 @@ from qzs import _validation, defaults
 from qzs._validation import choice as _choice
 from qzs.engine.accuracy import (PROBE_DURATION, check_band, estimate_difference_db,
                                  frequency_range, probe_excitation, probe_fft_length)
-from qzs.engine.step_search import (MAX_HALVINGS, MEASURE_UNITS, SAFETY, admissible_step,
-                                    bound_notes,
-                                    search_step, tolerance_measure)
-from qzs.errors import ParameterError, ToleranceNotMetError
+from qzs.engine.step_choice import ProbeSettings, admissible_step
+from qzs.engine.step_search import MAX_HALVINGS, MEASURE_UNITS, SAFETY
+from qzs.errors import ParameterError
 
-__all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error"]
+__all__ = ["choose_hexapod_step", "hexapod_probe", "hexapod_step_error", "HexapodProbe"]
 
 
 def hexapod_probe(excitation, band=None, probe_duration=None, duration=None,
@@ -151,12 +152,12 @@ def hexapod_step_error(coarse, fine, measure, *, axis=None, band=None, fft_lengt
 
 
 def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, excitation,
-                        tolerance_db=None, tolerance_state=None,
+                        tolerance=None, tolerance_state=None,
                         solver=defaults.SIMULATION["solver"],
                         sample_rate=defaults.SIMULATION["sample_rate"], band=None,
                         duration=None, finest=None, fallback=False, probe_duration=None,
                         cartesian=None, max_halvings=MAX_HALVINGS, safety=SAFETY,
-                        progress=False):
+                        progress=False, tolerance_db=None):
     """The largest fixed step of a six-axis run whose error stays within a tolerance.
 
     The method of :func:`qzs.engine.accuracy.choose_step` (module docstring): candidates
@@ -175,7 +176,7 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
         The legs; defaults if omitted.
     excitation : dict
         Axis name -> excitation, as :func:`~qzs.engine.hexapod.simulate.simulate_hexapod`'s.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance on the driven axis's column of the transmissibility [dB] (one moving
         axis).
     tolerance_state : float, optional
@@ -208,6 +209,8 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
         Factor [-] (>= 1) between the estimate and the tolerance.
     progress : bool
         Show a progress bar over the probe runs.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -223,60 +226,169 @@ def choose_hexapod_step(geometry, platform, isolator=None, controller=None, *, e
     ToleranceNotMetError
         No candidate meets the tolerance and no ``fallback`` was given.
     """
-    from qzs.engine.hexapod.prepare import (_excitations, _per_leg, _stability_limit,
-                                            hexapod_stability_test)
+    from qzs.engine.step_choice import choose, step_request
+
+    request = step_request(tolerance=tolerance, tolerance_state=tolerance_state,
+                           tolerance_db=tolerance_db, required=True)
+    return choose(request, HexapodProbe(
+        geometry=geometry, platform=platform, isolator=isolator, controller=controller,
+        excitation=excitation, solver=solver,
+        sample_rate=sample_rate, band=band, duration=duration, probe_duration=probe_duration,
+        cartesian=cartesian, max_halvings=max_halvings, safety=safety),
+        fallback=fallback, finest=finest, progress=progress)
+
+
+@dataclass(frozen=True, kw_only=True)
+class HexapodProbe(ProbeSettings):
+    """The probe of the six-leg platform: the inputs of :func:`choose_hexapod_step` but the
+    tolerance; nothing computed until :func:`qzs.engine.step_choice.choose` calls
+    :meth:`build` for a chosen step. Not cached (no key).
+
+    Attributes
+    ----------
+    geometry : HexapodGeometry
+        The platform's joints.
+    platform : PlatformParameters
+        Its mass and inertia.
+    isolator : IsolatorParameters or sequence of six or None
+        The legs' plants (None: the defaults).
+    controller : ControllerParameters or sequence of six or None
+        The legs' loops (None: the defaults).
+    excitation : dict
+        Axis name -> excitation (the moving axes).
+    solver : str
+        The integrator.
+    sample_rate : float
+        Output rate [Hz] of the run the step is for.
+    band : tuple of float or None
+        Band [Hz] of the transmissibility measure (None: the excitation's).
+    probe_duration : float or None
+        Length of the probe [s] (None: the default).
+    duration : float or None
+        The run's length [s]; a probe of a stationary excitation is not longer.
+    cartesian : CartesianController or None
+        Centralised loops.
+    max_halvings : int
+        Halvings of the admissible start tried at most [-].
+    safety : float
+        Factor [-] between the estimate and the tolerance.
+    """
+
+    geometry: Any
+    platform: Any
+    isolator: Any = None
+    controller: Any = None
+    duration: float | None = None
+    cartesian: Any = None
+
+    @property
+    def default_measure(self) -> str:
+        """The default request's measure: one chirping axis, its transmissibility; else the
+        pose."""
+        from qzs.model.excitation import Chirp
+
+        moving = dict(self.excitation or {})
+        one_chirp = len(moving) == 1 and isinstance(next(iter(moving.values())), Chirp)
+        return "transmissibility_db" if one_chirp else "state_m"
+
+    def _build(self, measure):
+        from qzs.engine.hexapod.prepare import _excitations
+        from qzs.engine.step_choice import Probe
+        from qzs.model.hexapod import platform_size
+
+        moving = _excitations(self.excitation)
+        if not moving:
+            raise ParameterError("`excitation` moves no base axis: there is nothing to choose "
+                                 "a step for; give e.g. excitation={'z': Chirp(duration=20.0)}.")
+        order, sample_rate, axis, band = self._settings(measure, moving)
+        isolators, controllers = self._legs()
+        probe, length = hexapod_probe(moving, band, self.probe_duration, self.duration,
+                                      sample_rate)
+        size = platform_size(self.geometry)
+        return Probe(
+            measure=measure, order=order, sample_rate=sample_rate, solver=self.solver,
+            excitation=probe, duration=length, band=band, shortened=True,
+            start=lambda: self._start(isolators, controllers, probe, length, sample_rate),
+            run=lambda dt, cases: [_probe_run(self, isolators, controllers, probe,
+                                                          length, dt, sample_rate)],
+            compare=lambda coarse, fine: hexapod_step_error(coarse, fine, measure, axis=axis,
+                                                            band=band, size=size),
+            max_halvings=self.max_halvings, safety=self.safety)
+
+    def _settings(self, measure, moving):
+        """The checked order [-], output rate [Hz], driven axis and band [Hz]."""
+        from qzs.engine.stability import SOLVERS
+
+        _, order = SOLVERS[_choice("solver", self.solver, tuple(SOLVERS))]
+        sample_rate = _validation.positive_real("sample_rate", self.sample_rate)
+        for name, value in (("duration", self.duration), ("probe_duration", self.probe_duration)):
+            if value is not None:
+                _validation.positive_real(name, value)
+        _validation.real("safety", self.safety, minimum=1.0)
+        _validation.integer("max_halvings", self.max_halvings, 2)
+        axis, band = None, self.band
+        if measure == "transmissibility_db":
+            if len(moving) != 1:
+                raise ParameterError(
+                    f"`tolerance` measures the driven axis's transmissibility, which needs the "
+                    f"base moving along one axis; it moves along {sorted(moving)}. Give "
+                    "`tolerance_state` [m] (the pose) instead, or excite one axis.",
+                    ("tolerance", "tolerance_state"))
+            axis, = moving
+            band = check_band(band, moving[axis], sample_rate)
+        return order, sample_rate, axis, band
+
+    def _legs(self):
+        """The six legs' isolators and controllers (defaults if omitted)."""
+        from qzs.engine.hexapod.prepare import _per_leg
+        from qzs.model.controller import ControllerParameters
+        from qzs.model.isolator import IsolatorParameters
+
+        isolators = _per_leg("isolator", IsolatorParameters() if self.isolator is None
+                             else self.isolator, IsolatorParameters)
+        controllers = _per_leg("controller", ControllerParameters() if self.controller is None
+                               else self.controller, ControllerParameters)
+        return isolators, controllers
+
+    def _start(self, isolators, controllers, probe, length, sample_rate):
+        """The stability limit, resolving step and admissible start (``Probe.start``)."""
+        from qzs.engine.hexapod.prepare import _stability_limit, hexapod_stability_test
+        from qzs.engine.prepare import resolving_step
+
+        stable = hexapod_stability_test(self.geometry, self.platform, isolators, controllers,
+                                        self.solver)
+        limit = _stability_limit(self.geometry, self.platform, isolators, controllers,
+                                 self.solver)
+        resolving = min(resolving_step(value, length) for value in probe.values())
+        dt0, k0 = admissible_step(sample_rate, controllers[0].controller_rate,
+                                  lambda dt: dt <= resolving and stable(dt))
+        return limit, resolving, dt0, k0
+
+
+def _probe_run(probe_of, isolators, controllers, probe, length, dt, sample_rate):
+    """One probe run of the six-leg platform at step ``dt`` [s] (``Probe.run``).
+
+    Parameters
+    ----------
+    probe_of : HexapodProbe
+        The builder (geometry, platform, solver, centralised loops).
+    isolators, controllers : list
+        The six legs.
+    probe : dict
+        Axis name -> the probe's excitation.
+    length : float
+        The probe's length [s].
+    dt : float
+        The step [s].
+    sample_rate : float
+        Output rate [Hz].
+
+    Returns
+    -------
+    HexapodResult
+    """
     from qzs.engine.hexapod.simulate import simulate_hexapod
-    from qzs.engine.prepare import resolving_step
-    from qzs.engine.stability import SOLVERS
-    from qzs.model.controller import ControllerParameters
-    from qzs.model.hexapod import platform_size
-    from qzs.model.isolator import IsolatorParameters
 
-    measure, tolerance = tolerance_measure(tolerance_db, tolerance_state)
-    moving = _excitations(excitation)
-    if not moving:
-        raise ParameterError("`excitation` moves no base axis: there is nothing to choose a "
-                             "step for; give e.g. excitation={'z': Chirp(duration=20.0)}.")
-    _, order = SOLVERS[_choice("solver", solver, tuple(SOLVERS))]
-    sample_rate = _validation.positive_real("sample_rate", sample_rate)
-    for name, value in (("duration", duration), ("finest", finest),
-                        ("probe_duration", probe_duration)):
-        if value is not None:
-            _validation.positive_real(name, value)
-    _validation.real("safety", safety, minimum=1.0)
-    _validation.integer("max_halvings", max_halvings, 2)
-    axis = None
-    if measure == "transmissibility_db":
-        if len(moving) != 1:
-            raise ParameterError(
-                f"`tolerance_db` measures the driven axis's transmissibility, which needs the "
-                f"base moving along one axis; it moves along {sorted(moving)}. Give "
-                "`tolerance_state` [m] (the pose) instead, or excite one axis.")
-        axis, = moving
-        band = check_band(band, moving[axis], sample_rate)
-    isolators = _per_leg("isolator", IsolatorParameters() if isolator is None else isolator,
-                         IsolatorParameters)
-    controllers = _per_leg("controller",
-                           ControllerParameters() if controller is None else controller,
-                           ControllerParameters)
-    probe, length = hexapod_probe(moving, band, probe_duration, duration, sample_rate)
-    stable = hexapod_stability_test(geometry, platform, isolators, controllers, solver)
-    limit = _stability_limit(geometry, platform, isolators, controllers, solver)
-    resolving = min(resolving_step(value, length) for value in probe.values())
-    dt0, k0 = admissible_step(sample_rate, controllers[0].controller_rate,
-                              lambda dt: dt <= resolving and stable(dt))
-    size = platform_size(geometry)
-
-    def run(dt, cases):
-        return [simulate_hexapod(geometry, platform, isolators, controllers, excitation=probe,
-                                 duration=length, dt=dt, sample_rate=sample_rate, solver=solver,
-                                 cartesian=cartesian)]
-
-    return search_step(
-        run=run, compare=lambda coarse, fine: hexapod_step_error(
-            coarse, fine, measure, axis=axis, band=band, size=size),
-        dt0=dt0, order=order, measure=measure, tolerance=tolerance, sample_rate=sample_rate,
-        solver=solver, probe=probe, probe_duration=length, band=band,
-        notes=bound_notes(dt0, k0, sample_rate, limit, resolving, measure, True),
-        stability_limit=limit, max_halvings=max_halvings, safety=safety, finest=finest,
-        fallback=fallback, progress=progress)
+    return simulate_hexapod(probe_of.geometry, probe_of.platform, isolators, controllers,
+                            excitation=probe, duration=length, dt=dt, sample_rate=sample_rate,
+                            solver=probe_of.solver, cartesian=probe_of.cartesian)

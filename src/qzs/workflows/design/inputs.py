@@ -16,7 +16,8 @@ from qzs.model.registry import model_inputs
 from qzs.workflows.design.cases import DesignCase
 from qzs.engine.prepare import divides
 from qzs.workflows.design.integration_step import _stroke_step, choose_dt
-from qzs.workflows.design.settings import COSTS, FFT_LENGTH, QUICK_CHIRP, SAMPLE_RATE, _Settings
+from qzs.workflows.design.settings import (COSTS, FFT_LENGTH, QUICK_CHIRP, SAMPLE_RATE,
+                                           DesignSettings)
 
 
 def _design_settings(isolator, controller, *, excitation, stiction_range, mass_range,
@@ -30,8 +31,8 @@ def _design_settings(isolator, controller, *, excitation, stiction_range, mass_r
 
     Returns
     -------
-    _Settings
-        The validated inputs every stage shares.
+    DesignSettings
+        The validated inputs every stage shares, with the chosen steps.
     """
     isolator, controller = model_inputs(isolator, controller)
     _check_ratio(controller)
@@ -54,7 +55,7 @@ def _design_settings(isolator, controller, *, excitation, stiction_range, mass_r
     for fs in stiction_range:  # the case parameters must be valid before anything runs
         for m in mass_range:
             DesignCase("base", fs, m).isolator(isolator)
-    settings = _Settings(
+    settings = DesignSettings(
         isolator=isolator, controller=controller, excitation=excitation, duration=duration,
         stiction_range=stiction_range, mass_range=mass_range, force_steps=steps, band=band,
         cost=cost, controller_rate=rate, delay=delay, quick=bool(quick), dt=math.nan,
@@ -66,8 +67,7 @@ def _design_settings(isolator, controller, *, excitation, stiction_range, mass_r
     if rate > 0:
         cd.sampled_loop(isolator, controller, rate, delay)  # validates the rate
     _check_duration(settings)
-    _set_steps(settings, dt)
-    return settings
+    return _with_steps(settings, dt)
 
 
 def _check_ratio(controller):
@@ -148,24 +148,27 @@ def _check_duration(settings):
             f"{2 * settings.fft_length / sample_rate:g} s.")
 
 
-def _set_steps(settings, dt):
-    """Set ``settings.dt`` (given, or accuracy-driven) and the PI search's ``stroke_dt``."""
+def _with_steps(settings, dt):
+    """The settings with their steps: ``dt`` (given, or accuracy-driven), its note, and the
+    PI search's ``stroke_dt`` (a new frozen plan; ``settings`` is not changed)."""
     rate = settings.controller_rate
     if dt is None:
         if rate > 0:  # a rate that shares no step with the output fails here, not after probes
             from qzs import defaults
-            from qzs.engine.accuracy import admissible_step
             from qzs.engine.stability import stability_test
+            from qzs.engine.step_choice import admissible_step
 
             stiffest = settings.controller_at(settings.controller.pi_kp, settings.damping_gain_max)
             admissible_step(settings.sample_rate, rate, stability_test(
                 settings.isolator, stiffest, defaults.SIMULATION["solver"]))
-        settings.dt, settings.dt_note = choose_dt(settings, settings.controller.pi_kp)
+        step, note = choose_dt(settings, settings.controller.pi_kp)
     else:
-        settings.dt = real("dt", dt, minimum=0.0, strict=True, fix="in seconds, e.g. 0.001")
-        settings.dt_note = "given"
-    if rate > 0 and not divides(rate, settings.dt):
+        step = real("dt", dt, minimum=0.0, strict=True, fix="in seconds, e.g. 0.001")
+        note = "given"
+    if rate > 0 and not divides(rate, step):
         raise ParameterError(f"`controller_rate` ({rate:g} Hz) must divide 1/dt "
-                             f"({1 / settings.dt:g} Hz); choose e.g. {1 / settings.dt:g} Hz or "
+                             f"({1 / step:g} Hz); choose e.g. {1 / step:g} Hz or "
                              "a whole fraction of it.")
-    settings.stroke_dt = settings.dt if dt is not None else _stroke_step(settings)
+    settings = dataclasses.replace(settings, dt=step, dt_note=note)
+    return dataclasses.replace(settings, stroke_dt=step if dt is not None
+                               else _stroke_step(settings))

@@ -108,7 +108,7 @@ def fix_step(problem, *, progress=False):
     """The problem with its integration step fixed.
 
     A problem whose ``[simulation]`` gives no ``dt`` runs at the step chosen for its
-    ``tolerance_db`` on :func:`probe_designs` (each at the uncertain parameters' medians),
+    ``tolerance`` on :func:`probe_designs` (each at the uncertain parameters' medians),
     by :func:`qzs.workflows.sweeps.step.choose_sweep_step`, the sweeps' choice. A
     problem of linear metrics only needs no step.
 

@@ -45,7 +45,7 @@ is wanted::
     method = "sobol"             # or "morris"
     samples = 256
 
-    [simulation]                 # as in a sweep file: solver, dt or tolerance_db
+    [simulation]                 # as in a sweep file: solver, dt or tolerance
     [analysis]                   # as in a sweep file: sample_rate, fft_length, band, ...
 
 Metrics are those of :data:`qzs.workflows.design_space.metrics.METRICS`. Every

@@ -34,7 +34,7 @@ the ends, at probability 0 and 1, are infinite for an unbounded distribution).
 Each sample point is one case ``{name: value}``, evaluated by
 :func:`qzs.workflows.design_space.evaluation.evaluate_cases`, the path of every design of an
 optimisation: simulated metrics through the sweep batch task (the step chosen first for
-the problem's ``tolerance_db`` if ``[simulation]`` gives no ``dt``, by the optimiser's
+the problem's ``tolerance`` if ``[simulation]`` gives no ``dt``, by the optimiser's
 :func:`~qzs.workflows.design_space.optimizer.fix_step`, so both integrate a problem at
 one step), linear metrics by the
 linear analysis. A case whose metric is undefined (a failed run) leaves that metric's

@@ -15,7 +15,7 @@ import numpy as np
 
 from qzs._format import unit_label
 from qzs.errors import ParameterError
-from qzs.identify._protocol import deprecated_alias
+from qzs._validation import deprecated_alias
 from qzs.iotools.schema import Schema, Variable, to_dataset
 
 if TYPE_CHECKING:

@@ -263,11 +263,12 @@ def load_hexapod(path: str | Path,
 def simulate_setup(setup: HexapodSetup, *,
                    excitation: Mapping[str, Mapping[str, Any]] | None = None,
                    duration: float | None = None, dt: float | None = None,
-                   tolerance_db: float | None = None, tolerance_state: float | None = None,
+                   tolerance: float | None = None, tolerance_state: float | None = None,
                    sample_rate: float | None = None, solver: str | None = None,
                    progress: bool = False, out: str | Path | None = None,
                    interruptible: bool = False, argument: str = "out",
-                   names: Mapping[str, str] | None = None) -> HexapodResult:
+                   names: Mapping[str, str] | None = None,
+                   tolerance_db: float | None = None) -> HexapodResult:
     """Simulate a set-up: its file's ``[excitation.<axis>]`` and ``[simulation]``, overridable.
 
     With ``out`` every sample is streamed to that NetCDF file as the run goes
@@ -290,7 +291,7 @@ def simulate_setup(setup: HexapodSetup, *,
         file's ``[simulation] dt`` (else 1e-4 s) and taking it where no coarser step meets
         the tolerance (:func:`qzs.engine.run_spec.resolve_hexapod`); ``result.run`` says
         which (:meth:`~qzs.engine.step_search.StepChoice.attributes`).
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance [dB] on the driven axis's column of the transmissibility (one moving
         axis); the default measure, at ``qzs.defaults.ACCURACY["tolerance_db"]``, for a
         chirp along one axis.
@@ -316,6 +317,8 @@ def simulate_setup(setup: HexapodSetup, *,
         How the caller names the options of ``excitation`` in messages (the command line's
         ``{"duration": "--excitation-duration"}``); the file's are named by their table
         (``[excitation.z] duration``).
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -329,11 +332,14 @@ def simulate_setup(setup: HexapodSetup, *,
     OutputPathError
         ``out`` cannot be written (suffix, folder, permissions, free space), before the run.
     """
+    from qzs._validation import renamed_keyword
     from qzs.defaults import SIMULATION
     from qzs.engine.hexapod import simulate_hexapod
     from qzs.engine.hexapod.prepare import record_option
     from qzs.engine.run_spec import resolve_hexapod
     from qzs.model.excitation import build_excitation
+
+    tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
 
     tables = {**setup.excitation, **(excitation or {})}
     if not tables:
@@ -361,7 +367,7 @@ def simulate_setup(setup: HexapodSetup, *,
     try:
         resolved = resolve_hexapod(
             setup.geometry, setup.platform, setup.isolators, setup.controllers, excitation=built,
-            duration=arguments["duration"], dt=dt, tolerance_db=tolerance_db,
+            duration=arguments["duration"], dt=dt, tolerance=tolerance,
             tolerance_state=tolerance_state, sample_rate=arguments["sample_rate"],
             solver=arguments["solver"], cartesian=setup.cartesian, finest=arguments["dt"],
             step="chosen", progress=progress)

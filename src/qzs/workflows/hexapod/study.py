@@ -406,9 +406,10 @@ def _findings(cases, rows):
 
 # ---------------------------------------------------------------- the run
 def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bool = False,
-                      dt: float | None = None, tolerance_db: float | None = None,
+                      dt: float | None = None, tolerance: float | None = None,
                       workers: int | None = None, progress: bool = True,
-                      frequency_scale: str | None = None) -> HexapodStudyResult:
+                      frequency_scale: str | None = None,
+                      tolerance_db: float | None = None) -> HexapodStudyResult:
     """Run the shipped hexapod study and write its report (``qzs hexapod study``).
 
     Parameters
@@ -420,7 +421,7 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     dt : float, optional
         A literal step [s] for every run; default the accuracy-driven step of each run
         (:mod:`qzs.workflows.hexapod.transmissibility`).
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance [dB] of the accuracy-driven step on each run's column; default
         ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     workers : int, optional
@@ -430,12 +431,16 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     frequency_scale : {"log", "linear"}, optional
         Frequency axis of the figures; default ``qzs.defaults.FIGURES["frequency_scale"]``
         (log).
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
     HexapodStudyResult
     """
-    from qzs._validation import integer
+    from qzs._validation import integer, renamed_keyword
+
+    tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
 
     if workers is not None:
         workers = integer("workers", workers, 1)
@@ -454,7 +459,7 @@ def run_hexapod_study(folder: str | Path = "results/hexapod_study", *, quick: bo
     for label, setup in setups.items():
         cases[label] = hexapod_transmissibility(setup, axes=STUDY_AXES,
                                                 duration=settings["duration"],
-                                                dt=dt, tolerance_db=tolerance_db,
+                                                dt=dt, tolerance=tolerance,
                                                 workers=workers,
                                                 progress=progress)
     return study_result(cases, folder, quick=quick, run_seconds=time.perf_counter() - start,

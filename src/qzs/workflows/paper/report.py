@@ -187,8 +187,9 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
               folder: str | Path = "results/paper", *, quick: bool = False,
               workers: int | None = None, progress: bool = True,
               argument: str = "folder", dt: float | None = None,
-              tolerance_db: float | None = None,
-              frequency_scale: str | None = None, spring: SpringLaw | None = None
+              tolerance: float | None = None,
+              frequency_scale: str | None = None, spring: SpringLaw | None = None,
+              tolerance_db: float | None = None
               ) -> tuple[list[StudyResult], list[Verdict], float]:
     """Run studies and write their report (``qzs paper``, ``qzs study``).
 
@@ -209,8 +210,8 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
         How the caller names ``folder`` in messages (``"--out"`` on the command line).
     dt : float, optional
         Integration step [s] of every case, as given (the paper's: 1e-4); default chosen
-        for ``tolerance_db`` (a study file's ``[simulation] dt`` is kept).
-    tolerance_db : float, optional
+        for ``tolerance`` (a study file's ``[simulation] dt`` is kept).
+    tolerance : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets; default
         :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
     frequency_scale : {"log", "linear"}, optional
@@ -219,6 +220,8 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     spring : SpringLaw, optional
         The spring law of every case (docs/model.md §3.1; ``--spring``); default the
         MagSpring's tanh, the paper's.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -234,11 +237,14 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
         ``folder`` is a file, or cannot be created or written (checked before any study
         runs: on a cold cache they take minutes).
     ParameterError
-        A study file is invalid, or both ``dt`` and ``tolerance_db`` are given.
+        A study file is invalid, or both ``dt`` and ``tolerance`` are given.
     """
     import time
 
+    from qzs._validation import renamed_keyword
     from qzs.iotools.paths import check_output_path
+
+    tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
 
     check_output_path(folder, argument=argument, suffixes=None, directory=True,
                       estimated_bytes=PAPER_BYTES)
@@ -248,7 +254,7 @@ def run_paper(definitions: Sequence[str | Path] | None = None,
     studies = [load_study(p) for p in paths]
     start = time.perf_counter()
     results = run_studies(studies, quick=quick, workers=workers, progress=progress, dt=dt,
-                          tolerance_db=tolerance_db, spring=spring)
+                          tolerance=tolerance, spring=spring)
     wall = time.perf_counter() - start
     verdicts = write_paper_outputs(results, folder, quick=quick, wall_seconds=wall,
                                    workers=workers, frequency_scale=frequency_scale,

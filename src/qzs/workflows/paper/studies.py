@@ -24,8 +24,8 @@ its bins are trusted (docs/model.md §10), and every metric comes from those bin
 The integration step: a ``[simulation] dt`` in the file, or ``dt`` given to
 :func:`run_studies` (``qzs paper --dt``), is used as it is; otherwise the cases that share
 an excitation get one step, the coarsest that keeps every one's transmissibility within
-``tolerance_db`` (default :data:`qzs.defaults.ACCURACY`), chosen by
-:func:`qzs.engine.accuracy_batch.choose_batch_step` on one lockstep probe of them all
+``tolerance`` (default :data:`qzs.defaults.ACCURACY`), chosen by
+:func:`qzs.engine.step_choice.choose` on one lockstep probe of them all
 (docs/model.md §7).
 """
 import dataclasses
@@ -37,7 +37,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from qzs._validation import known_keys, read_toml, worker_count
-from qzs.defaults import ACCURACY, ANALYSIS, FREQUENCY_SCALES, SIMULATION
+from qzs.defaults import ANALYSIS, FREQUENCY_SCALES, SIMULATION
 from qzs.errors import ParameterError
 from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.iotools.shipped import resolve_shipped, shipped_files
@@ -362,7 +362,7 @@ def _study_cases(study, quick, dt=None, spring=None):
 
 
 def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=True, dt=None,
-                tolerance_db=None, spring=None):
+                tolerance=None, spring=None, tolerance_db=None):
     """Run several studies, all their cases in parallel.
 
     Cases that share their chirp, sample rate, step and solver (the paper's
@@ -386,15 +386,17 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
         through the one-case driver, one per process (the same numbers, slower).
     dt : float, optional
         Integration step [s] of every case (the paper's: 1e-4); default a file's
-        ``[simulation] dt``, else chosen for ``tolerance_db``.
-    tolerance_db : float, optional
+        ``[simulation] dt``, else chosen for ``tolerance``.
+    tolerance : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets (one step per group
-        of cases sharing an excitation, :func:`qzs.engine.accuracy_batch.choose_batch_step`);
+        of cases sharing an excitation, :func:`qzs.engine.step_choice.choose`);
         default :data:`qzs.defaults.ACCURACY`. Not with ``dt``.
     spring : SpringLaw, optional
         The spring law of every case (docs/model.md §3.1); default the MagSpring's tanh (the
         paper's: a ``TanhSpring`` of Table 1's numbers is the default, another tanh runs
         with its own). The spring study then measures and fits that law.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -403,15 +405,18 @@ def run_studies(studies, *, quick=False, workers=None, progress=True, lockstep=T
     Raises
     ------
     ParameterError
-        Both ``dt`` and ``tolerance_db``, or a non-positive one.
+        Both ``dt`` and ``tolerance``, or a non-positive one.
     """
+    from qzs._validation import renamed_keyword
+
+    tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
     plan = plan_studies(studies, quick=quick, workers=workers, progress=progress, dt=dt,
-                        tolerance_db=tolerance_db, spring=spring)
+                        tolerance=tolerance, spring=spring)
     return run_plan(plan, workers=workers, progress=progress, lockstep=lockstep)
 
 
 def plan_studies(studies, *, quick=False, workers=None, progress=True, dt=None,
-                 tolerance_db=None, spring=None):
+                 tolerance=None, spring=None, tolerance_db=None):
     """Resolve studies to run together: their inputs checked, their steps chosen.
 
     Parameters
@@ -426,10 +431,12 @@ def plan_studies(studies, *, quick=False, workers=None, progress=True, dt=None,
         Show the step choice's progress.
     dt : float, optional
         Integration step [s] of every case; default a file's, else chosen.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance on the transmissibility [dB] the chosen step meets; not with ``dt``.
     spring : SpringLaw, optional
         The spring law of every case; default the MagSpring's tanh.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -438,20 +445,16 @@ def plan_studies(studies, *, quick=False, workers=None, progress=True, dt=None,
     Raises
     ------
     ParameterError
-        Both ``dt`` and ``tolerance_db``, or a non-positive one.
+        Both ``dt`` and ``tolerance``, or a non-positive one.
     """
-    from qzs._validation import positive_real
+    from qzs.engine.step_choice import step_request
 
-    if dt is not None and tolerance_db is not None:
-        raise ParameterError("give `dt` (a literal step [s]) or `tolerance_db` (the accuracy "
-                             "the step is chosen for [dB]), not both.")
-    dt = None if dt is None else positive_real("dt", dt)
-    tolerance_db = positive_real("tolerance_db", ACCURACY["tolerance_db"] if tolerance_db is None
-                                 else tolerance_db)
+    request = step_request(dt=dt, tolerance=tolerance, tolerance_db=tolerance_db)
+    dt = None if dt is None else float(request.dt)
     given = IsolatorParameters(spring=spring).spring_law  # validated
     spring = None if given == IsolatorParameters().spring_law else given  # the MagSpring: None
     per_study = [_study_cases(study, quick, dt, spring) for study in studies]
-    cases, steps = _choose_steps(per_study, tolerance_db, worker_count(workers), progress)
+    cases, steps = _choose_steps(per_study, request, worker_count(workers), progress)
     return StudyPlan(studies=tuple(studies), cases=cases, steps=steps, quick=quick,
                      spring=spring)
 
@@ -538,11 +541,13 @@ def run_study(study, **options):
     return run_studies([study], **options)[0]
 
 
-def _choose_steps(per_study, tolerance_db, workers, progress):
+def _choose_steps(per_study, request, workers, progress):
     """Choose the step of every simulated case without one.
 
     The cases that share their chirp, sample rate and solver (a lockstep batch) get one
-    step: :func:`qzs.engine.accuracy_batch.choose_batch_step` over their distinct cases.
+    step: :func:`qzs.engine.step_choice.choose` of ``request`` (a
+    :class:`~qzs.engine.step_choice.StepRequest`: its tolerance, else the default) on a batch
+    probe of their distinct cases.
 
     Returns
     -------
@@ -551,7 +556,8 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
     steps : tuple of dict
         Each study's :func:`_step_record`.
     """
-    from qzs.engine.accuracy_batch import choose_batch_step
+    from qzs.engine.accuracy_batch import BatchProbe
+    from qzs.engine.step_choice import choose
 
     groups = {}
     for i, cases in enumerate(per_study):
@@ -567,11 +573,10 @@ def _choose_steps(per_study, tolerance_db, workers, progress):
         for i, j in members:
             isolator, controller, _, _ = case_inputs(per_study[i][j])
             index.setdefault((isolator, controller), []).append((i, j))
-        # no step meeting the tolerance for any case: the one fallback (the paper's step)
-        choice = choose_batch_step(
-            list(index), excitation, tolerance_db=tolerance_db, solver=solver,
-            sample_rate=rate, fallback=True, workers=workers, progress=progress,
-            labels=[per_study[i][j].label for (i, j), *_ in index.values()], cache=True)
+        choice = choose(request, BatchProbe(
+            cases=list(index), excitation=excitation, solver=solver, sample_rate=rate,
+            workers=workers, labels=[per_study[i][j].label for (i, j), *_ in index.values()]),
+            fallback=True, progress=progress, cache=True)
         seconds = time.perf_counter() - start
         for c, same in enumerate(index.values()):
             for place in same:
@@ -595,7 +600,7 @@ def _step_record(cases, choices):
     record = {"dt": float(first.dt), "source": first.step_source}
     if chosen is not None and not chosen[0].met:
         choice, _, seconds, group = chosen
-        record.update(source="fallback", tolerance_db=choice.tolerance, notes=[choice.notes[-1]],
+        record.update(source="fallback", tolerance_db=choice.tolerance, notes=[choice.unmet_note],
                       unmet=[case.label for case, _ in simulated], seconds=seconds,
                       group=group)
     elif chosen is not None:

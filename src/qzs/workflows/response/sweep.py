@@ -164,12 +164,12 @@ def settle_time_cap(isolator=None, controller=None):
     return float(np.clip(SETTLE_TIME_CONSTANTS / decay.min(), MIN_TIME, MAX_TIME))
 
 
-def response_step(frequencies, amplitude, isolator, controller, *, solver, tolerance_db,
-                  sample_rate=None, progress=False):
+def response_step(frequencies, amplitude, isolator, controller, *, solver, tolerance=None,
+                  sample_rate=None, progress=False, tolerance_db=None):
     """The accuracy-driven step of a stepped-sine response: a chirp over its band.
 
-    The step search (:func:`qzs.engine.accuracy.choose_step`, with the one fallback) on a
-    60 s chirp of the response's amplitude from the lowest frequency (0.8 times it for one
+    The one call (:func:`qzs.engine.step_choice.choose`, with the one fallback) on a probe of
+    a 60 s chirp of the response's amplitude from the lowest frequency (0.8 times it for one
     frequency) to the highest, at an output rate of at least ``MIN_STEPS_PER_PERIOD`` samples
     per period of the highest, measured over that band.
 
@@ -185,21 +185,25 @@ def response_step(frequencies, amplitude, isolator, controller, *, solver, toler
         PI and damping loops.
     solver : str
         The integrator.
-    tolerance_db : float
-        Tolerance on the transmissibility [dB].
+    tolerance : float, optional
+        Tolerance on the transmissibility [dB]; default ``qzs.defaults.ACCURACY``'s.
     sample_rate : float, optional
         The probe's output rate [Hz]; default the larger of the default rate and
         ``MIN_STEPS_PER_PERIOD`` per period of the highest frequency.
     progress : bool
         Show the probe runs' progress.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
     StepChoice
-        The record (``met`` False, ``error`` NaN and a note for the fallback).
+        The record (``met`` False, ``error`` NaN and the unmet sentence for the fallback).
     """
-    from qzs.engine.accuracy import choose_step
+    from qzs.engine.accuracy import SingleProbe
+    from qzs.engine.step_choice import choose, step_request
 
+    request = step_request(tolerance=tolerance, tolerance_db=tolerance_db)
     low, high = float(frequencies[0]), float(frequencies[-1])
     if sample_rate is None:
         sample_rate = max(defaults.SIMULATION["sample_rate"], math.ceil(MIN_STEPS_PER_PERIOD * high))
@@ -207,9 +211,10 @@ def response_step(frequencies, amplitude, isolator, controller, *, solver, toler
         low = 0.8 * high
     probe = Chirp(amplitude=amplitude, f0=low, f1=high, duration=60.0,
                   fade_in=min(2.0 / low, 15.0))
-    return choose_step(probe, isolator, controller, tolerance_db=tolerance_db, solver=solver,
-                       sample_rate=sample_rate, band=(low, high), fallback=True,
-                       progress=progress, cache=True)
+    return choose(request, SingleProbe(excitation=probe, isolator=isolator,
+                                       controller=controller, solver=solver,
+                                       sample_rate=sample_rate, band=(low, high)),
+                  fallback=True, progress=progress, cache=True)
 
 
 def steady_state_response(frequencies: ArrayLike,
@@ -217,7 +222,7 @@ def steady_state_response(frequencies: ArrayLike,
                           isolator: IsolatorParameters | None = None,
                           controller: ControllerParameters | None = None, *,
                           direction: str = "both", dt: float | None = None,
-                          tolerance_db: float | None = None,
+                          tolerance: float | None = None,
                           solver: str = defaults.SIMULATION["solver"],
                           periodic_tolerance: float = PERIODIC_TOLERANCE,
                           max_periods: int = MAX_PERIODS, max_time: float | None = None,
@@ -225,7 +230,8 @@ def steady_state_response(frequencies: ArrayLike,
                           harmonic_balance: bool = True, friction_velocity: float | None = None,
                           balance_harmonics: int | None = None, compare_chirp: bool = False,
                           workers: int | None = None,
-                          progress: bool = False) -> SteadyStateResponse:
+                          progress: bool = False,
+                          tolerance_db: float | None = None) -> SteadyStateResponse:
     """Steady-state frequency response by stepped-sine simulation.
 
     Each sweep (``up``: rising frequency, ``down``: falling) starts from rest at its first
@@ -258,9 +264,8 @@ def steady_state_response(frequencies: ArrayLike,
     dt : float, optional
         Largest integration step [s]; each frequency uses the largest step at most this
         with a whole number of output samples per period. Default: chosen for
-        ``tolerance_db`` (:func:`qzs.engine.accuracy.choose_step`, on a chirp over the
-        band).
-    tolerance_db : float, optional
+        ``tolerance`` (:func:`response_step`, on a chirp over the band).
+    tolerance : float, optional
         Accuracy of the chosen step [dB]; default 0.01 (``qzs.defaults.ACCURACY``). Not
         with ``dt``.
     solver : {"ode3", "rk4", "euler"}
@@ -295,6 +300,8 @@ def steady_state_response(frequencies: ArrayLike,
         1 runs everything in this process.
     progress : bool
         Show a progress bar over frequencies.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -306,7 +313,7 @@ def steady_state_response(frequencies: ArrayLike,
         Invalid input, found before any simulation: frequencies not positive and finite,
         more than :data:`MAX_FREQUENCIES` of them (:class:`~qzs.errors.CountLimitError`) or
         above a tenth of the step's Nyquist rate, a non-positive amplitude, an unknown
-        direction, both ``dt`` and ``tolerance_db``, an unstable ``dt``, a sampled
+        direction, both ``dt`` and ``tolerance``, an unstable ``dt``, a sampled
         controller.
     """
     started = time.perf_counter()
@@ -322,11 +329,9 @@ def steady_state_response(frequencies: ArrayLike,
     from qzs.engine.stability import SOLVERS
 
     solver = choice("solver", solver, tuple(SOLVERS))
-    if dt is not None and tolerance_db is not None:
-        raise ParameterError("give `dt` (a fixed largest step) or `tolerance_db` (the step "
-                             "chosen for an accuracy), not both.")
-    if tolerance_db is not None:
-        tolerance_db = positive_real("tolerance_db", tolerance_db)
+    from qzs.engine.step_choice import step_request
+
+    request = step_request(dt=dt, tolerance=tolerance, tolerance_db=tolerance_db)
     if dt is not None:
         dt = positive_real("dt", dt)
     periodic_tolerance = positive_real("periodic_tolerance", periodic_tolerance)
@@ -363,9 +368,8 @@ def steady_state_response(frequencies: ArrayLike,
     notes = []
     step = None
     if dt is None:
-        tolerance_db = defaults.ACCURACY["tolerance_db"] if tolerance_db is None else tolerance_db
         step = response_step(frequencies, amplitude, isolator, controller, solver=solver,
-                             tolerance_db=tolerance_db, progress=progress)
+                             tolerance=request.tolerance, progress=progress)
         dt = step.dt
         notes.append(f"dt <= {step.line()}, on a {step.probe.f0:g}-{step.probe.f1:g} Hz chirp "
                      "probe")

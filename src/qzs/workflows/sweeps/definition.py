@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import Any
 import numpy as np
 
-from qzs._validation import integer, known_keys, positive_real, read_toml, real
+from qzs._validation import (integer, known_keys, positive_real, read_toml, real,
+                             renamed_keyword)
 from qzs._validation import seed as checked_seed
 from qzs.analysis.spectral import required_duration, welch_average_count
 from qzs.defaults import ACCURACY, ANALYSIS, REPORTED_FREQUENCIES, SIMULATION
@@ -57,7 +58,8 @@ EXCITATION_PARAMETERS = {kind: parameters for kind, parameters
 TABLES = ("sweep", "parameters", "excitation", "grid", "distributions", "simulation",
           "analysis", "outputs", "spring")
 SWEEP_KEYS = ("name", "title", "description", "method", "samples", "seed", "batch_size")
-#: ``dt`` None: the step is chosen for ``tolerance_db`` before the sweep runs
+#: ``dt`` None: the step is chosen for ``tolerance`` (kept as ``tolerance_db`` [dB], the
+#: records' name) before the sweep runs
 #: (:func:`qzs.workflows.sweeps.step.choose_sweep_step`); a ``dt`` in the file fixes it.
 SIMULATION_DEFAULTS = {"dt": None, "solver": SIMULATION["solver"],
                        "tolerance_db": ACCURACY["tolerance_db"]}
@@ -206,6 +208,21 @@ def _keys(table, name, allowed):
     return known_keys(table, allowed, f"[{name}]")
 
 
+def _simulation_table(table):
+    """``[simulation]`` with its tolerance under the records' key ``tolerance_db`` [dB].
+
+    The file writes ``tolerance`` (the one spelling); ``tolerance_db`` is its deprecated
+    name, read one release more with a :class:`DeprecationWarning`
+    (:func:`qzs._validation.renamed_keyword`).
+    """
+    table = dict(_keys(table, "simulation", (*SIMULATION_DEFAULTS, "tolerance")))
+    tolerance = renamed_keyword("tolerance", table.pop("tolerance", None), "tolerance_db",
+                                table.pop("tolerance_db", None), stacklevel=4)
+    if tolerance is not None:
+        table["tolerance_db"] = tolerance
+    return table
+
+
 def _check_name(name, kind):
     """A varied parameter must be a model parameter or ``excitation.<parameter of kind>``."""
     excitation = [f"excitation.{k}" for k in EXCITATION_PARAMETERS[kind]]
@@ -289,20 +306,20 @@ def _definition(document, where, stem, path=None):
     if not grid and not distributions:
         raise ParameterError("nothing varies: add a [grid] or a [distributions] table.")
 
-    simulation = {**SIMULATION_DEFAULTS, **_keys(document.get("simulation", {}), "simulation",
-                                                 SIMULATION_DEFAULTS)}
+    given = _simulation_table(document.get("simulation", {}))
+    simulation = {**SIMULATION_DEFAULTS, **given}
     if simulation["solver"] not in SOLVERS:
         raise ParameterError(f"`solver` must be one of {tuple(SOLVERS)}, got "
                              f"{simulation['solver']!r}.")
-    given = document.get("simulation", {})
     if "dt" in given and "tolerance_db" in given:
-        raise ParameterError("give either `dt` (a fixed step [s]) or `tolerance_db` (the "
-                             "accuracy the step is chosen for [dB]) in [simulation], not both.")
+        raise ParameterError("give either `dt` (a fixed step [s]) or `tolerance` (the "
+                             "accuracy the step is chosen for [dB]) in [simulation], not both.",
+                             ("dt", "tolerance"))
     if "dt" in given:
         simulation["dt"] = positive_real("dt", simulation["dt"])
         simulation["tolerance_db"] = None
     else:
-        simulation["tolerance_db"] = positive_real("tolerance_db", simulation["tolerance_db"])
+        simulation["tolerance_db"] = positive_real("tolerance", simulation["tolerance_db"])
     analysis = _analysis(document.get("analysis", {}), simulation["dt"])
     top = excitation.get("f1")
     if (kind != "sine" and "band" not in document.get("analysis", {})

@@ -1,13 +1,13 @@
 """A sweep's integration step, chosen for its tolerance on a few of its cases.
 
 A sweep whose file gives no ``dt`` is integrated at the step :func:`choose_sweep_step`
-chooses for ``[simulation] tolerance_db`` on :data:`STEP_CASES` cases spread over it.
+chooses for ``[simulation] tolerance`` on :data:`STEP_CASES` cases spread over it.
 """
 import warnings
 
 import numpy as np
 
-from qzs.defaults import SIMULATION
+from qzs.engine.step_choice import fallback_step
 from qzs.errors import DataWarning, ParameterError
 from qzs.workflows.sweeps.cases import build_case
 
@@ -20,12 +20,12 @@ STEP_CASES = 3
 
 
 def choose_sweep_step(definition, settings, *, progress=False):
-    """Fix a sweep's step: the largest meeting its ``tolerance_db`` on every case probed.
+    """Fix a sweep's step: the largest meeting its ``tolerance`` on every case probed.
 
     A sweep whose file gives no ``dt`` is integrated at the step chosen for
-    ``[simulation] tolerance_db`` (default :data:`qzs.defaults.ACCURACY`) on
+    ``[simulation] tolerance`` (default :data:`qzs.defaults.ACCURACY`) on
     :data:`STEP_CASES` cases spread over the sweep, probed at once
-    (:func:`qzs.engine.accuracy_batch.choose_batch_step`, each group of them sharing an
+    (:func:`qzs.engine.step_choice.choose` on a batch probe, each group of them sharing an
     excitation in one batch); the smallest of their steps serves every case (all cases of
     a batch share their steps). Choosing is deterministic, so a resumed sweep gets the
     same step.
@@ -61,9 +61,6 @@ def choose_sweep_step(definition, settings, *, progress=False):
     """
     import dataclasses
 
-    from qzs.engine.accuracy_batch import choose_batch_step
-    from qzs.engine.step_search import MAX_HALVINGS
-
     simulation = definition.simulation
     if simulation["dt"] is not None:
         return definition, ()
@@ -77,19 +74,15 @@ def choose_sweep_step(definition, settings, *, progress=False):
             continue
         groups.setdefault(key, (excitation, []))[1].append((i, (isolator, controller)))
     if not groups:
-        raise ParameterError("no step could be chosen for `tolerance_db`: the cases probed "
+        raise ParameterError("no step could be chosen for `tolerance`: the cases probed "
                              f"are invalid ({'; '.join(reasons)}); fix them or give `dt`.")
     tolerance = simulation["tolerance_db"]
     choices, unmet = [], []
     for excitation, members in groups.values():  # the probed cases of one excitation at once
         labels = [f"case {i}" for i, _ in members]
-        batch = choose_batch_step([pair for _, pair in members], excitation,
-                                  tolerance_db=tolerance, solver=simulation["solver"],
-                                  sample_rate=definition.analysis["sample_rate"],
-                                  max_halvings=MAX_HALVINGS, fallback=True, progress=progress,
-                                  labels=labels, cache=True)
+        batch = _choose(definition, excitation, members, labels, progress)
         if not batch.met:  # the one fallback: no case of this excitation sets the step
-            unmet.append(f"{', '.join(labels)}: {batch.notes[-1]}")
+            unmet.append(f"{', '.join(labels)}: {batch.unmet_note}")
             continue
         choices += [(i, dataclasses.replace(batch, dt=batch.case_steps[c],
                                             error=batch.case_errors[c]))
@@ -101,7 +94,7 @@ def choose_sweep_step(definition, settings, *, progress=False):
                 "cases " + ", ".join(f"{i} (dt {c.dt:g} s, estimated error {c.error:.2g} dB)"
                                      for i, c in choices))
     else:
-        dt = SIMULATION["dt"]
+        dt = fallback_step()
         note = f"dt = {dt:g} s, the paper's step: no case probed meets {tolerance:g} dB"
     if unmet:
         note += "; " + "; ".join(unmet) + "; their curves carry that uncertainty"
@@ -109,3 +102,16 @@ def choose_sweep_step(definition, settings, *, progress=False):
     simulation = {**simulation, "dt": dt, "step_note": note}
     return dataclasses.replace(definition, simulation=simulation), tuple(choices)
 
+
+def _choose(definition, excitation, members, labels, progress):
+    """The one call on a batch probe of the probed cases sharing ``excitation``."""
+    from qzs.engine.accuracy_batch import BatchProbe
+    from qzs.engine.step_choice import StepRequest, choose
+    from qzs.engine.step_search import MAX_HALVINGS
+
+    request = StepRequest(tolerance=definition.simulation["tolerance_db"])
+    return choose(request, BatchProbe(cases=[pair for _, pair in members], excitation=excitation,
+                                      solver=definition.simulation["solver"],
+                                      sample_rate=definition.analysis["sample_rate"],
+                                      max_halvings=MAX_HALVINGS, labels=labels),
+                  fallback=True, progress=progress, cache=True)

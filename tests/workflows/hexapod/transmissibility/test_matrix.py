@@ -234,6 +234,9 @@ def test_the_result_repackages_and_delegates(raised, tmp_path):
     (dict(workers=0), "`workers`"), (dict(progress="yes"), "`progress`"),
     (dict(setup="paper_legs_cubic"), "`setup` must be a HexapodSetup"),
     (dict(dt=0.1, sample_rate=10.0, f1=4.0), "too large for a stable"),
+    (dict(dt=1e-3, tolerance=0.01), "`dt`.*`tolerance`.*not both"),
+    (dict(tolerance=-0.01), "`tolerance`.*-0.01"),
+    (dict(tolerance=0.01, tolerance_db=0.01), "give `tolerance` only"),
 ])
 def test_bad_arguments_raise_before_any_run(monkeypatch, change, match):
     import qzs.engine.hexapod
@@ -250,6 +253,13 @@ def test_bad_arguments_raise_before_any_run(monkeypatch, change, match):
     with pytest.raises(error, match=match):
         hexapod_transmissibility(arguments.pop("setup"), **arguments)
     assert time.perf_counter() - start < 1.0
+
+
+def test_tolerance_db_is_the_deprecated_name_of_tolerance():
+    with pytest.warns(DeprecationWarning, match="use `tolerance`"), \
+            pytest.raises(ParameterError, match="`dt`.*`tolerance`.*not both"):
+        hexapod_transmissibility(load_hexapod("paper_legs_cubic"), axes=("z",), dt=1e-3,
+                                 tolerance_db=0.01, progress=False)
 
 
 def test_the_command_writes_the_grid_and_the_matrix(tmp_path, capsys):

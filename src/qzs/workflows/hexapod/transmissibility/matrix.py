@@ -23,11 +23,12 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
                              amplitude: float | Mapping[str, float] | None = None,
                              f0: float = CHIRP["f0"], f1: float = CHIRP["f1"],
                              duration: float = CHIRP["duration"], dt: float | None = None,
-                             tolerance_db: float | None = None,
+                             tolerance: float | None = None,
                              sample_rate: float | None = None, solver: str | None = None,
                              fft_length: int | None = None, estimator: str = "h1",
                              floor_db: float = FLOOR_DB, workers: int | None = None,
-                             progress: bool = True) -> HexapodTransmissibility:
+                             progress: bool = True,
+                             tolerance_db: float | None = None) -> HexapodTransmissibility:
     """Simulate one chirp per base axis and estimate the 6x6 transmissibility matrix.
 
     Each axis of ``axes`` is one run of :func:`qzs.engine.hexapod.simulate_hexapod` with
@@ -59,7 +60,7 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
         A literal integration step [s] for every run. Default: accuracy-driven per run
         (module docstring), falling back to the set-up's ``[simulation] dt`` (1e-4 s if it
         gives none); each run's record says which, with the estimated error.
-    tolerance_db : float, optional
+    tolerance : float, optional
         Tolerance [dB] of the accuracy-driven step on each run's column of the matrix;
         default ``qzs.defaults.ACCURACY["tolerance_db"]`` (0.01). Not with ``dt``.
     sample_rate : float, optional
@@ -80,6 +81,8 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
         one after another in this process.
     progress : bool
         Show a progress bar over the runs.
+    tolerance_db : float, optional
+        Deprecated name of ``tolerance`` (warns; removed in the next release).
 
     Returns
     -------
@@ -95,9 +98,12 @@ def hexapod_transmissibility(setup: HexapodSetup, *, axes: Sequence[str] | str =
     SimulationError
         A run diverged.
     """
+    from qzs._validation import renamed_keyword
+
+    tolerance = renamed_keyword("tolerance", tolerance, "tolerance_db", tolerance_db)
     axes, amplitudes, common, runs, workers = _plan(
         setup, axes, amplitude, f0, f1, duration, dt, sample_rate, solver, fft_length,
-        estimator, floor_db, workers, progress, tolerance_db)
+        estimator, floor_db, workers, progress, tolerance)
     from qzs.engine.progress import progress_bar
 
     _dry_run(runs[0])

@@ -67,9 +67,10 @@ def _tolerance_db(tolerance_db, dt):
     if tolerance_db is None:
         return None if dt is not None else defaults.ACCURACY["tolerance_db"]
     if dt is not None:
-        raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or `tolerance_db` "
-                             f"({tolerance_db!r} dB, the step chosen to meet it), not both.")
-    return positive_real("tolerance_db", tolerance_db,
+        raise ParameterError(f"give either `dt` ({dt!r} s, a literal step) or `tolerance` "
+                             f"({tolerance_db!r} dB, the step chosen to meet it), not both.",
+                             ("dt", "tolerance"))
+    return positive_real("tolerance", tolerance_db,
                          fix="a tolerance on the transmissibility in dB, e.g. 0.01")
 
 

@@ -113,7 +113,7 @@ def _simulate(run, excitation, dt, duration):
 def axis_step(task):
     """The step of one run: accuracy-driven (see the module docstring), or the set-up's.
 
-    :func:`qzs.engine.hexapod.accuracy.choose_hexapod_step` on the run's chirp, the driven
+    :func:`qzs.engine.step_choice.choose` on the run's chirp (a six-leg probe), the driven
     axis's transmissibility against ``task.tolerance_db``, halving down to the set-up's
     ``dt`` and falling back to it where no coarser step meets the tolerance (the one
     fallback, :mod:`qzs.engine.step_search`).
@@ -133,15 +133,17 @@ def axis_step(task):
         ``step_probe_duration``, ``step_reason``) and ``step_history`` (``(dt [s],
         difference to the next finer step [dB])`` per step compared).
     """
-    from qzs.engine.hexapod.accuracy import choose_hexapod_step
+    from qzs.engine.hexapod.accuracy import HexapodProbe
+    from qzs.engine.step_choice import StepRequest, choose
 
     f0, f1 = task.f0, task.f1
-    choice = choose_hexapod_step(
-        task.geometry, task.platform, task.isolator, task.controller,
-        excitation={task.axis: task.excitation}, tolerance_db=task.tolerance_db,
+    probe = HexapodProbe(
+        geometry=task.geometry, platform=task.platform, isolator=task.isolator,
+        controller=task.controller, excitation={task.axis: task.excitation},
         solver=task.solver, sample_rate=task.sample_rate,
-        band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1), finest=task.setup_dt,
-        fallback=True, **task.control)
+        band=(min(1.0, 0.5 * f1) if f0 == 0 else f0, f1), **task.control)
+    choice = choose(StepRequest(tolerance=task.tolerance_db), probe, finest=task.setup_dt,
+                    fallback=True)
     history = tuple((dt, d) for dt, d, _ in choice.history)
     return choice.dt, dict(choice.attributes(), step_history=history)
 
