@@ -7,7 +7,6 @@ A fit holds its numbers; :class:`FitProtocol` gives it the result protocol by de
 :func:`qzs.iotools.schema.to_dataset` of the fit's own schema. Its confidence intervals
 are spelled once: ``intervals``, estimated name -> ``(low, high)`` at ``confidence``.
 """
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any

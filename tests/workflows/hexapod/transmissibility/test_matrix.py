@@ -215,8 +215,9 @@ def test_the_result_repackages_and_delegates(raised, tmp_path):
         assert raw["magnitude_translation_per_rotation"].attrs["units"] == "m/rad"  # one unit
         back = from_file_layout(raw)  # the blocks joined again (decision 34)
         np.testing.assert_allclose(back["magnitude"].values, result.magnitude)
-    with pytest.raises(ParameterError, match="must end in .nc"):
-        result.save(tmp_path / "matrix.csv")
+    with pytest.raises(ParameterError, match=r"\.xlsx.*\.nc"):  # named, before any work
+        result.save(tmp_path / "matrix.xlsx")
+    assert not (tmp_path / "matrix.xlsx").exists()
     text = result.summary()
     assert "untrusted everywhere" in text and "ledger" in text
 
