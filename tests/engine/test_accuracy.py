@@ -396,3 +396,16 @@ def test_the_step_divides_every_rate_a_controller_samples_at():
     for rate in (1000.0, 2000.0, 3000.0):
         steps_per_sample(rate, choice.dt, "rate")  # a whole number of steps per period
     assert choice.dt <= 1.0 / 6000.0 * (1 + 1e-12)
+
+
+def test_a_step_of_exactly_the_resolving_fraction_of_a_period_is_admissible():
+    """10 steps per period (MIN_STEPS_PER_PERIOD) follow the base motion: a 200 Hz sine's
+    resolving step, 1/2000 s, is itself the admissible start (k = 2 at 1 kHz), not the next
+    finer output fraction."""
+    from qzs.engine.accuracy import SingleProbe
+    from qzs.engine.prepare import MIN_STEPS_PER_PERIOD
+
+    probe = SingleProbe(excitation=Sine(frequency=200.0, amplitude=1e-5)).build("state_m")
+    limit, resolving, dt0, k0 = probe.start()
+    assert MIN_STEPS_PER_PERIOD == 10 and resolving == 1.0 / 2000.0 < limit
+    assert (dt0, k0) == (resolving, 2)
