@@ -271,3 +271,13 @@ def test_no_module_but_validation_checks_a_tables_keys_by_hand():
         if lines:
             found[str(path.relative_to(SOURCE))] = lines
     assert not found, f"use qzs._validation.known_keys at {found}"
+
+
+def test_known_keys_names_the_key_its_message_is_about_when_keys_are_both_unknown_and_missing():
+    """An unknown key and a missing one: the message is about the unknown key, so the error's
+    key and value are that key's (the missing one has no value to show)."""
+    build = Structured(build=lambda key, value, reason: ProblemError("t", key, value, reason))
+    with pytest.raises(ProblemError) as info:
+        known_keys({"q": 7}, ("a",), "[t]", required=("b",), error=build)
+    assert (info.value.key, info.value.value) == ("q", 7)
+    assert info.value.fix.startswith("unknown key(s) ['q'] in [t]")

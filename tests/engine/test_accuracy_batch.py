@@ -91,3 +91,59 @@ def test_bad_arguments_raise_before_any_simulation(monkeypatch, cases, options, 
     monkeypatch.setattr(qzs.engine.batch, "simulate_batch", refuse)
     with pytest.raises(ParameterError, match=match):
         choose_batch_step(cases, CHIRP, probe_duration=PROBE, **options)
+
+
+def test_the_batch_records_the_stability_limit_of_its_stiffest_case():
+    """Every case shares the step, so the batch's stability limit is the smallest of its
+    cases' (a stiff spring's), the one the record and the notes quote."""
+    from qzs.engine.stability import largest_stable_step
+
+    soft = (IsolatorParameters(), ControllerParameters())
+    stiff = (IsolatorParameters(), ControllerParameters(pi_kp=2e6, damping_gain=2e3))
+    limits = [largest_stable_step(*case, defaults.SIMULATION["solver"]) for case in (soft, stiff)]
+    assert limits[1] < limits[0]
+    batch = choose_batch_step([soft, stiff], CHIRP, tolerance=0.5, probe_duration=PROBE,
+                              max_halvings=3, fallback=True)
+    assert batch.stability_limit == min(limits)
+
+
+def test_the_batch_step_divides_every_case_s_controller_period():
+    """Cases sampled at 2000 Hz and 3000 Hz in one batch: the shared step divides both
+    periods (and the 1 ms output period): 1/6000 s or a halving of it."""
+    from qzs.engine.prepare import steps_per_sample
+
+    cases = [(IsolatorParameters(), ControllerParameters(controller_rate=rate))
+             for rate in (2000.0, 3000.0)]
+    batch = choose_batch_step(cases, CHIRP, tolerance=0.5, probe_duration=PROBE,
+                              max_halvings=3, fallback=True)
+    for rate in (1000.0, 2000.0, 3000.0):
+        steps_per_sample(rate, batch.dt, "rate")  # a whole number of steps per period
+    assert batch.dt <= 1.0 / 6000.0 * (1 + 1e-12)
+
+
+def test_a_batch_choice_at_another_welch_length_is_not_read_from_the_cache(monkeypatch,
+                                                                          tmp_path):
+    """The Welch segment length changes the measured transmissibility, so the choice made
+    with one answers no batch asking with another; its own is then read back."""
+    monkeypatch.setenv("QZS_CACHE_DIR", str(tmp_path))
+    options = dict(tolerance=0.5, probe_duration=PROBE, max_halvings=3, fallback=True,
+                   cache=True)
+    first = choose_batch_step([NO_PI], CHIRP, fft_length=4096, **options)
+    other = choose_batch_step([NO_PI], CHIRP, fft_length=2048, **options)
+    again = choose_batch_step([NO_PI], CHIRP, fft_length=2048, **options)
+    assert not first.cached and not other.cached and again.cached
+
+
+def test_a_batch_halves_its_start_at_most_its_own_default_times():
+    """A batch tries BATCH_MAX_HALVINGS halvings by default (fewer than one axis: every
+    candidate runs every case): an unreachable tolerance is given up at the finest candidate
+    estimated, dt_0 / 2**(BATCH_MAX_HALVINGS - 2), the one the fallback names."""
+    from qzs.engine.accuracy_batch import BATCH_MAX_HALVINGS, BatchProbe
+    from qzs.engine.step_choice import StepRequest, choose
+
+    choice = choose(StepRequest(tolerance=1e-9), BatchProbe(cases=[NO_PI], excitation=CHIRP,
+                                                            probe_duration=PROBE),
+                    fallback=True)
+    finest = choice.history[0][0] / 2 ** (BATCH_MAX_HALVINGS - 2)
+    assert not choice.met
+    assert choice.unmet_note.startswith(f"no step down to {finest:.3g} s met")

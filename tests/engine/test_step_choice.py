@@ -188,3 +188,67 @@ def test_an_unmet_tolerance_falls_back_with_the_one_sentence():
     assert choice.unmet_note.endswith(unmet_sentence("", choice.dt))
     assert choice.attributes()["step_reason"] == choice.unmet_note
     assert fallback_step(5e-4) == 5e-4
+
+
+# ---------------------------------------------------------------- the admissible start
+def test_a_sampled_controller_whose_period_the_stable_start_divides_starts_there():
+    """Stable up to 0.25 ms, 1000 Hz output: the stable start is k = 4 (0.25 ms), and a
+    4000 Hz controller's period is that very step, so the start is k = 4, not a finer one;
+    a 2000 Hz controller (two such steps) too; 3000 Hz first at k = 6 (1/6000 s)."""
+    from qzs.engine.step_choice import admissible_step
+
+    def stable(dt):
+        return dt <= 2.5e-4
+
+    assert admissible_step(1000.0, 0.0, stable) == (pytest.approx(2.5e-4), 4)
+    for rate in (4000.0, 2000.0, 1000.0):
+        assert admissible_step(1000.0, rate, stable) == (pytest.approx(2.5e-4), 4)
+    assert admissible_step(1000.0, 3000.0, stable) == (pytest.approx(1 / 6000), 6)
+
+
+@pytest.mark.parametrize("k0, limit, resolving, bound", [
+    (1, 2e-3, 1e-2, "the output rate bounds the step"),
+    (2, 6e-4, 1e-2, "stability bounds the step"),
+    (2, 1e-2, 6e-4, "the base motion bounds the step"),
+    (3, 4e-4, 1e-2, "stability bounds the step"),
+])
+def test_the_note_names_what_bounds_the_coarsest_candidate(k0, limit, resolving, bound):
+    """dt_0 = 1/(sample_rate*k0): at k0 = 1 the output period bounds it (a coarser step
+    would be stable); any finer start is bound by the smaller of stability and the base
+    motion's resolution."""
+    from qzs.engine.step_choice import bound_notes
+
+    notes = bound_notes(1e-3 / k0, k0, 1000.0, limit, resolving, "transmissibility_db", False)
+    assert len(notes) == 1 and notes[0].startswith(bound)
+
+
+def test_the_cache_answers_only_the_question_it_was_asked(monkeypatch, tmp_path):
+    """A tolerance no candidate meets: the fallback is the ``finest`` step asked for, so a
+    cached fallback at one ``finest`` is no answer at another; nor to a caller without
+    ``fallback``, who gets the error instead."""
+    from qzs.errors import ToleranceNotMetError
+
+    monkeypatch.setenv("QZS_CACHE_DIR", str(tmp_path))
+    probe = SingleProbe(excitation=CHIRP, max_halvings=3)
+    request = StepRequest(tolerance=1e-9)
+    first = choose(request, probe, fallback=True, finest=1e-4, cache=True)
+    assert not first.met and first.dt == 1e-4 and not first.cached
+    other = choose(request, probe, fallback=True, finest=5e-5, cache=True)
+    assert not other.met and other.dt == 5e-5 and not other.cached
+    again = choose(request, probe, fallback=True, finest=1e-4, cache=True)
+    assert again.cached and again.dt == 1e-4
+    with pytest.raises(ToleranceNotMetError):
+        choose(request, probe, finest=1e-4, cache=True)
+
+
+def test_a_probe_s_default_safety_is_the_search_s():
+    """Without ``safety`` a probe keeps the documented factor (SAFETY = 2): a tolerance of
+    1.5 times the coarsest candidate's estimate refuses that candidate (2 x > 1.5 x)."""
+    from qzs.engine.step_search import SAFETY
+
+    loose = choose(StepRequest(tolerance=1.0), SingleProbe(excitation=CHIRP, max_halvings=4))
+    first = loose.history[0][2]
+    assert loose.dt == loose.history[0][0] and 0 < first < math.inf
+    choice = choose(StepRequest(tolerance=1.5 * first),
+                    SingleProbe(excitation=CHIRP, max_halvings=4), fallback=True)
+    assert SAFETY == 2.0 and choice.dt < loose.dt

@@ -191,3 +191,24 @@ def test_a_hopeless_case_leaves_the_search_at_once_and_a_reachable_one_does_not(
                           max_halvings=halvings)
     assert late.dt == finest == _expected_step(reachable, tolerance, halvings)
     assert late.unmet == ()
+
+
+def test_an_unmet_case_s_note_names_the_finest_candidate_estimated_as_the_fallback_does():
+    """A case whose differences never shrink is searched to the end: its note names the
+    finest candidate whose error was estimated (the last in the history, the one compared
+    with two finer runs), the step the one-case fallback sentence names too."""
+    stuck = [0.0]
+
+    def run(dt, cases):
+        return [1e3 * dt ** ORDER if c == 0 else (stuck.__setitem__(0, stuck[0] + 1) or stuck[0])
+                for c in cases]
+
+    mixed = search_step(run=run, compare=lambda a, b: abs(a - b), cases=2, dt0=DT0,
+                        order=ORDER, measure="transmissibility_db", tolerance=1e-3,
+                        sample_rate=1000.0, solver="ode3", probe=None, probe_duration=10.0,
+                        band=(1.0, 20.0), stability_limit=0.005, labels=["ok", "stuck"])
+    finest = min(dt for dt, _, _ in mixed.history)
+    note, = [note for note in mixed.notes if note.startswith("stuck:")]
+    assert f"no step down to {finest:.3g} s meets" in note
+    alone, _ = _search([1e12], 1e-12, fallback=True)
+    assert f"no step down to {min(dt for dt, _, _ in alone.history):.3g} s met" in alone.notes[-1]

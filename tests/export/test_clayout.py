@@ -93,3 +93,39 @@ def test_the_exports_refuse_before_writing_anything(monkeypatch, tmp_path, capsy
     assert main(["export", "fmu", "--out", str(tmp_path / "cli.fmu")]) == 1
     assert "QZS_P_VREG: C 21, Python kernels.P_VREG = 22" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("family", ["P", "S", "A", "I", "E", "C", "M"])
+def test_an_index_of_any_packed_family_left_in_c_alone_is_refused(family):
+    """Parameters, state, auxiliaries, flags, excitation, channels, controller blocks: a C
+    index of any packed array with no Python twin is a difference."""
+    plant = source_text("qzs_plant.h") + f"\n#define QZS_{family}_OLD 99\n"
+    texts = [plant if name == "qzs_plant.h" else source_text(name)
+             for name in clayout.C_HEADERS]
+    mismatches = clayout._index_mismatches(clayout.c_constants(texts),
+                                           clayout.python_constants())
+    assert mismatches == [(f"QZS_{family}_OLD", 99, None)]
+
+
+def _bound_checks():
+    """Every ``REQUIRE(X, V(X) > 0.0`` or ``>= 0.0`` of a registry parameter in the shipped
+    qzs_fmu.c."""
+    import re
+
+    macros = {f"{info.section}_{name}".upper() for name, info in registry.PARAMETERS.items()}
+    found = re.findall(r"REQUIRE\((\w+), V\(\1\) (>=?) 0\.0\b", source_text("qzs_fmu.c"))
+    return [(macro, bound) for macro, bound in found if macro in macros]
+
+
+@pytest.mark.parametrize("macro, bound", _bound_checks())
+def test_every_bound_the_fmu_checks_is_compared_with_the_parameter_classes(macro, bound):
+    """Whatever the parameter's unit (kg, N, N/m, Hz, ...), turning its C bound from > 0 to
+    >= 0 (or back) is the one difference found, naming the parameter and both bounds."""
+    fmu = source_text("qzs_fmu.c")
+    shipped = f"REQUIRE({macro}, V({macro}) {bound} 0.0"
+    other = ">=" if bound == ">" else ">"
+    shown = {">": "> 0", ">=": ">= 0"}
+    flipped = fmu.replace(shipped, f"REQUIRE({macro}, V({macro}) {other} 0.0", 1)
+    label = macro.lower().replace("_", ".", 1)
+    assert clayout._check_mismatches(flipped) == [
+        (label, f"REQUIRE {shown[other]}", f"checked {shown[bound]}")]

@@ -66,3 +66,19 @@ def test_a_spring_fits_json_and_dataset_read_back(tmp_path):
         assert np.array_equal(read["force"].values, fit.force)
         assert read["displacement"].attrs["units"] == "m"
         assert read.attrs["plateau_lower"] == fit.intervals["plateau"][0]
+
+
+def test_the_alias_s_warning_points_at_the_line_that_reads_it():
+    """The warning names the caller's file and line (where the old spelling is to be
+    changed), not qzs's."""
+    fit = _Fit({"gain": (1.5, 2.5)})
+    with pytest.warns(DeprecationWarning) as record:
+        line = _line() + 1
+        _ = fit.old  # the read is what warns
+    assert (record[0].filename, record[0].lineno) == (__file__, line)
+
+
+def _line():
+    import inspect
+
+    return inspect.currentframe().f_back.f_lineno

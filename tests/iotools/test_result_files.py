@@ -69,3 +69,17 @@ def test_a_record_json_cannot_hold_is_refused_and_leaves_no_file(tmp_path):
     with pytest.raises(TypeError):
         write_json({"x": Unwritable()}, tmp_path / "bad.json")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_writer_s_extension_is_case_insensitive_too(tmp_path):
+    """A writer given for ``.TOML`` writes ``a.toml`` (and ``a.Toml``): an extension chooses
+    its format whatever its case, the writer's own included."""
+    written = []
+
+    def write(path):
+        written.append(path.name)
+        return write_json({"written": True}, path)
+
+    for name in ("a.toml", "b.Toml"):
+        save_by_extension(tmp_path / name, writers={".TOML": write})
+    assert written == ["a.toml", "b.Toml"]

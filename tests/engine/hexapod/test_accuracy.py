@@ -131,3 +131,39 @@ def test_the_probe_of_a_chirp_sweeps_the_band_and_a_sine_stops_with_the_run():
     # a run shorter than a probe is its own probe (the state measure: no band)
     probe, length = hexapod_probe({"x": sine, "z": chirp}, duration=5.0)
     assert probe == {"x": sine, "z": chirp} and length == 5.0
+
+
+@pytest.mark.parametrize("halvings", [1, 0])
+def test_too_few_halvings_to_estimate_an_error_are_refused_before_any_run(setup, monkeypatch,
+                                                                         halvings):
+    """An estimate compares a candidate with two finer ones: fewer than two halvings
+    estimate nothing, so they are refused naming `max_halvings`."""
+    import qzs.engine.hexapod.simulate as simulate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a probe ran")
+
+    monkeypatch.setattr(simulate, "simulate_hexapod", no_run)
+    geometry, platform = setup
+    with pytest.raises(ParameterError, match="`max_halvings` must be an integer >= 2") as info:
+        choose_hexapod_step(geometry, platform, controller=STABLE, tolerance=0.01,
+                            excitation={"x": Chirp(amplitude=0.002, f1=8.0, duration=20.0)},
+                            sample_rate=RATE, max_halvings=halvings)
+    assert not isinstance(info.value, ToleranceNotMetError)
+
+
+@pytest.mark.parametrize("excitation, measure", [
+    ({"z": Chirp(duration=20.0)}, "transmissibility_db"),
+    ({"z": Chirp(duration=20.0), "x": Chirp(duration=20.0)}, "state_m"),
+    ({"z": Sine(frequency=2.0)}, "state_m"),
+    ({}, "state_m"),
+])
+def test_the_default_request_measures_one_chirping_axis_s_transmissibility_else_the_pose(
+        setup, excitation, measure):
+    """Without a tolerance: one chirping base axis is judged by its transmissibility; two
+    axes (no one driven axis) or a sine (no band) by the pose."""
+    from qzs.engine.hexapod.accuracy import HexapodProbe
+
+    geometry, platform = setup
+    probe = HexapodProbe(geometry=geometry, platform=platform, excitation=excitation)
+    assert probe.default_measure == measure

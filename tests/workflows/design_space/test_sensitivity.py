@@ -282,3 +282,33 @@ def test_an_evaluator_must_return_every_metric_per_case():
                     evaluate=lambda s: {ISHIGAMI_COLUMN: np.zeros(3)})
     with pytest.raises(ParameterError, match="`evaluate` must be a callable"):
         sensitivity(ishigami_problem(samples=4), evaluate=3, progress=False)
+
+
+@pytest.mark.parametrize("confidence", [0.9, 0.5])
+def test_each_interval_is_the_index_plus_minus_salib_s_bootstrap_half_width(confidence):
+    """The interval of an index is the index -/+ SALib's ``<index>_conf`` at the asked
+    ``confidence`` (the bootstrap's quantile half-width), recomputed here by SALib on the
+    metric's values the analysis was given, with its seed and resamples."""
+    from SALib.analyze import sobol
+
+    from qzs.workflows.design_space.sensitivity import NUM_RESAMPLES
+
+    seen = []
+
+    def evaluate(settings):
+        out = ishigami(settings)
+        seen.append(np.asarray(out[ISHIGAMI_COLUMN], dtype=float))
+        return out
+
+    result = sensitivity(ishigami_problem(samples=2 ** 8, confidence=confidence),
+                         evaluate=evaluate, progress=False)
+    assert result.confidence == confidence
+    found = sobol.analyze({"num_vars": 3, "names": list(ISHIGAMI_NAMES),
+                           "bounds": [[0.0, 1.0]] * 3}, np.concatenate(seen),
+                          calc_second_order=False, num_resamples=NUM_RESAMPLES,
+                          conf_level=confidence, seed=result.seed)
+    for name, key in (("first_order", "S1"), ("total_order", "ST")):
+        low, high = result.intervals[name]
+        np.testing.assert_allclose(getattr(result, name)[0], found[key], rtol=1e-12)
+        np.testing.assert_allclose(high[0] - low[0], 2 * found[f"{key}_conf"], rtol=1e-9)
+        np.testing.assert_allclose(low[0] + high[0], 2 * found[key], rtol=1e-9, atol=1e-12)

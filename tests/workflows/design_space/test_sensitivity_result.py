@@ -101,3 +101,19 @@ def test_intervals_are_one_mapping_and_the_old_names_warn(ishigami_sobol):
         assert np.array_equal(old, np.stack([low, high], axis=-1))
     with pytest.warns(DeprecationWarning):
         assert result.mu_star_interval is None  # a Sobol result has no Morris interval
+
+
+def test_the_summary_shows_each_index_and_its_interval_s_half_width(ishigami_sobol):
+    """Each row: S1 +- half its interval's width, ST +- half its (three decimals)."""
+    result = ishigami_sobol
+    rows = {line.split()[0]: [float(x) for x in line.split()[-4:]]
+            for line in result.summary().splitlines() if line.startswith(("  pi_", "  damping"))}
+    assert len(rows) == len(result.parameters)
+    for j, name in enumerate(result.parameters):
+        s1, s1_half, st, st_half = rows[name]
+        (low1, high1), (lowt, hight) = (result.intervals[k] for k in ("first_order",
+                                                                      "total_order"))
+        assert s1 == pytest.approx(result.first_order[0, j], abs=6e-4)
+        assert s1_half == pytest.approx((high1[0, j] - low1[0, j]) / 2, abs=6e-4)
+        assert st == pytest.approx(result.total_order[0, j], abs=6e-4)
+        assert st_half == pytest.approx((hight[0, j] - lowt[0, j]) / 2, abs=6e-4)

@@ -50,3 +50,15 @@ def test_the_figures_and_curve_files_are_named_by_the_views_and_the_study(tmp_pa
     assert figure_names(result("spring_characteristic", [])) == ["fig05_spring"]
     assert [p.name for p in curve_files(study, tmp_path)] == [
         f"s_curves{suffix}" for suffix in (".nc", ".csv", ".mat")]
+
+
+def test_the_experiment_style_curve_is_trusted_on_its_own_bins():
+    """The experiment-style estimate has its own bins and its own trusted mask: the figure
+    draws that mask (and its coherence, phase) with its curve, not the ideal's."""
+    extra = dict(frequency=np.array([1.0, 2.0, 3.0]), magnitude=np.array([0.5, 0.4, 0.3]),
+                 highpass=1.0, n_averages=6, trusted=np.array([False, True, True]),
+                 coherence=np.array([0.2, 0.95, 0.97]), phase=np.array([0.0, -0.1, -0.2]))
+    ideal, experiment = figure_curves(result("processing", [case("x", {}, extra)]))
+    for key in ("frequency", "trusted", "coherence", "phase"):
+        np.testing.assert_array_equal(experiment[key], extra[key])
+    assert ideal["trusted"].shape == ideal["frequency"].shape

@@ -51,3 +51,11 @@ def test_the_report_says_why_its_chirp_and_natural_frequency_differ_from_the_pap
     assert f"{passive:.3g} Hz for Kp 50" in table and 0.07 <= passive <= 0.09
     # an undefined metric: a dash with its reason as the table's numbered note
     assert "&mdash;<sup>1</sup>" in table and "<li>no peak on the trusted bins</li>" in table
+
+
+def test_the_case_table_gives_the_locked_time_in_percent():
+    """A locked fraction of 0.1 [-] is 10.0 % in the "locked [%]" column."""
+    from qzs.workflows.findings.html import case_table
+
+    table = case_table(study("a", [case("Kp 50", {"pi_kp": 50.0})]))
+    assert "locked [%]" in table and ">10.0<" in table and ">0.1<" not in table

@@ -35,3 +35,19 @@ def test_a_document_s_head_and_its_text_file(tmp_path):
     assert path == tmp_path / "report.md"
     assert path.read_text(encoding="utf-8") == "µ — text\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report.md"]  # nothing left behind
+
+
+def test_a_flag_is_no_metric_and_a_setting_the_cases_differ_in_lists_their_values():
+    """A bool is not a number to show (the dash and its note); the run settings give a
+    setting's one value where the cases share it, every distinct value where they differ."""
+    import types
+
+    from qzs.workflows.findings.tables import run_settings
+
+    notes = {}
+    assert metric_cell(True, "a flag, not a metric", notes) == "—<sup>1</sup>"
+    result = types.SimpleNamespace(cases=[
+        types.SimpleNamespace(run={"dt": 1e-4, "solver": "ode3"}),
+        types.SimpleNamespace(run={"dt": 2e-4, "solver": "ode3"}),
+        types.SimpleNamespace(run={"dt": 1e-4, "solver": "ode3"})])
+    assert run_settings(result) == {"dt": [1e-4, 2e-4], "solver": "ode3"}

@@ -368,3 +368,19 @@ def test_unknown_claim_id_names_the_file_the_id_and_the_known_ids(tmp_path):
                     "[[case]]\nlabel='a'\n")
     with pytest.raises(ParameterError, match="must be a list of claim ids"):
         load_study(path)
+
+
+def test_a_stiction_trend_that_levels_off_does_not_fall():
+    """"Must not fall": two cases with the same low-frequency level, or the same onset,
+    keep the trend reproduced."""
+    flat = stiction_cases(levels=(0.80, 0.85, 0.85, 0.90), onsets=(0.9, 1.4, 1.4, 2.4))
+    assert verdict(study("s", ["stiction_low_frequency"], flat),
+                   "stiction_low_frequency").label == "reproduced"
+
+
+def test_a_case_with_an_integral_gain_alone_has_pi():
+    """"Without PI" is Kp = Ki = 0: an integral-only loop (Kp = 0, Ki > 0) is a PI case,
+    so its holding the payload off the stops reproduces the claim."""
+    cases = [*no_pi_cases(), case("I only", {"pi_kp": 0.0, "pi_ki": 2.0},
+                                  stats={"stop_contacts": 0})]
+    assert verdict(study("n", ["no_pi_stops"], cases), "no_pi_stops").label == "reproduced"

@@ -423,3 +423,16 @@ def test_a_linear_plant_settles_when_its_closed_form_transient_is_within_toleran
     assert abs(point.periods - expected) <= 1, (point.periods, expected, rho)
     assert point.residual <= TOLERANCE
 
+
+
+def test_a_run_keeps_the_direction_of_its_sweep():
+    """``plan.at(direction, ...)`` is a run of that direction: a downward sweep's points are
+    recorded as such."""
+    from qzs.workflows.response.frequency import FrequencyRun, SweepPlan
+
+    plan = SweepPlan(amplitude=0.001, isolator=None, controller=None, dt=1e-3, solver="ode3",
+                     periodic_tolerance=1e-3, max_periods=10, max_time=10.0, fade_in=1.0,
+                     harmonics=3)
+    for direction in ("up", "down"):
+        assert plan.at(direction, 2.0) == FrequencyRun(plan=plan, direction=direction,
+                                                       frequency=2.0)

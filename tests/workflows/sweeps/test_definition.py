@@ -343,3 +343,13 @@ def test_a_table_law_s_csv_is_read_beside_the_sweep_file(tmp_path, monkeypatch):
     sweep = load_sweep(path)
     assert sweep.spring == qzs.TabulatedSpring(positions=(-0.1, -0.05, 0.0),
                                                forces=(40.0, 62.0, 80.0))
+
+
+def test_a_sweep_spelled_with_the_deprecated_tolerance_db_is_the_same_sweep():
+    """`tolerance` and `tolerance_db` give the same [simulation] settings, key for key (what
+    the store and a resume compare), the value under the records' key alone."""
+    grid = {"pi_kp": [1.0]}
+    new = load_sweep(definition(grid=grid, simulation={"tolerance": 0.2}))
+    with pytest.warns(DeprecationWarning):
+        old = load_sweep(definition(grid=grid, simulation={"tolerance_db": 0.2}))
+    assert new.simulation == old.simulation

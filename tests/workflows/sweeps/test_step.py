@@ -58,3 +58,17 @@ def test_a_case_no_step_can_settle_is_named_and_the_others_set_the_step():
     assert [i for i, _ in choices] == [1]
     assert chosen.simulation["dt"] == choices[0][1].dt
     assert "case 0: no step" in chosen.simulation["step_note"]
+
+
+def test_the_sweep_takes_the_finest_of_its_probed_cases_steps():
+    """A soft and a stiff PI loop: the stiff one needs a finer step for the same tolerance;
+    every case of the sweep runs at the step of the one that needs it most."""
+    from qzs.workflows.sweeps.cases import case_settings
+    from qzs.workflows.sweeps.step import choose_sweep_step
+
+    sweep = load_sweep(definition(grid={"pi_kp": [2000.0, 2e5]},
+                                  simulation={"tolerance": 0.01}))
+    chosen, choices = choose_sweep_step(sweep, case_settings(sweep, sample_cases(sweep)))
+    steps = [c.dt for _, c in choices]
+    assert len(set(steps)) == 2  # the two cases' own steps differ
+    assert chosen.simulation["dt"] == min(steps)

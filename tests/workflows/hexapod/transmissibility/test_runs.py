@@ -52,3 +52,38 @@ def test_the_plan_gives_one_frozen_run_per_axis_with_the_common_settings():
     with pytest.raises(dataclasses.FrozenInstanceError):
         runs[0].dt = 1e-3
     assert dataclasses.replace(runs[0], cartesian="c").control == {"cartesian": "c"}
+
+
+def test_axis_step_asks_the_one_call_for_the_run_s_tolerance_band_and_finest_step(monkeypatch):
+    """The six-leg probe of the run's chirp, measured over its band (from f0, or from the
+    lower of 1 Hz and f1/2 for a chirp from rest), halving down to the set-up's dt and
+    falling back to it; the record's history is each step and its difference [dB]."""
+    import qzs.engine.step_choice as step_choice
+    from qzs.engine.step_search import StepChoice
+    from qzs.workflows.hexapod.setups import hexapod_setup
+    from qzs.workflows.hexapod.transmissibility import plan
+    from qzs.workflows.hexapod.transmissibility.runs import axis_step
+
+    asked = []
+
+    def choose(request, probe, **options):
+        asked.append((request, probe, options))
+        return StepChoice(dt=5e-4, error=0.01, measure="transmissibility_db", tolerance=0.05,
+                          reference_dt=1.25e-4, stability_limit=1e-2, sample_rate=1000.0,
+                          solver="ode3", probe=None, probe_duration=20.0, band=probe.band,
+                          history=((1e-3, 0.5, 0.8), (5e-4, 0.006, 0.007)), notes=())
+
+    monkeypatch.setattr(step_choice, "choose", choose)
+    _, _, _, runs, _ = plan._plan(hexapod_setup(), ("z",), None, 0.0, 20.0, 60.0, None, None,
+                                  None, None, "h1", -100.0, 1, False)
+    run, = runs
+    for f0, f1, band in ((0.0, 20.0, (1.0, 20.0)), (0.0, 1.5, (0.75, 1.5)),
+                         (2.0, 20.0, (2.0, 20.0))):
+        asked.clear()
+        dt, record = axis_step(dataclasses.replace(run, f0=f0, f1=f1))
+        (request, probe, options), = asked
+        assert dt == 5e-4 and probe.band == band
+        assert request == step_choice.StepRequest(tolerance=run.tolerance_db)
+        assert options == {"finest": run.setup_dt, "fallback": True}
+        assert record["step_history"] == ((1e-3, 0.5), (5e-4, 0.006))
+        assert record["step"] == "accuracy-driven"
