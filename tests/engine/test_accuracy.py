@@ -22,6 +22,7 @@ from qzs import Chirp, ControllerParameters, IsolatorParameters, Sine, simulate
 from qzs.engine import StepChoice, choose_step
 from qzs.engine.accuracy import (SAFETY, admissible_step, halving_search, probe_excitation,
                                  step_error)
+from qzs.engine.accuracy_batch import choose_batch_step
 from qzs.engine.prepare import resolving_step, steps_per_sample
 from qzs.engine.stability import largest_stable_step, stability_test
 from qzs.errors import ParameterError
@@ -354,10 +355,6 @@ def test_a_state_tolerance_on_a_shortened_chirp_says_its_probe_is_shortened():
     assert any("shortened chirp" in note for note in shortened.notes)
 
 
-@pytest.mark.xfail(strict=True, reason="SingleProbe (and BatchProbe) flag the probe as "
-                   "shortened by `probe is not excitation`, and probe_excitation always makes a "
-                   "new chirp (f1 widened 10 %), so a chirp probed over its whole length is said "
-                   "to be measured on a 'shortened chirp'")
 def test_a_chirp_probed_over_its_whole_length_is_not_called_shortened():
     """A 20 s chirp with a 20 s probe: the probe is as long as the run, so the state error
     is measured over the run's whole time and no shortened-probe caveat applies."""
@@ -365,6 +362,13 @@ def test_a_chirp_probed_over_its_whole_length_is_not_called_shortened():
                         probe_duration=PROBE, max_halvings=3, fallback=True)
     assert whole.probe_duration == PROBE
     assert not any("shortened chirp" in note for note in whole.notes)
+    part = choose_step(Chirp(f0=0.0, f1=5.0, duration=4 * PROBE), tolerance_state=1e-2,
+                       probe_duration=PROBE, max_halvings=3, fallback=True)
+    assert any("shortened chirp" in note for note in part.notes)  # a quarter of the sweep
+    lanes = choose_batch_step([(None, None)], Chirp(f0=0.0, f1=5.0, duration=PROBE),
+                              tolerance_state=1e-2, probe_duration=PROBE, max_halvings=3,
+                              fallback=True)
+    assert not any("shortened chirp" in note for note in lanes.notes)
 
 
 def test_a_choice_for_another_initial_state_is_not_read_from_the_cache(monkeypatch, tmp_path):

@@ -30,7 +30,7 @@ from qzs.model.excitation import Chirp, RandomExcitation, Sine
 __all__ = ["StepChoice", "choose_step", "probe_excitation", "step_error",
            "halving_search", "admissible_step", "estimate_difference_db", "excitation_over",
            "MEASURE_UNITS", "frequency_range", "check_band", "probe_fft_length",
-           "probe_settings", "spectral_beside_probes", "SingleProbe"]
+           "probe_settings", "spectral_beside_probes", "SingleProbe", "shortened_chirp"]
 
 #: Default length [s] of the probe of a chirp, a random excitation or a record.
 PROBE_DURATION = 60.0
@@ -119,6 +119,26 @@ def probe_excitation(excitation, band, probe_duration=None):
         return excitation, float(probe_duration)
     duration = min(excitation.duration, probe_duration or PROBE_DURATION)
     return excitation, duration
+
+
+def shortened_chirp(excitation, duration, sample_rate):
+    """Whether a chirp's probe is shorter than the run: its state error is then measured on
+    part of the sweep (a note says so; a probe as long as the chirp is no stand-in).
+
+    Parameters
+    ----------
+    excitation : Chirp, Sine, RandomExcitation or DisplacementRecord
+        The run's excitation.
+    duration : float
+        The probe's length [s] (whole output periods).
+    sample_rate : float
+        Output rate [Hz].
+
+    Returns
+    -------
+    bool
+    """
+    return isinstance(excitation, Chirp) and duration < excitation.duration - 0.5 / sample_rate
 
 
 def excitation_over(excitation, duration):
@@ -349,7 +369,7 @@ class SingleProbe(ProbeSettings):
         return Probe(
             measure=measure, order=order, sample_rate=sample_rate, solver=solver,
             excitation=probe, duration=duration, band=band,
-            shortened=probe is not excitation,
+            shortened=shortened_chirp(excitation, duration, sample_rate),
             start=lambda: _single_start(probe, duration, isolator, controller, solver,
                                         sample_rate),
             run=run, compare=lambda coarse, fine: step_error(coarse, fine, measure, band=band,

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from qzs import defaults
-from qzs.engine.accuracy import probe_settings, step_error
+from qzs.engine.accuracy import probe_settings, shortened_chirp, step_error
 from qzs.engine.step_choice import ProbeSettings, admissible_step
 from qzs.engine.step_search import SAFETY, StepChoice
 from qzs.errors import ParameterError
@@ -186,7 +186,8 @@ class BatchProbe(ProbeSettings):
         fft_length = self.fft_length
         return Probe(
             measure=measure, order=order, sample_rate=sample_rate, solver=self.solver,
-            excitation=probe, duration=duration, band=band, shortened=probe is not excitation,
+            excitation=probe, duration=duration, band=band,
+            shortened=shortened_chirp(excitation, duration, sample_rate),
             start=lambda: _batch_start(cases, probe, duration, self.solver, sample_rate),
             run=_batch_run(cases, probe, duration, sample_rate, self.solver, self.workers,
                            labels),
