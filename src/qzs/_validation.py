@@ -6,7 +6,9 @@ import dataclasses
 import math
 import numbers
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -481,7 +483,7 @@ def renamed_keyword(new, value, old, old_value, *, stacklevel=3):
     return old_value
 
 
-def deprecated_alias(old, new, value):
+def deprecated_alias(old: str, new: str, value: Callable[[Any], Any]) -> property:
     """A property ``old`` that warns (DeprecationWarning naming ``new``) and returns ``value``:
     an attribute's old spelling kept one release (:func:`renamed_keyword` for a keyword).
 
@@ -498,7 +500,7 @@ def deprecated_alias(old, new, value):
     -------
     property
     """
-    def get(self):
+    def get(self: Any) -> Any:
         import warnings
 
         warnings.warn(f"`{type(self).__name__}.{old}` is deprecated and will be removed in "

@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,6 +35,10 @@ from qzs import defaults
 from qzs._format import STEP_RECORD_UNITS as RECORD_UNITS
 from qzs._format import step_line as record_line
 from qzs.errors import ParameterError, ToleranceNotMetError
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = ["StepChoice", "search_step", "halving_search", "fallback_step", "unmet_sentence",
            "record_line", "RECORD_UNITS", "MEASURE_UNITS", "SAFETY", "MAX_HALVINGS"]
@@ -258,7 +263,7 @@ class StepChoice:
     #: The extensions :meth:`save` accepts: the candidates (.nc, .csv, .mat), the record (.json).
     save_suffixes = (".nc", ".csv", ".mat", ".json")
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The candidates tried, with the record as attributes
         (:func:`qzs.engine.step_views.step_dataset`).
 
@@ -272,7 +277,7 @@ class StepChoice:
 
         return step_dataset(self)
 
-    def plot(self, path=None, *, title=None):
+    def plot(self, path: str | Path | None = None, *, title: str | None = None) -> Figure:
         """Each candidate's estimated error against its step, the tolerance and the chosen
         step (:func:`qzs.viz.step.plot_step_choice`).
 
@@ -291,7 +296,7 @@ class StepChoice:
 
         return plot_step_choice(self, path=path, title=title)
 
-    def save(self, path):
+    def save(self, path: str | Path) -> Path:
         """Write the choice by the extension of ``path``, atomically: the candidates as .nc,
         .csv or .mat (:meth:`to_xarray`), the record as .json (:meth:`to_dict`).
 

@@ -34,6 +34,7 @@ table          a cubic smoothing spline (``scipy.interpolate.make_smoothing_spli
 =============  ===========================================================================
 """
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -245,7 +246,7 @@ def criterion_record(fit: Any) -> dict[str, Any]:
             "n_parameters": fit.n_parameters}
 
 
-def law_force(kind: str, law: SpringLaw | None, parameters: dict,
+def law_force(kind: str, law: SpringLaw | None, parameters: Mapping[str, float],
               displacement: ArrayLike) -> NDArray[np.float64]:
     """A fitted law's force at ``displacement`` [N]: the law's, or, where the fitted numbers
     made none, the tanh's or the mechanism's formula of its parameters.
