@@ -3,19 +3,19 @@
 This layer knows no result type: each declares its own schema beside its class
 (``qzs.engine.channels.simulation_schema``, ...) and hands it to the functions here.
 
-=============  ==================================================================
-``schema``     a result's variables, dimensions, units and flags; its dataset
-``cf_layout``  the NetCDF file layout: what CF-1.10 has no home for, in CF's own means
-``writer``     the atomic CF writer of a schema: streamed (NetCDF, CSV, MATLAB), whole datasets, tables
-``matfile``    MATLAB files (MAT 5, MAT 7.3) of a dataset or a streamed schema
-``files``      atomic writes; result files read back
+================  ==================================================================
+``schema``        a result's variables, dimensions, units and flags; its dataset
+``cf_layout``     the NetCDF file layout: what CF-1.10 has no home for, in CF's own means
+``writer``        the atomic CF writer of a schema: streamed (NetCDF, CSV, MATLAB), whole datasets, tables
+``matfile``       MATLAB files (MAT 5, MAT 7.3) of a dataset or a streamed schema
+``files``         atomic writes; result files read back
 ``result_files``  a result's ``save``: the format chosen by the extension (.nc, .csv, .mat, .json)
-``paths``      output paths checked before the work starts
-``config``     run configurations (TOML)
-``rig``        subpackage: test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
-``shipped``    the study, sweep and hexapod files shipped with qzs
-``docs``       the model and workflow pages shipped inside the package (``qzs docs``)
-=============  ==================================================================
+``paths``         output paths checked before the work starts
+``config``        run configurations (TOML)
+``rig``           subpackage: test-rig logs (CSV, dSPACE MAT, MF4, NetCDF) through a channel map
+``shipped``       the study, sweep and hexapod files shipped with qzs
+``docs``          the model and workflow pages shipped inside the package (``qzs docs``)
+================  ==================================================================
 """
 from qzs._lazy import lazy_exports
 

@@ -98,8 +98,8 @@ def save_doc(formats: str) -> str:
     Parameters
     ----------
     formats : str
-        What each extension writes (``"``.nc``, ``.csv``, ``.mat``: :meth:`to_xarray`"``),
-        wrapped into the docstring's first paragraph.
+        What each extension writes (e.g. ".nc, .csv, .mat: the dataset"), wrapped into
+        the docstring's first paragraph.
 
     Returns
     -------

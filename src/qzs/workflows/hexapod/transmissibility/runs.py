@@ -13,8 +13,8 @@ __all__ = ["AxisRun", "axis_step", "run_axis"]
 
 @dataclass(frozen=True, kw_only=True)
 class AxisRun:
-    """One run of the matrix, resolved (:func:`~qzs.workflows.hexapod.transmissibility.
-    hexapod_transmissibility` plans them): one base axis's chirp, the platform, the analysis.
+    """One run of the matrix, resolved: one base axis's chirp, the platform, the analysis
+    (:func:`~qzs.workflows.hexapod.transmissibility.hexapod_transmissibility` plans them).
 
     Attributes
     ----------
