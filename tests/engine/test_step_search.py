@@ -203,10 +203,10 @@ def test_an_unmet_case_s_note_names_the_finest_candidate_estimated_as_the_fallba
         return [1e3 * dt ** ORDER if c == 0 else (stuck.__setitem__(0, stuck[0] + 1) or stuck[0])
                 for c in cases]
 
-    mixed = search_step(run=run, compare=lambda a, b: abs(a - b), cases=2, dt0=DT0,
-                        order=ORDER, measure="transmissibility_db", tolerance=1e-3,
-                        sample_rate=1000.0, solver="ode3", probe=None, probe_duration=10.0,
-                        band=(1.0, 20.0), stability_limit=0.005, labels=["ok", "stuck"])
+    mixed = search(run=run, compare=lambda a, b: abs(a - b), cases=2, dt0=DT0,
+                   order=ORDER, measure="transmissibility_db", tolerance=1e-3,
+                   sample_rate=1000.0, solver="ode3", probe=None, probe_duration=10.0,
+                   band=(1.0, 20.0), stability_limit=0.005, labels=["ok", "stuck"])
     finest = min(dt for dt, _, _ in mixed.history)
     note, = [note for note in mixed.notes if note.startswith("stuck:")]
     assert f"no step down to {finest:.3g} s meets" in note
