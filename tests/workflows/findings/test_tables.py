@@ -4,8 +4,9 @@ import math
 import numpy as np
 
 from qzs._version import __version__
+from qzs.iotools.files import write_text
 from qzs.workflows.findings.tables import (document_head, metric_cell, significant,
-                                           with_reasons, write_text)
+                                           with_reasons)
 
 
 def test_a_defined_metric_is_its_text_and_an_undefined_one_a_numbered_note():

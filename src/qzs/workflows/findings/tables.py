@@ -7,11 +7,9 @@ import numpy as np
 
 from qzs._format import footnoted, number
 from qzs._version import __version__
-from qzs.iotools.files import atomic_path
 
 __all__ = ["with_reasons", "metric_rows", "case_row", "study_record", "case_text",
-           "claims_record", "run_settings", "document_head", "metric_cell", "significant",
-           "write_text"]
+           "claims_record", "run_settings", "document_head", "metric_cell", "significant"]
 
 
 def with_reasons(metrics, reasons, prefix=""):
@@ -231,22 +229,3 @@ def document_head(quick, wall_seconds):
         ``qzs_version``, ``quick``, ``wall_seconds``.
     """
     return {"qzs_version": __version__, "quick": quick, "wall_seconds": wall_seconds}
-
-
-def write_text(path, text):
-    """Write ``text`` (UTF-8) to ``path`` atomically; returns ``path``.
-
-    Parameters
-    ----------
-    path : Path
-        The file.
-    text : str
-        Its content.
-
-    Returns
-    -------
-    Path
-    """
-    with atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return path

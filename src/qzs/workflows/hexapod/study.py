@@ -42,12 +42,13 @@ from qzs.analysis.hexapod_linear import entry_unit
 from qzs.analysis.spectral import transmissibility_metrics
 from qzs.defaults import AXES, AXIS_UNITS
 from qzs.errors import ParameterError
+from qzs.iotools.files import write_text
 from qzs.iotools.result_files import save_by_extension, save_doc, suffixes_of
 from qzs.viz.figures import check_frequency_scale
 from qzs.workflows.hexapod.setups import SHIPPED_DEFAULT, load_hexapod
 from qzs.workflows.hexapod.transmissibility import hexapod_transmissibility
 from qzs.workflows.findings.markdown import study_markdown, study_summary
-from qzs.workflows.findings.tables import document_head, significant, write_text
+from qzs.workflows.findings.tables import document_head, significant
 
 if TYPE_CHECKING:
     import xarray as xr

@@ -24,14 +24,14 @@ from typing import Any
 
 from qzs._format import json_ready, json_text
 from qzs._validation import worker_count
+from qzs.iotools.files import write_text
 from qzs.iotools.writer import write_table
 from qzs.model.springs import SpringLaw
 from qzs.viz.figures import check_frequency_scale
 from qzs.workflows.findings.figures import curve_files, curves_of, draw_studies, figure_names
 from qzs.workflows.findings.html import paper_html
 from qzs.workflows.findings.tables import (claims_record, document_head, metric_rows,
-                                           run_settings, study_record, with_reasons,
-                                           write_text)
+                                           run_settings, study_record, with_reasons)
 from qzs.workflows.findings.verdicts import (CLAIMS, TREND_CLAIMS, Verdict, damping_changes,
                                              decide_claims)
 from qzs.workflows.paper.curves import write_curves
